@@ -1,0 +1,181 @@
+"""The whole pipeline: scenario -> stance -> constraints -> areas -> impact -> answer."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .areas import BalanceAreas, areas_from_polytope
+from .constraints import wrench_polytope
+from .criteria import VelocityLimit, capped_velocity, max_contact_velocity, zmp_max_contact_velocity
+from .impact import ImpactModel, impact_model
+from .qp import QPOptions, QPResult, solve_contact_velocity_qp, static_torques
+from .scenario import Scenario, load_scenario
+from .stance import Stance
+
+__all__ = ["ImpactAnswer", "Analysis", "analyze"]
+
+
+def _num(x: float) -> float | None:
+    """JSON-safe float (inf -> None)."""
+    return float(x) if np.isfinite(x) else None
+
+
+@dataclass(frozen=True)
+class ImpactAnswer:
+    """What the impact analysis concludes.
+
+    Attributes:
+        model: Impact model (impulse rates, W, cone).
+        com_limit: Maximum approach speed by the CoM velocity criterion (m/s).
+        zmp_limit: Maximum approach speed by the ZMP criterion (m/s).
+        contact_velocity: Reference velocity with its approach component capped (m/s, world),
+            or None without a reference velocity.
+        qp: The paper's QP solution when requested.
+    """
+
+    model: ImpactModel
+    com_limit: VelocityLimit
+    zmp_limit: VelocityLimit
+    contact_velocity: np.ndarray | None
+    qp: QPResult | None = None
+
+    @property
+    def max_contact_velocity(self) -> float:
+        return self.com_limit.max_approach_speed
+
+    @property
+    def zmp_max_contact_velocity(self) -> float:
+        return self.zmp_limit.max_approach_speed
+
+    def evaluation_speed(self) -> float:
+        """Approach speed at which sets are reported: the maximum, or the reference's if unbounded."""
+        if self.com_limit.is_finite:
+            return self.com_limit.max_approach_speed
+        ref = self.model.spec.reference_velocity
+        return max(0.0, self.model.approach_speed(ref)) if ref is not None else 0.0
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """Result of :func:`analyze`. ``to_dict()`` is the JSON of ``impact-balance analyze --json``."""
+
+    scenario: Scenario
+    stance: Stance
+    areas: BalanceAreas
+    impact: ImpactAnswer | None
+    timings: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def com_velocity(self) -> np.ndarray:
+        return np.asarray(self.scenario.com_velocity, dtype=float)
+
+    @property
+    def com_velocity_inside(self) -> bool:
+        """Whether the pre-impact CoM velocity can be brought to rest on these contacts."""
+        return bool(self.areas.can_balance and self.areas.com_velocity_area.contains(self.com_velocity, 1e-10))
+
+    @property
+    def verdict(self) -> str:
+        if not self.areas.can_balance:
+            return "cannot balance: the contacts cannot hold the robot at rest (empty areas)"
+        if not self.com_velocity_inside:
+            return "falling: the CoM velocity is outside the CoM velocity area"
+        return "balanced"
+
+    def to_dict(self) -> dict[str, Any]:
+        a = self.areas
+        out: dict[str, Any] = {
+            "scenario": self.scenario.name,
+            "robot": self.stance.robot.name,
+            "verdict": self.verdict,
+            "can_balance": a.can_balance,
+            "mass": self.stance.mass,
+            "com": self.stance.com.tolist(),
+            "omega": a.omega,
+            "plane_height": a.plane_height,
+            "gravity": a.gravity,
+            "com_velocity": self.com_velocity.tolist(),
+            "com_velocity_inside": self.com_velocity_inside,
+            "com_velocity_area": a.com_velocity_area.to_dict(),
+            "zmp_area": a.zmp_area.to_dict(),
+            "contacts": [
+                {"frame": c.spec.frame, "position": c.position.tolist(), "normal": c.normal.tolist(),
+                 "friction": c.spec.friction, "size": list(c.spec.size)}
+                for c in self.stance.contacts
+            ],
+            "timings_ms": {k: 1e3 * v for k, v in self.timings.items()},
+        }
+        if self.impact is not None:
+            im = self.impact
+            s = im.evaluation_speed()
+            out["impact"] = {
+                "frame": im.model.spec.frame,
+                "point": im.model.point.tolist(),
+                "normal": im.model.normal.tolist(),
+                "friction": im.model.spec.friction,
+                "restitution": list(im.model.spec.restitution),
+                "cone_edges": im.model.spec.cone_edges,
+                "max_contact_velocity": _num(im.max_contact_velocity),
+                "status": im.com_limit.status,
+                "reference_velocity": None if im.model.spec.reference_velocity is None else list(im.model.spec.reference_velocity),
+                "contact_velocity": None if im.contact_velocity is None else im.contact_velocity.tolist(),
+                "evaluated_at_approach_speed": s,
+                "impulse_vertices": im.model.impulse_vertices(s).tolist(),
+                "post_impact_com_velocities": im.model.post_impact_com_velocities(self.com_velocity, s).tolist(),
+                "zmp_max_contact_velocity": _num(im.zmp_max_contact_velocity),
+                "zmp_status": im.zmp_limit.status,
+                "W": im.model.W.tolist(),
+            }
+            if im.qp is not None:
+                out["impact"]["qp"] = {
+                    "status": im.qp.status,
+                    "approach_speed": _num(im.qp.approach_speed),
+                    "contact_velocity": None if im.qp.contact_velocity is None else im.qp.contact_velocity.tolist(),
+                }
+        return out
+
+
+def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
+    """Run the whole pipeline on a scenario (object, file path or bundled name).
+
+    ``solve_qp`` overrides the scenario's ``impact.qp.solve``.
+    """
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
+    timings: dict[str, float] = {}
+    t0 = time.perf_counter()
+    stance = scenario.build_stance()
+    t1 = time.perf_counter()
+    polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
+    t2 = time.perf_counter()
+    areas = areas_from_polytope(polytope, scenario.plane_height)
+    t3 = time.perf_counter()
+    timings.update(stance=t1 - t0, constraints=t2 - t1, areas=t3 - t2)
+    answer = None
+    if scenario.impact is not None:
+        cfg = scenario.impact
+        model = impact_model(stance, cfg.spec())
+        com_limit = max_contact_velocity(areas.com_velocity_area, model, scenario.com_velocity)
+        zmp_limit = zmp_max_contact_velocity(
+            areas.zmp_area, model, stance.com, scenario.plane_height, scenario.gravity, cfg.duration
+        )
+        contact_velocity = None
+        if cfg.reference_velocity is not None:
+            contact_velocity = capped_velocity(cfg.reference_velocity, model.normal, com_limit.max_approach_speed)
+        qp = None
+        if (cfg.qp.solve if solve_qp is None else solve_qp) and cfg.reference_velocity is not None:
+            tau0 = static_torques(stance, polytope) if cfg.qp.impulsive_torque_limits else None
+            options = QPOptions(
+                cfg.qp.joint_velocity_limits, cfg.qp.impulsive_torque_limits, cfg.qp.peak_factor, cfg.duration, cfg.qp.solver
+            )
+            qp = solve_contact_velocity_qp(
+                model, areas.com_velocity_area, scenario.com_velocity, cfg.reference_velocity, stance.robot, tau0, options
+            )
+        answer = ImpactAnswer(model, com_limit, zmp_limit, contact_velocity, qp)
+        timings["impact"] = time.perf_counter() - t3
+    timings["total"] = time.perf_counter() - t0
+    return Analysis(scenario, stance, areas, answer, timings)

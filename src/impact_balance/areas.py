@@ -1,0 +1,102 @@
+"""The ZMP support area and the CoM velocity area of a stance (paper sec. IV).
+
+Under the LIPM constraints the moment about the CoM is zero, so the resultant force passes
+through the CoM and meets the plane ``z = h`` at the ZMP
+
+    zmp = c_xy + (h - c_z) / (m g) * f_xy,
+
+and the zero-step capture condition (the DCM stays in the ZMP support area) gives the CoM
+velocity area ``{ omega (zmp - c_xy) }``, omega = sqrt(g / (c_z - h)). Both areas are affine
+images of ONE projection: the set of feasible resultant horizontal forces, obtained by
+projecting the contact-wrench polytope (:mod:`impact_balance.constraints`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .constants import GRAVITY
+from .constraints import WrenchPolytope, wrench_polytope
+from .exceptions import ScenarioError
+from .polygon import Polygon
+from .projection import project_polytope
+from .stance import Stance
+
+__all__ = ["BalanceAreas", "balance_areas", "areas_from_polytope", "omega"]
+
+#: Projection tolerance on the resultant horizontal force, as a fraction of m g.
+FORCE_TOLERANCE = 1e-8
+#: Clipping box on the resultant horizontal force for unbounded directions, in units of m g.
+FORCE_BOX = 1e3
+
+
+def omega(com_height: float, plane_height: float = 0.0, gravity: float = GRAVITY) -> float:
+    """LIPM natural frequency sqrt(g / (c_z - h)), 1/s; the plane must be below the CoM."""
+    if not com_height > plane_height:
+        raise ScenarioError("plane_height", plane_height, f"must be below the CoM height {com_height:.4g} m")
+    return math.sqrt(gravity / (com_height - plane_height))
+
+
+@dataclass(frozen=True)
+class BalanceAreas:
+    """Both areas of a stance.
+
+    Attributes:
+        force_area: Feasible resultant horizontal forces divided by m g (dimensionless).
+        zmp_area: ZMP support area, world (x, y) on the plane, m.
+        com_velocity_area: CoM velocity area (zero-step capture region), world axes, m/s.
+        omega: LIPM natural frequency, 1/s.
+        com: CoM, m.  plane_height: h, m.  mass: kg.  gravity: m/s^2.
+        n_lp: LPs solved by the projection.
+    """
+
+    force_area: Polygon
+    zmp_area: Polygon
+    com_velocity_area: Polygon
+    omega: float
+    com: np.ndarray
+    plane_height: float
+    mass: float
+    gravity: float
+    n_lp: int = 0
+
+    @property
+    def can_balance(self) -> bool:
+        """False when the stance cannot hold the robot at rest (empty areas)."""
+        return not self.com_velocity_area.is_empty
+
+
+def areas_from_polytope(polytope: WrenchPolytope, plane_height: float = 0.0) -> BalanceAreas:
+    """Project a contact-wrench polytope and map it to the ZMP and CoM velocity areas."""
+    com = polytope.com
+    w = omega(float(com[2]), plane_height, polytope.gravity)
+    weight = polytope.weight
+    # Work in units of m g so that tolerances mean the same for every robot.
+    result = project_polytope(
+        polytope.A,
+        polytope.b / weight,
+        polytope.C,
+        polytope.d / weight,
+        polytope.F,
+        tol=FORCE_TOLERANCE,
+        box=FORCE_BOX,
+    )
+    force = result.polygon
+    depth = plane_height - float(com[2])  # < 0
+    if force.is_empty:
+        zmp = vel = Polygon.empty()
+    else:
+        zmp = force.affine(depth, com[:2])
+        vel = force.affine(w * depth, np.zeros(2))
+    return BalanceAreas(force, zmp, vel, w, com.copy(), plane_height, polytope.mass, polytope.gravity, result.n_lp)
+
+
+def balance_areas(
+    stance: Stance, plane_height: float = 0.0, torque_limits: bool = True, gravity: float = GRAVITY
+) -> BalanceAreas:
+    """ZMP support area and CoM velocity area of ``stance``."""
+    omega(float(stance.com[2]), plane_height, gravity)  # validate the plane before any work
+    return areas_from_polytope(wrench_polytope(stance, torque_limits, gravity), plane_height)

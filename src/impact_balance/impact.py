@@ -1,0 +1,162 @@
+"""Frictional impact model at a point contact (paper sec. V-A).
+
+During the impact the kinematically controlled robot behaves as one composite rigid body,
+so an impulse ``iota`` (N s, world axes) at point p changes the contact-point velocity by
+``W iota`` with
+
+    W = I / m - [r]x Ic^-1 [r]x,   r = p - c,
+
+and the CoM velocity by ``iota / m``. With the discretised friction cone (generators K_i)
+and the restitution range [c_lo, c_hi], the impulse set is the polytope with 2N vertices
+``lambda K_i`` on the two planes of restitution ``n^T W (lambda K_i) = (1 + c_r) v_n``,
+v_n >= 0 being the approach speed. Every vertex is linear in v_n.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from .exceptions import ImpactModelError
+from .spatial import skew, unit
+from .stance import Stance
+
+__all__ = ["ImpactSpec", "ImpactModel", "friction_cone", "impact_model", "INERTIA_MODELS"]
+
+#: "composite": the robot as one rigid body (paper, default); "joint_space": J M^-1 J^T.
+INERTIA_MODELS = ("composite", "joint_space")
+
+
+@dataclass(frozen=True)
+class ImpactSpec:
+    """An intended impact.
+
+    Attributes:
+        frame: Robot frame of the impacting end-effector.
+        normal: World unit vector from the impacted surface into the robot (direction of
+            the normal impulse on the robot).
+        friction: Friction coefficient at the impact (>= 0).
+        restitution: (lo, hi) restitution range, 0 <= lo <= hi <= 1.
+        cone_edges: N, number of friction-cone generators (>= 3).
+        reference_velocity: Desired end-effector velocity, world, m/s.
+        duration: Impact duration for the ZMP-based comparison, s.
+        offset: Fixed pose of the impact point in the frame.
+        inertia: "composite" (default) or "joint_space".
+    """
+
+    frame: str
+    normal: tuple[float, float, float]
+    friction: float = 0.24
+    restitution: tuple[float, float] = (0.0, 0.2)
+    cone_edges: int = 16
+    reference_velocity: tuple[float, float, float] | None = None
+    duration: float = 0.005
+    offset: pin.SE3 = field(default_factory=pin.SE3.Identity)
+    inertia: str = "composite"
+
+
+def cone_tangents(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(t1, t2): t1 is world z made orthogonal to n (world x if n is vertical), t2 = n x t1."""
+    n = unit(normal)
+    for axis in (np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])):
+        t = axis - (axis @ n) * n
+        if np.linalg.norm(t) > 1e-9:
+            t1 = t / np.linalg.norm(t)
+            return t1, np.cross(n, t1)
+    raise AssertionError("unreachable")  # pragma: no cover
+
+
+def friction_cone(normal: Sequence[float], mu: float, edges: int) -> np.ndarray:
+    """Generators K (3 x N): K_i = n + mu (cos a_i t1 + sin a_i t2), a_i = 2 pi i / N."""
+    n = unit(normal)
+    t1, t2 = cone_tangents(n)
+    a = 2.0 * np.pi * np.arange(edges) / edges
+    return n[:, None] + mu * (np.outer(t1, np.cos(a)) + np.outer(t2, np.sin(a)))
+
+
+@dataclass(frozen=True)
+class ImpactModel:
+    """Impulse set and CoM velocity jumps of an impact, per unit approach speed.
+
+    Attributes:
+        spec: The impact specification.
+        point: Impact point, world, m.
+        normal: Unit normal, world.
+        cone: Friction-cone generators K (3 x N).
+        W: Impulse-to-velocity map at the impact point (3 x 3), 1/kg.
+        mass: Robot mass, kg.
+        jacobian: 3 x nv translational Jacobian of the impact point (world axes).
+        impulse_rates: (2N, 3) impulse vertices per unit approach speed, N s / (m/s); rows
+            2i and 2i+1 are generator i on the planes c_hi and c_lo (paper's ordering).
+    """
+
+    spec: ImpactSpec
+    point: np.ndarray
+    normal: np.ndarray
+    cone: np.ndarray
+    W: np.ndarray
+    mass: float
+    jacobian: np.ndarray
+    impulse_rates: np.ndarray
+
+    @property
+    def com_jump_rates(self) -> np.ndarray:
+        """(2N, 2) planar CoM velocity jumps per unit approach speed (iota_xy / m)."""
+        return self.impulse_rates[:, :2] / self.mass
+
+    def impulse_vertices(self, approach_speed: float) -> np.ndarray:
+        """(2N, 3) impulse vertices, N s, at approach speed v_n (m/s)."""
+        return approach_speed * self.impulse_rates
+
+    def com_velocity_jumps(self, approach_speed: float) -> np.ndarray:
+        """(2N, 3) CoM velocity jumps iota / m, m/s."""
+        return approach_speed * self.impulse_rates / self.mass
+
+    def post_impact_com_velocities(self, com_velocity: Sequence[float], approach_speed: float) -> np.ndarray:
+        """(2N, 2) vertices of the post-impact planar CoM velocity set, m/s."""
+        return np.asarray(com_velocity, dtype=float)[None, :2] + approach_speed * self.com_jump_rates
+
+    def approach_speed(self, velocity: Sequence[float]) -> float:
+        """Approach speed -n . v of an end-effector velocity (m/s)."""
+        return float(-self.normal @ np.asarray(velocity, dtype=float))
+
+
+def impulse_to_velocity(stance: Stance, point: np.ndarray, jacobian: np.ndarray, model: str = "composite") -> np.ndarray:
+    """W at ``point``: composite rigid body (default) or joint space J M^-1 J^T."""
+    if model == "composite":
+        r = skew(point - stance.com)
+        return np.eye(3) / stance.mass - r @ np.linalg.solve(stance.com_inertia, r)
+    if model == "joint_space":
+        M = pin.crba(stance.model, stance.model.createData(), stance.q)
+        M = np.triu(M) + np.triu(M, 1).T
+        return jacobian @ np.linalg.solve(M, jacobian.T)
+    raise ImpactModelError("impact.inertia", model, f"must be one of {', '.join(INERTIA_MODELS)}")
+
+
+def impact_model(stance: Stance, spec: ImpactSpec) -> ImpactModel:
+    """Build the impact model of ``spec`` at the stance's configuration."""
+    placement, J6 = stance.point(spec.frame, spec.offset, field="impact.frame")
+    try:
+        n = unit(spec.normal)
+    except ValueError:
+        raise ImpactModelError("impact.normal", list(spec.normal), "must be a non-zero vector") from None
+    K = friction_cone(n, spec.friction, spec.cone_edges)
+    point = placement.translation.copy()
+    J = J6[:3].copy()
+    W = impulse_to_velocity(stance, point, J, spec.inertia)
+    normal_response = n @ W @ K  # n^T W K_i, > 0 for an impulse that pushes the point back
+    if np.any(normal_response <= 1e-12):
+        raise ImpactModelError(
+            "impact.friction",
+            spec.friction,
+            f"a friction-cone edge gives n^T W K_i = {normal_response.min():.3g} <= 0: the impulse "
+            "would not separate the contact (lower the friction or change the normal)",
+        )
+    lo, hi = spec.restitution
+    rates = np.empty((2 * K.shape[1], 3))
+    rates[0::2] = ((1.0 + hi) / normal_response)[:, None] * K.T
+    rates[1::2] = ((1.0 + lo) / normal_response)[:, None] * K.T
+    return ImpactModel(spec, point, n, K, W, stance.mass, J, rates)

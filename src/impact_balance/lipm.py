@@ -1,0 +1,83 @@
+"""LIPM phase portrait along one axis (paper sec. III-B).
+
+With the ZMP z limited to [z_lo, z_hi], the stable standing region is the set of states
+(c, cd) whose DCM c + cd / omega lies in [z_lo, z_hi]. At c = c_ref the CoM velocity bounds
+are omega (z_lo - c), omega (z_hi - c): for c_z = 0.78 m and z in [-0.13, 0.13] m,
++-0.4610 m/s with g = 9.81 (the paper's 0.4608 corresponds to g = 9.8).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .constants import GRAVITY
+from .exceptions import ScenarioError
+
+__all__ = ["PhasePortrait", "phase_portrait", "lipm_omega", "com_velocity_bounds"]
+
+
+def lipm_omega(com_height: float, plane_height: float = 0.0, gravity: float = GRAVITY) -> float:
+    """omega = sqrt(g / (c_z - h)), 1/s."""
+    if not (math.isfinite(com_height) and com_height > plane_height):
+        raise ScenarioError("com_height", com_height, f"must be above the plane height {plane_height} m")
+    if not gravity > 0:
+        raise ScenarioError("gravity", gravity, "must be > 0")
+    return math.sqrt(gravity / (com_height - plane_height))
+
+
+def com_velocity_bounds(
+    com_height: float, zmp_range: tuple[float, float], com_position: float = 0.0, gravity: float = GRAVITY
+) -> tuple[float, float]:
+    """CoM velocity interval (m/s) from which the CoM can be brought to rest at ``com_position``."""
+    lo, hi = zmp_range
+    if not lo <= hi:
+        raise ScenarioError("zmp_range", [lo, hi], "must be [lo, hi] with lo <= hi")
+    w = lipm_omega(com_height, 0.0, gravity)
+    return w * (lo - com_position), w * (hi - com_position)
+
+
+@dataclass(frozen=True)
+class PhasePortrait:
+    """Phase portrait data of the saturated-ZMP LIPM along one axis.
+
+    Attributes:
+        omega: 1/s.  zmp_range: (lo, hi), m.  com_velocity_bounds: (lo, hi) at c = 0, m/s.
+        trajectories: list of (T, 2) arrays of (c, cd) under a ZMP that brakes as hard as
+            allowed (saturated), for plotting.
+    """
+
+    omega: float
+    com_height: float
+    zmp_range: tuple[float, float]
+    com_velocity_bounds: tuple[float, float]
+    trajectories: list[np.ndarray]
+
+    def is_capturable(self, com: float, com_velocity: float) -> bool:
+        """Whether the DCM c + cd / omega lies in the ZMP range (stable standing region)."""
+        dcm = com + com_velocity / self.omega
+        return self.zmp_range[0] <= dcm <= self.zmp_range[1]
+
+
+def phase_portrait(
+    com_height: float, zmp_range: tuple[float, float], gravity: float = GRAVITY, n_trajectories: int = 9
+) -> PhasePortrait:
+    """LIPM phase portrait with the ZMP saturated in ``zmp_range`` (paper Fig. lipm-pplane)."""
+    w = lipm_omega(com_height, 0.0, gravity)
+    bounds = com_velocity_bounds(com_height, zmp_range, 0.0, gravity)
+    lo, hi = zmp_range
+    width = max(hi - lo, 1e-3)
+    trajectories = []
+    t = np.linspace(0.0, 1.5, 200)
+    for c0 in np.linspace(lo - width, hi + width, n_trajectories):
+        for v0 in (bounds[0] * 1.5, bounds[1] * 1.5):
+            # Brake with the saturated ZMP: z = hi if moving forward, lo otherwise (closed form).
+            z = hi if v0 > 0 else lo
+            x0 = c0 - z
+            c = z + x0 * np.cosh(w * t) + v0 / w * np.sinh(w * t)
+            cd = x0 * w * np.sinh(w * t) + v0 * np.cosh(w * t)
+            keep = np.abs(c) < 3 * width + abs(c0)
+            trajectories.append(np.column_stack([c[keep], cd[keep]]))
+    return PhasePortrait(w, com_height, (lo, hi), bounds, trajectories)

@@ -1,0 +1,156 @@
+"""The ZMP support area and the CoM velocity area with the post-impact sets (paper Fig. solving-opt)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from matplotlib import colormaps
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+from ..analysis import Analysis
+from ._common import (
+    AREA_COLOR,
+    COM_COLOR,
+    CONTACT_COLOR,
+    FALL_COLOR,
+    ZMP_COLOR,
+    area_view_points,
+    centre_message,
+    draw_polygon,
+    fmt_speed,
+    hull,
+    new_figure,
+    scenario_title,
+    set_limits,
+    text_box,
+)
+
+__all__ = ["plot_areas", "draw_zmp_area", "draw_com_velocity_area"]
+
+
+def draw_zmp_area(ax: Axes, analysis: Analysis) -> None:
+    """ZMP support area, the contact rectangles projected on the plane and the CoM projection."""
+    areas = analysis.areas
+    zmp = areas.zmp_area
+    view = []
+    for i, contact in enumerate(analysis.stance.contacts):
+        corners = contact.corners()[:, :2]
+        view.append(corners)
+        draw_polygon(ax, hull(corners), color=CONTACT_COLOR, lw=1.4, ls="--", zorder=2, fill=False,
+                     label="contact rectangles (projected)" if i == 0 else None)
+    if zmp.is_empty:
+        centre_message(ax, "cannot balance:\nempty ZMP support area")
+    else:
+        if zmp.bounded:
+            label = f"ZMP support area ({zmp.area * 1e4:.0f} cm$^2$)"
+        else:
+            label = "ZMP support area, unbounded (clipped)"
+        draw_polygon(ax, zmp, color=ZMP_COLOR, alpha=0.45, lw=2, label=label, zorder=1)
+    com = areas.com[:2]
+    ax.plot(*com, "o", color=COM_COLOR, ms=7, mfc="white", mew=2, label="CoM projection", zorder=5)
+    view.append(com)
+    set_limits(ax, area_view_points(zmp, view), margin=0.15, min_ratio=0.3)
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_title(f"ZMP support area (plane z = {areas.plane_height:g} m)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="upper left", fontsize=8, framealpha=0.9)
+
+
+def draw_com_velocity_area(ax: Axes, analysis: Analysis, n_steps: int = 5) -> None:
+    """CoM velocity area, pre-impact CoM velocity and post-impact sets for increasing speeds."""
+    areas = analysis.areas
+    area = areas.com_velocity_area
+    c0 = analysis.com_velocity[:2]
+    view: list[np.ndarray] = [c0]
+    lines = []
+    if area.is_empty:
+        centre_message(ax, "cannot balance:\nempty CoM velocity area")
+    else:
+        label = f"CoM velocity area ({len(area.vertices)} vertices)"
+        if not area.bounded:
+            label += ", unbounded (clipped)"
+        draw_polygon(ax, area, color=AREA_COLOR, alpha=0.4, lw=2, edge="teal", label=label, zorder=1)
+    ax.plot(*c0, "o", color=COM_COLOR, ms=7, label="pre-impact CoM velocity", zorder=6)
+
+    im = analysis.impact
+    if im is not None:
+        model = im.model
+        limit = im.com_limit
+        vmax = limit.max_approach_speed
+        ref = model.spec.reference_velocity
+        v_ref = max(0.0, model.approach_speed(ref)) if ref is not None else None
+        # The series k / n * v_max (or of the reference speed when there is no limit).
+        top = vmax if limit.is_finite else v_ref
+        if top is not None and top > 0:
+            cmap = colormaps["Blues"]
+            for k in range(1, n_steps + 1):
+                s = top * k / n_steps
+                pts = model.post_impact_com_velocities(c0, s)
+                view.append(pts)
+                last = k == n_steps
+                if last and limit.is_finite:
+                    lab = f"post-impact set at v_max = {s:.3g} m/s"
+                else:
+                    lab = f"post-impact set at {s:.3g} m/s"
+                color = cmap(0.35 + 0.6 * k / n_steps)
+                draw_polygon(ax, hull(pts), color=color, alpha=0.25 if not last else 0.45,
+                             edge="navy" if last else color, lw=2.5 if last else 1.0, label=lab, zorder=3 + 0.1 * k)
+            if limit.is_finite and limit.limiting_vertex is not None:
+                p = model.post_impact_com_velocities(c0, vmax)[limit.limiting_vertex]
+                ax.plot(*p, marker="*", color="gold", mec="black", ms=16, zorder=8,
+                        label=f"limiting vertex #{limit.limiting_vertex} (on the boundary)")
+                if limit.limiting_edge is not None and len(area.vertices) >= 3:
+                    k = limit.limiting_edge
+                    e = area.vertices[[k, (k + 1) % len(area.vertices)]]
+                    ax.plot(e[:, 0], e[:, 1], "-", color="gold", lw=4, alpha=0.8, zorder=2.5,
+                            label="limiting edge of the area")
+        if v_ref is not None and limit.is_finite and v_ref > vmax + 1e-12:
+            pts = model.post_impact_com_velocities(c0, v_ref)
+            view.append(pts)
+            draw_polygon(ax, hull(pts), color=FALL_COLOR, alpha=0.2, edge=FALL_COLOR, lw=1.8, ls="--",
+                         label=f"at the reference {v_ref:.3g} m/s: falls", zorder=4)
+        lines.append("maximum approach speed:")
+        lines.append(f"  CoM criterion: {fmt_speed(vmax)}")
+        lines.append(f"  ZMP criterion: {fmt_speed(im.zmp_max_contact_velocity)}")
+        if v_ref is not None:
+            lines.append(f"  reference: {v_ref:.3g} m/s")
+        lines.append(f"impact friction {model.spec.friction:g}, restitution "
+                     f"[{model.spec.restitution[0]:g}, {model.spec.restitution[1]:g}]")
+        if limit.status == "unbounded":
+            lines.append("no approach speed can leave the area")
+    else:
+        lines.append("no impact in this scenario")
+    falling = not area.is_empty and not analysis.com_velocity_inside
+    if falling:
+        lines.insert(0, "FALLING: the pre-impact CoM velocity\nis outside the area (v_max = 0)")
+    lines.append(f"omega = {areas.omega:.3f} 1/s")
+    text_box(ax, "\n".join(lines), loc="upper left", fontsize=8, edgecolor=FALL_COLOR if falling else "0.6")
+    set_limits(ax, area_view_points(area, view), margin=0.12, min_ratio=0.5)
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel(r"$\dot c_x$ (m/s)")
+    ax.set_ylabel(r"$\dot c_y$ (m/s)")
+    ax.set_title("CoM velocity area and post-impact CoM velocities")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="lower right", fontsize=7.5, framealpha=0.9)
+
+
+def plot_areas(analysis: Analysis, n_steps: int = 5) -> Figure:
+    """ZMP support area (left) and CoM velocity area with the post-impact sets (right).
+
+    The post-impact CoM velocity sets are drawn for the approach speeds ``k / n_steps * v_max``,
+    k = 1..n_steps (paper Fig. solving-opt), the one at v_max highlighted with its limiting
+    vertex; when the reference approach speed exceeds v_max, the set at the reference speed is
+    drawn in red. Without an impact only the areas are drawn.
+    """
+    if n_steps < 1 or not math.isfinite(n_steps):
+        raise ValueError("n_steps must be >= 1")
+    fig = new_figure(13, 6.2)
+    left, right = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.25]})
+    draw_zmp_area(left, analysis)
+    draw_com_velocity_area(right, analysis, n_steps)
+    fig.suptitle(f"Balance areas: {scenario_title(analysis)} - {analysis.verdict}", fontsize=12)
+    return fig

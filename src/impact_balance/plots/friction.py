@@ -1,0 +1,103 @@
+"""Post-impact sets and maximum contact velocities for several impact frictions (paper Fig. miu-compare)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from matplotlib import colormaps
+from matplotlib.figure import Figure
+
+from ..analysis import Analysis
+from ._common import AREA_COLOR, COM_COLOR, area_view_points, draw_polygon, fmt_speed, hull, new_figure, set_limits
+from .impulse import impulse_set_speed
+
+__all__ = ["plot_friction_comparison"]
+
+
+def _same_area(a: Analysis, b: Analysis) -> bool:
+    va, vb = a.areas.com_velocity_area.vertices, b.areas.com_velocity_area.vertices
+    return va.shape == vb.shape and bool(np.allclose(va, vb, atol=1e-9))
+
+
+def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
+    """Post-impact CoM velocity sets at each analysis' own maximum, one colour per impact friction.
+
+    Left: the sets on the (common) CoM velocity area, legend ``mu = 0.1: v_max = ... m/s``; an
+    analysis whose area differs from the first one also gets its area outlined in its colour.
+    Right: the maximum approach speed against mu for the CoM and the ZMP criteria.
+
+    Raises:
+        ValueError: when no analysis has an impact.
+    """
+    runs = sorted((a for a in analyses if a.impact is not None), key=lambda a: a.impact.model.spec.friction)
+    if not runs:
+        raise ValueError("plot_friction_comparison needs at least one analysis with an impact")
+    fig = new_figure(12, 6.2)
+    ax, bar = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.1, 1]})
+    base = runs[0]
+    area = base.areas.com_velocity_area
+    if not area.is_empty:
+        draw_polygon(ax, area, color=AREA_COLOR, alpha=0.4, edge="teal", lw=2, label="CoM velocity area", zorder=1)
+    view = list(area_view_points(area))
+    cmap = colormaps["plasma"]
+    colors = [cmap(0.05 + 0.75 * i / max(len(runs) - 1, 1)) for i in range(len(runs))]
+    for run, color in zip(runs, colors):
+        im = run.impact
+        mu = im.model.spec.friction
+        c0 = run.com_velocity[:2]
+        if not _same_area(run, base) and not run.areas.com_velocity_area.is_empty:
+            draw_polygon(ax, run.areas.com_velocity_area, color=color, fill=False, lw=1.2, ls=":", zorder=1.5,
+                         label=f"mu = {mu:g}: its own CoM velocity area")
+            view += area_view_points(run.areas.com_velocity_area)
+        speed, which = impulse_set_speed(run)
+        pts = im.model.post_impact_com_velocities(c0, speed)
+        view.append(pts)
+        label = f"mu = {mu:g}: v_max = {fmt_speed(im.max_contact_velocity)}"
+        if which != "v_max":
+            label += f" (set at {speed:.3g} m/s)"
+        draw_polygon(ax, hull(pts), color=color, alpha=0.35, edge=color, lw=2, label=label, zorder=3)
+        lim = im.com_limit
+        if lim.is_finite and lim.limiting_vertex is not None:
+            ax.plot(*pts[lim.limiting_vertex], "*", color=color, mec="black", ms=13, zorder=5)
+        view.append(c0)
+    c0s = np.array([r.com_velocity[:2] for r in runs])
+    ax.plot(*c0s.T, "o", color=COM_COLOR, ms=7, label="pre-impact CoM velocity", zorder=6)
+    set_limits(ax, view, margin=0.1, min_ratio=0.5)
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel(r"$\dot c_x$ (m/s)")
+    ax.set_ylabel(r"$\dot c_y$ (m/s)")
+    ax.set_title("Post-impact CoM velocity sets at each maximum (stars: limiting vertices)", fontsize=10)
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="lower right", fontsize=8, framealpha=0.9)
+
+    # v_max against mu, both criteria (bars with their values written on them).
+    mus = [r.impact.model.spec.friction for r in runs]
+    com = np.array([r.impact.max_contact_velocity for r in runs], dtype=float)
+    zmp = np.array([r.impact.zmp_max_contact_velocity for r in runs], dtype=float)
+    x = np.arange(len(runs))
+    width = 0.38
+    finite = np.concatenate([com[np.isfinite(com)], zmp[np.isfinite(zmp)]])
+    top = float(finite.max()) if finite.size else 1.0
+    top = top if top > 0 else 1.0
+    for values, dx, color, name in ((com, -width / 2, "tab:blue", "CoM velocity criterion"),
+                                    (zmp, width / 2, "tab:orange", "ZMP criterion")):
+        shown = np.where(np.isfinite(values), values, 1.1 * top)
+        bars = bar.bar(x + dx, shown, width, color=color, label=name)
+        for rect, v in zip(bars, values):
+            if not np.isfinite(v):
+                rect.set_hatch("//")  # no limit: drawn above the largest finite value
+            text = f"{v:.3g}" if np.isfinite(v) else "unbounded"
+            bar.text(rect.get_x() + rect.get_width() / 2, rect.get_height() + 0.01 * top, text,
+                     ha="center", va="bottom", fontsize=8)
+    bar.set_xticks(x, [f"{m:g}" for m in mus])
+    bar.set_xlabel("impact friction coefficient mu (-)")
+    bar.set_ylabel("maximum approach speed (m/s)")
+    bar.set_ylim(0, 1.25 * top)
+    bar.set_title("Maximum contact velocity vs impact friction", fontsize=10)
+    bar.grid(True, axis="y", alpha=0.3)
+    bar.legend(loc="upper right", fontsize=8)
+    names = list(dict.fromkeys(r.scenario.name or "scenario" for r in runs))
+    stem = ", ".join(names) if len(names) <= 4 else f"{len(names)} scenarios"
+    fig.suptitle(f"Impact friction comparison ({stem}; robot {base.stance.robot.name})", fontsize=12)
+    return fig

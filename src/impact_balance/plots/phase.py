@@ -1,0 +1,102 @@
+"""LIPM phase portrait with the stable standing region (paper Fig. lipm-pplane)."""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ..analysis import Analysis
+from ..lipm import PhasePortrait, phase_portrait
+from ._common import new_figure
+
+__all__ = ["plot_phase_portrait", "analysis_phase_portrait"]
+
+
+def analysis_phase_portrait(analysis: Analysis, axis: int = 0) -> PhasePortrait:
+    """Sagittal (``axis=0``) or lateral (``axis=1``) phase portrait of an analysis' stance.
+
+    The ZMP range is the chord of the ZMP support area through the CoM projection along that
+    axis, relative to the CoM (so that c = 0 is the current CoM); the pendulum height is the
+    CoM height above the ZMP plane.
+
+    Raises:
+        ValueError: when the ZMP support area does not contain the CoM projection along the axis.
+    """
+    areas = analysis.areas
+    com = areas.com
+    zmp = areas.zmp_area
+    if zmp.is_empty:
+        raise ValueError("empty ZMP support area: no phase portrait")
+    G, h = zmp.halfplanes
+    d = np.zeros(2)
+    d[axis] = 1.0
+    # { com_xy + t d : G (com_xy + t d) <= h }
+    slack = h - G @ com[:2]
+    rate = G @ d
+    lo, hi = -np.inf, np.inf
+    for s, r in zip(slack, rate):
+        if abs(r) < 1e-12:
+            if s < -1e-9:
+                raise ValueError("the CoM projection is outside the ZMP support area along this axis")
+            continue
+        if r > 0:
+            hi = min(hi, s / r)
+        else:
+            lo = max(lo, s / r)
+    if not (np.isfinite(lo) and np.isfinite(hi)) or lo > hi + 1e-12:
+        raise ValueError("the ZMP support area has no bounded chord through the CoM along this axis")
+    return phase_portrait(float(com[2] - areas.plane_height), (float(lo), float(hi)), areas.gravity)
+
+
+def plot_phase_portrait(portrait: PhasePortrait, title: str | None = None) -> Figure:
+    """LIPM phase portrait (c in m, cd in m/s) with the stable standing region shaded.
+
+    The region lies between the lines c + cd / omega = z_lo and z_hi; its intersection with
+    c = 0 gives the CoM velocity bounds, marked and annotated.
+    """
+    w = portrait.omega
+    z_lo, z_hi = portrait.zmp_range
+    v_lo, v_hi = portrait.com_velocity_bounds
+    width = max(z_hi - z_lo, 1e-3)
+    vmax = max(abs(v_lo), abs(v_hi), w * width / 2, 1e-3)
+    xlim = (min(z_lo, 0.0) - 1.2 * width, max(z_hi, 0.0) + 1.2 * width)
+    ylim = (-2.0 * vmax, 2.0 * vmax)
+
+    fig = new_figure(8.5, 6.5)
+    ax = fig.subplots()
+    c = np.linspace(*xlim, 200)
+    ax.fill_between(c, w * (z_lo - c), w * (z_hi - c), color="#b5e3b5", alpha=0.6, lw=0,
+                    label=r"stable standing region: $z_{lo} \leq c + \dot c/\omega \leq z_{hi}$")
+    ax.plot(c, w * (z_lo - c), "-", color="darkgreen", lw=1.5)
+    ax.plot(c, w * (z_hi - c), "-", color="darkgreen", lw=1.5)
+    for z, name in ((z_lo, "lo"), (z_hi, "hi")):
+        # Label each boundary line where it crosses the top or bottom of the view.
+        cd = 0.8 * ylim[1] if name == "lo" else 0.8 * ylim[0]
+        cx = z - cd / w
+        if xlim[0] < cx < xlim[1]:
+            ax.annotate(rf"$c + \dot c/\omega = {z:+.3g}$ m", (cx, cd), xytext=(6, 0), textcoords="offset points",
+                        fontsize=8, color="darkgreen", va="center")
+    for k, traj in enumerate(portrait.trajectories):
+        traj = np.asarray(traj, dtype=float)
+        if len(traj) < 2:
+            continue
+        ax.plot(traj[:, 0], traj[:, 1], "-", color="0.45", lw=0.8, label="LIPM trajectories (ZMP held at the braking bound)" if k == 0 else None)
+        inside = np.flatnonzero((traj[:, 0] > xlim[0]) & (traj[:, 0] < xlim[1]) & (np.abs(traj[:, 1]) < ylim[1]))
+        if len(inside) > 4:
+            i = inside[len(inside) // 3]
+            ax.annotate("", xy=traj[i + 1], xytext=traj[i], arrowprops=dict(arrowstyle="->", color="0.35", lw=0.9))
+    ax.axvline(0.0, color="tab:green", lw=1.2, ls="--", label="c = 0 (CoM at the reference)")
+    ax.axhline(0.0, color="0.6", lw=0.6)
+    ax.plot([0.0, 0.0], [v_lo, v_hi], "o", color="tab:red", ms=8, zorder=5, label="CoM velocity bounds at c = 0")
+    for v in (v_lo, v_hi):
+        ax.annotate(f"({0:g}, {v:+.4f} m/s)", (0.0, v), xytext=(10, 8 if v > 0 else -14), textcoords="offset points",
+                    fontsize=9, color="tab:red", fontweight="bold")
+    ax.set_xlim(*xlim)
+    ax.set_ylim(*ylim)
+    ax.set_xlabel("CoM position c (m)")
+    ax.set_ylabel(r"CoM velocity $\dot c$ (m/s)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
+    ax.set_title(title or (f"LIPM phase portrait: CoM height {portrait.com_height:.3g} m, "
+                           f"ZMP in [{z_lo:.3g}, {z_hi:.3g}] m, omega = {w:.3f} 1/s"), fontsize=10)
+    return fig

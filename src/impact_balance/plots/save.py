@@ -1,0 +1,52 @@
+"""Write all the figures of one analysis as PNG files."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from matplotlib.figure import Figure
+
+from ..analysis import Analysis
+from ._common import DPI
+from .areas import plot_areas
+from .impulse import plot_impulse_set
+from .phase import analysis_phase_portrait, plot_phase_portrait
+from .stance import plot_stance
+
+__all__ = ["save_figures", "figure_prefix"]
+
+
+def figure_prefix(analysis: Analysis) -> str:
+    """File-name prefix of an analysis' figures: its scenario name, made file-system safe."""
+    name = analysis.scenario.name or "scenario"
+    return re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._") or "scenario"
+
+
+def save_figures(analysis: Analysis, out_dir: str | Path, dpi: int = DPI) -> list[Path]:
+    """Write ``<scenario>_areas.png``, ``_stance.png``, ``_phase_portrait.png`` and, with an impact,
+    ``_impulse_set.png`` to ``out_dir`` (created if needed). Returns the paths written.
+
+    The phase portrait is the sagittal one of the stance (:func:`analysis_phase_portrait`); it is
+    skipped when the ZMP support area has no chord through the CoM along x.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    prefix = figure_prefix(analysis)
+    figures: list[tuple[str, Figure]] = [("areas", plot_areas(analysis)), ("stance", plot_stance(analysis))]
+    if analysis.impact is not None:
+        figures.append(("impulse_set", plot_impulse_set(analysis)))
+    try:
+        portrait = analysis_phase_portrait(analysis, axis=0)
+    except ValueError:
+        portrait = None
+    if portrait is not None:
+        title = (f"{prefix}: sagittal LIPM phase portrait, CoM height {portrait.com_height:.3g} m, "
+                 f"ZMP in [{portrait.zmp_range[0]:+.3g}, {portrait.zmp_range[1]:+.3g}] m about the CoM")
+        figures.append(("phase_portrait", plot_phase_portrait(portrait, title=title)))
+    written = []
+    for name, fig in figures:
+        path = out / f"{prefix}_{name}.png"
+        fig.savefig(path, dpi=dpi)
+        written.append(path)
+    return written

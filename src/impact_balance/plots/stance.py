@@ -1,0 +1,169 @@
+"""Top and side views of a stance: robot stick figure, contacts, CoM, ZMP area and impact."""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+from ..analysis import Analysis
+from ._common import (
+    COM_COLOR,
+    CONTACT_COLOR,
+    IMPACT_COLOR,
+    ZMP_COLOR,
+    draw_polygon,
+    hull,
+    new_figure,
+    scenario_title,
+    set_limits,
+)
+
+__all__ = ["plot_stance", "joint_positions"]
+
+#: Length of the contact and impact normal arrows, m.
+NORMAL_LENGTH = 0.15
+#: Drawing scale of velocity arrows, m per (m/s).
+VELOCITY_SCALE = 0.3
+
+
+def joint_positions(analysis: Analysis) -> tuple[np.ndarray, list[tuple[int, int]]]:
+    """World positions of the joint origins (njoints x 3, row 0 = universe) and the parent links.
+
+    Uses the stance's pinocchio data, already at the stance configuration (``data.oMi``).
+    """
+    stance = analysis.stance
+    model, data = stance.model, stance.data
+    pos = np.array([np.asarray(data.oMi[j].translation, dtype=float) for j in range(model.njoints)])
+    links = [(j, int(model.parents[j])) for j in range(1, model.njoints) if int(model.parents[j]) > 0]
+    return pos, links
+
+
+def _frame_joint(analysis: Analysis, frame: str) -> int | None:
+    stance = analysis.stance
+    try:
+        f = stance.model.frames[stance.robot.frame_id(frame)]
+    except Exception:  # noqa: BLE001 - a missing frame only removes a stick
+        return None
+    return int(f.parentJoint if hasattr(f, "parentJoint") else f.parent)  # pinocchio 3 / 2
+
+
+def _arrow(ax: Axes, start: np.ndarray, delta: np.ndarray, color: str, label: str | None, width: float = 0.012,
+           zorder: float = 7, ls: str = "-") -> bool:
+    """Arrow from ``start`` by ``delta`` (data units); nothing if it is too short to see."""
+    if float(np.linalg.norm(delta)) < 1e-4:
+        return False
+    ax.arrow(start[0], start[1], delta[0], delta[1], width=width * 0.35, head_width=width * 2.2,
+             head_length=width * 2.5, length_includes_head=True, color=color, zorder=zorder, label=label, ls=ls)
+    return True
+
+
+def _draw_view(ax: Axes, analysis: Analysis, axes: tuple[int, int], robot: bool) -> None:
+    stance = analysis.stance
+    areas = analysis.areas
+    i, k = axes
+    view: list[np.ndarray] = []
+    h = areas.plane_height
+    top = axes == (0, 1)
+
+    if robot:
+        pos, links = joint_positions(analysis)
+        for n, (j, p) in enumerate(links):
+            seg = pos[[p, j]][:, [i, k]]
+            ax.plot(*seg.T, "-", color="0.55", lw=2.0, solid_capstyle="round", zorder=2,
+                    label="robot (joint origins)" if n == 0 else None)
+        ax.plot(*pos[1:, [i, k]].T, "o", color="0.35", ms=3, zorder=2.1)
+        view.append(pos[1:, [i, k]])
+        # Sticks from the last joint to the contact and impact points.
+        ends = [(c.spec.frame, c.position) for c in stance.contacts]
+        if analysis.impact is not None:
+            ends.append((analysis.impact.model.spec.frame, analysis.impact.model.point))
+        for frame, point in ends:
+            j = _frame_joint(analysis, frame)
+            if j:
+                ax.plot(*np.vstack([pos[j], point])[:, [i, k]].T, ":", color="0.55", lw=1.5, zorder=2)
+
+    # ZMP support area on its plane.
+    zmp = areas.zmp_area
+    if not zmp.is_empty:
+        if top:
+            draw_polygon(ax, zmp, color=ZMP_COLOR, alpha=0.4, lw=1.5, label="ZMP support area", zorder=1)
+        else:
+            xs = zmp.vertices[:, 0] if i == 0 else zmp.vertices[:, 1]
+            ax.plot([xs.min(), xs.max()], [h, h], "-", color=ZMP_COLOR, lw=7, alpha=0.8, solid_capstyle="butt",
+                    label="ZMP support area", zorder=1)
+        if zmp.bounded:
+            view.append(np.column_stack([zmp.vertices[:, 0], zmp.vertices[:, 1]]) if top
+                        else np.array([[zmp.vertices[:, 0].min(), h], [zmp.vertices[:, 0].max(), h]]))
+    if not top:
+        ax.axhline(h, color="0.3", lw=0.8, ls="--", zorder=0.5, label=f"ZMP plane z = {h:g} m")
+
+    # Contacts and their normals.
+    for n, c in enumerate(stance.contacts):
+        corners = c.corners()[:, [i, k]]
+        view.append(corners)
+        draw_polygon(ax, hull(corners), color=CONTACT_COLOR, alpha=0.3, lw=1.5, zorder=1.5,
+                     label="contact rectangles" if n == 0 else None)
+        _arrow(ax, c.position[[i, k]], NORMAL_LENGTH * c.normal[[i, k]], CONTACT_COLOR,
+               "contact normals" if n == 0 else None, width=0.008)
+        view.append((c.position + NORMAL_LENGTH * c.normal)[None, [i, k]])
+
+    # CoM and its projection on the ZMP plane.
+    com = areas.com
+    ax.plot(*com[[i, k]], "o", color=COM_COLOR, ms=9, mfc="yellow", mew=2, zorder=9, label="CoM")
+    if not top:
+        ax.plot([com[i], com[i]], [com[2], h], "--", color=COM_COLOR, lw=1, zorder=8)
+        ax.plot(com[i], h, "x", color=COM_COLOR, ms=9, mew=2, zorder=9, label="CoM projection")
+    view.append(com[None, [i, k]])
+
+    # Impact point, normal, reference and capped contact velocities.
+    im = analysis.impact
+    if im is not None:
+        p = im.model.point
+        ax.plot(*p[[i, k]], "o", color=IMPACT_COLOR, ms=8, zorder=9, label="impact point")
+        view.append(p[None, [i, k]])
+        _arrow(ax, p[[i, k]], NORMAL_LENGTH * im.model.normal[[i, k]], IMPACT_COLOR,
+               "impact normal (impulse on the robot)", width=0.01)
+        view.append((p + NORMAL_LENGTH * im.model.normal)[None, [i, k]])
+        ref = im.model.spec.reference_velocity
+        if ref is not None:
+            ref = np.asarray(ref, dtype=float)
+            _arrow(ax, p[[i, k]], VELOCITY_SCALE * ref[[i, k]], "darkorange",
+                   f"reference velocity {np.linalg.norm(ref):.3g} m/s", width=0.012, zorder=7)
+            view.append((p + VELOCITY_SCALE * ref)[None, [i, k]])
+        if im.contact_velocity is not None and ref is not None and not np.allclose(im.contact_velocity, ref):
+            v = im.contact_velocity
+            _arrow(ax, p[[i, k]], VELOCITY_SCALE * v[[i, k]], "tab:green",
+                   f"capped at v_max: {np.linalg.norm(v):.3g} m/s", width=0.007, zorder=7.5)
+
+    set_limits(ax, view, margin=0.08, min_span=0.3)
+    ax.set_aspect("equal", adjustable="box")
+    names = "xyz"
+    ax.set_xlabel(f"{names[i]} (m)")
+    ax.set_ylabel(f"{names[k]} (m)")
+    ax.grid(True, alpha=0.3)
+
+
+def plot_stance(analysis: Analysis, robot: bool = True) -> Figure:
+    """Top view (x-y) and side view (x-z) of the stance.
+
+    Shows the contact rectangles with their normals, the CoM and its projection, the ZMP
+    support area on its plane, the impact point with the impact normal and the reference
+    velocity (and the velocity capped at v_max), and, with ``robot``, a stick figure of the
+    joint origins. Velocity arrows are drawn at 0.3 m per m/s, normals 0.15 m long.
+    """
+    fig = new_figure(13, 7)
+    top, side = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.25, 1]})
+    _draw_view(top, analysis, (0, 1), robot)
+    top.set_title("Top view (x-y)")
+    _draw_view(side, analysis, (0, 2), robot)
+    side.set_title("Side view (x-z)")
+    handles, labels = side.get_legend_handles_labels()
+    th, tl = top.get_legend_handles_labels()
+    for hnd, lab in zip(th, tl):
+        if lab not in labels:
+            handles.append(hnd)
+            labels.append(lab)
+    fig.legend(handles, labels, loc="outside lower center", ncol=4, fontsize=8.5, framealpha=0.9)
+    fig.suptitle(f"Stance: {scenario_title(analysis)}, mass {analysis.stance.mass:.1f} kg", fontsize=12)
+    return fig

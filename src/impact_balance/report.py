@@ -1,0 +1,62 @@
+"""Plain-text reports of analyses (what ``impact-balance demo`` and ``analyze`` print)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .analysis import Analysis
+
+__all__ = ["format_analysis", "format_speed"]
+
+
+def format_speed(value: float) -> str:
+    """m/s with 3 decimals, "unbounded" for inf."""
+    return f"{value:.3f} m/s" if np.isfinite(value) else "unbounded"
+
+
+def _vec(v, digits: int = 3) -> str:
+    return "(" + ", ".join(f"{x:.{digits}f}" for x in v) + ")"
+
+
+def format_analysis(analysis: Analysis) -> str:
+    """Multi-line human-readable summary of one analysis."""
+    a, st, sc = analysis.areas, analysis.stance, analysis.scenario
+    lines = [f"{sc.name or 'scenario'}: {sc.description or ''}".rstrip(": ")]
+    lines.append(
+        f"  robot {st.robot.name}, mass {st.mass:.2f} kg, CoM {_vec(st.com)} m, omega {a.omega:.4f} 1/s, "
+        f"{len(st.contacts)} contact(s), torque limits {'on' if sc.torque_limits else 'off'}"
+    )
+    if not a.can_balance:
+        lines.append("  CANNOT BALANCE: these contacts cannot hold the robot at rest (empty areas)")
+        return "\n".join(lines)
+    v = a.com_velocity_area
+    lo, hi = v.vertices.min(axis=0), v.vertices.max(axis=0)
+    lines.append(
+        f"  CoM velocity area: {len(v.vertices)} vertices, {v.area:.4f} m^2/s^2, "
+        f"x in [{lo[0]:.3f}, {hi[0]:.3f}] m/s, y in [{lo[1]:.3f}, {hi[1]:.3f}] m/s"
+        + ("" if v.bounded else " (unbounded, clipped)")
+    )
+    z = a.zmp_area
+    lines.append(f"  ZMP support area: {len(z.vertices)} vertices, {z.area:.4f} m^2")
+    lines.append(f"  pre-impact CoM velocity {_vec(analysis.com_velocity)} m/s: {analysis.verdict}")
+    im = analysis.impact
+    if im is not None:
+        spec = im.model.spec
+        lines.append(
+            f"  impact at {spec.frame}, point {_vec(im.model.point)} m, normal {_vec(im.model.normal, 2)}, "
+            f"mu {spec.friction:g}, restitution [{spec.restitution[0]:g}, {spec.restitution[1]:g}], N = {spec.cone_edges}"
+        )
+        com_v, zmp_v = im.max_contact_velocity, im.zmp_max_contact_velocity
+        ratio = f" (x{com_v / zmp_v:.1f})" if np.isfinite(com_v) and zmp_v > 0 else ""
+        lines.append(
+            f"  max contact velocity: CoM criterion {format_speed(com_v)}, ZMP criterion {format_speed(zmp_v)}{ratio}"
+        )
+        if im.contact_velocity is not None:
+            lines.append(
+                f"  reference velocity {_vec(spec.reference_velocity)} m/s -> contact velocity "
+                f"{_vec(im.contact_velocity)} m/s"
+            )
+        if im.qp is not None:
+            lines.append(f"  paper's QP ({im.qp.status}): approach speed {format_speed(im.qp.approach_speed)}")
+    lines.append(f"  computed in {1e3 * analysis.timings.get('total', float('nan')):.1f} ms")
+    return "\n".join(lines)

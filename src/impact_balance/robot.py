@@ -1,0 +1,211 @@
+"""Robot models: bundled humanoids from example-robot-data, or any URDF + SRDF.
+
+Models are loaded with pinocchio, with a free-flyer root joint (the robot is floating).
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.metadata
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from .exceptions import (
+    RobotLoadError,
+    UnknownConfigurationError,
+    UnknownFrameError,
+    UnknownJointError,
+    UnknownRobotError,
+)
+
+__all__ = ["RobotSpec", "Robot", "BUNDLED_ROBOTS", "load_robot", "example_robot_data_root"]
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    """Where a bundled robot's files live, relative to the example-robot-data root.
+
+    Attributes:
+        urdf: URDF path.
+        srdf: SRDF path (reference configurations), or None.
+        standing: Name of the default standing configuration ("neutral" if no SRDF has one).
+        description: One line for listings.
+    """
+
+    urdf: str
+    srdf: str | None
+    standing: str
+    description: str
+
+
+BUNDLED_ROBOTS: dict[str, RobotSpec] = {
+    "talos": RobotSpec(
+        "talos_data/robots/talos_reduced.urdf",
+        "talos_data/srdf/talos.srdf",
+        "half_sitting",
+        "PAL Robotics TALOS, 90 kg humanoid (reduced model, 32 actuated joints)",
+    ),
+    "g1": RobotSpec(
+        "g1_description/urdf/g1_29dof_rev_1_0.urdf",
+        None,
+        "neutral",
+        "Unitree G1, 33 kg humanoid (29 actuated joints); no SRDF: neutral configuration",
+    ),
+    "romeo": RobotSpec(
+        "romeo_description/urdf/romeo.urdf",
+        "romeo_description/srdf/romeo.srdf",
+        "half_sitting",
+        "Aldebaran Romeo, 41 kg humanoid",
+    ),
+    "icub": RobotSpec(
+        "icub_description/robots/icub_reduced.urdf",
+        "icub_description/srdf/icub.srdf",
+        "half_sitting",
+        "IIT iCub, 28 kg humanoid (reduced model)",
+    ),
+}
+
+
+def example_robot_data_root() -> Path:
+    """Folder holding example-robot-data's ``robots/`` tree (installed by its wheel)."""
+    try:
+        dist = importlib.metadata.distribution("example-robot-data")
+    except importlib.metadata.PackageNotFoundError as exc:  # pragma: no cover - install issue
+        raise RobotLoadError("example-robot-data", "package not installed") from exc
+    root = Path(str(dist.locate_file("cmeel.prefix/share/example-robot-data/robots")))
+    if not root.is_dir():  # pragma: no cover - install issue
+        raise RobotLoadError(str(root), "example-robot-data's robots folder not found")
+    return root
+
+
+@dataclass
+class Robot:
+    """A floating-base robot model.
+
+    Attributes:
+        name: Bundled name, or the URDF file stem.
+        model: pinocchio model with a free-flyer root (nq = 7 + joints, nv = 6 + joints).
+        reference_configurations: Named configurations from the SRDF, plus "neutral".
+        standing: Name of the default standing configuration.
+        urdf_path, srdf_path: Source files (meshes are resolved relative to the URDF's package).
+    """
+
+    name: str
+    model: pin.Model
+    reference_configurations: dict[str, np.ndarray]
+    standing: str
+    urdf_path: Path
+    srdf_path: Path | None = None
+    package_dirs: list[str] = field(default_factory=list)
+
+    @property
+    def mass(self) -> float:
+        """Total mass, kg."""
+        return float(sum(inertia.mass for inertia in self.model.inertias))
+
+    @property
+    def frame_names(self) -> list[str]:
+        """Names of all frames of the model."""
+        return [f.name for f in self.model.frames]
+
+    @property
+    def joint_names(self) -> list[str]:
+        """Names of the actuated (non-root) joints."""
+        return list(self.model.names)[2:]
+
+    def frame_id(self, name: str, field: str = "frame") -> int:
+        """Index of frame ``name``; :class:`UnknownFrameError` naming the valid ones if absent."""
+        if not isinstance(name, str) or not self.model.existFrame(name):
+            raise UnknownFrameError(field, name, set(self.frame_names))
+        return self.model.getFrameId(name)
+
+    def joint_id(self, name: str, field: str = "joint") -> int:
+        """Index of a non-root joint; :class:`UnknownJointError` if absent."""
+        if name not in self.joint_names:
+            raise UnknownJointError(field, name, self.joint_names)
+        return self.model.getJointId(name)
+
+    def configuration(self, name: str | None = None, field: str = "configuration") -> np.ndarray:
+        """A copy of the named reference configuration (default: the standing one)."""
+        key = self.standing if name is None else name
+        if key not in self.reference_configurations:
+            raise UnknownConfigurationError(field, key, self.reference_configurations)
+        return self.reference_configurations[key].copy()
+
+    def actuated_effort_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """Velocity indices of the torque-limited actuated joints and their effort limits (N m).
+
+        A joint whose URDF effort limit is 0, missing or infinite is unlimited and left out.
+        """
+        idx, lim = self._limited(self.model.effortLimit)
+        return idx, lim
+
+    def actuated_velocity_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """Velocity indices of the velocity-limited actuated joints and their limits (rad/s)."""
+        return self._limited(self.model.velocityLimit)
+
+    def _limited(self, limits: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        limits = np.asarray(limits, dtype=float)
+        offset = self.model.nv - limits.size  # some versions store nu entries, not nv
+        indices, values = [], []
+        for joint in list(self.model.joints)[2:]:
+            for k in range(joint.idx_v, joint.idx_v + joint.nv):
+                value = limits[k - offset] if 0 <= k - offset < limits.size else 0.0
+                if np.isfinite(value) and value > 0.0:
+                    indices.append(k)
+                    values.append(value)
+        return np.asarray(indices, dtype=int), np.asarray(values, dtype=float)
+
+
+def _load(urdf: Path, srdf: Path | None, name: str, standing: str | None) -> Robot:
+    package_dirs = [str(urdf.parent.parent.parent), str(urdf.parent.parent)]
+    try:
+        model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
+    except (RuntimeError, ValueError, OSError) as exc:
+        raise RobotLoadError(str(urdf), str(exc).strip().splitlines()[0] if str(exc) else "invalid URDF") from exc
+    configurations = {"neutral": pin.neutral(model)}
+    if srdf is not None:
+        if not srdf.is_file():
+            raise RobotLoadError(str(srdf), "no such file")
+        try:
+            pin.loadReferenceConfigurations(model, str(srdf), False)
+        except (RuntimeError, ValueError, OSError) as exc:
+            raise RobotLoadError(str(srdf), str(exc).strip() or "invalid SRDF") from exc
+        for entry in model.referenceConfigurations:
+            configurations[entry.key()] = np.array(entry.data(), dtype=float)
+    if standing is None:
+        standing = "half_sitting" if "half_sitting" in configurations else "neutral"
+    if standing not in configurations:
+        raise UnknownConfigurationError("robot.standing", standing, configurations)
+    return Robot(name, model, configurations, standing, urdf, srdf, package_dirs)
+
+
+@functools.lru_cache(maxsize=16)
+def _load_bundled(name: str) -> Robot:
+    spec = BUNDLED_ROBOTS[name]
+    root = example_robot_data_root()
+    return _load(root / spec.urdf, root / spec.srdf if spec.srdf else None, name, spec.standing)
+
+
+def load_robot(
+    robot: str | None = None,
+    urdf: str | Path | None = None,
+    srdf: str | Path | None = None,
+    standing: str | None = None,
+) -> Robot:
+    """Load a bundled robot by name, or any URDF (+ optional SRDF) that pinocchio reads.
+
+    Bundled models are cached: the returned :class:`Robot` is shared, do not mutate its model.
+    """
+    if urdf is None:
+        name = robot or "talos"
+        if name not in BUNDLED_ROBOTS:
+            raise UnknownRobotError("robot", name, BUNDLED_ROBOTS)
+        return _load_bundled(name)
+    urdf = Path(urdf)
+    if not urdf.is_file():
+        raise RobotLoadError(str(urdf), "no such file")
+    return _load(urdf, Path(srdf) if srdf else None, robot or urdf.stem, standing)
