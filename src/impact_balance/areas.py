@@ -29,6 +29,10 @@ __all__ = ["BalanceAreas", "balance_areas", "areas_from_polytope", "omega"]
 
 #: Projection tolerance on the resultant horizontal force, as a fraction of m g.
 FORCE_TOLERANCE = 1e-8
+#: Vertices closer than this (units of m g) to a neighbour or to the line through their
+#: neighbours are merged: a kink of 1e-6 (c_z - h) m ~ 1 micron in the ZMP area is noise of
+#: the model (e.g. feet aligned to 1e-7 m by IK), not a feature.
+MERGE_TOLERANCE = 1e-6
 #: Clipping box on the resultant horizontal force for unbounded directions, in units of m g.
 FORCE_BOX = 1e3
 
@@ -83,6 +87,7 @@ def areas_from_polytope(polytope: WrenchPolytope, plane_height: float = 0.0) -> 
         polytope.F,
         tol=FORCE_TOLERANCE,
         box=FORCE_BOX,
+        merge_tol=MERGE_TOLERANCE,
     )
     force = result.polygon
     depth = plane_height - float(com[2])  # < 0

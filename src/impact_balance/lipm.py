@@ -62,22 +62,37 @@ class PhasePortrait:
 
 
 def phase_portrait(
-    com_height: float, zmp_range: tuple[float, float], gravity: float = GRAVITY, n_trajectories: int = 9
+    com_height: float,
+    zmp_range: tuple[float, float],
+    gravity: float = GRAVITY,
+    n_trajectories: int = 9,
+    gain: float = 1.0,
+    horizon: float = 2.0,
 ) -> PhasePortrait:
-    """LIPM phase portrait with the ZMP saturated in ``zmp_range`` (paper Fig. lipm-pplane)."""
+    """LIPM phase portrait with a saturated ZMP (paper Fig. lipm-pplane, after Sugihara 2009).
+
+    Trajectories follow the capture feedback ``z = clip((1 + gain) xi, z_lo, z_hi)`` on the
+    DCM xi = c + cd / omega: inside the stable standing region they converge to rest at the
+    origin, outside it they diverge whatever the (bounded) ZMP does.
+    """
     w = lipm_omega(com_height, 0.0, gravity)
     bounds = com_velocity_bounds(com_height, zmp_range, 0.0, gravity)
     lo, hi = zmp_range
     width = max(hi - lo, 1e-3)
+    limit = 3.0 * width + max(abs(lo), abs(hi))
+    starts = [(c0, v0) for c0 in np.linspace(lo - 0.5 * width, hi + 0.5 * width, n_trajectories)
+              for v0 in (1.4 * bounds[0], 1.4 * bounds[1])]
+    dt = 1e-3
     trajectories = []
-    t = np.linspace(0.0, 1.5, 200)
-    for c0 in np.linspace(lo - width, hi + width, n_trajectories):
-        for v0 in (bounds[0] * 1.5, bounds[1] * 1.5):
-            # Brake with the saturated ZMP: z = hi if moving forward, lo otherwise (closed form).
-            z = hi if v0 > 0 else lo
-            x0 = c0 - z
-            c = z + x0 * np.cosh(w * t) + v0 / w * np.sinh(w * t)
-            cd = x0 * w * np.sinh(w * t) + v0 * np.cosh(w * t)
-            keep = np.abs(c) < 3 * width + abs(c0)
-            trajectories.append(np.column_stack([c[keep], cd[keep]]))
+    for c0, v0 in starts:
+        c, cd, path = c0, v0, [(c0, v0)]
+        for _ in range(int(horizon / dt)):
+            xi = c + cd / w
+            z = min(max((1.0 + gain) * xi, lo), hi)
+            cd += dt * w * w * (c - z)
+            c += dt * cd
+            path.append((c, cd))
+            if abs(c) > limit:
+                break
+        trajectories.append(np.array(path))
     return PhasePortrait(w, com_height, (lo, hi), bounds, trajectories)

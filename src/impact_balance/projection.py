@@ -54,6 +54,7 @@ def project_polytope(
     tol: float = 1e-8,
     box: float = 1e3,
     max_lp: int = 2000,
+    merge_tol: float | None = None,
 ) -> ProjectionResult:
     """Project ``{x : A x <= b, C x = d}`` onto ``y = E x``.
 
@@ -63,6 +64,8 @@ def project_polytope(
         tol: Distance (in y units) under which a new support point is considered on the edge.
         box: Clipping box ``|y_k| <= box`` for unbounded directions.
         max_lp: Safety cap on the number of LPs.
+        merge_tol: Distance under which final vertices are merged with a neighbour or with
+            the line through their neighbours (default: ``tol``).
     """
     E = np.asarray(E, dtype=float)
     n = E.shape[1]
@@ -122,6 +125,6 @@ def project_polytope(
         else:
             confirmed[i] = True
             i = (i + 1) % len(vertices)
-    polygon_vertices = simplify(np.array(vertices), tol)
+    polygon_vertices = simplify(np.array(vertices), tol if merge_tol is None else merge_tol)
     bounded = bool(np.all(np.abs(polygon_vertices) < box * (1 - 1e-9)))
     return ProjectionResult(Polygon(polygon_vertices, bounded), count)

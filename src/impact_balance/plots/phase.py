@@ -80,7 +80,7 @@ def plot_phase_portrait(portrait: PhasePortrait, title: str | None = None) -> Fi
         traj = np.asarray(traj, dtype=float)
         if len(traj) < 2:
             continue
-        ax.plot(traj[:, 0], traj[:, 1], "-", color="0.45", lw=0.8, label="LIPM trajectories (ZMP held at the braking bound)" if k == 0 else None)
+        ax.plot(traj[:, 0], traj[:, 1], "-", color="0.45", lw=0.8, label="LIPM trajectories, saturated ZMP feedback" if k == 0 else None)
         inside = np.flatnonzero((traj[:, 0] > xlim[0]) & (traj[:, 0] < xlim[1]) & (np.abs(traj[:, 1]) < ylim[1]))
         if len(inside) > 4:
             i = inside[len(inside) // 3]
