@@ -13,7 +13,8 @@ from .constraints import wrench_polytope
 from .criteria import VelocityLimit, capped_velocity, max_contact_velocity, zmp_max_contact_velocity
 from .impact import ImpactModel, impact_model
 from .qp import QPOptions, QPResult, solve_contact_velocity_qp, static_torques
-from .scenario import Scenario, load_scenario
+from .exceptions import ScenarioError
+from .scenario import Scenario, load_scenario, with_source
 from .stance import Stance
 
 __all__ = ["ImpactAnswer", "Analysis", "analyze"]
@@ -158,7 +159,10 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
     answer = None
     if scenario.impact is not None:
         cfg = scenario.impact
-        model = impact_model(stance, cfg.spec())
+        try:
+            model = impact_model(stance, cfg.spec())
+        except ScenarioError as exc:
+            raise with_source(exc, scenario.source) from None
         com_limit = max_contact_velocity(areas.com_velocity_area, model, scenario.com_velocity)
         zmp_limit = zmp_max_contact_velocity(
             areas.zmp_area, model, stance.com, scenario.plane_height, scenario.gravity, cfg.duration

@@ -231,6 +231,13 @@ class Scenario(_Model):
         return q
 
     def build_stance(self, robot: Robot | None = None) -> Stance:
+        """Resolve robot, configuration and contacts into a :class:`Stance` (see ``_build_stance``)."""
+        try:
+            return self._build_stance(robot)
+        except ScenarioError as exc:
+            raise with_source(exc, self.source) from None
+
+    def _build_stance(self, robot: Robot | None = None) -> Stance:
         """Resolve robot, configuration and contacts into a :class:`Stance`.
 
         Without a ``base`` key the robot is translated vertically so that its lowest contact
@@ -273,6 +280,8 @@ def scenario_path(name_or_path: str | Path) -> Path:
     path = Path(name_or_path)
     if path.is_file():
         return path
+    if path.suffix in (".yaml", ".yml") or "/" in str(name_or_path) or "\\" in str(name_or_path):
+        raise ScenarioError("scenario", str(name_or_path), "no such file")
     bundled = _scenario_dir() / f"{name_or_path}.yaml"
     if bundled.is_file():
         return Path(str(bundled))
@@ -303,6 +312,8 @@ def _read(path: Path, seen: tuple[Path, ...] = ()) -> dict:
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         problem = getattr(exc, "problem", None) or "syntax error"
         raise ScenarioError("scenario", str(path), f"not valid YAML: {problem}{where}") from None
+    if raw is None:
+        raise ScenarioError("scenario", str(path), "the file is empty")
     if not isinstance(raw, dict):
         raise ScenarioError("scenario", str(path), f"must be a YAML mapping of keys, got {type(raw).__name__}")
     parent = raw.pop("extends", None)
@@ -310,7 +321,12 @@ def _read(path: Path, seen: tuple[Path, ...] = ()) -> dict:
         if not isinstance(parent, str):
             raise ScenarioError("extends", parent, "must be a bundled scenario name or a file path")
         candidate = path.parent / parent
-        parent_path = candidate if candidate.is_file() else scenario_path(parent)
+        try:
+            parent_path = candidate if candidate.is_file() else scenario_path(parent)
+        except UnknownScenarioError as exc:
+            raise UnknownScenarioError("extends", parent, exc.valid, str(path)) from None
+        except ScenarioError as exc:
+            raise ScenarioError("extends", parent, exc.reason, str(path)) from None
         raw = _merge(_read(parent_path, seen + (path.resolve(),)), raw)
     return raw
 
@@ -332,16 +348,39 @@ def scenario_from_dict(raw: dict, source: str | None = None) -> Scenario:
     try:
         return Scenario.model_validate({**raw, "source": source})
     except ValidationError as exc:
-        err = exc.errors()[0]
+        errors = exc.errors()
+        # A typo shows up as an unknown key AND a missing one: report the typo.
+        err = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
         loc = tuple(p for p in err["loc"] if p not in ("str", "RobotFiles"))
         reason = err["msg"].removeprefix("Value error, ")
+        value = err.get("input")
         if err["type"] == "extra_forbidden":
             reason = "unknown key"
         elif err["type"] == "missing":
-            reason = "missing required key"
-        raise ScenarioError(_field(loc), err.get("input"), reason, source) from None
+            if loc and isinstance(loc[-1], int):  # a short list/tuple: report the whole list
+                value, reason, loc = _lookup(raw, loc[:-1]), f"too few items (item {loc[-1]} is missing)", loc[:-1]
+            else:
+                value, reason = None, "missing required key"
+        raise ScenarioError(_field(loc), value, reason, source) from None
     except ScenarioError as exc:
         raise ScenarioError(exc.field, exc.value, exc.reason, source) from None
+
+
+def _lookup(raw: Any, loc: tuple) -> Any:
+    for part in loc:
+        try:
+            raw = raw[part]
+        except (KeyError, IndexError, TypeError):
+            return None
+    return raw
+
+
+def with_source(exc: ScenarioError, source: str | None) -> ScenarioError:
+    """Prefix a scenario error found after loading (unknown frame...) with its file name."""
+    if source and exc.source is None:
+        exc.source = source
+        exc.args = (f"{source}: {exc.args[0]}",) + exc.args[1:]
+    return exc
 
 
 def load_scenario(name_or_path: str | Path) -> Scenario:
