@@ -62,10 +62,11 @@ def first_exit(margins: np.ndarray, rates: np.ndarray, tol: float = BOUNDARY_TOL
     positive = rates > tol * max(1.0, float(np.abs(rates).max(initial=0.0)))
     if not positive.any():
         return VelocityLimit(float("inf"), "unbounded")
-    ratios = np.full(rates.shape, np.inf)
-    ratios[positive] = np.maximum(margins, 0.0)[None, :].repeat(rates.shape[0], 0)[positive] / rates[positive]
-    j, k = np.unravel_index(int(np.argmin(ratios)), ratios.shape)
-    return VelocityLimit(float(ratios[j, k]), "ok", int(j), int(k))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratios = np.where(positive, np.maximum(margins, 0.0) / rates, np.inf)
+    flat = int(np.argmin(ratios))
+    j, k = divmod(flat, rates.shape[1])
+    return VelocityLimit(float(ratios.flat[flat]), "ok", j, k)
 
 
 def max_contact_velocity(area: Polygon, impact: ImpactModel, com_velocity: Sequence[float]) -> VelocityLimit:

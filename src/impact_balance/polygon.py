@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
@@ -42,6 +43,13 @@ def simplify(vertices: np.ndarray, tol: float = 1e-9) -> np.ndarray:
                 changed = True
                 break
     return np.array(v).reshape(-1, 2)
+
+
+def _frozen(G: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Read-only arrays: the half-planes are cached on the (immutable) polygon."""
+    G.setflags(write=False)
+    h.setflags(write=False)
+    return G, h
 
 
 @dataclass(frozen=True)
@@ -103,7 +111,7 @@ class Polygon:
         a = cross.sum() / 2
         return np.array([((x + xs) * cross).sum(), ((y + ys) * cross).sum()]) / (6 * a)
 
-    @property
+    @cached_property
     def halfplanes(self) -> tuple[np.ndarray, np.ndarray]:
         """``(G, h)`` with unit-norm rows such that the polygon is ``{x : G x <= h}``.
 
@@ -112,20 +120,20 @@ class Polygon:
         """
         v = self.vertices
         if len(v) == 0:
-            return np.zeros((1, 2)), np.array([-1.0])
+            return _frozen(np.zeros((1, 2)), np.array([-1.0]))
         if len(v) == 1:
             G = np.array([[1.0, 0], [-1.0, 0], [0, 1.0], [0, -1.0]])
-            return G, G @ v[0]
+            return _frozen(G, G @ v[0])
         if len(v) == 2:
             e = (v[1] - v[0]) / np.linalg.norm(v[1] - v[0])
             n = np.array([e[1], -e[0]])
             G = np.array([n, -n, e, -e])
             h = np.array([n @ v[0], -n @ v[0], e @ v[1], -e @ v[0]])
-            return G, h
+            return _frozen(G, h)
         edges = np.roll(v, -1, axis=0) - v
         normals = np.column_stack([edges[:, 1], -edges[:, 0]])
         normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-        return normals, np.einsum("ij,ij->i", normals, v)
+        return _frozen(normals, np.einsum("ij,ij->i", normals, v))
 
     def margins(self, points: np.ndarray) -> np.ndarray:
         """Signed distance-like margin of each point: ``min_k (h_k - G_k p)`` (>= 0 inside)."""

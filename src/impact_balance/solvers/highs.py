@@ -63,6 +63,11 @@ class HighsLP:
         h.setOptionValue("primal_feasibility_tolerance", tolerance)
         h.setOptionValue("dual_feasibility_tolerance", tolerance)
         h.setOptionValue("random_seed", 0)
+        # Small LPs re-solved from a warm basis: presolve and threads only cost time here
+        # (measured in benchmarks/: 5.7 -> 3.6 ms on a two-foot stance).
+        h.setOptionValue("presolve", "off")
+        h.setOptionValue("threads", 1)
+        h.setOptionValue("simplex_strategy", 4)  # primal simplex
         status = h.passModel(lp)
         if status == highspy.HighsStatus.kError:
             raise SolverError("HiGHS", "kError", "the LP could not be passed to HiGHS")
