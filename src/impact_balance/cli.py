@@ -137,15 +137,11 @@ def _cmd_demo(args: argparse.Namespace) -> int:
             fig.savefig(out / fname, dpi=120)
             written.append(out / fname)
         print(f"\n{len(written)} figures written to {out}/")
-    bounds = np.round(phase_portrait_bounds(), 4)
-    print(f"LIPM check (paper sec. III-B): c_z 0.78 m, ZMP in [-0.13, 0.13] m -> CoM velocity in [{bounds[0]}, {bounds[1]}] m/s")
-    return 0
-
-
-def phase_portrait_bounds() -> tuple[float, float]:
     from .lipm import com_velocity_bounds
 
-    return com_velocity_bounds(0.78, (-0.13, 0.13))
+    bounds = np.round(com_velocity_bounds(0.78, (-0.13, 0.13)), 4)
+    print(f"LIPM check (paper sec. III-B): c_z 0.78 m, ZMP in [-0.13, 0.13] m -> CoM velocity in [{bounds[0]}, {bounds[1]}] m/s")
+    return 0
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -15,7 +15,7 @@ from typing import Any, Literal
 import numpy as np
 import pinocchio as pin
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from .exceptions import ScenarioError, UnknownScenarioError
 from .impact import ImpactSpec
@@ -189,12 +189,13 @@ class Scenario(_Model):
 
     _check = field_validator("com_velocity", "plane_height")(lambda v: _finite(v))
 
-    @model_validator(mode="after")
-    def _joint_values(self) -> Scenario:
-        for name, value in self.joints.items():
-            if not math.isfinite(value):
-                raise ScenarioError(f"joints.{name}", value, "must be finite")
-        return self
+    @field_validator("joints")
+    @classmethod
+    def _joint_values(cls, joints: dict[str, float]) -> dict[str, float]:
+        bad = [name for name, value in joints.items() if not math.isfinite(value)]
+        if bad:
+            raise ValueError(f"joint values must be finite (not {', '.join(bad)})")
+        return joints
 
     # -- resolution against a robot model -------------------------------------------------
     def load_robot(self) -> Robot:
