@@ -6,9 +6,11 @@
 Measures, in one run and on the same polytopes:
 
 1. the CoM-velocity-area projection (``impact_balance.projection.project_polytope``, what
-   ``areas_from_polytope`` calls) against ``pypoman.project_polytope(..., method="bretl")``
-   given the same inequality, equality and projection matrices, and checks at every
-   repetition that both give the same polygon (relative area of the symmetric difference);
+   ``areas_from_polytope`` calls: the compiled parametric walk) against
+   ``pypoman.project_polytope(..., method="bretl")`` and against the project's own
+   LP-per-edge Bretl path (HiGHS), given the same inequality, equality and projection
+   matrices, and checks at every repetition that all give the same polygon (relative area of
+   the symmetric difference);
 2. the whole pipeline from a configuration to the answer, stage by stage, and
    ``impact_balance.analyze`` end to end (YAML loading excluded);
 3. the maximum contact velocity alone, given the area;
@@ -202,6 +204,9 @@ def projection_cases(poly: ib.WrenchPolytope, scale: float, seed: int) -> dict[s
     def ours():
         return project_polytope(A, b, C, d, F, tol=FORCE_TOLERANCE, box=FORCE_BOX)
 
+    def ours_bretl():
+        return project_polytope(A, b, C, d, F, tol=FORCE_TOLERANCE, box=FORCE_BOX, method="bretl").polygon.vertices
+
     def theirs():
         try:
             vertices = pypoman.project_polytope(
@@ -215,6 +220,7 @@ def projection_cases(poly: ib.WrenchPolytope, scale: float, seed: int) -> dict[s
         np.random.seed((seed + i) % 2**32)
 
     cases = {"ours": Case(ours, keep=lambda r: r)}  # a ProjectionResult holds only the polygon
+    cases["bretl_highs"] = Case(ours_bretl, keep=lambda r: r)
     if pypoman is not None:
         cases["pypoman"] = Case(theirs, reseed, keep=lambda r: r)
     return cases
@@ -225,9 +231,13 @@ def check_projection(results: dict[str, list[Any]]) -> dict[str, Any]:
     ours = results["ours"]
     ref = ours[0].polygon.vertices
     out: dict[str, Any] = {
-        "n_lp": ours[0].n_lp, "n_vertices": len(ref), "bounded": bool(ours[0].polygon.bounded),
+        "method": ours[0].method, "pivots": ours[0].pivots, "n_lp": ours[0].n_lp,
+        "n_vertices": len(ref), "bounded": bool(ours[0].polygon.bounded),
         "ours_deterministic": all(np.array_equal(r.polygon.vertices, ref) for r in ours),
     }
+    if "bretl_highs" in results:  # our LP-per-edge path: same polygon
+        sd = [compare(ref, v)["symdiff_rel"] for v in results["bretl_highs"]] if len(ref) else [0.0]
+        out["bretl_highs_symdiff_rel"] = float(max(sd))
     if "pypoman" not in results:
         return out
     diffs, errors, nverts = [], [], []
@@ -261,11 +271,14 @@ def bench_projection(poly, args) -> dict[str, Any]:
         "project_us": stats(times["ours"]),
     }
     entry.update(check_projection(results))
+    entry["bretl_highs_us"] = stats(times["bretl_highs"])
+    entry["ratio_vs_bretl_highs"] = entry["bretl_highs_us"]["median"] / entry["project_us"]["median"]
     if "pypoman" in times:
         entry["pypoman_us"] = stats(times["pypoman"])
         entry["ratio_vs_pypoman"] = entry["pypoman_us"]["median"] / entry["project_us"]["median"]
         entry["match"] = (
             not entry["pypoman_errors"] and entry.get("symdiff_rel", math.inf) <= args.tol and entry["ours_deterministic"]
+            and entry["bretl_highs_symdiff_rel"] <= args.tol
         )
     return entry
 
@@ -365,7 +378,7 @@ def bench_contacts(args) -> list[dict[str, Any]]:
             }
             entry.update(bench_projection(poly, args))
             rows.append(entry)
-            progress(f"  scaling {label}, torque limits {tl}: {entry['project_us']['median']:.0f} us, {entry['n_lp']} LPs")
+            progress(f"  scaling {label}, torque limits {tl}: {entry['project_us']['median']:.0f} us, {entry['pivots']} pivots")
     return rows
 
 
@@ -423,13 +436,14 @@ def _cprofile(fn: Callable[[], Any], n: int, top: int) -> dict[str, Any]:
 def profile_report(args) -> dict[str, Any]:
     """cProfile of analyze() and of the projection, plus a micro-breakdown of the costs.
 
-    cProfile does not see inside pinocchio's boost.python calls: their time is counted in
-    the calling Python function (Stance.__init__), hence the micro-breakdown.
+    cProfile sees neither inside pinocchio's boost.python calls nor inside the compiled
+    projection kernel: their time is counted in the calling Python function, hence the
+    micro-breakdown.
     """
-    import highspy
     import pinocchio as pin
 
-    from impact_balance.solvers import HighsLP, LinearProgram
+    from impact_balance.criteria import first_exit
+    from impact_balance.projection import _kernel, project_walk
 
     out: dict[str, Any] = {}
     sc = ib.load_scenario(TARGET_PIPELINE_SCENARIO)
@@ -455,66 +469,43 @@ def profile_report(args) -> dict[str, Any]:
 
     poly = wrench_polytope(stance, sc.torque_limits, sc.gravity)
     w = poly.weight
-    problem = LinearProgram(poly.A, poly.b / w, poly.C, poly.d / w, R=poly.F, lo=np.full(2, -FORCE_BOX), hi=np.full(2, FORCE_BOX))
+    A, b, C, d, F = poly.A, poly.b / w, poly.C, poly.d / w, poly.F
+    U, S, Vt = np.linalg.svd(C)
+    x0 = Vt[:len(S)].T @ ((U.T @ d) / S)
+    N = np.ascontiguousarray(Vt[len(S):].T)
     areas = ib.areas_from_polytope(poly, sc.plane_height)
     model_imp = ib.impact_model(stance, sc.impact.spec())
     vel = areas.com_velocity_area
     G, h = vel.halfplanes
-    from impact_balance.criteria import first_exit
-
-    trivial = highspy.Highs()
-    trivial.setOptionValue("output_flag", False)
-    trivial.addVar(0.0, 1.0)
-    trivial.changeColCost(0, 1.0)
     n = max(50, args.repeat)
     micro = {
-        "pin Model.createData() (in Stance.__init__)": _median_us(model.createData, n),
+        "pin Model.createData()": _median_us(model.createData, n),
         "pin kinematics+Jacobians+CRBA+CoM+gravity": _median_us(kinematics, n),
         "Scenario.configuration_vector": _median_us(lambda: sc.configuration_vector(robot), n),
         "Stance(robot, q, contacts)": _median_us(lambda: Stance(robot, q, specs), n),
         "Scenario.build_stance": _median_us(sc.build_stance, n),
-        "Robot.actuated_effort_limits (in wrench_polytope)": _median_us(robot.actuated_effort_limits, n),
         "wrench_polytope": _median_us(lambda: wrench_polytope(stance, sc.torque_limits, sc.gravity), n),
-        "HighsLP(...) model build (scipy csc + passModel)": _median_us(lambda: HighsLP(problem), n),
-        "HiGHS run() of a 1-variable LP (fixed overhead)": _median_us(trivial.run, 10 * n),
-        "project_polytope (areas_from_polytope)": _median_us(lambda: ib.areas_from_polytope(poly, sc.plane_height), n),
+        "numpy SVD of the LIPM equalities (in project_walk)": _median_us(lambda: np.linalg.svd(C), n),
+        "compiled kernel project() alone": _median_us(
+            lambda: _kernel.project(A, b, F, x0, N, FORCE_BOX, 1e-6, 5000), n),
+        "project_walk": _median_us(lambda: project_walk(A, b, C, d, F, box=FORCE_BOX, merge_tol=1e-6), n),
+        "areas_from_polytope (walk + affine maps)": _median_us(lambda: ib.areas_from_polytope(poly, sc.plane_height), n),
+        "project_polytope(method='bretl') (HiGHS, for comparison)": _median_us(
+            lambda: project_polytope(A, b, C, d, F, box=FORCE_BOX, method="bretl"), n),
         "impact_model": _median_us(lambda: ib.impact_model(stance, sc.impact.spec()), 10 * n),
         "Polygon.halfplanes (recomputed per call)": _median_us(lambda: vel.halfplanes, 10 * n),
         "criteria.first_exit": _median_us(lambda: first_exit(h - G @ np.zeros(2), model_imp.com_jump_rates @ G.T), 10 * n),
         "max_contact_velocity": _median_us(lambda: ib.max_contact_velocity(vel, model_imp, sc.com_velocity), 10 * n),
     }
-    # Per-LP cost inside the projection: wrap HighsLP.maximize for a few calls, then restore.
-    original = HighsLP.maximize
-    per_lp: list[tuple[float, int]] = []
-
-    def timed(self, c):
-        t0 = time.perf_counter()
-        r = original(self, c)
-        per_lp.append(((time.perf_counter() - t0) * 1e6, int(self._h.getInfo().simplex_iteration_count)))
-        return r
-
-    HighsLP.maximize = timed
-    try:
-        for _ in range(5):
-            per_lp.clear()
-            ib.areas_from_polytope(poly, sc.plane_height)
-    finally:
-        HighsLP.maximize = original
-    lp_us = np.array([t for t, _ in per_lp])
-    iters = np.array([k for _, k in per_lp])
     out["micro_us"] = micro
-    out["lp_in_projection"] = {
-        "scenario": TARGET_PIPELINE_SCENARIO, "n_lp": len(per_lp), "sum_us": float(lp_us.sum()),
-        "median_us": float(np.median(lp_us)), "first_lp_us": float(lp_us[0]),
-        "median_us_0_iterations": float(np.median(lp_us[iters == 0])) if (iters == 0).any() else None,
-        "median_simplex_iterations": float(np.median(iters)),
-        "us_per_lp_and_iterations": [[round(float(t)), int(k)] for t, k in per_lp],
-    }
+    walk = project_walk(A, b, C, d, F, box=FORCE_BOX, merge_tol=1e-6)
+    out["walk"] = {"scenario": TARGET_PIPELINE_SCENARIO, "pivots": walk.pivots, "vertices": len(walk.polygon.vertices),
+                   "reduced_variables": int(N.shape[1]), "rows": int(A.shape[0])}
     return out
 
 
 def profile_text(p: dict[str, Any]) -> str:
-    out = ["", "Profile (cProfile; pinocchio/HiGHS C++ calls are counted in their Python caller)"]
+    out = ["", "Profile (cProfile; pinocchio and the compiled kernel are counted in their Python caller)"]
     for key in ("analyze", "projection_talos_three_contacts"):
         e = p[key]
         out.append(f"  {key}: {e['total_us_per_run']:.0f} us per run under cProfile ({e['runs']} runs); top by own time:")
@@ -523,11 +514,9 @@ def profile_text(p: dict[str, Any]) -> str:
     out.append("  micro-breakdown, median us (palm_push_two_feet):")
     for k, v in p["micro_us"].items():
         out.append(f"    {v:9.1f}  {k}")
-    lp = p["lp_in_projection"]
-    out.append(f"  LPs in the projection: {lp['n_lp']} LPs, {lp['sum_us']:.0f} us in HighsLP.maximize, median {lp['median_us']:.0f} us/LP,"
-               f" first (cold) {lp['first_lp_us']:.0f} us, median with 0 simplex iterations "
-               f"{'-' if lp['median_us_0_iterations'] is None else format(lp['median_us_0_iterations'], '.0f')} us;"
-               f" (us, iterations) per LP: {lp['us_per_lp_and_iterations']}")
+    w = p["walk"]
+    out.append(f"  walk on {w['scenario']}: {w['pivots']} pivots for {w['vertices']} vertices"
+               f" ({w['reduced_variables']} variables after the equalities, {w['rows']} rows before dropping zero rows)")
     return "\n".join(out)
 
 
@@ -557,7 +546,7 @@ def machine_info() -> dict[str, Any]:
         "cpu_count": os.cpu_count(),
         "affinity": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else None,
         "python": sys.version.split()[0],
-        "versions": {d: version(d) for d in ("impact-balance", "numpy", "scipy", "highspy", "pin", "pypoman", "cvxopt")},
+        "versions": {d: version(d) for d in ("impact-balance", "numpy", "scipy", "numba", "highspy", "pin", "pypoman", "cvxopt")},
     }
     if pypoman is not None:
         from pypoman.lp import GLPK_IF_AVAILABLE
@@ -627,21 +616,23 @@ def text_report(result: dict[str, Any], args) -> str:
     s = result["settings"]
     out.append(f"Repeats: {s['repeat']} (cheap calls {s['repeat_cheap']}), warm-up {s['warmup']}; times in us, median (p10-p90)")
     out.append("")
-    out.append("1. Projection (resultant horizontal force polygon, units of m g): ours vs pypoman bretl"
-               f" (onto {s['pypoman_scale']:g} F; agreement = relative area of the symmetric difference, tol {s['tol']:g})")
+    out.append("1. Projection (resultant horizontal force polygon, units of m g): ours (compiled walk) vs pypoman bretl"
+               f" (onto {s['pypoman_scale']:g} F) and vs our own Bretl/HiGHS path;"
+               f" agreement = relative area of the symmetric difference, tol {s['tol']:g}, with both")
     rows = []
     for name, e in result["stances"].items():
         p = e["projection"]
         rows.append([
-            name, e["robot"], str(e["n_contacts"]), str(p["n_ineq"]), str(p["n_lp"]), str(p["n_vertices"]),
+            name, e["robot"], str(e["n_contacts"]), str(p["n_ineq"]), str(p["pivots"]), str(p["n_vertices"]),
             fmt_us(p["project_us"]), fmt_us(p.get("pypoman_us")),
-            f"{p['ratio_vs_pypoman']:.2f}" if "ratio_vs_pypoman" in p else "-",
+            f"{p['ratio_vs_pypoman']:.1f}" if "ratio_vs_pypoman" in p else "-",
+            fmt_us(p["bretl_highs_us"], False), f"{p['ratio_vs_bretl_highs']:.1f}",
             f"{p['area_rel_diff']:+.1e}" if "area_rel_diff" in p else "-",
             f"{p['symdiff_rel']:.1e}" if "symdiff_rel" in p else "-",
             ("ok" if p.get("match") else "MISMATCH") if "match" in p else "-",
         ])
-    out.append(table(["stance", "robot", "contacts", "ineq rows", "LPs", "verts", "ours us", "pypoman us",
-                      "ratio", "area rel diff", "symdiff", "check"], rows))
+    out.append(table(["stance", "robot", "contacts", "ineq rows", "pivots", "verts", "ours us", "pypoman us",
+                      "ratio", "bretl/HiGHS us", "ratio", "area rel diff", "symdiff", "check"], rows))
     out.append("")
     out.append("2. Pipeline per stage (median us; analyze() = whole pipeline end to end, YAML excluded)")
     rows = []
@@ -667,13 +658,13 @@ def text_report(result: dict[str, Any], args) -> str:
         rows = []
         for e in sc["contacts"]:
             rows.append([
-                e["contacts"], "yes" if e["torque_limits"] else "no", str(e["n_ineq"]), str(e["n_lp"]), str(e["n_vertices"]),
+                e["contacts"], "yes" if e["torque_limits"] else "no", str(e["n_ineq"]), str(e["pivots"]), str(e["n_vertices"]),
                 fmt_us(e["stance_us"], False), fmt_us(e["constraints_us"], False), fmt_us(e["project_us"]),
-                fmt_us(e.get("pypoman_us")), f"{e['ratio_vs_pypoman']:.2f}" if "ratio_vs_pypoman" in e else "-",
+                fmt_us(e.get("pypoman_us")), f"{e['ratio_vs_pypoman']:.1f}" if "ratio_vs_pypoman" in e else "-",
                 f"{e['symdiff_rel']:.1e}" if "symdiff_rel" in e else "-",
                 ("ok" if e.get("match") else "MISMATCH") if "match" in e else "-",
             ])
-        out.append(table(["contacts", "torque lim", "ineq rows", "LPs", "verts", "Stance us", "constraints us",
+        out.append(table(["contacts", "torque lim", "ineq rows", "pivots", "verts", "Stance us", "constraints us",
                           "ours us", "pypoman us", "ratio", "symdiff", "check"], rows))
         out.append("")
         out.append("4b. Scaling with friction-cone edges of the impact (median us)")
@@ -689,7 +680,7 @@ def text_report(result: dict[str, Any], args) -> str:
     c = result["checks"]
     out.append("")
     if c["ok"]:
-        out.append(f"Answers: OK, every pypoman polygon matches ours within {s['tol']:g} relative area "
+        out.append(f"Answers: OK, every pypoman and Bretl/HiGHS polygon matches ours within {s['tol']:g} relative area "
                    f"(worst symmetric difference {c['worst_symdiff_rel']:.1e}).")
     else:
         out.append("Answers: MISMATCH")
@@ -761,7 +752,8 @@ def main(argv: list[str] | None = None) -> int:
         worst = max(worst, p.get("symdiff_rel", 0.0))
         if not p["match"]:
             why = "; ".join(p["pypoman_errors"][:2]) or (
-                f"symmetric difference {p.get('symdiff_rel', float('nan')):.2e} > {args.tol:g}"
+                f"symmetric difference {p.get('symdiff_rel', float('nan')):.2e} (pypoman),"
+                f" {p.get('bretl_highs_symdiff_rel', float('nan')):.2e} (Bretl/HiGHS) > {args.tol:g}"
                 if p["ours_deterministic"] else "ours not deterministic across repeats")
             failures.append(f"{label}: {why}")
     for name, e in stances.items():

@@ -19,9 +19,11 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from scipy.optimize import linprog
 
-from impact_balance.areas import areas_from_polytope, balance_areas
+from impact_balance.areas import MERGE_TOLERANCE, areas_from_polytope, balance_areas
 from impact_balance.constraints import contact_polytope, torque_limit_rows, wrench_polytope
 from impact_balance.exceptions import ScenarioError
+from impact_balance.projection import project_polytope
+from impact_balance.scenario import bundled_scenarios, load_scenario
 
 G = 9.81
 MASS = 60.0
@@ -348,6 +350,22 @@ def test_force_and_com_velocity_areas_match_pypoman(geo, stance_polytope):
     k = math.sqrt(G / P.com[2]) * (0.0 - P.com[2])  # velocity = omega (h - c_z) force / (m g)
     assert res.com_velocity_area.area == pytest.approx(geo.area(ref) * k * k, rel=1e-6)
     assert geo.hausdorff(res.com_velocity_area.vertices, k * ref) <= 1e-6 * size * abs(k)
+
+
+@pytest.mark.parametrize("torque_limits", [True, False])
+@pytest.mark.parametrize("name", sorted(bundled_scenarios()))
+def test_walk_and_bretl_agree_on_every_bundled_stance(geo, name, torque_limits):
+    """The default projection (the parametric walk) answers by itself, without falling back,
+    and equals the LP-per-edge Bretl projection of the same polytope."""
+    sc = load_scenario(name)
+    P = wrench_polytope(sc.build_stance(), torque_limits, sc.gravity)
+    args = (P.A, P.b / P.weight, P.C, P.d / P.weight, P.F)
+    walk = project_polytope(*args, method="walk", merge_tol=MERGE_TOLERANCE)
+    bretl = project_polytope(*args, method="bretl", merge_tol=MERGE_TOLERANCE)
+    assert walk.method == "walk" and bretl.method == "bretl"
+    size = float(np.max(np.abs(bretl.polygon.vertices)))
+    assert_same_polygon(geo, walk.polygon.vertices, bretl.polygon.vertices, tol=1e-7 * size)
+    assert walk.polygon.bounded == bretl.polygon.bounded
 
 
 # (e) CoM far outside the support: single level contact ------------------------------------

@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 from scipy.optimize import linprog, nnls
 from scipy.spatial.transform import Rotation
 
-from impact_balance.cwc import cwc_faces, cwc_faces_world, cwc_span
+from impact_balance.cwc import cwc_faces, cwc_faces_world, cwc_span, rotate_wrench_matrix
 
 MU = st.floats(0.1, 1.5)
 HALF = st.floats(0.01, 0.3)
@@ -222,3 +222,16 @@ def test_world_faces_for_a_wall_contact():
         p = R @ np.array([x, 0.0, 0.0])
         w = np.concatenate([push[:3], np.cross(p, push[:3])])
         assert (np.max(Cw @ w) <= 0) == ok
+
+
+def test_cached_faces_are_handed_out_as_copies():
+    """The local face matrix is cached per (mu, X, Y): mutating a returned one changes nothing."""
+    mu, X, Y = 0.7, 0.1, 0.05
+    R = Rotation.from_euler("xyz", [0.3, -0.2, 1.0]).as_matrix()
+    C, Cw = cwc_faces(mu, X, Y), cwc_faces_world(mu, X, Y, R)
+    expected_C, expected_Cw = C.copy(), Cw.copy()
+    C[:] = 0.0
+    Cw[:] = 0.0
+    np.testing.assert_array_equal(cwc_faces(mu, X, Y), expected_C)
+    np.testing.assert_array_equal(cwc_faces_world(mu, X, Y, R), expected_Cw)
+    np.testing.assert_allclose(expected_Cw, expected_C @ rotate_wrench_matrix(R).T, rtol=0, atol=1e-15)

@@ -64,6 +64,23 @@ def test_composite_W_is_the_rigid_body_response(analyses):
         np.testing.assert_allclose(W @ iota, dv_com + np.cross(domega, r), rtol=1e-10, atol=1e-12)
 
 
+def test_spd_solve_of_W_matches_lapack():
+    """W's 3 x 3 solve (Cholesky in floats) agrees with LAPACK; non-SPD matrices go to LAPACK."""
+    from impact_balance.impact import _solve_spd3
+
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        M = rng.normal(size=(3, 3))
+        A, B = M @ M.T + 1e-3 * np.eye(3), rng.normal(size=(3, 3))
+        expected = np.linalg.solve(A, B)
+        bound = 1e-14 * np.linalg.cond(A) * np.abs(expected).max()
+        np.testing.assert_allclose(_solve_spd3(A, B), expected, rtol=0, atol=bound)
+    indefinite = np.diag([1.0, -2.0, 4.0])
+    np.testing.assert_allclose(_solve_spd3(indefinite, np.eye(3)), np.diag([1.0, -0.5, 0.25]))
+    with pytest.raises(np.linalg.LinAlgError):
+        _solve_spd3(np.zeros((3, 3)), np.eye(3))
+
+
 def test_joint_space_W_option(analyses):
     a = analyses["palm_push_two_feet"]
     spec = dataclasses.replace(a.impact.model.spec, inertia="joint_space")

@@ -1,6 +1,7 @@
-"""Bretl projection of polytopes onto the plane, and the Polygon it returns.
+"""Projection of polytopes onto the plane (both methods: the parametric walk and Bretl's
+LP-per-edge algorithm), and the Polygon it returns.
 
-Expected polygons come from geometry (boxes, simplices, zonotopes as hulls of projected
+Every projection test runs for both methods (the ``method`` fixture). Expected polygons come from geometry (boxes, simplices, zonotopes as hulls of projected
 vertices) or from independent LPs (scipy.optimize.linprog): support values in many
 directions, the distance of each returned vertex to the true projection, and membership.
 """
@@ -15,9 +16,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import linprog
 
+from impact_balance.exceptions import SolverError
 from impact_balance.polygon import Polygon
-from impact_balance.projection import project_polytope
+from impact_balance.projection import project_bretl, project_polytope, project_walk
 
+
+@pytest.fixture(scope="module", params=["walk", "bretl"])
+def method(request):
+    return request.param
 
 
 def project(A, b, E, C=None, d=None, **kw):
@@ -98,29 +104,33 @@ def assert_is_projection(A, b, C, d, E, poly, tol=1e-7, n_dirs=64):
 
 
 # Analytic polytopes --------------------------------------------------------------------
-def test_box_projects_to_its_rectangle(geo):
+def test_box_projects_to_its_rectangle(geo, method):
     lo, hi = np.array([-1.0, 0.5, -3, -2]), np.array([2.0, 1.5, 3, 2])
     A, b = box_rows(lo, hi)
     E = np.eye(4)[:2]
-    res = project(A, b, E)
+    res = project(A, b, E, method=method)
     poly = res.polygon
     assert poly.bounded and len(poly.vertices) == 4
     assert_ccw_convex(poly.vertices)
     rect = np.array([[-1, 0.5], [2, 0.5], [2, 1.5], [-1, 1.5]])
     assert geo.hausdorff(poly.vertices, rect) <= 1e-9
     assert poly.area == pytest.approx(3.0, rel=1e-12)
-    assert res.n_lp >= 4  # at least one LP per edge to confirm it
+    assert res.method == method
+    if method == "bretl":
+        assert res.n_lp >= 4  # at least one LP per edge to confirm it
+    else:
+        assert res.pivots >= 3  # at least one pivot per vertex after the first
 
 
 @settings(max_examples=30, deadline=None)
 @given(n=st.integers(2, 5), seed=st.integers(0, 2**32 - 1))
-def test_box_under_random_map_is_the_zonotope_hull(geo, n, seed):
+def test_box_under_random_map_is_the_zonotope_hull(geo, n, seed, method):
     rng = np.random.default_rng(seed)
     lo = rng.uniform(-2, 0, n)
     hi = lo + rng.uniform(0.05, 2, n)
     E = rng.normal(size=(2, n))
     A, b = box_rows(lo, hi)
-    poly = project(A, b, E).polygon
+    poly = project(A, b, E, method=method).polygon
     corners = np.array(list(itertools.product(*zip(lo, hi))))
     expected = geo.hull(corners @ E.T)
     assert_ccw_convex(poly.vertices)
@@ -129,23 +139,23 @@ def test_box_under_random_map_is_the_zonotope_hull(geo, n, seed):
     assert len(poly.vertices) == len(expected)
 
 
-def test_simplex_with_inequalities_and_with_an_equality(geo):
+def test_simplex_with_inequalities_and_with_an_equality(geo, method):
     tri = np.array([[0, 0], [1, 0], [0, 1.0]])
     # {x >= 0, sum x <= 1} in R^3
     A = np.vstack([-np.eye(3), np.ones((1, 3))])
     b = np.array([0, 0, 0, 1.0])
-    poly = project(A, b, np.eye(3)[:2]).polygon
+    poly = project(A, b, np.eye(3)[:2], method=method).polygon
     assert len(poly.vertices) == 3 and geo.hausdorff(poly.vertices, tri) <= 1e-9
     assert poly.area == pytest.approx(0.5, rel=1e-12)
     # {x >= 0, sum x = 1} in R^3: same triangle, and the map E sends vertex e_i to E[:, i]
     E = np.array([[2.0, -1.0, 0.5], [0.0, 1.0, 3.0]])
-    poly = project(-np.eye(3), np.zeros(3), E, C=np.ones((1, 3)), d=np.array([1.0])).polygon
+    poly = project(-np.eye(3), np.zeros(3), E, C=np.ones((1, 3)), d=np.array([1.0]), method=method).polygon
     assert len(poly.vertices) == 3 and geo.hausdorff(poly.vertices, E.T) <= 1e-9
 
 
-def test_unbounded_polyhedron_is_flagged_and_clipped():
+def test_unbounded_polyhedron_is_flagged_and_clipped(method):
     # quadrant {x >= 0}: the clipped projection is [0, box]^2
-    res = project(-np.eye(2), np.zeros(2), np.eye(2), box=50.0)
+    res = project(-np.eye(2), np.zeros(2), np.eye(2), box=50.0, method=method)
     poly = res.polygon
     assert not poly.bounded
     assert np.all(np.abs(poly.vertices) <= 50.0 + 1e-9)
@@ -153,43 +163,43 @@ def test_unbounded_polyhedron_is_flagged_and_clipped():
     assert poly.area == pytest.approx(2500.0, rel=1e-9)
     # half-strip {0 <= x1 <= 1, x2 >= 0}, also in a higher dimension with a free coordinate
     A = np.array([[1.0, 0, 0], [-1, 0, 0], [0, -1, 0]])
-    poly = project(A, np.array([1.0, 0, 0]), np.eye(3)[:2]).polygon
+    poly = project(A, np.array([1.0, 0, 0]), np.eye(3)[:2], method=method).polygon
     assert not poly.bounded
     # a bounded polytope well inside the box stays bounded
     A, b = box_rows(-np.full(2, 500.0), np.full(2, 500.0))
-    assert project(A, b, np.eye(2)).polygon.bounded
+    assert project(A, b, np.eye(2), method=method).polygon.bounded
 
 
-def test_infeasible_polytope_gives_the_empty_polygon():
+def test_infeasible_polytope_gives_the_empty_polygon(method):
     A = np.array([[1.0, 0], [-1.0, 0]])
     b = np.array([-1.0, -1.0])  # x1 <= -1 and x1 >= 1
-    poly = project(A, b, np.eye(2)).polygon
+    poly = project(A, b, np.eye(2), method=method).polygon
     assert poly.is_empty and len(poly.vertices) == 0 and poly.area == 0.0
     # feasible inequalities, inconsistent equality
     A, b = box_rows(np.zeros(3), np.ones(3))
-    poly = project(A, b, np.eye(3)[:2], C=np.array([[1.0, 1, 1]]), d=np.array([4.0])).polygon
+    poly = project(A, b, np.eye(3)[:2], C=np.array([[1.0, 1, 1]]), d=np.array([4.0]), method=method).polygon
     assert poly.is_empty
     G, h = poly.halfplanes
     assert not np.any(G @ np.zeros(2) <= h)  # the empty set's half-planes exclude everything
     assert not poly.contains(np.zeros(2))
 
 
-def test_degenerate_projections_segment_and_point(geo):
+def test_degenerate_projections_segment_and_point(geo, method):
     A, b = box_rows(np.zeros(3), np.ones(3))
     # rank-1 map: the segment from (0, 0) to (2, 4)
     E = np.array([[1.0, 1, 0], [2, 2, 0]])
-    poly = project(A, b, E).polygon
+    poly = project(A, b, E, method=method).polygon
     assert len(poly.vertices) == 2 and poly.area == 0.0
     assert geo.hausdorff(poly.vertices, [[0, 0], [2, 4]]) <= 1e-9
     # segment by an equality: x1 = x2 within the unit box, projected on (x1, x2)
-    poly = project(A, b, np.eye(3)[:2], C=np.array([[1.0, -1, 0]]), d=np.zeros(1)).polygon
+    poly = project(A, b, np.eye(3)[:2], C=np.array([[1.0, -1, 0]]), d=np.zeros(1), method=method).polygon
     assert len(poly.vertices) == 2 and geo.hausdorff(poly.vertices, [[0, 0], [1, 1]]) <= 1e-9
     # point: zero map, and a fully pinned polytope
-    poly = project(A, b, np.zeros((2, 3))).polygon
+    poly = project(A, b, np.zeros((2, 3)), method=method).polygon
     assert len(poly.vertices) == 1 and np.allclose(poly.vertices[0], 0, atol=1e-12)
     E = np.array([[1.0, 2, 3], [-1, 0, 1]])
     c = np.array([0.2, 0.3, 0.4])
-    poly = project(A, b, E, C=np.eye(3), d=c).polygon
+    poly = project(A, b, E, C=np.eye(3), d=c, method=method).polygon
     assert len(poly.vertices) == 1 and np.allclose(poly.vertices[0], E @ c, atol=1e-9)
 
 
@@ -208,31 +218,88 @@ def _random_polytope(rng, n, m, with_eq):
     return A, b, C, d, E
 
 
-def test_determinism():
+def test_determinism(method):
     A, b, C, d, E = _random_polytope(np.random.default_rng(7), 5, 12, True)
-    r1, r2 = project_polytope(A, b, C, d, E), project_polytope(A, b, C, d, E)
+    r1, r2 = project_polytope(A, b, C, d, E, method=method), project_polytope(A, b, C, d, E, method=method)
     assert len(r1.polygon.vertices) >= 3
     assert np.array_equal(r1.polygon.vertices, r2.polygon.vertices)
-    assert r1.n_lp == r2.n_lp and r1.polygon.bounded == r2.polygon.bounded
+    assert r1.method == r2.method == method
+    assert (r1.n_lp, r1.pivots) == (r2.n_lp, r2.pivots) and r1.polygon.bounded == r2.polygon.bounded
 
 
 @settings(max_examples=30, deadline=None)
 @given(n=st.integers(2, 5), m=st.integers(3, 12), with_eq=st.booleans(), seed=st.integers(0, 2**32 - 1))
-def test_random_polytopes_against_linprog(n, m, with_eq, seed):
+def test_random_polytopes_against_linprog(n, m, with_eq, seed, method):
     A, b, C, d, E = _random_polytope(np.random.default_rng(seed), n, m, with_eq)
-    poly = project_polytope(A, b, C, d, E).polygon
+    poly = project_polytope(A, b, C, d, E, method=method).polygon
     assert poly.bounded
     assert_ccw_convex(poly.vertices)
     assert_is_projection(A, b, C, d, E, poly)
 
 
+# The walk against Bretl ------------------------------------------------------------------
+def _cone_polytope(rng, n_contacts, faces):
+    """Stacked pyramids {F_i x_i <= 0} sharing a load sum(x_i[-1]) = 1: degenerate at every apex
+    (a contact carrying nothing), like the contact wrench cones of a stance."""
+    k = 3
+    blocks = []
+    for _ in range(n_contacts):
+        mu = rng.uniform(0.2, 1.0)
+        angles = np.linspace(0, 2 * np.pi, faces, endpoint=False) + rng.uniform(0, 1)
+        blocks.append(np.column_stack([np.cos(angles), np.sin(angles), -mu * np.ones(faces)]))
+    n = k * n_contacts
+    A = np.zeros((faces * n_contacts, n))
+    for i, F in enumerate(blocks):
+        A[i * faces:(i + 1) * faces, i * k:(i + 1) * k] = F
+    b = np.zeros(len(A))
+    C = np.zeros((1, n))
+    C[0, k - 1::k] = 1.0
+    d = np.ones(1)
+    E = np.zeros((2, n))
+    for i in range(n_contacts):  # resultant horizontal force, plus a random twist
+        E[:, i * k:i * k + 2] = np.eye(2) + 0.3 * rng.normal(size=(2, 2))
+    return A, b, C, d, E
+
+
+@settings(max_examples=40, deadline=None)
+@given(n_contacts=st.integers(1, 4), faces=st.integers(3, 8), seed=st.integers(0, 2**32 - 1))
+def test_walk_equals_bretl_on_degenerate_cone_stacks(geo, n_contacts, faces, seed):
+    A, b, C, d, E = _cone_polytope(np.random.default_rng(seed), n_contacts, faces)
+    walk = project_walk(A, b, C, d, E)
+    assert walk is not None and walk.method == "walk"
+    bretl = project_bretl(A, b, C, d, E)
+    assert_ccw_convex(walk.polygon.vertices)
+    assert len(walk.polygon.vertices) == len(bretl.polygon.vertices)
+    assert geo.hausdorff(walk.polygon.vertices, bretl.polygon.vertices) <= 1e-7
+    assert_is_projection(A, b, C, d, E, walk.polygon)
+
+
+def test_lines_in_the_polytope_are_quotiented_out(geo, method):
+    # the strip |x1| <= 1 (x2 free) under a map that ignores x2: the walk has no vertex to
+    # start from until the line is projected out
+    A = np.array([[1.0, 0], [-1.0, 0]])
+    E = np.array([[1.0, 0], [0.5, 0]])
+    res = project(A, np.ones(2), E, method=method)
+    assert res.method == method
+    assert geo.hausdorff(res.polygon.vertices, [[-1, -0.5], [1, 0.5]]) <= 1e-9
+    # a slab in R^3 with a free coordinate, projected onto a plane with the free one
+    A = np.array([[1.0, 1, 0], [-1.0, -1, 0], [0, 1, 0], [0, -1, 0]])
+    res = project(A, np.ones(4), np.array([[1.0, 0, 0], [0, 1, 0]]), method=method)
+    assert geo.hausdorff(res.polygon.vertices, [[-2, 1], [0, -1], [2, -1], [0, 1]]) <= 1e-9
+
+
+def test_unknown_method_is_refused():
+    with pytest.raises(SolverError, match="unknown method"):
+        project(np.eye(2), np.ones(2), np.eye(2), method="simplex")
+
+
 # Polygon.halfplanes and contains ---------------------------------------------------------
 @settings(max_examples=30, deadline=None)
 @given(n=st.integers(2, 5), m=st.integers(3, 12), seed=st.integers(0, 2**32 - 1))
-def test_halfplanes_round_trip_and_membership(n, m, seed):
+def test_halfplanes_round_trip_and_membership(n, m, seed, method):
     rng = np.random.default_rng(seed)
     A, b, C, d, E = _random_polytope(rng, n, m, False)
-    poly = project_polytope(A, b, C, d, E).polygon
+    poly = project_polytope(A, b, C, d, E, method=method).polygon
     v = poly.vertices
     G, h = poly.halfplanes
     assert len(v) >= 3 and len(G) == len(v)

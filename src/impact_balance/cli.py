@@ -1,4 +1,4 @@
-"""Command line: ``impact-balance {demo, analyze, phase-portrait, scenarios, robots}``.
+"""Command line: ``impact-balance {demo, analyze, phase-portrait, scenarios, robots, gui}``.
 
 Errors of the library (bad scenario, unknown frame...) print one line on stderr and exit
 with status 2; no traceback.
@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from .exceptions import ImpactBalanceError
+from .projection.walk import kernel_is_compiled
 
 __all__ = ["main", "DEMO_SCENARIOS", "FRICTION_SWEEP"]
 
@@ -45,6 +46,11 @@ def _parser() -> argparse.ArgumentParser:
     pp.add_argument("--plot", metavar="FILE", help="write the phase portrait figure (PNG)")
     sub.add_parser("scenarios", help="list the bundled scenarios")
     sub.add_parser("robots", help="list the bundled robots")
+    g = sub.add_parser("gui", help="interactive web GUI: edit a stance, see its areas and limits live")
+    g.add_argument("scenario", nargs="?", default=None,
+                   help="YAML file or bundled scenario name (default: palm_push_two_feet)")
+    g.add_argument("--host", default="127.0.0.1", help="interface to listen on (default: %(default)s, this machine only)")
+    g.add_argument("--port", type=int, default=8080, help="TCP port (default: %(default)s; the next free one if taken)")
     return p
 
 
@@ -106,6 +112,22 @@ def _cmd_phase_portrait(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_gui(args: argparse.Namespace) -> int:
+    try:
+        from .gui.app import run
+        from .gui.state import DEFAULT_SCENARIO
+    except ImportError as exc:  # pragma: no cover - viser is a dependency
+        print(f"impact-balance: error: the GUI needs viser ({exc})", file=sys.stderr)
+        return 2
+
+    def ready(app) -> None:
+        print(f"impact-balance gui: {app.session.state.scenario.name or 'scenario'} at {app.url}  (Ctrl-C to stop)",
+              flush=True)
+
+    run(args.scenario or DEFAULT_SCENARIO, host=args.host, port=args.port, ready=ready)
+    return 0
+
+
 def _cmd_demo(args: argparse.Namespace) -> int:
     from .analysis import analyze
     from .report import format_analysis, format_speed
@@ -152,7 +174,11 @@ def main(argv: list[str] | None = None) -> int:
         "phase-portrait": _cmd_phase_portrait,
         "scenarios": _cmd_scenarios,
         "robots": _cmd_robots,
+        "gui": _cmd_gui,
     }[args.command]
+    if args.command in ("demo", "analyze", "gui") and not kernel_is_compiled():
+        print("impact-balance: compiling the projection kernel (first run only, 10-30 s; cached afterwards) ...",
+              file=sys.stderr, flush=True)
     try:
         return handler(args)
     except ImpactBalanceError as exc:

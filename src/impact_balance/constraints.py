@@ -16,17 +16,23 @@ acceleration (see CONVENTIONS).
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from .constants import GRAVITY
 from .cwc import cwc_faces_world
-from .spatial import skew
 from .stance import Contact, Stance
 
 __all__ = ["WrenchPolytope", "grasp_matrix", "contact_polytope", "torque_limit_rows", "wrench_polytope"]
+
+
+#: Grasp-matrix block entries [p]x: rows, columns, and the component of p and sign of each.
+_SKEW_ROWS, _SKEW_COLS = (3, 3, 4, 4, 5, 5), (1, 2, 0, 2, 0, 1)
+_SKEW_COMPONENTS = np.array([2, 1, 2, 0, 1, 0])
+_SKEW_SIGNS = np.array([-1.0, 1.0, 1.0, -1.0, -1.0, 1.0])
 
 
 def grasp_matrix(positions: np.ndarray) -> np.ndarray:
@@ -34,13 +40,25 @@ def grasp_matrix(positions: np.ndarray) -> np.ndarray:
 
     Block i is ``[[I, 0], [[p_i]x, I]]``: forces add up, and each force adds ``p_i x f_i``.
     """
-    positions = np.atleast_2d(positions)
-    G = np.zeros((6, 6 * len(positions)))
-    for i, p in enumerate(positions):
-        G[:3, 6 * i : 6 * i + 3] = np.eye(3)
-        G[3:, 6 * i : 6 * i + 3] = skew(p)
-        G[3:, 6 * i + 3 : 6 * i + 6] = np.eye(3)
+    positions = np.atleast_2d(np.asarray(positions, dtype=float))
+    identity, rows, cols = _grasp_pattern(len(positions))
+    G = identity.copy()
+    # [p]x = [[0, -z, y], [z, 0, -x], [-y, x, 0]]: its 6 off-diagonal entries, contact by contact.
+    G[rows, cols] = (positions[:, _SKEW_COMPONENTS] * _SKEW_SIGNS).ravel()
     return G
+
+
+@functools.lru_cache(maxsize=16)
+def _grasp_pattern(m: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The grasp matrix's constant part for m contacts (identity blocks, read-only) and the
+    (row, column) indices of its skew entries, in the order of ``_SKEW_COMPONENTS``."""
+    identity = np.zeros((6, 6 * m))
+    for r in range(6):
+        identity[r, r::6] = 1.0
+    identity.setflags(write=False)
+    rows = np.tile(_SKEW_ROWS, m)
+    cols = (6 * np.arange(m)[:, None] + _SKEW_COLS).ravel()
+    return identity, rows, cols
 
 
 @dataclass(frozen=True)
@@ -84,21 +102,7 @@ def contact_polytope(
 
     ``contacts`` only need ``spec``, ``rotation`` and ``position`` (the Jacobian is unused).
     """
-    n = 6 * len(contacts)
-    A = np.zeros((16 * len(contacts), n))
-    for i, c in enumerate(contacts):
-        A[16 * i : 16 * i + 16, 6 * i : 6 * i + 6] = cwc_faces_world(
-            c.spec.friction, c.half_length, c.half_width, c.rotation
-        )
-    com = np.asarray(com, dtype=float)
-    G = grasp_matrix(np.array([c.position for c in contacts]).reshape(-1, 3))
-    # Moment about the CoM: tau_O - c x f = 0; vertical force: f_z = m g.
-    L = np.zeros((4, 6))
-    L[0, 2] = 1.0
-    L[1:, :3] = -skew(com)
-    L[1:, 3:] = np.eye(3)
-    d = np.array([mass * gravity, 0.0, 0.0, 0.0])
-    return WrenchPolytope(A, np.zeros(A.shape[0]), L @ G, d, G[:2].copy(), G, A.shape[0], float(mass), com.copy(), gravity)
+    return _assemble(contacts, mass, com, gravity, None)
 
 
 def torque_limit_rows(stance: Stance) -> tuple[np.ndarray, np.ndarray]:
@@ -107,19 +111,58 @@ def torque_limit_rows(stance: Stance) -> tuple[np.ndarray, np.ndarray]:
     ``tau = g_a(q) - (J^T w)_a`` and ``|tau| <= tau_max`` give ``J_a^T w <= tau_max + g_a``
     and ``-J_a^T w <= tau_max - g_a``. Joints without a finite positive effort limit are free.
     """
-    idx, limit = stance.robot.actuated_effort_limits()
     n = 6 * len(stance.contacts)
-    if idx.size == 0 or n == 0:
-        return np.zeros((0, n)), np.zeros(0)
-    JT = np.hstack([c.jacobian.T for c in stance.contacts])[idx]
-    g = stance.gravity_torques[idx]
-    return np.vstack([JT, -JT]), np.concatenate([limit + g, limit - g])
+    k = _n_torque_rows(stance)
+    A, b = np.zeros((2 * k, n)), np.zeros(2 * k)
+    _fill_torque_rows(stance, A, b)
+    return A, b
 
 
 def wrench_polytope(stance: Stance, torque_limits: bool = True, gravity: float = GRAVITY) -> WrenchPolytope:
     """Assemble the contact-wrench polytope of ``stance`` (CWC + torque limits + LIPM)."""
-    poly = contact_polytope(stance.contacts, stance.mass, stance.com, gravity)
-    if not torque_limits:
-        return poly
-    A_tau, b_tau = torque_limit_rows(stance)
-    return replace(poly, A=np.vstack([poly.A, A_tau]), b=np.concatenate([poly.b, b_tau]))
+    return _assemble(stance.contacts, stance.mass, stance.com, gravity, stance if torque_limits else None)
+
+
+def _n_torque_rows(stance: Stance) -> int:
+    """Number of torque-limited joints that act on the wrenches (0 without contacts)."""
+    return stance.robot.effort_limits[0].size if stance.contacts else 0
+
+
+def _fill_torque_rows(stance: Stance, A: np.ndarray, b: np.ndarray) -> None:
+    """Write :func:`torque_limit_rows` into ``A`` (2k x 6m) and ``b`` (2k), k limited joints."""
+    k = A.shape[0] // 2
+    if k == 0:
+        return
+    idx, limit = stance.robot.effort_limits
+    # Row r is the actuated joint idx[r]'s column of every contact Jacobian: (J_a^T)[r].
+    J = np.concatenate([c.jacobian for c in stance.contacts])
+    A[:k] = J[:, idx].T
+    np.negative(A[:k], out=A[k:])
+    g = stance.gravity_torques[idx]
+    np.add(limit, g, out=b[:k])
+    np.subtract(limit, g, out=b[k:])
+
+
+def _assemble(
+    contacts: Sequence[Contact], mass: float, com: np.ndarray, gravity: float, torque_stance: Stance | None
+) -> WrenchPolytope:
+    """The polytope, with the torque-limit rows of ``torque_stance`` when given, in one allocation."""
+    m = len(contacts)
+    n, n_cwc = 6 * m, 16 * m
+    k = _n_torque_rows(torque_stance) if torque_stance is not None else 0
+    A = np.zeros((n_cwc + 2 * k, n))
+    b = np.zeros(n_cwc + 2 * k)
+    for i, c in enumerate(contacts):
+        A[16 * i : 16 * i + 16, 6 * i : 6 * i + 6] = cwc_faces_world(
+            c.spec.friction, c.half_length, c.half_width, c.rotation
+        )
+    if k:
+        _fill_torque_rows(torque_stance, A[n_cwc:], b[n_cwc:])
+    com = np.array(com, dtype=float)
+    positions = np.array([c.position for c in contacts], dtype=float).reshape(-1, 3)
+    G = grasp_matrix(positions)
+    # LIPM: vertical force f_z = m g, and moment about the CoM sum (p_i - c) x f_i + tau_i = 0:
+    # rows 2-5 of the grasp matrix taken at the CoM (the same numbers as [[e_z^T], [-[c]x, I]] G).
+    C = grasp_matrix(positions - com)[2:]
+    d = np.array([mass * gravity, 0.0, 0.0, 0.0])
+    return WrenchPolytope(A, b, C, d, G[:2].copy(), G, n_cwc, float(mass), com, gravity)

@@ -14,6 +14,7 @@ is added to the gravity-compensating wrench (m g up, through the CoM). The predi
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -47,7 +48,7 @@ class VelocityLimit:
 
     @property
     def is_finite(self) -> bool:
-        return bool(np.isfinite(self.max_approach_speed))
+        return math.isfinite(self.max_approach_speed)
 
 
 def first_exit(margins: np.ndarray, rates: np.ndarray, tol: float = BOUNDARY_TOLERANCE) -> VelocityLimit:
@@ -57,14 +58,15 @@ def first_exit(margins: np.ndarray, rates: np.ndarray, tol: float = BOUNDARY_TOL
         margins: (n_c,) slack of the starting point in each half-plane.
         rates: (n_v, n_c) rate at which vertex j uses up half-plane k's slack.
     """
-    if np.any(margins < -tol):
+    if (margins < -tol).any():
         return VelocityLimit(0.0, "already_falling")
     positive = rates > tol * max(1.0, float(np.abs(rates).max(initial=0.0)))
     if not positive.any():
         return VelocityLimit(float("inf"), "unbounded")
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratios = np.where(positive, np.maximum(margins, 0.0) / rates, np.inf)
-    flat = int(np.argmin(ratios))
+    # Divide only where the rate is positive: no division warnings to silence.
+    ratios = np.full(rates.shape, np.inf)
+    np.divide(np.maximum(margins, 0.0), rates, out=ratios, where=positive)
+    flat = int(ratios.argmin())
     j, k = divmod(flat, rates.shape[1])
     return VelocityLimit(float(ratios.flat[flat]), "ok", j, k)
 
@@ -94,20 +96,22 @@ def zmp_max_contact_velocity(
     G, h = zmp_area.halfplanes
     weight = impact.mass * gravity
     p = impact.point
-    # Numerator N(F) = (-tau_y + h f_x, tau_x + h f_y), linear in F; N(0) = m g c_xy.
-    forces = impact.impulse_rates / duration  # (2N, 3) force per unit approach speed
-    tau = np.cross(p, forces)
-    numer = np.column_stack([-tau[:, 1] + plane_height * forces[:, 0], tau[:, 0] + plane_height * forces[:, 1]])
+    # With F = iota / dt at p, N(F) - m g c_xy = (plane_height - p_z) F_xy + F_z p_xy, so half-plane
+    # k is used up at the rate G_k N_F - h_k F_z = iota . M_k per unit approach speed, with
+    # M_k = [(plane_height - p_z) G_k, G_k p_xy - h_k] / dt.
+    M = np.empty((3, len(h)))
+    M[:2] = ((plane_height - float(p[2])) / duration) * G.T
+    M[2] = (G @ p[:2] - h) / duration
     margins = weight * (h - G @ np.asarray(com, dtype=float)[:2])
-    rates = numer @ G.T - forces[:, 2:3] * h[None, :]
-    limit = first_exit(margins, rates)
+    limit = first_exit(margins, impact.impulse_rates @ M)
     # The ZMP exists only while the vertical force stays positive (no lift-off).
-    pulling = forces[:, 2] < 0
+    fz = impact.impulse_rates[:, 2] / duration  # N per (m/s)
+    pulling = fz < 0
     if limit.status != "already_falling" and pulling.any():
-        lift = float(np.min(weight / -forces[pulling, 2]))
-        if lift < limit.max_approach_speed:
-            j = int(np.flatnonzero(pulling)[np.argmin(weight / -forces[pulling, 2])])
-            return VelocityLimit(lift, "ok", j, None)
+        lift = weight / -fz[pulling]
+        j = int(lift.argmin())
+        if lift[j] < limit.max_approach_speed:
+            return VelocityLimit(float(lift[j]), "ok", int(np.flatnonzero(pulling)[j]), None)
     return limit
 
 
@@ -116,8 +120,8 @@ def capped_velocity(reference: Sequence[float], normal: np.ndarray, max_approach
 
     This is the minimiser of ||v - v_ref|| subject to -n.v <= max (the paper's QP objective).
     """
-    v = np.asarray(reference, dtype=float).copy()
+    v = np.array(reference, dtype=float)
     excess = -(normal @ v) - max_approach_speed
-    if np.isfinite(max_approach_speed) and excess > 0:
+    if math.isfinite(max_approach_speed) and excess > 0:
         v += excess * normal
     return v

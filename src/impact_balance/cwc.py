@@ -7,6 +7,8 @@ rectangle spans ``[-X, X] x [-Y, Y]`` where X, Y are the HALF length and width.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 __all__ = ["cwc_faces", "cwc_faces_world", "cwc_span", "rotate_wrench_matrix"]
@@ -19,8 +21,12 @@ def cwc_faces(mu: float, half_length: float, half_width: float) -> np.ndarray:
     |tau_y| <= X fz (4), then the yaw-torque bounds tau_min <= tau_z <= tau_max (8), as in
     the paper's appendix with its ``[tau; f]`` columns reordered to ``[f; tau]``.
     """
-    X, Y = float(half_length), float(half_width)
-    m = float(mu)
+    return _local_faces(float(mu), float(half_length), float(half_width)).copy()
+
+
+@functools.lru_cache(maxsize=256)
+def _local_faces(m: float, X: float, Y: float) -> np.ndarray:
+    """:func:`cwc_faces`, cached per (mu, X, Y) as a read-only array (contacts repeat)."""
     s = -(X + Y) * m
     # Columns in the paper's order: tau_x, tau_y, tau_z, f_x, f_y, f_z.
     paper = np.array(
@@ -44,7 +50,9 @@ def cwc_faces(mu: float, half_length: float, half_width: float) -> np.ndarray:
         ],
         dtype=float,
     )
-    return np.hstack([paper[:, 3:], paper[:, :3]])
+    faces = np.hstack([paper[:, 3:], paper[:, :3]])
+    faces.setflags(write=False)
+    return faces
 
 
 def rotate_wrench_matrix(rotation: np.ndarray) -> np.ndarray:
@@ -59,8 +67,11 @@ def cwc_faces_world(mu: float, half_length: float, half_width: float, rotation: 
     """Face matrix acting on the wrench at the contact point in WORLD-aligned axes.
 
     ``rotation`` maps contact-frame vectors to world vectors (pinocchio's ``oMf.rotation``).
+    The result is ``cwc_faces @ rotate_wrench_matrix(rotation).T``, computed blockwise:
+    each row's force and torque halves are rotated by one (32 x 3) @ (3 x 3) product.
     """
-    return cwc_faces(mu, half_length, half_width) @ rotate_wrench_matrix(rotation).T
+    faces = _local_faces(float(mu), float(half_length), float(half_width))
+    return (faces.reshape(32, 3) @ np.asarray(rotation, dtype=float).T).reshape(16, 6)
 
 
 def cwc_span(mu: float, half_length: float, half_width: float) -> np.ndarray:

@@ -8,41 +8,55 @@ from functools import cached_property
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
+from ._jit import njit
+
 __all__ = ["Polygon"]
 
 
-def _cross(o: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
-    return float((a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]))
+@njit(cache=True)
+def _simplify(v: np.ndarray, tol: float) -> np.ndarray:
+    """Compiled loop of :func:`simplify` on a (k, 2) C-contiguous array."""
+    idx = np.arange(len(v))
+    k = len(v)
+    changed = True
+    while changed and k > 1:
+        changed = False
+        # duplicates: drop the successor of a vertex within tol
+        i = 0
+        while i < k and k > 1:
+            a, b = idx[i], idx[(i + 1) % k]
+            if np.hypot(v[a, 0] - v[b, 0], v[a, 1] - v[b, 1]) <= tol:
+                j = (i + 1) % k
+                idx[j:k - 1] = idx[j + 1:k].copy()
+                k -= 1
+                changed = True
+            else:
+                i += 1
+        if k < 3:
+            break
+        # collinear: drop the first vertex within tol of the line through its neighbours
+        for i in range(k):
+            p, c, n = idx[i - 1], idx[i], idx[(i + 1) % k]
+            base = np.hypot(v[n, 0] - v[p, 0], v[n, 1] - v[p, 1])
+            cross = (v[c, 0] - v[p, 0]) * (v[n, 1] - v[p, 1]) - (v[c, 1] - v[p, 1]) * (v[n, 0] - v[p, 0])
+            if base > 0 and abs(cross) / base <= tol:
+                idx[i:k - 1] = idx[i + 1:k].copy()
+                k -= 1
+                changed = True
+                break
+    return v[idx[:k]].copy()
 
 
 def simplify(vertices: np.ndarray, tol: float = 1e-9) -> np.ndarray:
     """Merge duplicate and collinear consecutive vertices of a CCW convex polygon.
 
     ``tol`` is a distance: a vertex closer than ``tol`` to its neighbour, or to the line
-    through its two neighbours, is dropped.
+    through its two neighbours, is dropped (one at a time, until none is).
     """
-    v = [np.asarray(p, dtype=float) for p in vertices]
-    changed = True
-    while changed and len(v) > 1:
-        changed = False
-        # duplicates
-        k = 0
-        while k < len(v) and len(v) > 1:
-            if np.linalg.norm(v[k] - v[(k + 1) % len(v)]) <= tol:
-                del v[(k + 1) % len(v)]
-                changed = True
-            else:
-                k += 1
-        if len(v) < 3:
-            break
-        for k in range(len(v)):
-            prev, cur, nxt = v[k - 1], v[k], v[(k + 1) % len(v)]
-            base = np.linalg.norm(nxt - prev)
-            if base > 0 and abs(_cross(prev, cur, nxt)) / base <= tol:
-                del v[k]
-                changed = True
-                break
-    return np.array(v).reshape(-1, 2)
+    v = np.ascontiguousarray(np.asarray(vertices, dtype=float).reshape(-1, 2))
+    if len(v) == 0:
+        return v.copy()
+    return _simplify(v, float(tol))
 
 
 def _frozen(G: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

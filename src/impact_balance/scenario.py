@@ -7,6 +7,7 @@ mappings are merged recursively, everything else is replaced.
 
 from __future__ import annotations
 
+import functools
 import math
 from importlib import resources
 from pathlib import Path
@@ -87,7 +88,50 @@ class ContactConfig(_Model):
         return v
 
     def spec(self) -> ContactSpec:
-        return ContactSpec(self.frame, self.friction, tuple(self.size), self.offset.se3())
+        """The contact's :class:`ContactSpec` (cached by content: treat it as immutable)."""
+        return _contact_spec(self.frame, self.friction, tuple(self.size), self.offset.position, self.offset.rpy)
+
+
+# Specs are cached by content, not on the models (pydantic's model_copy would carry a cached
+# value over to an updated copy): a scenario is analysed again and again, and building the
+# offset SE3 through pinocchio costs more than the rest of the model update's bookkeeping.
+@functools.lru_cache(maxsize=256)
+def _contact_spec(frame: str, friction: float, size: Vec2, position: Vec3, rpy: Vec3) -> ContactSpec:
+    return ContactSpec(frame, friction, size, pose(position, rpy))
+
+
+@functools.lru_cache(maxsize=64)
+def _impact_spec(
+    frame: str,
+    normal: Vec3,
+    friction: float,
+    restitution: Vec2,
+    cone_edges: int,
+    reference_velocity: Vec3 | None,
+    duration: float,
+    position: Vec3,
+    rpy: Vec3,
+    inertia: str,
+) -> ImpactSpec:
+    return ImpactSpec(
+        frame=frame,
+        normal=normal,
+        friction=friction,
+        restitution=restitution,
+        cone_edges=cone_edges,
+        reference_velocity=reference_velocity,
+        duration=duration,
+        offset=pose(position, rpy),
+        inertia=inertia,
+    )
+
+
+@functools.lru_cache(maxsize=256)
+def _quaternion(rpy: Vec3) -> np.ndarray:
+    """Quaternion coefficients (x, y, z, w) of roll-pitch-yaw angles (rad), read-only."""
+    coeffs = np.array(pin.Quaternion(pin.rpy.rpyToMatrix(*rpy)).coeffs(), dtype=float)
+    coeffs.setflags(write=False)
+    return coeffs
 
 
 class QPConfig(_Model):
@@ -142,16 +186,18 @@ class ImpactConfig(_Model):
     _check = field_validator("reference_velocity")(lambda v: _finite(v) if v is not None else v)
 
     def spec(self) -> ImpactSpec:
-        return ImpactSpec(
-            frame=self.frame,
-            normal=tuple(self.normal),
-            friction=self.friction,
-            restitution=tuple(self.restitution),
-            cone_edges=self.cone_edges,
-            reference_velocity=None if self.reference_velocity is None else tuple(self.reference_velocity),
-            duration=self.duration,
-            offset=self.offset.se3(),
-            inertia=self.inertia,
+        """The impact's :class:`ImpactSpec` (cached by content: treat it as immutable)."""
+        return _impact_spec(
+            self.frame,
+            tuple(self.normal),
+            self.friction,
+            tuple(self.restitution),
+            self.cone_edges,
+            None if self.reference_velocity is None else tuple(self.reference_velocity),
+            self.duration,
+            self.offset.position,
+            self.offset.rpy,
+            self.inertia,
         )
 
 
@@ -208,27 +254,14 @@ class Scenario(_Model):
 
     def configuration_vector(self, robot: Robot) -> np.ndarray:
         """q from the named configuration, the joint overrides and the base override."""
-        model = robot.model
         q = robot.configuration(self.configuration)
-        for name, value in self.joints.items():
-            jid = robot.joint_id(name, field=f"joints.{name}")
-            joint = model.joints[jid]
-            lo = model.lowerPositionLimit[joint.idx_q]
-            hi = model.upperPositionLimit[joint.idx_q]
-            if joint.nq == 1:
-                if np.isfinite(lo) and np.isfinite(hi) and lo < hi and not (lo - 1e-9 <= value <= hi + 1e-9):
-                    raise ScenarioError(f"joints.{name}", value, f"outside the joint limits [{lo:.4g}, {hi:.4g}] rad")
-                q[joint.idx_q] = value
-            elif joint.nq == 2 and joint.nv == 1:  # continuous joint: (cos, sin)
-                q[joint.idx_q : joint.idx_q + 2] = (math.cos(value), math.sin(value))
-            else:
-                raise ScenarioError(f"joints.{name}", value, "only 1-dof joints can be set by a single value")
+        indices, values = robot.joint_assignment(self.joints, field="joints")
+        q[indices] = values
         if self.base is not None:
             if self.base.position is not None:
                 q[:3] = self.base.position
             if self.base.rpy is not None:
-                quat = pin.Quaternion(pin.rpy.rpyToMatrix(*self.base.rpy))
-                q[3:7] = quat.coeffs()
+                q[3:7] = _quaternion(self.base.rpy)
         return q
 
     def build_stance(self, robot: Robot | None = None) -> Stance:

@@ -7,6 +7,7 @@ constraint, area and impact steps.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -17,6 +18,8 @@ from .robot import Robot
 from .spatial import skew
 
 __all__ = ["ContactSpec", "Contact", "Stance"]
+
+_IDENTITY = pin.SE3.Identity()
 
 
 @dataclass(frozen=True)
@@ -77,9 +80,14 @@ class Contact:
 class Stance:
     """Robot configuration + contacts, with everything the criteria need from the model.
 
+    The kinematics are computed in the robot's per-thread scratch Data (see
+    :class:`impact_balance.robot.Workspace`) and every attribute is a copy, so stances of the
+    same robot never alias. :meth:`point` recomputes the joint placements and Jacobians
+    (~4 us) when another stance has used the scratch Data since.
+
     Attributes:
         robot: The robot.
-        q: Configuration (nq).
+        q: Configuration (nq); read-only in spirit: everything below was computed from it.
         contacts: The sustained contacts, resolved.
         com: Centre of mass in world, m.
         mass: Total mass, kg.
@@ -90,45 +98,77 @@ class Stance:
     def __init__(self, robot: Robot, q: np.ndarray, contacts: Sequence[ContactSpec] = ()):
         model = robot.model
         self.robot = robot
-        self.q = np.asarray(q, dtype=float).copy()
-        self.data = model.createData()
-        data = self.data
-        v0 = np.zeros(model.nv)
-        pin.computeJointJacobians(model, data, self.q)
-        pin.updateFramePlacements(model, data)
-        pin.ccrba(model, data, self.q, v0)  # data.Ig: centroidal composite inertia, world axes
-        self.com = np.array(pin.centerOfMass(model, data, self.q, False), dtype=float)
-        self.mass = float(data.Ig.mass)
-        self.com_inertia = np.array(data.Ig.inertia, dtype=float)
+        self.q = np.array(q, dtype=float)
+        workspace = robot.workspace()
+        data = workspace.data
+        # ccrba runs the forward kinematics and also fills the joint Jacobians data.J (as
+        # computeJointJacobians does) and data.Ig, the centroidal composite inertia in world axes.
+        pin.ccrba(model, data, self.q, np.zeros(model.nv))
+        workspace.holder = self.q.tobytes()
+        self.com = np.array(pin.centerOfMass(model, data, pin.KinematicLevel.POSITION, False), dtype=float)
+        Ig = data.Ig
+        self.mass = float(Ig.mass)
+        self.com_inertia = np.array(Ig.inertia, dtype=float)
         self.gravity_torques = np.array(pin.computeGeneralizedGravity(model, data, self.q), dtype=float)
-        self.contacts: list[Contact] = [self._resolve(spec, i) for i, spec in enumerate(contacts)]
+        self.contacts: list[Contact] = []
+        for i, spec in enumerate(contacts):
+            fid = robot.frame_id(spec.frame, f"contacts[{i}].frame")
+            placement, jacobian = self._point(data, fid, spec.offset)
+            self.contacts.append(Contact(spec, placement.rotation.copy(), placement.translation.copy(), jacobian))
 
     @property
     def model(self) -> pin.Model:
         return self.robot.model
 
-    def _resolve(self, spec: ContactSpec, index: int) -> Contact:
-        placement, jacobian = self.point(spec.frame, spec.offset, field=f"contacts[{index}].frame")
-        return Contact(spec, placement.rotation.copy(), placement.translation.copy(), jacobian)
+    @functools.cached_property
+    def data(self) -> pin.Data:
+        """A pinocchio Data of this stance's own, made on first access (~1 ms).
+
+        It holds the joint and frame placements, Jacobians, composite inertia, CoM and
+        gravity at ``q``, for callers that read the model directly (plots, GUI meshes);
+        the pipeline never needs it.
+        """
+        model, data = self.model, self.model.createData()
+        pin.computeJointJacobians(model, data, self.q)
+        pin.updateFramePlacements(model, data)
+        pin.ccrba(model, data, self.q, np.zeros(model.nv))
+        pin.centerOfMass(model, data, self.q, False)
+        pin.computeGeneralizedGravity(model, data, self.q)
+        return data
+
+    def _kinematics(self) -> pin.Data:
+        """The scratch Data holding this stance's joint placements and joint Jacobians."""
+        workspace = self.robot.workspace()
+        key = self.q.tobytes()
+        if workspace.holder != key:
+            pin.computeJointJacobians(self.model, workspace.data, self.q)
+            workspace.holder = key
+        return workspace.data
 
     def point(self, frame: str, offset: pin.SE3 | None = None, field: str = "frame") -> tuple[pin.SE3, np.ndarray]:
         """World pose of ``frame * offset`` and its 6 x nv world-aligned Jacobian (linear first)."""
         fid = self.robot.frame_id(frame, field)
-        offset = pin.SE3.Identity() if offset is None else offset
-        placement = self.data.oMf[fid] * offset
-        J = pin.getFrameJacobian(self.model, self.data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED).copy()
+        return self._point(self._kinematics(), fid, offset)
+
+    def _point(self, data: pin.Data, fid: int, offset: pin.SE3 | None) -> tuple[pin.SE3, np.ndarray]:
+        """:meth:`point` of frame ``fid`` from ``data`` holding this stance's kinematics (copies)."""
+        model = self.model
+        frame_pose = pin.updateFramePlacement(model, data, fid)
+        J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        if offset is None or offset == _IDENTITY:  # exact test: contacts mostly have no offset
+            return frame_pose, J
+        placement = frame_pose * offset
         # Shift the reference point from the frame origin to the offset point: v_p = v_o + w x r.
-        r = placement.translation - self.data.oMf[fid].translation
-        J[:3] -= skew(r) @ J[3:]
+        J[:3] -= skew(placement.translation - frame_pose.translation) @ J[3:]
         return placement, J
 
     def frame_pose(self, frame: str) -> pin.SE3:
         """World pose of a frame (a copy)."""
-        return pin.SE3(self.data.oMf[self.robot.frame_id(frame)])
+        fid = self.robot.frame_id(frame)
+        return pin.updateFramePlacement(self.model, self._kinematics(), fid)
 
     def lowest_contact_height(self) -> float:
         """Lowest z of any contact corner, m (nan without contacts)."""
         if not self.contacts:
             return float("nan")
         return float(min(c.corners()[:, 2].min() for c in self.contacts))
-

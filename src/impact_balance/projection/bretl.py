@@ -1,4 +1,5 @@
-"""Projection of a polytope onto a plane: Bretl & Lall's incremental algorithm (2008).
+"""Projection of a polytope onto a plane: Bretl & Lall's incremental algorithm (2008), one
+HiGHS LP per support direction. The reference path (and the fallback of the walk).
 
 Given ``P = {x : A x <= b, C x = d}`` and a 2 x n map ``E``, computes the convex polygon
 ``E P`` exactly (up to a documented tolerance) by solving one LP per support direction:
@@ -18,34 +19,20 @@ the empty polygon.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from .exceptions import SolverError
-from .polygon import Polygon, simplify
-from .solvers import HighsLP, LinearProgram
+from ..exceptions import SolverError
+from ..polygon import Polygon, simplify
+from ..solvers import HighsLP, LinearProgram
+from .result import ProjectionResult
 
-__all__ = ["ProjectionResult", "project_polytope"]
+__all__ = ["project_bretl"]
 
 #: First ray directions (rad).
 INITIAL_ANGLES = (0.0, 2.0 * np.pi / 3.0, 4.0 * np.pi / 3.0)
 
 
-@dataclass(frozen=True)
-class ProjectionResult:
-    """The projected polygon and how it was obtained.
-
-    Attributes:
-        polygon: The projection.
-        n_lp: Number of LPs solved.
-    """
-
-    polygon: Polygon
-    n_lp: int
-
-
-def project_polytope(
+def project_bretl(
     A: np.ndarray,
     b: np.ndarray,
     C: np.ndarray,
@@ -98,11 +85,11 @@ def project_polytope(
     for angle in INITIAL_ANGLES:
         y = support(np.array([np.cos(angle), np.sin(angle)]))
         if y is None:
-            return ProjectionResult(Polygon.empty(), count)
+            return ProjectionResult(Polygon.empty(), "bretl", n_lp=count)
         first.append(y)
     vertices = [v for v in simplify(np.array(first), tol)]
     if len(vertices) == 1:
-        return ProjectionResult(Polygon(np.array(vertices)), count)
+        return ProjectionResult(Polygon(np.array(vertices)), "bretl", n_lp=count)
     confirmed = [False] * len(vertices)  # confirmed[i]: edge from vertex i to vertex i+1
     i = 0
     while not all(confirmed):
@@ -127,4 +114,4 @@ def project_polytope(
             i = (i + 1) % len(vertices)
     polygon_vertices = simplify(np.array(vertices), tol if merge_tol is None else merge_tol)
     bounded = bool(np.all(np.abs(polygon_vertices) < box * (1 - 1e-9)))
-    return ProjectionResult(Polygon(polygon_vertices, bounded), count)
+    return ProjectionResult(Polygon(polygon_vertices, bounded), "bretl", n_lp=count)

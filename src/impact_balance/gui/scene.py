@@ -1,0 +1,201 @@
+"""What the 3D view draws, as plain data: an :class:`Analysis` to named scene objects.
+
+Nothing here knows about the browser: :func:`scene_objects` returns line segments, points,
+arrows and translucent surfaces in world coordinates (m), and the app draws them with viser.
+Names are stable ("contacts/0/outline", "impact/cone"...) so that a redraw replaces objects.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..analysis import Analysis
+from ..polygon import Polygon
+
+__all__ = [
+    "Segments",
+    "Points",
+    "Arrows",
+    "Surface",
+    "Label",
+    "SceneObject",
+    "scene_objects",
+    "COLORS",
+    "IMPULSE_LENGTH",
+    "CONE_LENGTH",
+]
+
+#: Colours (hex), the same as the figures' (plots/_common.py).
+COLORS = {
+    "contact": "#8c564b",
+    "contact_normal": "#8c564b",
+    "com": "#111111",
+    "com_projection": "#111111",
+    "com_velocity": "#1f77b4",
+    "zmp_area": "#8fbc8f",
+    "zmp_edge": "#2e6b2e",
+    "impact": "#d62728",
+    "impact_normal": "#d62728",
+    "cone": "#d62728",
+    "impulse": "#ff7f0e",
+}
+#: Length of the drawn friction cone along the normal, m.
+CONE_LENGTH = 0.15
+#: Length of the longest drawn impulse direction, m.
+IMPULSE_LENGTH = 0.3
+#: Lift of drawings on the ZMP plane, so they do not flicker against the floor grid, m.
+PLANE_LIFT = 2e-3
+
+
+@dataclass(frozen=True)
+class Segments:
+    """Line segments, ``segments`` (N, 2, 3) m; ``width`` m."""
+
+    name: str
+    segments: np.ndarray
+    color: str
+    width: float = 0.006
+
+
+@dataclass(frozen=True)
+class Points:
+    """Spheres at ``points`` (N, 3) m, of radius ``radius`` m."""
+
+    name: str
+    points: np.ndarray
+    color: str
+    radius: float = 0.02
+
+
+@dataclass(frozen=True)
+class Arrows:
+    """Arrows from ``starts`` to ``ends`` (N, 3) m."""
+
+    name: str
+    starts: np.ndarray
+    ends: np.ndarray
+    color: str
+    radius: float = 0.006
+
+
+@dataclass(frozen=True)
+class Surface:
+    """A triangle mesh: ``vertices`` (N, 3) m, ``faces`` (M, 3) indices."""
+
+    name: str
+    vertices: np.ndarray
+    faces: np.ndarray
+    color: str
+    opacity: float = 0.5
+
+
+@dataclass(frozen=True)
+class Label:
+    """A text label at ``position`` (3,) m, drawn on top of everything."""
+
+    name: str
+    text: str
+    position: np.ndarray
+    color: str = "#111111"
+
+
+SceneObject = Segments | Points | Arrows | Surface | Label
+
+
+def polyline_segments(points: np.ndarray, closed: bool = True) -> np.ndarray:
+    """(N, 2, 3) segments joining consecutive points (and the last to the first if closed)."""
+    p = np.asarray(points, dtype=float).reshape(-1, 3)
+    if len(p) < 2:
+        return np.zeros((0, 2, 3))
+    ends = np.roll(p, -1, axis=0) if closed and len(p) > 2 else p[1:]
+    starts = p if closed and len(p) > 2 else p[:-1]
+    return np.stack([starts, ends], axis=1)
+
+
+def _fan(polygon: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Triangles of a convex polygon (N, 3), both sides (so it shows from below too)."""
+    n = len(polygon)
+    front = np.array([[0, i, i + 1] for i in range(1, n - 1)], dtype=np.uint32).reshape(-1, 3)
+    return polygon, np.vstack([front, front[:, ::-1]])
+
+
+def _on_plane(vertices: np.ndarray, height: float) -> np.ndarray:
+    v = np.asarray(vertices, dtype=float).reshape(-1, 2)
+    return np.column_stack([v, np.full(len(v), height)])
+
+
+def _area_objects(prefix: str, area: Polygon, height: float, fill: str, edge: str) -> list[SceneObject]:
+    if area.is_empty:
+        return []
+    pts = _on_plane(area.vertices, height)
+    out: list[SceneObject] = [Segments(f"{prefix}/outline", polyline_segments(pts), edge, 0.006)]
+    if len(pts) >= 3:
+        vertices, faces = _fan(pts)
+        out.append(Surface(f"{prefix}/fill", vertices, faces, fill, 0.55))
+    elif len(pts) == 1:
+        out.append(Points(f"{prefix}/point", pts, edge, 0.01))
+    return out
+
+
+def scene_objects(analysis: Analysis) -> list[SceneObject]:
+    """Everything the 3D view shows besides the robot, by stable name.
+
+    - ``contacts/<i>/outline``, ``contacts/<i>/normal``: each contact rectangle on its surface
+      and its normal (from the environment into the robot).
+    - ``com/point``, ``com/label``, ``com/projection``, ``com/drop``: the CoM, its vertical projection on the
+      ZMP plane and the line joining them; ``com/velocity``: the pre-impact CoM velocity
+      (drawn at the CoM, 1 m per m/s) when not zero.
+    - ``zmp_area/outline``, ``zmp_area/fill``: the ZMP support area on its plane (absent when
+      the stance cannot balance).
+    - ``impact/point``, ``impact/label``, ``impact/normal``, ``impact/cone``: the impact point, its normal
+      (into the robot) and its friction cone (apex at the point, opening along the normal);
+      ``impact/impulses``: the directions of the 2N impulse vertices, scaled so the longest
+      is :data:`IMPULSE_LENGTH` (the set's shape does not depend on the approach speed),
+      and ``impact/impulse_set_hi`` / ``_lo``: their ends on the two restitution planes.
+    """
+    areas = analysis.areas
+    h = areas.plane_height
+    out: list[SceneObject] = []
+    for i, contact in enumerate(analysis.stance.contacts):
+        out.append(Segments(f"contacts/{i}/outline", polyline_segments(contact.corners()), COLORS["contact"], 0.008))
+        size = min(contact.spec.size)
+        out.append(Arrows(f"contacts/{i}/normal", contact.position[None], (contact.position + 0.5 * size * contact.normal)[None],
+                          COLORS["contact_normal"], 0.004))
+    com = np.asarray(areas.com, dtype=float)
+    projection = np.array([com[0], com[1], h + PLANE_LIFT])
+    out.append(Points("com/point", com[None], COLORS["com"], 0.035))
+    out.append(Label("com/label", "CoM", com))
+    out.append(Points("com/projection", projection[None], COLORS["com_projection"], 0.015))
+    out.append(Segments("com/drop", np.array([[com, projection]]), COLORS["com_projection"], 0.003))
+    c0 = np.asarray(analysis.com_velocity, dtype=float)
+    if np.linalg.norm(c0) > 1e-9:
+        out.append(Arrows("com/velocity", com[None], (com + np.array([c0[0], c0[1], 0.0]))[None], COLORS["com_velocity"], 0.008))
+    out += _area_objects("zmp_area", areas.zmp_area, h + PLANE_LIFT, COLORS["zmp_area"], COLORS["zmp_edge"])
+
+    im = analysis.impact
+    if im is not None:
+        model = im.model
+        p = np.asarray(model.point, dtype=float)
+        n = np.asarray(model.normal, dtype=float)
+        out.append(Points("impact/point", p[None], COLORS["impact"], 0.018))
+        out.append(Label("impact/label", "impact", p, COLORS["impact"]))
+        out.append(Arrows("impact/normal", p[None], (p + 0.25 * n)[None], COLORS["impact_normal"], 0.006))
+        # Cone generators K_i = n + mu t_i: scaled to CONE_LENGTH along n.
+        rim = p + CONE_LENGTH * np.asarray(model.cone, dtype=float).T
+        vertices = np.vstack([p, rim])
+        k = len(rim)
+        faces = np.array([[0, 1 + j, 1 + (j + 1) % k] for j in range(k)], dtype=np.uint32)
+        out.append(Surface("impact/cone", vertices, np.vstack([faces, faces[:, ::-1]]), COLORS["cone"], 0.25))
+        out.append(Segments("impact/cone_edges", np.stack([np.repeat(p[None], k, 0), rim], axis=1), COLORS["cone"], 0.002))
+        rates = np.asarray(model.impulse_rates, dtype=float)
+        longest = float(np.max(np.linalg.norm(rates, axis=1))) if len(rates) else 0.0
+        if longest > 0:
+            ends = p + IMPULSE_LENGTH * rates / longest
+            out.append(Segments("impact/impulses", np.stack([np.repeat(p[None], len(ends), 0), ends], axis=1),
+                                COLORS["impulse"], 0.003))
+            # The two restitution planes' polygons (rows 2i: c_hi, 2i+1: c_lo).
+            out.append(Segments("impact/impulse_set_hi", polyline_segments(ends[0::2]), COLORS["impulse"], 0.004))
+            out.append(Segments("impact/impulse_set_lo", polyline_segments(ends[1::2]), COLORS["impulse"], 0.004))
+    return out

@@ -1,0 +1,175 @@
+"""One GUI session: the current state, its analysis, and all-or-nothing edits.
+
+Every edit (a field, a load, a gizmo drag) builds a new :class:`~.state.GuiState`, analyses
+it with :func:`impact_balance.analyze` and only then replaces the current one. A refused edit
+(a bad value, an unknown frame, an IK failure...) leaves the session as it was and sets
+:attr:`Session.message`; nothing raises. An infeasible stance is not refused: it is an answer
+("cannot balance"), shown as such.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import threading
+import time
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pinocchio as pin
+
+from ..analysis import Analysis, analyze
+from ..exceptions import ImpactBalanceError
+from .drag import DragTarget, drag_changes
+from .state import DEFAULT_SCENARIO, FieldPath, GuiState
+
+__all__ = ["Summary", "Session", "format_speed"]
+
+log = logging.getLogger(__name__)
+
+
+def format_speed(value: float | None) -> str:
+    """An approach speed for display: ``0.481 m/s``, ``unbounded`` or ``-`` (no impact)."""
+    if value is None:
+        return "-"
+    return f"{value:.3f} m/s" if math.isfinite(value) else "unbounded"
+
+
+@dataclass(frozen=True)
+class Summary:
+    """The numbers the GUI shows for an analysis.
+
+    Attributes:
+        verdict: "balanced", "falling: ..." or "cannot balance: ..." (see :attr:`Analysis.verdict`).
+        can_balance: Whether the contacts can hold the robot at rest.
+        max_contact_velocity: Maximum approach speed by the CoM velocity criterion, m/s
+            (``inf`` unbounded, None without an impact).
+        zmp_max_contact_velocity: The same by the ZMP criterion, m/s.
+        reference_speed: Approach speed of the reference velocity, m/s (None without one).
+        falls_at_reference: Whether the reference approach speed exceeds the maximum.
+    """
+
+    verdict: str
+    can_balance: bool
+    max_contact_velocity: float | None
+    zmp_max_contact_velocity: float | None
+    reference_speed: float | None
+    falls_at_reference: bool
+
+    @classmethod
+    def of(cls, analysis: Analysis) -> Summary:
+        im = analysis.impact
+        vmax = zmp = ref = None
+        falls = False
+        if im is not None:
+            vmax, zmp = im.max_contact_velocity, im.zmp_max_contact_velocity
+            v_ref = im.model.spec.reference_velocity
+            if v_ref is not None:
+                ref = max(0.0, im.model.approach_speed(v_ref))
+                falls = ref > vmax + 1e-12
+        return cls(analysis.verdict, analysis.areas.can_balance, vmax, zmp, ref, falls)
+
+    @property
+    def headline(self) -> str:
+        """The verdict in a few words: "balanced", "falling" or "cannot balance"."""
+        return self.verdict.split(":")[0]
+
+
+class Session:
+    """The GUI's model: state, analysis, last message. Thread-safe (one edit at a time).
+
+    Attributes:
+        state: The current (valid) state.
+        analysis: Its analysis.
+        message: Why the last edit was refused, or a note about it (None when all went well).
+        refused: Whether the last edit was refused.
+        analysis_ms: Wall time of the last successful validation + analysis, ms.
+        lock: Re-entrant lock held during every edit (the app holds it while redrawing).
+    """
+
+    def __init__(self, state: GuiState | str | Path = DEFAULT_SCENARIO):
+        if not isinstance(state, GuiState):
+            state = GuiState.from_file(state)
+        self.lock = threading.RLock()
+        self.state = state
+        self.analysis: Analysis = analyze(state.scenario)
+        self.message: str | None = None
+        self.refused = False
+        self.analysis_ms = 1e3 * self.analysis.timings.get("total", 0.0)
+        #: Incremented on every accepted change (the app redraws when it moves).
+        self.revision = 0
+
+    # -- edits ----------------------------------------------------------------------------
+    def _commit(self, build, note: str | None = None) -> bool:
+        with self.lock:
+            t0 = time.perf_counter()
+            try:
+                state = build()
+                analysis = analyze(state.scenario)
+            except ImpactBalanceError as exc:
+                self.message, self.refused = str(exc), True
+                return False
+            except Exception as exc:  # noqa: BLE001 - the GUI must survive a library bug
+                log.exception("unexpected error while applying an edit")
+                self.message, self.refused = f"internal error ({exc.__class__.__name__}): {exc}", True
+                return False
+            self.state, self.analysis = state, analysis
+            self.analysis_ms = 1e3 * (time.perf_counter() - t0)
+            self.message, self.refused = note, False
+            self.revision += 1
+            return True
+
+    def apply(self, changes: Mapping[FieldPath, Any] | Iterable[tuple[FieldPath, Any]]) -> bool:
+        """Apply scenario changes; False (and :attr:`message`) when refused."""
+        changes = dict(changes.items() if isinstance(changes, Mapping) else changes)
+        return self._commit(lambda: self.state.with_changes(changes))
+
+    def set(self, path: FieldPath, value: Any) -> bool:
+        """Set one field; False (and :attr:`message`) when refused."""
+        return self.apply({tuple(path): value})
+
+    def replace(self, state: GuiState) -> bool:
+        """Switch to another (already parsed) state."""
+        return self._commit(lambda: state)
+
+    def load(self, name_or_path: str | Path) -> bool:
+        """Load a scenario file or a bundled scenario by name."""
+        return self._commit(lambda: GuiState.from_file(name_or_path))
+
+    def load_yaml(self, text: str, source: str | None = None) -> bool:
+        """Load scenario YAML text (e.g. an uploaded file)."""
+        return self._commit(lambda: GuiState.from_yaml(text, source))
+
+    def save(self, path: str | Path) -> Path | None:
+        """Save the current state as a scenario file; None (and :attr:`message`) on failure."""
+        with self.lock:
+            try:
+                out = self.state.save(path)
+            except ImpactBalanceError as exc:
+                self.message, self.refused = str(exc), True
+                return None
+            self.message, self.refused = f"saved {out}", False
+            return out
+
+    def drag(self, target: DragTarget, pose: pin.SE3) -> bool:
+        """Move a contact or the impact point to a world pose by IK, other contacts fixed."""
+        with self.lock:
+            note: list[str] = []
+
+            def build() -> GuiState:
+                result = drag_changes(self.state, self.analysis.stance, target, pose)
+                if not result.reached:
+                    note.append(f"out of reach: moved as close as possible ({1e3 * result.residual:.0f} mm away)")
+                return self.state.with_changes(result.changes)
+
+            ok = self._commit(build)
+            if ok and note:
+                self.message = note[0]
+            return ok
+
+    # -- reading --------------------------------------------------------------------------
+    @property
+    def summary(self) -> Summary:
+        return Summary.of(self.analysis)

@@ -1,0 +1,212 @@
+"""The GUI's editable state: a scenario as a plain mapping, validated on every edit.
+
+A :class:`GuiState` is immutable. An edit (:meth:`GuiState.with_changes`) returns a new state
+or raises :class:`~impact_balance.exceptions.ScenarioError` naming the bad field, so that the
+caller keeps the previous good state and shows the message. The mapping has the schema of the
+scenario files (README, "Scenario files"): :meth:`GuiState.to_yaml` writes a file that
+``impact-balance analyze`` reads, and :meth:`GuiState.from_file` reads any scenario file.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from collections.abc import Hashable, Iterable, Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from ..exceptions import ScenarioError
+from ..scenario import RobotFiles, Scenario, load_scenario, scenario_from_dict
+
+__all__ = ["FieldPath", "GuiState", "DEFAULT_SCENARIO", "plain"]
+
+#: The scenario the GUI opens when none is given (the demo's first study).
+DEFAULT_SCENARIO = "palm_push_two_feet"
+
+#: Where a value sits in the scenario mapping: keys and list indices, e.g.
+#: ``("contacts", 0, "friction")``.
+FieldPath = tuple[Hashable, ...]
+
+
+def plain(value: Any) -> Any:
+    """``value`` as plain YAML-safe Python data (numpy arrays and scalars to lists and floats)."""
+    if isinstance(value, np.ndarray):
+        return [plain(v) for v in value.tolist()]
+    if isinstance(value, (np.floating, np.integer, np.bool_)):
+        return value.item()
+    if isinstance(value, Mapping):
+        return {str(k): plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [plain(v) for v in value]
+    return value
+
+
+def _field_name(path: FieldPath) -> str:
+    out = ""
+    for part in path:
+        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
+    return out or "scenario"
+
+
+def _set(raw: dict, path: FieldPath, value: Any) -> None:
+    """Set ``raw[path] = value`` in place, creating missing mappings; None deletes the key."""
+    if not path:
+        raise ScenarioError("scenario", value, "empty field path")
+    node: Any = raw
+    for i, part in enumerate(path[:-1]):
+        try:
+            child = node[part]
+        except (KeyError, IndexError, TypeError):
+            if isinstance(node, dict) and value is not None:
+                child = node[part] = {}
+            elif value is None:
+                return  # deleting under a missing key: nothing to do
+            else:
+                raise ScenarioError(_field_name(path[: i + 1]), None, "no such item") from None
+        if child is None and value is not None and isinstance(node, dict):
+            child = node[part] = {}
+        node = child
+    last = path[-1]
+    if value is None:
+        if isinstance(node, dict):
+            node.pop(last, None)
+        elif isinstance(node, list) and isinstance(last, int) and -len(node) <= last < len(node):
+            node.pop(last)
+        return
+    try:
+        node[last] = value
+    except (IndexError, TypeError):
+        raise ScenarioError(_field_name(path), value, "no such item") from None
+
+
+def _check_finite(path: FieldPath, value: Any) -> None:
+    """Refuse NaN and infinities early, with the GUI's field name (some fields would take inf)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        raise ScenarioError(_field_name(path), value, "must be a finite number")
+    if isinstance(value, dict):
+        for key, item in value.items():
+            _check_finite(path + (key,), item)
+    elif isinstance(value, list):
+        for i, item in enumerate(value):
+            if isinstance(item, (dict, list)):
+                _check_finite(path + (i,), item)
+            elif isinstance(item, float) and not math.isfinite(item):
+                raise ScenarioError(_field_name(path), value, "must be finite numbers")
+
+
+class GuiState:
+    """A validated scenario mapping and the :class:`~impact_balance.scenario.Scenario` built from it.
+
+    Attributes:
+        scenario: The validated scenario (what :func:`impact_balance.analyze` takes).
+        source: File the state was read from (relative robot paths were made absolute, so the
+            state can be saved anywhere).
+    """
+
+    __slots__ = ("_raw", "scenario", "source")
+
+    def __init__(self, raw: Mapping[str, Any], source: str | None = None):
+        data = plain(copy.deepcopy(dict(raw)))
+        self.scenario: Scenario = scenario_from_dict(data, source)
+        self._raw: dict[str, Any] = data
+        self.source = source
+
+    # -- construction -------------------------------------------------------------------
+    @classmethod
+    def from_scenario(cls, scenario: Scenario) -> GuiState:
+        """The state of an already validated scenario (the keys it was given, no defaults added)."""
+        raw = scenario.model_dump(mode="json", exclude_unset=True)
+        if isinstance(scenario.robot, RobotFiles) and scenario.source:
+            # Relative robot paths are relative to the scenario file: make them absolute so a
+            # state saved elsewhere still finds its robot.
+            base = Path(scenario.source).parent
+            files = raw["robot"]
+            files["urdf"] = str((base / scenario.robot.urdf).resolve())
+            if scenario.robot.srdf:
+                files["srdf"] = str((base / scenario.robot.srdf).resolve())
+        return cls(raw, scenario.source)
+
+    @classmethod
+    def from_file(cls, name_or_path: str | Path = DEFAULT_SCENARIO) -> GuiState:
+        """Read a scenario file or a bundled scenario by name (``extends`` resolved)."""
+        return cls.from_scenario(load_scenario(name_or_path))
+
+    @classmethod
+    def from_yaml(cls, text: str, source: str | None = None) -> GuiState:
+        """Parse scenario YAML text (an uploaded file); ``extends`` is resolved like a file's."""
+        import tempfile
+
+        # load_scenario reads files (it resolves `extends` and reports YAML errors with their
+        # line): write the text to a temporary file rather than duplicate that logic.
+        name = Path(source).name if source else "uploaded.yaml"
+        if not name.endswith((".yaml", ".yml")):
+            name += ".yaml"
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / name
+            path.write_text(text)
+            try:
+                scenario = load_scenario(path)
+            except ScenarioError as exc:
+                raise ScenarioError(exc.field, exc.value, exc.reason, source or name) from None
+        state = cls.from_scenario(scenario)
+        return cls(state.raw, source)
+
+    # -- reading ------------------------------------------------------------------------
+    @property
+    def raw(self) -> dict[str, Any]:
+        """A deep copy of the scenario mapping."""
+        return copy.deepcopy(self._raw)
+
+    def get(self, path: FieldPath, default: Any = None) -> Any:
+        """The value at ``path`` in the mapping (a copy), or ``default`` when absent."""
+        node: Any = self._raw
+        for part in path:
+            try:
+                node = node[part]
+            except (KeyError, IndexError, TypeError):
+                return default
+        return copy.deepcopy(node)
+
+    def to_yaml(self) -> str:
+        """The scenario as YAML, in the schema of the scenario files."""
+        return yaml.safe_dump(self._raw, sort_keys=False, default_flow_style=None, width=100)
+
+    def save(self, path: str | Path) -> Path:
+        """Write :meth:`to_yaml` to ``path`` (folders created); :class:`ScenarioError` if it cannot."""
+        path = Path(path).expanduser()
+        if path.suffix not in (".yaml", ".yml"):
+            raise ScenarioError("file", str(path), "a scenario file name must end with .yaml or .yml")
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(self.to_yaml())
+        except OSError as exc:
+            raise ScenarioError("file", str(path), f"cannot write: {exc.strerror or exc}") from None
+        return path
+
+    # -- editing ------------------------------------------------------------------------
+    def with_value(self, path: FieldPath, value: Any) -> GuiState:
+        """A new state with ``value`` at ``path`` (None removes the key)."""
+        return self.with_changes({path: value})
+
+    def with_changes(self, changes: Mapping[FieldPath, Any] | Iterable[tuple[FieldPath, Any]]) -> GuiState:
+        """A new state with every change applied; raises :class:`ScenarioError` for a bad one.
+
+        Changes are applied in order, then the whole mapping is validated once.
+        """
+        items = list(changes.items()) if isinstance(changes, Mapping) else list(changes)
+        raw = copy.deepcopy(self._raw)
+        for path, value in items:
+            path = tuple(path)
+            value = plain(value)
+            _check_finite(path, value)
+            _set(raw, path, value)
+        return GuiState(raw, self.source)
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, GuiState) and self._raw == other._raw
+
+    def __repr__(self) -> str:
+        return f"GuiState({self.scenario.name or 'unnamed'!r}, {len(self._raw.get('contacts', []))} contacts)"

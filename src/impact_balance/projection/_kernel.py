@@ -1,0 +1,580 @@
+"""Compiled kernel of the parametric walk (see :mod:`impact_balance.projection.walk`).
+
+An active-set primal simplex on ``max c(theta)^T z  s.t.  H z <= h`` with
+``c(theta) = G^T (cos theta, sin theta)``, dense, for the small LPs of contact stances
+(n up to a few tens of variables, m up to a few hundred rows). A basis is a set of n
+linearly independent active rows B; its vertex solves ``H_B z = h_B`` and it is optimal for
+theta while the multipliers ``lambda(theta) = H_B^-T c(theta)`` are non-negative. Each
+multiplier is ``rho cos(theta - alpha)``, so the end of a basis' optimal arc has a closed
+form, and the walk hops from basis to basis in increasing theta: the support points it
+records are the vertices of the projection ``G {z : H z <= h}``, counter-clockwise, exactly
+(there is no stopping tolerance).
+
+Optimality "at theta+" (just after a breakpoint) is lexicographic in (lambda, dlambda/dtheta),
+i.e. for the objective ``c(theta) + eps c'(theta)``. The leaving row is chosen by steepest
+edge; after 2n zero steps in a row, by Bland's rule (smallest row index leaves, smallest row
+index enters among ties), so degenerate vertices cannot cycle. A
+multiplier counts as zero within a tolerance scaled by its column of ``H_B^-1`` (its rounding
+error grows with it), which keeps Bland's rule from chasing rounding noise.
+
+The basis inverse is kept explicitly, updated by the rank-one formula at each pivot and
+recomputed every ``_REFACTOR`` pivots. Without numba the same code runs as plain Python.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._jit import njit
+from ..polygon import _simplify
+
+__all__ = ["project", "equality_basis", "walk", "OK", "INFEASIBLE", "FAILED", "LINE"]
+
+#: Kernel statuses. LINE: the polytope contains a line (no vertex); the caller can quotient
+#: it out and call again.
+OK, INFEASIBLE, FAILED, LINE = 0, 1, 2, 3
+
+#: Relative multiplier tolerance (times |column of H_B^-1| |c|).
+_EPS_DUAL = 1e-11
+#: Smallest |H_j p| (rows and p unit vectors) that blocks a step; smaller: parallel rows.
+_EPS_PIVOT = 1e-9
+#: Relative tie in the ratio test.
+_EPS_TIE = 1e-12
+#: Largest phase-1 infeasibility (units of h) of a feasible polytope.
+_EPS_FEASIBLE = 1e-9
+#: Relative norm under which a singular value or a row counts as zero.
+_RANK = 1e-12
+#: Pivots between two recomputations of the basis inverse.
+_REFACTOR = 16
+
+
+@njit(cache=True)
+def _column_norm(M, i):
+    """Euclidean norm of column i (a strided slice: a loop avoids a copy)."""
+    acc = 0.0
+    for k in range(M.shape[0]):
+        acc += M[k, i] * M[k, i]
+    return math.sqrt(acc)
+
+
+@njit(cache=True)
+def _norm(v):
+    """Euclidean norm (a loop: numba's linalg would add seconds of compile time)."""
+    acc = 0.0
+    for x in v:
+        acc += x * x
+    return math.sqrt(acc)
+
+
+@njit(cache=True)
+def _times(M, v):
+    """M v for a 2-D M (a loop, for compile time and no BLAS call on tiny sizes)."""
+    out = np.zeros(M.shape[0])
+    for i in range(M.shape[0]):
+        for j in range(M.shape[1]):
+            out[i] += M[i, j] * v[j]
+    return out
+
+
+@njit(cache=True)
+def _point(g0, GT, z):
+    """The projected point g0 + G z."""
+    y = g0.copy()
+    for r in range(GT.shape[0]):
+        y[0] += GT[r, 0] * z[r]
+        y[1] += GT[r, 1] * z[r]
+    return y
+
+
+@njit(cache=True)
+def _ratio_test(H, h, z, p, active):
+    """Largest step along unit ``p`` that keeps ``H z <= h``: (row, step), row -1 if none.
+
+    Ties (within a relative 1e-12) go to the smallest row index (Bland).
+    """
+    m, n = H.shape
+    hp = np.empty(m)
+    slack = np.empty(m)
+    best = math.inf
+    for j in range(m):
+        if active[j]:
+            continue
+        a = 0.0
+        b = h[j]
+        for k in range(n):
+            a += H[j, k] * p[k]
+            b -= H[j, k] * z[k]
+        hp[j] = a
+        slack[j] = b
+        if a > _EPS_PIVOT:
+            t = max(b, 0.0) / a
+            if t < best:
+                best = t
+    if best == math.inf:
+        return -1, 0.0
+    bound = best + _EPS_TIE * (1.0 + best)
+    for j in range(m):
+        if not active[j] and hp[j] > _EPS_PIVOT and max(slack[j], 0.0) / hp[j] <= bound:
+            return j, best
+    return -1, 0.0  # unreachable
+
+
+@njit(cache=True)
+def _project_out(Q, k, v, out):
+    """``out`` = v minus its components along the k orthonormal rows of Q; returns |out|."""
+    n = Q.shape[1]
+    out[:] = v
+    for _ in range(2):  # twice is enough (Kahan): keeps out orthogonal to working precision
+        for i in range(k):
+            d = 0.0
+            for j in range(n):
+                d += Q[i, j] * out[j]
+            for j in range(n):
+                out[j] -= d * Q[i, j]
+    acc = 0.0
+    for j in range(n):
+        acc += out[j] * out[j]
+    return math.sqrt(acc)
+
+
+@njit(cache=True)
+def _null_direction(Q, k, c, dc, p):
+    """Unit direction ``p`` orthogonal to the k working rows (orthonormal basis ``Q[:k]``),
+    lexicographically ascending for (c, dc): the projection of c, else of dc, else of the
+    coordinate axis that keeps most of its length.
+
+    Returns kind: 0 = ascending for c, 1 = ascending for dc only, 2 = neutral.
+    """
+    n = Q.shape[1]
+    kind = 0
+    norm = _project_out(Q, k, c, p)
+    if norm <= 1e-9:
+        kind = 1
+        norm = _project_out(Q, k, dc, p)
+    if norm <= 1e-9:
+        # Column norms of I - Q^T Q: |P e_i|^2 = 1 - sum_r Q[r, i]^2.
+        kind = 2
+        best, axis = -1.0, 0
+        for i in range(n):
+            left = 1.0
+            for r in range(k):
+                left -= Q[r, i] * Q[r, i]
+            if left > best:
+                best, axis = left, i
+        e = np.zeros(n)
+        e[axis] = 1.0
+        norm = _project_out(Q, k, e, p)
+    for j in range(n):
+        p[j] /= norm
+    return kind
+
+
+@njit(cache=True)
+def _crash(H, h, z, W, k, active, c, dc):
+    """Grow the working set to n rows by steps orthogonal to it (z feasible, moved in place).
+
+    Returns (status, k).
+    """
+    n = H.shape[1]
+    Q = np.zeros((n, n))  # orthonormal basis of the working rows, by Gram-Schmidt
+    p = np.empty(n)
+    for i in range(k):
+        norm = _project_out(Q, i, H[W[i]], Q[i])
+        Q[i] /= norm
+    while k < n:
+        kind = _null_direction(Q, k, c, dc, p)
+        j, t = _ratio_test(H, h, z, p, active)
+        if j < 0:
+            if kind != 2:
+                return FAILED, k  # ascending without bound
+            p *= -1.0
+            j, t = _ratio_test(H, h, z, p, active)
+            if j < 0:
+                return LINE, k  # a line in the polytope: no vertex
+        for i in range(n):
+            z[i] += t * p[i]
+        W[k] = j
+        active[j] = True
+        norm = _project_out(Q, k, H[j], Q[k])
+        Q[k] /= norm
+        k += 1
+    return OK, k
+
+
+@njit(cache=True)
+def _invert(B, out):
+    """Gauss-Jordan inverse with partial pivoting into ``out`` (B is overwritten).
+
+    For the small bases here this beats a LAPACK call through numba by its fixed cost.
+    Returns False when B is singular to working precision.
+    """
+    n = B.shape[0]
+    out[:, :] = 0.0
+    for i in range(n):
+        out[i, i] = 1.0
+    norm = 0.0
+    for i in range(n):
+        for j in range(n):
+            norm = max(norm, abs(B[i, j]))
+    for col in range(n):
+        piv = col
+        for r in range(col + 1, n):
+            if abs(B[r, col]) > abs(B[piv, col]):
+                piv = r
+        if abs(B[piv, col]) <= 1e-14 * norm:
+            return False
+        if piv != col:
+            for j in range(n):
+                B[col, j], B[piv, j] = B[piv, j], B[col, j]
+                out[col, j], out[piv, j] = out[piv, j], out[col, j]
+        inv = 1.0 / B[col, col]
+        for j in range(n):
+            B[col, j] *= inv
+            out[col, j] *= inv
+        for r in range(n):
+            if r != col:
+                f = B[r, col]
+                if f != 0.0:
+                    for j in range(n):
+                        B[r, j] -= f * B[col, j]
+                        out[r, j] -= f * out[col, j]
+    return True
+
+
+@njit(cache=True)
+def _refactor(H, h, W, Binv, z):
+    """Recompute the basis inverse and the vertex from scratch; False if singular."""
+    n = H.shape[1]
+    B = np.empty((n, n))
+    for i in range(n):
+        B[i] = H[W[i]]
+    if not _invert(B, Binv):
+        return False
+    _vertex(h, W, Binv, z)
+    return True
+
+
+@njit(cache=True)
+def _pivot(H, h, W, Binv, z, leave, j, since):
+    """Row ``j`` replaces the basis row in position ``leave``; updates Binv and z in place.
+
+    Returns the pivots since the last refactorisation.
+    """
+    n = H.shape[1]
+    W[leave] = j
+    if since + 1 >= _REFACTOR and _refactor(H, h, W, Binv, z):
+        return 0
+    # Rank-one update: column i of the new inverse is Binv[:, i] - col (a . Binv[:, i]) / piv
+    # for i != leave, and col / piv for i == leave, with col = Binv[:, leave], a = H[j].
+    col = np.empty(n)
+    alpha = np.zeros(n)
+    for r in range(n):
+        col[r] = Binv[r, leave]
+        for i in range(n):
+            alpha[i] += H[j, r] * Binv[r, i]
+    piv = alpha[leave]
+    for r in range(n):
+        for i in range(n):
+            if i == leave:
+                Binv[r, i] = col[r] / piv
+            else:
+                Binv[r, i] -= col[r] * (alpha[i] / piv)
+    _vertex(h, W, Binv, z)
+    return since + 1
+
+
+@njit(cache=True)
+def _vertex(h, W, Binv, z):
+    """z = Binv h_W."""
+    n = Binv.shape[0]
+    for r in range(n):
+        acc = 0.0
+        for i in range(n):
+            acc += Binv[r, i] * h[W[i]]
+        z[r] = acc
+
+
+@njit(cache=True)
+def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots):
+    """Simplex pivots from the vertex basis (W, Binv, z) until it is optimal for the
+    lexicographic objective (c, dc); ``scale`` scales the multiplier tolerance.
+    Returns (status, pivots)."""
+    n = H.shape[1]
+    pivots = 0
+    since = 0
+    p = np.empty(n)
+    stalled = 0  # consecutive zero steps
+    while True:
+        # Entering candidates: multipliers negative at theta+. Steepest edge (most negative
+        # lambda_i / |Binv[:, i]|, the objective's rate along the unit edge direction), with
+        # the theta-derivative as a tie-break tier; Bland's rule once zero steps pile up.
+        bland = stalled > 2 * n
+        leave = -1
+        tier = 2
+        best = 0.0
+        for i in range(n):
+            # lambda_i = Binv[:, i] . c, its theta-derivative Binv[:, i] . dc
+            lam, dlam, norm = 0.0, 0.0, 0.0
+            for r in range(n):
+                lam += Binv[r, i] * c[r]
+                dlam += Binv[r, i] * dc[r]
+                norm += Binv[r, i] * Binv[r, i]
+            norm = math.sqrt(norm)
+            eps = _EPS_DUAL * scale * max(1.0, norm)
+            if lam < -eps:
+                this_tier, rate = 0, lam / norm
+            elif lam <= eps and dlam < -eps:
+                this_tier, rate = 1, dlam / norm
+            else:
+                continue
+            if bland:
+                if leave < 0 or W[i] < W[leave]:
+                    leave = i
+            elif this_tier < tier or (this_tier == tier and rate < best):
+                leave, tier, best = i, this_tier, rate
+        if leave < 0:
+            return OK, pivots
+        pivots += 1
+        if pivots > max_pivots:
+            return FAILED, pivots
+        norm = _column_norm(Binv, leave)
+        for r in range(n):
+            p[r] = -Binv[r, leave] / norm
+        active[W[leave]] = False
+        j, t = _ratio_test(H, h, z, p, active)
+        if j < 0:
+            return FAILED, pivots  # unbounded edge: the box is missing
+        stalled = stalled + 1 if t == 0.0 else 0
+        active[j] = True
+        since = _pivot(H, h, W, Binv, z, leave, j, since)
+
+
+@njit(cache=True)
+def _breakpoint(Binv, GT, theta, scale):
+    """Smallest angle > theta at which a multiplier of the basis turns negative (inf if none)."""
+    n = Binv.shape[0]
+    step = math.inf
+    for i in range(n):
+        # lambda_i(theta) = a cos(theta) + b sin(theta)
+        a = 0.0
+        b = 0.0
+        for k in range(n):
+            a += GT[k, 0] * Binv[k, i]
+            b += GT[k, 1] * Binv[k, i]
+        rho = math.hypot(a, b)
+        if rho <= _EPS_DUAL * scale * max(1.0, _column_norm(Binv, i)):
+            continue  # identically zero multiplier
+        # lambda_i = rho cos(theta - alpha_i) turns negative when theta - alpha_i passes pi/2
+        d = (math.atan2(b, a) + 0.5 * math.pi - theta) % (2.0 * math.pi)
+        if d < 1e-13:
+            d = 2.0 * math.pi
+        step = min(step, d)
+    return theta + step
+
+
+@njit(cache=True)
+def walk(H, h, GT, g0, theta0, max_pivots):
+    """Vertices of ``g0 + G {z : H z <= h}`` (rows of H unit norm; ``GT`` = G^T, n x 2).
+
+    Returns (status, vertices, count, pivots): ``vertices[:count]`` are the support points
+    in counter-clockwise order, consecutive duplicates removed (the last may equal the first).
+    """
+    m, n = H.shape
+    vertices = np.empty((0, 2))
+    # Phase 1: max -s over {H z - s <= h, s >= 0} from (0, s0), s0 feasible.
+    Ha = np.zeros((m + 1, n + 1))
+    Ha[:m, :n] = H
+    Ha[:m, n] = -1.0
+    Ha[m, n] = -1.0
+    ha = np.zeros(m + 1)
+    ha[:m] = h
+    za = np.zeros(n + 1)
+    za[n] = max(0.0, -h.min()) + 1.0
+    Wa = np.zeros(n + 1, dtype=np.int64)
+    active_a = np.zeros(m + 1, dtype=np.bool_)
+    c1 = np.zeros(n + 1)
+    c1[n] = -1.0
+    status, _ = _crash(Ha, ha, za, Wa, 0, active_a, c1, np.zeros(n + 1))
+    if status != OK:
+        return status, vertices, 0, 0
+    Binv_a = np.empty((n + 1, n + 1))
+    if not _refactor(Ha, ha, Wa, Binv_a, za):
+        return FAILED, vertices, 0, 0
+    status, pivots = _optimize(Ha, ha, za, Wa, Binv_a, active_a, c1, np.zeros(n + 1), 1.0, max_pivots)
+    if status != OK:
+        return status, vertices, 0, pivots
+    if za[n] > _EPS_FEASIBLE:
+        return INFEASIBLE, vertices, 0, pivots
+    # Phase 2: an optimal basis for theta0+, then around the circle. When s >= 0 is in the
+    # phase-1 basis, the other n rows are a vertex basis of {H z <= h}; else crash again.
+    z = za[:n].copy()
+    W = np.zeros(n, dtype=np.int64)
+    active = np.zeros(m, dtype=np.bool_)
+    k = 0
+    if active_a[m]:
+        for i in range(n + 1):
+            if Wa[i] != m:
+                W[k] = Wa[i]
+                active[Wa[i]] = True
+                k += 1
+    u = np.array([math.cos(theta0), math.sin(theta0)])
+    du = np.array([-math.sin(theta0), math.cos(theta0)])
+    c, dc = _times(GT, u), _times(GT, du)
+    status, k = _crash(H, h, z, W, k, active, c, dc)
+    if status != OK:
+        return status, vertices, 0, pivots
+    Binv = np.empty((n, n))
+    if not _refactor(H, h, W, Binv, z):
+        return FAILED, vertices, 0, pivots
+    scale = _norm(GT.ravel())  # sqrt(|G^T u|^2 + |G^T u'|^2), the same for every theta
+    status, piv = _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots)
+    pivots += piv
+    if status != OK:
+        return status, vertices, 0, pivots
+    vertices = np.empty((max_pivots + 2, 2))
+    vertices[0] = _point(g0, GT, z)
+    count = 1
+    theta = theta0
+    while True:
+        theta = _breakpoint(Binv, GT, theta, scale)
+        if theta >= theta0 + 2.0 * math.pi:
+            break
+        u[0], u[1] = math.cos(theta), math.sin(theta)
+        du[0], du[1] = -math.sin(theta), math.cos(theta)
+        if not _refactor(H, h, W, Binv, z):  # each vertex from a fresh inverse: no drift
+            return FAILED, vertices, count, pivots
+        status, piv = _optimize(H, h, z, W, Binv, active, _times(GT, u), _times(GT, du), scale, max_pivots)
+        pivots += piv
+        if status != OK or count > max_pivots:
+            return FAILED, vertices, count, pivots
+        # piv == 0: the crossing multiplier was within the tolerance of zero; the next
+        # breakpoint search starts past it.
+        y = _point(g0, GT, z)
+        if abs(y[0] - vertices[count - 1, 0]) + abs(y[1] - vertices[count - 1, 1]) > 0.0:
+            vertices[count] = y
+            count += 1
+    return OK, vertices, count, pivots
+
+
+@njit(cache=True)
+def project(A, b, E, x0, N, box, merge_tol, max_pivots):
+    """Projection of ``{x : A x <= b, x = x0 + N z}`` onto ``y = E x``, clipped to ``|y_k| <= box``.
+
+    Drops zero rows of ``A N`` (checking them), scales the rows to unit norm, adds the box as
+    four rows, walks, and merges vertices within ``merge_tol``.
+    Returns (status, vertices (k, 2) counter-clockwise, pivots).
+    """
+    none = np.empty((0, 2))
+    n, k = N.shape
+    m0 = A.shape[0]
+    H0 = np.zeros((m0, k))
+    h0 = b - _times(A, x0)
+    G = np.zeros((2, k))
+    g0 = _times(E, x0)
+    for i in range(m0):
+        for r in range(n):
+            if A[i, r] != 0.0:  # A is sparse (contact blocks)
+                for j in range(k):
+                    H0[i, j] += A[i, r] * N[r, j]
+    for i in range(2):
+        for r in range(n):
+            for j in range(k):
+                G[i, j] += E[i, r] * N[r, j]
+    if k == 0:  # a single point
+        for i in range(m0):
+            if h0[i] < -_EPS_FEASIBLE:
+                return INFEASIBLE, none, 0
+        out = np.empty((1, 2))
+        out[0] = g0
+        return OK, out, 0
+    # Unit rows; zero rows are checked then dropped.
+    norms = np.empty(m0)
+    biggest = 1.0
+    for i in range(m0):
+        norms[i] = _norm(H0[i])
+        biggest = max(biggest, norms[i])
+    H = np.empty((m0 + 4, k))
+    h = np.empty(m0 + 4)
+    m = 0
+    for i in range(m0):
+        if norms[i] <= _RANK * biggest:
+            if h0[i] < -_EPS_FEASIBLE:
+                return INFEASIBLE, none, 0
+        else:
+            H[m] = H0[i] / norms[i]
+            h[m] = h0[i] / norms[i]
+            m += 1
+    # The clipping box: +-G_k z <= box -+ g0_k.
+    for i in range(2):
+        gk = _norm(G[i])
+        if gk > 0.0:
+            H[m] = G[i] / gk
+            h[m] = (box - g0[i]) / gk
+            H[m + 1] = -G[i] / gk
+            h[m + 1] = (box + g0[i]) / gk
+            m += 2
+    status, vertices, count, pivots = walk(H[:m].copy(), h[:m].copy(), G.T.copy(), g0, 0.0, max_pivots)
+    if status != OK:
+        return status, none, pivots
+    return OK, _simplify(vertices[:count].copy(), merge_tol), pivots
+
+
+@njit(cache=True)
+def equality_basis(C, d):
+    """``x = x0 + N z`` spanning ``{x : C x = d}``: minimum-norm x0, orthonormal columns N.
+
+    Modified Gram-Schmidt (twice) on the rows of C; dependent rows are checked for
+    consistency. Returns (status, x0, N); status INFEASIBLE for inconsistent equalities.
+    """
+    m, n = C.shape
+    Q = np.zeros((n, n))  # orthonormal rows: the row space of C, then its complement
+    y = np.zeros(n)  # coordinates of x0 along Q's rows
+    scale = 1.0
+    size = 1.0
+    for i in range(m):
+        scale = max(scale, _norm(C[i]))
+        size += abs(d[i])
+    r = 0
+    v = np.empty(n)
+    for i in range(m):
+        v[:] = C[i]
+        di = d[i]
+        for _ in range(2):
+            for k in range(r):
+                c = 0.0
+                for j in range(n):
+                    c += Q[k, j] * v[j]
+                for j in range(n):
+                    v[j] -= c * Q[k, j]
+                di -= c * y[k]
+        nv = _norm(v)
+        if nv <= 1e-10 * scale:  # a dependent row: it must agree with the others
+            if abs(di) > _EPS_FEASIBLE * size:
+                return INFEASIBLE, np.zeros(n), np.zeros((n, 0))
+            continue
+        for j in range(n):
+            Q[r, j] = v[j] / nv
+        y[r] = di / nv
+        r += 1
+    x0 = np.zeros(n)
+    for k in range(r):
+        for j in range(n):
+            x0[j] += y[k] * Q[k, j]
+    # Complete Q with the coordinate axes that keep most of their length (pivoted).
+    e = np.empty(n)
+    for count in range(r, n):
+        best, axis = -1.0, 0
+        for i in range(n):
+            left = 1.0
+            for k in range(count):
+                left -= Q[k, i] * Q[k, i]
+            if left > best:
+                best, axis = left, i
+        e[:] = 0.0
+        e[axis] = 1.0
+        norm = _project_out(Q, count, e, v)
+        for j in range(n):
+            Q[count, j] = v[j] / norm
+    return OK, x0, Q[r:].T.copy()

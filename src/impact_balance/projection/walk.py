@@ -1,0 +1,87 @@
+"""Projection of a polytope onto a plane by a parametric simplex walk around the polygon.
+
+The support point of ``E P`` in direction ``u(theta) = (cos theta, sin theta)`` is the
+projection of an optimal vertex of ``max u^T E x`` over ``P = {A x <= b, C x = d}``. A vertex
+basis stays optimal over an arc of theta that has a closed form; at its end one simplex pivot
+(or a few, at a degenerate vertex) gives the next basis. Walking theta once around the circle
+visits every vertex of the projected polygon in counter-clockwise order. This is what
+Bretl & Lall's algorithm computes with one LP per edge, but each step here is a pivot on a
+dense n x n basis instead of a solver call, in a compiled kernel
+(:mod:`impact_balance.projection._kernel`).
+
+Before walking, the equalities are eliminated (``x = x0 + N z``), zero rows are checked and
+dropped, rows are scaled to unit norm, and the clipping box ``|y_k| <= box`` is added as four
+rows, so unbounded directions are clipped as in the Bretl path. The vertices are exact
+support points (no stopping tolerance); duplicates and collinear ones are merged within
+``merge_tol`` as in the Bretl path.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from .._jit import HAVE_NUMBA
+
+from ..polygon import Polygon
+from ._kernel import FAILED, INFEASIBLE, LINE, equality_basis, project
+from .result import ProjectionResult
+
+__all__ = ["project_walk", "kernel_is_compiled"]
+
+#: Relative singular-value threshold for the rank of the lines of the polytope.
+RANK_TOLERANCE = 1e-12
+
+def project_walk(
+    A: np.ndarray,
+    b: np.ndarray,
+    C: np.ndarray,
+    d: np.ndarray,
+    E: np.ndarray,
+    box: float = 1e3,
+    merge_tol: float = 1e-8,
+    max_pivots: int = 5000,
+) -> ProjectionResult | None:
+    """Project ``{x : A x <= b, C x = d}`` onto ``y = E x`` (2 x n), clipped to ``|y_k| <= box``.
+
+    Lines in the polytope (directions the constraints leave free and E ignores) are
+    quotiented out. Returns None when the walk cannot answer (a pivot met a numerical dead
+    end, or an iteration cap): the caller falls back to :func:`~.bretl.project_bretl`.
+    """
+    E = np.ascontiguousarray(E, dtype=float)
+    n = E.shape[1]
+    A = np.ascontiguousarray(np.reshape(A, (-1, n)), dtype=float)
+    C = np.ascontiguousarray(np.reshape(C, (-1, n)), dtype=float)
+    b = np.ascontiguousarray(np.reshape(b, -1), dtype=float)
+    d = np.ascontiguousarray(np.reshape(d, -1), dtype=float)
+    # x = x0 + N z spans {C x = d} (compiled Gram-Schmidt, cheaper than a numpy SVD here).
+    status, x0, N = equality_basis(C, d)
+    if status == INFEASIBLE:
+        return ProjectionResult(Polygon.empty(), "walk")
+    status, vertices, pivots = project(A, b, E, x0, N, float(box), float(merge_tol), int(max_pivots))
+    if status == LINE:
+        # Lines of the polytope are the null space of [A N; E N] (a line along which E x
+        # changed would have met the box rows); keep z in its orthogonal complement.
+        _, S, Vt = np.linalg.svd(np.vstack([A @ N, E @ N]))
+        r = int(np.sum(S > RANK_TOLERANCE * max(float(S[0]) if S.size else 0.0, 1.0)))
+        N = np.ascontiguousarray(N @ Vt[:r].T)
+        status, vertices, more = project(A, b, E, x0, N, float(box), float(merge_tol), int(max_pivots))
+        pivots += more
+    if status in (FAILED, LINE):
+        return None
+    if status == INFEASIBLE:
+        return ProjectionResult(Polygon.empty(), "walk", n_lp=1, pivots=pivots)
+    bounded = bool(np.all(np.abs(vertices) < box * (1 - 1e-9)))
+    return ProjectionResult(Polygon(vertices, bounded), "walk", n_lp=1, pivots=pivots)
+
+
+def kernel_is_compiled() -> bool:
+    """Whether numba's on-disk cache holds the kernel; if not, the first projection compiles
+    it (10 to 30 s, once per installation). True without numba (nothing to compile)."""
+    if not HAVE_NUMBA:
+        return True
+    try:  # numba's cache index of the entry point; private API, hence the guard
+        return os.path.exists(project._cache._cache_file._index_path)
+    except AttributeError:
+        return True
