@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..exceptions import SolverError
-from .bretl import INITIAL_ANGLES, project_bretl
+from .bretl import project_bretl
 from .result import ProjectionResult
 from .walk import project_walk
 

@@ -140,6 +140,23 @@ def _project_out(Q, k, v, out):
 
 
 @njit(cache=True)
+def _longest_axis(Q, k, out):
+    """``out`` = the coordinate axis that keeps most of its length once the k orthonormal rows
+    of Q are projected out (pivoted, hence well conditioned), projected; returns |out|."""
+    n = Q.shape[1]
+    best, axis = -1.0, 0
+    for i in range(n):
+        left = 1.0  # |P e_i|^2 = 1 - sum_r Q[r, i]^2
+        for r in range(k):
+            left -= Q[r, i] * Q[r, i]
+        if left > best:
+            best, axis = left, i
+    e = np.zeros(n)
+    e[axis] = 1.0
+    return _project_out(Q, k, e, out)
+
+
+@njit(cache=True)
 def _null_direction(Q, k, c, dc, p):
     """Unit direction ``p`` orthogonal to the k working rows (orthonormal basis ``Q[:k]``),
     lexicographically ascending for (c, dc): the projection of c, else of dc, else of the
@@ -147,27 +164,15 @@ def _null_direction(Q, k, c, dc, p):
 
     Returns kind: 0 = ascending for c, 1 = ascending for dc only, 2 = neutral.
     """
-    n = Q.shape[1]
     kind = 0
     norm = _project_out(Q, k, c, p)
     if norm <= 1e-9:
         kind = 1
         norm = _project_out(Q, k, dc, p)
     if norm <= 1e-9:
-        # Column norms of I - Q^T Q: |P e_i|^2 = 1 - sum_r Q[r, i]^2.
         kind = 2
-        best, axis = -1.0, 0
-        for i in range(n):
-            left = 1.0
-            for r in range(k):
-                left -= Q[r, i] * Q[r, i]
-            if left > best:
-                best, axis = left, i
-        e = np.zeros(n)
-        e[axis] = 1.0
-        norm = _project_out(Q, k, e, p)
-    for j in range(n):
-        p[j] /= norm
+        norm = _longest_axis(Q, k, p)
+    p /= norm
     return kind
 
 
@@ -562,19 +567,9 @@ def equality_basis(C, d):
     for k in range(r):
         for j in range(n):
             x0[j] += y[k] * Q[k, j]
-    # Complete Q with the coordinate axes that keep most of their length (pivoted).
-    e = np.empty(n)
+    # Complete Q with the coordinate axes that keep most of their length.
     for count in range(r, n):
-        best, axis = -1.0, 0
-        for i in range(n):
-            left = 1.0
-            for k in range(count):
-                left -= Q[k, i] * Q[k, i]
-            if left > best:
-                best, axis = left, i
-        e[:] = 0.0
-        e[axis] = 1.0
-        norm = _project_out(Q, count, e, v)
+        norm = _longest_axis(Q, count, v)
         for j in range(n):
             Q[count, j] = v[j] / norm
     return OK, x0, Q[r:].T.copy()
