@@ -1,0 +1,39 @@
+"""``impact-balance analyze SCENARIO``: one scenario, as text or one JSON object."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+__all__ = ["add_parser", "run", "USES_KERNEL"]
+
+USES_KERNEL = True
+
+
+def add_parser(sub) -> list[str]:
+    a = sub.add_parser("analyze", help="analyze one scenario (file or bundled name)")
+    a.add_argument("scenario", help="YAML file, or the name of a bundled scenario (see `impact-balance scenarios`)")
+    a.add_argument("--json", action="store_true", help="print one JSON object")
+    a.add_argument("--plots", metavar="DIR", help="write the scenario's figures to DIR")
+    a.add_argument("--qp", action="store_true", help="also solve the paper's QP in joint velocities")
+    return ["analyze"]
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..analysis import analyze
+    from ..report import format_analysis
+
+    analysis = analyze(args.scenario, solve_qp=True if args.qp else None)
+    written = []
+    if args.plots:
+        from ..plots import save_figures
+
+        written = save_figures(analysis, Path(args.plots))
+    if args.json:
+        print(json.dumps(analysis.to_dict()))
+    else:
+        print(format_analysis(analysis))
+        for path in written:
+            print(f"  figure: {path}")
+    return 0

@@ -1,0 +1,29 @@
+"""``impact-balance scenarios`` and ``impact-balance robots``: what is bundled."""
+
+from __future__ import annotations
+
+import argparse
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub) -> list[str]:
+    sub.add_parser("scenarios", help="list the bundled scenarios")
+    sub.add_parser("robots", help="list the bundled robots")
+    return ["scenarios", "robots"]
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.command == "scenarios":
+        from ..scenario import bundled_scenarios
+
+        items = bundled_scenarios()
+        width = max(map(len, items), default=0)
+        for name, description in items.items():
+            print(f"{name:<{width}}  {description}")
+    else:
+        from ..robot import BUNDLED_ROBOTS
+
+        for name, spec in BUNDLED_ROBOTS.items():
+            print(f"{name:<6}  {spec.description}")
+    return 0
