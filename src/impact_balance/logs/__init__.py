@@ -1,0 +1,11 @@
+"""Time-series logs of a robot's motion: one schema, written by the simulation and read by the log checker.
+
+A log is a table, one row per sample, stored as Parquet (``.parquet``) or CSV (``.csv``).
+See :mod:`impact_balance.logs.schema` for the columns.
+"""
+
+from .io import read_log, write_log
+from .schema import LOG_VERSION, LogColumns, joint_position_column, joint_velocity_column, force_columns
+
+__all__ = ["read_log", "write_log", "LOG_VERSION", "LogColumns", "joint_position_column",
+           "joint_velocity_column", "force_columns"]
