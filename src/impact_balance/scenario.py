@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
 from typing import Any, Literal
@@ -37,6 +38,9 @@ __all__ = [
     "scenario_path",
     "scenario_from_dict",
 ]
+
+#: ``extends`` resolver: (the value, the file that extends) -> the file to read.
+ExtendsResolver = Callable[[str, Path], Path]
 
 Vec2 = tuple[float, float]
 Vec3 = tuple[float, float, float]
@@ -332,7 +336,7 @@ def _merge(base: dict, override: dict) -> dict:
     return out
 
 
-def _read(path: Path, seen: tuple[Path, ...] = ()) -> dict:
+def _read(path: Path, seen: tuple[Path, ...] = (), resolve_path: ExtendsResolver | None = None) -> dict:
     if path.resolve() in seen:
         raise ScenarioError("extends", str(path), "circular extends")
     try:
@@ -356,12 +360,15 @@ def _read(path: Path, seen: tuple[Path, ...] = ()) -> dict:
             raise ScenarioError("extends", parent, "must be a bundled scenario name or a file path")
         candidate = path.parent / parent
         try:
-            parent_path = candidate if candidate.is_file() else scenario_path(parent)
+            if resolve_path is not None:
+                parent_path = resolve_path(parent, path)
+            else:
+                parent_path = candidate if candidate.is_file() else scenario_path(parent)
         except UnknownScenarioError as exc:
             raise UnknownScenarioError("extends", parent, exc.valid, str(path)) from None
         except ScenarioError as exc:
             raise ScenarioError("extends", parent, exc.reason, str(path)) from None
-        raw = _merge(_read(parent_path, seen + (path.resolve(),)), raw)
+        raw = _merge(_read(parent_path, seen + (path.resolve(),), resolve_path), raw)
     return raw
 
 
@@ -417,9 +424,15 @@ def with_source(exc: ScenarioError, source: str | None) -> ScenarioError:
     return exc
 
 
-def load_scenario(name_or_path: str | Path) -> Scenario:
-    """Load and validate a scenario file (or a bundled scenario by name)."""
+def load_scenario(name_or_path: str | Path, resolve_path: ExtendsResolver | None = None) -> Scenario:
+    """Load and validate a scenario file (or a bundled scenario by name).
+
+    Args:
+        resolve_path: Optional rule for ``extends:`` (value, path of the file that extends) ->
+            path to read, raising :class:`ScenarioError` to refuse. The GUI passes its
+            workspace's rule; without it, a path relative to the file or a bundled name.
+    """
     path = scenario_path(name_or_path)
-    raw = _read(path)
+    raw = _read(path, (), resolve_path)
     raw.setdefault("name", path.stem)
     return scenario_from_dict(raw, str(path))
