@@ -79,7 +79,7 @@ def _split_host(value: str) -> tuple[str, int | None] | None:
     else:
         host, sep, port = value.partition(":")
         rest = sep + port
-    if rest and not (rest.startswith(":") and rest[1:].isdigit() and len(rest) <= 6):
+    if rest and not (rest.startswith(":") and rest[1:].isdigit() and len(rest) <= 6 and int(rest[1:]) <= 65535):
         return None
     if not host:
         return None
