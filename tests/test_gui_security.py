@@ -226,7 +226,7 @@ def test_messages_never_quote_file_content(session, ws):
     (ws / "secret.yaml").write_text(f"password: {SECRET}\ntoken: {'x' * 5000}\n")
     assert not session.load("secret.yaml")
     assert SECRET not in session.message and "xxxxx" not in session.message
-    assert session.message in ("secret.yaml: password: unknown key", "secret.yaml: token: unknown key")
+    assert session.message.startswith(("secret.yaml: password: unknown key", "secret.yaml: token: unknown key"))
     (ws / "broken.yaml").write_text(f"contacts: [\n  {SECRET}: [\n")
     assert not session.load("broken.yaml")
     assert SECRET not in session.message and "not valid YAML" in session.message

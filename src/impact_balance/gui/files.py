@@ -58,12 +58,13 @@ def describe(exc: BaseException, workspace: Workspace | None = None) -> str:
         if source and workspace is not None:
             source = workspace.relative(source) or Path(source).name
         where = f"{source}: " if source else ""
-        if exc.reason == "unknown key" or exc.value is None:
+        if str(exc.reason).startswith("unknown key") or exc.value is None:
             text = f"{where}{exc.field}: {exc.reason}"
         else:
             text = f"{where}{exc.field} = {_short(exc.value)}: {exc.reason}"
+        text = " ".join(text.split())  # one line
     elif isinstance(exc, ImpactBalanceError):
-        text = str(exc)
+        text = " ".join(str(exc).split())
     else:
         text = f"internal error ({exc.__class__.__name__})"
     return text if len(text) <= MAX_MESSAGE else text[: MAX_MESSAGE - 3] + "..."
