@@ -14,6 +14,7 @@ from typing import Any
 __all__ = [
     "ImpactBalanceError",
     "ScenarioError",
+    "WorkspaceError",
     "UnknownNameError",
     "UnknownRobotError",
     "UnknownFrameError",
@@ -23,7 +24,6 @@ __all__ = [
     "RobotLoadError",
     "ImpactModelError",
     "SolverError",
-    "WorkspaceError",
 ]
 
 
@@ -101,6 +101,20 @@ class UnknownScenarioError(UnknownNameError):
     kind = "scenario"
 
 
+class WorkspaceError(ScenarioError):
+    """A file name outside what the workspace allows (see :mod:`impact_balance.workspace`).
+
+    Attributes:
+        field: What named the file ("file", "extends", "robot.urdf", "workspace").
+        value: The name, cut to 80 characters.
+        reason: Why it is refused.
+    """
+
+    def __init__(self, field: str, value: str, reason: str):
+        text = str(value)
+        super().__init__(field, text if len(text) <= 80 else text[:77] + "...", reason)
+
+
 class RobotLoadError(ImpactBalanceError):
     """A robot description (URDF/SRDF) cannot be read.
 
@@ -142,17 +156,3 @@ class SolverError(ImpactBalanceError, RuntimeError):
         self.status = status
         extra = f": {detail}" if detail else ""
         super().__init__(f"{solver} failed with status {status}{extra}")
-
-
-class WorkspaceError(ScenarioError):
-    """A file name outside what the workspace allows (see :mod:`impact_balance.workspace`).
-
-    Attributes:
-        field: What named the file ("file", "extends", "robot.urdf", "workspace").
-        value: The name, cut to 80 characters.
-        reason: Why it is refused.
-    """
-
-    def __init__(self, field: str, value: str, reason: str):
-        text = str(value)
-        super().__init__(field, text if len(text) <= 80 else text[:77] + "...", reason)

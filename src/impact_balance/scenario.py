@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable
+import typing
 from importlib import resources
 from pathlib import Path
 from typing import Any, Literal
@@ -40,7 +40,7 @@ __all__ = [
 ]
 
 #: ``extends`` resolver: (the value, the file that extends) -> the file to read.
-ExtendsResolver = Callable[[str, Path], Path]
+ExtendsResolver = typing.Callable[[str, Path], Path]
 
 Vec2 = tuple[float, float]
 Vec3 = tuple[float, float, float]
