@@ -195,6 +195,31 @@ def test_upload_is_confined_and_bounded(session, ws):
     assert not session.upload("bin.yaml", b"\xff\xfe") and "UTF-8" in session.message
 
 
+ALIAS_BOMB = "\n".join(
+    [f"a0: &a0 [{', '.join(['lol'] * 9)}]"]
+    + [f"a{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 9)}]" for i in range(1, 9)]
+    + ["contacts: *a8", ""]
+).encode()  # 370 bytes that expand to 9^9 items
+
+
+@pytest.mark.parametrize("content", [ALIAS_BOMB, b"contacts: " + b"[" * 600 + b"]" * 600 + b"\n"],
+                         ids=["alias-bomb", "deep-nesting"])
+def test_hostile_uploads_are_refused_without_hanging(session, content):
+    import threading
+
+    state = session.state
+    done = threading.Event()
+
+    def upload():
+        session.upload("hostile.yaml", content)
+        done.set()
+
+    threading.Thread(target=upload, daemon=True).start()
+    assert done.wait(60), "the upload hangs"  # a hang guard, not a speed test
+    assert session.refused and session.state is state
+    assert session.message.startswith("hostile.yaml") and len(session.message) <= 300 and "lol" not in session.message
+
+
 def test_robot_files_must_be_in_the_workspace(session, ws):
     erd = example_robot_data_root()
     urdf, srdf = erd / "talos_data/robots/talos_reduced.urdf", erd / "talos_data/srdf/talos.srdf"

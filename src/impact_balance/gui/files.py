@@ -20,7 +20,7 @@ from importlib import resources
 from pathlib import Path
 
 from ..exceptions import ImpactBalanceError, ScenarioError, UnknownScenarioError, WorkspaceError
-from ..scenario import RobotFiles, Scenario, bundled_scenarios, load_scenario
+from ..scenario import ExtendsResolver, RobotFiles, Scenario, bundled_scenarios, load_scenario
 from ..workspace import MAX_FILE_BYTES, Workspace
 from .state import GuiState
 
@@ -70,6 +70,14 @@ def describe(exc: BaseException, workspace: Workspace | None = None) -> str:
     return text if len(text) <= MAX_MESSAGE else text[: MAX_MESSAGE - 3] + "..."
 
 
+def _load(path: Path, resolve: ExtendsResolver, shown: str) -> Scenario:
+    """:func:`load_scenario` with a last net: a file nested too deeply for Python is refused."""
+    try:
+        return load_scenario(path, resolve_path=resolve)
+    except RecursionError:
+        raise ScenarioError("scenario", shown, "nested too deeply", shown) from None
+
+
 class GuiFiles:
     """Loads, uploads and saves of one GUI, confined to one workspace.
 
@@ -114,7 +122,7 @@ class GuiFiles:
                                            sorted(_bundled_names()))
             return GuiState.from_file(path)
         path = self.workspace.resolve(name)
-        scenario = load_scenario(path, resolve_path=self._extends)
+        scenario = _load(path, self._extends, name)
         return GuiState.from_scenario(self._robot_files(scenario, path.parent))
 
     def upload(self, filename: str, content: bytes) -> GuiState:
@@ -133,7 +141,7 @@ class GuiFiles:
             path = Path(tmp) / f"{stem}.yaml"
             path.write_text(text, encoding="utf-8")
             try:
-                scenario = load_scenario(path, resolve_path=self._extends)
+                scenario = _load(path, self._extends, shown)
             except ScenarioError as exc:
                 value = shown if exc.value == str(path) else exc.value
                 raise ScenarioError(exc.field, value, exc.reason, shown) from None
