@@ -12,6 +12,7 @@ from __future__ import annotations
 import asyncio
 import html
 import logging
+import os
 import threading
 import time
 from collections import deque
@@ -450,8 +451,9 @@ class GuiApp:
             self.w_impact_inertia.value = impact.inertia
             self.w_impact_duration.value = float(impact.duration)
         # File: the workspace name of the file last loaded (not a bundled one, not an upload).
-        name = self.workspace.relative(state.source) if state.source else None
-        if name is not None and Path(state.source).is_absolute():
+        source = state.source
+        name = self.workspace.relative(os.path.abspath(source)) if source and source.endswith((".yaml", ".yml")) else None
+        if name is not None:
             self.w_file.value = name
 
     # -- controls -------------------------------------------------------------------------
