@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import functools
 import math
+import typing
 from importlib import resources
 from pathlib import Path
 from typing import Any, Literal
@@ -18,7 +19,8 @@ import pinocchio as pin
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
-from .exceptions import ScenarioError, UnknownScenarioError
+from .exceptions import ScenarioError, UnknownKeyError, UnknownScenarioError
+from .input_limits import MAX_EXTENDS, check_path_text, check_structure, read_yaml
 from .impact import ImpactSpec
 from .robot import Robot, load_robot
 from .spatial import pose
@@ -246,6 +248,9 @@ class Scenario(_Model):
     # -- resolution against a robot model -------------------------------------------------
     def load_robot(self) -> Robot:
         if isinstance(self.robot, RobotFiles):
+            check_path_text("robot.urdf", self.robot.urdf, self.source)
+            if self.robot.srdf:
+                check_path_text("robot.srdf", self.robot.srdf, self.source)
             base = Path(self.source).parent if self.source else Path.cwd()
             urdf = (base / self.robot.urdf).resolve()
             srdf = (base / self.robot.srdf).resolve() if self.robot.srdf else None
@@ -311,13 +316,14 @@ def bundled_scenarios() -> dict[str, str]:
 
 def scenario_path(name_or_path: str | Path) -> Path:
     """A scenario file's path: an existing file, or the name of a bundled scenario."""
+    check_path_text("scenario", str(name_or_path))
     path = Path(name_or_path)
-    if path.is_file():
+    if _is_file(path):
         return path
     if path.suffix in (".yaml", ".yml") or "/" in str(name_or_path) or "\\" in str(name_or_path):
         raise ScenarioError("scenario", str(name_or_path), "no such file")
     bundled = _scenario_dir() / f"{name_or_path}.yaml"
-    if bundled.is_file():
+    if _is_file(Path(str(bundled))):
         return Path(str(bundled))
     raise UnknownScenarioError("scenario", str(name_or_path), list(bundled_scenarios()))
 
@@ -332,20 +338,19 @@ def _merge(base: dict, override: dict) -> dict:
     return out
 
 
+def _is_file(path: Path) -> bool:
+    try:
+        return path.is_file()
+    except (OSError, ValueError):  # a name the OS refuses is simply not an existing file
+        return False
+
+
 def _read(path: Path, seen: tuple[Path, ...] = ()) -> dict:
     if path.resolve() in seen:
         raise ScenarioError("extends", str(path), "circular extends")
-    try:
-        text = path.read_text()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ScenarioError("scenario", str(path), f"cannot read: {exc.__class__.__name__}") from None
-    try:
-        raw = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(exc, "problem", None) or "syntax error"
-        raise ScenarioError("scenario", str(path), f"not valid YAML: {problem}{where}") from None
+    if len(seen) >= MAX_EXTENDS:
+        raise ScenarioError("extends", str(path), f"a chain of more than {MAX_EXTENDS} extends")
+    raw = read_yaml(path)
     if raw is None:
         raise ScenarioError("scenario", str(path), "the file is empty")
     if not isinstance(raw, dict):
@@ -353,10 +358,11 @@ def _read(path: Path, seen: tuple[Path, ...] = ()) -> dict:
     parent = raw.pop("extends", None)
     if parent is not None:
         if not isinstance(parent, str):
-            raise ScenarioError("extends", parent, "must be a bundled scenario name or a file path")
+            raise ScenarioError("extends", parent, "must be a bundled scenario name or a file path", str(path))
+        check_path_text("extends", parent, str(path))
         candidate = path.parent / parent
         try:
-            parent_path = candidate if candidate.is_file() else scenario_path(parent)
+            parent_path = candidate if _is_file(candidate) else scenario_path(parent)
         except UnknownScenarioError as exc:
             raise UnknownScenarioError("extends", parent, exc.valid, str(path)) from None
         except ScenarioError as exc:
@@ -379,6 +385,7 @@ def _field(loc: tuple) -> str:
 
 def scenario_from_dict(raw: dict, source: str | None = None) -> Scenario:
     """Validate a scenario mapping; raises :class:`ScenarioError` on the first bad field."""
+    check_structure(raw, source)
     try:
         return Scenario.model_validate({**raw, "source": source})
     except ValidationError as exc:
@@ -388,8 +395,8 @@ def scenario_from_dict(raw: dict, source: str | None = None) -> Scenario:
         loc = tuple(p for p in err["loc"] if p not in ("str", "RobotFiles"))
         reason = err["msg"].removeprefix("Value error, ")
         value = err.get("input")
-        if err["type"] == "extra_forbidden":
-            reason = "unknown key"
+        if err["type"] == "extra_forbidden" and loc:
+            raise UnknownKeyError(_field(loc), str(loc[-1]), value, _keys_at(loc[:-1]), source) from None
         elif err["type"] == "missing":
             if loc and isinstance(loc[-1], int):  # a short list/tuple: report the whole list
                 value, reason, loc = _lookup(raw, loc[:-1]), f"too few items (item {loc[-1]} is missing)", loc[:-1]
@@ -398,6 +405,30 @@ def scenario_from_dict(raw: dict, source: str | None = None) -> Scenario:
         raise ScenarioError(_field(loc), value, reason, source) from None
     except ScenarioError as exc:
         raise ScenarioError(exc.field, exc.value, exc.reason, source) from None
+
+
+def _model_in(annotation: Any) -> type[BaseModel] | None:
+    """The pydantic model inside an annotation (``X | None``, ``list[X]``, ``str | X``), if any."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    for arg in typing.get_args(annotation):
+        found = _model_in(arg)
+        if found is not None:
+            return found
+    return None
+
+
+def _keys_at(loc: tuple) -> list[str]:
+    """The keys the schema accepts in the mapping at ``loc`` (for "did you mean")."""
+    model: type[BaseModel] | None = Scenario
+    for part in loc:
+        if isinstance(part, int) or model is None:
+            continue
+        info = model.model_fields.get(part)
+        model = _model_in(info.annotation) if info is not None else None
+    if model is None:
+        return []
+    return [name for name, info in model.model_fields.items() if not info.exclude]
 
 
 def _lookup(raw: Any, loc: tuple) -> Any:
