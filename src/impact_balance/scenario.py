@@ -12,12 +12,12 @@ import math
 import typing
 from importlib import resources
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 import pinocchio as pin
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from .exceptions import ScenarioError, UnknownKeyError, UnknownScenarioError
 from .input_limits import MAX_EXTENDS, check_path_text, check_structure, read_yaml
@@ -43,9 +43,73 @@ __all__ = [
 Vec2 = tuple[float, float]
 Vec3 = tuple[float, float, float]
 
+# -- physical ranges ----------------------------------------------------------------------
+# Every number must be finite (NaN and infinities are refused by the schema itself), and lie
+# in a range a physical robot can have. The ranges are wide on purpose: they refuse what is
+# surely a mistake (a mistyped exponent, a value in mm for m), not an unusual robot.
+#: Largest friction coefficient (contacts and impact). A "no slip" contact is mu = 1e3.
+MAX_FRICTION = 1e6
+#: Largest contact side, m.
+MAX_SIZE = 10.0
+#: Largest coordinate of a position (base, offsets) and |plane_height|, m.
+MAX_POSITION = 1e4
+#: Largest |roll|, |pitch|, |yaw|, rad (two turns).
+MAX_ANGLE = 4 * math.pi
+#: Largest speed (reference velocity, CoM velocity), m/s.
+MAX_SPEED = 100.0
+#: Accepted gravity, m/s^2 (the Moon's 1.62 to Jupiter's 24.8, with margin).
+GRAVITY_RANGE = (0.1, 100.0)
+#: Longest impact duration, s (impacts last milliseconds).
+MAX_DURATION = 1.0
+#: Largest ratio of peak to mean impulsive force.
+MAX_PEAK_FACTOR = 1e3
+#: Longest scenario name (it names figure files), characters.
+MAX_NAME = 100
+#: Longest description, characters.
+MAX_DESCRIPTION = 2000
+
+
+def _interval(lo: float, hi: float, lo_open: bool = False, hi_open: bool = False) -> str:
+    return f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
+
+
+def _scalar(lo: float, hi: float, unit: str = "", lo_open: bool = False, hi_open: bool = False) -> AfterValidator:
+    """A validator keeping a number within [lo, hi] (or open ends), naming the range."""
+    text = _interval(lo, hi, lo_open, hi_open) + (f" {unit}" if unit else "")
+
+    def check(v: float) -> float:
+        if not ((lo < v if lo_open else lo <= v) and (v < hi if hi_open else v <= hi)):
+            raise ValueError(f"must be in {text}")
+        return v
+
+    return AfterValidator(check)
+
+
+def _coordinates(limit: float, unit: str) -> AfterValidator:
+    """A validator keeping every coordinate of a vector within [-limit, limit]."""
+
+    def check(v: tuple) -> tuple:
+        if any(abs(x) > limit for x in v):
+            raise ValueError(f"each coordinate must be in [{-limit:g}, {limit:g}] {unit}")
+        return v
+
+    return AfterValidator(check)
+
+
+def _speed(v: tuple) -> tuple:
+    if math.hypot(*v) > MAX_SPEED:
+        raise ValueError(f"the speed must be at most {MAX_SPEED:g} m/s")
+    return v
+
+
+Position = Annotated[Vec3, _coordinates(MAX_POSITION, "m")]
+Angles = Annotated[Vec3, _coordinates(MAX_ANGLE, "rad")]
+Friction = Annotated[float, _scalar(0.0, MAX_FRICTION, lo_open=True)]
+
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, strict=False)
+    # allow_inf_nan=False: NaN and infinities are refused in every float field.
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=False, allow_inf_nan=False)
 
 
 def _finite(values: Any, what: str = "value") -> Any:
@@ -58,10 +122,8 @@ def _finite(values: Any, what: str = "value") -> Any:
 class Offset(_Model):
     """Fixed pose in a robot frame: position (m) and roll-pitch-yaw (rad)."""
 
-    position: Vec3 = (0.0, 0.0, 0.0)
-    rpy: Vec3 = (0.0, 0.0, 0.0)
-
-    _check = field_validator("position", "rpy")(lambda v: _finite(v))
+    position: Position = (0.0, 0.0, 0.0)
+    rpy: Angles = (0.0, 0.0, 0.0)
 
     def se3(self) -> pin.SE3:
         return pose(self.position, self.rpy)
@@ -71,22 +133,15 @@ class ContactConfig(_Model):
     """A sustained rectangular contact (see :class:`impact_balance.stance.ContactSpec`)."""
 
     frame: str
-    friction: float
+    friction: Friction
     size: Vec2
     offset: Offset = Offset()
-
-    @field_validator("friction")
-    @classmethod
-    def _friction(cls, v: float) -> float:
-        if not (math.isfinite(v) and v > 0):
-            raise ValueError("friction must be a finite number > 0")
-        return v
 
     @field_validator("size")
     @classmethod
     def _size(cls, v: Vec2) -> Vec2:
-        if not all(math.isfinite(x) and x > 0 for x in v):
-            raise ValueError("size must be [length, width], both finite and > 0 (m)")
+        if not all(0 < x <= MAX_SIZE for x in v):
+            raise ValueError(f"size must be [length, width], both in (0, {MAX_SIZE:g}] m")
         return v
 
     def spec(self) -> ContactSpec:
@@ -142,7 +197,7 @@ class QPConfig(_Model):
     solve: bool = False
     joint_velocity_limits: bool = False
     impulsive_torque_limits: bool = False
-    peak_factor: float = Field(1.0, gt=0)
+    peak_factor: Annotated[float, _scalar(0.0, MAX_PEAK_FACTOR, lo_open=True)] = 1.0
     solver: str = "daqp"
 
 
@@ -151,12 +206,12 @@ class ImpactConfig(_Model):
 
     frame: str
     offset: Offset = Offset()
-    normal: Vec3
-    friction: float = 0.24
+    normal: Annotated[Vec3, _coordinates(1e6, "(any scale; it is normalised)")]
+    friction: Annotated[float, _scalar(0.0, MAX_FRICTION)] = 0.24
     restitution: Vec2 = (0.0, 0.2)
     cone_edges: int = Field(16, ge=3, le=1024)
-    reference_velocity: Vec3 | None = None
-    duration: float = Field(0.005, gt=0)
+    reference_velocity: Annotated[Vec3, AfterValidator(_speed)] | None = None
+    duration: Annotated[float, _scalar(0.0, MAX_DURATION, "s", lo_open=True)] = 0.005
     inertia: Literal["composite", "joint_space"] = "composite"
     qp: QPConfig = QPConfig()
 
@@ -168,13 +223,6 @@ class ImpactConfig(_Model):
             raise ValueError("normal must be a non-zero vector")
         return v
 
-    @field_validator("friction")
-    @classmethod
-    def _friction(cls, v: float) -> float:
-        if not (math.isfinite(v) and v >= 0):
-            raise ValueError("friction must be a finite number >= 0")
-        return v
-
     @field_validator("restitution")
     @classmethod
     def _restitution(cls, v: Vec2) -> Vec2:
@@ -184,8 +232,6 @@ class ImpactConfig(_Model):
         if lo > hi:
             raise ValueError("restitution must be [lo, hi] with lo <= hi")
         return v
-
-    _check = field_validator("reference_velocity")(lambda v: _finite(v) if v is not None else v)
 
     def spec(self) -> ImpactSpec:
         """The impact's :class:`ImpactSpec` (cached by content: treat it as immutable)."""
@@ -214,28 +260,26 @@ class RobotFiles(_Model):
 class BasePose(_Model):
     """Free-flyer pose override in world: position (m), roll-pitch-yaw (rad)."""
 
-    position: Vec3 | None = None
-    rpy: Vec3 | None = None
+    position: Position | None = None
+    rpy: Angles | None = None
 
 
 class Scenario(_Model):
     """One situation. See README, "Scenario files", for every key."""
 
-    name: str | None = None
-    description: str | None = None
+    name: Annotated[str, Field(max_length=MAX_NAME)] | None = None
+    description: Annotated[str, Field(max_length=MAX_DESCRIPTION)] | None = None
     robot: str | RobotFiles = "talos"
     configuration: str | None = None
     joints: dict[str, float] = {}
     base: BasePose | None = None
-    com_velocity: Vec2 = (0.0, 0.0)
-    plane_height: float = 0.0
+    com_velocity: Annotated[Vec2, AfterValidator(_speed)] = (0.0, 0.0)
+    plane_height: Annotated[float, _scalar(-MAX_POSITION, MAX_POSITION, "m")] = 0.0
     torque_limits: bool = True
-    gravity: float = Field(9.81, gt=0)
+    gravity: Annotated[float, _scalar(*GRAVITY_RANGE, "m/s^2")] = 9.81
     contacts: list[ContactConfig] = Field(min_length=1)
     impact: ImpactConfig | None = None
     source: str | None = Field(None, exclude=True)
-
-    _check = field_validator("com_velocity", "plane_height")(lambda v: _finite(v))
 
     @field_validator("joints")
     @classmethod
