@@ -19,6 +19,18 @@ import pinocchio as pin
 import yaml
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError, field_validator
 
+from .constants import (
+    GRAVITY_RANGE,
+    MAX_ANGLE,
+    MAX_DESCRIPTION,
+    MAX_DURATION,
+    MAX_FRICTION,
+    MAX_NAME,
+    MAX_PEAK_FACTOR,
+    MAX_POSITION,
+    MAX_SIZE,
+    MAX_SPEED,
+)
 from .exceptions import ScenarioError, UnknownKeyError, UnknownScenarioError
 from .input_limits import MAX_EXTENDS, check_path_text, check_structure, read_yaml
 from .impact import ImpactSpec
@@ -43,30 +55,7 @@ __all__ = [
 Vec2 = tuple[float, float]
 Vec3 = tuple[float, float, float]
 
-# -- physical ranges ----------------------------------------------------------------------
-# Every number must be finite (NaN and infinities are refused by the schema itself), and lie
-# in a range a physical robot can have. The ranges are wide on purpose: they refuse what is
-# surely a mistake (a mistyped exponent, a value in mm for m), not an unusual robot.
-#: Largest friction coefficient (contacts and impact). A "no slip" contact is mu = 1e3.
-MAX_FRICTION = 1e6
-#: Largest contact side, m.
-MAX_SIZE = 10.0
-#: Largest coordinate of a position (base, offsets) and |plane_height|, m.
-MAX_POSITION = 1e4
-#: Largest |roll|, |pitch|, |yaw|, rad (two turns).
-MAX_ANGLE = 4 * math.pi
-#: Largest speed (reference velocity, CoM velocity), m/s.
-MAX_SPEED = 100.0
-#: Accepted gravity, m/s^2 (the Moon's 1.62 to Jupiter's 24.8, with margin).
-GRAVITY_RANGE = (0.1, 100.0)
-#: Longest impact duration, s (impacts last milliseconds).
-MAX_DURATION = 1.0
-#: Largest ratio of peak to mean impulsive force.
-MAX_PEAK_FACTOR = 1e3
-#: Longest scenario name (it names figure files), characters.
-MAX_NAME = 100
-#: Longest description, characters.
-MAX_DESCRIPTION = 2000
+# The physical ranges the schema accepts are in constants.py (shared with lipm.py).
 
 
 def _interval(lo: float, hi: float, lo_open: bool = False, hi_open: bool = False) -> str:
