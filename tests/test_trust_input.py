@@ -448,3 +448,25 @@ def test_pinocchio_frame_count_is_independent():
     """The frame count in messages is pinocchio's, not a count of the message's own list."""
     model = pin.buildModelFromUrdf(str(load_robot("talos").urdf_path), pin.JointModelFreeFlyer())
     assert model.nframes == len(load_robot("talos").frame_names)
+
+
+def test_gui_shows_the_warnings(tmp_path):
+    from impact_balance.gui.app import GuiApp
+
+    path = write(tmp_path, scenario_with(impact=dict(IMPACT, normal=[1.0, 0.0, 0.0], reference_velocity=[0.8, 0.0, 0.0])))
+    app = GuiApp(str(path), port=0)
+    try:
+        assert app.session.summary.warnings and "[impact_moving_away]" in app.session.summary.warnings[0]
+        assert 'class="ib-warning"' in app.w_results.content and "impact_moving_away" in app.w_results.content
+        app.edit(lambda: app.session.load("palm_push_two_feet"))  # control: no warning, no line
+        assert 'class="ib-warning"' not in app.w_results.content
+    finally:
+        app.stop()
+
+
+def test_phase_portrait_refuses_non_finite_gravity(capsys):
+    line = one_error_line(*run_cli(capsys, "phase-portrait", "--com-height", "0.8", "--zmp-range", "-0.1", "0.1",
+                                   "--gravity", "inf", "--json"))
+    assert "gravity = inf" in line and "[0.1, 100]" in line
+    rc, out, _ = run_cli(capsys, "phase-portrait", "--com-height", "0.78", "--zmp-range", "-0.13", "0.13", "--json")
+    assert rc == 0 and strict_json(out)["com_velocity_bounds"][1] == pytest.approx(0.13 * math.sqrt(9.81 / 0.78))

@@ -363,6 +363,9 @@ class GuiApp:
         rows.append(f'<tr><td>update (analysis + redraw)</td><td style="text-align:right" id="ib-update-ms">'
                     f'{self.last_update_ms:.1f} ms</td></tr>')
         rows.append("</table>")
+        for warning in s.warnings:
+            rows.append('<div class="ib-warning" style="color:#b8860b;font-size:0.85em;margin-top:4px;'
+                        f'overflow-wrap:anywhere">warning: {html.escape(warning)}</div>')
         msg = self.session.message
         if msg:
             mcolor = "#d62728" if self.session.refused else "#555"

@@ -49,6 +49,7 @@ class Summary:
         zmp_max_contact_velocity: The same by the ZMP criterion, m/s.
         reference_speed: Approach speed of the reference velocity, m/s (None without one).
         falls_at_reference: Whether the reference approach speed exceeds the maximum.
+        warnings: The analysis' warnings, one line each (see :mod:`impact_balance.diagnostics`).
     """
 
     verdict: str
@@ -57,6 +58,7 @@ class Summary:
     zmp_max_contact_velocity: float | None
     reference_speed: float | None
     falls_at_reference: bool
+    warnings: tuple[str, ...] = ()
 
     @classmethod
     def of(cls, analysis: Analysis) -> Summary:
@@ -69,7 +71,8 @@ class Summary:
             if v_ref is not None:
                 ref = max(0.0, im.model.approach_speed(v_ref))
                 falls = ref > vmax + 1e-12
-        return cls(analysis.verdict, analysis.areas.can_balance, vmax, zmp, ref, falls)
+        warnings = tuple(str(w) for w in analysis.warnings)
+        return cls(analysis.verdict, analysis.areas.can_balance, vmax, zmp, ref, falls, warnings)
 
     @property
     def headline(self) -> str:
