@@ -13,7 +13,7 @@ The rules (codes):
   :data:`WALL_TILT` (70°) from the vertical. Plausible surfaces are floors and ramps (tilt
   up to 40°, steeper than any walkable ramp) and walls (tilt 70° to 90°); in between is usually
   a frame whose z axis is not the sole's normal (some robots' foot frames are tilted 45°).
-- ``impact_moving_away``: the reference velocity does not approach the impacted surface
+- ``impact_moving_away``: the reference velocity does not move towards the impacted surface
   (approach speed ``-n . v <= 0``): there is no impact to cap. Usually ``impact.normal``
   has the wrong sign (it points from the surface into the robot).
 - ``qp_capped_by_reference``: the paper's QP tracks the reference velocity, so its approach
@@ -105,9 +105,9 @@ def impact_diagnostics(answer: ImpactAnswer, reference_velocity: Sequence[float]
     if approach <= 0.0:
         out.append(Diagnostic(
             "impact_moving_away", "impact.reference_velocity",
-            f"the reference velocity moves away from the impacted surface (approach speed -n.v = {approach:.3g} m/s "
-            "<= 0), so there is no impact and nothing to cap; impact.normal must point from the surface into "
-            "the robot (is its sign flipped?)",
+            f"the reference velocity does not move towards the impacted surface (approach speed -n.v = "
+            f"{approach:.3g} m/s <= 0), so there is no impact and nothing to cap; impact.normal must point from "
+            "the surface into the robot (is its sign flipped?)",
         ))
     qp = answer.qp
     limit = answer.max_contact_velocity

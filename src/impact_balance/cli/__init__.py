@@ -20,7 +20,7 @@ from ..projection.walk import kernel_is_compiled
 from . import analyze, demo, frames, gui, listing, phase_portrait
 from .demo import DEMO_SCENARIOS, FRICTION_SWEEP
 
-__all__ = ["main", "DEMO_SCENARIOS", "FRICTION_SWEEP", "COMMANDS"]
+__all__ = ["main", "DEMO_SCENARIOS", "FRICTION_SWEEP", "COMMANDS", "EXIT_BROKEN_PIPE"]
 
 #: Command modules, in the order of ``--help``.
 COMMANDS: tuple[ModuleType, ...] = (demo, analyze, phase_portrait, listing, frames, gui)
