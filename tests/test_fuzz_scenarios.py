@@ -20,6 +20,7 @@ import copy
 import io
 import json
 import math
+import os
 import resource
 import subprocess
 import sys
@@ -36,6 +37,8 @@ from hypothesis import strategies as st
 from impact_balance import cli
 from impact_balance.exceptions import MESSAGE_CHARS
 
+#: Multiplies the number of examples: IMPACT_BALANCE_FUZZ_SCALE=20 for a deeper search (minutes).
+SCALE = float(os.environ.get("IMPACT_BALANCE_FUZZ_SCALE", "1"))
 BUNDLED = sorted(p.name for p in (resources.files("impact_balance") / "scenarios").iterdir() if p.name.endswith(".yaml"))
 #: The parsed bundled files (extends unresolved: a mutation may remove it or point it elsewhere).
 RAW = {name: yaml.safe_load((resources.files("impact_balance") / "scenarios" / name).read_text()) for name in BUNDLED}
@@ -163,7 +166,7 @@ def warm_up():
         assert rc == 0, err
 
 
-@settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@settings(max_examples=int(300 * SCALE), deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(data=mutated_scenarios())
 def test_mutated_scenario_gives_clean_error_or_strict_json(data):
     with tempfile.TemporaryDirectory() as tmp:
@@ -181,7 +184,7 @@ def _alias_text(base: str, fan: int, levels: int) -> str:
     return "\n".join(lines) + "\n" + base
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=int(60 * SCALE), deadline=None)
 @given(
     name=st.sampled_from(BUNDLED),
     kind=st.sampled_from(["alias_tree", "alias_as_value", "cycle", "extends_cycle", "extends_chain", "long_extends",
