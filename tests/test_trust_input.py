@@ -436,7 +436,7 @@ def test_frames_of_a_scenario_and_of_an_unknown_robot(capsys):
     rc, out, _ = run_cli(capsys, "frames", "g1_two_feet", "--json")
     assert rc == 0 and strict_json(out)["robot"] == "g1"
     line = one_error_line(*run_cli(capsys, "frames", "atlas"))
-    assert "atlas" in line
+    assert "robot = 'atlas': unknown robot" in line and "talos" in line
 
 
 def test_version(capsys):
@@ -472,3 +472,24 @@ def test_phase_portrait_refuses_non_finite_gravity(capsys):
     assert "gravity = inf" in line and "[0.1, 100]" in line
     rc, out, _ = run_cli(capsys, "phase-portrait", "--com-height", "0.78", "--zmp-range", "-0.13", "0.13", "--json")
     assert rc == 0 and strict_json(out)["com_velocity_bounds"][1] == pytest.approx(0.13 * math.sqrt(9.81 / 0.78))
+
+
+def test_solo12_foot_frames_are_tilted(tmp_path):
+    """The case a user met: solo12's *_FOOT frames have their z axis 45 degrees off the vertical."""
+    from impact_balance.robot import example_robot_data_root
+
+    root = example_robot_data_root() / "solo_description"
+    feet = ["FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"]
+    data = {"robot": {"urdf": str(root / "robots" / "solo12.urdf"), "srdf": str(root / "srdf" / "solo.srdf"),
+                      "standing": "straight_standing"},
+            "torque_limits": False,
+            "contacts": [{"frame": f, "friction": 0.7, "size": [0.02, 0.02]} for f in feet]}
+    analysis = analyze(write(tmp_path, data))
+    assert codes(analysis) == ["contact_normal_tilted"] * 4
+    # independent: the frames' z axes from pinocchio's forward kinematics at the same q
+    robot, q = analysis.stance.robot, analysis.stance.q
+    frame_data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, frame_data, q)
+    for foot in feet:
+        z = frame_data.oMf[robot.model.getFrameId(foot)].rotation[:, 2]
+        assert 40 < math.degrees(math.acos(z[2])) < 70

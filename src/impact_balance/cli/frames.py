@@ -16,6 +16,7 @@ def add_parser(sub) -> list[str]:
 
 
 def _robot(name: str):
+    from ..exceptions import UnknownRobotError, UnknownScenarioError
     from ..robot import BUNDLED_ROBOTS, load_robot
     from ..scenario import load_scenario
 
@@ -23,7 +24,10 @@ def _robot(name: str):
         return load_robot(name)
     if name.endswith(".urdf"):
         return load_robot(None, name)
-    return load_scenario(name).load_robot()  # a scenario file or a bundled scenario's name
+    try:
+        return load_scenario(name).load_robot()  # a scenario file or a bundled scenario's name
+    except UnknownScenarioError:  # neither: say which robots there are
+        raise UnknownRobotError("robot", name, BUNDLED_ROBOTS) from None
 
 
 def robot_listing(robot) -> dict:
