@@ -189,9 +189,9 @@ def check_path_text(field: str, text: str, source: str | None = None) -> None:
     if "\x00" in text:
         raise ScenarioError(field, text, "a file name cannot contain a NUL character", source)
     if len(text) > MAX_PATH_CHARS:
-        raise ScenarioError(field, text, f"too long for a path ({len(text)} characters, at most {MAX_PATH_CHARS})", source)
+        reason = f"too long for a path ({len(text)} characters, at most {MAX_PATH_CHARS})"
+        raise ScenarioError(field, text, reason, source)
     longest = max((len(part) for part in text.replace("\\", "/").split("/")), default=0)
     if longest > MAX_NAME_CHARS:
-        raise ScenarioError(
-            field, text, f"a file or scenario name has at most {MAX_NAME_CHARS} characters (this one has {longest})", source
-        )
+        reason = f"a file or scenario name has at most {MAX_NAME_CHARS} characters (this one has {longest})"
+        raise ScenarioError(field, text, reason, source)
