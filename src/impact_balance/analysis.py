@@ -11,9 +11,10 @@ import numpy as np
 from .areas import BalanceAreas, areas_from_polytope
 from .constraints import wrench_polytope
 from .criteria import VelocityLimit, capped_velocity, max_contact_velocity, zmp_max_contact_velocity
+from .diagnostics import Diagnostic, diagnose
 from .impact import ImpactModel, impact_model
 from .qp import QPOptions, QPResult, solve_contact_velocity_qp, static_torques
-from .exceptions import ScenarioError
+from .exceptions import ScenarioError, SolverError
 from .scenario import Scenario, load_scenario, with_source
 from .stance import Stance
 
@@ -69,6 +70,8 @@ class Analysis:
     areas: BalanceAreas
     impact: ImpactAnswer | None
     timings: dict[str, float] = field(default_factory=dict)
+    #: Valid input that is probably a mistake, or an answer with a caveat (see diagnostics).
+    warnings: tuple[Diagnostic, ...] = ()
 
     @property
     def com_velocity(self) -> np.ndarray:
@@ -109,6 +112,7 @@ class Analysis:
                 for c in self.stance.contacts
             ],
             "timings_ms": {k: 1e3 * v for k, v in self.timings.items()},
+            "warnings": [w.to_dict() for w in self.warnings],
         }
         if self.impact is not None:
             im = self.impact
@@ -153,7 +157,10 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
     t1 = time.perf_counter()
     polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
     t2 = time.perf_counter()
-    areas = areas_from_polytope(polytope, scenario.plane_height)
+    try:
+        areas = areas_from_polytope(polytope, scenario.plane_height)
+    except SolverError as exc:
+        raise exc.within("contacts (projection of the contact wrench polytope)") from None
     t3 = time.perf_counter()
     timings.update(stance=t1 - t0, constraints=t2 - t1, areas=t3 - t2)
     answer = None
@@ -176,10 +183,14 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
             options = QPOptions(
                 cfg.qp.joint_velocity_limits, cfg.qp.impulsive_torque_limits, cfg.qp.peak_factor, cfg.duration, cfg.qp.solver
             )
-            qp = solve_contact_velocity_qp(
-                model, areas.com_velocity_area, scenario.com_velocity, cfg.reference_velocity, stance.robot, tau0, options
-            )
+            try:
+                qp = solve_contact_velocity_qp(
+                    model, areas.com_velocity_area, scenario.com_velocity, cfg.reference_velocity, stance.robot, tau0,
+                    options,
+                )
+            except SolverError as exc:
+                raise exc.within("impact.qp") from None
         answer = ImpactAnswer(model, com_limit, zmp_limit, contact_velocity, qp)
         timings["impact"] = time.perf_counter() - t3
     timings["total"] = time.perf_counter() - t0
-    return Analysis(scenario, stance, areas, answer, timings)
+    return Analysis(scenario, stance, areas, answer, timings, diagnose(scenario, stance, answer))

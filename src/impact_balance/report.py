@@ -26,9 +26,10 @@ def format_analysis(analysis: Analysis) -> str:
         f"  robot {st.robot.name}, mass {st.mass:.2f} kg, CoM {_vec(st.com)} m, omega {a.omega:.4f} 1/s, "
         f"{len(st.contacts)} contact(s), torque limits {'on' if sc.torque_limits else 'off'}"
     )
+    warnings = [f"  warning: {w}" for w in analysis.warnings]
     if not a.can_balance:
         lines.append("  CANNOT BALANCE: these contacts cannot hold the robot at rest (empty areas)")
-        return "\n".join(lines)
+        return "\n".join(lines + warnings)
     v = a.com_velocity_area
     lo, hi = v.vertices.min(axis=0), v.vertices.max(axis=0)
     lines.append(
@@ -59,4 +60,4 @@ def format_analysis(analysis: Analysis) -> str:
         if im.qp is not None:
             lines.append(f"  paper's QP ({im.qp.status}): approach speed {format_speed(im.qp.approach_speed)}")
     lines.append(f"  computed in {1e3 * analysis.timings.get('total', float('nan')):.1f} ms")
-    return "\n".join(lines)
+    return "\n".join(lines + warnings)

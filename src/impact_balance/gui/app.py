@@ -383,7 +383,7 @@ class GuiApp:
         if s.warnings:
             items = "".join(f"<li>{html.escape(w if len(w) <= 300 else w[:297] + '...')}</li>" for w in s.warnings[:10])
             more = f"<li>... {len(s.warnings) - 10} more</li>" if len(s.warnings) > 10 else ""
-            rows.append(f'<ul id="ib-warnings" style="color:#b36b00;font-size:0.85em;margin:4px 0;'
+            rows.append(f'<ul id="ib-warnings" class="ib-warning" style="color:#b36b00;font-size:0.85em;margin:4px 0;'
                         f'padding-left:1.2em;overflow-wrap:anywhere">{items}{more}</ul>')
         msg = self.session.message
         if msg:

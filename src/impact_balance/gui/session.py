@@ -51,7 +51,7 @@ class Summary:
         zmp_max_contact_velocity: The same by the ZMP criterion, m/s.
         reference_speed: Approach speed of the reference velocity, m/s (None without one).
         falls_at_reference: Whether the reference approach speed exceeds the maximum.
-        warnings: One line per warning of the analysis (a doubtful input, a capped value...).
+        warnings: The analysis' warnings, one line each (see :mod:`impact_balance.diagnostics`).
     """
 
     verdict: str
@@ -73,8 +73,7 @@ class Summary:
             if v_ref is not None:
                 ref = max(0.0, im.model.approach_speed(v_ref))
                 falls = ref > vmax + 1e-12
-        # getattr: analyses without warnings (older library versions) show none.
-        warnings = tuple(str(w) for w in getattr(analysis, "warnings", None) or ())
+        warnings = tuple(str(w) for w in analysis.warnings)
         return cls(analysis.verdict, analysis.areas.can_balance, vmax, zmp, ref, falls, warnings)
 
     @property

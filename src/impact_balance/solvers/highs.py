@@ -13,6 +13,16 @@ __all__ = ["HighsLP"]
 
 _INF = highspy.kHighsInf
 
+try:
+    # highspy.Highs() enables its Python callbacks in its constructor, and that first call into
+    # HiGHS prints the "Running HiGHS ..." banner on stdout before any option can be set,
+    # which would break `analyze --json` (stdout must be one JSON document). The core object
+    # it wraps has every method used here, and prints nothing until asked to solve; the
+    # output flag is switched off before that.
+    from highspy._core import _Highs as _Solver
+except ImportError:  # pragma: no cover - a highspy without the private core name
+    _Solver = highspy.Highs
+
 
 class HighsLP:
     """Persistent HiGHS model of a :class:`LinearProgram`; :meth:`maximize` re-solves it.
@@ -57,9 +67,10 @@ class HighsLP:
         lp.a_matrix_.value_ = M.data
         lp.sense_ = highspy.ObjSense.kMaximize
         self._n = n
-        self._h = highspy.Highs()
+        self._h = _Solver()
         h = self._h
         h.setOptionValue("output_flag", False)
+        h.setOptionValue("log_to_console", False)
         h.setOptionValue("primal_feasibility_tolerance", tolerance)
         h.setOptionValue("dual_feasibility_tolerance", tolerance)
         h.setOptionValue("random_seed", 0)
