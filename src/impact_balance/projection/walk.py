@@ -25,13 +25,17 @@ import numpy as np
 from .._jit import HAVE_NUMBA
 
 from ..polygon import Polygon
-from ._kernel import FAILED, INFEASIBLE, LINE, equality_basis, project
+from ._kernel import FAILED, INFEASIBLE, LINE, OK, equality_basis, project
 from .result import ProjectionResult
 
 __all__ = ["project_walk", "kernel_is_compiled"]
 
 #: Relative singular-value threshold for the rank of the lines of the polytope.
 RANK_TOLERANCE = 1e-12
+#: Largest constraint violation (unit rows, in units of b, relative to 1 + max |b|) a
+#: vertex of a sound walk may show; beyond it the walk is rejected (badly scaled rows, e.g.
+#: friction 1e9 next to 1e-9) and the caller falls back to Bretl.
+SLACK_TOLERANCE = 1e-7
 
 def project_walk(
     A: np.ndarray,
@@ -47,7 +51,8 @@ def project_walk(
 
     Lines in the polytope (directions the constraints leave free and E ignores) are
     quotiented out. Returns None when the walk cannot answer (a pivot met a numerical dead
-    end, or an iteration cap): the caller falls back to :func:`~.bretl.project_bretl`.
+    end, an iteration cap, a vertex that violates a constraint, or vertices that are not a
+    convex counter-clockwise polygon): the caller falls back to :func:`~.bretl.project_bretl`.
     """
     E = np.ascontiguousarray(E, dtype=float)
     n = E.shape[1]
@@ -59,16 +64,22 @@ def project_walk(
     status, x0, N = equality_basis(C, d)
     if status == INFEASIBLE:
         return ProjectionResult(Polygon.empty(), "walk")
-    status, vertices, pivots = project(A, b, E, x0, N, float(box), float(merge_tol), int(max_pivots))
+    status, vertices, pivots, worst = project(A, b, E, x0, N, float(box), float(merge_tol), int(max_pivots))
     if status == LINE:
         # Lines of the polytope are the null space of [A N; E N] (a line along which E x
         # changed would have met the box rows); keep z in its orthogonal complement.
         _, S, Vt = np.linalg.svd(np.vstack([A @ N, E @ N]))
         r = int(np.sum(S > RANK_TOLERANCE * max(float(S[0]) if S.size else 0.0, 1.0)))
         N = np.ascontiguousarray(N @ Vt[:r].T)
-        status, vertices, more = project(A, b, E, x0, N, float(box), float(merge_tol), int(max_pivots))
+        status, vertices, more, worst = project(A, b, E, x0, N, float(box), float(merge_tol), int(max_pivots))
         pivots += more
     if status in (FAILED, LINE):
+        return None
+    # Certificate: every vertex was feasible (the kernel checked each against every row, and
+    # each is optimal for its arc by the multipliers' signs) and the polygon is convex,
+    # counter-clockwise and winds once (checked in the kernel too). Anything else is a
+    # numerical failure of the walk, never an answer.
+    if status == OK and worst < -SLACK_TOLERANCE * (1.0 + float(np.abs(b).max(initial=0.0))):
         return None
     if status == INFEASIBLE:
         return ProjectionResult(Polygon.empty(), "walk", n_lp=1, pivots=pivots)
