@@ -13,7 +13,7 @@ from .constraints import wrench_polytope
 from .criteria import VelocityLimit, capped_velocity, max_contact_velocity, zmp_max_contact_velocity
 from .impact import ImpactModel, impact_model
 from .qp import QPOptions, QPResult, solve_contact_velocity_qp, static_torques
-from .exceptions import ScenarioError
+from .exceptions import NonFiniteResultError, ScenarioError
 from .scenario import Scenario, load_scenario, with_source
 from .stance import Stance
 
@@ -156,6 +156,7 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
     areas = areas_from_polytope(polytope, scenario.plane_height)
     t3 = time.perf_counter()
     timings.update(stance=t1 - t0, constraints=t2 - t1, areas=t3 - t2)
+    _check_finite(_area_checks(stance, areas))
     answer = None
     if scenario.impact is not None:
         cfg = scenario.impact
@@ -163,6 +164,7 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
             model = impact_model(stance, cfg.spec())
         except ScenarioError as exc:
             raise with_source(exc, scenario.source) from None
+        _check_finite(_impact_checks(model))
         com_limit = max_contact_velocity(areas.com_velocity_area, model, scenario.com_velocity)
         zmp_limit = zmp_max_contact_velocity(
             areas.zmp_area, model, stance.com, scenario.plane_height, scenario.gravity, cfg.duration
@@ -183,3 +185,45 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
         timings["impact"] = time.perf_counter() - t3
     timings["total"] = time.perf_counter() - t0
     return Analysis(scenario, stance, areas, answer, timings)
+
+
+def _area_checks(stance: Stance, areas: BalanceAreas) -> list[tuple[str, Any, tuple[str, ...]]]:
+    """(result field, value, scenario fields that can make it overflow) of the areas step."""
+    return [
+        ("com", stance.com, ("base.position",)),
+        ("omega", areas.omega, ("plane_height", "gravity")),
+        # The squared sizes: their overflow is that of the areas and of the edge normals.
+        ("zmp_area", _squared_size(areas.zmp_area), ("plane_height", "base.position")),
+        ("com_velocity_area", _squared_size(areas.com_velocity_area), ("plane_height", "gravity")),
+    ]
+
+
+def _squared_size(polygon) -> float:
+    """Sum of the squared vertex coordinates (inf when they overflow, NaN with a NaN)."""
+    v = polygon.vertices.ravel()
+    with np.errstate(over="ignore", invalid="ignore"):
+        return float(v @ v)
+
+
+def _impact_checks(model: ImpactModel) -> list[tuple[str, Any, tuple[str, ...]]]:
+    """Like :func:`_area_checks`, for the impact model."""
+    return [
+        ("impact.point", model.point, ("impact.offset", "base.position")),
+        ("impact.W", model.W, ("impact.offset",)),
+        ("impact.impulse_vertices", model.impulse_rates, ("impact.offset", "impact.friction")),
+    ]
+
+
+def _check_finite(checks: list[tuple[str, Any, tuple[str, ...]]]) -> None:
+    """Raise :class:`NonFiniteResultError` naming the first non-finite result (never NaN out).
+
+    One sum over everything first (a NaN or an infinity anywhere makes it non-finite), so the
+    common case costs a few microseconds; the field is looked for only on failure.
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        if np.isfinite(sum(float(np.sum(value)) for _, value, _ in checks)):
+            return
+        for name, value, inputs in checks:
+            if not np.isfinite(value).all():
+                raise NonFiniteResultError(name, inputs)
+        # every part finite: only their sum overflowed

@@ -23,6 +23,7 @@ __all__ = [
     "RobotLoadError",
     "ImpactModelError",
     "SolverError",
+    "NonFiniteResultError",
 ]
 
 
@@ -141,3 +142,20 @@ class SolverError(ImpactBalanceError, RuntimeError):
         self.status = status
         extra = f": {detail}" if detail else ""
         super().__init__(f"{solver} failed with status {status}{extra}")
+
+
+class NonFiniteResultError(ImpactBalanceError, ValueError):
+    """A computed quantity overflowed (inf or NaN): the input's numbers are out of scale.
+
+    Raised instead of returning NaN or infinity (which strict JSON cannot carry).
+
+    Attributes:
+        field: The result field that is not finite, e.g. ``impact.W``.
+        inputs: The scenario fields whose size can cause it.
+    """
+
+    def __init__(self, field: str, inputs: Sequence[str]):
+        self.field = field
+        self.inputs = tuple(inputs)
+        hint = f" (check {', '.join(self.inputs)})" if self.inputs else ""
+        super().__init__(f"{field} is not finite: the scenario's numbers are too large{hint}")
