@@ -10,7 +10,7 @@ import numpy as np
 
 from .areas import BalanceAreas, areas_from_polytope
 from .constraints import wrench_polytope
-from .criteria import VelocityLimit, capped_velocity, max_contact_velocity, zmp_max_contact_velocity
+from .criteria import VelocityLimit, capped_velocity, max_contact_velocity, safe_interval, zmp_max_contact_velocity
 from .impact import ImpactModel, impact_model
 from .qp import QPOptions, QPResult, solve_contact_velocity_qp, static_torques
 from .exceptions import NonFiniteResultError, ScenarioError
@@ -36,6 +36,9 @@ class ImpactAnswer:
         contact_velocity: Reference velocity with its approach component capped (m/s, world),
             or None without a reference velocity.
         qp: The paper's QP solution when requested.
+        safe_interval: The approach speeds (lo, hi) m/s whose post-impact CoM velocities all
+            stay in the area (hi may be inf), or None when there are none; see
+            :func:`~impact_balance.criteria.safe_interval`.
     """
 
     model: ImpactModel
@@ -43,6 +46,7 @@ class ImpactAnswer:
     zmp_limit: VelocityLimit
     contact_velocity: np.ndarray | None
     qp: QPResult | None = None
+    safe_interval: tuple[float, float] | None = None
 
     @property
     def max_contact_velocity(self) -> float:
@@ -127,6 +131,7 @@ class Analysis:
                 "evaluated_at_approach_speed": s,
                 "impulse_vertices": im.model.impulse_vertices(s).tolist(),
                 "post_impact_com_velocities": im.model.post_impact_com_velocities(self.com_velocity, s).tolist(),
+                "safe_interval": None if im.safe_interval is None else [_num(x) for x in im.safe_interval],
                 "zmp_max_contact_velocity": _num(im.zmp_max_contact_velocity),
                 "zmp_status": im.zmp_limit.status,
                 "W": im.model.W.tolist(),
@@ -181,7 +186,8 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
             qp = solve_contact_velocity_qp(
                 model, areas.com_velocity_area, scenario.com_velocity, cfg.reference_velocity, stance.robot, tau0, options
             )
-        answer = ImpactAnswer(model, com_limit, zmp_limit, contact_velocity, qp)
+        interval = safe_interval(areas.com_velocity_area, model, scenario.com_velocity)
+        answer = ImpactAnswer(model, com_limit, zmp_limit, contact_velocity, qp, interval)
         timings["impact"] = time.perf_counter() - t3
     timings["total"] = time.perf_counter() - t0
     return Analysis(scenario, stance, areas, answer, timings)

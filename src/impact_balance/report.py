@@ -6,12 +6,23 @@ import numpy as np
 
 from .analysis import Analysis
 
-__all__ = ["format_analysis", "format_speed"]
+__all__ = ["format_analysis", "format_speed", "format_safe_interval"]
 
 
 def format_speed(value: float) -> str:
     """m/s with 3 decimals, "unbounded" for inf."""
     return f"{value:.3f} m/s" if np.isfinite(value) else "unbounded"
+
+
+def format_safe_interval(interval: tuple[float, float] | None, inside: bool) -> str:
+    """One line on the approach speeds that keep every post-impact CoM velocity in the area."""
+    if interval is None:
+        return "safe approach speeds: none (no impact speed brings the CoM velocity into the area)"
+    lo, hi = interval
+    text = f"safe approach speeds: [{lo:.3f}, {f'{hi:.3f}' if np.isfinite(hi) else 'unbounded'}] m/s"
+    if not inside:
+        text += " (the CoM velocity is outside the area: an impact in this range would bring it back inside)"
+    return text
 
 
 def _vec(v, digits: int = 3) -> str:
@@ -51,6 +62,7 @@ def format_analysis(analysis: Analysis) -> str:
         lines.append(
             f"  max contact velocity: CoM criterion {format_speed(com_v)}, ZMP criterion {format_speed(zmp_v)}{ratio}"
         )
+        lines.append("  " + format_safe_interval(im.safe_interval, analysis.com_velocity_inside))
         if im.contact_velocity is not None:
             lines.append(
                 f"  reference velocity {_vec(spec.reference_velocity)} m/s -> contact velocity "
