@@ -8,11 +8,12 @@ from typing import Any
 
 import numpy as np
 
-from .areas import BalanceAreas, areas_from_polytope
+from .areas import BalanceAreas, areas_from_polytope, with_reason
 from .constraints import wrench_polytope
 from .criteria import VelocityLimit, capped_velocity, max_contact_velocity, safe_interval, zmp_max_contact_velocity
 from .impact import ImpactModel, impact_model
 from .qp import QPOptions, QPResult, solve_contact_velocity_qp, static_torques
+from .diagnosis import CannotBalanceReason
 from .exceptions import NonFiniteResultError, ScenarioError
 from .scenario import Scenario, load_scenario, with_source
 from .stance import Stance
@@ -84,6 +85,11 @@ class Analysis:
         return bool(self.areas.can_balance and self.areas.com_velocity_area.contains(self.com_velocity, 1e-10))
 
     @property
+    def cannot_balance_reason(self) -> CannotBalanceReason | None:
+        """Why the robot cannot balance (None when it can); see :mod:`impact_balance.diagnosis`."""
+        return self.areas.reason
+
+    @property
     def verdict(self) -> str:
         if not self.areas.can_balance:
             return "cannot balance: the contacts cannot hold the robot at rest (empty areas)"
@@ -98,6 +104,7 @@ class Analysis:
             "robot": self.stance.robot.name,
             "verdict": self.verdict,
             "can_balance": a.can_balance,
+            "cannot_balance_reason": None if a.reason is None else a.reason.to_dict(),
             "mass": self.stance.mass,
             "com": self.stance.com.tolist(),
             "omega": a.omega,
@@ -161,6 +168,10 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
     areas = areas_from_polytope(polytope, scenario.plane_height)
     t3 = time.perf_counter()
     timings.update(stance=t1 - t0, constraints=t2 - t1, areas=t3 - t2)
+    if not areas.can_balance:  # explain why (LPs; only for a stance that cannot balance)
+        areas = with_reason(areas, stance, scenario.torque_limits, scenario.gravity)
+        timings["diagnosis"] = time.perf_counter() - t3
+        t3 = time.perf_counter()
     _check_finite(_area_checks(stance, areas))
     answer = None
     if scenario.impact is not None:

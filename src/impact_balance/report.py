@@ -39,6 +39,8 @@ def format_analysis(analysis: Analysis) -> str:
     )
     if not a.can_balance:
         lines.append("  CANNOT BALANCE: these contacts cannot hold the robot at rest (empty areas)")
+        if a.reason is not None:
+            lines.append(f"  reason: {a.reason}")
         return "\n".join(lines)
     v = a.com_velocity_area
     lo, hi = v.vertices.min(axis=0), v.vertices.max(axis=0)
