@@ -332,6 +332,27 @@ def _merge(base: dict, override: dict) -> dict:
     return out
 
 
+def _parse(text: str) -> Any:
+    """``yaml.safe_load(text)``, cached by content (parsing is ~95 % of loading a scenario:
+    PyYAML's pure-Python parser takes 5-20 ms for a bundled file). The cached tree is never
+    handed out: callers get a fresh copy of its dicts and lists (scalars are immutable)."""
+    return _copy_tree(_parse_cached(text))
+
+
+@functools.lru_cache(maxsize=64)
+def _parse_cached(text: str) -> Any:
+    return yaml.safe_load(text)
+
+
+def _copy_tree(node: Any) -> Any:
+    """Copy of a parsed YAML tree's containers (faster than copy.deepcopy for plain data)."""
+    if isinstance(node, dict):
+        return {k: _copy_tree(v) for k, v in node.items()}
+    if isinstance(node, list):
+        return [_copy_tree(v) for v in node]
+    return node
+
+
 def _read(path: Path, seen: tuple[Path, ...] = ()) -> dict:
     if path.resolve() in seen:
         raise ScenarioError("extends", str(path), "circular extends")
@@ -340,7 +361,7 @@ def _read(path: Path, seen: tuple[Path, ...] = ()) -> dict:
     except (OSError, UnicodeDecodeError) as exc:
         raise ScenarioError("scenario", str(path), f"cannot read: {exc.__class__.__name__}") from None
     try:
-        raw = yaml.safe_load(text)
+        raw = _parse(text)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""

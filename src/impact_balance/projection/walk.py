@@ -28,7 +28,7 @@ from ..polygon import Polygon
 from ._kernel import FAILED, INFEASIBLE, LINE, OK, equality_basis, project
 from .result import ProjectionResult
 
-__all__ = ["project_walk", "kernel_is_compiled"]
+__all__ = ["project_walk", "kernel_is_compiled", "warm_up"]
 
 #: Relative singular-value threshold for the rank of the lines of the polytope.
 RANK_TOLERANCE = 1e-12
@@ -96,3 +96,23 @@ def kernel_is_compiled() -> bool:
         return os.path.exists(project._cache._cache_file._index_path)
     except AttributeError:
         return True
+
+
+_warm = False
+
+
+def warm_up() -> float:
+    """Load (or compile) the kernel now, by projecting a square; returns the seconds spent
+    (0.0 once done). numba loads a cached kernel on its first call (0.1-0.5 s, 10-30 s to
+    compile after an installation): callers that time a projection call this first, so
+    that the load is not mistaken for the projection."""
+    global _warm
+    if _warm:
+        return 0.0
+    import time
+
+    t = time.perf_counter()
+    eye = np.eye(2)
+    project_walk(np.vstack([eye, -eye]), np.ones(4), np.zeros((0, 2)), np.zeros(0), eye)
+    _warm = True
+    return time.perf_counter() - t
