@@ -22,7 +22,7 @@ import numpy as np
 from .constants import GRAVITY
 from .constraints import WrenchPolytope, wrench_polytope
 from .diagnosis import CannotBalanceReason, explain_cannot_balance
-from .exceptions import ScenarioError
+from .exceptions import ScenarioError, SolverError
 from .polygon import Polygon
 from .projection import project_polytope
 from .stance import Stance
@@ -118,4 +118,8 @@ def with_reason(areas: BalanceAreas, stance: Stance, torque_limits: bool, gravit
     """``areas`` with :attr:`BalanceAreas.reason` filled in when they are empty."""
     if areas.can_balance or areas.reason is not None:
         return areas
-    return dataclasses.replace(areas, reason=explain_cannot_balance(stance, torque_limits, gravity))
+    try:
+        reason = explain_cannot_balance(stance, torque_limits, gravity)
+    except SolverError as exc:  # the areas are the answer; an explanation is a bonus
+        reason = CannotBalanceReason("unknown", f"the diagnosis failed ({exc})")
+    return dataclasses.replace(areas, reason=reason)

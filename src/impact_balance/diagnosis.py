@@ -66,7 +66,8 @@ class CannotBalanceReason:
     """Why the contacts cannot hold the robot at rest.
 
     Attributes:
-        kind: "torque_limits", "friction" or "com_outside" (see the module docstring).
+        kind: "torque_limits", "friction" or "com_outside" (see the module docstring), or
+            "unknown" when an LP of the diagnosis failed.
         message: One line for people.
         binding_joints: For "torque_limits": the joints whose limit alone, raised by
             ``min_scale``, restores balance (smallest first), then those that bind at the
@@ -95,7 +96,7 @@ class CannotBalanceReason:
 
 
 def _feasible(A: np.ndarray, b: np.ndarray, C: np.ndarray, d: np.ndarray) -> bool:
-    lp = HighsLP(LinearProgram(A, b, C, d))
+    lp = HighsLP(LinearProgram(A, b, C, d), warm=False)
     return lp.maximize(np.zeros(A.shape[1])).status != "infeasible"
 
 
@@ -113,7 +114,7 @@ def _min_scale(A, b, C, d, rows: np.ndarray, limits: np.ndarray) -> float | None
     # s >= 0 (a negative scale means nothing); HiGHS's free columns, so as a row.
     A_s = np.vstack([A_s, c])
     b_s = np.append(b, 0.0)
-    sol = HighsLP(LinearProgram(A_s, b_s, C_s, d)).maximize(c)
+    sol = HighsLP(LinearProgram(A_s, b_s, C_s, d), warm=False).maximize(c)
     if sol.status == "infeasible":
         return None
     if sol.status == "unbounded":  # cannot happen with s >= 0 and a bounded objective
@@ -232,7 +233,7 @@ def _active_at_uniform(A, b0, C, d, rows, L, t, names, limits):
     """Joints whose torque is at t times its limit at a solution with the common factor t."""
     Lfull = np.zeros(A.shape[0])
     Lfull[rows] = L
-    sol = HighsLP(LinearProgram(A, b0 + t * (1 + 1e-9) * Lfull, C, d)).maximize(np.zeros(A.shape[1]))
+    sol = HighsLP(LinearProgram(A, b0 + t * (1 + 1e-9) * Lfull, C, d), warm=False).maximize(np.zeros(A.shape[1]))
     if not sol.optimal:
         return []
     slack = (b0 + t * Lfull - A @ sol.x)[rows]
