@@ -112,3 +112,13 @@ def test_upside_down_foot_is_com_outside():
     assert not balance_areas(stance, torque_limits=False).can_balance
     reason = explain_cannot_balance(stance, torque_limits=True)
     assert reason.kind == "com_outside" and "static-equilibrium" in str(reason)
+
+
+def test_both_feet_flipped_through_analyze():
+    """Both soles upside down (what a GUI user did): an explained answer, not a solver error."""
+    scenario = ib.load_scenario("palm_push_two_feet")
+    contacts = [c.model_copy(update={"offset": c.offset.model_copy(update={"rpy": (np.pi, 0.0, 0.0)})})
+                for c in scenario.contacts]
+    analysis = ib.analyze(scenario.model_copy(update={"contacts": contacts}))
+    assert not analysis.areas.can_balance
+    assert analysis.cannot_balance_reason.kind == "com_outside"
