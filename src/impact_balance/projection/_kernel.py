@@ -89,12 +89,10 @@ def _point(g0, GT, z):
 
 
 @njit(cache=True)
-def _ratio_test(H, h, z, p, active, worst):
+def _ratio_test(H, h, z, p, active):
     """Largest step along unit ``p`` that keeps ``H z <= h``: (row, step), row -1 if none.
 
-    Ties (within a relative 1e-12) go to the smallest row index (Bland). ``worst[0]`` keeps
-    the smallest slack ``h_j - H_j z`` seen (negative: z left the polytope, a numerical
-    failure the caller checks).
+    Ties (within a relative 1e-12) go to the smallest row index (Bland).
     """
     m, n = H.shape
     hp = np.empty(m)
@@ -110,8 +108,6 @@ def _ratio_test(H, h, z, p, active, worst):
             b -= H[j, k] * z[k]
         hp[j] = a
         slack[j] = b
-        if b < worst[0]:
-            worst[0] = b
         if a > _EPS_PIVOT:
             t = max(b, 0.0) / a
             if t < best:
@@ -181,7 +177,7 @@ def _null_direction(Q, k, c, dc, p):
 
 
 @njit(cache=True)
-def _crash(H, h, z, W, k, active, c, dc, worst):
+def _crash(H, h, z, W, k, active, c, dc):
     """Grow the working set to n rows by steps orthogonal to it (z feasible, moved in place).
 
     Returns (status, k).
@@ -194,12 +190,12 @@ def _crash(H, h, z, W, k, active, c, dc, worst):
         Q[i] /= norm
     while k < n:
         kind = _null_direction(Q, k, c, dc, p)
-        j, t = _ratio_test(H, h, z, p, active, worst)
+        j, t = _ratio_test(H, h, z, p, active)
         if j < 0:
             if kind != 2:
                 return FAILED, k  # ascending without bound
             p *= -1.0
-            j, t = _ratio_test(H, h, z, p, active, worst)
+            j, t = _ratio_test(H, h, z, p, active)
             if j < 0:
                 return LINE, k  # a line in the polytope: no vertex
         for i in range(n):
@@ -306,7 +302,7 @@ def _vertex(h, W, Binv, z):
 
 
 @njit(cache=True)
-def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, worst):
+def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots):
     """Simplex pivots from the vertex basis (W, Binv, z) until it is optimal for the
     lexicographic objective (c, dc); ``scale`` scales the multiplier tolerance.
     Returns (status, pivots)."""
@@ -352,7 +348,7 @@ def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, worst):
         for r in range(n):
             p[r] = -Binv[r, leave] / norm
         active[W[leave]] = False
-        j, t = _ratio_test(H, h, z, p, active, worst)
+        j, t = _ratio_test(H, h, z, p, active)
         if j < 0:
             return FAILED, pivots  # unbounded edge: the box is missing
         stalled = stalled + 1 if t == 0.0 else 0
@@ -400,8 +396,8 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst):
 
     Returns (status, vertices, count, pivots): ``vertices[:count]`` are the support points
     in counter-clockwise order, consecutive duplicates removed (the last may equal the first).
-    ``worst[0]`` receives the smallest slack of any point visited, every recorded vertex
-    included (>= -rounding for a sound walk; the caller rejects the walk otherwise).
+    ``worst[0]`` receives the smallest slack of the recorded vertices (>= -rounding for a
+    sound walk; the caller rejects the walk otherwise).
     """
     m, n = H.shape
     vertices = np.empty((0, 2))
@@ -418,13 +414,13 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst):
     active_a = np.zeros(m + 1, dtype=np.bool_)
     c1 = np.zeros(n + 1)
     c1[n] = -1.0
-    status, _ = _crash(Ha, ha, za, Wa, 0, active_a, c1, np.zeros(n + 1), worst)
+    status, _ = _crash(Ha, ha, za, Wa, 0, active_a, c1, np.zeros(n + 1))
     if status != OK:
         return status, vertices, 0, 0
     Binv_a = np.empty((n + 1, n + 1))
     if not _refactor(Ha, ha, Wa, Binv_a, za):
         return FAILED, vertices, 0, 0
-    status, pivots = _optimize(Ha, ha, za, Wa, Binv_a, active_a, c1, np.zeros(n + 1), 1.0, max_pivots, worst)
+    status, pivots = _optimize(Ha, ha, za, Wa, Binv_a, active_a, c1, np.zeros(n + 1), 1.0, max_pivots)
     if status != OK:
         return status, vertices, 0, pivots
     if za[n] > _EPS_FEASIBLE:
@@ -444,14 +440,14 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst):
     u = np.array([math.cos(theta0), math.sin(theta0)])
     du = np.array([-math.sin(theta0), math.cos(theta0)])
     c, dc = _times(GT, u), _times(GT, du)
-    status, k = _crash(H, h, z, W, k, active, c, dc, worst)
+    status, k = _crash(H, h, z, W, k, active, c, dc)
     if status != OK:
         return status, vertices, 0, pivots
     Binv = np.empty((n, n))
     if not _refactor(H, h, W, Binv, z):
         return FAILED, vertices, 0, pivots
     scale = _norm(GT.ravel())  # sqrt(|G^T u|^2 + |G^T u'|^2), the same for every theta
-    status, piv = _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, worst)
+    status, piv = _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots)
     pivots += piv
     if status != OK:
         return status, vertices, 0, pivots
@@ -468,7 +464,7 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst):
         du[0], du[1] = -math.sin(theta), math.cos(theta)
         if not _refactor(H, h, W, Binv, z):  # each vertex from a fresh inverse: no drift
             return FAILED, vertices, count, pivots
-        status, piv = _optimize(H, h, z, W, Binv, active, _times(GT, u), _times(GT, du), scale, max_pivots, worst)
+        status, piv = _optimize(H, h, z, W, Binv, active, _times(GT, u), _times(GT, du), scale, max_pivots)
         pivots += piv
         if status != OK or count > max_pivots:
             return FAILED, vertices, count, pivots
