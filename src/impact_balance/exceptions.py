@@ -36,6 +36,7 @@ __all__ = [
     "SolverError",
     "UnknownKeyError",
     "StrictWarningsError",
+    "NonFiniteResultError",
 ]
 
 #: Longest shown repr of a value in a message (characters).
@@ -273,3 +274,20 @@ class StrictWarningsError(ImpactBalanceError):
         self.warnings = tuple(warnings)
         more = f" (and {len(self.warnings) - 1} more)" if len(self.warnings) > 1 else ""
         super().__init__(f"warning treated as an error (--strict): {self.warnings[0]}{more}")
+
+
+class NonFiniteResultError(ImpactBalanceError, ValueError):
+    """A computed quantity overflowed (inf or NaN): the input's numbers are out of scale.
+
+    Raised instead of returning NaN or infinity (which strict JSON cannot carry).
+
+    Attributes:
+        field: The result field that is not finite, e.g. ``impact.W``.
+        inputs: The scenario fields whose size can cause it.
+    """
+
+    def __init__(self, field: str, inputs: Sequence[str]):
+        self.field = field
+        self.inputs = tuple(inputs)
+        hint = f" (check {', '.join(self.inputs)})" if self.inputs else ""
+        super().__init__(f"{field} is not finite: the scenario's numbers are too large{hint}")

@@ -390,7 +390,9 @@ def load_robot(
 ) -> Robot:
     """Load a bundled robot by name, or any URDF (+ optional SRDF) that pinocchio reads.
 
-    Bundled models are cached: the returned :class:`Robot` is shared, do not mutate its model.
+    Models are cached (bundled ones by name, files by path, modification time and size):
+    the returned :class:`Robot` is shared, do not mutate its model (copy it:
+    ``dataclasses.replace(robot, model=pinocchio.Model(robot.model))``).
     """
     if urdf is None:
         name = robot or "talos"
@@ -400,4 +402,26 @@ def load_robot(
     urdf = Path(urdf)
     if not _is_file(urdf):
         raise RobotLoadError(str(urdf), "no such file")
-    return _load(urdf, Path(srdf) if srdf else None, robot or urdf.stem, standing)
+    srdf_path = Path(srdf) if srdf else None
+    # Cached by the files' identity and modification: an edited URDF or SRDF is reloaded.
+    key = (_file_key(urdf), _file_key(srdf_path) if srdf_path else None, robot or urdf.stem, standing)
+    cached = _FILE_ROBOTS.get(key)
+    if cached is None:
+        cached = _load(urdf, srdf_path, robot or urdf.stem, standing)
+        if len(_FILE_ROBOTS) >= 16:  # bounded
+            _FILE_ROBOTS.pop(next(iter(_FILE_ROBOTS)))
+        _FILE_ROBOTS[key] = cached
+    return cached
+
+
+#: Robots loaded from files, by :func:`_file_key` of their URDF and SRDF.
+_FILE_ROBOTS: dict[tuple, Robot] = {}
+
+
+def _file_key(path: Path) -> tuple[str, int, int]:
+    """(resolved path, modification time in ns, size) of a file; (path, -1, -1) if absent."""
+    try:
+        st = path.stat()
+    except OSError:
+        return (str(path), -1, -1)
+    return (str(path.resolve()), st.st_mtime_ns, st.st_size)

@@ -47,8 +47,11 @@ def save_figures(
         if skipped is not None:
             skipped.append(Diagnostic("figure_skipped", "plots", f"no {prefix}_phase_portrait.png: {exc}"))
     if portrait is not None:
-        title = (f"{prefix}: sagittal LIPM phase portrait, CoM height {portrait.com_height:.3g} m, "
-                 f"ZMP in [{portrait.zmp_range[0]:+.3g}, {portrait.zmp_range[1]:+.3g}] m about the CoM")
+        com = analysis.areas.com
+        title = (f"{prefix}: sagittal LIPM phase portrait, CoM height {portrait.com_height:.3g} m\n"
+                 f"ZMP in [{portrait.zmp_range[0]:+.3g}, {portrait.zmp_range[1]:+.3g}] m about the CoM: "
+                 f"the chord of the ZMP support area along x\nthrough the CoM (at y = {com[1]:.3f} m); "
+                 f"other slices of the area give other bounds")
         figures.append(("phase_portrait", plot_phase_portrait(portrait, title=title)))
     written = []
     for name, fig in figures:

@@ -33,9 +33,12 @@ class HighsLP:
     Args:
         problem: The constraints.
         tolerance: Primal and dual feasibility tolerance.
+        warm: Tune HiGHS for many re-solves from a warm basis (no presolve, primal simplex,
+            as ray shooting wants); False keeps HiGHS's defaults, sturdier for a one-off LP
+            (the tuned settings can end a zero-objective feasibility LP with status Unknown).
     """
 
-    def __init__(self, problem: LinearProgram, tolerance: float = 1e-9):
+    def __init__(self, problem: LinearProgram, tolerance: float = 1e-9, warm: bool = True):
         A, C = np.atleast_2d(problem.A), np.atleast_2d(problem.C)
         n = max(A.shape[1], C.shape[1])
         blocks, lower, upper = [], [], []
@@ -76,9 +79,10 @@ class HighsLP:
         h.setOptionValue("random_seed", 0)
         # Small LPs re-solved from a warm basis: presolve and threads only cost time here
         # (measured in benchmarks/: 5.7 -> 3.6 ms on a two-foot stance).
-        h.setOptionValue("presolve", "off")
         h.setOptionValue("threads", 1)
-        h.setOptionValue("simplex_strategy", 4)  # primal simplex
+        if warm:
+            h.setOptionValue("presolve", "off")
+            h.setOptionValue("simplex_strategy", 4)  # primal simplex
         status = h.passModel(lp)
         if status == highspy.HighsStatus.kError:
             raise SolverError("HiGHS", "kError", "the LP could not be passed to HiGHS")
