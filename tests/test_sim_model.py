@@ -85,6 +85,14 @@ def test_contact_boxes_and_impact_sphere_at_the_stance(models, name, joints):
         np.testing.assert_allclose(R, contact.rotation, atol=1e-12)
         np.testing.assert_allclose(sim.model.geom_size[geom][:2], [contact.half_length, contact.half_width])
         assert sim.model.geom_friction[geom][0] == contact.spec.friction
+    # Explicit pairs only: each box with its support (and the ground), the sphere with the surface.
+    m = sim.model
+    pairs = {(int(a), int(b)): float(mu) for a, b, mu in zip(m.pair_geom1, m.pair_geom2, m.pair_friction[:, 0])}
+    for contact, geom, support in zip(sim.stance.contacts, sim.contact_geoms, sim.support_geoms):
+        assert pairs[(support, geom)] == contact.spec.friction
+        assert pairs[(sim.ground_geom, geom)] == contact.spec.friction
+    assert pairs[(sim.surface_geom, sim.impact_geom)] == sim.scenario.impact.friction
+    assert not m.geom_contype.any() and not m.geom_conaffinity.any()
     # Each contact's support touches it: its face is the contact plane, normals opposed.
     for contact, geom in zip(sim.stance.contacts, sim.support_geoms):
         R = d.geom_xmat[geom].reshape(3, 3)
@@ -136,8 +144,9 @@ def test_state_round_trip_and_com_velocity_against_pinocchio(models, name):
     sim.set_state(sim.stance.q)
 
 
-def test_servo_holds_the_stance_under_gravity():
-    sim = build_model("palm_push_two_feet", "servo", LIGHT)
+@pytest.mark.parametrize("name", ["palm_push_two_feet", "talos_three_contacts"])
+def test_servo_holds_the_stance_under_gravity(name):
+    sim = build_model(name, "servo", LIGHT)
     com0 = sim.com()
     for _ in range(int(0.5 / sim.model.opt.timestep)):
         mujoco.mj_step(sim.model, sim.data)

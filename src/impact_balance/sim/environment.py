@@ -13,10 +13,11 @@ In the world:
 - the impacted surface: a block whose face passes through the impact point with the impact
   normal.
 
-Only robot-environment pairs collide: sustained-contact boxes with the supports
-(:data:`SUPPORT_BIT`), the impact sphere with the impacted surface (:data:`IMPACT_BIT`).
-The robot's geoms carry a higher ``priority``, so each pair uses the robot side's friction
-and solver parameters, i.e. the scenario's friction of that contact.
+Only the pairs the scenario means collide, declared as explicit MuJoCo contact pairs (every
+geom has ``contype = conaffinity = 0``): each contact box with its own support (and with the
+ground, should a foot on a ramp slip down to it), the impact sphere with the impacted
+surface. A pair carries its contact's friction (sliding only, ``condim`` 3) and solver
+parameters. Explicit pairs keep a support block from catching a neighbouring foot.
 """
 
 from __future__ import annotations
@@ -30,12 +31,8 @@ import pinocchio as pin
 from ..impact import cone_tangents
 from ..stance import Stance
 
-__all__ = ["ContactParameters", "Geometry", "add_geometry", "SUPPORT_BIT", "IMPACT_BIT", "ENVIRONMENT_GROUP"]
+__all__ = ["ContactParameters", "Geometry", "add_geometry", "ENVIRONMENT_GROUP", "CONTACT_GROUP"]
 
-#: Collision bit of sustained contacts and their supports.
-SUPPORT_BIT = 1
-#: Collision bit of the impact sphere and the impacted surface.
-IMPACT_BIT = 2
 #: Geom group of the contact geometry (robot side) and of the environment.
 CONTACT_GROUP = 3
 ENVIRONMENT_GROUP = 0
@@ -96,6 +93,13 @@ def _in_joint(stance: Stance, joint_id: int, world: pin.SE3) -> pin.SE3:
     return stance.data.oMi[joint_id].actInv(world)
 
 
+def _pair(spec: mujoco.MjSpec, robot_geom: str, world_geom: str, mu: float, solref, params: ContactParameters) -> None:
+    spec.add_pair(
+        name=f"{robot_geom}-{world_geom}", geomname1=world_geom, geomname2=robot_geom, condim=3,
+        friction=[mu, mu, 0.0, 0.0, 0.0], solref=list(solref), solimp=list(params.solimp),
+    )
+
+
 def add_geometry(
     spec: mujoco.MjSpec, stance: Stance, bodies: dict[int, mujoco.MjsBody], impact, params: ContactParameters
 ) -> Geometry:
@@ -117,7 +121,7 @@ def add_geometry(
     ground = "ground"
     spec.worldbody.add_geom(
         name=ground, type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 1.0], pos=[0.0, 0.0, ground_z],
-        contype=0, conaffinity=SUPPORT_BIT, group=ENVIRONMENT_GROUP, rgba=[0.6, 0.6, 0.6, 1.0],
+        contype=0, conaffinity=0, group=ENVIRONMENT_GROUP, rgba=[0.6, 0.6, 0.6, 1.0],
     )
     contacts, supports = [], []
     for i, contact in enumerate(stance.contacts):
@@ -128,11 +132,12 @@ def add_geometry(
         name = f"contact_{i}"
         bodies[frame.parentJoint].add_geom(
             name=name, type=mujoco.mjtGeom.mjGEOM_BOX, size=[contact.half_length, contact.half_width, t],
-            pos=box.translation, quat=_quat(box.rotation), contype=SUPPORT_BIT, conaffinity=0, condim=3,
-            friction=[spec_i.friction, 0.0, 0.0], priority=1, solref=list(params.contact_solref),
+            pos=box.translation, quat=_quat(box.rotation), contype=0, conaffinity=0, condim=3,
+            friction=[spec_i.friction, 0.0, 0.0], solref=list(params.contact_solref),
             solimp=list(params.solimp), group=CONTACT_GROUP, rgba=[0.1, 0.6, 0.1, 0.8],
         )
         contacts.append(name)
+        _pair(spec, name, ground, spec_i.friction, params.contact_solref, params)
         on_ground = contact.normal[2] > _HORIZONTAL and abs(contact.position[2] - ground_z) < 1e-3
         if on_ground:
             supports.append(ground)
@@ -144,10 +149,11 @@ def add_geometry(
         spec.worldbody.add_geom(
             name=support, type=mujoco.mjtGeom.mjGEOM_BOX,
             size=[contact.half_length + params.support_margin, contact.half_width + params.support_margin, depth],
-            pos=centre, quat=_quat(contact.rotation), contype=0, conaffinity=SUPPORT_BIT,
+            pos=centre, quat=_quat(contact.rotation), contype=0, conaffinity=0,
             group=ENVIRONMENT_GROUP, rgba=[0.55, 0.5, 0.45, 1.0],
         )
         supports.append(support)
+        _pair(spec, name, support, spec_i.friction, params.contact_solref, params)
     impact_name = surface_name = None
     if impact is not None:
         frame = model.frames[stance.robot.frame_id(impact.frame, "impact.frame")]
@@ -158,7 +164,7 @@ def add_geometry(
         impact_name = "impact"
         bodies[frame.parentJoint].add_geom(
             name=impact_name, type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[r, 0.0, 0.0], pos=centre,
-            contype=IMPACT_BIT, conaffinity=0, condim=3, friction=[impact.friction, 0.0, 0.0], priority=1,
+            contype=0, conaffinity=0, condim=3, friction=[impact.friction, 0.0, 0.0],
             solref=list(params.impact_solref), solimp=list(params.solimp), group=CONTACT_GROUP,
             rgba=[0.9, 0.1, 0.1, 1.0],
         )
@@ -167,7 +173,8 @@ def add_geometry(
         surface_name = "impact_surface"
         spec.worldbody.add_geom(
             name=surface_name, type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.25, 0.25, depth], pos=point - depth * n,
-            quat=_quat(np.column_stack([t1, t2, n])), contype=0, conaffinity=IMPACT_BIT,
+            quat=_quat(np.column_stack([t1, t2, n])), contype=0, conaffinity=0,
             group=ENVIRONMENT_GROUP, rgba=[0.7, 0.45, 0.3, 0.6],
         )
+        _pair(spec, impact_name, surface_name, impact.friction, params.impact_solref, params)
     return Geometry(tuple(contacts), tuple(supports), ground, impact_name, surface_name)

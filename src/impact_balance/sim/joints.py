@@ -55,7 +55,7 @@ class ServoOptions:
         effort_limits: Clamp each servo's torque to the joint's URDF effort limit.
     """
 
-    bandwidth: float = 2.0 * math.pi * 8.0
+    bandwidth: float = 2.0 * math.pi * 15.0
     damping_ratio: float = 1.0
     armature: float = 0.0
     effort_limits: bool = True
