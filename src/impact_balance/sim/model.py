@@ -52,7 +52,7 @@ class SimOptions:
             4 edges, inscribed, and would under-estimate friction between its edges.
     """
 
-    timestep: float = 0.0005
+    timestep: float = 0.001
     contact: ContactParameters = field(default_factory=ContactParameters)
     servo: ServoOptions = field(default_factory=ServoOptions)
     meshes: bool = True
@@ -170,6 +170,44 @@ class SimModel:
             world = contact.frame.reshape(3, 3).T @ local[:3]
             total += world if contact.geom2 == geom else -world
         return total
+
+    def contact_forces(self, geoms: tuple[int, ...] | list[int]) -> np.ndarray:
+        """:meth:`contact_force` of several geoms at once, (len(geoms), 3), N, world, on the robot.
+
+        Vectorised over the contacts: with elliptic cones (the default) a contact's force in
+        its frame is its rows of ``efc_force`` (normal, then the two tangents), which is what
+        ``mj_contactForce`` returns; with pyramidal cones it falls back to that function.
+        """
+        m, d = self.model, self.data
+        out = np.zeros((len(geoms), 3))
+        if d.ncon == 0:
+            return out
+        if m.opt.cone != mujoco.mjtCone.mjCONE_ELLIPTIC:
+            for k, g in enumerate(geoms):
+                out[k] = self.contact_force(g)
+            return out
+        contacts = d.contact
+        address = contacts.efc_address
+        active = (address >= 0) & (contacts.dim >= 3)
+        if not active.any():
+            return out
+        address = address[active]
+        local = d.efc_force[address[:, None] + np.arange(3)]  # (k, 3) in each contact frame
+        world = np.einsum("kji,kj->ki", contacts.frame[active].reshape(-1, 3, 3), local)
+        g1, g2 = contacts.geom1[active], contacts.geom2[active]
+        for k, g in enumerate(geoms):
+            out[k] = world[g2 == g].sum(axis=0) - world[g1 == g].sum(axis=0)
+        return out
+
+    def enable_supports(self, enabled: bool = True) -> None:
+        """Let the sustained contacts touch their supports (default), or not (a floating robot).
+
+        Disabling sets the pairs' margin to -1 m (contact only past 1 m of penetration).
+        """
+        surface = {self.surface_geom}
+        for i in range(self.model.npair):
+            if int(self.model.pair_geom1[i]) not in surface:
+                self.model.pair_margin[i] = 0.0 if enabled else -1.0
 
     def set_servo_targets(self, q_ref: np.ndarray, v_ref: np.ndarray | None = None) -> None:
         """Servo commands: target joint positions (pinocchio ``q``) and velocities (pinocchio ``v``), holding torques added."""
