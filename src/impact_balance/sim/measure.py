@@ -1,7 +1,7 @@
 """What a trial measured, against what the impact model predicts.
 
-Measured, across the impact (from the last step before the impact force appears to the end
-of the impact, see :func:`impact_window`):
+Measured, across the impact (from the last step before the impact force appears to the
+separation, or 20 ms later if the limb keeps pressing, see :func:`impact_window`):
 - the impulse at the impact point: the integrated contact force on the robot, N s, world;
 - the CoM velocity jump (xy), m/s;
 - the approach speed (``-n . v`` of the impact point just before) and the restitution
@@ -31,10 +31,10 @@ from .trial import TrialRecord
 
 __all__ = ["Prediction", "TrialResult", "impact_window", "measure", "distance_to_hull"]
 
-#: A force below this fraction of the peak counts as zero (end of the impact).
-_FORCE_FLOOR = 1e-3
-#: The impact ends at separation, or once the force falls below this fraction of its peak.
-_DECAY = 0.05
+#: A force below this fraction of the peak counts as zero.
+_FORCE_FLOOR = 1e-6
+#: Longest impact, s: a servo-held limb may keep pressing on the surface after the impact.
+MAX_IMPACT_DURATION = 0.02
 
 
 @dataclass(frozen=True)
@@ -138,22 +138,24 @@ def distance_to_hull(point: np.ndarray, vertices: np.ndarray) -> float:
     return best
 
 
-def impact_window(record: TrialRecord) -> tuple[int, int]:
-    """Indices (before, end): the last sample before the impact force appears, and the impact's end.
+def impact_window(record: TrialRecord, max_duration: float = MAX_IMPACT_DURATION) -> tuple[int, int]:
+    """Indices (before, end) of the impact: the force of sample k acts from sample k to k + 1.
 
-    The end is the first sample after the force peak where the force is zero (separation)
-    or below 5 % of the peak (the servo-held robot may keep pressing).
+    ``before`` is the last sample without impact force; ``end`` the first sample where it is
+    zero again (separation), or ``max_duration`` after the impact began if the limb keeps
+    pressing. So the impulse is the sum of the forces of samples ``before .. end - 1`` times
+    the step, and it changes the velocities from sample ``before`` to sample ``end``.
     """
     force = np.linalg.norm(record.forces["impact"], axis=1)
     peak = force.max(initial=0.0)
     if peak <= 0.0:
         raise ValueError("no impact")
-    touching = np.flatnonzero(force > _FORCE_FLOOR * peak)
-    first = int(touching[0])
+    touching = force > _FORCE_FLOOR * peak
+    first = int(np.flatnonzero(touching)[0])
     before = max(first - 1, 0)
-    k_peak = first + int(np.argmax(force[first:]))
-    after = np.flatnonzero(force[k_peak:] <= _DECAY * peak)
-    end = k_peak + int(after[0]) if after.size else len(force) - 1
+    last = min(len(force) - 1, int(np.searchsorted(record.time, record.time[first] + max_duration)))
+    released = np.flatnonzero(~touching[first:last])
+    end = first + int(released[0]) if released.size else last
     return before, end
 
 
@@ -170,7 +172,7 @@ def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialR
             "--duration", round(record.simulated_time, 4), "the impact point never reached the surface in that time"
         ) from None
     dt = sim.model.opt.timestep
-    impulse = record.forces["impact"][before + 1 : end + 1].sum(axis=0) * dt
+    impulse = record.forces["impact"][before:end].sum(axis=0) * dt
     jump = (record.com_velocity[end] - record.com_velocity[before])[:2]
     v_before, v_after = record.impact_velocity[before], record.impact_velocity[end]
     approach = float(-n @ v_before)

@@ -194,10 +194,10 @@ class SimModel:
         address = address[active]
         local = d.efc_force[address[:, None] + np.arange(3)]  # (k, 3) in each contact frame
         world = np.einsum("kji,kj->ki", contacts.frame[active].reshape(-1, 3, 3), local)
-        g1, g2 = contacts.geom1[active], contacts.geom2[active]
-        for k, g in enumerate(geoms):
-            out[k] = world[g2 == g].sum(axis=0) - world[g1 == g].sum(axis=0)
-        return out
+        wanted = np.asarray(geoms)[:, None]
+        sign = (contacts.geom2[active][None, :] == wanted).astype(float)
+        sign -= contacts.geom1[active][None, :] == wanted
+        return sign @ world
 
     def enable_supports(self, enabled: bool = True) -> None:
         """Let the sustained contacts touch their supports (default), or not (a floating robot).

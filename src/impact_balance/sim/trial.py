@@ -159,7 +159,7 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
     steps = int(round(total / dt))
     names = [c.spec.frame for c in sim.stance.contacts] + ["impact"]
     geoms = [*sim.contact_geoms, sim.impact_geom]
-    T = steps + 1
+    T = steps
     rec_t = np.empty(T)
     qpos, qvel = np.empty((T, m.nq)), np.empty((T, m.nv))
     com, comd = np.empty((T, 3)), np.empty((T, 3))
@@ -167,25 +167,17 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
     point_v = np.empty((T, 3))
     contact_pos = np.empty((T, len(sim.contact_geoms), 3))
 
-    def record(k: int) -> None:
-        rec_t[k] = d.time
-        qpos[k], qvel[k] = d.qpos, d.qvel
-        mujoco.mj_subtreeVel(m, d)
-        com[k] = d.subtree_com[sim.root_body]
-        comd[k] = d.subtree_linvel[sim.root_body]
-        forces[k] = sim.contact_forces(geoms)
-        point_v[k] = _point_velocity(sim, n)
-        contact_pos[k] = d.geom_xpos[list(sim.contact_geoms)]
-
+    # mj_step computes the kinematics, contacts and forces of the state it starts from, then
+    # integrates: sample k is the state before step k, with what mj_step computed from it
+    # (its contact forces act from sample k to sample k + 1).
     d.time = 0.0
     start = time.perf_counter()
     frozen = None  # servo targets once the impact begins
     try:
-        record(0)
-        for k in range(1, T):
+        for k in range(T):
             if limb_dq is not None:
                 s = d.time - settle  # time into the approach
-                if frozen is None and s > 0.0 and forces[k - 1, -1].any():
+                if frozen is None and s > 0.0 and k > 0 and forces[k - 1, -1].any():
                     # A kinematic controller stops the limb at contact: hold the targets there.
                     frozen = pin.integrate(sim.stance.model, q_start, s * v_n * limb_dq)
                 if frozen is not None:
@@ -193,8 +185,15 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
                 elif s > 0.0:
                     # Past the stance if need be: the servos lag, the surface is where the stance touches it.
                     sim.set_servo_targets(pin.integrate(sim.stance.model, q_start, s * v_n * limb_dq), v_n * limb_dq)
+            rec_t[k] = d.time
+            qpos[k], qvel[k] = d.qpos, d.qvel
             mujoco.mj_step(m, d)
-            record(k)
+            mujoco.mj_subtreeVel(m, d)
+            com[k] = d.subtree_com[sim.root_body]
+            comd[k] = d.subtree_linvel[sim.root_body]
+            forces[k] = sim.contact_forces(geoms)
+            point_v[k] = _point_velocity(sim, n)
+            contact_pos[k] = d.geom_xpos[list(sim.contact_geoms)]
     finally:
         wall = time.perf_counter() - start
         m.opt.gravity[:] = gravity
