@@ -196,3 +196,20 @@ def test_cli_video(tmp_path):
     reader = imageio.get_reader(video)
     frame = reader.get_data(0)
     assert frame.shape[2] == 3 and frame.std() > 5  # a picture, not a blank frame
+
+
+def test_armature_enters_gains_and_joint_space_prediction():
+    import pinocchio as pin
+
+    from impact_balance.sim import ServoOptions
+    from impact_balance.sim.measure import _stance_with_armature
+
+    sim = build_model("kick_one_foot", "servo", SimOptions(meshes=False, servo=ServoOptions(armature=0.3)))
+    M = pin.crba(sim.stance.model, sim.stance.model.createData(), sim.stance.q)
+    w = sim.options.servo.bandwidth
+    np.testing.assert_allclose(sim.kp, (M[sim.v_index, sim.v_index] + 0.3) * w**2, rtol=1e-9)
+    np.testing.assert_allclose(sim.model.dof_armature[sim.dof_adr], 0.3)
+    stance = _stance_with_armature(sim)
+    M2 = pin.crba(stance.model, stance.model.createData(), stance.q)
+    np.testing.assert_allclose(np.diag(M2 - M)[sim.v_index], 0.3, atol=1e-12)
+    assert not sim.robot.model.armature.any()  # the shared robot model is untouched

@@ -20,6 +20,8 @@ def add_parser(sub) -> list[str]:
                    help="approach speed(s) of the impact point along the normal, m/s (default 0.3)")
     a.add_argument("--joints", default="rigid", metavar="rigid|servo",
                    help="joint model: rigid (welded at the stance, the paper's model) or servo (position servos)")
+    a.add_argument("--armature", type=float, default=0.0, metavar="KG_M2",
+                   help="servo only: rotor inertia added to every joint, kg m^2 (default 0, as in the URDF)")
     a.add_argument("--duration", type=float, default=0.15, metavar="S",
                    help="simulated time kept after the impact begins, s (default 0.15)")
     a.add_argument("--json", action="store_true", help="print one JSON object (a list for several speeds)")
@@ -88,6 +90,8 @@ def run(args: argparse.Namespace) -> int:
         raise SimulationError("--joints", args.joints, f"unknown joint model; valid: {', '.join(JOINT_MODELS)}")
     if not (math.isfinite(args.duration) and 0.0 < args.duration <= 10.0):
         raise SimulationError("--duration", args.duration, "must be in (0, 10] s")
+    if not (math.isfinite(args.armature) and 0.0 <= args.armature <= 100.0):
+        raise SimulationError("--armature", args.armature, "must be in [0, 100] kg m^2")
     if args.log and Path(args.log).suffix.lower() not in (".parquet", ".csv"):
         raise SimulationError("--log", args.log, "a log is a .parquet or .csv file")
     if args.video and Path(args.video).suffix.lower() != ".mp4":
@@ -95,9 +99,10 @@ def run(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
     if scenario.impact is None:
         raise SimulationError("impact", None, f"scenario {args.scenario!r} has no impact to simulate")
-    from ..sim import SimOptions
+    from ..sim import ServoOptions, SimOptions
 
-    sim = build_model(scenario, args.joints, SimOptions(meshes=bool(args.video)))
+    options = SimOptions(meshes=bool(args.video), servo=ServoOptions(armature=args.armature))
+    sim = build_model(scenario, args.joints, options)
     name = scenario.name or Path(str(args.scenario)).stem
     several = len(speeds) > 1
     results, written = [], []

@@ -11,7 +11,7 @@ separation, or 20 ms later if the limb keeps pressing, see :func:`impact_window`
 Predicted: the impact model (:func:`impact_balance.impact.impact_model`) at the stance, with
 the restitution range set to the measured value ``[e, e]`` and evaluated at the measured
 approach speed, for both inertia models (``composite``: the robot as one rigid body;
-``joint_space``: ``J M^-1 J^T``, every joint free). Its CoM velocity jumps span a polygon;
+``joint_space``: ``J M^-1 J^T``, every joint free, ``M`` including the servos' armature). Its CoM velocity jumps span a polygon;
 the distance of the measured jump to it (0 inside) says how far the model is from the
 simulation.
 """
@@ -23,9 +23,11 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import pinocchio as pin
 
 from ..impact import INERTIA_MODELS, impact_model
 from ..polygon import Polygon
+from ..stance import Stance
 from .model import SimModel
 from .trial import TrialRecord
 
@@ -159,6 +161,19 @@ def impact_window(record: TrialRecord, max_duration: float = MAX_IMPACT_DURATION
     return before, end
 
 
+def _stance_with_armature(sim: SimModel) -> Stance:
+    """The stance, on a copy of the robot model carrying the servos' armature (pinocchio's
+    ``crba`` adds ``model.armature`` to the mass matrix), so that ``joint_space`` predicts for
+    the simulated robot. The shared robot model is never modified."""
+    armature = sim.options.servo.armature
+    if sim.joints != "servo" or armature == 0.0:
+        return sim.stance
+    model = pin.Model(sim.robot.model)
+    model.armature[sim.v_index] = armature
+    robot = dataclasses.replace(sim.robot, model=model)
+    return Stance(robot, sim.stance.q, [c.spec for c in sim.stance.contacts])
+
+
 def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialResult:
     """Measurement and predictions of one trial (see the module docstring)."""
     from ..exceptions import SimulationError
@@ -179,9 +194,10 @@ def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialR
     restitution = max(0.0, float(n @ v_after)) / approach if approach > 0 else float("nan")
     slip = float(np.linalg.norm(v_after - (n @ v_after) * n))
     predicted = {}
+    stance = _stance_with_armature(sim)
     for inertia in INERTIA_MODELS:
         model_spec = dataclasses.replace(spec, restitution=(restitution, restitution), inertia=inertia)
-        model = impact_model(sim.stance, model_spec)
+        model = impact_model(stance if inertia == "joint_space" else sim.stance, model_spec)
         jumps = model.com_velocity_jumps(approach)[:, :2]
         predicted[inertia] = Prediction(inertia, jumps, distance_to_hull(jump, jumps))
     kept = None
