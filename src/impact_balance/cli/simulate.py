@@ -72,6 +72,8 @@ def _table(name: str, r) -> str:
     kept = "n/a (floating)" if r.contacts_kept is None else ("yes" if r.contacts_kept else "NO")
     lines.append(f"  impulse {i[0]:+.3f} {i[1]:+.3f} {i[2]:+.3f} N s; contacts kept: {kept}; "
                  f"simulated/wall time {r.sim_time_ratio:.1f}x")
+    if r.saturated_joints:
+        lines.append(f"  at their effort limit during the impact: {', '.join(r.saturated_joints)}")
     return "\n".join(lines)
 
 

@@ -11,9 +11,9 @@ separation, or 20 ms later if the limb keeps pressing, see :func:`impact_window`
 Predicted: the impact model (:func:`impact_balance.impact.impact_model`) at the stance, with
 the restitution range set to the measured value ``[e, e]`` and evaluated at the measured
 approach speed, for both inertia models (``composite``: the robot as one rigid body;
-``joint_space``: ``J M^-1 J^T``, every joint free, ``M`` including the servos' armature). Its CoM velocity jumps span a polygon;
-the distance of the measured jump to it (0 inside) says how far the model is from the
-simulation.
+``joint_space``: ``J M^-1 J^T``, every joint free, ``M`` including the servos' armature).
+Its CoM velocity jumps span a polygon; the distance of the measured jump to it (0 inside)
+says how far the model is from the simulation.
 """
 
 from __future__ import annotations
@@ -76,6 +76,8 @@ class TrialResult:
         contacts_kept: Every sustained contact kept touching its support without sliding
             more than 1 cm (``servo``); None for ``rigid``, whose robot floats.
         predicted: Prediction per inertia model.
+        saturated_joints: ``servo``: joints whose torque reached its effort limit during the
+            impact (empty for ``rigid``).
         sim_time_ratio: Simulated time over wall-clock time.
         record: The time series.
     """
@@ -90,6 +92,7 @@ class TrialResult:
     impact_time: tuple[float, float]
     contacts_kept: bool | None
     predicted: dict[str, Prediction]
+    saturated_joints: list[str]
     sim_time_ratio: float
     record: TrialRecord | None = None
 
@@ -117,6 +120,7 @@ class TrialResult:
                 for name, p in self.predicted.items()
             },
             "contacts_kept": self.contacts_kept,
+            "saturated_joints": list(self.saturated_joints),
             "sim_time_ratio": num(self.sim_time_ratio),
         }
 
@@ -208,10 +212,18 @@ def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialR
         )  # (k, T)
         moved = np.linalg.norm(record.contact_positions[start:] - record.contact_positions[start], axis=2).max()
         kept = bool((normal_forces > 0.0).all() and moved < 0.01)
+    saturated: list[str] = []
+    if sim.joints == "servo" and record.actuator_force.size:
+        limits = sim.model.actuator_forcerange[sim.actuator_ids, 1]
+        peak = np.abs(record.actuator_force[before:end + 1]).max(axis=0)
+        limited = sim.model.actuator_forcelimited[sim.actuator_ids].astype(bool)
+        saturated = [name for name, p, lim, on in zip(sim.joint_names, peak, limits, limited)
+                     if on and p >= lim * (1 - 1e-6)]
     ratio = record.simulated_time / record.wall_time if record.wall_time > 0 else float("nan")
     return TrialResult(
         approach_speed=approach_speed, joints=sim.joints, approach_speed_measured=approach,
         restitution_measured=restitution, impulse_measured=impulse, com_velocity_jump_measured=jump,
         slip_speed=slip, impact_time=(float(record.time[before]), float(record.time[end])),
-        contacts_kept=kept, predicted=predicted, sim_time_ratio=ratio, record=record,
+        contacts_kept=kept, predicted=predicted, saturated_joints=saturated, sim_time_ratio=ratio,
+        record=record,
     )

@@ -210,7 +210,10 @@ class SimModel:
                 self.model.pair_margin[i] = 0.0 if enabled else -1.0
 
     def set_servo_targets(self, q_ref: np.ndarray, v_ref: np.ndarray | None = None) -> None:
-        """Servo commands: target joint positions (pinocchio ``q``) and velocities (pinocchio ``v``), holding torques added."""
+        """Servo commands from target joint positions (pinocchio ``q``) and velocities (pinocchio ``v``).
+
+        The holding torques (:attr:`tau_hold`) are added as a feed-forward.
+        """
         if self.actuator_ids.size == 0:
             return
         target = np.asarray(q_ref, dtype=float)[self.q_index]
