@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from ._common import IMPACT_COLOR, draw_polygon, hull, new_figure, text_box
 
@@ -23,7 +24,10 @@ def plot_jump_on_sets(result, title: str) -> Figure:
     jump = np.asarray(result.com_velocity_jump_measured)
     for ax, names in zip(axes, (("composite", "joint_space"), ("joint_space",))):
         zoom = len(names) == 1
-        points = [np.zeros((1, 2))] if zoom else [jump[None, :], np.zeros((1, 2))]
+        points = [jump[None, :], np.zeros((1, 2))]
+        if zoom:  # keep the measured jump in view unless it is far beyond the set
+            extent = float(np.linalg.norm(result.predicted[names[0]].com_velocity_jumps, axis=1).max())
+            points = points[1:] if np.linalg.norm(jump) > 5.0 * extent else points
         for name in names:
             p = result.predicted[name]
             draw_polygon(ax, hull(p.com_velocity_jumps), color=_MODEL_COLORS[name], alpha=0.3,
@@ -41,6 +45,7 @@ def plot_jump_on_sets(result, title: str) -> Figure:
         ax.set_xlim(lo[0] - pad, hi[0] + pad)
         ax.set_ylim(lo[1] - pad, hi[1] + pad)
         ax.set_aspect("equal", adjustable="box")
+        ax.xaxis.set_major_locator(MaxNLocator(5))
         ax.set_xlabel("CoM velocity jump x (m/s)")
         ax.set_ylabel("CoM velocity jump y (m/s)")
         ax.grid(alpha=0.3)
