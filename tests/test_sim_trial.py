@@ -213,3 +213,16 @@ def test_armature_enters_gains_and_joint_space_prediction():
     M2 = pin.crba(stance.model, stance.model.createData(), stance.q)
     np.testing.assert_allclose(np.diag(M2 - M)[sim.v_index], 0.3, atol=1e-12)
     assert not sim.robot.model.armature.any()  # the shared robot model is untouched
+
+
+def test_cli_unusable_gl_backend_is_one_line(tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, MUJOCO_GL="no-such-backend")
+    proc = subprocess.run([sys.executable, "-m", "impact_balance", "simulate", "kick_one_foot", "--duration", "0.01",
+                           "--video", str(tmp_path / "v.mp4")], capture_output=True, text=True, timeout=300, env=env)
+    assert proc.returncode == 2
+    assert proc.stderr.strip().splitlines() == [proc.stderr.strip()] and "MUJOCO_GL" in proc.stderr
+    assert "Traceback" not in proc.stderr

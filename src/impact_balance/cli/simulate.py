@@ -82,6 +82,12 @@ def run(args: argparse.Namespace) -> int:
     if args.video:
         os.environ.setdefault("MUJOCO_GL", "egl")
     from ..exceptions import SimulationError
+
+    try:
+        import mujoco  # noqa: F401  (reads MUJOCO_GL when imported)
+    except Exception as exc:  # an unusable backend fails inside MuJoCo's import, with various types
+        raise SimulationError("MUJOCO_GL", os.environ.get("MUJOCO_GL"), f"MuJoCo cannot start with this OpenGL "
+                              f"backend ({type(exc).__name__}); use MUJOCO_GL=egl, or unset it") from None
     from ..scenario import load_scenario
     from ..sim import JOINT_MODELS, build_model
     from ..sim.measure import measure

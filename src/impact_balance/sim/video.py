@@ -7,6 +7,7 @@ scenes. Without a backend, :func:`write_video` raises :class:`SimulationError` (
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import mujoco
@@ -33,7 +34,9 @@ def write_video(sim: SimModel, record: TrialRecord, path: str | Path, fps: int =
     model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
     model.vis.global_.offheight = max(model.vis.global_.offheight, height)
     try:
-        renderer = mujoco.Renderer(model, height, width)
+        with warnings.catch_warnings():  # GLFW warns before failing: the error line says it all
+            warnings.simplefilter("ignore")
+            renderer = mujoco.Renderer(model, height, width)
     except Exception as exc:  # no GL context: the error type depends on the backend
         raise SimulationError("--video", str(path)[:80], f"no offscreen OpenGL here ({type(exc).__name__}); "
                               "set MUJOCO_GL=egl on a machine with EGL") from None
