@@ -50,6 +50,9 @@ class SimOptions:
         meshes: Load the robot's meshes (visual only; needed for video).
         elliptic_cone: Elliptic friction cones (exact Coulomb); MuJoCo's default pyramid has
             4 edges, inscribed, and would under-estimate friction between its edges.
+        impratio: MuJoCo's ratio of frictional to normal constraint impedance. MuJoCo's soft
+            friction lets a loaded contact creep; 10 (instead of 1) stiffens friction so that a
+            foot on the 30 degree ramp stays put (CoM drift 7 mm in 2 s instead of 8 cm).
     """
 
     timestep: float = 0.001
@@ -57,6 +60,7 @@ class SimOptions:
     servo: ServoOptions = field(default_factory=ServoOptions)
     meshes: bool = True
     elliptic_cone: bool = True
+    impratio: float = 10.0
 
 
 @dataclass
@@ -254,7 +258,7 @@ def build_model(
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     if options.elliptic_cone:
         spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
-    spec.option.noslip_iterations = 0
+    spec.option.impratio = options.impratio
     names = add_geometry(spec, stance, _joint_bodies(spec, stance), impact, options.contact)
 
     # Joints simulated as joints (1-dof ones; pinocchio's continuous joints have nq = 2).
