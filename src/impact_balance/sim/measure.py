@@ -207,9 +207,8 @@ def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialR
     kept = None
     if sim.joints != "rigid":
         start = int(np.searchsorted(record.time, record.approach_start))
-        normal_forces = np.array(
-            [record.forces[c.spec.frame][start:] @ c.normal for c in sim.stance.contacts]
-        )  # (k, T)
+        contact_forces = [f for name, f in record.forces.items() if name != "impact"]  # in contact order
+        normal_forces = np.array([f[start:] @ c.normal for f, c in zip(contact_forces, sim.stance.contacts)])
         moved = np.linalg.norm(record.contact_positions[start:] - record.contact_positions[start], axis=2).max()
         kept = bool((normal_forces > 0.0).all() and moved < 0.01)
     saturated: list[str] = []

@@ -162,7 +162,9 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
         settle = options.settle
     total = settle + 1.5 * travel + options.after
     steps = int(round(total / dt))
-    names = [c.spec.frame for c in sim.stance.contacts] + ["impact"]
+    frames = [c.spec.frame for c in sim.stance.contacts]
+    # Log names: the contact's frame, made unique with its index when two contacts share a frame.
+    names = [f if frames.count(f) == 1 else f"{f}_{i}" for i, f in enumerate(frames)] + ["impact"]
     geoms = [*sim.contact_geoms, sim.impact_geom]
     T = steps
     rec_t = np.empty(T)
