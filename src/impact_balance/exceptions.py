@@ -37,6 +37,7 @@ __all__ = [
     "UnknownKeyError",
     "StrictWarningsError",
     "NonFiniteResultError",
+    "SimulationError",
 ]
 
 #: Longest shown repr of a value in a message (characters).
@@ -291,3 +292,19 @@ class NonFiniteResultError(ImpactBalanceError, ValueError):
         self.inputs = tuple(inputs)
         hint = f" (check {', '.join(self.inputs)})" if self.inputs else ""
         super().__init__(f"{field} is not finite: the scenario's numbers are too large{hint}")
+
+
+class SimulationError(ImpactBalanceError, ValueError):
+    """A simulation request cannot be carried out (bad option, no impact, no renderer...).
+
+    Attributes:
+        field: The option or scenario field at fault (e.g. ``--speed``, ``impact``).
+        value: Its value.
+        reason: Why it is refused.
+    """
+
+    def __init__(self, field: str, value: Any, reason: str):
+        self.field = field
+        self.value = value
+        self.reason = reason
+        super().__init__(one_line(f"{field} = {short_repr(value)}: {reason}"))
