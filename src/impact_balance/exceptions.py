@@ -23,6 +23,8 @@ __all__ = [
     "RobotLoadError",
     "ImpactModelError",
     "SolverError",
+    "SweepError",
+    "UnknownKeyError",
 ]
 
 
@@ -141,3 +143,16 @@ class SolverError(ImpactBalanceError, RuntimeError):
         self.status = status
         extra = f": {detail}" if detail else ""
         super().__init__(f"{solver} failed with status {status}{extra}")
+
+
+class SweepError(ScenarioError):
+    """A sweep file field has a bad value (same data as :class:`ScenarioError`).
+
+    Also raised when an output folder holds the results of a different sweep.
+    """
+
+
+class UnknownKeyError(UnknownNameError):
+    """A sweep axis path names a scenario key that does not exist; lists the valid paths."""
+
+    kind = "key"
