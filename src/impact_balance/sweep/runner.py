@@ -102,6 +102,7 @@ def _init_process(plan: SweepPlan) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     global _EVALUATOR
     _EVALUATOR = Evaluator(plan)
+    _EVALUATOR.warm_up()
 
 
 def _process_chunk(chunk: int) -> pa.Table:
@@ -118,7 +119,9 @@ def dask_chunk(plan: SweepPlan, chunk: int) -> pa.Table:
     with _LOCK:
         evaluator = _EVALUATORS.get(plan.digest)
         if evaluator is None:
-            evaluator = _EVALUATORS[plan.digest] = Evaluator(plan)
+            evaluator = Evaluator(plan)
+            evaluator.warm_up()
+            _EVALUATORS[plan.digest] = evaluator
     return evaluator.evaluate_chunk(chunk)
 
 
@@ -135,6 +138,7 @@ class _Inline:
 
     def __init__(self, plan: SweepPlan):
         self.evaluator = Evaluator(plan)
+        self.evaluator.warm_up()
         self.workers = 1
 
     def run(self, chunks: list[int]) -> Iterator[tuple[int, pa.Table]]:
