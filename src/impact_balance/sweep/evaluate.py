@@ -50,6 +50,7 @@ RESULT_COLUMNS: tuple[tuple[str, pa.DataType, str], ...] = (
     ("zmp_area", pa.float64(), "area of the ZMP support area, m^2"),
     ("limiting_vertex", pa.int32(), "post-impact vertex (row of the impulse set) that reaches the boundary first"),
     ("limiting_edge", pa.int32(), "half-plane (edge) of the CoM velocity area it reaches"),
+    ("limiting_direction", pa.float64(), "outward normal of that edge, degrees from world +x about z: where the robot would fall"),
     ("impact_x", pa.float64(), "impact point, world, m"),
     ("impact_y", pa.float64(), "impact point, world, m"),
     ("impact_z", pa.float64(), "impact point, world, m"),
@@ -75,6 +76,7 @@ class _StanceEntry:
     com_velocity_area: float | None = None
     zmp_area: float | None = None
     verdicts: dict[tuple[float, float], str] | None = None
+    edge_directions: list[float] | None = None
 
 
 def _verdict(areas: BalanceAreas, com_velocity: tuple[float, float]) -> str:
@@ -199,6 +201,7 @@ class Evaluator:
             zmp_area=entry.zmp_area,
             limiting_vertex=com.limiting_vertex,
             limiting_edge=com.limiting_edge,
+            limiting_direction=None if com.limiting_edge is None else entry.edge_directions[com.limiting_edge],
             impact_x=float(model.point[0]),
             impact_y=float(model.point[1]),
             impact_z=float(model.point[2]),
@@ -220,7 +223,7 @@ class Evaluator:
         except ImpactBalanceError as exc:
             return _StanceEntry(None, None, "error", f"{exc.__class__.__name__}: {exc}", residual)
         return _StanceEntry(stance, areas, ik_residual=residual, com_velocity_area=areas.com_velocity_area.area,
-                            zmp_area=areas.zmp_area.area, verdicts={})
+                            zmp_area=areas.zmp_area.area, verdicts={}, edge_directions=_directions(areas))
 
     def _place(self, scenario: Scenario, stance: Stance, values: dict[str, Any], warm: dict) -> tuple[Stance, float]:
         """The stance with the posture point moved to its target, the contact frames kept."""
@@ -244,6 +247,14 @@ class Evaluator:
         placed = Stance(self.robot, q, [c.spec for c in stance.contacts])
         residual = _worst_pose_error(placed, targets)
         return placed, residual
+
+
+def _directions(areas: BalanceAreas) -> list[float]:
+    """Outward normal angle (deg, world, from +x about z) of each half-plane of the CoM velocity area."""
+    if areas.com_velocity_area.is_empty:
+        return []
+    G, _ = areas.com_velocity_area.halfplanes
+    return [math.degrees(math.atan2(float(gy), float(gx))) for gx, gy in G]
 
 
 def _get_coord(stance: Stance, evaluator: Evaluator, d) -> Any:

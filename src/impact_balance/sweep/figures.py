@@ -42,6 +42,46 @@ def _values(df: pd.DataFrame) -> np.ndarray:
     return v
 
 
+#: Two limiting edges whose outward normals differ by more than this (deg) are different cases.
+TURN_DEG = 10.0
+
+
+def _turns(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Where the limiting-edge direction changes between neighbours (both evaluated)."""
+    diff = np.abs((a - b + 180.0) % 360.0 - 180.0)
+    return np.isfinite(a) & np.isfinite(b) & (diff > TURN_DEG)
+
+
+def _cell_edges(v: np.ndarray) -> np.ndarray:
+    mid = 0.5 * (v[1:] + v[:-1])
+    first = v[0] - (mid[0] - v[0]) if len(v) > 1 else v[0] - 0.5
+    last = v[-1] + (v[-1] - mid[-1]) if len(v) > 1 else v[-1] + 0.5
+    return np.concatenate([[first], mid, [last]])
+
+
+def _draw_turns(ax, xs: np.ndarray, ys: np.ndarray, E: np.ndarray) -> None:
+    """White dotted lines between grid cells limited by different edges of the area."""
+    bx, by = _cell_edges(xs), _cell_edges(ys)
+    segments = []
+    for i, j in zip(*np.nonzero(_turns(E[:, 1:], E[:, :-1]))):  # neighbours along x
+        segments.append([(bx[j + 1], by[i]), (bx[j + 1], by[i + 1])])
+    for i, j in zip(*np.nonzero(_turns(E[1:, :], E[:-1, :]))):  # neighbours along y
+        segments.append([(bx[j], by[i + 1]), (bx[j + 1], by[i + 1])])
+    if segments:
+        from matplotlib.collections import LineCollection
+
+        ax.add_collection(LineCollection(segments, colors="w", linewidths=1.0, linestyles=":",
+                                         label=f"limiting edge turns > {TURN_DEG:g} deg"))
+
+
+def _label(name: str) -> str:
+    if name.startswith("posture."):
+        return f"{name} (m, world)"
+    if name.endswith((".azimuth", ".elevation")):
+        return f"{name} (deg)"
+    return name
+
+
 def _curve(df: pd.DataFrame, x: str, title: str):
     fig = new_figure(6.4, 4.0)
     ax = fig.add_subplot()
@@ -60,11 +100,11 @@ def _curve(df: pd.DataFrame, x: str, title: str):
     bad = np.isnan(v)
     if bad.any():
         ax.plot(xs[bad], np.zeros(bad.sum()), "x", color="0.5", label="not evaluated")
-    edges = df["limiting_edge"].to_numpy(dtype=float)
-    changes = np.flatnonzero((edges[1:] != edges[:-1]) & np.isfinite(edges[1:]) & np.isfinite(edges[:-1]))
+    directions = df["limiting_direction"].to_numpy(dtype=float)
+    changes = np.flatnonzero(_turns(directions[1:], directions[:-1]))
     for i, k in enumerate(changes):
         ax.axvline(0.5 * (xs[k] + xs[k + 1]), ls=":", color="k", lw=0.8, label="limiting edge changes" if i == 0 else None)
-    ax.set_xlabel(x)
+    ax.set_xlabel(_label(x))
     ax.set_ylabel("maximum contact velocity (m/s)")
     ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
@@ -78,7 +118,10 @@ def _heatmap(df: pd.DataFrame, x: str, y: str, others: list[str], title: str):
     df = df.assign(_v=_values(df))
     # Worst case over the other dimensions (NaN, i.e. not evaluated, only if every point is).
     cell = df.groupby([x, y], sort=True)["_v"].min() if others else df.set_index([x, y])["_v"]
-    edge = df.groupby([x, y], sort=True)["limiting_edge"].first() if others else df.set_index([x, y])["limiting_edge"]
+    # The limiting edge of the worst case of each cell, by the direction of its outward normal
+    # (edge indices are not comparable across stances; directions are).
+    worst = df.loc[df.assign(_w=df["_v"].fillna(np.inf)).groupby([x, y], sort=True)["_w"].idxmin()] if others else df
+    edge = worst.set_index([x, y])["limiting_direction"]
     xs, ys = np.unique(df[x].to_numpy(dtype=float)), np.unique(df[y].to_numpy(dtype=float))
     grid = len(cell) == len(xs) * len(ys)
     finite = np.isfinite(df["_v"].to_numpy())
@@ -88,10 +131,7 @@ def _heatmap(df: pd.DataFrame, x: str, y: str, others: list[str], title: str):
         shown = np.where(np.isinf(V), vmax, V)
         mesh = ax.pcolormesh(xs, ys, np.ma.masked_invalid(shown), shading="nearest", cmap="viridis", vmin=0.0, vmax=vmax)
         E = edge.unstack(level=0).reindex(index=ys, columns=xs).to_numpy(dtype=float)
-        if np.isfinite(E).sum() > 3 and len(np.unique(E[np.isfinite(E)])) > 1 and len(xs) > 1 and len(ys) > 1:
-            levels = np.unique(E[np.isfinite(E)])
-            ax.contour(xs, ys, np.ma.masked_invalid(E), levels=0.5 * (levels[1:] + levels[:-1]), colors="w", linewidths=0.8,
-                       linestyles=":")
+        _draw_turns(ax, xs, ys, E)
         X, Y = np.meshgrid(xs, ys)
         bad = np.isnan(V)
         if bad.any():
@@ -108,8 +148,8 @@ def _heatmap(df: pd.DataFrame, x: str, y: str, others: list[str], title: str):
         b, w = ok.loc[ok["_v"].idxmax()], ok.loc[ok["_v"].idxmin()]
         ax.plot(b[x], b[y], "*", ms=16, mfc="tab:green", mec="w", label=f"best {b['_v']:.3g} m/s")
         ax.plot(w[x], w[y], "X", ms=11, mfc="tab:red", mec="w", label=f"worst {w['_v']:.3g} m/s")
-    ax.set_xlabel(x)
-    ax.set_ylabel(y)
+    ax.set_xlabel(_label(x))
+    ax.set_ylabel(_label(y))
     ax.set_title(title, fontsize=9)
     ax.legend(fontsize=8, loc="best")
     return fig
