@@ -231,10 +231,12 @@ def make_plan(spec: SweepSpec, robot: Robot | None = None) -> SweepPlan:
         exc.source = spec.source
         exc.args = (f"{spec.source}: {exc.args[0]}",) if spec.source else exc.args
         raise
-    posture = next((a for a in spec.axes if isinstance(a, PostureAxis)), None)
-    if posture is not None:
-        frame = posture.frame or base_scenario.impact.frame
-        robot.frame_id(frame, field="posture.frame")
+    for i, axis in enumerate(spec.axes):
+        if isinstance(axis, PostureAxis):
+            try:
+                robot.frame_id(axis.frame or base_scenario.impact.frame, field=f"axes[{i}].posture.frame")
+            except ScenarioError as exc:
+                raise type(exc)(*_args(exc, exc.field)[:3], spec.source) from None
     if spec.sampling.method == "grid":
         shape = tuple(len(d.grid_values()) for d in dims)
         n_points, samples = int(np.prod(shape)), None
