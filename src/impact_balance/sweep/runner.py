@@ -4,8 +4,9 @@ Three backends, one loop:
 
 - ``workers=1``: the chunks run in this process (no start-up cost).
 - ``workers=N`` (default: every core this process may use): a
-  :class:`concurrent.futures.ProcessPoolExecutor` with the ``spawn`` start method (no fork of a
-  process holding pinocchio and numba state); each worker builds one
+  :class:`concurrent.futures.ProcessPoolExecutor` with the ``forkserver`` start method (``spawn``
+  where there is none; never a fork of this process, which holds threads and solver state);
+  each worker builds one
   :class:`~impact_balance.sweep.evaluate.Evaluator` in its initializer, so the robot is loaded
   once per worker and the compiled projection kernel comes from numba's disk cache.
 - ``scheduler=ADDRESS`` (or a :class:`distributed.Client`): Dask distributed. The plan is
@@ -132,6 +133,17 @@ def _warm_kernel(plan: SweepPlan) -> None:
     areas_from_polytope(wrench_polytope(stance, scenario.torque_limits, scenario.gravity), scenario.plane_height)
 
 
+def _context() -> multiprocessing.context.BaseContext:
+    """``forkserver`` where available (Linux): one server process imports the library once and
+    forks the workers from that clean, single-threaded state, so N workers cost one import;
+    ``spawn`` elsewhere. Never a plain fork of this process (threads, open solvers)."""
+    if "forkserver" in multiprocessing.get_all_start_methods():
+        context = multiprocessing.get_context("forkserver")
+        context.set_forkserver_preload([__name__])
+        return context
+    return multiprocessing.get_context("spawn")  # pragma: no cover - not Linux
+
+
 # -- backends: each yields (chunk, table) as chunks finish ---------------------------------
 class _Inline:
     name = "inline"
@@ -154,7 +166,7 @@ class _Processes:
 
     def __init__(self, plan: SweepPlan, workers: int):
         _warm_kernel(plan)
-        context = multiprocessing.get_context("spawn")
+        context = _context()
         self.workers = workers
         self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_init_process, initargs=(plan,))
         # Start every worker (and its robot) before the clock of the computing loop starts.

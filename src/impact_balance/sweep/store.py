@@ -61,6 +61,8 @@ class ResultStore:
         elif root.exists() and any(root.iterdir()):
             raise SweepError("--out", str(root), "exists and is not a sweep folder (no manifest.json): choose another --out")
         (root / PARTS).mkdir(parents=True, exist_ok=True)
+        for stale in (root / PARTS).glob(".part-*.tmp"):  # a write cut short by a kill
+            stale.unlink(missing_ok=True)
         store = cls(root, plan)
         if not manifest.is_file():
             _atomic_write_text(manifest, json.dumps(store.manifest(), indent=1))
