@@ -76,14 +76,26 @@ def per_core_rate(plan, chunks: list[int]) -> dict[str, float]:
     return {"points": n, "wall_s": wall, "cpu_s": cpu, "per_s": n / wall, "per_cpu_s": n / cpu}
 
 
-def speedup(tmp: Path, quick: bool) -> dict[str, Any]:
-    plan = _plan(IMPACT_AXES[:2] + [{"direction": "impact.normal", "azimuth": {"range": [150.0, 210.0], "count": 10 if quick else 20}}])
-    one = run_sweep(plan, tmp / "one", workers=1, progress=False)
-    two = run_sweep(plan, tmp / "two", workers=2, progress=False)
-    same = read_results(tmp / "one").equals(read_results(tmp / "two"))
-    return {"points": plan.n_points, "rate_1": one.rate, "rate_2": two.rate, "speedup": two.rate / one.rate,
-            "startup_2_s": two.startup_s, "wall_1_s": one.elapsed_s + one.startup_s, "wall_2_s": two.elapsed_s + two.startup_s,
-            "rows_identical": same}
+def speedup(tmp: Path, quick: bool, rounds: int = 3) -> dict[str, Any]:
+    """1 worker against 2, alternated ``rounds`` times; the best rate of each (the machine is
+    shared: the best round is the one least slowed down by other processes)."""
+    plan = _plan(IMPACT_AXES[:2] + [{"direction": "impact.normal", "azimuth": {"range": [150.0, 210.0], "count": 10}}])
+    rates: dict[int, list[float]] = {1: [], 2: []}
+    startup = []
+    same = True
+    for r in range(1 if quick else rounds):
+        for workers in (1, 2):
+            out = tmp / f"speed-{workers}-{r}"
+            report = run_sweep(plan, out, workers=workers, progress=False)
+            rates[workers].append(report.rate)
+            if workers == 2:
+                startup.append(report.startup_s)
+                same = same and read_results(out).equals(read_results(tmp / f"speed-1-{r}"))
+            shutil.rmtree(out) if workers == 2 else None
+        shutil.rmtree(tmp / f"speed-1-{r}")
+    best1, best2 = max(rates[1]), max(rates[2])
+    return {"points": plan.n_points, "rates_1": rates[1], "rates_2": rates[2], "rate_1": best1, "rate_2": best2,
+            "speedup": best2 / best1, "startup_2_s": max(startup), "rows_identical": same}
 
 
 def identical(tmp: Path) -> dict[str, Any]:
@@ -203,8 +215,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{key:28s} {t['measured']:10.1f}   target >= {t['target']:g}   {'PASS' if t['pass'] else 'FAIL'}")
     print(f"{'rows_identical':28s} {result['rows_identical']}  (1 worker, 2 workers, Dask LocalCluster)")
     sp = d["speedup"]
-    print(f"speed-up on {sp['points']} points: {sp['rate_1']:.0f} -> {sp['rate_2']:.0f} points/s "
-          f"(2 workers start in {sp['startup_2_s']:.1f} s; wall {sp['wall_1_s']:.1f} s -> {sp['wall_2_s']:.1f} s)")
+    print(f"speed-up on {sp['points']} points (best of {len(sp['rates_1'])}): {sp['rate_1']:.0f} -> {sp['rate_2']:.0f} points/s "
+          f"(2 workers start in {sp['startup_2_s']:.1f} s, not counted)")
     big = d["sweep_100k"]
     if big:
         print(f"100 000 points via the CLI: {big['wall_s']:.1f} s in all"

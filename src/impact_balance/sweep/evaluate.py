@@ -120,21 +120,20 @@ class Evaluator:
             else:
                 self._posture_offset = pin.SE3.Identity()
 
-    def warm_up(self) -> None:
-        """Evaluate the base scenario once: loads the compiled kernel and every lazy import,
-        so that a worker's first chunk is not slower than the others."""
-        stance = self.base_scenario.build_stance(self.robot)
-        polytope = wrench_polytope(stance, self.base_scenario.torque_limits, self.base_scenario.gravity)
-        areas = areas_from_polytope(polytope, self.base_scenario.plane_height)
-        model = impact_model(stance, self.base_scenario.impact.spec())
-        max_contact_velocity(areas.com_velocity_area, model, self.base_scenario.com_velocity)
-        if self._posture is not None:
-            self._place(self.base_scenario, stance, {d.name: _get_coord(stance, self, d) for d in self.plan.dims}, {})
+    def warm_up(self, points: int = 20) -> None:
+        """Evaluate the first few points of the sweep and drop the rows: loads the compiled
+        kernel and every lazy import and cache, so that a worker's first chunk is not slower
+        than the others."""
+        start, stop = self.plan.chunk_range(0)
+        self._rows(0, start, min(stop, start + points))
 
     # -- one chunk --------------------------------------------------------------------------
     def evaluate_chunk(self, chunk: int) -> pa.Table:
         """The rows of chunk ``chunk`` (a table with :func:`result_schema`)."""
         start, stop = self.plan.chunk_range(chunk)
+        return self._rows(chunk, start, stop)
+
+    def _rows(self, chunk: int, start: int, stop: int) -> pa.Table:
         points = self.plan.points(start, stop)
         names = [d.name for d in self.plan.dims]
         columns: dict[str, list[Any]] = {f.name: [] for f in self.schema}
@@ -255,14 +254,6 @@ def _directions(areas: BalanceAreas) -> list[float]:
         return []
     G, _ = areas.com_velocity_area.halfplanes
     return [math.degrees(math.atan2(float(gy), float(gx))) for gx, gy in G]
-
-
-def _get_coord(stance: Stance, evaluator: Evaluator, d) -> Any:
-    """A value of dimension ``d`` at the base stance (posture: the point's own coordinate)."""
-    if d.kind == "posture":
-        point = stance.frame_pose(evaluator._posture_frame) * evaluator._posture_offset
-        return float(point.translation[d.coord])
-    return d.grid_values()[0] if d.dim.values is not None or d.dim.count else d.dim.range[0]
 
 
 def _get(base: Any, tokens) -> Any:
