@@ -299,3 +299,26 @@ def test_bundled_sweeps_plan():
     for name in names:
         plan = plan_sweep(name)
         assert plan.n_points > 100
+
+
+def test_list_values_and_unexpected_errors_are_rows(monkeypatch):
+    plan = plan_of([{"path": "contacts[0].size", "values": [[0.2, 0.1], [0.3, 0.1], [0.2]]}])
+    df = rows(plan)
+    assert list(df["status"]) == ["ok", "ok", "invalid"] and df["contacts[0].size"][1] == "[0.3, 0.1]"
+    ref = _analyze_with(**{"contacts[0].size": [0.3, 0.1]})
+    assert df["max_contact_velocity"][1] == pytest.approx(ref.impact.max_contact_velocity, rel=1e-12)
+    # A bug deep in one point (here a simulated one) is that point's row, not the end of the chunk.
+    import impact_balance.sweep.evaluate as evaluate
+
+    calls = {"n": 0}
+    real = evaluate.max_contact_velocity
+
+    def flaky(*args):
+        calls["n"] += 1
+        if calls["n"] == 2:
+            raise FloatingPointError("simulated")
+        return real(*args)
+
+    monkeypatch.setattr(evaluate, "max_contact_velocity", flaky)
+    df = rows(plan_of([{"path": "impact.friction", "values": [0.1, 0.2, 0.3]}]))
+    assert list(df["status"]) == ["ok", "error", "ok"] and df["message"][1] == "FloatingPointError: simulated"

@@ -141,7 +141,10 @@ class Evaluator:
         warm: dict[tuple, np.ndarray] = {}
         for k in range(stop - start):
             values = {name: points[name][k] for name in names}
-            row = self._evaluate_point(values, cache, warm)
+            try:
+                row = self._evaluate_point(values, cache, warm)
+            except Exception as exc:  # noqa: BLE001 - one bad point is a row, never the end of the sweep
+                row = {"status": "error", "message": f"{exc.__class__.__name__}: {exc}"}
             columns["point"].append(start + k)
             columns["chunk"].append(chunk)
             for d in self.plan.dims:
@@ -172,7 +175,7 @@ class Evaluator:
             scenario = self._scenario(values)
         except ScenarioError as exc:
             return {"status": "invalid", "message": str(exc)}
-        key = tuple(values[name] for name in self._stance_dims)
+        key = tuple(_key(values[name]) for name in self._stance_dims)
         entry = cache.get(key)
         if entry is None:
             entry = cache[key] = self._stance_entry(scenario, values, warm)
@@ -237,7 +240,7 @@ class Evaluator:
         targets[frame] = goal
         # Warm start from the previous target reached in this chunk with the same base stance:
         # neighbouring grid targets need a few IK steps instead of tens.
-        base_key = tuple(values[d] for d in self._stance_dims if not d.startswith("posture."))
+        base_key = tuple(_key(values[d]) for d in self._stance_dims if not d.startswith("posture."))
         q0 = warm.get(base_key, stance.q)
         posture = self._posture
         q = solve_stance(self.robot, q0, targets, posture_target=stance.q,
@@ -254,6 +257,11 @@ def _directions(areas: BalanceAreas) -> list[float]:
         return []
     G, _ = areas.com_velocity_area.halfplanes
     return [math.degrees(math.atan2(float(gy), float(gx))) for gx, gy in G]
+
+
+def _key(value: Any) -> Any:
+    """A hashable stand-in for a dimension value (lists and mappings by their repr)."""
+    return repr(value) if isinstance(value, (list, dict)) else value
 
 
 def _get(base: Any, tokens) -> Any:
