@@ -322,3 +322,12 @@ def test_list_values_and_unexpected_errors_are_rows(monkeypatch):
     monkeypatch.setattr(evaluate, "max_contact_velocity", flaky)
     df = rows(plan_of([{"path": "impact.friction", "values": [0.1, 0.2, 0.3]}]))
     assert list(df["status"]) == ["ok", "error", "ok"] and df["message"][1] == "FloatingPointError: simulated"
+
+
+def test_posture_at_the_base_point_gives_the_base_answer():
+    ref = analyze(BASE)
+    x, y, z = ref.impact.model.point
+    plan = plan_of([{"posture": {"x": {"values": [float(x)]}, "y": {"values": [float(y)]}, "z": {"values": [float(z)]}}}])
+    r = rows(plan).iloc[0]
+    assert r["status"] == "ok" and r["ik_residual"] < 1e-6
+    assert r["max_contact_velocity"] == pytest.approx(ref.impact.max_contact_velocity, rel=1e-6)
