@@ -331,3 +331,16 @@ def test_posture_at_the_base_point_gives_the_base_answer():
     r = rows(plan).iloc[0]
     assert r["status"] == "ok" and r["ik_residual"] < 1e-6
     assert r["max_contact_velocity"] == pytest.approx(ref.impact.max_contact_velocity, rel=1e-6)
+
+
+def test_base_file_relative_to_the_sweep_file(tmp_path):
+    from impact_balance.sweep import load_sweep_spec
+
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "mine.yaml").write_text("extends: palm_push_two_feet\ncom_velocity: [0.05, 0.0]\n")
+    (tmp_path / "sub" / "s.yaml").write_text("base: mine.yaml\naxes:\n  - {path: 'com_velocity[1]', values: [0.0]}\n")
+    plan = make_plan(load_sweep_spec(tmp_path / "sub" / "s.yaml"))
+    r = rows(plan).iloc[0]
+    ref = _analyze_with(**{"com_velocity": [0.05, 0.0]})
+    assert r["max_contact_velocity"] == pytest.approx(ref.impact.max_contact_velocity, rel=1e-12)
+    assert ref.impact.max_contact_velocity != pytest.approx(analyze(BASE).impact.max_contact_velocity, rel=1e-6)
