@@ -83,7 +83,7 @@ def speedup(tmp: Path, quick: bool, rounds: int = 3) -> dict[str, Any]:
     rates: dict[int, list[float]] = {1: [], 2: []}
     startup = []
     same = True
-    for r in range(1 if quick else rounds):
+    for r in range(rounds):
         for workers in (1, 2):
             out = tmp / f"speed-{workers}-{r}"
             report = run_sweep(plan, out, workers=workers, progress=False)
