@@ -25,11 +25,14 @@ from scipy.stats import qmc
 
 from ..exceptions import ScenarioError, SweepError
 from ..robot import Robot
-from ..scenario import Scenario, _merge, _read, scenario_from_dict, scenario_path
+from ..scenario import _merge, _read, scenario_from_dict, scenario_path
 from .paths import STANCE_FREE_ROOTS, Token, check_path, format_path, parse_path
 from .spec import Dim, DirectionAxis, PathAxis, PostureAxis, SweepSpec, load_sweep_spec
 
 __all__ = ["Dimension", "SweepPlan", "make_plan", "plan_sweep", "PLAN_VERSION"]
+
+#: Default points per chunk, without and with a posture axis.
+DEFAULT_CHUNK, DEFAULT_CHUNK_IK = 1000, 25
 
 #: Bumped when the rows of the same spec would change (columns, ordering): old results are not resumed.
 PLAN_VERSION = 1
@@ -107,7 +110,11 @@ class SweepPlan:
 
     @property
     def chunk_size(self) -> int:
-        return self.spec.chunk_size
+        """Points per chunk: the file's ``chunk_size``, else 1000, or 25 with a posture axis (IK
+        takes milliseconds per point: small chunks keep every worker busy to the end)."""
+        if self.spec.chunk_size is not None:
+            return self.spec.chunk_size
+        return DEFAULT_CHUNK_IK if self.posture is not None else DEFAULT_CHUNK
 
     @property
     def n_chunks(self) -> int:

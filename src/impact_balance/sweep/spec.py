@@ -4,7 +4,7 @@
 description: "maximum contact velocity against impact friction and restitution"
 base: palm_push_two_feet          # bundled scenario name, a path (relative to this file), or a mapping
 sampling: grid                    # or {method: sobol | halton | lhs, samples: 4096, seed: 0}
-chunk_size: 1000                  # points per chunk (the unit of work, of output and of resume)
+chunk_size: 1000                  # points per chunk (work, output, resume); default 1000, 25 with posture
 axes:
   - path: impact.friction         # any scenario key path
     range: [0.0, 0.6]             # with count (grid), or values: [...]
@@ -163,7 +163,7 @@ class SweepSpec(_Model):
     base: str | dict[str, Any]
     axes: tuple[Axis, ...]
     sampling: Sampling = Sampling()
-    chunk_size: int = Field(1000, ge=1, le=1_000_000)
+    chunk_size: int | None = Field(None, ge=1, le=1_000_000)
     source: str | None = Field(None, exclude=True)
 
     def digest_data(self) -> dict[str, Any]:
