@@ -344,3 +344,13 @@ def test_base_file_relative_to_the_sweep_file(tmp_path):
     ref = _analyze_with(**{"com_velocity": [0.05, 0.0]})
     assert r["max_contact_velocity"] == pytest.approx(ref.impact.max_contact_velocity, rel=1e-12)
     assert ref.impact.max_contact_velocity != pytest.approx(analyze(BASE).impact.max_contact_velocity, rel=1e-6)
+
+
+def test_impact_offset_axis_moves_the_impact_point():
+    plan = plan_of([{"path": "impact.offset.position[1]", "values": [0.0, 0.05]}])
+    df = rows(plan)
+    for _, r in df.iterrows():
+        a = _analyze_with(**{"impact.offset.position[1]": r["impact.offset.position[1]"]})
+        assert np.allclose([r["impact_x"], r["impact_y"], r["impact_z"]], a.impact.model.point, atol=1e-12)
+        assert r["max_contact_velocity"] == pytest.approx(a.impact.max_contact_velocity, rel=1e-12)
+    assert abs(df["impact_y"][1] - df["impact_y"][0]) > 0.04  # the point moved
