@@ -38,6 +38,8 @@ __all__ = [
     "StrictWarningsError",
     "NonFiniteResultError",
     "SimulationError",
+    "SweepError",
+    "UnknownPathError",
 ]
 
 #: Longest shown repr of a value in a message (characters).
@@ -308,3 +310,16 @@ class SimulationError(ImpactBalanceError, ValueError):
         self.value = value
         self.reason = reason
         super().__init__(one_line(f"{field} = {short_repr(value)}: {reason}"))
+
+
+class SweepError(ScenarioError):
+    """A sweep file field has a bad value (same data as :class:`ScenarioError`).
+
+    Also raised when an output folder holds the results of a different sweep.
+    """
+
+
+class UnknownPathError(UnknownNameError):
+    """A sweep axis path names a scenario key that does not exist; lists the valid paths."""
+
+    kind = "key"
