@@ -36,9 +36,8 @@ def _project(name: str, frictions, method: str = "auto"):
     robot, q, specs = _base(name)
     specs = [ContactSpec(s.frame, float(mu), s.size, s.offset) for s, mu in zip(specs, frictions)]
     polytope = wrench_polytope(Stance(robot, q, specs))
-    w = polytope.weight
     return project_polytope(
-        polytope.A, polytope.b / w, polytope.C, polytope.d / w, polytope.F,
+        *polytope.projection_data(),
         tol=FORCE_TOLERANCE, box=FORCE_BOX, merge_tol=MERGE_TOLERANCE, method=method,
     )
 

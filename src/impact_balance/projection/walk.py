@@ -24,8 +24,8 @@ import numpy as np
 
 from .._jit import HAVE_NUMBA
 
-from ..polygon import Polygon
-from ._kernel import FAILED, INFEASIBLE, LINE, OK, equality_basis, project
+from ..polygon import Polygon, simplify
+from ._kernel import FAILED, INFEASIBLE, LINE, OK, convex_ccw, equality_basis, project
 from .result import ProjectionResult
 
 __all__ = ["project_walk", "kernel_is_compiled", "warm_up"]
@@ -64,14 +64,14 @@ def project_walk(
     status, x0, N = equality_basis(C, d)
     if status == INFEASIBLE:
         return ProjectionResult(Polygon.empty(), "walk")
-    status, vertices, pivots, worst = project(A, b, E, x0, N, float(box), float(merge_tol), int(max_pivots))
+    status, vertices, pivots, worst = project(A, b, E, x0, N, float(box), int(max_pivots))
     if status == LINE:
         # Lines of the polytope are the null space of [A N; E N] (a line along which E x
         # changed would have met the box rows); keep z in its orthogonal complement.
         _, S, Vt = np.linalg.svd(np.vstack([A @ N, E @ N]))
         r = int(np.sum(S > RANK_TOLERANCE * max(float(S[0]) if S.size else 0.0, 1.0)))
         N = np.ascontiguousarray(N @ Vt[:r].T)
-        status, vertices, more, worst = project(A, b, E, x0, N, float(box), float(merge_tol), int(max_pivots))
+        status, vertices, more, worst = project(A, b, E, x0, N, float(box), int(max_pivots))
         pivots += more
     if status in (FAILED, LINE):
         return None
@@ -83,6 +83,9 @@ def project_walk(
         return None
     if status == INFEASIBLE:
         return ProjectionResult(Polygon.empty(), "walk", n_lp=1, pivots=pivots)
+    vertices = simplify(vertices, merge_tol)
+    if not convex_ccw(vertices):
+        return None
     bounded = bool(np.all(np.abs(vertices) < box * (1 - 1e-9)))
     return ProjectionResult(Polygon(vertices, bounded), "walk", n_lp=1, pivots=pivots)
 
