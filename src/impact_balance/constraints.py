@@ -74,8 +74,8 @@ class WrenchPolytope:
         mass, com, gravity: The stance's mass (kg), CoM (m) and g (m/s^2).
         scaling: 6m x 6m block-diagonal change of variables ``w = scaling @ v`` (None: the
             identity). In ``v`` each contact's wrench is in its contact frame with f_x, f_y
-            and tau_z divided by its friction mu, where every contact wrench cone is the
-            mu = 1 cone (see :meth:`projection_data`).
+            and tau_z divided by its friction mu when mu > 1, where such a contact wrench
+            cone is the mu = 1 cone (see :meth:`projection_data`).
     """
 
     A: np.ndarray
@@ -104,9 +104,10 @@ class WrenchPolytope:
         times tau_x, tau_y and f_z) are nearly parallel to each other and to the centre-of-
         pressure rows, 1/mu apart; a vertex basis holding them has a condition number up to
         mu^2, so a projection loses up to mu^2 eps of precision (a vertex 0.5 outside a
-        row at mu = 1e8, 4e-7 at 1e6). A small mu makes the pyramid rows nearly opposite
-        instead. In ``v`` every cone is the mu = 1 cone, and mu moves to the columns of the
-        torque, LIPM and force-map rows, which stay well conditioned.
+        row at mu = 1e8, 4e-7 at 1e6). In ``v`` such a cone is the mu = 1 cone, and mu moves
+        to the columns of the
+        torque, LIPM and force-map rows, which stay well conditioned. (A small mu makes the
+        pyramid rows nearly opposite instead, which the projections handle as they are.)
         """
         w = self.weight
         if self.scaling is None:
@@ -212,13 +213,14 @@ _TANGENTIAL = np.array([True, True, False, False, False, True])
 
 def _scaling(contacts: Sequence[Contact]) -> np.ndarray:
     """Block-diagonal ``S`` (6m x 6m), block i = ``diag(R_i, R_i) diag(s_i)``: ``s_i`` is mu_i
-    on f_x, f_y, tau_z and 1 elsewhere (1 everywhere when mu_i = 0). See
-    :meth:`WrenchPolytope.projection_data`."""
+    on f_x, f_y, tau_z and 1 elsewhere, or 1 everywhere when mu_i <= 1: a small mu needs
+    no help (HiGHS, in Bretl's path, was less precise with it divided out: 1e-5 relative on a
+    2 mu-wide area). See :meth:`WrenchPolytope.projection_data`."""
     m = len(contacts)
     S = np.zeros((6 * m, 6 * m))
     for i, c in enumerate(contacts):
         mu = float(c.spec.friction)
-        scale = np.where(_TANGENTIAL, mu if mu > 0.0 else 1.0, 1.0)
+        scale = np.where(_TANGENTIAL, max(mu, 1.0), 1.0)
         R = np.asarray(c.rotation, dtype=float)
         block = S[6 * i : 6 * i + 6, 6 * i : 6 * i + 6]
         block[:3, :3] = R * scale[:3]

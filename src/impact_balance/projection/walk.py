@@ -36,6 +36,9 @@ RANK_TOLERANCE = 1e-12
 #: vertex of a sound walk may show; beyond it the walk is rejected (badly scaled rows, e.g.
 #: friction 1e9 next to 1e-9) and the caller falls back to Bretl.
 SLACK_TOLERANCE = 1e-7
+#: Distance (units of y) under which raw vertices are merged before the convexity check:
+#: above the rounding of a vertex (1e-12 to 1e-10), below any backtrack worth catching.
+CHECK_MERGE = 1e-9
 
 def project_walk(
     A: np.ndarray,
@@ -83,9 +86,13 @@ def project_walk(
         return None
     if status == INFEASIBLE:
         return ProjectionResult(Polygon.empty(), "walk", n_lp=1, pivots=pivots)
-    vertices = simplify(vertices, merge_tol)
+    # Check convexity before the merge: merging first could hide a backtrack (a walk that
+    # went 1e-6 back inside and returned, whose detour then replaced the true corner). The
+    # first pass only drops rounding-level duplicates, which would fail the strict check.
+    vertices = simplify(vertices, min(merge_tol, CHECK_MERGE))
     if not convex_ccw(vertices):
         return None
+    vertices = simplify(vertices, merge_tol)
     bounded = bool(np.all(np.abs(vertices) < box * (1 - 1e-9)))
     return ProjectionResult(Polygon(vertices, bounded), "walk", n_lp=1, pivots=pivots)
 
