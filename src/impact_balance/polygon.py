@@ -29,8 +29,9 @@ def _chord_distance(v, p, c, n):
 @njit(cache=True)
 def _simplify(v: np.ndarray, tol: float) -> np.ndarray:
     """Compiled loop of :func:`simplify` on a (k, 2) C-contiguous array."""
-    idx = np.arange(len(v))
-    k = len(v)
+    total = len(v)
+    idx = np.arange(total)
+    k = total
     while k > 2:
         # The vertex closest to the chord of its neighbours goes first (a duplicate is within
         # its distance to its twin of that chord). Dropping the first vertex found within tol
@@ -38,7 +39,12 @@ def _simplify(v: np.ndarray, tol: float) -> np.ndarray:
         # below it on a side was dropped, shrinking the area by 1e-6 relative.
         best, drop = math.inf, -1
         for i in range(k):
-            dist = _chord_distance(v, idx[(i - 1) % k], idx[i], idx[(i + 1) % k])  # idx[k:] is stale
+            p, n = idx[(i - 1) % k], idx[(i + 1) % k]  # idx[k:] is stale
+            dist = 0.0
+            j = (p + 1) % total
+            while j != n:  # every original vertex the chord replaces, dropped ones included:
+                dist = max(dist, _chord_distance(v, p, j, n))  # drift cannot add up
+                j = (j + 1) % total
             if dist < best:
                 best, drop = dist, i
         if best > tol:
@@ -53,10 +59,12 @@ def _simplify(v: np.ndarray, tol: float) -> np.ndarray:
 def simplify(vertices: np.ndarray, tol: float = 1e-9) -> np.ndarray:
     """Merge duplicate and collinear consecutive vertices of a CCW convex polygon.
 
-    ``tol`` is a distance: while some vertex lies within ``tol`` of the line through its two
-    neighbours (a vertex within ``tol`` of a neighbour does), the closest one is dropped.
-    Closest first keeps the extreme vertices: of a corner and a near-duplicate of it on a
-    side, the near-duplicate goes.
+    ``tol`` is a distance: while some vertex can be dropped with every vertex dropped so far
+    between its neighbours within ``tol`` of the chord that replaces them (a vertex within
+    ``tol`` of a neighbour can), the one with the smallest such distance is dropped. So
+    every input vertex lies within ``tol`` of the result (Hausdorff distance <= tol: the
+    merge cannot drift), and closest first keeps the extreme vertices: of a corner and a
+    near-duplicate of it on a side, the near-duplicate goes.
     """
     v = np.ascontiguousarray(np.asarray(vertices, dtype=float).reshape(-1, 2))
     if len(v) == 0:

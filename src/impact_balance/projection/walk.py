@@ -88,8 +88,10 @@ def project_walk(
         return ProjectionResult(Polygon.empty(), "walk", n_lp=1, pivots=pivots)
     # Check convexity before the merge: merging first could hide a backtrack (a walk that
     # went 1e-6 back inside and returned, whose detour then replaced the true corner). The
-    # first pass only drops rounding-level duplicates, which would fail the strict check.
-    vertices = simplify(vertices, min(merge_tol, CHECK_MERGE))
+    # first pass only drops rounding-level duplicates, which would fail the strict check:
+    # within 1e-9, or 10 times the worst slack (a vertex's rounding shows in its slacks; 1e-8
+    # with a friction of 2.5e4 on Talos's foot).
+    vertices = simplify(vertices, min(merge_tol, max(CHECK_MERGE, -10.0 * worst)))
     if not convex_ccw(vertices):
         return None
     vertices = simplify(vertices, merge_tol)
