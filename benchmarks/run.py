@@ -194,11 +194,16 @@ def compare(reference: np.ndarray, other: np.ndarray) -> dict[str, float]:
 def projection_cases(poly: ib.WrenchPolytope, scale: float, seed: int) -> dict[str, Case]:
     """Both projections of ``poly`` onto the resultant horizontal force (units of m g).
 
-    Same matrices for both; pypoman projects onto ``scale * F`` (its stopping and merging
+    Ours projects ``poly.projection_data()`` (as areas_from_polytope does), pypoman the same
+    set in the original variables; pypoman projects onto ``scale * F`` (its stopping and merging
     tolerances are absolute) and clips unbounded directions with the same box as ours.
     """
     A, b, C, d, F = poly.projection_data()  # what areas_from_polytope projects
-    E, f = scale * F, np.zeros(2)
+    # pypoman gets the polytope in the original variables (the same set, an independent
+    # formulation: its absolute tolerances would not suit the friction-normalised columns).
+    w = poly.weight
+    A0, b0, C0, d0, E = poly.A, poly.b / w, poly.C, poly.d / w, scale * poly.F
+    f = np.zeros(2)
 
     def ours():
         return project_polytope(A, b, C, d, F, tol=FORCE_TOLERANCE, box=FORCE_BOX)
@@ -209,7 +214,7 @@ def projection_cases(poly: ib.WrenchPolytope, scale: float, seed: int) -> dict[s
     def theirs():
         try:
             vertices = pypoman.project_polytope(
-                proj=(E, f), ineq=(A, b), eq=(C, d), method="bretl", max_radius=scale * FORCE_BOX
+                proj=(E, f), ineq=(A0, b0), eq=(C0, d0), method="bretl", max_radius=scale * FORCE_BOX
             )
             return np.array(vertices) / scale
         except Exception as exc:  # noqa: BLE001 - report, do not crash the benchmark

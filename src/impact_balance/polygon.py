@@ -33,11 +33,30 @@ def _chord_distance(v, p, c, n):
 
 
 @njit(cache=True)
+def _merge_cost(v, idx, k, i, total):
+    """(distance, area) of dropping the vertex in position i of ``idx[:k]``: the largest
+    distance from the chord between its neighbours of the original vertices it replaces
+    (dropped ones included, so that drops cannot drift), and the area of the triangle lost."""
+    p, c, n = idx[(i - 1) % k], idx[i], idx[(i + 1) % k]  # idx[k:] is stale
+    dist = 0.0
+    j = (p + 1) % total
+    while j != n:
+        dist = max(dist, _chord_distance(v, p, j, n))
+        j = (j + 1) % total
+    lost = 0.5 * abs((v[c, 0] - v[p, 0]) * (v[n, 1] - v[p, 1]) - (v[c, 1] - v[p, 1]) * (v[n, 0] - v[p, 0]))
+    return dist, lost
+
+
+@njit(cache=True)
 def _simplify(v: np.ndarray, tol: float, area_tol: float) -> np.ndarray:
     """Compiled loop of :func:`simplify` on a (k, 2) C-contiguous array."""
     total = len(v)
     idx = np.arange(total)
     k = total
+    if total < 3:
+        if total == 2 and math.hypot(v[0, 0] - v[1, 0], v[0, 1] - v[1, 1]) <= tol:
+            k = 1
+        return v[idx[:k]].copy()
     area = 0.0  # shoelace area of the input: the budget of area the merge may remove
     for i in range(total):
         j = (i + 1) % total
@@ -48,28 +67,36 @@ def _simplify(v: np.ndarray, tol: float, area_tol: float) -> np.ndarray:
     # (1e-14 size^2) is free, so that collinear vertices of a segment still go.
     budget = area_tol * abs(area) if abs(area) > tol * size else math.inf
     free = 1e-14 * size * size
+    # Rounding-level duplicates (within 1e-12 size; a walk records a vertex once per
+    # pivot) go first in one pass: which of them stays cannot matter.
+    k = 1
+    for i in range(1, total):
+        if math.hypot(v[i, 0] - v[idx[k - 1], 0], v[i, 1] - v[idx[k - 1], 1]) > 1e-12 * size:
+            idx[k] = i
+            k += 1
+    while k > 1 and math.hypot(v[idx[k - 1], 0] - v[idx[0], 0], v[idx[k - 1], 1] - v[idx[0], 1]) <= 1e-12 * size:
+        k -= 1
+    dist = np.empty(total)
+    lost = np.empty(total)
+    for i in range(k):
+        dist[i], lost[i] = _merge_cost(v, idx, k, i, total)
     while k > 2:
-        # Of the vertices whose removal keeps every vertex removed so far between the new
-        # neighbours within tol of the new chord (no drift), and fits in the area budget,
-        # the closest to its chord goes first. Dropping the first vertex found within tol
-        # made the answer depend on the order: a true corner next to a vertex 7e-7 below it
-        # on a side was dropped, shrinking the area by 1e-6 relative.
-        best, drop, cost = math.inf, -1, 0.0
+        # Of the vertices whose removal keeps every vertex removed so far within tol of the
+        # new chord and fits in the area budget, the closest to its chord goes first.
+        # Dropping the first vertex found within tol made the answer depend on the order: a
+        # true corner next to a vertex 7e-7 below it on a side was dropped (area -1e-6).
+        best, drop = math.inf, -1
         for i in range(k):
-            p, c, n = idx[(i - 1) % k], idx[i], idx[(i + 1) % k]  # idx[k:] is stale
-            dist = 0.0
-            j = (p + 1) % total
-            while j != n:  # every original vertex the chord replaces, dropped ones included
-                dist = max(dist, _chord_distance(v, p, j, n))
-                j = (j + 1) % total
-            lost = 0.5 * abs((v[c, 0] - v[p, 0]) * (v[n, 1] - v[p, 1]) - (v[c, 1] - v[p, 1]) * (v[n, 0] - v[p, 0]))
-            if dist < best and dist <= tol and (lost <= budget or lost <= free):
-                best, drop, cost = dist, i, lost
+            if dist[i] < best and dist[i] <= tol and (lost[i] <= budget or lost[i] <= free):
+                best, drop = dist[i], i
         if drop < 0:
             break
-        budget -= max(cost - free, 0.0)
-        idx[drop:k - 1] = idx[drop + 1:k].copy()
+        budget -= max(lost[drop] - free, 0.0)
+        for j in range(drop, k - 1):  # in place: a slice copy per drop cost microseconds
+            idx[j], dist[j], lost[j] = idx[j + 1], dist[j + 1], lost[j + 1]
         k -= 1
+        for i in ((drop - 1) % k, drop % k):  # only the two new neighbours' costs change
+            dist[i], lost[i] = _merge_cost(v, idx, k, i, total)
     if k == 2 and math.hypot(v[idx[0], 0] - v[idx[1], 0], v[idx[0], 1] - v[idx[1], 1]) <= tol:
         k = 1
     return v[idx[:k]].copy()
