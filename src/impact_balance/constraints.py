@@ -211,11 +211,14 @@ def _assemble(
 _TANGENTIAL = np.array([True, True, False, False, False, True])
 
 
-def _scaling(contacts: Sequence[Contact]) -> np.ndarray:
+def _scaling(contacts: Sequence[Contact]) -> np.ndarray | None:
     """Block-diagonal ``S`` (6m x 6m), block i = ``diag(R_i, R_i) diag(s_i)``: ``s_i`` is mu_i
-    on f_x, f_y, tau_z and 1 elsewhere, or 1 everywhere when mu_i <= 1: a small mu needs
+    on f_x, f_y, tau_z and 1 elsewhere, or 1 everywhere when mu_i <= 1 (None when every
+    mu_i is; :meth:`WrenchPolytope.projection_data` then skips the products): a small mu needs
     no help (HiGHS, in Bretl's path, was less precise with it divided out: 1e-5 relative on a
     2 mu-wide area). See :meth:`WrenchPolytope.projection_data`."""
+    if all(float(c.spec.friction) <= 1.0 for c in contacts):
+        return None  # the identity: no work on the hot path of common stances
     m = len(contacts)
     S = np.zeros((6 * m, 6 * m))
     for i, c in enumerate(contacts):
