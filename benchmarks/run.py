@@ -194,12 +194,16 @@ def compare(reference: np.ndarray, other: np.ndarray) -> dict[str, float]:
 def projection_cases(poly: ib.WrenchPolytope, scale: float, seed: int) -> dict[str, Case]:
     """Both projections of ``poly`` onto the resultant horizontal force (units of m g).
 
-    Same matrices for both; pypoman projects onto ``scale * F`` (its stopping and merging
+    Ours projects ``poly.projection_data()`` (as areas_from_polytope does), pypoman the same
+    set in the original variables; pypoman projects onto ``scale * F`` (its stopping and merging
     tolerances are absolute) and clips unbounded directions with the same box as ours.
     """
+    A, b, C, d, F = poly.projection_data()  # what areas_from_polytope projects
+    # pypoman gets the polytope in the original variables (the same set, an independent
+    # formulation: its absolute tolerances would not suit the friction-normalised columns).
     w = poly.weight
-    A, b, C, d, F = poly.A, poly.b / w, poly.C, poly.d / w, poly.F
-    E, f = scale * F, np.zeros(2)
+    A0, b0, C0, d0, E = poly.A, poly.b / w, poly.C, poly.d / w, scale * poly.F
+    f = np.zeros(2)
 
     def ours():
         return project_polytope(A, b, C, d, F, tol=FORCE_TOLERANCE, box=FORCE_BOX)
@@ -210,7 +214,7 @@ def projection_cases(poly: ib.WrenchPolytope, scale: float, seed: int) -> dict[s
     def theirs():
         try:
             vertices = pypoman.project_polytope(
-                proj=(E, f), ineq=(A, b), eq=(C, d), method="bretl", max_radius=scale * FORCE_BOX
+                proj=(E, f), ineq=(A0, b0), eq=(C0, d0), method="bretl", max_radius=scale * FORCE_BOX
             )
             return np.array(vertices) / scale
         except Exception as exc:  # noqa: BLE001 - report, do not crash the benchmark
@@ -468,8 +472,7 @@ def profile_report(args) -> dict[str, Any]:
         pin.computeGeneralizedGravity(model, data, q)
 
     poly = wrench_polytope(stance, sc.torque_limits, sc.gravity)
-    w = poly.weight
-    A, b, C, d, F = poly.A, poly.b / w, poly.C, poly.d / w, poly.F
+    A, b, C, d, F = poly.projection_data()
     U, S, Vt = np.linalg.svd(C)
     x0 = Vt[:len(S)].T @ ((U.T @ d) / S)
     N = np.ascontiguousarray(Vt[len(S):].T)
@@ -487,7 +490,7 @@ def profile_report(args) -> dict[str, Any]:
         "wrench_polytope": _median_us(lambda: wrench_polytope(stance, sc.torque_limits, sc.gravity), n),
         "numpy SVD of the LIPM equalities (in project_walk)": _median_us(lambda: np.linalg.svd(C), n),
         "compiled kernel project() alone": _median_us(
-            lambda: _kernel.project(A, b, F, x0, N, FORCE_BOX, 1e-6, 5000), n),
+            lambda: _kernel.project(A, b, F, x0, N, FORCE_BOX, 5000), n),
         "project_walk": _median_us(lambda: project_walk(A, b, C, d, F, box=FORCE_BOX, merge_tol=1e-6), n),
         "areas_from_polytope (walk + affine maps)": _median_us(lambda: ib.areas_from_polytope(poly, sc.plane_height), n),
         "project_polytope(method='bretl') (HiGHS, for comparison)": _median_us(

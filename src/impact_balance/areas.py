@@ -83,14 +83,10 @@ def areas_from_polytope(polytope: WrenchPolytope, plane_height: float = 0.0) -> 
     """Project a contact-wrench polytope and map it to the ZMP and CoM velocity areas."""
     com = polytope.com
     w = omega(float(com[2]), plane_height, polytope.gravity)
-    weight = polytope.weight
-    # Work in units of m g so that tolerances mean the same for every robot.
+    # Work in units of m g so that tolerances mean the same for every robot, and in
+    # friction-normalised variables so that a large or small friction keeps full precision.
     result = project_polytope(
-        polytope.A,
-        polytope.b / weight,
-        polytope.C,
-        polytope.d / weight,
-        polytope.F,
+        *polytope.projection_data(),
         tol=FORCE_TOLERANCE,
         box=FORCE_BOX,
         merge_tol=MERGE_TOLERANCE,

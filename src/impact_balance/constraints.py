@@ -72,6 +72,10 @@ class WrenchPolytope:
         grasp: 6 x 6m grasp matrix at the world origin.
         n_cwc_rows: How many of A's rows are CWC rows.
         mass, com, gravity: The stance's mass (kg), CoM (m) and g (m/s^2).
+        scaling: 6m x 6m block-diagonal change of variables ``w = scaling @ v`` (None: the
+            identity). In ``v`` each contact's wrench is in its contact frame with f_x, f_y
+            and tau_z divided by its friction mu when mu > 1, where such a contact wrench
+            cone is the mu = 1 cone (see :meth:`projection_data`).
     """
 
     A: np.ndarray
@@ -84,10 +88,32 @@ class WrenchPolytope:
     mass: float
     com: np.ndarray
     gravity: float
+    scaling: np.ndarray | None = None
 
     @property
     def dim(self) -> int:
         return self.A.shape[1]
+
+    def projection_data(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(A', b', C', d', F')``: the same polytope and map in friction-normalised variables
+        ``v`` (``w = scaling @ v``), forces in units of m g: ``A' = A S``, ``b' = b / (m g)``,
+        ``C' = C S``, ``d' = d / (m g)``, ``F' = F S`` with ``S = scaling``. ``F' v`` is the
+        resultant horizontal force over m g, so both describe the same force area.
+
+        Why: in ``w`` the rows of a cone with a large mu (|f_x| <= mu f_z, tau_z bounds with mu
+        times tau_x, tau_y and f_z) are nearly parallel to each other and to the centre-of-
+        pressure rows, 1/mu apart; a vertex basis holding them has a condition number up to
+        mu^2, so a projection loses up to mu^2 eps of precision (a vertex 0.5 outside a
+        row at mu = 1e8, 4e-7 at 1e6). In ``v`` such a cone is the mu = 1 cone, and mu moves
+        to the columns of the
+        torque, LIPM and force-map rows, which stay well conditioned. (A small mu makes the
+        pyramid rows nearly opposite instead, which the projections handle as they are.)
+        """
+        w = self.weight
+        if self.scaling is None:
+            return self.A, self.b / w, self.C, self.d / w, self.F
+        S = self.scaling
+        return self.A @ S, self.b / w, self.C @ S, self.d / w, self.F @ S
 
     @property
     def weight(self) -> float:
@@ -178,4 +204,28 @@ def _assemble(
     # rows 2-5 of the grasp matrix taken at the CoM (the same numbers as [[e_z^T], [-[c]x, I]] G).
     C = grasp_matrix(arms)[2:]
     d = np.array([mass * gravity, 0.0, 0.0, 0.0])
-    return WrenchPolytope(A, b, C, d, G[:2].copy(), G, n_cwc, float(mass), com, gravity)
+    return WrenchPolytope(A, b, C, d, G[:2].copy(), G, n_cwc, float(mass), com, gravity, _scaling(contacts))
+
+
+#: Components of a wrench [f; tau] (contact frame) divided by mu in the normalised variables.
+_TANGENTIAL = np.array([True, True, False, False, False, True])
+
+
+def _scaling(contacts: Sequence[Contact]) -> np.ndarray | None:
+    """Block-diagonal ``S`` (6m x 6m), block i = ``diag(R_i, R_i) diag(s_i)``: ``s_i`` is mu_i
+    on f_x, f_y, tau_z and 1 elsewhere, or 1 everywhere when mu_i <= 1 (None when every
+    mu_i is; :meth:`WrenchPolytope.projection_data` then skips the products): a small mu needs
+    no help (HiGHS, in Bretl's path, was less precise with it divided out: 1e-5 relative on a
+    2 mu-wide area). See :meth:`WrenchPolytope.projection_data`."""
+    if all(float(c.spec.friction) <= 1.0 for c in contacts):
+        return None  # the identity: no work on the hot path of common stances
+    m = len(contacts)
+    S = np.zeros((6 * m, 6 * m))
+    for i, c in enumerate(contacts):
+        mu = float(c.spec.friction)
+        scale = np.where(_TANGENTIAL, max(mu, 1.0), 1.0)
+        R = np.asarray(c.rotation, dtype=float)
+        block = S[6 * i : 6 * i + 6, 6 * i : 6 * i + 6]
+        block[:3, :3] = R * scale[:3]
+        block[3:, 3:] = R * scale[3:]
+    return S

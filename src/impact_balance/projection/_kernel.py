@@ -28,9 +28,8 @@ import math
 import numpy as np
 
 from .._jit import njit
-from ..polygon import _simplify
 
-__all__ = ["project", "equality_basis", "walk", "OK", "INFEASIBLE", "FAILED", "LINE"]
+__all__ = ["project", "equality_basis", "walk", "convex_ccw", "OK", "INFEASIBLE", "FAILED", "LINE"]
 
 #: Kernel statuses. LINE: the polytope contains a line (no vertex); the caller can quotient
 #: it out and call again.
@@ -479,7 +478,7 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst):
 
 
 @njit(cache=True)
-def _convex_ccw(v):
+def convex_ccw(v):
     """Whether the (k, 2) vertices form a convex counter-clockwise polygon that winds once.
 
     Every turn must be a left turn (cross product >= -1e-9 of the edge lengths' product,
@@ -509,15 +508,13 @@ def _convex_ccw(v):
 
 
 @njit(cache=True)
-def project(A, b, E, x0, N, box, merge_tol, max_pivots):
+def project(A, b, E, x0, N, box, max_pivots):
     """Projection of ``{x : A x <= b, x = x0 + N z}`` onto ``y = E x``, clipped to ``|y_k| <= box``.
 
     Drops zero rows of ``A N`` (checking them), scales the rows to unit norm, adds the box as
-    four rows, walks, and merges vertices within ``merge_tol``.
-    Returns (status, vertices (k, 2) counter-clockwise, pivots, worst): ``worst`` is the
-    smallest slack of a visited point in the unit-row constraints (see :func:`walk`); the
-    status is FAILED when the vertices do not form a convex counter-clockwise polygon that
-    winds once.
+    four rows and walks.
+    Returns (status, vertices (k, 2) counter-clockwise, unmerged, pivots, worst): ``worst``
+    is the smallest slack of a visited point in the unit-row constraints (see :func:`walk`).
     """
     none = np.empty((0, 2))
     n, k = N.shape
@@ -572,10 +569,10 @@ def project(A, b, E, x0, N, box, merge_tol, max_pivots):
     status, vertices, count, pivots = walk(H[:m].copy(), h[:m].copy(), G.T.copy(), g0, 0.0, max_pivots, worst)
     if status != OK:
         return status, none, pivots, worst[0]
-    polygon = _simplify(vertices[:count].copy(), merge_tol)
-    if not _convex_ccw(polygon):
-        return FAILED, none, pivots, worst[0]
-    return OK, polygon, pivots, worst[0]
+    # The caller merges near-duplicate vertices (polygon.simplify) and checks convexity: the
+    # merge is compiled in its own module, and numba's cache of this kernel would not notice
+    # a change there (it hashes this file only).
+    return OK, vertices[:count].copy(), pivots, worst[0]
 
 
 @njit(cache=True)

@@ -112,6 +112,9 @@ def project_bretl(
         else:
             confirmed[i] = True
             i = (i + 1) % len(vertices)
-    polygon_vertices = simplify(np.array(vertices), tol if merge_tol is None else merge_tol)
+    # Every vertex is a support point, so their convex hull is the answer. Ordering them by
+    # hull rather than by insertion matters with nearly opposite rows (a hand's friction
+    # 1.6e-6): rounding then inserted a second lap, and the list wound twice (double area).
+    polygon_vertices = Polygon.from_points(np.array(vertices), tol if merge_tol is None else merge_tol).vertices
     bounded = bool(np.all(np.abs(polygon_vertices) < box * (1 - 1e-9)))
     return ProjectionResult(Polygon(polygon_vertices, bounded), "bretl", n_lp=count)

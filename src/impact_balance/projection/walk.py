@@ -24,8 +24,8 @@ import numpy as np
 
 from .._jit import HAVE_NUMBA
 
-from ..polygon import Polygon
-from ._kernel import FAILED, INFEASIBLE, LINE, OK, equality_basis, project
+from ..polygon import Polygon, simplify
+from ._kernel import FAILED, INFEASIBLE, LINE, OK, convex_ccw, equality_basis, project
 from .result import ProjectionResult
 
 __all__ = ["project_walk", "kernel_is_compiled", "warm_up"]
@@ -36,6 +36,9 @@ RANK_TOLERANCE = 1e-12
 #: vertex of a sound walk may show; beyond it the walk is rejected (badly scaled rows, e.g.
 #: friction 1e9 next to 1e-9) and the caller falls back to Bretl.
 SLACK_TOLERANCE = 1e-7
+#: Distance (units of y) under which raw vertices are merged before the convexity check:
+#: above the rounding of a vertex (1e-12 to 1e-10), below any backtrack worth catching.
+CHECK_MERGE = 1e-9
 
 def project_walk(
     A: np.ndarray,
@@ -64,14 +67,14 @@ def project_walk(
     status, x0, N = equality_basis(C, d)
     if status == INFEASIBLE:
         return ProjectionResult(Polygon.empty(), "walk")
-    status, vertices, pivots, worst = project(A, b, E, x0, N, float(box), float(merge_tol), int(max_pivots))
+    status, vertices, pivots, worst = project(A, b, E, x0, N, float(box), int(max_pivots))
     if status == LINE:
         # Lines of the polytope are the null space of [A N; E N] (a line along which E x
         # changed would have met the box rows); keep z in its orthogonal complement.
         _, S, Vt = np.linalg.svd(np.vstack([A @ N, E @ N]))
         r = int(np.sum(S > RANK_TOLERANCE * max(float(S[0]) if S.size else 0.0, 1.0)))
         N = np.ascontiguousarray(N @ Vt[:r].T)
-        status, vertices, more, worst = project(A, b, E, x0, N, float(box), float(merge_tol), int(max_pivots))
+        status, vertices, more, worst = project(A, b, E, x0, N, float(box), int(max_pivots))
         pivots += more
     if status in (FAILED, LINE):
         return None
@@ -83,6 +86,15 @@ def project_walk(
         return None
     if status == INFEASIBLE:
         return ProjectionResult(Polygon.empty(), "walk", n_lp=1, pivots=pivots)
+    # Check convexity before the merge: merging first could hide a backtrack (a walk that
+    # went 1e-6 back inside and returned, whose detour then replaced the true corner). The
+    # first pass only drops rounding-level duplicates, which would fail the strict check:
+    # within 1e-9, or 10 times the worst slack (a vertex's rounding shows in its slacks; 1e-8
+    # with a friction of 2.5e4 on Talos's foot).
+    vertices = simplify(vertices, min(merge_tol, max(CHECK_MERGE, -10.0 * worst)))
+    if not convex_ccw(vertices):
+        return None
+    vertices = simplify(vertices, merge_tol)
     bounded = bool(np.all(np.abs(vertices) < box * (1 - 1e-9)))
     return ProjectionResult(Polygon(vertices, bounded), "walk", n_lp=1, pivots=pivots)
 
