@@ -17,7 +17,7 @@ __all__ = ["Polygon", "MERGE_AREA_TOLERANCE"]
 #: vertices may remove. Bounded so that a larger set never gets a smaller merged area by
 #: more than this (the distance bound alone allowed tol x perimeter: 2.9e-6 of the force
 #: area of g1_two_feet with a foot friction of 6e4).
-MERGE_AREA_TOLERANCE = 5e-7
+MERGE_AREA_TOLERANCE = 1e-6
 
 
 @njit(cache=True)
