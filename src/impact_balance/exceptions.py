@@ -23,6 +23,7 @@ __all__ = [
     "RobotLoadError",
     "ImpactModelError",
     "SolverError",
+    "SimulationError",
 ]
 
 
@@ -141,3 +142,19 @@ class SolverError(ImpactBalanceError, RuntimeError):
         self.status = status
         extra = f": {detail}" if detail else ""
         super().__init__(f"{solver} failed with status {status}{extra}")
+
+
+class SimulationError(ImpactBalanceError, ValueError):
+    """A simulation request cannot be carried out (bad option, no impact, no renderer...).
+
+    Attributes:
+        field: The option or scenario field at fault (e.g. ``--speed``, ``impact``).
+        value: Its value.
+        reason: Why it is refused.
+    """
+
+    def __init__(self, field: str, value: Any, reason: str):
+        self.field = field
+        self.value = value
+        self.reason = reason
+        super().__init__(f"{field} = {value!r}: {reason}")

@@ -1,0 +1,1 @@
+"""Simulation of a scenario in MuJoCo (model, joint models, trials, balance controller, falls)."""
