@@ -1,1 +1,22 @@
-"""Simulation of a scenario in MuJoCo (model, joint models, trials, balance controller, falls)."""
+"""Simulation of a scenario in MuJoCo: the model (:mod:`.model`), its joint models (:mod:`.joints`),
+an impact trial (:mod:`.trial`) and its measurement against the impact model (:mod:`.measure`).
+
+See :func:`build_model`, :class:`SimModel` and :func:`simulate`.
+"""
+
+from .environment import ContactParameters
+from .joints import JOINT_MODELS, ServoOptions
+from .measure import Prediction, TrialResult, measure
+from .model import SimModel, SimOptions, build_model
+from .trial import TrialOptions, TrialRecord, run_trial
+
+__all__ = ["build_model", "SimModel", "SimOptions", "ContactParameters", "ServoOptions", "JOINT_MODELS",
+           "TrialOptions", "TrialRecord", "run_trial", "Prediction", "TrialResult", "measure", "simulate"]
+
+
+def simulate(scenario, approach_speed: float, joints: str = "rigid", options: SimOptions | None = None,
+             after: float = 0.15) -> TrialResult:
+    """Build the model, run one impact trial at ``approach_speed`` (m/s) and measure it."""
+    sim = build_model(scenario, joints, options)
+    record = run_trial(sim, TrialOptions(approach_speed, after=after))
+    return measure(sim, record, approach_speed)

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..scenario import Scenario, load_scenario
 from ..exceptions import SimulationError
-from .trial import Push, TrialOptions, TrialResult, TrialSetup, run_trial
+from .balance_trial import Push, TrialOptions, TrialResult, TrialSetup, run_trial
 
 __all__ = ["PushOutcome", "PushTestResult", "push_test", "confusion", "DEFAULT_MAGNITUDES"]
 

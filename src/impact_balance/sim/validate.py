@@ -16,7 +16,7 @@ import numpy as np
 from ..analysis import analyze
 from ..exceptions import SimulationError
 from ..scenario import Scenario, load_scenario
-from .trial import TrialOptions, TrialResult, TrialSetup, run_trial
+from .balance_trial import TrialOptions, TrialResult, TrialSetup, run_trial
 
 __all__ = ["predictions", "ValidationResult", "validate", "INERTIA_MODELS"]
 

@@ -1,0 +1,199 @@
+"""What a trial measured, against what the impact model predicts.
+
+Measured, across the impact (from the last step before the impact force appears to the end
+of the impact, see :func:`impact_window`):
+- the impulse at the impact point: the integrated contact force on the robot, N s, world;
+- the CoM velocity jump (xy), m/s;
+- the approach speed (``-n . v`` of the impact point just before) and the restitution
+  (separation speed ``n . v`` just after, over the approach speed, clamped at 0);
+- the slip: the tangential speed of the impact point just after, m/s.
+
+Predicted: the impact model (:func:`impact_balance.impact.impact_model`) at the stance, with
+the restitution range set to the measured value ``[e, e]`` and evaluated at the measured
+approach speed, for both inertia models (``composite``: the robot as one rigid body;
+``joint_space``: ``J M^-1 J^T``, every joint free). Its CoM velocity jumps span a polygon;
+the distance of the measured jump to it (0 inside) says how far the model is from the
+simulation.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..impact import INERTIA_MODELS, impact_model
+from ..polygon import Polygon
+from .model import SimModel
+from .trial import TrialRecord
+
+__all__ = ["Prediction", "TrialResult", "impact_window", "measure", "distance_to_hull"]
+
+#: A force below this fraction of the peak counts as zero (end of the impact).
+_FORCE_FLOOR = 1e-3
+#: The impact ends at separation, or once the force falls below this fraction of its peak.
+_DECAY = 0.05
+
+
+@dataclass(frozen=True)
+class Prediction:
+    """The impact model's CoM velocity jumps at the measured speed and restitution.
+
+    Attributes:
+        inertia: "composite" or "joint_space".
+        com_velocity_jumps: (2N, 2) vertices, m/s (rows 2i, 2i+1: cone edge i, both at e).
+        distance: Distance from the measured jump to their convex hull, m/s (0 inside).
+    """
+
+    inertia: str
+    com_velocity_jumps: np.ndarray
+    distance: float
+
+    @property
+    def relative_distance(self) -> float:
+        """``distance`` over the size of the predicted jumps (their largest norm)."""
+        size = float(np.linalg.norm(self.com_velocity_jumps, axis=1).max())
+        return self.distance / size if size > 0 else float("nan")
+
+
+@dataclass
+class TrialResult:
+    """One trial's measurement and the predictions (see the module docstring).
+
+    Attributes:
+        approach_speed: Commanded approach speed, m/s.
+        joints: Joint model.
+        approach_speed_measured: Normal approach speed of the impact point just before, m/s.
+        restitution_measured: Separation over approach normal speed (>= 0).
+        impulse_measured: Impulse on the robot at the impact point, N s, world (3).
+        com_velocity_jump_measured: CoM velocity jump across the impact, m/s (2).
+        slip_speed: Tangential speed of the impact point just after the impact, m/s.
+        impact_time: (start, end) of the impact, s.
+        contacts_kept: Every sustained contact kept touching its support without sliding
+            more than 1 cm (``servo``); None for ``rigid``, whose robot floats.
+        predicted: Prediction per inertia model.
+        sim_time_ratio: Simulated time over wall-clock time.
+        record: The time series.
+    """
+
+    approach_speed: float
+    joints: str
+    approach_speed_measured: float
+    restitution_measured: float
+    impulse_measured: np.ndarray
+    com_velocity_jump_measured: np.ndarray
+    slip_speed: float
+    impact_time: tuple[float, float]
+    contacts_kept: bool | None
+    predicted: dict[str, Prediction]
+    sim_time_ratio: float
+    record: TrialRecord | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready (strict: no NaN)."""
+
+        def num(x: float) -> float | None:
+            return float(x) if np.isfinite(x) else None
+
+        return {
+            "approach_speed": num(self.approach_speed),
+            "joints": self.joints,
+            "approach_speed_measured": num(self.approach_speed_measured),
+            "restitution_measured": num(self.restitution_measured),
+            "impulse_measured": [num(x) for x in self.impulse_measured],
+            "com_velocity_jump_measured": [num(x) for x in self.com_velocity_jump_measured],
+            "slip_speed": num(self.slip_speed),
+            "impact_time": [num(x) for x in self.impact_time],
+            "predicted": {
+                name: {
+                    "com_velocity_jumps": [[num(x) for x in row] for row in p.com_velocity_jumps],
+                    "distance": num(p.distance),
+                    "relative_distance": num(p.relative_distance),
+                }
+                for name, p in self.predicted.items()
+            },
+            "contacts_kept": self.contacts_kept,
+            "sim_time_ratio": num(self.sim_time_ratio),
+        }
+
+
+def distance_to_hull(point: np.ndarray, vertices: np.ndarray) -> float:
+    """Euclidean distance from ``point`` to the convex hull of ``vertices`` (2D), 0 inside."""
+    point = np.asarray(point, dtype=float)
+    hull = Polygon.from_points(np.asarray(vertices, dtype=float), tol=1e-12)
+    v = hull.vertices
+    if len(v) >= 3 and hull.contains(point[None, :], tol=0.0).all():
+        return 0.0
+    if len(v) == 0:
+        return float("nan")
+    if len(v) == 1:
+        return float(np.linalg.norm(point - v[0]))
+    best = np.inf
+    for a, b in zip(v, np.roll(v, -1, axis=0)):
+        ab = b - a
+        t = np.clip((point - a) @ ab / max(ab @ ab, 1e-300), 0.0, 1.0)
+        best = min(best, float(np.linalg.norm(point - (a + t * ab))))
+    return best
+
+
+def impact_window(record: TrialRecord) -> tuple[int, int]:
+    """Indices (before, end): the last sample before the impact force appears, and the impact's end.
+
+    The end is the first sample after the force peak where the force is zero (separation)
+    or below 5 % of the peak (the servo-held robot may keep pressing).
+    """
+    force = np.linalg.norm(record.forces["impact"], axis=1)
+    peak = force.max(initial=0.0)
+    if peak <= 0.0:
+        raise ValueError("no impact")
+    touching = np.flatnonzero(force > _FORCE_FLOOR * peak)
+    first = int(touching[0])
+    before = max(first - 1, 0)
+    k_peak = first + int(np.argmax(force[first:]))
+    after = np.flatnonzero(force[k_peak:] <= _DECAY * peak)
+    end = k_peak + int(after[0]) if after.size else len(force) - 1
+    return before, end
+
+
+def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialResult:
+    """Measurement and predictions of one trial (see the module docstring)."""
+    from ..exceptions import SimulationError
+
+    spec = sim.scenario.impact.spec()
+    n = np.asarray(spec.normal, dtype=float) / np.linalg.norm(spec.normal)
+    try:
+        before, end = impact_window(record)
+    except ValueError:
+        raise SimulationError(
+            "--duration", round(record.simulated_time, 4), "the impact point never reached the surface in that time"
+        ) from None
+    dt = sim.model.opt.timestep
+    impulse = record.forces["impact"][before + 1 : end + 1].sum(axis=0) * dt
+    jump = (record.com_velocity[end] - record.com_velocity[before])[:2]
+    v_before, v_after = record.impact_velocity[before], record.impact_velocity[end]
+    approach = float(-n @ v_before)
+    restitution = max(0.0, float(n @ v_after)) / approach if approach > 0 else float("nan")
+    slip = float(np.linalg.norm(v_after - (n @ v_after) * n))
+    predicted = {}
+    for inertia in INERTIA_MODELS:
+        model_spec = dataclasses.replace(spec, restitution=(restitution, restitution), inertia=inertia)
+        model = impact_model(sim.stance, model_spec)
+        jumps = model.com_velocity_jumps(approach)[:, :2]
+        predicted[inertia] = Prediction(inertia, jumps, distance_to_hull(jump, jumps))
+    kept = None
+    if sim.joints != "rigid":
+        start = int(np.searchsorted(record.time, record.approach_start))
+        normal_forces = np.array(
+            [record.forces[c.spec.frame][start:] @ c.normal for c in sim.stance.contacts]
+        )  # (k, T)
+        moved = np.linalg.norm(record.contact_positions[start:] - record.contact_positions[start], axis=2).max()
+        kept = bool((normal_forces > 0.0).all() and moved < 0.01)
+    ratio = record.simulated_time / record.wall_time if record.wall_time > 0 else float("nan")
+    return TrialResult(
+        approach_speed=approach_speed, joints=sim.joints, approach_speed_measured=approach,
+        restitution_measured=restitution, impulse_measured=impulse, com_velocity_jump_measured=jump,
+        slip_speed=slip, impact_time=(float(record.time[before]), float(record.time[end])),
+        contacts_kept=kept, predicted=predicted, sim_time_ratio=ratio, record=record,
+    )
