@@ -38,7 +38,7 @@ from pink.tasks import ComTask, FrameTask, PostureTask
 
 from ..analysis import Analysis
 from ..ik import solve_stance
-from .zmp import DcmFeedback
+from .zmp import DcmFeedback, clamp_to_polygon
 
 __all__ = ["BalanceGains", "ImpactTask", "BalanceController", "ControlOutput", "retracted_stance"]
 
@@ -52,6 +52,8 @@ class BalanceGains:
         dcm_gain: DCM error decay rate k [1/s] (p = xi + k/omega (xi - xi_ref)).
         zmp_margin: Desired ZMP kept this far inside the ZMP support area [m].
         zmp_admittance: K_zmp, CoM command velocity per metre of ZMP error [1/s].
+        zmp_filter: Time constant of the first-order filter on the measured ZMP [s].
+        max_com_speed: Bound on the CoM command's speed [m/s].
         com_cost: Weight of the CoM task [1/m].
         contact_cost: Weight of each contact frame task (position [1/m] and orientation [1/rad]).
         impact_cost: Weight of the impact point task [1/m] (its orientation: a tenth).
@@ -64,6 +66,8 @@ class BalanceGains:
     dcm_gain: float = 3.0
     zmp_margin: float = 0.01
     zmp_admittance: float = 5.0
+    zmp_filter: float = 0.01
+    max_com_speed: float = 0.3
     com_cost: float = 10.0
     contact_cost: float = 10.0
     impact_cost: float = 1.0
@@ -202,6 +206,7 @@ class BalanceController:
         self.omega = float(np.sqrt(self.gravity / (com0[2] - self.plane_height)))
         self.feedback = DcmFeedback(areas.zmp_area, self.omega, com0[:2].copy(), gains.dcm_gain, gains.zmp_margin)
         self.com_command = com0[:2].copy()
+        self._zmp_filtered: np.ndarray | None = None
         self.contact_tasks = []
         for c in stance.contacts:
             task = FrameTask(c.spec.frame, gains.contact_cost, gains.contact_cost)
@@ -239,7 +244,16 @@ class BalanceController:
         com, com_velocity = self.measure(q, v)
         zmp, xi, clamped = self.feedback.desired_zmp(com[:2], com_velocity[:2])
         if zmp_measured is not None and np.all(np.isfinite(zmp_measured)):
-            self.com_command += dt * g.zmp_admittance * (np.asarray(zmp_measured)[:2] - zmp)
+            zmp_measured = np.asarray(zmp_measured, dtype=float)[:2]
+            if self._zmp_filtered is None:
+                self._zmp_filtered = zmp_measured.copy()
+            self._zmp_filtered += min(1.0, dt / g.zmp_filter) * (zmp_measured - self._zmp_filtered)
+            speed = g.zmp_admittance * (self._zmp_filtered - zmp)
+            norm = float(np.linalg.norm(speed))
+            if norm > g.max_com_speed:
+                speed *= g.max_com_speed / norm
+            # The commanded CoM stays over the ZMP support area: a reference that could stand still.
+            self.com_command = clamp_to_polygon(self.feedback.zmp_area, self.com_command + dt * speed, g.zmp_margin)
         self.com_task.set_target(np.array([*self.com_command, self.com_height]))
         tasks = [self.com_task, *self.contact_tasks, self.posture_task]
         if self.impact is not None:

@@ -1,7 +1,7 @@
 """One balance trial in MuJoCo: the controller holds the stance through an impact or a push.
 
-:class:`TrialSetup` prepares a scenario once (analysis, MuJoCo model, the start configuration
-with the hand backed off); :func:`run_trial` resets the model and runs one trial:
+:class:`BalanceSetup` prepares a scenario once (analysis, MuJoCo model, the start configuration
+with the hand backed off); :func:`run_balance_trial` resets the model and runs one trial:
 
 - ``impact_speed``: the impact task drives the impact point into the surface at that speed
   (m/s), then pulls back (see :class:`~.balance.ImpactTask`);
@@ -30,9 +30,17 @@ from ..logs.schema import LogColumns, force_columns, joint_position_column, join
 from ..scenario import Scenario, load_scenario
 from .balance import BalanceController, BalanceGains, ImpactTask, retracted_stance
 from .falls import FallCriteria, FallDetector
+from .joints import JOINT_MODELS, ServoOptions
 from .model import SimModel, SimOptions, build_model
 
-__all__ = ["Push", "TrialOptions", "TrialSetup", "TrialResult", "run_trial", "measured_zmp"]
+#: Iterations of MuJoCo's no-slip solver in balance trials.
+NOSLIP_ITERATIONS = 10
+
+#: Servos of the ``rigid`` joint model in balance trials: 30 Hz bandwidth, no effort limits. A welded
+#: robot cannot be controlled; this is the closest a controlled robot gets to the paper's rigid body.
+STIFF_SERVOS = ServoOptions(bandwidth=2.0 * np.pi * 30.0, effort_limits=False)
+
+__all__ = ["STIFF_SERVOS", "Push", "BalanceTrialOptions", "BalanceSetup", "BalanceTrialResult", "run_balance_trial", "measured_zmp"]
 
 
 @dataclass(frozen=True)
@@ -60,7 +68,7 @@ class Push:
 
 
 @dataclass(frozen=True)
-class TrialOptions:
+class BalanceTrialOptions:
     """Options of a trial.
 
     Attributes:
@@ -83,7 +91,7 @@ class TrialOptions:
 
 
 @dataclass
-class TrialSetup:
+class BalanceSetup:
     """A scenario prepared for trials: analysis, MuJoCo model, start configuration."""
 
     scenario: Scenario
@@ -94,24 +102,31 @@ class TrialSetup:
     standoff: float
 
     @classmethod
-    def create(cls, scenario: Scenario | str, joints: str = "servo", options: TrialOptions | None = None,
-               sim_options: SimOptions | None = None) -> TrialSetup:
-        options = options or TrialOptions()
+    def create(cls, scenario: Scenario | str, joints: str = "servo", options: BalanceTrialOptions | None = None,
+               sim_options: SimOptions | None = None) -> BalanceSetup:
+        options = options or BalanceTrialOptions()
         if not isinstance(scenario, Scenario):
             scenario = load_scenario(scenario)
-        if joints != "servo":
-            raise SimulationError("--joints", joints,
-                                  "balance trials need joints that move (servo); a rigid robot has no controller")
+        if joints not in JOINT_MODELS:
+            raise SimulationError("--joints", joints, f"unknown joint model; valid: {', '.join(JOINT_MODELS)}")
         analysis = analyze(scenario)
-        # 1 ms steps: the stiffest contact (impact, time constant 4 ms) still spans 4 steps.
-        sim = build_model(scenario, joints, sim_options or SimOptions(timestep=0.001, meshes=False))
+        if sim_options is None:
+            # 1 ms steps: the stiffest contact (impact, time constant 4 ms) still spans 4 steps.
+            servo = ServoOptions() if joints == "servo" else STIFF_SERVOS
+            sim_options = SimOptions(timestep=0.001, meshes=False, servo=servo)
+        # Welded joints admit no controller: "rigid" balance trials use stiff servos without effort limits.
+        sim = build_model(scenario, "servo", sim_options)
+        # MuJoCo's soft friction lets a loaded contact creep (a sole on the 30 degree ramp slides about
+        # 3 mm/s within its friction cone); the no-slip pass removes that drift, which would otherwise
+        # count as a slip after a few seconds.
+        sim.model.opt.noslip_iterations = NOSLIP_ITERATIONS
         standoff = options.standoff if analysis.impact is not None else 0.0
         q_start = retracted_stance(analysis, standoff)
         return cls(scenario, joints, analysis, sim, q_start, standoff)
 
 
 @dataclass
-class TrialResult:
+class BalanceTrialResult:
     """Outcome and measurements of one trial (SI units, world frame).
 
     ``series`` holds the per-control-step arrays: ``time``, ``zmp`` (measured, k x 2),
@@ -156,35 +171,21 @@ class TrialResult:
         }
 
 
-def measured_zmp(sim: SimModel, plane_height: float) -> tuple[np.ndarray, np.ndarray]:
-    """ZMP of the sustained contacts' forces on the plane ``z = plane_height`` and each contact's force.
+def measured_zmp(sim: SimModel, com: np.ndarray, plane_height: float) -> tuple[np.ndarray, np.ndarray]:
+    """ZMP of the sustained contacts' resultant force, in the LIPM sense, and each contact's force.
 
-    The ZMP is the point of the plane about which the contact forces have no horizontal moment:
-    ``p_x = sum(x f_z - (z - h) f_x) / sum(f_z)`` (and likewise for y), summed over every MuJoCo
-    contact point of a sustained-contact geom (not the impact). Returns ``(zmp (2,), forces (k, 3))``
-    with forces on the robot, N, world; the ZMP is NaN when the contacts carry no vertical force.
+    The ZMP support area is defined through the resultant contact force ``f``:
+    ``p = c_xy + (h - c_z) f_xy / f_z`` (the point of the plane ``z = h`` on the line of action of
+    ``f`` through the CoM ``c``, as in the LIPM where the moment about the CoM is zero). Internal
+    forces between non-coplanar contacts cancel in the sum, so this is the ZMP the CoM motion
+    controls: ``f = m (c_dd + g)``. Returns ``(zmp (2,), forces (k, 3))``, forces on the robot, N,
+    world; the ZMP is NaN when the contacts carry no vertical force.
     """
-    m, d = sim.model, sim.data
-    index = {g: i for i, g in enumerate(sim.contact_geoms)}
-    forces = np.zeros((len(sim.contact_geoms), 3))
-    num = np.zeros(2)
-    fz = 0.0
-    local = np.zeros(6)
-    for i in range(d.ncon):
-        c = d.contact[i]
-        k = index.get(c.geom1, index.get(c.geom2))
-        if k is None:
-            continue
-        mujoco.mj_contactForce(m, d, i, local)
-        world = c.frame.reshape(3, 3).T @ local[:3]
-        f = world if c.geom2 == sim.contact_geoms[k] else -world
-        forces[k] += f
-        r = c.pos
-        num[0] += r[0] * f[2] - (r[2] - plane_height) * f[0]
-        num[1] += r[1] * f[2] - (r[2] - plane_height) * f[1]
-        fz += f[2]
-    zmp = num / fz if fz > 1e-6 else np.full(2, np.nan)
-    return zmp, forces
+    forces = sim.contact_forces(sim.contact_geoms)
+    total = forces.sum(axis=0)
+    if total[2] <= 1e-6:
+        return np.full(2, np.nan), forces
+    return com[:2] + (plane_height - com[2]) * total[:2] / total[2], forces
 
 
 def _push_body(sim: SimModel, name: str | None) -> int:
@@ -230,10 +231,10 @@ class _Recorder:
         return pd.DataFrame(np.array(self.rows), columns=self.columns)
 
 
-def run_trial(setup: TrialSetup, impact_speed: float | None = None, push: Push | None = None,
-              options: TrialOptions | None = None) -> TrialResult:
+def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, push: Push | None = None,
+              options: BalanceTrialOptions | None = None) -> BalanceTrialResult:
     """Run one trial (an impact at ``impact_speed``, or a ``push``) from rest; see the module docstring."""
-    options = options or TrialOptions()
+    options = options or BalanceTrialOptions()
     sim, analysis = setup.sim, setup.analysis
     m, d = sim.model, sim.data
     if impact_speed is not None and analysis.impact is None:
@@ -302,7 +303,8 @@ def run_trial(setup: TrialSetup, impact_speed: float | None = None, push: Push |
                 if disturbance is None:
                     mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_GEOM, sim.impact_geom, impact_velocity, 0)
                     approach_measured = float(-impact_velocity[3:] @ n)
-            zmp, forces = measured_zmp(sim, h)
+            com_now, _ = controller.measure(q, v)
+            zmp, forces = measured_zmp(sim, com_now, h)
             out = controller.step(t, q, v, zmp, fn)
             sim.set_servo_targets(out.q, out.v)
             com, com_velocity = out.com, out.com_velocity
@@ -333,7 +335,7 @@ def run_trial(setup: TrialSetup, impact_speed: float | None = None, push: Push |
         else:
             detector.finish(t, arrays["com_velocity"][-1])
     verdict = detector.verdict
-    result = TrialResult(
+    result = BalanceTrialResult(
         fell=verdict.fell, reason=verdict.reason, detail=verdict.detail, fall_time=verdict.time,
         disturbance_time=disturbance, disturbance_end=disturbance_end, approach_speed=impact_speed,
         approach_speed_measured=approach_measured, max_tilt=detector.max_tilt, max_slip=detector.max_slip,

@@ -1,6 +1,6 @@
 """Push recovery (paper Exp. 2): impulsive pushes at the torso in every direction, several magnitudes.
 
-For every push the trial (:func:`~.trial.run_trial`) gives the outcome (fell or not), and what each
+For every push the trial (:func:`~.trial.run_balance_trial`) gives the outcome (fell or not), and what each
 criterion predicted from the measured motion:
 
 - the CoM criterion: at the end of the push, the measured CoM velocity lies in the CoM velocity area
@@ -19,7 +19,7 @@ import numpy as np
 
 from ..scenario import Scenario, load_scenario
 from ..exceptions import SimulationError
-from .balance_trial import Push, TrialOptions, TrialResult, TrialSetup, run_trial
+from .balance_trial import Push, BalanceTrialOptions, BalanceTrialResult, BalanceSetup, run_balance_trial
 
 __all__ = ["PushOutcome", "PushTestResult", "push_test", "confusion", "DEFAULT_MAGNITUDES"]
 
@@ -30,7 +30,7 @@ DEFAULT_MAGNITUDES = (10.0, 20.0, 30.0, 40.0, 50.0, 60.0)
 @dataclass
 class PushOutcome:
     push: Push
-    result: TrialResult
+    result: BalanceTrialResult
 
     def to_dict(self) -> dict:
         r = self.result
@@ -62,7 +62,7 @@ class PushTestResult:
     outcomes: list[PushOutcome]
     controller: dict
     fall_criteria: dict
-    setup: TrialSetup
+    setup: BalanceSetup
     wall_time: float
 
     def confusion(self) -> dict:
@@ -77,8 +77,8 @@ class PushTestResult:
 
 
 def push_test(scenario: Scenario | str, directions: int = 16, magnitudes: Sequence[float] = DEFAULT_MAGNITUDES,
-              duration: float = 0.02, body: str | None = None, options: TrialOptions | None = None,
-              progress: Callable[[PushOutcome], None] | None = None, setup: TrialSetup | None = None) -> PushTestResult:
+              duration: float = 0.02, body: str | None = None, options: BalanceTrialOptions | None = None,
+              progress: Callable[[PushOutcome], None] | None = None, setup: BalanceSetup | None = None) -> PushTestResult:
     """Push the robot in ``directions`` evenly spaced directions at every magnitude (N s) for ``duration`` s."""
     import time
 
@@ -91,13 +91,13 @@ def push_test(scenario: Scenario | str, directions: int = 16, magnitudes: Sequen
         raise SimulationError("--magnitudes", list(magnitudes), "each must be in (0, 1000] N s")
     if not (0.001 <= duration <= 0.2):
         raise SimulationError("--duration", duration, "must be in [0.001, 0.2] s (an impulsive push: 10-50 ms)")
-    options = options or TrialOptions()
-    setup = setup or TrialSetup.create(scenario, "servo", options)
+    options = options or BalanceTrialOptions()
+    setup = setup or BalanceSetup.create(scenario, "servo", options)
     outcomes = []
     for magnitude in magnitudes:
         for k in range(directions):
             push = Push(2 * np.pi * k / directions, float(magnitude), duration, options.settle, body)
-            outcome = PushOutcome(push, run_trial(setup, push=push, options=options))
+            outcome = PushOutcome(push, run_balance_trial(setup, push=push, options=options))
             outcomes.append(outcome)
             if progress:
                 progress(outcome)

@@ -1,6 +1,6 @@
 """Empirical fall threshold of an impact (paper Exp. 1): bisection on the commanded approach speed.
 
-:func:`validate` runs balance trials (:func:`~.trial.run_trial`) at increasing commanded approach
+:func:`validate` runs balance trials (:func:`~.trial.run_balance_trial`) at increasing commanded approach
 speeds until the robot falls, then bisects until the bracket ``[survived, fell]`` is within a relative
 tolerance (5 %), and puts it beside the predictions: the maximum contact velocity by the CoM criterion
 and by the ZMP criterion, each with both inertia models (``composite`` and ``joint_space``).
@@ -16,7 +16,7 @@ import numpy as np
 from ..analysis import analyze
 from ..exceptions import SimulationError
 from ..scenario import Scenario, load_scenario
-from .balance_trial import TrialOptions, TrialResult, TrialSetup, run_trial
+from .balance_trial import BalanceTrialOptions, BalanceTrialResult, BalanceSetup, run_balance_trial
 
 __all__ = ["predictions", "ValidationResult", "validate", "INERTIA_MODELS"]
 
@@ -47,7 +47,7 @@ class ValidationResult:
     predicted: dict
     survived: float | None
     fell: float | None
-    trials: list[tuple[float, TrialResult]]
+    trials: list[tuple[float, BalanceTrialResult]]
     controller: dict
     fall_criteria: dict
     tolerance: float
@@ -79,9 +79,9 @@ class ValidationResult:
 
 
 def validate(scenario: Scenario | str, joints: str = "servo", *, tolerance: float = 0.05, max_speed: float = 4.0,
-             min_speed: float = 0.02, options: TrialOptions | None = None,
-             progress: Callable[[float, TrialResult, float | None, float | None], None] | None = None,
-             setup: TrialSetup | None = None) -> ValidationResult:
+             min_speed: float = 0.02, options: BalanceTrialOptions | None = None,
+             progress: Callable[[float, BalanceTrialResult, float | None, float | None], None] | None = None,
+             setup: BalanceSetup | None = None) -> ValidationResult:
     """Bracket the commanded approach speed at which the robot starts to fall (m/s).
 
     Starts at the CoM criterion's prediction (composite), doubles (or halves) until the outcome
@@ -98,13 +98,13 @@ def validate(scenario: Scenario | str, joints: str = "servo", *, tolerance: floa
         raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact to validate")
     if not (0 < tolerance < 1):
         raise SimulationError("--tolerance", tolerance, "must be in (0, 1)")
-    options = options or TrialOptions()
+    options = options or BalanceTrialOptions()
     predicted = predictions(scenario)
-    setup = setup or TrialSetup.create(scenario, joints, options)
-    trials: list[tuple[float, TrialResult]] = []
+    setup = setup or BalanceSetup.create(scenario, joints, options)
+    trials: list[tuple[float, BalanceTrialResult]] = []
 
     def trial(speed: float) -> bool:
-        result = run_trial(setup, impact_speed=speed, options=options)
+        result = run_balance_trial(setup, impact_speed=speed, options=options)
         trials.append((speed, result))
         return result.fell
 
