@@ -206,7 +206,9 @@ class _Recorder:
     def __init__(self, sim: SimModel, contact_names: list[str], impact: bool):
         cols = LogColumns()
         robot = sim.robot
-        self.joint_slots = [robot.joint_slot(n) for n in robot.joint_names]
+        slots = [robot.joint_slot(n) for n in robot.joint_names]
+        self.q_index = np.array([s.idx_q for s in slots])
+        self.v_index = np.array([robot.model.joints[s.id].idx_v for s in slots])
         self.columns = [cols.time, *cols.base_position, *cols.base_quaternion, *cols.base_linear_velocity,
                         *cols.base_angular_velocity]
         self.columns += [joint_position_column(n) for n in robot.joint_names]
@@ -220,8 +222,7 @@ class _Recorder:
 
     def add(self, t, q, v, sim: SimModel, zmp, com, com_velocity, forces, impact_force) -> None:
         lin, ang = sim.base_velocity_world()
-        qj = [q[s.idx_q] for s in self.joint_slots]
-        vj = [v[s.idx_v] for s in self.joint_slots]
+        qj, vj = q[self.q_index], v[self.v_index]
         parts = [[t], q[:7], lin, ang, qj, vj, zmp, com, com_velocity, forces.ravel()]
         if impact_force is not None:
             parts.append(impact_force)
