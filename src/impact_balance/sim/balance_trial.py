@@ -220,7 +220,10 @@ class _Recorder:
             self.columns += list(force_columns("impact"))
         self.rows: list[np.ndarray] = []
 
-    def add(self, t, q, v, sim: SimModel, zmp, com, com_velocity, forces, impact_force) -> None:
+    def add(self, t, q, v, sim: SimModel, zmp, forces, impact_force) -> None:
+        # The CoM columns are MuJoCo's own (subtree CoM and velocity): a cross-check for the log checker,
+        # which recomputes them with pinocchio from the base and joint columns.
+        com, com_velocity = sim.com(), sim.com_velocity()
         lin, ang = sim.base_velocity_world()
         qj, vj = q[self.q_index], v[self.v_index]
         parts = [[t], q[:7], lin, ang, qj, vj, zmp, com, com_velocity, forces.ravel()]
@@ -321,7 +324,7 @@ def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, pu
                             np.array([pdata.oMf[f].rotation for f in contact_frames]),
                             np.einsum("ij,ij->i", forces, normals), float(q[2]))
             if recorder is not None:
-                recorder.add(t, q, v, sim, zmp, com, com_velocity, forces, impact_force)
+                recorder.add(t, q, v, sim, zmp, forces, impact_force)
             if detector.fell:
                 break
         if body is not None:
