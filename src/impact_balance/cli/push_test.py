@@ -31,12 +31,13 @@ def run(args: argparse.Namespace) -> int:
     from ..logs import write_log
     from ..scenario import load_scenario
     from ..sim.balance_trial import BalanceTrialOptions, run_balance_trial
-    from ..sim.push import push_test
+    from ..sim.push import check_push_arguments, push_test
     from ._common import progress_bar, strict_json
 
     scenario = load_scenario(args.scenario)
     if args.log and Path(args.log).suffix.lower() not in (".parquet", ".csv"):
         raise ScenarioError("--log", args.log, "a log is a .parquet or .csv file")
+    check_push_arguments(args.directions, args.magnitudes, args.duration)
     bar = progress_bar(f"push-test {scenario.name}", args.directions * len(args.magnitudes))
 
     def progress(outcome):

@@ -223,6 +223,11 @@ class _Recorder:
     def add(self, t, q, v, sim: SimModel, zmp, forces, impact_force) -> None:
         # The CoM columns are MuJoCo's own (subtree CoM and velocity): a cross-check for the log checker,
         # which recomputes them with pinocchio from the base and joint columns.
+        # After mj_step, MuJoCo's CoM quantities still describe the state before the step: refresh them
+        # for the current state (position-dependent stages only; the next step recomputes them anyway).
+        mujoco.mj_kinematics(sim.model, sim.data)
+        mujoco.mj_comPos(sim.model, sim.data)
+        mujoco.mj_comVel(sim.model, sim.data)
         com, com_velocity = sim.com(), sim.com_velocity()
         lin, ang = sim.base_velocity_world()
         qj, vj = q[self.q_index], v[self.v_index]

@@ -21,7 +21,7 @@ from ..scenario import Scenario, load_scenario
 from ..exceptions import SimulationError
 from .balance_trial import Push, BalanceTrialOptions, BalanceTrialResult, BalanceSetup, run_balance_trial
 
-__all__ = ["PushOutcome", "PushTestResult", "push_test", "confusion", "DEFAULT_MAGNITUDES"]
+__all__ = ["check_push_arguments", "PushOutcome", "PushTestResult", "push_test", "confusion", "DEFAULT_MAGNITUDES"]
 
 #: Default impulses (N s): for a 90 kg robot, CoM velocity changes of about 0.1 to 0.7 m/s.
 DEFAULT_MAGNITUDES = (10.0, 20.0, 30.0, 40.0, 50.0, 60.0)
@@ -76,6 +76,16 @@ class PushTestResult:
                 "fall_criteria": self.fall_criteria, "wall_time": self.wall_time}
 
 
+def check_push_arguments(directions: int, magnitudes: Sequence[float], duration: float) -> None:
+    """Refuse bad push-test arguments with one clear error naming the option."""
+    if not (isinstance(directions, int) and 1 <= directions <= 360):
+        raise SimulationError("--directions", directions, "must be an integer in [1, 360]")
+    if not magnitudes or any(not (np.isfinite(m) and 0 < m <= 1000) for m in magnitudes):
+        raise SimulationError("--magnitudes", list(magnitudes), "each must be in (0, 1000] N s")
+    if not (0.001 <= duration <= 0.2):
+        raise SimulationError("--duration", duration, "must be in [0.001, 0.2] s (an impulsive push: 10-50 ms)")
+
+
 def push_test(scenario: Scenario | str, directions: int = 16, magnitudes: Sequence[float] = DEFAULT_MAGNITUDES,
               duration: float = 0.02, body: str | None = None, options: BalanceTrialOptions | None = None,
               progress: Callable[[PushOutcome], None] | None = None, setup: BalanceSetup | None = None) -> PushTestResult:
@@ -85,12 +95,7 @@ def push_test(scenario: Scenario | str, directions: int = 16, magnitudes: Sequen
     wall0 = time.perf_counter()
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
-    if not (isinstance(directions, int) and 1 <= directions <= 360):
-        raise SimulationError("--directions", directions, "must be an integer in [1, 360]")
-    if not magnitudes or any(not (np.isfinite(m) and 0 < m <= 1000) for m in magnitudes):
-        raise SimulationError("--magnitudes", list(magnitudes), "each must be in (0, 1000] N s")
-    if not (0.001 <= duration <= 0.2):
-        raise SimulationError("--duration", duration, "must be in [0.001, 0.2] s (an impulsive push: 10-50 ms)")
+    check_push_arguments(directions, magnitudes, duration)
     options = options or BalanceTrialOptions()
     setup = setup or BalanceSetup.create(scenario, "servo", options)
     outcomes = []
