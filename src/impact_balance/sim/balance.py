@@ -63,7 +63,7 @@ class BalanceGains:
     """
 
     rate: float = 500.0
-    dcm_gain: float = 3.0
+    dcm_gain: float = 1.5
     zmp_margin: float = 0.01
     zmp_admittance: float = 5.0
     zmp_filter: float = 0.01

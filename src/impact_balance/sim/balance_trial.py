@@ -36,6 +36,9 @@ from .model import SimModel, SimOptions, build_model
 #: Iterations of MuJoCo's no-slip solver in balance trials.
 NOSLIP_ITERATIONS = 10
 
+#: Support-limb servo stiffness, in units of the robot's gravity stiffness m g h (see stiffen_support_limbs).
+SUPPORT_STIFFNESS_FACTOR = 1.0
+
 #: Servos of the ``rigid`` joint model in balance trials: 30 Hz bandwidth, no effort limits. A welded
 #: robot cannot be controlled; this is the closest a controlled robot gets to the paper's rigid body.
 STIFF_SERVOS = ServoOptions(bandwidth=2.0 * np.pi * 30.0, effort_limits=False)
@@ -120,6 +123,7 @@ class BalanceSetup:
         # 3 mm/s within its friction cone); the no-slip pass removes that drift, which would otherwise
         # count as a slip after a few seconds.
         sim.model.opt.noslip_iterations = NOSLIP_ITERATIONS
+        stiffen_support_limbs(sim, analysis)
         standoff = options.standoff if analysis.impact is not None else 0.0
         q_start = retracted_stance(analysis, standoff)
         return cls(scenario, joints, analysis, sim, q_start, standoff)
@@ -169,6 +173,45 @@ class BalanceTrialResult:
             "max_tilt_deg": float(np.rad2deg(self.max_tilt)), "max_slip": float(self.max_slip),
             "sim_time": self.sim_time, "wall_time": self.wall_time,
         }
+
+
+def support_joints(sim: SimModel, analysis: Analysis) -> list[str]:
+    """Simulated joints on the chain from the root to any sustained contact's frame (the support limbs)."""
+    model = analysis.stance.model
+    names: set[str] = set()
+    for contact in analysis.stance.contacts:
+        j = model.frames[model.getFrameId(contact.spec.frame)].parentJoint
+        while j > 1:
+            names.add(model.names[j])
+            j = model.parents[j]
+    return [n for n in sim.joint_names if n in names]
+
+
+def stiffen_support_limbs(sim: SimModel, analysis: Analysis, factor: float = SUPPORT_STIFFNESS_FACTOR) -> None:
+    """Raise the servo gains of the support limbs so that they can hold the robot up.
+
+    The servo rule of :mod:`.joints` scales each joint's gains by the inertia the joint moves with
+    the base free (``M_jj``): for an ankle, that is the foot alone, about 0.03 kg m^2, so
+    ``kp`` is about 90-230 N m/rad at 15 Hz, while standing on that ankle the whole robot is an
+    inverted pendulum of gravity stiffness ``m g h`` (about 820 N m/rad for Talos): the robot
+    would topple slowly whatever the controller does. Here every joint of a support limb gets at
+    least ``kp = factor m g h`` and ``kd = 2 sqrt(kp m h^2)`` (critical damping of the whole robot
+    swinging about that joint at height ``h`` of the CoM); effort limits are kept.
+    """
+    m = analysis.stance.mass
+    h = float(analysis.stance.com[2] - analysis.stance.lowest_contact_height())
+    kp_min = factor * m * analysis.areas.gravity * h
+    kd_min = 2.0 * np.sqrt(kp_min * m * h * h)
+    chosen = set(support_joints(sim, analysis))
+    for k, name in enumerate(sim.joint_names):
+        if name not in chosen:
+            continue
+        a = sim.actuator_ids[k]
+        kp, kd = max(sim.kp[k], kp_min), max(sim.kd[k], kd_min)
+        sim.model.actuator_gainprm[a, 0] = kp
+        sim.model.actuator_biasprm[a, 1] = -kp
+        sim.model.actuator_biasprm[a, 2] = -kd
+        sim.kp[k], sim.kd[k] = kp, kd
 
 
 def measured_zmp(sim: SimModel, com: np.ndarray, plane_height: float) -> tuple[np.ndarray, np.ndarray]:
@@ -315,7 +358,7 @@ def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, pu
             com_now, _ = controller.measure(q, v)
             zmp, forces = measured_zmp(sim, com_now, h)
             out = controller.step(t, q, v, zmp, fn)
-            sim.set_servo_targets(out.q, out.v)
+            sim.set_servo_targets(out.q)
             com, com_velocity = out.com, out.com_velocity
             omega = np.sqrt(g / (com[2] - h))
             zmp_margin = float(zmp_area.margins(zmp)[0]) if np.all(np.isfinite(zmp)) else -np.inf
@@ -327,7 +370,8 @@ def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, pu
             pin.framesForwardKinematics(model, pdata, q)
             detector.update(t, np.array([pdata.oMf[f].translation for f in contact_frames]),
                             np.array([pdata.oMf[f].rotation for f in contact_frames]),
-                            np.einsum("ij,ij->i", forces, normals), float(q[2]))
+                            np.einsum("ij,ij->i", forces, normals), float(q[2]),
+                            impulsive=push is not None and push.start <= t < disturbance_end)
             if recorder is not None:
                 recorder.add(t, q, v, sim, zmp, forces, impact_force)
             if detector.fell:

@@ -4,7 +4,9 @@ The criterion's promise is zero-step balance: every sustained contact stays wher
 robot comes back to rest. So a trial *fails* (the robot "fell") at the first of:
 
 - ``contact_lost``: a contact's normal force stays below ``min_force`` (1 N) for longer than
-  ``lost_time`` (20 ms). Short flickers during the impact are tolerated.
+  ``lost_time`` (20 ms), counted from the end of the disturbance: while an impulsive push acts
+  (10-50 ms) the feet may unload, as the criterion treats the push as instantaneous and judges
+  the state it leaves; short flickers during an impact are tolerated the same way.
 - ``contact_tilted``: a contact frame rotates more than ``max_tilt`` (5 degrees) from its initial
   orientation: a sole rolling over its edge.
 - ``contact_slipped``: a contact frame's origin moves more than ``max_slip`` (1 cm) from its
@@ -89,8 +91,11 @@ class FallDetector:
             self.verdict = FallVerdict(True, reason, float(t), detail)
 
     def update(self, t: float, positions: np.ndarray, rotations: np.ndarray, normal_forces: np.ndarray | None,
-               base_height: float) -> bool:
-        """Check one sample (contact frame poses, normal forces in N or None if unknown); returns ``fell``."""
+               base_height: float, impulsive: bool = False) -> bool:
+        """Check one sample (contact frame poses, normal forces in N or None if unknown); returns ``fell``.
+
+        ``impulsive``: a push is acting now; unloading does not count until it ends.
+        """
         c = self.criteria
         positions = np.asarray(positions, dtype=float).reshape(-1, 3)
         rotations = np.asarray(rotations, dtype=float).reshape(-1, 3, 3)
@@ -106,7 +111,9 @@ class FallDetector:
             if slip > c.max_slip:
                 self._fail("contact_slipped", t, f"{name} moved {100 * slip:.1f} cm")
             if normal_forces is not None:
-                if normal_forces[i] < c.min_force:
+                if impulsive:
+                    self._low_since[i] = np.nan
+                elif normal_forces[i] < c.min_force:
                     if np.isnan(self._low_since[i]):
                         self._low_since[i] = t
                     elif t - self._low_since[i] > c.lost_time:

@@ -23,8 +23,8 @@ from .balance_trial import Push, BalanceTrialOptions, BalanceTrialResult, Balanc
 
 __all__ = ["check_push_arguments", "PushOutcome", "PushTestResult", "push_test", "confusion", "DEFAULT_MAGNITUDES"]
 
-#: Default impulses (N s): for a 90 kg robot, CoM velocity changes of about 0.1 to 0.7 m/s.
-DEFAULT_MAGNITUDES = (10.0, 20.0, 30.0, 40.0, 50.0, 60.0)
+#: Default impulses (N s): for a 90 kg robot, CoM velocity changes of about 0.06 to 0.33 m/s.
+DEFAULT_MAGNITUDES = (5.0, 10.0, 15.0, 20.0, 25.0, 30.0)
 
 
 @dataclass
