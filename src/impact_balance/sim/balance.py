@@ -63,9 +63,9 @@ class BalanceGains:
     """
 
     rate: float = 500.0
-    dcm_gain: float = 1.5
+    dcm_gain: float = 1.0
     zmp_margin: float = 0.01
-    zmp_admittance: float = 5.0
+    zmp_admittance: float = 1.0
     zmp_filter: float = 0.01
     max_com_speed: float = 0.3
     com_cost: float = 10.0

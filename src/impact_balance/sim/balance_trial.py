@@ -103,6 +103,7 @@ class BalanceSetup:
     sim: SimModel
     q_start: np.ndarray
     standoff: float
+    support_v_index: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
 
     @classmethod
     def create(cls, scenario: Scenario | str, joints: str = "servo", options: BalanceTrialOptions | None = None,
@@ -126,7 +127,9 @@ class BalanceSetup:
         stiffen_support_limbs(sim, analysis)
         standoff = options.standoff if analysis.impact is not None else 0.0
         q_start = retracted_stance(analysis, standoff)
-        return cls(scenario, joints, analysis, sim, q_start, standoff)
+        support = [analysis.stance.robot.joint_slot(n) for n in support_joints(sim, analysis)]
+        support_v = np.array([analysis.stance.model.joints[j.id].idx_v for j in support], dtype=int)
+        return cls(scenario, joints, analysis, sim, q_start, standoff, support_v)
 
 
 @dataclass
@@ -358,7 +361,11 @@ def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, pu
             com_now, _ = controller.measure(q, v)
             zmp, forces = measured_zmp(sim, com_now, h)
             out = controller.step(t, q, v, zmp, fn)
-            sim.set_servo_targets(out.q)
+            # Velocity feed-forward (kd v_ref) for the free limbs only: on the stiffened support limbs
+            # it would turn the dead-beat IK's velocity noise into large torques.
+            v_ff = out.v.copy()
+            v_ff[setup.support_v_index] = 0.0
+            sim.set_servo_targets(out.q, v_ff)
             com, com_velocity = out.com, out.com_velocity
             omega = np.sqrt(g / (com[2] - h))
             zmp_margin = float(zmp_area.margins(zmp)[0]) if np.all(np.isfinite(zmp)) else -np.inf
