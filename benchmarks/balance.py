@@ -37,6 +37,7 @@ def main() -> int:
     p.add_argument("--scenarios", nargs="*", help="impact scenarios (default: every bundled one)")
     p.add_argument("--joints", nargs="+", default=["servo", "rigid"])
     p.add_argument("--push-scenario", default="palm_push_ramp")
+    p.add_argument("--push-body", default=None, help="MuJoCo body pushed (default: the torso)")
     p.add_argument("--directions", type=int, default=16)
     p.add_argument("--magnitudes", type=float, nargs="+", default=list(DEFAULT_MAGNITUDES))
     p.add_argument("--skip", nargs="*", default=[], choices=["speed", "validate", "push"])
@@ -72,10 +73,10 @@ def main() -> int:
         out["validate"] = rows
     if "push" not in args.skip:
         t0 = time.perf_counter()
-        r = push_test(args.push_scenario, args.directions, args.magnitudes, 0.05)
+        r = push_test(args.push_scenario, args.directions, args.magnitudes, 0.05, args.push_body)
         d = r.to_dict()
         out["push"] = d
-        print(f"\n## Pushes on {args.push_scenario} ({len(r.outcomes)} pushes, 50 ms, {time.perf_counter() - t0:.0f} s)\n")
+        print(f"\n## Pushes on {args.push_scenario} at {args.push_body or 'the torso'} ({len(r.outcomes)} pushes, 50 ms, {time.perf_counter() - t0:.0f} s)\n")
         print("| magnitude (N s) | fell | CoM criterion safe | ZMP criterion safe | reasons |")
         print("|---|---|---|---|---|")
         for m in args.magnitudes:

@@ -152,3 +152,15 @@ def test_fall_detector_reasons(kind):
     det2.update(0.1, np.array([[0.009, 0, 0], [0, 0, 0]]), R2, forces, 0.95)
     assert not det2.fell
     assert det2.finish(3.0, np.array([0.06, 0.0, 0.0])).reason == "not_at_rest"
+
+
+def test_a_contact_that_never_carried_load_is_not_lost():
+    det = _detector()
+    P, R = np.zeros((2, 3)), np.stack([np.eye(3)] * 2)
+    for k in range(100):  # contact "b" rests without load for 100 ms
+        det.update(0.001 * k, P, R, np.array([800.0, 0.0]), 1.0)
+    assert not det.fell
+    det.update(0.2, P, R, np.array([700.0, 100.0]), 1.0)
+    for k in range(30):  # once loaded, unloading for 30 ms is a loss
+        det.update(0.201 + 0.001 * k, P, R, np.array([800.0, 0.0]), 1.0)
+    assert det.verdict.reason == "contact_lost"

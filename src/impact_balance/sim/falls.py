@@ -6,7 +6,9 @@ robot comes back to rest. So a trial *fails* (the robot "fell") at the first of:
 - ``contact_lost``: a contact's normal force stays below ``min_force`` (1 N) for longer than
   ``lost_time`` (20 ms), counted from the end of the disturbance: while an impulsive push acts
   (10-50 ms) the feet may unload, as the criterion treats the push as instantaneous and judges
-  the state it leaves; short flickers during an impact are tolerated the same way.
+  the state it leaves; short flickers during an impact are tolerated the same way. A contact
+  counts only once it has carried ``min_force`` (a hand resting on a wall with no load is
+  not "lost" when it carries none).
 - ``contact_tilted``: a contact frame rotates more than ``max_tilt`` (5 degrees) from its initial
   orientation: a sole rolling over its edge.
 - ``contact_slipped``: a contact frame's origin moves more than ``max_slip`` (1 cm) from its
@@ -76,11 +78,13 @@ class FallDetector:
     max_tilt: float = field(default=0.0, init=False)
     max_slip: float = field(default=0.0, init=False)
     _low_since: np.ndarray = field(init=False)
+    _loaded: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
         self.positions = np.asarray(self.positions, dtype=float).reshape(-1, 3)
         self.rotations = np.asarray(self.rotations, dtype=float).reshape(-1, 3, 3)
         self._low_since = np.full(len(self.names), np.nan)
+        self._loaded = np.zeros(len(self.names), dtype=bool)
 
     @property
     def fell(self) -> bool:
@@ -111,7 +115,8 @@ class FallDetector:
             if slip > c.max_slip:
                 self._fail("contact_slipped", t, f"{name} moved {100 * slip:.1f} cm")
             if normal_forces is not None:
-                if impulsive:
+                self._loaded[i] |= normal_forces[i] >= c.min_force
+                if impulsive or not self._loaded[i]:
                     self._low_since[i] = np.nan
                 elif normal_forces[i] < c.min_force:
                     if np.isnan(self._low_since[i]):
