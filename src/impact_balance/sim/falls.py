@@ -7,8 +7,8 @@ robot comes back to rest. So a trial *fails* (the robot "fell") at the first of:
   ``lost_time`` (20 ms), counted from the end of the disturbance: while an impulsive push acts
   (10-50 ms) the feet may unload, as the criterion treats the push as instantaneous and judges
   the state it leaves; short flickers during an impact are tolerated the same way. A contact
-  counts only once it has carried ``min_force`` (a hand resting on a wall with no load is
-  not "lost" when it carries none).
+  counts only once it has carried ``load_force`` (20 N): a hand resting on a wall with hardly
+  any load is not "lost" when it carries none.
 - ``contact_tilted``: a contact frame rotates more than ``max_tilt`` (5 degrees) from its initial
   orientation: a sole rolling over its edge.
 - ``contact_slipped``: a contact frame's origin moves more than ``max_slip`` (1 cm) from its
@@ -36,6 +36,7 @@ class FallCriteria:
     """Thresholds of :class:`FallDetector` (SI units, angles in radians)."""
 
     min_force: float = 1.0
+    load_force: float = 20.0
     lost_time: float = 0.02
     max_tilt: float = np.deg2rad(5.0)
     max_slip: float = 0.01
@@ -115,7 +116,7 @@ class FallDetector:
             if slip > c.max_slip:
                 self._fail("contact_slipped", t, f"{name} moved {100 * slip:.1f} cm")
             if normal_forces is not None:
-                self._loaded[i] |= normal_forces[i] >= c.min_force
+                self._loaded[i] |= normal_forces[i] >= c.load_force
                 if impulsive or not self._loaded[i]:
                     self._low_since[i] = np.nan
                 elif normal_forces[i] < c.min_force:
