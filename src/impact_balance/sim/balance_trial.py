@@ -33,6 +33,10 @@ from .falls import FallCriteria, FallDetector
 from .joints import JOINT_MODELS, ServoOptions
 from .model import SimModel, SimOptions, build_model
 
+#: Logs start here (s): the first steps settle the model's initial contact penetration, which
+#: briefly loads one foot with thousands of newtons and unloads the other.
+LOG_START = 0.05
+
 #: Iterations of MuJoCo's no-slip solver in balance trials.
 NOSLIP_ITERATIONS = 10
 
@@ -379,7 +383,7 @@ def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, pu
                             np.array([pdata.oMf[f].rotation for f in contact_frames]),
                             np.einsum("ij,ij->i", forces, normals), float(q[2]),
                             impulsive=push is not None and push.start <= t < disturbance_end)
-            if recorder is not None:
+            if recorder is not None and t >= LOG_START:
                 recorder.add(t, q, v, sim, zmp, forces, impact_force)
             if detector.fell:
                 break
