@@ -144,11 +144,11 @@ def test_state_round_trip_and_com_velocity_against_pinocchio(models, name):
     sim.set_state(sim.stance.q)
 
 
-@pytest.mark.parametrize("name", ["palm_push_two_feet", "talos_three_contacts"])
+@pytest.mark.parametrize("name", ["palm_push_two_feet", "talos_three_contacts", "palm_push_ramp", "kick_one_foot"])
 def test_servo_holds_the_stance_under_gravity(name):
     sim = build_model(name, "servo", LIGHT)
     com0 = sim.com()
-    for _ in range(int(0.5 / sim.model.opt.timestep)):
+    for _ in range(int(1.0 / sim.model.opt.timestep)):
         mujoco.mj_step(sim.model, sim.data)
     weight = sim.mass * sim.scenario.gravity
     total = sum(sim.contact_force(g) for g in sim.contact_geoms)

@@ -14,13 +14,13 @@ from types import ModuleType
 
 from ..exceptions import ImpactBalanceError
 from ..projection.walk import kernel_is_compiled
-from . import analyze, check_log, demo, gui, listing, phase_portrait, push_test, validate
+from . import analyze, check_log, demo, gui, listing, phase_portrait, push_test, simulate, validate
 from .demo import DEMO_SCENARIOS, FRICTION_SWEEP
 
 __all__ = ["main", "DEMO_SCENARIOS", "FRICTION_SWEEP", "COMMANDS"]
 
 #: Command modules, in the order of ``--help``.
-COMMANDS: tuple[ModuleType, ...] = (demo, analyze, phase_portrait, listing, gui, validate, push_test, check_log)
+COMMANDS: tuple[ModuleType, ...] = (demo, analyze, phase_portrait, listing, gui, simulate, validate, push_test, check_log)
 
 
 def _parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:

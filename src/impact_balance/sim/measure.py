@@ -1,7 +1,7 @@
 """What a trial measured, against what the impact model predicts.
 
-Measured, across the impact (from the last step before the impact force appears to the end
-of the impact, see :func:`impact_window`):
+Measured, across the impact (from the last step before the impact force appears to the
+separation, or 20 ms later if the limb keeps pressing, see :func:`impact_window`):
 - the impulse at the impact point: the integrated contact force on the robot, N s, world;
 - the CoM velocity jump (xy), m/s;
 - the approach speed (``-n . v`` of the impact point just before) and the restitution
@@ -11,9 +11,9 @@ of the impact, see :func:`impact_window`):
 Predicted: the impact model (:func:`impact_balance.impact.impact_model`) at the stance, with
 the restitution range set to the measured value ``[e, e]`` and evaluated at the measured
 approach speed, for both inertia models (``composite``: the robot as one rigid body;
-``joint_space``: ``J M^-1 J^T``, every joint free). Its CoM velocity jumps span a polygon;
-the distance of the measured jump to it (0 inside) says how far the model is from the
-simulation.
+``joint_space``: ``J M^-1 J^T``, every joint free, ``M`` including the servos' armature).
+Its CoM velocity jumps span a polygon; the distance of the measured jump to it (0 inside)
+says how far the model is from the simulation.
 """
 
 from __future__ import annotations
@@ -23,18 +23,20 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import pinocchio as pin
 
 from ..impact import INERTIA_MODELS, impact_model
 from ..polygon import Polygon
+from ..stance import Stance
 from .model import SimModel
 from .trial import TrialRecord
 
 __all__ = ["Prediction", "TrialResult", "impact_window", "measure", "distance_to_hull"]
 
-#: A force below this fraction of the peak counts as zero (end of the impact).
-_FORCE_FLOOR = 1e-3
-#: The impact ends at separation, or once the force falls below this fraction of its peak.
-_DECAY = 0.05
+#: A force below this fraction of the peak counts as zero.
+_FORCE_FLOOR = 1e-6
+#: Longest impact, s: a servo-held limb may keep pressing on the surface after the impact.
+MAX_IMPACT_DURATION = 0.02
 
 
 @dataclass(frozen=True)
@@ -74,6 +76,8 @@ class TrialResult:
         contacts_kept: Every sustained contact kept touching its support without sliding
             more than 1 cm (``servo``); None for ``rigid``, whose robot floats.
         predicted: Prediction per inertia model.
+        saturated_joints: ``servo``: joints whose torque reached its effort limit during the
+            impact (empty for ``rigid``).
         sim_time_ratio: Simulated time over wall-clock time.
         record: The time series.
     """
@@ -88,6 +92,7 @@ class TrialResult:
     impact_time: tuple[float, float]
     contacts_kept: bool | None
     predicted: dict[str, Prediction]
+    saturated_joints: list[str]
     sim_time_ratio: float
     record: TrialRecord | None = None
 
@@ -115,6 +120,7 @@ class TrialResult:
                 for name, p in self.predicted.items()
             },
             "contacts_kept": self.contacts_kept,
+            "saturated_joints": list(self.saturated_joints),
             "sim_time_ratio": num(self.sim_time_ratio),
         }
 
@@ -138,23 +144,38 @@ def distance_to_hull(point: np.ndarray, vertices: np.ndarray) -> float:
     return best
 
 
-def impact_window(record: TrialRecord) -> tuple[int, int]:
-    """Indices (before, end): the last sample before the impact force appears, and the impact's end.
+def impact_window(record: TrialRecord, max_duration: float = MAX_IMPACT_DURATION) -> tuple[int, int]:
+    """Indices (before, end) of the impact: the force of sample k acts from sample k to k + 1.
 
-    The end is the first sample after the force peak where the force is zero (separation)
-    or below 5 % of the peak (the servo-held robot may keep pressing).
+    ``before`` is the last sample without impact force; ``end`` the first sample where it is
+    zero again (separation), or ``max_duration`` after the impact began if the limb keeps
+    pressing. So the impulse is the sum of the forces of samples ``before .. end - 1`` times
+    the step, and it changes the velocities from sample ``before`` to sample ``end``.
     """
     force = np.linalg.norm(record.forces["impact"], axis=1)
     peak = force.max(initial=0.0)
     if peak <= 0.0:
         raise ValueError("no impact")
-    touching = np.flatnonzero(force > _FORCE_FLOOR * peak)
-    first = int(touching[0])
+    touching = force > _FORCE_FLOOR * peak
+    first = int(np.flatnonzero(touching)[0])
     before = max(first - 1, 0)
-    k_peak = first + int(np.argmax(force[first:]))
-    after = np.flatnonzero(force[k_peak:] <= _DECAY * peak)
-    end = k_peak + int(after[0]) if after.size else len(force) - 1
+    last = min(len(force) - 1, int(np.searchsorted(record.time, record.time[first] + max_duration)))
+    released = np.flatnonzero(~touching[first:last])
+    end = first + int(released[0]) if released.size else last
     return before, end
+
+
+def _stance_with_armature(sim: SimModel) -> Stance:
+    """The stance, on a copy of the robot model carrying the servos' armature (pinocchio's
+    ``crba`` adds ``model.armature`` to the mass matrix), so that ``joint_space`` predicts for
+    the simulated robot. The shared robot model is never modified."""
+    armature = sim.options.servo.armature
+    if sim.joints != "servo" or armature == 0.0:
+        return sim.stance
+    model = pin.Model(sim.robot.model)
+    model.armature[sim.v_index] = armature
+    robot = dataclasses.replace(sim.robot, model=model)
+    return Stance(robot, sim.stance.q, [c.spec for c in sim.stance.contacts])
 
 
 def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialResult:
@@ -170,30 +191,38 @@ def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialR
             "--duration", round(record.simulated_time, 4), "the impact point never reached the surface in that time"
         ) from None
     dt = sim.model.opt.timestep
-    impulse = record.forces["impact"][before + 1 : end + 1].sum(axis=0) * dt
+    impulse = record.forces["impact"][before:end].sum(axis=0) * dt
     jump = (record.com_velocity[end] - record.com_velocity[before])[:2]
     v_before, v_after = record.impact_velocity[before], record.impact_velocity[end]
     approach = float(-n @ v_before)
     restitution = max(0.0, float(n @ v_after)) / approach if approach > 0 else float("nan")
     slip = float(np.linalg.norm(v_after - (n @ v_after) * n))
     predicted = {}
+    stance = _stance_with_armature(sim)
     for inertia in INERTIA_MODELS:
         model_spec = dataclasses.replace(spec, restitution=(restitution, restitution), inertia=inertia)
-        model = impact_model(sim.stance, model_spec)
+        model = impact_model(stance if inertia == "joint_space" else sim.stance, model_spec)
         jumps = model.com_velocity_jumps(approach)[:, :2]
         predicted[inertia] = Prediction(inertia, jumps, distance_to_hull(jump, jumps))
     kept = None
     if sim.joints != "rigid":
         start = int(np.searchsorted(record.time, record.approach_start))
-        normal_forces = np.array(
-            [record.forces[c.spec.frame][start:] @ c.normal for c in sim.stance.contacts]
-        )  # (k, T)
+        contact_forces = [f for name, f in record.forces.items() if name != "impact"]  # in contact order
+        normal_forces = np.array([f[start:] @ c.normal for f, c in zip(contact_forces, sim.stance.contacts)])
         moved = np.linalg.norm(record.contact_positions[start:] - record.contact_positions[start], axis=2).max()
         kept = bool((normal_forces > 0.0).all() and moved < 0.01)
+    saturated: list[str] = []
+    if sim.joints == "servo" and record.actuator_force.size:
+        limits = sim.model.actuator_forcerange[sim.actuator_ids, 1]
+        peak = np.abs(record.actuator_force[before:end + 1]).max(axis=0)
+        limited = sim.model.actuator_forcelimited[sim.actuator_ids].astype(bool)
+        saturated = [name for name, p, lim, on in zip(sim.joint_names, peak, limits, limited)
+                     if on and p >= lim * (1 - 1e-6)]
     ratio = record.simulated_time / record.wall_time if record.wall_time > 0 else float("nan")
     return TrialResult(
         approach_speed=approach_speed, joints=sim.joints, approach_speed_measured=approach,
         restitution_measured=restitution, impulse_measured=impulse, com_velocity_jump_measured=jump,
         slip_speed=slip, impact_time=(float(record.time[before]), float(record.time[end])),
-        contacts_kept=kept, predicted=predicted, sim_time_ratio=ratio, record=record,
+        contacts_kept=kept, predicted=predicted, saturated_joints=saturated, sim_time_ratio=ratio,
+        record=record,
     )

@@ -50,6 +50,9 @@ class SimOptions:
         meshes: Load the robot's meshes (visual only; needed for video).
         elliptic_cone: Elliptic friction cones (exact Coulomb); MuJoCo's default pyramid has
             4 edges, inscribed, and would under-estimate friction between its edges.
+        impratio: MuJoCo's ratio of frictional to normal constraint impedance. MuJoCo's soft
+            friction lets a loaded contact creep; 10 (instead of 1) stiffens friction so that a
+            foot on the 30 degree ramp stays put (CoM drift 7 mm in 2 s instead of 8 cm).
     """
 
     timestep: float = 0.001
@@ -57,6 +60,7 @@ class SimOptions:
     servo: ServoOptions = field(default_factory=ServoOptions)
     meshes: bool = True
     elliptic_cone: bool = True
+    impratio: float = 10.0
 
 
 @dataclass
@@ -194,10 +198,10 @@ class SimModel:
         address = address[active]
         local = d.efc_force[address[:, None] + np.arange(3)]  # (k, 3) in each contact frame
         world = np.einsum("kji,kj->ki", contacts.frame[active].reshape(-1, 3, 3), local)
-        g1, g2 = contacts.geom1[active], contacts.geom2[active]
-        for k, g in enumerate(geoms):
-            out[k] = world[g2 == g].sum(axis=0) - world[g1 == g].sum(axis=0)
-        return out
+        wanted = np.asarray(geoms)[:, None]
+        sign = (contacts.geom2[active][None, :] == wanted).astype(float)
+        sign -= contacts.geom1[active][None, :] == wanted
+        return sign @ world
 
     def enable_supports(self, enabled: bool = True) -> None:
         """Let the sustained contacts touch their supports (default), or not (a floating robot).
@@ -210,7 +214,10 @@ class SimModel:
                 self.model.pair_margin[i] = 0.0 if enabled else -1.0
 
     def set_servo_targets(self, q_ref: np.ndarray, v_ref: np.ndarray | None = None) -> None:
-        """Servo commands: target joint positions (pinocchio ``q``) and velocities (pinocchio ``v``), holding torques added."""
+        """Servo commands from target joint positions (pinocchio ``q``) and velocities (pinocchio ``v``).
+
+        The holding torques (:attr:`tau_hold`) are added as a feed-forward.
+        """
         if self.actuator_ids.size == 0:
             return
         target = np.asarray(q_ref, dtype=float)[self.q_index]
@@ -251,7 +258,7 @@ def build_model(
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     if options.elliptic_cone:
         spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
-    spec.option.noslip_iterations = 0
+    spec.option.impratio = options.impratio
     names = add_geometry(spec, stance, _joint_bodies(spec, stance), impact, options.contact)
 
     # Joints simulated as joints (1-dof ones; pinocchio's continuous joints have nq = 2).

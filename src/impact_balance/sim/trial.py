@@ -8,10 +8,11 @@ impact of one rigid body.
 ``servo`` joints: gravity on, the robot stands on its contacts. It first settles for
 ``settle`` seconds with the impacting limb retracted by ``gap``; then the limb's servo
 targets move the impact point along ``-n`` at ``v_n`` (joint velocities from the limb's
-Jacobian pseudo-inverse at the stance, positions integrated from the retracted pose). They go on past the stance if the servos lag, and stop where they are once the impact
-force appears (a kinematic controller stops at contact). Every other joint holds the stance. The limb is the chain of
-joints that leads to the impact frame and carries nothing else (Talos' right arm for a palm
-push, the left leg for a kick).
+Jacobian pseudo-inverse at the stance, positions integrated from the retracted pose). They
+go on past the stance if the servos lag, and stop where they are once the impact force
+appears (a kinematic controller stops at contact). Every other joint holds the stance. The
+limb is the chain of joints that leads to the impact frame and carries nothing else (Talos'
+right arm for a palm push, the left leg for a kick).
 
 The recorded time series (:class:`TrialRecord`) is what :mod:`.measure` reads and what the
 log and the figures show.
@@ -68,6 +69,8 @@ class TrialRecord:
         forces: Force on the robot per name (each contact's frame, and ``impact``), N, (T, 3).
         impact_velocity: Velocity of the impact point, m/s, (T, 3).
         approach_start: Time the approach begins (end of settling), s.
+        contact_positions: Centre of each sustained-contact box, world, m, (T, k, 3).
+        actuator_force: Servo torques (N m), (T, nu), aligned with ``SimModel.joint_names``.
         wall_time: Wall-clock time of the simulation loop (recording included), s.
     """
 
@@ -81,6 +84,7 @@ class TrialRecord:
     approach_start: float
     wall_time: float
     contact_positions: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 3)))
+    actuator_force: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
 
     @property
     def simulated_time(self) -> float:
@@ -146,7 +150,8 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
         sim.enable_supports(True)
         limb = impact_limb(sim)
         if not limb:
-            raise SimulationError("impact.frame", spec.frame, "no joint moves the impact point without moving a contact")
+            raise SimulationError("impact.frame", spec.frame,
+                                  "no joint moves the impact point without moving a contact")
         _, J6 = sim.stance.point(spec.frame, spec.offset)
         v_cols = np.array([sim.robot.model.joints[sim.robot.joint_slot(j).id].idx_v for j in limb])
         limb_dq = np.zeros(sim.stance.model.nv)
@@ -157,35 +162,30 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
         settle = options.settle
     total = settle + 1.5 * travel + options.after
     steps = int(round(total / dt))
-    names = [c.spec.frame for c in sim.stance.contacts] + ["impact"]
+    frames = [c.spec.frame for c in sim.stance.contacts]
+    # Log names: the contact's frame, made unique with its index when two contacts share a frame.
+    names = [f if frames.count(f) == 1 else f"{f}_{i}" for i, f in enumerate(frames)] + ["impact"]
     geoms = [*sim.contact_geoms, sim.impact_geom]
-    T = steps + 1
+    T = steps
     rec_t = np.empty(T)
     qpos, qvel = np.empty((T, m.nq)), np.empty((T, m.nv))
     com, comd = np.empty((T, 3)), np.empty((T, 3))
     forces = np.empty((T, len(geoms), 3))
     point_v = np.empty((T, 3))
     contact_pos = np.empty((T, len(sim.contact_geoms), 3))
+    torques = np.empty((T, m.nu))
 
-    def record(k: int) -> None:
-        rec_t[k] = d.time
-        qpos[k], qvel[k] = d.qpos, d.qvel
-        mujoco.mj_subtreeVel(m, d)
-        com[k] = d.subtree_com[sim.root_body]
-        comd[k] = d.subtree_linvel[sim.root_body]
-        forces[k] = sim.contact_forces(geoms)
-        point_v[k] = _point_velocity(sim, n)
-        contact_pos[k] = d.geom_xpos[list(sim.contact_geoms)]
-
+    # mj_step computes the kinematics, contacts and forces of the state it starts from, then
+    # integrates: sample k is the state before step k, with what mj_step computed from it
+    # (its contact forces act from sample k to sample k + 1).
     d.time = 0.0
     start = time.perf_counter()
     frozen = None  # servo targets once the impact begins
     try:
-        record(0)
-        for k in range(1, T):
+        for k in range(T):
             if limb_dq is not None:
                 s = d.time - settle  # time into the approach
-                if frozen is None and s > 0.0 and forces[k - 1, -1].any():
+                if frozen is None and s > 0.0 and k > 0 and forces[k - 1, -1].any():
                     # A kinematic controller stops the limb at contact: hold the targets there.
                     frozen = pin.integrate(sim.stance.model, q_start, s * v_n * limb_dq)
                 if frozen is not None:
@@ -193,8 +193,16 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
                 elif s > 0.0:
                     # Past the stance if need be: the servos lag, the surface is where the stance touches it.
                     sim.set_servo_targets(pin.integrate(sim.stance.model, q_start, s * v_n * limb_dq), v_n * limb_dq)
+            rec_t[k] = d.time
+            qpos[k], qvel[k] = d.qpos, d.qvel
             mujoco.mj_step(m, d)
-            record(k)
+            mujoco.mj_subtreeVel(m, d)
+            com[k] = d.subtree_com[sim.root_body]
+            comd[k] = d.subtree_linvel[sim.root_body]
+            forces[k] = sim.contact_forces(geoms)
+            point_v[k] = _point_velocity(sim, n)
+            contact_pos[k] = d.geom_xpos[list(sim.contact_geoms)]
+            torques[k] = d.actuator_force
     finally:
         wall = time.perf_counter() - start
         m.opt.gravity[:] = gravity
@@ -203,4 +211,5 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
         time=rec_t, qpos=qpos, qvel=qvel, com=com, com_velocity=comd,
         forces={name: forces[:, i] for i, name in enumerate(names)}, impact_velocity=point_v,
         approach_start=settle, wall_time=wall, contact_positions=contact_pos,
+        actuator_force=torques[:, sim.actuator_ids] if m.nu else torques,
     )

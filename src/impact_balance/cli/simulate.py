@@ -1,0 +1,149 @@
+"""``impact-balance simulate SCENARIO``: the scenario's impact in MuJoCo, measured against the impact model."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+from pathlib import Path
+
+__all__ = ["add_parser", "run", "parse_speeds"]
+
+USES_KERNEL = False
+
+
+def add_parser(sub) -> list[str]:
+    a = sub.add_parser("simulate", help="simulate the scenario's impact in MuJoCo and compare with the impact model")
+    a.add_argument("scenario", help="YAML file, or the name of a bundled scenario with an impact")
+    a.add_argument("--speed", default="0.3", metavar="V[,V...]",
+                   help="approach speed(s) of the impact point along the normal, m/s (default 0.3)")
+    a.add_argument("--joints", default="rigid", metavar="rigid|servo",
+                   help="joint model: rigid (welded at the stance, the paper's model) or servo (position servos)")
+    a.add_argument("--armature", type=float, default=0.0, metavar="KG_M2",
+                   help="servo only: rotor inertia added to every joint, kg m^2 (default 0, as in the URDF)")
+    a.add_argument("--duration", type=float, default=0.15, metavar="S",
+                   help="simulated time kept after the impact begins, s (default 0.15)")
+    a.add_argument("--json", action="store_true", help="print one JSON object (a list for several speeds)")
+    a.add_argument("--plots", metavar="DIR", help="write the figures to DIR")
+    a.add_argument("--log", metavar="FILE", help="write the time series (.parquet or .csv); one file per speed")
+    a.add_argument("--video", metavar="FILE", help="render an MP4 (offscreen, EGL); one file per speed")
+    return ["simulate"]
+
+
+def parse_speeds(text: str) -> list[float]:
+    """Approach speeds from ``"0.1,0.3"``; :class:`SimulationError` on a bad one."""
+    from ..exceptions import SimulationError
+    from ..sim.trial import MAX_APPROACH_SPEED
+
+    speeds = []
+    for part in str(text).split(","):
+        try:
+            value = float(part)
+        except ValueError:
+            raise SimulationError("--speed", part.strip(), "not a number") from None
+        if not (math.isfinite(value) and 0.0 < value <= MAX_APPROACH_SPEED):
+            raise SimulationError("--speed", value, f"approach speed must be in (0, {MAX_APPROACH_SPEED:g}] m/s")
+        speeds.append(value)
+    return speeds
+
+
+def _per_speed(path: str, speed: float, several: bool) -> Path:
+    p = Path(path)
+    return p.with_name(f"{p.stem}_{speed:g}{p.suffix}") if several else p
+
+
+def _table(name: str, r) -> str:
+    jump = r.com_velocity_jump_measured
+    size = float(math.hypot(*jump))
+    lines = [
+        f"{name}: {r.joints} joints, approach speed {r.approach_speed:.3f} m/s "
+        f"(measured {r.approach_speed_measured:.3f}), restitution measured {r.restitution_measured:.3f}, "
+        f"slip {r.slip_speed:.3f} m/s",
+        f"  {'':<26}{'CoM velocity jump x, y (m/s)':<34}{'distance to set (m/s)':>22}",
+        f"  {'measured':<26}{jump[0]:+10.5f} {jump[1]:+10.5f}",
+    ]
+    for model, p in r.predicted.items():
+        lo, hi = p.com_velocity_jumps.min(axis=0), p.com_velocity_jumps.max(axis=0)
+        span = f"x [{lo[0]:+.4f}, {hi[0]:+.4f}] y [{lo[1]:+.4f}, {hi[1]:+.4f}]"
+        rel = f" ({100 * p.distance / size:.2f} % of |jump|)" if size > 0 else ""
+        lines.append(f"  {model + ' (predicted)':<26}{span:<34}{p.distance:>10.5f}{rel}")
+    i = r.impulse_measured
+    kept = "n/a (floating)" if r.contacts_kept is None else ("yes" if r.contacts_kept else "NO")
+    lines.append(f"  impulse {i[0]:+.3f} {i[1]:+.3f} {i[2]:+.3f} N s; contacts kept: {kept}; "
+                 f"simulated/wall time {r.sim_time_ratio:.1f}x")
+    if r.saturated_joints:
+        lines.append(f"  at their effort limit during the impact: {', '.join(r.saturated_joints)}")
+    return "\n".join(lines)
+
+
+def run(args: argparse.Namespace) -> int:
+    # Offscreen rendering: EGL works headless, and must be chosen before MuJoCo is imported.
+    if args.video:
+        os.environ.setdefault("MUJOCO_GL", "egl")
+    from ..exceptions import SimulationError
+
+    try:
+        import mujoco  # noqa: F401  (reads MUJOCO_GL when imported)
+    except Exception as exc:  # an unusable backend fails inside MuJoCo's import, with various types
+        raise SimulationError("MUJOCO_GL", os.environ.get("MUJOCO_GL"), f"MuJoCo cannot start with this OpenGL "
+                              f"backend ({type(exc).__name__}); use MUJOCO_GL=egl, or unset it") from None
+    from ..scenario import load_scenario
+    from ..sim import JOINT_MODELS, build_model
+    from ..sim.measure import measure
+    from ..sim.trial import TrialOptions, run_trial
+
+    speeds = parse_speeds(args.speed)
+    if args.joints not in JOINT_MODELS:
+        raise SimulationError("--joints", args.joints, f"unknown joint model; valid: {', '.join(JOINT_MODELS)}")
+    if not (math.isfinite(args.duration) and 0.0 < args.duration <= 10.0):
+        raise SimulationError("--duration", args.duration, "must be in (0, 10] s")
+    if not (math.isfinite(args.armature) and 0.0 <= args.armature <= 100.0):
+        raise SimulationError("--armature", args.armature, "must be in [0, 100] kg m^2")
+    if args.log and Path(args.log).suffix.lower() not in (".parquet", ".csv"):
+        raise SimulationError("--log", args.log, "a log is a .parquet or .csv file")
+    if args.video and Path(args.video).suffix.lower() != ".mp4":
+        raise SimulationError("--video", args.video, "the video is an .mp4 file")
+    scenario = load_scenario(args.scenario)
+    if scenario.impact is None:
+        raise SimulationError("impact", None, f"scenario {args.scenario!r} has no impact to simulate")
+    from ..sim import ServoOptions, SimOptions
+
+    options = SimOptions(meshes=bool(args.video), servo=ServoOptions(armature=args.armature))
+    sim = build_model(scenario, args.joints, options)
+    name = scenario.name or Path(str(args.scenario)).stem
+    several = len(speeds) > 1
+    results, written = [], []
+    for speed in speeds:
+        record = run_trial(sim, TrialOptions(speed, after=args.duration))
+        result = measure(sim, record, speed)
+        results.append(result)
+        if args.log:
+            from ..logs import write_log
+            from ..sim.log import log_frame
+
+            written.append(write_log(log_frame(sim, record), _per_speed(args.log, speed, several),
+                                     {"scenario": name, "joints": args.joints, "approach_speed": speed}))
+        if args.video:
+            from ..sim.video import write_video
+
+            written.append(write_video(sim, record, _per_speed(args.video, speed, several)))
+        if args.plots:
+            from ..plots._common import DPI
+            from ..plots.simulation import plot_jump_on_sets, plot_time_series
+
+            title = f"{name}: {args.joints} joints, approach {speed:g} m/s, restitution {result.restitution_measured:.2f}"
+            out = Path(args.plots)
+            out.mkdir(parents=True, exist_ok=True)
+            for kind, fig in (("jump", plot_jump_on_sets(result, title)), ("time", plot_time_series(result, title))):
+                path = out / f"{name}_simulate_{args.joints}_{speed:g}_{kind}.png"
+                fig.savefig(path, dpi=DPI)
+                written.append(path)
+    if args.json:
+        docs = [r.to_dict() for r in results]
+        print(json.dumps(docs if several else docs[0], allow_nan=False))
+    else:
+        print("\n\n".join(_table(name, r) for r in results))
+        for path in written:
+            print(f"  wrote: {path}")
+    return 0
