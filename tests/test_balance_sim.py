@@ -75,3 +75,17 @@ def test_push_test_json(capsys):
     assert set(push) >= {"direction", "magnitude", "fell", "reason", "com_criterion_safe", "zmp_criterion_safe"}
     assert push["magnitude"] == 5.0 and push["fell"] is False
     assert out["confusion"]["com"]["total"] == 1 and out["confusion"]["com"]["safe_survived"] == 1
+
+
+def test_checker_reads_simulate_logs(tmp_path, capsys):
+    """`simulate --log` (servo joints, a palm impact) writes a log the checker reads; its CoM is MuJoCo's."""
+    path = tmp_path / "simulate.csv"
+    assert main(["simulate", SCENARIO, "--speed", "0.2", "--joints", "servo", "--log", str(path)]) == 0
+    capsys.readouterr()
+    frame = read_log(path)
+    check = check_log(frame, SCENARIO)
+    ours = check.samples[["comd_x", "comd_y", "comd_z"]].to_numpy()
+    assert np.abs(ours - frame[["comd_x", "comd_y", "comd_z"]].to_numpy()).max() < 1e-9
+    assert main(["check-log", str(path), "--scenario", SCENARIO, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["samples"] == len(frame) and "violations" in out
