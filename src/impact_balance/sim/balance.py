@@ -10,13 +10,14 @@ Choice (documented in ``docs/validation.md``): a *kinematic* controller, as the 
 3. ZMP feedback through the CoM (the admittance of position-controlled humanoids, Kajita et al.
    2010): the commanded CoM moves at ``c_cmd_d = K_zmp (p_measured - p)``. If the measured ZMP is
    ahead of the desired one, the CoM is accelerated forward, which moves the ZMP back. With ideal
-   tracking the closed loop ``s^2 + (omega (1 + k/omega) + omega^2/K_zmp) s + omega k`` is stable
-   for any positive gains. The measured ZMP comes from the contact forces (force sensors); without
-   it (no vertical force) the CoM command holds.
-4. pink's differential IK moves a reference configuration so that its CoM follows ``c_r``, every
-   contact frame stays at its initial pose, the impacting point follows the impact task, and a
-   posture task holds the rest. The reference joint angles (and velocities) go to the joint
-   position servos.
+   tracking the closed loop ``s^2 + (omega + k + omega^2/K_zmp) s + omega k`` is stable for any
+   positive gains. The measured ZMP comes from the contact forces (force sensors); without it
+   (no vertical force) the CoM command holds. The measured ZMP is filtered, the command's speed
+   bounded, and the commanded CoM kept over the ZMP support area.
+4. pink's differential IK moves a reference configuration so that its CoM follows ``c_cmd``,
+   every contact frame stays at its initial pose, the impacting point follows the impact task,
+   and a posture task holds the rest. The reference joint angles go to the joint position servos
+   (the trial adds the reference velocities as feed-forward on the free limbs).
 
 The impact task (:class:`ImpactTask`): hold; then the impact point's target moves towards the
 surface along ``-n`` at the commanded approach speed (through the surface, so that the hand is
