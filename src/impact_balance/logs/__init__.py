@@ -4,8 +4,9 @@ A log is a table, one row per sample, stored as Parquet (``.parquet``) or CSV (`
 See :mod:`impact_balance.logs.schema` for the columns.
 """
 
+from .check import LogCheck, Violation, check_log
 from .io import read_log, write_log
 from .schema import LOG_VERSION, LogColumns, joint_position_column, joint_velocity_column, force_columns
 
-__all__ = ["read_log", "write_log", "LOG_VERSION", "LogColumns", "joint_position_column",
+__all__ = ["check_log", "LogCheck", "Violation", "read_log", "write_log", "LOG_VERSION", "LogColumns", "joint_position_column",
            "joint_velocity_column", "force_columns"]
