@@ -22,7 +22,7 @@ def add_parser(sub) -> list[str]:
 
 def run(args: argparse.Namespace) -> int:
     from ..logs import check_log, read_log
-    from ._common import strict_json
+    from .output import print_json
 
     frame = read_log(args.log)
     check = check_log(frame, args.scenario, source=str(args.log)[:80])
@@ -30,7 +30,7 @@ def run(args: argparse.Namespace) -> int:
     out["log"] = str(args.log)
     written = _plots(check, Path(args.plots)) if args.plots else []
     if args.json:
-        print(strict_json(out))
+        print_json(out)
         return 0
     print(f"{args.log}: {out['samples']} samples over {out['duration']:.3f} s, scenario {check.scenario},"
           f" {len(check.segments)} stance(s)")

@@ -1,4 +1,4 @@
-"""What the commands write to stdout: strict JSON documents.
+"""What the commands write: strict JSON documents on stdout, progress bars on stderr.
 
 Under ``--json`` stdout is exactly one JSON document that any parser reads: non-finite numbers
 are ``null`` where they are produced (an unbounded maximum, for example), and
@@ -9,11 +9,14 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from typing import Any
+
+import numpy as np
 
 from ..exceptions import ImpactBalanceError
 
-__all__ = ["print_json", "NonFiniteOutputError"]
+__all__ = ["print_json", "progress_bar", "NonFiniteOutputError"]
 
 
 class NonFiniteOutputError(ImpactBalanceError):
@@ -42,10 +45,26 @@ def _non_finite_path(obj: Any, path: str = "") -> str | None:
     return None
 
 
+def _plain(obj: Any) -> Any:
+    """numpy arrays and scalars as plain lists and numbers (json knows neither)."""
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, np.generic):
+        return obj.item()
+    raise TypeError(f"{type(obj).__name__} is not JSON serializable")
+
+
 def print_json(document: Any) -> None:
     """Print one strict JSON document (no NaN/Infinity) on stdout."""
     try:
-        text = json.dumps(document, allow_nan=False)
+        text = json.dumps(document, allow_nan=False, default=_plain)
     except ValueError:
         raise NonFiniteOutputError(_non_finite_path(document) or "(document)") from None
     print(text)
+
+
+def progress_bar(desc: str, total: int | None = None, unit: str = "trial"):
+    """A tqdm progress bar on stderr (stdout stays for the answer)."""
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=desc, file=sys.stderr, unit=unit, leave=False, dynamic_ncols=True)

@@ -31,7 +31,7 @@ def run(args: argparse.Namespace) -> int:
     from ..scenario import load_scenario
     from ..sim.balance_trial import BalanceTrialOptions, run_balance_trial
     from ..sim.push import DEFAULT_MAGNITUDES, check_push_arguments, push_test
-    from ._common import progress_bar, strict_json
+    from .output import print_json, progress_bar
 
     scenario = load_scenario(args.scenario)
     if args.magnitudes is None:
@@ -60,7 +60,7 @@ def run(args: argparse.Namespace) -> int:
     if args.plots:
         written += _plots(result, Path(args.plots))
     if args.json:
-        print(strict_json(out))
+        print_json(out)
         return 0
     c = out["confusion"]
     print(f"{scenario.name}: {len(result.outcomes)} pushes ({args.directions} directions x {len(args.magnitudes)} magnitudes,"

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 from pathlib import Path
+
+from .output import print_json
 
 __all__ = ["add_parser", "run", "parse_speeds"]
 
@@ -141,7 +142,7 @@ def run(args: argparse.Namespace) -> int:
                 written.append(path)
     if args.json:
         docs = [r.to_dict() for r in results]
-        print(json.dumps(docs if several else docs[0], allow_nan=False))
+        print_json(docs if several else docs[0])
     else:
         print("\n\n".join(_table(name, r) for r in results))
         for path in written:

@@ -7,9 +7,10 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
+
+from .output import print_json
 
 __all__ = ["add_parser", "run", "USES_KERNEL"]
 
@@ -52,7 +53,7 @@ def _print(summary: dict, as_json: bool) -> None:
     from ..sweep.summary import format_summary
 
     if as_json:
-        print(json.dumps(summary, allow_nan=False))
+        print_json(summary)
     else:
         print(format_summary(summary))
 

@@ -29,7 +29,7 @@ def run(args: argparse.Namespace) -> int:
     from ..scenario import load_scenario
     from ..sim.balance_trial import BalanceTrialOptions, run_balance_trial
     from ..sim.validate import validate
-    from ._common import progress_bar, strict_json
+    from .output import print_json, progress_bar
 
     scenario = load_scenario(args.scenario)
     if scenario.impact is None:
@@ -61,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
     if args.plots:
         written += _plots(result, Path(args.plots))
     if args.json:
-        print(strict_json(out))
+        print_json(out)
         return 0
     p = out["predicted"]
     print(f"{scenario.name}: empirical fall threshold ({args.joints} joints, {len(result.trials)} trials)")
@@ -90,8 +90,6 @@ def _f(x) -> str:
 
 
 def _plots(result, out: Path) -> list[Path]:
-    import numpy as np
-
     from ..plots.balance import plot_com_velocity_trajectories, plot_validation
     from ..plots.save import figure_prefix
 

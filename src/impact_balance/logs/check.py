@@ -61,7 +61,9 @@ class Violation:
     samples: int
 
     def to_dict(self) -> dict:
-        return {"kind": self.kind, "start": self.start, "end": self.end, "worst_margin": self.worst_margin,
+        # -inf margin: the stance had no area at all (it cannot balance); JSON null.
+        worst = self.worst_margin if np.isfinite(self.worst_margin) else None
+        return {"kind": self.kind, "start": self.start, "end": self.end, "worst_margin": worst,
                 "worst_time": self.worst_time, "samples": self.samples}
 
 

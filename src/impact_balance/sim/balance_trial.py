@@ -31,11 +31,8 @@ from ..scenario import Scenario, load_scenario
 from .balance import BalanceController, BalanceGains, ImpactTask, retracted_stance
 from .falls import FallCriteria, FallDetector
 from .joints import JOINT_MODELS, ServoOptions
+from .log import LOG_START
 from .model import SimModel, SimOptions, build_model
-
-#: Logs start here (s): the first steps settle the model's initial contact penetration, which
-#: briefly loads one foot with thousands of newtons and unloads the other.
-LOG_START = 0.05
 
 #: Iterations of MuJoCo's no-slip solver in balance trials.
 NOSLIP_ITERATIONS = 10
@@ -340,7 +337,6 @@ def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, pu
         end_time = options.settle + (setup.standoff / impact_speed + options.max_approach_time
                                      if impact_speed else 0.0) + options.after
     steps_per_control = max(1, int(round(1.0 / (options.gains.rate * m.opt.timestep))))
-    dt = m.opt.timestep
     series: dict[str, list] = {k: [] for k in ("time", "zmp", "zmp_desired", "com", "com_velocity", "dcm",
                                                "zmp_margin", "com_velocity_margin")}
     approach_measured = None

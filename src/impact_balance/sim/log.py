@@ -9,7 +9,12 @@ from ..logs import LogColumns, force_columns, joint_position_column, joint_veloc
 from .model import SimModel
 from .trial import TrialRecord
 
-__all__ = ["log_frame"]
+__all__ = ["log_frame", "LOG_START"]
+
+#: Logs start here (s): the first steps settle the model's initial contact penetration (the
+#: contacts carry nothing at t = 0, then briefly one foot carries thousands of newtons), a
+#: transient of the simulation's start, not of the robot's motion.
+LOG_START = 0.05
 
 
 def _rotations(quaternions_wxyz: np.ndarray) -> np.ndarray:
@@ -22,8 +27,8 @@ def _rotations(quaternions_wxyz: np.ndarray) -> np.ndarray:
     ], axis=1)
 
 
-def log_frame(sim: SimModel, record: TrialRecord) -> pd.DataFrame:
-    """One row per step: time, base pose (quaternion x, y, z, w) and world-axes velocities, every
+def log_frame(sim: SimModel, record: TrialRecord, start: float = LOG_START) -> pd.DataFrame:
+    """One row per step from ``start`` (s) on: time, base pose (quaternion x, y, z, w) and world-axes velocities, every
     actuated joint's position and velocity (welded ones at the stance, velocity 0), the contact
     forces on the robot and MuJoCo's CoM and CoM velocity.
 
@@ -63,4 +68,5 @@ def log_frame(sim: SimModel, record: TrialRecord) -> pd.DataFrame:
         data[name] = record.com[:, k]
     for k, name in enumerate(cols.com_velocity):
         data[name] = record.com_velocity[:, k]
-    return pd.DataFrame(data)
+    frame = pd.DataFrame(data)
+    return frame[frame[cols.time] >= start - 1e-12].reset_index(drop=True)
