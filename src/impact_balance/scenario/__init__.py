@@ -1,0 +1,34 @@
+"""Scenario files: one YAML file describes one situation (robot, stance, contacts, impact).
+
+Files are validated with pydantic; every problem becomes a :class:`ScenarioError` naming the
+field and the bad value. A scenario may ``extends:`` another (a bundled name or a path):
+mappings are merged recursively, everything else is replaced.
+
+- :mod:`.fields`: value types and bounds (vectors, ranges with units, the strict base model).
+- :mod:`.schema`: the pydantic models (:class:`Scenario` and its parts) and stance building.
+- :mod:`.specs`: library specs built from scenario values, cached by content.
+- :mod:`.validate`: a mapping to a :class:`Scenario`, pydantic's errors to one ``ScenarioError``.
+- :mod:`.bundled`: the scenarios shipped in ``impact_balance/scenarios/`` and name lookup.
+- :mod:`.load`: files, ``extends:`` chains and :func:`load_scenario`.
+"""
+
+# Also re-exported: the helpers sweep/, gui/, analysis.py and tests import from here
+# (ExtendsResolver, with_source, _field, _merge, _read).
+from .bundled import bundled_scenarios, scenario_path
+from .load import ExtendsResolver, _merge, _read, load_scenario
+from .schema import BasePose, ContactConfig, ImpactConfig, Offset, QPConfig, RobotFiles, Scenario, with_source
+from .validate import _field, scenario_from_dict
+
+__all__ = [
+    "Offset",
+    "ContactConfig",
+    "QPConfig",
+    "ImpactConfig",
+    "RobotFiles",
+    "BasePose",
+    "Scenario",
+    "load_scenario",
+    "bundled_scenarios",
+    "scenario_path",
+    "scenario_from_dict",
+]

@@ -1,0 +1,48 @@
+"""The scenarios shipped with the package (``impact_balance/scenarios/*.yaml``) and name lookup."""
+
+from __future__ import annotations
+
+from importlib import resources
+from pathlib import Path
+
+import yaml
+
+from ..exceptions import ScenarioError, UnknownScenarioError
+from ..input_limits import check_path_text
+
+__all__ = ["bundled_scenarios", "scenario_path"]
+
+
+def _scenario_dir():
+    return resources.files("impact_balance") / "scenarios"
+
+
+def bundled_scenarios() -> dict[str, str]:
+    """Bundled scenario names and their one-line descriptions."""
+    out = {}
+    for entry in sorted(_scenario_dir().iterdir(), key=lambda e: e.name):
+        if entry.name.endswith(".yaml"):
+            raw = yaml.safe_load(entry.read_text()) or {}
+            out[entry.name[:-5]] = str(raw.get("description", "")).strip()
+    return out
+
+
+def scenario_path(name_or_path: str | Path) -> Path:
+    """A scenario file's path: an existing file, or the name of a bundled scenario."""
+    check_path_text("scenario", str(name_or_path))
+    path = Path(name_or_path)
+    if _is_file(path):
+        return path
+    if path.suffix in (".yaml", ".yml") or "/" in str(name_or_path) or "\\" in str(name_or_path):
+        raise ScenarioError("scenario", str(name_or_path), "no such file")
+    bundled = _scenario_dir() / f"{name_or_path}.yaml"
+    if _is_file(Path(str(bundled))):
+        return Path(str(bundled))
+    raise UnknownScenarioError("scenario", str(name_or_path), list(bundled_scenarios()))
+
+
+def _is_file(path: Path) -> bool:
+    try:
+        return path.is_file()
+    except (OSError, ValueError):  # a name the OS refuses is simply not an existing file
+        return False

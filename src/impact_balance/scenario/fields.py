@@ -1,0 +1,70 @@
+"""The value types of the scenario schema: vectors, bounded numbers, and the strict base model.
+
+Every bound names its range and unit in the message pydantic raises; the physical ranges
+themselves live in :mod:`impact_balance.constants` (shared with lipm.py).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Any
+
+import numpy as np
+from pydantic import AfterValidator, BaseModel, ConfigDict
+
+from ..constants import MAX_ANGLE, MAX_FRICTION, MAX_POSITION, MAX_SPEED
+
+__all__ = ["Vec2", "Vec3", "Position", "Angles", "Friction"]
+
+Vec2 = tuple[float, float]
+Vec3 = tuple[float, float, float]
+
+
+def _interval(lo: float, hi: float, lo_open: bool = False, hi_open: bool = False) -> str:
+    return f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
+
+
+def _scalar(lo: float, hi: float, unit: str = "", lo_open: bool = False, hi_open: bool = False) -> AfterValidator:
+    """A validator keeping a number within [lo, hi] (or open ends), naming the range."""
+    text = _interval(lo, hi, lo_open, hi_open) + (f" {unit}" if unit else "")
+
+    def check(v: float) -> float:
+        if not ((lo < v if lo_open else lo <= v) and (v < hi if hi_open else v <= hi)):
+            raise ValueError(f"must be in {text}")
+        return v
+
+    return AfterValidator(check)
+
+
+def _coordinates(limit: float, unit: str) -> AfterValidator:
+    """A validator keeping every coordinate of a vector within [-limit, limit]."""
+
+    def check(v: tuple) -> tuple:
+        if any(abs(x) > limit for x in v):
+            raise ValueError(f"each coordinate must be in [{-limit:g}, {limit:g}] {unit}")
+        return v
+
+    return AfterValidator(check)
+
+
+def _speed(v: tuple) -> tuple:
+    if math.hypot(*v) > MAX_SPEED:
+        raise ValueError(f"the speed must be at most {MAX_SPEED:g} m/s")
+    return v
+
+
+Position = Annotated[Vec3, _coordinates(MAX_POSITION, "m")]
+Angles = Annotated[Vec3, _coordinates(MAX_ANGLE, "rad")]
+Friction = Annotated[float, _scalar(0.0, MAX_FRICTION, lo_open=True)]
+
+
+class _Model(BaseModel):
+    # allow_inf_nan=False: NaN and infinities are refused in every float field.
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=False, allow_inf_nan=False)
+
+
+def _finite(values: Any, what: str = "value") -> Any:
+    for v in np.atleast_1d(np.asarray(values, dtype=float)):
+        if not math.isfinite(v):
+            raise ValueError(f"{what} must be finite")
+    return values

@@ -1,0 +1,217 @@
+"""The scenario YAML schema: one pydantic model per mapping, strict and bounded.
+
+Every model refuses unknown keys, NaN and infinities; :class:`Scenario` resolves itself
+against a robot model into a :class:`~impact_balance.stance.Stance`.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated, Literal
+
+import numpy as np
+import pinocchio as pin
+from pydantic import AfterValidator, Field, field_validator
+
+from ..constants import GRAVITY_RANGE, MAX_DESCRIPTION, MAX_DURATION, MAX_FRICTION, MAX_NAME, MAX_PEAK_FACTOR, MAX_POSITION, MAX_SIZE
+from ..exceptions import ScenarioError
+from ..impact import ImpactSpec
+from ..input_limits import check_path_text
+from ..robot import Robot, load_robot
+from ..spatial import pose
+from ..stance import ContactSpec, Stance
+from .fields import Angles, Friction, Position, Vec2, Vec3, _coordinates, _finite, _Model, _scalar, _speed
+from .specs import _contact_spec, _impact_spec, _quaternion
+
+__all__ = ["Offset", "ContactConfig", "QPConfig", "ImpactConfig", "RobotFiles", "BasePose", "Scenario", "with_source"]
+
+
+class Offset(_Model):
+    """Fixed pose in a robot frame: position (m) and roll-pitch-yaw (rad)."""
+
+    position: Position = (0.0, 0.0, 0.0)
+    rpy: Angles = (0.0, 0.0, 0.0)
+
+    def se3(self) -> pin.SE3:
+        return pose(self.position, self.rpy)
+
+
+class ContactConfig(_Model):
+    """A sustained rectangular contact (see :class:`impact_balance.stance.ContactSpec`)."""
+
+    frame: str
+    friction: Friction
+    size: Vec2
+    offset: Offset = Offset()
+
+    @field_validator("size")
+    @classmethod
+    def _size(cls, v: Vec2) -> Vec2:
+        if not all(0 < x <= MAX_SIZE for x in v):
+            raise ValueError(f"size must be [length, width], both in (0, {MAX_SIZE:g}] m")
+        return v
+
+    def spec(self) -> ContactSpec:
+        """The contact's :class:`ContactSpec` (cached by content: treat it as immutable)."""
+        return _contact_spec(self.frame, self.friction, tuple(self.size), self.offset.position, self.offset.rpy)
+
+
+class QPConfig(_Model):
+    """The paper's QP in joint velocities (optional; the exact answer never needs it)."""
+
+    solve: bool = False
+    joint_velocity_limits: bool = False
+    impulsive_torque_limits: bool = False
+    peak_factor: Annotated[float, _scalar(0.0, MAX_PEAK_FACTOR, lo_open=True)] = 1.0
+    solver: str = "daqp"
+
+
+class ImpactConfig(_Model):
+    """The intended impact (see :class:`impact_balance.impact.ImpactSpec`)."""
+
+    frame: str
+    offset: Offset = Offset()
+    normal: Annotated[Vec3, _coordinates(1e6, "(any scale; it is normalised)")]
+    friction: Annotated[float, _scalar(0.0, MAX_FRICTION)] = 0.24
+    restitution: Vec2 = (0.0, 0.2)
+    cone_edges: int = Field(16, ge=3, le=1024)
+    reference_velocity: Annotated[Vec3, AfterValidator(_speed)] | None = None
+    duration: Annotated[float, _scalar(0.0, MAX_DURATION, "s", lo_open=True)] = 0.005
+    inertia: Literal["composite", "joint_space"] = "composite"
+    qp: QPConfig = QPConfig()
+
+    @field_validator("normal")
+    @classmethod
+    def _normal(cls, v: Vec3) -> Vec3:
+        _finite(v, "normal")
+        if float(np.linalg.norm(v)) < 1e-9:
+            raise ValueError("normal must be a non-zero vector")
+        return v
+
+    @field_validator("restitution")
+    @classmethod
+    def _restitution(cls, v: Vec2) -> Vec2:
+        lo, hi = v
+        if not (0.0 <= lo <= 1.0 and 0.0 <= hi <= 1.0):
+            raise ValueError("restitution values must lie in [0, 1]")
+        if lo > hi:
+            raise ValueError("restitution must be [lo, hi] with lo <= hi")
+        return v
+
+    def spec(self) -> ImpactSpec:
+        """The impact's :class:`ImpactSpec` (cached by content: treat it as immutable)."""
+        return _impact_spec(
+            self.frame,
+            tuple(self.normal),
+            self.friction,
+            tuple(self.restitution),
+            self.cone_edges,
+            None if self.reference_velocity is None else tuple(self.reference_velocity),
+            self.duration,
+            self.offset.position,
+            self.offset.rpy,
+            self.inertia,
+        )
+
+
+class RobotFiles(_Model):
+    """A robot given by files (paths relative to the scenario file)."""
+
+    urdf: str
+    srdf: str | None = None
+    standing: str | None = None
+
+
+class BasePose(_Model):
+    """Free-flyer pose override in world: position (m), roll-pitch-yaw (rad)."""
+
+    position: Position | None = None
+    rpy: Angles | None = None
+
+
+class Scenario(_Model):
+    """One situation. See README, "Scenario files", for every key."""
+
+    name: Annotated[str, Field(max_length=MAX_NAME)] | None = None
+    description: Annotated[str, Field(max_length=MAX_DESCRIPTION)] | None = None
+    robot: str | RobotFiles = "talos"
+    configuration: str | None = None
+    joints: dict[str, float] = {}
+    base: BasePose | None = None
+    com_velocity: Annotated[Vec2, AfterValidator(_speed)] = (0.0, 0.0)
+    plane_height: Annotated[float, _scalar(-MAX_POSITION, MAX_POSITION, "m")] = 0.0
+    torque_limits: bool = True
+    gravity: Annotated[float, _scalar(*GRAVITY_RANGE, "m/s^2")] = 9.81
+    contacts: list[ContactConfig] = Field(min_length=1)
+    impact: ImpactConfig | None = None
+    source: str | None = Field(None, exclude=True)
+
+    @field_validator("joints")
+    @classmethod
+    def _joint_values(cls, joints: dict[str, float]) -> dict[str, float]:
+        bad = [name for name, value in joints.items() if not math.isfinite(value)]
+        if bad:
+            raise ValueError(f"joint values must be finite (not {', '.join(bad)})")
+        return joints
+
+    # -- resolution against a robot model -------------------------------------------------
+    def load_robot(self) -> Robot:
+        if isinstance(self.robot, RobotFiles):
+            check_path_text("robot.urdf", self.robot.urdf, self.source)
+            if self.robot.srdf:
+                check_path_text("robot.srdf", self.robot.srdf, self.source)
+            base = Path(self.source).parent if self.source else Path.cwd()
+            urdf = (base / self.robot.urdf).resolve()
+            srdf = (base / self.robot.srdf).resolve() if self.robot.srdf else None
+            return load_robot(None, urdf, srdf, self.robot.standing)
+        return load_robot(self.robot)
+
+    def configuration_vector(self, robot: Robot) -> np.ndarray:
+        """q from the named configuration, the joint overrides and the base override."""
+        q = robot.configuration(self.configuration)
+        indices, values = robot.joint_assignment(self.joints, field="joints")
+        q[indices] = values
+        if self.base is not None:
+            if self.base.position is not None:
+                q[:3] = self.base.position
+            if self.base.rpy is not None:
+                q[3:7] = _quaternion(self.base.rpy)
+        return q
+
+    def build_stance(self, robot: Robot | None = None) -> Stance:
+        """Resolve robot, configuration and contacts into a :class:`Stance` (see ``_build_stance``)."""
+        try:
+            return self._build_stance(robot)
+        except ScenarioError as exc:
+            raise with_source(exc, self.source) from None
+
+    def _build_stance(self, robot: Robot | None = None) -> Stance:
+        """Resolve robot, configuration and contacts into a :class:`Stance`.
+
+        Without a ``base`` key the robot is translated vertically so that its lowest contact
+        corner touches z = 0 (robots' neutral configurations often float or sink).
+        """
+        robot = robot or self.load_robot()
+        q = self.configuration_vector(robot)
+        specs = [c.spec() for c in self.contacts]
+        stance = Stance(robot, q, specs)
+        if self.base is None:
+            lift = -stance.lowest_contact_height()
+            if abs(lift) > 1e-12:
+                q = q.copy()
+                q[2] += lift
+                stance = Stance(robot, q, specs)
+        if not stance.com[2] > self.plane_height:
+            raise ScenarioError(
+                "plane_height", self.plane_height, f"must be below the CoM height {stance.com[2]:.4g} m"
+            )
+        return stance
+
+
+def with_source(exc: ScenarioError, source: str | None) -> ScenarioError:
+    """Prefix a scenario error found after loading (unknown frame...) with its file name."""
+    if source and exc.source is None:
+        exc.source = source
+        exc.args = (f"{source}: {exc.args[0]}",) + exc.args[1:]
+    return exc
