@@ -8,7 +8,10 @@
 - :mod:`.scene`: what the 3D view draws, as plain data.
 - :mod:`.view2d`: the 2D view (areas and post-impact sets) as SVG.
 - :mod:`.limbs`: joints grouped by limb for the sliders.
-- :mod:`.meshes`, :mod:`.app`: the viser server (imported lazily: it needs ``viser``).
+- :mod:`.app`: the viser server, wiring the parts below (imported lazily: it needs ``viser``):
+  :mod:`.server` (where it may listen), :mod:`.viser_scene` and :mod:`.meshes` (the 3D view),
+  :mod:`.gizmos` (drag handles), :mod:`.panels` (the Impact, Contacts and Joints tabs),
+  :mod:`.scenario_tab` (settings and file controls), :mod:`.results` (the numbers as HTML).
 """
 
 from .drag import DragResult, DragTarget, drag_changes, handle_pose

@@ -1,0 +1,109 @@
+"""The 3D view in viser: lights, ground and camera, the robot meshes, and the scene objects of
+:mod:`.scene` sent as few messages as possible (unchanged objects are skipped)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .meshes import RobotMeshes
+from .scene import Arrows, Label, Points, Segments, Surface, scene_objects
+
+__all__ = ["SceneMixin", "add_object", "update_object"]
+
+
+def _rgb(color: str) -> tuple[int, int, int]:
+    c = color.lstrip("#")
+    return int(c[0:2], 16), int(c[2:4], 16), int(c[4:6], 16)
+
+
+def _geometry(obj: Any) -> tuple[np.ndarray, ...] | None:
+    """The arrays viser gets for a scene object (float32, as sent), None if there is nothing to draw."""
+    if isinstance(obj, Segments):
+        return (np.asarray(obj.segments, dtype=np.float32),) if len(obj.segments) else None
+    if isinstance(obj, Points):
+        return (np.asarray(obj.points[0], dtype=np.float32),)
+    if isinstance(obj, Arrows):
+        return (np.stack([obj.starts, obj.ends], axis=1).astype(np.float32),)
+    if isinstance(obj, Surface):
+        return np.asarray(obj.vertices, dtype=np.float32), np.asarray(obj.faces, dtype=np.uint32)
+    if isinstance(obj, Label):
+        return (np.asarray(obj.position, dtype=np.float32),)
+    return None
+
+
+def add_object(scene: Any, name: str, obj: Any, data: tuple[np.ndarray, ...]) -> Any:
+    """Add one scene object (its :func:`_geometry` arrays ``data``) to the viser ``scene``; returns the handle."""
+    color = _rgb(obj.color)
+    if isinstance(obj, Segments):
+        return scene.add_line_segments(name, data[0], color, thickness=obj.width)
+    if isinstance(obj, Points):
+        return scene.add_icosphere(name, radius=obj.radius, color=color, subdivisions=2,
+                                   position=tuple(data[0]), cast_shadow=False)
+    if isinstance(obj, Arrows):
+        return scene.add_arrows(name, data[0], color, shaft_radius=obj.radius,
+                                head_radius=2.5 * obj.radius, head_length=6 * obj.radius)
+    if isinstance(obj, Label):
+        return scene.add_label(name, obj.text, position=tuple(data[0]), anchor="bottom-left")
+    return scene.add_mesh_simple(name, data[0], data[1], color=color, opacity=obj.opacity,
+                                 side="double", cast_shadow=False, receive_shadow=False)
+
+
+def update_object(handle: Any, obj: Any, data: tuple[np.ndarray, ...]) -> None:
+    """Move an object of the same kind in place (one message, no remove and add)."""
+    if isinstance(obj, (Segments, Arrows)):
+        handle.points = data[0]
+    elif isinstance(obj, (Points, Label)):
+        handle.position = data[0]
+    else:
+        handle.vertices, handle.faces = data
+
+
+class SceneMixin:
+    """The viser scene of :class:`~.app.GuiApp` (uses its ``server``, ``session``, ``w_opacity``,
+    ``_scene_handles``, ``_scene_data`` and ``_meshes``)."""
+
+    def _setup_scene(self) -> None:
+        scene = self.server.scene
+        scene.set_up_direction("+z")
+        # No shadows: they cost a render pass per light, which software WebGL (no GPU, as on
+        # this project's machines) pays on every redraw.
+        scene.configure_default_lights(True, cast_shadow=False)
+        scene.add_grid("/ground", width=4.0, height=4.0, cell_size=0.1, section_size=0.5, plane="xy",
+                       shadow_opacity=0.0)
+        self.server.initial_camera.position = (1.0, -1.9, 1.25)
+        self.server.initial_camera.look_at = (0.1, 0.0, 0.6)
+
+    def _draw_objects(self) -> None:
+        """Draw :func:`scene_objects`: unchanged objects are skipped, changed ones updated in place."""
+        scene = self.server.scene
+        seen = set()
+        for obj in scene_objects(self.session.analysis):
+            name = f"/analysis/{obj.name}"
+            data = _geometry(obj)
+            if data is None:
+                continue
+            seen.add(name)
+            previous = self._scene_data.get(name)
+            if previous is not None and type(previous[0]) is type(obj):
+                if all(a.shape == b.shape and np.array_equal(a, b) for a, b in zip(previous[1], data, strict=True)):
+                    continue  # most objects do not move when one joint does: send nothing
+                update_object(self._scene_handles[name], obj, data)
+            else:
+                if name in self._scene_handles:
+                    self._scene_handles.pop(name).remove()
+                self._scene_handles[name] = add_object(scene, name, obj, data)
+            self._scene_data[name] = (obj, data)
+        for name in list(self._scene_handles):
+            if name not in seen:
+                self._scene_handles.pop(name).remove()
+                self._scene_data.pop(name, None)
+
+    def _draw_robot(self) -> None:
+        stance = self.session.analysis.stance
+        if self._meshes is None or self._meshes.robot is not stance.robot:
+            if self._meshes is not None:
+                self._meshes.remove()
+            self._meshes = RobotMeshes(self.server.scene, stance.robot, opacity=self.w_opacity.value)
+        self._meshes.update(stance.data)
