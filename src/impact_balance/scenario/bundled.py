@@ -10,21 +10,26 @@ import yaml
 from ..exceptions import ScenarioError, UnknownScenarioError
 from ..input_limits import check_path_text
 
-__all__ = ["bundled_scenarios", "scenario_path"]
+__all__ = ["bundled_descriptions", "bundled_scenarios", "scenario_path"]
 
 
 def _scenario_dir():
     return resources.files("impact_balance") / "scenarios"
 
 
-def bundled_scenarios() -> dict[str, str]:
-    """Bundled scenario names and their one-line descriptions."""
+def bundled_descriptions(folder: str) -> dict[str, str]:
+    """The ``*.yaml`` files of the package data folder ``impact_balance/<folder>``: name -> one-line description."""
     out = {}
-    for entry in sorted(_scenario_dir().iterdir(), key=lambda e: e.name):
+    for entry in sorted((resources.files("impact_balance") / folder).iterdir(), key=lambda e: e.name):
         if entry.name.endswith(".yaml"):
             raw = yaml.safe_load(entry.read_text()) or {}
             out[entry.name[:-5]] = str(raw.get("description", "")).strip()
     return out
+
+
+def bundled_scenarios() -> dict[str, str]:
+    """Bundled scenario names and their one-line descriptions."""
+    return bundled_descriptions("scenarios")
 
 
 def scenario_path(name_or_path: str | Path) -> Path:

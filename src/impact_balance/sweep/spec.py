@@ -36,6 +36,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from ..exceptions import SweepError, UnknownNameError
 from ..scenario import Offset, _field
+from ..scenario.bundled import bundled_descriptions
 
 __all__ = [
     "Dim",
@@ -234,12 +235,7 @@ def _sweep_dir():
 
 def bundled_sweeps() -> dict[str, str]:
     """Bundled sweep names and their one-line descriptions."""
-    out = {}
-    for entry in sorted(_sweep_dir().iterdir(), key=lambda e: e.name):
-        if entry.name.endswith(".yaml"):
-            raw = yaml.safe_load(entry.read_text()) or {}
-            out[entry.name[:-5]] = str(raw.get("description", "")).strip()
-    return out
+    return bundled_descriptions("sweeps")
 
 
 class UnknownSweepError(UnknownNameError, SweepError):
