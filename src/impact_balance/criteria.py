@@ -157,7 +157,8 @@ def zmp_max_contact_velocity(
     fz = impact.impulse_rates[:, 2] / duration  # N per (m/s)
     pulling = fz < 0
     if limit.status != "already_falling" and pulling.any():
-        lift = weight / -fz[pulling]
+        with np.errstate(over="ignore"):  # a vanishing pull (friction ~1e-300) never lifts: inf is right
+            lift = weight / -fz[pulling]
         j = int(lift.argmin())
         if lift[j] < limit.max_approach_speed:
             return VelocityLimit(float(lift[j]), "ok", int(np.flatnonzero(pulling)[j]), None)
