@@ -15,7 +15,7 @@ from .diagnostics import Diagnostic, diagnose
 from .impact import ImpactModel, impact_model
 from .projection.walk import warm_up
 from .qp import QPOptions, QPResult, solve_contact_velocity_qp, static_torques
-from .diagnosis import CannotBalanceReason
+from .infeasibility import CannotBalanceReason
 from .exceptions import NonFiniteResultError, ScenarioError, SolverError
 from .scenario import Scenario, load_scenario, with_source
 from .stance import Stance
@@ -97,7 +97,7 @@ class Analysis:
 
     @property
     def cannot_balance_reason(self) -> CannotBalanceReason | None:
-        """Why the robot cannot balance (None when it can); see :mod:`impact_balance.diagnosis`."""
+        """Why the robot cannot balance (None when it can); see :mod:`impact_balance.infeasibility`."""
         return self.areas.reason
 
     @property

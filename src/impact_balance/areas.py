@@ -21,7 +21,7 @@ import numpy as np
 
 from .constants import GRAVITY
 from .constraints import WrenchPolytope, wrench_polytope
-from .diagnosis import CannotBalanceReason, explain_cannot_balance
+from .infeasibility import CannotBalanceReason, explain_cannot_balance
 from .exceptions import ScenarioError, SolverError
 from .polygon import Polygon
 from .projection import project_polytope
@@ -59,7 +59,7 @@ class BalanceAreas:
         n_lp: LPs solved by the projection.
         reason: Why the stance cannot balance when the areas are empty and they were
             computed from a stance (:func:`balance_areas`, :func:`~impact_balance.analyze`);
-            None otherwise. See :mod:`impact_balance.diagnosis`.
+            None otherwise. See :mod:`impact_balance.infeasibility`.
     """
 
     force_area: Polygon

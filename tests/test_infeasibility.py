@@ -16,7 +16,7 @@ import pytest
 
 import impact_balance as ib
 from impact_balance.areas import balance_areas
-from impact_balance.diagnosis import explain_cannot_balance
+from impact_balance.infeasibility import explain_cannot_balance
 from impact_balance.robot import example_robot_data_root
 from impact_balance.stance import ContactSpec, Stance
 
