@@ -67,4 +67,5 @@ def progress_bar(desc: str, total: int | None = None, unit: str = "trial"):
     """A tqdm progress bar on stderr (stdout stays for the answer)."""
     from tqdm import tqdm
 
-    return tqdm(total=total, desc=desc, file=sys.stderr, unit=unit, leave=False, dynamic_ncols=True)
+    # disable=None: drawn on a terminal only, so logs and pipes get no carriage-return noise.
+    return tqdm(total=total, desc=desc, file=sys.stderr, unit=unit, leave=False, dynamic_ncols=True, disable=None)
