@@ -702,6 +702,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--tol", type=float, default=1e-6, help="max relative area of the symmetric difference (default 1e-6)")
     ap.add_argument("--profile", action="store_true", help="also profile analyze() and the projection (cProfile + micro-breakdown)")
     ap.add_argument("--seed", type=int, default=0, help="seed of numpy's global RNG for pypoman (seed + repetition)")
+    ap.add_argument("--no-sweep", action="store_true", help="skip the sweep rates (benchmarks/sweep.py --quick)")
     args = ap.parse_args(argv)
     args.repeat = max(1, args.repeat)
     args.repeat_cheap = 10 * args.repeat
@@ -764,6 +765,11 @@ def main(argv: list[str] | None = None) -> int:
     if args.profile:
         progress("profile ...")
         result["profile"] = profile_report(args)
+    if not args.no_sweep:
+        progress("sweep (benchmarks/sweep.py --quick) ...")
+        from sweep import measure as measure_sweep  # benchmarks/sweep.py, beside this file
+
+        result["sweep"] = measure_sweep(quick=True)
     result["wall_time_s"] = time.perf_counter() - t_start
 
     if args.json:

@@ -47,8 +47,8 @@ TOL = 1e-9
 
 
 @pytest.fixture()
-def session() -> Session:
-    return Session(DEFAULT_SCENARIO)
+def session(tmp_path) -> Session:
+    return Session(DEFAULT_SCENARIO, workspace=tmp_path)
 
 
 def by_name(objects) -> dict:
@@ -143,10 +143,12 @@ def test_save_load_round_trip_equals_the_original(tmp_path, name):
     assert GuiState.from_file(path) == state
 
 
-def test_saved_edits_are_analysed_like_the_gui(tmp_path, session):
+def test_saved_edits_are_analysed_like_the_gui(tmp_path):
+    session = Session(DEFAULT_SCENARIO, workspace=tmp_path)
     assert session.apply({("impact", "friction"): 0.1, ("com_velocity",): [0.05, -0.02], ("torque_limits",): False})
-    path = session.save(tmp_path / "tuned" / "stance.yaml")
-    assert path is not None and "saved" in session.message
+    (tmp_path / "tuned").mkdir()
+    path = session.save("tuned/stance.yaml")
+    assert path == tmp_path / "tuned" / "stance.yaml" and session.message == "saved tuned/stance.yaml"
     loaded = analyze(str(path))
     assert loaded.impact.max_contact_velocity == pytest.approx(session.summary.max_contact_velocity, rel=1e-12)
     assert loaded.scenario.torque_limits is False and loaded.scenario.com_velocity == (0.05, -0.02)
@@ -156,12 +158,15 @@ def test_saved_edits_are_analysed_like_the_gui(tmp_path, session):
     assert other.state == session.state
 
 
-def test_save_refuses_a_bad_file_name(tmp_path, session):
-    assert session.save(tmp_path / "stance.txt") is None
+def test_save_refuses_a_bad_file_name(tmp_path):
+    session = Session(DEFAULT_SCENARIO, workspace=tmp_path)
+    assert session.save("stance.txt") is None
     assert session.refused and ".yaml" in session.message
     (tmp_path / "blocker").write_text("")
-    assert session.save(tmp_path / "blocker" / "x.yaml") is None
-    assert "cannot write" in session.message
+    assert session.save("blocker/x.yaml") is None
+    assert "blocker is not a folder" in session.message
+    assert session.save("no_folder/x.yaml") is None  # folders are not created
+    assert "no such folder" in session.message and not (tmp_path / "no_folder").exists()
 
 
 def test_load_bad_yaml_is_refused(session):
@@ -356,10 +361,10 @@ def test_drag_of_a_missing_target_is_refused(session):
 
 # -- the server, driven without a browser --------------------------------------------------------
 @pytest.fixture(scope="module")
-def app():
+def app(tmp_path_factory):
     from impact_balance.gui.app import GuiApp
 
-    app = GuiApp(DEFAULT_SCENARIO, port=0)
+    app = GuiApp(DEFAULT_SCENARIO, port=0, workspace=tmp_path_factory.mktemp("workspace"))
     yield app
     app.stop()
 
@@ -445,15 +450,16 @@ def test_app_contacts_impact_and_load(app, tmp_path):
     app.w_contact_rpy.value = (math.pi, 0.0, 0.0)
     assert "CANNOT BALANCE" in app.w_results.content
     # Save, load another scenario, load the file back: the same state.
-    app.w_file.value = str(tmp_path / "gui.yaml")
+    app.w_file.value = "gui_test_saved.yaml"
     saved = app.session.state
-    app.edit(lambda: app.session.save(app.w_file.value))
-    assert (tmp_path / "gui.yaml").is_file()
+    app._save()
+    target = app.workspace.root / "gui_test_saved.yaml"
+    assert target.is_file() and app.session.message == "saved gui_test_saved.yaml"
     app.w_bundled.value = "g1_two_feet"
     app.edit(lambda: app.session.load(app.w_bundled.value))
     assert app.session.analysis.stance.robot.name == "g1"
     assert "left_knee_joint" in app._joint_widgets and "leg_left_4_joint" not in app._joint_widgets
-    app.edit(lambda: app.session.load(str(tmp_path / "gui.yaml")))
+    app.edit(lambda: app.session.load("gui_test_saved.yaml"))
     assert app.session.state == saved and "CANNOT BALANCE" in app.w_results.content
     reset(app)
     assert app.session.analysis.stance.robot.name == "talos"

@@ -3,6 +3,8 @@
 The test starts the GUI server on a free port, opens the page, edits the impact friction
 field and waits for the displayed maximum contact velocity to change; then types a bad value
 and checks that it is refused with a message. It saves screenshots under pytest's tmp path.
+Last, a page of another local site, in the same browser, tries to open the GUI's WebSocket:
+the server refuses it (its Origin is not the GUI's page).
 
 It needs ``/usr/bin/chromium`` (``apt-get install chromium``; ``.ci/run`` installs it) and
 playwright (the ``[test]`` extra). No browser is downloaded: playwright launches that binary.
@@ -12,8 +14,10 @@ browser is a failure.
 
 from __future__ import annotations
 
+import http.server
 import os
 import shutil
+import threading
 from pathlib import Path
 
 import pytest
@@ -120,3 +124,48 @@ def test_a_bad_value_is_refused_and_the_page_lives_on(page, app):
     )
     assert vmax_text(page) == f"{app.session.summary.max_contact_velocity:.3f} m/s"
     assert page.locator("#ib-message").count() == 0
+
+
+#: Opens a WebSocket to the GUI as viser's client does; resolves to "open" or "refused".
+OPEN_WEBSOCKET = """([url, protocol]) => new Promise((resolve) => {
+    const ws = new WebSocket(url, [protocol]);
+    ws.onopen = () => { ws.close(); resolve("open"); };
+    ws.onerror = () => resolve("refused");
+})"""
+
+
+class _OtherSite(http.server.BaseHTTPRequestHandler):
+    """Another web site on this machine (any local server the user's browser visits)."""
+
+    def do_GET(self):  # noqa: N802 - http.server's name
+        body = b"<html><body>another site</body></html>"
+        self.send_response(200)
+        self.send_header("Content-Type", "text/html")
+        self.send_header("Content-Length", str(len(body)))
+        self.end_headers()
+        self.wfile.write(body)
+
+    def log_message(self, *args):
+        pass
+
+
+def test_another_site_cannot_drive_the_gui(page, app):
+    """A page of another origin, in the same browser, cannot open the GUI's WebSocket.
+
+    The other site is local (another port): a public site's request to 127.0.0.1 may also be
+    stopped by Chromium's local-network rules, which would hide whether the GUI refuses it.
+    """
+    import viser
+
+    url, protocol = f"ws://127.0.0.1:{app.server.get_port()}", f"viser-v{viser.__version__}"
+    site = http.server.ThreadingHTTPServer(("127.0.0.1", 0), _OtherSite)
+    threading.Thread(target=site.serve_forever, daemon=True).start()
+    other = page.context.browser.new_page()
+    try:
+        other.goto(f"http://localhost:{site.server_address[1]}/")
+        assert other.evaluate(OPEN_WEBSOCKET, [url, protocol]) == "refused"
+        # The GUI's own page may (the same script, the page's origin).
+        assert page.evaluate(OPEN_WEBSOCKET, [url, protocol]) == "open"
+    finally:
+        other.close()
+        site.shutdown()

@@ -117,8 +117,8 @@ def test_plot_friction_comparison(analysis: ib.Analysis, no_impact: ib.Analysis)
     fig = plot_friction_comparison([analysis, low, no_impact])
     _check_axes(fig, 2)
     labels = _legend_texts(fig.axes[0])
-    assert f"mu = 0.1: v_max = {low.impact.max_contact_velocity:.3g} m/s" in labels
-    assert f"mu = 0.24: v_max = {analysis.impact.max_contact_velocity:.3g} m/s" in labels
+    assert f"μ = 0.1: v_max = {low.impact.max_contact_velocity:.3g} m/s" in labels
+    assert f"μ = 0.24: v_max = {analysis.impact.max_contact_velocity:.3g} m/s" in labels
     assert len(fig.axes[1].patches) == 4  # two criteria x two frictions
     with pytest.raises(ValueError):
         plot_friction_comparison([no_impact])

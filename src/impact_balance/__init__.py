@@ -13,15 +13,18 @@ from .constants import GRAVITY
 from .constraints import WrenchPolytope, contact_polytope, wrench_polytope
 from .criteria import VelocityLimit, capped_velocity, max_contact_velocity, zmp_max_contact_velocity
 from .cwc import cwc_faces, cwc_faces_world, cwc_span
+from .diagnostics import Diagnostic
 from .exceptions import (
     ImpactBalanceError,
     ImpactModelError,
     RobotLoadError,
     ScenarioError,
     SolverError,
+    StrictWarningsError,
     UnknownConfigurationError,
     UnknownFrameError,
     UnknownJointError,
+    UnknownKeyError,
     UnknownRobotError,
     UnknownScenarioError,
 )
@@ -43,9 +46,10 @@ __all__ = [
     "WrenchPolytope", "contact_polytope", "wrench_polytope",
     "VelocityLimit", "capped_velocity", "max_contact_velocity", "zmp_max_contact_velocity",
     "cwc_faces", "cwc_faces_world", "cwc_span",
+    "Diagnostic",
     "ImpactBalanceError", "ImpactModelError", "RobotLoadError", "ScenarioError", "SolverError",
     "UnknownConfigurationError", "UnknownFrameError", "UnknownJointError", "UnknownRobotError",
-    "UnknownScenarioError",
+    "UnknownScenarioError", "UnknownKeyError", "StrictWarningsError",
     "ImpactModel", "ImpactSpec", "friction_cone", "impact_model",
     "PhasePortrait", "com_velocity_bounds", "lipm_omega", "phase_portrait",
     "Polygon", "project_polytope",

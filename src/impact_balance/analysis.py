@@ -8,12 +8,15 @@ from typing import Any
 
 import numpy as np
 
-from .areas import BalanceAreas, areas_from_polytope
+from .areas import BalanceAreas, areas_from_polytope, with_reason
 from .constraints import wrench_polytope
-from .criteria import VelocityLimit, capped_velocity, max_contact_velocity, zmp_max_contact_velocity
+from .criteria import VelocityLimit, capped_velocity, max_contact_velocity, safe_interval, zmp_max_contact_velocity
+from .diagnostics import Diagnostic, diagnose
 from .impact import ImpactModel, impact_model
+from .projection.walk import warm_up
 from .qp import QPOptions, QPResult, solve_contact_velocity_qp, static_torques
-from .exceptions import ScenarioError
+from .diagnosis import CannotBalanceReason
+from .exceptions import NonFiniteResultError, ScenarioError, SolverError
 from .scenario import Scenario, load_scenario, with_source
 from .stance import Stance
 
@@ -36,6 +39,9 @@ class ImpactAnswer:
         contact_velocity: Reference velocity with its approach component capped (m/s, world),
             or None without a reference velocity.
         qp: The paper's QP solution when requested.
+        safe_interval: The approach speeds (lo, hi) m/s whose post-impact CoM velocities all
+            stay in the area (hi may be inf), or None when there are none; see
+            :func:`~impact_balance.criteria.safe_interval`.
     """
 
     model: ImpactModel
@@ -43,6 +49,7 @@ class ImpactAnswer:
     zmp_limit: VelocityLimit
     contact_velocity: np.ndarray | None
     qp: QPResult | None = None
+    safe_interval: tuple[float, float] | None = None
 
     @property
     def max_contact_velocity(self) -> float:
@@ -62,13 +69,22 @@ class ImpactAnswer:
 
 @dataclass(frozen=True)
 class Analysis:
-    """Result of :func:`analyze`. ``to_dict()`` is the JSON of ``impact-balance analyze --json``."""
+    """Result of :func:`analyze`. ``to_dict()`` is the JSON of ``impact-balance analyze --json``.
+
+    ``timings`` (s): ``total`` is the analysis itself (stance, constraints, areas, impact,
+    and ``diagnosis`` when it cannot balance), without loading; ``scenario_loading`` (when
+    given a name or a path), ``robot_loading`` (the robot model, cached after its first
+    use) and ``kernel_loading`` (the compiled projection kernel, first call of the process
+    only) are apart.
+    """
 
     scenario: Scenario
     stance: Stance
     areas: BalanceAreas
     impact: ImpactAnswer | None
     timings: dict[str, float] = field(default_factory=dict)
+    #: Valid input that is probably a mistake, or an answer with a caveat (see diagnostics).
+    warnings: tuple[Diagnostic, ...] = ()
 
     @property
     def com_velocity(self) -> np.ndarray:
@@ -78,6 +94,11 @@ class Analysis:
     def com_velocity_inside(self) -> bool:
         """Whether the pre-impact CoM velocity can be brought to rest on these contacts."""
         return bool(self.areas.can_balance and self.areas.com_velocity_area.contains(self.com_velocity, 1e-10))
+
+    @property
+    def cannot_balance_reason(self) -> CannotBalanceReason | None:
+        """Why the robot cannot balance (None when it can); see :mod:`impact_balance.diagnosis`."""
+        return self.areas.reason
 
     @property
     def verdict(self) -> str:
@@ -94,6 +115,7 @@ class Analysis:
             "robot": self.stance.robot.name,
             "verdict": self.verdict,
             "can_balance": a.can_balance,
+            "cannot_balance_reason": None if a.reason is None else a.reason.to_dict(),
             "mass": self.stance.mass,
             "com": self.stance.com.tolist(),
             "omega": a.omega,
@@ -109,6 +131,7 @@ class Analysis:
                 for c in self.stance.contacts
             ],
             "timings_ms": {k: 1e3 * v for k, v in self.timings.items()},
+            "warnings": [w.to_dict() for w in self.warnings],
         }
         if self.impact is not None:
             im = self.impact
@@ -127,6 +150,7 @@ class Analysis:
                 "evaluated_at_approach_speed": s,
                 "impulse_vertices": im.model.impulse_vertices(s).tolist(),
                 "post_impact_com_velocities": im.model.post_impact_com_velocities(self.com_velocity, s).tolist(),
+                "safe_interval": None if im.safe_interval is None else [_num(x) for x in im.safe_interval],
                 "zmp_max_contact_velocity": _num(im.zmp_max_contact_velocity),
                 "zmp_status": im.zmp_limit.status,
                 "W": im.model.W.tolist(),
@@ -145,17 +169,37 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
 
     ``solve_qp`` overrides the scenario's ``impact.qp.solve``.
     """
-    if not isinstance(scenario, Scenario):
-        scenario = load_scenario(scenario)
     timings: dict[str, float] = {}
+    if not isinstance(scenario, Scenario):
+        t = time.perf_counter()
+        scenario = load_scenario(scenario)
+        timings["scenario_loading"] = time.perf_counter() - t
+    t = time.perf_counter()
+    try:
+        robot = scenario.load_robot()  # cached after the first use of a robot
+    except ScenarioError as exc:
+        raise with_source(exc, scenario.source) from None
+    robot.workspace()  # its scratch pinocchio Data (~2-7 ms, first use per thread): loading too
+    timings["robot_loading"] = time.perf_counter() - t
+    kernel = warm_up()  # the compiled projection kernel's one-time load, timed apart
+    if kernel:
+        timings["kernel_loading"] = kernel
     t0 = time.perf_counter()
-    stance = scenario.build_stance()
+    stance = scenario.build_stance(robot)
     t1 = time.perf_counter()
     polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
     t2 = time.perf_counter()
-    areas = areas_from_polytope(polytope, scenario.plane_height)
+    try:
+        areas = areas_from_polytope(polytope, scenario.plane_height)
+    except SolverError as exc:
+        raise exc.within("contacts (projection of the contact wrench polytope)") from None
     t3 = time.perf_counter()
     timings.update(stance=t1 - t0, constraints=t2 - t1, areas=t3 - t2)
+    if not areas.can_balance:  # explain why (LPs; only for a stance that cannot balance)
+        areas = with_reason(areas, stance, scenario.torque_limits, scenario.gravity)
+        timings["diagnosis"] = time.perf_counter() - t3
+        t3 = time.perf_counter()
+    _check_finite(_area_checks(stance, areas))
     answer = None
     if scenario.impact is not None:
         cfg = scenario.impact
@@ -163,6 +207,7 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
             model = impact_model(stance, cfg.spec())
         except ScenarioError as exc:
             raise with_source(exc, scenario.source) from None
+        _check_finite(_impact_checks(model))
         com_limit = max_contact_velocity(areas.com_velocity_area, model, scenario.com_velocity)
         zmp_limit = zmp_max_contact_velocity(
             areas.zmp_area, model, stance.com, scenario.plane_height, scenario.gravity, cfg.duration
@@ -176,10 +221,57 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
             options = QPOptions(
                 cfg.qp.joint_velocity_limits, cfg.qp.impulsive_torque_limits, cfg.qp.peak_factor, cfg.duration, cfg.qp.solver
             )
-            qp = solve_contact_velocity_qp(
-                model, areas.com_velocity_area, scenario.com_velocity, cfg.reference_velocity, stance.robot, tau0, options
-            )
-        answer = ImpactAnswer(model, com_limit, zmp_limit, contact_velocity, qp)
+            try:
+                qp = solve_contact_velocity_qp(
+                    model, areas.com_velocity_area, scenario.com_velocity, cfg.reference_velocity, stance.robot, tau0,
+                    options,
+                )
+            except SolverError as exc:
+                raise exc.within("impact.qp") from None
+        interval = safe_interval(areas.com_velocity_area, model, scenario.com_velocity)
+        answer = ImpactAnswer(model, com_limit, zmp_limit, contact_velocity, qp, interval)
         timings["impact"] = time.perf_counter() - t3
     timings["total"] = time.perf_counter() - t0
-    return Analysis(scenario, stance, areas, answer, timings)
+    return Analysis(scenario, stance, areas, answer, timings, diagnose(scenario, stance, answer))
+
+
+def _area_checks(stance: Stance, areas: BalanceAreas) -> list[tuple[str, Any, tuple[str, ...]]]:
+    """(result field, value, scenario fields that can make it overflow) of the areas step."""
+    return [
+        ("com", stance.com, ("base.position",)),
+        ("omega", areas.omega, ("plane_height", "gravity")),
+        # The squared sizes: their overflow is that of the areas and of the edge normals.
+        ("zmp_area", _squared_size(areas.zmp_area), ("plane_height", "base.position")),
+        ("com_velocity_area", _squared_size(areas.com_velocity_area), ("plane_height", "gravity")),
+    ]
+
+
+def _squared_size(polygon) -> float:
+    """Sum of the squared vertex coordinates (inf when they overflow, NaN with a NaN)."""
+    v = polygon.vertices.ravel()
+    with np.errstate(over="ignore", invalid="ignore"):
+        return float(v @ v)
+
+
+def _impact_checks(model: ImpactModel) -> list[tuple[str, Any, tuple[str, ...]]]:
+    """Like :func:`_area_checks`, for the impact model."""
+    return [
+        ("impact.point", model.point, ("impact.offset", "base.position")),
+        ("impact.W", model.W, ("impact.offset",)),
+        ("impact.impulse_vertices", model.impulse_rates, ("impact.offset", "impact.friction")),
+    ]
+
+
+def _check_finite(checks: list[tuple[str, Any, tuple[str, ...]]]) -> None:
+    """Raise :class:`NonFiniteResultError` naming the first non-finite result (never NaN out).
+
+    One sum over everything first (a NaN or an infinity anywhere makes it non-finite), so the
+    common case costs a few microseconds; the field is looked for only on failure.
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        if np.isfinite(sum(float(np.sum(value)) for _, value, _ in checks)):
+            return
+        for name, value, inputs in checks:
+            if not np.isfinite(value).all():
+                raise NonFiniteResultError(name, inputs)
+        # every part finite: only their sum overflowed

@@ -13,6 +13,7 @@ projecting the contact-wrench polytope (:mod:`impact_balance.constraints`).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -20,12 +21,13 @@ import numpy as np
 
 from .constants import GRAVITY
 from .constraints import WrenchPolytope, wrench_polytope
-from .exceptions import ScenarioError
+from .diagnosis import CannotBalanceReason, explain_cannot_balance
+from .exceptions import ScenarioError, SolverError
 from .polygon import Polygon
 from .projection import project_polytope
 from .stance import Stance
 
-__all__ = ["BalanceAreas", "balance_areas", "areas_from_polytope", "omega"]
+__all__ = ["BalanceAreas", "balance_areas", "areas_from_polytope", "omega", "with_reason"]
 
 #: Projection tolerance on the resultant horizontal force, as a fraction of m g.
 FORCE_TOLERANCE = 1e-8
@@ -55,6 +57,9 @@ class BalanceAreas:
         omega: LIPM natural frequency, 1/s.
         com: CoM, m.  plane_height: h, m.  mass: kg.  gravity: m/s^2.
         n_lp: LPs solved by the projection.
+        reason: Why the stance cannot balance when the areas are empty and they were
+            computed from a stance (:func:`balance_areas`, :func:`~impact_balance.analyze`);
+            None otherwise. See :mod:`impact_balance.diagnosis`.
     """
 
     force_area: Polygon
@@ -66,6 +71,7 @@ class BalanceAreas:
     mass: float
     gravity: float
     n_lp: int = 0
+    reason: CannotBalanceReason | None = None
 
     @property
     def can_balance(self) -> bool:
@@ -104,4 +110,16 @@ def balance_areas(
 ) -> BalanceAreas:
     """ZMP support area and CoM velocity area of ``stance``."""
     omega(float(stance.com[2]), plane_height, gravity)  # validate the plane before any work
-    return areas_from_polytope(wrench_polytope(stance, torque_limits, gravity), plane_height)
+    areas = areas_from_polytope(wrench_polytope(stance, torque_limits, gravity), plane_height)
+    return with_reason(areas, stance, torque_limits, gravity)
+
+
+def with_reason(areas: BalanceAreas, stance: Stance, torque_limits: bool, gravity: float) -> BalanceAreas:
+    """``areas`` with :attr:`BalanceAreas.reason` filled in when they are empty."""
+    if areas.can_balance or areas.reason is not None:
+        return areas
+    try:
+        reason = explain_cannot_balance(stance, torque_limits, gravity)
+    except SolverError as exc:  # the areas are the answer; an explanation is a bonus
+        reason = CannotBalanceReason("unknown", f"the diagnosis failed ({exc})")
+    return dataclasses.replace(areas, reason=reason)

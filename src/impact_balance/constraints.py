@@ -102,7 +102,9 @@ def contact_polytope(
 
     ``contacts`` only need ``spec``, ``rotation`` and ``position`` (the Jacobian is unused).
     """
-    return _assemble(contacts, mass, com, gravity, None)
+    com = np.array(com, dtype=float)
+    arms = np.array([c.position for c in contacts], dtype=float).reshape(-1, 3) - com
+    return _assemble(contacts, mass, com, arms, gravity, None)
 
 
 def torque_limit_rows(stance: Stance) -> tuple[np.ndarray, np.ndarray]:
@@ -120,7 +122,9 @@ def torque_limit_rows(stance: Stance) -> tuple[np.ndarray, np.ndarray]:
 
 def wrench_polytope(stance: Stance, torque_limits: bool = True, gravity: float = GRAVITY) -> WrenchPolytope:
     """Assemble the contact-wrench polytope of ``stance`` (CWC + torque limits + LIPM)."""
-    return _assemble(stance.contacts, stance.mass, stance.com, gravity, stance if torque_limits else None)
+    # Lever arms from stance-frame positions: exact however far from the origin the stance is.
+    arms = np.array([c.local_position for c in stance.contacts], dtype=float).reshape(-1, 3) - stance.com_local
+    return _assemble(stance.contacts, stance.mass, stance.com, arms, gravity, stance if torque_limits else None)
 
 
 def _n_torque_rows(stance: Stance) -> int:
@@ -144,9 +148,18 @@ def _fill_torque_rows(stance: Stance, A: np.ndarray, b: np.ndarray) -> None:
 
 
 def _assemble(
-    contacts: Sequence[Contact], mass: float, com: np.ndarray, gravity: float, torque_stance: Stance | None
+    contacts: Sequence[Contact],
+    mass: float,
+    com: np.ndarray,
+    arms: np.ndarray,
+    gravity: float,
+    torque_stance: Stance | None,
 ) -> WrenchPolytope:
-    """The polytope, with the torque-limit rows of ``torque_stance`` when given, in one allocation."""
+    """The polytope, with the torque-limit rows of ``torque_stance`` when given, in one allocation.
+
+    ``arms`` (m x 3) are the contact positions minus the CoM: the LIPM rows use them, not
+    world positions, so that they keep their precision far from the origin.
+    """
     m = len(contacts)
     n, n_cwc = 6 * m, 16 * m
     k = _n_torque_rows(torque_stance) if torque_stance is not None else 0
@@ -163,6 +176,6 @@ def _assemble(
     G = grasp_matrix(positions)
     # LIPM: vertical force f_z = m g, and moment about the CoM sum (p_i - c) x f_i + tau_i = 0:
     # rows 2-5 of the grasp matrix taken at the CoM (the same numbers as [[e_z^T], [-[c]x, I]] G).
-    C = grasp_matrix(positions - com)[2:]
+    C = grasp_matrix(arms)[2:]
     d = np.array([mass * gravity, 0.0, 0.0, 0.0])
     return WrenchPolytope(A, b, C, d, G[:2].copy(), G, n_cwc, float(mass), com, gravity)

@@ -23,7 +23,15 @@ import numpy as np
 from .impact import ImpactModel
 from .polygon import Polygon
 
-__all__ = ["VelocityLimit", "max_contact_velocity", "zmp_max_contact_velocity", "capped_velocity", "first_exit"]
+__all__ = [
+    "VelocityLimit",
+    "max_contact_velocity",
+    "zmp_max_contact_velocity",
+    "capped_velocity",
+    "first_exit",
+    "safe_interval",
+    "speed_interval",
+]
 
 #: Margin under which a point counts as on the boundary (same units as the area).
 BOUNDARY_TOLERANCE = 1e-10
@@ -69,6 +77,47 @@ def first_exit(margins: np.ndarray, rates: np.ndarray, tol: float = BOUNDARY_TOL
     flat = int(ratios.argmin())
     j, k = divmod(flat, rates.shape[1])
     return VelocityLimit(float(ratios.flat[flat]), "ok", j, k)
+
+
+def speed_interval(margins: np.ndarray, rates: np.ndarray, tol: float = BOUNDARY_TOLERANCE) -> tuple[float, float] | None:
+    """All s >= 0 with ``margins[k] - s * rates[j, k] >= 0`` for all j, k: ``(lo, hi)`` or None.
+
+    Each constraint is linear in s, so the solutions form an interval: a positive rate caps
+    s from above (s <= margin / rate), a negative one from below (s >= margin / rate, which
+    matters only for a negative margin), a zero rate needs a non-negative margin. ``hi`` is
+    inf when nothing caps s. With every margin >= 0, ``lo`` = 0 and ``hi`` is
+    :func:`first_exit`'s maximum.
+    """
+    scale = tol * max(1.0, float(np.abs(rates).max(initial=0.0)))
+    positive, negative = rates > scale, rates < -scale
+    flat = ~(positive | negative)
+    m = np.broadcast_to(margins, rates.shape)
+    if (m[flat] < -tol).any():
+        return None  # a vertex outside that the impact does not move along that edge's normal
+    inside = bool((margins >= -tol).all())
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = m / rates
+    hi = float(np.min(np.maximum(ratio[positive], 0.0) if inside else ratio[positive], initial=np.inf))
+    lo = 0.0 if inside else max(0.0, float(np.max(ratio[negative], initial=0.0)))
+    if lo > hi * (1.0 + 1e-12) + tol:
+        return None
+    return lo, max(lo, hi)
+
+
+def safe_interval(area: Polygon, impact: ImpactModel, com_velocity: Sequence[float]) -> tuple[float, float] | None:
+    """The approach speeds s >= 0 whose whole post-impact CoM velocity set lies in ``area``.
+
+    The post-impact vertices ``c0 + s d_j`` are linear in s, so these speeds form one
+    interval ``(s_lo, s_hi)`` (m/s; ``s_hi`` may be inf); None when it is empty (or the
+    area is). With ``c0`` inside the area, ``s_lo`` = 0 and ``s_hi`` is the maximum contact
+    velocity. With ``c0`` outside (the robot falls without an impact), a non-empty interval
+    is the impacts that catch the fall: ``s_lo`` > 0.
+    """
+    if area.is_empty:
+        return None
+    G, h = area.halfplanes
+    c0 = np.asarray(com_velocity, dtype=float)[:2]
+    return speed_interval(h - G @ c0, impact.com_jump_rates @ G.T)
 
 
 def max_contact_velocity(area: Polygon, impact: ImpactModel, com_velocity: Sequence[float]) -> VelocityLimit:

@@ -3,17 +3,28 @@
 Every error the library raises on purpose derives from :class:`ImpactBalanceError` and
 carries the data that explains it (field, value, valid names), so that callers can react
 programmatically and the command line can print one clear line.
+
+One formatting rule bounds every message: a value is shown by :func:`short_repr` (at most
+:data:`VALUE_CHARS` characters, built lazily so that a huge or deeply shared structure, such as
+a YAML alias bomb, is never expanded), a list of valid names is cut to the closest few and a
+count, and a whole message is one line of at most :data:`MESSAGE_CHARS` characters.
 """
 
 from __future__ import annotations
 
 import difflib
+import reprlib
 from collections.abc import Iterable, Sequence
 from typing import Any
 
 __all__ = [
+    "VALUE_CHARS",
+    "MESSAGE_CHARS",
+    "short_repr",
+    "one_line",
     "ImpactBalanceError",
     "ScenarioError",
+    "WorkspaceError",
     "UnknownNameError",
     "UnknownRobotError",
     "UnknownFrameError",
@@ -23,12 +34,73 @@ __all__ = [
     "RobotLoadError",
     "ImpactModelError",
     "SolverError",
+    "UnknownKeyError",
+    "StrictWarningsError",
+    "NonFiniteResultError",
     "SimulationError",
+    "SweepError",
+    "UnknownPathError",
 ]
+
+#: Longest shown repr of a value in a message (characters).
+VALUE_CHARS = 80
+#: Longest message (characters); longer ones are cut with "...".
+MESSAGE_CHARS = 400
+#: A list of valid names longer than this is replaced by the closest few and a count.
+LISTED_NAMES = 12
+#: Names longer than this are never compared with difflib (quadratic in the length).
+_MATCHED_CHARS = 255
+
+
+def _reprer() -> reprlib.Repr:
+    r = reprlib.Repr()
+    # reprlib stops at these sizes instead of walking the whole structure: an alias bomb
+    # (a small YAML file that expands to 10^9 items) is shown in microseconds.
+    r.maxlevel, r.maxlist, r.maxtuple, r.maxdict, r.maxset = 3, 4, 4, 3, 4
+    r.maxstring, r.maxother, r.maxlong = VALUE_CHARS, VALUE_CHARS, 40
+    return r
+
+
+_REPR = _reprer()
+
+
+def _cut(text: str, limit: int) -> str:
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def short_repr(value: Any, limit: int = VALUE_CHARS) -> str:
+    """``repr(value)`` cut to ``limit`` characters, without ever building the full repr."""
+    if isinstance(value, (int, float, bool)) or value is None:
+        try:
+            return _cut(repr(value), limit)
+        except ValueError:  # an int too large to convert to a string
+            return "<a very large integer>"
+    try:
+        text = _REPR.repr(value)
+    except Exception:  # a broken __repr__ must not hide the error being reported
+        text = f"<{type(value).__name__}>"
+    return _cut(text, limit)
+
+
+def one_line(text: str, limit: int = MESSAGE_CHARS) -> str:
+    """``text`` on one line (line breaks become spaces) of at most ``limit`` characters."""
+    return _cut(" ".join(str(text).split()), limit)
+
+
+def _closest(value: Any, valid: Sequence[str], n: int = 3) -> list[str]:
+    if not isinstance(value, str) or len(value) > _MATCHED_CHARS:
+        return []
+    return difflib.get_close_matches(value, valid, n=n, cutoff=0.5)
 
 
 class ImpactBalanceError(Exception):
-    """Base class of all errors raised by impact-balance."""
+    """Base class of all errors raised by impact-balance.
+
+    ``str()`` is one line of at most :data:`MESSAGE_CHARS` characters.
+    """
+
+    def __str__(self) -> str:
+        return one_line(self.args[0] if self.args else self.__class__.__name__)
 
 
 class ScenarioError(ImpactBalanceError, ValueError):
@@ -46,8 +118,8 @@ class ScenarioError(ImpactBalanceError, ValueError):
         self.value = value
         self.reason = reason
         self.source = source
-        where = f"{source}: " if source else ""
-        super().__init__(f"{where}{field} = {value!r}: {reason}")
+        where = f"{_cut(str(source), 120)}: " if source else ""
+        super().__init__(f"{where}{_cut(str(field), 120)} = {short_repr(value)}: {reason}")
 
 
 class UnknownNameError(ScenarioError, KeyError):
@@ -60,15 +132,22 @@ class UnknownNameError(ScenarioError, KeyError):
 
     kind = "name"
 
-    def __init__(self, field: str, value: str, valid: Iterable[str], source: str | None = None):
+    def __init__(
+        self, field: str, value: str, valid: Iterable[str], source: str | None = None, listing: str | None = None
+    ):
+        """``listing`` says where the full list is when it is too long to print (a command)."""
         self.valid: Sequence[str] = sorted(valid)
-        close = difflib.get_close_matches(str(value), self.valid, n=3, cutoff=0.5)
+        close = _closest(value, self.valid)
         hint = f" (did you mean {', '.join(close)}?)" if close else ""
-        reason = f"unknown {self.kind}{hint}; valid {self.kind}s: {', '.join(self.valid)}"
-        super().__init__(field, value, reason, source)
+        if len(self.valid) <= LISTED_NAMES:
+            names = f"valid {self.kind}s: {', '.join(self.valid)}"
+        else:
+            where = f"; `{listing}` lists them" if listing else ""
+            names = f"{len(self.valid)} valid {self.kind}s{where}"
+        super().__init__(field, value, f"unknown {self.kind}{hint}; {names}", source)
 
     def __str__(self) -> str:  # KeyError would otherwise quote the message
-        return self.args[0]
+        return one_line(self.args[0])
 
 
 class UnknownRobotError(UnknownNameError):
@@ -101,6 +180,20 @@ class UnknownScenarioError(UnknownNameError):
     kind = "scenario"
 
 
+class WorkspaceError(ScenarioError):
+    """A file name outside what the workspace allows (see :mod:`impact_balance.workspace`).
+
+    Attributes:
+        field: What named the file ("file", "extends", "robot.urdf", "workspace").
+        value: The name, cut to 80 characters.
+        reason: Why it is refused.
+    """
+
+    def __init__(self, field: str, value: str, reason: str):
+        text = str(value)
+        super().__init__(field, text if len(text) <= 80 else text[:77] + "...", reason)
+
+
 class RobotLoadError(ImpactBalanceError):
     """A robot description (URDF/SRDF) cannot be read.
 
@@ -126,7 +219,7 @@ class ImpactModelError(ImpactBalanceError, ValueError):
         self.field = field
         self.value = value
         self.reason = reason
-        super().__init__(f"{field} = {value!r}: {reason}")
+        super().__init__(f"{field} = {short_repr(value)}: {reason}")
 
 
 class SolverError(ImpactBalanceError, RuntimeError):
@@ -135,13 +228,72 @@ class SolverError(ImpactBalanceError, RuntimeError):
     Attributes:
         solver: Solver name.
         status: The solver's status string.
+        field: What was being computed, in the user's terms (e.g. "com_velocity_area",
+            "impact.qp"), or None when the solver's caller did not say.
     """
 
-    def __init__(self, solver: str, status: str, detail: str = ""):
+    def __init__(self, solver: str, status: str, detail: str = "", field: str | None = None):
         self.solver = solver
         self.status = status
+        self.detail = detail
+        self.field = field
         extra = f": {detail}" if detail else ""
-        super().__init__(f"{solver} failed with status {status}{extra}")
+        where = f"{field}: " if field else ""
+        super().__init__(f"{where}{solver} failed with status {status}{extra}")
+
+    def within(self, field: str) -> SolverError:
+        """The same failure, attributed to ``field`` (kept if already attributed)."""
+        if self.field is not None:
+            return self
+        return SolverError(self.solver, self.status, self.detail, field)
+
+
+class UnknownKeyError(ScenarioError):
+    """A scenario mapping has a key the schema does not know; suggests the nearest valid key.
+
+    Attributes:
+        key: The unknown key.
+        valid: The keys valid at that place, sorted.
+        suggestion: The nearest valid key, or None.
+    """
+
+    def __init__(self, field: str, key: str, value: Any, valid: Iterable[str], source: str | None = None):
+        self.key = key
+        self.valid: Sequence[str] = sorted(valid)
+        close = _closest(key, self.valid, n=1)
+        self.suggestion = close[0] if close else None
+        hint = f" (did you mean {self.suggestion}?)" if self.suggestion else ""
+        super().__init__(field, value, f"unknown key{hint}", source)
+
+
+class StrictWarningsError(ImpactBalanceError):
+    """Warnings were raised while warnings are errors (``--strict``).
+
+    Attributes:
+        warnings: The diagnostics (:class:`impact_balance.diagnostics.Diagnostic`).
+    """
+
+    def __init__(self, warnings: Sequence[Any]):
+        self.warnings = tuple(warnings)
+        more = f" (and {len(self.warnings) - 1} more)" if len(self.warnings) > 1 else ""
+        super().__init__(f"warning treated as an error (--strict): {self.warnings[0]}{more}")
+
+
+class NonFiniteResultError(ImpactBalanceError, ValueError):
+    """A computed quantity overflowed (inf or NaN): the input's numbers are out of scale.
+
+    Raised instead of returning NaN or infinity (which strict JSON cannot carry).
+
+    Attributes:
+        field: The result field that is not finite, e.g. ``impact.W``.
+        inputs: The scenario fields whose size can cause it.
+    """
+
+    def __init__(self, field: str, inputs: Sequence[str]):
+        self.field = field
+        self.inputs = tuple(inputs)
+        hint = f" (check {', '.join(self.inputs)})" if self.inputs else ""
+        super().__init__(f"{field} is not finite: the scenario's numbers are too large{hint}")
 
 
 class SimulationError(ImpactBalanceError, ValueError):
@@ -157,4 +309,17 @@ class SimulationError(ImpactBalanceError, ValueError):
         self.field = field
         self.value = value
         self.reason = reason
-        super().__init__(f"{field} = {value!r}: {reason}")
+        super().__init__(one_line(f"{field} = {short_repr(value)}: {reason}"))
+
+
+class SweepError(ScenarioError):
+    """A sweep file field has a bad value (same data as :class:`ScenarioError`).
+
+    Also raised when an output folder holds the results of a different sweep.
+    """
+
+
+class UnknownPathError(UnknownNameError):
+    """A sweep axis path names a scenario key that does not exist; lists the valid paths."""
+
+    kind = "key"

@@ -142,10 +142,16 @@ class ImpactModel:
         return float(-self.normal @ np.asarray(velocity, dtype=float))
 
 
-def impulse_to_velocity(stance: Stance, point: np.ndarray, jacobian: np.ndarray, model: str = "composite") -> np.ndarray:
-    """W at ``point``: composite rigid body (default) or joint space J M^-1 J^T."""
+def impulse_to_velocity(
+    stance: Stance, point: np.ndarray, jacobian: np.ndarray, model: str = "composite", arm: np.ndarray | None = None
+) -> np.ndarray:
+    """W at ``point``: composite rigid body (default) or joint space J M^-1 J^T.
+
+    ``arm`` is ``point - com`` when the caller has it exactly (stance-frame positions);
+    by default it is computed from the world positions.
+    """
     if model == "composite":
-        r = skew(point - stance.com)
+        r = skew(point - stance.com if arm is None else arm)
         return np.eye(3) / stance.mass - r @ _solve_spd3(stance.com_inertia, r)
     if model == "joint_space":
         workspace = stance.robot.workspace()  # scratch Data: createData costs up to ~2 ms
@@ -188,17 +194,28 @@ def _solve_spd3(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     return np.array(columns).T
 
 
+def _short(v: np.ndarray) -> list[float]:
+    """A vector as 4-significant-digit floats, for messages."""
+    return [float(f"{x:.4g}") for x in np.asarray(v, dtype=float)]
+
+
 def impact_model(stance: Stance, spec: ImpactSpec) -> ImpactModel:
     """Build the impact model of ``spec`` at the stance's configuration."""
-    placement, J6 = stance.point(spec.frame, spec.offset, field="impact.frame")
+    placement, J6 = stance.local_point(spec.frame, spec.offset, field="impact.frame")
     try:
         n, K = _normal_and_cone(tuple(spec.normal), spec.friction, spec.cone_edges)
     except ValueError:  # from unit(): friction_cone raises nothing once n is a unit vector
         raise ImpactModelError("impact.normal", list(spec.normal), "must be a non-zero vector") from None
     n, K = n.copy(), K.copy()
-    point = placement.translation.copy()
+    arm = placement.translation - stance.com_local  # exact far from the origin (stance frame)
+    point = placement.translation + stance.origin
     J = J6[:3].copy()
-    W = impulse_to_velocity(stance, point, J, spec.inertia)
+    with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported just below
+        W = impulse_to_velocity(stance, point, J, spec.inertia, arm=arm)
+    if not np.isfinite(W).all():
+        raise ImpactModelError(
+            "impact.offset", _short(arm), "the impact point is too far from the CoM: W is not finite"
+        )
     normal_response = n @ W @ K  # n^T W K_i, > 0 for an impulse that pushes the point back
     if (normal_response <= 1e-12).any():
         raise ImpactModelError(

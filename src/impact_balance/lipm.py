@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .constants import GRAVITY
+from .constants import GRAVITY, GRAVITY_RANGE, MAX_POSITION
 from .exceptions import ScenarioError
 
 __all__ = ["PhasePortrait", "phase_portrait", "lipm_omega", "com_velocity_bounds"]
@@ -21,10 +21,12 @@ __all__ = ["PhasePortrait", "phase_portrait", "lipm_omega", "com_velocity_bounds
 
 def lipm_omega(com_height: float, plane_height: float = 0.0, gravity: float = GRAVITY) -> float:
     """omega = sqrt(g / (c_z - h)), 1/s."""
-    if not (math.isfinite(com_height) and com_height > plane_height):
-        raise ScenarioError("com_height", com_height, f"must be above the plane height {plane_height} m")
-    if not gravity > 0:
-        raise ScenarioError("gravity", gravity, "must be > 0")
+    if not (math.isfinite(com_height) and 0 < com_height - plane_height <= 2 * MAX_POSITION):
+        raise ScenarioError(
+            "com_height", com_height, f"must be above the plane height {plane_height} m (at most {2 * MAX_POSITION:g} m above)"
+        )
+    if not GRAVITY_RANGE[0] <= gravity <= GRAVITY_RANGE[1]:
+        raise ScenarioError("gravity", gravity, f"must be in [{GRAVITY_RANGE[0]:g}, {GRAVITY_RANGE[1]:g}] m/s^2")
     return math.sqrt(gravity / (com_height - plane_height))
 
 
@@ -33,8 +35,8 @@ def com_velocity_bounds(
 ) -> tuple[float, float]:
     """CoM velocity interval (m/s) from which the CoM can be brought to rest at ``com_position``."""
     lo, hi = zmp_range
-    if not lo <= hi:
-        raise ScenarioError("zmp_range", [lo, hi], "must be [lo, hi] with lo <= hi")
+    if not -MAX_POSITION <= lo <= hi <= MAX_POSITION:
+        raise ScenarioError("zmp_range", [lo, hi], f"must be [lo, hi] with lo <= hi, within [{-MAX_POSITION:g}, {MAX_POSITION:g}] m")
     w = lipm_omega(com_height, 0.0, gravity)
     return w * (lo - com_position), w * (hi - com_position)
 

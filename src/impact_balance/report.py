@@ -6,12 +6,37 @@ import numpy as np
 
 from .analysis import Analysis
 
-__all__ = ["format_analysis", "format_speed"]
+__all__ = ["format_analysis", "format_speed", "format_safe_interval", "format_timings"]
 
 
 def format_speed(value: float) -> str:
     """m/s with 3 decimals, "unbounded" for inf."""
     return f"{value:.3f} m/s" if np.isfinite(value) else "unbounded"
+
+
+def format_timings(timings: dict[str, float]) -> str:
+    """What each measured time is: the analysis, then the loading (not part of it)."""
+    text = f"analysis {1e3 * timings.get('total', float('nan')):.1f} ms"
+    extra = []
+    if "scenario_loading" in timings:
+        extra.append(f"scenario loading {1e3 * timings['scenario_loading']:.1f} ms")
+    robot = timings.get("robot_loading", 0.0)
+    if robot > 1e-3:  # a cached model takes microseconds: only the first use is worth a word
+        extra.append(f"robot model loading {1e3 * robot:.0f} ms (first use)")
+    if "kernel_loading" in timings:
+        extra.append(f"projection kernel loading {1e3 * timings['kernel_loading']:.0f} ms (first call)")
+    return text + (f"; not included: {', '.join(extra)}" if extra else "")
+
+
+def format_safe_interval(interval: tuple[float, float] | None, inside: bool) -> str:
+    """One line on the approach speeds that keep every post-impact CoM velocity in the area."""
+    if interval is None:
+        return "safe approach speeds: none (no impact speed brings the CoM velocity into the area)"
+    lo, hi = interval
+    text = f"safe approach speeds: [{lo:.3f}, {f'{hi:.3f}' if np.isfinite(hi) else 'unbounded'}] m/s"
+    if not inside:
+        text += " (the CoM velocity is outside the area: an impact in this range would bring it back inside)"
+    return text
 
 
 def _vec(v, digits: int = 3) -> str:
@@ -26,9 +51,13 @@ def format_analysis(analysis: Analysis) -> str:
         f"  robot {st.robot.name}, mass {st.mass:.2f} kg, CoM {_vec(st.com)} m, omega {a.omega:.4f} 1/s, "
         f"{len(st.contacts)} contact(s), torque limits {'on' if sc.torque_limits else 'off'}"
     )
+    warnings = [f"  warning: {w}" for w in analysis.warnings]
     if not a.can_balance:
         lines.append("  CANNOT BALANCE: these contacts cannot hold the robot at rest (empty areas)")
-        return "\n".join(lines)
+        if a.reason is not None:
+            lines.append(f"  reason: {a.reason}")
+        lines.append(f"  {format_timings(analysis.timings)}")
+        return "\n".join(lines + warnings)
     v = a.com_velocity_area
     lo, hi = v.vertices.min(axis=0), v.vertices.max(axis=0)
     lines.append(
@@ -51,6 +80,7 @@ def format_analysis(analysis: Analysis) -> str:
         lines.append(
             f"  max contact velocity: CoM criterion {format_speed(com_v)}, ZMP criterion {format_speed(zmp_v)}{ratio}"
         )
+        lines.append("  " + format_safe_interval(im.safe_interval, analysis.com_velocity_inside))
         if im.contact_velocity is not None:
             lines.append(
                 f"  reference velocity {_vec(spec.reference_velocity)} m/s -> contact velocity "
@@ -58,5 +88,5 @@ def format_analysis(analysis: Analysis) -> str:
             )
         if im.qp is not None:
             lines.append(f"  paper's QP ({im.qp.status}): approach speed {format_speed(im.qp.approach_speed)}")
-    lines.append(f"  computed in {1e3 * analysis.timings.get('total', float('nan')):.1f} ms")
-    return "\n".join(lines)
+    lines.append(f"  {format_timings(analysis.timings)}")
+    return "\n".join(lines + warnings)

@@ -5,9 +5,13 @@ Models are loaded with pinocchio, with a free-flyer root joint (the robot is flo
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import importlib.metadata
 import math
+import os
+import sys
+import tempfile
 import threading
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
@@ -163,6 +167,12 @@ class Robot:
         """Names of the actuated (non-root) joints."""
         return list(self._joint_slots)
 
+    @property
+    def listing_command(self) -> str:
+        """The command that lists this robot's frames and joints (named in error messages)."""
+        bundled = self.name in BUNDLED_ROBOTS and self.urdf_path == _bundled_urdf(self.name)
+        return f"impact-balance frames {self.name if bundled else self.urdf_path}"
+
     @functools.cached_property
     def _frame_ids(self) -> dict[str, int]:
         ids: dict[str, int] = {}
@@ -186,7 +196,7 @@ class Robot:
         """Index of frame ``name``; :class:`UnknownFrameError` naming the valid ones if absent."""
         fid = self._frame_ids.get(name) if isinstance(name, str) else None
         if fid is None:
-            raise UnknownFrameError(field, name, set(self.frame_names))
+            raise UnknownFrameError(field, name, set(self.frame_names), listing=self.listing_command)
         return fid
 
     def joint_id(self, name: str, field: str = "joint") -> int:
@@ -197,7 +207,7 @@ class Robot:
         """Configuration slot and position limits of a non-root joint; :class:`UnknownJointError` if absent."""
         slot = self._joint_slots.get(name) if isinstance(name, str) else None
         if slot is None:
-            raise UnknownJointError(field, name, self.joint_names)
+            raise UnknownJointError(field, name, self.joint_names, listing=self.listing_command)
         return slot
 
     def joint_assignment(self, joints: Mapping[str, float], field: str = "joints") -> tuple[np.ndarray, np.ndarray]:
@@ -292,20 +302,66 @@ class Robot:
         return self._workspace
 
 
+def _is_file(path: Path) -> bool:
+    try:
+        return path.is_file()
+    except (OSError, ValueError):  # a name too long for the file system, a NUL character
+        return False
+
+
+_FD_LOCK = threading.Lock()
+
+
+@contextlib.contextmanager
+def _native_stderr(lines: list[str]):
+    """Collect what C++ code writes to file descriptor 2 (urdfdom's "Error: ..." lines) into
+    ``lines`` instead of the terminal: a failure is reported once, as one line naming the file.
+
+    Redirecting a descriptor is process-wide, so loads are serialised; another thread's
+    writes to stderr during a load (a few ms) are collected too, and dropped.
+    """
+    with _FD_LOCK, tempfile.TemporaryFile(mode="w+b") as sink:
+        sys.stderr.flush()
+        saved = os.dup(2)
+        try:
+            os.dup2(sink.fileno(), 2)
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            sink.seek(0)
+            text = sink.read(20_000).decode("utf-8", "replace")
+            lines += [ln.strip() for ln in text.splitlines() if ln.strip()]
+
+
+def _native_reason(lines: list[str], fallback: str) -> str:
+    """The first urdfdom "Error:" line (the cause), else ``fallback``."""
+    for line in lines:
+        if line.startswith("Error:"):
+            return f"{fallback} ({line.removeprefix('Error:').strip()})"
+    return fallback
+
+
 def _load(urdf: Path, srdf: Path | None, name: str, standing: str | None) -> Robot:
     package_dirs = [str(urdf.parent.parent.parent), str(urdf.parent.parent)]
+    native: list[str] = []
     try:
-        model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
+        with _native_stderr(native):
+            model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
     except (RuntimeError, ValueError, OSError) as exc:
-        raise RobotLoadError(str(urdf), str(exc).strip().splitlines()[0] if str(exc) else "invalid URDF") from exc
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else "invalid URDF"
+        if str(urdf) in first:  # pinocchio repeats the path
+            first = "not a valid URDF model"
+        raise RobotLoadError(str(urdf), _native_reason(native, first)) from None
     configurations = {"neutral": pin.neutral(model)}
     if srdf is not None:
-        if not srdf.is_file():
+        if not _is_file(srdf):
             raise RobotLoadError(str(srdf), "no such file")
         try:
-            pin.loadReferenceConfigurations(model, str(srdf), False)
+            with _native_stderr(native):
+                pin.loadReferenceConfigurations(model, str(srdf), False)
         except (RuntimeError, ValueError, OSError) as exc:
-            raise RobotLoadError(str(srdf), str(exc).strip() or "invalid SRDF") from exc
+            raise RobotLoadError(str(srdf), _native_reason(native, str(exc).strip() or "invalid SRDF")) from None
         for entry in model.referenceConfigurations:
             configurations[entry.key()] = np.array(entry.data(), dtype=float)
     if standing is None:
@@ -313,6 +369,10 @@ def _load(urdf: Path, srdf: Path | None, name: str, standing: str | None) -> Rob
     if standing not in configurations:
         raise UnknownConfigurationError("robot.standing", standing, configurations)
     return Robot(name, model, configurations, standing, urdf, srdf, package_dirs)
+
+
+def _bundled_urdf(name: str) -> Path:
+    return example_robot_data_root() / BUNDLED_ROBOTS[name].urdf
 
 
 @functools.lru_cache(maxsize=16)
@@ -330,7 +390,9 @@ def load_robot(
 ) -> Robot:
     """Load a bundled robot by name, or any URDF (+ optional SRDF) that pinocchio reads.
 
-    Bundled models are cached: the returned :class:`Robot` is shared, do not mutate its model.
+    Models are cached (bundled ones by name, files by path, modification time and size):
+    the returned :class:`Robot` is shared, do not mutate its model (copy it:
+    ``dataclasses.replace(robot, model=pinocchio.Model(robot.model))``).
     """
     if urdf is None:
         name = robot or "talos"
@@ -338,6 +400,28 @@ def load_robot(
             raise UnknownRobotError("robot", name, BUNDLED_ROBOTS)
         return _load_bundled(name)
     urdf = Path(urdf)
-    if not urdf.is_file():
+    if not _is_file(urdf):
         raise RobotLoadError(str(urdf), "no such file")
-    return _load(urdf, Path(srdf) if srdf else None, robot or urdf.stem, standing)
+    srdf_path = Path(srdf) if srdf else None
+    # Cached by the files' identity and modification: an edited URDF or SRDF is reloaded.
+    key = (_file_key(urdf), _file_key(srdf_path) if srdf_path else None, robot or urdf.stem, standing)
+    cached = _FILE_ROBOTS.get(key)
+    if cached is None:
+        cached = _load(urdf, srdf_path, robot or urdf.stem, standing)
+        if len(_FILE_ROBOTS) >= 16:  # bounded
+            _FILE_ROBOTS.pop(next(iter(_FILE_ROBOTS)))
+        _FILE_ROBOTS[key] = cached
+    return cached
+
+
+#: Robots loaded from files, by :func:`_file_key` of their URDF and SRDF.
+_FILE_ROBOTS: dict[tuple, Robot] = {}
+
+
+def _file_key(path: Path) -> tuple[str, int, int]:
+    """(resolved path, modification time in ns, size) of a file; (path, -1, -1) if absent."""
+    try:
+        st = path.stat()
+    except OSError:
+        return (str(path), -1, -1)
+    return (str(path.resolve()), st.st_mtime_ns, st.st_size)

@@ -9,16 +9,30 @@ from __future__ import annotations
 
 import functools
 import math
+import typing
 from importlib import resources
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 import pinocchio as pin
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError, field_validator
 
-from .exceptions import ScenarioError, UnknownScenarioError
+from .constants import (
+    GRAVITY_RANGE,
+    MAX_ANGLE,
+    MAX_DESCRIPTION,
+    MAX_DURATION,
+    MAX_FRICTION,
+    MAX_NAME,
+    MAX_PEAK_FACTOR,
+    MAX_POSITION,
+    MAX_SIZE,
+    MAX_SPEED,
+)
+from .exceptions import ScenarioError, UnknownKeyError, UnknownScenarioError
+from .input_limits import MAX_EXTENDS, check_path_text, check_structure, read_yaml
 from .impact import ImpactSpec
 from .robot import Robot, load_robot
 from .spatial import pose
@@ -38,12 +52,56 @@ __all__ = [
     "scenario_from_dict",
 ]
 
+#: ``extends`` resolver: (the value, the file that extends) -> the file to read.
+ExtendsResolver = typing.Callable[[str, Path], Path]
+
 Vec2 = tuple[float, float]
 Vec3 = tuple[float, float, float]
 
+# The physical ranges the schema accepts are in constants.py (shared with lipm.py).
+
+
+def _interval(lo: float, hi: float, lo_open: bool = False, hi_open: bool = False) -> str:
+    return f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
+
+
+def _scalar(lo: float, hi: float, unit: str = "", lo_open: bool = False, hi_open: bool = False) -> AfterValidator:
+    """A validator keeping a number within [lo, hi] (or open ends), naming the range."""
+    text = _interval(lo, hi, lo_open, hi_open) + (f" {unit}" if unit else "")
+
+    def check(v: float) -> float:
+        if not ((lo < v if lo_open else lo <= v) and (v < hi if hi_open else v <= hi)):
+            raise ValueError(f"must be in {text}")
+        return v
+
+    return AfterValidator(check)
+
+
+def _coordinates(limit: float, unit: str) -> AfterValidator:
+    """A validator keeping every coordinate of a vector within [-limit, limit]."""
+
+    def check(v: tuple) -> tuple:
+        if any(abs(x) > limit for x in v):
+            raise ValueError(f"each coordinate must be in [{-limit:g}, {limit:g}] {unit}")
+        return v
+
+    return AfterValidator(check)
+
+
+def _speed(v: tuple) -> tuple:
+    if math.hypot(*v) > MAX_SPEED:
+        raise ValueError(f"the speed must be at most {MAX_SPEED:g} m/s")
+    return v
+
+
+Position = Annotated[Vec3, _coordinates(MAX_POSITION, "m")]
+Angles = Annotated[Vec3, _coordinates(MAX_ANGLE, "rad")]
+Friction = Annotated[float, _scalar(0.0, MAX_FRICTION, lo_open=True)]
+
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, strict=False)
+    # allow_inf_nan=False: NaN and infinities are refused in every float field.
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=False, allow_inf_nan=False)
 
 
 def _finite(values: Any, what: str = "value") -> Any:
@@ -56,10 +114,8 @@ def _finite(values: Any, what: str = "value") -> Any:
 class Offset(_Model):
     """Fixed pose in a robot frame: position (m) and roll-pitch-yaw (rad)."""
 
-    position: Vec3 = (0.0, 0.0, 0.0)
-    rpy: Vec3 = (0.0, 0.0, 0.0)
-
-    _check = field_validator("position", "rpy")(lambda v: _finite(v))
+    position: Position = (0.0, 0.0, 0.0)
+    rpy: Angles = (0.0, 0.0, 0.0)
 
     def se3(self) -> pin.SE3:
         return pose(self.position, self.rpy)
@@ -69,22 +125,15 @@ class ContactConfig(_Model):
     """A sustained rectangular contact (see :class:`impact_balance.stance.ContactSpec`)."""
 
     frame: str
-    friction: float
+    friction: Friction
     size: Vec2
     offset: Offset = Offset()
-
-    @field_validator("friction")
-    @classmethod
-    def _friction(cls, v: float) -> float:
-        if not (math.isfinite(v) and v > 0):
-            raise ValueError("friction must be a finite number > 0")
-        return v
 
     @field_validator("size")
     @classmethod
     def _size(cls, v: Vec2) -> Vec2:
-        if not all(math.isfinite(x) and x > 0 for x in v):
-            raise ValueError("size must be [length, width], both finite and > 0 (m)")
+        if not all(0 < x <= MAX_SIZE for x in v):
+            raise ValueError(f"size must be [length, width], both in (0, {MAX_SIZE:g}] m")
         return v
 
     def spec(self) -> ContactSpec:
@@ -140,7 +189,7 @@ class QPConfig(_Model):
     solve: bool = False
     joint_velocity_limits: bool = False
     impulsive_torque_limits: bool = False
-    peak_factor: float = Field(1.0, gt=0)
+    peak_factor: Annotated[float, _scalar(0.0, MAX_PEAK_FACTOR, lo_open=True)] = 1.0
     solver: str = "daqp"
 
 
@@ -149,12 +198,12 @@ class ImpactConfig(_Model):
 
     frame: str
     offset: Offset = Offset()
-    normal: Vec3
-    friction: float = 0.24
+    normal: Annotated[Vec3, _coordinates(1e6, "(any scale; it is normalised)")]
+    friction: Annotated[float, _scalar(0.0, MAX_FRICTION)] = 0.24
     restitution: Vec2 = (0.0, 0.2)
     cone_edges: int = Field(16, ge=3, le=1024)
-    reference_velocity: Vec3 | None = None
-    duration: float = Field(0.005, gt=0)
+    reference_velocity: Annotated[Vec3, AfterValidator(_speed)] | None = None
+    duration: Annotated[float, _scalar(0.0, MAX_DURATION, "s", lo_open=True)] = 0.005
     inertia: Literal["composite", "joint_space"] = "composite"
     qp: QPConfig = QPConfig()
 
@@ -166,13 +215,6 @@ class ImpactConfig(_Model):
             raise ValueError("normal must be a non-zero vector")
         return v
 
-    @field_validator("friction")
-    @classmethod
-    def _friction(cls, v: float) -> float:
-        if not (math.isfinite(v) and v >= 0):
-            raise ValueError("friction must be a finite number >= 0")
-        return v
-
     @field_validator("restitution")
     @classmethod
     def _restitution(cls, v: Vec2) -> Vec2:
@@ -182,8 +224,6 @@ class ImpactConfig(_Model):
         if lo > hi:
             raise ValueError("restitution must be [lo, hi] with lo <= hi")
         return v
-
-    _check = field_validator("reference_velocity")(lambda v: _finite(v) if v is not None else v)
 
     def spec(self) -> ImpactSpec:
         """The impact's :class:`ImpactSpec` (cached by content: treat it as immutable)."""
@@ -212,28 +252,26 @@ class RobotFiles(_Model):
 class BasePose(_Model):
     """Free-flyer pose override in world: position (m), roll-pitch-yaw (rad)."""
 
-    position: Vec3 | None = None
-    rpy: Vec3 | None = None
+    position: Position | None = None
+    rpy: Angles | None = None
 
 
 class Scenario(_Model):
     """One situation. See README, "Scenario files", for every key."""
 
-    name: str | None = None
-    description: str | None = None
+    name: Annotated[str, Field(max_length=MAX_NAME)] | None = None
+    description: Annotated[str, Field(max_length=MAX_DESCRIPTION)] | None = None
     robot: str | RobotFiles = "talos"
     configuration: str | None = None
     joints: dict[str, float] = {}
     base: BasePose | None = None
-    com_velocity: Vec2 = (0.0, 0.0)
-    plane_height: float = 0.0
+    com_velocity: Annotated[Vec2, AfterValidator(_speed)] = (0.0, 0.0)
+    plane_height: Annotated[float, _scalar(-MAX_POSITION, MAX_POSITION, "m")] = 0.0
     torque_limits: bool = True
-    gravity: float = Field(9.81, gt=0)
+    gravity: Annotated[float, _scalar(*GRAVITY_RANGE, "m/s^2")] = 9.81
     contacts: list[ContactConfig] = Field(min_length=1)
     impact: ImpactConfig | None = None
     source: str | None = Field(None, exclude=True)
-
-    _check = field_validator("com_velocity", "plane_height")(lambda v: _finite(v))
 
     @field_validator("joints")
     @classmethod
@@ -246,6 +284,9 @@ class Scenario(_Model):
     # -- resolution against a robot model -------------------------------------------------
     def load_robot(self) -> Robot:
         if isinstance(self.robot, RobotFiles):
+            check_path_text("robot.urdf", self.robot.urdf, self.source)
+            if self.robot.srdf:
+                check_path_text("robot.srdf", self.robot.srdf, self.source)
             base = Path(self.source).parent if self.source else Path.cwd()
             urdf = (base / self.robot.urdf).resolve()
             srdf = (base / self.robot.srdf).resolve() if self.robot.srdf else None
@@ -311,13 +352,14 @@ def bundled_scenarios() -> dict[str, str]:
 
 def scenario_path(name_or_path: str | Path) -> Path:
     """A scenario file's path: an existing file, or the name of a bundled scenario."""
+    check_path_text("scenario", str(name_or_path))
     path = Path(name_or_path)
-    if path.is_file():
+    if _is_file(path):
         return path
     if path.suffix in (".yaml", ".yml") or "/" in str(name_or_path) or "\\" in str(name_or_path):
         raise ScenarioError("scenario", str(name_or_path), "no such file")
     bundled = _scenario_dir() / f"{name_or_path}.yaml"
-    if bundled.is_file():
+    if _is_file(Path(str(bundled))):
         return Path(str(bundled))
     raise UnknownScenarioError("scenario", str(name_or_path), list(bundled_scenarios()))
 
@@ -332,20 +374,19 @@ def _merge(base: dict, override: dict) -> dict:
     return out
 
 
-def _read(path: Path, seen: tuple[Path, ...] = ()) -> dict:
+def _is_file(path: Path) -> bool:
+    try:
+        return path.is_file()
+    except (OSError, ValueError):  # a name the OS refuses is simply not an existing file
+        return False
+
+
+def _read(path: Path, seen: tuple[Path, ...] = (), resolve_path: ExtendsResolver | None = None) -> dict:
     if path.resolve() in seen:
         raise ScenarioError("extends", str(path), "circular extends")
-    try:
-        text = path.read_text()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ScenarioError("scenario", str(path), f"cannot read: {exc.__class__.__name__}") from None
-    try:
-        raw = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(exc, "problem", None) or "syntax error"
-        raise ScenarioError("scenario", str(path), f"not valid YAML: {problem}{where}") from None
+    if len(seen) >= MAX_EXTENDS:
+        raise ScenarioError("extends", str(path), f"a chain of more than {MAX_EXTENDS} extends")
+    raw = read_yaml(path)
     if raw is None:
         raise ScenarioError("scenario", str(path), "the file is empty")
     if not isinstance(raw, dict):
@@ -353,15 +394,19 @@ def _read(path: Path, seen: tuple[Path, ...] = ()) -> dict:
     parent = raw.pop("extends", None)
     if parent is not None:
         if not isinstance(parent, str):
-            raise ScenarioError("extends", parent, "must be a bundled scenario name or a file path")
+            raise ScenarioError("extends", parent, "must be a bundled scenario name or a file path", str(path))
+        check_path_text("extends", parent, str(path))
         candidate = path.parent / parent
         try:
-            parent_path = candidate if candidate.is_file() else scenario_path(parent)
+            if resolve_path is not None:
+                parent_path = resolve_path(parent, path)
+            else:
+                parent_path = candidate if _is_file(candidate) else scenario_path(parent)
         except UnknownScenarioError as exc:
             raise UnknownScenarioError("extends", parent, exc.valid, str(path)) from None
         except ScenarioError as exc:
             raise ScenarioError("extends", parent, exc.reason, str(path)) from None
-        raw = _merge(_read(parent_path, seen + (path.resolve(),)), raw)
+        raw = _merge(_read(parent_path, seen + (path.resolve(),), resolve_path), raw)
     return raw
 
 
@@ -379,6 +424,7 @@ def _field(loc: tuple) -> str:
 
 def scenario_from_dict(raw: dict, source: str | None = None) -> Scenario:
     """Validate a scenario mapping; raises :class:`ScenarioError` on the first bad field."""
+    check_structure(raw, source)
     try:
         return Scenario.model_validate({**raw, "source": source})
     except ValidationError as exc:
@@ -388,8 +434,8 @@ def scenario_from_dict(raw: dict, source: str | None = None) -> Scenario:
         loc = tuple(p for p in err["loc"] if p not in ("str", "RobotFiles"))
         reason = err["msg"].removeprefix("Value error, ")
         value = err.get("input")
-        if err["type"] == "extra_forbidden":
-            reason = "unknown key"
+        if err["type"] == "extra_forbidden" and loc:
+            raise UnknownKeyError(_field(loc), str(loc[-1]), value, _keys_at(loc[:-1]), source) from None
         elif err["type"] == "missing":
             if loc and isinstance(loc[-1], int):  # a short list/tuple: report the whole list
                 value, reason, loc = _lookup(raw, loc[:-1]), f"too few items (item {loc[-1]} is missing)", loc[:-1]
@@ -398,6 +444,30 @@ def scenario_from_dict(raw: dict, source: str | None = None) -> Scenario:
         raise ScenarioError(_field(loc), value, reason, source) from None
     except ScenarioError as exc:
         raise ScenarioError(exc.field, exc.value, exc.reason, source) from None
+
+
+def _model_in(annotation: Any) -> type[BaseModel] | None:
+    """The pydantic model inside an annotation (``X | None``, ``list[X]``, ``str | X``), if any."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    for arg in typing.get_args(annotation):
+        found = _model_in(arg)
+        if found is not None:
+            return found
+    return None
+
+
+def _keys_at(loc: tuple) -> list[str]:
+    """The keys the schema accepts in the mapping at ``loc`` (for "did you mean")."""
+    model: type[BaseModel] | None = Scenario
+    for part in loc:
+        if isinstance(part, int) or model is None:
+            continue
+        info = model.model_fields.get(part)
+        model = _model_in(info.annotation) if info is not None else None
+    if model is None:
+        return []
+    return [name for name, info in model.model_fields.items() if not info.exclude]
 
 
 def _lookup(raw: Any, loc: tuple) -> Any:
@@ -417,9 +487,15 @@ def with_source(exc: ScenarioError, source: str | None) -> ScenarioError:
     return exc
 
 
-def load_scenario(name_or_path: str | Path) -> Scenario:
-    """Load and validate a scenario file (or a bundled scenario by name)."""
+def load_scenario(name_or_path: str | Path, resolve_path: ExtendsResolver | None = None) -> Scenario:
+    """Load and validate a scenario file (or a bundled scenario by name).
+
+    Args:
+        resolve_path: Optional rule for ``extends:`` (value, path of the file that extends) ->
+            path to read, raising :class:`ScenarioError` to refuse. The GUI passes its
+            workspace's rule; without it, a path relative to the file or a bundled name.
+    """
     path = scenario_path(name_or_path)
-    raw = _read(path)
+    raw = _read(path, (), resolve_path)
     raw.setdefault("name", path.stem)
     return scenario_from_dict(raw, str(path))

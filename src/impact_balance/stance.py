@@ -22,6 +22,11 @@ __all__ = ["ContactSpec", "Contact", "Stance"]
 _IDENTITY = pin.SE3.Identity()
 
 
+def _has_free_flyer(model: pin.Model) -> bool:
+    """Whether the model's first joint is a free flyer (then q[:3] is the base position)."""
+    return model.njoints > 1 and model.joints[1].shortname() == "JointModelFreeFlyer"
+
+
 @dataclass(frozen=True)
 class ContactSpec:
     """A rectangular sustained contact on a robot frame.
@@ -50,12 +55,16 @@ class Contact:
         position: Contact centre in world, m.
         jacobian: 6 x nv Jacobian of the contact point in world-aligned axes
             (linear rows first), so that ``jacobian.T @ [f; tau]`` is the generalized force.
+        local_position: Contact centre in the stance frame (world axes, origin at the
+            stance's ``origin``), m; None for contacts built without a stance (then
+            ``position`` is used).
     """
 
     spec: ContactSpec
     rotation: np.ndarray
     position: np.ndarray
     jacobian: np.ndarray
+    local_position: np.ndarray | None = None
 
     @property
     def half_length(self) -> float:
@@ -85,11 +94,22 @@ class Stance:
     same robot never alias. :meth:`point` recomputes the joint placements and Jacobians
     (~4 us) when another stance has used the scratch Data since.
 
+    Precision far from the origin: the kinematics are computed with the free-flyer's
+    translation set to zero, in the *stance frame* (world axes, origin at ``origin``, the
+    base position of ``q``), and world positions are that plus ``origin``. The constraint and
+    impact steps use differences of stance-frame positions (contact or impact point minus
+    CoM), which do not depend on where the robot stands: translating the whole stance by
+    1e6 m changes no area and no maximum (at 1e15 m a double's spacing is 0.125 m, and world
+    coordinates would lose the lever arms).
+
     Attributes:
         robot: The robot.
         q: Configuration (nq); read-only in spirit: everything below was computed from it.
+        origin: The stance frame's origin in world (the free-flyer position of ``q``, or 0
+            for a fixed base), m.
         contacts: The sustained contacts, resolved.
         com: Centre of mass in world, m.
+        com_local: Centre of mass in the stance frame, m.
         mass: Total mass, kg.
         gravity_torques: Generalized gravity vector g(q) (nv), N and N m.
         com_inertia: Composite rotational inertia about the CoM, world axes, kg m^2.
@@ -99,22 +119,31 @@ class Stance:
         model = robot.model
         self.robot = robot
         self.q = np.array(q, dtype=float)
+        self.origin = np.zeros(3)
+        self._q_local = self.q
+        if _has_free_flyer(model):
+            self.origin = self.q[:3].copy()
+            self._q_local = self.q.copy()
+            self._q_local[:3] = 0.0
         workspace = robot.workspace()
         data = workspace.data
         # ccrba runs the forward kinematics and also fills the joint Jacobians data.J (as
         # computeJointJacobians does) and data.Ig, the centroidal composite inertia in world axes.
-        pin.ccrba(model, data, self.q, np.zeros(model.nv))
-        workspace.holder = self.q.tobytes()
-        self.com = np.array(pin.centerOfMass(model, data, pin.KinematicLevel.POSITION, False), dtype=float)
+        pin.ccrba(model, data, self._q_local, np.zeros(model.nv))
+        workspace.holder = self._q_local.tobytes()
+        self.com_local = np.array(pin.centerOfMass(model, data, pin.KinematicLevel.POSITION, False), dtype=float)
+        self.com = self.com_local + self.origin
         Ig = data.Ig
         self.mass = float(Ig.mass)
         self.com_inertia = np.array(Ig.inertia, dtype=float)
-        self.gravity_torques = np.array(pin.computeGeneralizedGravity(model, data, self.q), dtype=float)
+        # g(q) does not depend on the base position (its base rows are moments about the base).
+        self.gravity_torques = np.array(pin.computeGeneralizedGravity(model, data, self._q_local), dtype=float)
         self.contacts: list[Contact] = []
         for i, spec in enumerate(contacts):
             fid = robot.frame_id(spec.frame, f"contacts[{i}].frame")
             placement, jacobian = self._point(data, fid, spec.offset)
-            self.contacts.append(Contact(spec, placement.rotation.copy(), placement.translation.copy(), jacobian))
+            local = placement.translation.copy()
+            self.contacts.append(Contact(spec, placement.rotation.copy(), local + self.origin, jacobian, local))
 
     @property
     def model(self) -> pin.Model:
@@ -139,14 +168,19 @@ class Stance:
     def _kinematics(self) -> pin.Data:
         """The scratch Data holding this stance's joint placements and joint Jacobians."""
         workspace = self.robot.workspace()
-        key = self.q.tobytes()
+        key = self._q_local.tobytes()
         if workspace.holder != key:
-            pin.computeJointJacobians(self.model, workspace.data, self.q)
+            pin.computeJointJacobians(self.model, workspace.data, self._q_local)
             workspace.holder = key
         return workspace.data
 
     def point(self, frame: str, offset: pin.SE3 | None = None, field: str = "frame") -> tuple[pin.SE3, np.ndarray]:
         """World pose of ``frame * offset`` and its 6 x nv world-aligned Jacobian (linear first)."""
+        placement, J = self.local_point(frame, offset, field)
+        return pin.SE3(placement.rotation, placement.translation + self.origin), J
+
+    def local_point(self, frame: str, offset: pin.SE3 | None = None, field: str = "frame") -> tuple[pin.SE3, np.ndarray]:
+        """:meth:`point` in the stance frame (world axes, origin at :attr:`origin`)."""
         fid = self.robot.frame_id(frame, field)
         return self._point(self._kinematics(), fid, offset)
 
@@ -165,7 +199,8 @@ class Stance:
     def frame_pose(self, frame: str) -> pin.SE3:
         """World pose of a frame (a copy)."""
         fid = self.robot.frame_id(frame)
-        return pin.updateFramePlacement(self.model, self._kinematics(), fid)
+        placement = pin.updateFramePlacement(self.model, self._kinematics(), fid)
+        return pin.SE3(placement.rotation, placement.translation + self.origin)
 
     def lowest_contact_height(self) -> float:
         """Lowest z of any contact corner, m (nan without contacts)."""

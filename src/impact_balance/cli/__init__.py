@@ -3,24 +3,48 @@
 One module per command (``demo``, ``analyze``, ...), each with ``add_parser(sub)`` and
 ``run(args) -> int``; this module assembles them and applies the one error rule: an error of
 the library (bad scenario, unknown frame...) prints one line on stderr and exits with status
-2, with no traceback.
+2, with no traceback. A closed stdout (``analyze --json | head -c 10``) ends quietly with
+status 141, what a shell reports for a command stopped by SIGPIPE.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib.metadata
+import os
 import sys
 from types import ModuleType
 
-from ..exceptions import ImpactBalanceError
+from ..exceptions import ImpactBalanceError, one_line
 from ..projection.walk import kernel_is_compiled
-from . import analyze, check_log, demo, gui, listing, phase_portrait, push_test, simulate, validate
+from . import analyze, check_log, demo, frames, gui, listing, phase_portrait, push_test, simulate, sweep, validate
 from .demo import DEMO_SCENARIOS, FRICTION_SWEEP
 
-__all__ = ["main", "DEMO_SCENARIOS", "FRICTION_SWEEP", "COMMANDS"]
+__all__ = ["main", "DEMO_SCENARIOS", "FRICTION_SWEEP", "COMMANDS", "EXIT_BROKEN_PIPE"]
 
 #: Command modules, in the order of ``--help``.
-COMMANDS: tuple[ModuleType, ...] = (demo, analyze, phase_portrait, listing, gui, simulate, validate, push_test, check_log)
+COMMANDS: tuple[ModuleType, ...] = (demo, analyze, phase_portrait, listing, frames, gui, simulate, validate, push_test, check_log, sweep)
+
+#: Exit status when stdout is closed early (128 + SIGPIPE, as a shell reports it).
+EXIT_BROKEN_PIPE = 141
+
+
+def _version() -> str:
+    try:
+        return importlib.metadata.version("impact-balance")
+    except importlib.metadata.PackageNotFoundError:  # pragma: no cover - run from a source tree
+        return "unknown (not installed)"
+
+
+def _stdout_closed() -> int:
+    """Point stdout at /dev/null so that the interpreter's final flush cannot fail again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):  # stdout is not a file (tests capture it)
+        pass
+    return EXIT_BROKEN_PIPE
 
 
 def _parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
@@ -28,6 +52,7 @@ def _parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
         prog="impact-balance",
         description="Impact-aware multi-contact balance: CoM velocity area and maximum contact velocity.",
     )
+    p.add_argument("--version", action="version", version=f"impact-balance {_version()}")
     sub = p.add_subparsers(dest="command", required=True)
     owners: dict[str, ModuleType] = {}
     for module in COMMANDS:
@@ -44,9 +69,13 @@ def main(argv: list[str] | None = None) -> int:
         print("impact-balance: compiling the projection kernel (first run only, 10-30 s; cached afterwards) ...",
               file=sys.stderr, flush=True)
     try:
-        return module.run(args)
+        status = module.run(args)
+        sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at exit
+        return status
+    except BrokenPipeError:
+        return _stdout_closed()
     except ImpactBalanceError as exc:
-        print(f"impact-balance: error: {exc}", file=sys.stderr)
+        print(f"impact-balance: error: {one_line(str(exc))}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:  # pragma: no cover
         return 130

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import argparse
-import json
+import dataclasses
 from pathlib import Path
 
 __all__ = ["add_parser", "run", "USES_KERNEL"]
@@ -17,6 +17,7 @@ def add_parser(sub) -> list[str]:
     a.add_argument("--json", action="store_true", help="print one JSON object")
     a.add_argument("--plots", metavar="DIR", help="write the scenario's figures to DIR")
     a.add_argument("--qp", action="store_true", help="also solve the paper's QP in joint velocities")
+    a.add_argument("--strict", action="store_true", help="treat warnings as errors (exit status 2)")
     return ["analyze"]
 
 
@@ -24,14 +25,23 @@ def run(args: argparse.Namespace) -> int:
     from ..analysis import analyze
     from ..report import format_analysis
 
+    from ..exceptions import StrictWarningsError
+    from .output import print_json
+
     analysis = analyze(args.scenario, solve_qp=True if args.qp else None)
+    if args.strict and analysis.warnings:
+        raise StrictWarningsError(analysis.warnings)
     written = []
     if args.plots:
         from ..plots import save_figures
 
-        written = save_figures(analysis, Path(args.plots))
+        skipped: list = []
+        written = save_figures(analysis, Path(args.plots), skipped=skipped)
+        analysis = dataclasses.replace(analysis, warnings=analysis.warnings + tuple(skipped))
+        if args.strict and skipped:
+            raise StrictWarningsError(skipped)
     if args.json:
-        print(json.dumps(analysis.to_dict()))
+        print_json(analysis.to_dict())
     else:
         print(format_analysis(analysis))
         for path in written:

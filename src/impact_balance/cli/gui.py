@@ -16,6 +16,11 @@ def add_parser(sub) -> list[str]:
                    help="YAML file or bundled scenario name (default: palm_push_two_feet)")
     g.add_argument("--host", default="127.0.0.1", help="interface to listen on (default: %(default)s, this machine only)")
     g.add_argument("--port", type=int, default=8080, help="TCP port (default: %(default)s; the next free one if taken)")
+    g.add_argument("--workspace", default=".", metavar="DIR",
+                   help="the only folder the GUI loads and saves .yaml files in (default: the current folder)")
+    g.add_argument("--allow-origin", action="append", default=[], metavar="ORIGIN",
+                   help="also accept pages from ORIGIN (scheme://host[:port], e.g. a reverse proxy); repeatable. "
+                        "By default only the GUI's own page may connect")
     return ["gui"]
 
 
@@ -27,9 +32,19 @@ def run(args: argparse.Namespace) -> int:
         print(f"impact-balance: error: the GUI needs viser ({exc})", file=sys.stderr)
         return 2
 
-    def ready(app) -> None:
-        print(f"impact-balance gui: {app.session.state.scenario.name or 'scenario'} at {app.url}  (Ctrl-C to stop)",
-              flush=True)
+    from ..gui.guard import normalize_origin
+    from ..workspace import Workspace
 
-    run_app(args.scenario or DEFAULT_SCENARIO, host=args.host, port=args.port, ready=ready)
+    # Check the flags before anything loads or listens (errors: one line, exit 2).
+    workspace = Workspace(args.workspace)
+    origins = tuple(normalize_origin(o) for o in args.allow_origin)
+
+    def ready(app) -> None:
+        print(f"impact-balance gui: {app.session.state.scenario.name or 'scenario'} at {app.url}  (Ctrl-C to stop)\n"
+              f"  workspace: {app.workspace.root}  (the GUI loads and saves .yaml files here only)", flush=True)
+        if origins:
+            print(f"  also accepting pages from: {', '.join(origins)}", flush=True)
+
+    run_app(args.scenario or DEFAULT_SCENARIO, host=args.host, port=args.port, ready=ready,
+            workspace=workspace, allow_origins=origins)
     return 0

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
 __all__ = ["add_parser", "run"]
@@ -30,8 +29,10 @@ def run(args: argparse.Namespace) -> int:
         Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
         fig.savefig(args.plot, dpi=120)
     if args.json:
-        print(json.dumps({"omega": portrait.omega, "com_height": args.com_height, "zmp_range": list(portrait.zmp_range),
-                          "gravity": args.gravity, "com_velocity_bounds": list(portrait.com_velocity_bounds)}))
+        from .output import print_json
+
+        print_json({"omega": portrait.omega, "com_height": args.com_height, "zmp_range": list(portrait.zmp_range),
+                          "gravity": args.gravity, "com_velocity_bounds": list(portrait.com_velocity_bounds)})
     else:
         lo, hi = portrait.com_velocity_bounds
         print(f"omega = {portrait.omega:.4f} 1/s; CoM velocity bounds at c = 0: [{lo:.4f}, {hi:.4f}] m/s")

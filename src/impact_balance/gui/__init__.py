@@ -2,6 +2,8 @@
 
 - :mod:`.state`: the editable scenario (a validated mapping; load and save YAML).
 - :mod:`.session`: state + analysis, all-or-nothing edits, the numbers shown.
+- :mod:`.files`: every load, upload and save, confined to the workspace folder.
+- :mod:`.guard`: the Host and Origin checks in front of the server (no other page drives it).
 - :mod:`.drag`: gizmo drags solved by whole-body IK (pink), other contacts fixed.
 - :mod:`.scene`: what the 3D view draws, as plain data.
 - :mod:`.view2d`: the 2D view (areas and post-impact sets) as SVG.

@@ -12,6 +12,7 @@ from __future__ import annotations
 import asyncio
 import html
 import logging
+import os
 import threading
 import time
 from collections import deque
@@ -24,7 +25,9 @@ import pinocchio as pin
 
 from ..exceptions import ImpactBalanceError
 from ..scenario import bundled_scenarios
+from ..workspace import Workspace
 from .drag import DragTarget, handle_pose
+from .guard import AccessPolicy, guarded_start
 from .limbs import joint_groups, joint_values
 from .meshes import RobotMeshes
 from .scene import Arrows, Label, Points, Segments, Surface, scene_objects
@@ -117,20 +120,29 @@ class GuiApp:
         host: Interface to bind (default: localhost only).
         port: TCP port; 0 picks a free one. viser moves to the next free port if it is taken.
         verbose: Let viser print its banner and logs.
+        workspace: The only folder the GUI loads from and saves to (see :mod:`.files`).
+        allow_origins: Origins allowed besides the page's own (see :mod:`.guard`).
 
     Attributes:
         session: The model (state, analysis).
         server: The :class:`viser.ViserServer`.
+        policy: Which Host and Origin headers the server answers.
         update_times_ms: Recent update times (edit + analysis + redraw), ms.
     """
 
     def __init__(self, scenario: str | Path | GuiState = DEFAULT_SCENARIO, host: str = "127.0.0.1",
-                 port: int = 8080, verbose: bool = False):
+                 port: int = 8080, verbose: bool = False, workspace: Workspace | str | Path = ".",
+                 allow_origins: tuple[str, ...] | list[str] = ()):
         import viser
 
         check_listen_address(host, port)
-        self.session = Session(scenario)
-        self.server = viser.ViserServer(host=host, port=port, label="impact-balance", verbose=verbose)
+        self.policy = AccessPolicy.for_bind(host, allow_origins)
+        self.session = Session(scenario, workspace)
+        with guarded_start(self.policy) as started:
+            self.server = viser.ViserServer(host=host, port=port, label="impact-balance", verbose=verbose)
+        if not started:  # a viser that starts its server another way: do not serve unguarded
+            self.server.stop()
+            raise GuiError(host, port, "cannot install the Host/Origin check on this viser version")
         self.update_times_ms: deque[float] = deque(maxlen=500)
         self.last_update_ms = float("nan")
         self._syncing = False
@@ -154,6 +166,11 @@ class GuiApp:
             self.refresh()
 
     # -- life cycle -----------------------------------------------------------------------
+    @property
+    def workspace(self) -> Workspace:
+        """The folder the GUI loads from and saves to."""
+        return self.session.files.workspace
+
     @property
     def url(self) -> str:
         host = self.server.get_host()
@@ -363,6 +380,11 @@ class GuiApp:
         rows.append(f'<tr><td>update (analysis + redraw)</td><td style="text-align:right" id="ib-update-ms">'
                     f'{self.last_update_ms:.1f} ms</td></tr>')
         rows.append("</table>")
+        if s.warnings:
+            items = "".join(f"<li>{html.escape(w if len(w) <= 300 else w[:297] + '...')}</li>" for w in s.warnings[:10])
+            more = f"<li>... {len(s.warnings) - 10} more</li>" if len(s.warnings) > 10 else ""
+            rows.append(f'<ul id="ib-warnings" class="ib-warning" style="color:#b36b00;font-size:0.85em;margin:4px 0;'
+                        f'padding-left:1.2em;overflow-wrap:anywhere">{items}{more}</ul>')
         msg = self.session.message
         if msg:
             mcolor = "#d62728" if self.session.refused else "#555"
@@ -428,9 +450,11 @@ class GuiApp:
             self.w_impact_offset.value = _vec(impact.offset.position, 3)
             self.w_impact_inertia.value = impact.inertia
             self.w_impact_duration.value = float(impact.duration)
-        # File.
-        if state.source and not str(state.source).startswith(str(Path(__file__).parents[1])):
-            self.w_file.value = str(state.source)
+        # File: the workspace name of the file last loaded (not a bundled one, not an upload).
+        source = state.source
+        name = self.workspace.relative(os.path.abspath(source)) if source and source.endswith((".yaml", ".yml")) else None
+        if name is not None:
+            self.w_file.value = name
 
     # -- controls -------------------------------------------------------------------------
     def _build_gui(self) -> None:
@@ -628,15 +652,25 @@ class GuiApp:
         self.w_bundled = gui.add_dropdown("bundled", names, initial_value=DEFAULT_SCENARIO if DEFAULT_SCENARIO in names else names[0])
         load_bundled = gui.add_button("Load bundled scenario")
         load_bundled.on_click(lambda _: self.edit(lambda: self.session.load(self.w_bundled.value)))
-        self.w_file = gui.add_text("file", str(Path.cwd() / "scenario.yaml"), hint="Scenario YAML path on the server")
-        load = gui.add_button("Load file")
+        root = self.workspace.root
+        self.w_file = gui.add_text("file", "scenario.yaml",
+                                   hint=f"A .yaml file in the workspace {root} (a name relative to it)")
+        load = gui.add_button("Load file", hint=f"Read the file from the workspace {root}")
         load.on_click(lambda _: self.edit(lambda: self.session.load(self.w_file.value)))
-        save = gui.add_button("Save file")
-        save.on_click(lambda _: self.edit(lambda: self.session.save(self.w_file.value)))
+        self.w_overwrite = gui.add_checkbox("overwrite", False,
+                                            hint="Allow the next save to replace an existing file")
+        save = gui.add_button("Save file", hint=f"Write the scenario to the workspace {root}")
+        save.on_click(lambda _: self.edit(self._save))
         upload = gui.add_upload_button("Upload YAML", mime_type=".yaml,.yml,application/x-yaml,text/yaml")
         upload.on_upload(self._on_upload)
         download = gui.add_button("Download YAML")
         download.on_click(self._on_download)
+
+    def _save(self) -> None:
+        try:
+            self.session.save(self.w_file.value, overwrite=bool(self.w_overwrite.value))
+        finally:
+            self.w_overwrite.value = False  # one confirmation, one save
 
     def _on_opacity(self, event: Any) -> None:
         with self.session.lock:
@@ -646,15 +680,7 @@ class GuiApp:
     def _on_upload(self, event: Any) -> None:
         file = event.target.value
 
-        def apply() -> bool:
-            try:
-                text = file.content.decode("utf-8")
-            except UnicodeDecodeError:
-                self.session.message, self.session.refused = f"{file.name}: not a UTF-8 text file", True
-                return False
-            return self.session.load_yaml(text, file.name)
-
-        self.edit(apply)
+        self.edit(lambda: self.session.upload(str(file.name), bytes(file.content)))
 
     def _on_download(self, event: Any) -> None:
         with self.session.lock:
@@ -665,23 +691,29 @@ class GuiApp:
 
 
 def run(scenario: str | Path = DEFAULT_SCENARIO, host: str = "127.0.0.1", port: int = 8080,
-        ready: Callable[[GuiApp], None] | None = None, stop: threading.Event | None = None) -> None:
+        ready: Callable[[GuiApp], None] | None = None, stop: threading.Event | None = None,
+        workspace: Workspace | str | Path = ".", allow_origins: tuple[str, ...] | list[str] = ()) -> None:
     """Start the GUI and serve until Ctrl-C, SIGTERM, or ``stop`` is set.
 
     Args:
-        scenario: Scenario file or bundled name.
+        scenario: Scenario file or bundled name (read as given: it comes from the command line).
         host, port: Where to listen.
         ready: Called with the app once it serves (the CLI prints the URL there).
         stop: Optional event that ends the loop (for tests).
+        workspace: The folder the GUI loads from and saves to.
+        allow_origins: Origins allowed besides the page's own.
     """
     import signal
 
     stop = stop or threading.Event()
     previous = None
     if threading.current_thread() is threading.main_thread():
-        # SIGTERM (kill, service managers) ends the server as cleanly as Ctrl-C does.
-        previous = signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    app = GuiApp(scenario, host=host, port=port)
+        # SIGTERM ends the process at once, by the system's default action: a Python handler
+        # would wait for the main thread, which cannot run while a worker holds the interpreter
+        # (a long parse), and interpreter exit would wait for busy workers. Nothing is lost: the
+        # GUI keeps no unsaved files, and a save replaces its file in one step.
+        previous = signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    app = GuiApp(scenario, host=host, port=port, workspace=workspace, allow_origins=allow_origins)
     try:
         if ready is not None:
             ready(app)

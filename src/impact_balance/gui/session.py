@@ -22,7 +22,9 @@ import pinocchio as pin
 
 from ..analysis import Analysis, analyze
 from ..exceptions import ImpactBalanceError
+from ..workspace import Workspace
 from .drag import DragTarget, drag_changes
+from .files import GuiFiles, describe
 from .state import DEFAULT_SCENARIO, FieldPath, GuiState
 
 __all__ = ["Summary", "Session", "format_speed"]
@@ -49,6 +51,7 @@ class Summary:
         zmp_max_contact_velocity: The same by the ZMP criterion, m/s.
         reference_speed: Approach speed of the reference velocity, m/s (None without one).
         falls_at_reference: Whether the reference approach speed exceeds the maximum.
+        warnings: The analysis' warnings, one line each (see :mod:`impact_balance.diagnostics`).
     """
 
     verdict: str
@@ -57,6 +60,7 @@ class Summary:
     zmp_max_contact_velocity: float | None
     reference_speed: float | None
     falls_at_reference: bool
+    warnings: tuple[str, ...] = ()
 
     @classmethod
     def of(cls, analysis: Analysis) -> Summary:
@@ -69,7 +73,8 @@ class Summary:
             if v_ref is not None:
                 ref = max(0.0, im.model.approach_speed(v_ref))
                 falls = ref > vmax + 1e-12
-        return cls(analysis.verdict, analysis.areas.can_balance, vmax, zmp, ref, falls)
+        warnings = tuple(str(w) for w in analysis.warnings)
+        return cls(analysis.verdict, analysis.areas.can_balance, vmax, zmp, ref, falls, warnings)
 
     @property
     def headline(self) -> str:
@@ -80,8 +85,14 @@ class Summary:
 class Session:
     """The GUI's model: state, analysis, last message. Thread-safe (one edit at a time).
 
+    Args:
+        state: The first state: a :class:`GuiState`, or a scenario file or bundled name given
+            on the command line (read as is; later loads go through the workspace).
+        workspace: The folder every load and save from the GUI is confined to.
+
     Attributes:
         state: The current (valid) state.
+        files: Loads, uploads and saves, confined to the workspace.
         analysis: Its analysis.
         message: Why the last edit was refused, or a note about it (None when all went well).
         refused: Whether the last edit was refused.
@@ -89,7 +100,8 @@ class Session:
         lock: Re-entrant lock held during every edit (the app holds it while redrawing).
     """
 
-    def __init__(self, state: GuiState | str | Path = DEFAULT_SCENARIO):
+    def __init__(self, state: GuiState | str | Path = DEFAULT_SCENARIO, workspace: Workspace | str | Path = "."):
+        self.files = GuiFiles(workspace)
         if not isinstance(state, GuiState):
             state = GuiState.from_file(state)
         self.lock = threading.RLock()
@@ -109,11 +121,11 @@ class Session:
                 state = build()
                 analysis = analyze(state.scenario)
             except ImpactBalanceError as exc:
-                self.message, self.refused = str(exc), True
+                self.message, self.refused = describe(exc, self.files.workspace), True
                 return False
             except Exception as exc:  # noqa: BLE001 - the GUI must survive a library bug
                 log.exception("unexpected error while applying an edit")
-                self.message, self.refused = f"internal error ({exc.__class__.__name__}): {exc}", True
+                self.message, self.refused = describe(exc), True
                 return False
             self.state, self.analysis = state, analysis
             self.analysis_ms = 1e3 * (time.perf_counter() - t0)
@@ -134,23 +146,30 @@ class Session:
         """Switch to another (already parsed) state."""
         return self._commit(lambda: state)
 
-    def load(self, name_or_path: str | Path) -> bool:
-        """Load a scenario file or a bundled scenario by name."""
-        return self._commit(lambda: GuiState.from_file(name_or_path))
+    def load(self, name: str) -> bool:
+        """Load a bundled scenario by name, or a ``.yaml`` file of the workspace by its relative name."""
+        return self._commit(lambda: self.files.load(name))
+
+    def upload(self, filename: str, content: bytes) -> bool:
+        """Load an uploaded scenario file (its bytes; size-limited, parsed like a file)."""
+        return self._commit(lambda: self.files.upload(filename, content))
 
     def load_yaml(self, text: str, source: str | None = None) -> bool:
-        """Load scenario YAML text (e.g. an uploaded file)."""
-        return self._commit(lambda: GuiState.from_yaml(text, source))
+        """Load scenario YAML text, as an upload named ``source``."""
+        return self.upload(source or "uploaded.yaml", text.encode("utf-8"))
 
-    def save(self, path: str | Path) -> Path | None:
-        """Save the current state as a scenario file; None (and :attr:`message`) on failure."""
+    def save(self, name: str, overwrite: bool = False) -> Path | None:
+        """Save the current state to a workspace file; None (and :attr:`message`) if refused.
+
+        An existing file is replaced only with ``overwrite`` (the GUI's confirmation box).
+        """
         with self.lock:
             try:
-                out = self.state.save(path)
+                out = self.files.save(self.state, name, overwrite=overwrite)
             except ImpactBalanceError as exc:
-                self.message, self.refused = str(exc), True
+                self.message, self.refused = describe(exc, self.files.workspace), True
                 return None
-            self.message, self.refused = f"saved {out}", False
+            self.message, self.refused = f"saved {self.files.workspace.relative(out)}", False
             return out
 
     def drag(self, target: DragTarget, pose: pin.SE3) -> bool:

@@ -4,7 +4,8 @@ A :class:`GuiState` is immutable. An edit (:meth:`GuiState.with_changes`) return
 or raises :class:`~impact_balance.exceptions.ScenarioError` naming the bad field, so that the
 caller keeps the previous good state and shows the message. The mapping has the schema of the
 scenario files (README, "Scenario files"): :meth:`GuiState.to_yaml` writes a file that
-``impact-balance analyze`` reads, and :meth:`GuiState.from_file` reads any scenario file.
+``impact-balance analyze`` reads, and :meth:`GuiState.from_file` reads any scenario file (the
+GUI reads and writes files only through :mod:`.files`, confined to its workspace).
 """
 
 from __future__ import annotations
@@ -134,26 +135,6 @@ class GuiState:
         """Read a scenario file or a bundled scenario by name (``extends`` resolved)."""
         return cls.from_scenario(load_scenario(name_or_path))
 
-    @classmethod
-    def from_yaml(cls, text: str, source: str | None = None) -> GuiState:
-        """Parse scenario YAML text (an uploaded file); ``extends`` is resolved like a file's."""
-        import tempfile
-
-        # load_scenario reads files (it resolves `extends` and reports YAML errors with their
-        # line): write the text to a temporary file rather than duplicate that logic.
-        name = Path(source).name if source else "uploaded.yaml"
-        if not name.endswith((".yaml", ".yml")):
-            name += ".yaml"
-        with tempfile.TemporaryDirectory() as tmp:
-            path = Path(tmp) / name
-            path.write_text(text)
-            try:
-                scenario = load_scenario(path)
-            except ScenarioError as exc:
-                raise ScenarioError(exc.field, exc.value, exc.reason, source or name) from None
-        state = cls.from_scenario(scenario)
-        return cls(state.raw, source)
-
     # -- reading ------------------------------------------------------------------------
     @property
     def raw(self) -> dict[str, Any]:
@@ -175,7 +156,11 @@ class GuiState:
         return yaml.safe_dump(self._raw, sort_keys=False, default_flow_style=None, width=100)
 
     def save(self, path: str | Path) -> Path:
-        """Write :meth:`to_yaml` to ``path`` (folders created); :class:`ScenarioError` if it cannot."""
+        """Write :meth:`to_yaml` to ``path`` (folders created); :class:`ScenarioError` if it cannot.
+
+        For scripts: anywhere, no confirmation. The GUI never calls it; it saves through its
+        workspace (:meth:`impact_balance.gui.files.GuiFiles.save`).
+        """
         path = Path(path).expanduser()
         if path.suffix not in (".yaml", ".yml"):
             raise ScenarioError("file", str(path), "a scenario file name must end with .yaml or .yml")

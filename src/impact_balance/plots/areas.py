@@ -24,7 +24,6 @@ from ._common import (
     new_figure,
     scenario_title,
     set_limits,
-    text_box,
 )
 
 __all__ = ["plot_areas", "draw_zmp_area", "draw_com_velocity_area"]
@@ -57,7 +56,8 @@ def draw_zmp_area(ax: Axes, analysis: Analysis) -> None:
     ax.set_ylabel("y (m)")
     ax.set_title(f"ZMP support area (plane z = {areas.plane_height:g} m)")
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="upper left", fontsize=8, framealpha=0.9)
+    # Below the axes: a legend inside would cover the area's boundary.
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.0), borderaxespad=4.8, fontsize=8, framealpha=0.9, ncol=2)
 
 
 def draw_com_velocity_area(ax: Axes, analysis: Analysis, n_steps: int = 5) -> None:
@@ -118,8 +118,8 @@ def draw_com_velocity_area(ax: Axes, analysis: Analysis, n_steps: int = 5) -> No
         lines.append(f"  ZMP criterion: {fmt_speed(im.zmp_max_contact_velocity)}")
         if v_ref is not None:
             lines.append(f"  reference: {v_ref:.3g} m/s")
-        lines.append(f"impact friction {model.spec.friction:g}, restitution "
-                     f"[{model.spec.restitution[0]:g}, {model.spec.restitution[1]:g}]")
+        lines.append(f"impact friction μ = {model.spec.friction:g}")
+        lines.append(f"restitution [{model.spec.restitution[0]:g}, {model.spec.restitution[1]:g}]")
         if limit.status == "unbounded":
             lines.append("no approach speed can leave the area")
     else:
@@ -127,15 +127,19 @@ def draw_com_velocity_area(ax: Axes, analysis: Analysis, n_steps: int = 5) -> No
     falling = not area.is_empty and not analysis.com_velocity_inside
     if falling:
         lines.insert(0, "FALLING: the pre-impact CoM velocity\nis outside the area (v_max = 0)")
-    lines.append(f"omega = {areas.omega:.3f} 1/s")
-    text_box(ax, "\n".join(lines), loc="upper left", fontsize=8, edgecolor=FALL_COLOR if falling else "0.6")
+    lines.append(f"ω = {areas.omega:.3f} 1/s")
+    # Outside the axes, right of them (the legend above, this note below): nothing covers
+    # the area's boundary, whatever its shape.
+    ax.text(1.03, 0.0, "\n".join(lines), transform=ax.transAxes, ha="left", va="bottom", fontsize=8, zorder=10,
+            bbox=dict(boxstyle="round,pad=0.4", facecolor="white", edgecolor=FALL_COLOR if falling else "0.6",
+                      lw=2 if falling else 1))
     set_limits(ax, area_view_points(area, view), margin=0.12, min_ratio=0.5)
     ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel(r"$\dot c_x$ (m/s)")
     ax.set_ylabel(r"$\dot c_y$ (m/s)")
     ax.set_title("CoM velocity area and post-impact CoM velocities")
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="lower right", fontsize=7.5, framealpha=0.9)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.03, 1.0), fontsize=7.5, framealpha=0.9)
 
 
 def plot_areas(analysis: Analysis, n_steps: int = 5) -> Figure:
@@ -148,9 +152,19 @@ def plot_areas(analysis: Analysis, n_steps: int = 5) -> Figure:
     """
     if n_steps < 1 or not math.isfinite(n_steps):
         raise ValueError("n_steps must be >= 1")
-    fig = new_figure(13, 6.2)
+    fig = new_figure(15, 6.2)
     left, right = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.25]})
     draw_zmp_area(left, analysis)
     draw_com_velocity_area(right, analysis, n_steps)
+    # Height from the data: both axes have an equal aspect, so a flat area in a fixed-height
+    # figure leaves bands of blank space above and below it.
+    ratio = max(_aspect(left), _aspect(right))
+    fig.set_figheight(float(np.clip(4.2 * ratio + 2.6, 4.0, 9.0)))
     fig.suptitle(f"Balance areas: {scenario_title(analysis)} - {analysis.verdict}", fontsize=12)
     return fig
+
+
+def _aspect(ax: Axes) -> float:
+    """Height / width of the axes' data limits."""
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    return abs(y1 - y0) / max(abs(x1 - x0), 1e-12)

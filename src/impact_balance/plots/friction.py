@@ -23,7 +23,7 @@ def _same_area(a: Analysis, b: Analysis) -> bool:
 def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
     """Post-impact CoM velocity sets at each analysis' own maximum, one colour per impact friction.
 
-    Left: the sets on the (common) CoM velocity area, legend ``mu = 0.1: v_max = ... m/s``; an
+    Left: the sets on the (common) CoM velocity area, legend ``μ = 0.1: v_max = ... m/s``; an
     analysis whose area differs from the first one also gets its area outlined in its colour.
     Right: the maximum approach speed against mu for the CoM and the ZMP criteria.
 
@@ -48,12 +48,12 @@ def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
         c0 = run.com_velocity[:2]
         if not _same_area(run, base) and not run.areas.com_velocity_area.is_empty:
             draw_polygon(ax, run.areas.com_velocity_area, color=color, fill=False, lw=1.2, ls=":", zorder=1.5,
-                         label=f"mu = {mu:g}: its own CoM velocity area")
+                         label=f"μ = {mu:g}: its own CoM velocity area")
             view += area_view_points(run.areas.com_velocity_area)
         speed, which = impulse_set_speed(run)
         pts = im.model.post_impact_com_velocities(c0, speed)
         view.append(pts)
-        label = f"mu = {mu:g}: v_max = {fmt_speed(im.max_contact_velocity)}"
+        label = f"μ = {mu:g}: v_max = {fmt_speed(im.max_contact_velocity)}"
         if which != "v_max":
             label += f" (set at {speed:.3g} m/s)"
         draw_polygon(ax, hull(pts), color=color, alpha=0.35, edge=color, lw=2, label=label, zorder=3)
@@ -69,7 +69,8 @@ def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
     ax.set_ylabel(r"$\dot c_y$ (m/s)")
     ax.set_title("Post-impact CoM velocity sets at each maximum (stars: limiting vertices)", fontsize=10)
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="lower right", fontsize=8, framealpha=0.9)
+    # Below the axes: inside, it would cover the area's boundary.
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.0), borderaxespad=4.8, fontsize=8, framealpha=0.9, ncol=2)
 
     # v_max against mu, both criteria (bars with their values written on them).
     mus = [r.impact.model.spec.friction for r in runs]
@@ -91,7 +92,7 @@ def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
             bar.text(rect.get_x() + rect.get_width() / 2, rect.get_height() + 0.01 * top, text,
                      ha="center", va="bottom", fontsize=8)
     bar.set_xticks(x, [f"{m:g}" for m in mus])
-    bar.set_xlabel("impact friction coefficient mu (-)")
+    bar.set_xlabel("impact friction coefficient μ (-)")
     bar.set_ylabel("maximum approach speed (m/s)")
     bar.set_ylim(0, 1.25 * top)
     bar.set_title("Maximum contact velocity vs impact friction", fontsize=10)

@@ -72,11 +72,16 @@ def _draw_impulse_polytope(ax: Axes, model: ImpactModel, speed: float) -> None:
     ax.set_xlim(centre[0] - half, centre[0] + half)
     ax.set_ylim(centre[1] - half, centre[1] + half)
     ax.set_zlim(centre[2] - half, centre[2] + half)
-    ax.set_box_aspect((1, 1, 1))
-    ax.set_xlabel(r"$\iota_x$ (N s)")
-    ax.set_ylabel(r"$\iota_y$ (N s)")
-    ax.zaxis.set_rotate_label(False)
-    ax.set_zlabel(r"$\iota_z$ (N s)", rotation=90)
+    # Zoomed out a little: constrained layout does not see 3D axis labels, which the full
+    # box would push out of the figure.
+    ax.set_box_aspect((1, 1, 1), zoom=0.82)
+    # Horizontal labels, padded off the ticks: labels rotated along the axes read upside
+    # down from some view directions.
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.set_rotate_label(False)
+    ax.set_xlabel(r"$\iota_x$ (N s)", labelpad=14)
+    ax.set_ylabel(r"$\iota_y$ (N s)", labelpad=14)
+    ax.set_zlabel(r"$\iota_z$ (N s)", labelpad=10)
     # Look from between the impulse direction and the normal of the planes of restitution
     # (W^T n), slightly from above: the two rings then show as ellipses, not edge-on.
     nrm = model.normal
@@ -84,7 +89,7 @@ def _draw_impulse_polytope(ax: Axes, model: ImpactModel, speed: float) -> None:
     look = nrm + plane / max(float(np.linalg.norm(plane)), 1e-12)
     azim = float(np.degrees(np.arctan2(look[1], look[0]))) if np.linalg.norm(look[:2]) > 1e-6 else -60.0
     ax.view_init(elev=30, azim=azim)
-    ax.legend(loc="upper left", fontsize=7.5)
+    ax.legend(loc="upper left", bbox_to_anchor=(0.0, 1.0), fontsize=7.5)
 
 
 def _draw_jump_set(ax: Axes, model: ImpactModel, speed: float) -> None:
@@ -135,7 +140,7 @@ def plot_impulse_set(analysis: Analysis, approach_speed: float | None = None) ->
     model = im.model
     n = model.cone.shape[1]
     _draw_impulse_polytope(ax3, model, speed)
-    ax3.set_title(f"Impulse set: {2 * n} vertices, friction cone with N = {n} edges (mu = {model.spec.friction:g})",
+    ax3.set_title(f"Impulse set: {2 * n} vertices, friction cone with N = {n} edges (μ = {model.spec.friction:g})",
                   fontsize=10)
     _draw_jump_set(ax2, model, speed)
     ax2.set_title(f"CoM velocity jump set (xy), mass {model.mass:.1f} kg", fontsize=10)

@@ -74,8 +74,11 @@ def plot_phase_portrait(portrait: PhasePortrait, title: str | None = None) -> Fi
         cd = 0.8 * ylim[1] if name == "lo" else 0.8 * ylim[0]
         cx = z - cd / w
         if xlim[0] < cx < xlim[1]:
-            ax.annotate(rf"$c + \dot c/\omega = {z:+.3g}$ m", (cx, cd), xytext=(6, 0), textcoords="offset points",
-                        fontsize=8, color="darkgreen", va="center")
+            # Written towards the middle of the view, so that it never runs out of the axes.
+            right_half = cx > 0.5 * (xlim[0] + xlim[1])
+            ax.annotate(rf"$c + \dot c/\omega = {z:+.3g}$ m", (cx, cd), xytext=(-6 if right_half else 6, 0),
+                        textcoords="offset points", fontsize=8, color="darkgreen", va="center",
+                        ha="right" if right_half else "left")
     for k, traj in enumerate(portrait.trajectories):
         traj = np.asarray(traj, dtype=float)
         if len(traj) < 2:
@@ -98,5 +101,5 @@ def plot_phase_portrait(portrait: PhasePortrait, title: str | None = None) -> Fi
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
     ax.set_title(title or (f"LIPM phase portrait: CoM height {portrait.com_height:.3g} m, "
-                           f"ZMP in [{z_lo:.3g}, {z_hi:.3g}] m, omega = {w:.3f} 1/s"), fontsize=10)
+                           f"ZMP in [{z_lo:.3g}, {z_hi:.3g}] m, ω = {w:.3f} 1/s"), fontsize=10)
     return fig

@@ -8,6 +8,7 @@ from pathlib import Path
 from matplotlib.figure import Figure
 
 from ..analysis import Analysis
+from ..diagnostics import Diagnostic
 from ._common import DPI
 from .areas import plot_areas
 from .impulse import plot_impulse_set
@@ -23,12 +24,15 @@ def figure_prefix(analysis: Analysis) -> str:
     return re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._") or "scenario"
 
 
-def save_figures(analysis: Analysis, out_dir: str | Path, dpi: int = DPI) -> list[Path]:
+def save_figures(
+    analysis: Analysis, out_dir: str | Path, dpi: int = DPI, skipped: list[Diagnostic] | None = None
+) -> list[Path]:
     """Write ``<scenario>_areas.png``, ``_stance.png``, ``_phase_portrait.png`` and, with an impact,
     ``_impulse_set.png`` to ``out_dir`` (created if needed). Returns the paths written.
 
     The phase portrait is the sagittal one of the stance (:func:`analysis_phase_portrait`); it is
-    skipped when the ZMP support area has no chord through the CoM along x.
+    skipped when the ZMP support area has no chord through the CoM along x; a skipped figure is
+    appended to ``skipped`` as a ``figure_skipped`` :class:`Diagnostic` saying why.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -38,11 +42,16 @@ def save_figures(analysis: Analysis, out_dir: str | Path, dpi: int = DPI) -> lis
         figures.append(("impulse_set", plot_impulse_set(analysis)))
     try:
         portrait = analysis_phase_portrait(analysis, axis=0)
-    except ValueError:
+    except ValueError as exc:
         portrait = None
+        if skipped is not None:
+            skipped.append(Diagnostic("figure_skipped", "plots", f"no {prefix}_phase_portrait.png: {exc}"))
     if portrait is not None:
-        title = (f"{prefix}: sagittal LIPM phase portrait, CoM height {portrait.com_height:.3g} m, "
-                 f"ZMP in [{portrait.zmp_range[0]:+.3g}, {portrait.zmp_range[1]:+.3g}] m about the CoM")
+        com = analysis.areas.com
+        title = (f"{prefix}: sagittal LIPM phase portrait, CoM height {portrait.com_height:.3g} m\n"
+                 f"ZMP in [{portrait.zmp_range[0]:+.3g}, {portrait.zmp_range[1]:+.3g}] m about the CoM: "
+                 f"the chord of the ZMP support area along x\nthrough the CoM (at y = {com[1]:.3f} m); "
+                 f"other slices of the area give other bounds")
         figures.append(("phase_portrait", plot_phase_portrait(portrait, title=title)))
     written = []
     for name, fig in figures:

@@ -6,7 +6,10 @@ other and against pypoman):
 - ``walk`` (default): a parametric simplex walk around the polygon in a compiled kernel,
   one pivot per vertex (:mod:`.walk`);
 - ``bretl``: Bretl & Lall's incremental projection, one HiGHS LP per edge (:mod:`.bretl`),
-  used as the fallback when the walk cannot answer (a polytope containing a line).
+  used as the fallback when the walk cannot answer: a polytope containing a line, or a walk
+  that fails its own certificate (a vertex violating a constraint by more than 1e-7, or
+  vertices that are not a convex counter-clockwise polygon winding once), which happens with
+  badly scaled rows such as friction 1e9 beside 0.7.
 """
 
 from __future__ import annotations
@@ -61,4 +64,8 @@ def project_polytope(
             return result
         if method == "walk":
             raise SolverError("projection walk", "failed", "the polytope contains a line or a pivot was singular; use method='bretl'")
-    return project_bretl(A, b, C, d, E, tol=tol, box=box, max_lp=max_lp, merge_tol=merge)
+    result = project_bretl(A, b, C, d, E, tol=tol, box=box, max_lp=max_lp, merge_tol=merge)
+    polygon = result.polygon
+    if not (np.isfinite(polygon.vertices).all() and polygon.area >= 0.0):  # never a wrong answer
+        raise SolverError("projection", "bretl", "the projected polygon is not finite and counter-clockwise")
+    return result

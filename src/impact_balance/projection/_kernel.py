@@ -357,6 +357,17 @@ def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots):
 
 
 @njit(cache=True)
+def _min_slack(H, h, z, worst):
+    """``worst[0]`` = min(worst[0], min_j h_j - H_j z): a vertex's feasibility check."""
+    for j in range(H.shape[0]):
+        b = h[j]
+        for k in range(H.shape[1]):
+            b -= H[j, k] * z[k]
+        if b < worst[0]:
+            worst[0] = b
+
+
+@njit(cache=True)
 def _breakpoint(Binv, GT, theta, scale):
     """Smallest angle > theta at which a multiplier of the basis turns negative (inf if none)."""
     n = Binv.shape[0]
@@ -380,11 +391,13 @@ def _breakpoint(Binv, GT, theta, scale):
 
 
 @njit(cache=True)
-def walk(H, h, GT, g0, theta0, max_pivots):
+def walk(H, h, GT, g0, theta0, max_pivots, worst):
     """Vertices of ``g0 + G {z : H z <= h}`` (rows of H unit norm; ``GT`` = G^T, n x 2).
 
     Returns (status, vertices, count, pivots): ``vertices[:count]`` are the support points
     in counter-clockwise order, consecutive duplicates removed (the last may equal the first).
+    ``worst[0]`` receives the smallest slack of the recorded vertices (>= -rounding for a
+    sound walk; the caller rejects the walk otherwise).
     """
     m, n = H.shape
     vertices = np.empty((0, 2))
@@ -439,6 +452,7 @@ def walk(H, h, GT, g0, theta0, max_pivots):
     if status != OK:
         return status, vertices, 0, pivots
     vertices = np.empty((max_pivots + 2, 2))
+    _min_slack(H, h, z, worst)
     vertices[0] = _point(g0, GT, z)
     count = 1
     theta = theta0
@@ -456,6 +470,7 @@ def walk(H, h, GT, g0, theta0, max_pivots):
             return FAILED, vertices, count, pivots
         # piv == 0: the crossing multiplier was within the tolerance of zero; the next
         # breakpoint search starts past it.
+        _min_slack(H, h, z, worst)
         y = _point(g0, GT, z)
         if abs(y[0] - vertices[count - 1, 0]) + abs(y[1] - vertices[count - 1, 1]) > 0.0:
             vertices[count] = y
@@ -464,12 +479,45 @@ def walk(H, h, GT, g0, theta0, max_pivots):
 
 
 @njit(cache=True)
+def _convex_ccw(v):
+    """Whether the (k, 2) vertices form a convex counter-clockwise polygon that winds once.
+
+    Every turn must be a left turn (cross product >= -1e-9 of the edge lengths' product,
+    i.e. a clockwise kink under a nano-radian) and the turning angles must add up to 2 pi:
+    a walk that lost its way backtracks (a half-turn) or winds twice. Fewer than 3
+    vertices (a point or a segment) pass; non-finite coordinates fail.
+    """
+    k = v.shape[0]
+    for i in range(k):
+        if not (math.isfinite(v[i, 0]) and math.isfinite(v[i, 1])):
+            return False
+    if k < 3:
+        return True
+    total = 0.0
+    for i in range(k):
+        a = v[i - 1]
+        b = v[i]
+        c = v[(i + 1) % k]
+        e0x, e0y = b[0] - a[0], b[1] - a[1]
+        e1x, e1y = c[0] - b[0], c[1] - b[1]
+        cross = e0x * e1y - e0y * e1x
+        dot = e0x * e1x + e0y * e1y
+        if cross < -1e-9 * math.hypot(e0x, e0y) * math.hypot(e1x, e1y):
+            return False
+        total += math.atan2(cross, dot)
+    return abs(total - 2.0 * math.pi) < 1e-6
+
+
+@njit(cache=True)
 def project(A, b, E, x0, N, box, merge_tol, max_pivots):
     """Projection of ``{x : A x <= b, x = x0 + N z}`` onto ``y = E x``, clipped to ``|y_k| <= box``.
 
     Drops zero rows of ``A N`` (checking them), scales the rows to unit norm, adds the box as
     four rows, walks, and merges vertices within ``merge_tol``.
-    Returns (status, vertices (k, 2) counter-clockwise, pivots).
+    Returns (status, vertices (k, 2) counter-clockwise, pivots, worst): ``worst`` is the
+    smallest slack of a visited point in the unit-row constraints (see :func:`walk`); the
+    status is FAILED when the vertices do not form a convex counter-clockwise polygon that
+    winds once.
     """
     none = np.empty((0, 2))
     n, k = N.shape
@@ -490,10 +538,10 @@ def project(A, b, E, x0, N, box, merge_tol, max_pivots):
     if k == 0:  # a single point
         for i in range(m0):
             if h0[i] < -_EPS_FEASIBLE:
-                return INFEASIBLE, none, 0
+                return INFEASIBLE, none, 0, 0.0
         out = np.empty((1, 2))
         out[0] = g0
-        return OK, out, 0
+        return OK, out, 0, 0.0
     # Unit rows; zero rows are checked then dropped.
     norms = np.empty(m0)
     biggest = 1.0
@@ -506,7 +554,7 @@ def project(A, b, E, x0, N, box, merge_tol, max_pivots):
     for i in range(m0):
         if norms[i] <= _RANK * biggest:
             if h0[i] < -_EPS_FEASIBLE:
-                return INFEASIBLE, none, 0
+                return INFEASIBLE, none, 0, 0.0
         else:
             H[m] = H0[i] / norms[i]
             h[m] = h0[i] / norms[i]
@@ -520,10 +568,14 @@ def project(A, b, E, x0, N, box, merge_tol, max_pivots):
             H[m + 1] = -G[i] / gk
             h[m + 1] = (box + g0[i]) / gk
             m += 2
-    status, vertices, count, pivots = walk(H[:m].copy(), h[:m].copy(), G.T.copy(), g0, 0.0, max_pivots)
+    worst = np.zeros(1)
+    status, vertices, count, pivots = walk(H[:m].copy(), h[:m].copy(), G.T.copy(), g0, 0.0, max_pivots, worst)
     if status != OK:
-        return status, none, pivots
-    return OK, _simplify(vertices[:count].copy(), merge_tol), pivots
+        return status, none, pivots, worst[0]
+    polygon = _simplify(vertices[:count].copy(), merge_tol)
+    if not _convex_ccw(polygon):
+        return FAILED, none, pivots, worst[0]
+    return OK, polygon, pivots, worst[0]
 
 
 @njit(cache=True)

@@ -25,13 +25,17 @@ import numpy as np
 from .._jit import HAVE_NUMBA
 
 from ..polygon import Polygon
-from ._kernel import FAILED, INFEASIBLE, LINE, equality_basis, project
+from ._kernel import FAILED, INFEASIBLE, LINE, OK, equality_basis, project
 from .result import ProjectionResult
 
-__all__ = ["project_walk", "kernel_is_compiled"]
+__all__ = ["project_walk", "kernel_is_compiled", "warm_up"]
 
 #: Relative singular-value threshold for the rank of the lines of the polytope.
 RANK_TOLERANCE = 1e-12
+#: Largest constraint violation (unit rows, in units of b, relative to 1 + max |b|) a
+#: vertex of a sound walk may show; beyond it the walk is rejected (badly scaled rows, e.g.
+#: friction 1e9 next to 1e-9) and the caller falls back to Bretl.
+SLACK_TOLERANCE = 1e-7
 
 def project_walk(
     A: np.ndarray,
@@ -47,7 +51,8 @@ def project_walk(
 
     Lines in the polytope (directions the constraints leave free and E ignores) are
     quotiented out. Returns None when the walk cannot answer (a pivot met a numerical dead
-    end, or an iteration cap): the caller falls back to :func:`~.bretl.project_bretl`.
+    end, an iteration cap, a vertex that violates a constraint, or vertices that are not a
+    convex counter-clockwise polygon): the caller falls back to :func:`~.bretl.project_bretl`.
     """
     E = np.ascontiguousarray(E, dtype=float)
     n = E.shape[1]
@@ -59,16 +64,22 @@ def project_walk(
     status, x0, N = equality_basis(C, d)
     if status == INFEASIBLE:
         return ProjectionResult(Polygon.empty(), "walk")
-    status, vertices, pivots = project(A, b, E, x0, N, float(box), float(merge_tol), int(max_pivots))
+    status, vertices, pivots, worst = project(A, b, E, x0, N, float(box), float(merge_tol), int(max_pivots))
     if status == LINE:
         # Lines of the polytope are the null space of [A N; E N] (a line along which E x
         # changed would have met the box rows); keep z in its orthogonal complement.
         _, S, Vt = np.linalg.svd(np.vstack([A @ N, E @ N]))
         r = int(np.sum(S > RANK_TOLERANCE * max(float(S[0]) if S.size else 0.0, 1.0)))
         N = np.ascontiguousarray(N @ Vt[:r].T)
-        status, vertices, more = project(A, b, E, x0, N, float(box), float(merge_tol), int(max_pivots))
+        status, vertices, more, worst = project(A, b, E, x0, N, float(box), float(merge_tol), int(max_pivots))
         pivots += more
     if status in (FAILED, LINE):
+        return None
+    # Certificate: every vertex was feasible (the kernel checked each against every row, and
+    # each is optimal for its arc by the multipliers' signs) and the polygon is convex,
+    # counter-clockwise and winds once (checked in the kernel too). Anything else is a
+    # numerical failure of the walk, never an answer.
+    if status == OK and worst < -SLACK_TOLERANCE * (1.0 + float(np.abs(b).max(initial=0.0))):
         return None
     if status == INFEASIBLE:
         return ProjectionResult(Polygon.empty(), "walk", n_lp=1, pivots=pivots)
@@ -85,3 +96,23 @@ def kernel_is_compiled() -> bool:
         return os.path.exists(project._cache._cache_file._index_path)
     except AttributeError:
         return True
+
+
+_warm = False
+
+
+def warm_up() -> float:
+    """Load (or compile) the kernel now, by projecting a square; returns the seconds spent
+    (0.0 once done). numba loads a cached kernel on its first call (0.1-0.5 s, 10-30 s to
+    compile after an installation): callers that time a projection call this first, so
+    that the load is not mistaken for the projection."""
+    global _warm
+    if _warm:
+        return 0.0
+    import time
+
+    t = time.perf_counter()
+    eye = np.eye(2)
+    project_walk(np.vstack([eye, -eye]), np.ones(4), np.zeros((0, 2)), np.zeros(0), eye)
+    _warm = True
+    return time.perf_counter() - t

@@ -1,0 +1,51 @@
+"""What the commands write to stdout: strict JSON documents.
+
+Under ``--json`` stdout is exactly one JSON document that any parser reads: non-finite numbers
+are ``null`` where they are produced (an unbounded maximum, for example), and
+:func:`print_json` refuses NaN and Infinity (``allow_nan=False``) rather than print them.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any
+
+from ..exceptions import ImpactBalanceError
+
+__all__ = ["print_json", "NonFiniteOutputError"]
+
+
+class NonFiniteOutputError(ImpactBalanceError):
+    """A result to print holds NaN or an infinity where a number is expected (a bug, reported
+    as one line naming the field rather than printed as invalid JSON).
+
+    Attributes:
+        field: Dotted path of the value in the document.
+    """
+
+    def __init__(self, field: str):
+        self.field = field
+        super().__init__(f"{field}: the result is not a finite number (please report this scenario)")
+
+
+def _non_finite_path(obj: Any, path: str = "") -> str | None:
+    stack = [(obj, path)]
+    while stack:
+        node, where = stack.pop()
+        if isinstance(node, float) and not math.isfinite(node):
+            return where or "(document)"
+        if isinstance(node, dict):
+            stack.extend((v, f"{where}.{k}" if where else str(k)) for k, v in node.items())
+        elif isinstance(node, (list, tuple)):
+            stack.extend((v, f"{where}[{i}]") for i, v in enumerate(node))
+    return None
+
+
+def print_json(document: Any) -> None:
+    """Print one strict JSON document (no NaN/Infinity) on stdout."""
+    try:
+        text = json.dumps(document, allow_nan=False)
+    except ValueError:
+        raise NonFiniteOutputError(_non_finite_path(document) or "(document)") from None
+    print(text)

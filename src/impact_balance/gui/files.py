@@ -1,0 +1,155 @@
+"""Every file the GUI reads or writes, through the workspace rule (:mod:`impact_balance.workspace`).
+
+- load: a bundled scenario by name, or a ``.yaml`` file of the workspace;
+- ``extends:`` in a loaded or uploaded file: a bundled name or a workspace file;
+- ``robot: {urdf, srdf}`` in a loaded or uploaded file: workspace files (``.urdf``/``.srdf``);
+- upload: at most :data:`~impact_balance.workspace.MAX_FILE_BYTES`, parsed like a file;
+- save: a workspace name, an existing file replaced only with ``overwrite``.
+
+:func:`describe` turns an error into the line the browser shows: the file, the field, the
+reason, and the value only cut short (at most 80 characters) and never for an unknown key,
+whose value is content of a file that is not a scenario.
+"""
+
+from __future__ import annotations
+
+import functools
+import reprlib
+import tempfile
+from importlib import resources
+from pathlib import Path
+
+from ..exceptions import ImpactBalanceError, ScenarioError, UnknownScenarioError, WorkspaceError
+from ..scenario import ExtendsResolver, RobotFiles, Scenario, bundled_scenarios, load_scenario
+from ..workspace import MAX_FILE_BYTES, Workspace
+from .state import GuiState
+
+__all__ = ["GuiFiles", "describe", "bundled_path", "MAX_MESSAGE"]
+
+#: Longest message shown in the browser, characters.
+MAX_MESSAGE = 300
+_VALUE = reprlib.Repr()
+_VALUE.maxlevel, _VALUE.maxdict, _VALUE.maxlist, _VALUE.maxtuple = 2, 4, 6, 6
+_VALUE.maxstring = _VALUE.maxother = 70
+
+
+def _short(value: object, limit: int = 80) -> str:
+    """``repr(value)`` bounded in time and length (reprlib stops early on huge or deep values)."""
+    text = _VALUE.repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+@functools.lru_cache(maxsize=1)
+def _bundled_names() -> frozenset[str]:
+    return frozenset(bundled_scenarios())
+
+
+def bundled_path(name: str) -> Path | None:
+    """The file of the bundled scenario ``name``, None if there is no such bundled scenario."""
+    if name not in _bundled_names():
+        return None
+    return Path(str(resources.files("impact_balance") / "scenarios" / f"{name}.yaml"))
+
+
+def describe(exc: BaseException, workspace: Workspace | None = None) -> str:
+    """The one line the GUI shows for a refused load, save or edit (no file content)."""
+    if isinstance(exc, ScenarioError):
+        source = exc.source
+        if source and workspace is not None:
+            source = workspace.relative(source) or Path(source).name
+        where = f"{source}: " if source else ""
+        if str(exc.reason).startswith("unknown key") or exc.value is None:
+            text = f"{where}{exc.field}: {exc.reason}"
+        else:
+            text = f"{where}{exc.field} = {_short(exc.value)}: {exc.reason}"
+        text = " ".join(text.split())  # one line
+    elif isinstance(exc, ImpactBalanceError):
+        text = " ".join(str(exc).split())
+    else:
+        text = f"internal error ({exc.__class__.__name__})"
+    return text if len(text) <= MAX_MESSAGE else text[: MAX_MESSAGE - 3] + "..."
+
+
+def _load(path: Path, resolve: ExtendsResolver, shown: str) -> Scenario:
+    """:func:`load_scenario` with a last net: a file nested too deeply for Python is refused."""
+    try:
+        return load_scenario(path, resolve_path=resolve)
+    except RecursionError:
+        raise ScenarioError("scenario", shown, "nested too deeply", shown) from None
+
+
+class GuiFiles:
+    """Loads, uploads and saves of one GUI, confined to one workspace.
+
+    Attributes:
+        workspace: The folder.
+    """
+
+    def __init__(self, workspace: Workspace | str | Path = "."):
+        self.workspace = workspace if isinstance(workspace, Workspace) else Workspace(workspace)
+
+    def _extends(self, name: str, referrer: Path) -> Path:
+        return self.workspace.extends_resolver(bundled_path)(name, referrer)
+
+    def _robot_files(self, scenario: Scenario, folder: Path) -> Scenario:
+        """``scenario`` with its robot files checked against the workspace and made absolute.
+
+        Relative paths are taken from ``folder`` (the loaded file's, the workspace's for an upload).
+        """
+        robot = scenario.robot
+        if not isinstance(robot, RobotFiles):
+            return scenario
+
+        def check(value: str, field: str, suffix: str) -> str:
+            name = self.workspace.relative(folder / value)
+            if name is None:
+                raise WorkspaceError(field, value, f"outside the workspace {self.workspace.root}")
+            return str(self.workspace.resolve(name, field=field, suffixes=(suffix,)))
+
+        files = RobotFiles(urdf=check(robot.urdf, "robot.urdf", ".urdf"),
+                           srdf=check(robot.srdf, "robot.srdf", ".srdf") if robot.srdf else None,
+                           standing=robot.standing)
+        return scenario.model_copy(update={"robot": files})
+
+    # -- loads ------------------------------------------------------------------------------
+    def load(self, name: str) -> GuiState:
+        """A bundled scenario (a name without suffix) or a workspace ``.yaml``/``.yml`` file."""
+        name = str(name)
+        if not name.lower().endswith((".yaml", ".yml")):
+            path = bundled_path(name)
+            if path is None:
+                raise UnknownScenarioError("scenario", name if len(name) <= 80 else name[:77] + "...",
+                                           sorted(_bundled_names()))
+            return GuiState.from_file(path)
+        path = self.workspace.resolve(name)
+        scenario = _load(path, self._extends, name)
+        return GuiState.from_scenario(self._robot_files(scenario, path.parent))
+
+    def upload(self, filename: str, content: bytes) -> GuiState:
+        """A scenario from an uploaded file's bytes; ``extends`` and robot files from the workspace."""
+        shown = Path(str(filename).replace("\\", "/")).name[:80] or "uploaded.yaml"
+        if len(content) > MAX_FILE_BYTES:
+            raise ScenarioError("upload", shown, f"larger than {MAX_FILE_BYTES >> 10} KiB")
+        try:
+            text = content.decode("utf-8")
+        except UnicodeDecodeError:
+            raise ScenarioError("upload", shown, "not a UTF-8 text file") from None
+        stem = "".join(c if c.isalnum() or c in "-_." else "_" for c in Path(shown).stem)[:80] or "uploaded"
+        with tempfile.TemporaryDirectory() as tmp:
+            # The scenario loader reads files (it resolves `extends`, reports YAML errors with
+            # their line): give it one, outside the workspace, gone after the parse.
+            path = Path(tmp) / f"{stem}.yaml"
+            path.write_text(text, encoding="utf-8")
+            try:
+                scenario = _load(path, self._extends, shown)
+            except ScenarioError as exc:
+                value = shown if exc.value == str(path) else exc.value
+                raise ScenarioError(exc.field, value, exc.reason, shown) from None
+        scenario = self._robot_files(scenario, self.workspace.root)
+        state = GuiState.from_scenario(scenario)
+        return GuiState(state.raw, shown)
+
+    # -- saves ------------------------------------------------------------------------------
+    def save(self, state: GuiState, name: str, overwrite: bool = False) -> Path:
+        """Write ``state`` as a scenario file to the workspace; refuse an existing file unless ``overwrite``."""
+        return self.workspace.write_text(name, state.to_yaml(), overwrite=overwrite)

@@ -1,0 +1,283 @@
+"""Evaluate the points of a chunk: one row per point, never an exception for a bad point.
+
+A worker builds one :class:`Evaluator` (the robot is loaded once) and evaluates chunks with
+it. Within a chunk, points that share a stance (same values of every stance dimension) share
+its areas: only the impact model and the two criteria are recomputed. Each chunk starts from a
+clean cache and the posture IK of each chunk starts from the base stance, so that a chunk's
+rows depend on the plan alone, never on which worker ran it or what it ran before.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+import pyarrow as pa
+
+from ..areas import BalanceAreas, areas_from_polytope
+from ..constraints import wrench_polytope
+from ..criteria import max_contact_velocity, zmp_max_contact_velocity
+from ..exceptions import ImpactBalanceError, ScenarioError
+from ..ik import IKError, solve_stance
+from ..impact import impact_model
+from ..robot import Robot
+from ..scenario import Scenario, scenario_from_dict
+from ..stance import Stance
+from .paths import set_path
+from .plan import SweepPlan
+
+__all__ = ["Evaluator", "RESULT_COLUMNS", "STATUSES", "result_schema"]
+
+#: Row statuses. The first four are answers (the point was evaluated): "ok" (finite maximum),
+#: "unbounded" (no approach speed makes it fall), "already_falling" (pre-impact CoM velocity
+#: outside the area: maximum 0), "cannot_balance" (empty areas: maximum 0). The last three are
+#: points that could not be evaluated: "invalid" (a value the scenario refuses), "unreachable"
+#: (the posture IK did not reach the target with the contacts kept), "error" (anything else).
+STATUSES = ("ok", "unbounded", "already_falling", "cannot_balance", "invalid", "unreachable", "error")
+
+#: Result columns after the point index and the dimensions: name, Arrow type, meaning.
+RESULT_COLUMNS: tuple[tuple[str, pa.DataType, str], ...] = (
+    ("status", pa.string(), "see STATUSES"),
+    ("message", pa.string(), "why a point is invalid/unreachable/error (null otherwise)"),
+    ("verdict", pa.string(), "balanced, falling or cannot balance (null when not evaluated)"),
+    ("max_contact_velocity", pa.float64(), "CoM criterion, approach speed, m/s (inf when unbounded)"),
+    ("zmp_max_contact_velocity", pa.float64(), "ZMP criterion, m/s (inf when unbounded)"),
+    ("zmp_status", pa.string(), "status of the ZMP criterion"),
+    ("com_velocity_area", pa.float64(), "area of the CoM velocity area, m^2/s^2"),
+    ("zmp_area", pa.float64(), "area of the ZMP support area, m^2"),
+    ("limiting_vertex", pa.int32(), "post-impact vertex (row of the impulse set) that reaches the boundary first"),
+    ("limiting_edge", pa.int32(), "half-plane (edge) of the CoM velocity area it reaches"),
+    ("limiting_direction", pa.float64(), "outward normal of that edge, degrees from world +x about z: where the robot would fall"),
+    ("impact_x", pa.float64(), "impact point, world, m"),
+    ("impact_y", pa.float64(), "impact point, world, m"),
+    ("impact_z", pa.float64(), "impact point, world, m"),
+    ("ik_residual", pa.float64(), "largest posture IK residual, m or rad (posture sweeps)"),
+)
+
+
+def result_schema(plan: SweepPlan) -> pa.Schema:
+    """Arrow schema of the rows: ``point``, ``chunk``, one column per dimension, the results."""
+    fields = [pa.field("point", pa.int64()), pa.field("chunk", pa.int32())]
+    fields += [pa.field(d.name, pa.float64() if d.numeric else pa.string()) for d in plan.dims]
+    fields += [pa.field(name, typ) for name, typ, _ in RESULT_COLUMNS]
+    return pa.schema(fields, metadata={"impact_balance.sweep": plan.digest})
+
+
+@dataclass
+class _StanceEntry:
+    stance: Stance | None
+    areas: BalanceAreas | None
+    status: str | None = None
+    message: str | None = None
+    ik_residual: float | None = None
+    com_velocity_area: float | None = None
+    zmp_area: float | None = None
+    verdicts: dict[tuple[float, float], str] | None = None
+    edge_directions: list[float] | None = None
+
+
+def _verdict(areas: BalanceAreas, com_velocity: tuple[float, float]) -> str:
+    if not areas.can_balance:
+        return "cannot balance"
+    return "balanced" if areas.com_velocity_area.contains(np.asarray(com_velocity, dtype=float), 1e-10) else "falling"
+
+
+class Evaluator:
+    """Evaluates chunks of a plan; holds the robot and the base scenario (built once).
+
+    Thread-safe: :meth:`evaluate_chunk` keeps its caches local (the robot's scratch data are
+    per thread), so one evaluator may serve the threads of a Dask worker.
+    """
+
+    def __init__(self, plan: SweepPlan, robot: Robot | None = None):
+        self.plan = plan
+        self.base_scenario = scenario_from_dict(plan.base, plan.base_source)
+        self.robot = robot or self.base_scenario.load_robot()
+        self.schema = result_schema(plan)
+        self._path_dims = [d for d in plan.dims if d.kind == "path"]
+        # Unchanged top-level keys go to the validation as the base's validated models (pydantic
+        # does not revalidate model instances); only the changed ones are validated per point.
+        self._base_fields = {name: getattr(self.base_scenario, name) for name in Scenario.model_fields if name != "source"}
+        self._roots = sorted({d.tokens[0] for d in plan.dims if d.tokens})
+        self._direction = {}
+        for d in plan.dims:
+            if d.kind in ("azimuth", "elevation"):
+                self._direction.setdefault(d.axis, {})[d.kind] = d
+        self._stance_dims = [d.name for d in plan.dims if d.stance]
+        self._posture_dims = [d for d in plan.dims if d.kind == "posture"]
+        posture = plan.posture
+        self._posture = posture
+        if posture is not None:
+            impact = self.base_scenario.impact
+            self._posture_frame = posture.frame or impact.frame
+            if posture.offset is not None:
+                self._posture_offset = posture.offset.se3()
+            elif self._posture_frame == impact.frame:
+                self._posture_offset = impact.offset.se3()
+            else:
+                self._posture_offset = pin.SE3.Identity()
+
+    def warm_up(self, points: int = 20) -> None:
+        """Evaluate the first few points of the sweep and drop the rows: loads the compiled
+        kernel and every lazy import and cache, so that a worker's first chunk is not slower
+        than the others."""
+        start, stop = self.plan.chunk_range(0)
+        self._rows(0, start, min(stop, start + points))
+
+    # -- one chunk --------------------------------------------------------------------------
+    def evaluate_chunk(self, chunk: int) -> pa.Table:
+        """The rows of chunk ``chunk`` (a table with :func:`result_schema`)."""
+        start, stop = self.plan.chunk_range(chunk)
+        return self._rows(chunk, start, stop)
+
+    def _rows(self, chunk: int, start: int, stop: int) -> pa.Table:
+        points = self.plan.points(start, stop)
+        names = [d.name for d in self.plan.dims]
+        columns: dict[str, list[Any]] = {f.name: [] for f in self.schema}
+        cache: dict[tuple, _StanceEntry] = {}
+        warm: dict[tuple, np.ndarray] = {}
+        for k in range(stop - start):
+            values = {name: points[name][k] for name in names}
+            try:
+                row = self._evaluate_point(values, cache, warm)
+            except Exception as exc:  # noqa: BLE001 - one bad point is a row, never the end of the sweep
+                row = {"status": "error", "message": f"{exc.__class__.__name__}: {exc}"}
+            columns["point"].append(start + k)
+            columns["chunk"].append(chunk)
+            for d in self.plan.dims:
+                v = values[d.name]
+                columns[d.name].append(float(v) if d.numeric else (v if isinstance(v, str) else repr(v)))
+            for name, _, _ in RESULT_COLUMNS:
+                columns[name].append(row.get(name))
+        return pa.table(columns, schema=self.schema)
+
+    # -- one point --------------------------------------------------------------------------
+    def _scenario(self, values: dict[str, Any]) -> Scenario:
+        raw = dict(self._base_fields)
+        for root in self._roots:
+            raw[root] = self.plan.base[root]
+        for d in self._path_dims:
+            raw = set_path(raw, d.tokens, values[d.name])
+        for pair in self._direction.values():
+            az_dim, el_dim = pair["azimuth"], pair["elevation"]
+            base_vec = np.asarray(_get(self.plan.base, az_dim.tokens), dtype=float)
+            az, el = math.radians(float(values[az_dim.name])), math.radians(float(values[el_dim.name]))
+            length = float(np.linalg.norm(base_vec))
+            vec = [length * math.cos(el) * math.cos(az), length * math.cos(el) * math.sin(az), length * math.sin(el)]
+            raw = set_path(raw, az_dim.tokens, vec)
+        return scenario_from_dict(raw, None)
+
+    def _evaluate_point(self, values: dict[str, Any], cache: dict, warm: dict) -> dict[str, Any]:
+        try:
+            scenario = self._scenario(values)
+        except ScenarioError as exc:
+            return {"status": "invalid", "message": str(exc)}
+        key = tuple(_key(values[name]) for name in self._stance_dims)
+        entry = cache.get(key)
+        if entry is None:
+            entry = cache[key] = self._stance_entry(scenario, values, warm)
+        out: dict[str, Any] = {"ik_residual": entry.ik_residual}
+        if entry.status is not None:
+            return {**out, "status": entry.status, "message": entry.message}
+        stance, areas = entry.stance, entry.areas
+        cfg = scenario.impact
+        try:
+            model = impact_model(stance, cfg.spec())
+        except ImpactBalanceError as exc:
+            return {**out, "status": "invalid", "message": str(exc)}
+        com = max_contact_velocity(areas.com_velocity_area, model, scenario.com_velocity)
+        zmp = zmp_max_contact_velocity(areas.zmp_area, model, stance.com, scenario.plane_height, scenario.gravity, cfg.duration)
+        verdict = entry.verdicts.get(scenario.com_velocity)
+        if verdict is None:
+            verdict = entry.verdicts[scenario.com_velocity] = _verdict(areas, scenario.com_velocity)
+        out.update(
+            status=com.status,
+            verdict=verdict,
+            max_contact_velocity=com.max_approach_speed,
+            zmp_max_contact_velocity=zmp.max_approach_speed,
+            zmp_status=zmp.status,
+            com_velocity_area=entry.com_velocity_area,
+            zmp_area=entry.zmp_area,
+            limiting_vertex=com.limiting_vertex,
+            limiting_edge=com.limiting_edge,
+            limiting_direction=None if com.limiting_edge is None else entry.edge_directions[com.limiting_edge],
+            impact_x=float(model.point[0]),
+            impact_y=float(model.point[1]),
+            impact_z=float(model.point[2]),
+        )
+        return out
+
+    def _stance_entry(self, scenario: Scenario, values: dict[str, Any], warm: dict) -> _StanceEntry:
+        residual = None
+        try:
+            stance = scenario.build_stance(self.robot)
+            if self._posture is not None:
+                stance, residual = self._place(scenario, stance, values, warm)
+            polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
+            areas = areas_from_polytope(polytope, scenario.plane_height)
+        except IKError as exc:
+            return _StanceEntry(None, None, "unreachable", str(exc), _worst(exc.residuals))
+        except ScenarioError as exc:
+            return _StanceEntry(None, None, "invalid", str(exc), residual)
+        except ImpactBalanceError as exc:
+            return _StanceEntry(None, None, "error", f"{exc.__class__.__name__}: {exc}", residual)
+        return _StanceEntry(stance, areas, ik_residual=residual, com_velocity_area=areas.com_velocity_area.area,
+                            zmp_area=areas.zmp_area.area, verdicts={}, edge_directions=_directions(areas))
+
+    def _place(self, scenario: Scenario, stance: Stance, values: dict[str, Any], warm: dict) -> tuple[Stance, float]:
+        """The stance with the posture point moved to its target, the contact frames kept."""
+        frame, offset = self._posture_frame, self._posture_offset
+        point = stance.frame_pose(frame) * offset
+        target = np.array(point.translation)
+        for d in self._posture_dims:
+            target[d.coord] = float(values[d.name])
+        goal = pin.SE3(point.rotation, target) * offset.inverse()
+        fixed = [c.spec.frame for c in stance.contacts if c.spec.frame != frame]
+        targets = {name: stance.frame_pose(name) for name in fixed}
+        targets[frame] = goal
+        # Warm start from the previous target reached in this chunk with the same base stance:
+        # neighbouring grid targets need a few IK steps instead of tens.
+        base_key = tuple(_key(values[d]) for d in self._stance_dims if not d.startswith("posture."))
+        q0 = warm.get(base_key, stance.q)
+        posture = self._posture
+        q = solve_stance(self.robot, q0, targets, posture_target=stance.q,
+                         tolerance=posture.tolerance, max_iterations=posture.max_iterations)
+        warm[base_key] = q
+        placed = Stance(self.robot, q, [c.spec for c in stance.contacts])
+        residual = _worst_pose_error(placed, targets)
+        return placed, residual
+
+
+def _directions(areas: BalanceAreas) -> list[float]:
+    """Outward normal angle (deg, world, from +x about z) of each half-plane of the CoM velocity area."""
+    if areas.com_velocity_area.is_empty:
+        return []
+    G, _ = areas.com_velocity_area.halfplanes
+    return [math.degrees(math.atan2(float(gy), float(gx))) for gx, gy in G]
+
+
+def _key(value: Any) -> Any:
+    """A hashable stand-in for a dimension value (lists and mappings by their repr)."""
+    return repr(value) if isinstance(value, (list, dict)) else value
+
+
+def _get(base: Any, tokens) -> Any:
+    for t in tokens:
+        base = base[t]
+    return base
+
+
+def _worst(residuals: dict[str, float]) -> float:
+    return float(max(residuals.values(), default=0.0))
+
+
+def _worst_pose_error(stance: Stance, targets: dict[str, pin.SE3]) -> float:
+    worst = 0.0
+    for name, target in targets.items():
+        actual = stance.frame_pose(name)
+        worst = max(worst, float(np.linalg.norm(actual.translation - target.translation)),
+                    float(np.linalg.norm(pin.log3(target.rotation.T @ actual.rotation))))
+    return worst

@@ -1,0 +1,182 @@
+"""Figures of a sweep: a curve for one varying dimension, a heat map for two.
+
+The maximum contact velocity of the CoM criterion is drawn (the ZMP criterion as a second
+curve on the one-dimensional plot). Limiting cases are marked: the best and the worst point,
+the points that could not be evaluated (grey crosses), and where the limiting edge of the CoM
+velocity area changes (dotted lines on a curve, contour lines on a grid heat map): on each
+side of such a line a different constraint of the area limits the impact.
+
+With more than two varying dimensions the heat map shows the first two (in the order of the
+results) and, in each cell, the minimum over the others (the worst case), as its title says.
+"""
+
+from __future__ import annotations
+
+import re
+import textwrap
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from ..plots._common import DPI, new_figure
+from .summary import EVALUATED, load_frame
+
+__all__ = ["sweep_figures", "save_sweep_figures"]
+
+
+def _varying(manifest: dict[str, Any], df: pd.DataFrame) -> list[str]:
+    dims = []
+    for d in manifest["dimensions"]:
+        col = df[d["name"]]
+        if pd.api.types.is_numeric_dtype(col) and col.nunique() > 1:
+            dims.append(d["name"])
+    return dims
+
+
+def _values(df: pd.DataFrame) -> np.ndarray:
+    """Maximum contact velocity for plotting: NaN when not evaluated (unbounded stays inf)."""
+    v = df["max_contact_velocity"].to_numpy(dtype=float).copy()
+    v[~df["status"].isin(EVALUATED).to_numpy()] = np.nan
+    return v
+
+
+#: Two limiting edges whose outward normals differ by more than this (deg) are different cases.
+TURN_DEG = 10.0
+
+
+def _turns(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Where the limiting-edge direction changes between neighbours (both evaluated)."""
+    diff = np.abs((a - b + 180.0) % 360.0 - 180.0)
+    return np.isfinite(a) & np.isfinite(b) & (diff > TURN_DEG)
+
+
+def _cell_edges(v: np.ndarray) -> np.ndarray:
+    mid = 0.5 * (v[1:] + v[:-1])
+    first = v[0] - (mid[0] - v[0]) if len(v) > 1 else v[0] - 0.5
+    last = v[-1] + (v[-1] - mid[-1]) if len(v) > 1 else v[-1] + 0.5
+    return np.concatenate([[first], mid, [last]])
+
+
+def _draw_turns(ax, xs: np.ndarray, ys: np.ndarray, E: np.ndarray) -> None:
+    """White dotted lines between grid cells limited by different edges of the area."""
+    bx, by = _cell_edges(xs), _cell_edges(ys)
+    segments = []
+    for i, j in zip(*np.nonzero(_turns(E[:, 1:], E[:, :-1]))):  # neighbours along x
+        segments.append([(bx[j + 1], by[i]), (bx[j + 1], by[i + 1])])
+    for i, j in zip(*np.nonzero(_turns(E[1:, :], E[:-1, :]))):  # neighbours along y
+        segments.append([(bx[j], by[i + 1]), (bx[j + 1], by[i + 1])])
+    if segments:
+        from matplotlib.collections import LineCollection
+
+        ax.add_collection(LineCollection(segments, colors="w", linewidths=1.0, linestyles=":",
+                                         label=f"limiting edge turns > {TURN_DEG:g} deg"))
+
+
+def _label(name: str) -> str:
+    if name.startswith("posture."):
+        return f"{name} (m, world)"
+    if name.endswith((".azimuth", ".elevation")):
+        return f"{name} (deg)"
+    return name
+
+
+def _curve(df: pd.DataFrame, x: str, title: str):
+    fig = new_figure(6.4, 4.0)
+    ax = fig.add_subplot()
+    df = df.sort_values([x, "point"], kind="stable")
+    xs = df[x].to_numpy(dtype=float)
+    v = _values(df)
+    z = df["zmp_max_contact_velocity"].to_numpy(dtype=float).copy()
+    z[np.isnan(v)] = np.nan
+    ax.plot(xs, np.where(np.isfinite(v), v, np.nan), "-o", ms=3, color="tab:blue", label="CoM criterion")
+    ax.plot(xs, np.where(np.isfinite(z), z, np.nan), "--", color="tab:gray", label="ZMP criterion")
+    ok = np.isfinite(v)
+    if ok.any():
+        best, worst = int(np.nanargmax(np.where(ok, v, -np.inf))), int(np.nanargmin(np.where(ok, v, np.inf)))
+        ax.plot(xs[best], v[best], "*", ms=14, color="tab:green", label=f"best {v[best]:.3g} m/s")
+        ax.plot(xs[worst], v[worst], "X", ms=10, color="tab:red", label=f"worst {v[worst]:.3g} m/s")
+    bad = np.isnan(v)
+    if bad.any():
+        ax.plot(xs[bad], np.zeros(bad.sum()), "x", color="0.5", label="not evaluated")
+    directions = df["limiting_direction"].to_numpy(dtype=float)
+    changes = np.flatnonzero(_turns(directions[1:], directions[:-1]))
+    for i, k in enumerate(changes):
+        ax.axvline(0.5 * (xs[k] + xs[k + 1]), ls=":", color="k", lw=0.8, label="limiting edge changes" if i == 0 else None)
+    ax.set_xlabel(_label(x))
+    ax.set_ylabel("maximum contact velocity (m/s)")
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return fig
+
+
+def _heatmap(df: pd.DataFrame, x: str, y: str, others: list[str], title: str):
+    fig = new_figure(6.4, 5.0)
+    ax = fig.add_subplot()
+    df = df.assign(_v=_values(df))
+    # Worst case over the other dimensions (NaN, i.e. not evaluated, only if every point is).
+    cell = df.groupby([x, y], sort=True)["_v"].min() if others else df.set_index([x, y])["_v"]
+    # The limiting edge of the worst case of each cell, by the direction of its outward normal
+    # (edge indices are not comparable across stances; directions are).
+    worst = df.loc[df.assign(_w=df["_v"].fillna(np.inf)).groupby([x, y], sort=True)["_w"].idxmin()] if others else df
+    edge = worst.set_index([x, y])["limiting_direction"]
+    xs, ys = np.unique(df[x].to_numpy(dtype=float)), np.unique(df[y].to_numpy(dtype=float))
+    grid = len(cell) == len(xs) * len(ys)
+    finite = np.isfinite(df["_v"].to_numpy())
+    vmax = float(np.nanmax(np.where(finite, df["_v"], np.nan))) if finite.any() else 1.0
+    if grid:
+        V = cell.unstack(level=0).reindex(index=ys, columns=xs).to_numpy(dtype=float)
+        shown = np.where(np.isinf(V), vmax, V)
+        mesh = ax.pcolormesh(xs, ys, np.ma.masked_invalid(shown), shading="nearest", cmap="viridis", vmin=0.0, vmax=vmax)
+        E = edge.unstack(level=0).reindex(index=ys, columns=xs).to_numpy(dtype=float)
+        _draw_turns(ax, xs, ys, E)
+        X, Y = np.meshgrid(xs, ys)
+        bad = np.isnan(V)
+        if bad.any():
+            ax.plot(X[bad], Y[bad], "x", color="0.5", ms=5, label="not evaluated")
+    else:
+        pts = df[np.isfinite(df["_v"])]
+        mesh = ax.scatter(pts[x], pts[y], c=pts["_v"], cmap="viridis", vmin=0.0, vmax=vmax, s=12)
+        bad = df[np.isnan(df["_v"])]
+        if len(bad):
+            ax.plot(bad[x], bad[y], "x", color="0.5", ms=5, label="not evaluated")
+    fig.colorbar(mesh, ax=ax, label="maximum contact velocity (m/s)" + (" (min over other axes)" if others else ""))
+    ok = df[np.isfinite(df["_v"])]
+    if len(ok):
+        b, w = ok.loc[ok["_v"].idxmax()], ok.loc[ok["_v"].idxmin()]
+        ax.plot(b[x], b[y], "*", ms=16, mfc="tab:green", mec="w", label=f"best {b['_v']:.3g} m/s")
+        ax.plot(w[x], w[y], "X", ms=11, mfc="tab:red", mec="w", label=f"worst {w['_v']:.3g} m/s")
+    ax.set_xlabel(_label(x))
+    ax.set_ylabel(_label(y))
+    ax.set_title(title, fontsize=9)
+    ax.legend(fontsize=8, loc="best")
+    return fig
+
+
+def sweep_figures(root: str | Path) -> list[tuple[str, Any]]:
+    """(name, Figure) pairs for a sweep folder: a curve or a heat map (empty without data)."""
+    manifest, df = load_frame(root)
+    if not len(df):
+        return []
+    dims = _varying(manifest, df)
+    title = (manifest.get("description") or "").strip()
+    title = textwrap.fill(title, 90)
+    if len(dims) == 1:
+        return [(f"curve_{dims[0]}", _curve(df, dims[0], title))]
+    if len(dims) >= 2:
+        return [(f"heatmap_{dims[0]}_{dims[1]}", _heatmap(df, dims[0], dims[1], dims[2:], title))]
+    return []
+
+
+def save_sweep_figures(root: str | Path, out_dir: str | Path | None = None, dpi: int = DPI) -> list[Path]:
+    """Write the figures of a sweep folder as PNG files (default ``ROOT/figures``)."""
+    out = Path(out_dir) if out_dir is not None else Path(root) / "figures"
+    written = []
+    for name, fig in sweep_figures(root):
+        out.mkdir(parents=True, exist_ok=True)
+        path = out / (re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._") + ".png")
+        fig.savefig(path, dpi=dpi)
+        written.append(path)
+    return written

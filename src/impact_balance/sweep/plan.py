@@ -1,0 +1,260 @@
+"""A sweep plan: the base scenario resolved, the axes checked, the points enumerated in chunks.
+
+The plan is everything a worker needs (it pickles): the base scenario as a full mapping (every
+default filled in), the dimensions, and how to produce the points of any chunk. Points are
+numbered once and for all by the plan, so a chunk's rows never depend on the number of
+workers or on which worker computes it.
+
+Grid order: dimensions that change the stance vary slowest, then those of the impact and of the
+CoM velocity, so that consecutive points share a stance and its areas (only the impact part
+is recomputed). Within each group the axes keep the file's order.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from scipy.stats import qmc
+
+from ..exceptions import ScenarioError, SweepError
+from ..robot import Robot
+from ..scenario import _merge, _read, scenario_from_dict, scenario_path
+from .paths import STANCE_FREE_ROOTS, Token, check_path, format_path, parse_path
+from .spec import Dim, DirectionAxis, PathAxis, PostureAxis, SweepSpec, load_sweep_spec
+
+__all__ = ["Dimension", "SweepPlan", "make_plan", "plan_sweep", "PLAN_VERSION"]
+
+#: Default points per chunk, without and with a posture axis.
+DEFAULT_CHUNK, DEFAULT_CHUNK_IK = 1000, 25
+
+#: Bumped when the rows of the same spec would change (columns, ordering): old results are not resumed.
+PLAN_VERSION = 1
+
+
+@dataclass(frozen=True)
+class Dimension:
+    """One column of the points.
+
+    Attributes:
+        name: Column name (the axis path, ``PATH.azimuth`` / ``PATH.elevation`` in degrees, or
+            ``posture.x`` / ``.y`` / ``.z`` in m).
+        axis: Index of its axis in the sweep file.
+        kind: "path", "azimuth", "elevation" or "posture".
+        dim: The values or range.
+        tokens: The scenario key path (path and direction axes).
+        coord: 0, 1, 2 for posture x, y, z.
+        stance: True when it changes the stance (hence the areas).
+    """
+
+    name: str
+    axis: int
+    kind: str
+    dim: Dim
+    tokens: tuple[Token, ...] = ()
+    coord: int = -1
+    stance: bool = True
+
+    @property
+    def numeric(self) -> bool:
+        return self.dim.numeric
+
+    def grid_values(self) -> list[Any]:
+        d = self.dim
+        if d.values is not None:
+            return list(d.values)
+        if d.count is None:
+            raise SweepError(f"axes[{self.axis}]", self.name, "a grid needs count with range (or values: [...])")
+        lo, hi = d.range
+        return np.linspace(lo, hi, d.count).tolist()
+
+    def from_unit(self, u: np.ndarray) -> list[Any] | np.ndarray:
+        """Map quasi-random samples in [0, 1) to values."""
+        d = self.dim
+        if d.values is not None:
+            idx = np.minimum((u * len(d.values)).astype(int), len(d.values) - 1)
+            return [d.values[i] for i in idx] if not d.numeric else np.asarray(d.values, dtype=float)[idx]
+        lo, hi = d.range
+        return lo + u * (hi - lo)
+
+
+@dataclass(frozen=True)
+class SweepPlan:
+    """A checked sweep, ready to run (see the module docstring).
+
+    Attributes:
+        spec: The sweep file.
+        base: The base scenario, a full mapping (defaults filled in, ``extends`` resolved).
+        base_source: File the base scenario came from (resolves relative robot paths).
+        dims: The dimensions, in enumeration order (stance first for a grid).
+        shape: Grid shape (grid only).
+        samples: Quasi-random points, one column per dimension (qmc only).
+        n_points: Number of points.
+        digest: Hash of everything that defines the rows (resume checks it).
+    """
+
+    spec: SweepSpec
+    base: dict[str, Any]
+    base_source: str | None
+    dims: tuple[Dimension, ...]
+    shape: tuple[int, ...] | None
+    samples: dict[str, Any] | None
+    n_points: int
+    digest: str
+
+    @property
+    def chunk_size(self) -> int:
+        """Points per chunk: the file's ``chunk_size``, else 1000, or 25 with a posture axis (IK
+        takes milliseconds per point: small chunks keep every worker busy to the end)."""
+        if self.spec.chunk_size is not None:
+            return self.spec.chunk_size
+        return DEFAULT_CHUNK_IK if self.posture is not None else DEFAULT_CHUNK
+
+    @property
+    def n_chunks(self) -> int:
+        return math.ceil(self.n_points / self.chunk_size)
+
+    def chunk_range(self, chunk: int) -> tuple[int, int]:
+        start = chunk * self.chunk_size
+        return start, min(self.n_points, start + self.chunk_size)
+
+    def points(self, start: int, stop: int) -> dict[str, list[Any]]:
+        """The values of points ``start .. stop - 1``, by dimension name."""
+        if self.samples is not None:
+            return {d.name: list(self.samples[d.name][start:stop]) for d in self.dims}
+        index = np.unravel_index(np.arange(start, stop), self.shape)
+        out = {}
+        for d, idx in zip(self.dims, index):
+            values = d.grid_values()
+            out[d.name] = [values[i] for i in idx]
+        return out
+
+    @property
+    def posture(self) -> PostureAxis | None:
+        return next((a for a in self.spec.axes if isinstance(a, PostureAxis)), None)
+
+
+def _base_mapping(spec: SweepSpec) -> tuple[dict[str, Any], str | None]:
+    here = Path(spec.source).parent if spec.source else Path.cwd()
+    if isinstance(spec.base, str):
+        candidate = here / spec.base
+        try:
+            path = candidate if candidate.is_file() else scenario_path(spec.base)
+        except ScenarioError as exc:
+            raise type(exc)(*_args(exc, "base")) from None
+        raw = _read(path)
+        raw.setdefault("name", path.stem)
+        return raw, str(path)
+    raw = dict(spec.base)
+    parent = raw.pop("extends", None)
+    if parent is not None:
+        candidate = here / str(parent)
+        try:
+            path = candidate if candidate.is_file() else scenario_path(parent)
+        except ScenarioError as exc:
+            raise type(exc)(*_args(exc, "base.extends")) from None
+        raw = _merge(_read(path), raw)
+    raw.setdefault("name", Path(spec.source).stem if spec.source else "sweep")
+    return raw, spec.source
+
+
+def _args(exc: ScenarioError, field: str) -> tuple:
+    valid = getattr(exc, "valid", None)
+    return (field, exc.value, valid, exc.source) if valid is not None else (field, exc.value, exc.reason, exc.source)
+
+
+def _dimensions(spec: SweepSpec, base: dict[str, Any], robot: Robot) -> list[Dimension]:
+    dims: list[Dimension] = []
+    joints = robot.joint_names
+    for i, axis in enumerate(spec.axes):
+        if isinstance(axis, PathAxis):
+            tokens = parse_path(axis.path, f"axes[{i}].path")
+            leaf = check_path(base, tokens, f"axes[{i}].path", joints)
+            if axis.range is not None and leaf is not None and not isinstance(leaf, (int, float)):
+                raise SweepError(f"axes[{i}].path", axis.path, f"is {leaf!r}, not a number: a range needs a number (use values: [...])")
+            dims.append(Dimension(format_path(tokens), i, "path", axis, tokens, stance=tokens[0] not in STANCE_FREE_ROOTS))
+        elif isinstance(axis, DirectionAxis):
+            tokens = parse_path(axis.direction, f"axes[{i}].direction")
+            leaf = check_path(base, tokens, f"axes[{i}].direction", joints)
+            if not (isinstance(leaf, (list, tuple)) and len(leaf) == 3):
+                raise SweepError(f"axes[{i}].direction", axis.direction, f"is {leaf!r}, not a 3-vector")
+            if float(np.linalg.norm(np.asarray(leaf, dtype=float))) == 0.0:
+                raise SweepError(f"axes[{i}].direction", axis.direction, "is the zero vector in the base scenario: no length to keep")
+            name = format_path(tokens)
+            stance = tokens[0] not in STANCE_FREE_ROOTS
+            dims.append(Dimension(f"{name}.azimuth", i, "azimuth", axis.azimuth, tokens, stance=stance))
+            dims.append(Dimension(f"{name}.elevation", i, "elevation", axis.elevation, tokens, stance=stance))
+        else:
+            for coord, key in enumerate("xyz"):
+                d = getattr(axis, key)
+                if d is not None:
+                    dims.append(Dimension(f"posture.{key}", i, "posture", d, coord=coord))
+    names = [d.name for d in dims]
+    for name in names:
+        if names.count(name) > 1:
+            raise SweepError("axes", name, "appears in two axes")
+    # Stance dimensions first (stable): consecutive grid points then share a stance.
+    return sorted(dims, key=lambda d: not d.stance)
+
+
+def _samples(spec: SweepSpec, dims: list[Dimension]) -> dict[str, Any]:
+    s = spec.sampling
+    n, d = int(s.samples), len(dims)
+    engine = {"sobol": qmc.Sobol, "halton": qmc.Halton, "lhs": qmc.LatinHypercube}[s.method](d, rng=s.seed)
+    with warnings.catch_warnings():
+        # Sobol warns when n is not a power of two (balance properties): the user chose n.
+        warnings.simplefilter("ignore", UserWarning)
+        u = engine.random(n)
+    return {dim.name: dim.from_unit(u[:, k]) for k, dim in enumerate(dims)}
+
+
+def make_plan(spec: SweepSpec, robot: Robot | None = None) -> SweepPlan:
+    """Resolve the base scenario, check every axis against it, and enumerate the points.
+
+    Raises:
+        SweepError, UnknownPathError: a bad axis (the message names the path and the valid keys).
+        ScenarioError: a bad base scenario.
+    """
+    raw, source = _base_mapping(spec)
+    try:
+        base_scenario = scenario_from_dict(raw, source)
+    except ScenarioError as exc:
+        raise type(exc)(*_args(exc, f"base: {exc.field}")) from None
+    if base_scenario.impact is None:
+        raise SweepError("base", spec.base if isinstance(spec.base, str) else "(mapping)",
+                         "the base scenario has no impact: a sweep maps the maximum contact velocity", spec.source)
+    robot = robot or base_scenario.load_robot()
+    base_scenario.build_stance(robot)  # unknown frames, plane above the CoM...: fail now, not per point
+    base = base_scenario.model_dump(mode="python", exclude={"source"})
+    try:
+        dims = _dimensions(spec, base, robot)
+    except ScenarioError as exc:
+        exc.source = spec.source
+        exc.args = (f"{spec.source}: {exc.args[0]}",) if spec.source else exc.args
+        raise
+    for i, axis in enumerate(spec.axes):
+        if isinstance(axis, PostureAxis):
+            try:
+                robot.frame_id(axis.frame or base_scenario.impact.frame, field=f"axes[{i}].posture.frame")
+            except ScenarioError as exc:
+                raise type(exc)(*_args(exc, exc.field)[:3], spec.source) from None
+    if spec.sampling.method == "grid":
+        shape = tuple(len(d.grid_values()) for d in dims)
+        n_points, samples = int(np.prod(shape)), None
+    else:
+        shape, samples = None, _samples(spec, dims)
+        n_points = int(spec.sampling.samples)
+    digest_input = {"version": PLAN_VERSION, "spec": spec.digest_data(), "base": json.loads(json.dumps(base, default=list))}
+    digest = hashlib.sha256(json.dumps(digest_input, sort_keys=True).encode()).hexdigest()[:16]
+    return SweepPlan(spec, base, source, tuple(dims), shape, samples, n_points, digest)
+
+
+def plan_sweep(name_or_path: str | Path) -> SweepPlan:
+    """Load a sweep file (or a bundled sweep by name) and plan it."""
+    return make_plan(load_sweep_spec(name_or_path))

@@ -1,0 +1,301 @@
+"""Run a sweep: chunks on this process, on local worker processes, or on a Dask cluster.
+
+Three backends, one loop:
+
+- ``workers=1``: the chunks run in this process (no start-up cost).
+- ``workers=N`` (default: every core this process may use): a
+  :class:`concurrent.futures.ProcessPoolExecutor` with the ``forkserver`` start method (``spawn``
+  where there is none; never a fork of this process, which holds threads and solver state);
+  each worker builds one
+  :class:`~impact_balance.sweep.evaluate.Evaluator` in its initializer, so the robot is loaded
+  once per worker and the compiled projection kernel comes from numba's disk cache.
+- ``scheduler=ADDRESS`` (or a :class:`distributed.Client`): Dask distributed. The plan is
+  scattered to every worker once; each worker keeps one evaluator per plan.
+
+Whatever the backend, the parent writes each finished chunk at once (see
+:mod:`~impact_balance.sweep.store`), and skips the chunks already written: the same command
+resumes an interrupted sweep. The rows of a chunk depend on the plan only, so the results are
+the same on any number of workers.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import signal
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterator
+from concurrent.futures import Future, ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pyarrow as pa
+from tqdm import tqdm
+
+from ..areas import areas_from_polytope
+from ..constraints import wrench_polytope
+from ..scenario import scenario_from_dict
+from .evaluate import Evaluator
+from .plan import SweepPlan
+from .store import ResultStore
+
+__all__ = ["RunReport", "run_sweep", "default_workers"]
+
+
+def default_workers() -> int:
+    """The number of cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - not Linux
+        return os.cpu_count() or 1
+
+
+@dataclass(frozen=True)
+class RunReport:
+    """What a run did.
+
+    Attributes:
+        out: The output folder.
+        backend: "inline", "processes" or "dask".
+        workers: Worker count (Dask: the cluster's threads).
+        n_points, n_chunks: Size of the sweep.
+        chunks_before: Chunks already done when the run started (resumed).
+        chunks_computed: Chunks computed and written by this run.
+        points_computed: Points of those chunks.
+        interrupted: True after Ctrl-C or ``stop_after``: run the same command to finish.
+        elapsed_s: Wall time of the computing loop (after the workers started), s.
+        startup_s: Time to start the workers and load the robot in them, s.
+    """
+
+    out: Path
+    backend: str
+    workers: int
+    n_points: int
+    n_chunks: int
+    chunks_before: int
+    chunks_computed: int
+    points_computed: int
+    interrupted: bool
+    elapsed_s: float
+    startup_s: float
+
+    @property
+    def complete(self) -> bool:
+        return self.chunks_before + self.chunks_computed == self.n_chunks
+
+    @property
+    def rate(self) -> float:
+        """Points per second of the computing loop."""
+        return self.points_computed / self.elapsed_s if self.elapsed_s > 0 else float("nan")
+
+
+# -- worker-side entry points (module level: picklable by reference) -----------------------
+_EVALUATOR: Evaluator | None = None
+_EVALUATORS: dict[str, Evaluator] = {}
+_LOCK = threading.Lock()
+
+
+def _init_process(plan: SweepPlan) -> None:
+    # The parent handles Ctrl-C (it cancels the queue and keeps what is finished).
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    global _EVALUATOR
+    _EVALUATOR = Evaluator(plan)
+    _EVALUATOR.warm_up()
+
+
+def _process_chunk(chunk: int) -> pa.Table:
+    assert _EVALUATOR is not None
+    return _EVALUATOR.evaluate_chunk(chunk)
+
+
+def _ready() -> int:
+    return os.getpid()
+
+
+def dask_chunk(plan: SweepPlan, chunk: int) -> pa.Table:
+    """Evaluate one chunk on a Dask worker (one evaluator per plan and worker process)."""
+    with _LOCK:
+        evaluator = _EVALUATORS.get(plan.digest)
+        if evaluator is None:
+            evaluator = Evaluator(plan)
+            evaluator.warm_up()
+            _EVALUATORS[plan.digest] = evaluator
+    return evaluator.evaluate_chunk(chunk)
+
+
+def _warm_kernel(plan: SweepPlan) -> None:
+    """Compile (or load from numba's cache) the projection kernel before workers start."""
+    scenario = scenario_from_dict(plan.base, plan.base_source)
+    stance = scenario.build_stance()
+    areas_from_polytope(wrench_polytope(stance, scenario.torque_limits, scenario.gravity), scenario.plane_height)
+
+
+def _context() -> multiprocessing.context.BaseContext:
+    """``forkserver`` where available (Linux): one server process imports the library once and
+    forks the workers from that clean, single-threaded state, so N workers cost one import;
+    ``spawn`` elsewhere. Never a plain fork of this process (threads, open solvers)."""
+    if "forkserver" in multiprocessing.get_all_start_methods():
+        context = multiprocessing.get_context("forkserver")
+        context.set_forkserver_preload([__name__])
+        return context
+    return multiprocessing.get_context("spawn")  # pragma: no cover - not Linux
+
+
+# -- backends: each yields (chunk, table) as chunks finish ---------------------------------
+class _Inline:
+    name = "inline"
+
+    def __init__(self, plan: SweepPlan):
+        self.evaluator = Evaluator(plan)
+        self.evaluator.warm_up()
+        self.workers = 1
+
+    def run(self, chunks: list[int]) -> Iterator[tuple[int, pa.Table]]:
+        for chunk in chunks:
+            yield chunk, self.evaluator.evaluate_chunk(chunk)
+
+    def stop(self) -> list[tuple[int, pa.Table]]:
+        return []
+
+
+class _Processes:
+    name = "processes"
+
+    def __init__(self, plan: SweepPlan, workers: int):
+        _warm_kernel(plan)
+        context = _context()
+        self.workers = workers
+        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_init_process, initargs=(plan,))
+        # Start every worker (and its robot) before the clock of the computing loop starts.
+        for f in [self.pool.submit(_ready) for _ in range(workers)]:
+            f.result()
+        self.futures: dict[Future, int] = {}
+
+    def run(self, chunks: list[int]) -> Iterator[tuple[int, pa.Table]]:
+        self.futures = {self.pool.submit(_process_chunk, c): c for c in chunks}
+        for f in as_completed(self.futures):
+            chunk = self.futures.pop(f)
+            yield chunk, f.result()
+
+    def stop(self) -> list[tuple[int, pa.Table]]:
+        """Cancel what has not started, wait for what runs, return what finished meanwhile."""
+        for f in self.futures:
+            f.cancel()
+        self.pool.shutdown(wait=True, cancel_futures=True)
+        done = [(c, f.result()) for f, c in self.futures.items() if f.done() and not f.cancelled() and f.exception() is None]
+        self.futures = {}
+        return done
+
+    def close(self) -> None:
+        self.pool.shutdown(wait=True, cancel_futures=True)
+
+
+class _Dask:
+    name = "dask"
+
+    def __init__(self, plan: SweepPlan, scheduler: Any):
+        from distributed import Client
+
+        self.own = not isinstance(scheduler, Client)
+        self.client = Client(scheduler) if self.own else scheduler
+        self.workers = sum(self.client.nthreads().values()) or 1
+        self.plan_future = self.client.scatter(plan, broadcast=True)
+        self.plan = plan
+        self.futures: dict[Any, int] = {}
+
+    def run(self, chunks: list[int]) -> Iterator[tuple[int, pa.Table]]:
+        from distributed import as_completed as dask_completed
+
+        self.futures = {
+            self.client.submit(dask_chunk, self.plan_future, c, key=f"impact-balance-sweep-{self.plan.digest}-{c}", pure=False): c
+            for c in chunks
+        }
+        for f in dask_completed(list(self.futures)):
+            chunk = self.futures.pop(f)
+            yield chunk, f.result()
+
+    def stop(self) -> list[tuple[int, pa.Table]]:
+        done = [(c, f.result()) for f, c in self.futures.items() if f.status == "finished"]
+        self.client.cancel(list(self.futures))
+        self.futures = {}
+        return done
+
+    def close(self) -> None:
+        if self.own:
+            self.client.close()
+
+
+def run_sweep(
+    plan: SweepPlan,
+    out: str | Path,
+    workers: int | None = None,
+    scheduler: Any = None,
+    progress: bool = True,
+    stop_after: int | None = None,
+    on_chunk: Callable[[int], None] | None = None,
+) -> RunReport:
+    """Compute the chunks of ``plan`` not yet in ``out``, writing each one as it finishes.
+
+    Args:
+        plan: The sweep.
+        out: Output folder (created; an existing one with the same sweep is resumed).
+        workers: Local worker processes (default: every core); 1 runs in this process.
+        scheduler: A Dask scheduler address (``tcp://host:8786``) or a ``distributed.Client``;
+            then ``workers`` is ignored.
+        progress: Show a progress bar (tqdm, on stderr) with the rate and the time left.
+        stop_after: Stop after writing this many chunks (as if killed; for tests and demos).
+        on_chunk: Called with each chunk index once its part file is written.
+
+    Ctrl-C stops the run: chunks already written stay, chunks that finish while it stops are
+    written too, and the report says ``interrupted``.
+    """
+    store = ResultStore.open(out, plan)
+    done = store.finished()
+    todo = [c for c in range(plan.n_chunks) if c not in done]
+    t0 = time.perf_counter()
+    n = workers or default_workers()
+    if scheduler is not None:
+        backend: Any = _Dask(plan, scheduler)
+    elif n <= 1 or len(todo) <= 1:
+        backend = _Inline(plan)
+    else:
+        backend = _Processes(plan, min(n, len(todo)))
+    startup = time.perf_counter() - t0
+    done_points = sum(plan.chunk_range(c)[1] - plan.chunk_range(c)[0] for c in done)
+    bar = tqdm(total=plan.n_points, initial=done_points, unit="pt", desc="sweep", file=sys.stderr,
+               disable=not progress, dynamic_ncols=True, smoothing=0.05)
+    computed = points = 0
+    interrupted = False
+    t1 = time.perf_counter()
+
+    def keep(chunk: int, table: pa.Table) -> None:
+        nonlocal computed, points
+        store.write(chunk, table)
+        computed += 1
+        points += table.num_rows
+        bar.update(table.num_rows)
+        if on_chunk is not None:
+            on_chunk(chunk)
+
+    try:
+        for chunk, table in backend.run(todo):
+            keep(chunk, table)
+            if stop_after is not None and computed >= stop_after:
+                interrupted = computed < len(todo)
+                break
+    except KeyboardInterrupt:
+        interrupted = True
+        for chunk, table in backend.stop():
+            keep(chunk, table)
+    finally:
+        elapsed = time.perf_counter() - t1
+        if interrupted and not isinstance(backend, _Inline):
+            backend.stop()
+        if hasattr(backend, "close"):
+            backend.close()
+        bar.close()
+    return RunReport(Path(out), backend.name, backend.workers, plan.n_points, plan.n_chunks, len(done), computed,
+                     points, interrupted, elapsed, startup)

@@ -1,0 +1,277 @@
+"""Sweep files: a base scenario and axes, validated with pydantic like scenario files.
+
+```yaml
+description: "maximum contact velocity against impact friction and restitution"
+base: palm_push_two_feet          # bundled scenario name, a path (relative to this file), or a mapping
+sampling: grid                    # or {method: sobol | halton | lhs, samples: 4096, seed: 0}
+chunk_size: 1000                  # points per chunk (work, output, resume); default 1000, 25 with posture
+axes:
+  - path: impact.friction         # any scenario key path
+    range: [0.0, 0.6]             # with count (grid), or values: [...]
+    count: 25
+  - path: impact.restitution[1]
+    values: [0.0, 0.2, 0.5, 1.0]
+  - direction: impact.normal      # a 3-vector by azimuth/elevation, degrees (length kept)
+    azimuth: {range: [150, 210], count: 13}
+    elevation: {values: [0]}
+  - posture:                      # move a frame to world targets by IK, the contacts kept
+      frame: gripper_right_base_link   # default: the impact frame (with the impact offset)
+      y: {range: [-0.6, 0.1], count: 15}   # world target of the point, m; x, y, z each optional
+      z: {range: [0.7, 1.4], count: 15}
+```
+
+Every problem becomes a :class:`~impact_balance.exceptions.SweepError` naming the field and
+the value.
+"""
+
+from __future__ import annotations
+
+import math
+from importlib import resources
+from pathlib import Path
+from typing import Any, Literal
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from ..exceptions import SweepError, UnknownNameError
+from ..scenario import Offset, _field
+
+__all__ = [
+    "Dim",
+    "PathAxis",
+    "DirectionAxis",
+    "PostureAxis",
+    "Sampling",
+    "SweepSpec",
+    "load_sweep_spec",
+    "sweep_spec_from_dict",
+    "bundled_sweeps",
+    "sweep_path",
+    "QMC_METHODS",
+]
+
+#: Quasi-random sampling methods (``scipy.stats.qmc``): Sobol, Halton, Latin hypercube.
+QMC_METHODS = ("sobol", "halton", "lhs")
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Dim(_Model):
+    """Values of one dimension: explicit ``values``, or a closed ``range`` [lo, hi].
+
+    A grid needs ``count`` with a range (``count`` evenly spaced values, both ends included);
+    quasi-random sampling draws from the range (or picks among the values).
+    """
+
+    values: list[Any] | None = Field(None, min_length=1)
+    range: tuple[float, float] | None = None
+    count: int | None = Field(None, ge=1, le=1_000_000)
+
+    @model_validator(mode="after")
+    def _one_of(self) -> "Dim":
+        if (self.values is None) == (self.range is None):
+            raise ValueError("give either values: [...] or range: [lo, hi] (with count for a grid)")
+        if self.values is not None and self.count is not None:
+            raise ValueError("count goes with range, not with values")
+        if self.range is not None:
+            lo, hi = self.range
+            if not (math.isfinite(lo) and math.isfinite(hi)) or lo > hi:
+                raise ValueError("range must be [lo, hi], finite, with lo <= hi")
+        return self
+
+    @property
+    def numeric(self) -> bool:
+        return self.values is None or all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in self.values)
+
+
+class PathAxis(Dim):
+    """One scenario key, e.g. ``impact.friction`` or ``joints.arm_right_4_joint``."""
+
+    path: str
+
+
+class DirectionAxis(_Model):
+    """A 3-vector key (``impact.normal``...) by azimuth and elevation in degrees, world axes.
+
+    ``v = |v_base| (cos el cos az, cos el sin az, sin el)``: azimuth about world z from +x,
+    elevation above the horizontal plane. The base vector's length is kept.
+    """
+
+    direction: str
+    azimuth: Dim = Dim(values=[0.0])
+    elevation: Dim = Dim(values=[0.0])
+
+    @model_validator(mode="after")
+    def _numbers(self) -> "DirectionAxis":
+        if not (self.azimuth.numeric and self.elevation.numeric):
+            raise ValueError("azimuth and elevation must be numbers (degrees)")
+        return self
+
+
+class PostureAxis(_Model):
+    """Move a point of a frame to world targets by whole-body IK; the contact frames stay put.
+
+    The point is ``frame * offset``; its world orientation is kept from the base stance and
+    its world position takes the targets ``x``, ``y``, ``z`` (m), each optional (a missing
+    coordinate keeps the base value).
+    """
+
+    frame: str | None = None
+    offset: Offset | None = None
+    x: Dim | None = None
+    y: Dim | None = None
+    z: Dim | None = None
+    tolerance: float = Field(1e-4, gt=0, le=1e-2)
+    max_iterations: int = Field(200, ge=1, le=10_000)
+
+    @model_validator(mode="after")
+    def _some_target(self) -> "PostureAxis":
+        dims = [d for d in (self.x, self.y, self.z) if d is not None]
+        if not dims:
+            raise ValueError("give at least one target coordinate: x, y or z (world, m)")
+        if not all(d.numeric for d in dims):
+            raise ValueError("target coordinates must be numbers (m)")
+        return self
+
+
+class Sampling(_Model):
+    """``grid`` (every combination) or quasi-random ``samples`` points (scipy.stats.qmc)."""
+
+    method: Literal["grid", "sobol", "halton", "lhs"] = "grid"
+    samples: int | None = Field(None, ge=1, le=100_000_000)
+    seed: int = Field(0, ge=0)
+
+    @model_validator(mode="after")
+    def _samples(self) -> "Sampling":
+        if self.method == "grid" and self.samples is not None:
+            raise ValueError("samples goes with a quasi-random method (sobol, halton, lhs), not grid")
+        if self.method != "grid" and self.samples is None:
+            raise ValueError(f"{self.method} sampling needs samples: N")
+        return self
+
+
+Axis = PathAxis | DirectionAxis | PostureAxis
+
+
+class SweepSpec(_Model):
+    """A validated sweep file (see the module docstring for every key)."""
+
+    description: str | None = None
+    base: str | dict[str, Any]
+    axes: tuple[Axis, ...]
+    sampling: Sampling = Sampling()
+    chunk_size: int | None = Field(None, ge=1, le=1_000_000)
+    source: str | None = Field(None, exclude=True)
+
+    def digest_data(self) -> dict[str, Any]:
+        """The keys that define the results (not the description), JSON-ready."""
+        return self.model_dump(mode="json", exclude={"description", "source"})
+
+
+def _raise(exc: ValidationError, raw: Any, prefix: str, source: str | None) -> None:
+    err = exc.errors()[0]
+    loc = tuple(p for p in err["loc"] if not (isinstance(p, str) and ("[" in p or p in ("function-after", "tagged-union"))))
+    field = _field(loc)
+    field = f"{prefix}.{field}" if prefix and field != "scenario" else (prefix or field)
+    reason = err["msg"].removeprefix("Value error, ")
+    value = err.get("input")
+    if err["type"] == "extra_forbidden":
+        reason = "unknown key"
+    elif err["type"] == "missing":
+        value, reason = None, "missing required key"
+    raise SweepError(field, value, reason, source) from None
+
+
+def _axis(raw: Any, i: int, source: str | None) -> Axis:
+    field = f"axes[{i}]"
+    if not isinstance(raw, dict):
+        raise SweepError(field, raw, "an axis is a mapping with one of path, direction or posture", source)
+    kinds = [k for k in ("path", "direction", "posture") if k in raw]
+    if len(kinds) != 1:
+        raise SweepError(field, raw, "an axis needs exactly one of path, direction or posture", source)
+    try:
+        if kinds[0] == "posture":
+            extra = set(raw) - {"posture"}
+            if extra:
+                raise SweepError(f"{field}.{sorted(extra)[0]}", raw[sorted(extra)[0]], "unknown key (posture options go under posture:)", source)
+            body = raw["posture"]
+            if not isinstance(body, dict):
+                raise SweepError(f"{field}.posture", body, "must be a mapping (frame, x, y, z, ...)", source)
+            return PostureAxis.model_validate(body)
+        return (PathAxis if kinds[0] == "path" else DirectionAxis).model_validate(raw)
+    except ValidationError as exc:
+        _raise(exc, raw, field + (".posture" if kinds[0] == "posture" else ""), source)
+        raise AssertionError("unreachable")  # pragma: no cover
+
+
+def sweep_spec_from_dict(raw: Any, source: str | None = None) -> SweepSpec:
+    """Validate a sweep mapping; raises :class:`SweepError` on the first bad field."""
+    if not isinstance(raw, dict):
+        raise SweepError("sweep", raw, "must be a YAML mapping of keys", source)
+    axes_raw = raw.get("axes")
+    if not isinstance(axes_raw, list) or not axes_raw:
+        raise SweepError("axes", axes_raw, "must be a non-empty list of axes", source)
+    axes = tuple(_axis(a, i, source) for i, a in enumerate(axes_raw))
+    if sum(isinstance(a, PostureAxis) for a in axes) > 1:
+        raise SweepError("axes", "posture", "at most one posture axis", source)
+    body = {k: v for k, v in raw.items() if k != "axes"}
+    if isinstance(body.get("sampling"), str):
+        body["sampling"] = {"method": body["sampling"]}
+    try:
+        return SweepSpec.model_validate({**body, "axes": axes, "source": source})
+    except ValidationError as exc:
+        _raise(exc, raw, "", source)
+        raise AssertionError("unreachable")  # pragma: no cover
+
+
+# -- files ------------------------------------------------------------------------------
+def _sweep_dir():
+    return resources.files("impact_balance") / "sweeps"
+
+
+def bundled_sweeps() -> dict[str, str]:
+    """Bundled sweep names and their one-line descriptions."""
+    out = {}
+    for entry in sorted(_sweep_dir().iterdir(), key=lambda e: e.name):
+        if entry.name.endswith(".yaml"):
+            raw = yaml.safe_load(entry.read_text()) or {}
+            out[entry.name[:-5]] = str(raw.get("description", "")).strip()
+    return out
+
+
+class UnknownSweepError(UnknownNameError, SweepError):
+    """The sweep is neither a file nor a bundled sweep's name."""
+
+    kind = "sweep"
+
+
+def sweep_path(name_or_path: str | Path) -> Path:
+    """A sweep file's path: an existing file, or the name of a bundled sweep."""
+    path = Path(name_or_path)
+    if path.is_file():
+        return path
+    if path.suffix in (".yaml", ".yml") or "/" in str(name_or_path):
+        raise SweepError("sweep", str(name_or_path), "no such file")
+    bundled = _sweep_dir() / f"{name_or_path}.yaml"
+    if bundled.is_file():
+        return Path(str(bundled))
+    raise UnknownSweepError("sweep", str(name_or_path), list(bundled_sweeps()))
+
+
+def load_sweep_spec(name_or_path: str | Path) -> SweepSpec:
+    """Read and validate a sweep file (or a bundled sweep by name)."""
+    path = sweep_path(name_or_path)
+    try:
+        raw = yaml.safe_load(path.read_text())
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SweepError("sweep", str(path), f"cannot read: {exc.__class__.__name__}") from None
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        raise SweepError("sweep", str(path), f"not valid YAML: {getattr(exc, 'problem', None) or 'syntax error'}{where}") from None
+    if raw is None:
+        raise SweepError("sweep", str(path), "the file is empty")
+    return sweep_spec_from_dict(raw, str(path))

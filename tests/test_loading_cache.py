@@ -1,0 +1,53 @@
+"""Loading caches (issue 8, section 6): fast repeated loads that never serve stale or shared
+mutable data, and printed timings that say what they measure."""
+
+from __future__ import annotations
+
+import os
+import shutil
+
+import impact_balance as ib
+from impact_balance.report import format_timings
+from impact_balance.robot import example_robot_data_root
+from impact_balance.input_limits import parse_yaml as _parse
+from impact_balance.scenario import load_scenario
+
+SIMPLE = example_robot_data_root() / "simple_humanoid_description"
+
+
+def test_parse_cache_hands_out_copies():
+    text = "a: {b: [1, 2]}\nc: 3\n"
+    first = _parse(text)
+    first["a"]["b"].append(99)
+    first["c"] = 0
+    assert _parse(text) == {"a": {"b": [1, 2]}, "c": 3}
+
+
+def test_edited_scenario_file_is_reloaded(tmp_path):
+    path = tmp_path / "s.yaml"
+    path.write_text("extends: palm_push_two_feet\ncom_velocity: [0.1, 0.0]\n")
+    assert load_scenario(path).com_velocity == (0.1, 0.0)
+    path.write_text("extends: palm_push_two_feet\ncom_velocity: [0.2, 0.0]\n")
+    assert load_scenario(path).com_velocity == (0.2, 0.0)
+
+
+def test_robot_file_cache_follows_the_file(tmp_path):
+    urdf = tmp_path / "robot.urdf"
+    shutil.copy(SIMPLE / "urdf" / "simple_humanoid.urdf", urdf)
+    first = ib.load_robot(None, urdf)
+    assert ib.load_robot(None, urdf) is first  # cached
+    stat = urdf.stat()
+    os.utime(urdf, ns=(stat.st_atime_ns, stat.st_mtime_ns + 10**9))  # "edited"
+    assert ib.load_robot(None, urdf) is not first
+
+
+def test_timings_say_what_they_measure():
+    analysis = ib.analyze("palm_push_two_feet")
+    t = analysis.timings
+    assert {"scenario_loading", "robot_loading", "total"} <= set(t)
+    steps = sum(t[k] for k in ("stance", "constraints", "areas", "impact"))
+    assert t["total"] >= steps  # the analysis only: loading is apart
+    text = format_timings({"total": 0.0008, "scenario_loading": 0.0003, "robot_loading": 0.25, "kernel_loading": 0.4})
+    assert text.startswith("analysis 0.8 ms; not included: scenario loading 0.3 ms")
+    assert "robot model loading 250 ms (first use)" in text and "kernel loading 400 ms (first call)" in text
+    assert format_timings({"total": 0.0008, "robot_loading": 1e-6}) == "analysis 0.8 ms"
