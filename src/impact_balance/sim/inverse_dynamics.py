@@ -71,7 +71,16 @@ class InverseDynamicsGains:
         impact_stiffness, impact_damping: PD of the impact point to its target [1/s^2], [1/s].
         com_weight, angular_momentum_weight, posture_weight, base_orientation_weight, impact_weight,
         impact_orientation_weight: task weights.
-        acceleration_regularization, wrench_regularization: regularisation weights.
+        acceleration_regularization, wrench_regularization: regularisation weights (the latter on the
+            contact forces).
+        torque_regularization: regularisation weight of the contact torques (N m): keeps the centres
+            of pressure central and the yaw torques small.
+        friction_scale: The QP's friction coefficient is this fraction of the contact's: a margin
+            against slipping, as MuJoCo's contact, like a real one, is not exactly the ideal cone.
+        cop_margin: The QP's contact rectangles are shrunk by this much on every side [m].
+        min_normal_force: Every contact carries at least this normal force [N]. The ZMP support area
+            includes ZMPs reached only by unloading a contact (its cone contains zero); the fall
+            detector counts an unloaded contact as lost, so the QP keeps each one loaded.
     """
 
     rate: float = 500.0
@@ -95,6 +104,10 @@ class InverseDynamicsGains:
     impact_orientation_weight: float = 1.0
     acceleration_regularization: float = 1e-6
     wrench_regularization: float = 1e-7
+    torque_regularization: float = 1e-5
+    friction_scale: float = 0.8
+    cop_margin: float = 0.01
+    min_normal_force: float = 20.0
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -187,7 +200,8 @@ class InverseDynamicsController:
         self.contact_frames = [model.getFrameId(c.spec.frame) for c in stance.contacts]
         self.contact_offsets = [c.spec.offset for c in stance.contacts]
         self.contact_specs = [c.spec for c in stance.contacts]
-        self.contact_half_sizes = [(c.half_length, c.half_width) for c in stance.contacts]
+        self.contact_half_sizes = [(max(c.half_length - gains.cop_margin, 0.5 * c.half_length),
+                                    max(c.half_width - gains.cop_margin, 0.5 * c.half_width)) for c in stance.contacts]
         # Torque limits on the actuated rows (velocity index >= 6); 0 or missing effort: unbounded.
         effort = np.full(nv - 6, np.inf)
         idx, values = stance.robot.effort_limits
@@ -214,9 +228,10 @@ class InverseDynamicsController:
         n, nc = self.n, self.nc
         P_diag = np.zeros((n, n))
         P_diag[np.arange(nv), np.arange(nv)] = self._posture_w + gains.acceleration_regularization
-        P_diag[np.arange(nv, n), np.arange(nv, n)] = gains.wrench_regularization
+        P_diag[np.arange(nv, n), np.arange(nv, n)] = np.tile(
+            [gains.wrench_regularization] * 3 + [gains.torque_regularization] * 3, nc)
         self._P_diag, self._P = P_diag, np.zeros((n, n))
-        m = 6 + 6 * nc + 16 * nc + self._limited.size
+        m = 6 + 6 * nc + 17 * nc + self._limited.size
         self._C = np.zeros((m, n))
         self._upper = np.zeros(m)
         self._lower = np.full(m, -1e30)
@@ -319,14 +334,20 @@ class InverseDynamicsController:
             upper[r:r + 6] = -drift - g.contact_damping * (J @ v)
             self._Jw[6 * i:6 * i + 6] = J
             k = ne + 16 * i
-            C[k:k + 16, nv + 6 * i:nv + 6 * i + 6] = cwc_faces_world(spec.friction, *self.contact_half_sizes[i],
+            C[k:k + 16, nv + 6 * i:nv + 6 * i + 6] = cwc_faces_world(g.friction_scale * spec.friction, *self.contact_half_sizes[i],
                                                                      placement.rotation)
         lower[:ne] = upper[:ne]
+        # Minimum normal force (rows after the cones): n_i . f_i >= f_min.
+        k = ne + 16 * nc
+        for i, fid in enumerate(self.contact_frames):
+            C[k + i, nv + 6 * i:nv + 6 * i + 3] = data.oMf[fid].rotation[:, 2]
+        lower[k:k + nc] = g.min_normal_force
+        upper[k:k + nc] = 1e30
         # tau = M[6:] a + h[6:] - Jw[:, 6:]^T w (actuated rows)
         T = np.hstack([M[6:], -self._Jw[:, 6:].T])
         t0 = h[6:]
         limited = self._limited
-        m0 = ne + 16 * nc
+        m0 = ne + 17 * nc
         if limited.size:
             C[m0:, :] = T[limited]
             upper[m0:] = self.effort[limited] - t0[limited]
