@@ -96,7 +96,7 @@ class InverseDynamicsGains:
     base_orientation_damping: float = 20.0
     impact_stiffness: float = 400.0
     impact_damping: float = 40.0
-    com_weight: float = 100.0
+    com_weight: float = 1000.0
     angular_momentum_weight: float = 1.0
     posture_weight: float = 1e-2
     base_orientation_weight: float = 1.0
@@ -105,7 +105,7 @@ class InverseDynamicsGains:
     acceleration_regularization: float = 1e-6
     wrench_regularization: float = 1e-7
     torque_regularization: float = 1e-5
-    friction_scale: float = 0.8
+    friction_scale: float = 0.65
     cop_margin: float = 0.01
     min_normal_force: float = 20.0
 
