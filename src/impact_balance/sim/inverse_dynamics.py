@@ -47,7 +47,7 @@ from ..spatial import skew
 from .balance import ImpactTask
 from .zmp import DcmFeedback
 
-__all__ = ["InverseDynamicsGains", "InverseDynamicsController", "TorqueOutput"]
+__all__ = ["InverseDynamicsGains", "InverseDynamicsController", "TorqueOutput", "describe"]
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -374,3 +374,11 @@ class InverseDynamicsController:
         """Name and gains (the ``controller`` object of ``validate --json``)."""
         return {"name": self.name, "gains": self.gains.to_dict(), "omega": self.omega,
                 "effort_limits": self.effort_limits}
+
+
+def describe(gains: InverseDynamicsGains, sim_timestep: float, effort_limits: bool) -> dict:
+    """The ``controller`` object of ``validate --json`` and ``push-test --json`` for the ``id`` controller."""
+    return {"name": InverseDynamicsController.name, "gains": gains.to_dict(), "control_rate_hz": gains.rate,
+            "sim_timestep": sim_timestep, "actuators": "torque motors (MuJoCo), viscous joint damping compensated",
+            "effort_limits": effort_limits,
+            "impact_task": {"force_threshold": 15.0, "retract": 0.05}}
