@@ -97,9 +97,9 @@ class InverseDynamicsGains:
     impact_stiffness: float = 400.0
     impact_damping: float = 40.0
     com_weight: float = 1000.0
-    angular_momentum_weight: float = 1.0
+    angular_momentum_weight: float = 0.1
     posture_weight: float = 1e-2
-    base_orientation_weight: float = 1.0
+    base_orientation_weight: float = 0.1
     impact_weight: float = 10.0
     impact_orientation_weight: float = 1.0
     acceleration_regularization: float = 1e-6
