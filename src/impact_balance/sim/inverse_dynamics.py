@@ -18,15 +18,16 @@ free-flyer velocity in the base frame):
 
    - equalities: the 6 unactuated rows of ``M a + h = S^T tau + sum J_i^T w_i`` (the floating
      base), and ``J_i a + J_i_dot v = -K_c J_i v`` for each contact (the contacts stay);
-   - inequalities: each ``w_i`` in its contact wrench cone (:func:`impact_balance.cwc.cwc_faces_world`),
-     and ``|tau| <= effort`` with ``tau`` the actuated rows of ``M a + h - sum J_i^T w_i``;
+   - inequalities: each ``w_i`` in its contact wrench cone (:func:`impact_balance.cwc.cwc_faces_world`)
+     with a minimum normal force, the joint position limits (as acceleration bounds), and
+     ``|tau| <= effort`` with ``tau`` the actuated rows of ``M a + h - sum J_i^T w_i``;
    - cost (weighted least squares): the CoM acceleration of the LIPM, ``c_dd_xy = omega^2 (c_xy - p)``,
      with a PD on the CoM height; angular momentum damping ``L_dot = -K_L L``; the impact point's
      acceleration (PD to the :class:`~.balance.ImpactTask` target and its velocity); a posture
      PD to the start configuration (joints, and the base orientation); a small regularisation.
 
    If the torque limits make the QP infeasible, it is solved without them and the torques are
-   clipped (MuJoCo clips them too).
+   clipped (MuJoCo clips them too); then, if need be, without the joint limits.
 4. The torques ``tau`` go to MuJoCo's motors.
 
 The measured ZMP is not needed (the wrenches are chosen, not admitted); the argument is kept so
@@ -81,6 +82,9 @@ class InverseDynamicsGains:
         min_normal_force: Every contact carries at least this normal force [N]. The ZMP support area
             includes ZMPs reached only by unloading a contact (its cone contains zero); the fall
             detector counts an unloaded contact as lost, so the QP keeps each one loaded.
+        joint_limit_horizon: T [s] of the joint position limits on the accelerations: braking at
+            ``a`` from ``(q, v)`` stays within the limits for T, ``q + v T + a T^2 / 2`` in
+            ``[lower, upper]``. MuJoCo enforces the limits with forces the QP would not know.
     """
 
     rate: float = 500.0
@@ -108,6 +112,7 @@ class InverseDynamicsGains:
     friction_scale: float = 0.65
     cop_margin: float = 0.01
     min_normal_force: float = 20.0
+    joint_limit_horizon: float = 0.1
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -231,7 +236,9 @@ class InverseDynamicsController:
         P_diag[np.arange(nv, n), np.arange(nv, n)] = np.tile(
             [gains.wrench_regularization] * 3 + [gains.torque_regularization] * 3, nc)
         self._P_diag, self._P = P_diag, np.zeros((n, n))
-        m = 6 + 6 * nc + 17 * nc + self._limited.size
+        self._q_lower = model.lowerPositionLimit[7:].copy()
+        self._q_upper = model.upperPositionLimit[7:].copy()
+        m = 6 + 6 * nc + 17 * nc + (nv - 6) + self._limited.size
         self._C = np.zeros((m, n))
         self._upper = np.zeros(m)
         self._lower = np.full(m, -1e30)
@@ -348,15 +355,25 @@ class InverseDynamicsController:
         t0 = h[6:]
         limited = self._limited
         m0 = ne + 17 * nc
+        # Joint position limits (rows after the minimum normal forces), then the torque limits.
+        T2 = g.joint_limit_horizon
+        qj, vj = q[7:], v[6:]
+        C[m0:m0 + nv - 6, 6:nv] = np.eye(nv - 6)
+        upper[m0:m0 + nv - 6] = 2.0 * (self._q_upper - qj - vj * T2) / T2**2
+        lower[m0:m0 + nv - 6] = np.minimum(2.0 * (self._q_lower - qj - vj * T2) / T2**2, upper[m0:m0 + nv - 6])
+        m1 = m0 + nv - 6
         if limited.size:
-            C[m0:, :] = T[limited]
-            upper[m0:] = self.effort[limited] - t0[limited]
-            lower[m0:] = -self.effort[limited] - t0[limited]
+            C[m1:, :] = T[limited]
+            upper[m1:] = self.effort[limited] - t0[limited]
+            lower[m1:] = -self.effort[limited] - t0[limited]
         x, _, exitflag, _ = daqp.solve(P, c, C, upper, lower, self._sense)
         torque_limited = False
-        if exitflag < 1 and limited.size:
+        # Infeasible: drop the torque limits (the torques are clipped below), then the joint limits.
+        for rows in ((m1,) if limited.size else ()) + (m0,):
+            if exitflag >= 1:
+                break
             torque_limited = True
-            x, _, exitflag, _ = daqp.solve(P, c, C[:m0], upper[:m0], lower[:m0], self._sense[:m0])
+            x, _, exitflag, _ = daqp.solve(P, c, C[:rows], upper[:rows], lower[:rows], self._sense[:rows])
         if exitflag < 1:
             # Not even the cones and the contacts together: hold the last command.
             torque_limited = True
