@@ -236,9 +236,13 @@ class InverseDynamicsController:
         P_diag[np.arange(nv, n), np.arange(nv, n)] = np.tile(
             [gains.wrench_regularization] * 3 + [gains.torque_regularization] * 3, nc)
         self._P_diag, self._P = P_diag, np.zeros((n, n))
-        self._q_lower = model.lowerPositionLimit[7:].copy()
-        self._q_upper = model.upperPositionLimit[7:].copy()
-        m = 6 + 6 * nc + 17 * nc + (nv - 6) + self._limited.size
+        # Position limits of the 1-dof joints (a continuous joint has nq = 2 and no limit).
+        one_dof = [j for j in model.joints[2:] if j.nq == 1 and j.nv == 1]
+        self._limit_q = np.array([j.idx_q for j in one_dof], dtype=int)
+        self._limit_v = np.array([j.idx_v for j in one_dof], dtype=int)
+        self._q_lower = model.lowerPositionLimit[self._limit_q].copy()
+        self._q_upper = model.upperPositionLimit[self._limit_q].copy()
+        m = 6 + 6 * nc + 17 * nc + self._limit_q.size + self._limited.size
         self._C = np.zeros((m, n))
         self._upper = np.zeros(m)
         self._lower = np.full(m, -1e30)
@@ -357,11 +361,11 @@ class InverseDynamicsController:
         m0 = ne + 17 * nc
         # Joint position limits (rows after the minimum normal forces), then the torque limits.
         T2 = g.joint_limit_horizon
-        qj, vj = q[7:], v[6:]
-        C[m0:m0 + nv - 6, 6:nv] = np.eye(nv - 6)
-        upper[m0:m0 + nv - 6] = 2.0 * (self._q_upper - qj - vj * T2) / T2**2
-        lower[m0:m0 + nv - 6] = np.minimum(2.0 * (self._q_lower - qj - vj * T2) / T2**2, upper[m0:m0 + nv - 6])
-        m1 = m0 + nv - 6
+        qj, vj = q[self._limit_q], v[self._limit_v]
+        m1 = m0 + self._limit_q.size
+        C[np.arange(m0, m1), self._limit_v] = 1.0
+        upper[m0:m1] = 2.0 * (self._q_upper - qj - vj * T2) / T2**2
+        lower[m0:m1] = np.minimum(2.0 * (self._q_lower - qj - vj * T2) / T2**2, upper[m0:m1])
         if limited.size:
             C[m1:, :] = T[limited]
             upper[m1:] = self.effort[limited] - t0[limited]
