@@ -8,7 +8,9 @@ with the hand backed off); :func:`run_balance_trial` resets the model and runs o
 - ``push``: a force on a body (the torso) for a short time (see :class:`Push`).
 
 At every control step (500 Hz) the loop reads MuJoCo's state as pinocchio's ``(q, v)``,
-runs :class:`~.balance.BalanceController`, writes the servo targets, and feeds the
+runs :class:`~.balance.BalanceController` and writes the servo targets (``controller="ik"``), or
+runs :class:`~.inverse_dynamics.InverseDynamicsController` and writes the motor torques
+(``controller="id"``, the actuators then being torque motors), and feeds the
 :class:`~.falls.FallDetector`. It records the measured ZMP (from the sustained contacts' forces,
 on the plane ``z = h``), the CoM, the CoM velocity and the DCM, and their margins in the
 scenario's ZMP support area and CoM velocity area, and optionally a log (:mod:`impact_balance.logs`).
