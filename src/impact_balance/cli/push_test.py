@@ -11,13 +11,12 @@ USES_KERNEL = True
 
 
 def add_parser(sub) -> list[str]:
-    from ..sim.push import DEFAULT_MAGNITUDES
-
+    # No import of the simulation here: mujoco is imported only when a simulation command runs.
     a = sub.add_parser("push-test", help="push the simulated robot in every direction; confusion matrices of both criteria")
     a.add_argument("scenario", help="YAML file or bundled scenario name")
     a.add_argument("--directions", type=int, default=16, help="number of push directions (default 16)")
-    a.add_argument("--magnitudes", type=float, nargs="+", default=list(DEFAULT_MAGNITUDES), metavar="NS",
-                   help=f"impulses, N s (default {' '.join(f'{m:g}' for m in DEFAULT_MAGNITUDES)})")
+    a.add_argument("--magnitudes", type=float, nargs="+", default=None, metavar="NS",
+                   help="impulses, N s (default 5 10 15 20 25 30)")
     a.add_argument("--duration", type=float, default=0.05, help="push duration, s (default 0.05)")
     a.add_argument("--body", help="MuJoCo body pushed (default: the torso)")
     a.add_argument("--controller", default="ik", choices=("ik", "id"),
@@ -33,10 +32,12 @@ def run(args: argparse.Namespace) -> int:
     from ..logs import write_log
     from ..scenario import load_scenario
     from ..sim.balance_trial import BalanceTrialOptions, run_balance_trial
-    from ..sim.push import check_push_arguments, push_test
+    from ..sim.push import DEFAULT_MAGNITUDES, check_push_arguments, push_test
     from ._common import progress_bar, strict_json
 
     scenario = load_scenario(args.scenario)
+    if args.magnitudes is None:
+        args.magnitudes = list(DEFAULT_MAGNITUDES)
     if args.log and Path(args.log).suffix.lower() not in (".parquet", ".csv"):
         raise ScenarioError("--log", args.log, "a log is a .parquet or .csv file")
     check_push_arguments(args.directions, args.magnitudes, args.duration)
