@@ -13,18 +13,20 @@ free-flyer velocity in the base frame):
    axes, at the contact point) and their drifts ``J_i_dot v``.
 2. :class:`~.zmp.DcmFeedback` (the same as the kinematic controller's) picks the desired ZMP
    ``p = xi + (k/omega)(xi - xi_ref)`` clamped to the scenario's ZMP support area.
-3. One dense QP (daqp, called directly: the step must stay well under a millisecond) in ``x = [a (nv); w_1 .. w_nc (6 each)]``, the joint
-   accelerations and the contact wrenches ``[f; tau]`` (world axes, at each contact point):
+3. One dense QP (daqp, called directly: the step must stay well under a millisecond) in
+   ``x = [a (nv); w_1 .. w_nc (6 each)]``, the joint accelerations and the contact wrenches
+   ``[f; tau]`` (world axes, at each contact point):
 
    - equalities: the 6 unactuated rows of ``M a + h = S^T tau + sum J_i^T w_i`` (the floating
      base), and ``J_i a + J_i_dot v = -K_c J_i v`` for each contact (the contacts stay);
    - inequalities: each ``w_i`` in its contact wrench cone (:func:`impact_balance.cwc.cwc_faces_world`)
-     with a minimum normal force, the joint position limits (as acceleration bounds), and
+     (friction and rectangle shrunk by margins, see :class:`InverseDynamicsGains`) with a
+     minimum normal force, the joint position limits (as acceleration bounds), and
      ``|tau| <= effort`` with ``tau`` the actuated rows of ``M a + h - sum J_i^T w_i``;
    - cost (weighted least squares): the CoM acceleration of the LIPM, ``c_dd_xy = omega^2 (c_xy - p)``,
      with a PD on the CoM height; angular momentum damping ``L_dot = -K_L L``; the impact point's
      acceleration (PD to the :class:`~.balance.ImpactTask` target and its velocity); a posture
-     PD to the start configuration (joints, and the base orientation); a small regularisation.
+     PD to the start configuration (joints) and one on the base orientation; a small regularisation.
 
    If the torque limits make the QP infeasible, it is solved without them and the torques are
    clipped (MuJoCo clips them too); then, if need be, without the joint limits.
