@@ -19,6 +19,8 @@ def add_parser(sub) -> list[str]:
                    help="impulses, N s (default 5 10 15 20 25 30)")
     a.add_argument("--duration", type=float, default=0.05, help="push duration, s (default 0.05)")
     a.add_argument("--body", help="MuJoCo body pushed (default: the torso)")
+    a.add_argument("--controller", default="ik", choices=("ik", "id"),
+                   help="ik: pink IK -> position servos (default); id: inverse-dynamics QP -> torque motors")
     a.add_argument("--json", action="store_true", help="print one JSON object")
     a.add_argument("--plots", metavar="DIR", help="write the figures to DIR")
     a.add_argument("--log", metavar="FILE", help="write the time series (.parquet or .csv) of one telling push")
@@ -46,14 +48,15 @@ def run(args: argparse.Namespace) -> int:
         bar.set_postfix_str(f"{outcome.push.magnitude:g} N s {'fell' if outcome.result.fell else 'ok'}")
 
     try:
-        result = push_test(scenario, args.directions, args.magnitudes, args.duration, args.body, progress=progress)
+        result = push_test(scenario, args.directions, args.magnitudes, args.duration, args.body, progress=progress,
+                           options=BalanceTrialOptions(controller=args.controller))
     finally:
         bar.close()
     out = result.to_dict()
     written = []
     if args.log:
         chosen = _telling(result.outcomes)
-        trial = run_balance_trial(result.setup, push=chosen.push, options=BalanceTrialOptions(record=True))
+        trial = run_balance_trial(result.setup, push=chosen.push, options=BalanceTrialOptions(record=True, controller=args.controller))
         written.append(write_log(trial.log, args.log, {"scenario": scenario.name, "push_direction": chosen.push.direction,
                                                        "push_magnitude": chosen.push.magnitude}))
         out["log"] = {"file": str(args.log), "direction": chosen.push.direction, "magnitude": chosen.push.magnitude}

@@ -15,6 +15,8 @@ def add_parser(sub) -> list[str]:
     a.add_argument("scenario", help="YAML file or bundled scenario name (must have an impact)")
     a.add_argument("--joints", default="servo", choices=("rigid", "servo"),
                    help="servo: URDF effort limits, 15 Hz servos; rigid: stiff 30 Hz servos, no effort limits")
+    a.add_argument("--controller", default="ik", choices=("ik", "id"),
+                   help="ik: pink IK -> position servos (default); id: inverse-dynamics QP -> torque motors")
     a.add_argument("--tolerance", type=float, default=0.05, help="relative width of the bracket (default 0.05)")
     a.add_argument("--max-speed", type=float, default=4.0, help="largest approach speed tried, m/s (default 4)")
     a.add_argument("--json", action="store_true", help="print one JSON object")
@@ -47,14 +49,15 @@ def run(args: argparse.Namespace) -> int:
         bar.set_postfix_str(f"{speed:.3f} m/s {'fell' if result.fell else 'ok'}; bracket [{lo}, {hi}]")
 
     try:
-        result = validate(scenario, args.joints, tolerance=args.tolerance, max_speed=args.max_speed, progress=progress)
+        result = validate(scenario, args.joints, tolerance=args.tolerance, max_speed=args.max_speed, progress=progress,
+                          options=BalanceTrialOptions(controller=args.controller))
     finally:
         bar.close()
     out = result.to_dict()
     written = []
     if args.log:
         speed = result.survived if result.survived is not None else result.fell
-        trial = run_balance_trial(result.extra["setup"], impact_speed=speed, options=BalanceTrialOptions(record=True))
+        trial = run_balance_trial(result.extra["setup"], impact_speed=speed, options=BalanceTrialOptions(record=True, controller=args.controller))
         written.append(write_log(trial.log, args.log, {"scenario": scenario.name, "approach_speed": speed,
                                                        "joints": args.joints}))
         out["log"] = {"file": str(args.log), "approach_speed": speed}
@@ -64,7 +67,8 @@ def run(args: argparse.Namespace) -> int:
         print_json(out)
         return 0
     p = out["predicted"]
-    print(f"{scenario.name}: empirical fall threshold ({args.joints} joints, {len(result.trials)} trials)")
+    print(f"{scenario.name}: empirical fall threshold ({args.joints} joints, {args.controller} controller,"
+          f" {len(result.trials)} trials)")
     print(f"  survived at {_f(result.survived)}, fell at {_f(result.fell)} (commanded approach speed)")
     print("  predicted maximum contact velocity:")
     for crit in ("com_criterion", "zmp_criterion"):

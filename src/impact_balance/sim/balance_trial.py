@@ -8,7 +8,9 @@ with the hand backed off); :func:`run_balance_trial` resets the model and runs o
 - ``push``: a force on a body (the torso) for a short time (see :class:`Push`).
 
 At every control step (500 Hz) the loop reads MuJoCo's state as pinocchio's ``(q, v)``,
-runs :class:`~.balance.BalanceController`, writes the servo targets, and feeds the
+runs :class:`~.balance.BalanceController` and writes the servo targets (``controller="ik"``), or
+runs :class:`~.inverse_dynamics.InverseDynamicsController` and writes the motor torques
+(``controller="id"``, the actuators then being torque motors), and feeds the
 :class:`~.falls.FallDetector`. It records the measured ZMP (from the sustained contacts' forces,
 on the plane ``z = h``), the CoM, the CoM velocity and the DCM, and their margins in the
 scenario's ZMP support area and CoM velocity area, and optionally a log (:mod:`impact_balance.logs`).
@@ -30,6 +32,7 @@ from ..logs.schema import LogColumns, force_columns, joint_position_column, join
 from ..scenario import Scenario, load_scenario
 from .balance import BalanceController, BalanceGains, ImpactTask, retracted_stance
 from .falls import FallCriteria, FallDetector
+from .inverse_dynamics import InverseDynamicsController, InverseDynamicsGains
 from .joints import JOINT_MODELS, ServoOptions
 from .log import LOG_START
 from .model import SimModel, SimOptions, build_model
@@ -44,7 +47,11 @@ SUPPORT_STIFFNESS_FACTOR = 0.4
 #: robot cannot be controlled; this is the closest a controlled robot gets to the paper's rigid body.
 STIFF_SERVOS = ServoOptions(bandwidth=2.0 * np.pi * 30.0, effort_limits=False)
 
-__all__ = ["STIFF_SERVOS", "Push", "BalanceTrialOptions", "BalanceSetup", "BalanceTrialResult", "run_balance_trial", "measured_zmp"]
+#: Balance controllers: ``ik`` (pink IK -> position servos, :mod:`.balance`) and ``id`` (inverse-dynamics QP ->
+#: torque motors, :mod:`.inverse_dynamics`).
+CONTROLLERS = ("ik", "id")
+
+__all__ = ["CONTROLLERS", "STIFF_SERVOS", "Push", "BalanceTrialOptions", "BalanceSetup", "BalanceTrialResult", "run_balance_trial", "measured_zmp"]
 
 
 @dataclass(frozen=True)
@@ -80,9 +87,12 @@ class BalanceTrialOptions:
         settle: Time standing still before the disturbance (s).
         standoff: Distance of the impact point from the surface at the start (m).
         max_approach_time: Longest approach before the trial gives up waiting for the contact (s).
-        gains: Controller gains.
+        gains: Gains of the ``ik`` controller.
         criteria: Fall thresholds.
         record: Keep a log (:mod:`impact_balance.logs` columns) in the result.
+        controller: ``ik`` (pink IK, position servos) or ``id`` (inverse-dynamics QP, torque motors); it
+            decides the actuators, so it is read when the :class:`BalanceSetup` is created.
+        id_gains: Gains of the ``id`` controller.
     """
 
     after: float = 2.5
@@ -92,6 +102,8 @@ class BalanceTrialOptions:
     gains: BalanceGains = field(default_factory=BalanceGains)
     criteria: FallCriteria = field(default_factory=FallCriteria)
     record: bool = False
+    controller: str = "ik"
+    id_gains: InverseDynamicsGains = field(default_factory=InverseDynamicsGains)
 
 
 @dataclass
@@ -105,6 +117,7 @@ class BalanceSetup:
     q_start: np.ndarray
     standoff: float
     support_v_index: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    controller: str = "ik"
 
     @classmethod
     def create(cls, scenario: Scenario | str, joints: str = "servo", options: BalanceTrialOptions | None = None,
@@ -114,6 +127,8 @@ class BalanceSetup:
             scenario = load_scenario(scenario)
         if joints not in JOINT_MODELS:
             raise SimulationError("--joints", joints, f"unknown joint model; valid: {', '.join(JOINT_MODELS)}")
+        if options.controller not in CONTROLLERS:
+            raise SimulationError("--controller", options.controller, f"unknown controller; valid: {', '.join(CONTROLLERS)}")
         analysis = analyze(scenario)
         if sim_options is None:
             # 1 ms steps: the stiffest contact (impact, time constant 4 ms) still spans 4 steps.
@@ -125,12 +140,15 @@ class BalanceSetup:
         # 3 mm/s within its friction cone); the no-slip pass removes that drift, which would otherwise
         # count as a slip after a few seconds.
         sim.model.opt.noslip_iterations = NOSLIP_ITERATIONS
-        stiffen_support_limbs(sim, analysis)
+        if options.controller == "id":
+            use_torque_motors(sim)
+        else:
+            stiffen_support_limbs(sim, analysis)
         standoff = options.standoff if analysis.impact is not None else 0.0
         q_start = retracted_stance(analysis, standoff)
         support = [analysis.stance.robot.joint_slot(n) for n in support_joints(sim, analysis)]
         support_v = np.array([analysis.stance.model.joints[j.id].idx_v for j in support], dtype=int)
-        return cls(scenario, joints, analysis, sim, q_start, standoff, support_v)
+        return cls(scenario, joints, analysis, sim, q_start, standoff, support_v, options.controller)
 
 
 @dataclass
@@ -220,6 +238,20 @@ def stiffen_support_limbs(sim: SimModel, analysis: Analysis, factor: float = SUP
         sim.kp[k], sim.kd[k] = kp, kd
 
 
+def use_torque_motors(sim: SimModel) -> None:
+    """Turn the servo actuators into torque motors (force = ctrl), for the ``id`` controller.
+
+    The servo actuators are MuJoCo ``general`` actuators with force ``kp ctrl - kp q - kd qdot``;
+    setting the gain to 1 and the bias to 0 leaves ``force = ctrl``, clipped to the same force range
+    (the URDF effort limit with ``servo`` joints, none with ``rigid``). ``kp``/``kd`` become 0.
+    """
+    ids = sim.actuator_ids
+    sim.model.actuator_gainprm[ids, 0] = 1.0
+    sim.model.actuator_biasprm[ids, :3] = 0.0
+    sim.kp[:] = 0.0
+    sim.kd[:] = 0.0
+
+
 def measured_zmp(sim: SimModel, com: np.ndarray, plane_height: float) -> tuple[np.ndarray, np.ndarray]:
     """ZMP of the sustained contacts' resultant force, in the LIPM sense, and each contact's force.
 
@@ -301,7 +333,10 @@ def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, pu
         raise SimulationError("speed", impact_speed, "must be in (0, 20] m/s")
     mujoco.mj_resetData(m, d)
     sim.set_state(setup.q_start)
-    sim.set_servo_targets(setup.q_start)
+    if setup.controller == "id":
+        d.ctrl[sim.actuator_ids] = sim.tau_hold  # motors: the holding torques until the first control step
+    else:
+        sim.set_servo_targets(setup.q_start)
     stance = analysis.stance
     model = stance.robot.model
     pdata = model.createData()
@@ -313,7 +348,16 @@ def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, pu
         n = im.normal
         task = ImpactTask(im.spec.frame, im.spec.offset, im.point, n, impact_speed, start_time=options.settle,
                           standoff=setup.standoff)
-    controller = BalanceController(analysis, setup.q_start, options.gains, task)
+    torque = setup.controller == "id"
+    if torque:
+        controller = InverseDynamicsController(analysis, setup.q_start, options.id_gains, task,
+                                               effort_limits=bool(sim.model.actuator_forcelimited[sim.actuator_ids].any()))
+        # MuJoCo's viscous joint damping (the URDF's) is compensated: the motors add damping * qdot.
+        joint_damping = m.dof_damping[sim.dof_adr].copy()
+        rate = options.id_gains.rate
+    else:
+        controller = BalanceController(analysis, setup.q_start, options.gains, task)
+        rate = options.gains.rate
     contact_frames = [model.getFrameId(c.spec.frame) for c in stance.contacts]
     pin.framesForwardKinematics(model, pdata, setup.q_start)
     detector = FallDetector(
@@ -336,7 +380,7 @@ def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, pu
         disturbance = disturbance_end = None
         end_time = options.settle + (setup.standoff / impact_speed + options.max_approach_time
                                      if impact_speed else 0.0) + options.after
-    steps_per_control = max(1, int(round(1.0 / (options.gains.rate * m.opt.timestep))))
+    steps_per_control = max(1, int(round(1.0 / (rate * m.opt.timestep))))
     series: dict[str, list] = {k: [] for k in ("time", "zmp", "zmp_desired", "com", "com_velocity", "dcm",
                                                "zmp_margin", "com_velocity_margin")}
     approach_measured = None
@@ -363,11 +407,14 @@ def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, pu
             com_now, _ = controller.measure(q, v)
             zmp, forces = measured_zmp(sim, com_now, h)
             out = controller.step(t, q, v, zmp, fn)
-            # Velocity feed-forward (kd v_ref) for the free limbs only: on the stiffened support limbs
-            # it would turn the dead-beat IK's velocity noise into large torques.
-            v_ff = out.v.copy()
-            v_ff[setup.support_v_index] = 0.0
-            sim.set_servo_targets(out.q, v_ff)
+            if torque:
+                d.ctrl[sim.actuator_ids] = out.tau[sim.v_index - 6] + joint_damping * d.qvel[sim.dof_adr]
+            else:
+                # Velocity feed-forward (kd v_ref) for the free limbs only: on the stiffened support limbs
+                # it would turn the dead-beat IK's velocity noise into large torques.
+                v_ff = out.v.copy()
+                v_ff[setup.support_v_index] = 0.0
+                sim.set_servo_targets(out.q, v_ff)
             com, com_velocity = out.com, out.com_velocity
             omega = np.sqrt(g / (com[2] - h))
             zmp_margin = float(zmp_area.margins(zmp)[0]) if np.all(np.isfinite(zmp)) else -np.inf

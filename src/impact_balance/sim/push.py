@@ -106,6 +106,11 @@ def push_test(scenario: Scenario | str, directions: int = 16, magnitudes: Sequen
             outcomes.append(outcome)
             if progress:
                 progress(outcome)
-    controller = {"name": "dcm-zmp-clamp + pink IK -> joint position servos", "gains": options.gains.to_dict()}
+    if setup.controller == "id":
+        from .inverse_dynamics import describe
+
+        controller = describe(options.id_gains, float(setup.sim.model.opt.timestep), True)
+    else:
+        controller = {"name": "dcm-zmp-clamp + pink IK -> joint position servos", "gains": options.gains.to_dict()}
     return PushTestResult(scenario.name, outcomes, controller, options.criteria.to_dict(), setup,
                           time.perf_counter() - wall0)

@@ -142,6 +142,11 @@ def validate(scenario: Scenario | str, joints: str = "servo", *, tolerance: floa
                         "servo": {"kp": setup.sim.kp.tolist(), "kd": setup.sim.kd.tolist(),
                                   "joints": list(setup.sim.joint_names)},
                         "impact_task": {"standoff": setup.standoff, "force_threshold": 15.0, "retract": 0.05}}
+    if setup.controller == "id":
+        from .inverse_dynamics import describe
+
+        setup_controller = describe(options.id_gains, float(setup.sim.model.opt.timestep), joints == "servo")
+        setup_controller["impact_task"]["standoff"] = setup.standoff
     return ValidationResult(scenario.name, joints, predicted, survived, fell, trials, setup_controller,
                             options.criteria.to_dict(), tolerance, max_speed, time.perf_counter() - wall0,
                             {"setup": setup})
