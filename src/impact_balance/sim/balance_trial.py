@@ -172,6 +172,7 @@ class BalanceTrialResult:
     max_zmp_excursion: float = 0.0
     max_com_velocity_excursion: float = 0.0
     min_com_velocity_margin: float = float("inf")
+    com_velocity_margin_at_end: float | None = None  # m/s, at the end of the disturbance (push)
     com_criterion_safe: bool | None = None
     zmp_criterion_safe: bool | None = None
     max_tilt: float = 0.0
@@ -462,6 +463,7 @@ def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, pu
         end_idx = int(np.searchsorted(tt, disturbance_end + 1e-9))
         end_idx = min(end_idx, len(tt) - 1)
         during = (tt >= disturbance) & (tt <= disturbance_end + 1e-9)
+        result.com_velocity_margin_at_end = float(vm[end_idx])
         result.com_criterion_safe = bool(vm[end_idx] >= 0.0)
         result.zmp_criterion_safe = bool(np.all(zm[during] >= 0.0)) if during.any() else bool(zm[end_idx] >= 0)
     return result

@@ -38,6 +38,10 @@ class PushOutcome:
             "direction": float(self.push.direction), "magnitude": float(self.push.magnitude),
             "duration": float(self.push.duration), "fell": r.fell, "reason": r.reason, "detail": r.detail,
             "com_criterion_safe": r.com_criterion_safe, "zmp_criterion_safe": r.zmp_criterion_safe,
+            # How close the CoM criterion's call was: m/s inside (>= 0) or outside the area at the push's end.
+            "com_velocity_margin_at_end": (None if r.com_velocity_margin_at_end is None
+                                           or not np.isfinite(r.com_velocity_margin_at_end)
+                                           else r.com_velocity_margin_at_end),
             "max_zmp_excursion": r.max_zmp_excursion, "max_com_velocity_excursion": r.max_com_velocity_excursion,
         }
 
