@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ._options import add_controller_option, add_output_options
+
 __all__ = ["add_parser", "run", "USES_KERNEL"]
 
 USES_KERNEL = True
@@ -19,17 +21,13 @@ def add_parser(sub) -> list[str]:
                    help="impulses, N s (default 5 10 15 20 25 30)")
     a.add_argument("--duration", type=float, default=0.05, help="push duration, s (default 0.05)")
     a.add_argument("--body", help="MuJoCo body pushed (default: the torso)")
-    a.add_argument("--controller", default="ik", choices=("ik", "id"),
-                   help="ik: pink IK -> position servos (default); id: inverse-dynamics QP -> torque motors")
-    a.add_argument("--json", action="store_true", help="print one JSON object")
-    a.add_argument("--plots", metavar="DIR", help="write the figures to DIR")
-    a.add_argument("--log", metavar="FILE", help="write the time series (.parquet or .csv) of one telling push")
+    add_controller_option(a)
+    add_output_options(a, "of one telling push")
     return ["push-test"]
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..exceptions import ScenarioError
-    from ..logs import write_log
+    from ..logs import check_log_path, write_log
     from ..scenario import load_scenario
     from ..sim.balance_trial import BalanceTrialOptions, run_balance_trial
     from ..sim.push import DEFAULT_MAGNITUDES, check_push_arguments, push_test
@@ -38,8 +36,8 @@ def run(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
     if args.magnitudes is None:
         args.magnitudes = list(DEFAULT_MAGNITUDES)
-    if args.log and Path(args.log).suffix.lower() not in (".parquet", ".csv"):
-        raise ScenarioError("--log", args.log, "a log is a .parquet or .csv file")
+    if args.log:
+        check_log_path(args.log)
     check_push_arguments(args.directions, args.magnitudes, args.duration)
     bar = progress_bar(f"push-test {scenario.name}", args.directions * len(args.magnitudes))
 

@@ -89,6 +89,7 @@ def run(args: argparse.Namespace) -> int:
     except Exception as exc:  # an unusable backend fails inside MuJoCo's import, with various types
         raise SimulationError("MUJOCO_GL", os.environ.get("MUJOCO_GL"), f"MuJoCo cannot start with this OpenGL "
                               f"backend ({type(exc).__name__}); use MUJOCO_GL=egl, or unset it") from None
+    from ..logs import check_log_path
     from ..scenario import load_scenario
     from ..sim import JOINT_MODELS, build_model
     from ..sim.measure import measure
@@ -101,8 +102,8 @@ def run(args: argparse.Namespace) -> int:
         raise SimulationError("--duration", args.duration, "must be in (0, 10] s")
     if not (math.isfinite(args.armature) and 0.0 <= args.armature <= 100.0):
         raise SimulationError("--armature", args.armature, "must be in [0, 100] kg m^2")
-    if args.log and Path(args.log).suffix.lower() not in (".parquet", ".csv"):
-        raise SimulationError("--log", args.log, "a log is a .parquet or .csv file")
+    if args.log:
+        check_log_path(args.log)
     if args.video and Path(args.video).suffix.lower() != ".mp4":
         raise SimulationError("--video", args.video, "the video is an .mp4 file")
     scenario = load_scenario(args.scenario)

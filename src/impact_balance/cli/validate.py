@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ._options import add_controller_option, add_output_options
+
 __all__ = ["add_parser", "run", "USES_KERNEL"]
 
 USES_KERNEL = True
@@ -15,19 +17,16 @@ def add_parser(sub) -> list[str]:
     a.add_argument("scenario", help="YAML file or bundled scenario name (must have an impact)")
     a.add_argument("--joints", default="servo", choices=("rigid", "servo"),
                    help="servo: URDF effort limits, 15 Hz servos; rigid: stiff 30 Hz servos, no effort limits")
-    a.add_argument("--controller", default="ik", choices=("ik", "id"),
-                   help="ik: pink IK -> position servos (default); id: inverse-dynamics QP -> torque motors")
+    add_controller_option(a)
     a.add_argument("--tolerance", type=float, default=0.05, help="relative width of the bracket (default 0.05)")
     a.add_argument("--max-speed", type=float, default=4.0, help="largest approach speed tried, m/s (default 4)")
-    a.add_argument("--json", action="store_true", help="print one JSON object")
-    a.add_argument("--plots", metavar="DIR", help="write the figures to DIR")
-    a.add_argument("--log", metavar="FILE", help="write the time series (.parquet or .csv) of the fastest trial survived")
+    add_output_options(a, "of the fastest trial survived")
     return ["validate"]
 
 
 def run(args: argparse.Namespace) -> int:
     from ..exceptions import SimulationError
-    from ..logs import write_log
+    from ..logs import check_log_path, write_log
     from ..scenario import load_scenario
     from ..sim.balance_trial import BalanceTrialOptions, run_balance_trial
     from ..sim.validate import validate
@@ -38,8 +37,8 @@ def run(args: argparse.Namespace) -> int:
         raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact: validate needs one")
     if not (0 < args.max_speed <= 5.0):
         raise SimulationError("--max-speed", args.max_speed, "must be in (0, 5] m/s")
-    if args.log and Path(args.log).suffix.lower() not in (".parquet", ".csv"):
-        _bad_log(args.log)
+    if args.log:
+        check_log_path(args.log)
     bar = progress_bar(f"validate {scenario.name}")
 
     def progress(speed, result, survived, fell):
@@ -81,12 +80,6 @@ def run(args: argparse.Namespace) -> int:
     for path in written:
         print(f"  wrote {path}")
     return 0
-
-
-def _bad_log(path: str) -> None:
-    from ..exceptions import ScenarioError
-
-    raise ScenarioError("--log", path, "a log is a .parquet or .csv file")
 
 
 def _f(x) -> str:

@@ -9,13 +9,16 @@ import pandas as pd
 from ..exceptions import ScenarioError
 from .schema import LOG_VERSION, LogColumns
 
-__all__ = ["write_log", "read_log", "SUFFIXES"]
+__all__ = ["write_log", "read_log", "check_log_path", "SUFFIXES"]
 
 #: Supported file types.
 SUFFIXES = (".parquet", ".csv")
 
 
-def _suffix(path: Path, field: str) -> str:
+def check_log_path(path: str | Path, field: str = "--log") -> str:
+    """The suffix of a log file name (``.parquet`` or ``.csv``); :class:`ScenarioError` naming
+    ``field`` otherwise. Commands call it before a long run, so a bad name fails at once."""
+    path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in SUFFIXES:
         raise ScenarioError(field, str(path)[:80], f"a log is a .parquet or .csv file, not {suffix or 'no suffix'!r}")
@@ -25,7 +28,7 @@ def _suffix(path: Path, field: str) -> str:
 def write_log(frame: pd.DataFrame, path: str | Path, metadata: dict[str, str] | None = None) -> Path:
     """Write ``frame`` (columns of :mod:`.schema`) to ``path``; Parquet files keep ``metadata`` and the version."""
     path = Path(path)
-    suffix = _suffix(path, "--log")
+    suffix = check_log_path(path, "--log")
     missing = [c for c in LogColumns().required if c not in frame.columns]
     if missing:
         raise ScenarioError("log", ", ".join(missing), "missing required columns")
@@ -48,7 +51,7 @@ def write_log(frame: pd.DataFrame, path: str | Path, metadata: dict[str, str] | 
 def read_log(path: str | Path) -> pd.DataFrame:
     """Read a log; refuse a file without the required columns, naming them."""
     path = Path(path)
-    suffix = _suffix(path, "LOG")
+    suffix = check_log_path(path, "LOG")
     if not path.is_file():
         raise ScenarioError("LOG", str(path)[:80], "no such file")
     try:
