@@ -18,6 +18,7 @@ from impact_balance.scenario import _read, scenario_from_dict, scenario_path
 from impact_balance.sweep import (
     Evaluator,
     bundled_sweeps,
+    load_sweep_spec,
     make_plan,
     plan_sweep,
     read_results,
@@ -101,6 +102,23 @@ def test_sampling_and_top_level_errors():
 
 
 # -- paths and points -----------------------------------------------------------------------
+def test_hostile_sweep_file_is_refused_quickly(tmp_path):
+    """A sweep file is read like a scenario file: an alias bomb ("billion laughs") is refused
+    in milliseconds with one message naming the file, not expanded."""
+    import time
+
+    bomb = "a: &a [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
+        f"{c}: &{c} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n"
+        for p, c in zip("abcdefgh", "bcdefghi"))
+    path = tmp_path / "bomb.yaml"
+    path.write_text(bomb + "base: palm_push_two_feet\naxes: []\n")
+    t = time.perf_counter()
+    with pytest.raises(SweepError) as info:
+        load_sweep_spec(path)
+    assert time.perf_counter() - t < 5.0
+    assert info.value.field == "sweep" and "100000" in str(info.value) and len(str(info.value)) < 400
+
+
 def test_set_path_copies_only_the_path():
     base = {"impact": {"restitution": (0.0, 0.2), "friction": 0.24}, "contacts": [{"friction": 0.7}, {"friction": 0.7}]}
     out = set_path(base, parse_path("impact.restitution[1]"), 0.5)

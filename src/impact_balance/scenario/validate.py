@@ -27,9 +27,16 @@ def _field(loc: tuple) -> str:
     return out or "scenario"
 
 
-def scenario_from_dict(raw: dict, source: str | None = None) -> Scenario:
-    """Validate a scenario mapping; raises :class:`ScenarioError` on the first bad field."""
-    check_structure(raw, source)
+def scenario_from_dict(raw: dict, source: str | None = None, check_size: bool = True) -> Scenario:
+    """Validate a scenario mapping; raises :class:`ScenarioError` on the first bad field.
+
+    ``check_size=False`` skips the nesting and expanded-size check of
+    :func:`~impact_balance.input_limits.check_structure`, for a mapping the library built from
+    input that already passed it (a sweep's points: its base scenario and its file were
+    checked once, when the sweep was planned).
+    """
+    if check_size:
+        check_structure(raw, source)
     try:
         return Scenario.model_validate({**raw, "source": source})
     except ValidationError as exc:

@@ -31,10 +31,10 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Literal
 
-import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from ..exceptions import SweepError, UnknownNameError
+from ..exceptions import ScenarioError, SweepError, UnknownNameError
+from ..input_limits import read_yaml
 from ..scenario import Offset, _field
 from ..scenario.bundled import bundled_descriptions
 
@@ -260,14 +260,10 @@ def sweep_path(name_or_path: str | Path) -> Path:
 def load_sweep_spec(name_or_path: str | Path) -> SweepSpec:
     """Read and validate a sweep file (or a bundled sweep by name)."""
     path = sweep_path(name_or_path)
-    try:
-        raw = yaml.safe_load(path.read_text())
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SweepError("sweep", str(path), f"cannot read: {exc.__class__.__name__}") from None
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        raise SweepError("sweep", str(path), f"not valid YAML: {getattr(exc, 'problem', None) or 'syntax error'}{where}") from None
+    try:  # the project's bounded reader: size, nesting and expanded-alias limits, as for scenarios
+        raw = read_yaml(path)
+    except ScenarioError as exc:
+        raise SweepError("sweep", str(path), exc.reason) from None
     if raw is None:
         raise SweepError("sweep", str(path), "the file is empty")
     return sweep_spec_from_dict(raw, str(path))
