@@ -69,7 +69,7 @@ def test_cli_errors_are_one_line(capsys, tmp_path):
 
 
 def test_push_test_json(capsys):
-    assert main(["push-test", SCENARIO, "--directions", "1", "--magnitudes", "5", "--json"]) == 0
+    assert main(["push-test", SCENARIO, "--controller", "ik", "--directions", "1", "--magnitudes", "5", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     (push,) = out["pushes"]
     assert set(push) >= {"direction", "magnitude", "fell", "reason", "com_criterion_safe", "zmp_criterion_safe"}

@@ -7,10 +7,11 @@ import argparse
 __all__ = ["add_controller_option", "add_output_options"]
 
 
-def add_controller_option(parser: argparse.ArgumentParser) -> None:
-    """``--controller ik|id``: the balance controller of the trials."""
-    parser.add_argument("--controller", default="ik", choices=("ik", "id"),
-                        help="ik: pink IK -> position servos (default); id: inverse-dynamics QP -> torque motors")
+def add_controller_option(parser: argparse.ArgumentParser, default: str, why: str) -> None:
+    """``--controller ik|id``: the balance controller of the trials (``why``: the default's reason)."""
+    parser.add_argument("--controller", default=default, choices=("ik", "id"),
+                        help=f"ik: pink IK -> position servos; id: inverse-dynamics QP -> torque motors "
+                             f"(default: {default}, {why})")
 
 
 def add_output_options(parser: argparse.ArgumentParser, log_help: str) -> None:

@@ -21,7 +21,7 @@ def add_parser(sub) -> list[str]:
                    help="impulses, N s (default 5 10 15 20 25 30)")
     a.add_argument("--duration", type=float, default=0.05, help="push duration, s (default 0.05)")
     a.add_argument("--body", help="MuJoCo body pushed (default: the torso)")
-    add_controller_option(a)
+    add_controller_option(a, "id", "it places the ZMP anywhere in the support area, as the criterion assumes")
     add_output_options(a, "of one telling push")
     return ["push-test"]
 

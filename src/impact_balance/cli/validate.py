@@ -17,7 +17,7 @@ def add_parser(sub) -> list[str]:
     a.add_argument("scenario", help="YAML file or bundled scenario name (must have an impact)")
     a.add_argument("--joints", default="servo", choices=("rigid", "servo"),
                    help="servo: URDF effort limits, 15 Hz servos; rigid: stiff 30 Hz servos, no effort limits")
-    add_controller_option(a)
+    add_controller_option(a, "ik", "a kinematically controlled robot, as the paper's impact model assumes")
     a.add_argument("--tolerance", type=float, default=0.05, help="relative width of the bracket (default 0.05)")
     a.add_argument("--max-speed", type=float, default=4.0, help="largest approach speed tried, m/s (default 4)")
     add_output_options(a, "of the fastest trial survived")
