@@ -109,6 +109,21 @@ def test_unknown_command_is_argparse_error(capsys):
     assert "invalid choice" in err and "Traceback" not in err
 
 
+@pytest.mark.parametrize("argv, needle", [
+    (["bogus"], "invalid choice: 'bogus'"),
+    (["analyze"], "required: scenario"),
+    (["validate", "kick_one_foot", "--joints", "foo"], "--joints: invalid choice"),
+    (["push-test", "palm_push_ramp", "--directions", "many"], "--directions: invalid int value"),
+])
+def test_usage_errors_are_one_line(capsys, argv, needle):
+    """A usage error follows the project's rule too: one line naming the option, exit 2."""
+    with pytest.raises(SystemExit) as info:
+        cli.main(argv)
+    assert info.value.code == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and needle in err and "--help" in err
+
+
 def test_no_command_is_argparse_error(capsys):
     with pytest.raises(SystemExit) as info:
         cli.main([])

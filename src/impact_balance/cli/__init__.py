@@ -47,8 +47,16 @@ def _stdout_closed() -> int:
     return EXIT_BROKEN_PIPE
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse, with the project's error rule: a usage error is one line on stderr, exit 2
+    (argparse's default prints the whole usage block first)."""
+
+    def error(self, message: str):  # noqa: D102 - argparse's hook
+        self.exit(2, one_line(f"{self.prog}: error: {message} (see {self.prog} --help)") + "\n")
+
+
 def _parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
-    p = argparse.ArgumentParser(
+    p = _Parser(
         prog="impact-balance",
         description="Impact-aware multi-contact balance: CoM velocity area and maximum contact velocity.",
     )
