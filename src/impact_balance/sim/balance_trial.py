@@ -28,24 +28,17 @@ import pinocchio as pin
 
 from ..analysis import Analysis, analyze
 from ..exceptions import SimulationError
-from ..logs.schema import LogColumns, force_columns, joint_position_column, joint_velocity_column
 from ..scenario import Scenario, load_scenario
 from .balance import BalanceController, BalanceGains, ImpactTask, retracted_stance
 from .falls import FallCriteria, FallDetector
 from .inverse_dynamics import InverseDynamicsController, InverseDynamicsGains
+from .actuation import STIFF_SERVOS, stiffen_support_limbs, support_joints, use_torque_motors
 from .joints import JOINT_MODELS, ServoOptions
-from .log import LOG_START
+from .log import LOG_START, LogRecorder
 from .model import SimModel, SimOptions, build_model
 
 #: Iterations of MuJoCo's no-slip solver in balance trials.
 NOSLIP_ITERATIONS = 10
-
-#: Support-limb servo stiffness floor, in units of the robot's gravity stiffness m g h (see stiffen_support_limbs).
-SUPPORT_STIFFNESS_FACTOR = 0.4
-
-#: Servos of the ``rigid`` joint model in balance trials: 30 Hz bandwidth, no effort limits. A welded
-#: robot cannot be controlled; this is the closest a controlled robot gets to the paper's rigid body.
-STIFF_SERVOS = ServoOptions(bandwidth=2.0 * np.pi * 30.0, effort_limits=False)
 
 #: Balance controllers: ``ik`` (pink IK -> position servos, :mod:`.balance`) and ``id`` (inverse-dynamics QP ->
 #: torque motors, :mod:`.inverse_dynamics`).
@@ -198,61 +191,6 @@ class BalanceTrialResult:
         }
 
 
-def support_joints(sim: SimModel, analysis: Analysis) -> list[str]:
-    """Simulated joints on the chain from the root to any sustained contact's frame (the support limbs)."""
-    model = analysis.stance.model
-    names: set[str] = set()
-    for contact in analysis.stance.contacts:
-        j = model.frames[model.getFrameId(contact.spec.frame)].parentJoint
-        while j > 1:
-            names.add(model.names[j])
-            j = model.parents[j]
-    return [n for n in sim.joint_names if n in names]
-
-
-def stiffen_support_limbs(sim: SimModel, analysis: Analysis, factor: float = SUPPORT_STIFFNESS_FACTOR) -> None:
-    """Raise the servo gains of the support limbs to a floor set by the robot's gravity stiffness.
-
-    The servo rule of :mod:`.joints` scales each joint's gains by the inertia the joint moves with
-    the base free (``M_jj``): for an ankle, that is the foot alone, about 0.03 kg m^2, so ``kp``
-    is 88 N m/rad (ankle roll) to 230 N m/rad (ankle pitch) at 15 Hz, against a gravity stiffness
-    ``m g h`` of about 820 N m/rad for Talos standing on that ankle. Every joint of a support limb
-    gets at least ``kp = factor m g h`` and ``kd = 2 sqrt(kp m h^2)`` (critical damping of the whole
-    robot swinging about that joint at the CoM height ``h``); effort limits are kept. The factor,
-    0.4, was chosen by measurement: at 1 the stiff legs made the robot rock and lift a foot after
-    pushes (half the 15-20 N s pushes survived); at 0.25-0.4 the most survived; the DCM/ZMP feedback
-    holds the rest of the pendulum (Talos stands on one foot at 0.4).
-    """
-    m = analysis.stance.mass
-    h = float(analysis.stance.com[2] - analysis.stance.lowest_contact_height())
-    kp_min = factor * m * analysis.areas.gravity * h
-    kd_min = 2.0 * np.sqrt(kp_min * m * h * h)
-    chosen = set(support_joints(sim, analysis))
-    for k, name in enumerate(sim.joint_names):
-        if name not in chosen:
-            continue
-        a = sim.actuator_ids[k]
-        kp, kd = max(sim.kp[k], kp_min), max(sim.kd[k], kd_min)
-        sim.model.actuator_gainprm[a, 0] = kp
-        sim.model.actuator_biasprm[a, 1] = -kp
-        sim.model.actuator_biasprm[a, 2] = -kd
-        sim.kp[k], sim.kd[k] = kp, kd
-
-
-def use_torque_motors(sim: SimModel) -> None:
-    """Turn the servo actuators into torque motors (force = ctrl), for the ``id`` controller.
-
-    The servo actuators are MuJoCo ``general`` actuators with force ``kp ctrl - kp q - kd qdot``;
-    setting the gain to 1 and the bias to 0 leaves ``force = ctrl``, clipped to the same force range
-    (the URDF effort limit with ``servo`` joints, none with ``rigid``). ``kp``/``kd`` become 0.
-    """
-    ids = sim.actuator_ids
-    sim.model.actuator_gainprm[ids, 0] = 1.0
-    sim.model.actuator_biasprm[ids, :3] = 0.0
-    sim.kp[:] = 0.0
-    sim.kd[:] = 0.0
-
-
 def measured_zmp(sim: SimModel, com: np.ndarray, plane_height: float) -> tuple[np.ndarray, np.ndarray]:
     """ZMP of the sustained contacts' resultant force, in the LIPM sense, and each contact's force.
 
@@ -280,46 +218,6 @@ def _push_body(sim: SimModel, name: str | None) -> int:
             raise SimulationError("--body", name, f"no such body; valid: {valid}") from None
     torso = [i for i in range(m.nbody) if "torso" in m.body(i).name and m.body_mass[i] > 0]
     return max(torso) if torso else sim.root_body
-
-
-class _Recorder:
-    """Rows of a log (columns of :mod:`impact_balance.logs.schema`), kept as arrays."""
-
-    def __init__(self, sim: SimModel, contact_names: list[str], impact: bool):
-        cols = LogColumns()
-        robot = sim.robot
-        slots = [robot.joint_slot(n) for n in robot.joint_names]
-        self.q_index = np.array([s.idx_q for s in slots])
-        self.v_index = np.array([robot.model.joints[s.id].idx_v for s in slots])
-        self.columns = [cols.time, *cols.base_position, *cols.base_quaternion, *cols.base_linear_velocity,
-                        *cols.base_angular_velocity]
-        self.columns += [joint_position_column(n) for n in robot.joint_names]
-        self.columns += [joint_velocity_column(n) for n in robot.joint_names]
-        self.columns += list(cols.zmp) + list(cols.com) + list(cols.com_velocity)
-        for name in contact_names:
-            self.columns += list(force_columns(name))
-        if impact:
-            self.columns += list(force_columns("impact"))
-        self.rows: list[np.ndarray] = []
-
-    def add(self, t, q, v, sim: SimModel, zmp, forces, impact_force) -> None:
-        # The CoM columns are MuJoCo's own (subtree CoM and velocity): a cross-check for the log checker,
-        # which recomputes them with pinocchio from the base and joint columns.
-        # After mj_step, MuJoCo's CoM quantities still describe the state before the step: refresh them
-        # for the current state (position-dependent stages only; the next step recomputes them anyway).
-        mujoco.mj_kinematics(sim.model, sim.data)
-        mujoco.mj_comPos(sim.model, sim.data)
-        mujoco.mj_comVel(sim.model, sim.data)
-        com, com_velocity = sim.com(), sim.com_velocity()
-        lin, ang = sim.base_velocity_world()
-        qj, vj = q[self.q_index], v[self.v_index]
-        parts = [[t], q[:7], lin, ang, qj, vj, zmp, com, com_velocity, forces.ravel()]
-        if impact_force is not None:
-            parts.append(impact_force)
-        self.rows.append(np.concatenate([np.asarray(p, dtype=float).ravel() for p in parts]))
-
-    def frame(self) -> pd.DataFrame:
-        return pd.DataFrame(np.array(self.rows), columns=self.columns)
 
 
 def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, push: Push | None = None,
@@ -370,7 +268,7 @@ def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, pu
     normals = np.array([c.normal for c in stance.contacts])
     zmp_area = analysis.areas.zmp_area
     h, g = analysis.areas.plane_height, analysis.areas.gravity
-    recorder = _Recorder(sim, [c.spec.frame for c in stance.contacts], task is not None) if options.record else None
+    recorder = LogRecorder(sim, [c.spec.frame for c in stance.contacts], task is not None) if options.record else None
 
     body = None
     if push is not None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 import pandas as pd
 
@@ -9,7 +10,7 @@ from ..logs import LogColumns, force_columns, joint_position_column, joint_veloc
 from .model import SimModel
 from .trial import TrialRecord
 
-__all__ = ["log_frame", "LOG_START"]
+__all__ = ["log_frame", "LogRecorder", "LOG_START"]
 
 #: Logs start here (s): the first steps settle the model's initial contact penetration (the
 #: contacts carry nothing at t = 0, then briefly one foot carries thousands of newtons), a
@@ -70,3 +71,44 @@ def log_frame(sim: SimModel, record: TrialRecord, start: float = LOG_START) -> p
         data[name] = record.com_velocity[:, k]
     frame = pd.DataFrame(data)
     return frame[frame[cols.time] >= start - 1e-12].reset_index(drop=True)
+
+
+class LogRecorder:
+    """A log built step by step (the balance trials' loop), from pinocchio's ``(q, v)`` and MuJoCo's
+    state; :func:`log_frame` builds the same columns from an impact trial's recorded arrays."""
+
+    def __init__(self, sim: SimModel, contact_names: list[str], impact: bool):
+        cols = LogColumns()
+        robot = sim.robot
+        slots = [robot.joint_slot(n) for n in robot.joint_names]
+        self.q_index = np.array([s.idx_q for s in slots])
+        self.v_index = np.array([robot.model.joints[s.id].idx_v for s in slots])
+        self.columns = [cols.time, *cols.base_position, *cols.base_quaternion, *cols.base_linear_velocity,
+                        *cols.base_angular_velocity]
+        self.columns += [joint_position_column(n) for n in robot.joint_names]
+        self.columns += [joint_velocity_column(n) for n in robot.joint_names]
+        self.columns += list(cols.zmp) + list(cols.com) + list(cols.com_velocity)
+        for name in contact_names:
+            self.columns += list(force_columns(name))
+        if impact:
+            self.columns += list(force_columns("impact"))
+        self.rows: list[np.ndarray] = []
+
+    def add(self, t, q, v, sim: SimModel, zmp, forces, impact_force) -> None:
+        # The CoM columns are MuJoCo's own (subtree CoM and velocity): a cross-check for the log checker,
+        # which recomputes them with pinocchio from the base and joint columns.
+        # After mj_step, MuJoCo's CoM quantities still describe the state before the step: refresh them
+        # for the current state (position-dependent stages only; the next step recomputes them anyway).
+        mujoco.mj_kinematics(sim.model, sim.data)
+        mujoco.mj_comPos(sim.model, sim.data)
+        mujoco.mj_comVel(sim.model, sim.data)
+        com, com_velocity = sim.com(), sim.com_velocity()
+        lin, ang = sim.base_velocity_world()
+        qj, vj = q[self.q_index], v[self.v_index]
+        parts = [[t], q[:7], lin, ang, qj, vj, zmp, com, com_velocity, forces.ravel()]
+        if impact_force is not None:
+            parts.append(impact_force)
+        self.rows.append(np.concatenate([np.asarray(p, dtype=float).ravel() for p in parts]))
+
+    def frame(self) -> pd.DataFrame:
+        return pd.DataFrame(np.array(self.rows), columns=self.columns)
