@@ -27,9 +27,9 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..logs import check_log_path, write_log
+    from ..logs import check_log_path
     from ..scenario import load_scenario
-    from ..sim.balance_trial import BalanceTrialOptions, run_balance_trial
+    from ..sim.balance_trial import BalanceTrialOptions, write_trial_log
     from ..sim.push import DEFAULT_MAGNITUDES, check_push_arguments, push_test
     from .output import print_json, progress_bar
 
@@ -54,9 +54,8 @@ def run(args: argparse.Namespace) -> int:
     written = []
     if args.log:
         chosen = _telling(result.outcomes)
-        trial = run_balance_trial(result.setup, push=chosen.push, options=BalanceTrialOptions(record=True, controller=args.controller))
-        written.append(write_log(trial.log, args.log, {"scenario": scenario.name, "push_direction": chosen.push.direction,
-                                                       "push_magnitude": chosen.push.magnitude}))
+        written.append(write_trial_log(result.setup, args.log, args.controller, {
+            "push_direction": chosen.push.direction, "push_magnitude": chosen.push.magnitude}, push=chosen.push))
         out["log"] = {"file": str(args.log), "direction": chosen.push.direction, "magnitude": chosen.push.magnitude}
     if args.plots:
         written += _plots(result, Path(args.plots))

@@ -26,9 +26,9 @@ def add_parser(sub) -> list[str]:
 
 def run(args: argparse.Namespace) -> int:
     from ..exceptions import SimulationError
-    from ..logs import check_log_path, write_log
+    from ..logs import check_log_path
     from ..scenario import load_scenario
-    from ..sim.balance_trial import BalanceTrialOptions, run_balance_trial
+    from ..sim.balance_trial import BalanceTrialOptions, write_trial_log
     from ..sim.validate import validate
     from .output import print_json, progress_bar
 
@@ -56,9 +56,8 @@ def run(args: argparse.Namespace) -> int:
     written = []
     if args.log:
         speed = result.survived if result.survived is not None else result.fell
-        trial = run_balance_trial(result.extra["setup"], impact_speed=speed, options=BalanceTrialOptions(record=True, controller=args.controller))
-        written.append(write_log(trial.log, args.log, {"scenario": scenario.name, "approach_speed": speed,
-                                                       "joints": args.joints}))
+        written.append(write_trial_log(result.extra["setup"], args.log, args.controller,
+                                       {"approach_speed": speed, "joints": args.joints}, impact_speed=speed))
         out["log"] = {"file": str(args.log), "approach_speed": speed}
     if args.plots:
         written += _plots(result, Path(args.plots))

@@ -29,41 +29,38 @@ def _legend(ax, area_label: str, area_color: str) -> None:
     ], loc="best", fontsize=8)
 
 
+def _trajectories_over(area: Polygon, area_label: str, area_color: str, trajectories: Sequence[np.ndarray],
+                       fell: Sequence[bool], quantity: str, unit: str, title: str, mark_ends: bool) -> Figure:
+    """Trajectories (each k x 2, world) over an area, coloured by outcome (the two figures of Exp. 2)."""
+    fig = new_figure(5.5, 5.0)
+    ax = fig.add_subplot()
+    draw_polygon(ax, area, color=area_color, label=area_label)
+    for path, f in zip(trajectories, fell):
+        ax.plot(path[:, 0], path[:, 1], color=FALL_COLOR if f else OK_COLOR, lw=0.8, alpha=0.7)
+        if mark_ends:
+            ax.plot(path[-1:, 0], path[-1:, 1], "o", ms=2, color=FALL_COLOR if f else OK_COLOR)
+    set_limits(ax, [area.vertices, *[p[np.all(np.isfinite(p), axis=1)] for p in trajectories]], min_ratio=0.5)
+    ax.set_aspect("equal")
+    ax.set_xlabel(f"{quantity}x ({unit})")
+    ax.set_ylabel(f"{quantity}y ({unit})")
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    _legend(ax, area_label, area_color)
+    return fig
+
+
 def plot_zmp_trajectories(area: Polygon, trajectories: Sequence[np.ndarray], fell: Sequence[bool],
                           title: str = "") -> Figure:
     """Measured ZMP trajectories (each k x 2, m, world) over the ZMP support area."""
-    fig = new_figure(5.5, 5.0)
-    ax = fig.add_subplot()
-    draw_polygon(ax, area, color=ZMP_COLOR, label="ZMP support area")
-    for path, f in zip(trajectories, fell):
-        ax.plot(path[:, 0], path[:, 1], color=FALL_COLOR if f else OK_COLOR, lw=0.8, alpha=0.7)
-    set_limits(ax, [area.vertices, *[p[np.all(np.isfinite(p), axis=1)] for p in trajectories]], min_ratio=0.5)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    ax.set_title(title or "ZMP over the ZMP support area", fontsize=10)
-    ax.grid(alpha=0.3)
-    _legend(ax, "ZMP support area", ZMP_COLOR)
-    return fig
+    return _trajectories_over(area, "ZMP support area", ZMP_COLOR, trajectories, fell, "", "m",
+                              title or "ZMP over the ZMP support area", mark_ends=False)
 
 
 def plot_com_velocity_trajectories(area: Polygon, trajectories: Sequence[np.ndarray], fell: Sequence[bool],
                                    title: str = "") -> Figure:
     """Measured CoM velocity trajectories (each k x 2, m/s, world) over the CoM velocity area."""
-    fig = new_figure(5.5, 5.0)
-    ax = fig.add_subplot()
-    draw_polygon(ax, area, color=AREA_COLOR, label="CoM velocity area")
-    for path, f in zip(trajectories, fell):
-        ax.plot(path[:, 0], path[:, 1], color=FALL_COLOR if f else OK_COLOR, lw=0.8, alpha=0.7)
-        ax.plot(path[-1:, 0], path[-1:, 1], "o", ms=2, color=FALL_COLOR if f else OK_COLOR)
-    set_limits(ax, [area.vertices, *trajectories], min_ratio=0.5)
-    ax.set_aspect("equal")
-    ax.set_xlabel("CoM velocity x (m/s)")
-    ax.set_ylabel("CoM velocity y (m/s)")
-    ax.set_title(title or "CoM velocity over the CoM velocity area", fontsize=10)
-    ax.grid(alpha=0.3)
-    _legend(ax, "CoM velocity area", AREA_COLOR)
-    return fig
+    return _trajectories_over(area, "CoM velocity area", AREA_COLOR, trajectories, fell, "CoM velocity ", "m/s",
+                              title or "CoM velocity over the CoM velocity area", mark_ends=True)
 
 
 def plot_validation(speeds: Sequence[float], fell: Sequence[bool], predicted: dict, title: str = "") -> Figure:

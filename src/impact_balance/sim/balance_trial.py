@@ -31,8 +31,9 @@ from ..exceptions import SimulationError
 from ..scenario import Scenario, load_scenario
 from .balance import BalanceController, BalanceGains, ImpactTask, retracted_stance
 from .falls import FallCriteria, FallDetector
-from .inverse_dynamics import InverseDynamicsController, InverseDynamicsGains
+from ..logs import write_log
 from .actuation import STIFF_SERVOS, stiffen_support_limbs, support_joints, use_torque_motors
+from .inverse_dynamics import InverseDynamicsController, InverseDynamicsGains
 from .joints import JOINT_MODELS, ServoOptions
 from .log import LOG_START, LogRecorder
 from .model import SimModel, SimOptions, build_model
@@ -44,7 +45,7 @@ NOSLIP_ITERATIONS = 10
 #: torque motors, :mod:`.inverse_dynamics`).
 CONTROLLERS = ("ik", "id")
 
-__all__ = ["CONTROLLERS", "STIFF_SERVOS", "Push", "BalanceTrialOptions", "BalanceSetup", "BalanceTrialResult", "run_balance_trial", "measured_zmp"]
+__all__ = ["CONTROLLERS", "STIFF_SERVOS", "Push", "BalanceTrialOptions", "BalanceSetup", "BalanceTrialResult", "run_balance_trial", "write_trial_log", "measured_zmp"]
 
 
 @dataclass(frozen=True)
@@ -365,3 +366,14 @@ def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, pu
         result.com_criterion_safe = bool(vm[end_idx] >= 0.0)
         result.zmp_criterion_safe = bool(np.all(zm[during] >= 0.0)) if during.any() else bool(zm[end_idx] >= 0)
     return result
+
+
+def write_trial_log(setup: BalanceSetup, path, controller: str, metadata: dict, impact_speed: float | None = None,
+                    push: Push | None = None):
+    """Run one trial again with recording on and write its log (searches run their trials unrecorded).
+
+    Returns the path written; ``metadata`` goes into the Parquet metadata with the scenario's name.
+    """
+    trial = run_balance_trial(setup, impact_speed=impact_speed, push=push,
+                              options=BalanceTrialOptions(record=True, controller=controller))
+    return write_log(trial.log, path, {"scenario": setup.scenario.name, **metadata})
