@@ -228,7 +228,7 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
                 )
             except SolverError as exc:
                 raise exc.within("impact.qp") from None
-        interval = safe_interval(areas.com_velocity_area, model, scenario.com_velocity)
+        interval = safe_interval(areas.com_velocity_area, model, scenario.com_velocity, com_limit)
         answer = ImpactAnswer(model, com_limit, zmp_limit, contact_velocity, qp, interval)
         timings["impact"] = time.perf_counter() - t3
     timings["total"] = time.perf_counter() - t0

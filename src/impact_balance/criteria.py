@@ -104,7 +104,8 @@ def speed_interval(margins: np.ndarray, rates: np.ndarray, tol: float = BOUNDARY
     return lo, max(lo, hi)
 
 
-def safe_interval(area: Polygon, impact: ImpactModel, com_velocity: Sequence[float]) -> tuple[float, float] | None:
+def safe_interval(area: Polygon, impact: ImpactModel, com_velocity: Sequence[float],
+                  limit: VelocityLimit | None = None) -> tuple[float, float] | None:
     """The approach speeds s >= 0 whose whole post-impact CoM velocity set lies in ``area``.
 
     The post-impact vertices ``c0 + s d_j`` are linear in s, so these speeds form one
@@ -112,9 +113,14 @@ def safe_interval(area: Polygon, impact: ImpactModel, com_velocity: Sequence[flo
     area is). With ``c0`` inside the area, ``s_lo`` = 0 and ``s_hi`` is the maximum contact
     velocity. With ``c0`` outside (the robot falls without an impact), a non-empty interval
     is the impacts that catch the fall: ``s_lo`` > 0.
+
+    ``limit``, :func:`max_contact_velocity`'s answer for the same data when the caller has it:
+    with ``c0`` inside, the interval is ``(0, limit)`` and is not computed again.
     """
     if area.is_empty:
         return None
+    if limit is not None and limit.status in ("ok", "unbounded"):
+        return 0.0, limit.max_approach_speed
     G, h = area.halfplanes
     c0 = np.asarray(com_velocity, dtype=float)[:2]
     return speed_interval(h - G @ c0, impact.com_jump_rates @ G.T)
