@@ -120,6 +120,7 @@ class Analysis:
             "com": self.stance.com.tolist(),
             "omega": a.omega,
             "plane_height": a.plane_height,
+            "zmp_margin": a.zmp_margin,
             "gravity": a.gravity,
             "com_velocity": self.com_velocity.tolist(),
             "com_velocity_inside": self.com_velocity_inside,
@@ -190,7 +191,7 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
     polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
     t2 = time.perf_counter()
     try:
-        areas = areas_from_polytope(polytope, scenario.plane_height)
+        areas = areas_from_polytope(polytope, scenario.plane_height, scenario.zmp_margin)
     except SolverError as exc:
         raise exc.within("contacts (projection of the contact wrench polytope)") from None
     t3 = time.perf_counter()

@@ -9,6 +9,10 @@ and the zero-step capture condition (the DCM stays in the ZMP support area) give
 velocity area ``{ omega (zmp - c_xy) }``, omega = sqrt(g / (c_z - h)). Both areas are affine
 images of ONE projection: the set of feasible resultant horizontal forces, obtained by
 projecting the contact-wrench polytope (:mod:`impact_balance.constraints`).
+
+A ZMP margin ``M`` (m) shrinks the ZMP support area to the points at least ``M`` inside its
+edges (:meth:`~impact_balance.polygon.Polygon.inset`), as a controller that keeps its ZMP away
+from the edges does; the CoM velocity area follows (it is the same set, scaled by omega).
 """
 
 from __future__ import annotations
@@ -60,6 +64,8 @@ class BalanceAreas:
         reason: Why the stance cannot balance when the areas are empty and they were
             computed from a stance (:func:`balance_areas`, :func:`~impact_balance.analyze`);
             None otherwise. See :mod:`impact_balance.infeasibility`.
+        zmp_margin: The margin (m) by which ``zmp_area`` (and so ``com_velocity_area``) was
+            shrunk; ``force_area`` is the projection itself, without it.
     """
 
     force_area: Polygon
@@ -72,15 +78,24 @@ class BalanceAreas:
     gravity: float
     n_lp: int = 0
     reason: CannotBalanceReason | None = None
+    zmp_margin: float = 0.0
 
     @property
     def can_balance(self) -> bool:
         """False when the stance cannot hold the robot at rest (empty areas)."""
         return not self.com_velocity_area.is_empty
 
+    @property
+    def zmp_area_without_margin(self) -> Polygon:
+        """The ZMP support area before the margin (equal to ``zmp_area`` when it is 0)."""
+        if self.zmp_margin == 0.0 or self.force_area.is_empty:
+            return self.zmp_area
+        return self.force_area.affine(self.plane_height - float(self.com[2]), self.com[:2])
 
-def areas_from_polytope(polytope: WrenchPolytope, plane_height: float = 0.0) -> BalanceAreas:
-    """Project a contact-wrench polytope and map it to the ZMP and CoM velocity areas."""
+
+def areas_from_polytope(polytope: WrenchPolytope, plane_height: float = 0.0, zmp_margin: float = 0.0) -> BalanceAreas:
+    """Project a contact-wrench polytope and map it to the ZMP and CoM velocity areas, the ZMP
+    support area shrunk by ``zmp_margin`` (m)."""
     com = polytope.com
     w = omega(float(com[2]), plane_height, polytope.gravity)
     # Work in units of m g so that tolerances mean the same for every robot, and in
@@ -95,18 +110,23 @@ def areas_from_polytope(polytope: WrenchPolytope, plane_height: float = 0.0) -> 
     depth = plane_height - float(com[2])  # < 0
     if force.is_empty:
         zmp = vel = Polygon.empty()
+    elif zmp_margin > 0.0:
+        zmp = force.affine(depth, com[:2]).inset(zmp_margin)
+        vel = zmp.affine(w, -w * com[:2]) if not zmp.is_empty else Polygon.empty()
     else:
         zmp = force.affine(depth, com[:2])
         vel = force.affine(w * depth, np.zeros(2))
-    return BalanceAreas(force, zmp, vel, w, com.copy(), plane_height, polytope.mass, polytope.gravity, result.n_lp)
+    return BalanceAreas(force, zmp, vel, w, com.copy(), plane_height, polytope.mass, polytope.gravity, result.n_lp,
+                        zmp_margin=float(zmp_margin))
 
 
 def balance_areas(
-    stance: Stance, plane_height: float = 0.0, torque_limits: bool = True, gravity: float = GRAVITY
+    stance: Stance, plane_height: float = 0.0, torque_limits: bool = True, gravity: float = GRAVITY,
+    zmp_margin: float = 0.0,
 ) -> BalanceAreas:
-    """ZMP support area and CoM velocity area of ``stance``."""
+    """ZMP support area (shrunk by ``zmp_margin``, m) and CoM velocity area of ``stance``."""
     omega(float(stance.com[2]), plane_height, gravity)  # validate the plane before any work
-    areas = areas_from_polytope(wrench_polytope(stance, torque_limits, gravity), plane_height)
+    areas = areas_from_polytope(wrench_polytope(stance, torque_limits, gravity), plane_height, zmp_margin)
     return with_reason(areas, stance, torque_limits, gravity)
 
 
@@ -114,6 +134,9 @@ def with_reason(areas: BalanceAreas, stance: Stance, torque_limits: bool, gravit
     """``areas`` with :attr:`BalanceAreas.reason` filled in when they are empty."""
     if areas.can_balance or areas.reason is not None:
         return areas
+    if not areas.force_area.is_empty:  # the stance balances; the margin leaves nothing
+        return dataclasses.replace(areas, reason=CannotBalanceReason(
+            "zmp_margin", f"no point of the ZMP support area is {areas.zmp_margin:g} m (the ZMP margin) inside its edges"))
     try:
         reason = explain_cannot_balance(stance, torque_limits, gravity)
     except SolverError as exc:  # the areas are the answer; an explanation is a bonus

@@ -66,8 +66,9 @@ class CannotBalanceReason:
     """Why the contacts cannot hold the robot at rest.
 
     Attributes:
-        kind: "torque_limits", "friction" or "com_outside" (see the module docstring), or
-            "unknown" when an LP of the diagnosis failed.
+        kind: "torque_limits", "friction" or "com_outside" (see the module docstring),
+            "zmp_margin" when the stance balances but its ZMP support area is too small for the
+            margin asked (:mod:`impact_balance.areas`), or "unknown" when an LP of the diagnosis failed.
         message: One line for people.
         binding_joints: For "torque_limits": the joints whose limit alone, raised by
             ``min_scale``, restores balance (smallest first), then those that bind at the

@@ -120,6 +120,92 @@ def simplify(vertices: np.ndarray, tol: float = 1e-9, area_tol: float = MERGE_AR
     return _simplify(v, float(tol), float(area_tol))
 
 
+@njit(cache=True)
+def _corner(n: np.ndarray, h: np.ndarray, a: int, b: int) -> tuple[float, float, float, float]:
+    """Corner of lines ``a`` and ``b`` (``n_k . x = h_k - t``) as ``x0 + t x1``: (x0, y0, x1, y1).
+
+    Undefined (NaN) when the lines are parallel."""
+    det = n[a, 0] * n[b, 1] - n[a, 1] * n[b, 0]
+    if det <= 1e-15:
+        return math.nan, math.nan, math.nan, math.nan
+    # Inverse of [[n_a], [n_b]] applied to (h_a, h_b) and to (-1, -1).
+    x0 = (n[b, 1] * h[a] - n[a, 1] * h[b]) / det
+    y0 = (-n[b, 0] * h[a] + n[a, 0] * h[b]) / det
+    x1 = (-n[b, 1] + n[a, 1]) / det
+    y1 = (n[b, 0] - n[a, 0]) / det
+    return x0, y0, x1, y1
+
+
+@njit(cache=True)
+def _collapse_time(n: np.ndarray, h: np.ndarray, a: int, i: int, b: int) -> float:
+    """When edge ``i`` (between lines ``a`` and ``b``) shrinks to nothing as every line moves
+    inwards at unit speed (inf if it never does; -inf if its neighbours are parallel)."""
+    p = _corner(n, h, a, i)
+    q = _corner(n, h, i, b)
+    if math.isnan(p[0]) or math.isnan(q[0]):
+        return -math.inf
+    ex, ey = -n[i, 1], n[i, 0]  # the edge's direction (CCW)
+    length0 = (q[0] - p[0]) * ex + (q[1] - p[1]) * ey
+    rate = (q[2] - p[2]) * ex + (q[3] - p[3]) * ey
+    if rate >= 0.0:
+        return math.inf
+    return -length0 / rate
+
+
+@njit(cache=True)
+def _inset(n: np.ndarray, h: np.ndarray, d: float) -> np.ndarray:
+    """Vertices of ``{x : n_k . x <= h_k - d}`` for the edges (unit outward normals ``n``, CCW)
+    of a convex polygon; (0, 2) when empty.
+
+    The lines move inwards together; an edge whose length reaches zero before ``d`` leaves
+    (earliest first, as in the straight skeleton of a convex polygon) and its neighbours meet.
+    """
+    k = len(h)
+    nxt = np.empty(k, dtype=np.int64)
+    prv = np.empty(k, dtype=np.int64)
+    for i in range(k):
+        nxt[i] = (i + 1) % k
+        prv[i] = (i - 1) % k
+    times = np.empty(k)
+    for i in range(k):
+        times[i] = _collapse_time(n, h, prv[i], i, nxt[i])
+    alive = np.ones(k, dtype=np.bool_)
+    count = k
+    while count >= 3:
+        i = -1
+        earliest = math.inf
+        for j in range(k):
+            if alive[j] and times[j] < earliest:
+                earliest, i = times[j], j
+        if i < 0 or earliest > d:
+            break
+        alive[i] = False
+        count -= 1
+        a, b = prv[i], nxt[i]
+        nxt[a], prv[b] = b, a
+        if count >= 3:
+            times[a] = _collapse_time(n, h, prv[a], a, b)
+            times[b] = _collapse_time(n, h, a, b, nxt[b])
+    if count < 3:
+        return np.zeros((0, 2))
+    out = np.empty((count, 2))
+    first = 0
+    while not alive[first]:
+        first += 1
+    i, m = first, 0
+    while True:
+        c = _corner(n, h, i, nxt[i])
+        if math.isnan(c[0]):
+            return np.zeros((0, 2))
+        out[m, 0] = c[0] + d * c[2]
+        out[m, 1] = c[1] + d * c[3]
+        m += 1
+        i = nxt[i]
+        if i == first:
+            break
+    return out
+
+
 def _frozen(G: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Read-only arrays: the half-planes are cached on the (immutable) polygon."""
     G.setflags(write=False)
@@ -226,6 +312,31 @@ class Polygon:
         if scale == 0.0:
             raise ValueError("scale must be non-zero")
         return Polygon(self.vertices * scale + np.asarray(offset, dtype=float), self.bounded)
+
+    def inset(self, distance: float) -> Polygon:
+        """The points at least ``distance`` inside the polygon (its erosion by a disc): the
+        intersection of its half-planes moved inwards by ``distance`` (same units).
+
+        Empty from the inradius on (what is left there has no interior); a point or a segment
+        has nothing left for any positive distance. ``distance`` 0 returns the polygon itself.
+        """
+        distance = float(distance)
+        if not (math.isfinite(distance) and distance >= 0.0):
+            raise ValueError(f"inset distance must be finite and >= 0, not {distance}")
+        if distance == 0.0:
+            return self
+        if len(self.vertices) < 3:
+            return Polygon.empty()
+        G, h = self.halfplanes
+        # Relative to a point inside (the vertices' mean): corners stay well conditioned far
+        # from the origin.
+        centre = self.vertices.mean(axis=0)
+        v = _inset(G, h - G @ centre, distance)
+        if len(v) == 0:
+            return Polygon.empty()
+        # Edges that left at about ``distance`` leave (near-)duplicate corners: merge them.
+        scale = float(np.abs(v).max())
+        return Polygon(simplify(v, 1e-12 * max(1.0, scale)) + centre, self.bounded)
 
     def to_dict(self) -> dict:
         G, h = self.halfplanes

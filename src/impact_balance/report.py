@@ -66,7 +66,8 @@ def format_analysis(analysis: Analysis) -> str:
         + ("" if v.bounded else " (unbounded, clipped)")
     )
     z = a.zmp_area
-    lines.append(f"  ZMP support area: {len(z.vertices)} vertices, {z.area:.4f} m^2")
+    margin = f", shrunk by the ZMP margin {a.zmp_margin:g} m" if a.zmp_margin > 0 else ""
+    lines.append(f"  ZMP support area: {len(z.vertices)} vertices, {z.area:.4f} m^2{margin}")
     lines.append(f"  pre-impact CoM velocity {_vec(analysis.com_velocity)} m/s: {analysis.verdict}")
     im = analysis.impact
     if im is not None:

@@ -6,6 +6,8 @@ import argparse
 import dataclasses
 from pathlib import Path
 
+from ._options import add_zmp_margin_option, with_zmp_margin
+
 __all__ = ["add_parser", "run", "USES_KERNEL"]
 
 USES_KERNEL = True
@@ -18,6 +20,7 @@ def add_parser(sub) -> list[str]:
     a.add_argument("--plots", metavar="DIR", help="write the scenario's figures to DIR")
     a.add_argument("--qp", action="store_true", help="also solve the paper's QP in joint velocities")
     a.add_argument("--strict", action="store_true", help="treat warnings as errors (exit status 2)")
+    add_zmp_margin_option(a, "default: the scenario's zmp_margin, 0 unless set")
     return ["analyze"]
 
 
@@ -28,7 +31,12 @@ def run(args: argparse.Namespace) -> int:
     from ..exceptions import StrictWarningsError
     from .output import print_json
 
-    analysis = analyze(args.scenario, solve_qp=True if args.qp else None)
+    scenario = args.scenario
+    if args.zmp_margin is not None:
+        from ..scenario import load_scenario
+
+        scenario = with_zmp_margin(load_scenario(scenario), args.zmp_margin)
+    analysis = analyze(scenario, solve_qp=True if args.qp else None)
     if args.strict and analysis.warnings:
         raise StrictWarningsError(analysis.warnings)
     written = []

@@ -70,6 +70,7 @@ class PanelsMixin:
         self.w_torque.value = bool(scenario.torque_limits)
         self.w_com_velocity.value = _vec(scenario.com_velocity, 2)
         self.w_plane.value = float(scenario.plane_height)
+        self.w_zmp_margin.value = float(scenario.zmp_margin)
         # Base and joints (the actual values, whether set or from the configuration).
         self.w_base_auto.value = state.get(("base",)) is None
         self.w_base_position.value = _vec(stance.q[:3], 3)

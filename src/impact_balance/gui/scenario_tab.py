@@ -24,6 +24,9 @@ class ScenarioTabMixin:
         self.w_com_velocity.on_update(self._field(("com_velocity",), list))
         self.w_plane = gui.add_number("plane height (m)", 0.0, step=0.01, hint="Height of the ZMP plane, m")
         self.w_plane.on_update(self._field(("plane_height",), float))
+        self.w_zmp_margin = gui.add_number("ZMP margin (m)", 0.0, min=0.0, step=0.005,
+                                           hint="Shrink the ZMP support area by this margin (and the CoM velocity area with it), m")
+        self.w_zmp_margin.on_update(self._field(("zmp_margin",), float))
         self.w_gizmos = gui.add_checkbox("drag gizmos", True,
                                          hint="Gizmos on the contacts and the impact point: drag one, IK moves the robot")
         self.w_gizmos.on_update(lambda _: self.edit(lambda: None))

@@ -235,7 +235,8 @@ def svg_view(analysis: Analysis, width: int = 420) -> str:
 
     # -- ZMP support area -----------------------------------------------------------------
     y += 6
-    parts.append(_text(pad, y + 12, f"ZMP support area (plane z = {areas.plane_height:g} m)", 12, weight="bold"))
+    shrunk = f", shrunk by {areas.zmp_margin * 100:g} cm" if areas.zmp_margin > 0 else ""
+    parts.append(_text(pad, y + 12, f"ZMP support area (plane z = {areas.plane_height:g} m{shrunk})", 12, weight="bold"))
     y += 20
     bottom = _Panel(margin_left, y, plot_w, plot_h, min_span=0.3)
     zmp = areas.zmp_area

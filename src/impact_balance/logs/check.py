@@ -239,7 +239,7 @@ def check_log(frame: pd.DataFrame, scenario: Scenario | str, *, force_threshold:
             chosen = [s for s in specs if s.frame in active_t]
             if chosen and com[2] > h:
                 stance = Stance(robot, q, chosen)
-                zmp_area = balance_areas(stance, h, scenario.torque_limits, g).zmp_area
+                zmp_area = balance_areas(stance, h, scenario.torque_limits, g, scenario.zmp_margin).zmp_area
             else:
                 zmp_area = Polygon.empty()
             segments.append(StanceSegment(float(times[k]), active_t, zmp_area, com.copy(), not zmp_area.is_empty))

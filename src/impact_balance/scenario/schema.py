@@ -141,6 +141,8 @@ class Scenario(_Model):
     base: BasePose | None = None
     com_velocity: Annotated[Vec2, AfterValidator(_speed)] = (0.0, 0.0)
     plane_height: Annotated[float, _scalar(-MAX_POSITION, MAX_POSITION, "m")] = 0.0
+    #: The ZMP support area is shrunk by this margin (m), and the CoM velocity area with it.
+    zmp_margin: Annotated[float, _scalar(0.0, MAX_SIZE, "m")] = 0.0
     torque_limits: bool = True
     gravity: Annotated[float, _scalar(*GRAVITY_RANGE, "m/s^2")] = 9.81
     contacts: list[ContactConfig] = Field(min_length=1)

@@ -218,7 +218,7 @@ class Evaluator:
             if self._posture is not None:
                 stance, residual = self._place(scenario, stance, values, warm)
             polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
-            areas = areas_from_polytope(polytope, scenario.plane_height)
+            areas = areas_from_polytope(polytope, scenario.plane_height, scenario.zmp_margin)
         except IKError as exc:
             return _StanceEntry(None, None, "unreachable", str(exc), _worst(exc.residuals))
         except ScenarioError as exc:

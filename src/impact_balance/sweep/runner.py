@@ -130,7 +130,7 @@ def _warm_kernel(plan: SweepPlan) -> None:
     """Compile (or load from numba's cache) the projection kernel before workers start."""
     scenario = scenario_from_dict(plan.base, plan.base_source)
     stance = scenario.build_stance()
-    areas_from_polytope(wrench_polytope(stance, scenario.torque_limits, scenario.gravity), scenario.plane_height)
+    areas_from_polytope(wrench_polytope(stance, scenario.torque_limits, scenario.gravity), scenario.plane_height, scenario.zmp_margin)
 
 
 def _context() -> multiprocessing.context.BaseContext:
