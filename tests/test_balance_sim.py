@@ -22,8 +22,8 @@ def setup():
 
 def test_small_push_is_recovered_and_logged(setup, tmp_path):
     result = run_balance_trial(setup, push=Push(0.0, 5.0, 0.05), options=BalanceTrialOptions(after=1.0, record=True))
-    assert not result.fell, result.detail
-    assert result.com_criterion_safe and result.min_com_velocity_margin > 0
+    assert result.outcome == "balanced", result.detail
+    assert result.com_velocity_margin_at_end > 0 and result.min_com_velocity_margin > 0
     # A 5 N s push changes the CoM velocity by about 5 / 90 m/s; the controller brings it back.
     peak = np.abs(result.series["com_velocity"][:, 0]).max()
     assert 0.03 < peak < 0.12
@@ -41,20 +41,44 @@ def test_small_push_is_recovered_and_logged(setup, tmp_path):
 
 def test_large_push_falls_and_the_com_criterion_saw_it(setup):
     result = run_balance_trial(setup, push=Push(0.0, 100.0, 0.05), options=BalanceTrialOptions(after=1.5))
-    assert result.fell and result.reason is not None
-    assert result.com_criterion_safe is False  # ~1.1 m/s is far outside the CoM velocity area
+    assert result.fell and result.reason in ("base_dropped", "trunk_tipped")
+    assert result.com_velocity_margin_at_end < 0  # ~1.1 m/s is far outside the CoM velocity area
+    json.dumps(result.summary(), allow_nan=False)
 
 
-def test_validate_brackets_the_threshold(setup):
-    result = validate(SCENARIO, tolerance=0.5, options=BalanceTrialOptions(after=0.6), setup=setup)
-    out = json.loads(json.dumps(result.to_dict()))
+def test_validate_brackets_the_threshold_in_measured_speed(tmp_path):
+    """The paper's robot at the impact (joints held) with the torque controller: a bracket near the prediction."""
+    from impact_balance.sim.journal import TrialJournal
+
+    options = BalanceTrialOptions(after=1.0, controller="id", rigid_impact=True)
+    setup = BalanceSetup.create(SCENARIO, options=options)
+    journal = TrialJournal.open(tmp_path / "v.jsonl", "digest")
+    result = validate(SCENARIO, tolerance=0.5, options=options, setup=setup, journal=journal)
+    journal.close()
+    out = json.loads(json.dumps(result.to_dict(), allow_nan=False))
     assert set(out["predicted"]) == {"com_criterion", "zmp_criterion"}
     assert set(out["predicted"]["com_criterion"]) == {"composite", "joint_space"}
-    s, f = out["empirical"]["survived"], out["empirical"]["fell"]
-    assert s is not None and f is not None and s < f and f - s <= 0.5 * f
-    assert all({"speed", "fell", "reason", "max_zmp_excursion", "max_com_velocity_excursion"} <= set(t) for t in out["trials"])
+    e = out["empirical"]
+    s, f = e["survived"], e["fell"]
+    assert s is not None and f is not None and s < f
+    assert e["survived_commanded"] < e["fell_commanded"] and e["fell_commanded"] - e["survived_commanded"] <= 0.5 * e["fell_commanded"]
+    measured = {t["speed"]: t["approach_speed_measured"] for t in out["trials"]}
+    assert s in measured.values() and f in measured.values()  # the bracket is in measured speed
+    for t in out["trials"]:
+        assert t["outcome"] in ("balanced", "contact_broken", "fell", "aborted")
+        assert t["fell"] == (t["outcome"] == "fell")
+        assert t["approach_speed_measured"] == pytest.approx(t["speed"], rel=0.35)  # reached before the surface
     assert any(t["fell"] for t in out["trials"]) and any(not t["fell"] for t in out["trials"])
-    assert out["controller"]["name"] and out["controller"]["gains"]["rate"] == 500.0
+    assert out["controller"]["name"] and out["rigid_impact"] is True
+    predicted = out["predicted"]["com_criterion"]["composite"]
+    assert 0.5 * predicted < f < 2.0 * predicted  # loose here; benchmarks/balance.py measures it
+    for t in out["trials"]:
+        hold = t["trial"]["impact"]["rigid_hold"]
+        assert hold["duration"] is not None and hold["max_joint_velocity_change"] < 0.01
+    # The same search again reuses every trial from the journal and gives the same answer.
+    again = validate(SCENARIO, tolerance=0.5, options=options, setup=setup,
+                     journal=TrialJournal.open(tmp_path / "v.jsonl", "digest"))
+    assert again.reused == len(result.trials) and again.bracket() == result.bracket()
 
 
 def test_cli_errors_are_one_line(capsys, tmp_path):
@@ -68,13 +92,22 @@ def test_cli_errors_are_one_line(capsys, tmp_path):
     assert len(err) == 1 and "--magnitudes" in err[0]
 
 
-def test_push_test_json(capsys):
-    assert main(["push-test", SCENARIO, "--controller", "ik", "--directions", "1", "--magnitudes", "5", "--json"]) == 0
-    out = json.loads(capsys.readouterr().out)
+def test_push_test_json(capsys, tmp_path):
+    argv = ["push-test", SCENARIO, "--controller", "ik", "--directions", "1", "--magnitudes", "5", "--json",
+            "--journal", str(tmp_path / "j.jsonl")]
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out, parse_constant=lambda c: pytest.fail(c))
     (push,) = out["pushes"]
-    assert set(push) >= {"direction", "magnitude", "fell", "reason", "com_criterion_safe", "zmp_criterion_safe"}
-    assert push["magnitude"] == 5.0 and push["fell"] is False
-    assert out["confusion"]["com"]["total"] == 1 and out["confusion"]["com"]["safe_survived"] == 1
+    assert set(push) >= {"direction", "magnitude", "outcome", "fell", "reason", "com_criterion_safe",
+                         "com_criterion_safe_in_trial", "zmp_criterion_safe", "com_velocity_margin"}
+    assert push["magnitude"] == 5.0 and push["fell"] is False and push["outcome"] == "balanced"
+    assert push["com_criterion_safe"] is True and push["com_velocity_margin"] > 0
+    assert out["zmp_margin"] == pytest.approx(0.01)  # the ik controller's own margin, by default
+    c = out["scores"]["com"]
+    assert c["total"] == 1 and c["safe_survived"] == 1 and c["accuracy_ci95"][1] == 1.0
+    assert main(argv[:-2] + ["--journal", str(tmp_path / "j.jsonl"), "--zmp-margin", "0"]) == 0
+    again = json.loads(capsys.readouterr().out)
+    assert again["reused_trials"] == 1 and again["zmp_margin"] == 0.0
 
 
 def test_checker_reads_simulate_logs(tmp_path, capsys):

@@ -204,15 +204,37 @@ def test_armature_enters_gains_and_joint_space_prediction():
     from impact_balance.sim import ServoOptions
     from impact_balance.sim.measure import _stance_with_armature
 
+    from impact_balance.robot import load_robot
+
+    shared = load_robot("talos").model.armature.copy()
     sim = build_model("kick_one_foot", "servo", SimOptions(meshes=False, servo=ServoOptions(armature=0.3)))
-    M = pin.crba(sim.stance.model, sim.stance.model.createData(), sim.stance.q)
+    bare = pin.Model(sim.stance.model)
+    bare.armature[:] = 0.0
+    M = pin.crba(bare, bare.createData(), sim.stance.q)
     w = sim.options.servo.bandwidth
     np.testing.assert_allclose(sim.kp, (M[sim.v_index, sim.v_index] + 0.3) * w**2, rtol=1e-9)
     np.testing.assert_allclose(sim.model.dof_armature[sim.dof_adr], 0.3)
+    assert sim.armature_source.startswith("--armature 0.3")
     stance = _stance_with_armature(sim)
     M2 = pin.crba(stance.model, stance.model.createData(), stance.q)
     np.testing.assert_allclose(np.diag(M2 - M)[sim.v_index], 0.3, atol=1e-12)
-    assert not sim.robot.model.armature.any()  # the shared robot model is untouched
+    np.testing.assert_array_equal(sim.robot.model.armature, shared)  # the shared robot model keeps its own
+
+
+def test_declared_rotor_inertia_is_the_default_armature():
+    """Talos's SRDF declares rotor_params (rotor inertia 1e-5 kg m^2, gear ratio 100): 0.1 kg m^2 per joint."""
+    import xml.etree.ElementTree as ET
+
+    sim = build_model("palm_push_two_feet", "servo", SimOptions(meshes=False))
+    root = ET.parse(sim.robot.srdf_path).getroot()
+    declared = {j.get("name"): float(j.get("gear_ratio")) ** 2 * float(j.get("mass"))
+                for j in root.iter("joint") if j.get("gear_ratio") is not None}
+    expected = [declared.get(name, 0.0) for name in sim.joint_names]
+    np.testing.assert_allclose(sim.model.dof_armature[sim.dof_adr], expected, rtol=1e-12)
+    np.testing.assert_allclose(sim.armature, expected, rtol=1e-12)
+    assert "rotor_params" in sim.armature_source and sim.robot.armature_source is not None
+    g1 = build_model("g1_two_feet", "servo", SimOptions(meshes=False))
+    assert not g1.armature.any() and "none declared" in g1.armature_source
 
 
 def test_cli_unusable_gl_backend_is_one_line(tmp_path):

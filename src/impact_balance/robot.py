@@ -138,6 +138,10 @@ class Robot:
         reference_configurations: Named configurations from the SRDF, plus "neutral".
         standing: Name of the default standing configuration.
         urdf_path, srdf_path: Source files (meshes are resolved relative to the URDF's package).
+        armature_source: Where ``model.armature`` (the reflected rotor inertia of each joint,
+            kg m^2, which pinocchio's mass matrix includes) comes from: the SRDF's
+            ``rotor_params`` (armature = gear ratio^2 x rotor inertia), or None when the robot
+            files declare none (armature 0).
     """
 
     name: str
@@ -147,6 +151,7 @@ class Robot:
     urdf_path: Path
     srdf_path: Path | None = None
     package_dirs: list[str] = field(default_factory=list)
+    armature_source: str | None = None
 
     def __getstate__(self) -> dict:
         # The caches (thread-local Data, look-up tables) are rebuilt on demand, never copied.
@@ -354,6 +359,7 @@ def _load(urdf: Path, srdf: Path | None, name: str, standing: str | None) -> Rob
             first = "not a valid URDF model"
         raise RobotLoadError(str(urdf), _native_reason(native, first)) from None
     configurations = {"neutral": pin.neutral(model)}
+    armature_source = None
     if srdf is not None:
         if not _is_file(srdf):
             raise RobotLoadError(str(srdf), "no such file")
@@ -364,11 +370,32 @@ def _load(urdf: Path, srdf: Path | None, name: str, standing: str | None) -> Rob
             raise RobotLoadError(str(srdf), _native_reason(native, str(exc).strip() or "invalid SRDF")) from None
         for entry in model.referenceConfigurations:
             configurations[entry.key()] = np.array(entry.data(), dtype=float)
+        armature_source = _load_rotor_parameters(model, srdf, native)
     if standing is None:
         standing = "half_sitting" if "half_sitting" in configurations else "neutral"
     if standing not in configurations:
         raise UnknownConfigurationError("robot.standing", standing, configurations)
-    return Robot(name, model, configurations, standing, urdf, srdf, package_dirs)
+    return Robot(name, model, configurations, standing, urdf, srdf, package_dirs, armature_source)
+
+
+def _load_rotor_parameters(model: pin.Model, srdf: Path, native: list[str]) -> str | None:
+    """Read the SRDF's ``rotor_params`` into the model (rotor inertia and gear ratio per joint) and set
+    ``model.armature`` = gear ratio^2 x rotor inertia, the rotor inertia reflected at the joint. Returns
+    where it came from, or None when the SRDF declares none."""
+    try:
+        declared = "rotor_params" in srdf.read_text(errors="replace")
+    except OSError:
+        return None
+    if not declared:
+        return None
+    try:
+        with _native_stderr(native):
+            pin.loadRotorParameters(model, str(srdf), False)
+    except (RuntimeError, ValueError, OSError) as exc:
+        raise RobotLoadError(str(srdf), _native_reason(native, str(exc).strip() or "invalid rotor_params")) from None
+    # pinocchio >= 3.? sets the armature itself; older versions only fill the rotor fields.
+    model.armature = np.asarray(model.rotorGearRatio) ** 2 * np.asarray(model.rotorInertia)
+    return f"{srdf.name} rotor_params (armature = gear ratio^2 x rotor inertia)"
 
 
 def _bundled_urdf(name: str) -> Path:

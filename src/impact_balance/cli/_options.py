@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-__all__ = ["add_controller_option", "add_output_options", "add_zmp_margin_option", "with_zmp_margin"]
+__all__ = ["add_controller_option", "add_output_options", "add_zmp_margin_option", "with_zmp_margin",
+           "add_trial_options", "open_journal"]
 
 
 def add_controller_option(parser: argparse.ArgumentParser, default: str, why: str) -> None:
@@ -38,3 +39,44 @@ def with_zmp_margin(scenario, margin: float | None):
     if not (margin == margin and 0.0 <= margin <= MAX_SIZE):  # NaN fails the first test
         raise ScenarioError("--zmp-margin", margin, f"must be in [0, {MAX_SIZE:g}] m")
     return scenario.model_copy(update={"zmp_margin": float(margin)})
+
+
+def add_trial_options(parser: argparse.ArgumentParser, impact: bool) -> None:
+    """Options of the balance-trial commands (``validate``, ``push-test``): ``--rigid-impact`` (impacts only),
+    ``--zmp-margin``, and the trials journal (``--journal FILE``, ``--fresh``, ``--no-journal``)."""
+    if impact:
+        parser.add_argument("--rigid-impact", action="store_true",
+                            help="hold every joint's velocity through the impact (the paper's rigid robot), "
+                                 "until the contact's normal velocity reaches zero")
+    add_zmp_margin_option(parser, "default: the ZMP margin the trials' controller keeps")
+    parser.add_argument("--journal", metavar="FILE",
+                        help="JSON-lines file of the finished trials, written as they end; running the same "
+                             "command again resumes from it (default: impact-balance-trials/<command>_<scenario>_<digest>.jsonl)")
+    parser.add_argument("--fresh", action="store_true", help="discard the journal's trials and run them all again")
+    parser.add_argument("--no-journal", action="store_true", help="keep no journal (nothing resumes)")
+
+
+def open_journal(args: argparse.Namespace, command: str, scenario, joints: str, options, extra: dict):
+    """The trials journal of a command (:class:`impact_balance.sim.journal.TrialJournal`), by the digest of
+    everything its trials depend on (the scoring margin excluded: scores are recomputed from the trials)."""
+    import dataclasses
+    import sys
+    from pathlib import Path
+
+    from ..sim.balance_trial import TRIAL_VERSION
+    from ..sim.journal import TrialJournal, default_journal_path, journal_digest
+
+    parts = {"command": command, "trial_version": TRIAL_VERSION,
+             "scenario": scenario.model_dump(mode="json", exclude={"zmp_margin", "name", "description"}),
+             "joints": joints, "options": dataclasses.asdict(dataclasses.replace(options, record=False)), **extra}
+    digest = journal_digest(parts)
+    if args.no_journal:
+        return TrialJournal.open(None, digest)
+    path = Path(args.journal) if args.journal else default_journal_path(command, scenario.name or "scenario", digest)
+    if args.fresh and path.exists():
+        path.unlink()
+    journal = TrialJournal.open(path, digest, {"command": command, "scenario": scenario.name})
+    note = f", {len(journal.entries)} finished trials to reuse" if journal.entries else ""
+    cut = f", {journal.skipped_lines} unreadable line(s) skipped" if journal.skipped_lines else ""
+    print(f"impact-balance: trials journal {path}{note}{cut}", file=sys.stderr)
+    return journal

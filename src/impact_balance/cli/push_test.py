@@ -1,11 +1,11 @@
-"""``impact-balance push-test SCENARIO``: impulsive pushes at the torso, outcome against both criteria."""
+"""``impact-balance push-test SCENARIO``: impulsive pushes, predicted before the trial and scored after."""
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
 
-from ._options import add_controller_option, add_output_options
+from ._options import add_controller_option, add_output_options, add_trial_options, open_journal, with_zmp_margin
 
 __all__ = ["add_parser", "run", "USES_KERNEL"]
 
@@ -14,14 +14,18 @@ USES_KERNEL = True
 
 def add_parser(sub) -> list[str]:
     # No import of the simulation here: mujoco is imported only when a simulation command runs.
-    a = sub.add_parser("push-test", help="push the simulated robot in every direction; confusion matrices of both criteria")
+    a = sub.add_parser("push-test", help="push the simulated robot in every direction; score both criteria")
     a.add_argument("scenario", help="YAML file or bundled scenario name")
     a.add_argument("--directions", type=int, default=16, help="number of push directions (default 16)")
     a.add_argument("--magnitudes", type=float, nargs="+", default=None, metavar="NS",
                    help="impulses, N s (default 5 10 15 20 25 30)")
+    a.add_argument("--relative", type=float, nargs="+", default=None, metavar="F",
+                   help="impulses as fractions of each direction's boundary impulse (the one that puts the "
+                        "predicted CoM velocity on the CoM velocity area's boundary), e.g. 0.6 0.8 1.0 1.2 1.4")
     a.add_argument("--duration", type=float, default=0.05, help="push duration, s (default 0.05)")
     a.add_argument("--body", help="MuJoCo body pushed (default: the torso)")
     add_controller_option(a, "id", "it places the ZMP anywhere in the support area, as the criterion assumes")
+    add_trial_options(a, impact=False)
     add_output_options(a, "of one telling push")
     return ["push-test"]
 
@@ -30,30 +34,33 @@ def run(args: argparse.Namespace) -> int:
     from ..logs import check_log_path
     from ..scenario import load_scenario
     from ..sim.balance_trial import BalanceTrialOptions, write_trial_log
-    from ..sim.push import DEFAULT_MAGNITUDES, check_push_arguments, push_test
+    from ..sim.push import check_push_arguments, push_test
     from .output import print_json, progress_bar
 
     scenario = load_scenario(args.scenario)
-    if args.magnitudes is None:
-        args.magnitudes = list(DEFAULT_MAGNITUDES)
     if args.log:
         check_log_path(args.log)
-    check_push_arguments(args.directions, args.magnitudes, args.duration)
-    bar = progress_bar(f"push-test {scenario.name}", args.directions * len(args.magnitudes))
+    check_push_arguments(args.directions, args.magnitudes, args.duration, args.relative)
+    with_zmp_margin(scenario, args.zmp_margin)  # checks the value before any trial
+    options = BalanceTrialOptions(controller=args.controller)
+    journal = open_journal(args, "push-test", scenario, "servo", options, {"body": args.body})
+    levels = len(args.relative or args.magnitudes or [0] * 6)
+    bar = progress_bar(f"push-test {scenario.name}", args.directions * levels)
 
     def progress(outcome):
         bar.update(1)
-        bar.set_postfix_str(f"{outcome.push.magnitude:g} N s {'fell' if outcome.result.fell else 'ok'}")
+        bar.set_postfix_str(f"{outcome.push.magnitude:.1f} N s {outcome.outcome}")
 
     try:
         result = push_test(scenario, args.directions, args.magnitudes, args.duration, args.body, progress=progress,
-                           options=BalanceTrialOptions(controller=args.controller))
+                           options=options, relative=args.relative, zmp_margin=args.zmp_margin, journal=journal)
     finally:
         bar.close()
+        journal.close()
     out = result.to_dict()
     written = []
     if args.log:
-        chosen = _telling(result.outcomes)
+        chosen = _telling(result)
         written.append(write_trial_log(result.setup, args.log, args.controller, {
             "push_direction": chosen.push.direction, "push_magnitude": chosen.push.magnitude}, push=chosen.push))
         out["log"] = {"file": str(args.log), "direction": chosen.push.direction, "magnitude": chosen.push.magnitude}
@@ -62,51 +69,80 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(out)
         return 0
-    c = out["confusion"]
-    print(f"{scenario.name}: {len(result.outcomes)} pushes ({args.directions} directions x {len(args.magnitudes)} magnitudes,"
-          f" {args.duration * 1e3:.0f} ms), {sum(o.result.fell for o in result.outcomes)} falls")
-    print(f"  {'magnitude':>9s} {'fell':>5s} {'CoM safe':>8s} {'ZMP safe':>8s}")
-    for m in args.magnitudes:
-        group = [o for o in result.outcomes if o.push.magnitude == m]
-        print(f"  {m:7g} Ns {sum(o.result.fell for o in group):5d} {sum(bool(o.result.com_criterion_safe) for o in group):8d}"
-              f" {sum(bool(o.result.zmp_criterion_safe) for o in group):8d}")
-    for name in ("com", "zmp"):
-        k = c[name]
-        print(f"  {name.upper()} criterion: predicted the outcome for {100 * k['accuracy']:.0f} % of pushes;"
-              f" safe & survived {k['safe_survived']}, safe & fell {k['safe_fell']} ({100 * k['safe_fell_rate']:.0f} %),"
-              f" unsafe & survived {k['unsafe_survived']}, unsafe & fell {k['unsafe_fell']}")
+    print(_text(result, out, args))
     for path in written:
         print(f"  wrote {path}")
     return 0
 
 
-def _telling(outcomes):
-    """The push of the paper's Exp. 2 if there is one (ZMP outside, no fall), else the largest survived, else the first."""
-    exp2 = [o for o in outcomes if not o.result.fell and not o.result.zmp_criterion_safe]
+def _pct(x) -> str:
+    return "-" if x is None else f"{100 * x:.1f} %"
+
+
+def _ci(c: list | None) -> str:
+    return "" if c is None else f" [{100 * c[0]:.0f}, {100 * c[1]:.0f}]"
+
+
+def _text(result, out: dict, args: argparse.Namespace) -> str:
+    counts = out["counts"]
+    o = counts["outcomes"]
+    controller = out["controller"].get("name", args.controller)
+    lines = [f"{result.scenario}: {len(result.outcomes)} pushes ({args.directions} directions, {args.duration * 1e3:.0f} ms) "
+             f"with the {args.controller} controller ({controller})",
+             f"  outcomes: {o['balanced']} balanced, {o['contact_broken']} contact broken (came to rest), "
+             f"{o['fell']} fell, {o['aborted']} aborted"]
+    if counts["reasons"]:
+        lines.append("  " + ", ".join(f"{k}: {v}" for k, v in sorted(counts["reasons"].items())))
+    margin = 1000 * out["zmp_margin"]
+    lines.append(f"  {'magnitude':>14s} {'balanced':>8s} {'broken':>6s} {'fell':>5s} {'CoM safe':>8s} {'ZMP safe':>8s}")
+    for row in _by_level(result):
+        lines.append(f"  {row['label']:>14s} {row['balanced']:8d} {row['contact_broken']:6d} {row['fell']:5d} "
+                     f"{row['com']:8d} {row['zmp']:8d}")
+    lines.append(f"  scores (fell against the rest; {len(result.scored)} pushes, ZMP margin {margin:g} mm; "
+                 f"95 % Wilson intervals):")
+    for key, label in (("com", "CoM criterion, before the trial"), ("com_in_trial", "CoM criterion, in the trial"),
+                       ("zmp", "ZMP criterion, before the trial"), ("zmp_in_trial", "ZMP criterion, in the trial")):
+        k = out["scores"][key]
+        lines.append(f"    {label:32s} right {_pct(k['accuracy'])}{_ci(k['accuracy_ci95'])}, "
+                     f"predicted safe and fell {_pct(k['safe_fell_rate'])}{_ci(k['safe_fell_rate_ci95'])}")
+    smallest = out["margin_study"]["smallest_margin"]["com"]
+    lines.append("  smallest ZMP margin that brings the CoM criterion's 'predicted safe, fell' to 5 % or less: "
+                 + ("none up to 6 cm" if smallest is None else f"{1000 * smallest:g} mm"))
+    if out["journal"]:
+        lines.append(f"  trials journal: {out['journal']} ({out['reused_trials']} reused)")
+    return "\n".join(lines)
+
+
+def _by_level(result) -> list[dict]:
+    rows: dict[float, dict] = {}
+    for o in result.outcomes:
+        level = o.relative if o.relative is not None else o.push.magnitude
+        label = f"x{o.relative:g} boundary" if o.relative is not None else f"{o.push.magnitude:g} N s"
+        row = rows.setdefault(level, {"label": label, "balanced": 0, "contact_broken": 0, "fell": 0, "com": 0, "zmp": 0})
+        if o.outcome in row:
+            row[o.outcome] += 1
+        row["com"] += o.safe("com", result.zmp_margin, result.omega)
+        row["zmp"] += o.safe("zmp", result.zmp_margin, result.omega)
+    return [rows[k] for k in sorted(rows)]
+
+
+def _telling(result):
+    """The push of the paper's Exp. 2 if there is one (ZMP outside in the trial, no fall), else the largest
+    that did not fall, else the first."""
+    stood = [o for o in result.scored if not o.fell]
+    exp2 = [o for o in stood if not o.safe("zmp_in_trial", 0.0, result.omega)]
     if exp2:
-        return max(exp2, key=lambda o: o.result.max_zmp_excursion)
-    survived = [o for o in outcomes if not o.result.fell]
-    return max(survived, key=lambda o: o.push.magnitude) if survived else outcomes[0]
+        return max(exp2, key=lambda o: o.push.magnitude)
+    return max(stood, key=lambda o: o.push.magnitude) if stood else result.outcomes[0]
 
 
 def _plots(result, out: Path) -> list[Path]:
-    from ..plots.balance import plot_com_velocity_trajectories, plot_zmp_trajectories
+    from ..plots.balance import plot_push_trajectories
     from ..plots.save import figure_prefix
 
     out.mkdir(parents=True, exist_ok=True)
-    analysis = result.setup.analysis
-    prefix = figure_prefix(analysis)
-    fell = [o.result.fell for o in result.outcomes]
-    zmp, vel = [], []
-    for o in result.outcomes:
-        s = o.result.series
-        t = s["time"]
-        # From the push to half a second after it (the paper's figures show the reaction to the push).
-        window = (t >= o.push.start) & (t <= o.push.start + o.push.duration + 0.5)
-        zmp.append(s["zmp"][window])
-        vel.append(s["com_velocity"][window][:, :2])
+    prefix = figure_prefix(result.setup.analysis)
     paths = [out / f"{prefix}_push_zmp.png", out / f"{prefix}_push_com_velocity.png"]
-    plot_zmp_trajectories(analysis.areas.zmp_area, zmp, fell, f"{result.scenario}: ZMP after each push").savefig(paths[0])
-    plot_com_velocity_trajectories(analysis.areas.com_velocity_area, vel, fell,
-                                   f"{result.scenario}: CoM velocity after each push").savefig(paths[1])
+    for path, kind in zip(paths, ("zmp", "com_velocity")):
+        plot_push_trajectories(result, kind).savefig(path)
     return paths

@@ -21,8 +21,12 @@ def add_parser(sub) -> list[str]:
                    help="approach speed(s) of the impact point along the normal, m/s (default 0.3)")
     a.add_argument("--joints", default="rigid", metavar="rigid|servo",
                    help="joint model: rigid (welded at the stance, the paper's model) or servo (position servos)")
-    a.add_argument("--armature", type=float, default=0.0, metavar="KG_M2",
-                   help="servo only: rotor inertia added to every joint, kg m^2 (default 0, as in the URDF)")
+    a.add_argument("--armature", type=float, default=None, metavar="KG_M2",
+                   help="servo only: rotor inertia of every joint, kg m^2 (default: what the robot files declare, "
+                        "the SRDF's rotor_params; 0 where they declare none)")
+    a.add_argument("--rigid-impact", action="store_true",
+                   help="servo only: hold every joint's velocity from the contact to the end of the compression "
+                        "(the paper's rigid robot at the impact)")
     a.add_argument("--duration", type=float, default=0.15, metavar="S",
                    help="simulated time kept after the impact begins, s (default 0.15)")
     a.add_argument("--json", action="store_true", help="print one JSON object (a list for several speeds)")
@@ -73,6 +77,14 @@ def _table(name: str, r) -> str:
     kept = "n/a (floating)" if r.contacts_kept is None else ("yes" if r.contacts_kept else "NO")
     lines.append(f"  impulse {i[0]:+.3f} {i[1]:+.3f} {i[2]:+.3f} N s; contacts kept: {kept}; "
                  f"simulated/wall time {r.sim_time_ratio:.1f}x")
+    if r.sustained_impulses:
+        parts = [f"{name} ({v[0]:+.2f}, {v[1]:+.2f}, {v[2]:+.2f})" for name, v in r.sustained_impulses.items()]
+        lines.append(f"  impulse at the sustained contacts (force before the impact subtracted), N s: {'; '.join(parts)}")
+    if r.hold is not None and r.hold["duration"] is not None:
+        lines.append(f"  joints held through the impact for {1e3 * r.hold['duration']:.1f} ms (largest joint velocity "
+                     f"change {r.hold['max_joint_velocity_change']:.2g} rad/s)")
+    if r.joints == "servo":
+        lines.append(f"  joint armature: {r.armature}")
     if r.saturated_joints:
         lines.append(f"  at their effort limit during the impact: {', '.join(r.saturated_joints)}")
     return "\n".join(lines)
@@ -100,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
         raise SimulationError("--joints", args.joints, f"unknown joint model; valid: {', '.join(JOINT_MODELS)}")
     if not (math.isfinite(args.duration) and 0.0 < args.duration <= 10.0):
         raise SimulationError("--duration", args.duration, "must be in (0, 10] s")
-    if not (math.isfinite(args.armature) and 0.0 <= args.armature <= 100.0):
+    if args.armature is not None and not (math.isfinite(args.armature) and 0.0 <= args.armature <= 100.0):
         raise SimulationError("--armature", args.armature, "must be in [0, 100] kg m^2")
     if args.log:
         check_log_path(args.log)
@@ -117,7 +129,7 @@ def run(args: argparse.Namespace) -> int:
     several = len(speeds) > 1
     results, written = [], []
     for speed in speeds:
-        record = run_trial(sim, TrialOptions(speed, after=args.duration))
+        record = run_trial(sim, TrialOptions(speed, after=args.duration, rigid_impact=args.rigid_impact))
         result = measure(sim, record, speed)
         results.append(result)
         if args.log:

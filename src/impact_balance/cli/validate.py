@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._options import add_controller_option, add_output_options
+from ._options import add_controller_option, add_output_options, add_trial_options, open_journal, with_zmp_margin
 
 __all__ = ["add_parser", "run", "USES_KERNEL"]
 
@@ -20,6 +20,7 @@ def add_parser(sub) -> list[str]:
     add_controller_option(a, "ik", "a kinematically controlled robot, as the paper's impact model assumes")
     a.add_argument("--tolerance", type=float, default=0.05, help="relative width of the bracket (default 0.05)")
     a.add_argument("--max-speed", type=float, default=4.0, help="largest approach speed tried, m/s (default 4)")
+    add_trial_options(a, impact=True)
     add_output_options(a, "of the fastest trial survived")
     return ["validate"]
 
@@ -37,45 +38,44 @@ def run(args: argparse.Namespace) -> int:
         raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact: validate needs one")
     if not (0 < args.max_speed <= 5.0):
         raise SimulationError("--max-speed", args.max_speed, "must be in (0, 5] m/s")
+    if not (0.001 <= args.tolerance < 1):
+        raise SimulationError("--tolerance", args.tolerance, "must be in [0.001, 1)")
+    with_zmp_margin(scenario, args.zmp_margin)  # checks the value before any trial
     if args.log:
         check_log_path(args.log)
+    options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
+    journal = open_journal(args, "validate", scenario, args.joints, options,
+                           {"tolerance": args.tolerance, "max_speed": args.max_speed})
     bar = progress_bar(f"validate {scenario.name}")
 
-    def progress(speed, result, survived, fell):
+    def progress(trial, stood, fell):
         bar.update(1)
-        lo = "?" if survived is None else f"{survived:.3f}"
+        lo = "?" if stood is None else f"{stood:.3f}"
         hi = "?" if fell is None else f"{fell:.3f}"
-        bar.set_postfix_str(f"{speed:.3f} m/s {'fell' if result.fell else 'ok'}; bracket [{lo}, {hi}]")
+        bar.set_postfix_str(f"{trial.speed:.3f} m/s {trial.outcome}; bracket (commanded) [{lo}, {hi}]")
 
     try:
         result = validate(scenario, args.joints, tolerance=args.tolerance, max_speed=args.max_speed, progress=progress,
-                          options=BalanceTrialOptions(controller=args.controller))
+                          options=options, zmp_margin=args.zmp_margin, journal=journal)
     finally:
         bar.close()
+        journal.close()
     out = result.to_dict()
     written = []
+    e = out["empirical"]
     if args.log:
-        speed = result.survived if result.survived is not None else result.fell
-        written.append(write_trial_log(result.extra["setup"], args.log, args.controller,
-                                       {"approach_speed": speed, "joints": args.joints}, impact_speed=speed))
-        out["log"] = {"file": str(args.log), "approach_speed": speed}
+        speed = e["survived_commanded"] if e["survived_commanded"] is not None else e["fell_commanded"]
+        if speed is not None:
+            written.append(write_trial_log(result.extra["setup"], args.log, args.controller,
+                                           {"approach_speed": speed, "joints": args.joints}, impact_speed=speed,
+                                           rigid_impact=args.rigid_impact))
+            out["log"] = {"file": str(args.log), "approach_speed": speed}
     if args.plots:
         written += _plots(result, Path(args.plots))
     if args.json:
         print_json(out)
         return 0
-    p = out["predicted"]
-    print(f"{scenario.name}: empirical fall threshold ({args.joints} joints, {args.controller} controller,"
-          f" {len(result.trials)} trials)")
-    print(f"  survived at {_f(result.survived)}, fell at {_f(result.fell)} (commanded approach speed)")
-    print("  predicted maximum contact velocity:")
-    for crit in ("com_criterion", "zmp_criterion"):
-        print(f"    {crit.replace('_', ' '):14s} composite {_f(p[crit]['composite'])}, joint_space {_f(p[crit]['joint_space'])}")
-    print("  trials:")
-    for t in out["trials"]:
-        meas = t["approach_speed_measured"]
-        print(f"    {t['speed']:.3f} m/s (measured {_f(meas)}): {'FELL ' + str(t['reason']) if t['fell'] else 'ok'}"
-              f"  max CoM velocity excursion {_f(t['max_com_velocity_excursion'])}")
+    print(_text(out, args, len(result.trials)))
     for path in written:
         print(f"  wrote {path}")
     return 0
@@ -85,22 +85,44 @@ def _f(x) -> str:
     return "-" if x is None else f"{x:.3f} m/s"
 
 
+def _text(out: dict, args: argparse.Namespace, n: int) -> str:
+    e, p, pm = out["empirical"], out["predicted"], out["predicted_with_margin"]
+    impact = "rigid impact (joints held through the impact)" if out["rigid_impact"] else "free impact"
+    lines = [f"{out['scenario']}: fall threshold of the impact ({args.joints} joints, {args.controller} controller, "
+             f"{impact}, {n} trials)",
+             f"  measured approach speed: stood at {_f(e['survived'])}, fell at {_f(e['fell'])}"
+             f" (commanded {_f(e['survived_commanded'])} / {_f(e['fell_commanded'])})"
+             + ("" if e["monotonic"] else "; NOT monotonic in measured speed")]
+    brk = out["contact_break"]
+    if brk is not None:
+        lines.append(f"  first contact break: {brk['contact']} {brk['kind']} at {_f(brk['measured'])} measured "
+                     f"({brk['outcome']})")
+    else:
+        lines.append("  no contact broke")
+    lines.append(f"  predicted maximum contact velocity (ZMP margin 0 / {1000 * out['zmp_margin']:g} mm):")
+    for crit, label in (("com_criterion", "CoM criterion"), ("zmp_criterion", "ZMP criterion")):
+        lines.append(f"    {label:14s} composite {_f(p[crit]['composite'])} / {_f(pm[crit]['composite'])}, "
+                     f"joint_space {_f(p[crit]['joint_space'])} / {_f(pm[crit]['joint_space'])}")
+    lines.append("  trials (commanded -> measured: outcome):")
+    for t in out["trials"]:
+        why = f" {t['reason']}" if t["reason"] else ""
+        call = {True: "CoM criterion: safe", False: "CoM criterion: unsafe", None: ""}[t["com_criterion_safe"]]
+        lines.append(f"    {t['speed']:.3f} -> {_f(t['approach_speed_measured'])}: {t['outcome']}{why}   {call}")
+    lines.append(f"  controller: {out['controller'].get('name', args.controller)}; joint armature: "
+                 f"{out['controller'].get('armature')}")
+    if out["journal"]:
+        lines.append(f"  trials journal: {out['journal']} ({out['reused_trials']} reused)")
+    return "\n".join(lines)
+
+
 def _plots(result, out: Path) -> list[Path]:
-    from ..plots.balance import plot_com_velocity_trajectories, plot_validation
+    from ..plots.balance import plot_impact_trajectories, plot_validation
     from ..plots.save import figure_prefix
 
     out.mkdir(parents=True, exist_ok=True)
     setup = result.extra["setup"]
     prefix = figure_prefix(setup.analysis)
-    speeds = [v for v, _ in result.trials]
-    fell = [r.fell for _, r in result.trials]
-    paths = []
-    fig = plot_validation(speeds, fell, result.predicted, f"{result.scenario}: trials and predictions ({result.joints})")
-    paths.append(out / f"{prefix}_validation.png")
-    fig.savefig(paths[-1])
-    traj = [r.series["com_velocity"][:, :2] for _, r in result.trials if len(r.series.get("com_velocity", []))]
-    fig = plot_com_velocity_trajectories(setup.analysis.areas.com_velocity_area, traj, fell,
-                                         f"{result.scenario}: CoM velocity of every trial")
-    paths.append(out / f"{prefix}_validation_com_velocity.png")
-    fig.savefig(paths[-1])
+    paths = [out / f"{prefix}_validation.png", out / f"{prefix}_validation_com_velocity.png"]
+    plot_validation(result).savefig(paths[0])
+    plot_impact_trajectories(result, setup.analysis).savefig(paths[1])
     return paths

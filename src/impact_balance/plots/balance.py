@@ -1,15 +1,17 @@
 """Figures of the balance trials (paper Exp. 1 and 2) and of a checked log.
 
-- :func:`plot_zmp_trajectories`: measured ZMP trajectories over the ZMP support area.
-- :func:`plot_com_velocity_trajectories`: measured CoM velocity trajectories over the CoM velocity area.
-- :func:`plot_validation`: outcome of every trial against the commanded approach speed, with the
-  predictions of both criteria and both inertia models.
+- :func:`plot_validation`: every impact trial's outcome against the measured approach speed (the
+  commanded one beside it), with the predicted maxima of both criteria.
+- :func:`plot_impact_trajectories`: the CoM velocity of every impact trial over the CoM velocity area.
+- :func:`plot_push_trajectories`: the ZMP (or the CoM velocity) after every push over its area, with the
+  before-trial predictions.
 - :func:`plot_log_margins`: the CoM velocity margin and the ZMP margin of a checked log over time.
+
+Outcomes have one colour everywhere (:data:`OUTCOME_COLORS`); falls are drawn first, so the trials that
+did not fall stay visible on top of them.
 """
 
 from __future__ import annotations
-
-from collections.abc import Sequence
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -18,76 +20,171 @@ from matplotlib.lines import Line2D
 from ..polygon import Polygon
 from ._common import AREA_COLOR, FALL_COLOR, OK_COLOR, ZMP_COLOR, draw_polygon, new_figure, set_limits
 
-__all__ = ["plot_zmp_trajectories", "plot_com_velocity_trajectories", "plot_validation", "plot_log_margins"]
+__all__ = ["OUTCOME_COLORS", "plot_validation", "plot_impact_trajectories", "plot_push_trajectories", "plot_log_margins"]
+
+#: Colour of each trial outcome.
+OUTCOME_COLORS = {"balanced": OK_COLOR, "contact_broken": "tab:orange", "fell": FALL_COLOR, "aborted": "0.6"}
+_ORDER = {"fell": 0, "aborted": 1, "contact_broken": 2, "balanced": 3}  # drawing order: falls underneath
 
 
-def _legend(ax, area_label: str, area_color: str) -> None:
-    ax.legend(handles=[
-        Line2D([], [], color=area_color, lw=6, alpha=0.5, label=area_label),
-        Line2D([], [], color=OK_COLOR, label="did not fall"),
-        Line2D([], [], color=FALL_COLOR, label="fell"),
-    ], loc="best", fontsize=8)
+def _outcome_handles(outcomes) -> list[Line2D]:
+    seen = set(outcomes)
+    present = [o for o in OUTCOME_COLORS if o in seen]
+    return [Line2D([], [], color=OUTCOME_COLORS[o], lw=1.5, label=o.replace("_", " ")) for o in present]
 
 
-def _trajectories_over(area: Polygon, area_label: str, area_color: str, trajectories: Sequence[np.ndarray],
-                       fell: Sequence[bool], quantity: str, unit: str, title: str, mark_ends: bool) -> Figure:
-    """Trajectories (each k x 2, world) over an area, coloured by outcome (the two figures of Exp. 2)."""
-    fig = new_figure(5.5, 5.0)
+def plot_validation(result) -> Figure:
+    """Each impact trial's outcome against its measured approach speed (filled) and commanded speed (open),
+    with the CoM and ZMP criteria's maximum contact velocity (composite; solid without margin, dashed with it)."""
+    fig = new_figure(8.0, 3.8)
     ax = fig.add_subplot()
-    draw_polygon(ax, area, color=area_color, label=area_label)
-    for path, f in zip(trajectories, fell):
-        ax.plot(path[:, 0], path[:, 1], color=FALL_COLOR if f else OK_COLOR, lw=0.8, alpha=0.7)
-        if mark_ends:
-            ax.plot(path[-1:, 0], path[-1:, 1], "o", ms=2, color=FALL_COLOR if f else OK_COLOR)
-    set_limits(ax, [area.vertices, *[p[np.all(np.isfinite(p), axis=1)] for p in trajectories]], min_ratio=0.5)
-    ax.set_aspect("equal")
-    ax.set_xlabel(f"{quantity}x ({unit})")
-    ax.set_ylabel(f"{quantity}y ({unit})")
-    ax.set_title(title, fontsize=10)
+    rows = {"balanced": 0, "contact_broken": 1, "fell": 2, "aborted": 3}
+    speeds = []
+    for t in result.trials:
+        y = rows[t.outcome]
+        color = OUTCOME_COLORS[t.outcome]
+        ax.plot([t.speed], [y + 0.18], "o", mfc="none", mec=color, ms=6, zorder=3)
+        speeds.append(t.speed)
+        if t.measured is not None:
+            ax.plot([t.speed, t.measured], [y + 0.18, y], color=color, lw=0.6, alpha=0.6, zorder=2)
+            ax.plot([t.measured], [y], "o", color=color, ms=6, zorder=4)
+            speeds.append(t.measured)
+    top = max(speeds + [0.1])
+    lines = []
+    for crit, color, name in (("com_criterion", "tab:blue", "CoM criterion"), ("zmp_criterion", "tab:green", "ZMP criterion")):
+        for values, ls, note in ((result.predicted, "-", "no margin"),
+                                 (result.predicted_with_margin, "--", f"ZMP margin {1000 * result.zmp_margin:g} mm")):
+            value = values[crit]["composite"]
+            if value is None:
+                continue
+            if value <= 1.3 * top:
+                ax.axvline(value, color=color, ls=ls, lw=1.2, zorder=1)
+            lines.append(Line2D([], [], color=color, ls=ls,
+                                label=f"{name} ({note}): {value:.3f} m/s" + ("" if value <= 1.3 * top else " (off scale)")))
+    b = result.bracket()
+    handles = [Line2D([], [], marker="o", color="0.3", ls="none", label="measured at first contact"),
+               Line2D([], [], marker="o", mfc="none", mec="0.3", ls="none", label="commanded"), *lines]
+    ax.set_yticks(list(rows.values()), [k.replace("_", " ") for k in rows])
+    ax.set_ylim(-0.5, 3.6)
+    ax.set_xlim(0, 1.35 * top)
+    ax.set_xlabel("approach speed (m/s)")
+    rigid = ", joints held through the impact" if result.rigid_impact else ""
+    fmt = lambda x: "-" if x is None else f"{x:.3f}"  # noqa: E731
+    bracket = f"stood {fmt(b['survived'])} m/s, fell {fmt(b['fell'])} m/s (measured)"
+    ax.set_title(f"{result.scenario}: impact trials ({result.joints} joints{rigid})\n{bracket}", fontsize=10)
     ax.grid(alpha=0.3)
-    _legend(ax, area_label, area_color)
+    fig.legend(handles=handles, loc="outside right center", fontsize=7, frameon=False)
     return fig
 
 
-def plot_zmp_trajectories(area: Polygon, trajectories: Sequence[np.ndarray], fell: Sequence[bool],
-                          title: str = "") -> Figure:
-    """Measured ZMP trajectories (each k x 2, m, world) over the ZMP support area."""
-    return _trajectories_over(area, "ZMP support area", ZMP_COLOR, trajectories, fell, "", "m",
-                              title or "ZMP over the ZMP support area", mark_ends=False)
+def _area_with_margin(ax, area: Polygon, margin_area: Polygon | None, color: str, label: str, margin: float) -> list:
+    draw_polygon(ax, area, color=color, label=label)
+    handles = [Line2D([], [], color=color, lw=6, alpha=0.5, label=label)]
+    if margin_area is not None and margin > 0 and not margin_area.is_empty:
+        draw_polygon(ax, margin_area, color=color, fill=False, ls="--", lw=1.0, edge="0.35")
+        handles.append(Line2D([], [], color="0.35", ls="--", lw=1.0, label=f"with the ZMP margin ({1000 * margin:g} mm)"))
+    return handles
 
 
-def plot_com_velocity_trajectories(area: Polygon, trajectories: Sequence[np.ndarray], fell: Sequence[bool],
-                                   title: str = "") -> Figure:
-    """Measured CoM velocity trajectories (each k x 2, m/s, world) over the CoM velocity area."""
-    return _trajectories_over(area, "CoM velocity area", AREA_COLOR, trajectories, fell, "CoM velocity ", "m/s",
-                              title or "CoM velocity over the CoM velocity area", mark_ends=True)
-
-
-def plot_validation(speeds: Sequence[float], fell: Sequence[bool], predicted: dict, title: str = "") -> Figure:
-    """Each trial's outcome against its commanded approach speed, with the predicted maxima."""
-    fig = new_figure(7.0, 3.2)
+def plot_impact_trajectories(result, analysis) -> Figure:
+    """The CoM velocity of every impact trial (from just before the contact to 1.5 s after) over the CoM
+    velocity area, each labelled with its measured approach speed."""
+    areas = analysis.areas
+    area = areas.com_velocity_area
+    shrunk = None
+    if result.zmp_margin > 0:
+        zmp = areas.zmp_area.inset(result.zmp_margin)
+        shrunk = zmp.affine(areas.omega, -areas.omega * areas.com[:2]) if not zmp.is_empty else None
+    fig = new_figure(6.4, 5.6)
     ax = fig.add_subplot()
-    s = np.asarray(speeds, dtype=float)
-    f = np.asarray(fell, dtype=bool)
-    ax.scatter(s[~f], np.zeros((~f).sum()), color=OK_COLOR, label="did not fall", zorder=3)
-    ax.scatter(s[f], np.ones(f.sum()), color=FALL_COLOR, marker="x", label="fell", zorder=3)
-    styles = {("com_criterion", "composite"): ("tab:blue", "-"), ("com_criterion", "joint_space"): ("tab:blue", ":"),
-              ("zmp_criterion", "composite"): ("tab:green", "-"), ("zmp_criterion", "joint_space"): ("tab:green", ":")}
-    top = max([*s.tolist(), 0.1])
-    for (crit, inertia), (color, ls) in styles.items():
-        value = predicted.get(crit, {}).get(inertia)
-        if value is None:
+    handles = _area_with_margin(ax, area, shrunk, AREA_COLOR, "CoM velocity area", result.zmp_margin)
+    paths = []
+    for t in sorted(result.trials, key=lambda t: _ORDER[t.outcome]):
+        path = np.array([p for p in t.trajectory.get("com_velocity", []) if p is not None], dtype=float).reshape(-1, 2)
+        if not len(path):
             continue
-        shown = min(value, 1.5 * top)
-        ax.axvline(shown, color=color, ls=ls, lw=1.2,
-                   label=f"{crit.replace('_', ' ')}, {inertia}: {value:.3g} m/s" + (" (off scale)" if value > shown else ""))
-    ax.set_yticks([0, 1], ["survived", "fell"])
-    ax.set_ylim(-0.5, 1.5)
-    ax.set_xlim(0, 1.55 * top)
-    ax.set_xlabel("commanded approach speed (m/s)")
-    ax.set_title(title or "Fall threshold: trials and predictions", fontsize=10)
-    ax.legend(fontsize=7, loc="center right")
+        color = OUTCOME_COLORS[t.outcome]
+        ax.plot(path[:, 0], path[:, 1], color=color, lw=0.9, alpha=0.8)
+        paths.append(path)
+        if t.measured is not None:
+            k = int(np.argmax(np.linalg.norm(path - path[0], axis=1)))
+            ax.annotate(f"{t.measured:.2f}", path[k], fontsize=6, color=color, xytext=(3, 3), textcoords="offset points")
+    set_limits(ax, [area.vertices, *paths], min_ratio=0.5)
+    ax.set_aspect("equal")
+    ax.set_xlabel("CoM velocity x (m/s)")
+    ax.set_ylabel("CoM velocity y (m/s)")
+    ax.set_title(f"{result.scenario}: CoM velocity through each impact\n(labels: measured approach speed, m/s)",
+                 fontsize=10)
     ax.grid(alpha=0.3)
+    fig.legend(handles=handles + _outcome_handles(t.outcome for t in result.trials), loc="outside lower center",
+               ncols=3, fontsize=7, frameon=False)
+    return fig
+
+
+def plot_push_trajectories(result, kind: str = "com_velocity") -> Figure:
+    """After every push, the CoM velocity (``kind="com_velocity"``) over the CoM velocity area, or the ZMP
+    (``"zmp"``) over the ZMP support area, coloured by outcome; crosses mark each push's before-trial
+    prediction (the post-push CoM velocity, or the quasi-static ZMP while it acts), and the outermost push
+    of each direction is labelled with its direction (deg) and impulse (N s)."""
+    areas = result.setup.analysis.areas
+    margin = result.zmp_margin
+    if kind == "zmp":
+        area, color, label, unit, quantity = areas.zmp_area, ZMP_COLOR, "ZMP support area", "m", "ZMP"
+        shrunk = areas.zmp_area.inset(margin) if margin > 0 else None
+    else:
+        area, color, label, unit, quantity = areas.com_velocity_area, AREA_COLOR, "CoM velocity area", "m/s", "CoM velocity"
+        zmp = areas.zmp_area.inset(margin) if margin > 0 else None
+        shrunk = None if zmp is None or zmp.is_empty else zmp.affine(areas.omega, -areas.omega * areas.com[:2])
+    fig = new_figure(6.4, 6.0)
+    ax = fig.add_subplot()
+    handles = _area_with_margin(ax, area, shrunk, color, label, margin)
+    paths, predicted = [], []
+    outermost: dict[float, object] = {}
+    for o in sorted(result.outcomes, key=lambda o: _ORDER[o.outcome]):
+        c = OUTCOME_COLORS[o.outcome]
+        path = np.array([p if p is not None else [np.nan, np.nan] for p in o.trajectory.get(kind, [])],
+                        dtype=float).reshape(-1, 2)
+        if len(path):
+            ax.plot(path[:, 0], path[:, 1], color=c, lw=0.7, alpha=0.75)
+            paths.append(path)
+        guess = o.prediction.zmp if kind == "zmp" else o.prediction.com_velocity
+        ax.plot([guess[0]], [guess[1]], "x", color=c, ms=4, mew=1.0, alpha=0.9, zorder=4)
+        predicted.append(np.asarray(guess, dtype=float).reshape(1, 2))
+        d = round(float(o.push.direction), 6)
+        if d not in outermost or o.push.magnitude > outermost[d].push.magnitude:
+            outermost[d] = o
+    view = [area.vertices, *paths]
+    if kind == "com_velocity":
+        view += predicted
+    set_limits(ax, view, min_ratio=0.5)
+    for o in outermost.values():  # labels where the predictions are drawn, inside the view
+        guess = o.prediction.zmp if kind == "zmp" else o.prediction.com_velocity
+        x0, x1 = ax.get_xlim()
+        y0, y1 = ax.get_ylim()
+        p = np.clip(np.asarray(guess, dtype=float), [x0, y0], [x1, y1])
+        cos, sin = np.cos(o.push.direction), np.sin(o.push.direction)
+        # Inwards from the outermost prediction, so the label stays inside the axes.
+        ax.annotate(f"{np.rad2deg(o.push.direction):.0f}°, {o.push.magnitude:.0f} N s", p, fontsize=6, color="0.25",
+                    xytext=(-6 * cos, -6 * sin + (5 if abs(sin) < 0.7 else 0)), textcoords="offset points",
+                    ha="right" if cos > 0.3 else ("left" if cos < -0.3 else "center"),
+                    va="top" if sin > 0.3 else ("bottom" if sin < -0.3 else "bottom"))
+    x0, x1 = ax.get_xlim()
+    y0, y1 = ax.get_ylim()
+    outside = [p[0] for p in predicted if not (x0 <= p[0, 0] <= x1 and y0 <= p[0, 1] <= y1)]
+    if outside:
+        far = np.linalg.norm(np.array(outside) - areas.com[:2], axis=1)
+        ax.text(0.5, 0.01, f"{len(outside)} predictions lie off the view ({far.min():.2f} to {far.max():.2f} m from "
+                f"the CoM); labels at the edge", transform=ax.transAxes, ha="center", va="bottom", fontsize=6, color="0.3")
+    ax.set_aspect("equal")
+    ax.set_xlabel(f"{quantity} x ({unit})")
+    ax.set_ylabel(f"{quantity} y ({unit})")
+    what = "ZMP during and after each push" if kind == "zmp" else "CoM velocity after each push"
+    ax.set_title(f"{result.scenario}: {what}\n({len(result.outcomes)} pushes, {result.setup.controller} controller, "
+                 f"{1000 * result.outcomes[0].push.duration:.0f} ms)", fontsize=9)
+    ax.grid(alpha=0.3)
+    handles += _outcome_handles(o.outcome for o in result.outcomes)
+    handles.append(Line2D([], [], marker="x", color="0.3", ls="none", label="predicted before the trial"))
+    fig.legend(handles=handles, loc="outside lower center", ncols=3, fontsize=7, frameon=False)
     return fig
 
 

@@ -19,10 +19,10 @@ Choice (documented in ``docs/validation.md``): a *kinematic* controller, as the 
    and a posture task holds the rest. The reference joint angles go to the joint position servos
    (the trial adds the reference velocities as feed-forward on the free limbs).
 
-The impact task (:class:`ImpactTask`): hold; then the impact point's target moves towards the
-surface along ``-n`` at the commanded approach speed (through the surface, so that the hand is
-still driven at that speed on arrival); once the measured normal force exceeds a threshold (15 N,
-as the paper's experiment) the target stops pushing and retracts along ``n``.
+The impact task (:class:`~.approach.ImpactTask`): hold; then the impact point's target accelerates
+towards the surface along ``-n`` (bounded acceleration) to the commanded approach speed, which it
+reaches before the surface; once the measured normal force exceeds a threshold (15 N, as the
+paper's experiment) the target stops pushing and withdraws along ``n``.
 
 Everything here is pinocchio and pink; MuJoCo is only seen through the measured ``(q, v)`` and
 the impact force passed to :meth:`BalanceController.step`.
@@ -30,7 +30,7 @@ the impact force passed to :meth:`BalanceController.step`.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 
 import numpy as np
 import pink
@@ -39,6 +39,7 @@ from pink.tasks import ComTask, FrameTask, PostureTask
 
 from ..analysis import Analysis
 from ..ik import solve_stance
+from .approach import ImpactTask
 from .zmp import DcmFeedback, clamp_to_polygon
 
 __all__ = ["BalanceGains", "ImpactTask", "BalanceController", "ControlOutput", "retracted_stance"]
@@ -78,62 +79,6 @@ class BalanceGains:
 
     def to_dict(self) -> dict:
         return asdict(self)
-
-
-@dataclass
-class ImpactTask:
-    """Drive an end-effector point into a surface at a commanded speed, then pull back.
-
-    Attributes:
-        frame: Robot frame of the impacting end-effector.
-        offset: Pose of the impact point in ``frame``.
-        surface_point: Impact point on the surface (m, world).
-        normal: Unit surface normal, from the surface into the robot (world).
-        speed: Commanded approach speed along ``-normal`` (m/s, > 0).
-        start_time: When the approach starts (s).
-        standoff: Distance of the point from the surface before the approach (m).
-        force_threshold: Normal force that marks the contact (N).
-        retract: How far to pull back along ``normal`` after the contact (m).
-    """
-
-    frame: str
-    offset: pin.SE3
-    surface_point: np.ndarray
-    normal: np.ndarray
-    speed: float
-    start_time: float = 0.3
-    standoff: float = 0.05
-    force_threshold: float = 15.0
-    retract: float = 0.05
-    contact_time: float | None = field(default=None, init=False)
-    contact_target: np.ndarray | None = field(default=None, init=False)
-
-    @property
-    def start_point(self) -> np.ndarray:
-        return np.asarray(self.surface_point, dtype=float) + self.standoff * np.asarray(self.normal, dtype=float)
-
-    def target(self, t: float, normal_force: float) -> np.ndarray:
-        """World target of the impact point at time ``t`` given the measured normal force (N)."""
-        n = np.asarray(self.normal, dtype=float)
-        if self.contact_time is None and normal_force > self.force_threshold:
-            self.contact_time = t
-            self.contact_target = self._approach(t)
-        if self.contact_time is not None:
-            # Retract at the approach speed (at least 0.1 m/s) up to `retract` beyond the contact target.
-            back = min(max(self.speed, 0.1) * (t - self.contact_time), self.retract + self.overshoot)
-            return self.contact_target + back * n
-        return self._approach(t)
-
-    @property
-    def overshoot(self) -> float:
-        """How far the target went beyond the surface when the contact was detected (m)."""
-        if self.contact_target is None:
-            return 0.0
-        return float(max(0.0, -np.dot(self.contact_target - self.surface_point, self.normal)))
-
-    def _approach(self, t: float) -> np.ndarray:
-        travel = self.speed * max(0.0, t - self.start_time)
-        return self.start_point - travel * np.asarray(self.normal, dtype=float)
 
 
 @dataclass(frozen=True)

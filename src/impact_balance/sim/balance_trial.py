@@ -1,19 +1,24 @@
 """One balance trial in MuJoCo: the controller holds the stance through an impact or a push.
 
-:class:`BalanceSetup` prepares a scenario once (analysis, MuJoCo model, the start configuration
-with the hand backed off); :func:`run_balance_trial` resets the model and runs one trial:
+:class:`BalanceSetup` prepares a scenario once (analysis, MuJoCo model, the start configurations
+with the impacting point backed off); :func:`run_balance_trial` resets the model and runs one trial:
 
-- ``impact_speed``: the impact task drives the impact point into the surface at that speed
-  (m/s), then pulls back (see :class:`~.balance.ImpactTask`);
+- ``impact_speed``: the impact task drives the impact point into the surface at that commanded
+  speed (m/s), reached before the surface with a bounded acceleration, then withdraws on contact
+  (:class:`~.approach.ImpactTask`); with ``rigid_impact`` the joints keep their velocities through
+  the impact (:class:`~.rigid_impact.RigidImpactHold`);
 - ``push``: a force on a body (the torso) for a short time (see :class:`Push`).
 
-At every control step (500 Hz) the loop reads MuJoCo's state as pinocchio's ``(q, v)``,
-runs :class:`~.balance.BalanceController` and writes the servo targets (``controller="ik"``), or
-runs :class:`~.inverse_dynamics.InverseDynamicsController` and writes the motor torques
+At every control step (500 Hz) the loop reads MuJoCo's state as pinocchio's ``(q, v)``, runs
+:class:`~.balance.BalanceController` and writes the servo targets (``controller="ik"``), or runs
+:class:`~.inverse_dynamics.InverseDynamicsController` and writes the motor torques
 (``controller="id"``, the actuators then being torque motors), and feeds the
-:class:`~.falls.FallDetector`. It records the measured ZMP (from the sustained contacts' forces,
-on the plane ``z = h``), the CoM, the CoM velocity and the DCM, and their margins in the
-scenario's ZMP support area and CoM velocity area, and optionally a log (:mod:`impact_balance.logs`).
+:class:`~.outcomes.OutcomeMonitor`. It records the measured ZMP (from the sustained contacts' forces,
+on the plane ``z = h``), the CoM, the CoM velocity and the DCM, and their margins in the scenario's
+ZMP support area and CoM velocity area (without margin: scores apply theirs), and optionally a log
+(:mod:`impact_balance.logs`). The impact itself is measured at every step (1 ms) by an
+:class:`~.impact_tracker.ImpactTracker`: the approach speed just before the contact (the measured
+speed), the impulses at the impact point and at the sustained contacts, and the CoM velocity across.
 """
 
 from __future__ import annotations
@@ -23,20 +28,27 @@ from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
-import pandas as pd
 import pinocchio as pin
 
 from ..analysis import Analysis, analyze
 from ..exceptions import SimulationError
-from ..scenario import Scenario, load_scenario
-from .balance import BalanceController, BalanceGains, ImpactTask, retracted_stance
-from .falls import FallCriteria, FallDetector
 from ..logs import write_log
+from ..scenario import Scenario, load_scenario
 from .actuation import STIFF_SERVOS, stiffen_support_limbs, support_joints, use_torque_motors
+from .approach import ImpactTask, standoff as approach_standoff
+from .balance import BalanceController, BalanceGains, retracted_stance
+from .impact_tracker import ImpactTracker
 from .inverse_dynamics import InverseDynamicsController, InverseDynamicsGains
 from .joints import JOINT_MODELS, ServoOptions
 from .log import LOG_START, LogRecorder
 from .model import SimModel, SimOptions, build_model
+from .outcomes import OutcomeCriteria, OutcomeMonitor
+from .rigid_impact import RigidImpactHold
+from .trial import _point_velocity
+from .trial_result import BalanceTrialResult
+
+#: Version of the trials' physics and measurements: journals of another version are not reused.
+TRIAL_VERSION = 2
 
 #: Iterations of MuJoCo's no-slip solver in balance trials.
 NOSLIP_ITERATIONS = 10
@@ -45,7 +57,8 @@ NOSLIP_ITERATIONS = 10
 #: torque motors, :mod:`.inverse_dynamics`).
 CONTROLLERS = ("ik", "id")
 
-__all__ = ["CONTROLLERS", "STIFF_SERVOS", "Push", "BalanceTrialOptions", "BalanceSetup", "BalanceTrialResult", "run_balance_trial", "write_trial_log", "measured_zmp"]
+__all__ = ["TRIAL_VERSION", "CONTROLLERS", "STIFF_SERVOS", "Push", "BalanceTrialOptions", "BalanceSetup", "BalanceTrialResult",
+           "run_balance_trial", "write_trial_log", "measured_zmp", "controller_margin"]
 
 
 @dataclass(frozen=True)
@@ -62,7 +75,7 @@ class Push:
 
     direction: float
     magnitude: float
-    duration: float = 0.02
+    duration: float = 0.05
     start: float = 0.3
     body: str | None = None
 
@@ -79,39 +92,45 @@ class BalanceTrialOptions:
     Attributes:
         after: Simulated time after the disturbance (contact or end of push) (s).
         settle: Time standing still before the disturbance (s).
-        standoff: Distance of the impact point from the surface at the start (m).
-        max_approach_time: Longest approach before the trial gives up waiting for the contact (s).
+        max_approach_time: Longest time after the reference reached the surface before the trial gives
+            up waiting for the contact (s).
         gains: Gains of the ``ik`` controller.
-        criteria: Fall thresholds.
+        criteria: Outcome thresholds (:mod:`.outcomes`).
         record: Keep a log (:mod:`impact_balance.logs` columns) in the result.
         controller: ``ik`` (pink IK, position servos) or ``id`` (inverse-dynamics QP, torque motors); it
             decides the actuators, so it is read when the :class:`BalanceSetup` is created.
         id_gains: Gains of the ``id`` controller.
+        rigid_impact: Hold every joint's velocity through the impact (:mod:`.rigid_impact`).
     """
 
     after: float = 2.5
     settle: float = 0.3
-    standoff: float = 0.05
-    max_approach_time: float = 2.0
+    max_approach_time: float = 1.0
     gains: BalanceGains = field(default_factory=BalanceGains)
-    criteria: FallCriteria = field(default_factory=FallCriteria)
+    criteria: OutcomeCriteria = field(default_factory=OutcomeCriteria)
     record: bool = False
     controller: str = "ik"
     id_gains: InverseDynamicsGains = field(default_factory=InverseDynamicsGains)
+    rigid_impact: bool = False
+
+
+def controller_margin(options: BalanceTrialOptions) -> float:
+    """The ZMP margin the trials' controller keeps inside the ZMP support area (m): the scores' default."""
+    return options.id_gains.zmp_margin if options.controller == "id" else options.gains.zmp_margin
 
 
 @dataclass
 class BalanceSetup:
-    """A scenario prepared for trials: analysis, MuJoCo model, start configuration."""
+    """A scenario prepared for trials: analysis (without ZMP margin: the controller is configured on its
+    own), MuJoCo model, start configurations (one per standoff of the impacting point)."""
 
     scenario: Scenario
     joints: str
     analysis: Analysis
     sim: SimModel
-    q_start: np.ndarray
-    standoff: float
     support_v_index: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     controller: str = "ik"
+    _starts: dict[float, np.ndarray] = field(default_factory=dict)
 
     @classmethod
     def create(cls, scenario: Scenario | str, joints: str = "servo", options: BalanceTrialOptions | None = None,
@@ -123,7 +142,11 @@ class BalanceSetup:
             raise SimulationError("--joints", joints, f"unknown joint model; valid: {', '.join(JOINT_MODELS)}")
         if options.controller not in CONTROLLERS:
             raise SimulationError("--controller", options.controller, f"unknown controller; valid: {', '.join(CONTROLLERS)}")
-        analysis = analyze(scenario)
+        # The controller works on the areas themselves: a scoring margin is applied afterwards.
+        analysis = analyze(scenario.model_copy(update={"zmp_margin": 0.0}))
+        if not analysis.areas.can_balance:
+            raise SimulationError("scenario", scenario.name, f"the stance cannot balance ({analysis.areas.reason}): "
+                                  "there is nothing to test")
         if sim_options is None:
             # 1 ms steps: the stiffest contact (impact, time constant 4 ms) still spans 4 steps.
             servo = ServoOptions() if joints == "servo" else STIFF_SERVOS
@@ -138,58 +161,16 @@ class BalanceSetup:
             use_torque_motors(sim)
         else:
             stiffen_support_limbs(sim, analysis)
-        standoff = options.standoff if analysis.impact is not None else 0.0
-        q_start = retracted_stance(analysis, standoff)
         support = [analysis.stance.robot.joint_slot(n) for n in support_joints(sim, analysis)]
         support_v = np.array([analysis.stance.model.joints[j.id].idx_v for j in support], dtype=int)
-        return cls(scenario, joints, analysis, sim, q_start, standoff, support_v, options.controller)
+        return cls(scenario, joints, analysis, sim, support_v, options.controller)
 
-
-@dataclass
-class BalanceTrialResult:
-    """Outcome and measurements of one trial (SI units, world frame).
-
-    ``series`` holds the per-control-step arrays: ``time``, ``zmp`` (measured, k x 2),
-    ``zmp_desired``, ``com`` (k x 3), ``com_velocity`` (k x 3), ``dcm`` (k x 2),
-    ``zmp_margin`` (m, >= 0 inside the ZMP support area), ``com_velocity_margin``
-    (m/s, >= 0 inside the CoM velocity area).
-    """
-
-    fell: bool
-    reason: str | None
-    detail: str
-    fall_time: float | None
-    disturbance_time: float | None
-    disturbance_end: float | None
-    approach_speed: float | None = None
-    approach_speed_measured: float | None = None
-    max_zmp_excursion: float = 0.0
-    max_com_velocity_excursion: float = 0.0
-    min_com_velocity_margin: float = float("inf")
-    com_velocity_margin_at_end: float | None = None  # m/s, at the end of the disturbance (push)
-    com_criterion_safe: bool | None = None
-    zmp_criterion_safe: bool | None = None
-    max_tilt: float = 0.0
-    max_slip: float = 0.0
-    sim_time: float = 0.0
-    wall_time: float = 0.0
-    series: dict[str, np.ndarray] = field(default_factory=dict)
-    log: pd.DataFrame | None = None
-
-    def summary(self) -> dict:
-        """JSON-ready summary (no series, no log)."""
-        def num(x):
-            return None if x is None or not np.isfinite(x) else float(x)
-        return {
-            "fell": self.fell, "reason": self.reason, "detail": self.detail, "fall_time": num(self.fall_time),
-            "approach_speed": num(self.approach_speed), "approach_speed_measured": num(self.approach_speed_measured),
-            "max_zmp_excursion": num(self.max_zmp_excursion),
-            "max_com_velocity_excursion": num(self.max_com_velocity_excursion),
-            "min_com_velocity_margin": num(self.min_com_velocity_margin),
-            "com_criterion_safe": self.com_criterion_safe, "zmp_criterion_safe": self.zmp_criterion_safe,
-            "max_tilt_deg": float(np.rad2deg(self.max_tilt)), "max_slip": float(self.max_slip),
-            "sim_time": self.sim_time, "wall_time": self.wall_time,
-        }
+    def start_configuration(self, standoff: float = 0.0) -> np.ndarray:
+        """The stance with the impact point backed off ``standoff`` (m) along the normal (whole-body IK, cached)."""
+        key = round(float(standoff), 6)
+        if key not in self._starts:
+            self._starts[key] = retracted_stance(self.analysis, key)
+        return self._starts[key]
 
 
 def measured_zmp(sim: SimModel, com: np.ndarray, plane_height: float) -> tuple[np.ndarray, np.ndarray]:
@@ -221,55 +202,76 @@ def _push_body(sim: SimModel, name: str | None) -> int:
     return max(torso) if torso else sim.root_body
 
 
+def _base_rotation(q: np.ndarray) -> np.ndarray:
+    return pin.Quaternion(q[6], q[3], q[4], q[5]).toRotationMatrix()
+
+
 def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, push: Push | None = None,
-              options: BalanceTrialOptions | None = None) -> BalanceTrialResult:
-    """Run one trial (an impact at ``impact_speed``, or a ``push``) from rest; see the module docstring."""
+                      options: BalanceTrialOptions | None = None) -> BalanceTrialResult:
+    """Run one trial (an impact at the commanded ``impact_speed``, or a ``push``) from rest; see the module docstring."""
     options = options or BalanceTrialOptions()
     sim, analysis = setup.sim, setup.analysis
-    m, d = sim.model, sim.data
     if impact_speed is not None and analysis.impact is None:
         raise SimulationError("impact", None, "the scenario has no impact")
     if impact_speed is not None and not (np.isfinite(impact_speed) and 0 < impact_speed <= 20):
         raise SimulationError("speed", impact_speed, "must be in (0, 20] m/s")
-    mujoco.mj_resetData(m, d)
-    sim.set_state(setup.q_start)
-    if setup.controller == "id":
-        d.ctrl[sim.actuator_ids] = sim.tau_hold  # motors: the holding torques until the first control step
-    else:
-        sim.set_servo_targets(setup.q_start)
+    hold = RigidImpactHold(sim) if (options.rigid_impact and impact_speed is not None) else None
+    try:
+        return _run(setup, impact_speed, push, options, hold)
+    finally:
+        if hold is not None:  # the setup's model is reused: never leave a joint held
+            hold.release(sim.data.time)
+
+
+def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, options: BalanceTrialOptions,
+         hold: RigidImpactHold | None) -> BalanceTrialResult:
+    sim, analysis = setup.sim, setup.analysis
+    m, d = sim.model, sim.data
     stance = analysis.stance
     model = stance.robot.model
     pdata = model.createData()
+    dt = float(m.opt.timestep)
 
-    task = None
+    task = tracker = None
     n = None
+    standoff = 0.0
     if impact_speed is not None:
         im = analysis.impact.model
         n = im.normal
-        task = ImpactTask(im.spec.frame, im.spec.offset, im.point, n, impact_speed, start_time=options.settle,
-                          standoff=setup.standoff)
+        standoff = approach_standoff(impact_speed)
+        task = ImpactTask(im.spec.frame, im.spec.offset, im.point, n, impact_speed, start_time=options.settle)
+        tracker = ImpactTracker(n, dt)
+    q_start = setup.start_configuration(standoff)
+    mujoco.mj_resetData(m, d)
+    sim.set_state(q_start)
+    if setup.controller == "id":
+        d.ctrl[sim.actuator_ids] = sim.tau_hold  # motors: the holding torques until the first control step
+    else:
+        sim.set_servo_targets(q_start)
+
     torque = setup.controller == "id"
     if torque:
-        controller = InverseDynamicsController(analysis, setup.q_start, options.id_gains, task,
+        controller = InverseDynamicsController(analysis, q_start, options.id_gains, task,
                                                effort_limits=bool(sim.model.actuator_forcelimited[sim.actuator_ids].any()))
         # MuJoCo's viscous joint damping (the URDF's) is compensated: the motors add damping * qdot.
         joint_damping = m.dof_damping[sim.dof_adr].copy()
         rate = options.id_gains.rate
     else:
-        controller = BalanceController(analysis, setup.q_start, options.gains, task)
+        controller = BalanceController(analysis, q_start, options.gains, task)
         rate = options.gains.rate
-    contact_frames = [model.getFrameId(c.spec.frame) for c in stance.contacts]
-    pin.framesForwardKinematics(model, pdata, setup.q_start)
-    detector = FallDetector(
-        [c.spec.frame for c in stance.contacts],
+    contact_names = [c.spec.frame for c in stance.contacts]
+    contact_frames = [model.getFrameId(name) for name in contact_names]
+    pin.framesForwardKinematics(model, pdata, q_start)
+    monitor = OutcomeMonitor(
+        contact_names,
         np.array([pdata.oMf[f].translation for f in contact_frames]),
         np.array([pdata.oMf[f].rotation for f in contact_frames]),
-        float(setup.q_start[2]), options.criteria,
+        float(q_start[2]), _base_rotation(q_start), options.criteria,
     )
     normals = np.array([c.normal for c in stance.contacts])
     zmp_area = analysis.areas.zmp_area
     h, g = analysis.areas.plane_height, analysis.areas.gravity
-    recorder = LogRecorder(sim, [c.spec.frame for c in stance.contacts], task is not None) if options.record else None
+    recorder = LogRecorder(sim, contact_names, task is not None) if options.record else None
 
     body = None
     if push is not None:
@@ -278,32 +280,39 @@ def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, pu
         end_time = disturbance_end + options.after
     else:
         disturbance = disturbance_end = None
-        end_time = options.settle + (setup.standoff / impact_speed + options.max_approach_time
-                                     if impact_speed else 0.0) + options.after
-    steps_per_control = max(1, int(round(1.0 / (rate * m.opt.timestep))))
+        end_time = (task.arrival_time + options.max_approach_time if task is not None else options.settle) + options.after
+    steps_per_control = max(1, int(round(1.0 / (rate * dt))))
     series: dict[str, list] = {k: [] for k in ("time", "zmp", "zmp_desired", "com", "com_velocity", "dcm",
                                                "zmp_margin", "com_velocity_margin")}
-    approach_measured = None
-    impact_velocity = np.zeros(6)
+    surface = None if task is None else float(n @ task.surface_point)
+    radius = 0.0 if task is None else float(m.geom_size[sim.impact_geom][0])
     wall0 = time.perf_counter()
     step = 0
-    t = 0.0
-    while t < end_time:
-        t = d.time
+    impact_force = np.zeros(3)
+    fn = 0.0
+    while d.time < end_time:
+        t = float(d.time)
+        if task is not None:
+            # Every step (1 ms): the forces of the last step, the impact point's velocity, the CoM velocity.
+            impact_force = sim.contact_force(sim.impact_geom)
+            fn = float(impact_force @ n)
+            point_v = _point_velocity(sim, n)
+            com_v = sim.com_velocity()
+            tracker.update(t, impact_force, sim.contact_forces(sim.contact_geoms), point_v, com_v)
+            if hold is not None:
+                hold.update(t, float(-point_v @ n))
+                # Hold from the step in which the point will touch: its gap closes within one step.
+                gap = float(n @ (sim.data.geom_xpos[sim.impact_geom] - radius * n)) - surface
+                if hold.start is None and gap - max(0.0, float(-point_v @ n)) * dt <= 0.0:
+                    hold.begin(t)
+            if disturbance is None and tracker.touched:
+                disturbance = tracker.start
+                monitor.start_disturbance(disturbance)
+                end_time = disturbance + options.after
+            if disturbance_end is None and tracker.done:
+                disturbance_end = tracker.end
         if step % steps_per_control == 0:
             q, v = sim.configuration(), sim.velocity()
-            impact_force = None
-            fn = 0.0
-            if task is not None:
-                impact_force = sim.contact_force(sim.impact_geom)
-                fn = float(impact_force @ n)
-                if disturbance is None and fn > 0.0:
-                    # First touch: the disturbance starts; the approach speed is the one just before.
-                    disturbance = disturbance_end = t
-                    end_time = t + options.after
-                if disturbance is None:
-                    mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_GEOM, sim.impact_geom, impact_velocity, 0)
-                    approach_measured = float(-impact_velocity[3:] @ n)
             com_now, _ = controller.measure(q, v)
             zmp, forces = measured_zmp(sim, com_now, h)
             out = controller.step(t, q, v, zmp, fn)
@@ -318,62 +327,77 @@ def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, pu
             com, com_velocity = out.com, out.com_velocity
             omega = np.sqrt(g / (com[2] - h))
             zmp_margin = float(zmp_area.margins(zmp)[0]) if np.all(np.isfinite(zmp)) else -np.inf
-            vel_margin = float(omega * zmp_area.margins(out.dcm)[0]) if not zmp_area.is_empty else -np.inf
+            dcm_margin = float(zmp_area.margins(out.dcm)[0])
             for key, value in (("time", t), ("zmp", zmp), ("zmp_desired", out.zmp), ("com", com),
                                ("com_velocity", com_velocity), ("dcm", out.dcm), ("zmp_margin", zmp_margin),
-                               ("com_velocity_margin", vel_margin)):
+                               ("com_velocity_margin", omega * dcm_margin)):
                 series[key].append(value)
             pin.framesForwardKinematics(model, pdata, q)
-            detector.update(t, np.array([pdata.oMf[f].translation for f in contact_frames]),
-                            np.array([pdata.oMf[f].rotation for f in contact_frames]),
-                            np.einsum("ij,ij->i", forces, normals), float(q[2]),
-                            impulsive=push is not None and push.start <= t < disturbance_end)
+            if push is not None and t >= push.start:
+                monitor.start_disturbance(push.start)
+            pushing = push is not None and push.start <= t < push.start + push.duration
+            monitor.update(t, np.array([pdata.oMf[f].translation for f in contact_frames]),
+                           np.array([pdata.oMf[f].rotation for f in contact_frames]),
+                           np.einsum("ij,ij->i", forces, normals), float(q[2]), _base_rotation(q),
+                           dcm_margin if disturbance is not None and t >= disturbance else None, impulsive=pushing)
             if recorder is not None and t >= LOG_START:
-                recorder.add(t, q, v, sim, zmp, forces, impact_force)
-            if detector.fell:
+                recorder.add(t, q, v, sim, zmp, forces, impact_force if task is not None else None)
+            if monitor.fell:
+                if monitor.disturbance is None:
+                    monitor.abort("fell_before_disturbance", t, "the robot fell before the disturbance")
                 break
         if body is not None:
-            d.xfrc_applied[body, :3] = push.force if push.start <= t < disturbance_end else 0.0
+            d.xfrc_applied[body, :3] = push.force if push.start <= t < push.start + push.duration else 0.0
         mujoco.mj_step(m, d)
         step += 1
     wall = time.perf_counter() - wall0
     arrays = {k: np.array(v) for k, v in series.items()}
-    if not detector.fell:
-        if disturbance is None and task is not None:
-            detector._fail("no_contact", t, "the impact point never reached the surface")
-        else:
-            detector.finish(t, arrays["com_velocity"][-1])
-    verdict = detector.verdict
+    t = float(d.time)
+    if task is not None and disturbance is None:
+        monitor.abort("no_contact", t, "the impact point never reached the surface")
+    outcome = monitor.finish(t, arrays["com_velocity"][-1] if len(arrays["com_velocity"]) else np.zeros(3))
     result = BalanceTrialResult(
-        fell=verdict.fell, reason=verdict.reason, detail=verdict.detail, fall_time=verdict.time,
-        disturbance_time=disturbance, disturbance_end=disturbance_end, approach_speed=impact_speed,
-        approach_speed_measured=approach_measured, max_tilt=detector.max_tilt, max_slip=detector.max_slip,
-        sim_time=float(d.time), wall_time=wall, series=arrays,
-        log=recorder.frame() if recorder is not None else None,
+        outcome=outcome.outcome, reason=outcome.reason, outcome_time=outcome.time, detail=outcome.detail,
+        events=outcome.events, disturbance_time=disturbance, disturbance_end=disturbance_end,
+        approach_speed=impact_speed, max_tilt=monitor.max_tilt, max_slip=monitor.max_slip,
+        max_trunk_tilt=monitor.max_trunk_tilt, max_drop=monitor.max_drop, sim_time=t, wall_time=wall,
+        contact_names=tuple(contact_names), series=arrays, log=recorder.frame() if recorder is not None else None,
     )
-    if disturbance is not None:
-        tt = arrays["time"]
-        after = tt >= disturbance
-        zm, vm = arrays["zmp_margin"], arrays["com_velocity_margin"]
-        result.max_zmp_excursion = float(max(0.0, -np.min(zm[after]))) if after.any() else 0.0
-        result.max_com_velocity_excursion = float(max(0.0, -np.min(vm[after]))) if after.any() else 0.0
-        result.min_com_velocity_margin = float(np.min(vm[after])) if after.any() else float("inf")
-        # Criteria judged at the end of the disturbance (CoM) and throughout it (ZMP).
-        end_idx = int(np.searchsorted(tt, disturbance_end + 1e-9))
-        end_idx = min(end_idx, len(tt) - 1)
-        during = (tt >= disturbance) & (tt <= disturbance_end + 1e-9)
-        result.com_velocity_margin_at_end = float(vm[end_idx])
-        result.com_criterion_safe = bool(vm[end_idx] >= 0.0)
-        result.zmp_criterion_safe = bool(np.all(zm[during] >= 0.0)) if during.any() else bool(zm[end_idx] >= 0)
+    if tracker is not None and tracker.touched:
+        result.impact = tracker.measurement(t, sim.com_velocity(), None if hold is None else hold.to_dict())
+    _margins(result, analysis, arrays)
     return result
 
 
+def _margins(result: BalanceTrialResult, analysis: Analysis, arrays: dict[str, np.ndarray]) -> None:
+    """The CoM velocity when the disturbance ended, its margin, the worst margin after it, and the worst ZMP
+    margin during a push (all in the areas without margin)."""
+    if result.disturbance_time is None or not len(arrays["time"]):
+        return
+    tt, vm, zm = arrays["time"], arrays["com_velocity_margin"], arrays["zmp_margin"]
+    after = tt >= result.disturbance_time
+    if after.any():
+        result.min_com_velocity_margin = float(np.min(vm[after]))
+    if result.impact is not None:
+        area = analysis.areas.com_velocity_area
+        result.com_velocity_at_end = result.impact.com_velocity_after
+        result.com_velocity_margin_at_end = float(area.margins(result.com_velocity_at_end)[0])
+    elif result.disturbance_end is not None and tt[-1] >= result.disturbance_end:
+        end = min(int(np.searchsorted(tt, result.disturbance_end - 1e-9)), len(tt) - 1)
+        result.com_velocity_at_end = arrays["com_velocity"][end][:2].copy()
+        result.com_velocity_margin_at_end = float(vm[end])
+        during = (tt >= result.disturbance_time) & (tt <= result.disturbance_end + 1e-9)
+        if during.any():
+            worst = float(np.min(zm[during]))
+            result.min_zmp_margin_during = worst if np.isfinite(worst) else None
+
+
 def write_trial_log(setup: BalanceSetup, path, controller: str, metadata: dict, impact_speed: float | None = None,
-                    push: Push | None = None):
+                    push: Push | None = None, rigid_impact: bool = False):
     """Run one trial again with recording on and write its log (searches run their trials unrecorded).
 
     Returns the path written; ``metadata`` goes into the Parquet metadata with the scenario's name.
     """
     trial = run_balance_trial(setup, impact_speed=impact_speed, push=push,
-                              options=BalanceTrialOptions(record=True, controller=controller))
+                              options=BalanceTrialOptions(record=True, controller=controller, rigid_impact=rigid_impact))
     return write_log(trial.log, path, {"scenario": setup.scenario.name, **metadata})

@@ -25,7 +25,8 @@ free-flyer velocity in the base frame):
      ``|tau| <= effort`` with ``tau`` the actuated rows of ``M a + h - sum J_i^T w_i``;
    - cost (weighted least squares): the CoM acceleration of the LIPM, ``c_dd_xy = omega^2 (c_xy - p)``,
      with a PD on the CoM height; angular momentum damping ``L_dot = -K_L L``; the impact point's
-     acceleration (PD to the :class:`~.balance.ImpactTask` target and its velocity); a posture
+     acceleration (the :class:`~.approach.ImpactTask` reference's acceleration, plus a PD to its
+     position and velocity); a posture
      PD to the start configuration (joints) and one on the base orientation; a small regularisation.
 
    If the torque limits make the QP infeasible, it is solved without them and the torques are
@@ -47,7 +48,7 @@ import daqp
 from ..analysis import Analysis
 from ..cwc import cwc_faces_world
 from ..spatial import skew
-from .balance import ImpactTask
+from .approach import ImpactTask
 from .zmp import DcmFeedback
 
 __all__ = ["InverseDynamicsGains", "InverseDynamicsController", "TorqueOutput", "describe"]
@@ -223,7 +224,6 @@ class InverseDynamicsController:
             self._impact_frame = model.getFrameId(impact.frame)
             pose = self.data.oMf[self._impact_frame] * impact.offset
             self._impact_rotation = pose.rotation.copy()
-            self._previous_target: np.ndarray | None = None
         self._zero = np.zeros(nv)
         # Posture weights per velocity row: none on the base translation (the CoM task owns it).
         self._posture_w = np.full(nv, gains.posture_weight)
@@ -313,11 +313,10 @@ class InverseDynamicsController:
         # Impact point: PD to the impact task's target and its velocity.
         if self.impact is not None:
             placement, Ji, drift = _point_jacobian(model, data, self._impact_frame, self.impact.offset)
-            target = self.impact.target(t, impact_force)
-            target_velocity = np.zeros(3) if self._previous_target is None else (target - self._previous_target) / self.dt
-            self._previous_target = target
+            target, target_velocity, target_acceleration = self.impact.reference(t, impact_force)
             vel = Ji @ v
-            lin = g.impact_stiffness * (target - placement.translation) + g.impact_damping * (target_velocity - vel[:3])
+            lin = (target_acceleration + g.impact_stiffness * (target - placement.translation)
+                   + g.impact_damping * (target_velocity - vel[:3]))
             ang = (g.impact_stiffness * (placement.rotation @ pin.log3(placement.rotation.T @ self._impact_rotation))
                    - g.impact_damping * vel[3:])
             task(Ji[:3], lin - drift[:3], g.impact_weight)

@@ -19,8 +19,9 @@
     all the others are locked) and ``zeta = 1``. The torque is clamped to the URDF effort
     limit (the actuator's force range; MuJoCo also keeps it as the joint's actuator force
     range), and the URDF damping and friction loss stay. ``armature`` (rotor inertia
-    reflected through the gearbox, kg m^2) is added to every joint (0 by default, as in the
-    URDF). The torque feed-forward holds the stance against gravity: the joint torques of
+    reflected through the gearbox, kg m^2) is added to every joint: by default what the robot
+    files declare (the SRDF's ``rotor_params``, see :attr:`impact_balance.robot.Robot.armature_source`;
+    0 where they declare none), or one value for every joint. The torque feed-forward holds the stance against gravity: the joint torques of
     the smallest contact wrenches (least squares) that balance gravity within the contact
     wrench cones, solved once at the stance.
 """
@@ -51,13 +52,14 @@ class ServoOptions:
     Attributes:
         bandwidth: Closed-loop natural frequency omega of every joint servo, rad/s.
         damping_ratio: zeta (1 = critically damped).
-        armature: Rotor inertia added to every actuated joint, kg m^2.
+        armature: Rotor inertia of every actuated joint, kg m^2; None: the robot files' own
+            (declared per joint, 0 where they declare none).
         effort_limits: Clamp each servo's torque to the joint's URDF effort limit.
     """
 
     bandwidth: float = 2.0 * math.pi * 15.0
     damping_ratio: float = 1.0
-    armature: float = 0.0
+    armature: float | None = None
     effort_limits: bool = True
 
 

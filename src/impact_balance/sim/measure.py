@@ -79,6 +79,10 @@ class TrialResult:
         saturated_joints: ``servo``: joints whose torque reached its effort limit during the
             impact (empty for ``rigid``).
         sim_time_ratio: Simulated time over wall-clock time.
+        sustained_impulses: Impulse on the robot at each sustained contact over the impact, its force
+            before the impact subtracted, N s, world (by contact name): what the paper neglects.
+        armature: Where the joints' rotor inertia came from (``servo``).
+        hold: The rigid-impact hold (``--rigid-impact``), or None.
         record: The time series.
     """
 
@@ -94,6 +98,9 @@ class TrialResult:
     predicted: dict[str, Prediction]
     saturated_joints: list[str]
     sim_time_ratio: float
+    sustained_impulses: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
+    armature: str = ""
+    hold: dict | None = None
     record: TrialRecord | None = None
 
     def to_dict(self) -> dict[str, Any]:
@@ -121,6 +128,9 @@ class TrialResult:
             },
             "contacts_kept": self.contacts_kept,
             "saturated_joints": list(self.saturated_joints),
+            "sustained_impulses": {k: [num(x) for x in v] for k, v in self.sustained_impulses.items()},
+            "armature": self.armature,
+            "rigid_hold": self.hold,
             "sim_time_ratio": num(self.sim_time_ratio),
         }
 
@@ -166,14 +176,13 @@ def impact_window(record: TrialRecord, max_duration: float = MAX_IMPACT_DURATION
 
 
 def _stance_with_armature(sim: SimModel) -> Stance:
-    """The stance, on a copy of the robot model carrying the servos' armature (pinocchio's
-    ``crba`` adds ``model.armature`` to the mass matrix), so that ``joint_space`` predicts for
-    the simulated robot. The shared robot model is never modified."""
-    armature = sim.options.servo.armature
-    if sim.joints != "servo" or armature == 0.0:
+    """The stance, on a copy of the robot model carrying the simulated joints' armature
+    (pinocchio's ``crba`` adds ``model.armature`` to the mass matrix), so that ``joint_space``
+    predicts for the simulated robot. The shared robot model is never modified."""
+    if sim.joints != "servo" or np.array_equal(sim.armature, np.asarray(sim.robot.model.armature)[sim.v_index]):
         return sim.stance
     model = pin.Model(sim.robot.model)
-    model.armature[sim.v_index] = armature
+    model.armature[sim.v_index] = sim.armature
     robot = dataclasses.replace(sim.robot, model=model)
     return Stance(robot, sim.stance.q, [c.spec for c in sim.stance.contacts])
 
@@ -219,10 +228,12 @@ def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialR
         saturated = [name for name, p, lim, on in zip(sim.joint_names, peak, limits, limited)
                      if on and p >= lim * (1 - 1e-6)]
     ratio = record.simulated_time / record.wall_time if record.wall_time > 0 else float("nan")
+    sustained = {name: (f[before:end] - f[before]).sum(axis=0) * dt for name, f in record.forces.items() if name != "impact"}
     return TrialResult(
         approach_speed=approach_speed, joints=sim.joints, approach_speed_measured=approach,
         restitution_measured=restitution, impulse_measured=impulse, com_velocity_jump_measured=jump,
         slip_speed=slip, impact_time=(float(record.time[before]), float(record.time[end])),
         contacts_kept=kept, predicted=predicted, saturated_joints=saturated, sim_time_ratio=ratio,
+        sustained_impulses=sustained if sim.joints != "rigid" else {}, armature=sim.armature_source, hold=record.hold,
         record=record,
     )

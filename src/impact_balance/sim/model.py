@@ -10,7 +10,8 @@ joints ``joint_names`` (pinocchio names; all 1-dof joints for ``servo``, none fo
 with their MuJoCo ``qpos_adr``, ``dof_adr`` and ``actuator_ids`` and pinocchio ``q_index``,
 ``v_index``; the geom ids ``contact_geoms`` (one per scenario contact, in order),
 ``support_geoms``, ``ground_geom``, ``impact_geom`` and ``surface_geom`` (None without an
-impact); the servo gains ``kp``, ``kd`` and the holding torques ``tau_hold``. Its helpers
+impact); the servo gains ``kp``, ``kd``, the holding torques ``tau_hold``, and the joints' rotor
+inertia ``armature`` (kg m^2) with where it came from, ``armature_source``. Its helpers
 convert state both ways: ``set_state(q, v)`` takes a pinocchio configuration and velocity
 (free-flyer ``[x, y, z, qx, qy, qz, qw]``, base velocity in the base frame) and runs
 ``mj_forward``; ``configuration()`` and ``velocity()`` read them back; ``com()`` and
@@ -91,6 +92,8 @@ class SimModel:
     kp: np.ndarray
     kd: np.ndarray
     tau_hold: np.ndarray
+    armature: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    armature_source: str = "none (rigid joints)"
 
     @property
     def robot(self) -> Robot:
@@ -239,6 +242,17 @@ def _joint_bodies(spec: mujoco.MjSpec, stance: Stance) -> dict[int, mujoco.MjsBo
     return bodies
 
 
+def _armature(robot: Robot, override: float | None, v_index: list[int]) -> tuple[np.ndarray, str]:
+    """Rotor inertia of each simulated joint (kg m^2) and its source: ``override`` for every joint, or
+    what the robot files declare (pinocchio's ``model.armature``, read from the SRDF's rotor_params)."""
+    if override is not None:
+        return np.full(len(v_index), float(override)), f"--armature {override:g} kg m^2 (every joint)"
+    declared = np.asarray(robot.model.armature, dtype=float)[v_index] if v_index else np.zeros(0)
+    if robot.armature_source is None:
+        return declared, "none declared by the robot files (0)"
+    return declared, robot.armature_source
+
+
 def build_model(
     scenario: Scenario | str | Path, joints: str = "servo", options: SimOptions | None = None
 ) -> SimModel:
@@ -276,10 +290,12 @@ def build_model(
         value = stance.q[slot.idx_q] if slot.nq == 1 else np.arctan2(stance.q[slot.idx_q + 1], stance.q[slot.idx_q])
         stance_qpos[first.joint(name).qposadr[0]] = value
 
-    armature = options.servo.armature
+    v_of = {name: robot.model.joints[slots[name].id].idx_v for name in sim_joints}
+    armature, armature_source = _armature(robot, options.servo.armature, [v_of[n] for n in sim_joints])
     if joints == "rigid":
         weld_joints(spec, first, stance_qpos)
         sim_joints = []
+        armature, armature_source = np.zeros(0), "none (rigid joints)"
     else:
         data = mujoco.MjData(first)
         data.qpos[:] = stance_qpos
@@ -289,9 +305,9 @@ def build_model(
         inertia = np.array([full[first.joint(n).dofadr[0], first.joint(n).dofadr[0]] for n in sim_joints]) + armature
         kp, kd = servo_gains(inertia, options.servo)
         efforts = dict(zip(*(a.tolist() for a in robot.effort_limits)))  # velocity index -> N m
-        for name, p, d in zip(sim_joints, kp, kd):
+        for name, p, d, a in zip(sim_joints, kp, kd, armature):
             joint = spec.joint(name)
-            joint.armature = armature
+            joint.armature = float(a)
             effort = efforts.get(robot.model.joints[slots[name].id].idx_v, 0.0)
             limited = options.servo.effort_limits and effort > 0.0
             spec.add_actuator(
@@ -326,7 +342,7 @@ def build_model(
         contact_geoms=tuple(geom_id(n) for n in names.contacts),
         support_geoms=tuple(geom_id(n) for n in names.supports), ground_geom=geom_id(names.ground),
         impact_geom=geom_id(names.impact), surface_geom=geom_id(names.surface),
-        kp=kp, kd=kd, tau_hold=tau_hold,
+        kp=kp, kd=kd, tau_hold=tau_hold, armature=armature, armature_source=armature_source,
     )
     sim.set_state(stance.q)
     sim.set_servo_targets(stance.q)

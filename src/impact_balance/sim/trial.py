@@ -46,12 +46,15 @@ class TrialOptions:
         gap: Initial distance of the impact point from the surface, m (default: the larger
             of 2 cm and 0.1 s of travel, so the servos reach the commanded speed).
         settle: ``servo`` only: time standing still before the approach, s.
+        rigid_impact: ``servo`` only: hold every joint's velocity from the contact to the end of the
+            compression (:mod:`.rigid_impact`), the paper's rigid robot at the impact.
     """
 
     approach_speed: float
     after: float = 0.15
     gap: float | None = None
     settle: float = 0.2
+    rigid_impact: bool = False
 
     def resolved_gap(self) -> float:
         return self.gap if self.gap is not None else max(0.02, 0.1 * self.approach_speed)
@@ -69,6 +72,7 @@ class TrialRecord:
         forces: Force on the robot per name (each contact's frame, and ``impact``), N, (T, 3).
         impact_velocity: Velocity of the impact point, m/s, (T, 3).
         approach_start: Time the approach begins (end of settling), s.
+        hold: The rigid-impact hold (:meth:`.rigid_impact.RigidImpactHold.to_dict`), or None.
         contact_positions: Centre of each sustained-contact box, world, m, (T, k, 3).
         actuator_force: Servo torques (N m), (T, nu), aligned with ``SimModel.joint_names``.
         wall_time: Wall-clock time of the simulation loop (recording included), s.
@@ -85,6 +89,7 @@ class TrialRecord:
     wall_time: float
     contact_positions: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 3)))
     actuator_force: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    hold: dict | None = None
 
     @property
     def simulated_time(self) -> float:
@@ -181,8 +186,21 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
     d.time = 0.0
     start = time.perf_counter()
     frozen = None  # servo targets once the impact begins
+    hold = None
+    if options.rigid_impact and sim.joints == "servo":
+        from .rigid_impact import RigidImpactHold
+
+        hold = RigidImpactHold(sim)
+    surface = float(n @ np.asarray(sim.stance.point(spec.frame, spec.offset)[0].translation))
+    radius = float(m.geom_size[sim.impact_geom][0])
     try:
         for k in range(T):
+            if hold is not None and hold.start is None:
+                # Hold from the step in which the point will touch: its gap closes within one step.
+                approach = float(-n @ _point_velocity(sim, n))
+                gap = float(n @ (d.geom_xpos[sim.impact_geom] - radius * n)) - surface
+                if gap - max(0.0, approach) * dt <= 0.0:
+                    hold.begin(d.time)
             if limb_dq is not None:
                 s = d.time - settle  # time into the approach
                 if frozen is None and s > 0.0 and k > 0 and forces[k - 1, -1].any():
@@ -203,13 +221,18 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
             point_v[k] = _point_velocity(sim, n)
             contact_pos[k] = d.geom_xpos[list(sim.contact_geoms)]
             torques[k] = d.actuator_force
+            if hold is not None:
+                hold.update(d.time, float(-n @ point_v[k]))
     finally:
         wall = time.perf_counter() - start
         m.opt.gravity[:] = gravity
         sim.enable_supports(True)
+        if hold is not None:
+            hold.release(d.time)
     return TrialRecord(
         time=rec_t, qpos=qpos, qvel=qvel, com=com, com_velocity=comd,
         forces={name: forces[:, i] for i, name in enumerate(names)}, impact_velocity=point_v,
         approach_start=settle, wall_time=wall, contact_positions=contact_pos,
         actuator_force=torques[:, sim.actuator_ids] if m.nu else torques,
+        hold=None if hold is None else hold.to_dict(),
     )

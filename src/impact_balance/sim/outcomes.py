@@ -1,0 +1,242 @@
+"""What happened in a balance trial: ``balanced``, ``contact_broken``, ``fell`` or ``aborted``.
+
+The criterion makes two promises, and a trial can break either, or both:
+
+- *balance*: from a CoM velocity inside the CoM velocity area the robot comes back to rest
+  without a step. Breaking it is a **fall** (``fell``), at the first of:
+
+  - ``base_dropped``: the base sinks more than ``max_drop`` (10 cm) below its start: a robot
+    that kept its balance lowers its base by a few centimetres at most;
+  - ``trunk_tipped``: the base turns more than ``max_trunk_tilt`` (25 degrees) from its start
+    orientation: no recovery without a step comes back from there;
+  - ``dcm_escaped``: the DCM left the ZMP support area and was still outside at the end (the
+    robot cannot be at rest with its DCM outside its support);
+  - ``not_at_rest``: at the end (``settle_time``, 2.5 s after the disturbance) the CoM still
+    moves faster than ``rest_speed`` (5 cm/s).
+
+- *the contacts stay*: the paper assumes the impact does not break the sustained contacts.
+  A contact **event** is recorded (each kind once per contact, with its time) when a contact
+
+  - ``lifted``: had carried ``load_force`` (20 N) and then carried less than ``min_force``
+    (1 N) for more than ``lost_time`` (20 ms), counted from the end of the disturbance (an
+    impulsive push may unload a foot while it acts; the criterion judges the state it leaves);
+  - ``slipped``: its frame moved more than ``max_slip`` (1 cm) from its start;
+  - ``tilted``: its frame turned more than ``max_tilt`` (5 degrees) from its start.
+
+  A trial with an event after the disturbance and no fall is ``contact_broken``: the robot
+  came to rest without a step, but not on the contacts it started with.
+
+A trial is ``aborted`` when it went wrong before the disturbance (a fall or a contact event
+before the impact or the push, or an impact point that never reached the surface): it tests
+nothing and is left out of brackets and scores. Otherwise it is ``balanced``.
+
+The monitor only sees arrays (world frame, SI units), so the same logic serves MuJoCo trials and
+recorded logs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+__all__ = ["OUTCOMES", "FALL_REASONS", "EVENT_KINDS", "OutcomeCriteria", "ContactEvent", "Outcome", "OutcomeMonitor"]
+
+#: Trial outcomes.
+OUTCOMES = ("balanced", "contact_broken", "fell", "aborted")
+#: Reasons of ``fell``.
+FALL_REASONS = ("base_dropped", "trunk_tipped", "dcm_escaped", "not_at_rest")
+#: Kinds of contact events.
+EVENT_KINDS = ("lifted", "slipped", "tilted")
+
+
+@dataclass(frozen=True)
+class OutcomeCriteria:
+    """Thresholds of :class:`OutcomeMonitor` (SI units, angles in radians); see the module docstring."""
+
+    min_force: float = 1.0
+    load_force: float = 20.0
+    lost_time: float = 0.02
+    max_tilt: float = float(np.deg2rad(5.0))
+    max_slip: float = 0.01
+    max_drop: float = 0.10
+    max_trunk_tilt: float = float(np.deg2rad(25.0))
+    settle_time: float = 2.5
+    rest_speed: float = 0.05
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class ContactEvent:
+    """A sustained contact broke: ``contact`` (its frame), ``kind`` (lifted, slipped, tilted), ``time`` (s)
+    and ``value`` (the slip in m, the tilt in rad, the unloaded time in s)."""
+
+    contact: str
+    kind: str
+    time: float
+    value: float
+
+    def to_dict(self) -> dict:
+        return {"contact": self.contact, "kind": self.kind, "time": self.time, "value": self.value}
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """A trial's outcome: one of :data:`OUTCOMES`, its ``reason`` (a fall reason, the first contact
+    event, or why it was aborted; None when balanced), when (s), a ``detail`` line, and every
+    contact ``event``."""
+
+    outcome: str
+    reason: str | None
+    time: float | None
+    detail: str = ""
+    events: tuple[ContactEvent, ...] = ()
+
+    @property
+    def fell(self) -> bool:
+        return self.outcome == "fell"
+
+
+@dataclass
+class OutcomeMonitor:
+    """Watches the contacts, the base and the DCM during a trial; see the module docstring.
+
+    Args:
+        names: Contact names (frames), for the events.
+        positions: Start positions of the contact frames (k x 3, m, world).
+        rotations: Start rotations of the contact frames (k x 3 x 3, world).
+        base_height: Start height of the base (m).
+        base_rotation: Start rotation of the base (3 x 3, world).
+        criteria: Thresholds.
+    """
+
+    names: Sequence[str]
+    positions: np.ndarray
+    rotations: np.ndarray
+    base_height: float
+    base_rotation: np.ndarray
+    criteria: OutcomeCriteria = field(default_factory=OutcomeCriteria)
+    disturbance: float | None = field(default=None, init=False)
+    max_tilt: float = field(default=0.0, init=False)
+    max_slip: float = field(default=0.0, init=False)
+    max_trunk_tilt: float = field(default=0.0, init=False)
+    max_drop: float = field(default=0.0, init=False)
+    events: list[ContactEvent] = field(default_factory=list, init=False)
+    _fall: tuple[str, float, str] | None = field(default=None, init=False)
+    _dcm_out_since: float | None = field(default=None, init=False)
+    _abort: tuple[str, float, str] | None = field(default=None, init=False)
+    _low_since: np.ndarray = field(init=False)
+    _loaded: np.ndarray = field(init=False)
+    _seen: set = field(default_factory=set, init=False)
+
+    def __post_init__(self) -> None:
+        self.positions = np.asarray(self.positions, dtype=float).reshape(-1, 3)
+        self.rotations = np.asarray(self.rotations, dtype=float).reshape(-1, 3, 3)
+        self.base_rotation = np.asarray(self.base_rotation, dtype=float).reshape(3, 3)
+        self._low_since = np.full(len(self.names), np.nan)
+        self._loaded = np.zeros(len(self.names), dtype=bool)
+
+    # -- during the trial ---------------------------------------------------------------
+    @property
+    def fell(self) -> bool:
+        """A fall was seen (base or trunk): the trial can stop."""
+        return self._fall is not None
+
+    def start_disturbance(self, t: float) -> None:
+        """The disturbance (first contact of the impact, start of the push) begins at ``t`` (s).
+
+        A fall or a contact event before it aborts the trial."""
+        if self.disturbance is not None:
+            return
+        self.disturbance = float(t)
+        if self._fall is not None:
+            self._abort = ("before_disturbance", self._fall[1], f"{self._fall[2]} before the disturbance")
+        elif self.events:
+            e = self.events[0]
+            self._abort = ("before_disturbance", e.time, f"{e.contact} {e.kind} before the disturbance")
+
+    def abort(self, reason: str, t: float, detail: str) -> None:
+        """Mark the trial aborted (e.g. the impact point never reached the surface)."""
+        if self._abort is None:
+            self._abort = (reason, float(t), detail)
+
+    def _event(self, i: int, kind: str, t: float, value: float) -> None:
+        if (i, kind) not in self._seen:
+            self._seen.add((i, kind))
+            self.events.append(ContactEvent(self.names[i], kind, float(t), float(value)))
+
+    def update(self, t: float, positions: np.ndarray, rotations: np.ndarray, normal_forces: np.ndarray | None,
+               base_height: float, base_rotation: np.ndarray, dcm_margin: float | None = None,
+               impulsive: bool = False) -> bool:
+        """One sample: contact frame poses, their normal forces (N, None if unknown), the base height (m)
+        and rotation, the DCM's margin in the ZMP support area (m, >= 0 inside; None if unknown);
+        ``impulsive``: a push acts now (unloading does not count). Returns :attr:`fell`."""
+        c = self.criteria
+        positions = np.asarray(positions, dtype=float).reshape(-1, 3)
+        rotations = np.asarray(rotations, dtype=float).reshape(-1, 3, 3)
+        for i in range(len(self.names)):
+            slip = float(np.linalg.norm(positions[i] - self.positions[i]))
+            tilt = _angle(self.rotations[i], rotations[i])
+            self.max_slip = max(self.max_slip, slip)
+            self.max_tilt = max(self.max_tilt, tilt)
+            if tilt > c.max_tilt:
+                self._event(i, "tilted", t, tilt)
+            if slip > c.max_slip:
+                self._event(i, "slipped", t, slip)
+            if normal_forces is not None:
+                self._loaded[i] |= normal_forces[i] >= c.load_force
+                if impulsive or not self._loaded[i] or normal_forces[i] >= c.min_force:
+                    self._low_since[i] = np.nan
+                elif np.isnan(self._low_since[i]):
+                    self._low_since[i] = t
+                elif t - self._low_since[i] > c.lost_time:
+                    self._event(i, "lifted", self._low_since[i], t - self._low_since[i])
+        drop = self.base_height - float(base_height)
+        trunk = _angle(self.base_rotation, np.asarray(base_rotation, dtype=float).reshape(3, 3))
+        self.max_drop = max(self.max_drop, drop)
+        self.max_trunk_tilt = max(self.max_trunk_tilt, trunk)
+        if self._fall is None:
+            if drop > c.max_drop:
+                self._fall = ("base_dropped", float(t), f"base {100 * drop:.0f} cm below its start")
+            elif trunk > c.max_trunk_tilt:
+                self._fall = ("trunk_tipped", float(t), f"trunk turned {np.rad2deg(trunk):.0f} deg")
+        if dcm_margin is not None and np.isfinite(dcm_margin):
+            if dcm_margin < 0.0:
+                if self._dcm_out_since is None:
+                    self._dcm_out_since = float(t)
+            else:
+                self._dcm_out_since = None
+        return self.fell
+
+    # -- at the end ---------------------------------------------------------------------
+    def finish(self, t: float, com_velocity: np.ndarray) -> Outcome:
+        """The outcome at the end of the trial (time ``t``, CoM velocity in m/s, world)."""
+        events = tuple(self.events)
+        if self._abort is not None:
+            reason, when, detail = self._abort
+            return Outcome("aborted", reason, when, detail, events)
+        if self.disturbance is None:
+            return Outcome("aborted", "no_disturbance", float(t), "the disturbance never began", events)
+        if self._fall is not None:
+            reason, when, detail = self._fall
+            return Outcome("fell", reason, when, detail, events)
+        if self._dcm_out_since is not None:
+            return Outcome("fell", "dcm_escaped", self._dcm_out_since,
+                           "the DCM left the ZMP support area and did not come back", events)
+        speed = float(np.linalg.norm(np.asarray(com_velocity, dtype=float)))
+        if speed > self.criteria.rest_speed:
+            return Outcome("fell", "not_at_rest", float(t), f"CoM speed {speed:.3f} m/s at the end", events)
+        after = [e for e in events if e.time >= self.disturbance]
+        if after:
+            first = min(after, key=lambda e: e.time)
+            return Outcome("contact_broken", f"{first.kind}", first.time, f"{first.contact} {first.kind}", events)
+        return Outcome("balanced", None, None, "", events)
+
+
+def _angle(r0: np.ndarray, r1: np.ndarray) -> float:
+    """Rotation angle between two orientations (rad)."""
+    cos = (np.trace(r0.T @ r1) - 1.0) / 2.0
+    return float(np.arccos(np.clip(cos, -1.0, 1.0)))
