@@ -1,113 +1,179 @@
-"""Issue 10 measurements: fall thresholds against both criteria, push recovery, speed of a trial.
+"""Physics evidence: every table of README's and docs/validation.md's balance sections.
 
-    python benchmarks/balance.py [--scenarios NAME ...] [--joints servo rigid] [--push-scenario palm_push_ramp]
-                                 [--directions 16] [--magnitudes 10 20 30 40 50 60] [--json FILE]
-                                 [--controller ik|id]
+    python benchmarks/balance.py [--parts speed impacts pushes] [--out DIR] [--directions 8]
+                                 [--relative 0.5 0.7 0.85 1.0 1.15 1.3 1.5] [--scenarios ...] [--push-scenarios ...]
 
-Prints a markdown table per part and, with ``--json``, writes every number to FILE. It takes minutes
-(every trial simulates about 3 s); it is a measurement, not a test.
+Held-out protocol (docs/validation.md): the controllers' gains are frozen (benchmarks/tune_id.py tuned
+the ``id`` controller's margins on ``talos_tuning_stagger``, which is never scored); every push is
+predicted before its trial and scored after, on grids that straddle the boundary (fractions of each
+direction's boundary impulse); rates come with 95 % Wilson intervals. Trials are written to journals
+under ``--out`` as they finish: a second run resumes and recomputes only the scores. It takes tens of
+minutes on 2 cores; it prints markdown tables and writes every number to ``DIR/balance.json``.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
-from impact_balance.scenario import bundled_scenarios, load_scenario
-from impact_balance.sim.balance_trial import BalanceSetup, BalanceTrialOptions, Push, run_balance_trial
-from impact_balance.sim.push import DEFAULT_MAGNITUDES, push_test
+from impact_balance.sim.balance_trial import (TRIAL_VERSION, BalanceSetup, BalanceTrialOptions, Push,
+                                              controller_margin, run_balance_trial)
+from impact_balance.sim.journal import TrialJournal, journal_digest
+from impact_balance.sim.push import push_test
 from impact_balance.sim.validate import validate
 
+IMPACT_SCENARIOS = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot", "g1_two_feet", "talos_three_contacts",
+                    "talos_side_slope")
+PUSH_SCENARIOS = ("palm_push_two_feet", "palm_push_ramp", "g1_two_feet", "talos_three_contacts", "talos_side_slope")
+#: (controller, joints, rigid impact) of the impact rows.
+IMPACT_SETUPS = (("id", "servo", True), ("id", "servo", False), ("ik", "rigid", True), ("ik", "servo", False))
 
-def speed(scenario: str, repeats: int = 3, controller: str = "ik") -> dict:
+
+def _load() -> str:
+    return f"load average {os.getloadavg()[0]:.2f}"
+
+
+def _f(x, digits: int = 3) -> str:
+    return "-" if x is None else f"{x:.{digits}f}"
+
+
+def _pct(x) -> str:
+    return "-" if x is None else f"{100 * x:.1f}"
+
+
+def _ci(c) -> str:
+    return "" if c is None else f" [{100 * c[0]:.0f}, {100 * c[1]:.0f}]"
+
+
+def _journal(out: Path, name: str, parts: dict) -> TrialJournal:
+    digest = journal_digest({"trial_version": TRIAL_VERSION, **parts})
+    return TrialJournal.open(out / "journals" / f"{name}_{digest[:12]}.jsonl", digest, {"name": name})
+
+
+def speed(controller: str, repeats: int = 3) -> dict:
     """Wall time of a 3 s trial standing with the controller on (500 Hz control, 1 ms steps)."""
-    setup = BalanceSetup.create(scenario, options=BalanceTrialOptions(controller=controller))
+    options = BalanceTrialOptions(controller=controller, after=2.99)
+    setup = BalanceSetup.create("palm_push_two_feet", options=options)
     ratios = []
     for _ in range(repeats):
-        r = run_balance_trial(setup, push=Push(0.0, 1e-6, 0.01, start=0.0),
-                              options=BalanceTrialOptions(after=2.99, controller=controller))
+        r = run_balance_trial(setup, push=Push(0.0, 1e-6, 0.01, start=0.0), options=options)
         ratios.append(r.sim_time / r.wall_time)
-    return {"scenario": scenario, "sim_time": r.sim_time, "real_time_factor": ratios, "median": float(np.median(ratios))}
+    return {"controller": controller, "real_time_factor": ratios, "median": float(np.median(ratios)), "load": _load()}
+
+
+def impacts(names, out: Path) -> list[dict]:
+    rows = []
+    print("\n## Impacts: fall threshold in measured approach speed (m/s)\n")
+    print("| scenario | controller, joints | impact | CoM crit. (0 / margin) | stood / fell, measured | commanded | "
+          "fell / predicted | first contact break | palm impulse at 'fell' (N s) | sustained contacts' impulse | trials |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|", flush=True)
+    for name in names:
+        for controller, joints, rigid in IMPACT_SETUPS:
+            options = BalanceTrialOptions(controller=controller, rigid_impact=rigid)
+            journal = _journal(out, f"validate_{name}_{controller}_{joints}_{'rigid' if rigid else 'free'}",
+                               {"scenario": name, "controller": controller, "joints": joints, "rigid": rigid})
+            r = validate(name, joints, options=options, journal=journal)
+            journal.close()
+            d = r.to_dict()
+            rows.append(d)
+            e, p, pm = d["empirical"], d["predicted"]["com_criterion"], d["predicted_with_margin"]["com_criterion"]
+            ratio = None if e["fell"] is None or not p["composite"] else e["fell"] / p["composite"]
+            brk = d["contact_break"]
+            brk_text = "-" if brk is None else f"{brk['contact']} {brk['kind']} at {brk['measured']:.2f} ({brk['outcome']})"
+            at_fell = [t for t in d["trials"] if t["fell"] and t["approach_speed_measured"] == e["fell"]]
+            imp = at_fell[0]["trial"].get("impact") if at_fell else None
+            palm = "-" if imp is None or imp["impulse"] is None else f"{np.linalg.norm(imp['impulse']):.1f}"
+            sustained = "-" if imp is None else ", ".join(
+                f"{np.linalg.norm(v):.1f}" for v in imp["sustained_impulses"].values() if v is not None)
+            stood = _f(e["survived"]) + ("" if e["monotonic"] else " (non-monotonic)")
+            print(f"| {name} | {controller}, {joints} | {'rigid' if rigid else 'free'} | {_f(p['composite'])} / "
+                  f"{_f(pm['composite'])} | {stood} / {_f(e['fell'])} | {_f(e['survived_commanded'])} / "
+                  f"{_f(e['fell_commanded'])} | {_f(ratio, 2)} | {brk_text} | {palm} | {sustained} | {len(d['trials'])} |",
+                  flush=True)
+    return rows
+
+
+def pushes(names, directions: int, relative: list[float], out: Path) -> list[dict]:
+    rows = []
+    options = BalanceTrialOptions(controller="id")
+    own = controller_margin(options)
+    print(f"\n## Pushes (id controller, {directions} directions x {relative} of the boundary impulse, 50 ms, torso)\n")
+    print("| scenario | pushes | balanced / contact broken / fell / aborted | margin (mm) | CoM criterion before: "
+          "right / safe & fell | CoM in trial | ZMP before | ZMP in trial | smallest margin (CoM, <= 5 %) |")
+    print("|---|---|---|---|---|---|---|---|---|", flush=True)
+    for name in names:
+        journal = _journal(out, f"push_{name}_id", {"scenario": name, "controller": "id", "directions": directions})
+        t0 = time.perf_counter()
+        r = push_test(name, directions, relative=relative, options=options, journal=journal)
+        journal.close()
+        d = r.to_dict()
+        d["wall"] = time.perf_counter() - t0
+        study = r.margin_study()
+        d["margin_study"] = study
+        rows.append(d)
+        o = d["counts"]["outcomes"]
+        smallest = study["smallest_margin"]["com"]
+        for m in study["margins"]:
+            s = study["scores"][f"{m:g}"]
+            cells = [f"{_pct(s[k]['accuracy'])}{_ci(s[k]['accuracy_ci95'])} / {_pct(s[k]['safe_fell_rate'])}"
+                     f"{_ci(s[k]['safe_fell_rate_ci95'])}" for k in ("com", "com_in_trial", "zmp", "zmp_in_trial")]
+            first = m == study["margins"][0]
+            print(f"| {name if first else ''} | {len(r.outcomes) if first else ''} | "
+                  f"{(str(o['balanced']) + ' / ' + str(o['contact_broken']) + ' / ' + str(o['fell']) + ' / ' + str(o['aborted'])) if first else ''} | "
+                  f"{1e3 * m:g}{' (own)' if m == own else ''} | {' | '.join(cells)} | "
+                  f"{('-' if smallest is None else f'{1e3 * smallest:g} mm') if first else ''} |", flush=True)
+    print("\nContact breaks (no fall) and falls by fraction of the boundary impulse:\n")
+    print("| scenario | fraction | pushes | contact broken | fell | first event (count) |")
+    print("|---|---|---|---|---|---|")
+    for d in rows:
+        by: dict[float, dict] = {}
+        for p in d["pushes"]:
+            row = by.setdefault(p["relative"], {"n": 0, "broken": 0, "fell": 0, "first": {}})
+            row["n"] += 1
+            row["fell"] += p["fell"]
+            row["broken"] += p["outcome"] == "contact_broken"
+            if p["events"]:
+                e = min(p["events"], key=lambda e: e["time"])
+                key = f"{e['contact']} {e['kind']}"
+                row["first"][key] = row["first"].get(key, 0) + 1
+        for frac in sorted(by):
+            row = by[frac]
+            first = ", ".join(f"{k} ({v})" for k, v in sorted(row["first"].items(), key=lambda kv: -kv[1])) or "-"
+            print(f"| {d['scenario']} | {frac:g} | {row['n']} | {row['broken']} | {row['fell']} | {first} |")
+    return rows
 
 
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--scenarios", nargs="*", help="impact scenarios (default: every bundled one)")
-    p.add_argument("--joints", nargs="+", default=["servo", "rigid"])
-    p.add_argument("--push-scenario", default="palm_push_ramp")
-    p.add_argument("--push-body", default=None, help="MuJoCo body pushed (default: the torso)")
-    p.add_argument("--directions", type=int, default=16)
-    p.add_argument("--magnitudes", type=float, nargs="+", default=list(DEFAULT_MAGNITUDES))
-    p.add_argument("--skip", nargs="*", default=[], choices=["speed", "validate", "push"])
-    p.add_argument("--json", metavar="FILE")
-    p.add_argument("--controller", default="ik", choices=["ik", "id"],
-                   help="ik: pink IK -> position servos; id: inverse-dynamics QP -> torque motors")
+    p.add_argument("--parts", nargs="+", default=["speed", "impacts", "pushes"], choices=["speed", "impacts", "pushes"])
+    p.add_argument("--out", default="balance-benchmark", help="folder of the journals and of balance.json")
+    p.add_argument("--scenarios", nargs="+", default=list(IMPACT_SCENARIOS))
+    p.add_argument("--push-scenarios", nargs="+", default=list(PUSH_SCENARIOS))
+    p.add_argument("--directions", type=int, default=8)
+    p.add_argument("--relative", type=float, nargs="+", default=[0.5, 0.7, 0.85, 1.0, 1.15, 1.3, 1.5])
     args = p.parse_args()
-    out: dict = {"controller": args.controller}
-    options = BalanceTrialOptions(controller=args.controller)
-    if "speed" not in args.skip:
-        out["speed"] = speed("palm_push_two_feet", controller=args.controller)
-        print(f"## Speed\n\n3 s trial, controller on: {out['speed']['median']:.2f}x real time "
-              f"(runs: {', '.join(f'{x:.2f}' for x in out['speed']['real_time_factor'])})\n", flush=True)
-    if "validate" not in args.skip:
-        names = args.scenarios or [n for n in bundled_scenarios() if load_scenario(n).impact is not None]
-        rows = []
-        print("## Fall thresholds (m/s, commanded approach speed)\n")
-        print("| scenario | joints | CoM crit. composite | CoM crit. joint_space | ZMP crit. composite | ZMP crit. joint_space "
-              "| survived | fell | approach measured at 'fell' | reason | fastest survived: measured, CoM vel. margin "
-              "| trials | wall s |")
-        print("|---|---|---|---|---|---|---|---|---|---|---|---|---|", flush=True)
-        for name in names:
-            for joints in args.joints:
-                t0 = time.perf_counter()
-                r = validate(name, joints, options=options).to_dict()
-                r.pop("controller", None)
-                rows.append(r)
-                pc, pz = r["predicted"]["com_criterion"], r["predicted"]["zmp_criterion"]
-                e = r["empirical"]
-                at_fell = [t for t in r["trials"] if t["fell"] and t["speed"] == e["fell"]]
-                meas = at_fell[0]["approach_speed_measured"] if at_fell else None
-                reason = at_fell[0]["reason"] if at_fell else "-"
-                f = lambda x: "-" if x is None else f"{x:.3f}"
-                # The fastest survived trial: how fast the limb really went, and how close the CoM came.
-                ok = [t for t in r["trials"] if not t["fell"]]
-                best = max(ok, key=lambda t: t["speed"]) if ok else None
-                fastest = (f"{f(best['approach_speed_measured'])}, {f(best['min_com_velocity_margin'])}"
-                           if best else "-")
-                print(f"| {name} | {joints} | {f(pc['composite'])} | {f(pc['joint_space'])} | {f(pz['composite'])} | "
-                      f"{f(pz['joint_space'])} | {f(e['survived'])} | {f(e['fell'])} | {f(meas)} | {reason} | {fastest} | "
-                      f"{len(r['trials'])} | {time.perf_counter() - t0:.0f} |", flush=True)
-        out["validate"] = rows
-    if "push" not in args.skip:
-        t0 = time.perf_counter()
-        r = push_test(args.push_scenario, args.directions, args.magnitudes, 0.05, args.push_body, options=options)
-        d = r.to_dict()
-        out["push"] = d
-        print(f"\n## Pushes on {args.push_scenario} at {args.push_body or 'the torso'} ({len(r.outcomes)} pushes, 50 ms, {time.perf_counter() - t0:.0f} s)\n")
-        print("| magnitude (N s) | fell | CoM criterion safe | ZMP criterion safe | reasons |")
-        print("|---|---|---|---|---|")
-        for m in args.magnitudes:
-            g = [p for p in d["pushes"] if p["magnitude"] == m]
-            reasons = {}
-            for p in g:
-                if p["fell"]:
-                    reasons[p["reason"]] = reasons.get(p["reason"], 0) + 1
-            print(f"| {m:g} | {sum(p['fell'] for p in g)}/{len(g)} | {sum(bool(p['com_criterion_safe']) for p in g)} | "
-                  f"{sum(bool(p['zmp_criterion_safe']) for p in g)} | {reasons} |")
-        for k in ("com", "zmp"):
-            c = d["confusion"][k]
-            print(f"\n{k.upper()} criterion: accuracy {100 * c['accuracy']:.1f} %, predicted safe & fell {c['safe_fell']} "
-                  f"({100 * c['safe_fell_rate']:.1f} %), safe & survived {c['safe_survived']}, unsafe & survived "
-                  f"{c['unsafe_survived']}, unsafe & fell {c['unsafe_fell']}")
-    if args.json:
-        from impact_balance.cli._common import strict_json
-
-        with open(args.json, "w") as fh:
-            fh.write(strict_json(out))
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    result: dict = {"started": _load()}
+    print(f"{_load()} at the start", flush=True)
+    if "speed" in args.parts:
+        result["speed"] = [speed(c) for c in ("ik", "id")]
+        for s in result["speed"]:
+            print(f"3 s trial, {s['controller']} controller: {s['median']:.2f}x real time "
+                  f"(runs {', '.join(f'{x:.2f}' for x in s['real_time_factor'])}; {s['load']})", flush=True)
+    if "impacts" in args.parts:
+        result["impacts"] = impacts(args.scenarios, out)
+    if "pushes" in args.parts:
+        result["pushes"] = pushes(args.push_scenarios, args.directions, args.relative, out)
+    result["finished"] = _load()
+    print(f"\n{_load()} at the end")
+    (out / "balance.json").write_text(json.dumps(result, allow_nan=False, default=float))
     return 0
 
 

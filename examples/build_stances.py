@@ -89,6 +89,10 @@ RAMP_SOLE = (0.10, -0.085, 0.10)  # right sole centre on the ramp
 WALL_Y = 0.60  # wall plane on Talos' left (world y), for the three-contact stance
 HAND_CONTACT_OFFSET = se3((-0.057, 0.0, -0.045), (0.0, math.pi / 2, 0.0))  # gripper -x face, z_c = +x_g
 HAND_CONTACT_TARGET = se3((0.05, WALL_Y, 1.00), (math.pi / 2, 0.0, 0.0))  # contact z axis = world -y
+TALOS_STAGGER_LEFT = (0.08, 0.10, 0.0)
+TALOS_STAGGER_RIGHT = (-0.08, -0.10, 0.0)
+SIDE_SLOPE_ANGLE = math.radians(15.0)
+SIDE_SLOPE_SOLE = (-0.009, -0.12, 0.04)
 G1_SOLE_OFFSET = (0.035, 0.0, -0.035)  # sole centre in *_ankle_roll_link (collision spheres)
 G1_LEFT_SOLE = (0.0, 0.119, 0.0)
 G1_RIGHT_SOLE = (0.0, -0.119, 0.0)
@@ -165,6 +169,38 @@ PROBLEMS = [
         f"feet flat; left gripper's -x face on a wall at y = {WALL_Y} (contact centre (0.05, {WALL_Y}, 1.00)); "
         "right gripper as in palm_push_two_feet; CoM between the soles",
         _talos_both_arms,
+        {"joint_costs": TALOS_JOINT_COSTS},
+    ),
+    StanceProblem(
+        "talos_tuning_stagger",
+        "talos",
+        "half_sitting",
+        {
+            "left_sole_link": se3(TALOS_STAGGER_LEFT),
+            "right_sole_link": se3(TALOS_STAGGER_RIGHT),
+            "gripper_right_base_link": TALOS_PUSH_GRIPPER,
+        },
+        _mid(TALOS_STAGGER_LEFT, TALOS_STAGGER_RIGHT),
+        "feet flat, staggered: left sole 8 cm forward, right 8 cm back, 20 cm apart; right gripper as in "
+        "palm_push_two_feet; CoM between the soles. The balance controllers' gains are tuned here only.",
+        _talos_arm_forward,
+        {"joint_costs": TALOS_JOINT_COSTS},
+    ),
+    StanceProblem(
+        "talos_side_slope",
+        "talos",
+        "half_sitting",
+        {
+            "left_sole_link": se3(TALOS_LEFT_SOLE),
+            # Rolled 15 degrees about world x: the sole normal tilts inwards (+y), the slope rises outwards.
+            "right_sole_link": se3(SIDE_SLOPE_SOLE, (-SIDE_SLOPE_ANGLE, 0.0, 0.0)),
+            "gripper_right_base_link": TALOS_PUSH_GRIPPER,
+        },
+        _mid(TALOS_LEFT_SOLE, SIDE_SLOPE_SOLE),
+        "left sole flat; right sole on a 15 deg side slope (rolled, normal tilted inwards), centre at "
+        "(-0.009, -0.12, 0.04); right gripper as in palm_push_two_feet; CoM at the midpoint of the sole centres. "
+        "Written for the held-out scores: nothing is tuned on it.",
+        _talos_arm_forward,
         {"joint_costs": TALOS_JOINT_COSTS},
     ),
     StanceProblem(

@@ -90,7 +90,8 @@ class BalanceTrialOptions:
     """Options of a trial.
 
     Attributes:
-        after: Simulated time after the disturbance (contact or end of push) (s).
+        after: Simulated time after the disturbance (contact or end of push) (s); a robot still moving then
+            gets ``criteria.extra_time`` more (see :mod:`.outcomes`).
         settle: Time standing still before the disturbance (s).
         max_approach_time: Longest time after the reference reached the surface before the trial gives
             up waiting for the contact (s).
@@ -290,7 +291,15 @@ def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, opt
     step = 0
     impact_force = np.zeros(3)
     fn = 0.0
-    while d.time < end_time:
+    extended = False
+    while True:
+        if d.time >= end_time:
+            # Still moving at the end: the robot gets extra_time more to come to rest (a slow recovery is no fall).
+            moving = len(series["com_velocity"]) and np.linalg.norm(series["com_velocity"][-1]) > options.criteria.rest_speed
+            if extended or disturbance is None or not moving:
+                break
+            extended = True
+            end_time += options.criteria.extra_time
         t = float(d.time)
         if task is not None:
             # Every step (1 ms): the forces of the last step, the impact point's velocity, the CoM velocity.

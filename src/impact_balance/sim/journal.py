@@ -83,12 +83,13 @@ class TrialJournal:
         from ..exceptions import SimulationError
 
         with open(self.path, encoding="utf-8", errors="replace") as fh:
-            lines = fh.read().splitlines()
+            text = fh.read()
+        lines = text.splitlines()
         for number, line in enumerate(lines):
             try:
                 record = json.loads(line)
             except json.JSONDecodeError:
-                self.skipped_lines += 1
+                self.skipped_lines += bool(line.strip())
                 continue
             if number == 0:
                 if record.get("digest") != self.digest:
@@ -97,10 +98,10 @@ class TrialJournal:
                 continue
             if isinstance(record, dict) and "key" in record and "entry" in record:
                 self.entries[_key(record["key"])] = record["entry"]
-            else:
+            elif line.strip():
                 self.skipped_lines += 1
-        if lines and self.skipped_lines:
-            # A cut last line: end the file with a newline so that the next line starts clean.
+        if text and not text.endswith("\n"):
+            # A cut last line: end it, so that the next line starts clean.
             with open(self.path, "a", encoding="utf-8") as fh:
                 fh.write("\n")
 

@@ -11,8 +11,10 @@ The criterion makes two promises, and a trial can break either, or both:
     orientation: no recovery without a step comes back from there;
   - ``dcm_escaped``: the DCM left the ZMP support area and was still outside at the end (the
     robot cannot be at rest with its DCM outside its support);
-  - ``not_at_rest``: at the end (``settle_time``, 2.5 s after the disturbance) the CoM still
-    moves faster than ``rest_speed`` (5 cm/s).
+  - ``not_at_rest``: the CoM still moves faster than ``rest_speed`` (5 cm/s) at the end: 2.5 s
+    after the disturbance (``settle_time``), or, for a robot still moving then, up to
+    ``extra_time`` (2.5 s) later (a controller may bring the CoM back to its start slowly: that
+    is a recovery, not a fall).
 
 - *the contacts stay*: the paper assumes the impact does not break the sustained contacts.
   A contact **event** is recorded (each kind once per contact, with its time) when a contact
@@ -64,6 +66,7 @@ class OutcomeCriteria:
     max_trunk_tilt: float = float(np.deg2rad(25.0))
     settle_time: float = 2.5
     rest_speed: float = 0.05
+    extra_time: float = 2.5
 
     def to_dict(self) -> dict:
         return asdict(self)
