@@ -1,13 +1,16 @@
 """Issue 9 targets: the impact model against MuJoCo, and the simulation speed.
 
-    python benchmarks/simulate.py [--json] [--speeds 0.1,0.3,0.6] [--joints rigid,servo]
+    python benchmarks/simulate.py [--json] [--speeds 0.1,0.3,0.6] [--joints rigid,servo,held]
 
 For every bundled scenario with an impact, every approach speed and joint model, one trial
 (``impact_balance.sim``): the measured CoM velocity jump, its distance to the predicted
 ``composite`` and ``joint_space`` sets (at the measured speed and restitution), relative to
 the jump's magnitude, and where the jump falls between the two models (its magnitude over
-each set's size, the largest norm of its vertices). ``--armature`` adds rotor inertia to the
-servo joints (kg m^2) to show how the servo result moves towards the rigid one. Then the speed: standing Talos (``servo``, holding
+each set's size, the largest norm of its vertices, and its position between them: 0 at the
+``joint_space`` set's centroid, 1 at the ``composite`` one's). ``servo`` joints carry the rotor
+inertia the robot files declare (the SRDF's rotor_params; ``--armature`` sets one value for every
+joint instead); ``held`` is ``servo`` with ``--rigid-impact`` (every joint keeps its velocity
+through the impact). The impulse the sustained contacts take is reported too. Then the speed: standing Talos (``servo``, holding
 ``palm_push_two_feet``) stepped for 2 s of simulated time, bare ``mj_step`` and with the
 trial's recording.
 
@@ -36,15 +39,16 @@ def impact_scenarios() -> list[str]:
     return [name for name in bundled_scenarios() if load_scenario(name).impact is not None]
 
 
-def accuracy(speeds: list[float], joints: list[str], armature: float = 0.0,
+def accuracy(speeds: list[float], joints: list[str], armature: float | None = None,
              scenarios: list[str] | None = None) -> list[dict]:
     rows = []
     options = SimOptions(meshes=False, servo=ServoOptions(armature=armature))
     for name in scenarios or impact_scenarios():
         for joint_model in joints:
-            sim = build_model(name, joint_model, options)
+            held = joint_model == "held"
+            sim = build_model(name, "servo" if held else joint_model, options)
             for speed in speeds:
-                result = measure(sim, run_trial(sim, TrialOptions(speed, after=0.05)), speed)
+                result = measure(sim, run_trial(sim, TrialOptions(speed, after=0.05, rigid_impact=held)), speed)
                 jump = result.com_velocity_jump_measured
                 size = float(np.linalg.norm(jump))
                 row = {
@@ -52,8 +56,14 @@ def accuracy(speeds: list[float], joints: list[str], armature: float = 0.0,
                     "approach_measured": result.approach_speed_measured,
                     "restitution": result.restitution_measured, "slip": result.slip_speed,
                     "jump": jump.tolist(), "jump_norm": size, "contacts_kept": result.contacts_kept,
-                    "sim_time_ratio": result.sim_time_ratio, "armature": armature,
+                    "sim_time_ratio": result.sim_time_ratio, "armature": result.armature,
+                    "robot": sim.robot.name, "palm_impulse": float(np.linalg.norm(result.impulse_measured)),
+                    "sustained_impulse": float(sum(np.linalg.norm(v) for v in result.sustained_impulses.values())),
+                    "hold_ms": None if not result.hold or result.hold["duration"] is None else 1e3 * result.hold["duration"],
                 }
+                centre = {m: float(np.linalg.norm(p.com_velocity_jumps.mean(axis=0))) for m, p in result.predicted.items()}
+                span = centre["composite"] - centre["joint_space"]
+                row["position"] = (size - centre["joint_space"]) / span if span > 0 else float("nan")
                 for model, p in result.predicted.items():
                     extent = float(np.linalg.norm(p.com_velocity_jumps, axis=1).max())
                     row[f"{model}_distance"] = p.distance
@@ -81,14 +91,18 @@ def speed(seconds: float = 2.0) -> dict:
 
 
 def markdown(rows: list[dict], perf: dict) -> str:
-    out = ["| scenario | joints | v (m/s) | e | |jump| (m/s) | to composite | to joint_space | |jump| / composite size | |jump| / joint_space size | contacts kept |",
-           "|---|---|---|---|---|---|---|---|---|---|"]
+    out = ["| scenario (robot) | joints | v (m/s) | e | |jump| (m/s) | to composite | to joint_space | |jump| / composite size "
+           "| |jump| / joint_space size | position (0 joint_space, 1 composite) | impulse: impact / sustained (N s) | contacts kept |",
+           "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         kept = "n/a" if r["contacts_kept"] is None else ("yes" if r["contacts_kept"] else "no")
-        joints = r["joints"] + (f" (armature {r['armature']:g})" if r["joints"] == "servo" and r["armature"] else "")
-        out.append(f"| {r['scenario']} | {joints} | {r['speed']:g} | {r['restitution']:.2f} | {r['jump_norm']:.4f} | "
-                   f"{r['composite_relative']:.2%} | {r['joint_space_relative']:.0%} | {r['jump_over_composite']:.3f} | "
-                   f"{r['jump_over_joint_space']:.2f} | {kept} |")
+        out.append(f"| {r['scenario']} ({r['robot']}) | {r['joints']} | {r['speed']:g} | {r['restitution']:.2f} | "
+                   f"{r['jump_norm']:.4f} | {r['composite_relative']:.2%} | {r['joint_space_relative']:.0%} | "
+                   f"{r['jump_over_composite']:.3f} | {r['jump_over_joint_space']:.2f} | {r['position']:.2f} | "
+                   f"{r['palm_impulse']:.2f} / {r['sustained_impulse']:.2f} | {kept} |")
+    sources = sorted({(r["robot"], r["armature"]) for r in rows if r["joints"] != "rigid"})
+    out += [f"
+armature of {robot}: {source}" for robot, source in sources]
     rigid = [r for r in rows if r["joints"] == "rigid"]
     if rigid:
         worst = max(r["composite_relative"] for r in rigid)
@@ -107,8 +121,9 @@ def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--json", action="store_true")
     p.add_argument("--speeds", default="0.1,0.3,0.6")
-    p.add_argument("--joints", default="rigid,servo")
-    p.add_argument("--armature", type=float, default=0.0, help="servo rotor inertia, kg m^2")
+    p.add_argument("--joints", default="rigid,servo,held")
+    p.add_argument("--armature", type=float, default=None,
+                   help="servo rotor inertia of every joint, kg m^2 (default: what the robot files declare)")
     p.add_argument("--scenarios", default=None, help="comma-separated (default: every bundled one with an impact)")
     p.add_argument("--no-speed", action="store_true", help="skip the speed measurement")
     args = p.parse_args()

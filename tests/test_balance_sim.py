@@ -122,3 +122,24 @@ def test_checker_reads_simulate_logs(tmp_path, capsys):
     assert main(["check-log", str(path), "--scenario", SCENARIO, "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["samples"] == len(frame) and "violations" in out
+
+
+def test_validate_cli_json_keys_and_text(capsys, tmp_path):
+    argv = ["validate", SCENARIO, "--controller", "id", "--rigid-impact", "--max-speed", "0.3",
+            "--journal", str(tmp_path / "v.jsonl")]
+    assert main(argv + ["--json"]) == 0
+    cap = capsys.readouterr()
+    out = json.loads(cap.out, parse_constant=lambda c: pytest.fail(c))
+    assert "trials journal" in cap.err
+    e = out["empirical"]
+    assert set(e) >= {"survived", "fell", "survived_commanded", "fell_commanded", "monotonic"}
+    assert e["survived_commanded"] == 0.3 and e["fell"] is None and e["survived"] == pytest.approx(0.3, rel=0.1)
+    assert out["predicted"]["com_criterion"]["composite"] > out["predicted_with_margin"]["com_criterion"]["composite"]
+    assert out["zmp_margin"] == pytest.approx(0.005) and out["rigid_impact"] is True
+    (trial,) = out["trials"]
+    assert trial["outcome"] == "balanced" and trial["com_criterion_safe"] is True
+    impact = trial["trial"]["impact"]
+    assert set(impact["sustained_impulses"]) == {"left_sole_link", "right_sole_link"}
+    assert main(argv) == 0  # text, from the journal
+    text = capsys.readouterr().out
+    assert "measured approach speed: stood at" in text and "CoM criterion" in text and "(1 reused)" in text

@@ -54,7 +54,8 @@ def test_push_calls_at_a_margin_are_the_inset_area():
     """Safe at margin M exactly when the prediction lies in the area shrunk by M (omega M in CoM velocity)."""
     omega = 3.3
     summary = {"outcome": "balanced", "com_velocity_margin_at_end": 0.02, "min_zmp_margin_during": None}
-    o = PushOutcome(Push(0.0, 10.0), None, PushPrediction(np.zeros(2), 0.033, np.zeros(2), 0.004), summary)
+    o = PushOutcome(push=Push(0.0, 10.0), relative=None, summary=summary,
+                    prediction=PushPrediction(np.zeros(2), 0.033, np.zeros(2), 0.004))
     assert o.safe("com", 0.0, omega) and o.safe("com", 0.01, omega) and not o.safe("com", 0.0101, omega)
     assert o.safe("zmp", 0.004, omega) and not o.safe("zmp", 0.005, omega)
     assert o.safe("com_in_trial", 0.006, omega) and not o.safe("com_in_trial", 0.007, omega)

@@ -243,6 +243,8 @@ def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, opt
         task = ImpactTask(im.spec.frame, im.spec.offset, im.point, n, impact_speed, start_time=options.settle)
         tracker = ImpactTracker(n, dt)
     q_start = setup.start_configuration(standoff)
+    # A push trial has no impacted surface: a robot falling forward must not lean on the wall of the impact.
+    sim.enable_impact_surface(task is not None)
     mujoco.mj_resetData(m, d)
     sim.set_state(q_start)
     if setup.controller == "id":

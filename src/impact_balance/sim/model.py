@@ -216,6 +216,15 @@ class SimModel:
             if int(self.model.pair_geom1[i]) not in surface:
                 self.model.pair_margin[i] = 0.0 if enabled else -1.0
 
+    def enable_impact_surface(self, enabled: bool = True) -> None:
+        """Let the impact point touch the impacted surface (default), or not (a push trial: the surface is
+        not there, so a falling robot cannot lean on it). Disabling sets the pair's margin to -1 m."""
+        if self.surface_geom is None:
+            return
+        for i in range(self.model.npair):
+            if int(self.model.pair_geom1[i]) == self.surface_geom:
+                self.model.pair_margin[i] = 0.0 if enabled else -1.0
+
     def set_servo_targets(self, q_ref: np.ndarray, v_ref: np.ndarray | None = None) -> None:
         """Servo commands from target joint positions (pinocchio ``q``) and velocities (pinocchio ``v``).
 

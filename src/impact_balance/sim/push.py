@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
@@ -33,7 +33,7 @@ from ..scenario import Scenario, load_scenario
 from .balance_trial import (BalanceSetup, BalanceTrialOptions, Push, _push_body, controller_margin, run_balance_trial)
 from .journal import TrialJournal
 from .scores import MARGIN_GRID, confusion
-from .trial_result import trajectory
+from .trial_result import TrialEntry, trajectory
 
 __all__ = ["check_push_arguments", "boundary_impulse", "PushPrediction", "PushOutcome", "PushTestResult", "push_test",
            "DEFAULT_MAGNITUDES", "CRITERIA"]
@@ -93,27 +93,13 @@ class PushPrediction:
     zmp_margin: float
 
 
-@dataclass
-class PushOutcome:
+@dataclass(kw_only=True)
+class PushOutcome(TrialEntry):
     """One push: what was tried, what was predicted before, and the trial's summary and trajectory."""
 
     push: Push
     relative: float | None
     prediction: PushPrediction
-    summary: dict
-    trajectory: dict = field(default_factory=dict)
-
-    @property
-    def outcome(self) -> str:
-        return self.summary["outcome"]
-
-    @property
-    def fell(self) -> bool:
-        return self.outcome == "fell"
-
-    @property
-    def scored(self) -> bool:
-        return self.outcome != "aborted"
 
     def safe(self, criterion: str, margin: float, omega: float) -> bool:
         """Whether ``criterion`` (one of :data:`CRITERIA`) calls the push safe at ZMP margin ``margin`` (m)."""
@@ -291,8 +277,9 @@ def push_test(scenario: Scenario | str, directions: int = 16, magnitudes: Sequen
                 journal.add(key, entry)
             else:
                 reused += 1
-            outcome = PushOutcome(push, None if relative is None else float(level), predict_push(setup, push, height),
-                                  entry["summary"], entry["trajectory"])
+            outcome = PushOutcome(push=push, relative=None if relative is None else float(level),
+                                  prediction=predict_push(setup, push, height), summary=entry["summary"],
+                                  trajectory=entry["trajectory"])
             outcomes.append(outcome)
             if progress:
                 progress(outcome)

@@ -14,7 +14,7 @@ import pandas as pd
 
 from .outcomes import ContactEvent
 
-__all__ = ["ImpactMeasurement", "BalanceTrialResult", "finite_or_null", "trajectory"]
+__all__ = ["ImpactMeasurement", "BalanceTrialResult", "TrialEntry", "finite_or_null", "trajectory"]
 
 
 def finite_or_null(nulls: dict[str, str], name: str, value, reason: str):
@@ -182,3 +182,25 @@ def trajectory(result: BalanceTrialResult, start: float, stop: float, every: int
 
     return {"time": [float(x) for x in t[keep]], "com_velocity": rows(s["com_velocity"][keep][:, :2]),
             "zmp": rows(s["zmp"][keep]), "dcm": rows(s["dcm"][keep])}
+
+
+@dataclass
+class TrialEntry:
+    """A finished trial as the commands keep it (and as the journal stores it): its JSON ``summary``
+    (:meth:`BalanceTrialResult.summary`) and a short ``trajectory`` (:func:`trajectory`) for the figures."""
+
+    summary: dict
+    trajectory: dict = field(default_factory=dict)
+
+    @property
+    def outcome(self) -> str:
+        return self.summary["outcome"]
+
+    @property
+    def fell(self) -> bool:
+        return self.outcome == "fell"
+
+    @property
+    def scored(self) -> bool:
+        """Aborted trials test nothing: they are left out of brackets and scores."""
+        return self.outcome != "aborted"

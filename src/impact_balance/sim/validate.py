@@ -30,7 +30,7 @@ from ..exceptions import SimulationError
 from ..scenario import Scenario, load_scenario
 from .balance_trial import BalanceSetup, BalanceTrialOptions, controller_margin, run_balance_trial
 from .journal import TrialJournal
-from .trial_result import trajectory
+from .trial_result import TrialEntry, trajectory
 
 __all__ = ["predictions", "ValidationTrial", "ValidationResult", "validate", "INERTIA_MODELS"]
 
@@ -54,21 +54,11 @@ def predictions(scenario: Scenario, zmp_margin: float = 0.0) -> dict[str, dict[s
     return out
 
 
-@dataclass
-class ValidationTrial:
+@dataclass(kw_only=True)
+class ValidationTrial(TrialEntry):
     """One trial of the search: the commanded speed, the trial's summary and its CoM velocity trajectory."""
 
     speed: float
-    summary: dict
-    trajectory: dict = field(default_factory=dict)
-
-    @property
-    def outcome(self) -> str:
-        return self.summary["outcome"]
-
-    @property
-    def fell(self) -> bool:
-        return self.outcome == "fell"
 
     @property
     def measured(self) -> float | None:
@@ -98,7 +88,7 @@ class ValidationResult:
 
     @property
     def scored(self) -> list[ValidationTrial]:
-        return [t for t in self.trials if t.outcome != "aborted" and t.measured is not None]
+        return [t for t in self.trials if t.scored and t.measured is not None]
 
     def bracket(self) -> dict:
         """The bracket in measured and commanded approach speed (see the module docstring)."""
@@ -188,7 +178,7 @@ def validate(scenario: Scenario | str, joints: str = "servo", *, tolerance: floa
             journal.add(key, entry)
         else:
             reused += 1
-        trials.append(ValidationTrial(speed, entry["summary"], entry["trajectory"]))
+        trials.append(ValidationTrial(speed=speed, summary=entry["summary"], trajectory=entry["trajectory"]))
         return trials[-1].outcome
 
     stood: float | None = None
