@@ -99,20 +99,25 @@ def impacts(names, out: Path) -> list[dict]:
     return rows
 
 
-def pushes(names, directions: int, relative: list[float], out: Path) -> list[dict]:
+def pushes(names, directions: int, relative: list[float], out: Path, bodies: list[str]) -> list[dict]:
     rows = []
     options = BalanceTrialOptions(controller="id")
     own = controller_margin(options)
-    print(f"\n## Pushes (id controller, {directions} directions x {relative} of the boundary impulse, 50 ms, torso)\n")
-    print("| scenario | pushes | balanced / contact broken / fell / aborted | margin (mm) | CoM criterion before: "
-          "right / safe & fell | CoM in trial | ZMP before | ZMP in trial | smallest margin (CoM, <= 5 %) |")
-    print("|---|---|---|---|---|---|---|---|---|", flush=True)
-    for name in names:
-        journal = _journal(out, f"push_{name}_id", {"scenario": name, "controller": "id", "directions": directions})
+    print(f"\n## Pushes (id controller, {directions} directions x {relative} of the boundary impulse, 50 ms)\n")
+    print("| scenario | body | pushes | balanced / contact broken / fell / aborted | margin (mm) | CoM criterion before: "
+          "right / safe & fell (%) | CoM in trial | ZMP before | ZMP in trial | smallest margin (CoM, <= 5 %) |")
+    print("|---|---|---|---|---|---|---|---|---|---|", flush=True)
+    for name, which in ((n, b) for n in names for b in bodies):
+        setup = BalanceSetup.create(name, "servo", options)
+        # "torso": the push-test default; "base": the root body (Talos' base_link, G1's pelvis), near the CoM.
+        body = None if which == "torso" else setup.sim.model.body(setup.sim.root_body).name
+        journal = _journal(out, f"push_{name}_{which}_id", {"scenario": name, "controller": "id",
+                                                           "directions": directions, "body": body})
         t0 = time.perf_counter()
-        r = push_test(name, directions, relative=relative, options=options, journal=journal)
+        r = push_test(name, directions, relative=relative, options=options, journal=journal, body=body, setup=setup)
         journal.close()
         d = r.to_dict()
+        d["body"] = body or "torso"
         d["wall"] = time.perf_counter() - t0
         study = r.margin_study()
         d["margin_study"] = study
@@ -124,13 +129,13 @@ def pushes(names, directions: int, relative: list[float], out: Path) -> list[dic
             cells = [f"{_pct(s[k]['accuracy'])}{_ci(s[k]['accuracy_ci95'])} / {_pct(s[k]['safe_fell_rate'])}"
                      f"{_ci(s[k]['safe_fell_rate_ci95'])}" for k in ("com", "com_in_trial", "zmp", "zmp_in_trial")]
             first = m == study["margins"][0]
-            print(f"| {name if first else ''} | {len(r.outcomes) if first else ''} | "
+            print(f"| {name if first else ''} | {d['body'] if first else ''} | {len(r.outcomes) if first else ''} | "
                   f"{(str(o['balanced']) + ' / ' + str(o['contact_broken']) + ' / ' + str(o['fell']) + ' / ' + str(o['aborted'])) if first else ''} | "
                   f"{1e3 * m:g}{' (own)' if m == own else ''} | {' | '.join(cells)} | "
                   f"{('-' if smallest is None else f'{1e3 * smallest:g} mm') if first else ''} |", flush=True)
     print("\nContact breaks (no fall) and falls by fraction of the boundary impulse:\n")
-    print("| scenario | fraction | pushes | contact broken | fell | first event (count) |")
-    print("|---|---|---|---|---|---|")
+    print("| scenario | body | fraction | pushes | contact broken | fell | first event (count) |")
+    print("|---|---|---|---|---|---|---|")
     for d in rows:
         by: dict[float, dict] = {}
         for p in d["pushes"]:
@@ -145,7 +150,7 @@ def pushes(names, directions: int, relative: list[float], out: Path) -> list[dic
         for frac in sorted(by):
             row = by[frac]
             first = ", ".join(f"{k} ({v})" for k, v in sorted(row["first"].items(), key=lambda kv: -kv[1])) or "-"
-            print(f"| {d['scenario']} | {frac:g} | {row['n']} | {row['broken']} | {row['fell']} | {first} |")
+            print(f"| {d['scenario']} | {d['body']} | {frac:g} | {row['n']} | {row['broken']} | {row['fell']} | {first} |")
     return rows
 
 
@@ -157,6 +162,7 @@ def main() -> int:
     p.add_argument("--push-scenarios", nargs="+", default=list(PUSH_SCENARIOS))
     p.add_argument("--directions", type=int, default=8)
     p.add_argument("--relative", type=float, nargs="+", default=[0.5, 0.7, 0.85, 1.0, 1.15, 1.3, 1.5])
+    p.add_argument("--bodies", nargs="+", default=["torso", "base"], choices=["torso", "base"])
     args = p.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -170,7 +176,7 @@ def main() -> int:
     if "impacts" in args.parts:
         result["impacts"] = impacts(args.scenarios, out)
     if "pushes" in args.parts:
-        result["pushes"] = pushes(args.push_scenarios, args.directions, args.relative, out)
+        result["pushes"] = pushes(args.push_scenarios, args.directions, args.relative, out, args.bodies)
     result["finished"] = _load()
     print(f"\n{_load()} at the end")
     (out / "balance.json").write_text(json.dumps(result, allow_nan=False, default=float))

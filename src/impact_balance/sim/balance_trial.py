@@ -48,7 +48,7 @@ from .trial import _point_velocity
 from .trial_result import BalanceTrialResult
 
 #: Version of the trials' physics and measurements: journals of another version are not reused.
-TRIAL_VERSION = 2
+TRIAL_VERSION = 3
 
 #: Iterations of MuJoCo's no-slip solver in balance trials.
 NOSLIP_ITERATIONS = 10
@@ -294,6 +294,7 @@ def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, opt
     impact_force = np.zeros(3)
     fn = 0.0
     extended = False
+    angular_momentum = None
     while True:
         if d.time >= end_time:
             # Still moving at the end: the robot gets extra_time more to come to rest (a slow recovery is no fall).
@@ -344,6 +345,9 @@ def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, opt
                                ("com_velocity_margin", omega * dcm_margin)):
                 series[key].append(value)
             pin.framesForwardKinematics(model, pdata, q)
+            if angular_momentum is None and disturbance_end is not None and t >= disturbance_end:
+                # What the LIPM leaves out: the angular momentum about the CoM the disturbance left.
+                angular_momentum = np.array(pin.computeCentroidalMomentum(model, pdata, q, v).angular)
             if push is not None and t >= push.start:
                 monitor.start_disturbance(push.start)
             pushing = push is not None and push.start <= t < push.start + push.duration
@@ -373,6 +377,7 @@ def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, opt
         approach_speed=impact_speed, max_tilt=monitor.max_tilt, max_slip=monitor.max_slip,
         max_trunk_tilt=monitor.max_trunk_tilt, max_drop=monitor.max_drop, sim_time=t, wall_time=wall,
         contact_names=tuple(contact_names), series=arrays, log=recorder.frame() if recorder is not None else None,
+        angular_momentum_at_end=angular_momentum,
     )
     if tracker is not None and tracker.touched:
         result.impact = tracker.measurement(t, sim.com_velocity(), None if hold is None else hold.to_dict())

@@ -99,6 +99,8 @@ class BalanceTrialResult:
         min_zmp_margin_during: The worst margin of the measured ZMP during the push (m), None if undefined.
         max_tilt, max_slip, max_trunk_tilt, max_drop: Largest contact tilt (rad) and slip (m), base tilt
             (rad) and drop (m) seen.
+        angular_momentum_at_end: Angular momentum about the CoM when the disturbance ended (N m s, world):
+            what the LIPM leaves out (a push above the CoM leaves some).
         sim_time, wall_time: Simulated and wall-clock time (s).
     """
 
@@ -121,6 +123,7 @@ class BalanceTrialResult:
     max_drop: float = 0.0
     sim_time: float = 0.0
     wall_time: float = 0.0
+    angular_momentum_at_end: np.ndarray | None = None
     contact_names: tuple[str, ...] = ()
     series: dict[str, np.ndarray] = field(default_factory=dict)
     log: pd.DataFrame | None = None
@@ -157,6 +160,8 @@ class BalanceTrialResult:
                                                         "no sample after the disturbance"),
             "min_zmp_margin_during": finite_or_null(nulls, "min_zmp_margin_during", self.min_zmp_margin_during,
                                                     "the contacts carried no vertical force (ZMP undefined)"),
+            "angular_momentum_at_end": finite_or_null(nulls, "angular_momentum_at_end", self.angular_momentum_at_end,
+                                                      "the disturbance did not end"),
             "max_tilt_deg": float(np.rad2deg(self.max_tilt)), "max_slip": float(self.max_slip),
             "max_trunk_tilt_deg": float(np.rad2deg(self.max_trunk_tilt)), "max_drop": float(self.max_drop),
             "sim_time": float(self.sim_time), "wall_time": float(self.wall_time),

@@ -115,6 +115,21 @@ class ValidationResult:
         event = min(first.summary["events"], key=lambda e: e["time"])
         return {"measured": first.measured, "commanded": first.speed, "outcome": first.outcome, **event}
 
+    def post_impact(self, trial: ValidationTrial) -> dict | None:
+        """The measured post-impact CoM velocity against the predicted set (composite, the scenario's friction and
+        restitution range) at the measured speed from the measured pre-impact CoM velocity: the set's vertices and
+        the distance from the measurement to it (m/s, 0 inside)."""
+        impact = trial.summary.get("impact")
+        setup = self.extra.get("setup")
+        if impact is None or setup is None or None in (trial.measured, impact["com_velocity_before"],
+                                                        impact["com_velocity_after"]):
+            return None
+        from .measure import distance_to_hull
+
+        vertices = setup.analysis.impact.model.post_impact_com_velocities(impact["com_velocity_before"], trial.measured)
+        after = np.asarray(impact["com_velocity_after"], dtype=float)
+        return {"vertices": vertices.tolist(), "distance": float(distance_to_hull(after, vertices))}
+
     def to_dict(self) -> dict:
         com_max = self.predicted_with_margin["com_criterion"]["composite"]
         trials = []
@@ -126,6 +141,7 @@ class ValidationResult:
                 "reason": s["reason"], "detail": s["detail"], "events": s["events"],
                 "com_criterion_safe": None if t.measured is None or com_max is None else bool(t.measured <= com_max),
                 "com_criterion_safe_in_trial": None if margin_end is None else bool(margin_end >= self.omega * self.zmp_margin),
+                "predicted_post_impact": self.post_impact(t),
                 "trial": s,
             })
         empirical = {**self.bracket(), "tolerance": self.tolerance, "max_speed": self.max_speed}
