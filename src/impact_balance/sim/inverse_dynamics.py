@@ -92,7 +92,7 @@ class InverseDynamicsGains:
 
     rate: float = 500.0
     dcm_gain: float = 2.0
-    zmp_margin: float = 0.005
+    zmp_margin: float = 0.01
     com_height_stiffness: float = 100.0
     com_height_damping: float = 20.0
     angular_momentum_damping: float = 10.0
@@ -113,7 +113,7 @@ class InverseDynamicsGains:
     wrench_regularization: float = 1e-7
     torque_regularization: float = 1e-5
     friction_scale: float = 0.65
-    cop_margin: float = 0.005
+    cop_margin: float = 0.0
     min_normal_force: float = 20.0
     joint_limit_horizon: float = 0.1
 
