@@ -161,7 +161,7 @@ def main() -> int:
     p.add_argument("--scenarios", nargs="+", default=list(IMPACT_SCENARIOS))
     p.add_argument("--push-scenarios", nargs="+", default=list(PUSH_SCENARIOS))
     p.add_argument("--directions", type=int, default=8)
-    p.add_argument("--relative", type=float, nargs="+", default=[0.5, 0.7, 0.85, 1.0, 1.15, 1.3, 1.5])
+    p.add_argument("--relative", type=float, nargs="+", default=[0.5, 0.7, 0.85, 0.95, 1.05, 1.15, 1.3, 1.5])
     p.add_argument("--bodies", nargs="+", default=["torso", "base"], choices=["torso", "base"])
     args = p.parse_args()
     out = Path(args.out)

@@ -101,8 +101,7 @@ def markdown(rows: list[dict], perf: dict) -> str:
                    f"{r['jump_over_composite']:.3f} | {r['jump_over_joint_space']:.2f} | {r['position']:.2f} | "
                    f"{r['palm_impulse']:.2f} / {r['sustained_impulse']:.2f} | {kept} |")
     sources = sorted({(r["robot"], r["armature"]) for r in rows if r["joints"] != "rigid"})
-    out += [f"
-armature of {robot}: {source}" for robot, source in sources]
+    out += [f"\narmature of {robot}: {source}" for robot, source in sources]
     rigid = [r for r in rows if r["joints"] == "rigid"]
     if rigid:
         worst = max(r["composite_relative"] for r in rigid)
