@@ -63,7 +63,8 @@ class _VersionAction(argparse.Action):
                          help=help or "show the program's version number and exit")
 
     def __call__(self, parser, namespace, values, option_string=None):
-        parser.exit(message=f"impact-balance {_version()}\n")
+        print(f"impact-balance {_version()}")  # on stdout, as argparse's own version action
+        parser.exit()
 
 
 class _Parser(argparse.ArgumentParser):
