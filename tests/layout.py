@@ -31,6 +31,11 @@ UNIT = re.compile(r"\(.*\S.*\)|\[.*\S.*\]")
 BACKGROUND = "background"
 
 
+def is_panel(ax: Axes) -> bool:
+    """A drawn panel, not a frameless holder of legends (3D axes keep ``axison`` False)."""
+    return ax.get_visible() and (ax.axison or ax.name == "3d")
+
+
 def _visible_text(t: Text) -> bool:
     return t.get_visible() and bool(t.get_text().strip()) and t.get_alpha() != 0
 
@@ -164,9 +169,7 @@ def layout_problems(fig: Figure, units: bool = True, dpi: float = 120) -> list[s
         if ax.get_visible() and (b.x0 < -SLACK or b.y0 < -SLACK or b.x1 > W + SLACK or b.y1 > H + SLACK):
             problems.append(f"axes {ax.get_title()[:30]!r} is outside the canvas")
     for (k1, o1, a1, b1), (k2, o2, a2, b2) in itertools.combinations(boxes, 2):
-        if k1 == k2 == "tick" and o1 is o2:
-            continue  # tick labels of one axis are spaced by matplotlib
-        if _overlap(b1, b2):
+        if _overlap(b1, b2):  # tick labels of one axis too: a narrow panel crowds them
             problems.append(f"{_name(k1, a1)} overlaps {_name(k2, a2)}")
     # Legends over data.
     for ax in fig.axes:
@@ -185,7 +188,7 @@ def layout_problems(fig: Figure, units: bool = True, dpi: float = 120) -> list[s
                     problems.append(f"{what} covers {int(hit.sum())} points of {label!r}")
     if units:
         for ax in fig.axes:
-            if not ax.get_visible() or not ax.axison:
+            if not is_panel(ax):
                 continue
             for axis in _axes_axis(ax):
                 if not axis.get_visible():
@@ -199,3 +202,24 @@ def layout_problems(fig: Figure, units: bool = True, dpi: float = 120) -> list[s
 def assert_layout(fig: Figure, units: bool = True) -> None:
     problems = layout_problems(fig, units=units)
     assert not problems, "\n".join(problems)
+
+
+def largest_gap(fig: Figure) -> tuple[float, float]:
+    """The widest blank band across the figure, as fractions of its width and of its height.
+
+    The bands between the boxes of everything drawn (axes as shrunk by their aspect, texts,
+    legends), along x and along y, the canvas' edges included.
+    """
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    boxes = [ax.get_window_extent(renderer) for ax in fig.axes if is_panel(ax)]
+    boxes += [_box(artist, renderer) for _, _, artist in _texts(fig)]
+    out = []
+    for lo_attr, hi_attr, size in (("x0", "x1", fig.bbox.width), ("y0", "y1", fig.bbox.height)):
+        spans = sorted((max(0.0, getattr(b, lo_attr)), min(size, getattr(b, hi_attr))) for b in boxes)
+        gap, reach = 0.0, 0.0
+        for lo, hi in spans:
+            gap = max(gap, lo - reach)
+            reach = max(reach, hi)
+        out.append(max(gap, size - reach) / size)
+    return out[0], out[1]

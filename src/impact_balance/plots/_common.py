@@ -32,6 +32,9 @@ def new_figure(width: float, height: float) -> Figure:
     functions are safe in scripts, tests and notebooks alike; ``fig.savefig`` renders with Agg.
     """
     fig = Figure(figsize=(width, height), layout="constrained")
+    # A wider margin than the default (3 pt): a legend anchored outside its axes otherwise
+    # ends on the canvas' edge, where its frame is cut.
+    fig.get_layout_engine().set(w_pad=0.06, h_pad=0.06)
     FigureCanvasAgg(fig)
     return fig
 

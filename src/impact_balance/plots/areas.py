@@ -9,6 +9,7 @@ import numpy as np
 from matplotlib import colormaps
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from ..analysis import Analysis
 from ._common import (
@@ -89,6 +90,7 @@ def draw_zmp_area(ax: Axes, analysis: Analysis) -> None:
     ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
+    ax.xaxis.set_major_locator(MaxNLocator(5))  # a narrow panel crowds the default ticks
     ax.set_title(f"ZMP support area (plane z = {areas.plane_height:g} m)")
     ax.grid(True, alpha=0.3)
     # Below the axes: a legend inside would cover the area's boundary.
@@ -190,6 +192,7 @@ def draw_com_velocity_area(ax: Axes, analysis: Analysis, n_steps: int = 5, side:
     ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel(r"$\dot c_x$ (m/s)")
     ax.set_ylabel(r"$\dot c_y$ (m/s)")
+    ax.xaxis.set_major_locator(MaxNLocator(6))
     ax.set_title("CoM velocity area and post-impact CoM velocities")
     ax.grid(True, alpha=0.3)
     handles, labels = ax.get_legend_handles_labels()
@@ -219,8 +222,14 @@ def plot_areas(analysis: Analysis, n_steps: int = 5) -> Figure:
     draw_com_velocity_area(right, analysis, n_steps, side=side)
     # Height from the data: both axes have an equal aspect, so a flat area in a fixed-height
     # figure leaves bands of blank space above and below it.
+    # Panels as wide as their data at a common height: fixed ratios left a blank band beside
+    # a narrow (tall) area.
     ratio = max(_aspect(left), _aspect(right), 0.75 if analysis.cannot_balance_reason is not None else 0.0)
-    fig.set_figheight(float(np.clip(4.2 * ratio + 2.6, 4.0, 9.0)))
+    height = float(np.clip(4.2 * ratio + 2.6, 4.0, 9.0))
+    axes_height = height - 2.2  # titles, tick labels and the legend below the left panel
+    widths = [axes_height / _aspect(left), axes_height / _aspect(right), 3.0]  # inches; 3 for the legend
+    left.get_gridspec().set_width_ratios(widths)
+    fig.set_size_inches(float(np.clip(sum(widths) + 1.8, 10.0, 20.0)), height)
     why = short_reason(analysis)
     verdict = f"cannot balance because of the {why}" if why else analysis.verdict
     fig.suptitle(f"Balance areas: {scenario_title(analysis)} - {verdict}", fontsize=12)

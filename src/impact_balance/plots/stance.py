@@ -177,7 +177,8 @@ def plot_stance(analysis: Analysis, robot: bool = True) -> Figure:
     # the figure as wide as both: fixed ratios left a wide blank gap between the views.
     widths = [_aspect_width(ax) for ax in (top, side)]
     top.get_gridspec().set_width_ratios(widths)
-    fig.set_figwidth(float(np.clip(4.9 * sum(widths) + 1.6, 8.0, 16.0)))
+    axes_height = min(4.9, 13.4 / sum(widths))  # inches; lower for wide views, within 15 in
+    fig.set_size_inches(max(8.0, axes_height * sum(widths) + 1.6), axes_height + 2.3)
     handles, labels = side.get_legend_handles_labels()
     th, tl = top.get_legend_handles_labels()
     for hnd, lab in zip(th, tl):
