@@ -152,3 +152,14 @@ def test_json_answer_without_extras_is_strict():
     """)
     assert r.returncode == 0, r.stderr
     assert json.loads(r.stdout)["verdict"] == "balanced"
+
+
+def test_readme_test_command_is_what_ci_runs():
+    """README's second command (after the venv) and .ci/run install and test the same way."""
+    readme = (ROOT / "README.md").read_text()
+    block = readme.split("```bash", 1)[1].split("```", 1)[0]
+    lines = [line for line in block.splitlines() if line and not line.startswith("#")]
+    assert 'pip install ".[all]"' in lines[0]  # the first command installs everything
+    test_command = lines[1].split("&& ", 2)[2]  # after "python3 -m venv .venv && . .venv/bin/activate &&"
+    ci = (ROOT / ".ci" / "run").read_text()
+    assert test_command.strip() in ci
