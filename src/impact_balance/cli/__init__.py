@@ -94,7 +94,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     module = owners[args.command]
     if getattr(module, "USES_KERNEL", False) and not _kernel_is_compiled():
-        print("impact-balance: compiling the projection kernel (first run only, 10-30 s; cached afterwards) ...",
+        print("impact-balance: compiling the projection kernel (first run only, 0.5 to 1.5 min; cached afterwards) ...",
               file=sys.stderr, flush=True)
     try:
         require_for(args.command, args)  # a missing optional part is one line naming its extra
