@@ -94,12 +94,13 @@ def plot_time_series(result, title: str) -> Figure:
     fig = new_figure(9.0, 6.4)
     ax_f, ax_v = fig.subplots(2, 1, sharex=True)
     t = record.time
+    others = iter(("tab:blue", "tab:orange", "tab:brown", "tab:olive", "tab:cyan", "tab:pink"))
     for name, force in record.forces.items():
         label = "impact point" if name == "impact" else f"contact {name}"
-        ax_f.plot(t, np.linalg.norm(force, axis=1), label=label, color=IMPACT_COLOR if name == "impact" else None)
+        ax_f.plot(t, np.linalg.norm(force, axis=1), label=label, color=IMPACT_COLOR if name == "impact" else next(others, None))
     ax_f.set_ylabel("contact force |f| (N)")
-    for k, axis in enumerate("xy"):
-        ax_v.plot(t, record.com_velocity[:, k], label=f"CoM velocity {axis}")
+    for k, (axis, color) in enumerate(zip("xy", ("tab:green", "tab:purple"))):  # not the forces' colours:
+        ax_v.plot(t, record.com_velocity[:, k], label=f"CoM velocity {axis}", color=color)  # one legend
     ax_v.set_ylabel("CoM velocity (m/s)")
     ax_v.set_xlabel("time (s)")
     t0, t1 = result.impact_time
