@@ -39,7 +39,7 @@ import impact_balance as ib
 
 # The benchmark's modules live in speed/, beside this file (on sys.path as the script's folder).
 from speed.checks import answer_checks
-from speed.machine import machine_info
+from speed.machine import load_average, machine_info
 from speed.profiling import profile_report, profile_text
 from speed.projection import pypoman
 from speed.report import text_report
@@ -96,6 +96,7 @@ def main(argv: list[str] | None = None) -> int:
 
         result["sweep"] = measure_sweep(quick=True)
     result["wall_time_s"] = time.perf_counter() - t_start
+    result["machine"]["load_average_after"] = load_average()
 
     if args.json:
         print(json.dumps(result, indent=1, default=float))
@@ -103,7 +104,9 @@ def main(argv: list[str] | None = None) -> int:
         print(text_report(result, args))
         if args.profile:
             print(profile_text(result["profile"]))
-        print(f"\n(wall time {result['wall_time_s']:.0f} s)")
+        m = result["machine"]
+        print(f"\n(wall time {result['wall_time_s']:.0f} s; load average before "
+              f"{' '.join(map(str, m['load_average_before']))}, after {' '.join(map(str, m['load_average_after']))})")
     return 0 if result["checks"]["ok"] else 1
 
 

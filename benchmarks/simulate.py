@@ -21,6 +21,7 @@ Targets: ``rigid``: distance to ``composite`` <= 2 % of the jump everywhere; sta
 from __future__ import annotations
 
 import argparse
+import os
 import json
 import platform
 import sys
@@ -127,13 +128,17 @@ def main() -> int:
     p.add_argument("--no-speed", action="store_true", help="skip the speed measurement")
     args = p.parse_args()
     scenarios = args.scenarios.split(",") if args.scenarios else None
+    load_before = [round(x, 2) for x in os.getloadavg()]  # the machine is shared: say how busy it was
     rows = accuracy([float(s) for s in args.speeds.split(",")], args.joints.split(","), args.armature, scenarios)
     perf = None if args.no_speed else speed()
+    load_after = [round(x, 2) for x in os.getloadavg()]
     if args.json:
         print(json.dumps({"machine": platform.processor() or platform.machine(), "mujoco": mujoco.__version__,
+                          "load_average_before": load_before, "load_average_after": load_after,
                           "trials": rows, "speed": perf}))
     else:
         print(markdown(rows, perf))
+        print(f"\nload average before {' '.join(map(str, load_before))}, after {' '.join(map(str, load_after))}")
     return 0
 
 

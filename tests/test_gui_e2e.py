@@ -80,6 +80,22 @@ def test_page_shows_the_maximum_contact_velocity(page, app):
     assert page.locator("svg").filter(has_text="CoM velocity area").count() >= 1  # the 2D view
 
 
+def test_2d_view_fits_its_panel(page, app):
+    """At 1500 x 950 px the 2D view is whole: inside the window and clear of the panel's
+    scroll bar, its texts (maxima, axis labels) within the drawing."""
+    svg = page.locator("svg").filter(has_text="CoM velocity area").first
+    box = svg.bounding_box()
+    width = page.viewport_size["width"]
+    assert box["x"] >= 0 and box["x"] + box["width"] <= width - 12, box  # the scroll bar: ~10 px
+    overflow = svg.evaluate("""(svg) => {
+        const r = svg.getBoundingClientRect();
+        return Array.from(svg.querySelectorAll('text')).map((t) => t.getBoundingClientRect())
+            .filter((b) => b.left < r.left - 1 || b.right > r.right + 1).length;
+    }""")
+    assert overflow == 0
+    assert svg.locator("text", has_text="CoM velocity y (m/s)").count() == 1
+
+
 def test_editing_a_field_recomputes_and_redraws(page, app, tmp_path):
     before = vmax_text(page)
     page.screenshot(path=str(tmp_path / "gui_before.png"))

@@ -51,3 +51,32 @@ def test_timings_say_what_they_measure():
     assert text.startswith("analysis 0.8 ms; not included: scenario loading 0.3 ms")
     assert "robot model loading 250 ms (first use)" in text and "kernel loading 400 ms (first call)" in text
     assert format_timings({"total": 0.0008, "robot_loading": 1e-6}) == "analysis 0.8 ms"
+
+
+def test_scenario_cache_follows_every_file_of_the_chain(tmp_path):
+    """The validated scenario is cached by the text of each file of its extends chain: the same
+    object while nothing changed; a new one when the file or its parent changes, even with the
+    same size and modification time."""
+    parent, child = tmp_path / "parent.yaml", tmp_path / "child.yaml"
+    parent.write_text("extends: palm_push_two_feet\ncom_velocity: [0.1, 0.0]\n")
+    child.write_text("extends: parent.yaml\nplane_height: 0.0\n")
+    first = load_scenario(child)
+    assert load_scenario(child) is first and first.com_velocity == (0.1, 0.0)
+    stat = parent.stat()
+    parent.write_text("extends: palm_push_two_feet\ncom_velocity: [0.2, 0.0]\n")  # same size
+    os.utime(parent, ns=(stat.st_atime_ns, stat.st_mtime_ns))  # and the same time stamp
+    second = load_scenario(child)
+    assert second is not first and second.com_velocity == (0.2, 0.0)
+    # A broken parent is reported as before (the cache never hides an error).
+    parent.write_text("extends: palm_push_two_feet\ncom_velocity: [0.2]\n")
+    import pytest
+
+    with pytest.raises(ib.ScenarioError, match="com_velocity"):
+        load_scenario(child)
+
+
+def test_bundled_name_and_loaded_scenario_analyse_alike():
+    by_name = ib.analyze("palm_push_ramp")
+    loaded = ib.analyze(ib.load_scenario("palm_push_ramp"))
+    assert ib.load_scenario("palm_push_ramp") is ib.load_scenario("palm_push_ramp")
+    assert by_name.to_dict()["impact"]["max_contact_velocity"] == loaded.to_dict()["impact"]["max_contact_velocity"]

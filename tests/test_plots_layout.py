@@ -18,10 +18,10 @@ def test_areas_figure_keeps_the_areas_clear(name):
     fig = plot_areas(ib.analyze(name))
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
-    axes = [ax for ax in fig.axes if ax.get_visible()]
+    axes = [ax for ax in fig.axes if ax.get_visible() and ax.axison]  # not the legends' column
     boxes = [ax.get_window_extent(renderer) for ax in axes]
-    notes = [ax.get_legend().get_window_extent(renderer) for ax in axes if ax.get_legend()]
-    notes += [t.get_window_extent(renderer) for ax in axes for t in ax.texts]
+    notes = [ax.get_legend().get_window_extent(renderer) for ax in fig.axes if ax.get_legend()]
+    notes += [t.get_window_extent(renderer) for ax in fig.axes for t in ax.texts]
     assert len(notes) >= 3  # two legends and the info box
     for note in notes:
         for box in boxes:

@@ -8,7 +8,12 @@ import platform
 import sys
 from typing import Any
 
-__all__ = ["machine_info"]
+__all__ = ["machine_info", "load_average"]
+
+
+def load_average() -> list[float]:
+    """The 1, 5 and 15 minute load averages (``/proc/loadavg``): the machine is shared."""
+    return [round(x, 2) for x in os.getloadavg()]
 
 
 def machine_info() -> dict[str, Any]:
@@ -34,6 +39,7 @@ def machine_info() -> dict[str, Any]:
         "cpu_count": os.cpu_count(),
         "affinity": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else None,
         "python": sys.version.split()[0],
+        "load_average_before": load_average(),
         "versions": {d: version(d) for d in ("impact-balance", "numpy", "scipy", "numba", "highspy", "pin", "pypoman", "cvxopt")},
     }
     try:  # pypoman is a test extra of the project

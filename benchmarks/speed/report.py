@@ -28,7 +28,8 @@ def table(headers: list[str], rows: list[list[str]]) -> str:
 def text_report(result: dict[str, Any], args) -> str:
     out = []
     m = result["machine"]
-    out.append(f"Machine: {m['cpu']}, {m['cpu_count']} CPUs; {m['platform']}; Python {m['python']}")
+    out.append(f"Machine: {m['cpu']}, {m['cpu_count']} CPUs; {m['platform']}; Python {m['python']}; "
+               f"load average {' '.join(map(str, m.get('load_average_before', [])))} at the start")
     out.append("Versions: " + ", ".join(f"{k} {v}" for k, v in m["versions"].items()) + f"; pypoman LP solver: {m.get('pypoman_lp_solver')}")
     s = result["settings"]
     out.append(f"Repeats: {s['repeat']} (cheap calls {s['repeat_cheap']}), warm-up {s['warmup']}; times in us, median (p10-p90)")

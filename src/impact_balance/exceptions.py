@@ -40,6 +40,7 @@ __all__ = [
     "SimulationError",
     "SweepError",
     "UnknownPathError",
+    "MissingExtraError",
 ]
 
 #: Longest shown repr of a value in a message (characters).
@@ -323,3 +324,18 @@ class UnknownPathError(UnknownNameError):
     """A sweep axis path names a scenario key that does not exist; lists the valid paths."""
 
     kind = "key"
+
+
+class MissingExtraError(ImpactBalanceError, ImportError):
+    """An optional part of impact-balance is not installed (``pip install 'impact-balance[EXTRA]'``).
+
+    Attributes:
+        what: What needs it: a command (``simulate``) or an option (``--plots``).
+        extra: The extra that installs it (``sim``, ``gui``, ``sweep``, ``plots``, ``logs``).
+        missing: The Python modules that could not be imported.
+    """
+
+    def __init__(self, what: str, extra: str, missing: Sequence[str]):
+        self.what, self.extra, self.missing = what, extra, tuple(missing)
+        super().__init__(f"{what} needs the {extra!r} extra: pip install 'impact-balance[{extra}]' "
+                         f"({', '.join(self.missing)} not installed)")

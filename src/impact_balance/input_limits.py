@@ -41,6 +41,7 @@ __all__ = [
     "MAX_EXTENDS",
     "parse_yaml",
     "read_yaml",
+    "read_text",
     "check_structure",
     "check_path_text",
 ]
@@ -177,8 +178,8 @@ def _parse_cached(text: str, source: str) -> Any:
         loader.dispose()
 
 
-def read_yaml(path: Path) -> Any:
-    """Read and parse a scenario file within the limits (:class:`ScenarioError` otherwise)."""
+def read_text(path: Path) -> str:
+    """A scenario file's text, within the size limit (:class:`ScenarioError` otherwise)."""
     check_path_text("scenario", str(path))
     try:
         with open(path, "rb") as f:
@@ -188,10 +189,14 @@ def read_yaml(path: Path) -> Any:
     if len(data) > MAX_BYTES:
         raise ScenarioError("scenario", str(path), f"larger than {MAX_BYTES // 1000} kB, the limit for a scenario file")
     try:
-        text = data.decode("utf-8")
+        return data.decode("utf-8")
     except UnicodeDecodeError:
         raise ScenarioError("scenario", str(path), "cannot read: not UTF-8 text") from None
-    return parse_yaml(text, str(path))
+
+
+def read_yaml(path: Path) -> Any:
+    """Read and parse a scenario file within the limits (:class:`ScenarioError` otherwise)."""
+    return parse_yaml(read_text(path), str(path))
 
 
 def check_structure(raw: Any, source: str | None = None) -> None:

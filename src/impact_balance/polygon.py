@@ -7,7 +7,6 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-from scipy.spatial import ConvexHull, QhullError
 
 from ._jit import njit
 
@@ -239,6 +238,8 @@ class Polygon:
         points = np.asarray(points, dtype=float).reshape(-1, 2)
         if len(points) == 0:
             return cls.empty()
+        from scipy.spatial import ConvexHull, QhullError  # here: ~0.2 s to import, not needed to analyze
+
         try:
             hull = ConvexHull(points)
             return cls(simplify(points[hull.vertices], tol))  # qhull returns 2D hulls CCW

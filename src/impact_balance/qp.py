@@ -20,7 +20,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import qpsolvers
 
 from .exceptions import SolverError
 from .impact import ImpactModel
@@ -144,6 +143,8 @@ def solve_contact_velocity_qp(
     lb[nv:] = 0.0
     ub = np.full(nx, np.inf)
     tolerances = {"eps_abs": 1e-10, "eps_rel": 0.0} if options.solver == "proxqp" else {}
+    import qpsolvers  # here: its import takes ~0.4 s, and a plain analysis does not solve this QP
+
     try:
         x = qpsolvers.solve_qp(P, q, Gin, hin, Aeq, beq, lb, ub, solver=options.solver, **tolerances)
     except (qpsolvers.SolverNotFound, qpsolvers.SolverError, ValueError) as exc:
@@ -168,6 +169,8 @@ def static_torques(stance: Stance, polytope: WrenchPolytope) -> np.ndarray:
     weight = polytope.weight
     target = np.concatenate([[0.0, 0.0, weight], np.cross(stance.com, [0.0, 0.0, weight])])
     cwc = slice(0, polytope.n_cwc_rows)
+    import qpsolvers
+
     try:
         w = qpsolvers.solve_qp(
             np.eye(n), np.zeros(n), polytope.A[cwc], polytope.b[cwc], polytope.grasp, target, solver="daqp"

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import contextlib
 import functools
-import importlib.metadata
 import math
 import os
 import sys
@@ -80,6 +79,8 @@ BUNDLED_ROBOTS: dict[str, RobotSpec] = {
 
 def example_robot_data_root() -> Path:
     """Folder holding example-robot-data's ``robots/`` tree (installed by its wheel)."""
+    import importlib.metadata  # here: `impact-balance robots` lists names without it
+
     try:
         dist = importlib.metadata.distribution("example-robot-data")
     except importlib.metadata.PackageNotFoundError as exc:  # pragma: no cover - install issue

@@ -10,13 +10,12 @@ status 141, what a shell reports for a command stopped by SIGPIPE.
 from __future__ import annotations
 
 import argparse
-import importlib.metadata
 import os
 import sys
 from types import ModuleType
 
 from ..exceptions import ImpactBalanceError, one_line
-from ..projection.walk import kernel_is_compiled
+from ..extras import require_for
 from . import analyze, check_log, demo, frames, gui, listing, phase_portrait, push_test, simulate, sweep, validate
 from .demo import DEMO_SCENARIOS, FRICTION_SWEEP
 
@@ -29,7 +28,16 @@ COMMANDS: tuple[ModuleType, ...] = (demo, analyze, phase_portrait, listing, fram
 EXIT_BROKEN_PIPE = 141
 
 
+def _kernel_is_compiled() -> bool:
+    # Imported here: the kernel's module brings numba and scipy, which `robots` does not need.
+    from ..projection.walk import kernel_is_compiled
+
+    return kernel_is_compiled()
+
+
 def _version() -> str:
+    import importlib.metadata  # here: only --version reads it (the import costs ~50 ms)
+
     try:
         return importlib.metadata.version("impact-balance")
     except importlib.metadata.PackageNotFoundError:  # pragma: no cover - run from a source tree
@@ -47,6 +55,18 @@ def _stdout_closed() -> int:
     return EXIT_BROKEN_PIPE
 
 
+class _VersionAction(argparse.Action):
+    """``--version``, looked up only when asked for."""
+
+    def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS, help=None):
+        super().__init__(option_strings, dest, default=default, nargs=0,
+                         help=help or "show the program's version number and exit")
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(f"impact-balance {_version()}")  # on stdout, as argparse's own version action
+        parser.exit()
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse, with the project's error rule: a usage error is one line on stderr, exit 2
     (argparse's default prints the whole usage block first)."""
@@ -60,7 +80,7 @@ def _parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
         prog="impact-balance",
         description="Impact-aware multi-contact balance: CoM velocity area and maximum contact velocity.",
     )
-    p.add_argument("--version", action="version", version=f"impact-balance {_version()}")
+    p.add_argument("--version", action=_VersionAction)
     sub = p.add_subparsers(dest="command", required=True)
     owners: dict[str, ModuleType] = {}
     for module in COMMANDS:
@@ -73,10 +93,11 @@ def main(argv: list[str] | None = None) -> int:
     parser, owners = _parser()
     args = parser.parse_args(argv)
     module = owners[args.command]
-    if getattr(module, "USES_KERNEL", False) and not kernel_is_compiled():
-        print("impact-balance: compiling the projection kernel (first run only, 10-30 s; cached afterwards) ...",
+    if getattr(module, "USES_KERNEL", False) and not _kernel_is_compiled():
+        print("impact-balance: compiling the projection kernel (first run only, 0.5 to 1.5 min; cached afterwards) ...",
               file=sys.stderr, flush=True)
     try:
+        require_for(args.command, args)  # a missing optional part is one line naming its extra
         status = module.run(args)
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at exit
         return status

@@ -5,8 +5,6 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-import numpy as np
-
 __all__ = ["add_parser", "run", "DEMO_SCENARIOS", "FRICTION_SWEEP", "USES_KERNEL"]
 
 USES_KERNEL = True
@@ -57,6 +55,6 @@ def run(args: argparse.Namespace) -> int:
         print(f"\n{len(written)} figures written to {out}/")
     from ..lipm import com_velocity_bounds
 
-    bounds = np.round(com_velocity_bounds(0.78, (-0.13, 0.13)), 4)
+    bounds = [round(float(b), 4) for b in com_velocity_bounds(0.78, (-0.13, 0.13))]
     print(f"LIPM check (paper sec. III-B): c_z 0.78 m, ZMP in [-0.13, 0.13] m -> CoM velocity in [{bounds[0]}, {bounds[1]}] m/s")
     return 0

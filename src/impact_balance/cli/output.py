@@ -12,8 +12,6 @@ import math
 import sys
 from typing import Any
 
-import numpy as np
-
 from ..exceptions import ImpactBalanceError
 
 __all__ = ["print_json", "progress_bar", "NonFiniteOutputError"]
@@ -47,6 +45,8 @@ def _non_finite_path(obj: Any, path: str = "") -> str | None:
 
 def _plain(obj: Any) -> Any:
     """numpy arrays and scalars as plain lists and numbers (json knows neither)."""
+    import numpy as np  # here: `impact-balance scenarios` imports this module and needs no numpy
+
     if isinstance(obj, np.ndarray):
         return obj.tolist()
     if isinstance(obj, np.generic):

@@ -117,7 +117,8 @@ class _Panel:
 
         self.ops.append(draw)
 
-    def axes(self, unit: str) -> str:
+    def axes(self, unit: tuple[str, str]) -> str:
+        """Frame, grid, tick values, and the axis labels ``unit`` = (x label, y label) with units."""
         xmin, xmax, ymin, ymax = self.world_bounds()
         step = _nice_step(max(xmax - xmin, ymax - ymin), 6)
         out = [f'<rect x="{self.x0}" y="{self.y0}" width="{self.width}" height="{self.height}" fill="white" stroke="{PANEL_COLORS["axis"]}"/>']
@@ -138,11 +139,16 @@ class _Panel:
                     out.append(f'<text x="{self.x0 - 4}" y="{y + 3:.1f}" font-size="10" text-anchor="end" '
                                f'fill="#555">{_fmt_tick(v, step)}</text>')
                 k += 1
-        out.append(f'<text x="{self.x0 + self.width}" y="{self.y0 + self.height + 24}" font-size="10" '
-                   f'text-anchor="end" fill="#555">{html.escape(unit)}</text>')
+        xlabel, ylabel = unit
+        out.append(f'<text x="{self.x0 + self.width / 2:.1f}" y="{self.y0 + self.height + 26}" font-size="11" '
+                   f'text-anchor="middle" fill="#333">{html.escape(xlabel)}</text>')
+        # The y label, turned along the axis, left of the tick values.
+        cx, cy = self.x0 - 40, self.y0 + self.height / 2
+        out.append(f'<text x="{cx:.1f}" y="{cy:.1f}" font-size="11" text-anchor="middle" fill="#333" '
+                   f'transform="rotate(-90 {cx:.1f} {cy:.1f})">{html.escape(ylabel)}</text>')
         return "\n".join(out)
 
-    def render(self, unit: str) -> str:
+    def render(self, unit: tuple[str, str]) -> str:
         """Fit the limits to every queued point, then draw the axes and the queued items."""
         self.fit()
         clip = f"clip{int(self.x0)}_{int(self.y0)}"
@@ -182,7 +188,7 @@ def svg_view(analysis: Analysis, width: int = 420) -> str:
     """The 2D view of ``analysis`` as an ``<svg>`` element (scales to its container's width)."""
     summary = Summary.of(analysis)
     areas = analysis.areas
-    margin_left, pad = 44, 8
+    margin_left, pad = 62, 8  # room for the tick values and the turned y label
     plot_w = width - margin_left - pad
     plot_h = int(0.85 * plot_w)
     parts: list[str] = []
@@ -225,11 +231,11 @@ def svg_view(analysis: Analysis, width: int = 420) -> str:
             legend.append(("dot", PANEL_COLORS["limit"], f"limiting vertex #{limit.limiting_vertex}"))
     top.dot(c0, PANEL_COLORS["com"], 4)
     legend.append(("dot", PANEL_COLORS["com"], f"pre-impact CoM velocity ({c0[0]:.2f}, {c0[1]:.2f}) m/s"))
-    parts.append(top.render("ċ (m/s)"))
+    parts.append(top.render(("ċx, CoM velocity x (m/s)", "ċy, CoM velocity y (m/s)")))
     if area.is_empty:
         parts.append(_text(margin_left + plot_w / 2, y + plot_h / 2, "cannot balance", 18, PANEL_COLORS["falls"],
                            "bold", "middle"))
-    y += plot_h + 30
+    y += plot_h + 40
     svg, y = _legend(margin_left, y, legend)
     parts.append(svg)
 
@@ -253,13 +259,16 @@ def svg_view(analysis: Analysis, width: int = 420) -> str:
     com = np.asarray(areas.com, dtype=float)[:2]
     bottom.dot(com, PANEL_COLORS["com"], 4, "white", 2)
     legend.append(("dot", PANEL_COLORS["com"], f"CoM projection ({com[0]:.3f}, {com[1]:.3f}) m"))
-    parts.append(bottom.render("x, y (m)"))
+    parts.append(bottom.render(("x (m)", "y (m)")))
     if zmp.is_empty:
         parts.append(_text(margin_left + plot_w / 2, y + plot_h / 2, "cannot balance", 18, PANEL_COLORS["falls"],
                            "bold", "middle"))
-    y += plot_h + 30
+    y += plot_h + 40
     svg, y = _legend(margin_left, y, legend)
     parts.append(svg)
     height = int(y + 4)
-    return (f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {width} {height}" width="100%" '
-            f'style="font-family: sans-serif; background: white">' + "\n".join(parts) + "</svg>")
+    # Inside a box that keeps clear of the panel's scroll bar (which otherwise covers the right
+    # edge of the drawing: the maxima and the x labels were cut at a 1500 px wide window).
+    return (f'<div style="box-sizing: border-box; width: 100%; padding-right: 16px">'
+            f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {width} {height}" width="100%" '
+            f'style="font-family: sans-serif; background: white; display: block">' + "\n".join(parts) + "</svg></div>")

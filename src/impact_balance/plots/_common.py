@@ -32,6 +32,9 @@ def new_figure(width: float, height: float) -> Figure:
     functions are safe in scripts, tests and notebooks alike; ``fig.savefig`` renders with Agg.
     """
     fig = Figure(figsize=(width, height), layout="constrained")
+    # A wider margin than the default (3 pt): a legend anchored outside its axes otherwise
+    # ends on the canvas' edge, where its frame is cut.
+    fig.get_layout_engine().set(w_pad=0.06, h_pad=0.06)
     FigureCanvasAgg(fig)
     return fig
 
@@ -129,3 +132,17 @@ def area_view_points(polygon: Polygon, extra: Sequence[np.ndarray] = ()) -> list
     if polygon.bounded and not polygon.is_empty:
         out.append(polygon.vertices)
     return out
+
+
+def trim_height(fig: Figure, axes: Sequence[Axes], passes: int = 2) -> None:
+    """Shrink the figure's height to what its equal-aspect ``axes`` (one row) use.
+
+    Constrained layout gives each axes a cell; an equal aspect then shrinks the axes inside it
+    and leaves blank bands above and below. The height is reduced by the smallest band.
+    """
+    for _ in range(passes):
+        fig.canvas.draw()
+        spare = min(ax.get_position(original=True).height - ax.get_position(original=False).height for ax in axes)
+        if spare * fig.get_figheight() < 0.05:
+            return
+        fig.set_figheight(fig.get_figheight() * (1.0 - spare) + 0.02)

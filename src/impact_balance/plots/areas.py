@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import math
+import textwrap
 
 import numpy as np
 from matplotlib import colormaps
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from ..analysis import Analysis
 from ._common import (
@@ -26,7 +28,39 @@ from ._common import (
     set_limits,
 )
 
-__all__ = ["plot_areas", "draw_zmp_area", "draw_com_velocity_area"]
+__all__ = ["plot_areas", "draw_zmp_area", "draw_com_velocity_area", "short_reason"]
+
+
+def short_reason(analysis: Analysis) -> str | None:
+    """Why the robot cannot balance, in a few words for a title (None when it can)."""
+    reason = analysis.cannot_balance_reason
+    if reason is None:
+        return None
+    if reason.kind == "torque_limits":
+        scaled = [j for j in reason.binding_joints if j.min_scale is not None]
+        if scaled:
+            return f"torque limits ({scaled[0].joint} x{scaled[0].min_scale:.2g})"
+        if reason.uniform_scale is not None:
+            return f"torque limits (all x{reason.uniform_scale:.2g})"
+        return "torque limits"
+    if reason.kind == "friction":
+        return "friction" + (f" (needs μ ≥ {reason.min_friction:.2g})" if reason.min_friction is not None else "")
+    if reason.kind == "com_outside":
+        return "CoM outside the static-equilibrium region"
+    return reason.kind.replace("_", " ")
+
+
+def _headroom(ax: Axes, fraction: float = 0.3) -> None:
+    """Raise the top of the view by ``fraction`` of its height: room for the message above the data."""
+    y0, y1 = ax.get_ylim()
+    ax.set_ylim(y0, y1 + fraction * (y1 - y0))
+
+
+def _cannot_balance(ax: Axes, analysis: Analysis, what: str) -> None:
+    why = short_reason(analysis)
+    # High in the axes: the CoM projection and the contacts stay visible below it.
+    centre_message(ax, f"cannot balance: empty {what}" + (f"\nbecause of the {why}" if why else ""), y=0.9,
+                   fontsize=11)
 
 
 def draw_zmp_area(ax: Axes, analysis: Analysis) -> None:
@@ -40,7 +74,7 @@ def draw_zmp_area(ax: Axes, analysis: Analysis) -> None:
         draw_polygon(ax, hull(corners), color=CONTACT_COLOR, lw=1.4, ls="--", zorder=2, fill=False,
                      label="contact rectangles (projected)" if i == 0 else None)
     if zmp.is_empty:
-        centre_message(ax, "cannot balance:\nempty ZMP support area")
+        _cannot_balance(ax, analysis, "ZMP support area")
     else:
         if zmp.bounded:
             label = f"ZMP support area ({zmp.area * 1e4:.0f} cm$^2$)"
@@ -51,24 +85,31 @@ def draw_zmp_area(ax: Axes, analysis: Analysis) -> None:
     ax.plot(*com, "o", color=COM_COLOR, ms=7, mfc="white", mew=2, label="CoM projection", zorder=5)
     view.append(com)
     set_limits(ax, area_view_points(zmp, view), margin=0.15, min_ratio=0.3)
+    if zmp.is_empty:
+        _headroom(ax)
     ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
+    ax.xaxis.set_major_locator(MaxNLocator(5))  # a narrow panel crowds the default ticks
     ax.set_title(f"ZMP support area (plane z = {areas.plane_height:g} m)")
     ax.grid(True, alpha=0.3)
     # Below the axes: a legend inside would cover the area's boundary.
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.0), borderaxespad=4.8, fontsize=8, framealpha=0.9, ncol=2)
 
 
-def draw_com_velocity_area(ax: Axes, analysis: Analysis, n_steps: int = 5) -> None:
-    """CoM velocity area, pre-impact CoM velocity and post-impact sets for increasing speeds."""
+def draw_com_velocity_area(ax: Axes, analysis: Analysis, n_steps: int = 5, side: Axes | None = None) -> None:
+    """CoM velocity area, pre-impact CoM velocity and post-impact sets for increasing speeds.
+
+    The legend and the note (maxima, impact parameters, why the robot cannot balance) go in
+    ``side``, an axes without frame beside ``ax`` (default: right of ``ax``, outside it).
+    """
     areas = analysis.areas
     area = areas.com_velocity_area
     c0 = analysis.com_velocity[:2]
     view: list[np.ndarray] = [c0]
     lines = []
     if area.is_empty:
-        centre_message(ax, "cannot balance:\nempty CoM velocity area")
+        _cannot_balance(ax, analysis, "CoM velocity area")
     else:
         label = f"CoM velocity area ({len(area.vertices)} vertices)"
         if not area.bounded:
@@ -111,8 +152,14 @@ def draw_com_velocity_area(ax: Axes, analysis: Analysis, n_steps: int = 5) -> No
         if v_ref is not None and limit.is_finite and v_ref > vmax + 1e-12:
             pts = model.post_impact_com_velocities(c0, v_ref)
             view.append(pts)
-            draw_polygon(ax, hull(pts), color=FALL_COLOR, alpha=0.2, edge=FALL_COLOR, lw=1.8, ls="--",
-                         label=f"at the reference {v_ref:.3g} m/s: falls", zorder=4)
+            # An outline on top of the v_max set (no fill): when the reference is close to
+            # v_max the two sets nearly coincide, and a filled red set would hide the other.
+            above = 100.0 * (v_ref / vmax - 1.0) if vmax > 0 else math.inf
+            lab = f"at the reference {v_ref:.3g} m/s: falls"
+            if above < 10.0:
+                lab += f"\n(only {above:.1f} % above v_max: nearly the same set)"
+            draw_polygon(ax, hull(pts), color=FALL_COLOR, fill=False, edge=FALL_COLOR, lw=1.3, ls=(0, (4, 2)),
+                         label=lab, zorder=6)
         lines.append("maximum approach speed:")
         lines.append(f"  CoM criterion: {fmt_speed(vmax)}")
         lines.append(f"  ZMP criterion: {fmt_speed(im.zmp_max_contact_velocity)}")
@@ -127,19 +174,33 @@ def draw_com_velocity_area(ax: Axes, analysis: Analysis, n_steps: int = 5) -> No
     falling = not area.is_empty and not analysis.com_velocity_inside
     if falling:
         lines.insert(0, "FALLING: the pre-impact CoM velocity\nis outside the area (v_max = 0)")
+    reason = analysis.cannot_balance_reason
+    if reason is not None:
+        lines[:0] = ["CANNOT BALANCE, why:"] + textwrap.wrap(str(reason), 46) + [""]
     lines.append(f"ω = {areas.omega:.3f} 1/s")
-    # Outside the axes, right of them (the legend above, this note below): nothing covers
-    # the area's boundary, whatever its shape.
-    ax.text(1.03, 0.0, "\n".join(lines), transform=ax.transAxes, ha="left", va="bottom", fontsize=8, zorder=10,
-            bbox=dict(boxstyle="round,pad=0.4", facecolor="white", edgecolor=FALL_COLOR if falling else "0.6",
-                      lw=2 if falling else 1))
+    # Outside the axes, in the side column (the legend above, this note below): nothing
+    # covers the area's boundary, whatever its shape.
+    alarm = falling or reason is not None
+    where = side if side is not None else ax
+    x0 = 0.0 if side is not None else 1.03
+    where.text(x0, 0.0, "\n".join(lines), transform=where.transAxes, ha="left", va="bottom", fontsize=8, zorder=10,
+               bbox=dict(boxstyle="round,pad=0.4", facecolor="white", edgecolor=FALL_COLOR if alarm else "0.6",
+                         lw=2 if alarm else 1))
     set_limits(ax, area_view_points(area, view), margin=0.12, min_ratio=0.5)
+    if area.is_empty:
+        _headroom(ax)
     ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel(r"$\dot c_x$ (m/s)")
     ax.set_ylabel(r"$\dot c_y$ (m/s)")
+    ax.xaxis.set_major_locator(MaxNLocator(6))
     ax.set_title("CoM velocity area and post-impact CoM velocities")
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="upper left", bbox_to_anchor=(1.03, 1.0), fontsize=7.5, framealpha=0.9)
+    handles, labels = ax.get_legend_handles_labels()
+    if side is not None:
+        side.legend(handles, labels, loc="upper left", bbox_to_anchor=(0.0, 1.0), borderaxespad=0.0, fontsize=7.5,
+                    framealpha=0.9)
+    else:
+        ax.legend(loc="upper left", bbox_to_anchor=(1.03, 1.0), fontsize=7.5, framealpha=0.9)
 
 
 def plot_areas(analysis: Analysis, n_steps: int = 5) -> Figure:
@@ -153,14 +214,25 @@ def plot_areas(analysis: Analysis, n_steps: int = 5) -> Figure:
     if n_steps < 1 or not math.isfinite(n_steps):
         raise ValueError("n_steps must be >= 1")
     fig = new_figure(15, 6.2)
-    left, right = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.25]})
+    # A third column holds the right panel's legend and note: constrained layout then keeps
+    # them inside the canvas (a legend anchored outside an axes reached the edge).
+    left, right, side = fig.subplots(1, 3, gridspec_kw={"width_ratios": [1, 1.25, 0.5]})
+    side.set_axis_off()
     draw_zmp_area(left, analysis)
-    draw_com_velocity_area(right, analysis, n_steps)
+    draw_com_velocity_area(right, analysis, n_steps, side=side)
     # Height from the data: both axes have an equal aspect, so a flat area in a fixed-height
     # figure leaves bands of blank space above and below it.
-    ratio = max(_aspect(left), _aspect(right))
-    fig.set_figheight(float(np.clip(4.2 * ratio + 2.6, 4.0, 9.0)))
-    fig.suptitle(f"Balance areas: {scenario_title(analysis)} - {analysis.verdict}", fontsize=12)
+    # Panels as wide as their data at a common height: fixed ratios left a blank band beside
+    # a narrow (tall) area.
+    ratio = max(_aspect(left), _aspect(right), 0.75 if analysis.cannot_balance_reason is not None else 0.0)
+    height = float(np.clip(4.2 * ratio + 2.6, 4.0, 9.0))
+    axes_height = height - 2.2  # titles, tick labels and the legend below the left panel
+    widths = [axes_height / _aspect(left), axes_height / _aspect(right), 3.0]  # inches; 3 for the legend
+    left.get_gridspec().set_width_ratios(widths)
+    fig.set_size_inches(float(np.clip(sum(widths) + 1.8, 10.0, 20.0)), height)
+    why = short_reason(analysis)
+    verdict = f"cannot balance because of the {why}" if why else analysis.verdict
+    fig.suptitle(f"Balance areas: {scenario_title(analysis)} - {verdict}", fontsize=12)
     return fig
 
 

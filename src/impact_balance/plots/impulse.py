@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 from scipy.spatial import ConvexHull, QhullError
 
@@ -79,15 +80,21 @@ def _draw_impulse_polytope(ax: Axes, model: ImpactModel, speed: float) -> None:
     # down from some view directions.
     for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
         axis.set_rotate_label(False)
-    ax.set_xlabel(r"$\iota_x$ (N s)", labelpad=14)
-    ax.set_ylabel(r"$\iota_y$ (N s)", labelpad=14)
-    ax.set_zlabel(r"$\iota_z$ (N s)", labelpad=10)
+    # Padded well off the tick labels (checked on the rendered figure by the tests).
+    ax.set_xlabel(r"$\iota_x$ (N s)", labelpad=20)
+    ax.set_ylabel(r"$\iota_y$ (N s)", labelpad=20)
+    ax.set_zlabel(r"$\iota_z$ (N s)", labelpad=22)
     # Look from between the impulse direction and the normal of the planes of restitution
-    # (W^T n), slightly from above: the two rings then show as ellipses, not edge-on.
+    # (W^T n), slightly from above, snapped to the nearest diagonal of the x-y axes: the two
+    # rings show as ellipses, and neither horizontal axis is seen end-on (its ticks and its
+    # label would pile up).
     nrm = model.normal
     plane = model.W.T @ nrm
     look = nrm + plane / max(float(np.linalg.norm(plane)), 1e-12)
     azim = float(np.degrees(np.arctan2(look[1], look[0]))) if np.linalg.norm(look[:2]) > 1e-6 else -60.0
+    azim = 45.0 + 90.0 * round((azim - 45.0) / 90.0)
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.set_major_locator(MaxNLocator(5))
     ax.view_init(elev=30, azim=azim)
     ax.legend(loc="upper left", bbox_to_anchor=(0.0, 1.0), fontsize=7.5)
 
@@ -100,12 +107,15 @@ def _draw_jump_set(ax: Axes, model: ImpactModel, speed: float) -> None:
     ax.plot(*jumps[0::2].T, "o", color="red", ms=4.5, label=f"vertices, c_r = {c_hi:g}", zorder=4)
     ax.plot(*jumps[1::2].T, "o", mfc="white", mec="red", ms=4.5, label=f"vertices, c_r = {c_lo:g}", zorder=4)
     ax.plot(0, 0, "+", color="black", ms=12, mew=2, label="no jump", zorder=5)
-    set_limits(ax, [jumps, np.zeros((1, 2))], margin=0.15, min_span=0.02, min_ratio=0.4)
+    # Nearly square (the 3D panel beside it is): a flat set in a flat panel left most of the
+    # figure blank.
+    set_limits(ax, [jumps, np.zeros((1, 2))], margin=0.15, min_span=0.02, min_ratio=0.8)
     ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel(r"$\Delta\dot c_x$ (m/s)")
     ax.set_ylabel(r"$\Delta\dot c_y$ (m/s)")
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="best", fontsize=8)
+    # Under the figure (constrained layout makes room): inside, it covered vertices.
+    ax.figure.legend(*ax.get_legend_handles_labels(), loc="outside lower right", ncol=4, fontsize=8)
 
 
 def plot_impulse_set(analysis: Analysis, approach_speed: float | None = None) -> Figure:

@@ -62,7 +62,7 @@ def plot_phase_portrait(portrait: PhasePortrait, title: str | None = None) -> Fi
     xlim = (min(z_lo, 0.0) - 1.2 * width, max(z_hi, 0.0) + 1.2 * width)
     ylim = (-2.0 * vmax, 2.0 * vmax)
 
-    fig = new_figure(8.5, 6.5)
+    fig = new_figure(8.5, 7.2)
     ax = fig.subplots()
     c = np.linspace(*xlim, 200)
     ax.fill_between(c, w * (z_lo - c), w * (z_hi - c), color="#b5e3b5", alpha=0.6, lw=0,
@@ -90,16 +90,18 @@ def plot_phase_portrait(portrait: PhasePortrait, title: str | None = None) -> Fi
             ax.annotate("", xy=traj[i + 1], xytext=traj[i], arrowprops=dict(arrowstyle="->", color="0.35", lw=0.9))
     ax.axvline(0.0, color="tab:green", lw=1.2, ls="--", label="c = 0 (CoM at the reference)")
     ax.axhline(0.0, color="0.6", lw=0.6)
-    ax.plot([0.0, 0.0], [v_lo, v_hi], "o", color="tab:red", ms=8, zorder=5, label="CoM velocity bounds at c = 0")
-    for v in (v_lo, v_hi):
-        ax.annotate(f"({0:g}, {v:+.4f} m/s)", (0.0, v), xytext=(10, 8 if v > 0 else -14), textcoords="offset points",
-                    fontsize=9, color="tab:red", fontweight="bold")
+    # The values go in the legend, outside the axes: a label beside the points was crossed by
+    # the trajectories that converge there.
+    ax.plot([0.0, 0.0], [v_lo, v_hi], "o", color="tab:red", ms=8, zorder=5,
+            label=f"CoM velocity bounds at c = 0: {v_lo:+.4f} and {v_hi:+.4f} m/s")
     ax.set_xlim(*xlim)
     ax.set_ylim(*ylim)
     ax.set_xlabel("CoM position c (m)")
     ax.set_ylabel(r"CoM velocity $\dot c$ (m/s)")
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
+    # Below the axes: inside, the trajectories run under it wherever it goes.
+    fig.legend(loc="outside lower center", ncol=2, fontsize=8.5, framealpha=0.9)
+    gravity = w * w * portrait.com_height  # omega = sqrt(g / h)
     ax.set_title(title or (f"LIPM phase portrait: CoM height {portrait.com_height:.3g} m, "
-                           f"ZMP in [{z_lo:.3g}, {z_hi:.3g}] m, ω = {w:.3f} 1/s"), fontsize=10)
+                           f"ZMP in [{z_lo:.3g}, {z_hi:.3g}] m,\nω = {w:.4f} 1/s with g = {gravity:.4g} m/s²"), fontsize=10)
     return fig

@@ -48,7 +48,8 @@ def save_figures(
             skipped.append(Diagnostic("figure_skipped", "plots", f"no {prefix}_phase_portrait.png: {exc}"))
     if portrait is not None:
         com = analysis.areas.com
-        title = (f"{prefix}: sagittal LIPM phase portrait, CoM height {portrait.com_height:.3g} m\n"
+        title = (f"{prefix}: sagittal LIPM phase portrait, CoM height {portrait.com_height:.3g} m, "
+                 f"g = {analysis.areas.gravity:.4g} m/s², ω = {portrait.omega:.4f} 1/s\n"
                  f"ZMP in [{portrait.zmp_range[0]:+.3g}, {portrait.zmp_range[1]:+.3g}] m about the CoM: "
                  f"the chord of the ZMP support area along x\nthrough the CoM (at y = {com[1]:.3f} m); "
                  f"other slices of the area give other bounds")

@@ -98,14 +98,23 @@ def _draw_view(ax: Axes, analysis: Analysis, axes: tuple[int, int], robot: bool)
     if not top:
         ax.axhline(h, color="0.3", lw=0.8, ls="--", zorder=0.5, label=f"ZMP plane z = {h:g} m")
 
-    # Contacts and their normals.
+    # Contacts and their normals. A normal seen end-on (a flat foot from above) would be an
+    # arrow of no length: it is drawn as the usual symbol of a vector towards the viewer.
+    labelled = False
     for n, c in enumerate(stance.contacts):
         corners = c.corners()[:, [i, k]]
         view.append(corners)
         draw_polygon(ax, hull(corners), color=CONTACT_COLOR, alpha=0.3, lw=1.5, zorder=1.5,
                      label="contact rectangles" if n == 0 else None)
-        _arrow(ax, c.position[[i, k]], NORMAL_LENGTH * c.normal[[i, k]], CONTACT_COLOR,
-               "contact normals" if n == 0 else None, width=0.008)
+        seen = c.normal[[i, k]]
+        if float(np.linalg.norm(seen)) < 0.35:  # within ~20 deg of the line of sight
+            out = float(c.normal[3 - i - k]) * (1.0 if top else -1.0) > 0  # towards the viewer?
+            ax.plot(*c.position[[i, k]], marker=r"$\odot$" if out else r"$\otimes$", ms=15, color=CONTACT_COLOR,
+                    ls="", zorder=7, label=None if labelled else "contact normals (⊙ towards you)")
+        else:
+            _arrow(ax, c.position[[i, k]], NORMAL_LENGTH * seen, CONTACT_COLOR,
+                   None if labelled else "contact normals (⊙ towards you)", width=0.008)
+        labelled = True
         view.append((c.position + NORMAL_LENGTH * c.normal)[None, [i, k]])
 
     # CoM and its projection on the ZMP plane.
@@ -144,6 +153,12 @@ def _draw_view(ax: Axes, analysis: Analysis, axes: tuple[int, int], robot: bool)
     ax.grid(True, alpha=0.3)
 
 
+def _aspect_width(ax: Axes) -> float:
+    """Width / height of the axes' data limits."""
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    return abs(x1 - x0) / max(abs(y1 - y0), 1e-12)
+
+
 def plot_stance(analysis: Analysis, robot: bool = True) -> Figure:
     """Top view (x-y) and side view (x-z) of the stance.
 
@@ -153,17 +168,24 @@ def plot_stance(analysis: Analysis, robot: bool = True) -> Figure:
     joint origins. Velocity arrows are drawn at 0.3 m per m/s, normals 0.15 m long.
     """
     fig = new_figure(13, 7)
-    top, side = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.25, 1]})
+    top, side = fig.subplots(1, 2)
     _draw_view(top, analysis, (0, 1), robot)
     top.set_title("Top view (x-y)")
     _draw_view(side, analysis, (0, 2), robot)
     side.set_title("Side view (x-z)")
+    # Each panel as wide as its data at a common height (both have an equal aspect), and
+    # the figure as wide as both: fixed ratios left a wide blank gap between the views.
+    widths = [_aspect_width(ax) for ax in (top, side)]
+    top.get_gridspec().set_width_ratios(widths)
+    axes_height = min(4.9, 13.4 / sum(widths))  # inches; lower for wide views, within 15 in
+    fig.set_size_inches(max(8.0, axes_height * sum(widths) + 1.6), axes_height + 2.3)
     handles, labels = side.get_legend_handles_labels()
     th, tl = top.get_legend_handles_labels()
     for hnd, lab in zip(th, tl):
         if lab not in labels:
             handles.append(hnd)
             labels.append(lab)
-    fig.legend(handles, labels, loc="outside lower center", ncol=4, fontsize=8.5, framealpha=0.9)
+    ncol = max(2, min(4, int(fig.get_figwidth() / 3.3)))  # as many columns as the width holds
+    fig.legend(handles, labels, loc="outside lower center", ncol=ncol, fontsize=8.5, framealpha=0.9)
     fig.suptitle(f"Stance: {scenario_title(analysis)}, mass {analysis.stance.mass:.1f} kg", fontsize=12)
     return fig

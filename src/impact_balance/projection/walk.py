@@ -101,7 +101,7 @@ def project_walk(
 
 def kernel_is_compiled() -> bool:
     """Whether numba's on-disk cache holds the kernel; if not, the first projection compiles
-    it (10 to 30 s, once per installation). True without numba (nothing to compile)."""
+    it (0.5 to 1.5 min, once per installation). True without numba (nothing to compile)."""
     if not HAVE_NUMBA:
         return True
     try:  # numba's cache index of the entry point; private API, hence the guard
@@ -115,7 +115,7 @@ _warm = False
 
 def warm_up() -> float:
     """Load (or compile) the kernel now, by projecting a square; returns the seconds spent
-    (0.0 once done). numba loads a cached kernel on its first call (0.1-0.5 s, 10-30 s to
+    (0.0 once done). numba loads a cached kernel on its first call (0.3-1.5 s, 0.5 to 1.5 min to
     compile after an installation): callers that time a projection call this first, so
     that the load is not mistaken for the projection."""
     global _warm

@@ -12,12 +12,37 @@ mappings are merged recursively, everything else is replaced.
 - :mod:`.load`: files, ``extends:`` chains and :func:`load_scenario`.
 """
 
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
 # Also re-exported: the helpers sweep/, gui/, analysis.py and tests import from here
-# (ExtendsResolver, with_source, _field, _merge, _read).
-from .bundled import bundled_scenarios, scenario_path
-from .load import ExtendsResolver, _merge, _read, load_scenario
-from .schema import BasePose, ContactConfig, ImpactConfig, Offset, QPConfig, RobotFiles, Scenario, with_source
-from .validate import _field, scenario_from_dict
+# (ExtendsResolver, with_source, _field, _merge, _read). Imported on first use (PEP 562):
+# listing the bundled scenarios needs only .bundled, not pydantic and pinocchio.
+_EXPORTS: dict[str, str] = {
+    "bundled_scenarios": ".bundled", "scenario_path": ".bundled",
+    "ExtendsResolver": ".load", "_merge": ".load", "_read": ".load", "load_scenario": ".load",
+    "BasePose": ".schema", "ContactConfig": ".schema", "ImpactConfig": ".schema", "Offset": ".schema",
+    "QPConfig": ".schema", "RobotFiles": ".schema", "Scenario": ".schema", "with_source": ".schema",
+    "_field": ".validate", "scenario_from_dict": ".validate",
+}
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(module, __name__), name)
+    globals()[name] = value
+    return value
+
+
+if TYPE_CHECKING:
+    from .bundled import bundled_scenarios, scenario_path
+    from .load import ExtendsResolver, _merge, _read, load_scenario
+    from .schema import BasePose, ContactConfig, ImpactConfig, Offset, QPConfig, RobotFiles, Scenario, with_source
+    from .validate import _field, scenario_from_dict
 
 __all__ = [
     "Offset",

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from importlib import resources
 from pathlib import Path
 
@@ -13,8 +14,10 @@ from ..input_limits import check_path_text
 __all__ = ["bundled_descriptions", "bundled_scenarios", "scenario_path"]
 
 
-def _scenario_dir():
-    return resources.files("impact_balance") / "scenarios"
+@functools.cache
+def _scenario_dir() -> Path:
+    # Cached: importlib.resources' lookup costs more than reading a cached scenario.
+    return Path(str(resources.files("impact_balance") / "scenarios"))
 
 
 def bundled_descriptions(folder: str) -> dict[str, str]:
@@ -41,8 +44,8 @@ def scenario_path(name_or_path: str | Path) -> Path:
     if path.suffix in (".yaml", ".yml") or "/" in str(name_or_path) or "\\" in str(name_or_path):
         raise ScenarioError("scenario", str(name_or_path), "no such file")
     bundled = _scenario_dir() / f"{name_or_path}.yaml"
-    if _is_file(Path(str(bundled))):
-        return Path(str(bundled))
+    if _is_file(bundled):
+        return bundled
     raise UnknownScenarioError("scenario", str(name_or_path), list(bundled_scenarios()))
 
 

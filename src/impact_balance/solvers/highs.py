@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import highspy
 import numpy as np
-import scipy.sparse as sp
 
 from ..exceptions import SolverError
 from .lp import LinearProgram, LPSolution
@@ -54,6 +53,8 @@ class HighsLP:
             blocks.append(np.atleast_2d(problem.R))
             lower.append(np.asarray(problem.lo, dtype=float))
             upper.append(np.asarray(problem.hi, dtype=float))
+        import scipy.sparse as sp  # here: scipy.sparse costs ~0.1 s to import, and most analyses never build an LP
+
         M = sp.csc_matrix(np.vstack(blocks)) if blocks else sp.csc_matrix((0, n))
         M.eliminate_zeros()
         lp = highspy.HighsLp()

@@ -23,7 +23,7 @@ import pandas as pd
 from ..plots._common import DPI, new_figure
 from .summary import EVALUATED, load_frame
 
-__all__ = ["sweep_figures", "save_sweep_figures"]
+__all__ = ["sweep_figures", "save_sweep_figures", "axis_label"]
 
 
 def _varying(manifest: dict[str, Any], df: pd.DataFrame) -> list[str]:
@@ -36,10 +36,28 @@ def _varying(manifest: dict[str, Any], df: pd.DataFrame) -> list[str]:
 
 
 def _values(df: pd.DataFrame) -> np.ndarray:
-    """Maximum contact velocity for plotting: NaN when not evaluated (unbounded stays inf)."""
+    """Maximum contact velocity for plotting: NaN without one to show (unbounded stays inf).
+
+    A point already falling, or a stance that cannot balance, has a "maximum" of 0 in the
+    results, which is no contact velocity at all: it is drawn with its own marker, not as 0 m/s.
+    """
     v = df["max_contact_velocity"].to_numpy(dtype=float).copy()
-    v[~df["status"].isin(EVALUATED).to_numpy()] = np.nan
+    v[~df["status"].isin(VALUED).to_numpy()] = np.nan
     return v
+
+
+def _mark_statuses(ax, df: pd.DataFrame, x: str, y: str | None) -> None:
+    """Markers for the points without a maximum: falling, cannot balance, not evaluated."""
+    for status, (marker, color, text) in _MARKS.items():
+        rows = df[df["status"] == status]
+        if len(rows):
+            ys = rows[y] if y is not None else np.zeros(len(rows))
+            ax.plot(rows[x], ys, marker, color=color, mfc="none" if y is None else color, mec="w" if y else color,
+                    ms=7, ls="", label=f"{text}: {len(rows)}")
+    bad = df[~df["status"].isin(EVALUATED)]
+    if len(bad):
+        ys = bad[y] if y is not None else np.zeros(len(bad))
+        ax.plot(bad[x], ys, "x", color="0.5", ms=5, ls="", label=f"not evaluated (invalid, unreachable, error): {len(bad)}")
 
 
 #: Two limiting edges whose outward normals differ by more than this (deg) are different cases.
@@ -74,16 +92,72 @@ def _draw_turns(ax, xs: np.ndarray, ys: np.ndarray, E: np.ndarray) -> None:
                                          label=f"limiting edge turns > {TURN_DEG:g} deg"))
 
 
-def _label(name: str) -> str:
+#: Scenario keys (the last name of a key path): words and unit for an axis label.
+_KEYS: dict[str, tuple[str, str]] = {
+    "friction": ("friction coefficient", "-"),
+    "restitution": ("restitution coefficient", "-"),
+    "cone_edges": ("friction cone edges", "count"),
+    "reference_velocity": ("reference velocity", "m/s"),
+    "com_velocity": ("pre-impact CoM velocity", "m/s"),
+    "duration": ("impact duration", "s"),
+    "peak_factor": ("peak factor", "-"),
+    "plane_height": ("ZMP plane height", "m"),
+    "gravity": ("gravity", "m/s²"),
+    "size": ("size", "m"),
+    "position": ("position", "m"),
+    "rpy": ("roll-pitch-yaw", "rad"),
+    "normal": ("normal", "-"),
+}
+_XYZ = "xyz"
+_PART = re.compile(r"([A-Za-z_]+)(?:\[(\d+)\])?")
+
+
+def axis_label(name: str, frame: str | None = None) -> str:
+    """A sweep dimension as an axis label for people, with its unit and, below, its key path.
+
+    ``impact.friction`` -> "impact friction coefficient (-)"; ``impact.restitution[1]`` ->
+    "impact restitution coefficient, upper bound (-)"; ``posture.y`` -> "target y of the
+    impact frame by IK, world (m)"; ``joints.NAME`` -> "joint NAME (rad)".
+    """
     if name.startswith("posture."):
-        return f"{name} (m, world)"
-    if name.endswith((".azimuth", ".elevation")):
-        return f"{name} (deg)"
-    return name
+        words, unit = f"target {name.split('.', 1)[1]} of {frame or 'the impact frame'} by IK, world", "m"
+    elif name.endswith((".azimuth", ".elevation")):
+        words, unit = f"{name.rsplit('.', 2)[-2]} {name.rsplit('.', 1)[1]}", "deg"
+    elif name.startswith("joints."):
+        words, unit = f"joint {name.split('.', 1)[1]}", "rad or m"
+    else:
+        parts = name.split(".")
+        last = _PART.fullmatch(parts[-1])
+        key, index = (last.group(1), last.group(2)) if last else (parts[-1], None)
+        words, unit = _KEYS.get(key, (key.replace("_", " "), "scenario units"))
+        owners = []
+        for part in parts[:-1]:
+            m = _PART.fullmatch(part)
+            owners.append(f"{m.group(1).rstrip('s')} {m.group(2)}" if m and m.group(2) else part.replace("_", " "))
+        words = " ".join(owners + [words])
+        if index is not None:
+            if key == "restitution":
+                words += ", " + ("lower" if index == "0" else "upper") + " bound"
+            elif key == "size":
+                words += " " + ("length (x)" if index == "0" else "width (y)")
+            elif int(index) < 3:
+                words += " " + _XYZ[int(index)]
+            else:
+                words += f" [{index}]"
+    return f"{words} ({unit})\n{name}"
 
 
-def _curve(df: pd.DataFrame, x: str, title: str):
-    fig = new_figure(6.4, 4.0)
+#: Statuses drawn with a value; the other evaluated ones have markers of their own.
+VALUED = ("ok", "unbounded")
+#: Marker, colour and legend text of the points that have no maximum to show.
+_MARKS = {
+    "already_falling": ("v", "tab:red", "falling before the impact (no maximum)"),
+    "cannot_balance": ("s", "black", "cannot balance (no maximum)"),
+}
+
+
+def _curve(df: pd.DataFrame, x: str, title: str, frame: str | None = None):
+    fig = new_figure(6.4, 4.6)
     ax = fig.add_subplot()
     df = df.sort_values([x, "point"], kind="stable")
     xs = df[x].to_numpy(dtype=float)
@@ -95,25 +169,23 @@ def _curve(df: pd.DataFrame, x: str, title: str):
     ok = np.isfinite(v)
     if ok.any():
         best, worst = int(np.nanargmax(np.where(ok, v, -np.inf))), int(np.nanargmin(np.where(ok, v, np.inf)))
-        ax.plot(xs[best], v[best], "*", ms=14, color="tab:green", label=f"best {v[best]:.3g} m/s")
-        ax.plot(xs[worst], v[worst], "X", ms=10, color="tab:red", label=f"worst {v[worst]:.3g} m/s")
-    bad = np.isnan(v)
-    if bad.any():
-        ax.plot(xs[bad], np.zeros(bad.sum()), "x", color="0.5", label="not evaluated")
+        ax.plot(xs[best], v[best], "*", ms=14, color="tab:green", label=f"highest maximum {v[best]:.3g} m/s")
+        ax.plot(xs[worst], v[worst], "X", ms=10, color="tab:red", label=f"lowest maximum {v[worst]:.3g} m/s")
+    _mark_statuses(ax, df, x, None)
     directions = df["limiting_direction"].to_numpy(dtype=float)
     changes = np.flatnonzero(_turns(directions[1:], directions[:-1]))
     for i, k in enumerate(changes):
         ax.axvline(0.5 * (xs[k] + xs[k + 1]), ls=":", color="k", lw=0.8, label="limiting edge changes" if i == 0 else None)
-    ax.set_xlabel(_label(x))
+    ax.set_xlabel(axis_label(x, frame))
     ax.set_ylabel("maximum contact velocity (m/s)")
     ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    fig.legend(loc="outside lower center", ncol=2, fontsize=8)  # below: inside, it covered the curve
     return fig
 
 
-def _heatmap(df: pd.DataFrame, x: str, y: str, others: list[str], title: str):
-    fig = new_figure(6.4, 5.0)
+def _heatmap(df: pd.DataFrame, x: str, y: str, others: list[str], title: str, frame: str | None = None):
+    fig = new_figure(6.8, 6.2)
     ax = fig.add_subplot()
     df = df.assign(_v=_values(df))
     # Worst case over the other dimensions (NaN, i.e. not evaluated, only if every point is).
@@ -132,26 +204,22 @@ def _heatmap(df: pd.DataFrame, x: str, y: str, others: list[str], title: str):
         mesh = ax.pcolormesh(xs, ys, np.ma.masked_invalid(shown), shading="nearest", cmap="viridis", vmin=0.0, vmax=vmax)
         E = edge.unstack(level=0).reindex(index=ys, columns=xs).to_numpy(dtype=float)
         _draw_turns(ax, xs, ys, E)
-        X, Y = np.meshgrid(xs, ys)
-        bad = np.isnan(V)
-        if bad.any():
-            ax.plot(X[bad], Y[bad], "x", color="0.5", ms=5, label="not evaluated")
+        ax.set_facecolor("0.88")  # cells without a maximum (masked) show this grey
     else:
         pts = df[np.isfinite(df["_v"])]
         mesh = ax.scatter(pts[x], pts[y], c=pts["_v"], cmap="viridis", vmin=0.0, vmax=vmax, s=12)
-        bad = df[np.isnan(df["_v"])]
-        if len(bad):
-            ax.plot(bad[x], bad[y], "x", color="0.5", ms=5, label="not evaluated")
+    _mark_statuses(ax, df, x, y)
     fig.colorbar(mesh, ax=ax, label="maximum contact velocity (m/s)" + (" (min over other axes)" if others else ""))
     ok = df[np.isfinite(df["_v"])]
     if len(ok):
         b, w = ok.loc[ok["_v"].idxmax()], ok.loc[ok["_v"].idxmin()]
-        ax.plot(b[x], b[y], "*", ms=16, mfc="tab:green", mec="w", label=f"best {b['_v']:.3g} m/s")
-        ax.plot(w[x], w[y], "X", ms=11, mfc="tab:red", mec="w", label=f"worst {w['_v']:.3g} m/s")
-    ax.set_xlabel(_label(x))
-    ax.set_ylabel(_label(y))
+        ax.plot(b[x], b[y], "*", ms=16, mfc="tab:green", mec="w", label=f"highest maximum {b['_v']:.3g} m/s")
+        ax.plot(w[x], w[y], "X", ms=11, mfc="tab:red", mec="w", label=f"lowest maximum {w['_v']:.3g} m/s")
+    ax.set_xlabel(axis_label(x, frame))
+    ax.set_ylabel(axis_label(y, frame))
     ax.set_title(title, fontsize=9)
-    ax.legend(fontsize=8, loc="best")
+    # Below the map: inside, it covered cells. Grey: the white dotted turn lines show on it.
+    fig.legend(loc="outside lower center", ncol=2, fontsize=8, facecolor="0.85")
     return fig
 
 
@@ -163,10 +231,12 @@ def sweep_figures(root: str | Path) -> list[tuple[str, Any]]:
     dims = _varying(manifest, df)
     title = (manifest.get("description") or "").strip()
     title = textwrap.fill(title, 90)
+    frame = next((a.get("frame") for a in manifest.get("spec", {}).get("axes", []) if isinstance(a, dict)
+                  and "tolerance" in a and a.get("frame")), None)  # the posture axis' frame
     if len(dims) == 1:
-        return [(f"curve_{dims[0]}", _curve(df, dims[0], title))]
+        return [(f"curve_{dims[0]}", _curve(df, dims[0], title, frame))]
     if len(dims) >= 2:
-        return [(f"heatmap_{dims[0]}_{dims[1]}", _heatmap(df, dims[0], dims[1], dims[2:], title))]
+        return [(f"heatmap_{dims[0]}_{dims[1]}", _heatmap(df, dims[0], dims[1], dims[2:], title, frame))]
     return []
 
 

@@ -1,0 +1,165 @@
+"""Optional parts (issue 16, item 6): the core works without them, a command that needs a
+missing one says which extra to install in one line, and light commands import no heavy part.
+
+Absence is simulated the way Python marks a blocked import: ``sys.modules[name] = None``
+(in this process, through monkeypatch), or a meta-path finder that refuses the modules (in a
+subprocess, so that nothing already imported by other tests hides the check).
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import textwrap
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from impact_balance.cli import main
+from impact_balance.exceptions import ImpactBalanceError, MissingExtraError
+from impact_balance.extras import COMMAND_EXTRAS, EXTRAS, installed
+
+ROOT = Path(__file__).resolve().parents[1]
+SRC = ROOT / "src"
+#: Every module of every extra: the core must run with all of them missing.
+OPTIONAL = sorted({m for modules in EXTRAS.values() for m in modules} | {"dask", "viser", "imageio"})
+#: Heavy parts no light command may import.
+HEAVY = ("mujoco", "dask", "distributed", "viser", "matplotlib", "pandas", "pyarrow", "imageio")
+
+#: Arguments that reach each command's extra check.
+COMMAND_ARGS = {
+    "simulate": ["simulate", "palm_push_two_feet"],
+    "validate": ["validate", "palm_push_two_feet"],
+    "push-test": ["push-test", "palm_push_ramp"],
+    "check-log": ["check-log", "log.parquet", "--scenario", "palm_push_two_feet"],
+    "gui": ["gui", "palm_push_two_feet"],
+    "sweep": ["sweep", "--list"],
+}
+
+
+def _block(monkeypatch, modules):
+    for name in modules:
+        monkeypatch.setitem(sys.modules, name, None)
+
+
+@pytest.mark.parametrize("command", sorted(COMMAND_EXTRAS))
+def test_missing_extra_is_one_line_naming_it(command, monkeypatch, capsys):
+    extra = COMMAND_EXTRAS[command]
+    _block(monkeypatch, EXTRAS[extra][:1])
+    assert not installed(EXTRAS[extra][0])
+    assert main(COMMAND_ARGS[command]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert err.startswith(f"impact-balance: error: {command} needs the '{extra}' extra: "
+                          f"pip install 'impact-balance[{extra}]'"), err
+    assert EXTRAS[extra][0] in err
+
+
+@pytest.mark.parametrize("argv, option", [
+    (["analyze", "kick_one_foot", "--plots", "figs"], "analyze --plots"),
+    (["phase-portrait", "--com-height", "0.8", "--zmp-range", "-0.1", "0.1", "--plot", "p.png"], "phase-portrait --plot"),
+    (["demo"], "demo"),
+])
+def test_missing_plots_extra(argv, option, monkeypatch, capsys, tmp_path):
+    monkeypatch.chdir(tmp_path)
+    _block(monkeypatch, ["matplotlib"])
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"impact-balance: error: {option}") and "pip install 'impact-balance[plots]'" in err, err
+    assert not list(tmp_path.iterdir())  # refused before writing anything
+
+
+def test_missing_extra_error_carries_its_data():
+    exc = MissingExtraError("simulate", "sim", ["mujoco"])
+    assert isinstance(exc, ImpactBalanceError) and isinstance(exc, ImportError)
+    assert (exc.what, exc.extra, exc.missing) == ("simulate", "sim", ("mujoco",))
+
+
+def test_pyproject_extras_match_the_checked_modules():
+    """What extras.py checks is what pyproject.toml installs, and [all] is every extra."""
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    extras = project["optional-dependencies"]
+    dist = {"imageio_ffmpeg": "imageio-ffmpeg", "distributed": "dask"}
+    for extra, modules in EXTRAS.items():
+        names = {r.split("[")[0].split(">")[0].split("<")[0].split("=")[0].strip().lower() for r in extras[extra]}
+        assert {dist.get(m, m) for m in modules} <= names, extra
+    assert extras["all"] == [f"impact-balance[{','.join(EXTRAS)}]"]
+    core = " ".join(project["dependencies"]).lower()
+    for heavy in ("mujoco", "dask", "viser", "matplotlib", "pandas", "pyarrow", "imageio"):
+        assert heavy not in core, heavy
+
+
+_BLOCKER = textwrap.dedent("""
+    import sys, importlib.abc
+    BLOCKED = {blocked!r}
+
+    class Blocker(importlib.abc.MetaPathFinder):
+        def find_spec(self, name, path=None, target=None):
+            if name.split(".")[0] in BLOCKED:
+                raise ModuleNotFoundError(f"No module named {{name!r}} (blocked by the test)")
+            return None
+
+    sys.meta_path.insert(0, Blocker())
+""")
+
+
+def _run(code: str, blocked=OPTIONAL) -> subprocess.CompletedProcess:
+    script = _BLOCKER.format(blocked=set(blocked)) + textwrap.dedent(code)
+    return subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300,
+                          env={"PYTHONPATH": str(SRC), "PATH": "/usr/bin:/bin", "HOME": str(Path.home())})
+
+
+def test_core_runs_without_any_extra():
+    r = _run("""
+        import impact_balance as ib
+        a = ib.analyze("palm_push_ramp")
+        assert a.verdict == "balanced", a.verdict
+        print(round(a.impact.max_contact_velocity, 3))
+        from impact_balance.cli import main
+        assert main(["analyze", "kick_one_foot", "--json"]) == 0
+        assert main(["robots"]) == 0 and main(["scenarios"]) == 0
+        assert main(["demo", "--no-plots"]) == 0
+    """)
+    assert r.returncode == 0, r.stderr
+    first = r.stdout.splitlines()[0]
+    assert first == "0.788"
+
+
+@pytest.mark.parametrize("argv, absent", [
+    (["robots"], HEAVY + ("numba", "scipy", "pydantic")),
+    (["scenarios"], HEAVY + ("numba", "scipy", "pinocchio", "pydantic", "numpy")),
+    (["analyze", "palm_push_two_feet", "--json"], HEAVY + ("qpsolvers",)),
+])
+def test_light_commands_import_no_heavy_part(argv, absent):
+    """Nothing blocked: the command simply never imports these."""
+    r = _run(f"""
+        import io, contextlib
+        from impact_balance.cli import main
+        with contextlib.redirect_stdout(io.StringIO()) as out:
+            assert main({argv!r}) == 0
+        print(sorted(name for name in {absent!r} if name in sys.modules))
+    """, blocked=())
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "[]", r.stdout
+
+
+def test_json_answer_without_extras_is_strict():
+    r = _run("""
+        from impact_balance.cli import main
+        assert main(["analyze", "palm_push_two_feet", "--json"]) == 0
+    """)
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["verdict"] == "balanced"
+
+
+def test_readme_test_command_is_what_ci_runs():
+    """README's second command (after the venv) and .ci/run install and test the same way."""
+    readme = (ROOT / "README.md").read_text()
+    block = readme.split("```bash", 1)[1].split("```", 1)[0]
+    lines = [line for line in block.splitlines() if line and not line.startswith("#")]
+    assert 'pip install ".[all]"' in lines[0]  # the first command installs everything
+    test_command = lines[1].split("&& ", 2)[2]  # after "python3 -m venv .venv && . .venv/bin/activate &&"
+    ci = (ROOT / ".ci" / "run").read_text()
+    assert test_command.strip() in ci
