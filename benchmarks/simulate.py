@@ -6,8 +6,7 @@ For every bundled scenario with an impact, every approach speed and joint model,
 (``impact_balance.sim``): the measured CoM velocity jump, its distance to the predicted
 ``composite`` and ``joint_space`` sets (at the measured speed and restitution), relative to
 the jump's magnitude, and where the jump falls between the two models (its magnitude over
-each set's size, the largest norm of its vertices, and its position between them: 0 at the
-``joint_space`` set's centroid, 1 at the ``composite`` one's). ``servo`` joints carry the rotor
+each set's size, the largest norm of its vertices). ``servo`` joints carry the rotor
 inertia the robot files declare (the SRDF's rotor_params; ``--armature`` sets one value for every
 joint instead); ``held`` is ``servo`` with ``--rigid-impact`` (every joint keeps its velocity
 through the impact). The impulse the sustained contacts take is reported too. Then the speed: standing Talos (``servo``, holding
@@ -62,9 +61,6 @@ def accuracy(speeds: list[float], joints: list[str], armature: float | None = No
                     "sustained_impulse": float(sum(np.linalg.norm(v) for v in result.sustained_impulses.values())),
                     "hold_ms": None if not result.hold or result.hold["duration"] is None else 1e3 * result.hold["duration"],
                 }
-                centre = {m: float(np.linalg.norm(p.com_velocity_jumps.mean(axis=0))) for m, p in result.predicted.items()}
-                span = centre["composite"] - centre["joint_space"]
-                row["position"] = (size - centre["joint_space"]) / span if span > 0 else float("nan")
                 for model, p in result.predicted.items():
                     extent = float(np.linalg.norm(p.com_velocity_jumps, axis=1).max())
                     row[f"{model}_distance"] = p.distance
@@ -93,13 +89,13 @@ def speed(seconds: float = 2.0) -> dict:
 
 def markdown(rows: list[dict], perf: dict) -> str:
     out = ["| scenario (robot) | joints | v (m/s) | e | |jump| (m/s) | to composite | to joint_space | |jump| / composite size "
-           "| |jump| / joint_space size | position (0 joint_space, 1 composite) | impulse: impact / sustained (N s) | contacts kept |",
-           "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+           "| |jump| / joint_space size | impulse: impact / sustained (N s) | contacts kept |",
+           "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         kept = "n/a" if r["contacts_kept"] is None else ("yes" if r["contacts_kept"] else "no")
         out.append(f"| {r['scenario']} ({r['robot']}) | {r['joints']} | {r['speed']:g} | {r['restitution']:.2f} | "
                    f"{r['jump_norm']:.4f} | {r['composite_relative']:.2%} | {r['joint_space_relative']:.0%} | "
-                   f"{r['jump_over_composite']:.3f} | {r['jump_over_joint_space']:.2f} | {r['position']:.2f} | "
+                   f"{r['jump_over_composite']:.3f} | {r['jump_over_joint_space']:.2f} | "
                    f"{r['palm_impulse']:.2f} / {r['sustained_impulse']:.2f} | {kept} |")
     sources = sorted({(r["robot"], r["armature"]) for r in rows if r["joints"] != "rigid"})
     out += [f"\narmature of {robot}: {source}" for robot, source in sources]

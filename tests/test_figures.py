@@ -322,3 +322,80 @@ def test_gui_view_labels_both_axes_with_units(analyses):
         assert f">{label}<" in svg or f", {label}<" in svg, label
     assert 'rotate(-90' in svg  # the y labels run along their axes
     assert "padding-right" in svg  # kept clear of the panel's scroll bar
+
+
+# -- balance trials (synthetic results: the figures, not the simulation) ---------------------
+@pytest.fixture(scope="module")
+def balance_results():
+    from types import SimpleNamespace
+
+    from impact_balance.scenario import load_scenario
+    from impact_balance.sim.balance_trial import Push
+    from impact_balance.sim.push import PushOutcome, PushTestResult, boundary_impulse, predict_push
+    from impact_balance.sim.validate import ValidationResult, ValidationTrial, predictions
+
+    analysis = ib.analyze("palm_push_ramp")
+    scenario = load_scenario("palm_push_ramp")
+    trials = []
+    times = np.linspace(0.4, 1.9, 80)
+    for v, outcome in ((0.2, "balanced"), (0.4, "balanced"), (0.6, "contact_broken"), (0.69, "fell"), (0.77, "fell")):
+        grow = 4.0 if outcome == "fell" else 1.0
+        path = [[-0.58 * v * np.exp(-(t - 0.41)) * (1 + grow * (t - 0.41)), 0.04 * v] for t in times]
+        summary = {"outcome": outcome, "approach_speed_measured": v, "events": [], "reason": None, "detail": ""}
+        trials.append(ValidationTrial(speed=0.98 * v, summary=summary, trajectory={"time": list(times), "com_velocity": path}))
+    validation = ValidationResult("palm_push_ramp", "servo", True, predictions(scenario), predictions(scenario, 0.01),
+                                  0.01, analysis.areas.omega, trials, {}, {}, 0.05, 4.0)
+    setup = SimpleNamespace(analysis=analysis, controller="id")
+    outcomes = []
+    for fraction in (0.5, 0.85, 1.05, 1.5):
+        for k in range(8):
+            angle = 2 * np.pi * k / 8
+            push = Push(angle, fraction * boundary_impulse(analysis.areas.com_velocity_area, analysis.stance.mass, angle))
+            prediction = predict_push(setup, push, 1.2)
+            path = [list(prediction.com_velocity * s) for s in np.linspace(0, 1, 20)]
+            zmp = [list(analysis.stance.com[:2] + 0.1 * np.array(p)) for p in path]
+            outcomes.append(PushOutcome(push=push, relative=fraction, prediction=prediction,
+                                        summary={"outcome": "fell" if fraction > 1 else "balanced", "events": []},
+                                        trajectory={"com_velocity": path, "zmp": zmp}))
+    pushes = PushTestResult("palm_push_ramp", outcomes, {"name": "id"}, {}, setup, 0.01, 0.01, analysis.areas.omega, 0.0)
+    return analysis, validation, pushes
+
+
+def test_validation_figure_in_measured_speed(balance_results):
+    from impact_balance.plots.balance import plot_validation
+
+    _, validation, _ = balance_results
+    fig = plot_validation(validation)
+    assert_layout(fig, units=False)  # the y axis is the outcome (a category)
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "approach speed (m/s)"
+    assert [t.get_text() for t in ax.get_yticklabels()] == ["balanced", "contact broken", "fell", "aborted"]
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert "measured at first contact" in labels and "commanded" in labels
+    assert any("ZMP margin 10 mm" in t for t in labels) and "stood 0.600 m/s, fell 0.690 m/s (measured)" in ax.get_title()
+
+
+@pytest.mark.parametrize("kind", ["com_velocity", "zmp"])
+def test_push_figures_label_directions_and_keep_survivors_on_top(balance_results, kind):
+    from impact_balance.plots.balance import OUTCOME_COLORS, plot_push_trajectories
+
+    _, _, pushes = balance_results
+    fig = plot_push_trajectories(pushes, kind)
+    assert_layout(fig)
+    note = fig.legends[0].get_title().get_text()
+    assert "push direction from world x" in note and "0°:" in note and "315°:" in note
+    lines = [line for line in fig.axes[0].get_lines() if line.get_linestyle() == "-" and len(line.get_xdata()) > 1]
+    colors = [line.get_color() for line in lines]
+    last_fall = max(i for i, c in enumerate(colors) if c == OUTCOME_COLORS["fell"])
+    first_ok = min(i for i, c in enumerate(colors) if c == OUTCOME_COLORS["balanced"])
+    assert last_fall < first_ok  # falls drawn first: the pushes that did not fall stay visible on top
+
+
+def test_impact_trajectories_name_each_trial(balance_results):
+    from impact_balance.plots.balance import plot_impact_trajectories
+
+    analysis, validation, _ = balance_results
+    fig = plot_impact_trajectories(validation, analysis)
+    assert_layout(fig)
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert "0.690 m/s: fell" in labels and "0.200 m/s: balanced" in labels

@@ -86,46 +86,52 @@ def _area_with_margin(ax, area: Polygon, margin_area: Polygon | None, color: str
     return handles
 
 
+_MARKERS = "os^vDP*Xph<>"
+
+
 def plot_impact_trajectories(result, analysis) -> Figure:
     """The CoM velocity of every impact trial (from just before the contact to 1.5 s after) over the CoM
-    velocity area, each labelled with its measured approach speed."""
+    velocity area; each trial's line ends with a marker that the legend names by its measured speed."""
     areas = analysis.areas
     area = areas.com_velocity_area
     shrunk = None
     if result.zmp_margin > 0:
         zmp = areas.zmp_area.inset(result.zmp_margin)
         shrunk = zmp.affine(areas.omega, -areas.omega * areas.com[:2]) if not zmp.is_empty else None
-    fig = new_figure(6.4, 5.6)
+    fig = new_figure(6.4, 6.4)
     ax = fig.add_subplot()
     handles = _area_with_margin(ax, area, shrunk, AREA_COLOR, "CoM velocity area", result.zmp_margin)
-    paths = []
-    for t in sorted(result.trials, key=lambda t: _ORDER[t.outcome]):
-        path = np.array([p for p in t.trajectory.get("com_velocity", []) if p is not None], dtype=float).reshape(-1, 2)
+    paths, trial_handles = [], []
+    ranked = sorted((t for t in result.trials if t.trajectory.get("com_velocity")), key=lambda t: t.measured or 0.0)
+    marker = {id(t): _MARKERS[k % len(_MARKERS)] for k, t in enumerate(ranked)}
+    for t in sorted(ranked, key=lambda t: _ORDER[t.outcome]):
+        path = np.array([p for p in t.trajectory["com_velocity"] if p is not None], dtype=float).reshape(-1, 2)
         if not len(path):
             continue
         color = OUTCOME_COLORS[t.outcome]
         ax.plot(path[:, 0], path[:, 1], color=color, lw=0.9, alpha=0.8)
+        ax.plot(path[-1:, 0], path[-1:, 1], marker[id(t)], color=color, ms=5)
         paths.append(path)
-        if t.measured is not None:
-            k = int(np.argmax(np.linalg.norm(path - path[0], axis=1)))
-            ax.annotate(f"{t.measured:.2f}", path[k], fontsize=6, color=color, xytext=(3, 3), textcoords="offset points")
+    for t in ranked:
+        speed = "no contact" if t.measured is None else f"{t.measured:.3f} m/s"
+        trial_handles.append(Line2D([], [], marker=marker[id(t)], color=OUTCOME_COLORS[t.outcome], ls="none",
+                                    label=f"{speed}: {t.outcome.replace('_', ' ')}"))
     set_limits(ax, [area.vertices, *paths], min_ratio=0.5)
     ax.set_aspect("equal")
     ax.set_xlabel("CoM velocity x (m/s)")
     ax.set_ylabel("CoM velocity y (m/s)")
-    ax.set_title(f"{result.scenario}: CoM velocity through each impact\n(labels: measured approach speed, m/s)",
-                 fontsize=10)
+    ax.set_title(f"{result.scenario}: CoM velocity through each impact\n(from the contact to 1.5 s after; "
+                 f"markers at the end, by measured approach speed)", fontsize=9)
     ax.grid(alpha=0.3)
-    fig.legend(handles=handles + _outcome_handles(t.outcome for t in result.trials), loc="outside lower center",
-               ncols=3, fontsize=7, frameon=False)
+    fig.legend(handles=handles + trial_handles, loc="outside lower center", ncols=3, fontsize=7, frameon=False)
     return fig
 
 
 def plot_push_trajectories(result, kind: str = "com_velocity") -> Figure:
     """After every push, the CoM velocity (``kind="com_velocity"``) over the CoM velocity area, or the ZMP
     (``"zmp"``) over the ZMP support area, coloured by outcome; crosses mark each push's before-trial
-    prediction (the post-push CoM velocity, or the quasi-static ZMP while it acts), and the outermost push
-    of each direction is labelled with its direction (deg) and impulse (N s)."""
+    prediction (the post-push CoM velocity, or the quasi-static ZMP while it acts). The directions and
+    impulses are written under the figure."""
     areas = result.setup.analysis.areas
     margin = result.zmp_margin
     if kind == "zmp":
@@ -135,11 +141,10 @@ def plot_push_trajectories(result, kind: str = "com_velocity") -> Figure:
         area, color, label, unit, quantity = areas.com_velocity_area, AREA_COLOR, "CoM velocity area", "m/s", "CoM velocity"
         zmp = areas.zmp_area.inset(margin) if margin > 0 else None
         shrunk = None if zmp is None or zmp.is_empty else zmp.affine(areas.omega, -areas.omega * areas.com[:2])
-    fig = new_figure(6.4, 6.0)
+    fig = new_figure(6.4, 6.6)
     ax = fig.add_subplot()
     handles = _area_with_margin(ax, area, shrunk, color, label, margin)
     paths, predicted = [], []
-    outermost: dict[float, object] = {}
     for o in sorted(result.outcomes, key=lambda o: _ORDER[o.outcome]):
         c = OUTCOME_COLORS[o.outcome]
         path = np.array([p if p is not None else [np.nan, np.nan] for p in o.trajectory.get(kind, [])],
@@ -150,42 +155,41 @@ def plot_push_trajectories(result, kind: str = "com_velocity") -> Figure:
         guess = o.prediction.zmp if kind == "zmp" else o.prediction.com_velocity
         ax.plot([guess[0]], [guess[1]], "x", color=c, ms=4, mew=1.0, alpha=0.9, zorder=4)
         predicted.append(np.asarray(guess, dtype=float).reshape(1, 2))
-        d = round(float(o.push.direction), 6)
-        if d not in outermost or o.push.magnitude > outermost[d].push.magnitude:
-            outermost[d] = o
     view = [area.vertices, *paths]
     if kind == "com_velocity":
         view += predicted
     set_limits(ax, view, min_ratio=0.5)
-    for o in outermost.values():  # labels where the predictions are drawn, inside the view
-        guess = o.prediction.zmp if kind == "zmp" else o.prediction.com_velocity
-        x0, x1 = ax.get_xlim()
-        y0, y1 = ax.get_ylim()
-        p = np.clip(np.asarray(guess, dtype=float), [x0, y0], [x1, y1])
-        cos, sin = np.cos(o.push.direction), np.sin(o.push.direction)
-        # Inwards from the outermost prediction, so the label stays inside the axes.
-        ax.annotate(f"{np.rad2deg(o.push.direction):.0f}°, {o.push.magnitude:.0f} N s", p, fontsize=6, color="0.25",
-                    xytext=(-6 * cos, -6 * sin + (5 if abs(sin) < 0.7 else 0)), textcoords="offset points",
-                    ha="right" if cos > 0.3 else ("left" if cos < -0.3 else "center"),
-                    va="top" if sin > 0.3 else ("bottom" if sin < -0.3 else "bottom"))
+    notes = [_directions_note(result)]
     x0, x1 = ax.get_xlim()
     y0, y1 = ax.get_ylim()
     outside = [p[0] for p in predicted if not (x0 <= p[0, 0] <= x1 and y0 <= p[0, 1] <= y1)]
     if outside:
         far = np.linalg.norm(np.array(outside) - areas.com[:2], axis=1)
-        ax.text(0.5, 0.01, f"{len(outside)} predictions lie off the view ({far.min():.2f} to {far.max():.2f} m from "
-                f"the CoM); labels at the edge", transform=ax.transAxes, ha="center", va="bottom", fontsize=6, color="0.3")
+        notes.append(f"{len(outside)} predictions lie off the view, {far.min():.2f} to {far.max():.2f} m from the CoM")
     ax.set_aspect("equal")
     ax.set_xlabel(f"{quantity} x ({unit})")
     ax.set_ylabel(f"{quantity} y ({unit})")
     what = "ZMP during and after each push" if kind == "zmp" else "CoM velocity after each push"
-    ax.set_title(f"{result.scenario}: {what}\n({len(result.outcomes)} pushes, {result.setup.controller} controller, "
+    fig.suptitle(f"{result.scenario}: {what}\n({len(result.outcomes)} pushes, {result.setup.controller} controller, "
                  f"{1000 * result.outcomes[0].push.duration:.0f} ms)", fontsize=9)
     ax.grid(alpha=0.3)
     handles += _outcome_handles(o.outcome for o in result.outcomes)
     handles.append(Line2D([], [], marker="x", color="0.3", ls="none", label="predicted before the trial"))
-    fig.legend(handles=handles, loc="outside lower center", ncols=3, fontsize=7, frameon=False)
+    legend = fig.legend(handles=handles, loc="outside lower center", ncols=3, fontsize=7, frameon=False,
+                        title="\n".join(notes), title_fontsize=6)
+    legend.get_title().set_color("0.3")
     return fig
+
+
+def _directions_note(result) -> str:
+    """The pushes' directions (from world x) and impulse ranges, one line per group of directions."""
+    by: dict[float, list[float]] = {}
+    for o in result.outcomes:
+        by.setdefault(round(float(np.rad2deg(o.push.direction)), 1), []).append(o.push.magnitude)
+    parts = [f"{d:g}°: {min(m):.0f}–{max(m):.0f}" for d, m in sorted(by.items())]
+    lines = [", ".join(parts[i:i + 4]) for i in range(0, len(parts), 4)][:4]
+    more = " ..." if len(parts) > 16 else ""
+    return "push direction from world x: impulse (N s)\n" + "\n".join(lines) + more
 
 
 def plot_log_margins(time: np.ndarray, com_velocity_margin: np.ndarray, zmp_margin: np.ndarray | None,
