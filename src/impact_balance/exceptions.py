@@ -40,6 +40,8 @@ __all__ = [
     "SimulationError",
     "SweepError",
     "UnknownPathError",
+    "ImpactBalanceWarning",
+    "ModelRepairWarning",
 ]
 
 #: Longest shown repr of a value in a message (characters).
@@ -323,3 +325,22 @@ class UnknownPathError(UnknownNameError):
     """A sweep axis path names a scenario key that does not exist; lists the valid paths."""
 
     kind = "key"
+
+
+class ImpactBalanceWarning(UserWarning):
+    """Base class of the warnings impact-balance emits through :mod:`warnings` (the command
+    line prints each as one ``impact-balance: warning:`` line)."""
+
+
+class ModelRepairWarning(ImpactBalanceWarning):
+    """A robot model was changed to be simulated (see :mod:`impact_balance.sim.inertia`).
+
+    Attributes:
+        robot: The robot's name.
+        bodies: The bodies changed.
+    """
+
+    def __init__(self, robot: str, bodies: Sequence[str], message: str):
+        self.robot = robot
+        self.bodies = tuple(bodies)
+        super().__init__(message)

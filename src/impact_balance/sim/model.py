@@ -22,17 +22,19 @@ velocity in the base frame, but its linear velocity in world axes: the helpers c
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
-from ..exceptions import SimulationError
+from ..exceptions import ModelRepairWarning, SimulationError
 from ..robot import Robot
 from ..scenario import Scenario, load_scenario
 from ..stance import Stance
 from .environment import ContactParameters, add_geometry
+from .inertia import InertiaRepair, repair_message
 from .joints import JOINT_MODELS, ServoOptions, holding_torques, servo_gains, weld_joints
 from .urdf import ROOT_JOINT, robot_spec
 
@@ -91,6 +93,7 @@ class SimModel:
     kp: np.ndarray
     kd: np.ndarray
     tau_hold: np.ndarray
+    inertia_repair: InertiaRepair | None = None
 
     @property
     def robot(self) -> Robot:
@@ -252,7 +255,10 @@ def build_model(
     robot = stance.robot
     impact = scenario.impact.spec() if scenario.impact is not None else None
 
-    spec = robot_spec(robot, meshes=options.meshes)
+    spec, repair = robot_spec(robot, meshes=options.meshes)
+    if repair is not None:
+        # Once per robot and process (the warnings module's default filter shows a message once).
+        warnings.warn(ModelRepairWarning(robot.name, repair.bodies, repair_message(robot.name, repair)), stacklevel=2)
     spec.option.timestep = options.timestep
     spec.option.gravity = [0.0, 0.0, -scenario.gravity]
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
@@ -326,7 +332,7 @@ def build_model(
         contact_geoms=tuple(geom_id(n) for n in names.contacts),
         support_geoms=tuple(geom_id(n) for n in names.supports), ground_geom=geom_id(names.ground),
         impact_geom=geom_id(names.impact), surface_geom=geom_id(names.surface),
-        kp=kp, kd=kd, tau_hold=tau_hold,
+        kp=kp, kd=kd, tau_hold=tau_hold, inertia_repair=repair,
     )
     sim.set_state(stance.q)
     sim.set_servo_targets(stance.q)
