@@ -6,6 +6,7 @@
 """
 
 from .frames import FramePose, contact_poses, frame_poses
-from .pose import Placement, PoseResult, pose_scenario, posed_mapping
+from .pose import Placement, PoseResult, pose_scenario, posed_mapping, scenario_yaml
 
-__all__ = ["FramePose", "frame_poses", "contact_poses", "Placement", "PoseResult", "pose_scenario", "posed_mapping"]
+__all__ = ["FramePose", "frame_poses", "contact_poses", "Placement", "PoseResult", "pose_scenario", "posed_mapping",
+           "scenario_yaml"]

@@ -9,6 +9,8 @@
   without it the orientation is kept.
 - Every other contact stays where it is; ``--com X Y`` moves the CoM's horizontal position
   (kept free otherwise).
+- A frame on a chain of fewer than 6 joints from the base (a quadruped's 3-joint leg) cannot
+  hold an orientation: its position alone is placed or kept (a point foot).
 
 The IK is :func:`impact_balance.ik.solve_stance` (pink, as the GUI's drags), started from the
 scenario's stance and pulled towards it. The result is the scenario with an explicit ``base``
@@ -26,13 +28,14 @@ from typing import Any
 
 import numpy as np
 import pinocchio as pin
+import yaml
 
 from ..exceptions import ScenarioError
 from ..ik import solve_stance, stance_residuals
 from ..scenario import Scenario
 from ..spatial import aligning_rotation, unit
 
-__all__ = ["Placement", "PoseResult", "pose_scenario", "posed_mapping", "DIGITS"]
+__all__ = ["Placement", "PoseResult", "pose_scenario", "posed_mapping", "scenario_yaml", "chain_dofs", "DIGITS"]
 
 #: Decimals kept in the written base pose and joint values (1e-6 m, 1e-6 rad).
 DIGITS = 6
@@ -63,6 +66,7 @@ class PoseResult:
         residuals: Errors at ``q`` (``FRAME.position`` m, ``FRAME.orientation`` rad, ``com_xy`` m).
         com: CoM at ``q``, world, m.
         contact_normals: New world normals of placed contacts given by their normal, by index.
+        position_only: Frames whose orientation was left free (chains of fewer than 6 joints).
     """
 
     q: np.ndarray
@@ -70,6 +74,18 @@ class PoseResult:
     residuals: dict[str, float]
     com: np.ndarray
     contact_normals: dict[int, tuple[float, float, float]] = field(default_factory=dict)
+    position_only: tuple[str, ...] = ()
+
+
+def chain_dofs(robot, frame: str) -> int:
+    """Degrees of freedom of the joints between the floating base and ``frame`` (base excluded)."""
+    model = robot.model
+    joint = model.frames[robot.frame_id(frame)].parentJoint
+    count = 0
+    while joint > 1:
+        count += model.joints[joint].nv
+        joint = model.parents[joint]
+    return count
 
 
 def pose_scenario(
@@ -112,13 +128,18 @@ def pose_scenario(
                 normals[index] = tuple(float(x) for x in n)
         targets[p.frame] = pin.SE3(rotation, np.asarray(p.position, dtype=float)) * offset.inverse()
     kept = sorted({c.spec.frame for c in stance.contacts} - set(targets))
-    q = solve_stance(robot, stance.q, targets, com_xy, fixed_frames=kept, posture_target=stance.q,
-                     tolerance=tolerance, max_iterations=max_iterations)
     all_targets = dict(targets)
     all_targets.update({f: stance.frame_pose(f) for f in kept})
-    residuals = stance_residuals(robot, q, all_targets, com_xy)
+    free = tuple(f for f in all_targets if chain_dofs(robot, f) < 6)
+    for p in placements:
+        if p.normal is not None and p.frame in free:
+            raise ScenarioError("--normal", list(p.normal), f"{p.frame} is on a chain of {chain_dofs(robot, p.frame)} "
+                                "joints from the base: it cannot be turned, only placed")
+    q = solve_stance(robot, stance.q, all_targets, com_xy, position_only=free, posture_target=stance.q,
+                     tolerance=tolerance, max_iterations=max_iterations)
+    residuals = stance_residuals(robot, q, all_targets, com_xy, free)
     com = pin.centerOfMass(robot.model, robot.model.createData(), q)
-    return PoseResult(q, all_targets, residuals, np.array(com), normals)
+    return PoseResult(q, all_targets, residuals, np.array(com), normals, free)
 
 
 def _rounded(x: float) -> float:
@@ -134,7 +155,13 @@ def posed_mapping(raw: Mapping[str, Any], scenario: Scenario, result: PoseResult
     rewritten relative to ``out_dir`` (the written file's folder).
     """
     robot = scenario.load_robot()
-    out = {k: v for k, v in dict(raw).items() if k not in ("base", "joints", "name")}
+    out: dict[str, Any] = {}
+    for key, value in dict(raw).items():  # base and joints right after the configuration, as in bundled files
+        if key in ("base", "joints", "name"):
+            continue
+        out[key] = value
+        if key == "configuration" or (key == "robot" and "configuration" not in raw):
+            out["base"], out["joints"] = None, None
     q = result.q
     rpy = pin.rpy.matrixToRpy(pin.Quaternion(np.asarray(q[3:7])).normalized().matrix())
     out["base"] = {"position": [_rounded(v) for v in q[:3]], "rpy": [_rounded(v) for v in rpy]}
@@ -165,3 +192,18 @@ def posed_mapping(raw: Mapping[str, Any], scenario: Scenario, result: PoseResult
                 entry[key] = os.path.relpath(path, Path(out_dir).resolve()) if out_dir is not None else str(path)
         out["robot"] = entry
     return out
+
+
+class _Dumper(yaml.SafeDumper):
+    """YAML as the bundled scenarios are written: mappings in block style, vectors on one line."""
+
+
+_Dumper.add_representer(list, lambda dumper, data: dumper.represent_sequence(
+    "tag:yaml.org,2002:seq", data, flow_style=all(not isinstance(x, (dict, list)) for x in data)))
+_Dumper.add_representer(tuple, lambda dumper, data: _Dumper.yaml_representers[list](dumper, list(data)))
+
+
+def scenario_yaml(mapping: Mapping[str, Any], header: str = "") -> str:
+    """A scenario mapping as YAML text (block mappings, one-line vectors), after ``header`` comment lines."""
+    comment = "".join(f"# {line}\n" for line in header.splitlines())
+    return comment + yaml.dump(dict(mapping), Dumper=_Dumper, sort_keys=False, width=100, allow_unicode=True)

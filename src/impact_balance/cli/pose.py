@@ -55,9 +55,7 @@ def add_parser(sub) -> list[str]:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    import yaml
-
-    from ..authoring import Placement, pose_scenario, posed_mapping
+    from ..authoring import Placement, pose_scenario, posed_mapping, scenario_yaml
     from ..exceptions import ScenarioError, WorkspaceError
     from ..scenario import _read, load_scenario, scenario_from_dict, scenario_path
     from ..workspace import Workspace
@@ -77,9 +75,12 @@ def run(args: argparse.Namespace) -> int:
     result = pose_scenario(scenario, placements, args.com)
     mapping = posed_mapping(_read(scenario_path(args.scenario)), scenario, result, out.parent)
     scenario_from_dict(mapping, str(out)).build_stance()  # what is written loads
-    text = ("# Posed by impact-balance pose (whole-body IK, contacts kept) from "
-            f"{scenario.name or args.scenario}.\n" + yaml.safe_dump(mapping, sort_keys=False, default_flow_style=None,
-                                                                     width=100))
+    argv = " ".join(f"--place {p.frame} {' '.join(f'{x:g}' for x in p.position)}"
+                    + (f" --normal {' '.join(f'{x:g}' for x in p.normal)}" if p.normal else "") for p in placements)
+    if args.com is not None:
+        argv += f" --com {args.com[0]:g} {args.com[1]:g}"
+    text = scenario_yaml(mapping, f"Posed by `impact-balance pose {scenario.name or args.scenario} {argv.strip()}`\n"
+                                  "(whole-body IK, the other contacts kept).")
     written = workspace.write_text(out.name, text, overwrite=args.force, field="--out")
     worst = max(result.residuals.values(), default=0.0)
     if args.json:

@@ -14,6 +14,8 @@ MuJoCo reads URDF itself; three things make its model the same robot as pinocchi
   the rule of :mod:`.inertia` (merged into the moving body they are fused with, else raised
   to a floor below 1e-7 of the robot's mass and inertia); :func:`robot_spec` returns what
   it changed.
+- URDF ``<mimic>`` joints (Romeo's fingers) are independent joints in pinocchio's model, so
+  the equality constraints MuJoCo makes of them are dropped.
 - Meshes in formats MuJoCo does not decode (COLLADA ``.dae``, ASCII STL) are read by
   :func:`impact_balance.mesh_files.read_mesh` and given to MuJoCo as vertex arrays.
 
@@ -119,6 +121,8 @@ def robot_spec(robot: Robot, meshes: bool = True) -> tuple[mujoco.MjSpec, Inerti
     if root is None:
         raise RobotLoadError(str(robot.urdf_path), "no link in the URDF")
     root.add_freejoint(name=ROOT_JOINT)
+    for equality in list(spec.equalities):  # <mimic> couplings: pinocchio's joints are independent
+        spec.delete(equality)
     for geom in list(spec.geoms):
         if not meshes:
             spec.delete(geom)
