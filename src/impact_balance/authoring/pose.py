@@ -31,11 +31,11 @@ import pinocchio as pin
 import yaml
 
 from ..exceptions import ScenarioError
-from ..ik import solve_stance, stance_residuals
+from ..ik import chain_dofs, solve_stance, stance_residuals
 from ..scenario import Scenario
 from ..spatial import aligning_rotation, unit
 
-__all__ = ["Placement", "PoseResult", "pose_scenario", "posed_mapping", "scenario_yaml", "chain_dofs", "DIGITS"]
+__all__ = ["Placement", "PoseResult", "pose_scenario", "posed_mapping", "scenario_yaml", "DIGITS"]
 
 #: Decimals kept in the written base pose and joint values (1e-6 m, 1e-6 rad).
 DIGITS = 6
@@ -76,16 +76,6 @@ class PoseResult:
     contact_normals: dict[int, tuple[float, float, float]] = field(default_factory=dict)
     position_only: tuple[str, ...] = ()
 
-
-def chain_dofs(robot, frame: str) -> int:
-    """Degrees of freedom of the joints between the floating base and ``frame`` (base excluded)."""
-    model = robot.model
-    joint = model.frames[robot.frame_id(frame)].parentJoint
-    count = 0
-    while joint > 1:
-        count += model.joints[joint].nv
-        joint = model.parents[joint]
-    return count
 
 
 def pose_scenario(

@@ -257,8 +257,8 @@ def build_model(
 
     spec, repair = robot_spec(robot, meshes=options.meshes)
     if repair is not None:
-        # Once per robot and process (the warnings module's default filter shows a message once).
-        warnings.warn(ModelRepairWarning(robot.name, repair.bodies, repair_message(robot.name, repair)), stacklevel=2)
+        # Once per robot and process: the default filter shows a message once per place it is issued from.
+        warnings.warn(ModelRepairWarning(robot.name, repair.bodies, repair_message(robot.name, repair)), stacklevel=1)
     spec.option.timestep = options.timestep
     spec.option.gravity = [0.0, 0.0, -scenario.gravity]
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
