@@ -1,10 +1,10 @@
-"""Sole and hand sizes of the bundled robots, measured on their visual meshes (docs/robots.md).
+"""Sole and hand sizes of the bundled robots, measured on their meshes (docs/robots.md).
 
 Run from the repository root:
 
     PYTHONPATH=src python examples/robot_sizes.py
 
-For each robot it reads the URDF's visual geometry with pinocchio, the mesh files with
+For each robot it reads the URDF's collision and visual geometry with pinocchio, the mesh files with
 :func:`impact_balance.mesh_files.read_mesh`, and expresses every vertex of the links that move
 with the foot (or hand) frame in that frame, at the robot's standing configuration:
 
@@ -30,14 +30,12 @@ FRAMES = {
     "icub": ("l_sole", "l_hand"),
 }
 SOLE_BAND = 0.005
-#: The geometry measured (the visual meshes: iCub's simplified collision foot is turned 90 degrees).
-GEOMETRY = pin.GeometryType.VISUAL
 
 
-def _vertices_in(robot, frame: str) -> np.ndarray:
+def _vertices_in(robot, frame: str, kind: pin.GeometryType) -> np.ndarray:
     """Every collision vertex of the bodies moved by ``frame``'s parent joint, in ``frame``, m."""
     model = robot.model
-    geometry = pin.buildGeomFromUrdf(model, str(robot.urdf_path), GEOMETRY,
+    geometry = pin.buildGeomFromUrdf(model, str(robot.urdf_path), kind,
                                      package_dirs=[str(p) for p in robot.urdf_path.resolve().parents])
     data, gdata = model.createData(), geometry.createData()
     q = robot.configuration()
@@ -58,25 +56,26 @@ def _vertices_in(robot, frame: str) -> np.ndarray:
     return np.vstack(points) if points else np.zeros((0, 3))
 
 
-def sizes(name: str) -> dict:
+def sizes(name: str, kind: pin.GeometryType = pin.GeometryType.COLLISION) -> dict:
     robot = load_robot(name)
     sole, hand = FRAMES[name]
     out = {"robot": name, "mass": robot.mass, "sole_frame": sole, "hand_frame": hand}
-    v = _vertices_in(robot, sole)
+    v = _vertices_in(robot, sole, kind)
     if len(v):
         bottom = v[v[:, 2] <= v[:, 2].min() + SOLE_BAND]
         lo, hi = bottom[:, :2].min(axis=0), bottom[:, :2].max(axis=0)
         out["sole_size"] = (hi - lo).tolist()
         out["sole_centre"] = [*(0.5 * (lo + hi)).tolist(), float(v[:, 2].min())]
-    h = _vertices_in(robot, hand)
+    h = _vertices_in(robot, hand, kind)
     if len(h):
         out["hand_box"] = [h.min(axis=0).tolist(), h.max(axis=0).tolist()]
     return out
 
 
 def main() -> None:
-    for name in BUNDLED_ROBOTS:
-        s = sizes(name)
+    for name, kind in ((n, k) for k in (pin.GeometryType.COLLISION, pin.GeometryType.VISUAL) for n in BUNDLED_ROBOTS):
+        print(f"[{str(kind).rsplit('.', 1)[-1].lower()}] ", end="")
+        s = sizes(name, kind)
         sole = (f"sole {s['sole_size'][0]:.3f} x {s['sole_size'][1]:.3f} m, centre "
                 f"({', '.join(f'{x:+.3f}' for x in s['sole_centre'])}) in {s['sole_frame']}") if "sole_size" in s else "sole: no mesh"
         hand = ""
