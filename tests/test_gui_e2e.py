@@ -196,13 +196,14 @@ def test_romeo_is_drawn_from_its_collada_meshes(page, tmp_path):
         romeo._meshes.set_opacity(1.0)
         other.goto(romeo.url)
         other.locator("#ib-vmax-com").wait_for()
-        canvas = other.locator("canvas").first
+        box = other.locator("canvas").first.bounding_box()
+        clip = {"x": box["x"], "y": box["y"], "width": box["width"], "height": box["height"]}
         other.wait_for_timeout(2000)  # the software renderer draws the meshes
-        with_robot = canvas.screenshot(path=str(tmp_path / "romeo.png"))
+        with_robot = other.screenshot(path=str(tmp_path / "romeo.png"), clip=clip)
         with romeo.session.lock:
             romeo._meshes.remove()
         other.wait_for_timeout(2000)
-        without = canvas.screenshot(path=str(tmp_path / "romeo_without_meshes.png"))
+        without = other.screenshot(path=str(tmp_path / "romeo_without_meshes.png"), clip=clip)
         out = os.environ.get("IMPACT_BALANCE_E2E_ROMEO")
         if out:
             shutil.copy(tmp_path / "romeo.png", out)

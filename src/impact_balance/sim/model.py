@@ -16,7 +16,8 @@ convert state both ways: ``set_state(q, v)`` takes a pinocchio configuration and
 ``mj_forward``; ``configuration()`` and ``velocity()`` read them back; ``com()`` and
 ``com_velocity()`` (m, m/s, world); ``contact_force(geom)`` (N, world, on the robot);
 ``set_servo_targets(q_ref, v_ref)`` writes the servo commands (the holding torques
-included). MuJoCo's free joint stores the base orientation as (w, x, y, z) and its angular
+included). ``inertia_repair`` says which inertials were changed for MuJoCo (see
+:mod:`.inertia`; a :class:`~impact_balance.exceptions.ModelRepairWarning` names them once). MuJoCo's free joint stores the base orientation as (w, x, y, z) and its angular
 velocity in the base frame, but its linear velocity in world axes: the helpers convert.
 """
 
