@@ -10,7 +10,7 @@ import numpy as np
 
 from .areas import BalanceAreas, areas_from_polytope, with_reason
 from .constraints import wrench_polytope
-from .criteria import VelocityLimit, capped_velocity, max_contact_velocity, safe_interval, zmp_max_contact_velocity
+from .criteria import VelocityLimit, max_contact_velocity, safe_contact_velocity, safe_interval, zmp_max_contact_velocity
 from .diagnostics import Diagnostic, diagnose
 from .impact import ImpactModel, impact_model
 from .projection.walk import warm_up
@@ -36,8 +36,10 @@ class ImpactAnswer:
         model: Impact model (impulse rates, W, cone).
         com_limit: Maximum approach speed by the CoM velocity criterion (m/s).
         zmp_limit: Maximum approach speed by the ZMP criterion (m/s).
-        contact_velocity: Reference velocity with its approach component capped (m/s, world),
-            or None without a reference velocity.
+        contact_velocity: Reference velocity with its approach speed moved into the safe
+            interval (capped at the maximum when the CoM velocity is inside the area; see
+            :func:`~impact_balance.criteria.safe_contact_velocity`), m/s, world; None without a
+            reference velocity or when no approach speed is safe.
         qp: The paper's QP solution when requested.
         safe_interval: The approach speeds (lo, hi) m/s whose post-impact CoM velocities all
             stay in the area (hi may be inf), or None when there are none; see
@@ -213,9 +215,10 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
         zmp_limit = zmp_max_contact_velocity(
             areas.zmp_area, model, stance.com, scenario.plane_height, scenario.gravity, cfg.duration
         )
+        interval = safe_interval(areas.com_velocity_area, model, scenario.com_velocity, com_limit)
         contact_velocity = None
         if cfg.reference_velocity is not None:
-            contact_velocity = capped_velocity(cfg.reference_velocity, model.normal, com_limit.max_approach_speed)
+            contact_velocity = safe_contact_velocity(cfg.reference_velocity, model.normal, interval)
         qp = None
         if (cfg.qp.solve if solve_qp is None else solve_qp) and cfg.reference_velocity is not None:
             tau0 = static_torques(stance, polytope) if cfg.qp.impulsive_torque_limits else None
@@ -229,7 +232,6 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
                 )
             except SolverError as exc:
                 raise exc.within("impact.qp") from None
-        interval = safe_interval(areas.com_velocity_area, model, scenario.com_velocity, com_limit)
         answer = ImpactAnswer(model, com_limit, zmp_limit, contact_velocity, qp, interval)
         timings["impact"] = time.perf_counter() - t3
     timings["total"] = time.perf_counter() - t0

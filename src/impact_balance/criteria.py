@@ -28,6 +28,7 @@ __all__ = [
     "max_contact_velocity",
     "zmp_max_contact_velocity",
     "capped_velocity",
+    "safe_contact_velocity",
     "first_exit",
     "safe_interval",
     "speed_interval",
@@ -180,4 +181,25 @@ def capped_velocity(reference: Sequence[float], normal: np.ndarray, max_approach
     excess = -(normal @ v) - max_approach_speed
     if math.isfinite(max_approach_speed) and excess > 0:
         v += excess * normal
+    return v
+
+
+def safe_contact_velocity(reference: Sequence[float], normal: np.ndarray,
+                          interval: tuple[float, float] | None) -> np.ndarray | None:
+    """``reference`` with its approach speed -n.v moved to the nearest speed of the safe ``interval``.
+
+    With the CoM velocity inside the area the interval is ``[0, max]``, and this is
+    :func:`capped_velocity`. With the robot already falling it is ``[lo, hi]``, ``lo > 0``:
+    a reference within it is kept, one below ``lo`` is raised to ``lo`` (a softer impact
+    would not catch the fall), one above ``hi`` capped. None when no speed is safe. (A
+    reference moving away from the surface, with ``lo`` = 0, is kept: there is no impact.)
+    """
+    if interval is None:
+        return None
+    lo, hi = interval
+    v = np.array(reference, dtype=float)
+    speed = -(normal @ v)
+    target = min(max(speed, lo), hi) if lo > 0 else min(speed, hi)
+    if target != speed:
+        v += (speed - target) * normal
     return v

@@ -41,6 +41,8 @@ __all__ = [
     "SweepError",
     "UnknownPathError",
     "MissingExtraError",
+    "ImpactBalanceWarning",
+    "ModelRepairWarning",
 ]
 
 #: Longest shown repr of a value in a message (characters).
@@ -339,3 +341,22 @@ class MissingExtraError(ImpactBalanceError, ImportError):
         self.what, self.extra, self.missing = what, extra, tuple(missing)
         super().__init__(f"{what} needs the {extra!r} extra: pip install 'impact-balance[{extra}]' "
                          f"({', '.join(self.missing)} not installed)")
+
+
+class ImpactBalanceWarning(UserWarning):
+    """Base class of the warnings impact-balance emits through :mod:`warnings` (the command
+    line prints each as one ``impact-balance: warning:`` line)."""
+
+
+class ModelRepairWarning(ImpactBalanceWarning):
+    """A robot model was changed to be simulated (see :mod:`impact_balance.sim.inertia`).
+
+    Attributes:
+        robot: The robot's name.
+        bodies: The bodies changed.
+    """
+
+    def __init__(self, robot: str, bodies: Sequence[str], message: str):
+        self.robot = robot
+        self.bodies = tuple(bodies)
+        super().__init__(message)

@@ -27,7 +27,7 @@ from pink.tasks import ComTask, FrameTask, PostureTask
 from .exceptions import ImpactBalanceError
 from .robot import Robot
 
-__all__ = ["IKError", "solve_stance", "stance_residuals"]
+__all__ = ["IKError", "solve_stance", "stance_residuals", "chain_dofs"]
 
 #: Residual (m or rad) below which the regularisation is scaled down by ``_FINISH_SCALE``.
 _FINISH_THRESHOLD = 1e-3
@@ -69,6 +69,17 @@ def _reduced(robot: Robot, locked_joints: Iterable[str], q0: np.ndarray) -> tupl
         full = model.joints[model.getJointId(reduced.names[jid])]
         index.append((full.idx_q, joint.idx_q, joint.nq))
     return reduced, index
+
+
+def chain_dofs(robot: Robot, frame: str) -> int:
+    """Degrees of freedom of the joints between the floating base and ``frame`` (the base's excluded)."""
+    model = robot.model
+    joint = model.frames[robot.frame_id(frame)].parentJoint
+    count = 0
+    while joint > 1:
+        count += model.joints[joint].nv
+        joint = model.parents[joint]
+    return count
 
 
 def stance_residuals(
@@ -129,7 +140,10 @@ def solve_stance(
     select one solution among the many of a redundant robot. Once every residual is below
     1e-3 (m, rad) these two are scaled down by 1e-3, so that they no longer bias the targets.
     Joint limits are hard constraints of every step (pink's
-    :class:`~pink.limits.ConfigurationLimit`), so the result is always within limits.
+    :class:`~pink.limits.ConfigurationLimit`), so the result is always within limits; a ``q0``
+    outside them (some SRDF configurations are) is first clamped into them.
+    A frame on a chain of fewer than 6 joints from the base (a quadruped's 3-joint leg)
+    cannot hold an orientation: its target is a position only (as in ``position_only``).
     The result only depends on the inputs (no randomness).
 
     Args:
@@ -165,6 +179,9 @@ def solve_stance(
     model_full = robot.model
     if q0.shape != (model_full.nq,):
         raise ValueError(f"q0 must have {model_full.nq} coordinates, got shape {q0.shape}")
+    for slot in (robot.joint_slot(name) for name in robot.joint_names):
+        if slot.nq == 1 and np.isfinite(slot.lower) and np.isfinite(slot.upper) and slot.lower < slot.upper:
+            q0[slot.idx_q] = min(max(q0[slot.idx_q], slot.lower), slot.upper)
     data_full = model_full.createData()
     pin.framesForwardKinematics(model_full, data_full, q0)
 
@@ -174,7 +191,7 @@ def solve_stance(
     for name, target in (frame_targets or {}).items():
         robot.frame_id(name, field="frame_targets")
         targets[name] = pin.SE3(target)
-    free = set(position_only)
+    free = set(position_only) | {name for name in targets if chain_dofs(robot, name) < 6}
 
     model, index = _reduced(robot, locked_joints, q0)
 

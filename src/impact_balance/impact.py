@@ -148,7 +148,9 @@ def impulse_to_velocity(
     """W at ``point``: composite rigid body (default) or joint space J M^-1 J^T.
 
     ``arm`` is ``point - com`` when the caller has it exactly (stance-frame positions);
-    by default it is computed from the world positions.
+    by default it is computed from the world positions. Joints that move no mass (Romeo's
+    massless fingers: zero rows of M) are left out of the joint-space model; an impact point
+    that such a joint moves has no finite W and is refused.
     """
     if model == "composite":
         r = skew(point - stance.com if arm is None else arm)
@@ -158,6 +160,13 @@ def impulse_to_velocity(
         M = pin.crba(stance.model, workspace.data, stance.q)
         M = np.triu(M) + np.triu(M, 1).T
         workspace.holder = None  # crba rewrote the joint placements: point() recomputes them
+        diagonal = np.diag(M)
+        moving = diagonal > 1e-12 * diagonal.max()
+        if not moving.all():
+            if np.abs(jacobian[:, ~moving]).max() > 1e-12:
+                raise ImpactModelError("impact.inertia", "joint_space", "the impact point is moved by a joint "
+                                       "that moves no mass: no finite joint-space inertia there (use composite)")
+            M, jacobian = M[np.ix_(moving, moving)], jacobian[:, moving]
         return jacobian @ np.linalg.solve(M, jacobian.T)
     raise ImpactModelError("impact.inertia", model, f"must be one of {', '.join(INERTIA_MODELS)}")
 

@@ -77,16 +77,21 @@ def format_analysis(analysis: Analysis) -> str:
             f"mu {spec.friction:g}, restitution [{spec.restitution[0]:g}, {spec.restitution[1]:g}], N = {spec.cone_edges}"
         )
         com_v, zmp_v = im.max_contact_velocity, im.zmp_max_contact_velocity
-        ratio = f" (x{com_v / zmp_v:.1f})" if np.isfinite(com_v) and zmp_v > 0 else ""
-        lines.append(
-            f"  max contact velocity: CoM criterion {format_speed(com_v)}, ZMP criterion {format_speed(zmp_v)}{ratio}"
-        )
-        lines.append("  " + format_safe_interval(im.safe_interval, analysis.com_velocity_inside))
-        if im.contact_velocity is not None:
+        if im.com_limit.status == "already_falling":
+            # The ZMP criterion ignores the CoM velocity: its number is not comparable here.
+            lines.append(f"  max contact velocity: none, the robot is already falling (CoM criterion 0); "
+                         f"ZMP criterion {format_speed(zmp_v)} (it ignores the CoM velocity)")
+        else:
+            ratio = f" (x{com_v / zmp_v:.1f})" if np.isfinite(com_v) and com_v > 0 and zmp_v > 0 else ""
             lines.append(
-                f"  reference velocity {_vec(spec.reference_velocity)} m/s -> contact velocity "
-                f"{_vec(im.contact_velocity)} m/s"
+                f"  max contact velocity: CoM criterion {format_speed(com_v)}, ZMP criterion {format_speed(zmp_v)}{ratio}"
             )
+        lines.append("  " + format_safe_interval(im.safe_interval, analysis.com_velocity_inside))
+        if spec.reference_velocity is not None:
+            target = (f"contact velocity {_vec(im.contact_velocity)} m/s (approach speed "
+                      f"{im.model.approach_speed(im.contact_velocity):.3f}, in the safe interval)"
+                      if im.contact_velocity is not None else "no safe contact velocity (no approach speed is safe)")
+            lines.append(f"  reference velocity {_vec(spec.reference_velocity)} m/s -> {target}")
         if im.qp is not None:
             lines.append(f"  paper's QP ({im.qp.status}): approach speed {format_speed(im.qp.approach_speed)}")
     lines.append(f"  {format_timings(analysis.timings)}")

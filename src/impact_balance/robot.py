@@ -255,6 +255,18 @@ class Robot:
     def _assignments(self) -> dict[tuple, tuple[np.ndarray, np.ndarray]]:
         return {}
 
+    def joint_values(self, q: np.ndarray) -> dict[str, float]:
+        """Values of the 1-dof joints at configuration ``q``, rad or m (continuous joints by their angle)."""
+        model = self.model
+        out = {}
+        for jid in range(2, model.njoints):
+            joint = model.joints[jid]
+            if joint.nq == 1:
+                out[model.names[jid]] = float(q[joint.idx_q])
+            elif joint.nq == 2 and joint.nv == 1:
+                out[model.names[jid]] = math.atan2(float(q[joint.idx_q + 1]), float(q[joint.idx_q]))
+        return out
+
     def configuration(self, name: str | None = None, field: str = "configuration") -> np.ndarray:
         """A copy of the named reference configuration (default: the standing one)."""
         key = self.standing if name is None else name

@@ -196,9 +196,9 @@ class Stance:
         J[:3] -= skew(placement.translation - frame_pose.translation) @ J[3:]
         return placement, J
 
-    def frame_pose(self, frame: str) -> pin.SE3:
-        """World pose of a frame (a copy)."""
-        fid = self.robot.frame_id(frame)
+    def frame_pose(self, frame: str, field: str = "frame") -> pin.SE3:
+        """World pose of a frame (a copy); ``field`` names it in an unknown-frame error."""
+        fid = self.robot.frame_id(frame, field=field)
         placement = pin.updateFramePlacement(self.model, self._kinematics(), fid)
         return pin.SE3(placement.rotation, placement.translation + self.origin)
 

@@ -12,17 +12,19 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import warnings
 from types import ModuleType
 
-from ..exceptions import ImpactBalanceError, one_line
+from ..exceptions import ImpactBalanceError, ImpactBalanceWarning, one_line
 from ..extras import require_for
-from . import analyze, check_log, demo, frames, gui, listing, phase_portrait, push_test, simulate, sweep, validate
+from . import analyze, check_log, demo, frames, gui, listing, phase_portrait, pose, push_test, simulate, sweep, validate
 from .demo import DEMO_SCENARIOS, FRICTION_SWEEP
 
 __all__ = ["main", "DEMO_SCENARIOS", "FRICTION_SWEEP", "COMMANDS", "EXIT_BROKEN_PIPE"]
 
 #: Command modules, in the order of ``--help``.
-COMMANDS: tuple[ModuleType, ...] = (demo, analyze, phase_portrait, listing, frames, gui, simulate, validate, push_test, check_log, sweep)
+COMMANDS: tuple[ModuleType, ...] = (demo, analyze, phase_portrait, listing, frames, pose, gui, simulate, validate, push_test,
+                                     check_log, sweep)
 
 #: Exit status when stdout is closed early (128 + SIGPIPE, as a shell reports it).
 EXIT_BROKEN_PIPE = 141
@@ -89,7 +91,19 @@ def _parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
     return p, owners
 
 
+_show_warning = warnings.showwarning
+
+
+def _warning_line(message, category, filename, lineno, file=None, line=None):
+    """The library's own warnings as one ``impact-balance: warning:`` line (no source location)."""
+    if issubclass(category, ImpactBalanceWarning):
+        print(f"impact-balance: warning: {' '.join(str(message).split())}", file=sys.stderr if file is None else file)
+    else:
+        _show_warning(message, category, filename, lineno, file, line)
+
+
 def main(argv: list[str] | None = None) -> int:
+    warnings.showwarning = _warning_line
     parser, owners = _parser()
     args = parser.parse_args(argv)
     module = owners[args.command]

@@ -28,12 +28,17 @@ def run(args: argparse.Namespace) -> int:
     check = check_log(frame, args.scenario, source=str(args.log)[:80])
     out = check.to_dict(samples=args.samples)
     out["log"] = str(args.log)
-    written = _plots(check, Path(args.plots)) if args.plots else []
+    written = _plots(check, Path(args.plots)) if args.plots and not check.floating else []
     if args.json:
         print_json(out)
         return 0
     print(f"{args.log}: {out['samples']} samples over {out['duration']:.3f} s, scenario {check.scenario},"
           f" {len(check.segments)} stance(s)")
+    if check.floating:
+        print(f"  {check.note}")
+        if args.plots:
+            print("  no margins figure: no area to measure margins against")
+        return 0
     mv, mz = out["min_com_velocity_margin"], out["min_zmp_margin"]
     print(f"  smallest CoM velocity margin: {'-inf (no area)' if mv is None else f'{mv:.3f} m/s'}")
     if check.has_zmp:

@@ -1,4 +1,8 @@
-"""``impact-balance frames ROBOT``: every frame and joint of a robot (names for contacts and joints)."""
+"""``impact-balance frames ROBOT|SCENARIO``: every frame's pose and axes, and every joint of a robot.
+
+For a scenario, the poses are at its stance (and its contacts are listed, resolved); for a
+robot, at its standing configuration (the free-flyer as the configuration gives it).
+"""
 
 from __future__ import annotations
 
@@ -9,39 +13,40 @@ __all__ = ["add_parser", "run", "robot_listing"]
 
 
 def add_parser(sub) -> list[str]:
-    f = sub.add_parser("frames", help="list a robot's frames and joints (the names scenario files use)")
+    f = sub.add_parser("frames", help="list a robot's frames (world position and axes) and joints")
     f.add_argument("robot", help="a bundled robot (see `impact-balance robots`), a URDF file, or a scenario")
+    f.add_argument("--frame", action="append", metavar="NAME", help="only this frame (repeatable)")
     f.add_argument("--json", action="store_true", help="print one JSON object")
     return ["frames"]
 
 
-def _robot(name: str):
+def _robot_and_stance(name: str):
+    """(robot, configuration, configuration label, stance or None)."""
     from ..exceptions import UnknownRobotError, UnknownScenarioError
     from ..robot import BUNDLED_ROBOTS, load_robot
     from ..scenario import load_scenario
 
-    if name in BUNDLED_ROBOTS:
-        return load_robot(name)
-    if name.endswith(".urdf"):
-        return load_robot(None, name)
+    if name in BUNDLED_ROBOTS or name.endswith(".urdf"):
+        robot = load_robot(name) if name in BUNDLED_ROBOTS else load_robot(None, name)
+        return robot, robot.configuration(), f"configuration {robot.standing}", None
     try:
-        return load_scenario(name).load_robot()  # a scenario file or a bundled scenario's name
+        scenario = load_scenario(name)  # a scenario file or a bundled scenario's name
     except UnknownScenarioError:  # neither: say which robots there are
         raise UnknownRobotError("robot", name, BUNDLED_ROBOTS) from None
+    stance = scenario.build_stance()
+    return stance.robot, stance.q, f"stance of scenario {scenario.name or name}", stance
 
 
-def robot_listing(robot) -> dict:
-    """Frames (name, type, parent joint) and actuated joints (limits) of a robot, as a mapping."""
-    model = robot.model
-    frames = [
-        {"name": f.name, "type": str(f.type).rsplit(".", 1)[-1], "parent_joint": model.names[f.parentJoint]}
-        for f in model.frames
-    ]
+def robot_listing(robot, q=None, frames: list[str] | None = None) -> dict:
+    """Frames (name, type, parent joint, world pose at ``q``) and actuated joints (limits) of a robot."""
+    from ..authoring import frame_poses
+
+    q = robot.configuration() if q is None else q
     effort = dict(zip(*(list(x) for x in robot.effort_limits)))
     joints = []
     for name in robot.joint_names:
         slot = robot.joint_slot(name)
-        joint = model.joints[slot.id]
+        joint = robot.model.joints[slot.id]
         finite = slot.lower < slot.upper and abs(slot.lower) < 1e30 and abs(slot.upper) < 1e30
         joints.append({
             "name": name,
@@ -50,21 +55,43 @@ def robot_listing(robot) -> dict:
             "upper": slot.upper if finite and slot.nq == 1 else None,
             "effort": effort.get(joint.idx_v),
         })
-    return {"robot": robot.name, "urdf": str(Path(robot.urdf_path)), "frames": frames, "joints": joints}
+    return {"robot": robot.name, "urdf": str(Path(robot.urdf_path)),
+            "frames": [f.to_dict() for f in frame_poses(robot, q, frames)], "joints": joints}
+
+
+def _vec(v) -> str:
+    return "[" + " ".join(f"{x:+.3f}" for x in v) + "]"
 
 
 def run(args: argparse.Namespace) -> int:
-    listing = robot_listing(_robot(args.robot))
+    robot, q, label, stance = _robot_and_stance(args.robot)
+    listing = robot_listing(robot, q, args.frame)
+    listing["configuration"] = label
+    if stance is not None:
+        from ..authoring import contact_poses
+
+        listing["contacts"] = contact_poses(stance)
     if args.json:
         from .output import print_json
 
         print_json(listing)
         return 0
     print(f"{listing['robot']}: {len(listing['frames'])} frames, {len(listing['joints'])} joints ({listing['urdf']})")
-    print("frames (name, type, parent joint):")
-    width = max(len(f["name"]) for f in listing["frames"])
-    for f in listing["frames"]:
-        print(f"  {f['name']:<{width}}  {f['type']:<12} {f['parent_joint']}")
+    print(f"poses at the {label}; world axes, m; each axis is a unit vector in world coordinates")
+    rows = listing["frames"]
+    width = max((len(f["name"]) for f in rows), default=4)
+    print(f"  {'frame':<{width}}  {'type':<12} {'position':<22}  {'x axis':<22}  {'z axis':<22}  "
+          f"{'z tilt':>6}  parent joint")
+    for f in rows:
+        print(f"  {f['name']:<{width}}  {f['type']:<12} {_vec(f['position']):<22}  {_vec(f['axes']['x']):<22}  "
+              f"{_vec(f['axes']['z']):<22}  {f['z_tilt_deg']:5.1f}°  {f['parent_joint']}")
+    for i, c in enumerate(listing.get("contacts", [])):
+        if i == 0:
+            print("contacts (centre, normal, tilt from vertical):")
+        print(f"  [{i}] {c['frame']}: centre {_vec(c['centre'])}, normal {_vec(c['normal'])}, "
+              f"{c['normal_tilt_deg']:.1f}°, size {c['size'][0]:g} x {c['size'][1]:g} m")
+    if args.frame:
+        return 0
     print("joints (name, position limits, effort limit):")
     width = max((len(j["name"]) for j in listing["joints"]), default=0)
     for j in listing["joints"]:

@@ -114,12 +114,4 @@ def joint_groups(robot: Robot) -> dict[str, list[JointSlider]]:
 
 def joint_values(robot: Robot, q) -> dict[str, float]:
     """Values of the 1-dof joints at configuration ``q``, rad (continuous joints by their angle)."""
-    model = robot.model
-    out = {}
-    for jid in range(2, model.njoints):
-        joint = model.joints[jid]
-        if joint.nq == 1:
-            out[model.names[jid]] = float(q[joint.idx_q])
-        elif joint.nq == 2 and joint.nv == 1:
-            out[model.names[jid]] = math.atan2(float(q[joint.idx_q + 1]), float(q[joint.idx_q]))
-    return out
+    return robot.joint_values(q)

@@ -1,7 +1,9 @@
 """The robot's visual meshes (URDF ``<visual>`` geometry) in the viser scene.
 
-The meshes are read once per robot with pinocchio's visual ``GeometryModel`` and trimesh;
-an update only moves them (one pose per mesh), which is what keeps redraws cheap.
+The meshes are read once per robot with pinocchio's visual ``GeometryModel`` and
+:func:`impact_balance.mesh_files.read_mesh` (trimesh; COLLADA ``.dae`` through pycollada, as
+Romeo's and iCub's meshes are); an update only moves them (one pose per mesh), which is what
+keeps redraws cheap. Meshes that cannot be read are skipped with one warning naming them.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..exceptions import RobotLoadError
+from ..mesh_files import read_mesh
 from ..robot import Robot
 
 __all__ = ["VisualMesh", "load_visual_meshes", "RobotMeshes"]
@@ -44,8 +47,8 @@ def _package_dirs(robot: Robot) -> list[str]:
     return list(dict.fromkeys(dirs))
 
 
-def _triangles(obj: Any) -> tuple[np.ndarray, np.ndarray] | None:
-    """Vertices and faces of a geometry object, or None when it cannot be read."""
+def _triangles(obj: Any, problems: list[str]) -> tuple[np.ndarray, np.ndarray] | None:
+    """Vertices and faces of a geometry object, or None when it cannot be read (said in ``problems``)."""
     import trimesh
 
     geom = obj.geometry
@@ -53,11 +56,10 @@ def _triangles(obj: Any) -> tuple[np.ndarray, np.ndarray] | None:
     scale = np.asarray(obj.meshScale, dtype=float)
     if obj.meshPath and Path(obj.meshPath).is_file():
         try:
-            mesh = trimesh.load(obj.meshPath, force="mesh")
-            if len(mesh.faces):
-                return np.asarray(mesh.vertices) * scale, np.asarray(mesh.faces)
-        except Exception as exc:  # noqa: BLE001 - a bad mesh must not stop the GUI
-            log.warning("cannot read mesh %s: %s", obj.meshPath, exc)
+            vertices, faces = read_mesh(obj.meshPath)
+            return vertices * scale, faces
+        except RobotLoadError as exc:  # a bad mesh must not stop the GUI
+            problems.append(f"{Path(obj.meshPath).name} ({exc})")
     if kind == "Box":
         mesh = trimesh.creation.box(extents=2.0 * np.asarray(geom.halfSide))
     elif kind == "Sphere":
@@ -78,11 +80,11 @@ def load_visual_meshes(robot: Robot) -> tuple[pin.GeometryModel, list[VisualMesh
                                        package_dirs=_package_dirs(robot))
     except (RuntimeError, ValueError, OSError) as exc:
         raise RobotLoadError(str(robot.urdf_path), f"cannot read the visual meshes: {exc}") from exc
-    meshes = []
+    meshes, problems = [], []
     for i, obj in enumerate(gmodel.geometryObjects):
-        tri = _triangles(obj)
+        tri = _triangles(obj, problems)
         if tri is None:
-            log.warning("skipping visual geometry %s (%s)", obj.name, type(obj.geometry).__name__)
+            problems.append(f"{obj.name} ({type(obj.geometry).__name__})")
             continue
         rgba = np.asarray(obj.meshColor, dtype=float)
         color = tuple(float(c) for c in rgba[:3])
@@ -90,6 +92,9 @@ def load_visual_meshes(robot: Robot) -> tuple[pin.GeometryModel, list[VisualMesh
             color = DEFAULT_COLOR
         opacity = float(rgba[3]) if 0.0 < rgba[3] <= 1.0 else 1.0
         meshes.append(VisualMesh(obj.name, tri[0].astype(np.float32), tri[1].astype(np.uint32), color, opacity, i))
+    if problems:
+        log.warning("robot %s: %d visual geometries not drawn: %s", robot.name, len(problems), "; ".join(problems[:5])
+                    + ("; ..." if len(problems) > 5 else ""))
     return gmodel, meshes
 
 

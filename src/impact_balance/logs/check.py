@@ -18,6 +18,13 @@ For every sample of a log (:mod:`.schema`), from a simulation or a real robot:
 
 Violations are the maximal runs of consecutive samples outside an area, with their start, end and
 worst margin.
+
+A log in which no contact is ever loaded (every logged contact force below ``force_threshold``:
+a floating robot, such as ``simulate --joints rigid``, which also turns gravity off) has no area
+to check against. The result says so (``loaded_samples`` = 0, a ``note``), tells whether the CoM
+falls as under gravity (``com_vertical_acceleration``, fitted on the samples), and gives what such
+a log can be checked for: the CoM velocity change over the log (``com_velocity_change``, to be
+compared with the impact model's prediction, as ``simulate`` does).
 """
 
 from __future__ import annotations
@@ -77,6 +84,37 @@ class LogCheck:
     violations: list[Violation]
     has_zmp: bool
     settings: dict = field(default_factory=dict)
+    loaded_samples: int = 0
+    com_vertical_acceleration: float = float("nan")
+    com_velocity_change: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    gravity: float = 9.81
+
+    @property
+    def floating(self) -> bool:
+        """No contact is loaded in any sample: no balance area applies."""
+        return self.loaded_samples == 0
+
+    @property
+    def gravity_seen(self) -> bool:
+        """The floating CoM falls at about g (within 20 %); meaningless when a contact is loaded."""
+        return bool(np.isfinite(self.com_vertical_acceleration)
+                    and abs(self.com_vertical_acceleration + self.gravity) < 0.2 * self.gravity)
+
+    @property
+    def note(self) -> str | None:
+        """What the check could not do, and what the log can show instead (None when all was checked)."""
+        if not self.floating:
+            return None
+        text = ("no contact is loaded in any sample (every logged contact force is below "
+                f"{self.settings.get('force_threshold', 5.0):g} N): the robot floats, so no balance area applies")
+        if not self.gravity_seen:
+            text += (f"; its CoM does not fall (vertical acceleration {self.com_vertical_acceleration:.2f} m/s^2, "
+                     f"not -{self.gravity:g}): gravity is off, as in `simulate --joints rigid`")
+        dv = self.com_velocity_change
+        text += (f". What it shows: the CoM velocity changed by ({dv[0]:+.4f}, {dv[1]:+.4f}, {dv[2]:+.4f}) m/s; "
+                 "compare it with the impact model's jump (`impact-balance simulate SCENARIO --joints rigid --json`, "
+                 "`predicted`)")
+        return text
 
     @property
     def ok(self) -> bool:
@@ -95,6 +133,12 @@ class LogCheck:
             "min_com_velocity_margin": num(float(s["com_velocity_margin"].min())) if len(s) else None,
             "min_zmp_margin": num(float(s["zmp_margin"].min())) if self.has_zmp and len(s) else None,
             "violations": [v.to_dict() for v in self.violations],
+            "loaded_samples": self.loaded_samples,
+            "floating": self.floating,
+            "com_vertical_acceleration": num(self.com_vertical_acceleration),
+            "gravity_seen": self.gravity_seen if self.floating else None,
+            "com_velocity_change": [num(x) for x in self.com_velocity_change],
+            "note": self.note,
             "stances": [{"start": g.start, "contacts": list(g.contacts), "com": g.com.tolist(),
                          "can_balance": g.can_balance, "zmp_area": g.zmp_area.vertices.tolist()}
                         for g in self.segments],
@@ -197,7 +241,7 @@ def check_log(frame: pd.DataFrame, scenario: Scenario | str, *, force_threshold:
     if np.any(~np.isfinite(times)) or np.any(np.diff(times) < 0):
         raise ScenarioError("LOG", source, "time must be finite and increasing")
     Q, V = log_state(frame, robot)
-    specs = [c.spec() for c in scenario.contacts]
+    specs = [c.spec for c in scenario.build_stance(robot).contacts]  # contacts given by a normal: at the stance
     names = [s.frame for s in specs]
     forces = {n: frame[list(force_columns(n))].to_numpy(float) for n in names
               if all(c in frame.columns for c in force_columns(n))}
@@ -212,6 +256,7 @@ def check_log(frame: pd.DataFrame, scenario: Scenario | str, *, force_threshold:
     active_prev: tuple[str, ...] | None = None
     rows = np.full((len(frame), 12), np.nan)
     stance_index = np.zeros(len(frame), dtype=int)
+    loaded = 0
     for k in range(len(frame)):
         q, v = Q[k], V[k]
         pin.centerOfMass(model, data, q, v, False)
@@ -226,6 +271,7 @@ def check_log(frame: pd.DataFrame, scenario: Scenario | str, *, force_threshold:
                     continue
             active.append(spec.frame)
         active_t = tuple(active)
+        loaded += bool(active_t)
         changed = not segments or active_t != active_prev
         if not changed:
             seg = segments[-1]
@@ -273,4 +319,7 @@ def check_log(frame: pd.DataFrame, scenario: Scenario | str, *, force_threshold:
     violations.sort(key=lambda v: (v.start, v.kind))
     settings = {"force_threshold": force_threshold, "move_tolerance": move_tolerance,
                 "turn_tolerance": turn_tolerance, "com_tolerance": com_tolerance}
-    return LogCheck(scenario.name, samples, segments, violations, has_zmp, settings)
+    # The CoM's vertical acceleration, fitted over the log: -g for a falling robot, 0 with gravity off.
+    accel = float(np.polyfit(times, rows[:, 5], 1)[0]) if len(times) > 2 and np.ptp(times) > 0 else float("nan")
+    change = rows[-1, 3:6] - rows[0, 3:6]
+    return LogCheck(scenario.name, samples, segments, violations, has_zmp, settings, loaded, accel, change, g)

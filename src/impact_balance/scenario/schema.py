@@ -12,14 +12,14 @@ from typing import Annotated, Literal
 
 import numpy as np
 import pinocchio as pin
-from pydantic import AfterValidator, Field, field_validator
+from pydantic import AfterValidator, Field, ValidationInfo, field_validator
 
-from ..constants import GRAVITY_RANGE, MAX_DESCRIPTION, MAX_DURATION, MAX_FRICTION, MAX_NAME, MAX_PEAK_FACTOR, MAX_POSITION, MAX_SIZE
+from ..constants import GRAVITY_RANGE, MAX_ANGLE, MAX_DESCRIPTION, MAX_DURATION, MAX_FRICTION, MAX_NAME, MAX_PEAK_FACTOR, MAX_POSITION, MAX_SIZE
 from ..exceptions import ScenarioError
 from ..impact import ImpactSpec
 from ..input_limits import check_path_text
 from ..robot import Robot, load_robot
-from ..spatial import pose
+from ..spatial import pose, surface_rotation
 from ..stance import ContactSpec, Stance
 from .fields import Angles, Friction, Position, Vec2, Vec3, _coordinates, _finite, _Model, _scalar, _speed
 from .specs import _contact_spec, _impact_spec, _quaternion
@@ -38,12 +38,20 @@ class Offset(_Model):
 
 
 class ContactConfig(_Model):
-    """A sustained rectangular contact (see :class:`impact_balance.stance.ContactSpec`)."""
+    """A sustained rectangular contact (see :class:`impact_balance.stance.ContactSpec`).
+
+    Its orientation is either ``offset.rpy`` (in the frame) or ``normal`` (the surface
+    normal in the world, from the surface into the robot) with an optional ``angle`` (rad)
+    about it: see :func:`impact_balance.spatial.surface_rotation`. The normal form is
+    resolved at the scenario's configuration (:meth:`Scenario.contact_specs`).
+    """
 
     frame: str
     friction: Friction
     size: Vec2
     offset: Offset = Offset()
+    normal: Annotated[Vec3, _coordinates(1e6, "(any scale; it is normalised)")] | None = None
+    angle: Annotated[float, _scalar(-MAX_ANGLE, MAX_ANGLE, "rad")] | None = None
 
     @field_validator("size")
     @classmethod
@@ -52,9 +60,42 @@ class ContactConfig(_Model):
             raise ValueError(f"size must be [length, width], both in (0, {MAX_SIZE:g}] m")
         return v
 
-    def spec(self) -> ContactSpec:
-        """The contact's :class:`ContactSpec` (cached by content: treat it as immutable)."""
-        return _contact_spec(self.frame, self.friction, tuple(self.size), self.offset.position, self.offset.rpy)
+    @field_validator("normal")
+    @classmethod
+    def _normal(cls, v: Vec3 | None, info: ValidationInfo) -> Vec3 | None:
+        if v is None:
+            return v
+        _finite(v, "normal")
+        if float(np.linalg.norm(v)) < 1e-9:
+            raise ValueError("normal must be a non-zero vector")
+        offset = info.data.get("offset")
+        if offset is not None and any(offset.rpy):
+            raise ValueError("give the contact's orientation either as offset.rpy (in the frame) or as normal "
+                             "(in the world, with angle about it), not both")
+        return v
+
+    @field_validator("angle")
+    @classmethod
+    def _angle(cls, v: float | None, info: ValidationInfo) -> float | None:
+        if v is not None and info.data.get("normal") is None:
+            raise ValueError("angle turns the contact about its world normal: give normal too")
+        return v
+
+    def spec(self, frame_rotation: np.ndarray | None = None) -> ContactSpec:
+        """The contact's :class:`ContactSpec` (cached by content: treat it as immutable).
+
+        Args:
+            frame_rotation: The frame's world rotation at the scenario's configuration;
+                needed (and only used) when the contact is given by its ``normal``.
+        """
+        if self.normal is None:
+            return _contact_spec(self.frame, self.friction, tuple(self.size), self.offset.position, self.offset.rpy)
+        if frame_rotation is None:
+            raise ScenarioError("normal", self.normal, "a contact given by its world normal needs the configuration "
+                                "(use Scenario.contact_specs)")
+        world = surface_rotation(frame_rotation, self.normal, self.angle or 0.0)
+        offset = pin.SE3(np.asarray(frame_rotation).T @ world, np.asarray(self.offset.position, dtype=float))
+        return ContactSpec(self.frame, self.friction, tuple(self.size), offset)
 
 
 class QPConfig(_Model):
@@ -181,6 +222,19 @@ class Scenario(_Model):
                 q[3:7] = _quaternion(self.base.rpy)
         return q
 
+    def contact_specs(self, robot: Robot, q: np.ndarray) -> list[ContactSpec]:
+        """The contacts' specs at configuration ``q`` (which resolves the contacts given by a world normal)."""
+        if all(c.normal is None for c in self.contacts):
+            return [c.spec() for c in self.contacts]
+        frames = Stance(robot, q, [])
+        specs = []
+        for i, c in enumerate(self.contacts):
+            rotation = None
+            if c.normal is not None:
+                rotation = frames.frame_pose(c.frame, field=f"contacts[{i}].frame").rotation
+            specs.append(c.spec(rotation))
+        return specs
+
     def build_stance(self, robot: Robot | None = None) -> Stance:
         """Resolve robot, configuration and contacts into a :class:`Stance` (see ``_build_stance``)."""
         try:
@@ -196,7 +250,7 @@ class Scenario(_Model):
         """
         robot = robot or self.load_robot()
         q = self.configuration_vector(robot)
-        specs = [c.spec() for c in self.contacts]
+        specs = self.contact_specs(robot, q)
         stance = Stance(robot, q, specs)
         if self.base is None:
             lift = -stance.lowest_contact_height()

@@ -17,23 +17,26 @@ convert state both ways: ``set_state(q, v)`` takes a pinocchio configuration and
 ``mj_forward``; ``configuration()`` and ``velocity()`` read them back; ``com()`` and
 ``com_velocity()`` (m, m/s, world); ``contact_force(geom)`` (N, world, on the robot);
 ``set_servo_targets(q_ref, v_ref)`` writes the servo commands (the holding torques
-included). MuJoCo's free joint stores the base orientation as (w, x, y, z) and its angular
+included). ``inertia_repair`` says which inertials were changed for MuJoCo (see
+:mod:`.inertia`; a :class:`~impact_balance.exceptions.ModelRepairWarning` names them once). MuJoCo's free joint stores the base orientation as (w, x, y, z) and its angular
 velocity in the base frame, but its linear velocity in world axes: the helpers convert.
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
-from ..exceptions import SimulationError
+from ..exceptions import ModelRepairWarning, SimulationError
 from ..robot import Robot
 from ..scenario import Scenario, load_scenario
 from ..stance import Stance
 from .environment import ContactParameters, add_geometry
+from .inertia import InertiaRepair, repair_message
 from .joints import JOINT_MODELS, ServoOptions, holding_torques, servo_gains, weld_joints
 from .urdf import ROOT_JOINT, robot_spec
 
@@ -94,6 +97,7 @@ class SimModel:
     tau_hold: np.ndarray
     armature: np.ndarray = field(default_factory=lambda: np.zeros(0))
     armature_source: str = "none (rigid joints)"
+    inertia_repair: InertiaRepair | None = None
 
     @property
     def robot(self) -> Robot:
@@ -275,7 +279,10 @@ def build_model(
     robot = stance.robot
     impact = scenario.impact.spec() if scenario.impact is not None else None
 
-    spec = robot_spec(robot, meshes=options.meshes)
+    spec, repair = robot_spec(robot, meshes=options.meshes)
+    if repair is not None:
+        # Once per robot and process: the default filter shows a message once per place it is issued from.
+        warnings.warn(ModelRepairWarning(robot.name, repair.bodies, repair_message(robot.name, repair)), stacklevel=1)
     spec.option.timestep = options.timestep
     spec.option.gravity = [0.0, 0.0, -scenario.gravity]
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
@@ -352,6 +359,7 @@ def build_model(
         support_geoms=tuple(geom_id(n) for n in names.supports), ground_geom=geom_id(names.ground),
         impact_geom=geom_id(names.impact), surface_geom=geom_id(names.surface),
         kp=kp, kd=kd, tau_hold=tau_hold, armature=armature, armature_source=armature_source,
+        inertia_repair=repair,
     )
     sim.set_state(stance.q)
     sim.set_servo_targets(stance.q)

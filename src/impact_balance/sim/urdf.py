@@ -10,6 +10,15 @@ MuJoCo reads URDF itself; three things make its model the same robot as pinocchi
 - Inertias come from the URDF ``<inertial>`` tags only (``inertiafromgeom`` off), so that
   geoms added later for collision or display carry no mass.
 
+- Inertials MuJoCo refuses (massless moving links, singular inertia tensors) are repaired by
+  the rule of :mod:`.inertia` (merged into the moving body they are fused with, else raised
+  to a floor below 1e-7 of the robot's mass and inertia); :func:`robot_spec` returns what
+  it changed.
+- URDF ``<mimic>`` joints (Romeo's fingers) are independent joints in pinocchio's model, so
+  the equality constraints MuJoCo makes of them are dropped.
+- Meshes in formats MuJoCo does not decode (COLLADA ``.dae``, ASCII STL) are read by
+  :func:`impact_balance.mesh_files.read_mesh` and given to MuJoCo as vertex arrays.
+
 MuJoCo keeps the URDF ``effort`` limits as joint actuator force ranges (``actfrcrange``;
 Talos' wrists are limited to 3-6.6 N m) and imports ``damping`` and ``friction``
 (friction loss). Collision meshes are imported and made visual only (``contype`` =
@@ -26,7 +35,9 @@ from pathlib import Path
 import mujoco
 
 from ..exceptions import RobotLoadError
+from ..mesh_files import mujoco_reads, read_mesh
 from ..robot import Robot
+from .inertia import InertiaRepair, repair_inertias
 
 __all__ = ["robot_spec", "resolve_package_uri", "VISUAL_GROUP", "ROOT_JOINT"]
 
@@ -72,7 +83,19 @@ def _resolved_urdf(robot: Robot) -> str:
     return text
 
 
-def robot_spec(robot: Robot, meshes: bool = True) -> mujoco.MjSpec:
+def _mesh_arrays(spec: mujoco.MjSpec) -> None:
+    """Give MuJoCo the vertices of the meshes it cannot decode itself (.dae, ASCII STL)."""
+    for mesh in spec.meshes:
+        path = Path(mesh.file) if Path(mesh.file).is_absolute() else Path(spec.meshdir) / mesh.file
+        if not mesh.file or mujoco_reads(path):
+            continue
+        vertices, faces = read_mesh(path)
+        mesh.file = ""
+        mesh.uservert = vertices.reshape(-1).tolist()
+        mesh.userface = faces.reshape(-1).tolist()
+
+
+def robot_spec(robot: Robot, meshes: bool = True) -> tuple[mujoco.MjSpec, InertiaRepair | None]:
     """The robot as an ``MjSpec``: free joint at the root, meshes visual only, no actuators.
 
     Args:
@@ -80,6 +103,9 @@ def robot_spec(robot: Robot, meshes: bool = True) -> mujoco.MjSpec:
         meshes: Keep the URDF's collision geoms, as visual geoms (for display and video).
             Without them the model compiles faster and has no geom but those added for the
             contacts.
+
+    Returns:
+        The specification, and the inertia repairs made (see :mod:`.inertia`), or None.
     """
     text = _resolved_urdf(robot)
     try:
@@ -95,6 +121,8 @@ def robot_spec(robot: Robot, meshes: bool = True) -> mujoco.MjSpec:
     if root is None:
         raise RobotLoadError(str(robot.urdf_path), "no link in the URDF")
     root.add_freejoint(name=ROOT_JOINT)
+    for equality in list(spec.equalities):  # <mimic> couplings: pinocchio's joints are independent
+        spec.delete(equality)
     for geom in list(spec.geoms):
         if not meshes:
             spec.delete(geom)
@@ -105,4 +133,6 @@ def robot_spec(robot: Robot, meshes: bool = True) -> mujoco.MjSpec:
     if not meshes:
         for mesh in list(spec.meshes):
             spec.delete(mesh)
-    return spec
+    else:
+        _mesh_arrays(spec)
+    return spec, repair_inertias(spec, robot)

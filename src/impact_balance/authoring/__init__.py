@@ -1,0 +1,12 @@
+"""Stance authoring without code: where every frame is, and whole-body IK that writes scenarios.
+
+- :mod:`.frames`: each frame's world position and axes at a configuration (``impact-balance frames``).
+- :mod:`.pose`: place frames (and the CoM) by whole-body IK with the contacts kept, and the
+  posed scenario as a YAML mapping (``impact-balance pose``).
+"""
+
+from .frames import FramePose, contact_poses, frame_poses
+from .pose import Placement, PoseResult, pose_scenario, posed_mapping, scenario_yaml
+
+__all__ = ["FramePose", "frame_poses", "contact_poses", "Placement", "PoseResult", "pose_scenario", "posed_mapping",
+           "scenario_yaml"]
