@@ -25,6 +25,7 @@ from impact_balance.exceptions import ModelRepairWarning
 from impact_balance.robot import example_robot_data_root
 from impact_balance.sim import SimOptions, build_model
 from impact_balance.sim.balance_trial import BalanceTrialOptions
+from impact_balance.sim.outcomes import OUTCOMES
 from impact_balance.sim.push import push_test
 from impact_balance.sim.validate import validate
 
@@ -33,7 +34,6 @@ BUNDLED = {"talos": "palm_push_two_feet", "g1": "g1_two_feet", "romeo": "romeo_t
 LIGHT = SimOptions(meshes=False)
 # Short trials: 0.2 s standing, 0.6 s after the disturbance.
 SHORT = BalanceTrialOptions(after=0.6, settle=0.2)
-REASONS = {None, "contact_lost", "contact_tilted", "contact_slipped", "base_dropped", "not_at_rest", "no_contact"}
 
 
 def _draft(path, robot: str, contacts: str, impact: str) -> None:
@@ -130,13 +130,18 @@ def test_push_and_validate_run(extra_scenarios, robot):
         pushed = push_test(scenario_of(robot, extra_scenarios), directions=1, magnitudes=[5.0], options=SHORT)
         bracket = validate(scenario_of(robot, extra_scenarios), tolerance=0.5, max_speed=0.4, options=SHORT)
     (outcome,) = pushed.outcomes
-    summary = outcome.result.summary()
-    assert summary["reason"] in REASONS and (summary["reason"] is None) == (not summary["fell"])
-    assert outcome.result.sim_time > 0 and all(_finite(v) for v in (summary["max_zmp_excursion"],
-                                                                      summary["min_com_velocity_margin"]))
-    assert bracket.trials and (bracket.survived is not None or bracket.fell is not None)
-    for speed, trial in bracket.trials:
-        assert 0 < speed <= 0.4 and trial.reason in REASONS and trial.sim_time > 0
+    summary = outcome.summary
+    json.dumps(summary, allow_nan=False)  # every number finite or null
+    assert summary["outcome"] in OUTCOMES and summary["fell"] == (summary["outcome"] == "fell")
+    assert summary["outcome"] == "balanced" or summary["reason"] is not None
+    assert summary["sim_time"] > 0 and _finite(summary["worst_com_velocity_margin"])
+    b = bracket.bracket()
+    assert bracket.trials and (b["survived_commanded"] is not None or b["fell_commanded"] is not None
+                               or all(t.outcome == "aborted" for t in bracket.trials))
+    for trial in bracket.trials:
+        s = trial.summary
+        assert 0 < trial.speed <= 0.4 and s["outcome"] in OUTCOMES and s["sim_time"] > 0
+        json.dumps(s, allow_nan=False)
 
 
 def test_push_test_cli_on_romeo(capsys):
