@@ -150,4 +150,5 @@ def test_push_test_cli_on_romeo(capsys):
     assert rc == 0
     document = json.loads(captured.out)
     assert document and "impact-balance: warning: robot romeo" in captured.err
+    assert "LFinger11Link" in document["controller"]["inertia_repair"]["floored"]  # in the JSON too
     assert captured.err.count("warning: robot romeo") <= 1

@@ -73,6 +73,11 @@ class InertiaRepair:
         """Every moving body whose inertial changed, merged first."""
         return tuple(dict.fromkeys([name for name, _ in self.merged] + list(self.floored)))
 
+    def to_dict(self) -> dict:
+        """JSON-ready: the bodies merged (with their links) and floored, the floors and the mass added."""
+        return {"merged": {name: list(links) for name, links in self.merged}, "floored": list(self.floored),
+                "mass_floor": self.mass_floor, "inertia_floor": self.inertia_floor, "added_mass": self.added_mass}
+
 
 def _quat_matrix(quat) -> np.ndarray:
     out = np.empty(9)

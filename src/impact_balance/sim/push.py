@@ -290,6 +290,8 @@ def push_test(scenario: Scenario | str, directions: int = 16, magnitudes: Sequen
     else:
         controller = {"name": "dcm-zmp-clamp + pink IK -> joint position servos", "gains": options.gains.to_dict()}
     controller["armature"] = setup.sim.armature_source
+    repair = setup.sim.inertia_repair
+    controller["inertia_repair"] = None if repair is None else repair.to_dict()
     return PushTestResult(scenario.name, outcomes, controller, options.criteria.to_dict(), setup,
                           own if zmp_margin is None else float(zmp_margin), own, omega,
                           time.perf_counter() - wall0, None if journal.path is None else str(journal.path), reused)

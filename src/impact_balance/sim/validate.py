@@ -252,6 +252,8 @@ def validate(scenario: Scenario | str, joints: str = "servo", *, tolerance: floa
     controller["impact_task"] = {"approach": "bounded acceleration, then cruise", "acceleration": 20.0,
                                  "cruise": 0.03, "force_threshold": 15.0, "retract": 0.05}
     controller["armature"] = setup.sim.armature_source
+    repair = setup.sim.inertia_repair
+    controller["inertia_repair"] = None if repair is None else repair.to_dict()
     return ValidationResult(scenario.name, joints, options.rigid_impact, predicted, with_margin, margin,
                             float(setup.analysis.areas.omega), trials, controller, options.criteria.to_dict(),
                             tolerance, max_speed, time.perf_counter() - wall0,
