@@ -86,24 +86,43 @@ def _base_rotation(q: np.ndarray) -> np.ndarray:
 
 
 def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, push: Push | None = None,
-                      options: BalanceTrialOptions | None = None) -> BalanceTrialResult:
-    """Run one trial (an impact at the commanded ``impact_speed``, or a ``push``) from rest; see the module docstring."""
+                      options: BalanceTrialOptions | None = None, *, impact_task=None, surface_point=None,
+                      standoff: float | None = None, before_control=None,
+                      max_approach_time: float | None = None) -> BalanceTrialResult:
+    """Run one trial (an impact at the commanded ``impact_speed``, or a ``push``) from rest; see the module docstring.
+
+    An impact may instead follow ``impact_task`` (an object with ``reference(t, normal_force)``,
+    ``target``, ``start_time``, ``contact_time``, like :class:`~.approach.ImpactTask`), from a start
+    posture backed off ``standoff`` (m), towards a surface moved to ``surface_point`` (m, world; the
+    scenario's impact point by default), for at most ``max_approach_time`` (s) after ``start_time``
+    (:mod:`.wall` uses this). ``before_control(t, q, v)`` is called before every control step
+    with the measured state (pinocchio order).
+    """
     options = options or BalanceTrialOptions()
     sim, analysis = setup.sim, setup.analysis
-    if impact_speed is not None and analysis.impact is None:
+    impact = impact_speed is not None or impact_task is not None
+    if impact and analysis.impact is None:
         raise SimulationError("impact", None, "the scenario has no impact")
     if impact_speed is not None and not (np.isfinite(impact_speed) and 0 < impact_speed <= 20):
         raise SimulationError("speed", impact_speed, "must be in (0, 20] m/s")
-    hold = RigidImpactHold(sim) if (options.rigid_impact and impact_speed is not None) else None
+    hold = RigidImpactHold(sim) if (options.rigid_impact and impact) else None
+    moved = surface_point is not None and sim.surface_geom is not None
+    if moved:
+        home = sim.model.geom_pos[sim.surface_geom].copy()
+        sim.model.geom_pos[sim.surface_geom] = home + (np.asarray(surface_point, dtype=float) - analysis.impact.model.point)
     try:
-        return _run(setup, impact_speed, push, options, hold)
+        return _run(setup, impact_speed, push, options, hold, impact_task, surface_point, standoff, before_control,
+                    max_approach_time)
     finally:
-        if hold is not None:  # the setup's model is reused: never leave a joint held
+        if hold is not None:  # the setup's model is reused: never leave a joint held, nor the wall moved
             hold.release(sim.data.time)
+        if moved:
+            sim.model.geom_pos[sim.surface_geom] = home
 
 
 def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, options: BalanceTrialOptions,
-         hold: RigidImpactHold | None) -> BalanceTrialResult:
+         hold: RigidImpactHold | None, task, surface_point, standoff, before_control,
+         max_approach_time) -> BalanceTrialResult:
     sim, analysis = setup.sim, setup.analysis
     m, d = sim.model, sim.data
     stance = analysis.stance
@@ -111,16 +130,18 @@ def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, opt
     pdata = model.createData()
     dt = float(m.opt.timestep)
 
-    task = tracker = None
+    tracker = None
     n = None
-    standoff = 0.0
-    if impact_speed is not None:
+    if impact_speed is not None and task is None:
         im = analysis.impact.model
-        n = im.normal
         standoff = approach_standoff(impact_speed)
-        task = ImpactTask(im.spec.frame, im.spec.offset, im.point, n, impact_speed, start_time=options.settle)
+        task = ImpactTask(im.spec.frame, im.spec.offset, im.point, im.normal, impact_speed, start_time=options.settle)
+    if task is not None:
+        n = np.asarray(analysis.impact.model.normal, dtype=float)
         tracker = ImpactTracker(n, dt)
-    q_start = setup.start_configuration(standoff)
+        if surface_point is None:
+            surface_point = analysis.impact.model.point
+    q_start = setup.start_configuration(standoff or 0.0)
     # A push trial has no impacted surface: a robot falling forward must not lean on the wall of the impact.
     sim.enable_impact_surface(task is not None)
     mujoco.mj_resetData(m, d)
@@ -161,11 +182,16 @@ def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, opt
         end_time = disturbance_end + options.after
     else:
         disturbance = disturbance_end = None
-        end_time = (task.arrival_time + options.max_approach_time if task is not None else options.settle) + options.after
+        if task is None:
+            end_time = options.settle + options.after
+        elif max_approach_time is not None:
+            end_time = task.start_time + max_approach_time + options.after
+        else:
+            end_time = task.arrival_time + options.max_approach_time + options.after
     steps_per_control = max(1, int(round(1.0 / (rate * dt))))
     series: dict[str, list] = {k: [] for k in ("time", "zmp", "zmp_desired", "com", "com_velocity", "dcm",
                                                "zmp_margin", "com_velocity_margin")}
-    surface = None if task is None else float(n @ task.surface_point)
+    surface = None if task is None else float(n @ np.asarray(surface_point, dtype=float))
     radius = 0.0 if task is None else float(m.geom_size[sim.impact_geom][0])
     wall0 = time.perf_counter()
     step = 0
@@ -203,6 +229,8 @@ def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, opt
                 disturbance_end = tracker.end
         if step % steps_per_control == 0:
             q, v = sim.configuration(), sim.velocity()
+            if before_control is not None:
+                before_control(t, q, v)
             com_now, _ = controller.measure(q, v)
             zmp, forces = measured_zmp(sim, com_now, h)
             out = controller.step(t, q, v, zmp, fn)

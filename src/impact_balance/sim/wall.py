@@ -1,0 +1,192 @@
+"""The paper's Experiment 1 in simulation: the impacting point sent at a wall it does not know,
+its speed capped every control tick by an impact-speed governor.
+
+The robot stands on the scenario's contacts, its impacting point backed off ``standoff`` (15 cm)
+along the surface normal ``n``; the balance controller of ``validate`` holds it (``ik`` or ``id``).
+A wall, whose distance the controller is not told, stands ``wall_distance`` from the start point
+along ``-n``. From ``start_time`` on, the point's reference speed rises towards ``reference`` with
+a bounded acceleration (20 m/s^2), and every control tick (500 Hz) the governor
+(:class:`~impact_balance.governor.Governor`, fed the simulated ``(q, v)``) gives the speed
+allowed from the current posture and CoM velocity; the point is commanded at the smaller of
+the two (``governor="none"``: the reference alone). When the measured normal force exceeds
+15 N the reference stops pushing and withdraws 5 cm, as on HRP-4. The trial is then scored like
+any balance trial (:mod:`.outcomes`), and reports the measured approach speed at contact, the
+cap in force at contact, the time from the start of the approach to the contact, and the
+governor's time per tick.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..exceptions import SimulationError
+from .approach import _profile
+from .balance_trial import BalanceSetup, BalanceTrialOptions, run_balance_trial
+from .trial_result import BalanceTrialResult
+
+__all__ = ["GOVERNORS", "WallOptions", "GovernedApproach", "WallTrial", "run_wall_trial"]
+
+#: Governors of the approach: the CoM criterion's, the ZMP criterion's, or none (the reference alone).
+GOVERNORS = ("com", "zmp", "none")
+
+
+@dataclass(frozen=True)
+class WallOptions:
+    """One approach to an unknown wall.
+
+    Attributes:
+        reference: The reference approach speed (m/s, along ``-n``).
+        governor: "com", "zmp" or "none" (:data:`GOVERNORS`).
+        wall_distance: Distance from the point's start to the wall, along ``-n`` (m).
+        standoff: How far the start posture backs the point off the scenario's impact point (m).
+        acceleration: Bound on the reference speed's rate (m/s^2).
+        max_time: Longest approach before the trial gives up (s): a slow governor may not arrive.
+    """
+
+    reference: float
+    governor: str = "com"
+    wall_distance: float = 0.15
+    standoff: float = 0.15
+    acceleration: float = 20.0
+    max_time: float = 30.0
+
+
+@dataclass
+class GovernedApproach:
+    """The impacting point's reference when a governor caps its speed every tick (duck-types
+    :class:`~.approach.ImpactTask` for the balance controllers: ``reference``, ``target``, ``start_point``).
+
+    ``speed_limit(t)`` is called by the trial loop before each control step with the governor's
+    ceiling (m/s, ``inf`` without a governor); the reference's own speed follows a
+    bounded-acceleration profile to ``speed``; the command is the smaller of the two.
+    """
+
+    frame: str
+    offset: object
+    start: np.ndarray
+    normal: np.ndarray
+    speed: float
+    start_time: float = 0.3
+    acceleration: float = 20.0
+    force_threshold: float = 15.0
+    retract: float = 0.05
+    withdraw_speed: float = 0.3
+    contact_time: float | None = field(default=None, init=False)
+    ceiling: float = field(default=np.inf, init=False)
+    commanded: float = field(default=0.0, init=False)
+    _point: np.ndarray | None = field(default=None, init=False)
+    _last_t: float | None = field(default=None, init=False)
+    _contact_point: np.ndarray | None = field(default=None, init=False)
+
+    @property
+    def start_point(self) -> np.ndarray:
+        return self.start
+
+    def reference_speed(self, t: float) -> float:
+        """The reference's own speed at ``t`` (m/s): a bounded-acceleration ramp to ``speed``."""
+        return _profile(t - self.start_time, self.speed, self.acceleration, np.inf)[1]
+
+    def reference(self, t: float, normal_force: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """World position, velocity and acceleration of the point's reference at ``t`` (see the class docstring)."""
+        n = np.asarray(self.normal, dtype=float)
+        if self._point is None:
+            self._point = np.asarray(self.start, dtype=float).copy()
+        if self.contact_time is None and normal_force > self.force_threshold:
+            self.contact_time = float(t)
+            self._contact_point = self._point.copy()
+        if self.contact_time is not None:
+            s, ds, dds = _profile(t - self.contact_time, self.withdraw_speed, self.acceleration, self.retract)
+            return self._contact_point + s * n, ds * n, dds * n
+        dt = 0.0 if self._last_t is None else max(0.0, t - self._last_t)
+        self._last_t = float(t)
+        previous = self.commanded
+        self.commanded = min(self.reference_speed(t), max(0.0, self.ceiling))
+        self._point = self._point - self.commanded * dt * n
+        acceleration = 0.0 if dt <= 0.0 else (self.commanded - previous) / dt
+        return self._point.copy(), -self.commanded * n, -acceleration * n
+
+    def target(self, t: float, normal_force: float = 0.0) -> np.ndarray:
+        return self.reference(t, normal_force)[0]
+
+
+@dataclass
+class WallTrial:
+    """What one approach measured (SI units; see the module docstring)."""
+
+    options: WallOptions
+    result: BalanceTrialResult
+    speed_at_contact: float | None
+    cap_at_contact: float | None
+    time_to_contact: float | None
+    tick_us: dict
+    series: dict
+
+    def to_dict(self) -> dict:
+        s = self.result.summary()
+        o = self.options
+        return {"governor": o.governor, "reference": o.reference, "wall_distance": o.wall_distance,
+                "speed_at_contact": self.speed_at_contact, "cap_at_contact": self.cap_at_contact,
+                "time_to_contact": self.time_to_contact, "outcome": s["outcome"], "reason": s["reason"],
+                "detail": s["detail"], "events": s["events"], "tick_us": self.tick_us, "trial": s}
+
+
+def _finite(x) -> float | None:
+    return None if x is None or not np.isfinite(x) else float(x)
+
+
+def run_wall_trial(setup: BalanceSetup, options: WallOptions, trial_options: BalanceTrialOptions | None = None,
+                   governor=None) -> WallTrial:
+    """Run one approach (see the module docstring). ``governor``: a
+    :class:`~impact_balance.governor.Governor` of the setup's scenario and ``options.governor``'s criterion
+    (built here when None and the options ask for one)."""
+    if options.governor not in GOVERNORS:
+        raise SimulationError("--governor", options.governor, f"must be one of {', '.join(GOVERNORS)}")
+    if not (np.isfinite(options.reference) and 0.0 < options.reference <= 5.0):
+        raise SimulationError("--reference", options.reference, "must be in (0, 5] m/s")
+    if not (np.isfinite(options.wall_distance) and 0.0 < options.wall_distance <= 1.0):
+        raise SimulationError("--wall-distance", options.wall_distance, "must be in (0, 1] m")
+    analysis = setup.analysis
+    if analysis.impact is None:
+        raise SimulationError("impact", None, "the scenario has no impact")
+    trial_options = trial_options or BalanceTrialOptions(controller=setup.controller)
+    if governor is None and options.governor != "none":
+        from ..governor import Governor
+
+        governor = Governor(setup.scenario, criterion=options.governor)
+    im = analysis.impact.model
+    n = np.asarray(im.normal, dtype=float)
+    start = im.point + options.standoff * n
+    task = GovernedApproach(im.spec.frame, im.spec.offset, start, n, options.reference,
+                            start_time=trial_options.settle, acceleration=options.acceleration)
+    wall = start - options.wall_distance * n
+    ticks: list[float] = []
+    caps: list[tuple[float, float, float]] = []
+
+    def before_control(t: float, q: np.ndarray, v: np.ndarray) -> None:
+        if task.contact_time is not None or t < task.start_time:
+            return
+        if governor is not None:
+            t0 = time.perf_counter()
+            limit = governor.limit(q, v)
+            ticks.append(time.perf_counter() - t0)
+            task.ceiling = limit.ceiling
+        caps.append((t, task.reference_speed(t), task.ceiling))
+
+    result = run_balance_trial(setup, impact_task=task, surface_point=wall, standoff=options.standoff,
+                               options=trial_options, before_control=before_control,
+                               max_approach_time=options.max_time)
+    impact = result.impact
+    cap_at_contact = None
+    if impact is not None and caps:
+        k = max(0, int(np.searchsorted([c[0] for c in caps], impact.contact_time)) - 1)
+        cap_at_contact = _finite(caps[k][2])
+    us = np.asarray(ticks) * 1e6
+    tick_us = ({"median": float(np.median(us)), "p99": float(np.percentile(us, 99)), "count": int(us.size)}
+               if us.size else {"median": None, "p99": None, "count": 0})
+    series = {"time": [c[0] for c in caps], "reference": [c[1] for c in caps],
+              "cap": [_finite(c[2]) for c in caps]}
+    return WallTrial(options, result, None if impact is None else _finite(impact.approach_speed), cap_at_contact,
+                     None if impact is None else float(impact.contact_time - task.start_time), tick_us, series)
