@@ -9,7 +9,7 @@ of them, so a controller can depend on ``impact-balance`` alone. ``pip install
 |---|---|---|
 | ``plots`` | matplotlib | ``--plots`` / ``--plot`` of any command |
 | ``logs`` | pandas, pyarrow | ``check-log``, ``--log`` |
-| ``sim`` | mujoco, imageio, imageio-ffmpeg, pandas, pyarrow, matplotlib | ``simulate``, ``validate``, ``push-test`` |
+| ``sim`` | mujoco, imageio, imageio-ffmpeg, pandas, pyarrow, matplotlib | ``simulate``, ``validate``, ``push-test``, ``approach`` |
 | ``gui`` | viser (and trimesh, which it brings) | ``gui`` |
 | ``sweep`` | dask.distributed, pandas, pyarrow, matplotlib | ``sweep`` (figures included) |
 """
@@ -38,6 +38,7 @@ COMMAND_EXTRAS: dict[str, str] = {
     "simulate": "sim",
     "validate": "sim",
     "push-test": "sim",
+    "approach": "sim",
     "check-log": "logs",
     "gui": "gui",
     "sweep": "sweep",

@@ -17,14 +17,15 @@ from types import ModuleType
 
 from ..exceptions import ImpactBalanceError, ImpactBalanceWarning, one_line
 from ..extras import require_for
-from . import analyze, check_log, demo, frames, gui, listing, phase_portrait, pose, push_test, simulate, sweep, validate
+from . import (analyze, approach, check_log, demo, frames, gui, listing, phase_portrait, pose, push_test, simulate, sweep,
+               validate)
 from .demo import DEMO_SCENARIOS, FRICTION_SWEEP
 
 __all__ = ["main", "DEMO_SCENARIOS", "FRICTION_SWEEP", "COMMANDS", "EXIT_BROKEN_PIPE"]
 
 #: Command modules, in the order of ``--help``.
 COMMANDS: tuple[ModuleType, ...] = (demo, analyze, phase_portrait, listing, frames, pose, gui, simulate, validate, push_test,
-                                     check_log, sweep)
+                                     approach, check_log, sweep)
 
 #: Exit status when stdout is closed early (128 + SIGPIPE, as a shell reports it).
 EXIT_BROKEN_PIPE = 141

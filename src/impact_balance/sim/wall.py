@@ -25,9 +25,10 @@ import numpy as np
 from ..exceptions import SimulationError
 from .approach import _profile
 from .balance_trial import BalanceSetup, BalanceTrialOptions, run_balance_trial
+from .trial import TrialRecord, _point_velocity
 from .trial_result import BalanceTrialResult
 
-__all__ = ["GOVERNORS", "WallOptions", "GovernedApproach", "WallTrial", "run_wall_trial"]
+__all__ = ["GOVERNORS", "WallOptions", "GovernedApproach", "WallTrial", "run_wall_trial", "write_wall_video"]
 
 #: Governors of the approach: the CoM criterion's, the ZMP criterion's, or none (the reference alone).
 GOVERNORS = ("com", "zmp", "none")
@@ -114,7 +115,14 @@ class GovernedApproach:
 
 @dataclass
 class WallTrial:
-    """What one approach measured (SI units; see the module docstring)."""
+    """What one approach measured (SI units; see the module docstring).
+
+    ``series`` (per control tick from the start of the approach to the end of the trial): ``time``
+    (s), ``reference`` (the reference's own speed), ``cap`` (the governor's ceiling, None when
+    unbounded or without a governor), ``commanded`` (the speed commanded), ``measured`` (the
+    point's approach speed, ``-n . v``), all m/s. ``frames``: MuJoCo ``qpos``, CoM and impact force
+    per tick, for the video (when asked).
+    """
 
     options: WallOptions
     result: BalanceTrialResult
@@ -123,6 +131,8 @@ class WallTrial:
     time_to_contact: float | None
     tick_us: dict
     series: dict
+    wall: np.ndarray | None = None
+    frames: dict | None = None
 
     def to_dict(self) -> dict:
         s = self.result.summary()
@@ -138,10 +148,10 @@ def _finite(x) -> float | None:
 
 
 def run_wall_trial(setup: BalanceSetup, options: WallOptions, trial_options: BalanceTrialOptions | None = None,
-                   governor=None) -> WallTrial:
+                   governor=None, frames: bool = False) -> WallTrial:
     """Run one approach (see the module docstring). ``governor``: a
     :class:`~impact_balance.governor.Governor` of the setup's scenario and ``options.governor``'s criterion
-    (built here when None and the options ask for one)."""
+    (built here when None and the options ask for one); ``frames``: keep what a video needs."""
     if options.governor not in GOVERNORS:
         raise SimulationError("--governor", options.governor, f"must be one of {', '.join(GOVERNORS)}")
     if not (np.isfinite(options.reference) and 0.0 < options.reference <= 5.0):
@@ -164,16 +174,30 @@ def run_wall_trial(setup: BalanceSetup, options: WallOptions, trial_options: Bal
     wall = start - options.wall_distance * n
     ticks: list[float] = []
     caps: list[tuple[float, float, float]] = []
+    rows: dict[str, list] = {"time": [], "reference": [], "cap": [], "commanded": [], "measured": []}
+    kept: dict[str, list] = {"time": [], "qpos": [], "com": [], "impact": []}
+    sim = setup.sim
 
     def before_control(t: float, q: np.ndarray, v: np.ndarray) -> None:
-        if task.contact_time is not None or t < task.start_time:
+        if frames:
+            kept["time"].append(t)
+            kept["qpos"].append(sim.data.qpos.copy())
+            kept["com"].append(sim.com())
+            kept["impact"].append(sim.contact_force(sim.impact_geom))
+        if t < task.start_time:
             return
-        if governor is not None:
+        if task.contact_time is None and governor is not None:
             t0 = time.perf_counter()
             limit = governor.limit(q, v)
             ticks.append(time.perf_counter() - t0)
             task.ceiling = limit.ceiling
-        caps.append((t, task.reference_speed(t), task.ceiling))
+        if task.contact_time is None:
+            caps.append((t, task.reference_speed(t), task.ceiling))
+        rows["time"].append(t)
+        rows["reference"].append(task.reference_speed(t) if task.contact_time is None else 0.0)
+        rows["cap"].append(_finite(task.ceiling) if governor is not None else None)
+        rows["commanded"].append(task.commanded if task.contact_time is None else 0.0)
+        rows["measured"].append(float(-n @ _point_velocity(sim, n)))
 
     result = run_balance_trial(setup, impact_task=task, surface_point=wall, standoff=options.standoff,
                                options=trial_options, before_control=before_control,
@@ -186,7 +210,25 @@ def run_wall_trial(setup: BalanceSetup, options: WallOptions, trial_options: Bal
     us = np.asarray(ticks) * 1e6
     tick_us = ({"median": float(np.median(us)), "p99": float(np.percentile(us, 99)), "count": int(us.size)}
                if us.size else {"median": None, "p99": None, "count": 0})
-    series = {"time": [c[0] for c in caps], "reference": [c[1] for c in caps],
-              "cap": [_finite(c[2]) for c in caps]}
     return WallTrial(options, result, None if impact is None else _finite(impact.approach_speed), cap_at_contact,
-                     None if impact is None else float(impact.contact_time - task.start_time), tick_us, series)
+                     None if impact is None else float(impact.contact_time - task.start_time), tick_us, rows, wall,
+                     {k: np.array(x) for k, x in kept.items()} if frames else None)
+
+
+def write_wall_video(setup: BalanceSetup, trial: WallTrial, path, title: str | None = None):
+    """The approach as an MP4 (:func:`~.video.write_video`), the wall where it stood (``frames=True`` trials)."""
+    from .video import write_video
+
+    if not trial.frames or not len(trial.frames["time"]):
+        raise SimulationError("--video", str(path)[:80], "the trial kept no frames")
+    sim, f = setup.sim, trial.frames
+    k = len(f["time"])
+    record = TrialRecord(time=f["time"], qpos=f["qpos"], qvel=np.zeros((k, sim.model.nv)), com=f["com"],
+                         com_velocity=np.zeros((k, 3)), forces={"impact": f["impact"]}, impact_velocity=np.zeros((k, 3)),
+                         approach_start=float(f["time"][0]), wall_time=0.0)
+    home = sim.model.geom_pos[sim.surface_geom].copy()
+    sim.model.geom_pos[sim.surface_geom] = home + (trial.wall - setup.analysis.impact.model.point)
+    try:
+        return write_video(sim, record, path, title=title)
+    finally:
+        sim.model.geom_pos[sim.surface_geom] = home

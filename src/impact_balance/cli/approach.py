@@ -1,0 +1,122 @@
+"""``impact-balance approach SCENARIO``: the impacting point sent at an unknown wall, its speed
+capped every tick by a governor (the paper's Experiment 1, in MuJoCo)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ._options import add_controller_option
+
+__all__ = ["add_parser", "run", "USES_KERNEL"]
+
+USES_KERNEL = True
+
+
+def add_parser(sub) -> list[str]:
+    a = sub.add_parser("approach", help="send the impact point at an unknown wall, its speed capped by a governor (MuJoCo)")
+    a.add_argument("scenario", help="YAML file or bundled scenario name (must have an impact)")
+    a.add_argument("--reference", type=float, required=True, metavar="V",
+                   help="reference approach speed, m/s (the paper's 0.8)")
+    a.add_argument("--governor", default="com", choices=("com", "zmp", "none"),
+                   help="com: the CoM criterion's maximum contact velocity (default); zmp: the ZMP criterion's; "
+                        "none: the reference alone")
+    where = a.add_mutually_exclusive_group()
+    where.add_argument("--wall-distance", type=float, default=None, metavar="D",
+                       help="distance of the wall from the point's start, m (default 0.15: the scenario's impact point)")
+    where.add_argument("--wall-distance-range", type=float, nargs=2, default=None, metavar=("LO", "HI"),
+                       help="one trial at LO, the middle and HI, m")
+    a.add_argument("--rigid-impact", action="store_true",
+                   help="hold every joint's velocity through the impact (the paper's rigid robot)")
+    add_controller_option(a, "id", "it puts the ZMP anywhere in the support area after the impact")
+    a.add_argument("--max-time", type=float, default=30.0, metavar="S",
+                   help="longest approach before giving up, s (default 30: a ZMP governor is slow)")
+    a.add_argument("--json", action="store_true", help="print one JSON object")
+    a.add_argument("--plots", metavar="DIR", help="write the figure of each trial to DIR")
+    a.add_argument("--video", metavar="FILE", help="render an MP4 of the trial (one trial: give --wall-distance)")
+    return ["approach"]
+
+
+def run(args: argparse.Namespace) -> int:
+    import math
+
+    from ..exceptions import SimulationError
+    from ..scenario import load_scenario
+    from ..sim.balance_trial import BalanceSetup, BalanceTrialOptions
+    from ..sim.wall import WallOptions, run_wall_trial, write_wall_video
+    from .output import print_json
+
+    scenario = load_scenario(args.scenario)
+    if scenario.impact is None:
+        raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact: approach needs one")
+    if args.wall_distance_range is not None:
+        lo, hi = args.wall_distance_range
+        if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi <= 1):
+            raise SimulationError("--wall-distance-range", [lo, hi], "must be 0 < LO <= HI <= 1 m")
+        distances = [lo, 0.5 * (lo + hi), hi] if hi > lo else [lo]
+    else:
+        distances = [0.15 if args.wall_distance is None else args.wall_distance]
+    if not (math.isfinite(args.max_time) and 0 < args.max_time <= 120):
+        raise SimulationError("--max-time", args.max_time, "must be in (0, 120] s")
+    if args.video and (len(distances) > 1 or Path(args.video).suffix.lower() != ".mp4"):
+        raise SimulationError("--video", args.video, "one .mp4 for one trial (give --wall-distance, not a range)")
+    options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
+    setup = BalanceSetup.create(scenario, "servo", options)
+    governor = None
+    if args.governor != "none":
+        from ..governor import Governor
+
+        governor = Governor(scenario, criterion=args.governor)
+    trials, written = [], []
+    for distance in distances:
+        wall = WallOptions(reference=args.reference, governor=args.governor, wall_distance=distance,
+                           max_time=args.max_time)
+        trial = run_wall_trial(setup, wall, options, governor=governor, frames=bool(args.video))
+        trials.append(trial)
+        if args.plots:
+            written.append(_plot(trial, setup, Path(args.plots)))
+        if args.video:
+            written.append(write_wall_video(setup, trial, args.video, title=f"{scenario.name}: {args.governor} governor"))
+    docs = [t.to_dict() for t in trials]
+    for d in docs:
+        d["controller"] = args.controller
+        d["rigid_impact"] = args.rigid_impact
+    out = docs[0] if len(docs) == 1 else {"governor": args.governor, "reference": args.reference, "trials": docs}
+    if args.json:
+        print_json(out)
+        return 0
+    print(f"{scenario.name}: approach at {args.reference:g} m/s reference, {args.governor} governor, "
+          f"{args.controller} controller{', rigid impact' if args.rigid_impact else ''}")
+    for d in docs:
+        tick = d["tick_us"]
+        ticks = "" if tick["median"] is None else f"; governor {tick['median']:.0f} us per tick (p99 {tick['p99']:.0f})"
+        print(f"  wall {100 * d['wall_distance']:g} cm: speed at contact {_f(d['speed_at_contact'])}, cap at contact "
+              f"{_f(d['cap_at_contact'])}, time to contact {_s(d['time_to_contact'])}: {d['outcome']}"
+              f"{'' if d['reason'] is None else ' (' + str(d['reason']) + ')'}{ticks}")
+    for path in written:
+        print(f"  wrote {path}")
+    return 0
+
+
+def _f(x) -> str:
+    return "-" if x is None else f"{x:.3f} m/s"
+
+
+def _s(x) -> str:
+    return "never (gave up)" if x is None else f"{x:.2f} s"
+
+
+def _plot(trial, setup, out: Path) -> Path:
+    from ..plots.approach import plot_approach
+    from ..plots.save import figure_prefix
+
+    out.mkdir(parents=True, exist_ok=True)
+    areas = setup.analysis.areas
+    margin = None
+    if setup.scenario.zmp_margin > 0:
+        zmp = areas.zmp_area.inset(setup.scenario.zmp_margin)
+        margin = zmp.affine(areas.omega, -areas.omega * areas.com[:2]) if not zmp.is_empty else None
+    o = trial.options
+    path = out / f"{figure_prefix(setup.analysis)}_approach_{o.governor}_{o.reference:g}_{100 * o.wall_distance:g}cm.png"
+    plot_approach(trial, setup.analysis, margin).savefig(path)
+    return path
