@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._options import add_controller_option
+from ._options import add_controller_option, add_zmp_margin_option, with_zmp_margin
 
 __all__ = ["add_parser", "run", "USES_KERNEL"]
 
@@ -29,6 +29,7 @@ def add_parser(sub) -> list[str]:
     a.add_argument("--rigid-impact", action="store_true",
                    help="hold every joint's velocity through the impact (the paper's rigid robot)")
     add_controller_option(a, "id", "it puts the ZMP anywhere in the support area after the impact")
+    add_zmp_margin_option(a, "the governor's; default: the ZMP margin the trial's controller keeps")
     a.add_argument("--max-time", type=float, default=30.0, metavar="S",
                    help="longest approach before giving up, s (default 30: a ZMP governor is slow)")
     a.add_argument("--json", action="store_true", help="print one JSON object")
@@ -61,12 +62,16 @@ def run(args: argparse.Namespace) -> int:
     if args.video and (len(distances) > 1 or Path(args.video).suffix.lower() != ".mp4"):
         raise SimulationError("--video", args.video, "one .mp4 for one trial (give --wall-distance, not a range)")
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
+    from ..sim.balance_trial import controller_margin
+
+    margin = controller_margin(options) if args.zmp_margin is None else args.zmp_margin
+    governed = with_zmp_margin(scenario, margin)  # the governor's view: the area the controller can use
     setup = BalanceSetup.create(scenario, "servo", options)
     governor = None
     if args.governor != "none":
         from ..governor import Governor
 
-        governor = Governor(scenario, criterion=args.governor)
+        governor = Governor(governed, criterion=args.governor)
     trials, written = [], []
     for distance in distances:
         wall = WallOptions(reference=args.reference, governor=args.governor, wall_distance=distance,
@@ -74,13 +79,14 @@ def run(args: argparse.Namespace) -> int:
         trial = run_wall_trial(setup, wall, options, governor=governor, frames=bool(args.video))
         trials.append(trial)
         if args.plots:
-            written.append(_plot(trial, setup, Path(args.plots)))
+            written.append(_plot(trial, setup, Path(args.plots), margin))
         if args.video:
             written.append(write_wall_video(setup, trial, args.video, title=f"{scenario.name}: {args.governor} governor"))
     docs = [t.to_dict() for t in trials]
     for d in docs:
         d["controller"] = args.controller
         d["rigid_impact"] = args.rigid_impact
+        d["zmp_margin"] = margin
     out = docs[0] if len(docs) == 1 else {"governor": args.governor, "reference": args.reference, "trials": docs}
     if args.json:
         print_json(out)
@@ -106,15 +112,15 @@ def _s(x) -> str:
     return "never (gave up)" if x is None else f"{x:.2f} s"
 
 
-def _plot(trial, setup, out: Path) -> Path:
+def _plot(trial, setup, out: Path, zmp_margin: float) -> Path:
     from ..plots.approach import plot_approach
     from ..plots.save import figure_prefix
 
     out.mkdir(parents=True, exist_ok=True)
     areas = setup.analysis.areas
     margin = None
-    if setup.scenario.zmp_margin > 0:
-        zmp = areas.zmp_area.inset(setup.scenario.zmp_margin)
+    if zmp_margin > 0:
+        zmp = areas.zmp_area.inset(zmp_margin)
         margin = zmp.affine(areas.omega, -areas.omega * areas.com[:2]) if not zmp.is_empty else None
     o = trial.options
     path = out / f"{figure_prefix(setup.analysis)}_approach_{o.governor}_{o.reference:g}_{100 * o.wall_distance:g}cm.png"
