@@ -163,18 +163,27 @@ def _copy_tree(node: Any) -> Any:
 def _parse_cached(text: str, source: str) -> Any:
     if len(text) > MAX_BYTES:
         raise ScenarioError("scenario", source, f"larger than {MAX_BYTES // 1000} kB, the limit for a scenario file")
-    loader = _BoundedLoader(text)
+    loader = None
     try:
+        # PyYAML checks the characters when the loader is made (a control character or a NUL
+        # byte raises ReaderError there): inside the try, like every other YAML error.
+        loader = _BoundedLoader(text)
         return loader.get_single_data()
     except _LimitError as exc:
         raise ScenarioError("scenario", source, f"refused: {exc.problem}") from None
+    except yaml.reader.ReaderError as exc:
+        line = text.count("\n", 0, exc.position) + 1
+        what = "a NUL byte" if exc.character == 0 else f"the control character {exc.character:#04x}"
+        raise ScenarioError("scenario", source, f"not valid YAML: {what} at line {line} (YAML allows printable "
+                                                "text only)") from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         problem = getattr(exc, "problem", None) or "syntax error"
         raise ScenarioError("scenario", source, f"not valid YAML: {problem}{where}") from None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
 
 
 def read_yaml(path: Path) -> Any:

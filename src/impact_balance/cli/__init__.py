@@ -1,21 +1,26 @@
 """Command line: ``impact-balance COMMAND ...``.
 
 One module per command (``demo``, ``analyze``, ...), each with ``add_parser(sub)`` and
-``run(args) -> int``; this module assembles them and applies the one error rule: an error of
-the library (bad scenario, unknown frame...) prints one line on stderr and exits with status
-2, with no traceback. A closed stdout (``analyze --json | head -c 10``) ends quietly with
-status 141, what a shell reports for a command stopped by SIGPIPE.
+``run(args) -> int``; this module assembles them and applies the one error rule of
+:mod:`impact_balance.errors` to whatever a command raises (the project, the operating system,
+PyYAML, pyarrow, Dask, numpy): one line on stderr, exit status 2 for bad input and 1 for a
+failure of the machine, no traceback unless ``--debug`` (anywhere on the line) or
+``IMPACT_BALANCE_DEBUG=1``. A closed stdout (``analyze --json | head -c 10``) ends quietly
+with status 141, what a shell reports for a command stopped by SIGPIPE; Ctrl-C ends with 130.
 """
 
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib.metadata
 import os
 import sys
+import traceback
 from types import ModuleType
 
-from ..exceptions import ImpactBalanceError, one_line
+from ..errors import EXIT_BROKEN_PIPE, debug_requested, describe_error
+from ..exceptions import EnvironmentFailure, one_line
 from ..projection.walk import kernel_is_compiled
 from . import analyze, check_log, demo, frames, gui, listing, phase_portrait, push_test, simulate, sweep, validate
 from .demo import DEMO_SCENARIOS, FRICTION_SWEEP
@@ -25,9 +30,6 @@ __all__ = ["main", "DEMO_SCENARIOS", "FRICTION_SWEEP", "COMMANDS", "EXIT_BROKEN_
 #: Command modules, in the order of ``--help``.
 COMMANDS: tuple[ModuleType, ...] = (demo, analyze, phase_portrait, listing, frames, gui, simulate, validate, push_test, check_log, sweep)
 
-#: Exit status when stdout is closed early (128 + SIGPIPE, as a shell reports it).
-EXIT_BROKEN_PIPE = 141
-
 
 def _version() -> str:
     try:
@@ -36,7 +38,7 @@ def _version() -> str:
         return "unknown (not installed)"
 
 
-def _stdout_closed() -> int:
+def _silence_stdout() -> None:
     """Point stdout at /dev/null so that the interpreter's final flush cannot fail again."""
     try:
         devnull = os.open(os.devnull, os.O_WRONLY)
@@ -44,7 +46,62 @@ def _stdout_closed() -> int:
         os.close(devnull)
     except (OSError, ValueError, AttributeError):  # stdout is not a file (tests capture it)
         pass
-    return EXIT_BROKEN_PIPE
+
+
+class _Stdout:
+    """stdout for the time of a command: a write that fails (a full disk, a closed stream, ``>&-``)
+    becomes :class:`~impact_balance.exceptions.EnvironmentFailure` naming standard output, so
+    the error rule says what failed; a closed pipe stays a ``BrokenPipeError`` (quiet, 141)."""
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def _failed(self, exc: OSError) -> EnvironmentFailure:
+        reason = "it is closed" if self._stream is None else (exc.strerror or str(exc) or type(exc).__name__)
+        return EnvironmentFailure("standard output", None, f"cannot write the output: {reason}")
+
+    def write(self, text: str) -> int:
+        if self._stream is None:
+            raise self._failed(OSError(errno.EBADF, "closed"))
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            raise
+        except OSError as exc:
+            raise self._failed(exc) from None
+
+    def flush(self) -> None:
+        if self._stream is None:
+            return
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            raise
+        except OSError as exc:
+            raise self._failed(exc) from None
+
+    def isatty(self) -> bool:
+        return self._stream is not None and self._stream.isatty()
+
+    def __getattr__(self, name: str):
+        return getattr(self._stream, name)
+
+
+def _report(exc: BaseException, debug: bool) -> int:
+    """The one error rule: one line on stderr and the exit status (the traceback with ``--debug``)."""
+    if isinstance(exc, BrokenPipeError) or (isinstance(exc, OSError) and exc.errno == errno.EPIPE):
+        _silence_stdout()
+        return EXIT_BROKEN_PIPE
+    line, status = describe_error(exc)
+    if isinstance(exc, EnvironmentFailure) and exc.field == "standard output":
+        _silence_stdout()  # what is left in its buffer must not fail again at exit
+    try:
+        if debug:
+            traceback.print_exception(exc, file=sys.stderr)
+        print(f"impact-balance: error: {one_line(line)}", file=sys.stderr, flush=True)
+    except (OSError, ValueError):  # stderr itself is closed or full: the status is all that is left
+        pass
+    return status
 
 
 class _Parser(argparse.ArgumentParser):
@@ -61,6 +118,8 @@ def _parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
         description="Impact-aware multi-contact balance: CoM velocity area and maximum contact velocity.",
     )
     p.add_argument("--version", action="version", version=f"impact-balance {_version()}")
+    p.add_argument("--debug", action="store_true",
+                   help="show the traceback of an error (also anywhere after the command, or IMPACT_BALANCE_DEBUG=1)")
     sub = p.add_subparsers(dest="command", required=True)
     owners: dict[str, ModuleType] = {}
     for module in COMMANDS:
@@ -70,20 +129,25 @@ def _parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser, owners = _parser()
-    args = parser.parse_args(argv)
-    module = owners[args.command]
-    if getattr(module, "USES_KERNEL", False) and not kernel_is_compiled():
-        print("impact-balance: compiling the projection kernel (first run only, 10-30 s; cached afterwards) ...",
-              file=sys.stderr, flush=True)
+    """Run one command; returns its exit status (see the module docstring)."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    debug = debug_requested(argv)
+    argv = [a for a in argv if a != "--debug"]  # accepted anywhere on the line
+    stdout = sys.stdout
+    sys.stdout = _Stdout(stdout)
     try:
+        parser, owners = _parser()
+        args = parser.parse_args(argv)  # option types check values and outputs (exit 2 or 1)
+        module = owners[args.command]
+        if getattr(module, "USES_KERNEL", False) and not kernel_is_compiled():
+            print("impact-balance: compiling the projection kernel (first run only, 10-30 s; cached afterwards) ...",
+                  file=sys.stderr, flush=True)
         status = module.run(args)
-        sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at exit
+        sys.stdout.flush()  # a closed or full stdout shows here, inside the rule, not at exit
         return status
-    except BrokenPipeError:
-        return _stdout_closed()
-    except ImpactBalanceError as exc:
-        print(f"impact-balance: error: {one_line(str(exc))}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:  # pragma: no cover
-        return 130
+    except SystemExit:  # argparse's --help, --version and usage errors: already one line
+        raise
+    except BaseException as exc:  # noqa: BLE001 - the one error rule
+        return _report(exc, debug)
+    finally:
+        sys.stdout = stdout

@@ -1,10 +1,108 @@
-"""Options shared by the simulation commands (``simulate``, ``validate``, ``push-test``)."""
+"""Options shared by the commands, and the argparse types that check values when the line is read.
+
+A type here runs while argparse reads the command line, before the command loads or computes
+anything: a bad value is one line and exit status 2 (argparse's usage error), an output place
+the system refuses is one line and exit status 1 (:class:`~impact_balance.exceptions.OutputError`
+passes through argparse to the error rule of :func:`impact_balance.cli.main`).
+"""
 
 from __future__ import annotations
 
 import argparse
+import math
+from collections.abc import Callable, Sequence
 
-__all__ = ["add_controller_option", "add_output_options"]
+from ..exceptions import OptionError
+
+__all__ = [
+    "add_controller_option",
+    "add_output_options",
+    "output_folder",
+    "output_file",
+    "number",
+    "integer",
+    "LOG_SUFFIXES",
+]
+
+#: Suffixes of a log file (``--log``).
+LOG_SUFFIXES = (".parquet", ".csv")
+
+
+def _argparse_error(exc: OptionError) -> argparse.ArgumentTypeError:
+    from ..exceptions import short_repr
+
+    return argparse.ArgumentTypeError(f"{short_repr(exc.value)}: {exc.reason}")
+
+
+def output_folder(field: str) -> Callable[[str], str]:
+    """argparse type: a folder the command will write in (see :mod:`impact_balance.outputs`)."""
+
+    def check(text: str) -> str:
+        from ..outputs import check_output_folder
+
+        try:
+            check_output_folder(text, field)
+        except OptionError as exc:
+            raise _argparse_error(exc) from None
+        return text
+
+    check.__name__ = "folder"
+    return check
+
+
+def output_file(field: str, suffixes: Sequence[str] = ()) -> Callable[[str], str]:
+    """argparse type: a file the command will write (its folder checked, its suffix among ``suffixes``)."""
+
+    def check(text: str) -> str:
+        from ..outputs import check_output_file
+
+        try:
+            check_output_file(text, field, tuple(suffixes))
+        except OptionError as exc:
+            raise _argparse_error(exc) from None
+        return text
+
+    check.__name__ = "file"
+    return check
+
+
+def _interval(lo: float, hi: float, lo_open: bool, unit: str) -> str:
+    return f"{'(' if lo_open else '['}{lo:g}, {hi:g}]{f' {unit}' if unit else ''}"
+
+
+def number(lo: float, hi: float, unit: str = "", lo_open: bool = False, why: str = "") -> Callable[[str], float]:
+    """argparse type: a finite number in ``[lo, hi]`` (``(lo, hi]`` with ``lo_open``); ``why``
+    says where the limit comes from (shown in the error)."""
+    span = _interval(lo, hi, lo_open, unit)
+
+    def check(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+        inside = (lo < value if lo_open else lo <= value) and value <= hi
+        if not (math.isfinite(value) and inside):
+            raise argparse.ArgumentTypeError(f"{text} is outside {span}{f' ({why})' if why else ''}")
+        return value
+
+    check.__name__ = "number"
+    return check
+
+
+def integer(lo: int, hi: int, why: str = "") -> Callable[[str], int]:
+    """argparse type: an integer in ``[lo, hi]``."""
+
+    def check(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+        if not lo <= value <= hi:
+            raise argparse.ArgumentTypeError(f"{value} is outside [{lo}, {hi}]{f' ({why})' if why else ''}")
+        return value
+
+    check.__name__ = "integer"
+    return check
 
 
 def add_controller_option(parser: argparse.ArgumentParser, default: str, why: str) -> None:
@@ -15,7 +113,9 @@ def add_controller_option(parser: argparse.ArgumentParser, default: str, why: st
 
 
 def add_output_options(parser: argparse.ArgumentParser, log_help: str) -> None:
-    """``--json``, ``--plots DIR`` and ``--log FILE`` (what the log holds: ``log_help``)."""
+    """``--json``, ``--plots DIR`` and ``--log FILE`` (what the log holds: ``log_help``); the
+    places are checked when the line is read, before any simulation runs."""
     parser.add_argument("--json", action="store_true", help="print one JSON object")
-    parser.add_argument("--plots", metavar="DIR", help="write the figures to DIR")
-    parser.add_argument("--log", metavar="FILE", help=f"write the time series (.parquet or .csv) {log_help}")
+    parser.add_argument("--plots", metavar="DIR", type=output_folder("--plots"), help="write the figures to DIR")
+    parser.add_argument("--log", metavar="FILE", type=output_file("--log", LOG_SUFFIXES),
+                        help=f"write the time series (.parquet or .csv) {log_help}")

@@ -6,6 +6,8 @@ import argparse
 import dataclasses
 from pathlib import Path
 
+from ._options import output_folder
+
 __all__ = ["add_parser", "run", "USES_KERNEL"]
 
 USES_KERNEL = True
@@ -15,7 +17,7 @@ def add_parser(sub) -> list[str]:
     a = sub.add_parser("analyze", help="analyze one scenario (file or bundled name)")
     a.add_argument("scenario", help="YAML file, or the name of a bundled scenario (see `impact-balance scenarios`)")
     a.add_argument("--json", action="store_true", help="print one JSON object")
-    a.add_argument("--plots", metavar="DIR", help="write the scenario's figures to DIR")
+    a.add_argument("--plots", metavar="DIR", type=output_folder("--plots"), help="write the scenario's figures to DIR")
     a.add_argument("--qp", action="store_true", help="also solve the paper's QP in joint velocities")
     a.add_argument("--strict", action="store_true", help="treat warnings as errors (exit status 2)")
     return ["analyze"]

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ._options import output_folder
+
 __all__ = ["add_parser", "run", "USES_KERNEL"]
 
 USES_KERNEL = True
@@ -16,7 +18,7 @@ def add_parser(sub) -> list[str]:
     a.add_argument("--scenario", required=True, help="YAML file or bundled scenario name (robot and contacts)")
     a.add_argument("--json", action="store_true", help="print one JSON object")
     a.add_argument("--samples", action="store_true", help="with --json, include every sample's values")
-    a.add_argument("--plots", metavar="DIR", help="write the figures to DIR")
+    a.add_argument("--plots", metavar="DIR", type=output_folder("--plots"), help="write the figures to DIR")
     return ["check-log"]
 
 

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..scenario import Scenario, load_scenario
 from ..exceptions import SimulationError
+from ..numeric_limits import finite_or_none as _finite_or_none
 from .balance_trial import Push, BalanceTrialOptions, BalanceTrialResult, BalanceSetup, run_balance_trial
 
 __all__ = ["check_push_arguments", "PushOutcome", "PushTestResult", "push_test", "confusion", "DEFAULT_MAGNITUDES"]
@@ -42,7 +43,9 @@ class PushOutcome:
             "com_velocity_margin_at_end": (None if r.com_velocity_margin_at_end is None
                                            or not np.isfinite(r.com_velocity_margin_at_end)
                                            else r.com_velocity_margin_at_end),
-            "max_zmp_excursion": r.max_zmp_excursion, "max_com_velocity_excursion": r.max_com_velocity_excursion,
+            # null when undefined: no ZMP while the robot is off the ground (a push that throws it).
+            "max_zmp_excursion": _finite_or_none(r.max_zmp_excursion),
+            "max_com_velocity_excursion": _finite_or_none(r.max_com_velocity_excursion),
         }
 
 

@@ -15,6 +15,7 @@ import numpy as np
 
 from ..analysis import analyze
 from ..exceptions import SimulationError
+from ..numeric_limits import check_tolerance
 from ..scenario import Scenario, load_scenario
 from .balance_trial import BalanceTrialOptions, BalanceTrialResult, BalanceSetup, run_balance_trial
 
@@ -96,8 +97,7 @@ def validate(scenario: Scenario | str, joints: str = "servo", *, tolerance: floa
         scenario = load_scenario(scenario)
     if scenario.impact is None:
         raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact to validate")
-    if not (0 < tolerance < 1):
-        raise SimulationError("--tolerance", tolerance, "must be in (0, 1)")
+    check_tolerance(tolerance)  # numeric_limits: a bracket the bisection can close
     options = options or BalanceTrialOptions()
     predicted = predictions(scenario)
     setup = setup or BalanceSetup.create(scenario, joints, options)
