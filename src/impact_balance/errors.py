@@ -59,8 +59,13 @@ def _os_line(exc: OSError) -> str:
     return f"{where}: {reason}" if where else reason
 
 
-def describe_error(exc: BaseException) -> tuple[str, int]:
-    """One line (no prefix) and the exit status for ``exc``."""
+def describe_error(exc: BaseException, quote: bool = True) -> tuple[str, int]:
+    """One line (no prefix) and the exit status for ``exc``.
+
+    ``quote=False`` leaves out the message of an exception that is not the project's (a YAML
+    problem, a bug's text), which may quote input: the GUI shows such errors to whoever can
+    reach the page.
+    """
     if isinstance(exc, ImpactBalanceError):
         return str(exc), int(exc.exit_status)
     if isinstance(exc, KeyboardInterrupt):
@@ -78,10 +83,10 @@ def describe_error(exc: BaseException) -> tuple[str, int]:
     yaml = sys.modules.get("yaml")
     if yaml is not None and isinstance(exc, yaml.YAMLError):
         problem = getattr(exc, "problem", None) or str(exc)
-        return one_line(f"not valid YAML: {problem}"), EXIT_INPUT
+        return one_line(f"not valid YAML: {problem}" if quote else "not valid YAML"), EXIT_INPUT
     if isinstance(exc, RecursionError):
         return "input nested too deeply for this program", EXIT_INPUT
-    text = str(exc)
+    text = str(exc) if quote else ""
     detail = f": {text}" if text else ""
     return one_line(f"internal error ({_qualified(exc)}{detail}); rerun with --debug for the traceback "
                     "and please report it"), EXIT_ENVIRONMENT

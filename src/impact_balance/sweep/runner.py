@@ -56,7 +56,7 @@ from .store import ResultStore
 __all__ = ["RunReport", "run_sweep", "default_workers", "STOP_GRACE_S"]
 
 #: After Ctrl-C or SIGTERM, how long running chunks may finish before the workers are killed, s.
-STOP_GRACE_S = 2.0
+STOP_GRACE_S = 1.0
 
 
 def default_workers() -> int:
@@ -234,6 +234,7 @@ class _Processes:
         self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_init_process,
                                         initargs=(plan, os.getpid()))
         self.futures: dict[Future, int] = {}
+        self.processes: list[Any] = []
         # Start every worker (and its robot) before the clock of the computing loop starts.
         try:
             for f in [self.pool.submit(_ready) for _ in range(workers)]:
@@ -241,6 +242,9 @@ class _Processes:
         except BaseException:
             self.kill()
             raise
+        finally:
+            # CPython's executor keeps its processes here; kept to end them on a stop.
+            self.processes = list((getattr(self.pool, "_processes", None) or {}).values())
 
     def run(self, chunks: list[int]) -> Iterator[tuple[int, pa.Table]]:
         self.futures = {self.pool.submit(_process_chunk, c): c for c in chunks}
@@ -264,7 +268,7 @@ class _Processes:
 
     def kill(self) -> None:
         """End every worker now (their chunks in flight are lost; finished ones were returned)."""
-        processes = list(getattr(self.pool, "_processes", {}).values())  # CPython's executor keeps them here
+        processes = self.processes or list((getattr(self.pool, "_processes", None) or {}).values())
         for process in processes:
             with contextlib.suppress(Exception):
                 process.kill()
