@@ -23,7 +23,7 @@ limit. Mappings given directly (the GUI, the library) get the same depth and siz
 from __future__ import annotations
 
 import functools
-
+import re
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
@@ -138,6 +138,15 @@ class _BoundedLoader(yaml.SafeLoader):
         except ValueError as exc:
             raise _LimitError(str(exc), node.start_mark) from None
         return node
+
+
+# YAML 1.2 floats: PyYAML follows YAML 1.1, where ``5e-05`` or ``1e3`` (no dot) is a string. The
+# schema is strict (a string is not a number), so the reader knows them as the numbers they are.
+_BoundedLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
+    list("-+0123456789."),
+)
 
 
 def parse_yaml(text: str, source: str = "scenario") -> Any:
