@@ -15,6 +15,11 @@ reading it must finish quickly in bounded memory whatever it contains:
   component (the usual file-system limit) or :data:`MAX_PATH_CHARS` in all is refused before
   the operating system is asked.
 
+Logs (``check-log``) are bounded too, before they are read: a file of at most
+:data:`MAX_LOG_BYTES`, at most :data:`MAX_LOG_ROWS` rows, :data:`MAX_LOG_COLUMNS` columns and
+:data:`MAX_LOG_VALUES` values (rows x columns, 400 MB as float64). A Parquet log's counts come
+from its metadata; a CSV log is read up to the first row past the limit.
+
 Every refusal is a :class:`~impact_balance.exceptions.ScenarioError` naming the file and the
 limit. Mappings given directly (the GUI, the library) get the same depth and size checks
 (:func:`check_structure`).
@@ -39,6 +44,10 @@ __all__ = [
     "MAX_NAME_CHARS",
     "MAX_PATH_CHARS",
     "MAX_EXTENDS",
+    "MAX_LOG_BYTES",
+    "MAX_LOG_ROWS",
+    "MAX_LOG_COLUMNS",
+    "MAX_LOG_VALUES",
     "parse_yaml",
     "read_yaml",
     "check_structure",
@@ -57,6 +66,14 @@ MAX_NAME_CHARS = 255
 MAX_PATH_CHARS = 4096
 #: Longest chain of ``extends``.
 MAX_EXTENDS = 16
+#: Largest log file, bytes.
+MAX_LOG_BYTES = 1_000_000_000
+#: Most samples (rows) in a log (1000 s at 1 kHz).
+MAX_LOG_ROWS = 1_000_000
+#: Most columns in a log (a 100-joint robot has 217).
+MAX_LOG_COLUMNS = 2_000
+#: Most values (rows x columns) in a log: 400 MB once read as float64.
+MAX_LOG_VALUES = 50_000_000
 
 
 class _LimitError(yaml.YAMLError):

@@ -26,10 +26,12 @@ def run(args: argparse.Namespace) -> int:
     from ..logs import check_log, read_log
     from .output import print_json
 
-    frame = read_log(args.log)
+    notes: list = []
+    frame = read_log(args.log, warnings=notes)
     check = check_log(frame, args.scenario, source=str(args.log)[:80])
     out = check.to_dict(samples=args.samples)
     out["log"] = str(args.log)
+    out["warnings"] = [n.to_dict() for n in notes]
     written = _plots(check, Path(args.plots)) if args.plots else []
     if args.json:
         print_json(out)
@@ -50,6 +52,8 @@ def run(args: argparse.Namespace) -> int:
             unit = "m/s" if v.kind == "com_velocity" else "m"
             print(f"    {v.kind:12s} {v.start:8.3f} s to {v.end:8.3f} s ({v.samples} samples), worst {v.worst_margin:.4g} {unit}"
                   f" at {v.worst_time:.3f} s")
+    for note in notes:
+        print(f"  warning: {note}")
     for path in written:
         print(f"  wrote {path}")
     return 0
