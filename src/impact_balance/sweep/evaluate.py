@@ -61,9 +61,9 @@ RESULT_COLUMNS: tuple[tuple[str, pa.DataType, str], ...] = (
     ("impact_y", pa.float64(), "impact point, world, m"),
     ("impact_z", pa.float64(), "impact point, world, m"),
     ("ik_residual", pa.float64(), "largest posture IK residual, m or rad (posture sweeps)"),
-    ("robot", pa.string(), "the robot: a bundled name or its URDF file (null when the point is invalid)"),
-    ("contacts", pa.string(), "the contact frames, comma-separated (null when the point is invalid)"),
-    ("stance", pa.string(), "digest of robot, configuration and contacts: equal digests share their areas"),
+    ("robot_name", pa.string(), "the robot: a bundled name or its URDF file (null when the point is invalid)"),
+    ("contact_frames", pa.string(), "the contact frames, comma-separated (null when the point is invalid)"),
+    ("stance_digest", pa.string(), "digest of robot, configuration and contacts: equal digests share their areas"),
     ("q", pa.list_(pa.float64()), "the configuration, pinocchio's order (free-flyer base first)"),
 )
 
@@ -287,8 +287,8 @@ def _identity(scenario: Scenario, stance: Stance) -> dict[str, Any]:
     specs = [(c.spec.frame, c.spec.friction, tuple(c.spec.size), tuple(np.round(c.position, 12)),
               tuple(np.round(c.rotation.ravel(), 12))) for c in stance.contacts]
     text = json.dumps([_robot_key(scenario), np.round(q, 12).tolist(), repr(specs)])
-    return {"robot": robot, "contacts": ",".join(c.spec.frame for c in stance.contacts),
-            "stance": hashlib.sha256(text.encode()).hexdigest()[:12], "q": q.tolist()}
+    return {"robot_name": robot, "contact_frames": ",".join(c.spec.frame for c in stance.contacts),
+            "stance_digest": hashlib.sha256(text.encode()).hexdigest()[:12], "q": q.tolist()}
 
 
 def _directions(areas: BalanceAreas) -> list[float]:

@@ -223,6 +223,12 @@ def _dimensions(spec: SweepSpec, base: dict[str, Any], robot: Robot) -> list[Dim
     for name in names:
         if names.count(name) > 1:
             raise SweepError("axes", name, "appears in two axes")
+    from .evaluate import RESULT_COLUMNS  # the result columns' names are taken
+
+    taken = {"point", "chunk"} | {c[0] for c in RESULT_COLUMNS}
+    for d in dims:
+        if d.name in taken:
+            raise SweepError(f"axes[{d.axis}]", d.name, f"{d.name!r} is the name of a result column: vary a key inside it")
     # Stance dimensions first (stable): consecutive grid points then share a stance.
     return sorted(dims, key=lambda d: not d.stance)
 
