@@ -1,9 +1,10 @@
 """Options shared by the commands, and the argparse types that check values when the line is read.
 
 A type here runs while argparse reads the command line, before the command loads or computes
-anything: a bad value is one line and exit status 2 (argparse's usage error), an output place
-the system refuses is one line and exit status 1 (:class:`~impact_balance.exceptions.OutputError`
-passes through argparse to the error rule of :func:`impact_balance.cli.main`).
+anything. Its refusals are the project's errors, which pass through argparse (they are not
+``ValueError``) to the error rule of :func:`impact_balance.cli.main`: a bad value is one line
+``impact-balance: error: --OPTION = VALUE: reason`` and exit status 2, an output place the
+system refuses is one line and exit status 1.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ import argparse
 import math
 from collections.abc import Callable, Sequence
 
-from ..exceptions import OptionError
+from ..exceptions import ImpactBalanceError, OptionError, short_repr
 
 __all__ = [
     "add_controller_option",
@@ -22,16 +23,30 @@ __all__ = [
     "number",
     "integer",
     "LOG_SUFFIXES",
+    "CommandLineError",
 ]
 
 #: Suffixes of a log file (``--log``).
 LOG_SUFFIXES = (".parquet", ".csv")
 
 
-def _argparse_error(exc: OptionError) -> argparse.ArgumentTypeError:
-    from ..exceptions import short_repr
+class CommandLineError(ImpactBalanceError):
+    """An option's value refused while the line is read (exit status 2).
 
-    return argparse.ArgumentTypeError(f"{short_repr(exc.value)}: {exc.reason}")
+    Not a ``ValueError``, so that argparse lets it through to the error rule instead of
+    rewording it as "invalid value".
+
+    Attributes:
+        field, value, reason: As in :class:`~impact_balance.exceptions.OptionError`.
+    """
+
+    def __init__(self, field: str, value: object, reason: str):
+        self.field, self.value, self.reason = field, value, reason
+        super().__init__(f"{field} = {short_repr(value)}: {reason}")
+
+
+def _refused(exc: OptionError) -> CommandLineError:
+    return CommandLineError(exc.field, exc.value, exc.reason)
 
 
 def output_folder(field: str) -> Callable[[str], str]:
@@ -43,7 +58,7 @@ def output_folder(field: str) -> Callable[[str], str]:
         try:
             check_output_folder(text, field)
         except OptionError as exc:
-            raise _argparse_error(exc) from None
+            raise _refused(exc) from None
         return text
 
     check.__name__ = "folder"
@@ -59,7 +74,7 @@ def output_file(field: str, suffixes: Sequence[str] = ()) -> Callable[[str], str
         try:
             check_output_file(text, field, tuple(suffixes))
         except OptionError as exc:
-            raise _argparse_error(exc) from None
+            raise _refused(exc) from None
         return text
 
     check.__name__ = "file"
@@ -70,35 +85,35 @@ def _interval(lo: float, hi: float, lo_open: bool, unit: str) -> str:
     return f"{'(' if lo_open else '['}{lo:g}, {hi:g}]{f' {unit}' if unit else ''}"
 
 
-def number(lo: float, hi: float, unit: str = "", lo_open: bool = False, why: str = "") -> Callable[[str], float]:
-    """argparse type: a finite number in ``[lo, hi]`` (``(lo, hi]`` with ``lo_open``); ``why``
-    says where the limit comes from (shown in the error)."""
+def number(field: str, lo: float, hi: float, unit: str = "", lo_open: bool = False, why: str = "") -> Callable[[str], float]:
+    """argparse type: a finite number in ``[lo, hi]`` (``(lo, hi]`` with ``lo_open``) for option
+    ``field``; ``why`` says where the limit comes from (shown in the error)."""
     span = _interval(lo, hi, lo_open, unit)
 
     def check(text: str) -> float:
         try:
             value = float(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+            raise CommandLineError(field, text, "not a number") from None
         inside = (lo < value if lo_open else lo <= value) and value <= hi
         if not (math.isfinite(value) and inside):
-            raise argparse.ArgumentTypeError(f"{text} is outside {span}{f' ({why})' if why else ''}")
+            raise CommandLineError(field, text, f"must be in {span}{f' ({why})' if why else ''}")
         return value
 
     check.__name__ = "number"
     return check
 
 
-def integer(lo: int, hi: int, why: str = "") -> Callable[[str], int]:
-    """argparse type: an integer in ``[lo, hi]``."""
+def integer(field: str, lo: int, hi: int, why: str = "") -> Callable[[str], int]:
+    """argparse type: an integer in ``[lo, hi]`` for option ``field``."""
 
     def check(text: str) -> int:
         try:
             value = int(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+            raise CommandLineError(field, text, "not an integer") from None
         if not lo <= value <= hi:
-            raise argparse.ArgumentTypeError(f"{value} is outside [{lo}, {hi}]{f' ({why})' if why else ''}")
+            raise CommandLineError(field, text, f"must be in [{lo}, {hi}]{f' ({why})' if why else ''}")
         return value
 
     check.__name__ = "integer"

@@ -25,9 +25,9 @@ def add_parser(sub) -> list[str]:
                    help="approach speed(s) of the impact point along the normal, m/s (default 0.3)")
     a.add_argument("--joints", default="rigid", metavar="rigid|servo",
                    help="joint model: rigid (welded at the stance, the paper's model) or servo (position servos)")
-    a.add_argument("--armature", type=number(0.0, 100.0, "kg m^2"), default=0.0, metavar="KG_M2",
+    a.add_argument("--armature", type=number("--armature", 0.0, 100.0, "kg m^2"), default=0.0, metavar="KG_M2",
                    help="servo only: rotor inertia added to every joint, kg m^2 (default 0, as in the URDF)")
-    a.add_argument("--duration", type=number(0.0, 10.0, "s", lo_open=True), default=0.15, metavar="S",
+    a.add_argument("--duration", type=number("--duration", 0.0, 10.0, "s", lo_open=True), default=0.15, metavar="S",
                    help="simulated time kept after the impact begins, s (default 0.15)")
     a.add_argument("--json", action="store_true", help="print one JSON object (a list for several speeds)")
     a.add_argument("--plots", metavar="DIR", type=output_folder("--plots"), help="write the figures to DIR")

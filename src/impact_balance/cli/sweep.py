@@ -16,7 +16,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ._options import output_folder
+from ._options import CommandLineError, output_folder
 from .output import print_json
 
 __all__ = ["add_parser", "run", "USES_KERNEL"]
@@ -41,7 +41,7 @@ def _scheduler(text: str) -> str:
     try:
         return check_scheduler_address(text)
     except OptionError as exc:
-        raise argparse.ArgumentTypeError(f"{text!r}: {exc.reason}") from None
+        raise CommandLineError(exc.field, exc.value, exc.reason) from None
 
 
 def add_parser(sub) -> list[str]:
