@@ -58,7 +58,7 @@ def test_cli_option_overrides_the_scenario(capsys):
         analyze(with_margin("palm_push_two_feet", 0.01)).impact.max_contact_velocity, rel=1e-12)
     assert cli.main(["analyze", "palm_push_two_feet", "--zmp-margin", "-0.1"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "--zmp-margin = -0.1" in err
+    assert err.count("\n") == 1 and "--zmp-margin = '-0.1'" in err
 
 
 def test_sweep_axis_over_the_margin():

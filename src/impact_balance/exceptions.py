@@ -43,6 +43,9 @@ __all__ = [
     "MissingExtraError",
     "ImpactBalanceWarning",
     "ModelRepairWarning",
+    "OptionError",
+    "EnvironmentFailure",
+    "OutputError",
 ]
 
 #: Longest shown repr of a value in a message (characters).
@@ -100,7 +103,18 @@ class ImpactBalanceError(Exception):
     """Base class of all errors raised by impact-balance.
 
     ``str()`` is one line of at most :data:`MESSAGE_CHARS` characters.
+
+    Attributes:
+        exit_status: The command line's exit status for this error: 2 for bad input (the
+            default), 1 for a failure of the machine (a file that cannot be written, a server
+            that does not answer, a missing package). A subclass that is also an ``OSError``,
+            ``ImportError`` or ``MemoryError`` gets 1 without saying so; any subclass may set
+            ``exit_status`` as a class attribute.
     """
+
+    @property
+    def exit_status(self) -> int:
+        return 1 if isinstance(self, (OSError, ImportError, MemoryError)) else 2
 
     def __str__(self) -> str:
         return one_line(self.args[0] if self.args else self.__class__.__name__)
@@ -360,3 +374,45 @@ class ModelRepairWarning(ImpactBalanceWarning):
         self.robot = robot
         self.bodies = tuple(bodies)
         super().__init__(message)
+
+
+class OptionError(ImpactBalanceError, ValueError):
+    """A command-line option (or a library argument) has a value the code cannot use.
+
+    Attributes:
+        field: The option, e.g. ``--scheduler`` or ``--plots``.
+        value: Its value.
+        reason: Why it is refused (with the valid range or form).
+    """
+
+    def __init__(self, field: str, value: Any, reason: str):
+        self.field = field
+        self.value = value
+        self.reason = reason
+        super().__init__(f"{field} = {short_repr(value)}: {reason}")
+
+
+class EnvironmentFailure(ImpactBalanceError):
+    """The machine refused what the input asked for, which was itself good: a folder that
+    cannot be written, a server that does not answer, a stream that is closed or full.
+
+    Exit status 1 (bad input is 2).
+
+    Attributes:
+        field: What named the resource (an option, "standard output", a file name).
+        value: Its value (None when there is none to show).
+        reason: What the system said.
+    """
+
+    exit_status = 1
+
+    def __init__(self, field: str, value: Any, reason: str):
+        self.field = field
+        self.value = value
+        self.reason = reason
+        shown = "" if value is None else f" = {short_repr(value)}"
+        super().__init__(f"{field}{shown}: {reason}")
+
+
+class OutputError(EnvironmentFailure):
+    """An output file or folder cannot be written (checked before the command computes)."""

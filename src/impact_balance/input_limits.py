@@ -15,6 +15,11 @@ reading it must finish quickly in bounded memory whatever it contains:
   component (the usual file-system limit) or :data:`MAX_PATH_CHARS` in all is refused before
   the operating system is asked.
 
+Logs (``check-log``) are bounded too, before they are read: a file of at most
+:data:`MAX_LOG_BYTES`, at most :data:`MAX_LOG_ROWS` rows, :data:`MAX_LOG_COLUMNS` columns and
+:data:`MAX_LOG_VALUES` values (rows x columns, 400 MB as float64). A Parquet log's counts come
+from its metadata; a CSV log is read up to the first row past the limit.
+
 Every refusal is a :class:`~impact_balance.exceptions.ScenarioError` naming the file and the
 limit. Mappings given directly (the GUI, the library) get the same depth and size checks
 (:func:`check_structure`).
@@ -23,7 +28,7 @@ limit. Mappings given directly (the GUI, the library) get the same depth and siz
 from __future__ import annotations
 
 import functools
-
+import re
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
@@ -39,6 +44,10 @@ __all__ = [
     "MAX_NAME_CHARS",
     "MAX_PATH_CHARS",
     "MAX_EXTENDS",
+    "MAX_LOG_BYTES",
+    "MAX_LOG_ROWS",
+    "MAX_LOG_COLUMNS",
+    "MAX_LOG_VALUES",
     "parse_yaml",
     "read_yaml",
     "read_text",
@@ -58,6 +67,14 @@ MAX_NAME_CHARS = 255
 MAX_PATH_CHARS = 4096
 #: Longest chain of ``extends``.
 MAX_EXTENDS = 16
+#: Largest log file, bytes.
+MAX_LOG_BYTES = 1_000_000_000
+#: Most samples (rows) in a log (1000 s at 1 kHz).
+MAX_LOG_ROWS = 1_000_000
+#: Most columns in a log (a 100-joint robot has 217).
+MAX_LOG_COLUMNS = 2_000
+#: Most values (rows x columns) in a log: 400 MB once read as float64.
+MAX_LOG_VALUES = 50_000_000
 
 
 class _LimitError(yaml.YAMLError):
@@ -141,6 +158,15 @@ class _BoundedLoader(yaml.SafeLoader):
         return node
 
 
+# YAML 1.2 floats: PyYAML follows YAML 1.1, where ``5e-05`` or ``1e3`` (no dot) is a string. The
+# schema is strict (a string is not a number), so the reader knows them as the numbers they are.
+_BoundedLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
+    list("-+0123456789."),
+)
+
+
 def parse_yaml(text: str, source: str = "scenario") -> Any:
     """Parse YAML text within the limits; :class:`ScenarioError` on ``scenario`` naming ``source``.
 
@@ -164,18 +190,27 @@ def _copy_tree(node: Any) -> Any:
 def _parse_cached(text: str, source: str) -> Any:
     if len(text) > MAX_BYTES:
         raise ScenarioError("scenario", source, f"larger than {MAX_BYTES // 1000} kB, the limit for a scenario file")
-    loader = _BoundedLoader(text)
+    loader = None
     try:
+        # PyYAML checks the characters when the loader is made (a control character or a NUL
+        # byte raises ReaderError there): inside the try, like every other YAML error.
+        loader = _BoundedLoader(text)
         return loader.get_single_data()
     except _LimitError as exc:
         raise ScenarioError("scenario", source, f"refused: {exc.problem}") from None
+    except yaml.reader.ReaderError as exc:
+        line = text.count("\n", 0, exc.position) + 1
+        what = "a NUL byte" if exc.character == 0 else f"the control character {exc.character:#04x}"
+        raise ScenarioError("scenario", source, f"not valid YAML: {what} at line {line} (YAML allows printable "
+                                                "text only)") from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         problem = getattr(exc, "problem", None) or "syntax error"
         raise ScenarioError("scenario", source, f"not valid YAML: {problem}{where}") from None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
 
 
 def read_text(path: Path) -> str:

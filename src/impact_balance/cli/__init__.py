@@ -1,21 +1,26 @@
 """Command line: ``impact-balance COMMAND ...``.
 
 One module per command (``demo``, ``analyze``, ...), each with ``add_parser(sub)`` and
-``run(args) -> int``; this module assembles them and applies the one error rule: an error of
-the library (bad scenario, unknown frame...) prints one line on stderr and exits with status
-2, with no traceback. A closed stdout (``analyze --json | head -c 10``) ends quietly with
-status 141, what a shell reports for a command stopped by SIGPIPE.
+``run(args) -> int``; this module assembles them and applies the one error rule of
+:mod:`impact_balance.errors` to whatever a command raises (the project, the operating system,
+PyYAML, pyarrow, Dask, numpy): one line on stderr, exit status 2 for bad input and 1 for a
+failure of the machine, no traceback unless ``--debug`` (anywhere on the line) or
+``IMPACT_BALANCE_DEBUG=1``. A closed stdout (``analyze --json | head -c 10``) ends quietly
+with status 141, what a shell reports for a command stopped by SIGPIPE; Ctrl-C ends with 130.
 """
 
 from __future__ import annotations
 
 import argparse
+import errno
 import os
 import sys
+import traceback
 import warnings
 from types import ModuleType
 
-from ..exceptions import ImpactBalanceError, ImpactBalanceWarning, one_line
+from ..errors import EXIT_BROKEN_PIPE, debug_requested, describe_error
+from ..exceptions import EnvironmentFailure, ImpactBalanceWarning, one_line
 from ..extras import require_for
 from . import (analyze, approach, check_log, demo, frames, gui, listing, phase_portrait, pose, push_test, simulate, sweep,
                validate)
@@ -26,9 +31,6 @@ __all__ = ["main", "DEMO_SCENARIOS", "FRICTION_SWEEP", "COMMANDS", "EXIT_BROKEN_
 #: Command modules, in the order of ``--help``.
 COMMANDS: tuple[ModuleType, ...] = (demo, analyze, phase_portrait, listing, frames, pose, gui, simulate, validate, push_test,
                                      approach, check_log, sweep)
-
-#: Exit status when stdout is closed early (128 + SIGPIPE, as a shell reports it).
-EXIT_BROKEN_PIPE = 141
 
 
 def _kernel_is_compiled() -> bool:
@@ -47,7 +49,7 @@ def _version() -> str:
         return "unknown (not installed)"
 
 
-def _stdout_closed() -> int:
+def _silence_stdout() -> None:
     """Point stdout at /dev/null so that the interpreter's final flush cannot fail again."""
     try:
         devnull = os.open(os.devnull, os.O_WRONLY)
@@ -55,7 +57,62 @@ def _stdout_closed() -> int:
         os.close(devnull)
     except (OSError, ValueError, AttributeError):  # stdout is not a file (tests capture it)
         pass
-    return EXIT_BROKEN_PIPE
+
+
+class _Stdout:
+    """stdout for the time of a command: a write that fails (a full disk, a closed stream, ``>&-``)
+    becomes :class:`~impact_balance.exceptions.EnvironmentFailure` naming standard output, so
+    the error rule says what failed; a closed pipe stays a ``BrokenPipeError`` (quiet, 141)."""
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def _failed(self, exc: OSError) -> EnvironmentFailure:
+        reason = "it is closed" if self._stream is None else (exc.strerror or str(exc) or type(exc).__name__)
+        return EnvironmentFailure("standard output", None, f"cannot write the output: {reason}")
+
+    def write(self, text: str) -> int:
+        if self._stream is None:
+            raise self._failed(OSError(errno.EBADF, "closed"))
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            raise
+        except OSError as exc:
+            raise self._failed(exc) from None
+
+    def flush(self) -> None:
+        if self._stream is None:
+            return
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            raise
+        except OSError as exc:
+            raise self._failed(exc) from None
+
+    def isatty(self) -> bool:
+        return self._stream is not None and self._stream.isatty()
+
+    def __getattr__(self, name: str):
+        return getattr(self._stream, name)
+
+
+def _report(exc: BaseException, debug: bool) -> int:
+    """The one error rule: one line on stderr and the exit status (the traceback with ``--debug``)."""
+    if isinstance(exc, BrokenPipeError) or (isinstance(exc, OSError) and exc.errno == errno.EPIPE):
+        _silence_stdout()
+        return EXIT_BROKEN_PIPE
+    line, status = describe_error(exc)
+    if isinstance(exc, EnvironmentFailure) and exc.field == "standard output":
+        _silence_stdout()  # what is left in its buffer must not fail again at exit
+    try:
+        if debug:
+            traceback.print_exception(exc, file=sys.stderr)
+        print(f"impact-balance: error: {one_line(line)}", file=sys.stderr, flush=True)
+    except (OSError, ValueError):  # stderr itself is closed or full: the status is all that is left
+        pass
+    return status
 
 
 class _VersionAction(argparse.Action):
@@ -84,6 +141,8 @@ def _parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
         description="Impact-aware multi-contact balance: CoM velocity area and maximum contact velocity.",
     )
     p.add_argument("--version", action=_VersionAction)
+    p.add_argument("--debug", action="store_true",
+                   help="show the traceback of an error (also anywhere after the command, or IMPACT_BALANCE_DEBUG=1)")
     sub = p.add_subparsers(dest="command", required=True)
     owners: dict[str, ModuleType] = {}
     for module in COMMANDS:
@@ -104,22 +163,28 @@ def _warning_line(message, category, filename, lineno, file=None, line=None):
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run one command; returns its exit status (see the module docstring)."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    debug = debug_requested(argv)
+    argv = [a for a in argv if a != "--debug"]  # accepted anywhere on the line
+    stdout = sys.stdout
+    sys.stdout = _Stdout(stdout)
     warnings.showwarning = _warning_line
-    parser, owners = _parser()
-    args = parser.parse_args(argv)
-    module = owners[args.command]
-    if getattr(module, "USES_KERNEL", False) and not _kernel_is_compiled():
-        print("impact-balance: compiling the projection kernel (first run only, 0.5 to 1.5 min; cached afterwards) ...",
-              file=sys.stderr, flush=True)
     try:
+        parser, owners = _parser()
+        args = parser.parse_args(argv)  # option types check values and outputs (exit 2 or 1)
+        module = owners[args.command]
         require_for(args.command, args)  # a missing optional part is one line naming its extra
+        if getattr(module, "USES_KERNEL", False) and not _kernel_is_compiled():
+            print("impact-balance: compiling the projection kernel (first run only, 0.5 to 1.5 min; cached afterwards) ...",
+                  file=sys.stderr, flush=True)
         status = module.run(args)
-        sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at exit
+        sys.stdout.flush()  # a closed or full stdout shows here, inside the rule, not at exit
         return status
-    except BrokenPipeError:
-        return _stdout_closed()
-    except ImpactBalanceError as exc:
-        print(f"impact-balance: error: {one_line(str(exc))}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:  # pragma: no cover
-        return 130
+    except SystemExit:  # argparse's --help, --version and usage errors: already one line
+        raise
+    except BaseException as exc:  # noqa: BLE001 - the one error rule
+        return _report(exc, debug)
+    finally:
+        sys.stdout = stdout
+        warnings.showwarning = _show_warning

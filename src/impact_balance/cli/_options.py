@@ -1,11 +1,127 @@
-"""Options shared by the simulation commands (``simulate``, ``validate``, ``push-test``)."""
+"""Options shared by the commands, and the argparse types that check values when the line is read.
+
+A type here runs while argparse reads the command line, before the command loads or computes
+anything. Its refusals are the project's errors, which pass through argparse (they are not
+``ValueError``) to the error rule of :func:`impact_balance.cli.main`: a bad value is one line
+``impact-balance: error: --OPTION = VALUE: reason`` and exit status 2, an output place the
+system refuses is one line and exit status 1.
+"""
 
 from __future__ import annotations
 
 import argparse
+import math
+from collections.abc import Callable, Sequence
 
-__all__ = ["add_controller_option", "add_output_options", "add_zmp_margin_option", "with_zmp_margin",
-           "add_trial_options", "open_journal"]
+from ..exceptions import ImpactBalanceError, OptionError, short_repr
+
+__all__ = [
+    "add_controller_option",
+    "add_output_options",
+    "add_zmp_margin_option",
+    "with_zmp_margin",
+    "add_trial_options",
+    "open_journal",
+    "output_folder",
+    "output_file",
+    "number",
+    "integer",
+    "LOG_SUFFIXES",
+    "CommandLineError",
+]
+
+#: Suffixes of a log file (``--log``).
+LOG_SUFFIXES = (".parquet", ".csv")
+
+
+class CommandLineError(ImpactBalanceError):
+    """An option's value refused while the line is read (exit status 2).
+
+    Not a ``ValueError``, so that argparse lets it through to the error rule instead of
+    rewording it as "invalid value".
+
+    Attributes:
+        field, value, reason: As in :class:`~impact_balance.exceptions.OptionError`.
+    """
+
+    def __init__(self, field: str, value: object, reason: str):
+        self.field, self.value, self.reason = field, value, reason
+        super().__init__(f"{field} = {short_repr(value)}: {reason}")
+
+
+def _refused(exc: OptionError) -> CommandLineError:
+    return CommandLineError(exc.field, exc.value, exc.reason)
+
+
+def output_folder(field: str) -> Callable[[str], str]:
+    """argparse type: a folder the command will write in (see :mod:`impact_balance.outputs`)."""
+
+    def check(text: str) -> str:
+        from ..outputs import check_output_folder
+
+        try:
+            check_output_folder(text, field)
+        except OptionError as exc:
+            raise _refused(exc) from None
+        return text
+
+    check.__name__ = "folder"
+    return check
+
+
+def output_file(field: str, suffixes: Sequence[str] = ()) -> Callable[[str], str]:
+    """argparse type: a file the command will write (its folder checked, its suffix among ``suffixes``)."""
+
+    def check(text: str) -> str:
+        from ..outputs import check_output_file
+
+        try:
+            check_output_file(text, field, tuple(suffixes))
+        except OptionError as exc:
+            raise _refused(exc) from None
+        return text
+
+    check.__name__ = "file"
+    return check
+
+
+def _interval(lo: float, hi: float, lo_open: bool, unit: str) -> str:
+    return f"{'(' if lo_open else '['}{lo:g}, {hi:g}]{f' {unit}' if unit else ''}"
+
+
+def number(field: str, lo: float, hi: float, unit: str = "", lo_open: bool = False, why: str = "") -> Callable[[str], float]:
+    """argparse type: a finite number in ``[lo, hi]`` (``(lo, hi]`` with ``lo_open``) for option
+    ``field``; ``why`` says where the limit comes from (shown in the error)."""
+    span = _interval(lo, hi, lo_open, unit)
+
+    def check(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise CommandLineError(field, text, "not a number") from None
+        inside = (lo < value if lo_open else lo <= value) and value <= hi
+        if not (math.isfinite(value) and inside):
+            raise CommandLineError(field, text, f"must be in {span}{f' ({why})' if why else ''}")
+        return value
+
+    check.__name__ = "number"
+    return check
+
+
+def integer(field: str, lo: int, hi: int, why: str = "") -> Callable[[str], int]:
+    """argparse type: an integer in ``[lo, hi]`` for option ``field``."""
+
+    def check(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise CommandLineError(field, text, "not an integer") from None
+        if not lo <= value <= hi:
+            raise CommandLineError(field, text, f"must be in [{lo}, {hi}]{f' ({why})' if why else ''}")
+        return value
+
+    check.__name__ = "integer"
+    return check
 
 
 def add_controller_option(parser: argparse.ArgumentParser, default: str, why: str) -> None:
@@ -16,15 +132,19 @@ def add_controller_option(parser: argparse.ArgumentParser, default: str, why: st
 
 
 def add_output_options(parser: argparse.ArgumentParser, log_help: str) -> None:
-    """``--json``, ``--plots DIR`` and ``--log FILE`` (what the log holds: ``log_help``)."""
+    """``--json``, ``--plots DIR`` and ``--log FILE`` (what the log holds: ``log_help``); the
+    places are checked when the line is read, before any simulation runs."""
     parser.add_argument("--json", action="store_true", help="print one JSON object")
-    parser.add_argument("--plots", metavar="DIR", help="write the figures to DIR")
-    parser.add_argument("--log", metavar="FILE", help=f"write the time series (.parquet or .csv) {log_help}")
+    parser.add_argument("--plots", metavar="DIR", type=output_folder("--plots"), help="write the figures to DIR")
+    parser.add_argument("--log", metavar="FILE", type=output_file("--log", LOG_SUFFIXES),
+                        help=f"write the time series (.parquet or .csv) {log_help}")
 
 
 def add_zmp_margin_option(parser: argparse.ArgumentParser, default_help: str) -> None:
     """``--zmp-margin M``: the ZMP support area shrunk by M metres (``default_help``: what it defaults to)."""
-    parser.add_argument("--zmp-margin", type=float, default=None, metavar="M",
+    from ..constants import MAX_SIZE
+
+    parser.add_argument("--zmp-margin", type=number("--zmp-margin", 0.0, MAX_SIZE, "m"), default=None, metavar="M",
                         help=f"shrink the ZMP support area by M metres, and the CoM velocity area with it "
                              f"({default_help}; 0 is the paper's criterion)")
 
@@ -49,7 +169,7 @@ def add_trial_options(parser: argparse.ArgumentParser, impact: bool) -> None:
                             help="hold every joint's velocity through the impact (the paper's rigid robot), "
                                  "until the contact's normal velocity reaches zero")
     add_zmp_margin_option(parser, "default: the ZMP margin the trials' controller keeps")
-    parser.add_argument("--journal", metavar="FILE",
+    parser.add_argument("--journal", metavar="FILE", type=output_file("--journal", (".jsonl",)),
                         help="JSON-lines file of the finished trials, written as they end; running the same "
                              "command again resumes from it (default: impact-balance-trials/<command>_<scenario>_<digest>.jsonl)")
     parser.add_argument("--fresh", action="store_true", help="discard the journal's trials and run them all again")

@@ -6,7 +6,7 @@ import argparse
 import dataclasses
 from pathlib import Path
 
-from ._options import add_zmp_margin_option, with_zmp_margin
+from ._options import add_zmp_margin_option, output_folder, with_zmp_margin
 
 __all__ = ["add_parser", "run", "USES_KERNEL"]
 
@@ -17,7 +17,7 @@ def add_parser(sub) -> list[str]:
     a = sub.add_parser("analyze", help="analyze one scenario (file or bundled name)")
     a.add_argument("scenario", help="YAML file, or the name of a bundled scenario (see `impact-balance scenarios`)")
     a.add_argument("--json", action="store_true", help="print one JSON object")
-    a.add_argument("--plots", metavar="DIR", help="write the scenario's figures to DIR")
+    a.add_argument("--plots", metavar="DIR", type=output_folder("--plots"), help="write the scenario's figures to DIR")
     a.add_argument("--qp", action="store_true", help="also solve the paper's QP in joint velocities")
     a.add_argument("--strict", action="store_true", help="treat warnings as errors (exit status 2)")
     add_zmp_margin_option(a, "default: the scenario's zmp_margin, 0 unless set")

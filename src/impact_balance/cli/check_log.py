@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ._options import output_folder
+
 __all__ = ["add_parser", "run", "USES_KERNEL"]
 
 USES_KERNEL = True
@@ -16,7 +18,7 @@ def add_parser(sub) -> list[str]:
     a.add_argument("--scenario", required=True, help="YAML file or bundled scenario name (robot and contacts)")
     a.add_argument("--json", action="store_true", help="print one JSON object")
     a.add_argument("--samples", action="store_true", help="with --json, include every sample's values")
-    a.add_argument("--plots", metavar="DIR", help="write the figures to DIR")
+    a.add_argument("--plots", metavar="DIR", type=output_folder("--plots"), help="write the figures to DIR")
     return ["check-log"]
 
 
@@ -24,10 +26,12 @@ def run(args: argparse.Namespace) -> int:
     from ..logs import check_log, read_log
     from .output import print_json
 
-    frame = read_log(args.log)
+    notes: list = []
+    frame = read_log(args.log, warnings=notes)
     check = check_log(frame, args.scenario, source=str(args.log)[:80])
     out = check.to_dict(samples=args.samples)
     out["log"] = str(args.log)
+    out["warnings"] = [n.to_dict() for n in notes]
     written = _plots(check, Path(args.plots)) if args.plots and not check.floating else []
     if args.json:
         print_json(out)
@@ -53,6 +57,8 @@ def run(args: argparse.Namespace) -> int:
             unit = "m/s" if v.kind == "com_velocity" else "m"
             print(f"    {v.kind:12s} {v.start:8.3f} s to {v.end:8.3f} s ({v.samples} samples), worst {v.worst_margin:.4g} {unit}"
                   f" at {v.worst_time:.3f} s")
+    for note in notes:
+        print(f"  warning: {note}")
     for path in written:
         print(f"  wrote {path}")
     return 0

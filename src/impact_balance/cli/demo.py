@@ -27,6 +27,10 @@ def run(args: argparse.Namespace) -> int:
     from ..report import format_analysis, format_speed
 
     out = Path(args.out)
+    if not args.no_plots:
+        from ..outputs import check_output_folder
+
+        check_output_folder(out, "--out")  # before the studies run, not after
     print("impact-balance demo: the paper's studies on Talos (bundled scenarios)\n")
     written: list[Path] = []
     for name in DEMO_SCENARIOS:

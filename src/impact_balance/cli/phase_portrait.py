@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ._options import output_file
+
 __all__ = ["add_parser", "run"]
 
 
@@ -14,7 +16,8 @@ def add_parser(sub) -> list[str]:
     pp.add_argument("--zmp-range", type=float, nargs=2, required=True, metavar=("LO", "HI"), help="ZMP interval, m")
     pp.add_argument("--gravity", type=float, default=9.81, help="m/s^2 (default: %(default)s)")
     pp.add_argument("--json", action="store_true", help="print one JSON object")
-    pp.add_argument("--plot", metavar="FILE", help="write the phase portrait figure (PNG)")
+    pp.add_argument("--plot", metavar="FILE", type=output_file("--plot", (".png", ".pdf", ".svg")),
+                    help="write the phase portrait figure (.png, .pdf or .svg)")
     return ["phase-portrait"]
 
 

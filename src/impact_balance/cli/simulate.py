@@ -7,9 +7,13 @@ import math
 import os
 from pathlib import Path
 
+from ._options import LOG_SUFFIXES, number, output_file, output_folder
 from .output import print_json
 
-__all__ = ["add_parser", "run", "parse_speeds"]
+__all__ = ["add_parser", "run", "parse_speeds", "MAX_SPEEDS"]
+
+#: Most approach speeds in one ``simulate`` run (each is one trial, and one file per output).
+MAX_SPEEDS = 100
 
 USES_KERNEL = False
 
@@ -21,35 +25,39 @@ def add_parser(sub) -> list[str]:
                    help="approach speed(s) of the impact point along the normal, m/s (default 0.3)")
     a.add_argument("--joints", default="rigid", metavar="rigid|servo",
                    help="joint model: rigid (welded at the stance, the paper's model) or servo (position servos)")
-    a.add_argument("--armature", type=float, default=None, metavar="KG_M2",
+    a.add_argument("--armature", type=number("--armature", 0.0, 100.0, "kg m^2"), default=None, metavar="KG_M2",
                    help="servo only: rotor inertia of every joint, kg m^2 (default: what the robot files declare, "
                         "the SRDF's rotor_params; 0 where they declare none)")
     a.add_argument("--rigid-impact", action="store_true",
                    help="servo only: hold every joint's velocity from the contact to the end of the compression "
                         "(the paper's rigid robot at the impact)")
-    a.add_argument("--duration", type=float, default=0.15, metavar="S",
+    a.add_argument("--duration", type=number("--duration", 0.0, 10.0, "s", lo_open=True), default=0.15, metavar="S",
                    help="simulated time kept after the impact begins, s (default 0.15)")
     a.add_argument("--json", action="store_true", help="print one JSON object (a list for several speeds)")
-    a.add_argument("--plots", metavar="DIR", help="write the figures to DIR")
-    a.add_argument("--log", metavar="FILE", help="write the time series (.parquet or .csv); one file per speed")
-    a.add_argument("--video", metavar="FILE", help="render an MP4 (offscreen, EGL); one file per speed")
+    a.add_argument("--plots", metavar="DIR", type=output_folder("--plots"), help="write the figures to DIR")
+    a.add_argument("--log", metavar="FILE", type=output_file("--log", LOG_SUFFIXES),
+                   help="write the time series (.parquet or .csv); one file per speed")
+    a.add_argument("--video", metavar="FILE", type=output_file("--video", (".mp4",)),
+                   help="render an MP4 (offscreen, EGL); one file per speed")
     return ["simulate"]
 
 
 def parse_speeds(text: str) -> list[float]:
-    """Approach speeds from ``"0.1,0.3"``; :class:`SimulationError` on a bad one."""
+    """Approach speeds from ``"0.1,0.3"``; :class:`SimulationError` on a bad one (see
+    :mod:`impact_balance.numeric_limits` for the range)."""
     from ..exceptions import SimulationError
-    from ..sim.trial import MAX_APPROACH_SPEED
+    from ..numeric_limits import check_approach_speed
 
+    parts = str(text).split(",")
+    if len(parts) > MAX_SPEEDS:
+        raise SimulationError("--speed", text, f"at most {MAX_SPEEDS} speeds in one run")
     speeds = []
-    for part in str(text).split(","):
+    for part in parts:
         try:
             value = float(part)
         except ValueError:
             raise SimulationError("--speed", part.strip(), "not a number") from None
-        if not (math.isfinite(value) and 0.0 < value <= MAX_APPROACH_SPEED):
-            raise SimulationError("--speed", value, f"approach speed must be in (0, {MAX_APPROACH_SPEED:g}] m/s")
-        speeds.append(value)
+        speeds.append(check_approach_speed(value))
     return speeds
 
 
@@ -96,6 +104,7 @@ def run(args: argparse.Namespace) -> int:
         os.environ.setdefault("MUJOCO_GL", "egl")
     from ..exceptions import SimulationError
 
+    speeds = parse_speeds(args.speed)  # before MuJoCo loads: a bad speed is refused at once
     try:
         import mujoco  # noqa: F401  (reads MUJOCO_GL when imported)
     except Exception as exc:  # an unusable backend fails inside MuJoCo's import, with various types
@@ -107,17 +116,10 @@ def run(args: argparse.Namespace) -> int:
     from ..sim.measure import measure
     from ..sim.trial import TrialOptions, run_trial
 
-    speeds = parse_speeds(args.speed)
     if args.joints not in JOINT_MODELS:
         raise SimulationError("--joints", args.joints, f"unknown joint model; valid: {', '.join(JOINT_MODELS)}")
-    if not (math.isfinite(args.duration) and 0.0 < args.duration <= 10.0):
-        raise SimulationError("--duration", args.duration, "must be in (0, 10] s")
-    if args.armature is not None and not (math.isfinite(args.armature) and 0.0 <= args.armature <= 100.0):
-        raise SimulationError("--armature", args.armature, "must be in [0, 100] kg m^2")
     if args.log:
         check_log_path(args.log)
-    if args.video and Path(args.video).suffix.lower() != ".mp4":
-        raise SimulationError("--video", args.video, "the video is an .mp4 file")
     scenario = load_scenario(args.scenario)
     if scenario.impact is None:
         raise SimulationError("impact", None, f"scenario {args.scenario!r} has no impact to simulate")

@@ -1,7 +1,13 @@
 """``impact-balance sweep SPEC``: a study over many points, on all cores or a Dask cluster.
 
 ``impact-balance sweep --summary DIR`` prints the best and worst points of a sweep folder;
-``impact-balance sweep --list`` the bundled sweep files.
+``impact-balance sweep --verify DIR`` checks every part of a folder (exit status 2 when a part is
+bad); ``impact-balance sweep --list`` the bundled sweep files.
+
+Order, so that nothing is created for bad input: the options are checked when the line is read
+(``--out`` and ``--plots`` writable, ``--scheduler`` well formed), then the sweep file and its
+plan (robot loaded, axes checked, size bounded), then the workers or the scheduler, and only
+then is the output folder made.
 """
 
 from __future__ import annotations
@@ -10,6 +16,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from ._options import CommandLineError, output_folder
 from .output import print_json
 
 __all__ = ["add_parser", "run", "USES_KERNEL"]
@@ -27,6 +34,16 @@ def _positive(text: str) -> int:
     return value
 
 
+def _scheduler(text: str) -> str:
+    from ..exceptions import OptionError
+    from ..sweep.cluster import check_scheduler_address
+
+    try:
+        return check_scheduler_address(text)
+    except OptionError as exc:
+        raise CommandLineError(exc.field, exc.value, exc.reason) from None
+
+
 def add_parser(sub) -> list[str]:
     s = sub.add_parser(
         "sweep",
@@ -35,13 +52,17 @@ def add_parser(sub) -> list[str]:
         "are written at once: after Ctrl-C or a crash, the same command resumes.",
     )
     s.add_argument("spec", nargs="?", help="sweep YAML file, or the name of a bundled sweep (see --list)")
-    s.add_argument("--out", metavar="DIR", help="output folder (default: sweep-<name> in the current folder)")
+    s.add_argument("--out", metavar="DIR", type=output_folder("--out"),
+                   help="output folder (default: sweep-<name> in the current folder)")
     s.add_argument("--workers", type=_positive, metavar="N", help="local worker processes (default: every core)")
-    s.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler address, e.g. tcp://10.0.0.5:8786")
+    s.add_argument("--scheduler", metavar="ADDRESS", type=_scheduler,
+                   help="Dask scheduler address, tcp://HOST:PORT (e.g. tcp://10.0.0.5:8786)")
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
     s.add_argument("--no-plots", action="store_true", help="do not write the figures when the sweep completes")
     s.add_argument("--summary", metavar="DIR", help="print the best and worst points of a sweep folder, and exit")
-    s.add_argument("--plots", metavar="DIR", dest="plots_dir",
+    s.add_argument("--verify", metavar="DIR",
+                   help="check every part of a sweep folder (digest, chunk, rows, checksum), and exit")
+    s.add_argument("--plots", metavar="DIR", dest="plots_dir", type=output_folder("--plots"),
                    help="with --summary: write the figures to DIR; after a run: instead of OUT/figures")
     s.add_argument("--top", type=_positive, default=5, help="best and worst points shown (default 5)")
     s.add_argument("--json", action="store_true", help="print one JSON object (the summary) on stdout")
@@ -58,6 +79,26 @@ def _print(summary: dict, as_json: bool) -> None:
         print(format_summary(summary))
 
 
+def _warn(line: str) -> None:
+    print(f"impact-balance: warning: {line}", file=sys.stderr, flush=True)
+
+
+def _verify(args: argparse.Namespace) -> int:
+    from ..sweep.store import check_folder
+
+    check = check_folder(args.verify)
+    if args.json:
+        print_json(check.to_dict())
+    else:
+        for problem in check.problems:
+            print(problem.line())
+        state = "complete" if not check.missing else f"{len(check.missing)} of {check.n_chunks} chunks not computed yet"
+        verdict = "ok" if check.ok else f"{len(check.problems)} bad part(s)"
+        print(f"{args.verify}: {verdict}; {len(check.good)} good parts, {check.rows} of {check.manifest['n_points']} "
+              f"points; {state}")
+    return 0 if check.ok else 2
+
+
 def run(args: argparse.Namespace) -> int:
     from ..exceptions import SweepError
     from ..sweep import bundled_sweeps, load_sweep_spec, make_plan, run_sweep
@@ -68,10 +109,14 @@ def run(args: argparse.Namespace) -> int:
         for name, description in bundled_sweeps().items():
             print(f"{name:32s} {description}")
         return 0
+    if sum(bool(x) for x in (args.spec, args.summary, args.verify)) > 1:
+        raise SweepError("SPEC", args.spec or args.summary, "give one of a sweep file, --summary DIR or --verify DIR")
+    if args.verify:
+        return _verify(args)
     if args.summary:
-        if args.spec:
-            raise SweepError("SPEC", args.spec, "give either a sweep file or --summary DIR, not both")
         summary = summarize(args.summary, args.top)
+        for line in summary["problems"]:
+            _warn(f"{args.summary}/{line} (left out of the summary)")
         if args.plots_dir:
             summary["figures"] = [str(p) for p in save_sweep_figures(args.summary, args.plots_dir)]
         _print(summary, args.json)
@@ -83,8 +128,14 @@ def run(args: argparse.Namespace) -> int:
         raise SweepError("SPEC", None, "give a sweep file (or a bundled name: see --list), or --summary DIR")
     spec = load_sweep_spec(args.spec)
     plan = make_plan(spec)
-    out = Path(args.out) if args.out else Path(f"sweep-{Path(spec.source).stem}")
-    report = run_sweep(plan, out, workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress)
+    if args.out:
+        out = Path(args.out)
+    else:
+        from ..outputs import check_output_folder
+
+        out = check_output_folder(f"sweep-{Path(spec.source).stem}", "--out")
+    report = run_sweep(plan, out, workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress,
+                       notify=lambda line: _warn(f"{out}/{line}"))
     where = args.scheduler or f"{report.workers} worker{'s' if report.workers != 1 else ''}"
     print(f"impact-balance sweep: {report.points_computed} points in {report.elapsed_s:.1f} s on {where} "
           f"({report.rate:.0f} points/s; {report.chunks_before} of {report.n_chunks} chunks were already done) -> {out}",

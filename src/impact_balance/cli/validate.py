@@ -28,6 +28,7 @@ def add_parser(sub) -> list[str]:
 def run(args: argparse.Namespace) -> int:
     from ..exceptions import SimulationError
     from ..logs import check_log_path
+    from ..numeric_limits import check_tolerance
     from ..scenario import load_scenario
     from ..sim.balance_trial import BalanceTrialOptions, write_trial_log
     from ..sim.validate import validate
@@ -38,8 +39,7 @@ def run(args: argparse.Namespace) -> int:
         raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact: validate needs one")
     if not (0 < args.max_speed <= 5.0):
         raise SimulationError("--max-speed", args.max_speed, "must be in (0, 5] m/s")
-    if not (0.001 <= args.tolerance < 1):
-        raise SimulationError("--tolerance", args.tolerance, "must be in [0.001, 1)")
+    check_tolerance(args.tolerance)
     with_zmp_margin(scenario, args.zmp_margin)  # checks the value before any trial
     if args.log:
         check_log_path(args.log)

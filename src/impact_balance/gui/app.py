@@ -27,6 +27,7 @@ from .results import results_html
 from .scenario_tab import ScenarioTabMixin
 from .server import GuiError, check_listen_address
 from .session import Session
+from .uploads import limit_uploads
 from .state import DEFAULT_SCENARIO, GuiState
 from .view2d import svg_view
 from .viser_scene import SceneMixin
@@ -65,6 +66,11 @@ class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
         if not started:  # a viser that starts its server another way: do not serve unguarded
             self.server.stop()
             raise GuiError(host, port, "cannot install the Host/Origin check on this viser version")
+        try:  # uploads counted as they arrive (a viser without the expected handlers: do not serve)
+            self.uploads = limit_uploads(self.server, self._upload_refused)
+        except Exception:  # noqa: BLE001 - any mismatch with viser's internals
+            self.server.stop()
+            raise GuiError(host, port, "cannot install the upload limit on this viser version") from None
         self.update_times_ms: deque[float] = deque(maxlen=500)
         self.last_update_ms = float("nan")
         self._syncing = False
@@ -104,6 +110,10 @@ class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
     def stop(self) -> None:
         """Stop the server (its thread ends)."""
         self.server.stop()
+
+    def _upload_refused(self, filename: str, reason: str) -> None:
+        """An upload cut while it arrived (see :mod:`.uploads`): shown like a refused edit."""
+        self.edit(lambda: self.session.refuse(f"upload {filename}: {reason}"))
 
     # -- edits ----------------------------------------------------------------------------
     def edit(self, apply: Callable[[], Any]) -> None:

@@ -65,8 +65,11 @@ def describe(exc: BaseException, workspace: Workspace | None = None) -> str:
         text = " ".join(text.split())  # one line
     elif isinstance(exc, ImpactBalanceError):
         text = " ".join(str(exc).split())
-    else:
-        text = f"internal error ({exc.__class__.__name__})"
+    else:  # the command line's rule (impact_balance.errors): a YAML, OS or other error as one line
+        from ..errors import describe_error
+
+        line, _ = describe_error(exc, quote=False)  # never a third party's text: it may quote a file
+        text = line.split("; rerun with --debug")[0]
     return text if len(text) <= MAX_MESSAGE else text[: MAX_MESSAGE - 3] + "..."
 
 

@@ -11,7 +11,9 @@ rebinding. So every request is checked before viser sees it:
   and port); a plain HTTP request with an ``Origin`` is held to the same rule;
 - ``--allow-origin ORIGIN`` adds an origin (and its host name) on purpose, e.g. a reverse proxy.
 
-A refused request gets ``403 Forbidden`` and never reaches viser.
+A refused request gets ``403 Forbidden`` and never reaches viser. The same wrapper bounds what
+a connection may buffer: a message of at most :data:`~.uploads.MAX_MESSAGE_BYTES` (viser asks
+for 50 MiB) and :data:`~.uploads.MAX_QUEUED_MESSAGES` messages read ahead (see :mod:`.uploads`).
 
 Why a patch: viser (1.1) starts its websockets server inside ``ViserServer.__init__`` with its
 own ``process_request`` (the static file server) and passes no ``origins``; it offers no hook to
@@ -207,7 +209,11 @@ def guarded_start(policy: AccessPolicy) -> Iterator[list[int]]:
     def serve(handler: Any, *args: Any, process_request: Any = None, **kwargs: Any) -> Any:
         if inspect.iscoroutinefunction(process_request):  # pragma: no cover - viser's is a function
             raise RuntimeError("impact-balance's GUI guard expects a synchronous process_request")
+        from .uploads import MAX_MESSAGE_BYTES, MAX_QUEUED_MESSAGES
+
         started.append(1)
+        kwargs["max_size"] = min(kwargs.get("max_size") or MAX_MESSAGE_BYTES, MAX_MESSAGE_BYTES)
+        kwargs["max_queue"] = MAX_QUEUED_MESSAGES
         return original(handler, *args, process_request=_checker(policy, process_request), **kwargs)
 
     with _PATCH_LOCK:

@@ -133,6 +133,11 @@ class Session:
             self.revision += 1
             return True
 
+    def refuse(self, message: str) -> None:
+        """Show ``message`` as a refusal (an upload cut while it arrived); the state is kept."""
+        with self.lock:
+            self.message, self.refused = " ".join(str(message).split())[:300], True
+
     def apply(self, changes: Mapping[FieldPath, Any] | Iterable[tuple[FieldPath, Any]]) -> bool:
         """Apply scenario changes; False (and :attr:`message`) when refused."""
         changes = dict(changes.items() if isinstance(changes, Mapping) else changes)

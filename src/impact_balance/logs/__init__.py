@@ -5,8 +5,8 @@ See :mod:`impact_balance.logs.schema` for the columns.
 """
 
 from .check import LogCheck, Violation, check_log
-from .io import check_log_path, read_log, write_log
+from .io import check_log_columns, check_log_path, read_log, write_log
 from .schema import LOG_VERSION, LogColumns, joint_position_column, joint_velocity_column, force_columns
 
-__all__ = ["check_log", "LogCheck", "Violation", "read_log", "write_log", "check_log_path", "LOG_VERSION", "LogColumns", "joint_position_column",
+__all__ = ["check_log", "LogCheck", "Violation", "read_log", "write_log", "check_log_path", "check_log_columns", "LOG_VERSION", "LogColumns", "joint_position_column",
            "joint_velocity_column", "force_columns"]

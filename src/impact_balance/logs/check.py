@@ -40,6 +40,7 @@ from ..exceptions import ScenarioError
 from ..polygon import Polygon
 from ..scenario import Scenario, load_scenario
 from ..stance import Stance
+from .io import check_log_columns
 from .schema import LogColumns, force_columns, joint_position_column, joint_velocity_column
 
 __all__ = ["StanceSegment", "Violation", "LogCheck", "check_log", "log_state"]
@@ -235,6 +236,7 @@ def check_log(frame: pd.DataFrame, scenario: Scenario | str, *, force_threshold:
         raise ScenarioError("LOG", source, f"missing required columns: {', '.join(missing)}")
     if len(frame) == 0:
         raise ScenarioError("LOG", source, "no samples")
+    check_log_columns(frame, source)  # a NaN is named by its column, not by what it spoils later
     robot = scenario.load_robot()
     _joint_columns(frame, robot, source)
     times = frame[cols.time].to_numpy(float)

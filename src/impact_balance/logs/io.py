@@ -1,18 +1,38 @@
-"""Write and read logs (Parquet or CSV, chosen by the file's suffix) through pandas/pyarrow."""
+"""Write and read logs (Parquet or CSV, chosen by the file's suffix) through pandas/pyarrow.
+
+Reading is bounded and strict (see :mod:`impact_balance.input_limits` for the limits):
+
+- the file's size, row count, column count and value count are checked before it is read
+  (a Parquet file's from its metadata; a CSV file is read up to the first row past the limit);
+- every column the checker reads (``time``, the base pose and velocity, each ``q_``/``v_``
+  joint column) must hold finite numbers: text, a boolean, an empty cell, NaN or infinity is
+  named with its column and row (and the line of a CSV file);
+- the optional columns (ZMP, forces, reference CoM) must be numbers; an empty cell there means
+  "not measured at this sample";
+- a CSV file whose last line has no line break may have been cut while written: a last line
+  with missing fields is left out, with a warning; a complete one is kept, with a warning that
+  its last value may be cut.
+"""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
-from ..exceptions import ScenarioError
+from ..diagnostics import Diagnostic
+from ..exceptions import ScenarioError, short_repr
+from ..input_limits import MAX_LOG_BYTES, MAX_LOG_COLUMNS, MAX_LOG_ROWS, MAX_LOG_VALUES
 from .schema import LOG_VERSION, LogColumns
 
-__all__ = ["write_log", "read_log", "check_log_path", "SUFFIXES"]
+__all__ = ["write_log", "read_log", "check_log_path", "check_log_columns", "SUFFIXES"]
 
 #: Supported file types.
 SUFFIXES = (".parquet", ".csv")
+#: Prefixes of the optional numeric columns (an empty cell: not measured at that sample).
+_OPTIONAL = ("zmp_", "force_", "com_", "comd_")
 
 
 def check_log_path(path: str | Path, field: str = "--log") -> str:
@@ -48,17 +68,119 @@ def write_log(frame: pd.DataFrame, path: str | Path, metadata: dict[str, str] | 
     return path
 
 
-def read_log(path: str | Path) -> pd.DataFrame:
-    """Read a log; refuse a file without the required columns, naming them."""
+def _size_limits(shown: str, rows: int, columns: int) -> int:
+    """The rows a log of ``columns`` columns may have; refuses too many columns."""
+    if columns > MAX_LOG_COLUMNS:
+        raise ScenarioError("LOG", shown, f"{columns} columns: a log has at most {MAX_LOG_COLUMNS}")
+    allowed = min(MAX_LOG_ROWS, MAX_LOG_VALUES // max(columns, 1))
+    if rows > allowed:
+        raise ScenarioError("LOG", shown, f"{rows:,} rows of {columns} columns: a log has at most {MAX_LOG_ROWS:,} "
+                                          f"rows and {MAX_LOG_VALUES:,} values (split it)")
+    return allowed
+
+
+def _read_parquet(path: Path, shown: str) -> pd.DataFrame:
+    import pyarrow.parquet as pq
+
+    meta = pq.ParquetFile(path).metadata  # counts from the footer: nothing is read yet
+    _size_limits(shown, meta.num_rows, meta.num_columns)
+    return pd.read_parquet(path)
+
+
+def _last_line(path: Path) -> tuple[bool, str]:
+    """(ends with a line break, the last line's text)."""
+    size = path.stat().st_size
+    with open(path, "rb") as f:
+        f.seek(max(0, size - 65536))
+        tail = f.read()
+    ends = tail.endswith(b"\n")
+    last = tail.rstrip(b"\r\n").rsplit(b"\n", 1)[-1]
+    return ends, last.decode("utf-8", errors="replace")
+
+
+def _read_csv(path: Path, shown: str, warnings: list[Diagnostic] | None) -> pd.DataFrame:
+    with open(path, "rb") as f:
+        header = f.readline(1 << 20)
+    columns = header.count(b",") + 1 if header.strip() else 0
+    allowed = _size_limits(shown, 0, columns)
+    frame = pd.read_csv(path, nrows=allowed + 1)
+    _size_limits(shown, len(frame), columns)
+    ends, last = _last_line(path)
+    if not ends and len(frame):
+        fields = last.count(",") + 1
+        line = len(frame) + 1
+        if fields < len(frame.columns):
+            frame = frame.iloc[:-1]
+            note = f"the last line ({line}) has {fields} of {len(frame.columns)} fields and no line break: the " \
+                   "file was cut while written; that line is left out"
+        else:
+            note = f"the file does not end with a line break: its last line ({line}) may have been cut while " \
+                   "written (its last value may be short)"
+        if warnings is not None:
+            warnings.append(Diagnostic("log_cut", "LOG", note))
+    return frame
+
+
+def read_log(path: str | Path, warnings: list[Diagnostic] | None = None) -> pd.DataFrame:
+    """Read a log within the limits; refuse a file without the required columns (naming them)
+    or with a value the checker cannot use (naming its column and row). ``warnings``, if given,
+    receives the caveats (a CSV file cut in its last line)."""
     path = Path(path)
     suffix = check_log_path(path, "LOG")
+    shown = str(path)[:80]
     if not path.is_file():
-        raise ScenarioError("LOG", str(path)[:80], "no such file")
+        raise ScenarioError("LOG", shown, "no such file")
+    size = os.path.getsize(path)
+    if size > MAX_LOG_BYTES:
+        raise ScenarioError("LOG", shown, f"{size:,} bytes: a log file has at most {MAX_LOG_BYTES:,}")
     try:
-        frame = pd.read_csv(path) if suffix == ".csv" else pd.read_parquet(path)
+        frame = _read_csv(path, shown, warnings) if suffix == ".csv" else _read_parquet(path, shown)
+    except ScenarioError:
+        raise
+    except MemoryError:
+        raise
     except Exception as exc:  # pandas/pyarrow raise many types for a malformed file
-        raise ScenarioError("LOG", str(path)[:80], f"cannot read as {suffix[1:]}: {type(exc).__name__}") from None
+        raise ScenarioError("LOG", shown, f"cannot read as {suffix[1:]}: {type(exc).__name__}") from None
     missing = [c for c in LogColumns().required if c not in frame.columns]
     if missing:
-        raise ScenarioError("LOG", str(path)[:80], f"missing required columns: {', '.join(missing)}")
+        raise ScenarioError("LOG", shown, f"missing required columns: {', '.join(missing)}")
+    check_log_columns(frame, shown, line_offset=2 if suffix == ".csv" else None)
     return frame
+
+
+def _where(row: int, line_offset: int | None) -> str:
+    return f"row {row + 1}" + (f" (line {row + line_offset})" if line_offset is not None else "")
+
+
+def check_log_columns(frame: pd.DataFrame, source: str = "LOG", line_offset: int | None = None) -> None:
+    """Refuse a value the checker cannot use, naming its column and row (see the module docstring).
+
+    ``line_offset``: for a CSV file, the file line of row 0 (the header is line 1).
+    """
+    cols = LogColumns()
+    required = set(cols.required) | {c for c in frame.columns if str(c).startswith(("q_", "v_"))}
+    for name in frame.columns:
+        name_s = str(name)
+        needed = name in required
+        if not needed and not name_s.startswith(_OPTIONAL):
+            continue
+        column = frame[name]
+        if pd.api.types.is_bool_dtype(column):
+            raise ScenarioError("LOG", source, f"column {name_s}: true/false values, not numbers")
+        if not pd.api.types.is_numeric_dtype(column):
+            numbers = pd.to_numeric(column, errors="coerce")
+            bad = numbers.isna() & column.notna()
+            if bad.any():
+                row = int(np.flatnonzero(bad.to_numpy())[0])
+                value = short_repr(column.iloc[row], 30)
+                raise ScenarioError("LOG", source, f"column {name_s}, {_where(row, line_offset)}: {value} is not a number")
+            column = numbers
+        if needed:
+            values = column.to_numpy(dtype=float)
+            bad_rows = np.flatnonzero(~np.isfinite(values))
+            if bad_rows.size:
+                row = int(bad_rows[0])
+                what = "empty (or NaN)" if np.isnan(values[row]) else "infinite"
+                more = f"; {bad_rows.size} such rows" if bad_rows.size > 1 else ""
+                raise ScenarioError("LOG", source, f"column {name_s}, {_where(row, line_offset)}: {what}, not a finite "
+                                                   f"number{more}")

@@ -10,14 +10,48 @@ import math
 from typing import Annotated, Any
 
 import numpy as np
-from pydantic import AfterValidator, BaseModel, ConfigDict
+from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict
 
 from ..constants import MAX_ANGLE, MAX_FRICTION, MAX_POSITION, MAX_SPEED
 
-__all__ = ["Vec2", "Vec3", "Position", "Angles", "Friction"]
+__all__ = ["Number", "Integer", "Flag", "Vec2", "Vec3", "Position", "Angles", "Friction"]
 
-Vec2 = tuple[float, float]
-Vec3 = tuple[float, float, float]
+
+def _not_bool_or_text(v: Any, what: str) -> Any:
+    if isinstance(v, (bool, np.bool_)):
+        raise ValueError(f"must be {what}, not a boolean ({v})")
+    if isinstance(v, (str, bytes)):
+        raise ValueError(f"must be {what}, not text (write it without quotes)")
+    return v
+
+
+def _number(v: Any) -> Any:
+    return _not_bool_or_text(v, "a number")
+
+
+def _integer(v: Any) -> Any:
+    return _not_bool_or_text(v, "an integer")
+
+
+def _flag(v: Any) -> Any:
+    if isinstance(v, np.bool_):
+        return bool(v)
+    if not isinstance(v, bool):
+        raise ValueError("must be true or false")
+    return v
+
+
+# Strict types: YAML's `True`, `yes` or `'0.7'` is not read as a number, nor 1 as a boolean
+# (pydantic's lax mode would convert them silently); ints stay numbers.
+#: A number (int or float; a bool or a string is refused).
+Number = Annotated[float, BeforeValidator(_number)]
+#: An integer (a bool or a string is refused).
+Integer = Annotated[int, BeforeValidator(_integer)]
+#: true or false (a number or a string is refused).
+Flag = Annotated[bool, BeforeValidator(_flag)]
+
+Vec2 = tuple[Number, Number]
+Vec3 = tuple[Number, Number, Number]
 
 
 def _interval(lo: float, hi: float, lo_open: bool = False, hi_open: bool = False) -> str:
@@ -55,7 +89,7 @@ def _speed(v: tuple) -> tuple:
 
 Position = Annotated[Vec3, _coordinates(MAX_POSITION, "m")]
 Angles = Annotated[Vec3, _coordinates(MAX_ANGLE, "rad")]
-Friction = Annotated[float, _scalar(0.0, MAX_FRICTION, lo_open=True)]
+Friction = Annotated[Number, _scalar(0.0, MAX_FRICTION, lo_open=True)]
 
 
 class _Model(BaseModel):

@@ -21,7 +21,7 @@ from ..input_limits import check_path_text
 from ..robot import Robot, load_robot
 from ..spatial import pose, surface_rotation
 from ..stance import ContactSpec, Stance
-from .fields import Angles, Friction, Position, Vec2, Vec3, _coordinates, _finite, _Model, _scalar, _speed
+from .fields import Angles, Flag, Friction, Integer, Number, Position, Vec2, Vec3, _coordinates, _finite, _Model, _scalar, _speed
 from .specs import _contact_spec, _impact_spec, _quaternion
 
 __all__ = ["Offset", "ContactConfig", "QPConfig", "ImpactConfig", "RobotFiles", "BasePose", "Scenario", "with_source"]
@@ -51,7 +51,7 @@ class ContactConfig(_Model):
     size: Vec2
     offset: Offset = Offset()
     normal: Annotated[Vec3, _coordinates(1e6, "(any scale; it is normalised)")] | None = None
-    angle: Annotated[float, _scalar(-MAX_ANGLE, MAX_ANGLE, "rad")] | None = None
+    angle: Annotated[Number, _scalar(-MAX_ANGLE, MAX_ANGLE, "rad")] | None = None
 
     @field_validator("size")
     @classmethod
@@ -101,10 +101,10 @@ class ContactConfig(_Model):
 class QPConfig(_Model):
     """The paper's QP in joint velocities (optional; the exact answer never needs it)."""
 
-    solve: bool = False
-    joint_velocity_limits: bool = False
-    impulsive_torque_limits: bool = False
-    peak_factor: Annotated[float, _scalar(0.0, MAX_PEAK_FACTOR, lo_open=True)] = 1.0
+    solve: Flag = False
+    joint_velocity_limits: Flag = False
+    impulsive_torque_limits: Flag = False
+    peak_factor: Annotated[Number, _scalar(0.0, MAX_PEAK_FACTOR, lo_open=True)] = 1.0
     solver: str = "daqp"
 
 
@@ -114,11 +114,11 @@ class ImpactConfig(_Model):
     frame: str
     offset: Offset = Offset()
     normal: Annotated[Vec3, _coordinates(1e6, "(any scale; it is normalised)")]
-    friction: Annotated[float, _scalar(0.0, MAX_FRICTION)] = 0.24
+    friction: Annotated[Number, _scalar(0.0, MAX_FRICTION)] = 0.24
     restitution: Vec2 = (0.0, 0.2)
-    cone_edges: int = Field(16, ge=3, le=1024)
+    cone_edges: Integer = Field(16, ge=3, le=1024)
     reference_velocity: Annotated[Vec3, AfterValidator(_speed)] | None = None
-    duration: Annotated[float, _scalar(0.0, MAX_DURATION, "s", lo_open=True)] = 0.005
+    duration: Annotated[Number, _scalar(0.0, MAX_DURATION, "s", lo_open=True)] = 0.005
     inertia: Literal["composite", "joint_space"] = "composite"
     qp: QPConfig = QPConfig()
 
@@ -178,14 +178,14 @@ class Scenario(_Model):
     description: Annotated[str, Field(max_length=MAX_DESCRIPTION)] | None = None
     robot: str | RobotFiles = "talos"
     configuration: str | None = None
-    joints: dict[str, float] = {}
+    joints: dict[str, Number] = {}
     base: BasePose | None = None
     com_velocity: Annotated[Vec2, AfterValidator(_speed)] = (0.0, 0.0)
-    plane_height: Annotated[float, _scalar(-MAX_POSITION, MAX_POSITION, "m")] = 0.0
+    plane_height: Annotated[Number, _scalar(-MAX_POSITION, MAX_POSITION, "m")] = 0.0
     #: The ZMP support area is shrunk by this margin (m), and the CoM velocity area with it.
-    zmp_margin: Annotated[float, _scalar(0.0, MAX_SIZE, "m")] = 0.0
-    torque_limits: bool = True
-    gravity: Annotated[float, _scalar(*GRAVITY_RANGE, "m/s^2")] = 9.81
+    zmp_margin: Annotated[Number, _scalar(0.0, MAX_SIZE, "m")] = 0.0
+    torque_limits: Flag = True
+    gravity: Annotated[Number, _scalar(*GRAVITY_RANGE, "m/s^2")] = 9.81
     contacts: list[ContactConfig] = Field(min_length=1)
     impact: ImpactConfig | None = None
     source: str | None = Field(None, exclude=True)

@@ -28,12 +28,10 @@ import numpy as np
 import pinocchio as pin
 
 from ..exceptions import SimulationError
+from ..numeric_limits import MAX_APPROACH_SPEED, check_approach_speed
 from .model import SimModel
 
 __all__ = ["TrialOptions", "TrialRecord", "run_trial", "impact_limb", "MAX_APPROACH_SPEED"]
-
-#: Largest approach speed accepted, m/s (beyond, MuJoCo's soft contact at this step is not an impact model).
-MAX_APPROACH_SPEED = 5.0
 
 
 @dataclass(frozen=True)
@@ -130,8 +128,7 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
     if sim.scenario.impact is None or sim.impact_geom is None:
         raise SimulationError("impact", None, "the scenario has no impact to simulate")
     v_n = options.approach_speed
-    if not (np.isfinite(v_n) and 0.0 < v_n <= MAX_APPROACH_SPEED):
-        raise SimulationError("--speed", v_n, f"approach speed must be in (0, {MAX_APPROACH_SPEED:g}] m/s")
+    check_approach_speed(v_n)
     m, d = sim.model, sim.data
     spec = sim.scenario.impact.spec()
     n = np.asarray(spec.normal, dtype=float) / np.linalg.norm(spec.normal)

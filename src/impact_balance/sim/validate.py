@@ -27,6 +27,7 @@ import numpy as np
 
 from ..analysis import analyze
 from ..exceptions import SimulationError
+from ..numeric_limits import check_tolerance
 from ..scenario import Scenario, load_scenario
 from .balance_trial import BalanceSetup, BalanceTrialOptions, controller_margin, run_balance_trial
 from .journal import TrialJournal
@@ -172,8 +173,7 @@ def validate(scenario: Scenario | str, joints: str = "servo", *, tolerance: floa
         scenario = load_scenario(scenario)
     if scenario.impact is None:
         raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact to validate")
-    if not (0.001 <= tolerance < 1):
-        raise SimulationError("--tolerance", tolerance, "must be in [0.001, 1)")
+    check_tolerance(tolerance)  # numeric_limits: a bracket the bisection can close
     options = options or BalanceTrialOptions()
     margin = controller_margin(options) if zmp_margin is None else float(zmp_margin)
     predicted = predictions(scenario)

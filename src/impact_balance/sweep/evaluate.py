@@ -5,10 +5,16 @@ it. Within a chunk, points that share a stance (same values of every stance dime
 its areas: only the impact model and the two criteria are recomputed. Each chunk starts from a
 clean cache and the posture IK of each chunk starts from the base stance, so that a chunk's
 rows depend on the plan alone, never on which worker ran it or what it ran before.
+
+Each row says what was evaluated: the robot, the contact frames, the configuration ``q`` and a
+short digest of the stance (rows with the same digest share their areas). A robot axis loads
+each robot once per evaluator.
 """
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -55,6 +61,10 @@ RESULT_COLUMNS: tuple[tuple[str, pa.DataType, str], ...] = (
     ("impact_y", pa.float64(), "impact point, world, m"),
     ("impact_z", pa.float64(), "impact point, world, m"),
     ("ik_residual", pa.float64(), "largest posture IK residual, m or rad (posture sweeps)"),
+    ("robot_name", pa.string(), "the robot: a bundled name or its URDF file (null when the point is invalid)"),
+    ("contact_frames", pa.string(), "the contact frames, comma-separated (null when the point is invalid)"),
+    ("stance_digest", pa.string(), "digest of robot, configuration and contacts: equal digests share their areas"),
+    ("q", pa.list_(pa.float64()), "the configuration, pinocchio's order (free-flyer base first)"),
 )
 
 
@@ -77,6 +87,7 @@ class _StanceEntry:
     zmp_area: float | None = None
     verdicts: dict[tuple[float, float], str] | None = None
     edge_directions: list[float] | None = None
+    identity: dict[str, Any] | None = None
 
 
 def _verdict(areas: BalanceAreas, com_velocity: tuple[float, float]) -> str:
@@ -96,6 +107,7 @@ class Evaluator:
         self.plan = plan
         self.base_scenario = scenario_from_dict(plan.base, plan.base_source)
         self.robot = robot or self.base_scenario.load_robot()
+        self._robots = {_robot_key(self.base_scenario): self.robot}
         self.schema = result_schema(plan)
         self._path_dims = [d for d in plan.dims if d.kind == "path"]
         # Unchanged top-level keys go to the validation as the base's validated models (pydantic
@@ -180,7 +192,7 @@ class Evaluator:
         entry = cache.get(key)
         if entry is None:
             entry = cache[key] = self._stance_entry(scenario, values, warm)
-        out: dict[str, Any] = {"ik_residual": entry.ik_residual}
+        out: dict[str, Any] = {"ik_residual": entry.ik_residual, **(entry.identity or {})}
         if entry.status is not None:
             return {**out, "status": entry.status, "message": entry.message}
         stance, areas = entry.stance, entry.areas
@@ -211,10 +223,20 @@ class Evaluator:
         )
         return out
 
+    def _robot(self, scenario: Scenario) -> Robot:
+        """The scenario's robot, loaded once per evaluator (a robot axis varies it)."""
+        key = _robot_key(scenario)
+        robot = self._robots.get(key)
+        if robot is None:
+            # Robot files are relative to the base scenario's file, as in the plan's check.
+            robot = scenario.model_copy(update={"source": self.plan.base_source}).load_robot()
+            self._robots[key] = robot
+        return robot
+
     def _stance_entry(self, scenario: Scenario, values: dict[str, Any], warm: dict) -> _StanceEntry:
         residual = None
         try:
-            stance = scenario.build_stance(self.robot)
+            stance = scenario.build_stance(self._robot(scenario))
             if self._posture is not None:
                 stance, residual = self._place(scenario, stance, values, warm)
             polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
@@ -226,7 +248,8 @@ class Evaluator:
         except ImpactBalanceError as exc:
             return _StanceEntry(None, None, "error", f"{exc.__class__.__name__}: {exc}", residual)
         return _StanceEntry(stance, areas, ik_residual=residual, com_velocity_area=areas.com_velocity_area.area,
-                            zmp_area=areas.zmp_area.area, verdicts={}, edge_directions=_directions(areas))
+                            zmp_area=areas.zmp_area.area, verdicts={}, edge_directions=_directions(areas),
+                            identity=_identity(scenario, stance))
 
     def _place(self, scenario: Scenario, stance: Stance, values: dict[str, Any], warm: dict) -> tuple[Stance, float]:
         """The stance with the posture point moved to its target, the contact frames kept."""
@@ -250,6 +273,22 @@ class Evaluator:
         placed = Stance(self.robot, q, [c.spec for c in stance.contacts])
         residual = _worst_pose_error(placed, targets)
         return placed, residual
+
+
+def _robot_key(scenario: Scenario) -> str:
+    robot = scenario.robot
+    return robot if isinstance(robot, str) else json.dumps(robot.model_dump(mode="json"), sort_keys=True)
+
+
+def _identity(scenario: Scenario, stance: Stance) -> dict[str, Any]:
+    """The row's robot, contacts, configuration and stance digest."""
+    robot = scenario.robot if isinstance(scenario.robot, str) else scenario.robot.urdf
+    q = np.asarray(stance.q, dtype=float)
+    specs = [(c.spec.frame, c.spec.friction, tuple(c.spec.size), tuple(np.round(c.position, 12)),
+              tuple(np.round(c.rotation.ravel(), 12))) for c in stance.contacts]
+    text = json.dumps([_robot_key(scenario), np.round(q, 12).tolist(), repr(specs)])
+    return {"robot_name": robot, "contact_frames": ",".join(c.spec.frame for c in stance.contacts),
+            "stance_digest": hashlib.sha256(text.encode()).hexdigest()[:12], "q": q.tolist()}
 
 
 def _directions(areas: BalanceAreas) -> list[float]:

@@ -8,6 +8,11 @@ workers or on which worker computes it.
 Grid order: dimensions that change the stance vary slowest, then those of the impact and of the
 CoM velocity, so that consecutive points share a stance and its areas (only the impact part
 is recomputed). Within each group the axes keep the file's order.
+
+Every axis does what it says: an axis on ``robot`` (``robot: [g1, icub]``, or ``robot.urdf``
+for files) varies the robot, and each of its values is loaded and the base stance built with
+it when the sweep is planned, so that a robot that cannot take the base scenario's contacts
+(unknown frames) or cannot be read is refused at once, naming the value.
 """
 
 from __future__ import annotations
@@ -23,11 +28,12 @@ from typing import Any
 import numpy as np
 from scipy.stats import qmc
 
-from ..exceptions import ScenarioError, SweepError
+from ..exceptions import ImpactBalanceError, ScenarioError, SweepError
+from ..numeric_limits import MAX_SWEEP_POINTS
 from ..robot import Robot
 from ..scenario import _merge, _read, scenario_from_dict, scenario_path
-from .paths import STANCE_FREE_ROOTS, Token, check_path, format_path, parse_path
-from .spec import Dim, DirectionAxis, PathAxis, PostureAxis, SweepSpec, load_sweep_spec
+from .paths import STANCE_FREE_ROOTS, Token, check_path, format_path, parse_path, set_path
+from .spec import Dim, DirectionAxis, PathAxis, PostureAxis, SweepSpec, _check_size, load_sweep_spec
 
 __all__ = ["Dimension", "SweepPlan", "make_plan", "plan_sweep", "PLAN_VERSION"]
 
@@ -35,7 +41,8 @@ __all__ = ["Dimension", "SweepPlan", "make_plan", "plan_sweep", "PLAN_VERSION"]
 DEFAULT_CHUNK, DEFAULT_CHUNK_IK = 1000, 25
 
 #: Bumped when the rows of the same spec would change (columns, ordering): old results are not resumed.
-PLAN_VERSION = 1
+#: 2: rows carry robot, contacts, stance and q; parts carry their chunk, row count and checksum.
+PLAN_VERSION = 2
 
 
 @dataclass(frozen=True)
@@ -65,6 +72,11 @@ class Dimension:
     def numeric(self) -> bool:
         return self.dim.numeric
 
+    @property
+    def robot(self) -> bool:
+        """True when it varies the robot (an axis on ``robot`` or a key of it)."""
+        return bool(self.tokens) and self.tokens[0] == "robot"
+
     def grid_values(self) -> list[Any]:
         d = self.dim
         if d.values is not None:
@@ -73,6 +85,22 @@ class Dimension:
             raise SweepError(f"axes[{self.axis}]", self.name, "a grid needs count with range (or values: [...])")
         lo, hi = d.range
         return np.linspace(lo, hi, d.count).tolist()
+
+    def grid_value(self, index: np.ndarray) -> list[Any]:
+        """The grid values at ``index`` (what ``grid_values()[i]`` gives, without building the list)."""
+        d = self.dim
+        if d.values is not None:
+            return [d.values[i] for i in index]
+        if d.count is None:
+            raise SweepError(f"axes[{self.axis}]", self.name, "a grid needs count with range (or values: [...])")
+        lo, hi = d.range
+        if d.count == 1:
+            return [float(lo)] * len(index)
+        # numpy.linspace's own formula (start + i * step, the last value exactly hi).
+        step = (hi - lo) / (d.count - 1)
+        values = lo + np.asarray(index, dtype=float) * step
+        values[np.asarray(index) == d.count - 1] = hi
+        return values.tolist()
 
     def from_unit(self, u: np.ndarray) -> list[Any] | np.ndarray:
         """Map quasi-random samples in [0, 1) to values."""
@@ -129,11 +157,7 @@ class SweepPlan:
         if self.samples is not None:
             return {d.name: list(self.samples[d.name][start:stop]) for d in self.dims}
         index = np.unravel_index(np.arange(start, stop), self.shape)
-        out = {}
-        for d, idx in zip(self.dims, index):
-            values = d.grid_values()
-            out[d.name] = [values[i] for i in idx]
-        return out
+        return {d.name: d.grid_value(idx) for d, idx in zip(self.dims, index)}
 
     @property
     def posture(self) -> PostureAxis | None:
@@ -199,6 +223,12 @@ def _dimensions(spec: SweepSpec, base: dict[str, Any], robot: Robot) -> list[Dim
     for name in names:
         if names.count(name) > 1:
             raise SweepError("axes", name, "appears in two axes")
+    from .evaluate import RESULT_COLUMNS  # the result columns' names are taken
+
+    taken = {"point", "chunk"} | {c[0] for c in RESULT_COLUMNS}
+    for d in dims:
+        if d.name in taken:
+            raise SweepError(f"axes[{d.axis}]", d.name, f"{d.name!r} is the name of a result column: vary a key inside it")
     # Stance dimensions first (stable): consecutive grid points then share a stance.
     return sorted(dims, key=lambda d: not d.stance)
 
@@ -244,15 +274,38 @@ def make_plan(spec: SweepSpec, robot: Robot | None = None) -> SweepPlan:
                 robot.frame_id(axis.frame or base_scenario.impact.frame, field=f"axes[{i}].posture.frame")
             except ScenarioError as exc:
                 raise type(exc)(*_args(exc, exc.field)[:3], spec.source) from None
+    _check_robots(spec, base, source, dims)
+    _check_size(spec, spec.source)  # a spec built without sweep_spec_from_dict is bounded too
     if spec.sampling.method == "grid":
-        shape = tuple(len(d.grid_values()) for d in dims)
-        n_points, samples = int(np.prod(shape)), None
+        for d in dims:
+            d.grid_value(np.zeros(0, dtype=int))  # a range without count: named now
+        shape = tuple(d.dim.size for d in dims)
+        n_points, samples = math.prod(shape), None  # exact: Python integers
     else:
         shape, samples = None, _samples(spec, dims)
         n_points = int(spec.sampling.samples)
+    if n_points > MAX_SWEEP_POINTS:  # pragma: no cover - _check_size refuses it first
+        raise SweepError("axes", n_points, f"more than {MAX_SWEEP_POINTS} points", spec.source)
     digest_input = {"version": PLAN_VERSION, "spec": spec.digest_data(), "base": json.loads(json.dumps(base, default=list))}
     digest = hashlib.sha256(json.dumps(digest_input, sort_keys=True).encode()).hexdigest()[:16]
     return SweepPlan(spec, base, source, tuple(dims), shape, samples, n_points, digest)
+
+
+def _check_robots(spec: SweepSpec, base: dict[str, Any], source: str | None, dims: list[Dimension]) -> None:
+    """Load every robot of a robot axis and build the base stance with it (a robot that cannot
+    be read, or lacks the base scenario's frames, is refused now, naming its value)."""
+    for d in dims:
+        if not d.robot:
+            continue
+        if d.dim.values is None:
+            raise SweepError(f"axes[{d.axis}]", d.name, "a robot axis takes values: [...] (robot names or files)", spec.source)
+        for k, value in enumerate(d.dim.values):
+            field = f"axes[{d.axis}].values[{k}]"
+            try:
+                scenario = scenario_from_dict(set_path(base, d.tokens, value), source)
+                scenario.build_stance()
+            except ImpactBalanceError as exc:
+                raise SweepError(field, value, f"this robot cannot take the base scenario: {exc}", spec.source) from None
 
 
 def plan_sweep(name_or_path: str | Path) -> SweepPlan:

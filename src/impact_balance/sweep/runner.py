@@ -13,21 +13,32 @@ Three backends, one loop:
   scattered to every worker once; each worker keeps one evaluator per plan.
 
 Whatever the backend, the parent writes each finished chunk at once (see
-:mod:`~impact_balance.sweep.store`), and skips the chunks already written: the same command
-resumes an interrupted sweep. The rows of a chunk depend on the plan only, so the results are
-the same on any number of workers.
+:mod:`~impact_balance.sweep.store`), and skips the chunks already written and checked: the same
+command resumes an interrupted sweep (bad parts are moved aside and computed again). The rows
+of a chunk depend on the plan only, so the results are the same on any number of workers.
+
+Nothing is created before the inputs are known good: the output folder is checked, the
+workers started or the scheduler reached, and only then is the folder made.
+
+Workers die with their sweep: Ctrl-C or SIGTERM stops the run (finished chunks are written,
+running ones get :data:`STOP_GRACE_S` seconds, then the workers are killed), and each local
+worker watches the command's process and exits when it ends, even by SIGKILL (Linux: a pidfd;
+elsewhere it polls twice a second).
 """
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
 import os
+import select
 import signal
 import sys
 import threading
 import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor, as_completed
+from concurrent.futures import wait as wait_futures
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -42,7 +53,10 @@ from .evaluate import Evaluator
 from .plan import SweepPlan
 from .store import ResultStore
 
-__all__ = ["RunReport", "run_sweep", "default_workers"]
+__all__ = ["RunReport", "run_sweep", "default_workers", "STOP_GRACE_S"]
+
+#: After Ctrl-C or SIGTERM, how long running chunks may finish before the workers are killed, s.
+STOP_GRACE_S = 1.0
 
 
 def default_workers() -> int:
@@ -68,6 +82,7 @@ class RunReport:
         interrupted: True after Ctrl-C or ``stop_after``: run the same command to finish.
         elapsed_s: Wall time of the computing loop (after the workers started), s.
         startup_s: Time to start the workers and load the robot in them, s.
+        rejected: Bad parts found in the folder (moved to ``rejected/`` and computed again).
     """
 
     out: Path
@@ -81,6 +96,7 @@ class RunReport:
     interrupted: bool
     elapsed_s: float
     startup_s: float
+    rejected: tuple = ()
 
     @property
     def complete(self) -> bool:
@@ -98,9 +114,42 @@ _EVALUATORS: dict[str, Evaluator] = {}
 _LOCK = threading.Lock()
 
 
-def _init_process(plan: SweepPlan) -> None:
-    # The parent handles Ctrl-C (it cancels the queue and keeps what is finished).
+def _watch_parent(pid: int) -> None:
+    """End this worker when process ``pid`` (the sweep command) ends, however it ends.
+
+    The worker's own parent is multiprocessing's fork server, not the command: a daemon thread
+    waits on a pidfd of the command (readable when it exits), or polls it where there is none.
+    """
+    try:
+        fd = os.pidfd_open(pid)
+    except ProcessLookupError:  # already gone
+        os._exit(1)
+    except (AttributeError, OSError):  # not Linux >= 5.3
+        fd = None
+
+    def watch() -> None:
+        if fd is not None:
+            select.select([fd], [], [])
+        else:  # pragma: no cover - not Linux
+            while True:
+                time.sleep(0.5)
+                try:
+                    os.kill(pid, 0)
+                except ProcessLookupError:
+                    break
+                except PermissionError:
+                    continue
+        os._exit(1)
+
+    threading.Thread(target=watch, name="impact-balance-sweep-watch", daemon=True).start()
+
+
+def _init_process(plan: SweepPlan, parent: int | None = None) -> None:
+    # The parent handles Ctrl-C and SIGTERM (it cancels the queue and keeps what is finished).
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if parent is not None:
+        _watch_parent(parent)
     global _EVALUATOR
     _EVALUATOR = Evaluator(plan)
     _EVALUATOR.warm_up()
@@ -145,8 +194,22 @@ def _context() -> multiprocessing.context.BaseContext:
 
 
 # -- backends: each yields (chunk, table) as chunks finish ---------------------------------
+class _Done:
+    """Nothing left to compute (a finished folder)."""
+
+    name = "none"
+    workers = 0
+
+    def run(self, chunks: list[int]) -> Iterator[tuple[int, pa.Table]]:
+        return iter(())
+
+    def stop(self) -> list[tuple[int, pa.Table]]:
+        return []
+
+
 class _Inline:
     name = "inline"
+    workers = 1
 
     def __init__(self, plan: SweepPlan):
         self.evaluator = Evaluator(plan)
@@ -168,11 +231,20 @@ class _Processes:
         _warm_kernel(plan)
         context = _context()
         self.workers = workers
-        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_init_process, initargs=(plan,))
-        # Start every worker (and its robot) before the clock of the computing loop starts.
-        for f in [self.pool.submit(_ready) for _ in range(workers)]:
-            f.result()
+        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_init_process,
+                                        initargs=(plan, os.getpid()))
         self.futures: dict[Future, int] = {}
+        self.processes: list[Any] = []
+        # Start every worker (and its robot) before the clock of the computing loop starts.
+        try:
+            for f in [self.pool.submit(_ready) for _ in range(workers)]:
+                f.result()
+        except BaseException:
+            self.kill()
+            raise
+        finally:
+            # CPython's executor keeps its processes here; kept to end them on a stop.
+            self.processes = list((getattr(self.pool, "_processes", None) or {}).values())
 
     def run(self, chunks: list[int]) -> Iterator[tuple[int, pa.Table]]:
         self.futures = {self.pool.submit(_process_chunk, c): c for c in chunks}
@@ -181,13 +253,29 @@ class _Processes:
             yield chunk, f.result()
 
     def stop(self) -> list[tuple[int, pa.Table]]:
-        """Cancel what has not started, wait for what runs, return what finished meanwhile."""
+        """Cancel what has not started, give what runs :data:`STOP_GRACE_S` seconds, kill the
+        workers, and return what finished meanwhile."""
         for f in self.futures:
             f.cancel()
-        self.pool.shutdown(wait=True, cancel_futures=True)
-        done = [(c, f.result()) for f, c in self.futures.items() if f.done() and not f.cancelled() and f.exception() is None]
+        running = [f for f in self.futures if not f.done()]
+        if running:
+            wait_futures(running, timeout=STOP_GRACE_S)
+        done = [(c, f.result()) for f, c in self.futures.items()
+                if f.done() and not f.cancelled() and f.exception() is None]
         self.futures = {}
+        self.kill()
         return done
+
+    def kill(self) -> None:
+        """End every worker now (their chunks in flight are lost; finished ones were returned)."""
+        processes = self.processes or list((getattr(self.pool, "_processes", None) or {}).values())
+        for process in processes:
+            with contextlib.suppress(Exception):
+                process.kill()
+        self.pool.shutdown(wait=False, cancel_futures=True)
+        for process in processes:
+            with contextlib.suppress(Exception):
+                process.join(STOP_GRACE_S)
 
     def close(self) -> None:
         self.pool.shutdown(wait=True, cancel_futures=True)
@@ -197,10 +285,10 @@ class _Dask:
     name = "dask"
 
     def __init__(self, plan: SweepPlan, scheduler: Any):
-        from distributed import Client
+        from .cluster import connect
 
-        self.own = not isinstance(scheduler, Client)
-        self.client = Client(scheduler) if self.own else scheduler
+        self.own = isinstance(scheduler, str)
+        self.client = connect(scheduler) if self.own else scheduler
         self.workers = sum(self.client.nthreads().values()) or 1
         self.plan_future = self.client.scatter(plan, broadcast=True)
         self.plan = plan
@@ -236,6 +324,7 @@ def run_sweep(
     progress: bool = True,
     stop_after: int | None = None,
     on_chunk: Callable[[int], None] | None = None,
+    notify: Callable[[str], None] | None = None,
 ) -> RunReport:
     """Compute the chunks of ``plan`` not yet in ``out``, writing each one as it finishes.
 
@@ -248,22 +337,40 @@ def run_sweep(
         progress: Show a progress bar (tqdm, on stderr) with the rate and the time left.
         stop_after: Stop after writing this many chunks (as if killed; for tests and demos).
         on_chunk: Called with each chunk index once its part file is written.
+        notify: Called with one line per bad part found in ``out`` (moved to ``rejected/``,
+            computed again).
 
-    Ctrl-C stops the run: chunks already written stay, chunks that finish while it stops are
-    written too, and the report says ``interrupted``.
+    Ctrl-C (or SIGTERM, in the main thread) stops the run: chunks already written stay, chunks
+    that finish within :data:`STOP_GRACE_S` are written too, the workers are ended, and the
+    report says ``interrupted``.
+
+    Raises:
+        SweepError: ``out`` holds another sweep, or is not a sweep folder.
+        EnvironmentFailure: the scheduler cannot be reached (nothing is created then).
     """
-    store = ResultStore.open(out, plan)
-    done = store.finished()
-    todo = [c for c in range(plan.n_chunks) if c not in done]
+    store = ResultStore.prepare(out, plan)  # checks only: nothing is created yet
+    good = set(store.check.good) if store.check is not None else set()
+    todo = [c for c in range(plan.n_chunks) if c not in good]
     t0 = time.perf_counter()
     n = workers or default_workers()
-    if scheduler is not None:
-        backend: Any = _Dask(plan, scheduler)
+    if not todo:
+        backend: Any = _Done()
+    elif scheduler is not None:
+        backend = _Dask(plan, scheduler)
     elif n <= 1 or len(todo) <= 1:
         backend = _Inline(plan)
     else:
         backend = _Processes(plan, min(n, len(todo)))
     startup = time.perf_counter() - t0
+    try:
+        store.create(notify)  # the inputs are good and the workers are up: now the folder
+    except BaseException:
+        if hasattr(backend, "kill"):
+            backend.kill()
+        elif hasattr(backend, "close"):
+            backend.close()
+        raise
+    done = store.finished()
     done_points = sum(plan.chunk_range(c)[1] - plan.chunk_range(c)[0] for c in done)
     bar = tqdm(total=plan.n_points, initial=done_points, unit="pt", desc="sweep", file=sys.stderr,
                disable=not progress, dynamic_ncols=True, smoothing=0.05)
@@ -280,22 +387,47 @@ def run_sweep(
         if on_chunk is not None:
             on_chunk(chunk)
 
+    failed = False
     try:
-        for chunk, table in backend.run(todo):
-            keep(chunk, table)
-            if stop_after is not None and computed >= stop_after:
-                interrupted = computed < len(todo)
-                break
-    except KeyboardInterrupt:
-        interrupted = True
-        for chunk, table in backend.stop():
-            keep(chunk, table)
+        with _sigterm_interrupts():
+            try:
+                for chunk, table in backend.run(todo):
+                    keep(chunk, table)
+                    if stop_after is not None and computed >= stop_after:
+                        interrupted = computed < len(todo)
+                        break
+            except KeyboardInterrupt:
+                interrupted = True
+                for chunk, table in backend.stop():
+                    keep(chunk, table)
+    except BaseException:
+        failed = True
+        raise
     finally:
         elapsed = time.perf_counter() - t1
         if interrupted and not isinstance(backend, _Inline):
             backend.stop()
-        if hasattr(backend, "close"):
+        if failed and hasattr(backend, "kill"):
+            backend.kill()  # an error in the parent (a full disk...): no worker outlives it
+        elif hasattr(backend, "close"):
             backend.close()
         bar.close()
     return RunReport(Path(out), backend.name, backend.workers, plan.n_points, plan.n_chunks, len(done), computed,
-                     points, interrupted, elapsed, startup)
+                     points, interrupted, elapsed, startup, tuple(store.problems))
+
+
+@contextlib.contextmanager
+def _sigterm_interrupts() -> Iterator[None]:
+    """Within the block, SIGTERM stops the run as Ctrl-C does (main thread only)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum, frame):  # noqa: ANN001 - signal's signature
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGTERM, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)

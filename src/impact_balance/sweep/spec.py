@@ -21,7 +21,11 @@ axes:
 ```
 
 Every problem becomes a :class:`~impact_balance.exceptions.SweepError` naming the field and
-the value.
+the value. Numbers are strict (a bool or a quoted number is refused), finite, and a range's
+width must be finite too; the number of points is computed exactly (Python integers) from the
+file alone and refused above :data:`~impact_balance.numeric_limits.MAX_SWEEP_POINTS` before the
+robot is loaded or anything is allocated. The content of a file that is not a sweep file (a
+link to a system file, say) is never quoted: only its name and the key.
 """
 
 from __future__ import annotations
@@ -35,7 +39,9 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from ..exceptions import ScenarioError, SweepError, UnknownNameError
 from ..input_limits import read_yaml
+from ..numeric_limits import MAX_SWEEP_CHUNKS, MAX_SWEEP_POINTS
 from ..scenario import Offset, _field
+from ..scenario.fields import Integer, Number
 from ..scenario.bundled import bundled_descriptions
 
 __all__ = [
@@ -68,8 +74,8 @@ class Dim(_Model):
     """
 
     values: list[Any] | None = Field(None, min_length=1)
-    range: tuple[float, float] | None = None
-    count: int | None = Field(None, ge=1, le=1_000_000)
+    range: tuple[Number, Number] | None = None
+    count: Integer | None = Field(None, ge=1, le=MAX_SWEEP_POINTS)
 
     @model_validator(mode="after")
     def _one_of(self) -> "Dim":
@@ -81,7 +87,18 @@ class Dim(_Model):
             lo, hi = self.range
             if not (math.isfinite(lo) and math.isfinite(hi)) or lo > hi:
                 raise ValueError("range must be [lo, hi], finite, with lo <= hi")
+            if not math.isfinite(hi - lo):
+                raise ValueError("range is wider than a float can hold (hi - lo overflows): narrow it")
+        if self.values is not None:
+            for k, v in enumerate(self.values):
+                if isinstance(v, float) and not math.isfinite(v):
+                    raise ValueError(f"values[{k}] is {v}: values must be finite")
         return self
+
+    @property
+    def size(self) -> int | None:
+        """Number of grid values (None for a range without count)."""
+        return len(self.values) if self.values is not None else self.count
 
     @property
     def numeric(self) -> bool:
@@ -125,8 +142,8 @@ class PostureAxis(_Model):
     x: Dim | None = None
     y: Dim | None = None
     z: Dim | None = None
-    tolerance: float = Field(1e-4, gt=0, le=1e-2)
-    max_iterations: int = Field(200, ge=1, le=10_000)
+    tolerance: Number = Field(1e-4, gt=0, le=1e-2)
+    max_iterations: Integer = Field(200, ge=1, le=10_000)
 
     @model_validator(mode="after")
     def _some_target(self) -> "PostureAxis":
@@ -142,8 +159,8 @@ class Sampling(_Model):
     """``grid`` (every combination) or quasi-random ``samples`` points (scipy.stats.qmc)."""
 
     method: Literal["grid", "sobol", "halton", "lhs"] = "grid"
-    samples: int | None = Field(None, ge=1, le=100_000_000)
-    seed: int = Field(0, ge=0)
+    samples: Integer | None = Field(None, ge=1, le=MAX_SWEEP_POINTS)
+    seed: Integer = Field(0, ge=0, le=2**63 - 1)
 
     @model_validator(mode="after")
     def _samples(self) -> "Sampling":
@@ -164,8 +181,27 @@ class SweepSpec(_Model):
     base: str | dict[str, Any]
     axes: tuple[Axis, ...]
     sampling: Sampling = Sampling()
-    chunk_size: int | None = Field(None, ge=1, le=1_000_000)
+    chunk_size: Integer | None = Field(None, ge=1, le=MAX_SWEEP_POINTS)
     source: str | None = Field(None, exclude=True)
+
+    def dimension_sizes(self) -> list[int | None]:
+        """Grid values per dimension, in the file's order (None: a range without count)."""
+        sizes: list[int | None] = []
+        for axis in self.axes:
+            if isinstance(axis, PathAxis):
+                sizes.append(axis.size)
+            elif isinstance(axis, DirectionAxis):
+                sizes += [axis.azimuth.size, axis.elevation.size]
+            else:
+                sizes += [d.size for d in (axis.x, axis.y, axis.z) if d is not None]
+        return sizes
+
+    def point_count(self) -> int | None:
+        """The number of points, exact (Python integers; None when a grid range lacks its count)."""
+        if self.sampling.method != "grid":
+            return int(self.sampling.samples)
+        sizes = self.dimension_sizes()
+        return None if any(s is None for s in sizes) else math.prod(sizes)
 
     def digest_data(self) -> dict[str, Any]:
         """The keys that define the results (not the description), JSON-ready."""
@@ -180,7 +216,8 @@ def _raise(exc: ValidationError, raw: Any, prefix: str, source: str | None) -> N
     reason = err["msg"].removeprefix("Value error, ")
     value = err.get("input")
     if err["type"] == "extra_forbidden":
-        reason = "unknown key"
+        # The value of an unknown key is content of a file that may not be a sweep file: not shown.
+        value, reason = None, "unknown key"
     elif err["type"] == "missing":
         value, reason = None, "missing required key"
     raise SweepError(field, value, reason, source) from None
@@ -211,10 +248,13 @@ def _axis(raw: Any, i: int, source: str | None) -> Axis:
 def sweep_spec_from_dict(raw: Any, source: str | None = None) -> SweepSpec:
     """Validate a sweep mapping; raises :class:`SweepError` on the first bad field."""
     if not isinstance(raw, dict):
-        raise SweepError("sweep", raw, "must be a YAML mapping of keys", source)
+        # Name the file, not its content (a link to a system file must not be quoted).
+        raise SweepError("sweep", source or "(mapping)", f"must be a YAML mapping of keys, got {type(raw).__name__}",
+                         source)
     axes_raw = raw.get("axes")
     if not isinstance(axes_raw, list) or not axes_raw:
-        raise SweepError("axes", axes_raw, "must be a non-empty list of axes", source)
+        shown = axes_raw if axes_raw is None or isinstance(axes_raw, (list, int, float)) else type(axes_raw).__name__
+        raise SweepError("axes", shown, "must be a non-empty list of axes", source)
     axes = tuple(_axis(a, i, source) for i, a in enumerate(axes_raw))
     if sum(isinstance(a, PostureAxis) for a in axes) > 1:
         raise SweepError("axes", "posture", "at most one posture axis", source)
@@ -222,10 +262,32 @@ def sweep_spec_from_dict(raw: Any, source: str | None = None) -> SweepSpec:
     if isinstance(body.get("sampling"), str):
         body["sampling"] = {"method": body["sampling"]}
     try:
-        return SweepSpec.model_validate({**body, "axes": axes, "source": source})
+        spec = SweepSpec.model_validate({**body, "axes": axes, "source": source})
     except ValidationError as exc:
         _raise(exc, raw, "", source)
         raise AssertionError("unreachable")  # pragma: no cover
+    _check_size(spec, source)
+    return spec
+
+
+def _check_size(spec: SweepSpec, source: str | None) -> None:
+    """Refuse a sweep of more than MAX_SWEEP_POINTS points or MAX_SWEEP_CHUNKS chunks, from the
+    file alone (exact integers: no float overflow, no wrap-around), before anything is allocated."""
+    n = spec.point_count()
+    if n is None:
+        return  # a range without count: the plan names the axis
+    if n > MAX_SWEEP_POINTS:
+        field = "sampling.samples" if spec.sampling.method != "grid" else "axes"
+        how = "" if spec.sampling.method != "grid" else \
+            f" (the product of the axes' counts {' x '.join(str(s) for s in spec.dimension_sizes())})"
+        text = str(n) if n < 10**30 else f"about 10^{len(str(n)) - 1}"
+        raise SweepError(field, f"{text} points", f"a sweep has at most {MAX_SWEEP_POINTS:,} points{how}; "
+                                                  "split the study into several sweeps", source)
+    chunk = spec.chunk_size
+    if chunk is not None and -(-n // chunk) > MAX_SWEEP_CHUNKS:
+        raise SweepError("chunk_size", chunk, f"{-(-n // chunk):,} chunks for {n:,} points: at most "
+                                              f"{MAX_SWEEP_CHUNKS:,} chunks (use a chunk_size of at least "
+                                              f"{-(-n // MAX_SWEEP_CHUNKS)})", source)
 
 
 # -- files ------------------------------------------------------------------------------

@@ -1,72 +1,374 @@
-"""The output folder of a sweep: a manifest and one Parquet part file per finished chunk.
+"""The output folder of a sweep: a manifest, one Parquet part per finished chunk, checked like a database.
 
 ```
 OUT/manifest.json               what the sweep is (the plan's digest, points, chunks, columns)
-OUT/parts/part-000000.parquet   rows of chunk 0 ... (a Parquet dataset: read the folder)
+OUT/manifest-parts.jsonl        one line per part written: chunk, file, rows, checksum
+OUT/parts/part-000000.parquet   rows of chunk 0 ... (each part's metadata: digest, chunk, rows, checksum)
+OUT/rejected/                   parts a resume found bad, moved aside (never deleted)
 ```
 
-A part is written to a hidden temporary file and renamed, so a part file is either complete
-or absent: after Ctrl-C, a crash or a kill, the chunks with a part file are done and the same
-command computes only the others. A manifest with another digest means the folder holds a
-different sweep: it is refused rather than mixed.
+A part is written to a hidden temporary file and renamed, then recorded in the manifest of
+parts. A folder is never trusted by its file names: :func:`check_folder` opens every part and
+checks that it is readable to the end, that it belongs to this sweep (the digest in its
+metadata), that it holds the chunk its name says, the row count of that chunk, the points of
+that chunk, and the checksum of its values (against its metadata and against the manifest).
+A part that fails is named in one line with what is wrong:
+
+- ``damaged``: cut short, emptied, edited (checksum), the wrong rows, or not the part recorded;
+- ``foreign``: from another sweep (another digest), or not written by impact-balance;
+- ``renamed``: holds another chunk than its name says;
+- ``extra``: a chunk beyond the sweep, or a file that is not a part;
+- ``missing``: recorded in the manifest, but the file is gone.
+
+A resume (:func:`~impact_balance.sweep.runner.run_sweep`) moves every bad part to ``rejected/``
+and computes its chunk again: rows are never duplicated, never silently skipped, and a resumed
+folder holds the same rows as an uninterrupted run. ``--summary`` reads the good parts only and
+names the others; ``impact-balance sweep --verify DIR`` checks a folder.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import re
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pyarrow as pa
+import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
 from ..exceptions import SweepError
 from .plan import PLAN_VERSION, SweepPlan
 
-__all__ = ["ResultStore", "read_manifest", "read_results", "MANIFEST", "PARTS"]
+__all__ = [
+    "ResultStore",
+    "PartRecord",
+    "PartProblem",
+    "FolderCheck",
+    "check_folder",
+    "read_manifest",
+    "read_results",
+    "load_results",
+    "table_checksum",
+    "MANIFEST",
+    "LEDGER",
+    "PARTS",
+    "REJECTED",
+]
 
 MANIFEST = "manifest.json"
+LEDGER = "manifest-parts.jsonl"
 PARTS = "parts"
+REJECTED = "rejected"
 _PART = re.compile(r"^part-(\d{6})\.parquet$")
+_TMP = re.compile(r"^\.part-\d{6}\.parquet\.\d+\.tmp$")
+#: Keys of a part's Parquet metadata.
+META_DIGEST, META_CHUNK, META_ROWS, META_CHECKSUM = (b"impact_balance.sweep", b"impact_balance.chunk",
+                                                     b"impact_balance.rows", b"impact_balance.checksum")
 
 
 def _part_name(chunk: int) -> str:
     return f"part-{chunk:06d}.parquet"
 
 
+# -- checksum --------------------------------------------------------------------------------
+def _type_name(t: pa.DataType) -> str:
+    """A type's name without the child field's name (``list<item>`` and ``list<element>`` agree)."""
+    if pa.types.is_list(t) or pa.types.is_large_list(t):
+        return f"list<{_type_name(t.value_type)}>"
+    return "string" if pa.types.is_large_string(t) else str(t)
+
+
+def _hash_array(h: Any, arr: pa.Array) -> None:
+    h.update(np.packbits(arr.is_valid().to_numpy(zero_copy_only=False)).tobytes())
+    t = arr.type
+    if pa.types.is_list(t) or pa.types.is_large_list(t):
+        h.update(pc.list_value_length(arr).fill_null(0).to_numpy(zero_copy_only=False).astype("<i8").tobytes())
+        _hash_array(h, pc.list_flatten(arr))
+    elif pa.types.is_string(t) or pa.types.is_large_string(t):
+        values = arr.fill_null("").to_pylist()
+        h.update(np.asarray([len(v) for v in values], dtype="<i8").tobytes())
+        h.update("".join(values).encode("utf-8", "surrogatepass"))
+    else:
+        values = arr.fill_null(pa.scalar(0).cast(t) if not pa.types.is_boolean(t) else False)
+        data = values.to_numpy(zero_copy_only=False)
+        h.update(np.ascontiguousarray(data, dtype=data.dtype.newbyteorder("<")).tobytes())
+
+
+def table_checksum(table: pa.Table) -> str:
+    """``sha256:...`` of a table's column names, types, validity and values (not of its file
+    encoding: the same rows read back from Parquet give the same checksum)."""
+    h = hashlib.sha256(f"rows={table.num_rows}".encode())
+    for fld, column in zip(table.schema, table.columns):
+        h.update(b"\x00" + fld.name.encode() + b"\x00" + _type_name(fld.type).encode() + b"\x00")
+        _hash_array(h, column.combine_chunks())
+    return "sha256:" + h.hexdigest()
+
+
+# -- the folder ------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class PartRecord:
+    """A good part: its chunk, file (relative to the folder), row count and checksum."""
+
+    chunk: int
+    file: str
+    rows: int
+    checksum: str
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"chunk": self.chunk, "file": self.file, "rows": self.rows, "checksum": self.checksum}
+
+
+@dataclass(frozen=True)
+class PartProblem:
+    """A part that cannot be used, and why (see the module docstring for the kinds).
+
+    Attributes:
+        file: Its path relative to the folder (``parts/part-000003.parquet``).
+        kind: "damaged", "foreign", "renamed", "extra" or "missing".
+        reason: What is wrong, in words.
+        chunk: The chunk its name (or the manifest) gives, None for a file that is not a part.
+    """
+
+    file: str
+    kind: str
+    reason: str
+    chunk: int | None = None
+
+    def line(self) -> str:
+        return f"{self.file}: {self.kind}: {self.reason}"
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"file": self.file, "kind": self.kind, "reason": self.reason, "chunk": self.chunk}
+
+
+@dataclass
+class FolderCheck:
+    """What :func:`check_folder` found.
+
+    Attributes:
+        root: The folder.
+        manifest: Its manifest.
+        good: The good parts by chunk.
+        problems: The bad parts, each with its reason.
+        tables: The good parts' rows by chunk (when asked for).
+    """
+
+    root: Path
+    manifest: dict[str, Any]
+    good: dict[int, PartRecord] = field(default_factory=dict)
+    problems: list[PartProblem] = field(default_factory=list)
+    tables: dict[int, pa.Table] = field(default_factory=dict)
+
+    @property
+    def n_chunks(self) -> int:
+        return int(self.manifest["n_chunks"])
+
+    @property
+    def missing(self) -> list[int]:
+        """Chunks without a good part (to compute)."""
+        return [c for c in range(self.n_chunks) if c not in self.good]
+
+    @property
+    def ok(self) -> bool:
+        """No bad part (the folder may still be incomplete)."""
+        return not self.problems
+
+    @property
+    def rows(self) -> int:
+        return sum(r.rows for r in self.good.values())
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"out": str(self.root), "digest": self.manifest.get("digest"), "n_points": self.manifest.get("n_points"),
+                "n_chunks": self.n_chunks, "good_parts": len(self.good), "rows": self.rows,
+                "missing_chunks": len(self.missing), "complete": self.ok and not self.missing, "ok": self.ok,
+                "problems": [p.to_dict() for p in self.problems]}
+
+
+def _rows_of(manifest: dict[str, Any], chunk: int) -> tuple[int, int]:
+    size, n = int(manifest["chunk_size"]), int(manifest["n_points"])
+    start = chunk * size
+    return start, min(n, start + size)
+
+
+def _read_ledger(root: Path) -> dict[int, dict[str, Any]]:
+    """The manifest of parts: the last record of each chunk (a line cut by a kill is skipped)."""
+    records: dict[int, dict[str, Any]] = {}
+    try:
+        text = (root / LEDGER).read_text(encoding="utf-8", errors="replace")
+    except FileNotFoundError:
+        return records
+    except OSError as exc:
+        raise SweepError("DIR", str(root), f"cannot read {LEDGER} ({exc.strerror or type(exc).__name__})") from None
+    for line in text.splitlines():
+        try:
+            rec = json.loads(line)
+            chunk = rec["chunk"]
+            if isinstance(chunk, int) and isinstance(rec.get("checksum"), str):
+                records[chunk] = rec
+        except (ValueError, TypeError, KeyError):
+            continue
+    return records
+
+
+def _check_part(path: Path, manifest: dict[str, Any], ledger: dict[int, dict[str, Any]],
+                keep: dict[int, pa.Table] | None) -> PartRecord | PartProblem:
+    rel = f"{PARTS}/{path.name}"
+    named = int(_PART.match(path.name).group(1))
+    n_chunks = int(manifest["n_chunks"])
+    if path.is_symlink() or not path.is_file():
+        return PartProblem(rel, "extra", "not a regular file", named)
+    if named >= n_chunks:
+        return PartProblem(rel, "extra", f"chunk {named} is beyond this sweep's {n_chunks} chunks", named)
+    try:
+        parquet = pq.ParquetFile(path)
+        meta = parquet.schema_arrow.metadata or {}
+        stored_rows = parquet.metadata.num_rows
+    except Exception:  # noqa: BLE001 - pyarrow raises several types for a damaged file
+        return PartProblem(rel, "damaged", "not a readable Parquet file (cut short, emptied or overwritten)", named)
+    digest = meta.get(META_DIGEST)
+    if digest is None:
+        return PartProblem(rel, "foreign", "not a part of an impact-balance sweep (no sweep metadata)", named)
+    if digest.decode(errors="replace") != manifest["digest"]:
+        return PartProblem(rel, "foreign", f"a part of another sweep (digest {digest.decode(errors='replace')[:16]}; "
+                                           f"this folder's is {manifest['digest']})", named)
+    try:
+        chunk, rows, checksum = int(meta[META_CHUNK]), int(meta[META_ROWS]), meta[META_CHECKSUM].decode()
+    except (KeyError, ValueError, UnicodeDecodeError):
+        return PartProblem(rel, "damaged", "its sweep metadata is incomplete (no chunk, row count or checksum)", named)
+    if chunk != named:
+        return PartProblem(rel, "renamed", f"holds chunk {chunk}, but its name says chunk {named}", named)
+    start, stop = _rows_of(manifest, chunk)
+    if rows != stop - start or stored_rows != stop - start:
+        return PartProblem(rel, "damaged", f"{stored_rows} rows where chunk {chunk} has {stop - start}", named)
+    try:
+        table = parquet.read()
+    except Exception:  # noqa: BLE001
+        return PartProblem(rel, "damaged", "cannot be read to the end (cut short or overwritten)", named)
+    table = table.replace_schema_metadata(None)
+    if table_checksum(table) != checksum:
+        return PartProblem(rel, "damaged", "its values are not those written (checksum mismatch: edited or corrupted)", named)
+    try:
+        points_ok = table["point"].to_numpy().tolist() == list(range(start, stop)) and \
+            pc.all(pc.equal(table["chunk"], chunk)).as_py() is not False
+    except (KeyError, pa.ArrowInvalid):
+        points_ok = False
+    if not points_ok:
+        return PartProblem(rel, "damaged", f"its rows are not the points {start}..{stop - 1} of chunk {chunk}", named)
+    recorded = ledger.get(chunk)
+    if recorded is not None and recorded.get("checksum") != checksum:
+        return PartProblem(rel, "damaged", "not the part recorded in the manifest (another checksum)", named)
+    if keep is not None:
+        keep[chunk] = table
+    return PartRecord(chunk, rel, rows, checksum)
+
+
+def check_folder(root: str | Path, keep_tables: bool = False) -> FolderCheck:
+    """Check every part of a sweep folder (see the module docstring); never raises for a bad part.
+
+    Raises:
+        SweepError: ``root`` is not a sweep folder (no manifest, or an unreadable one).
+    """
+    root = Path(root)
+    manifest = read_manifest(root)
+    check = FolderCheck(root, manifest)
+    ledger = _read_ledger(root)
+    parts = root / PARTS
+    try:
+        entries = sorted(parts.iterdir()) if parts.is_dir() else []
+    except OSError as exc:
+        raise SweepError("DIR", str(root), f"cannot list {PARTS}/ ({exc.strerror or type(exc).__name__})") from None
+    keep = check.tables if keep_tables else None
+    for path in entries:
+        if _TMP.match(path.name):  # a write cut short by a kill: never a part
+            continue
+        if not _PART.match(path.name):
+            check.problems.append(PartProblem(f"{PARTS}/{path.name}", "extra", "not a part file name (part-NNNNNN.parquet)"))
+            continue
+        found = _check_part(path, manifest, ledger, keep)
+        if isinstance(found, PartRecord):
+            check.good[found.chunk] = found
+        else:
+            check.problems.append(found)
+    named = {p.chunk for p in check.problems if p.chunk is not None}
+    for chunk, rec in sorted(ledger.items()):
+        if chunk not in check.good and chunk not in named and 0 <= chunk < check.n_chunks:
+            check.problems.append(PartProblem(str(rec.get("file") or f"{PARTS}/{_part_name(chunk)}"), "missing",
+                                              "recorded in the manifest, but the file is gone", chunk))
+    return check
+
+
+# -- writing ---------------------------------------------------------------------------------
 @dataclass
 class ResultStore:
-    """Writes the parts of one plan into ``root`` (see the module docstring)."""
+    """The parts of one plan in ``root`` (see the module docstring).
+
+    :meth:`prepare` checks a folder without changing anything; :meth:`create` makes it (or
+    readies it for a resume: bad parts moved to ``rejected/``); :meth:`write` adds a part.
+    """
 
     root: Path
     plan: SweepPlan
+    check: FolderCheck | None = None
+    _good: set[int] = field(default_factory=set)
 
     @classmethod
-    def open(cls, root: str | Path, plan: SweepPlan) -> "ResultStore":
-        """Create the folder, or reopen it to resume the same sweep.
+    def prepare(cls, root: str | Path, plan: SweepPlan) -> "ResultStore":
+        """Check that ``root`` is new, empty, or a folder of the same sweep (its parts checked).
 
         Raises:
-            SweepError: the folder holds another sweep's results, or is not a sweep folder.
+            SweepError: a file, a folder of another sweep, a folder that is not a sweep's.
         """
         root = Path(root)
-        manifest = root / MANIFEST
-        if manifest.is_file():
+        if root.exists() and not root.is_dir():
+            raise SweepError("--out", str(root), "exists and is not a folder: choose another --out")
+        store = cls(root, plan)
+        if (root / MANIFEST).is_file():
             old = read_manifest(root)
             if old.get("digest") != plan.digest:
                 raise SweepError("--out", str(root), f"holds the results of a different sweep (digest {old.get('digest')}, "
                                  f"this one is {plan.digest}): choose another --out, or delete the folder to start again")
+            store.check = check_folder(root)
         elif root.exists() and any(root.iterdir()):
             raise SweepError("--out", str(root), "exists and is not a sweep folder (no manifest.json): choose another --out")
-        (root / PARTS).mkdir(parents=True, exist_ok=True)
-        for stale in (root / PARTS).glob(".part-*.tmp"):  # a write cut short by a kill
-            stale.unlink(missing_ok=True)
-        store = cls(root, plan)
-        if not manifest.is_file():
-            _atomic_write_text(manifest, json.dumps(store.manifest(), indent=1))
         return store
+
+    @classmethod
+    def open(cls, root: str | Path, plan: SweepPlan, notify: Callable[[str], None] | None = None) -> "ResultStore":
+        """:meth:`prepare` then :meth:`create`."""
+        store = cls.prepare(root, plan)
+        store.create(notify)
+        return store
+
+    @property
+    def problems(self) -> list[PartProblem]:
+        return list(self.check.problems) if self.check is not None else []
+
+    def create(self, notify: Callable[[str], None] | None = None) -> None:
+        """Make the folder and its manifest, or ready it for a resume: every bad part is moved
+        to ``rejected/`` (``notify`` gets one line per part) and the manifest of parts lists the
+        good ones."""
+        (self.root / PARTS).mkdir(parents=True, exist_ok=True)
+        for stale in (self.root / PARTS).iterdir():  # writes cut short by a kill
+            if _TMP.match(stale.name):
+                stale.unlink(missing_ok=True)
+        if not (self.root / MANIFEST).is_file():
+            _atomic_write_text(self.root / MANIFEST, json.dumps(self.manifest(), indent=1))
+        good: dict[int, PartRecord] = dict(self.check.good) if self.check is not None else {}
+        for problem in self.problems:
+            moved = _reject(self.root, problem)
+            if notify is not None:
+                again = f"; chunk {problem.chunk} is computed again" if problem.chunk is not None and \
+                    problem.chunk < self.plan.n_chunks and problem.chunk not in good else ""
+                notify(f"{problem.line()}{f': moved to {moved}' if moved else ''}{again}")
+        lines = "".join(json.dumps(good[c].to_dict()) + "\n" for c in sorted(good))
+        _atomic_write_text(self.root / LEDGER, lines)
+        self._good = set(good)
 
     def manifest(self) -> dict[str, Any]:
         plan = self.plan
@@ -86,31 +388,48 @@ class ResultStore:
         }
 
     def finished(self) -> set[int]:
-        """Chunks with a complete part file."""
-        return finished_chunks(self.root)
+        """Chunks with a good part (checked when the store was prepared)."""
+        return set(self._good)
 
     def write(self, chunk: int, table: pa.Table) -> Path:
-        """Write one chunk's rows at once (temporary file, then an atomic rename)."""
+        """Write one chunk's rows (temporary file, atomic rename), then record it in the manifest of parts."""
         path = self.root / PARTS / _part_name(chunk)
+        data = table.replace_schema_metadata(None)
+        checksum = table_checksum(data)
+        meta = {META_DIGEST: self.plan.digest.encode(), META_CHUNK: str(chunk).encode(),
+                META_ROWS: str(table.num_rows).encode(), META_CHECKSUM: checksum.encode()}
         tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-        pq.write_table(table, tmp)
+        pq.write_table(data.replace_schema_metadata(meta), tmp)
         os.replace(tmp, path)
+        record = PartRecord(chunk, f"{PARTS}/{path.name}", table.num_rows, checksum)
+        with open(self.root / LEDGER, "a", encoding="utf-8") as f:
+            f.write(json.dumps(record.to_dict()) + "\n")
         return path
 
 
-def finished_chunks(root: str | Path) -> set[int]:
-    parts = Path(root) / PARTS
-    if not parts.is_dir():
-        return set()
-    return {int(m.group(1)) for p in parts.iterdir() if (m := _PART.match(p.name))}
+def _reject(root: Path, problem: PartProblem) -> str | None:
+    """Move a bad part to ``rejected/`` (a free name); its new path relative to ``root``, None if gone."""
+    source = root / problem.file
+    if not (source.exists() or source.is_symlink()) or problem.kind == "missing":
+        return None
+    folder = root / REJECTED
+    folder.mkdir(exist_ok=True)
+    target = folder / source.name
+    k = 1
+    while target.exists() or target.is_symlink():
+        target = folder / f"{source.name}.{k}"
+        k += 1
+    os.replace(source, target)
+    return f"{REJECTED}/{target.name}"
 
 
 def _atomic_write_text(path: Path, text: str) -> None:
     tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text)
+    tmp.write_text(text, encoding="utf-8")
     os.replace(tmp, path)
 
 
+# -- reading ---------------------------------------------------------------------------------
 def read_manifest(root: str | Path) -> dict[str, Any]:
     """The manifest of a sweep folder.
 
@@ -119,21 +438,43 @@ def read_manifest(root: str | Path) -> dict[str, Any]:
     """
     path = Path(root) / MANIFEST
     try:
-        data = json.loads(path.read_text())
+        data = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise SweepError("DIR", str(root), "is not a sweep folder (no manifest.json)") from None
+    except NotADirectoryError:
+        raise SweepError("DIR", str(root), "is not a folder") from None
     except (OSError, ValueError) as exc:
         raise SweepError("DIR", str(root), f"cannot read manifest.json ({exc.__class__.__name__})") from None
-    if not isinstance(data, dict) or data.get("format") != "impact-balance sweep":
+    keys = ("digest", "n_points", "chunk_size", "n_chunks", "dimensions")
+    if not isinstance(data, dict) or data.get("format") != "impact-balance sweep" or not all(k in data for k in keys):
         raise SweepError("DIR", str(root), "manifest.json is not an impact-balance sweep manifest")
+    ints = [data[k] for k in ("n_points", "chunk_size", "n_chunks")]
+    if not all(isinstance(v, int) and not isinstance(v, bool) and v >= 0 for v in ints) or data["chunk_size"] < 1:
+        raise SweepError("DIR", str(root), "manifest.json is damaged (its point and chunk counts are not counts)")
     return data
 
 
-def read_results(root: str | Path) -> pa.Table:
-    """All finished rows of a sweep folder, sorted by point (an empty table if none)."""
-    read_manifest(root)
-    parts = sorted((Path(root) / PARTS).glob("part-*.parquet"))
-    if not parts:
-        return pa.table({})
-    table = pq.ParquetDataset([str(p) for p in parts]).read()
-    return table.sort_by("point")
+def load_results(root: str | Path) -> tuple[FolderCheck, pa.Table]:
+    """The folder's check and the rows of its good parts, sorted by point (an empty table if none)."""
+    check = check_folder(root, keep_tables=True)
+    tables = [check.tables[c] for c in sorted(check.tables)]
+    check.tables = {}
+    if not tables:
+        return check, pa.table({})
+    table = pa.concat_tables(tables).sort_by("point")
+    return check, table.replace_schema_metadata({META_DIGEST: str(check.manifest["digest"]).encode()})
+
+
+def read_results(root: str | Path, strict: bool = True) -> pa.Table:
+    """All rows of a sweep folder's good parts, sorted by point.
+
+    Args:
+        strict: Raise :class:`SweepError` naming the first bad part when a part is bad
+            (otherwise the good parts only are returned).
+    """
+    check, table = load_results(root)
+    if strict and check.problems:
+        more = f" (and {len(check.problems) - 1} more)" if len(check.problems) > 1 else ""
+        raise SweepError("DIR", str(root), f"{check.problems[0].line()}{more}; `impact-balance sweep --verify DIR` "
+                                           "lists them, a resume recomputes them")
+    return table

@@ -3,6 +3,9 @@
 "Best" and "worst" rank the evaluated points by the maximum contact velocity of the CoM
 criterion (an unbounded maximum ranks first); points that could not be evaluated (invalid,
 unreachable, error) are counted but not ranked.
+
+The folder is checked first (:func:`~impact_balance.sweep.store.check_folder`): only good parts
+are read; a bad part is named in ``problems`` (and the summary is not ``complete``).
 """
 
 from __future__ import annotations
@@ -15,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from .evaluate import STATUSES
-from .store import read_manifest, read_results
+from .store import FolderCheck, load_results
 
 __all__ = ["summarize", "format_summary", "load_frame", "EVALUATED"]
 
@@ -25,12 +28,16 @@ EVALUATED = ("ok", "unbounded", "already_falling", "cannot_balance")
 _SHOWN = ("status", "verdict", "max_contact_velocity", "zmp_max_contact_velocity", "limiting_vertex", "limiting_edge")
 
 
-def load_frame(root: str | Path) -> tuple[dict[str, Any], pd.DataFrame]:
-    """The manifest and the rows (a pandas DataFrame sorted by point)."""
-    manifest = read_manifest(root)
-    table = read_results(root)
+def load_frame(root: str | Path, check: list[FolderCheck] | None = None) -> tuple[dict[str, Any], pd.DataFrame]:
+    """The manifest and the rows of the good parts (a pandas DataFrame sorted by point, without
+    the configurations ``q``); ``check``, if given, receives the folder's check."""
+    found, table = load_results(root)
+    if check is not None:
+        check.append(found)
+    if "q" in table.column_names:
+        table = table.drop_columns(["q"])  # one array per row: heavy in pandas, not summarized
     frame = table.to_pandas() if table.num_columns else pd.DataFrame()
-    return manifest, frame
+    return found.manifest, frame
 
 
 def _clean(value: Any) -> Any:
@@ -59,7 +66,9 @@ def summarize(root: str | Path, top: int = 5) -> dict[str, Any]:
         over the evaluated points, and ``best`` / ``worst``: the ``top`` points with their axis
         values, point index and results (``max_contact_velocity`` null when unbounded).
     """
-    manifest, df = load_frame(root)
+    checks: list[FolderCheck] = []
+    manifest, df = load_frame(root, checks)
+    check = checks[0]
     dims = [d["name"] for d in manifest["dimensions"]]
     out: dict[str, Any] = {
         "out": str(root),
@@ -67,7 +76,8 @@ def summarize(root: str | Path, top: int = 5) -> dict[str, Any]:
         "digest": manifest["digest"],
         "n_points": manifest["n_points"],
         "rows": int(len(df)),
-        "complete": int(len(df)) == manifest["n_points"],
+        "complete": int(len(df)) == manifest["n_points"] and check.ok,
+        "problems": [p.line() for p in check.problems],
         "dimensions": dims,
         "status_counts": {s: int((df["status"] == s).sum()) for s in STATUSES if len(df) and (df["status"] == s).any()},
     }
@@ -105,8 +115,12 @@ def _fmt(value: Any) -> str:
 
 def format_summary(summary: dict[str, Any]) -> str:
     """The summary as text."""
+    problems = summary.get("problems") or []
     lines = [f"sweep {summary['out']}: {summary['rows']} of {summary['n_points']} points"
              + ("" if summary["complete"] else " (incomplete: run the same command to resume)")]
+    if problems:
+        lines.append(f"  {len(problems)} bad part(s) left out (named on stderr and by `sweep --verify`; a resume "
+                     "moves them to rejected/ and computes them again)")
     if summary.get("description"):
         lines.append(f"  {summary['description']}")
     lines.append("  status: " + ", ".join(f"{k} {v}" for k, v in summary["status_counts"].items()))

@@ -1,0 +1,143 @@
+"""GUI uploads counted as they arrive: cut at the limit, never held whole.
+
+viser (1.1) buffers an upload's parts in memory until the last one arrives, and the 1 MiB check
+of :meth:`~impact_balance.gui.files.GuiFiles.upload` could only run then: a 200 MB upload was
+held whole, and a client that declares 40 GB and sends slowly was held until it left. So the
+server counts an upload while it arrives:
+
+- the declared size must be at most :data:`MAX_UPLOAD_BYTES`, and the declared number of parts
+  at most :data:`MAX_UPLOAD_PARTS` (viser's page sends 512 KiB parts), else the transfer is
+  refused before one byte is kept;
+- each part is counted on arrival; the transfer is dropped (its buffered parts freed) as soon as
+  the bytes received pass the declared size or the limit;
+- a client has at most :data:`MAX_TRANSFERS_PER_CLIENT` uploads in flight;
+- a WebSocket message is at most :data:`MAX_MESSAGE_BYTES` and at most :data:`MAX_QUEUED_MESSAGES`
+  wait to be handled (:mod:`.guard` passes both to websockets), so a huge message or a flood of
+  them is not buffered either.
+
+A refused upload is shown in the GUI as one line, like any refused edit.
+
+Why a patch: viser registers its own handlers for the two upload messages and offers no hook;
+:func:`limit_uploads` puts a counting handler in front of each (the replaced handlers must be
+found, or the GUI refuses to start, as for the Host/Origin check).
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from collections.abc import Callable
+from typing import Any
+
+from ..workspace import MAX_FILE_BYTES
+
+__all__ = ["limit_uploads", "UploadLimit", "MAX_UPLOAD_BYTES", "MAX_UPLOAD_PARTS", "MAX_TRANSFERS_PER_CLIENT",
+           "MAX_MESSAGE_BYTES", "MAX_QUEUED_MESSAGES"]
+
+#: Largest upload, bytes (the workspace's file limit, 1 MiB).
+MAX_UPLOAD_BYTES = MAX_FILE_BYTES
+#: Most parts an upload may declare (the page sends 512 KiB parts: 2 for 1 MiB).
+MAX_UPLOAD_PARTS = 64
+#: Uploads one client may have in flight.
+MAX_TRANSFERS_PER_CLIENT = 2
+#: Largest WebSocket message from a browser, bytes (a 512 KiB upload part and its envelope).
+MAX_MESSAGE_BYTES = MAX_UPLOAD_BYTES + (64 << 10)
+#: Messages read ahead of the handlers, per connection.
+MAX_QUEUED_MESSAGES = 4
+
+
+class UploadLimit:
+    """The counting handlers installed by :func:`limit_uploads`.
+
+    Attributes:
+        refused: Number of uploads refused so far.
+        peak_bytes: Largest number of bytes held for one upload.
+    """
+
+    def __init__(self, server: Any, on_refused: Callable[[str, str], None], limit: int = MAX_UPLOAD_BYTES):
+        from viser import _messages
+
+        gui = server.gui
+        self._gui = gui
+        self._iface = gui._websock_interface
+        self._states: dict[str, Any] = gui._current_file_upload_states
+        self._start_original = gui._handle_file_transfer_start
+        self._part_original = gui._handle_file_transfer_part
+        self._messages = _messages
+        self._limit = int(limit)
+        self._on_refused = on_refused
+        self._received: dict[str, int] = {}
+        self._owner: dict[str, Any] = {}
+        self.refused = 0
+        self.peak_bytes = 0
+        handlers = self._iface._incoming_handlers
+        for cls, original, mine in ((_messages.FileTransferStartUpload, self._start_original, self._start),
+                                    (_messages.FileTransferPart, self._part_original, self._part)):
+            if original not in handlers.get(cls, []):
+                raise RuntimeError(f"viser's {cls.__name__} handler not found")
+            self._iface.unregister_handler(cls, original)
+            self._iface.register_handler(cls, mine)
+
+    def _refuse(self, client_id: Any, filename: Any, reason: str) -> None:
+        self.refused += 1
+        name = str(filename).replace("\\", "/").rsplit("/", 1)[-1][:80] or "upload"
+        # The GUI redraws under its lock: not in viser's event loop, which must keep serving.
+        threading.Thread(target=self._on_refused, args=(name, reason), daemon=True).start()
+
+    def _forget_finished(self) -> None:
+        for uuid in [u for u in self._received if u not in self._states]:
+            self._received.pop(uuid, None)
+            self._owner.pop(uuid, None)
+
+    def _start(self, client_id: Any, message: Any) -> None:
+        self._forget_finished()
+        size, parts = message.size_bytes, message.part_count
+        kib = self._limit >> 10
+        reason = None
+        if not isinstance(size, int) or not isinstance(parts, int) or size < 0 or parts < 0:
+            reason = "not a valid upload"
+        elif size > self._limit:
+            reason = f"larger than {kib} KiB ({size:,} bytes declared): refused before any byte was kept"
+        elif parts > MAX_UPLOAD_PARTS or (size > 0 and parts == 0) or parts > max(1, size):
+            reason = f"{parts} parts declared for {size:,} bytes: not a valid upload"
+        elif sum(owner == client_id for owner in self._owner.values()) >= MAX_TRANSFERS_PER_CLIENT:
+            reason = f"more than {MAX_TRANSFERS_PER_CLIENT} uploads at once"
+        if reason is not None:
+            self._refuse(client_id, message.filename, reason)
+            return
+        self._received[message.transfer_uuid] = 0
+        self._owner[message.transfer_uuid] = client_id
+        self._start_original(client_id, message)
+
+    def _part(self, client_id: Any, message: Any) -> None:
+        uuid = message.transfer_uuid
+        state = self._states.get(uuid)
+        if state is None or uuid not in self._received:
+            return  # unknown, refused or finished: nothing is kept
+        count = self._received[uuid] + len(message.content)
+        if count > self._limit or count > state["total_bytes"]:
+            self._states.pop(uuid, None)  # frees the parts buffered so far
+            self._received.pop(uuid, None)
+            self._owner.pop(uuid, None)
+            self._refuse(client_id, state.get("filename"),
+                         f"larger than {self._limit >> 10} KiB or than it declared: cut at {count:,} bytes")
+            return
+        self._received[uuid] = count
+        self.peak_bytes = max(self.peak_bytes, count)
+        self._part_original(client_id, message)
+        if uuid not in self._states:  # complete
+            self._received.pop(uuid, None)
+            self._owner.pop(uuid, None)
+
+
+def limit_uploads(server: Any, on_refused: Callable[[str, str], None], limit: int = MAX_UPLOAD_BYTES) -> UploadLimit:
+    """Count the uploads of ``server`` as they arrive (see the module docstring).
+
+    ``on_refused(filename, reason)`` is called (in a thread of its own) for each refused upload.
+
+    Raises:
+        RuntimeError: viser's upload handlers are not where this viser version should have them.
+    """
+    if not math.isfinite(limit) or limit < 0:
+        raise ValueError("limit must be a byte count")
+    return UploadLimit(server, on_refused, int(limit))
