@@ -23,10 +23,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from .constants import GRAVITY
-from .cwc import cwc_faces_world
+from ._jit import njit
+from .cwc import _local_faces
 from .stance import Contact, Stance
 
-__all__ = ["WrenchPolytope", "grasp_matrix", "contact_polytope", "torque_limit_rows", "wrench_polytope"]
+__all__ = ["WrenchPolytope", "grasp_matrix", "contact_polytope", "torque_limit_rows", "wrench_polytope", "assemble_polytope",
+           "friction_scaling"]
 
 
 #: Grasp-matrix block entries [p]x: rows, columns, and the component of p and sign of each.
@@ -164,13 +166,8 @@ def _fill_torque_rows(stance: Stance, A: np.ndarray, b: np.ndarray) -> None:
     if k == 0:
         return
     idx, limit = stance.robot.effort_limits
-    # Row r is the actuated joint idx[r]'s column of every contact Jacobian: (J_a^T)[r].
     J = np.concatenate([c.jacobian for c in stance.contacts])
-    A[:k] = J[:, idx].T
-    np.negative(A[:k], out=A[k:])
-    g = stance.gravity_torques[idx]
-    np.add(limit, g, out=b[:k])
-    np.subtract(limit, g, out=b[k:])
+    _torque_rows(J, idx, limit, stance.gravity_torques, A, b)
 
 
 def _assemble(
@@ -187,24 +184,107 @@ def _assemble(
     world positions, so that they keep their precision far from the origin.
     """
     m = len(contacts)
-    n, n_cwc = 6 * m, 16 * m
-    k = _n_torque_rows(torque_stance) if torque_stance is not None else 0
-    A = np.zeros((n_cwc + 2 * k, n))
-    b = np.zeros(n_cwc + 2 * k)
-    for i, c in enumerate(contacts):
-        A[16 * i : 16 * i + 16, 6 * i : 6 * i + 6] = cwc_faces_world(
-            c.spec.friction, c.half_length, c.half_width, c.rotation
-        )
+    faces = np.array([_local_faces(float(c.spec.friction), c.half_length, c.half_width) for c in contacts]).reshape(m, 16, 6)
+    rotations = np.array([c.rotation for c in contacts], dtype=float).reshape(m, 3, 3)
+    positions = np.array([c.position for c in contacts], dtype=float).reshape(m, 3)
+    if torque_stance is not None and _n_torque_rows(torque_stance):
+        idx, limit = torque_stance.robot.effort_limits
+        J = np.concatenate([c.jacobian for c in torque_stance.contacts])
+        g = torque_stance.gravity_torques
+    else:
+        idx, limit, J, g = _NO_ROWS, _NO_LIMITS, np.zeros((0, 0)), _NO_LIMITS
+    return assemble_polytope(faces, rotations, positions, arms, mass, com, gravity, J, idx, limit, g, _scaling(contacts))
+
+
+_NO_ROWS = np.zeros(0, dtype=np.int64)
+_NO_LIMITS = np.zeros(0)
+
+
+def assemble_polytope(
+    faces: np.ndarray, rotations: np.ndarray, positions: np.ndarray, arms: np.ndarray, mass: float,
+    com: np.ndarray, gravity: float, jacobians: np.ndarray, torque_indices: np.ndarray,
+    torque_limits: np.ndarray, gravity_torques: np.ndarray, scaling: np.ndarray | None = None,
+) -> WrenchPolytope:
+    """The polytope from arrays (what :func:`wrench_polytope` builds from a stance).
+
+    Args:
+        faces: (m, 16, 6) contact-frame CWC face matrices (:func:`~impact_balance.cwc.cwc_faces`).
+        rotations: (m, 3, 3) contact-to-world rotations.
+        positions: (m, 3) contact centres in world, m (for :attr:`WrenchPolytope.grasp`).
+        arms: (m, 3) contact centres minus the CoM, m (for the LIPM rows).
+        mass: kg. com: (3,) CoM in world, m. gravity: m/s^2.
+        jacobians: (6m, nv) contact Jacobians stacked (world-aligned, linear rows first), or
+            (0, 0) without torque limits.
+        torque_indices: (k,) velocity indices of the torque-limited joints (int64).
+        torque_limits: (k,) their effort limits, N m. gravity_torques: (nv,) g(q).
+        scaling: See :attr:`WrenchPolytope.scaling`.
+    """
+    m = len(faces)
+    k = torque_indices.size if jacobians.size else 0
+    A = np.zeros((16 * m + 2 * k, 6 * m))
+    b = np.zeros(16 * m + 2 * k)
+    C = np.zeros((4, 6 * m))
+    G = np.zeros((6, 6 * m))
+    # One batched product for every contact's block (the same numbers as cwc_faces_world).
+    blocks = np.matmul(faces.reshape(m, 32, 3), rotations.transpose(0, 2, 1))
+    _fill(blocks, positions, arms, A, C, G)
     if k:
-        _fill_torque_rows(torque_stance, A[n_cwc:], b[n_cwc:])
-    com = np.array(com, dtype=float)
-    positions = np.array([c.position for c in contacts], dtype=float).reshape(-1, 3)
-    G = grasp_matrix(positions)
-    # LIPM: vertical force f_z = m g, and moment about the CoM sum (p_i - c) x f_i + tau_i = 0:
-    # rows 2-5 of the grasp matrix taken at the CoM (the same numbers as [[e_z^T], [-[c]x, I]] G).
-    C = grasp_matrix(arms)[2:]
+        _torque_rows(jacobians, torque_indices, torque_limits, gravity_torques, A[16 * m :], b[16 * m :])
     d = np.array([mass * gravity, 0.0, 0.0, 0.0])
-    return WrenchPolytope(A, b, C, d, G[:2].copy(), G, n_cwc, float(mass), com, gravity, _scaling(contacts))
+    com = np.array(com, dtype=float)
+    return WrenchPolytope(A, b, C, d, G[:2].copy(), G, 16 * m, float(mass), com, gravity, scaling)
+
+
+@njit(cache=True)
+def _fill(blocks, positions, arms, A, C, G):
+    """The CWC blocks of ``A`` from ``blocks`` (m, 32, 3), each contact's face rows acting on
+    world-axes wrenches as (force, torque) halves (:func:`~impact_balance.cwc.cwc_faces_world`
+    reshaped), the LIPM rows ``C`` (rows 2-5 of the grasp matrix at the arms) and the grasp
+    matrix ``G`` at the world positions (:func:`grasp_matrix`). Compiled: numpy spent ~40 us
+    of call overhead per stance on these copies."""
+    m = blocks.shape[0]
+    for i in range(m):
+        for r in range(16):
+            for half in range(2):
+                for c in range(3):
+                    A[16 * i + r, 6 * i + 3 * half + c] = blocks[i, 2 * r + half, c]
+        _grasp_block(G, 0, i, positions[i])
+        # C = rows 2..5 of the grasp matrix at the arms.
+        o = 6 * i
+        x, y, z = arms[i, 0], arms[i, 1], arms[i, 2]
+        C[0, o + 2] = 1.0
+        C[1, o + 3] = 1.0
+        C[2, o + 4] = 1.0
+        C[3, o + 5] = 1.0
+        C[1, o + 1], C[1, o + 2] = -z, y
+        C[2, o + 0], C[2, o + 2] = z, -x
+        C[3, o + 0], C[3, o + 1] = -y, x
+
+
+@njit(cache=True)
+def _grasp_block(G, row0, i, p):
+    """Block i of the grasp matrix, ``[[I, 0], [[p]x, I]]``, into ``G`` from row ``row0``."""
+    o = 6 * i
+    for r in range(6):
+        G[row0 + r, o + r] = 1.0
+    x, y, z = p[0], p[1], p[2]
+    G[row0 + 3, o + 1], G[row0 + 3, o + 2] = -z, y
+    G[row0 + 4, o + 0], G[row0 + 4, o + 2] = z, -x
+    G[row0 + 5, o + 0], G[row0 + 5, o + 1] = -y, x
+
+
+@njit(cache=True)
+def _torque_rows(J, idx, limit, g, A, b):
+    """:func:`torque_limit_rows` into ``A`` (2k x 6m) and ``b`` (2k): row r is the limited
+    joint idx[r]'s column of every contact Jacobian, ``(J_a^T)[r]``, then its negative."""
+    k = idx.size
+    for r in range(k):
+        j = idx[r]
+        for c in range(J.shape[0]):
+            A[r, c] = J[c, j]
+            A[k + r, c] = -J[c, j]
+        b[r] = limit[r] + g[j]
+        b[k + r] = limit[r] - g[j]
 
 
 #: Components of a wrench [f; tau] (contact frame) divided by mu in the normalised variables.
@@ -212,19 +292,23 @@ _TANGENTIAL = np.array([True, True, False, False, False, True])
 
 
 def _scaling(contacts: Sequence[Contact]) -> np.ndarray | None:
+    """:func:`friction_scaling` of the contacts' frictions and rotations."""
+    return friction_scaling([c.spec.friction for c in contacts], [c.rotation for c in contacts])
+
+
+def friction_scaling(frictions: Sequence[float], rotations: Sequence[np.ndarray]) -> np.ndarray | None:
     """Block-diagonal ``S`` (6m x 6m), block i = ``diag(R_i, R_i) diag(s_i)``: ``s_i`` is mu_i
     on f_x, f_y, tau_z and 1 elsewhere, or 1 everywhere when mu_i <= 1 (None when every
     mu_i is; :meth:`WrenchPolytope.projection_data` then skips the products): a small mu needs
     no help (HiGHS, in Bretl's path, was less precise with it divided out: 1e-5 relative on a
     2 mu-wide area). See :meth:`WrenchPolytope.projection_data`."""
-    if all(float(c.spec.friction) <= 1.0 for c in contacts):
+    if all(float(mu) <= 1.0 for mu in frictions):
         return None  # the identity: no work on the hot path of common stances
-    m = len(contacts)
+    m = len(frictions)
     S = np.zeros((6 * m, 6 * m))
-    for i, c in enumerate(contacts):
-        mu = float(c.spec.friction)
-        scale = np.where(_TANGENTIAL, max(mu, 1.0), 1.0)
-        R = np.asarray(c.rotation, dtype=float)
+    for i, (mu, rotation) in enumerate(zip(frictions, rotations)):
+        scale = np.where(_TANGENTIAL, max(float(mu), 1.0), 1.0)
+        R = np.asarray(rotation, dtype=float)
         block = S[6 * i : 6 * i + 6, 6 * i : 6 * i + 6]
         block[:3, :3] = R * scale[:3]
         block[3:, 3:] = R * scale[3:]

@@ -46,6 +46,7 @@ __all__ = [
     "OptionError",
     "EnvironmentFailure",
     "OutputError",
+    "GovernorError",
 ]
 
 #: Longest shown repr of a value in a message (characters).
@@ -416,3 +417,20 @@ class EnvironmentFailure(ImpactBalanceError):
 
 class OutputError(EnvironmentFailure):
     """An output file or folder cannot be written (checked before the command computes)."""
+
+
+class GovernorError(ImpactBalanceError, ValueError):
+    """A governor call got a bad argument (a configuration of the wrong size, a NaN velocity,
+    an unknown criterion...); see :mod:`impact_balance.governor`.
+
+    Attributes:
+        field: The argument at fault (``q``, ``v``, ``reference_velocity``, ``criterion``...).
+        value: Its value (shown cut to :data:`VALUE_CHARS` characters).
+        reason: Why it is refused.
+    """
+
+    def __init__(self, field: str, value: Any, reason: str):
+        self.field = field
+        self.value = value
+        self.reason = reason
+        super().__init__(one_line(f"{field} = {short_repr(value)}: {reason}"))

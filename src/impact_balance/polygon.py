@@ -205,6 +205,24 @@ def _inset(n: np.ndarray, h: np.ndarray, d: float) -> np.ndarray:
     return out
 
 
+@njit(cache=True)
+def _edge_halfplanes(v):
+    """Unit outward normals ``G`` (k, 2) and offsets ``h`` (k,) of the edges of the CCW
+    polygon ``v`` (k >= 3): edge i goes from vertex i to i+1, its normal is the edge turned
+    clockwise. Compiled: numpy spent ~30 us of call overhead on these few flops."""
+    k = v.shape[0]
+    G = np.empty((k, 2))
+    h = np.empty(k)
+    for i in range(k):
+        j = (i + 1) % k
+        nx, ny = v[j, 1] - v[i, 1], -(v[j, 0] - v[i, 0])
+        norm = math.sqrt(nx * nx + ny * ny)
+        nx, ny = nx / norm, ny / norm
+        G[i, 0], G[i, 1] = nx, ny
+        h[i] = nx * v[i, 0] + ny * v[i, 1]
+    return G, h
+
+
 def _frozen(G: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Read-only arrays: the half-planes are cached on the (immutable) polygon."""
     G.setflags(write=False)
@@ -292,10 +310,7 @@ class Polygon:
             G = np.array([n, -n, e, -e])
             h = np.array([n @ v[0], -n @ v[0], e @ v[1], -e @ v[0]])
             return _frozen(G, h)
-        edges = np.roll(v, -1, axis=0) - v
-        normals = np.column_stack([edges[:, 1], -edges[:, 0]])
-        normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-        return _frozen(normals, np.einsum("ij,ij->i", normals, v))
+        return _frozen(*_edge_halfplanes(np.ascontiguousarray(v)))
 
     def margins(self, points: np.ndarray) -> np.ndarray:
         """Signed distance-like margin of each point: ``min_k (h_k - G_k p)`` (>= 0 inside)."""

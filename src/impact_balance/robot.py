@@ -29,7 +29,7 @@ from .exceptions import (
     UnknownRobotError,
 )
 
-__all__ = ["RobotSpec", "Robot", "JointSlot", "Workspace", "BUNDLED_ROBOTS", "load_robot", "example_robot_data_root"]
+__all__ = ["RobotSpec", "Robot", "JointSlot", "Scratch", "Workspace", "BUNDLED_ROBOTS", "load_robot", "example_robot_data_root"]
 
 
 @dataclass(frozen=True)
@@ -106,6 +106,24 @@ class JointSlot(NamedTuple):
     nv: int
     lower: float
     upper: float
+
+
+class Scratch:
+    """One pinocchio ``Data`` for one owner, and the key of the configuration it holds.
+
+    What :class:`Workspace` is per thread, for an owner that serialises its own calls (a
+    :class:`~impact_balance.governor.Governor` and its lock): :class:`~impact_balance.stance.Stance`
+    computes in it when given one.
+
+    Attributes:
+        data: The Data.
+        holder: Key of the configuration whose joint placements (``oMi``) and joint
+            Jacobians (``J``) ``data`` holds, or None when unknown.
+    """
+
+    def __init__(self, model: pin.Model):
+        self.data = model.createData()
+        self.holder: bytes | None = None
 
 
 class Workspace(threading.local):

@@ -14,10 +14,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from .robot import Robot
+from .robot import Robot, Scratch
 from .spatial import skew
 
-__all__ = ["ContactSpec", "Contact", "Stance"]
+__all__ = ["ContactSpec", "Contact", "Stance", "frame_point"]
 
 _IDENTITY = pin.SE3.Identity()
 
@@ -25,6 +25,23 @@ _IDENTITY = pin.SE3.Identity()
 def _has_free_flyer(model: pin.Model) -> bool:
     """Whether the model's first joint is a free flyer (then q[:3] is the base position)."""
     return model.njoints > 1 and model.joints[1].shortname() == "JointModelFreeFlyer"
+
+
+def frame_point(model: pin.Model, data: pin.Data, fid: int, offset: pin.SE3 | None,
+                jacobian: bool = True) -> tuple[pin.SE3, np.ndarray | None]:
+    """Pose of frame ``fid`` times ``offset`` and its 6 x nv Jacobian in world-aligned axes
+    (linear rows first, at the offset point), from ``data`` holding the joint placements and
+    joint Jacobians (in the frame of those placements); the Jacobian is skipped (None)
+    without ``jacobian``. The pose may be ``data``'s own: copy what you keep."""
+    frame_pose = pin.updateFramePlacement(model, data, fid)
+    J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED) if jacobian else None
+    if offset is None or offset == _IDENTITY:  # exact test: contacts mostly have no offset
+        return frame_pose, J
+    placement = frame_pose * offset
+    if J is not None:
+        # Shift the reference point from the frame origin to the offset point: v_p = v_o + w x r.
+        J[:3] -= skew(placement.translation - frame_pose.translation) @ J[3:]
+    return placement, J
 
 
 @dataclass(frozen=True)
@@ -90,9 +107,11 @@ class Stance:
     """Robot configuration + contacts, with everything the criteria need from the model.
 
     The kinematics are computed in the robot's per-thread scratch Data (see
-    :class:`impact_balance.robot.Workspace`) and every attribute is a copy, so stances of the
-    same robot never alias. :meth:`point` recomputes the joint placements and Jacobians
-    (~4 us) when another stance has used the scratch Data since.
+    :class:`impact_balance.robot.Workspace`), or in ``workspace`` when given (a
+    :class:`impact_balance.robot.Scratch` of the caller's, e.g. a governor's own Data), and
+    every attribute is a copy, so stances of the same robot never alias. :meth:`point`
+    recomputes the joint placements and Jacobians (~4 us) when another stance has used the
+    scratch Data since.
 
     Precision far from the origin: the kinematics are computed with the free-flyer's
     translation set to zero, in the *stance frame* (world axes, origin at ``origin``, the
@@ -115,9 +134,13 @@ class Stance:
         com_inertia: Composite rotational inertia about the CoM, world axes, kg m^2.
     """
 
-    def __init__(self, robot: Robot, q: np.ndarray, contacts: Sequence[ContactSpec] = ()):
+    def __init__(self, robot: Robot, q: np.ndarray, contacts: Sequence[ContactSpec] = (),
+                 workspace: Scratch | None = None):
         model = robot.model
         self.robot = robot
+        # An explicit scratch Data is kept; else the robot's per-thread one is looked up at
+        # each use (a stance may be read from another thread than the one that built it).
+        self._scratch = workspace
         self.q = np.array(q, dtype=float)
         self.origin = np.zeros(3)
         self._q_local = self.q
@@ -125,7 +148,7 @@ class Stance:
             self.origin = self.q[:3].copy()
             self._q_local = self.q.copy()
             self._q_local[:3] = 0.0
-        workspace = robot.workspace()
+        workspace = self.workspace()
         data = workspace.data
         # ccrba runs the forward kinematics and also fills the joint Jacobians data.J (as
         # computeJointJacobians does) and data.Ig, the centroidal composite inertia in world axes.
@@ -165,9 +188,14 @@ class Stance:
         pin.computeGeneralizedGravity(model, data, self.q)
         return data
 
+    def workspace(self) -> Scratch:
+        """The scratch Data this stance computes in: the one it was given, else the robot's
+        (per thread, :meth:`impact_balance.robot.Robot.workspace`)."""
+        return self._scratch if self._scratch is not None else self.robot.workspace()
+
     def _kinematics(self) -> pin.Data:
         """The scratch Data holding this stance's joint placements and joint Jacobians."""
-        workspace = self.robot.workspace()
+        workspace = self.workspace()
         key = self._q_local.tobytes()
         if workspace.holder != key:
             pin.computeJointJacobians(self.model, workspace.data, self._q_local)
@@ -186,15 +214,7 @@ class Stance:
 
     def _point(self, data: pin.Data, fid: int, offset: pin.SE3 | None) -> tuple[pin.SE3, np.ndarray]:
         """:meth:`point` of frame ``fid`` from ``data`` holding this stance's kinematics (copies)."""
-        model = self.model
-        frame_pose = pin.updateFramePlacement(model, data, fid)
-        J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
-        if offset is None or offset == _IDENTITY:  # exact test: contacts mostly have no offset
-            return frame_pose, J
-        placement = frame_pose * offset
-        # Shift the reference point from the frame origin to the offset point: v_p = v_o + w x r.
-        J[:3] -= skew(placement.translation - frame_pose.translation) @ J[3:]
-        return placement, J
+        return frame_point(self.model, data, fid, offset)
 
     def frame_pose(self, frame: str, field: str = "frame") -> pin.SE3:
         """World pose of a frame (a copy); ``field`` names it in an unknown-frame error."""

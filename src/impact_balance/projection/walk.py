@@ -82,7 +82,8 @@ def project_walk(
     # each is optimal for its arc by the multipliers' signs) and the polygon is convex,
     # counter-clockwise and winds once (checked in the kernel too). Anything else is a
     # numerical failure of the walk, never an answer.
-    if status == OK and worst < -SLACK_TOLERANCE * (1.0 + float(np.abs(b).max(initial=0.0))):
+    # (max |b| only when the slack is below the smallest threshold it can give: rarely.)
+    if status == OK and worst < -SLACK_TOLERANCE and worst < -SLACK_TOLERANCE * (1.0 + float(np.abs(b).max(initial=0.0))):
         return None
     if status == INFEASIBLE:
         return ProjectionResult(Polygon.empty(), "walk", n_lp=1, pivots=pivots)
@@ -95,7 +96,7 @@ def project_walk(
     if not convex_ccw(vertices):
         return None
     vertices = simplify(vertices, merge_tol)
-    bounded = bool(np.all(np.abs(vertices) < box * (1 - 1e-9)))
+    bounded = bool(np.abs(vertices).max() < box * (1 - 1e-9))  # all below (False with a NaN)
     return ProjectionResult(Polygon(vertices, bounded), "walk", n_lp=1, pivots=pivots)
 
 

@@ -1,0 +1,23 @@
+"""The criterion in the control loop: an impact-speed governor for any whole-body controller.
+
+The paper's Algorithm 1 ends with "track the maximum contact velocity with a whole-body QP".
+A :class:`Governor` gives that maximum every control tick, from the measured state::
+
+    from impact_balance.governor import Governor
+
+    governor = Governor("palm_push_two_feet")      # once: robot, contacts, impact, ZMP margin
+    limit = governor.limit(q, v)                   # each tick: pinocchio q (nq) and v (nv)
+    u = governor.cap(u_ref)                        # the reference velocity (world, m/s), capped
+
+- :mod:`.governor`: :class:`Governor` (construction, per-tick calls, reuse, the lock).
+- :mod:`.posture`: what is computed once per posture (:class:`Posture`).
+- :mod:`.limit`: the per-tick answer (:class:`SpeedLimit`) and the cap (:func:`cap_approach`).
+
+See docs/governor.md for the conventions and how pink, mink or any QP controller uses it.
+"""
+
+from .governor import CRITERIA, Governor
+from .limit import SpeedLimit, cap_approach
+from .posture import Posture, PostureEvaluator, PostureSettings
+
+__all__ = ["Governor", "CRITERIA", "SpeedLimit", "cap_approach", "Posture", "PostureEvaluator", "PostureSettings"]

@@ -1,0 +1,214 @@
+"""What a governor computes once per posture: everything but the CoM velocity.
+
+One posture is one configuration ``q``: the contact poses and Jacobians, the CoM, the
+composite inertia and g(q) (pinocchio, in the governor's own Data), the contact-wrench
+polytope and its projection (the ZMP support area and the CoM velocity area), the impact
+model at the impacting frame, and the criterion's data that do not depend on the CoM velocity.
+
+The steps are the pipeline's own functions at the array level
+(:func:`~impact_balance.stance.frame_point`, :func:`~impact_balance.constraints.assemble_polytope`,
+:func:`~impact_balance.areas.areas_from_polytope`, :func:`~impact_balance.impact.model_from_inertia_map`,
+:class:`~impact_balance.criteria.ComCriterion`), so a governor answers what
+:func:`~impact_balance.analyze` answers for the same posture (the tests check it to 1e-9);
+what a control loop does not read is skipped: the :class:`~impact_balance.stance.Stance`
+and :class:`~impact_balance.stance.Contact` objects (:attr:`Posture.stance` builds one on
+demand), the ZMP criterion in "com" mode, the diagnostics, the cannot-balance diagnosis.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from ..areas import BalanceAreas, areas_from_polytope
+from ..constraints import assemble_polytope, friction_scaling
+from ..criteria import ComCriterion, VelocityLimit, zmp_max_contact_velocity
+from ..cwc import _local_faces
+from ..exceptions import SolverError
+from ..impact import (
+    ImpactModel,
+    ImpactSpec,
+    composite_inertia_map,
+    impact_cone,
+    joint_space_inertia_map,
+    model_from_inertia_map,
+)
+from ..robot import Robot, Scratch
+from ..stance import ContactSpec, Stance, _has_free_flyer, frame_point
+
+__all__ = ["PostureSettings", "Posture", "PostureEvaluator"]
+
+_POSITION = pin.KinematicLevel.POSITION
+
+
+@dataclass(frozen=True)
+class PostureSettings:
+    """The scenario's data a posture is evaluated with (fixed for a governor).
+
+    Attributes:
+        contacts: The sustained contacts (robot frames; their world poses come from q).
+        impact: The intended impact (frame, offset, surface normal, friction, restitution,
+            inertia model, impact duration for the ZMP criterion).
+        plane_height: Height h of the LIPM plane, m.
+        gravity: m/s^2.
+        torque_limits: Whether the joint torque limits bound the contact wrenches.
+        zmp_margin: The ZMP support area is shrunk by this margin, m.
+        criterion: "com" or "zmp".
+    """
+
+    contacts: Sequence[ContactSpec]
+    impact: ImpactSpec
+    plane_height: float
+    gravity: float
+    torque_limits: bool
+    zmp_margin: float
+    criterion: str
+
+
+@dataclass(frozen=True)
+class Posture:
+    """One configuration's areas, impact model and criterion data.
+
+    Frames: world axes; positions in m (world, the free flyer's translation included).
+
+    Attributes:
+        key: ``q.tobytes()``: the exact configuration these are for.
+        q: The configuration (nq; read-only).
+        robot: The robot. settings: What it was evaluated with.
+        com: The CoM, m. mass: kg.
+        areas: The ZMP support area (shrunk by the ZMP margin) and the CoM velocity area.
+        impact: The impact model at this posture.
+        com_jacobian: (3, nv) map from the generalized velocity (pinocchio's convention: the
+            free flyer's linear and angular velocity in the base frame, then the joints) to
+            the CoM velocity in world axes, m/s.
+        com_criterion: The CoM criterion's half-planes and rates (None in "zmp" mode).
+        zmp_limit: The ZMP criterion's answer (None in "com" mode; it does not depend on
+            the CoM velocity).
+    """
+
+    key: bytes
+    q: np.ndarray
+    robot: Robot
+    settings: PostureSettings
+    com: np.ndarray
+    mass: float
+    areas: BalanceAreas
+    impact: ImpactModel
+    com_jacobian: np.ndarray
+    com_criterion: ComCriterion | None
+    zmp_limit: VelocityLimit | None
+
+    @functools.cached_property
+    def stance(self) -> Stance:
+        """The :class:`~impact_balance.stance.Stance` at ``q`` (built on first access, in the
+        robot's per-thread Data, ~50 us): for plots and displays."""
+        return Stance(self.robot, self.q, self.settings.contacts)
+
+
+class PostureEvaluator:
+    """Evaluates postures of one robot with one set of contacts and one impact, in a Data
+    of its own (not thread-safe: its owner, a :class:`~impact_balance.governor.Governor`,
+    holds a lock around :meth:`evaluate`).
+
+    What does not depend on q is made once here: frame indices, the contact-frame CWC faces,
+    the torque-limited joints, the impact's friction cone, the buffers.
+    """
+
+    def __init__(self, robot: Robot, settings: PostureSettings):
+        self.robot = robot
+        self.settings = settings
+        model = robot.model
+        self.scratch = Scratch(model)
+        self._free_flyer = _has_free_flyer(model)
+        contacts = settings.contacts
+        self._frames = [robot.frame_id(c.frame, f"contacts[{i}].frame") for i, c in enumerate(contacts)]
+        self._offsets = [c.offset for c in contacts]
+        m = len(contacts)
+        self._faces = np.array([_local_faces(float(c.friction), 0.5 * float(c.size[0]), 0.5 * float(c.size[1]))
+                                for c in contacts]).reshape(m, 16, 6)
+        self._frictions = [float(c.friction) for c in contacts]
+        idx, limit = robot.effort_limits
+        self._torques = bool(settings.torque_limits and m and idx.size)
+        self._idx, self._limit = (idx, limit) if self._torques else (np.zeros(0, dtype=np.int64), np.zeros(0))
+        impact = settings.impact
+        self._impact_frame = robot.frame_id(impact.frame, "impact.frame")
+        self._normal, self._cone = impact_cone(impact)
+        # Buffers, overwritten every posture (the answers keep copies).
+        self._q_local = np.zeros(model.nq)
+        self._zero_velocity = np.zeros(model.nv)
+
+    def evaluate(self, q: np.ndarray) -> Posture:
+        """Everything the governor needs at configuration ``q`` (nq, float64, contiguous).
+
+        Raises what the pipeline raises on a posture it cannot evaluate:
+        :class:`~impact_balance.exceptions.ScenarioError` (the CoM at or below the LIPM
+        plane), :class:`~impact_balance.exceptions.ImpactModelError` (a friction-cone edge
+        that would not separate the contact), :class:`~impact_balance.exceptions.SolverError`
+        (a projection that failed).
+        """
+        robot, settings, data = self.robot, self.settings, self.scratch.data
+        model = robot.model
+        # The kinematics in the stance frame (world axes, origin at the base position), as
+        # Stance does: lever arms keep their precision however far the robot stands.
+        q_local = self._q_local
+        q_local[:] = q
+        origin = np.zeros(3)
+        if self._free_flyer:
+            origin = q[:3].copy()
+            q_local[:3] = 0.0
+        # ccrba: joint placements, joint Jacobians, the composite inertia Ig and the centroidal
+        # momentum matrix Ag (its linear rows are m times the CoM Jacobian).
+        pin.ccrba(model, data, q_local, self._zero_velocity)
+        self.scratch.holder = None  # what it holds is this evaluator's, never a Stance's
+        com_local = np.array(pin.centerOfMass(model, data, _POSITION, False), dtype=float)
+        Ig = data.Ig
+        mass = float(Ig.mass)
+        com_jacobian = data.Ag[:3] / mass
+        m = len(self._frames)
+        rotations = np.empty((m, 3, 3))
+        local = np.empty((m, 3))
+        jacobians = np.empty((6 * m, model.nv)) if self._torques else np.zeros((0, 0))
+        for i, (fid, offset) in enumerate(zip(self._frames, self._offsets)):
+            placement, J = frame_point(model, data, fid, offset, self._torques)
+            rotations[i] = placement.rotation
+            local[i] = placement.translation
+            if J is not None:
+                jacobians[6 * i : 6 * i + 6] = J
+        gravity_torques = pin.computeGeneralizedGravity(model, data, q_local) if self._torques else self._zero_velocity
+        scaling = friction_scaling(self._frictions, rotations)
+        polytope = assemble_polytope(self._faces, rotations, local + origin, local - com_local, mass, com_local + origin,
+                                     settings.gravity, jacobians, self._idx, self._limit, gravity_torques, scaling)
+        try:
+            areas = areas_from_polytope(polytope, settings.plane_height, settings.zmp_margin)
+        except SolverError as exc:
+            raise exc.within("contacts (projection of the contact wrench polytope)") from None
+        impact = self._impact(q, q_local, origin, com_local, mass, np.array(Ig.inertia, dtype=float))
+        com_criterion = zmp = None
+        if settings.criterion == "zmp":
+            zmp = zmp_max_contact_velocity(areas.zmp_area, impact, polytope.com, settings.plane_height,
+                                           settings.gravity, settings.impact.duration)
+        else:
+            com_criterion = ComCriterion(areas.com_velocity_area, impact)
+        q = q.copy()
+        q.setflags(write=False)
+        return Posture(q.tobytes(), q, robot, settings, polytope.com, mass, areas, impact, com_jacobian,
+                       com_criterion, zmp)
+
+    def _impact(self, q: np.ndarray, q_local: np.ndarray, origin: np.ndarray, com_local: np.ndarray, mass: float,
+                inertia: np.ndarray) -> ImpactModel:
+        """The impact model at the kinematics held in the Data (as :func:`~impact_balance.impact.impact_model`)."""
+        spec, data, model = self.settings.impact, self.scratch.data, self.robot.model
+        placement, J6 = frame_point(model, data, self._impact_frame, spec.offset)
+        point_local = placement.translation.copy()
+        arm = point_local - com_local
+        J = J6[:3].copy()
+        with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported by the model
+            if spec.inertia == "joint_space":
+                W = joint_space_inertia_map(self.scratch, model, q, J)
+            else:
+                W = composite_inertia_map(arm, mass, inertia)
+        return model_from_inertia_map(spec, point_local + origin, arm, self._normal.copy(), self._cone.copy(), W, mass, J)
