@@ -32,3 +32,19 @@ def test_robot_log_example_finds_the_exit_of_the_area(tmp_path, capsys):
     assert f"com_velocity outside its area from {exit_time:.3f} s to {time[-1]:.3f} s" in out
     worst = v[-1, 0] - area.vertices[:, 0].max()
     assert f"worst margin {-worst:.3f} m/s" in out
+
+
+def test_governor_in_a_pink_loop_caps_the_speed_at_the_criterion(capsys):
+    """The commanded approach speed is min(reference, the cap), the cap is the analysis' maximum at the
+    start, and pink's IK tracks the commanded speed."""
+    example = _load("governor_pink")
+    fast = example.run("palm_push_two_feet", reference=0.8, ticks=80)
+    start = ib.analyze("palm_push_two_feet").impact.max_contact_velocity
+    assert fast["cap"][0] == np.float64(start) or abs(fast["cap"][0] - start) < 1e-9
+    assert np.allclose(fast["commanded"], np.minimum(0.8, fast["cap"]), atol=1e-12)
+    assert np.all(fast["commanded"] < 0.8)  # the cap binds: 0.48 m/s at most here
+    assert abs(np.median(fast["measured"][40:]) - np.median(fast["commanded"][40:])) < 0.05
+    slow = example.run("palm_push_two_feet", reference=0.2, ticks=40)
+    assert np.allclose(slow["commanded"], 0.2)  # below the cap: the reference as it is
+    assert example.main(["--ticks", "20"]) == 0
+    assert "com governor" in capsys.readouterr().out

@@ -164,3 +164,30 @@ def test_bad_arguments_are_one_line_errors(q, v, field):
         Governor("palm_push_two_feet", criterion="speed")
     with pytest.raises(GovernorError, match="call limit"):
         Governor("palm_push_two_feet").cap([0.5, 0.0, 0.0])
+
+
+def test_gui_shows_the_governors_cap_for_the_stance_being_edited(tmp_path):
+    from impact_balance.gui import Session
+    from impact_balance.gui.results import results_html
+
+    session = Session("palm_push_two_feet", workspace=tmp_path)
+    g = session.governed
+    a = session.analysis
+    assert g.ceiling == pytest.approx(a.impact.max_contact_velocity, abs=1e-9)
+    assert g.reference == pytest.approx(0.8) and g.capped == pytest.approx(min(0.8, g.ceiling), abs=1e-9)
+    first = session._governor
+    html = results_html(session, 1.0)
+    assert 'id="ib-governor-cap"' in html and f"{g.ceiling:.3f} m/s" in html
+    # A posture or CoM velocity edit reuses the governor; the numbers follow.
+    assert session.set(("com_velocity",), [0.1, 0.0])
+    assert session._governor is first
+    assert session.governed.ceiling == pytest.approx(session.analysis.impact.max_contact_velocity, abs=1e-9)
+    assert session.set(("joints", "arm_right_4_joint"), -1.2)
+    assert session._governor is first
+    assert session.governed.ceiling == pytest.approx(session.analysis.impact.max_contact_velocity, abs=1e-9)
+    # A change of the impact or the contacts builds a new one.
+    assert session.set(("impact", "friction"), 0.4)
+    assert session._governor is not first
+    assert session.governed.ceiling == pytest.approx(session.analysis.impact.max_contact_velocity, abs=1e-9)
+    assert session.set(("impact",), None)
+    assert session.governed is None and 'id="ib-governor-cap"' not in results_html(session, 1.0)

@@ -29,6 +29,16 @@ def results_html(session: Session, last_update_ms: float) -> str:
         verdict = "falls" if s.falls_at_reference else "holds"
         rows.append(f'<tr><td>reference approach speed</td><td style="text-align:right" id="ib-reference">'
                     f'{s.reference_speed:.3f} m/s ({verdict})</td></tr>')
+    g = session.governed
+    if g is not None:
+        rows.append('<tr><td colspan="2" style="color:#555">governor, live (from this posture and CoM velocity)</td></tr>')
+        rows.append(f'<tr><td>&nbsp;&nbsp;speed allowed</td><td style="text-align:right"><b id="ib-governor-cap">'
+                    f'{html.escape(format_speed(g.ceiling))}</b></td></tr>')
+        if g.reference is not None:
+            rows.append(f'<tr><td>&nbsp;&nbsp;reference, capped</td><td style="text-align:right" id="ib-governor-capped">'
+                        f'{g.reference:.3f} &rarr; {g.capped:.3f} m/s</td></tr>')
+        rows.append(f'<tr><td>&nbsp;&nbsp;governor tick</td><td style="text-align:right" id="ib-governor-us">'
+                    f'{g.tick_us:.0f} &micro;s</td></tr>')
     rows.append(f'<tr><td>update (analysis + redraw)</td><td style="text-align:right" id="ib-update-ms">'
                 f'{last_update_ms:.1f} ms</td></tr>')
     rows.append("</table>")

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pinocchio as pin
 
 from ..analysis import Analysis, analyze
@@ -27,9 +28,28 @@ from .drag import DragTarget, drag_changes
 from .files import GuiFiles, describe
 from .state import DEFAULT_SCENARIO, FieldPath, GuiState
 
-__all__ = ["Summary", "Session", "format_speed"]
+__all__ = ["Summary", "Governed", "Session", "format_speed"]
 
 log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class Governed:
+    """What the governor (:mod:`impact_balance.governor`) allows from the stance being edited.
+
+    Attributes:
+        ceiling: The largest approach speed it lets through, m/s (inf: no speed is unsafe).
+        status: The criterion's status ("ok", "unbounded", "already_falling"...).
+        tick_us: The governor's time for this tick, microseconds.
+        reference: The reference velocity's approach speed, m/s (None without one).
+        capped: The capped reference's approach speed, m/s (None without one).
+    """
+
+    ceiling: float
+    status: str
+    tick_us: float
+    reference: float | None
+    capped: float | None
 
 
 def format_speed(value: float | None) -> str:
@@ -112,6 +132,11 @@ class Session:
         self.analysis_ms = 1e3 * self.analysis.timings.get("total", 0.0)
         #: Incremented on every accepted change (the app redraws when it moves).
         self.revision = 0
+        self._governor = None
+        self._governor_key: str | None = None
+        #: The governor's answer for the stance being edited (None without an impact): see :meth:`_govern`.
+        self.governed: Governed | None = None
+        self._govern()
 
     # -- edits ----------------------------------------------------------------------------
     def _commit(self, build, note: str | None = None) -> bool:
@@ -131,7 +156,35 @@ class Session:
             self.analysis_ms = 1e3 * (time.perf_counter() - t0)
             self.message, self.refused = note, False
             self.revision += 1
+            self._govern()
             return True
+
+    def _govern(self) -> None:
+        """Ask the governor of the scenario (rebuilt when anything but the posture and the CoM velocity
+        changed) for the speed allowed from this posture and CoM velocity, and cap the reference."""
+        scenario = self.state.scenario
+        if scenario.impact is None or not self.analysis.areas.can_balance:
+            self.governed = None
+            return
+        from ..governor import Governor
+
+        key = scenario.model_dump_json(exclude={"configuration", "joints", "base", "com_velocity", "name",
+                                                "description"})
+        try:
+            if key != self._governor_key:
+                self._governor, self._governor_key = Governor(scenario), key
+            t0 = time.perf_counter()
+            limit = self._governor.limit_com(self.analysis.stance.q, scenario.com_velocity)
+            tick_us = 1e6 * (time.perf_counter() - t0)
+            reference = scenario.impact.reference_velocity
+            capped = None if reference is None else limit.cap(reference)
+        except ImpactBalanceError as exc:  # the analysis went through: the governor's failure is only a note
+            self.governed = None
+            log.info("governor: %s", exc)
+            return
+        self.governed = Governed(limit.ceiling, limit.status, tick_us,
+                                 None if reference is None else float(-np.dot(reference, limit.normal)),
+                                 None if capped is None else float(-np.dot(capped, limit.normal)))
 
     def refuse(self, message: str) -> None:
         """Show ``message`` as a refusal (an upload cut while it arrived); the state is kept."""
