@@ -2,6 +2,7 @@
 """Issue 15 targets: the governor's time per control tick, beside a full ``analyze()`` per tick.
 
     python benchmarks/governor.py [--json] [--ticks N] [--scenarios NAME ...] [--criterion com|zmp]
+    python benchmarks/governor.py --study [--out DIR] ...     # the wall study: see governor_study.py
 
 For each scenario of the wall study (palm_push_two_feet, palm_push_ramp, kick_one_foot,
 g1_two_feet), a 500 Hz trajectory of N ticks (default 2000, 4 s): every actuated joint follows
@@ -164,6 +165,11 @@ def evaluate_targets(rows: list[dict[str, Any]]) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] == ["--study"]:  # the wall study (issue 15, item 3): benchmarks/governor_study.py
+        import governor_study
+
+        return governor_study.main(argv[1:])
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
     ap.add_argument("--ticks", type=int, default=2000, help="ticks per scenario (default 2000: 4 s at 500 Hz)")

@@ -1,6 +1,6 @@
 """Issue 15's study: the governed approach to an unknown wall, on four stances.
 
-    python benchmarks/governor_study.py [--out DIR] [--scenarios ...] [--references 0.2 0.5 1.0 2.0]
+    python benchmarks/governor.py --study [--out DIR] [--scenarios ...] [--references 0.2 0.5 1.0 2.0]
                                         [--distances 0.12 0.15 0.18] [--governors com zmp none] [--impacts rigid free]
 
 For every scenario, reference speed, wall distance, governor and impact model (``rigid``: every joint
@@ -115,7 +115,7 @@ def figures(args, out: Path) -> list[Path]:
     return paths
 
 
-def main() -> int:
+def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--out", default="governor-study")
     p.add_argument("--scenarios", nargs="+", default=list(SCENARIOS))
@@ -125,7 +125,7 @@ def main() -> int:
     p.add_argument("--impacts", nargs="+", default=["rigid", "free"], choices=["rigid", "free"])
     p.add_argument("--max-time", type=float, default=30.0)
     p.add_argument("--no-figures", action="store_true")
-    args = p.parse_args()
+    args = p.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     print(f"{_load()} at the start", flush=True)

@@ -195,7 +195,7 @@ def run_wall_trial(setup: BalanceSetup, options: WallOptions, trial_options: Bal
             caps.append((t, task.reference_speed(t), task.ceiling))
         rows["time"].append(t)
         rows["reference"].append(task.reference_speed(t) if task.contact_time is None else 0.0)
-        rows["cap"].append(_finite(task.ceiling) if governor is not None else None)
+        rows["cap"].append(_finite(task.ceiling) if governor is not None and task.contact_time is None else None)
         rows["commanded"].append(task.commanded if task.contact_time is None else 0.0)
         rows["measured"].append(float(-n @ _point_velocity(sim, n)))
 

@@ -1,0 +1,62 @@
+"""The wall experiment (``impact-balance approach``): the impact point sent at an unknown wall,
+its speed capped every tick by a governor fed the simulated state."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import impact_balance as ib
+from impact_balance.cli import main
+from impact_balance.scenario import load_scenario
+
+KEYS = {"governor", "reference", "speed_at_contact", "cap_at_contact", "time_to_contact", "outcome", "reason", "tick_us"}
+
+
+def run_json(capsys, *argv):
+    assert main(["approach", *argv, "--json"]) == 0
+    return json.loads(capsys.readouterr().out, parse_constant=lambda c: pytest.fail(c))
+
+
+def test_com_governor_caps_the_speed_at_contact(capsys, tmp_path):
+    out = run_json(capsys, "palm_push_two_feet", "--reference", "0.8", "--governor", "com", "--rigid-impact",
+                   "--plots", str(tmp_path))
+    assert KEYS <= set(out) and set(out["tick_us"]) >= {"median", "p99"}
+    margin = load_scenario("palm_push_two_feet").model_copy(update={"zmp_margin": out["zmp_margin"]})
+    at_stance = ib.analyze(margin).impact.max_contact_velocity
+    # The cap in force at contact is the criterion's maximum at the posture of the contact (close to the stance's).
+    assert out["cap_at_contact"] == pytest.approx(at_stance, rel=0.05)
+    assert out["speed_at_contact"] == pytest.approx(out["cap_at_contact"], rel=0.1)  # tracked, not conservative for nothing
+    assert out["outcome"] in ("balanced", "contact_broken") and out["time_to_contact"] > 0
+    assert out["tick_us"]["median"] > 0 and out["tick_us"]["count"] > 10
+    assert any(p.name.endswith("_approach_com_0.8_15cm.png") for p in tmp_path.iterdir())
+
+
+def test_without_a_governor_the_reference_is_reached(capsys):
+    out = run_json(capsys, "palm_push_two_feet", "--reference", "0.5", "--governor", "none",
+                   "--wall-distance-range", "0.12", "0.18")
+    assert out["governor"] == "none" and len(out["trials"]) == 3
+    for trial in out["trials"]:
+        assert trial["cap_at_contact"] is None and trial["tick_us"]["median"] is None
+        assert trial["speed_at_contact"] == pytest.approx(0.5, rel=0.1)
+    times = [t["time_to_contact"] for t in out["trials"]]
+    assert times == sorted(times)  # a farther wall is reached later
+    assert np.diff(times) == pytest.approx([0.03 / 0.5] * 2, rel=0.25)  # 3 cm more at 0.5 m/s
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["--reference", "0.5", "--wall-distance-range", "0.2", "0.1"], "--wall-distance-range"),
+    (["--reference", "0.5", "--wall-distance-range", "0.1", "0.2", "--video", "v.mp4"], "--video"),
+    (["--reference", "9"], "--reference"),
+    (["--reference", "0.5", "--governor", "fast"], "--governor"),
+])
+def test_bad_options_are_one_line(capsys, argv, needle):
+    try:
+        rc = main(["approach", "palm_push_two_feet", *argv])
+    except SystemExit as exc:  # argparse's own usage errors exit (one line, status 2)
+        rc = exc.code
+    assert rc == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and needle in err and "Traceback" not in err
