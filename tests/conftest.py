@@ -129,3 +129,14 @@ def talos_stance():
         robot.configuration(),
         [ContactSpec("left_sole_link", 0.7, (0.2, 0.1)), ContactSpec("right_sole_link", 0.7, (0.2, 0.1))],
     )
+
+
+@pytest.fixture(autouse=True)
+def _trial_journals_in_tmp(tmp_path, monkeypatch):
+    """The simulation commands' default journals (``impact-balance-trials/`` in the current
+    directory) go to the test's own folder, not into the source tree."""
+    try:
+        from impact_balance.sim import journal
+    except ImportError:  # no sim extra: nothing writes journals
+        return
+    monkeypatch.setattr(journal, "JOURNAL_FOLDER", str(tmp_path / "impact-balance-trials"))

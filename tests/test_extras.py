@@ -131,7 +131,7 @@ def test_core_runs_without_any_extra():
 @pytest.mark.parametrize("argv, absent", [
     (["robots"], HEAVY + ("numba", "scipy", "pydantic")),
     (["scenarios"], HEAVY + ("numba", "scipy", "pinocchio", "pydantic", "numpy")),
-    (["analyze", "palm_push_two_feet", "--json"], HEAVY + ("qpsolvers",)),
+    (["analyze", "palm_push_two_feet", "--json"], HEAVY + ("qpsolvers", "numba")),
 ])
 def test_light_commands_import_no_heavy_part(argv, absent):
     """Nothing blocked: the command simply never imports these."""
@@ -144,6 +144,37 @@ def test_light_commands_import_no_heavy_part(argv, absent):
     """, blocked=())
     assert r.returncode == 0, r.stderr
     assert r.stdout.strip() == "[]", r.stdout
+
+
+def test_one_shot_analyze_is_interpreted_and_answers_as_the_compiled_kernel():
+    """``analyze`` in a fresh process runs the kernels as Python (numba never imported, the
+    variable not left behind); its answer is the compiled kernels' to the last digit."""
+    r = _run("""
+        import io, json, os, contextlib
+        from impact_balance.cli import main
+        with contextlib.redirect_stdout(io.StringIO()) as out:
+            assert main(["analyze", "talos_three_contacts", "--json"]) == 0
+        assert "numba" not in sys.modules and "IMPACT_BALANCE_JIT" not in os.environ
+        from impact_balance._jit import HAVE_NUMBA
+        assert not HAVE_NUMBA
+        print(out.getvalue())
+    """, blocked=())
+    assert r.returncode == 0, r.stderr
+    interpreted = json.loads(r.stdout)
+    from impact_balance import _jit
+    from impact_balance.analysis import analyze
+
+    assert _jit.HAVE_NUMBA  # this process compiles
+    compiled = analyze("talos_three_contacts").to_dict()
+    for answer in (interpreted, compiled):
+        answer.pop("timings_ms")
+    assert json.dumps(interpreted, sort_keys=True) == json.dumps(compiled, sort_keys=True)
+
+
+def test_jit_variable_is_named_once():
+    from impact_balance import _jit, cli
+
+    assert cli._JIT_VARIABLE == _jit.JIT_VARIABLE
 
 
 def test_json_answer_without_extras_is_strict():

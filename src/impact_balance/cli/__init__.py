@@ -40,6 +40,23 @@ def _kernel_is_compiled() -> bool:
     return kernel_is_compiled()
 
 
+#: ``impact_balance._jit.JIT_VARIABLE``, named here: importing ``_jit`` would import numba.
+_JIT_VARIABLE = "IMPACT_BALANCE_JIT"
+
+
+def _interpret_kernels() -> None:
+    """A one-shot command (``INTERPRETED = True``) runs the kernels as Python: numba's import and
+    cached-kernel load (0.4 to 0.8 s) cost more than one interpreted analysis. Only in a fresh
+    process (``_jit`` not yet imported) and only when ``IMPACT_BALANCE_JIT`` is unset."""
+    if _JIT_VARIABLE in os.environ or "impact_balance._jit" in sys.modules:
+        return
+    os.environ[_JIT_VARIABLE] = "0"
+    try:
+        import impact_balance._jit  # noqa: F401 - reads the variable now, once
+    finally:
+        del os.environ[_JIT_VARIABLE]  # not inherited by anything this process starts
+
+
 def _version() -> str:
     import importlib.metadata  # here: only --version reads it (the import costs ~50 ms)
 
@@ -175,6 +192,8 @@ def main(argv: list[str] | None = None) -> int:
         args = parser.parse_args(argv)  # option types check values and outputs (exit 2 or 1)
         module = owners[args.command]
         require_for(args.command, args)  # a missing optional part is one line naming its extra
+        if getattr(module, "INTERPRETED", False):
+            _interpret_kernels()
         if getattr(module, "USES_KERNEL", False) and not _kernel_is_compiled():
             print("impact-balance: compiling the projection kernel (first run only, 0.5 to 1.5 min; cached afterwards) ...",
                   file=sys.stderr, flush=True)

@@ -8,9 +8,11 @@ from pathlib import Path
 
 from ._options import add_zmp_margin_option, output_folder, with_zmp_margin
 
-__all__ = ["add_parser", "run", "USES_KERNEL"]
+__all__ = ["add_parser", "run", "USES_KERNEL", "INTERPRETED"]
 
 USES_KERNEL = True
+#: One analysis per process: interpreted kernels beat loading numba's cache (see ``impact_balance._jit``).
+INTERPRETED = True
 
 
 def add_parser(sub) -> list[str]:
