@@ -10,7 +10,7 @@ one-shot ``impact-balance analyze`` command runs that way unless the variable sa
 from __future__ import annotations
 
 import os
-from typing import Any, Callable
+from typing import Any
 
 __all__ = ["njit", "HAVE_NUMBA", "JIT_VARIABLE"]
 
