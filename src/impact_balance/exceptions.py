@@ -23,6 +23,7 @@ __all__ = [
     "short_repr",
     "one_line",
     "ImpactBalanceError",
+    "FieldError",
     "ScenarioError",
     "WorkspaceError",
     "UnknownNameError",
@@ -119,6 +120,22 @@ class ImpactBalanceError(Exception):
 
     def __str__(self) -> str:
         return one_line(self.args[0] if self.args else self.__class__.__name__)
+
+
+class FieldError(ImpactBalanceError):
+    """An error about one named field, option or argument: ``field = value: reason``.
+
+    Attributes:
+        field: What is at fault (a scenario field, an option, an argument).
+        value: Its value (shown cut to :data:`VALUE_CHARS` characters).
+        reason: Why it is refused.
+    """
+
+    def __init__(self, field: str, value: Any, reason: str):
+        self.field = field
+        self.value = value
+        self.reason = reason
+        super().__init__(f"{field} = {short_repr(value)}: {reason}")
 
 
 class ScenarioError(ImpactBalanceError, ValueError):
@@ -225,19 +242,13 @@ class RobotLoadError(ImpactBalanceError):
         super().__init__(f"cannot load robot description {path}: {reason}")
 
 
-class ImpactModelError(ImpactBalanceError, ValueError):
+class ImpactModelError(FieldError, ValueError):
     """The impact data are inconsistent (e.g. an impulse direction that does not push).
 
     Attributes:
         field: The scenario field at fault.
         value: Its value.
     """
-
-    def __init__(self, field: str, value: Any, reason: str):
-        self.field = field
-        self.value = value
-        self.reason = reason
-        super().__init__(f"{field} = {short_repr(value)}: {reason}")
 
 
 class SolverError(ImpactBalanceError, RuntimeError):
@@ -314,7 +325,7 @@ class NonFiniteResultError(ImpactBalanceError, ValueError):
         super().__init__(f"{field} is not finite: the scenario's numbers are too large{hint}")
 
 
-class SimulationError(ImpactBalanceError, ValueError):
+class SimulationError(FieldError, ValueError):
     """A simulation request cannot be carried out (bad option, no impact, no renderer...).
 
     Attributes:
@@ -322,12 +333,6 @@ class SimulationError(ImpactBalanceError, ValueError):
         value: Its value.
         reason: Why it is refused.
     """
-
-    def __init__(self, field: str, value: Any, reason: str):
-        self.field = field
-        self.value = value
-        self.reason = reason
-        super().__init__(one_line(f"{field} = {short_repr(value)}: {reason}"))
 
 
 class SweepError(ScenarioError):
@@ -377,7 +382,7 @@ class ModelRepairWarning(ImpactBalanceWarning):
         super().__init__(message)
 
 
-class OptionError(ImpactBalanceError, ValueError):
+class OptionError(FieldError, ValueError):
     """A command-line option (or a library argument) has a value the code cannot use.
 
     Attributes:
@@ -385,12 +390,6 @@ class OptionError(ImpactBalanceError, ValueError):
         value: Its value.
         reason: Why it is refused (with the valid range or form).
     """
-
-    def __init__(self, field: str, value: Any, reason: str):
-        self.field = field
-        self.value = value
-        self.reason = reason
-        super().__init__(f"{field} = {short_repr(value)}: {reason}")
 
 
 class EnvironmentFailure(ImpactBalanceError):
@@ -419,7 +418,7 @@ class OutputError(EnvironmentFailure):
     """An output file or folder cannot be written (checked before the command computes)."""
 
 
-class GovernorError(ImpactBalanceError, ValueError):
+class GovernorError(FieldError, ValueError):
     """A governor call got a bad argument (a configuration of the wrong size, a NaN velocity,
     an unknown criterion...); see :mod:`impact_balance.governor`.
 
@@ -428,9 +427,3 @@ class GovernorError(ImpactBalanceError, ValueError):
         value: Its value (shown cut to :data:`VALUE_CHARS` characters).
         reason: Why it is refused.
     """
-
-    def __init__(self, field: str, value: Any, reason: str):
-        self.field = field
-        self.value = value
-        self.reason = reason
-        super().__init__(one_line(f"{field} = {short_repr(value)}: {reason}"))
