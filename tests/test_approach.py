@@ -50,6 +50,11 @@ def test_without_a_governor_the_reference_is_reached(capsys):
     (["--reference", "0.5", "--wall-distance-range", "0.2", "0.1"], "--wall-distance-range"),
     (["--reference", "0.5", "--wall-distance-range", "0.1", "0.2", "--video", "v.mp4"], "--video"),
     (["--reference", "9"], "--reference"),
+    (["--reference", "nan"], "--reference"),
+    (["--reference", "0.5", "--wall-distance", "0"], "--wall-distance"),
+    (["--reference", "0.5", "--max-time", "1e9"], "--max-time"),
+    (["--reference", "0.5", "--video", "v.avi"], "--video"),
+    (["--reference", "0.5", "--plots", "/etc/passwd"], "--plots"),
     (["--reference", "0.5", "--governor", "fast"], "--governor"),
 ])
 def test_bad_options_are_one_line(capsys, argv, needle):
@@ -60,3 +65,34 @@ def test_bad_options_are_one_line(capsys, argv, needle):
     assert rc == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and needle in err and "Traceback" not in err
+
+
+def test_a_video_loads_the_robots_meshes_and_picks_egl_first(monkeypatch, tmp_path, capsys):
+    """The video's robot is drawn from its meshes (visual only), and MuJoCo's offscreen backend is
+    chosen before anything imports MuJoCo (``MUJOCO_GL`` left as the user set it)."""
+    from impact_balance.exceptions import SimulationError
+    from impact_balance.sim.trial_setup import BalanceSetup
+
+    seen = {}
+
+    def spy(cls, *args, **kwargs):
+        seen.update(kwargs)
+        raise SimulationError("spy", None, "stopped before the trial")
+
+    monkeypatch.setattr(BalanceSetup, "create", classmethod(spy))
+    monkeypatch.setenv("MUJOCO_GL", "egl")
+    assert main(["approach", "kick_one_foot", "--reference", "0.5", "--wall-distance", "0.15",
+                 "--video", str(tmp_path / "v.mp4")]) == 2
+    assert seen.get("meshes") is True and "spy" in capsys.readouterr().err
+    assert main(["approach", "kick_one_foot", "--reference", "0.5"]) == 2
+    assert seen.get("meshes") is False
+
+
+def test_meshes_are_visual_only():
+    from impact_balance.sim.trial_setup import BalanceSetup
+
+    bare = BalanceSetup.create("kick_one_foot")
+    drawn = BalanceSetup.create("kick_one_foot", meshes=True)
+    assert drawn.sim.model.ngeom > bare.sim.model.ngeom
+    extra = drawn.sim.model.geom_contype[drawn.sim.model.geom_group == drawn.sim.model.geom_group.max()]
+    assert (extra == 0).all() and drawn.sim.model.nv == bare.sim.model.nv

@@ -200,3 +200,20 @@ def open_journal(args: argparse.Namespace, command: str, scenario, joints: str, 
     cut = f", {journal.skipped_lines} unreadable line(s) skipped" if journal.skipped_lines else ""
     print(f"impact-balance: trials journal {path}{note}{cut}", file=sys.stderr)
     return journal
+
+
+def import_mujoco(video: bool) -> None:
+    """Import MuJoCo for a simulation command; with ``video``, offscreen rendering first picks
+    EGL (it works headless, and must be chosen before MuJoCo is imported) unless ``MUJOCO_GL``
+    says otherwise. An unusable backend is one :class:`~impact_balance.exceptions.SimulationError`."""
+    import os
+
+    from ..exceptions import SimulationError
+
+    if video:
+        os.environ.setdefault("MUJOCO_GL", "egl")
+    try:
+        import mujoco  # noqa: F401  (reads MUJOCO_GL when imported)
+    except Exception as exc:  # an unusable backend fails inside MuJoCo's import, with various types
+        raise SimulationError("MUJOCO_GL", os.environ.get("MUJOCO_GL"), f"MuJoCo cannot start with this OpenGL "
+                              f"backend ({type(exc).__name__}); use MUJOCO_GL=egl, or unset it") from None

@@ -6,7 +6,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._options import add_controller_option, add_zmp_margin_option, with_zmp_margin
+from ._options import (add_controller_option, add_zmp_margin_option, import_mujoco, number, output_file, output_folder,
+                       with_zmp_margin)
 
 __all__ = ["add_parser", "run", "USES_KERNEL"]
 
@@ -16,13 +17,14 @@ USES_KERNEL = True
 def add_parser(sub) -> list[str]:
     a = sub.add_parser("approach", help="send the impact point at an unknown wall, its speed capped by a governor (MuJoCo)")
     a.add_argument("scenario", help="YAML file or bundled scenario name (must have an impact)")
-    a.add_argument("--reference", type=float, required=True, metavar="V",
+    a.add_argument("--reference", type=number("--reference", 0.0, 5.0, "m/s", lo_open=True), required=True, metavar="V",
                    help="reference approach speed, m/s (the paper's 0.8)")
     a.add_argument("--governor", default="com", choices=("com", "zmp", "none"),
                    help="com: the CoM criterion's maximum contact velocity (default); zmp: the ZMP criterion's; "
                         "none: the reference alone")
     where = a.add_mutually_exclusive_group()
-    where.add_argument("--wall-distance", type=float, default=None, metavar="D",
+    where.add_argument("--wall-distance", type=number("--wall-distance", 0.0, 1.0, "m", lo_open=True), default=None,
+                       metavar="D",
                        help="distance of the wall from the point's start, m (default 0.15: the scenario's impact point)")
     where.add_argument("--wall-distance-range", type=float, nargs=2, default=None, metavar=("LO", "HI"),
                        help="one trial at LO, the middle and HI, m")
@@ -30,11 +32,12 @@ def add_parser(sub) -> list[str]:
                    help="hold every joint's velocity through the impact (the paper's rigid robot)")
     add_controller_option(a, "id", "it puts the ZMP anywhere in the support area after the impact")
     add_zmp_margin_option(a, "the governor's; default: the ZMP margin the trial's controller keeps")
-    a.add_argument("--max-time", type=float, default=30.0, metavar="S",
+    a.add_argument("--max-time", type=number("--max-time", 0.0, 120.0, "s", lo_open=True), default=30.0, metavar="S",
                    help="longest approach before giving up, s (default 30: a ZMP governor is slow)")
     a.add_argument("--json", action="store_true", help="print one JSON object")
-    a.add_argument("--plots", metavar="DIR", help="write the figure of each trial to DIR")
-    a.add_argument("--video", metavar="FILE", help="render an MP4 of the trial (one trial: give --wall-distance)")
+    a.add_argument("--plots", metavar="DIR", type=output_folder("--plots"), help="write the figure of each trial to DIR")
+    a.add_argument("--video", metavar="FILE", type=output_file("--video", (".mp4",)),
+                   help="render an MP4 of the trial (one trial: give --wall-distance)")
     return ["approach"]
 
 
@@ -42,6 +45,10 @@ def run(args: argparse.Namespace) -> int:
     import math
 
     from ..exceptions import SimulationError
+
+    if args.video and args.wall_distance_range is not None:
+        raise SimulationError("--video", args.video, "one .mp4 for one trial (give --wall-distance, not a range)")
+    import_mujoco(bool(args.video))  # before anything imports MuJoCo: the GL backend is read then
     from ..scenario import load_scenario
     from ..sim.balance_trial import BalanceSetup, BalanceTrialOptions
     from ..sim.wall import WallOptions, run_wall_trial, write_wall_video
@@ -59,14 +66,12 @@ def run(args: argparse.Namespace) -> int:
         distances = [0.15 if args.wall_distance is None else args.wall_distance]
     if not (math.isfinite(args.max_time) and 0 < args.max_time <= 120):
         raise SimulationError("--max-time", args.max_time, "must be in (0, 120] s")
-    if args.video and (len(distances) > 1 or Path(args.video).suffix.lower() != ".mp4"):
-        raise SimulationError("--video", args.video, "one .mp4 for one trial (give --wall-distance, not a range)")
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
     from ..sim.balance_trial import controller_margin
 
     margin = controller_margin(options) if args.zmp_margin is None else args.zmp_margin
     governed = with_zmp_margin(scenario, margin)  # the governor's view: the area the controller can use
-    setup = BalanceSetup.create(scenario, "servo", options)
+    setup = BalanceSetup.create(scenario, "servo", options, meshes=bool(args.video))  # meshes: visual only
     governor = None
     if args.governor != "none":
         from ..governor import Governor

@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 from pathlib import Path
 
-from ._options import LOG_SUFFIXES, number, output_file, output_folder
+from ._options import LOG_SUFFIXES, import_mujoco, number, output_file, output_folder
 from .output import print_json
 
 __all__ = ["add_parser", "run", "parse_speeds", "MAX_SPEEDS"]
@@ -99,17 +98,10 @@ def _table(name: str, r) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    # Offscreen rendering: EGL works headless, and must be chosen before MuJoCo is imported.
-    if args.video:
-        os.environ.setdefault("MUJOCO_GL", "egl")
     from ..exceptions import SimulationError
 
     speeds = parse_speeds(args.speed)  # before MuJoCo loads: a bad speed is refused at once
-    try:
-        import mujoco  # noqa: F401  (reads MUJOCO_GL when imported)
-    except Exception as exc:  # an unusable backend fails inside MuJoCo's import, with various types
-        raise SimulationError("MUJOCO_GL", os.environ.get("MUJOCO_GL"), f"MuJoCo cannot start with this OpenGL "
-                              f"backend ({type(exc).__name__}); use MUJOCO_GL=egl, or unset it") from None
+    import_mujoco(bool(args.video))
     from ..logs import check_log_path
     from ..scenario import load_scenario
     from ..sim import JOINT_MODELS, build_model

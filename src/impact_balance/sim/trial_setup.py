@@ -107,7 +107,10 @@ class BalanceSetup:
 
     @classmethod
     def create(cls, scenario: Scenario | str, joints: str = "servo", options: BalanceTrialOptions | None = None,
-               sim_options: SimOptions | None = None) -> BalanceSetup:
+               sim_options: SimOptions | None = None, meshes: bool = False) -> BalanceSetup:
+        """Analyse ``scenario`` and build its MuJoCo model for trials with ``joints`` and ``options``
+        (``sim_options``: the model's own, default 1 ms steps; ``meshes``: load the robot's meshes,
+        visual only, for a video)."""
         options = options or BalanceTrialOptions()
         if not isinstance(scenario, Scenario):
             scenario = load_scenario(scenario)
@@ -123,7 +126,7 @@ class BalanceSetup:
         if sim_options is None:
             # 1 ms steps: the stiffest contact (impact, time constant 4 ms) still spans 4 steps.
             servo = ServoOptions() if joints == "servo" else STIFF_SERVOS
-            sim_options = SimOptions(timestep=0.001, meshes=False, servo=servo)
+            sim_options = SimOptions(timestep=0.001, meshes=meshes, servo=servo)
         # Welded joints admit no controller: "rigid" balance trials use stiff servos without effort limits.
         sim = build_model(scenario, "servo", sim_options)
         # MuJoCo's soft friction lets a loaded contact creep (a sole on the 30 degree ramp slides about
