@@ -3,6 +3,7 @@
 
     python benchmarks/governor.py [--json] [--ticks N] [--scenarios NAME ...] [--criterion com|zmp]
     python benchmarks/governor.py --study [--out DIR] ...     # the wall study: see governor_study.py
+    python benchmarks/governor.py --tolerance ...             # posture_tolerance: see governor_tolerance.py
 
 For each scenario of the wall study (palm_push_two_feet, palm_push_ramp, kick_one_foot,
 g1_two_feet), a 500 Hz trajectory of N ticks (default 2000, 4 s): every actuated joint follows
@@ -170,6 +171,10 @@ def main(argv: list[str] | None = None) -> int:
         import governor_study
 
         return governor_study.main(argv[1:])
+    if argv[:1] == ["--tolerance"]:  # posture_tolerance in the wall experiment: benchmarks/governor_tolerance.py
+        import governor_tolerance
+
+        return governor_tolerance.main(argv[1:])
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
     ap.add_argument("--ticks", type=int, default=2000, help="ticks per scenario (default 2000: 4 s at 500 Hz)")
