@@ -39,15 +39,21 @@ def _f(x, d: int = 3) -> str:
     return "-" if x is None else f"{x:.{d}f}"
 
 
+def governed_setup(name: str, rigid: bool):
+    """One stance of the study: the ``id`` controller's options (joints held through the impact
+    or not), its ZMP margin (m), the scenario the governor uses (areas shrunk by that margin)
+    and the MuJoCo setup. Returns ``(options, margin, governed, setup)``."""
+    options = BalanceTrialOptions(controller="id", rigid_impact=rigid)
+    margin = controller_margin(options)
+    scenario = load_scenario(name)
+    return options, margin, scenario.model_copy(update={"zmp_margin": margin}), BalanceSetup.create(scenario, "servo", options)
+
+
 def study(args, out: Path) -> list[dict]:
     rows = []
     for name in args.scenarios:
         for impact in args.impacts:
-            options = BalanceTrialOptions(controller="id", rigid_impact=impact == "rigid")
-            margin = controller_margin(options)
-            scenario = load_scenario(name)
-            governed = scenario.model_copy(update={"zmp_margin": margin})
-            setup = BalanceSetup.create(scenario, "servo", options)
+            options, margin, governed, setup = governed_setup(name, impact == "rigid")
             governors = {g: (None if g == "none" else Governor(governed, criterion=g)) for g in args.governors}
             digest = journal_digest({"trial_version": TRIAL_VERSION, "scenario": name, "impact": impact, "margin": margin})
             journal = TrialJournal.open(out / "journals" / f"approach_{name}_{impact}_{digest[:12]}.jsonl", digest)
@@ -98,12 +104,9 @@ def figures(args, out: Path) -> list[Path]:
 
     paths = []
     name = args.scenarios[0]
-    options = BalanceTrialOptions(controller="id", rigid_impact=True)
-    scenario = load_scenario(name)
-    governed = scenario.model_copy(update={"zmp_margin": controller_margin(options)})
-    setup = BalanceSetup.create(scenario, "servo", options)
+    options, margin, governed, setup = governed_setup(name, True)
     areas = setup.analysis.areas
-    zmp = areas.zmp_area.inset(controller_margin(options))
+    zmp = areas.zmp_area.inset(margin)
     margin_area = zmp.affine(areas.omega, -areas.omega * areas.com[:2])
     for g in args.governors:
         governor = None if g == "none" else Governor(governed, criterion=g)

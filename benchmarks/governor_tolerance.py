@@ -21,12 +21,9 @@ import time
 
 import numpy as np
 
+from governor_study import SCENARIOS, governed_setup
 from impact_balance.governor import Governor
-from impact_balance.scenario import load_scenario
-from impact_balance.sim.balance_trial import BalanceSetup, BalanceTrialOptions, controller_margin
 from impact_balance.sim.wall import WallOptions, run_wall_trial
-
-SCENARIOS = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot", "g1_two_feet")
 
 
 class _Paired:
@@ -50,11 +47,8 @@ class _Paired:
 
 def run(scenarios, tolerances) -> list[dict]:
     rows = []
-    options = BalanceTrialOptions(controller="id", rigid_impact=True)
     for name in scenarios:
-        scenario = load_scenario(name)
-        governed = scenario.model_copy(update={"zmp_margin": controller_margin(options)})
-        setup = BalanceSetup.create(scenario, "servo", options)
+        options, _, governed, setup = governed_setup(name, True)
         for tolerance in tolerances:
             paired = _Paired(Governor(governed, posture_tolerance=tolerance), Governor(governed))
             trial = run_wall_trial(setup, WallOptions(reference=2.0, governor="com", wall_distance=0.15), options,

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 from collections.abc import Callable, Sequence
 
 from ..exceptions import ImpactBalanceError, OptionError, short_repr
@@ -206,8 +207,6 @@ def import_mujoco(video: bool) -> None:
     """Import MuJoCo for a simulation command; with ``video``, offscreen rendering first picks
     EGL (it works headless, and must be chosen before MuJoCo is imported) unless ``MUJOCO_GL``
     says otherwise. An unusable backend is one :class:`~impact_balance.exceptions.SimulationError`."""
-    import os
-
     from ..exceptions import SimulationError
 
     if video:

@@ -26,7 +26,8 @@ def add_parser(sub) -> list[str]:
     where.add_argument("--wall-distance", type=number("--wall-distance", 0.0, 1.0, "m", lo_open=True), default=None,
                        metavar="D",
                        help="distance of the wall from the point's start, m (default 0.15: the scenario's impact point)")
-    where.add_argument("--wall-distance-range", type=float, nargs=2, default=None, metavar=("LO", "HI"),
+    where.add_argument("--wall-distance-range", type=number("--wall-distance-range", 0.0, 1.0, "m", lo_open=True), nargs=2,
+                       default=None, metavar=("LO", "HI"),
                        help="one trial at LO, the middle and HI, m")
     a.add_argument("--rigid-impact", action="store_true",
                    help="hold every joint's velocity through the impact (the paper's rigid robot)")
@@ -42,15 +43,13 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    import math
-
     from ..exceptions import SimulationError
 
     if args.video and args.wall_distance_range is not None:
         raise SimulationError("--video", args.video, "one .mp4 for one trial (give --wall-distance, not a range)")
     import_mujoco(bool(args.video))  # before anything imports MuJoCo: the GL backend is read then
     from ..scenario import load_scenario
-    from ..sim.balance_trial import BalanceSetup, BalanceTrialOptions
+    from ..sim.balance_trial import BalanceSetup, BalanceTrialOptions, controller_margin
     from ..sim.wall import WallOptions, run_wall_trial, write_wall_video
     from .output import print_json
 
@@ -59,14 +58,12 @@ def run(args: argparse.Namespace) -> int:
         raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact: approach needs one")
     if args.wall_distance_range is not None:
         lo, hi = args.wall_distance_range
-        if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi <= 1):
+        if lo > hi:
             raise SimulationError("--wall-distance-range", [lo, hi], "must be 0 < LO <= HI <= 1 m")
         distances = [lo, 0.5 * (lo + hi), hi] if hi > lo else [lo]
     else:
         distances = [0.15 if args.wall_distance is None else args.wall_distance]
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
-    from ..sim.balance_trial import controller_margin
-
     margin = controller_margin(options) if args.zmp_margin is None else args.zmp_margin
     governed = with_zmp_margin(scenario, margin)  # the governor's view: the area the controller can use
     setup = BalanceSetup.create(scenario, "servo", options, meshes=bool(args.video))  # meshes: visual only
