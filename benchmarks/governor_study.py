@@ -105,9 +105,7 @@ def figures(args, out: Path) -> list[Path]:
     paths = []
     name = args.scenarios[0]
     options, margin, governed, setup = governed_setup(name, True)
-    areas = setup.analysis.areas
-    zmp = areas.zmp_area.inset(margin)
-    margin_area = zmp.affine(areas.omega, -areas.omega * areas.com[:2])
+    margin_area = setup.analysis.areas.com_velocity_area_inset(margin)
     for g in args.governors:
         governor = None if g == "none" else Governor(governed, criterion=g)
         trial = run_wall_trial(setup, WallOptions(reference=0.8, governor=g, wall_distance=0.15, max_time=args.max_time),

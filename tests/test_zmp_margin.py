@@ -82,3 +82,13 @@ def test_gui_edit_of_the_margin(tmp_path):
     assert "shrunk by 1 cm" in svg_view(session.analysis)
     assert not session.set(("zmp_margin",), -1.0)  # refused with a message, state kept
     assert session.analysis.areas.zmp_margin == 0.01
+
+
+@pytest.mark.parametrize("name, margin", [("palm_push_ramp", 0.01), ("kick_one_foot", 0.02), ("kick_one_foot", 0.5)])
+def test_com_velocity_area_inset_is_the_area_analyze_gives_with_that_margin(name, margin):
+    """The plots' and the governor's dashed outline is the area of the scenario with that margin."""
+    plain = analyze(name).areas.com_velocity_area_inset(margin)
+    margined = analyze(load_scenario(name).model_copy(update={"zmp_margin": margin})).areas.com_velocity_area
+    assert plain.is_empty == margined.is_empty
+    if not plain.is_empty:
+        np.testing.assert_allclose(plain.vertices, margined.vertices, atol=1e-12)

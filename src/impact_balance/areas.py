@@ -85,12 +85,22 @@ class BalanceAreas:
         """False when the stance cannot hold the robot at rest (empty areas)."""
         return not self.com_velocity_area.is_empty
 
+    def com_velocity_area_inset(self, margin: float) -> Polygon:
+        """The CoM velocity area of ``zmp_area`` shrunk by ``margin`` more metres (what a
+        controller that keeps its ZMP that far inside can use); empty when nothing is left."""
+        return _velocity_area(self.zmp_area.inset(margin), self.omega, self.com)
+
     @property
     def zmp_area_without_margin(self) -> Polygon:
         """The ZMP support area before the margin (equal to ``zmp_area`` when it is 0)."""
         if self.zmp_margin == 0.0 or self.force_area.is_empty:
             return self.zmp_area
         return self.force_area.affine(self.plane_height - float(self.com[2]), self.com[:2])
+
+
+def _velocity_area(zmp: Polygon, w: float, com: np.ndarray) -> Polygon:
+    """The CoM velocity area of ZMP support area ``zmp``: ``w (z - c_xy)`` over its points z."""
+    return Polygon.empty() if zmp.is_empty else zmp.affine(w, -w * com[:2])
 
 
 def areas_from_polytope(polytope: WrenchPolytope, plane_height: float = 0.0, zmp_margin: float = 0.0) -> BalanceAreas:
@@ -112,7 +122,7 @@ def areas_from_polytope(polytope: WrenchPolytope, plane_height: float = 0.0, zmp
         zmp = vel = Polygon.empty()
     elif zmp_margin > 0.0:
         zmp = force.affine(depth, com[:2]).inset(zmp_margin)
-        vel = zmp.affine(w, -w * com[:2]) if not zmp.is_empty else Polygon.empty()
+        vel = _velocity_area(zmp, w, com)
     else:
         zmp = force.affine(depth, com[:2])
         vel = force.affine(w * depth, np.zeros(2))

@@ -117,11 +117,7 @@ def _plot(trial, setup, out: Path, zmp_margin: float) -> Path:
     from ..plots.save import figure_prefix
 
     out.mkdir(parents=True, exist_ok=True)
-    areas = setup.analysis.areas
-    margin = None
-    if zmp_margin > 0:
-        zmp = areas.zmp_area.inset(zmp_margin)
-        margin = zmp.affine(areas.omega, -areas.omega * areas.com[:2]) if not zmp.is_empty else None
+    margin = setup.analysis.areas.com_velocity_area_inset(zmp_margin) if zmp_margin > 0 else None
     o = trial.options
     path = out / f"{figure_prefix(setup.analysis)}_approach_{o.governor}_{o.reference:g}_{100 * o.wall_distance:g}cm.png"
     plot_approach(trial, setup.analysis, margin).savefig(path)

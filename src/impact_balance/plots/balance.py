@@ -94,10 +94,7 @@ def plot_impact_trajectories(result, analysis) -> Figure:
     velocity area; each trial's line ends with a marker that the legend names by its measured speed."""
     areas = analysis.areas
     area = areas.com_velocity_area
-    shrunk = None
-    if result.zmp_margin > 0:
-        zmp = areas.zmp_area.inset(result.zmp_margin)
-        shrunk = zmp.affine(areas.omega, -areas.omega * areas.com[:2]) if not zmp.is_empty else None
+    shrunk = areas.com_velocity_area_inset(result.zmp_margin) if result.zmp_margin > 0 else None
     fig = new_figure(6.4, 6.4)
     ax = fig.add_subplot()
     handles = _area_with_margin(ax, area, shrunk, AREA_COLOR, "CoM velocity area", result.zmp_margin)
@@ -139,8 +136,7 @@ def plot_push_trajectories(result, kind: str = "com_velocity") -> Figure:
         shrunk = areas.zmp_area.inset(margin) if margin > 0 else None
     else:
         area, color, label, unit, quantity = areas.com_velocity_area, AREA_COLOR, "CoM velocity area", "m/s", "CoM velocity"
-        zmp = areas.zmp_area.inset(margin) if margin > 0 else None
-        shrunk = None if zmp is None or zmp.is_empty else zmp.affine(areas.omega, -areas.omega * areas.com[:2])
+        shrunk = areas.com_velocity_area_inset(margin) if margin > 0 else None
     fig = new_figure(6.4, 6.6)
     ax = fig.add_subplot()
     handles = _area_with_margin(ax, area, shrunk, color, label, margin)
