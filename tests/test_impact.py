@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import impact_balance as ib
-from impact_balance.criteria import capped_velocity, max_contact_velocity, zmp_max_contact_velocity
+from impact_balance.criteria import capped_velocity, max_contact_velocity
 from impact_balance.impact import cone_tangents, friction_cone, impact_model
 from impact_balance.qp import QPOptions, solve_contact_velocity_qp
 
@@ -64,21 +64,25 @@ def test_composite_W_is_the_rigid_body_response(analyses):
         np.testing.assert_allclose(W @ iota, dv_com + np.cross(domega, r), rtol=1e-10, atol=1e-12)
 
 
-def test_spd_solve_of_W_matches_lapack():
-    """W's 3 x 3 solve (Cholesky in floats) agrees with LAPACK; non-SPD matrices go to LAPACK."""
-    from impact_balance.impact import _solve_spd3
+def test_composite_W_matches_lapack():
+    """W's compiled 3 x 3 Cholesky solve agrees with LAPACK's; an inertia that is not positive
+    definite goes to LAPACK (which refuses a singular one)."""
+    from impact_balance.impact import composite_inertia_map
+    from impact_balance.spatial import skew
 
     rng = np.random.default_rng(3)
     for _ in range(200):
         M = rng.normal(size=(3, 3))
-        A, B = M @ M.T + 1e-3 * np.eye(3), rng.normal(size=(3, 3))
-        expected = np.linalg.solve(A, B)
+        A, r, m = M @ M.T + 1e-3 * np.eye(3), rng.normal(size=3), rng.uniform(1.0, 100.0)
+        expected = np.eye(3) / m - skew(r) @ np.linalg.solve(A, skew(r))
         bound = 1e-14 * np.linalg.cond(A) * np.abs(expected).max()
-        np.testing.assert_allclose(_solve_spd3(A, B), expected, rtol=0, atol=bound)
+        np.testing.assert_allclose(composite_inertia_map(r, m, A), expected, rtol=0, atol=bound)
     indefinite = np.diag([1.0, -2.0, 4.0])
-    np.testing.assert_allclose(_solve_spd3(indefinite, np.eye(3)), np.diag([1.0, -0.5, 0.25]))
+    r = np.array([0.3, -0.2, 0.5])
+    np.testing.assert_allclose(composite_inertia_map(r, 2.0, indefinite),
+                               np.eye(3) / 2.0 - skew(r) @ np.diag([1.0, -0.5, 0.25]) @ skew(r))
     with pytest.raises(np.linalg.LinAlgError):
-        _solve_spd3(np.zeros((3, 3)), np.eye(3))
+        composite_inertia_map(r, 2.0, np.zeros((3, 3)))
 
 
 def test_joint_space_W_option(analyses):

@@ -93,12 +93,15 @@ def test_extreme_friction_matches_bretl(frictions):
     _same_polygon(auto.polygon, bretl.polygon)
 
 
-def test_walk_rejects_a_bad_walk():
-    """method='walk' refuses (rather than answers) where the walk loses its way."""
+@pytest.mark.parametrize("frictions", [(0.7, 0.7, 1e8), (1e-9, 1e-9, 0.7)])
+def test_walk_rejects_a_bad_walk(frictions):
+    """method='walk' refuses (rather than answers) where the walk loses its way: on these
+    badly scaled rows (the unnormalised polytope) its vertices violate constraints by 2e-3
+    to 1.4 (units of the unit rows), which the certificate catches."""
     from impact_balance.exceptions import SolverError
 
     with pytest.raises(SolverError):
-        _project("talos_three_contacts", (0.7, 0.7, 1e9), method="walk")
+        _project("talos_three_contacts", frictions, method="walk")
 
 
 #: Nesting tolerance: the merge (MERGE_TOLERANCE) plus the walk's certified vertex precision.

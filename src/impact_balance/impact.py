@@ -164,8 +164,54 @@ def impulse_to_velocity(
 def composite_inertia_map(arm: np.ndarray, mass: float, com_inertia: np.ndarray) -> np.ndarray:
     """W = I / m - [r]x Ic^-1 [r]x (1/kg) of the robot as one rigid body: ``arm`` r = point - CoM
     (m), ``mass`` (kg), ``com_inertia`` Ic about the CoM in world axes (kg m^2)."""
-    r = skew(arm)
-    return np.eye(3) / mass - r @ _solve_spd3(com_inertia, r)
+    arm = np.ascontiguousarray(arm, dtype=float)
+    com_inertia = np.ascontiguousarray(com_inertia, dtype=float)
+    W = np.empty((3, 3))
+    if _composite_map(arm, float(mass), com_inertia, W):
+        return W
+    r = skew(arm)  # Ic not positive definite (not a rigid body's): LAPACK's LU says what it can
+    return np.eye(3) / mass - r @ np.linalg.solve(com_inertia, r)
+
+
+@njit(cache=True)
+def _composite_map(arm, mass, Ic, W):
+    """``W`` = I / m - [r]x Ic^-1 [r]x by a 3 x 3 Cholesky of ``Ic``, in floats; False (W
+    untouched) when ``Ic`` is not positive definite. Compiled: numpy's and LAPACK's set-up
+    cost ~15 us per call for these few flops, and a governor builds W every tick. Python
+    floats when interpreted: an overflow gives inf (reported by the caller), not a warning."""
+    a, b, c = float(Ic[0, 0]), float(Ic[0, 1]), float(Ic[0, 2])
+    d, e, f = float(Ic[1, 1]), float(Ic[1, 2]), float(Ic[2, 2])
+    if not a > 0.0:
+        return False
+    l00 = math.sqrt(a)
+    l10, l20 = b / l00, c / l00
+    p11 = d - l10 * l10
+    if not p11 > 0.0:
+        return False
+    l11 = math.sqrt(p11)
+    l21 = (e - l20 * l10) / l11
+    p22 = f - l20 * l20 - l21 * l21
+    if not p22 > 0.0:
+        return False
+    l22 = math.sqrt(p22)
+    rx, ry, rz = float(arm[0]), float(arm[1]), float(arm[2])
+    # Columns of S = [r]x; X = Ic^-1 S by L y = s, L^T x = y; W = I/m - S X.
+    S = ((0.0, rz, -ry), (-rz, 0.0, rx), (ry, -rx, 0.0))  # S[j] = column j of [r]x
+    X = np.empty((3, 3))
+    for j in range(3):
+        s0, s1, s2 = S[j]
+        y0 = s0 / l00
+        y1 = (s1 - l10 * y0) / l11
+        y2 = (s2 - l20 * y0 - l21 * y1) / l22
+        x2 = y2 / l22
+        x1 = (y1 - l21 * x2) / l11
+        X[0, j], X[1, j], X[2, j] = (y0 - l10 * x1 - l20 * x2) / l00, x1, x2
+    inverse_mass = 1.0 / mass
+    for i in range(3):  # row i of [r]x is minus column i
+        for j in range(3):
+            acc = -(S[i][0] * X[0, j] + S[i][1] * X[1, j] + S[i][2] * X[2, j])
+            W[i, j] = (inverse_mass if i == j else 0.0) - acc
+    return True
 
 
 def joint_space_inertia_map(workspace, model: pin.Model, q: np.ndarray, jacobian: np.ndarray) -> np.ndarray:
@@ -183,38 +229,6 @@ def joint_space_inertia_map(workspace, model: pin.Model, q: np.ndarray, jacobian
                                    "that moves no mass: no finite joint-space inertia there (use composite)")
         M, jacobian = M[np.ix_(moving, moving)], jacobian[:, moving]
     return jacobian @ np.linalg.solve(M, jacobian.T)
-
-
-def _solve_spd3(A: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """``A^-1 B`` for a symmetric positive definite 3 x 3 ``A`` (Cholesky, in Python floats).
-
-    ``np.linalg.solve`` spends ~6 us (~50 us with cold caches) in its Python and LAPACK
-    set-up for 3 x 3 systems; this takes ~3 us and agrees with it to a few ulps (``A`` is an
-    inertia, well conditioned). A matrix that is not positive definite goes to LAPACK.
-    """
-    (a, b, c), (_, d, e), (_, _, f) = A.tolist()
-    if not a > 0.0:
-        return np.linalg.solve(A, B)
-    l00 = math.sqrt(a)
-    l10, l20 = b / l00, c / l00
-    p11 = d - l10 * l10
-    if not p11 > 0.0:
-        return np.linalg.solve(A, B)
-    l11 = math.sqrt(p11)
-    l21 = (e - l20 * l10) / l11
-    p22 = f - l20 * l20 - l21 * l21
-    if not p22 > 0.0:
-        return np.linalg.solve(A, B)
-    l22 = math.sqrt(p22)
-    columns = []
-    for x0, x1, x2 in B.T.tolist():
-        y0 = x0 / l00  # L y = x, then L^T z = y
-        y1 = (x1 - l10 * y0) / l11
-        y2 = (x2 - l20 * y0 - l21 * y1) / l22
-        z2 = y2 / l22
-        z1 = (y1 - l21 * z2) / l11
-        columns.append(((y0 - l10 * z1 - l20 * z2) / l00, z1, z2))
-    return np.array(columns).T
 
 
 def _short(v: np.ndarray) -> list[float]:
@@ -259,9 +273,9 @@ def model_from_inertia_map(spec: ImpactSpec, point: np.ndarray, arm: np.ndarray,
         raise ImpactModelError(
             "impact.offset", _short(arm), "the impact point is too far from the CoM: W is not finite"
         )
-    normal_response = normal @ W @ cone  # n^T W K_i, > 0 for an impulse that pushes the point back
     lo, hi = spec.restitution
-    smallest, rates = _impulse_rates(normal_response, cone, float(lo), float(hi))
+    smallest, rates = _impulse_rates(np.ascontiguousarray(normal, dtype=float), np.ascontiguousarray(W, dtype=float),
+                                     np.ascontiguousarray(cone, dtype=float), float(lo), float(hi))
     if not smallest > 1e-12:  # the kernel's own threshold
         raise ImpactModelError(
             "impact.friction",
@@ -273,12 +287,21 @@ def model_from_inertia_map(spec: ImpactSpec, point: np.ndarray, arm: np.ndarray,
 
 
 @njit(cache=True)
-def _impulse_rates(normal_response, K, lo, hi):
+def _impulse_rates(normal, W, K, lo, hi):
     """``(min_i n^T W K_i, rates)``: rows 2i and 2i+1 of ``rates`` (2N, 3) are
     ``(1 + c) / (n^T W K_i) K_i`` for c = hi and lo (the impulse vertices per unit approach
-    speed). Compiled: numpy spent ~15 us of call overhead on these few multiplications."""
+    speed); n^T W K_i > 0 for an impulse that pushes the point back. Compiled: numpy spent
+    ~15 us of call overhead on these few multiplications."""
     N = K.shape[1]
     rates = np.empty((2 * N, 3))
+    nW = np.zeros(3)
+    for c in range(3):
+        for r in range(3):
+            nW[c] += normal[r] * W[r, c]
+    normal_response = np.zeros(N)
+    for i in range(N):
+        for c in range(3):
+            normal_response[i] += nW[c] * K[c, i]
     smallest = math.inf
     for i in range(N):
         if not normal_response[i] >= smallest:  # also takes a NaN, which fails the caller's check

@@ -101,6 +101,64 @@ def _simplify(v: np.ndarray, tol: float, area_tol: float) -> np.ndarray:
     return v[idx[:k]].copy()
 
 
+@njit(cache=True)
+def _convex_ccw(v):
+    """Whether the (k, 2) vertices form a convex counter-clockwise polygon that winds once.
+
+    Every turn must be a left turn (cross product >= -1e-9 of the edge lengths' product,
+    i.e. a clockwise kink under a nano-radian) and the turning angles must add up to 2 pi:
+    a walk that lost its way backtracks (a half-turn) or winds twice. Fewer than 3
+    vertices (a point or a segment) pass; non-finite coordinates fail.
+    """
+    k = v.shape[0]
+    for i in range(k):
+        if not (math.isfinite(v[i, 0]) and math.isfinite(v[i, 1])):
+            return False
+    if k < 3:
+        return True
+    total = 0.0
+    for i in range(k):
+        a = v[i - 1]
+        b = v[i]
+        c = v[(i + 1) % k]
+        e0x, e0y = b[0] - a[0], b[1] - a[1]
+        e1x, e1y = c[0] - b[0], c[1] - b[1]
+        cross = e0x * e1y - e0y * e1x
+        dot = e0x * e1x + e0y * e1y
+        if cross < -1e-9 * math.hypot(e0x, e0y) * math.hypot(e1x, e1y):
+            return False
+        total += math.atan2(cross, dot)
+    return abs(total - 2.0 * math.pi) < 1e-6
+
+
+@njit(cache=True)
+def _simplify_convex(v, check_tol, tol, area_tol, box):
+    """Compiled body of :func:`simplify_convex`."""
+    first = _simplify(v, check_tol, area_tol)
+    if not _convex_ccw(first):
+        return False, first, False
+    out = _simplify(first, tol, area_tol)
+    bounded = True
+    limit = box * (1.0 - 1e-9)
+    for i in range(out.shape[0]):
+        for j in range(2):
+            if not abs(out[i, j]) < limit:  # also False for a NaN
+                bounded = False
+    return True, out, bounded
+
+
+def simplify_convex(vertices: np.ndarray, check_tol: float, tol: float, box: float,
+                    area_tol: float = MERGE_AREA_TOLERANCE) -> tuple[np.ndarray, bool] | None:
+    """A projection's raw vertices (k >= 1, counter-clockwise), certified and merged in one
+    compiled call: merged within ``check_tol`` (rounding-level duplicates), checked convex,
+    counter-clockwise and winding once (see :func:`_convex_ccw`), then merged within ``tol``
+    (see :func:`simplify`). Returns ``(vertices, bounded)``, bounded when every coordinate is
+    under ``box`` (the clipping box), or None when the check fails."""
+    v = np.ascontiguousarray(np.asarray(vertices, dtype=float).reshape(-1, 2))
+    ok, out, bounded = _simplify_convex(v, float(check_tol), float(tol), float(area_tol), float(box))
+    return (out, bool(bounded)) if ok else None
+
+
 def simplify(vertices: np.ndarray, tol: float = 1e-9, area_tol: float = MERGE_AREA_TOLERANCE) -> np.ndarray:
     """Merge duplicate and collinear consecutive vertices of a CCW convex polygon.
 
@@ -223,6 +281,35 @@ def _edge_halfplanes(v):
     return G, h
 
 
+@njit(cache=True)
+def _inset_polygon(v, distance):
+    """Vertices of the CCW polygon ``v`` (k >= 3) shrunk by ``distance`` > 0; (0, 2) when
+    empty. One compiled call: a governor shrinks an area every tick."""
+    G, h = _edge_halfplanes(v)
+    # Relative to a point inside (the vertices' mean): corners stay well conditioned far
+    # from the origin.
+    k = v.shape[0]
+    cx, cy = 0.0, 0.0
+    for i in range(k):
+        cx += v[i, 0]
+        cy += v[i, 1]
+    cx, cy = cx / k, cy / k
+    for i in range(k):
+        h[i] -= G[i, 0] * cx + G[i, 1] * cy
+    out = _inset(G, h, distance)
+    if out.shape[0] == 0:
+        return out
+    # Edges that left at about ``distance`` leave (near-)duplicate corners: merge them.
+    scale = 0.0
+    for i in range(out.shape[0]):
+        scale = max(scale, abs(out[i, 0]), abs(out[i, 1]))
+    out = _simplify(out, 1e-12 * max(1.0, scale), MERGE_AREA_TOLERANCE)
+    for i in range(out.shape[0]):
+        out[i, 0] += cx
+        out[i, 1] += cy
+    return out
+
+
 def _frozen(G: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Read-only arrays: the half-planes are cached on the (immutable) polygon."""
     G.setflags(write=False)
@@ -343,16 +430,7 @@ class Polygon:
             return self
         if len(self.vertices) < 3:
             return Polygon.empty()
-        G, h = self.halfplanes
-        # Relative to a point inside (the vertices' mean): corners stay well conditioned far
-        # from the origin.
-        centre = self.vertices.mean(axis=0)
-        v = _inset(G, h - G @ centre, distance)
-        if len(v) == 0:
-            return Polygon.empty()
-        # Edges that left at about ``distance`` leave (near-)duplicate corners: merge them.
-        scale = float(np.abs(v).max())
-        return Polygon(simplify(v, 1e-12 * max(1.0, scale)) + centre, self.bounded)
+        return Polygon(_inset_polygon(np.ascontiguousarray(self.vertices), distance), self.bounded)
 
     def to_dict(self) -> dict:
         G, h = self.halfplanes

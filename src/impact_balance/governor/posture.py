@@ -121,12 +121,18 @@ class PostureEvaluator:
     def __init__(self, robot: Robot, settings: PostureSettings):
         self.robot = robot
         self.settings = settings
-        model = robot.model
+        contacts, impact = settings.contacts, settings.impact
+        frames = [robot.frame_id(c.frame, f"contacts[{i}].frame") for i, c in enumerate(contacts)]
+        impact_frame = robot.frame_id(impact.frame, "impact.frame")
+        # A copy of the model with each offset contact or impact point as a frame of its own
+        # (made once): pinocchio then gives its pose and Jacobian directly, where shifting the
+        # frame's Jacobian to the point in numpy cost ~5 us per point and tick.
+        self.model = model = pin.Model(robot.model)
+        self._frames = [_point_frame(model, fid, c.offset, f"impact_balance_contact_{i}")
+                        for i, (fid, c) in enumerate(zip(frames, contacts))]
+        self._impact_frame = _point_frame(model, impact_frame, impact.offset, "impact_balance_impact")
         self.scratch = Scratch(model)
         self._free_flyer = _has_free_flyer(model)
-        contacts = settings.contacts
-        self._frames = [robot.frame_id(c.frame, f"contacts[{i}].frame") for i, c in enumerate(contacts)]
-        self._offsets = [c.offset for c in contacts]
         m = len(contacts)
         self._faces = np.array([_local_faces(float(c.friction), 0.5 * float(c.size[0]), 0.5 * float(c.size[1]))
                                 for c in contacts]).reshape(m, 16, 6)
@@ -134,8 +140,6 @@ class PostureEvaluator:
         idx, limit = robot.effort_limits
         self._torques = bool(settings.torque_limits and m and idx.size)
         self._idx, self._limit = (idx, limit) if self._torques else (np.zeros(0, dtype=np.int64), np.zeros(0))
-        impact = settings.impact
-        self._impact_frame = robot.frame_id(impact.frame, "impact.frame")
         self._normal, self._cone = impact_cone(impact)
         # Buffers, overwritten every posture (the answers keep copies).
         self._q_local = np.zeros(model.nq)
@@ -150,8 +154,7 @@ class PostureEvaluator:
         that would not separate the contact), :class:`~impact_balance.exceptions.SolverError`
         (a projection that failed).
         """
-        robot, settings, data = self.robot, self.settings, self.scratch.data
-        model = robot.model
+        robot, settings, data, model = self.robot, self.settings, self.scratch.data, self.model
         # The kinematics in the stance frame (world axes, origin at the base position), as
         # Stance does: lever arms keep their precision however far the robot stands.
         q_local = self._q_local
@@ -172,8 +175,8 @@ class PostureEvaluator:
         rotations = np.empty((m, 3, 3))
         local = np.empty((m, 3))
         jacobians = np.empty((6 * m, model.nv)) if self._torques else np.zeros((0, 0))
-        for i, (fid, offset) in enumerate(zip(self._frames, self._offsets)):
-            placement, J = frame_point(model, data, fid, offset, self._torques)
+        for i, fid in enumerate(self._frames):
+            placement, J = frame_point(model, data, fid, None, self._torques)
             rotations[i] = placement.rotation
             local[i] = placement.translation
             if J is not None:
@@ -201,14 +204,23 @@ class PostureEvaluator:
     def _impact(self, q: np.ndarray, q_local: np.ndarray, origin: np.ndarray, com_local: np.ndarray, mass: float,
                 inertia: np.ndarray) -> ImpactModel:
         """The impact model at the kinematics held in the Data (as :func:`~impact_balance.impact.impact_model`)."""
-        spec, data, model = self.settings.impact, self.scratch.data, self.robot.model
-        placement, J6 = frame_point(model, data, self._impact_frame, spec.offset)
+        spec, data, model = self.settings.impact, self.scratch.data, self.model
+        placement, J6 = frame_point(model, data, self._impact_frame, None)
         point_local = placement.translation.copy()
         arm = point_local - com_local
         J = J6[:3].copy()
-        with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported by the model
-            if spec.inertia == "joint_space":
+        if spec.inertia == "joint_space":
+            with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported by the model
                 W = joint_space_inertia_map(self.scratch, model, q, J)
-            else:
-                W = composite_inertia_map(arm, mass, inertia)
+        else:  # compiled, in floats: an overflow is an inf, reported by the model, not a warning
+            W = composite_inertia_map(arm, mass, inertia)
         return model_from_inertia_map(spec, point_local + origin, arm, self._normal.copy(), self._cone.copy(), W, mass, J)
+
+
+def _point_frame(model: pin.Model, fid: int, offset: pin.SE3 | None, name: str) -> int:
+    """The id of a frame of ``model`` at frame ``fid`` times ``offset``: ``fid`` itself without
+    an offset, else a new operational frame on the same joint (``model`` is modified)."""
+    if offset is None or offset == pin.SE3.Identity():  # exact, as frame_point tests it
+        return fid
+    frame = model.frames[fid]
+    return model.addFrame(pin.Frame(name, frame.parentJoint, fid, frame.placement * offset, pin.FrameType.OP_FRAME))

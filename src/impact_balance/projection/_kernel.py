@@ -29,11 +29,11 @@ import numpy as np
 
 from .._jit import njit
 
-__all__ = ["project", "equality_basis", "walk", "convex_ccw", "OK", "INFEASIBLE", "FAILED", "LINE"]
+__all__ = ["project", "project_equalities", "equality_basis", "walk", "OK", "INFEASIBLE", "FAILED", "LINE", "INCONSISTENT"]
 
 #: Kernel statuses. LINE: the polytope contains a line (no vertex); the caller can quotient
-#: it out and call again.
-OK, INFEASIBLE, FAILED, LINE = 0, 1, 2, 3
+#: it out and call again. INCONSISTENT: the equalities have no solution.
+OK, INFEASIBLE, FAILED, LINE, INCONSISTENT = 0, 1, 2, 3, 4
 
 #: Relative multiplier tolerance (times |column of H_B^-1| |c|).
 _EPS_DUAL = 1e-11
@@ -78,6 +78,16 @@ def _times(M, v):
 
 
 @njit(cache=True)
+def _times_into(M, v, out):
+    """out = M v (out preallocated)."""
+    for i in range(M.shape[0]):
+        acc = 0.0
+        for j in range(M.shape[1]):
+            acc += M[i, j] * v[j]
+        out[i] = acc
+
+
+@njit(cache=True)
 def _point(g0, GT, z):
     """The projected point g0 + G z."""
     y = g0.copy()
@@ -88,14 +98,13 @@ def _point(g0, GT, z):
 
 
 @njit(cache=True)
-def _ratio_test(H, h, z, p, active):
+def _ratio_test(H, h, z, p, active, hp, slack):
     """Largest step along unit ``p`` that keeps ``H z <= h``: (row, step), row -1 if none.
 
-    Ties (within a relative 1e-12) go to the smallest row index (Bland).
+    Ties (within a relative 1e-12) go to the smallest row index (Bland). ``hp`` and ``slack``
+    (m) are work buffers.
     """
     m, n = H.shape
-    hp = np.empty(m)
-    slack = np.empty(m)
     best = math.inf
     for j in range(m):
         if active[j]:
@@ -184,17 +193,19 @@ def _crash(H, h, z, W, k, active, c, dc):
     n = H.shape[1]
     Q = np.zeros((n, n))  # orthonormal basis of the working rows, by Gram-Schmidt
     p = np.empty(n)
+    hp = np.empty(H.shape[0])
+    slack = np.empty(H.shape[0])
     for i in range(k):
         norm = _project_out(Q, i, H[W[i]], Q[i])
         Q[i] /= norm
     while k < n:
         kind = _null_direction(Q, k, c, dc, p)
-        j, t = _ratio_test(H, h, z, p, active)
+        j, t = _ratio_test(H, h, z, p, active, hp, slack)
         if j < 0:
             if kind != 2:
                 return FAILED, k  # ascending without bound
             p *= -1.0
-            j, t = _ratio_test(H, h, z, p, active)
+            j, t = _ratio_test(H, h, z, p, active, hp, slack)
             if j < 0:
                 return LINE, k  # a line in the polytope: no vertex
         for i in range(n):
@@ -248,10 +259,17 @@ def _invert(B, out):
 
 
 @njit(cache=True)
-def _refactor(H, h, W, Binv, z):
+def _workspace(m, n):
+    """The walk's work buffers, made once per walk (an allocation per pivot would cost as much
+    as the pivot): (p, col, alpha) of n, (hp, slack) of m, and an n x n basis copy."""
+    return np.empty(n), np.empty(n), np.empty(n), np.empty(m), np.empty(m), np.empty((n, n))
+
+
+@njit(cache=True)
+def _refactor(H, h, W, Binv, z, work):
     """Recompute the basis inverse and the vertex from scratch; False if singular."""
     n = H.shape[1]
-    B = np.empty((n, n))
+    B = work[5]
     for i in range(n):
         B[i] = H[W[i]]
     if not _invert(B, Binv):
@@ -261,19 +279,19 @@ def _refactor(H, h, W, Binv, z):
 
 
 @njit(cache=True)
-def _pivot(H, h, W, Binv, z, leave, j, since):
+def _pivot(H, h, W, Binv, z, leave, j, since, work):
     """Row ``j`` replaces the basis row in position ``leave``; updates Binv and z in place.
 
     Returns the pivots since the last refactorisation.
     """
     n = H.shape[1]
     W[leave] = j
-    if since + 1 >= _REFACTOR and _refactor(H, h, W, Binv, z):
+    if since + 1 >= _REFACTOR and _refactor(H, h, W, Binv, z, work):
         return 0
     # Rank-one update: column i of the new inverse is Binv[:, i] - col (a . Binv[:, i]) / piv
     # for i != leave, and col / piv for i == leave, with col = Binv[:, leave], a = H[j].
-    col = np.empty(n)
-    alpha = np.zeros(n)
+    col, alpha = work[1], work[2]
+    alpha[:] = 0.0
     for r in range(n):
         col[r] = Binv[r, leave]
         for i in range(n):
@@ -301,14 +319,18 @@ def _vertex(h, W, Binv, z):
 
 
 @njit(cache=True)
-def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots):
+def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, since, work):
     """Simplex pivots from the vertex basis (W, Binv, z) until it is optimal for the
-    lexicographic objective (c, dc); ``scale`` scales the multiplier tolerance.
-    Returns (status, pivots)."""
+    lexicographic objective (c, dc); ``scale`` scales the multiplier tolerance; ``since``:
+    pivots since Binv was last recomputed.
+
+    Returns (status, pivots, since, moved): ``moved`` is False when every pivot was a zero
+    step (the vertex z is the same point, a new basis of it).
+    """
     n = H.shape[1]
     pivots = 0
-    since = 0
-    p = np.empty(n)
+    moved = False
+    p = work[0]
     stalled = 0  # consecutive zero steps
     while True:
         # Entering candidates: multipliers negative at theta+. Steepest edge (most negative
@@ -339,20 +361,21 @@ def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots):
             elif this_tier < tier or (this_tier == tier and rate < best):
                 leave, tier, best = i, this_tier, rate
         if leave < 0:
-            return OK, pivots
+            return OK, pivots, since, moved
         pivots += 1
         if pivots > max_pivots:
-            return FAILED, pivots
+            return FAILED, pivots, since, moved
         norm = _column_norm(Binv, leave)
         for r in range(n):
             p[r] = -Binv[r, leave] / norm
         active[W[leave]] = False
-        j, t = _ratio_test(H, h, z, p, active)
+        j, t = _ratio_test(H, h, z, p, active, work[3], work[4])
         if j < 0:
-            return FAILED, pivots  # unbounded edge: the box is missing
+            return FAILED, pivots, since, moved  # unbounded edge: the box is missing
         stalled = stalled + 1 if t == 0.0 else 0
+        moved = moved or t > 0.0
         active[j] = True
-        since = _pivot(H, h, W, Binv, z, leave, j, since)
+        since = _pivot(H, h, W, Binv, z, leave, j, since, work)
 
 
 @njit(cache=True)
@@ -390,17 +413,13 @@ def _breakpoint(Binv, GT, theta, scale):
 
 
 @njit(cache=True)
-def walk(H, h, GT, g0, theta0, max_pivots, worst):
-    """Vertices of ``g0 + G {z : H z <= h}`` (rows of H unit norm; ``GT`` = G^T, n x 2).
+def _phase_one(H, h, z, W, active, max_pivots):
+    """A feasible point of ``{H z <= h}`` into ``z`` (and, when the phase-1 optimum is a vertex
+    basis of it, its rows into ``W[:k]``, flagged in ``active``). Returns (status, pivots, k).
 
-    Returns (status, vertices, count, pivots): ``vertices[:count]`` are the support points
-    in counter-clockwise order, consecutive duplicates removed (the last may equal the first).
-    ``worst[0]`` receives the smallest slack of the recorded vertices (>= -rounding for a
-    sound walk; the caller rejects the walk otherwise).
+    Phase 1: max -s over {H z - s <= h, s >= 0} from (0, s0), s0 feasible.
     """
     m, n = H.shape
-    vertices = np.empty((0, 2))
-    # Phase 1: max -s over {H z - s <= h, s >= 0} from (0, s0), s0 feasible.
     Ha = np.zeros((m + 1, n + 1))
     Ha[:m, :n] = H
     Ha[:m, n] = -1.0
@@ -415,20 +434,18 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst):
     c1[n] = -1.0
     status, _ = _crash(Ha, ha, za, Wa, 0, active_a, c1, np.zeros(n + 1))
     if status != OK:
-        return status, vertices, 0, 0
+        return status, 0, 0
     Binv_a = np.empty((n + 1, n + 1))
-    if not _refactor(Ha, ha, Wa, Binv_a, za):
-        return FAILED, vertices, 0, 0
-    status, pivots = _optimize(Ha, ha, za, Wa, Binv_a, active_a, c1, np.zeros(n + 1), 1.0, max_pivots)
+    work = _workspace(m + 1, n + 1)
+    if not _refactor(Ha, ha, Wa, Binv_a, za, work):
+        return FAILED, 0, 0
+    status, pivots, _, _ = _optimize(Ha, ha, za, Wa, Binv_a, active_a, c1, np.zeros(n + 1), 1.0, max_pivots, 0, work)
     if status != OK:
-        return status, vertices, 0, pivots
+        return status, pivots, 0
     if za[n] > _EPS_FEASIBLE:
-        return INFEASIBLE, vertices, 0, pivots
-    # Phase 2: an optimal basis for theta0+, then around the circle. When s >= 0 is in the
-    # phase-1 basis, the other n rows are a vertex basis of {H z <= h}; else crash again.
-    z = za[:n].copy()
-    W = np.zeros(n, dtype=np.int64)
-    active = np.zeros(m, dtype=np.bool_)
+        return INFEASIBLE, pivots, 0
+    # When s >= 0 is in the phase-1 basis, the other n rows are a vertex basis of {H z <= h}.
+    z[:] = za[:n]
     k = 0
     if active_a[m]:
         for i in range(n + 1):
@@ -436,6 +453,29 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst):
                 W[k] = Wa[i]
                 active[Wa[i]] = True
                 k += 1
+    return OK, pivots, k
+
+
+@njit(cache=True)
+def walk(H, h, GT, g0, theta0, max_pivots, worst):
+    """Vertices of ``g0 + G {z : H z <= h}`` (rows of H unit norm; ``GT`` = G^T, n x 2).
+
+    Returns (status, vertices, count, pivots): ``vertices[:count]`` are the support points
+    in counter-clockwise order, consecutive duplicates removed (the last may equal the first).
+    ``worst[0]`` receives the smallest slack of the recorded vertices (>= -rounding for a
+    sound walk; the caller rejects the walk otherwise).
+    """
+    m, n = H.shape
+    vertices = np.empty((0, 2))
+    z = np.zeros(n)
+    W = np.zeros(n, dtype=np.int64)
+    active = np.zeros(m, dtype=np.bool_)
+    k = 0
+    pivots = 0
+    if h.min() < 0.0:  # z = 0 is not feasible (it is for contact stances: x0 is inside)
+        status, pivots, k = _phase_one(H, h, z, W, active, max_pivots)
+        if status != OK:
+            return status, vertices, 0, pivots
     u = np.array([math.cos(theta0), math.sin(theta0)])
     du = np.array([-math.sin(theta0), math.cos(theta0)])
     c, dc = _times(GT, u), _times(GT, du)
@@ -443,10 +483,11 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst):
     if status != OK:
         return status, vertices, 0, pivots
     Binv = np.empty((n, n))
-    if not _refactor(H, h, W, Binv, z):
+    work = _workspace(m, n)
+    if not _refactor(H, h, W, Binv, z, work):
         return FAILED, vertices, 0, pivots
     scale = _norm(GT.ravel())  # sqrt(|G^T u|^2 + |G^T u'|^2), the same for every theta
-    status, piv = _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots)
+    status, piv, since, _ = _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, 0, work)
     pivots += piv
     if status != OK:
         return status, vertices, 0, pivots
@@ -461,50 +502,25 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst):
             break
         u[0], u[1] = math.cos(theta), math.sin(theta)
         du[0], du[1] = -math.sin(theta), math.cos(theta)
-        if not _refactor(H, h, W, Binv, z):  # each vertex from a fresh inverse: no drift
-            return FAILED, vertices, count, pivots
-        status, piv = _optimize(H, h, z, W, Binv, active, _times(GT, u), _times(GT, du), scale, max_pivots)
+        _times_into(GT, u, c)
+        _times_into(GT, du, dc)
+        # The inverse is recomputed every _REFACTOR pivots, counted across breakpoints: at a
+        # degenerate vertex most breakpoints are one zero step, and a fresh inverse for each
+        # cost more than the step.
+        status, piv, since, moved = _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, since, work)
         pivots += piv
         if status != OK or count > max_pivots:
             return FAILED, vertices, count, pivots
-        # piv == 0: the crossing multiplier was within the tolerance of zero; the next
-        # breakpoint search starts past it.
+        # Not moved: a new basis of the same vertex (or piv == 0: the crossing multiplier was
+        # within the tolerance of zero); the next breakpoint search starts past it.
+        if not moved:
+            continue
         _min_slack(H, h, z, worst)
         y = _point(g0, GT, z)
         if abs(y[0] - vertices[count - 1, 0]) + abs(y[1] - vertices[count - 1, 1]) > 0.0:
             vertices[count] = y
             count += 1
     return OK, vertices, count, pivots
-
-
-@njit(cache=True)
-def convex_ccw(v):
-    """Whether the (k, 2) vertices form a convex counter-clockwise polygon that winds once.
-
-    Every turn must be a left turn (cross product >= -1e-9 of the edge lengths' product,
-    i.e. a clockwise kink under a nano-radian) and the turning angles must add up to 2 pi:
-    a walk that lost its way backtracks (a half-turn) or winds twice. Fewer than 3
-    vertices (a point or a segment) pass; non-finite coordinates fail.
-    """
-    k = v.shape[0]
-    for i in range(k):
-        if not (math.isfinite(v[i, 0]) and math.isfinite(v[i, 1])):
-            return False
-    if k < 3:
-        return True
-    total = 0.0
-    for i in range(k):
-        a = v[i - 1]
-        b = v[i]
-        c = v[(i + 1) % k]
-        e0x, e0y = b[0] - a[0], b[1] - a[1]
-        e1x, e1y = c[0] - b[0], c[1] - b[1]
-        cross = e0x * e1y - e0y * e1x
-        dot = e0x * e1x + e0y * e1y
-        if cross < -1e-9 * math.hypot(e0x, e0y) * math.hypot(e1x, e1y):
-            return False
-        total += math.atan2(cross, dot)
-    return abs(total - 2.0 * math.pi) < 1e-6
 
 
 @njit(cache=True)
@@ -569,9 +585,9 @@ def project(A, b, E, x0, N, box, max_pivots):
     status, vertices, count, pivots = walk(H[:m].copy(), h[:m].copy(), G.T.copy(), g0, 0.0, max_pivots, worst)
     if status != OK:
         return status, none, pivots, worst[0]
-    # The caller merges near-duplicate vertices (polygon.simplify) and checks convexity: the
-    # merge is compiled in its own module, and numba's cache of this kernel would not notice
-    # a change there (it hashes this file only).
+    # The caller merges near-duplicate vertices and checks convexity
+    # (polygon.simplify_convex): the merge is compiled in its own module, and numba's cache of
+    # this kernel would not notice a change there (it hashes this file only).
     return OK, vertices[:count].copy(), pivots, worst[0]
 
 
@@ -622,3 +638,16 @@ def equality_basis(C, d):
         for j in range(n):
             Q[count, j] = v[j] / norm
     return OK, x0, Q[r:].T.copy()
+
+
+@njit(cache=True)
+def project_equalities(A, b, C, d, E, box, max_pivots):
+    """:func:`project` of ``{x : A x <= b, C x = d}``, the equalities eliminated by
+    :func:`equality_basis` in the same compiled call (a governor pays each call's dispatch
+    every tick). Returns (status, vertices, pivots, worst, x0, N); status INCONSISTENT for
+    inconsistent equalities."""
+    status, x0, N = equality_basis(C, d)
+    if status == INFEASIBLE:
+        return INCONSISTENT, np.empty((0, 2)), 0, 0.0, x0, N
+    status, vertices, pivots, worst = project(A, b, E, x0, N, box, max_pivots)
+    return status, vertices, pivots, worst, x0, N

@@ -24,8 +24,8 @@ import numpy as np
 
 from .._jit import HAVE_NUMBA
 
-from ..polygon import Polygon, simplify
-from ._kernel import FAILED, INFEASIBLE, LINE, OK, convex_ccw, equality_basis, project
+from ..polygon import Polygon, simplify_convex
+from ._kernel import FAILED, INCONSISTENT, INFEASIBLE, LINE, OK, project, project_equalities
 from .result import ProjectionResult
 
 __all__ = ["project_walk", "kernel_is_compiled", "warm_up"]
@@ -63,11 +63,11 @@ def project_walk(
     C = np.ascontiguousarray(np.reshape(C, (-1, n)), dtype=float)
     b = np.ascontiguousarray(np.reshape(b, -1), dtype=float)
     d = np.ascontiguousarray(np.reshape(d, -1), dtype=float)
-    # x = x0 + N z spans {C x = d} (compiled Gram-Schmidt, cheaper than a numpy SVD here).
-    status, x0, N = equality_basis(C, d)
-    if status == INFEASIBLE:
+    # x = x0 + N z spans {C x = d} (compiled Gram-Schmidt, cheaper than a numpy SVD here),
+    # then the walk, in one compiled call.
+    status, vertices, pivots, worst, x0, N = project_equalities(A, b, C, d, E, float(box), int(max_pivots))
+    if status == INCONSISTENT:
         return ProjectionResult(Polygon.empty(), "walk")
-    status, vertices, pivots, worst = project(A, b, E, x0, N, float(box), int(max_pivots))
     if status == LINE:
         # Lines of the polytope are the null space of [A N; E N] (a line along which E x
         # changed would have met the box rows); keep z in its orthogonal complement.
@@ -91,14 +91,12 @@ def project_walk(
     # went 1e-6 back inside and returned, whose detour then replaced the true corner). The
     # first pass only drops rounding-level duplicates, which would fail the strict check:
     # within 1e-9, or 10 times the worst slack (a vertex's rounding shows in its slacks; 1e-8
-    # with a friction of 2.5e4 on Talos's foot).
-    vertices = simplify(vertices, min(merge_tol, max(CHECK_MERGE, -10.0 * worst)))
-    if not convex_ccw(vertices):
+    # with a friction of 2.5e4 on Talos's foot). One compiled call does the three steps.
+    merged = simplify_convex(vertices, min(merge_tol, max(CHECK_MERGE, -10.0 * worst)), merge_tol, box)
+    if merged is None:
         return None
-    vertices = simplify(vertices, merge_tol)
-    bounded = bool(np.abs(vertices).max() < box * (1 - 1e-9))  # all below (False with a NaN)
+    vertices, bounded = merged
     return ProjectionResult(Polygon(vertices, bounded), "walk", n_lp=1, pivots=pivots)
-
 
 def kernel_is_compiled() -> bool:
     """Whether numba's on-disk cache holds the kernel; if not, the first projection compiles
