@@ -25,14 +25,15 @@ INERTIA_Y = MASS * (LENGTH**2 + HEIGHT**2) / 12  # about the CoM, around y
 
 
 def _box(arm: tuple[float, float, float]) -> Robot:
-    """A free-floating homogeneous box, CoM at its root; frame "sole" at its bottom face's centre
-    and frame "hit" at ``arm`` from the CoM."""
+    """A free-floating homogeneous box, CoM at its root; frame "sole" at its bottom face's centre,
+    "left" and "right" 0.1 m to either side of it, and frame "hit" at ``arm`` from the CoM."""
     model = pin.Model()
     joint = model.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), "root")
     inertia = MASS / 12 * np.diag([WIDTH**2 + HEIGHT**2, LENGTH**2 + HEIGHT**2, LENGTH**2 + WIDTH**2])
     model.appendBodyToJoint(joint, pin.Inertia(MASS, np.zeros(3), inertia), pin.SE3.Identity())
     body = model.addBodyFrame("box", joint, pin.SE3.Identity(), 0)
-    for name, position in (("sole", (0.0, 0.0, -HALF)), ("hit", arm)):
+    frames = (("sole", (0.0, 0.0, -HALF)), ("left", (0.0, 0.1, -HALF)), ("right", (0.0, -0.1, -HALF)), ("hit", arm))
+    for name, position in frames:
         model.addFrame(pin.Frame(name, joint, body, pin.SE3(np.eye(3), np.array(position)), pin.FrameType.OP_FRAME))
     q = pin.neutral(model)
     q[2] = HALF  # the sole on z = 0
@@ -97,6 +98,21 @@ def test_frictionless_pivot_about_the_rear_edge(restitution):
     np.testing.assert_allclose(result.corner_impulses[0, :2], 0.0, atol=1e-9)
     floating = -(1 + e) * v_n / (1 + MASS * a**2 / INERTIA_Y)
     assert abs(result.com_velocity_jump[0]) > abs(floating) + 0.05
+
+
+def test_two_symmetric_feet_share_the_impulse():
+    """Two frictionless feet side by side, pushed in the symmetry plane: the same pivot as one
+    sole (the jump does not depend on how the rear edge is split), and the statically
+    indeterminate rear corners get the least-norm impulses, equal."""
+    a, v_n, k = 0.3, 0.6, LENGTH / 2
+    robot = _box((LENGTH / 2, 0.0, a))
+    feet = [ContactSpec(name, 0.0, (LENGTH, 0.1)) for name in ("left", "right")]
+    result = contact_impact(Stance(robot, robot.reference_configurations["neutral"], feet), _push(0.0), v_n)
+    expected = -v_n / (1 + MASS * a**2 / (INERTIA_Y + MASS * k**2))
+    assert result.com_velocity_jump[0] == pytest.approx(expected, rel=1e-7)
+    rear = result.corner_impulses[:, 2:, 2]  # (-X, +-Y) corners of both feet, vertical impulse
+    np.testing.assert_allclose(rear, rear.mean(), rtol=1e-6)
+    np.testing.assert_allclose(result.corner_impulses[:, :2], 0.0, atol=1e-9)
 
 
 def test_sticking_pivot_about_the_rear_edge():
