@@ -93,11 +93,13 @@ def test_extreme_friction_matches_bretl(frictions):
     _same_polygon(auto.polygon, bretl.polygon)
 
 
-@pytest.mark.parametrize("frictions", [(0.7, 0.7, 1e8), (1e-9, 1e-9, 0.7)])
+@pytest.mark.parametrize("frictions", [(1e-9, 1e-9, 0.7), (1e-6, 0.7, 1e6)])
 def test_walk_rejects_a_bad_walk(frictions):
     """method='walk' refuses (rather than answers) where the walk loses its way: on these
-    badly scaled rows (the unnormalised polytope) its vertices violate constraints by 2e-3
-    to 1.4 (units of the unit rows), which the certificate catches."""
+    badly scaled rows (the unnormalised polytope) its vertices violate constraints by 1e-5
+    to 1.4 (units of the unit rows), which the certificate catches. (Where it keeps its way,
+    e.g. (0.7, 0.7, 1e9) since the walk stopped refactoring at every breakpoint, its answer
+    agrees with Bretl's: test_extreme_friction_matches_bretl.)"""
     from impact_balance.exceptions import SolverError
 
     with pytest.raises(SolverError):
@@ -183,3 +185,16 @@ def test_merge_is_within_its_tolerance_of_every_input_vertex():
     merged = Polygon(simplify(ring, 1e-7))
     assert merged.contains(ring, tol=1e-7 * (1 + 1e-9)).all()
     assert merged.contains(np.array([[1.0, -1.0], [1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0]]), tol=0.0).all()
+
+
+def test_certificate_refuses_a_spike_along_an_edge():
+    """A walk that backtracks along an edge (out and back: two half-turns whose cross
+    products are rounding of either sign) is refused, not certified convex: its half-planes
+    would carry a reversed edge normal (found at talos_three_contacts, a hand at mu 1e6)."""
+    from impact_balance.polygon import simplify_convex
+
+    square = np.array([[1.0, -1.0], [1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0]])
+    assert simplify_convex(square, 1e-9, 1e-8, 1e3) is not None
+    for eps in (0.0, 1e-17, -1e-17):  # the tip's cross product: zero or rounding either way
+        spiked = np.array([[1.0, -1.0], [1.0, 1.0], [0.0, 1.0], [0.5, 1.0 + eps], [-1.0, 1.0], [-1.0, -1.0]])
+        assert simplify_convex(spiked, 1e-9, 1e-8, 1e3) is None

@@ -114,6 +114,19 @@ def _first_exit(margins, rates, tol):
 
 
 @njit(cache=True)
+def _jump_rates(impulse_rates, mass, G):
+    """``rates[j, k] = (iota_j,xy / m) . G_k``: the rate (m/s per m/s of approach speed) at which
+    post-impact vertex j uses up half-plane k's margin (``ImpactModel.com_jump_rates @ G.T``,
+    compiled: a governor builds it every posture)."""
+    rates = np.empty((impulse_rates.shape[0], G.shape[0]))
+    for j in range(impulse_rates.shape[0]):
+        x, y = impulse_rates[j, 0] / mass, impulse_rates[j, 1] / mass
+        for k in range(G.shape[0]):
+            rates[j, k] = x * G[k, 0] + y * G[k, 1]
+    return rates
+
+
+@njit(cache=True)
 def _com_exit(G, h, c0x, c0y, rates, tol):
     """:func:`_first_exit` of the margins ``h - G c0`` of the CoM velocity ``c0``."""
     margins = np.empty(h.size)
@@ -170,7 +183,7 @@ class ComCriterion:
             self.G = self.h = self.rates = None
             return
         self.G, self.h = area.halfplanes
-        self.rates = np.ascontiguousarray(impact.com_jump_rates @ self.G.T)
+        self.rates = _jump_rates(impact.impulse_rates, float(impact.mass), self.G)
 
     def margins(self, com_velocity: Sequence[float]) -> np.ndarray:
         """``h - G c0``: the slack of the pre-impact CoM velocity in each half-plane, m/s."""

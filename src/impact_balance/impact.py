@@ -269,13 +269,13 @@ def model_from_inertia_map(spec: ImpactSpec, point: np.ndarray, arm: np.ndarray,
     Raises:
         ImpactModelError: W is not finite, or a cone edge would not separate the contact.
     """
-    if not np.isfinite(W).all():
+    lo, hi = spec.restitution
+    finite, smallest, rates = _impulse_rates(np.ascontiguousarray(normal, dtype=float), np.ascontiguousarray(W, dtype=float),
+                                             np.ascontiguousarray(cone, dtype=float), float(lo), float(hi))
+    if not finite:
         raise ImpactModelError(
             "impact.offset", _short(arm), "the impact point is too far from the CoM: W is not finite"
         )
-    lo, hi = spec.restitution
-    smallest, rates = _impulse_rates(np.ascontiguousarray(normal, dtype=float), np.ascontiguousarray(W, dtype=float),
-                                     np.ascontiguousarray(cone, dtype=float), float(lo), float(hi))
     if not smallest > 1e-12:  # the kernel's own threshold
         raise ImpactModelError(
             "impact.friction",
@@ -288,12 +288,16 @@ def model_from_inertia_map(spec: ImpactSpec, point: np.ndarray, arm: np.ndarray,
 
 @njit(cache=True)
 def _impulse_rates(normal, W, K, lo, hi):
-    """``(min_i n^T W K_i, rates)``: rows 2i and 2i+1 of ``rates`` (2N, 3) are
+    """``(W finite, min_i n^T W K_i, rates)``: rows 2i and 2i+1 of ``rates`` (2N, 3) are
     ``(1 + c) / (n^T W K_i) K_i`` for c = hi and lo (the impulse vertices per unit approach
     speed); n^T W K_i > 0 for an impulse that pushes the point back. Compiled: numpy spent
     ~15 us of call overhead on these few multiplications."""
     N = K.shape[1]
     rates = np.empty((2 * N, 3))
+    for r in range(3):
+        for c in range(3):
+            if not math.isfinite(W[r, c]):
+                return False, math.nan, rates
     nW = np.zeros(3)
     for c in range(3):
         for r in range(3):
@@ -307,11 +311,11 @@ def _impulse_rates(normal, W, K, lo, hi):
         if not normal_response[i] >= smallest:  # also takes a NaN, which fails the caller's check
             smallest = normal_response[i]
     if not smallest > 1e-12:
-        return smallest, rates  # refused by the caller: no division by a vanishing response
+        return True, smallest, rates  # refused by the caller: no division by a vanishing response
     for i in range(N):
         r = normal_response[i]
         a, b = (1.0 + hi) / r, (1.0 + lo) / r
         for c in range(3):
             rates[2 * i, c] = a * K[c, i]
             rates[2 * i + 1, c] = b * K[c, i]
-    return smallest, rates
+    return True, smallest, rates

@@ -107,8 +107,11 @@ def _convex_ccw(v):
 
     Every turn must be a left turn (cross product >= -1e-9 of the edge lengths' product,
     i.e. a clockwise kink under a nano-radian) and the turning angles must add up to 2 pi:
-    a walk that lost its way backtracks (a half-turn) or winds twice. Fewer than 3
-    vertices (a point or a segment) pass; non-finite coordinates fail.
+    a walk that lost its way backtracks (a half-turn) or winds twice. A turn counts in
+    [0, pi] (a tolerated clockwise kink as 0): a spike out and back along an edge is two
+    half-turns whose signs are rounding (cross ~ 0), which would cancel as +pi and -pi, and
+    instead add 2 pi too many. Fewer than 3 vertices (a point or a segment) pass; non-finite
+    coordinates fail.
     """
     k = v.shape[0]
     for i in range(k):
@@ -127,7 +130,7 @@ def _convex_ccw(v):
         dot = e0x * e1x + e0y * e1y
         if cross < -1e-9 * math.hypot(e0x, e0y) * math.hypot(e1x, e1y):
             return False
-        total += math.atan2(cross, dot)
+        total += math.atan2(cross if cross > 0.0 else 0.0, dot)  # +0.0: max(-0.0, 0.0) is -0.0
     return abs(total - 2.0 * math.pi) < 1e-6
 
 

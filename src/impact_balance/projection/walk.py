@@ -57,12 +57,9 @@ def project_walk(
     end, an iteration cap, a vertex that violates a constraint, or vertices that are not a
     convex counter-clockwise polygon): the caller falls back to :func:`~.bretl.project_bretl`.
     """
-    E = np.ascontiguousarray(E, dtype=float)
+    E = _array(E, 2)
     n = E.shape[1]
-    A = np.ascontiguousarray(np.reshape(A, (-1, n)), dtype=float)
-    C = np.ascontiguousarray(np.reshape(C, (-1, n)), dtype=float)
-    b = np.ascontiguousarray(np.reshape(b, -1), dtype=float)
-    d = np.ascontiguousarray(np.reshape(d, -1), dtype=float)
+    A, C, b, d = _array(A, 2, n), _array(C, 2, n), _array(b, 1), _array(d, 1)
     # x = x0 + N z spans {C x = d} (compiled Gram-Schmidt, cheaper than a numpy SVD here),
     # then the walk, in one compiled call.
     status, vertices, pivots, worst, x0, N = project_equalities(A, b, C, d, E, float(box), int(max_pivots))
@@ -97,6 +94,17 @@ def project_walk(
         return None
     vertices, bounded = merged
     return ProjectionResult(Polygon(vertices, bounded), "walk", n_lp=1, pivots=pivots)
+
+def _array(x, ndim: int, columns: int | None = None) -> np.ndarray:
+    """``x`` as a C-contiguous float64 array of ``ndim`` dimensions (``columns`` columns):
+    itself when it already is one (a polytope's own arrays, every governor tick)."""
+    if (type(x) is np.ndarray and x.dtype == np.float64 and x.ndim == ndim and x.flags.c_contiguous
+            and (columns is None or x.shape[1] == columns)):
+        return x
+    a = np.asarray(x, dtype=float)
+    shape = (-1,) if ndim == 1 else (-1, a.shape[-1] if columns is None else columns)
+    return np.ascontiguousarray(np.reshape(a, shape))
+
 
 def kernel_is_compiled() -> bool:
     """Whether numba's on-disk cache holds the kernel; if not, the first projection compiles
