@@ -25,11 +25,11 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from impact_balance import cli
-from impact_balance.exceptions import MESSAGE_CHARS, ImpactBalanceError
+from impact_balance.exceptions import MESSAGE_CHARS
 from impact_balance.numeric_limits import MAX_APPROACH_SPEED, MIN_APPROACH_SPEED, TOLERANCE_RANGE
 
 sys.path.insert(0, str(Path(__file__).parent))
-from test_fuzz_scenarios import HOSTILE_NUMBERS, HOSTILE_STRINGS, _apply, _paths, values  # noqa: E402
+from test_fuzz_scenarios import HOSTILE_NUMBERS, _apply, _paths, values  # noqa: E402
 
 #: Multiplies the number of examples: IMPACT_BALANCE_FUZZ_SCALE=20 for a deeper search (minutes).
 SCALE = float(os.environ.get("IMPACT_BALANCE_FUZZ_SCALE", "1"))

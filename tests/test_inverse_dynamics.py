@@ -78,7 +78,6 @@ def test_stands_still_for_a_second(setup):
 
 
 def test_dcm_converges_after_a_small_push(setup):
-    gains = InverseDynamicsGains()
     push = Push(np.pi / 2, 5.0, 0.05, start=0.2)
     result = run_balance_trial(setup, push=push, options=BalanceTrialOptions(controller="id", after=1.2))
     assert not result.fell, result.detail

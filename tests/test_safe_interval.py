@@ -7,7 +7,6 @@ speeds are found by hand below, independently of the half-plane code.
 from __future__ import annotations
 
 import numpy as np
-import pinocchio as pin
 import pytest
 
 import impact_balance as ib

@@ -32,7 +32,6 @@ from impact_balance.scenario import _read, scenario_from_dict, scenario_path
 from impact_balance.sweep import Evaluator, make_plan, read_results, run_sweep, sweep_spec_from_dict
 from impact_balance.sweep.cluster import check_scheduler_address, connect
 from impact_balance.sweep.store import LEDGER, check_folder, table_checksum
-from impact_balance.sweep.summary import summarize
 
 SRC = str(Path(__file__).parents[1] / "src")
 BASE = "palm_push_two_feet"
