@@ -225,8 +225,9 @@ def assemble_polytope(
     b = np.zeros(16 * m + 2 * k)
     C = np.zeros((4, 6 * m))
     G = np.zeros((6, 6 * m))
-    _fill(np.ascontiguousarray(faces, dtype=float), np.ascontiguousarray(rotations, dtype=float), positions, arms,
-          A, C, G)
+    # One batched product for every contact's block (the same numbers as cwc_faces_world).
+    blocks = np.matmul(faces.reshape(m, 32, 3), rotations.transpose(0, 2, 1))
+    _fill(blocks, positions, arms, A, C, G)
     if k:
         _torque_rows(jacobians, torque_indices, torque_limits, gravity_torques, A[16 * m :], b[16 * m :])
     d = np.array([mass * gravity, 0.0, 0.0, 0.0])
@@ -235,23 +236,18 @@ def assemble_polytope(
 
 
 @njit(cache=True)
-def _fill(faces, rotations, positions, arms, A, C, G):
-    """The CWC blocks of ``A``: each contact's face rows ``faces`` (m, 16, 6, contact frame)
-    acting on world-axes wrenches, their force and torque halves rotated by ``rotations``
-    (m, 3, 3; :func:`~impact_balance.cwc.cwc_faces_world`), the LIPM rows ``C`` (rows 2-5 of
-    the grasp matrix at the arms) and the grasp matrix ``G`` at the world positions
-    (:func:`grasp_matrix`). Compiled: numpy spent ~40 us of call overhead per stance on
-    these products and copies."""
-    m = faces.shape[0]
+def _fill(blocks, positions, arms, A, C, G):
+    """The CWC blocks of ``A`` from ``blocks`` (m, 32, 3), each contact's face rows acting on
+    world-axes wrenches as (force, torque) halves (:func:`~impact_balance.cwc.cwc_faces_world`
+    reshaped), the LIPM rows ``C`` (rows 2-5 of the grasp matrix at the arms) and the grasp
+    matrix ``G`` at the world positions (:func:`grasp_matrix`). Compiled: numpy spent ~40 us
+    of call overhead per stance on these copies."""
+    m = blocks.shape[0]
     for i in range(m):
-        R = rotations[i]
         for r in range(16):
             for half in range(2):
-                for c in range(3):  # (face half) R^T: component c is the half . row c of R
-                    acc = 0.0
-                    for k in range(3):
-                        acc += faces[i, r, 3 * half + k] * R[c, k]
-                    A[16 * i + r, 6 * i + 3 * half + c] = acc
+                for c in range(3):
+                    A[16 * i + r, 6 * i + 3 * half + c] = blocks[i, 2 * r + half, c]
         _grasp_block(G, 0, i, positions[i])
         # C = rows 2..5 of the grasp matrix at the arms.
         o = 6 * i
