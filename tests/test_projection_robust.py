@@ -97,9 +97,10 @@ def test_extreme_friction_matches_bretl(frictions):
 def test_walk_rejects_a_bad_walk(frictions):
     """method='walk' refuses (rather than answers) where the walk loses its way: on these
     badly scaled rows (the unnormalised polytope) its vertices violate constraints by 1e-5
-    to 1.4 (units of the unit rows), which the certificate catches. (Where it keeps its way,
-    e.g. (0.7, 0.7, 1e9) since the walk stopped refactoring at every breakpoint, its answer
-    agrees with Bretl's: test_extreme_friction_matches_bretl.)"""
+    to 1.4 (units of the unit rows), which the certificate catches. Whether the walk keeps
+    its way on such rows changes with rounding (a wall hand at 1e8 or 1e9 went either way
+    while the kernel changed); where it does, its answer agrees with Bretl's
+    (test_extreme_friction_matches_bretl)."""
     from impact_balance.exceptions import SolverError
 
     with pytest.raises(SolverError):
@@ -190,7 +191,8 @@ def test_merge_is_within_its_tolerance_of_every_input_vertex():
 def test_certificate_refuses_a_spike_along_an_edge():
     """A walk that backtracks along an edge (out and back: two half-turns whose cross
     products are rounding of either sign) is refused, not certified convex: its half-planes
-    would carry a reversed edge normal (found at talos_three_contacts, a hand at mu 1e6)."""
+    would carry a reversed edge normal (drawn by a variant of the walk, since dropped, on
+    talos_three_contacts with a hand at mu 1e6)."""
     from impact_balance.polygon import simplify_convex
 
     square = np.array([[1.0, -1.0], [1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0]])
