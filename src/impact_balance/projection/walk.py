@@ -77,7 +77,7 @@ def project_walk(
         return None
     # Certificate: every vertex was feasible (the kernel checked each against every row, and
     # each is optimal for its arc by the multipliers' signs) and the polygon is convex,
-    # counter-clockwise and winds once (checked in the kernel too). Anything else is a
+    # counter-clockwise and winds once (checked with the merge, below). Anything else is a
     # numerical failure of the walk, never an answer.
     # (max |b| only when the slack is below the smallest threshold it can give: rarely.)
     if status == OK and worst < -SLACK_TOLERANCE and worst < -SLACK_TOLERANCE * (1.0 + float(np.abs(b).max(initial=0.0))):
