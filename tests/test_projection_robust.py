@@ -200,3 +200,14 @@ def test_certificate_refuses_a_spike_along_an_edge():
     for eps in (0.0, 1e-17, -1e-17):  # the tip's cross product: zero or rounding either way
         spiked = np.array([[1.0, -1.0], [1.0, 1.0], [0.0, 1.0], [0.5, 1.0 + eps], [-1.0, 1.0], [-1.0, -1.0]])
         assert simplify_convex(spiked, 1e-9, 1e-8, 1e3) is None
+
+
+def test_an_empty_walk_is_confirmed_by_bretl():
+    """A wall hand at friction 1e12 (beyond the scenarios' 1e6, through the library): the
+    walk's phase 1 calls the badly scaled polytope infeasible; "auto" asks Bretl, which finds
+    the same area as at 1e10."""
+    auto = _project("talos_three_contacts", (0.7, 0.7, 1e12))
+    reference = _project("talos_three_contacts", (0.7, 0.7, 1e10), method="bretl")
+    _check_polygon(auto.polygon)
+    assert auto.method == "bretl"
+    _same_polygon(auto.polygon, reference.polygon)

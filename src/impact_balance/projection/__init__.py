@@ -60,7 +60,10 @@ def project_polytope(
         raise SolverError("projection", method, f"unknown method; valid: {', '.join(METHODS)}")
     if method != "bretl":
         result = project_walk(A, b, C, d, E, box=box, merge_tol=merge)
-        if result is not None:
+        # An empty walk is confirmed by Bretl's first LP under "auto": its phase 1 certifies
+        # nothing on badly scaled rows (a wall hand at friction 1e12 gave an empty area where
+        # the area is 0.195 (m g)^2). It costs that LP only on stances that cannot balance.
+        if result is not None and (method == "walk" or not result.polygon.is_empty):
             return result
         if method == "walk":
             raise SolverError("projection walk", "failed", "the polytope contains a line or a pivot was singular; use method='bretl'")
