@@ -172,7 +172,11 @@ def rigid_body_impact(mass: float, com_inertia: np.ndarray, points: Sequence[Poi
     iterations = 0
     for iterations in range(1, max_iterations + 1):
         problem = qpsolvers.Problem(M, np.zeros(6), G, base + gauges[owner])
-        solution = qpsolvers.solve_problem(problem, solver=solver)
+        try:
+            solution = qpsolvers.solve_problem(problem, solver=solver)
+        except (qpsolvers.SolverNotFound, qpsolvers.SolverError, ValueError) as exc:  # as qp.py: our error, one line
+            raise SolverError(solver, type(exc).__name__, str(exc).splitlines()[0] if str(exc) else "",
+                              field="contact_impact") from None
         if not solution.found or solution.x is None or solution.z is None:
             raise SolverError(solver, "not solved", "the contact impact QP", field="contact_impact")
         dxi, z = np.asarray(solution.x, dtype=float), np.maximum(np.asarray(solution.z, dtype=float), 0.0)
@@ -206,7 +210,7 @@ def _least_norm_multipliers(G: np.ndarray, h: np.ndarray, resultant: np.ndarray,
     try:
         least = qpsolvers.solve_qp(np.eye(len(z)), np.zeros(len(z)), A=-G.T, b=resultant,
                                    lb=np.zeros(len(z)), ub=upper, solver=solver)
-    except Exception:  # noqa: BLE001 - a selection among equivalent answers, never needed for dxi
+    except (qpsolvers.SolverNotFound, qpsolvers.SolverError, ValueError):  # a selection among equivalent answers
         least = None
     if least is None or np.abs(-G.T @ least - resultant).max() > 1e-6 * max(1.0, float(np.abs(resultant).max())):
         return z

@@ -70,10 +70,8 @@ def _norm(v):
 @njit(cache=True)
 def _times(M, v):
     """M v for a 2-D M (a loop, for compile time and no BLAS call on tiny sizes)."""
-    out = np.zeros(M.shape[0])
-    for i in range(M.shape[0]):
-        for j in range(M.shape[1]):
-            out[i] += M[i, j] * v[j]
+    out = np.empty(M.shape[0])
+    _times_into(M, v, out)
     return out
 
 
