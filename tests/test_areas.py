@@ -450,3 +450,47 @@ def test_single_level_contact_matches_statics(geo, make_contact, u, v, cz, mu, y
     com_inside = margin == 0.0
     if com_inside or margin > 1e-6:  # from rest iff the CoM is above the ZMP area
         assert res.com_velocity_area.contains(np.zeros(2)) == com_inside
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(st.tuples(st.floats(-2, 2), st.floats(-2, 2)), min_size=1, max_size=12),
+    st.floats(-1.5, -0.2), st.floats(-3, 3), st.floats(-3, 3), st.floats(1.0, 8.0),
+    st.sampled_from([0.0, 1e-3, 0.02, 0.3]), st.booleans(),
+)
+def test_compiled_maps_give_the_polygon_methods_numbers(points, depth, cx, cy, w, margin, bounded):
+    """The compiled areas pipeline's maps (``areas._maps``) are Polygon.affine and
+    Polygon.inset, number for number: the governor and analyze() read the same areas."""
+    from impact_balance.areas import _maps
+    from impact_balance.polygon import Polygon
+
+    force = Polygon(Polygon.from_points(np.array(points)).vertices, bounded)
+    zmp, zmp_bounded, vel, vel_bounded = _maps(np.ascontiguousarray(force.vertices), bounded, depth, cx, cy, w, margin)
+    if force.is_empty:
+        want_zmp = want_vel = Polygon.empty()
+    elif margin > 0.0:
+        want_zmp = force.affine(depth, np.array([cx, cy])).inset(margin)
+        want_vel = Polygon.empty() if want_zmp.is_empty else want_zmp.affine(w, -w * np.array([cx, cy]))
+    else:
+        want_zmp = force.affine(depth, np.array([cx, cy]))
+        want_vel = force.affine(w * depth, np.zeros(2))
+    np.testing.assert_array_equal(zmp, want_zmp.vertices)
+    np.testing.assert_array_equal(vel, want_vel.vertices)
+    assert (zmp_bounded, vel_bounded) == (want_zmp.bounded, want_vel.bounded)
+
+
+@pytest.mark.parametrize("name", ["palm_push_ramp", "g1_two_feet"])
+@pytest.mark.parametrize("margin", [0.0, 0.01])
+def test_velocity_area_halfplanes_from_the_compiled_pipeline_are_the_polygons_own(name, margin):
+    """The CoM velocity area comes with the half-planes the compiled pipeline computed; they
+    are the ones the polygon computes itself from its vertices."""
+    from impact_balance.polygon import Polygon
+
+    scenario = load_scenario(name)
+    stance = scenario.build_stance()
+    areas = areas_from_polytope(wrench_polytope(stance), scenario.plane_height, margin)
+    G, h = areas.com_velocity_area.halfplanes
+    G2, h2 = Polygon(areas.com_velocity_area.vertices.copy(), areas.com_velocity_area.bounded).halfplanes
+    assert len(G) >= 3
+    np.testing.assert_array_equal(G, G2)
+    np.testing.assert_array_equal(h, h2)

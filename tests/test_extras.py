@@ -195,3 +195,43 @@ def test_readme_test_command_is_what_ci_runs():
     test_command = lines[1].split("&& ", 2)[2]  # after "python3 -m venv .venv && . .venv/bin/activate &&"
     ci = (ROOT / ".ci" / "run").read_text()
     assert test_command.strip() in ci
+
+
+def test_compiled_pipeline_cache_is_stamped_with_the_modules_it_embeds(tmp_path):
+    """numba stamps a cached function with its own file only; a compiled function that embeds
+    another module's compiled functions (the areas pipeline) is also stamped with that
+    module's file, so that editing the module makes its cache stale."""
+    import importlib.util
+    import os
+
+    pytest.importorskip("numba")
+    from impact_balance._jit import HAVE_NUMBA, cache_depends_on
+
+    if not HAVE_NUMBA:
+        pytest.skip("numba turned off")
+    from impact_balance import areas
+
+    cache_file = getattr(getattr(areas._walk_areas, "_cache", None), "_cache_file", None)
+    if cache_file is None:
+        pytest.skip("numba's cache API moved (its own rule applies)")
+    dependency = tmp_path / "dependency.py"
+    dependency.write_text("X = 1\n")
+    spec = importlib.util.spec_from_file_location("dependency_for_test", dependency)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+
+    class Dispatcher:  # the attributes cache_depends_on reads, as numba's dispatcher has them
+        class _cache:
+            class _cache_file:
+                _source_stamp = "own"
+
+    cache_depends_on(Dispatcher, module)
+    first = Dispatcher._cache._cache_file._source_stamp
+    assert first != "own"
+    Dispatcher._cache._cache_file._source_stamp = "own"
+    st = os.stat(dependency)
+    os.utime(dependency, (st.st_atime, st.st_mtime + 10))
+    cache_depends_on(Dispatcher, module)
+    assert Dispatcher._cache._cache_file._source_stamp not in ("own", first)
+    # The real dispatchers were stamped at import: not numba's own stamp of their file.
+    assert isinstance(cache_file._source_stamp, str)

@@ -211,3 +211,30 @@ def test_an_empty_walk_is_confirmed_by_bretl():
     _check_polygon(auto.polygon)
     assert auto.method == "bretl"
     _same_polygon(auto.polygon, reference.polygon)
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.integers(min_value=2, max_value=12), st.integers(min_value=0, max_value=2**32 - 1))
+def test_carried_inverse_check_accepts_a_fresh_inverse_and_refuses_a_drifted_one(n, seed):
+    """The walk carries its basis inverse across breakpoints only while ``_accurate`` holds:
+    a fresh inverse of a well-conditioned basis passes it; the same inverse or vertex off by
+    1e-9 of its size (the drift of rank-one updates on an ill-conditioned basis) does not."""
+    from impact_balance.projection._kernel import _accurate
+
+    rng = np.random.default_rng(seed)
+    m = n + 5
+    H = rng.normal(size=(m, n))
+    H /= np.linalg.norm(H, axis=1)[:, None]
+    h = rng.uniform(0.1, 2.0, size=m)
+    W = rng.permutation(m)[:n].astype(np.int64)
+    B = H[W]
+    if np.linalg.cond(B) > 1e3:
+        return  # the check is about drift, not about bases that rounding alone puts off
+    Binv = np.linalg.inv(B)
+    z = Binv @ h[W]
+    buffer = np.empty(n)
+    assert _accurate(H, h, W, Binv, z, buffer)
+    drifted = Binv.copy()
+    drifted[rng.integers(n), rng.integers(n)] += 1e-9 * np.abs(Binv).max()
+    assert not _accurate(H, h, W, drifted, z, buffer)
+    assert not _accurate(H, h, W, Binv, z + 1e-9 * max(1.0, np.abs(z).max()) * rng.choice([-1.0, 1.0], size=n), buffer)

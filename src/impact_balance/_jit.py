@@ -9,10 +9,13 @@ one-shot ``impact-balance analyze`` command runs that way unless the variable sa
 
 from __future__ import annotations
 
+import hashlib
 import os
+import pickle
+from types import ModuleType
 from typing import Any
 
-__all__ = ["njit", "HAVE_NUMBA", "JIT_VARIABLE"]
+__all__ = ["njit", "HAVE_NUMBA", "JIT_VARIABLE", "cache_depends_on"]
 
 #: The environment variable that turns compilation off ("0", "false", "no" or "off").
 JIT_VARIABLE = "IMPACT_BALANCE_JIT"
@@ -30,3 +33,27 @@ except ImportError:
         if args and callable(args[0]):
             return args[0]
         return lambda f: f
+
+
+def cache_depends_on(dispatcher: Any, *modules: ModuleType) -> Any:
+    """Make numba's on-disk cache of ``dispatcher`` stale when a source file of ``modules``
+    changes, as it is when its own file does; returns ``dispatcher``.
+
+    numba stamps a cached function with its own file only, but a compiled function keeps a
+    copy of the compiled functions it calls: after an edit of a callee in another module, its
+    cache would run the old callee. Here its stamp also covers each module's file (modified
+    time and size, as numba's). Without numba, or if numba's private cache API moved (then
+    numba's own rule applies), nothing changes.
+    """
+    if not HAVE_NUMBA:
+        return dispatcher
+    try:
+        cache_file = dispatcher._cache._cache_file
+        stamps = [cache_file._source_stamp]
+        for module in modules:
+            st = os.stat(module.__file__)
+            stamps.append((os.path.basename(module.__file__), st.st_mtime, st.st_size))
+        cache_file._source_stamp = hashlib.sha256(pickle.dumps(stamps)).hexdigest()
+    except (AttributeError, OSError, TypeError):
+        pass
+    return dispatcher

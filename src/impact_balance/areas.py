@@ -23,12 +23,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import polygon
+from ._jit import cache_depends_on, njit
 from .constants import GRAVITY
 from .constraints import WrenchPolytope, wrench_polytope
 from .infeasibility import CannotBalanceReason, explain_cannot_balance
 from .exceptions import ScenarioError, SolverError
-from .polygon import Polygon
-from .projection import project_polytope
+from .polygon import MERGE_AREA_TOLERANCE, Polygon, _edge_halfplanes, _inset_polygon
+from .projection import _kernel, project_polytope, walk
+from .projection._kernel import LINE, OK
+from .projection.walk import MAX_PIVOTS, certified_walk
 from .stance import Stance
 
 __all__ = ["BalanceAreas", "balance_areas", "areas_from_polytope", "omega", "with_reason"]
@@ -108,26 +112,74 @@ def areas_from_polytope(polytope: WrenchPolytope, plane_height: float = 0.0, zmp
     support area shrunk by ``zmp_margin`` (m)."""
     com = polytope.com
     w = omega(float(com[2]), plane_height, polytope.gravity)
+    depth = plane_height - float(com[2])  # < 0
+    cx, cy, margin = float(com[0]), float(com[1]), float(zmp_margin)
     # Work in units of m g so that tolerances mean the same for every robot, and in
     # friction-normalised variables so that a large or small friction keeps full precision.
-    result = project_polytope(
-        *polytope.projection_data(),
-        tol=FORCE_TOLERANCE,
-        box=FORCE_BOX,
-        merge_tol=MERGE_TOLERANCE,
-    )
-    force = result.polygon
-    depth = plane_height - float(com[2])  # < 0
-    if force.is_empty:
-        zmp = vel = Polygon.empty()
-    elif zmp_margin > 0.0:
-        zmp = force.affine(depth, com[:2]).inset(zmp_margin)
-        vel = _velocity_area(zmp, w, com)
+    A, b, C, d, E = (np.ascontiguousarray(x, dtype=np.float64) for x in polytope.projection_data())
+    # The walk, its certificate and both maps in one compiled call (a governor's every tick);
+    # where the walk cannot answer, project_polytope chooses as it always does.
+    status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h = _walk_areas(
+        A, b, C, d, E, FORCE_BOX, MAX_PIVOTS, MERGE_TOLERANCE, MERGE_AREA_TOLERANCE, depth, cx, cy, w, margin)
+    n_lp = 1
+    if status != OK or force.shape[0] == 0:
+        result = project_polytope(A, b, C, d, E, tol=FORCE_TOLERANCE, box=FORCE_BOX, merge_tol=MERGE_TOLERANCE,
+                                  method="auto" if status == LINE else "bretl")
+        force, bounded, n_lp = result.polygon.vertices, result.polygon.bounded, result.n_lp
+        zmp, zmp_bounded, vel, vel_bounded = _maps(np.ascontiguousarray(force), bounded, depth, cx, cy, w, margin)
+        G = np.empty((0, 2))
+    # The criterion reads the CoM velocity area's half-planes: the compiled call made them.
+    velocity_area = (Polygon.with_halfplanes(vel, bool(vel_bounded), G, h) if len(G)
+                     else Polygon(vel, bool(vel_bounded)))
+    return BalanceAreas(Polygon(force, bool(bounded)), Polygon(zmp, bool(zmp_bounded)), velocity_area,
+                        w, com.copy(), plane_height, polytope.mass, polytope.gravity, n_lp, zmp_margin=margin)
+
+
+@njit(cache=True)
+def _affine(v, scale, ox, oy):
+    """:meth:`Polygon.affine`'s vertices ``v * scale + (ox, oy)``, the same numbers."""
+    out = np.empty_like(v)
+    for i in range(v.shape[0]):
+        out[i, 0] = v[i, 0] * scale + ox
+        out[i, 1] = v[i, 1] * scale + oy
+    return out
+
+
+@njit(cache=True)
+def _maps(force, bounded, depth, cx, cy, w, margin):
+    """The ZMP support area (shrunk by ``margin``) and the CoM velocity area of the force area
+    ``force`` (vertices, units of m g): ``(zmp, zmp_bounded, vel, vel_bounded)``, the numbers
+    :class:`Polygon`'s ``affine`` and ``inset`` give (``depth`` = h - c_z, CoM ``(cx, cy)``)."""
+    empty = np.empty((0, 2))
+    if force.shape[0] == 0:
+        return empty, True, empty, True
+    if not margin > 0.0:
+        return _affine(force, depth, cx, cy), bounded, _affine(force, w * depth, 0.0, 0.0), bounded
+    if force.shape[0] < 3:  # a point or a segment: nothing is a margin inside
+        return empty, True, empty, True
+    zmp = _inset_polygon(_affine(force, depth, cx, cy), margin)
+    if zmp.shape[0] == 0:
+        return zmp, bounded, empty, True
+    return zmp, bounded, _affine(zmp, w, -w * cx, -w * cy), bounded
+
+
+@njit(cache=True)
+def _walk_areas(A, b, C, d, E, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, margin):
+    """:func:`~impact_balance.projection.walk.certified_walk` and :func:`_maps` in one call:
+    ``(status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h)``, ``G, h`` the CoM
+    velocity area's half-planes when it has 3 vertices or more (else none)."""
+    status, force, bounded, _, _, _ = certified_walk(A, b, C, d, E, box, max_pivots, merge_tol, area_tol)
+    zmp, zmp_bounded, vel, vel_bounded = _maps(force, bounded, depth, cx, cy, w, margin)
+    if vel.shape[0] >= 3:
+        G, h = _edge_halfplanes(vel)
     else:
-        zmp = force.affine(depth, com[:2])
-        vel = force.affine(w * depth, np.zeros(2))
-    return BalanceAreas(force, zmp, vel, w, com.copy(), plane_height, polytope.mass, polytope.gravity, result.n_lp,
-                        zmp_margin=float(zmp_margin))
+        G, h = np.empty((0, 2)), np.empty(0)
+    return status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h
+
+
+# The compiled functions above embed the polygon module's and the walk's.
+cache_depends_on(_maps, polygon)
+cache_depends_on(_walk_areas, polygon, walk, _kernel)
 
 
 def balance_areas(

@@ -220,19 +220,38 @@ def assemble_polytope(
         scaling: See :attr:`WrenchPolytope.scaling`.
     """
     m = len(faces)
+    A, b, C, G = _assemble_arrays(np.ascontiguousarray(faces, dtype=float).reshape(m, 32, 3),
+                           np.ascontiguousarray(rotations, dtype=float), np.ascontiguousarray(positions, dtype=float),
+                           np.ascontiguousarray(arms, dtype=float), jacobians, torque_indices, torque_limits,
+                           gravity_torques)
+    d = np.array([mass * gravity, 0.0, 0.0, 0.0])
+    com = np.array(com, dtype=float)
+    return WrenchPolytope(A, b, C, d, G[:2].copy(), G, 16 * m, float(mass), com, gravity, scaling)
+
+
+@njit(cache=True)
+def _assemble_arrays(faces, rotations, positions, arms, jacobians, torque_indices, torque_limits, gravity_torques):
+    """The arrays ``(A, b, C, G)`` of :func:`assemble_polytope` in one compiled call (a
+    governor's every tick); ``faces`` (m, 32, 3) are the face matrices' force and torque halves."""
+    m = faces.shape[0]
     k = torque_indices.size if jacobians.size else 0
     A = np.zeros((16 * m + 2 * k, 6 * m))
     b = np.zeros(16 * m + 2 * k)
     C = np.zeros((4, 6 * m))
     G = np.zeros((6, 6 * m))
-    # One batched product for every contact's block (the same numbers as cwc_faces_world).
-    blocks = np.matmul(faces.reshape(m, 32, 3), rotations.transpose(0, 2, 1))
+    # Every contact's faces rotated to world axes (the numbers of cwc_faces_world).
+    blocks = np.empty((m, 32, 3))
+    for i in range(m):
+        for r in range(32):
+            for c in range(3):
+                acc = 0.0
+                for col in range(3):
+                    acc += faces[i, r, col] * rotations[i, c, col]
+                blocks[i, r, c] = acc
     _fill(blocks, positions, arms, A, C, G)
     if k:
         _torque_rows(jacobians, torque_indices, torque_limits, gravity_torques, A[16 * m :], b[16 * m :])
-    d = np.array([mass * gravity, 0.0, 0.0, 0.0])
-    com = np.array(com, dtype=float)
-    return WrenchPolytope(A, b, C, d, G[:2].copy(), G, 16 * m, float(mass), com, gravity, scaling)
+    return A, b, C, G
 
 
 @njit(cache=True)

@@ -341,6 +341,14 @@ class Polygon:
         return cls(np.zeros((0, 2)))
 
     @classmethod
+    def with_halfplanes(cls, vertices: np.ndarray, bounded: bool, G: np.ndarray, h: np.ndarray) -> Polygon:
+        """The polygon of ``vertices`` (k >= 3) whose :attr:`halfplanes` ``(G, h)`` were
+        computed with it (by ``_edge_halfplanes``, in a compiled pipeline): not computed again."""
+        polygon = cls(vertices, bounded)
+        polygon.__dict__["halfplanes"] = _frozen(G, h)  # the cached_property's own slot
+        return polygon
+
+    @classmethod
     def from_points(cls, points: np.ndarray, tol: float = 1e-9) -> Polygon:
         """Convex hull of a point cloud (degenerate clouds give a point or a segment)."""
         points = np.asarray(points, dtype=float).reshape(-1, 2)

@@ -137,6 +137,7 @@ class PostureEvaluator:
         self._faces = np.array([_local_faces(float(c.friction), 0.5 * float(c.size[0]), 0.5 * float(c.size[1]))
                                 for c in contacts]).reshape(m, 16, 6)
         self._frictions = [float(c.friction) for c in contacts]
+        self._scaled = any(mu > 1.0 for mu in self._frictions)  # else friction_scaling is None
         idx, limit = robot.effort_limits
         self._torques = bool(settings.torque_limits and m and idx.size)
         self._idx, self._limit = (idx, limit) if self._torques else (np.zeros(0, dtype=np.int64), np.zeros(0))
@@ -144,6 +145,7 @@ class PostureEvaluator:
         # Buffers, overwritten every posture (the answers keep copies).
         self._q_local = np.zeros(model.nq)
         self._zero_velocity = np.zeros(model.nv)
+        self._gravity = np.array(model.gravity.linear, dtype=float)  # m/s^2, world
 
     def evaluate(self, q: np.ndarray) -> Posture:
         """Everything the governor needs at configuration ``q`` (nq, float64, contiguous).
@@ -181,8 +183,11 @@ class PostureEvaluator:
             local[i] = placement.translation
             if J is not None:
                 jacobians[6 * i : 6 * i + 6] = J
-        gravity_torques = pin.computeGeneralizedGravity(model, data, q_local) if self._torques else self._zero_velocity
-        scaling = friction_scaling(self._frictions, rotations)
+        # g(q) = -Ag[:3]^T g: the gravity's generalized force is the CoM's (the centroidal
+        # momentum matrix's linear rows are m times the CoM Jacobian); equal to pinocchio's
+        # computeGeneralizedGravity to rounding (1e-14 N m of 327 on G1), without its pass.
+        gravity_torques = -(self._gravity @ data.Ag[:3]) if self._torques else self._zero_velocity
+        scaling = friction_scaling(self._frictions, rotations) if self._scaled else None
         polytope = assemble_polytope(self._faces, rotations, local + origin, local - com_local, mass, com_local + origin,
                                      settings.gravity, jacobians, self._idx, self._limit, gravity_torques, scaling)
         try:

@@ -22,13 +22,14 @@ import os
 
 import numpy as np
 
-from .._jit import HAVE_NUMBA
-
-from ..polygon import Polygon, simplify_convex
+from .. import polygon
+from .._jit import HAVE_NUMBA, cache_depends_on, njit
+from ..polygon import MERGE_AREA_TOLERANCE, Polygon, _simplify_convex
+from . import _kernel
 from ._kernel import FAILED, INCONSISTENT, INFEASIBLE, LINE, OK, project, project_equalities
 from .result import ProjectionResult
 
-__all__ = ["project_walk", "kernel_is_compiled", "warm_up"]
+__all__ = ["project_walk", "certified_walk", "kernel_is_compiled", "warm_up", "MAX_PIVOTS"]
 
 #: Relative singular-value threshold for the rank of the lines of the polytope.
 RANK_TOLERANCE = 1e-12
@@ -39,6 +40,8 @@ SLACK_TOLERANCE = 1e-7
 #: Distance (units of y) under which raw vertices are merged before the convexity check:
 #: above the rounding of a vertex (1e-12 to 1e-10), below any backtrack worth catching.
 CHECK_MERGE = 1e-9
+#: Safety cap on the pivots of one walk.
+MAX_PIVOTS = 5000
 
 def project_walk(
     A: np.ndarray,
@@ -48,7 +51,7 @@ def project_walk(
     E: np.ndarray,
     box: float = 1e3,
     merge_tol: float = 1e-8,
-    max_pivots: int = 5000,
+    max_pivots: int = MAX_PIVOTS,
 ) -> ProjectionResult | None:
     """Project ``{x : A x <= b, C x = d}`` onto ``y = E x`` (2 x n), clipped to ``|y_k| <= box``.
 
@@ -60,40 +63,79 @@ def project_walk(
     E = _array(E, 2)
     n = E.shape[1]
     A, C, b, d = _array(A, 2, n), _array(C, 2, n), _array(b, 1), _array(d, 1)
-    # x = x0 + N z spans {C x = d} (compiled Gram-Schmidt, cheaper than a numpy SVD here),
-    # then the walk, in one compiled call.
-    status, vertices, pivots, worst, x0, N = project_equalities(A, b, C, d, E, float(box), int(max_pivots))
-    if status == INCONSISTENT:
-        return ProjectionResult(Polygon.empty(), "walk")
+    status, vertices, bounded, pivots, x0, N = certified_walk(A, b, C, d, E, float(box), int(max_pivots),
+                                                              float(merge_tol), MERGE_AREA_TOLERANCE)
     if status == LINE:
         # Lines of the polytope are the null space of [A N; E N] (a line along which E x
         # changed would have met the box rows); keep z in its orthogonal complement.
         _, S, Vt = np.linalg.svd(np.vstack([A @ N, E @ N]))
         r = int(np.sum(S > RANK_TOLERANCE * max(float(S[0]) if S.size else 0.0, 1.0)))
         N = np.ascontiguousarray(N @ Vt[:r].T)
-        status, vertices, more, worst = project(A, b, E, x0, N, float(box), int(max_pivots))
+        status, raw, more, worst = project(A, b, E, x0, N, float(box), int(max_pivots))
         pivots += more
-    if status in (FAILED, LINE):
+        status, vertices, bounded = _certify(status, raw, worst, b, float(merge_tol), MERGE_AREA_TOLERANCE, float(box))
+    if status == INCONSISTENT:
+        return ProjectionResult(Polygon.empty(), "walk")
+    if status == INFEASIBLE:
+        return ProjectionResult(Polygon.empty(), "walk", n_lp=1, pivots=pivots)
+    if status != OK:
         return None
+    return ProjectionResult(Polygon(vertices, bool(bounded)), "walk", n_lp=1, pivots=pivots)
+
+
+@njit(cache=True)
+def _certify(status, vertices, worst, b, merge_tol, area_tol, box):
+    """A walk's raw vertices certified and merged: ``(status, vertices, bounded)``, status
+    FAILED when the walk cannot answer (see :func:`project_walk`)."""
+    none = np.empty((0, 2))
+    if status == FAILED or status == LINE:
+        return FAILED, none, True
     # Certificate: every vertex was feasible (the kernel checked each against every row, and
     # each is optimal for its arc by the multipliers' signs) and the polygon is convex,
     # counter-clockwise and winds once (checked with the merge, below). Anything else is a
     # numerical failure of the walk, never an answer.
     # (max |b| only when the slack is below the smallest threshold it can give: rarely.)
-    if status == OK and worst < -SLACK_TOLERANCE and worst < -SLACK_TOLERANCE * (1.0 + float(np.abs(b).max(initial=0.0))):
-        return None
-    if status == INFEASIBLE:
-        return ProjectionResult(Polygon.empty(), "walk", n_lp=1, pivots=pivots)
+    if status == OK and worst < -SLACK_TOLERANCE:
+        big = 0.0
+        for i in range(b.size):
+            big = max(big, abs(b[i]))
+        if worst < -SLACK_TOLERANCE * (1.0 + big):
+            return FAILED, none, True
+    if status != OK:
+        return status, none, True
     # Check convexity before the merge: merging first could hide a backtrack (a walk that
     # went 1e-6 back inside and returned, whose detour then replaced the true corner). The
     # first pass only drops rounding-level duplicates, which would fail the strict check:
     # within 1e-9, or 10 times the worst slack (a vertex's rounding shows in its slacks; 1e-8
-    # with a friction of 2.5e4 on Talos's foot). One compiled call does the three steps.
-    merged = simplify_convex(vertices, min(merge_tol, max(CHECK_MERGE, -10.0 * worst)), merge_tol, box)
-    if merged is None:
-        return None
-    vertices, bounded = merged
-    return ProjectionResult(Polygon(vertices, bounded), "walk", n_lp=1, pivots=pivots)
+    # with a friction of 2.5e4 on Talos's foot).
+    ok, merged, bounded = _simplify_convex(vertices, min(merge_tol, max(CHECK_MERGE, -10.0 * worst)), merge_tol,
+                                           area_tol, box)
+    if not ok:
+        return FAILED, none, True
+    return OK, merged, bounded
+
+
+@njit(cache=True)
+def certified_walk(A, b, C, d, E, box, max_pivots, merge_tol, area_tol):
+    """The walk of :func:`project_walk` in one compiled call, its certificate and merge
+    included (a governor pays each call's dispatch every tick).
+
+    Returns ``(status, vertices, bounded, pivots, x0, N)`` with a kernel status: OK (the
+    certified polygon), INFEASIBLE or INCONSISTENT (empty), FAILED (the walk cannot answer),
+    LINE (the polytope holds a line: :func:`project_walk` quotients it out; ``x0 + N z``
+    spans the equalities).
+    """
+    status, raw, pivots, worst, x0, N = project_equalities(A, b, C, d, E, box, max_pivots)
+    if status == LINE or status == INCONSISTENT:
+        return status, np.empty((0, 2)), True, pivots, x0, N
+    status, vertices, bounded = _certify(status, raw, worst, b, merge_tol, area_tol, box)
+    return status, vertices, bounded, pivots, x0, N
+
+
+# The compiled functions above embed the kernel's and the polygon module's.
+cache_depends_on(_certify, polygon)
+cache_depends_on(certified_walk, polygon, _kernel)
+
 
 def _array(x, ndim: int, columns: int | None = None) -> np.ndarray:
     """``x`` as a C-contiguous float64 array of ``ndim`` dimensions (``columns`` columns):
