@@ -149,7 +149,8 @@ def rigid_body_impact(mass: float, com_inertia: np.ndarray, points: Sequence[Poi
         max_iterations: Most QP solves.
         initial_dxi: A guess of the answer (6,), e.g. the previous posture's: the first
             gauges are those of its sliding velocities (a warm start; the fixed point reached
-            is the same one when it is unique, in fewer QP solves). Default: gauges 0.
+            is the same one when it is unique, in fewer QP solves; when the LCP has several
+            solutions it tends to stay on the guess's branch). Default: gauges 0.
 
     Returns:
         ``(dxi, impulses, iterations, converged)``: the 6-vector (dv_c m/s, dw rad/s), the
