@@ -31,7 +31,7 @@ def add_parser(sub) -> list[str]:
                        help="one trial at LO, the middle and HI, m")
     a.add_argument("--contact-aware", action="store_true",
                    help="com governor: also bound the speed by the contact-aware impact model (the robot standing "
-                        "on its supports; experimental, see docs/validation.md)")
+                        "on its supports; experimental, see docs/contact_aware_governor.md)")
     a.add_argument("--rigid-impact", action="store_true",
                    help="hold every joint's velocity through the impact (the paper's rigid robot)")
     add_controller_option(a, "id", "it puts the ZMP anywhere in the support area after the impact")
