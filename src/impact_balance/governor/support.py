@@ -26,6 +26,7 @@ branch of the first posture (on the ramp near the wall, the lateral jump of that
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -33,6 +34,7 @@ from ..contact_impact import contact_impact
 from ..criteria import VelocityLimit, first_exit, speed_interval
 from ..exceptions import GovernorError
 from ..impact import ImpactSpec
+from ..polygon import Polygon
 from ..stance import Stance
 
 __all__ = ["ContactAwareLimit", "ContactAwareAnswer", "contact_aware_rates"]
@@ -96,7 +98,7 @@ class ContactAwareLimit:
         self._age = 0
         self._count = 0
 
-    def new_posture(self, stance_of) -> None:
+    def new_posture(self, stance_of: Callable[[], Stance]) -> None:
         """A posture was evaluated; ``stance_of()`` builds its :class:`Stance` (called only when
         the rates are due)."""
         if self._rates is None or self._count % self.every == 0:
@@ -106,9 +108,9 @@ class ContactAwareLimit:
             self._age += 1
         self._count += 1
 
-    def answer(self, area, com_velocity: np.ndarray) -> ContactAwareAnswer:
-        """The limit and interval for the CoM velocity area ``area`` (a polygon with ``halfplanes``)
-        and the pre-impact CoM velocity (world, m/s)."""
+    def answer(self, area: Polygon, com_velocity: np.ndarray) -> ContactAwareAnswer:
+        """The limit and interval (m/s of approach speed) for the CoM velocity area ``area``
+        (world xy, m/s) and the pre-impact CoM velocity (world, m/s)."""
         if self._rates is None:
             raise GovernorError("contact_aware", None, "no posture evaluated yet")
         if area.is_empty:
@@ -122,7 +124,8 @@ class ContactAwareLimit:
 
 
 def combine(floating: tuple[float, float] | None, aware: tuple[float, float] | None) -> tuple[float, float] | None:
-    """The speeds safe for both models: the intersection of two safe intervals (or None)."""
+    """The approach speeds (m/s) safe for both models: the intersection of two safe intervals
+    (or None)."""
     if floating is None or aware is None:
         return None
     lo, hi = max(floating[0], aware[0]), min(floating[1], aware[1])
