@@ -29,6 +29,9 @@ def add_parser(sub) -> list[str]:
     where.add_argument("--wall-distance-range", type=number("--wall-distance-range", 0.0, 1.0, "m", lo_open=True), nargs=2,
                        default=None, metavar=("LO", "HI"),
                        help="one trial at LO, the middle and HI, m")
+    a.add_argument("--contact-aware", action="store_true",
+                   help="com governor: also bound the speed by the contact-aware impact model (the robot standing "
+                        "on its supports; experimental, see docs/contact_aware_governor.md)")
     a.add_argument("--rigid-impact", action="store_true",
                    help="hold every joint's velocity through the impact (the paper's rigid robot)")
     add_controller_option(a, "id", "it puts the ZMP anywhere in the support area after the impact")
@@ -71,7 +74,7 @@ def run(args: argparse.Namespace) -> int:
     if args.governor != "none":
         from ..governor import Governor
 
-        governor = Governor(governed, criterion=args.governor)
+        governor = Governor(governed, criterion=args.governor, contact_aware=args.contact_aware)
     trials, written = [], []
     for distance in distances:
         wall = WallOptions(reference=args.reference, governor=args.governor, wall_distance=distance,
@@ -87,6 +90,7 @@ def run(args: argparse.Namespace) -> int:
         d["controller"] = args.controller
         d["rigid_impact"] = args.rigid_impact
         d["zmp_margin"] = margin
+        d["contact_aware"] = bool(args.contact_aware and governor is not None)
     out = docs[0] if len(docs) == 1 else {"governor": args.governor, "reference": args.reference, "trials": docs}
     if args.json:
         print_json(out)

@@ -18,6 +18,7 @@ from ..scenario import BasePose, Scenario, load_scenario, scenario_from_dict, wi
 from ..stance import _has_free_flyer
 from .limit import SpeedLimit, cap_approach
 from .posture import Posture, PostureEvaluator, PostureSettings
+from .support import ContactAwareLimit, combine
 
 __all__ = ["Governor", "CRITERIA"]
 
@@ -68,6 +69,11 @@ class Governor:
             name; it must have an ``impact``.
         criterion: "com" (default) or "zmp" (see :data:`CRITERIA`).
         posture_tolerance: See "Reuse" above (>= 0).
+        contact_aware: Also bound the speed by the contact-aware impact model's CoM velocity
+            jump (:mod:`.support`: the robot standing on its supports; the answer is then the
+            criterion for the union of both models' post-impact CoM velocities, the smaller
+            maximum). "com" criterion, composite inertia only. Its jump rates are recomputed
+            every ``contact_aware_every`` posture evaluations (default 5), not every posture.
 
     Raises:
         ScenarioError: no impact, an unknown frame, an impact model that cannot be built at
@@ -75,7 +81,8 @@ class Governor:
         GovernorError: an unknown criterion or a bad tolerance.
     """
 
-    def __init__(self, scenario: Scenario | str | os.PathLike, criterion: str = "com", posture_tolerance: float = 0.0):
+    def __init__(self, scenario: Scenario | str | os.PathLike, criterion: str = "com", posture_tolerance: float = 0.0,
+                 contact_aware: bool = False, contact_aware_every: int = 5):
         if criterion not in CRITERIA:
             raise GovernorError("criterion", criterion, f"must be one of {', '.join(CRITERIA)}")
         try:
@@ -105,6 +112,11 @@ class Governor:
         self.configuration: np.ndarray = scenario.build_stance(self.robot).q.copy()
         self._evaluator = PostureEvaluator(self.robot, settings)
         self._lock = threading.Lock()
+        self._support: ContactAwareLimit | None = None
+        if contact_aware:
+            if criterion != "com":
+                raise GovernorError("contact_aware", criterion, "bounds the CoM criterion only")
+            self._support = ContactAwareLimit(settings.impact, contact_aware_every)
         self._posture: Posture | None = None
         self._last: SpeedLimit | None = None
         warm_up()  # the projection kernel's one-time load, not in the first tick
@@ -112,6 +124,7 @@ class Governor:
             self._posture = self._evaluator.evaluate(self.configuration)
         except ScenarioError as exc:
             raise with_source(exc, scenario.source) from None
+        self._support_posture: bytes | None = None
 
     # -- per tick ---------------------------------------------------------------------------
     def limit(self, q: Sequence[float], v: Sequence[float]) -> SpeedLimit:
@@ -230,15 +243,24 @@ class Governor:
         return posture, False
 
     def _answer(self, posture: Posture, com_velocity: np.ndarray, reused: bool) -> SpeedLimit:
+        binding = "floating"
         if posture.com_criterion is not None:
             limit = posture.com_criterion.limit(com_velocity)
             interval = posture.com_criterion.interval(com_velocity, limit)
+            if self._support is not None:
+                if self._support_posture != posture.key:  # a posture evaluated since: the rates may be due
+                    self._support.new_posture(lambda: posture.stance)
+                    self._support_posture = posture.key
+                aware = self._support.answer(posture.areas.com_velocity_area, com_velocity)
+                interval = combine(interval, aware.interval)
+                if aware.limit.max_approach_speed < limit.max_approach_speed:
+                    limit, binding = aware.limit, "contact_aware"
         else:
             limit = posture.zmp_limit
             interval = _zmp_interval(limit)
         model = posture.impact
         answer = SpeedLimit(self.criterion, limit.max_approach_speed, limit.status, limit.limiting_vertex,
-                            limit.limiting_edge, interval, com_velocity, model.normal, model.point, reused)
+                            limit.limiting_edge, interval, com_velocity, model.normal, model.point, reused, binding)
         self._last = answer
         return answer
 

@@ -42,6 +42,9 @@ class SpeedLimit:
         point: The impact point at this posture (3,), world, m.
         posture_reused: True when the posture was the previous call's (within the governor's
             ``posture_tolerance``) and only the CoM velocity was new (the fast path).
+        binding: Which impact model gave the maximum: "floating" (the paper's set; the only
+            one unless the governor is ``contact_aware``) or "contact_aware" (then
+            ``limiting_vertex`` 0 / 1 is its jump at the lower / upper restitution bound).
     """
 
     criterion: str
@@ -54,6 +57,7 @@ class SpeedLimit:
     normal: np.ndarray
     point: np.ndarray
     posture_reused: bool
+    binding: str = "floating"
 
     @property
     def ceiling(self) -> float:

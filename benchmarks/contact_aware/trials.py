@@ -1,0 +1,160 @@
+"""The simulated trials of ``score`` (governed, with or without the option, warm or cold start)
+and ``sweep`` (ungoverned, wall 15 cm, the inset rule), and their tables."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from governor_study import _f, governed_setup
+from impact_balance.governor import Governor
+from impact_balance.sim.wall import WallOptions, run_wall_trial
+from impact_balance.stance import Stance
+
+from .journal import journalled, open_journal, slim
+
+__all__ = ["OUTCOMES", "SWEEP_REFERENCES", "SWEEP_WALL", "score", "score_table", "sweep", "sweep_table"]
+
+SWEEP_WALL = 0.15  # m
+#: The ungoverned sweeps' commanded references (m/s), around each stance's fall.
+SWEEP_REFERENCES = {
+    "palm_push_two_feet": (0.42, 0.44, 0.46, 0.48, 0.5, 0.52, 0.55),
+    "palm_push_ramp": (0.55, 0.6, 0.62, 0.64, 0.66, 0.68, 0.7, 0.72, 0.74, 0.76, 0.8),
+    "kick_one_foot": (1.3, 1.4, 1.45, 1.5, 1.55, 1.6, 1.7),
+    "g1_two_feet": (0.38, 0.4, 0.42, 0.44, 0.46, 0.48, 0.5, 0.55),
+}
+OUTCOMES = ("balanced", "contact_broken", "fell")
+
+
+# -- score: the governed trials -------------------------------------------------------------------
+def _cold_start(governor: Governor) -> Governor:
+    """``governor`` with the contact-aware fixed point started from gauges 0 at every
+    recomputation (no continuation from the previous posture; the post hoc variant)."""
+    support = governor._support
+    inner = support.new_posture
+
+    def cold(stance_of: Callable[[], Stance]) -> None:
+        support._warm = None
+        inner(stance_of)
+
+    support.new_posture = cold
+    return governor
+
+
+def score(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
+    """The governed trials of ``args.variant`` (module docstring); rows and failures."""
+    rows, failures = [], 0
+    for name in args.scenarios:
+        options, margin, governed, setup = governed_setup(name, rigid=True)
+        journal = open_journal(out, "score", name, {"variant": args.variant, "margin": margin})
+
+        def new_governor() -> Governor:
+            governor = Governor(governed, criterion="com", contact_aware=args.variant != "off")
+            return _cold_start(governor) if args.variant == "cold" else governor
+
+        def run(key: dict) -> dict:
+            governor, trials = new_governor(), []  # one governor for the walls of a reference, as the command
+            for distance in key["distances"]:
+                if args.variant == "cold":
+                    governor = new_governor()
+                wall = WallOptions(reference=key["reference"], governor="com", wall_distance=distance)
+                trials.append(slim(run_wall_trial(setup, wall, options, governor=governor).to_dict()))
+                d = trials[-1]
+                print(f"  {name} {key['reference']:g} m/s {100 * distance:g} cm: {d['outcome']} speed "
+                      f"{_f(d['speed_at_contact'])} cap {_f(d['cap_at_contact'])}", file=sys.stderr, flush=True)
+            return {"trials": trials}
+
+        keys = [{"reference": r, "distances": list(args.distances)} for r in args.references]
+        pairs, failed = journalled(journal, keys, run, f"score {name}")
+        journal.close()
+        failures += failed
+        rows += [{"scenario": name, "variant": args.variant, **t} for _, e in pairs for t in e["trials"]]
+    return rows, failures
+
+
+def _signed(x: float | None, digits: int = 4) -> str:
+    return "-" if x is None else f"{x:+.{digits}f}"
+
+
+def _span(values: list[float], digits: int = 3) -> str:
+    return "-" if not values else f"{min(values):.{digits}f} to {max(values):.{digits}f}"
+
+
+def score_table(rows: list[dict]) -> str:
+    """Outcome counts and ranges per scenario (the table of docs/contact_aware_governor.md)."""
+    lines = ["| scenario | variant | trials | balanced / contact broken / fell | measured speed at contact (m/s) "
+             "| cap at contact (m/s) | speed / min(ref, cap) | tick median (us) | tick p99 (us) |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for name in dict.fromkeys(r["scenario"] for r in rows):
+        group = [r for r in rows if r["scenario"] == name]
+        counts = " / ".join(str(sum(r["outcome"] == o for r in group)) for o in OUTCOMES)
+        speeds = [r["speed_at_contact"] for r in group if r["speed_at_contact"] is not None]
+        caps = [r["cap_at_contact"] for r in group if r["cap_at_contact"] is not None]
+        ratios = [r["speed_at_contact"] / min(r["reference"], r["cap_at_contact"]) for r in group
+                  if r["speed_at_contact"] is not None and r["cap_at_contact"] is not None]
+        ticks = [r["tick_us"] for r in group if r["tick_us"]["median"] is not None]
+        lines.append(f"| {name} | {group[0]['variant']} | {len(group)} | {counts} | {_span(speeds)} | {_span(caps)} "
+                     f"| {_span(ratios, 2)} | {_span([t['median'] for t in ticks], 0)} "
+                     f"| {_span([t['p99'] for t in ticks], 0)} |")
+    lines += ["", "| scenario | reference (m/s) | wall (cm) | outcome | speed at contact (m/s) | cap at contact (m/s) "
+              "| raw margin at end (m/s) | slip (cm) |", "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['scenario']} | {r['reference']:g} | {100 * r['wall_distance']:g} | {r['outcome']} "
+                     f"| {_f(r['speed_at_contact'])} | {_f(r['cap_at_contact'])} | {r['margin_raw']:+.3f} "
+                     f"| {100 * r['max_slip']:.1f} |")
+    return "\n".join(lines)
+
+
+# -- sweep: ungoverned approaches and the inset rule ----------------------------------------------
+def sweep(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
+    """Ungoverned approaches at wall 15 cm with the inset margin at the end of the impact."""
+    rows, failures = [], 0
+    for name in args.scenarios:
+        options, margin, _, setup = governed_setup(name, rigid=True)
+        inset = setup.analysis.areas.com_velocity_area_inset(margin)
+        journal = open_journal(out, "sweep", name, {"wall": SWEEP_WALL, "margin": margin})
+
+        def run(key: dict) -> dict:
+            wall = WallOptions(reference=key["reference"], governor="none", wall_distance=SWEEP_WALL)
+            d = slim(run_wall_trial(setup, wall, options).to_dict())
+            after = np.asarray(d["com_velocity_after"] if d["com_velocity_after"] is not None else [np.nan] * 2)
+            d["margin_inset"] = float(inset.margins(after)[0]) if np.isfinite(after).all() else None
+            print(f"  {name} {key['reference']:g} m/s: {d['outcome']} speed {_f(d['speed_at_contact'])} "
+                  f"inset margin {_signed(d['margin_inset'])}", file=sys.stderr, flush=True)
+            return d
+
+        references = args.references or SWEEP_REFERENCES[name]
+        pairs, failed = journalled(journal, [{"reference": r} for r in references], run, f"sweep {name}")
+        journal.close()
+        failures += failed
+        rows += [{"scenario": name, **e} for _, e in pairs]
+    return rows, failures
+
+
+def sweep_table(rows: list[dict]) -> str:
+    """Every trial, then per stance the fastest that did not fall and the slowest that fell."""
+    lines = ["| scenario | reference (m/s) | measured v_n (m/s) | outcome | raw margin | inset margin | slip (cm) "
+             "| sustained impulse z per contact (N s) |", "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        sustained = ", ".join(f"{k} {v[2]:+.2f}" for k, v in (r["sustained_impulses"] or {}).items())
+        lines.append(f"| {r['scenario']} | {r['reference']:g} | {_f(r['speed_at_contact'])} | {r['outcome']} "
+                     f"| {r['margin_raw']:+.3f} | {_signed(r['margin_inset'])} | {100 * r['max_slip']:.2f} | {sustained} |")
+    lines += ["", "| scenario | trials | stood: largest v_n (inset margin) | fell: smallest v_n (inset margin) |",
+              "|---|---|---|---|"]
+    for name in dict.fromkeys(r["scenario"] for r in rows):
+        group = [r for r in rows if r["scenario"] == name and r["speed_at_contact"] is not None]
+        stood = [r for r in group if r["outcome"] != "fell"]
+        fell = [r for r in group if r["outcome"] == "fell"]
+        best = max(stood, key=lambda r: r["speed_at_contact"], default=None)
+        worst = min(fell, key=lambda r: r["speed_at_contact"], default=None)
+        cell = (lambda r: "-" if r is None else f"{r['speed_at_contact']:.3f} ({_signed(r['margin_inset'])})")  # noqa: E731
+        lines.append(f"| {name} | {len(group)} | {cell(best)} | {cell(worst)} |")
+    stood = [r["margin_inset"] for r in rows if r["outcome"] != "fell" and r["margin_inset"] is not None]
+    fell = [r["margin_inset"] for r in rows if r["outcome"] == "fell" and r["margin_inset"] is not None]
+    lines.append(f"\nThe inset rule over {len(rows)} trials: the trials that did not fall end with inset margins "
+                 f">= {_signed(min(stood, default=None))} m/s; those that fell <= {_signed(max(fell, default=None))} m/s.")
+    return "\n".join(lines)
