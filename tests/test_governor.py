@@ -42,15 +42,18 @@ def analyze_at(governor: Governor, q, v):
     return ib.analyze(governor.scenario_at(q, data.vcom[0]))
 
 
-@pytest.mark.parametrize("name, inertia, margin", [
-    ("palm_push_two_feet", "composite", 0.0),
-    ("palm_push_ramp", "composite", 0.01),
-    ("kick_one_foot", "joint_space", 0.0),
-    ("g1_two_feet", "composite", 0.005),
+@pytest.mark.parametrize("name, inertia, margin, friction", [
+    ("palm_push_two_feet", "composite", 0.0, None),
+    ("palm_push_ramp", "composite", 0.01, None),
+    ("kick_one_foot", "joint_space", 0.0, None),
+    ("g1_two_feet", "composite", 0.005, None),
+    ("palm_push_ramp", "composite", 0.01, 2.5),  # a friction above 1: the friction-normalised path
 ])
-def test_each_tick_is_analyze_of_the_same_state(name, inertia, margin):
+def test_each_tick_is_analyze_of_the_same_state(name, inertia, margin, friction):
     scenario = load_scenario(name)
-    scenario = scenario.model_copy(update={"zmp_margin": margin,
+    contacts = scenario.contacts if friction is None else [
+        c.model_copy(update={"friction": friction}) for c in scenario.contacts]
+    scenario = scenario.model_copy(update={"zmp_margin": margin, "contacts": contacts,
                                            "impact": scenario.impact.model_copy(update={"inertia": inertia})})
     governor = Governor(scenario)
     for q, v in states(governor, 6):

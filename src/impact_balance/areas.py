@@ -23,10 +23,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import polygon
+from . import constraints, polygon
 from ._jit import cache_depends_on, njit
 from .constants import GRAVITY
-from .constraints import WrenchPolytope, wrench_polytope
+from .constraints import WrenchPolytope, _assemble_arrays, wrench_polytope
 from .infeasibility import CannotBalanceReason, explain_cannot_balance
 from .exceptions import ScenarioError, SolverError
 from .polygon import MERGE_AREA_TOLERANCE, Polygon, _edge_halfplanes, _inset_polygon
@@ -35,7 +35,7 @@ from .projection._kernel import LINE, OK
 from .projection.walk import MAX_PIVOTS, certified_walk
 from .stance import Stance
 
-__all__ = ["BalanceAreas", "balance_areas", "areas_from_polytope", "omega", "with_reason"]
+__all__ = ["BalanceAreas", "balance_areas", "areas_from_polytope", "areas_from_arrays", "omega", "with_reason"]
 
 #: Projection tolerance on the resultant horizontal force, as a fraction of m g.
 FORCE_TOLERANCE = 1e-8
@@ -113,26 +113,54 @@ def areas_from_polytope(polytope: WrenchPolytope, plane_height: float = 0.0, zmp
     com = polytope.com
     w = omega(float(com[2]), plane_height, polytope.gravity)
     depth = plane_height - float(com[2])  # < 0
-    cx, cy, margin = float(com[0]), float(com[1]), float(zmp_margin)
     # Work in units of m g so that tolerances mean the same for every robot, and in
     # friction-normalised variables so that a large or small friction keeps full precision.
-    A, b, C, d, E = (np.ascontiguousarray(x, dtype=np.float64) for x in polytope.projection_data())
-    # The walk, its certificate and both maps in one compiled call (a governor's every tick);
-    # where the walk cannot answer, project_polytope chooses as it always does.
-    status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h = _walk_areas(
-        A, b, C, d, E, FORCE_BOX, MAX_PIVOTS, MERGE_TOLERANCE, MERGE_AREA_TOLERANCE, depth, cx, cy, w, margin)
+    data = tuple(np.ascontiguousarray(x, dtype=np.float64) for x in polytope.projection_data())
+    # The walk, its certificate and both maps in one compiled call (a governor's every tick).
+    walked = _walk_areas(*data, FORCE_BOX, MAX_PIVOTS, MERGE_TOLERANCE, MERGE_AREA_TOLERANCE, depth, float(com[0]),
+                         float(com[1]), w, float(zmp_margin))
+    return _balance_areas(walked, data, com, w, plane_height, polytope.mass, polytope.gravity, float(zmp_margin))
+
+
+def areas_from_arrays(
+    faces: np.ndarray, rotations: np.ndarray, positions: np.ndarray, arms: np.ndarray, mass: float, com: np.ndarray,
+    gravity: float, jacobians: np.ndarray, torque_indices: np.ndarray, torque_limits: np.ndarray,
+    gravity_torques: np.ndarray, plane_height: float = 0.0, zmp_margin: float = 0.0,
+) -> BalanceAreas:
+    """``areas_from_polytope(assemble_polytope(...))`` for contacts whose frictions are all at
+    most 1 (no friction scaling), in one compiled call: a governor's every tick.
+
+    The arguments are :func:`~impact_balance.constraints.assemble_polytope`'s (``faces`` (m,
+    16, 6), contiguous float64 arrays; ``com`` (3,) world, m), then the plane height (m) and
+    the ZMP margin (m).
+    """
+    w = omega(float(com[2]), plane_height, gravity)
+    depth = plane_height - float(com[2])
+    out = _assembled_areas(faces.reshape(len(faces), 32, 3), rotations, positions, arms, jacobians, torque_indices,
+                           torque_limits, gravity_torques, mass * gravity, FORCE_BOX, MAX_PIVOTS, MERGE_TOLERANCE,
+                           MERGE_AREA_TOLERANCE, depth, float(com[0]), float(com[1]), w, float(zmp_margin))
+    return _balance_areas(out[5:], out[:5], com, w, plane_height, mass, gravity, float(zmp_margin))
+
+
+def _balance_areas(walked: tuple, data: tuple, com: np.ndarray, w: float, plane_height: float, mass: float,
+                   gravity: float, margin: float) -> BalanceAreas:
+    """The areas from :func:`_walk_areas`' answer ``walked`` on the projection data ``data``
+    ``(A, b, C, d, E)``: where the walk cannot answer, project_polytope chooses as it always
+    does, and the same compiled maps make the ZMP and CoM velocity areas."""
+    status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h = walked
     n_lp = 1
     if status != OK or force.shape[0] == 0:
-        result = project_polytope(A, b, C, d, E, tol=FORCE_TOLERANCE, box=FORCE_BOX, merge_tol=MERGE_TOLERANCE,
+        result = project_polytope(*data, tol=FORCE_TOLERANCE, box=FORCE_BOX, merge_tol=MERGE_TOLERANCE,
                                   method="auto" if status == LINE else "bretl")
         force, bounded, n_lp = result.polygon.vertices, result.polygon.bounded, result.n_lp
-        zmp, zmp_bounded, vel, vel_bounded = _maps(np.ascontiguousarray(force), bounded, depth, cx, cy, w, margin)
+        zmp, zmp_bounded, vel, vel_bounded = _maps(np.ascontiguousarray(force), bounded, plane_height - float(com[2]),
+                                                   float(com[0]), float(com[1]), w, margin)
         G = np.empty((0, 2))
     # The criterion reads the CoM velocity area's half-planes: the compiled call made them.
     velocity_area = (Polygon.with_halfplanes(vel, bool(vel_bounded), G, h) if len(G)
                      else Polygon(vel, bool(vel_bounded)))
     return BalanceAreas(Polygon(force, bool(bounded)), Polygon(zmp, bool(zmp_bounded)), velocity_area,
-                        w, com.copy(), plane_height, polytope.mass, polytope.gravity, n_lp, zmp_margin=margin)
+                        w, np.array(com, dtype=float), plane_height, mass, gravity, n_lp, zmp_margin=margin)
 
 
 @njit(cache=True)
@@ -177,9 +205,27 @@ def _walk_areas(A, b, C, d, E, box, max_pivots, merge_tol, area_tol, depth, cx, 
     return status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h
 
 
-# The compiled functions above embed the polygon module's and the walk's.
+@njit(cache=True)
+def _assembled_areas(faces, rotations, positions, arms, jacobians, torque_indices, torque_limits, gravity_torques,
+                     weight, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, margin):
+    """The polytope's arrays (as :func:`~impact_balance.constraints.assemble_polytope`) in
+    units of m g (as ``WrenchPolytope.projection_data`` without scaling) and
+    :func:`_walk_areas` on them: ``(A, b, C, d, E) + _walk_areas(...)``."""
+    A, b, C, G = _assemble_arrays(faces, rotations, positions, arms, jacobians, torque_indices, torque_limits,
+                                  gravity_torques)
+    b = b / weight
+    d = np.zeros(4)
+    d[0] = weight / weight  # (m g, 0, 0, 0) / (m g)
+    E = G[:2].copy()
+    status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, Gv, hv = _walk_areas(
+        A, b, C, d, E, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, margin)
+    return A, b, C, d, E, status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, Gv, hv
+
+
+# The compiled functions above embed the polygon module's, the walk's and the assembly's.
 cache_depends_on(_maps, polygon)
 cache_depends_on(_walk_areas, polygon, walk, _kernel)
+cache_depends_on(_assembled_areas, polygon, walk, _kernel, constraints)
 
 
 def balance_areas(

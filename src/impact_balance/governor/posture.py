@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ..areas import BalanceAreas, areas_from_polytope
+from ..areas import BalanceAreas, areas_from_arrays, areas_from_polytope
 from ..constraints import assemble_polytope, friction_scaling
 from ..criteria import ComCriterion, VelocityLimit, zmp_max_contact_velocity
 from ..cwc import _local_faces
@@ -187,23 +187,29 @@ class PostureEvaluator:
         # momentum matrix's linear rows are m times the CoM Jacobian); equal to pinocchio's
         # computeGeneralizedGravity to rounding (1e-14 N m of 327 on G1), without its pass.
         gravity_torques = -(self._gravity @ data.Ag[:3]) if self._torques else self._zero_velocity
-        scaling = friction_scaling(self._frictions, rotations) if self._scaled else None
-        polytope = assemble_polytope(self._faces, rotations, local + origin, local - com_local, mass, com_local + origin,
-                                     settings.gravity, jacobians, self._idx, self._limit, gravity_torques, scaling)
+        com = com_local + origin
         try:
-            areas = areas_from_polytope(polytope, settings.plane_height, settings.zmp_margin)
+            if self._scaled:  # a friction above 1: the polytope in friction-normalised variables
+                polytope = assemble_polytope(self._faces, rotations, local + origin, local - com_local, mass, com,
+                                             settings.gravity, jacobians, self._idx, self._limit, gravity_torques,
+                                             friction_scaling(self._frictions, rotations))
+                areas = areas_from_polytope(polytope, settings.plane_height, settings.zmp_margin)
+            else:  # the same numbers, assembled and projected in one compiled call
+                areas = areas_from_arrays(self._faces, rotations, local + origin, local - com_local, mass, com,
+                                          settings.gravity, jacobians, self._idx, self._limit, gravity_torques,
+                                          settings.plane_height, settings.zmp_margin)
         except SolverError as exc:
             raise exc.within("contacts (projection of the contact wrench polytope)") from None
         impact = self._impact(q, q_local, origin, com_local, mass, np.array(Ig.inertia, dtype=float))
         com_criterion = zmp = None
         if settings.criterion == "zmp":
-            zmp = zmp_max_contact_velocity(areas.zmp_area, impact, polytope.com, settings.plane_height,
+            zmp = zmp_max_contact_velocity(areas.zmp_area, impact, com, settings.plane_height,
                                            settings.gravity, settings.impact.duration)
         else:
             com_criterion = ComCriterion(areas.com_velocity_area, impact)
         q = q.copy()
         q.setflags(write=False)
-        return Posture(q.tobytes(), q, robot, settings, polytope.com, mass, areas, impact, com_jacobian,
+        return Posture(q.tobytes(), q, robot, settings, com, mass, areas, impact, com_jacobian,
                        com_criterion, zmp)
 
     def _impact(self, q: np.ndarray, q_local: np.ndarray, origin: np.ndarray, com_local: np.ndarray, mass: float,
