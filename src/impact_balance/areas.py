@@ -26,7 +26,7 @@ import numpy as np
 from . import constraints, polygon
 from ._jit import cache_depends_on, njit
 from .constants import GRAVITY
-from .constraints import WrenchPolytope, _assemble_arrays, wrench_polytope
+from .constraints import WrenchPolytope, _assemble_arrays, face_blocks, wrench_polytope
 from .infeasibility import CannotBalanceReason, explain_cannot_balance
 from .exceptions import ScenarioError, SolverError
 from .polygon import MERGE_AREA_TOLERANCE, Polygon, _edge_halfplanes, _inset_polygon
@@ -136,7 +136,7 @@ def areas_from_arrays(
     """
     w = omega(float(com[2]), plane_height, gravity)
     depth = plane_height - float(com[2])
-    out = _assembled_areas(faces.reshape(len(faces), 32, 3), rotations, positions, arms, jacobians, torque_indices,
+    out = _assembled_areas(face_blocks(faces, rotations), positions, arms, jacobians, torque_indices,
                            torque_limits, gravity_torques, mass * gravity, FORCE_BOX, MAX_PIVOTS, MERGE_TOLERANCE,
                            MERGE_AREA_TOLERANCE, depth, float(com[0]), float(com[1]), w, float(zmp_margin))
     return _balance_areas(out[5:], out[:5], com, w, plane_height, mass, gravity, float(zmp_margin))
@@ -206,13 +206,12 @@ def _walk_areas(A, b, C, d, E, box, max_pivots, merge_tol, area_tol, depth, cx, 
 
 
 @njit(cache=True)
-def _assembled_areas(faces, rotations, positions, arms, jacobians, torque_indices, torque_limits, gravity_torques,
+def _assembled_areas(blocks, positions, arms, jacobians, torque_indices, torque_limits, gravity_torques,
                      weight, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, margin):
     """The polytope's arrays (as :func:`~impact_balance.constraints.assemble_polytope`) in
     units of m g (as ``WrenchPolytope.projection_data`` without scaling) and
     :func:`_walk_areas` on them: ``(A, b, C, d, E) + _walk_areas(...)``."""
-    A, b, C, G = _assemble_arrays(faces, rotations, positions, arms, jacobians, torque_indices, torque_limits,
-                                  gravity_torques)
+    A, b, C, G = _assemble_arrays(blocks, positions, arms, jacobians, torque_indices, torque_limits, gravity_torques)
     b = b / weight
     d = np.zeros(4)
     d[0] = weight / weight  # (m g, 0, 0, 0) / (m g)
