@@ -14,6 +14,7 @@ import json
 import mujoco
 import numpy as np
 import pandas as pd
+import pinocchio as pin
 import pytest
 
 from impact_balance import cli
@@ -21,7 +22,8 @@ from impact_balance.logs import read_log, write_log
 from impact_balance.sim import SimOptions, build_model
 from impact_balance.sim.log import log_frame
 from impact_balance.sim.measure import distance_to_hull, measure
-from impact_balance.sim.trial import TrialOptions, impact_limb, run_trial
+from impact_balance.exceptions import SimulationError
+from impact_balance.sim.trial import TrialOptions, approach_joint_velocity, impact_limb, run_trial
 
 LIGHT = SimOptions(meshes=False)
 
@@ -93,6 +95,41 @@ def test_servo_trial_falls_near_the_joint_space_model(models):
     assert result.approach_speed_measured == pytest.approx(0.3, rel=0.15)
     assert 0 < jump < 0.25 * composite  # the servo-held arm gives way: far below the rigid body
     assert result.predicted["joint_space"].distance < result.predicted["composite"].distance
+
+
+@pytest.mark.parametrize("name,speed", [("g1_two_feet", 0.75), ("romeo_two_feet", 0.75), ("palm_push_two_feet", 0.5)])
+def test_servo_approach_starts_within_joint_limits_and_hits_after_it_begins(models, name, speed):
+    """The retracted start pose is within the joints' ranges (G1's right wrist yaw and Romeo's right elbow yaw
+    left them with the Jacobian's pseudo-inverse alone), and the impact is the commanded approach's: after the
+    settling, near the commanded speed. A start pose beyond a limit is snapped back while the robot settles."""
+    sim = models(name, "servo")
+    spec = sim.scenario.impact.spec()
+    n = np.asarray(spec.normal, dtype=float) / np.linalg.norm(spec.normal)
+    limb = impact_limb(sim)
+    options = TrialOptions(speed, after=0.02, rigid_impact=True)
+    dq = approach_joint_velocity(sim, limb, n, options.resolved_gap())
+    _, J6 = sim.stance.point(spec.frame, spec.offset)
+    assert J6[:3] @ dq == pytest.approx(-n, abs=1e-9)  # unit approach speed along -n at the stance
+    start = pin.integrate(sim.stance.model, sim.stance.q, -options.resolved_gap() * dq)  # the trial's start pose
+    ids = [sim.model.joint(j).id for j in limb]
+    q_index = [sim.q_index[sim.joint_names.index(j)] for j in limb]
+    low, high = sim.model.jnt_range[ids].T
+    assert np.all((start[q_index] >= low - 1e-9) & (start[q_index] <= high + 1e-9))
+    record = run_trial(sim, options)
+    result = measure(sim, record, speed)
+    assert result.impact_time[0] > record.approach_start + 0.5 * options.resolved_gap() / speed
+    assert result.approach_speed_measured == pytest.approx(speed, rel=0.2)
+
+
+def test_servo_approach_beyond_joint_limits_is_refused(models):
+    """iCub's right hand hangs at a near-singular pose (the point Jacobian's smallest singular value 0.017
+    m/rad) with the shoulder pitch 0.085 rad from its limit: no straight joint path retracts the hand 5 cm
+    along the wall's normal within the limits. The trial used to start the shoulder 0.42 rad beyond its
+    limit; MuJoCo snapped it back and the hand hit the wall at 1.09 m/s during the settling, 0.15 s
+    before the commanded 0.5 m/s approach began."""
+    sim = models("icub_two_feet", "servo")
+    with pytest.raises(SimulationError, match="r_shoulder_pitch"):
+        run_trial(sim, TrialOptions(0.5, after=0.02, rigid_impact=True))
 
 
 def test_log_frame_matches_finite_differences(rigid_push, tmp_path):

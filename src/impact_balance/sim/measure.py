@@ -199,6 +199,11 @@ def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialR
         raise SimulationError(
             "--duration", round(record.simulated_time, 4), "the impact point never reached the surface in that time"
         ) from None
+    if record.time[before] < record.approach_start:
+        # Not the commanded approach's impact (e.g. a joint snapped back into its range while settling).
+        raise SimulationError(
+            "impact", spec.frame, f"the impact point touched the surface at {record.time[before]:.3f} s, before "
+            f"the approach began ({record.approach_start:.3f} s): the limb was not held at its start pose")
     dt = sim.model.opt.timestep
     impulse = record.forces["impact"][before:end].sum(axis=0) * dt
     jump = (record.com_velocity[end] - record.com_velocity[before])[:2]

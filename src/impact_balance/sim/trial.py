@@ -8,7 +8,9 @@ impact of one rigid body.
 ``servo`` joints: gravity on, the robot stands on its contacts. It first settles for
 ``settle`` seconds with the impacting limb retracted by ``gap``; then the limb's servo
 targets move the impact point along ``-n`` at ``v_n`` (joint velocities from the limb's
-Jacobian pseudo-inverse at the stance, positions integrated from the retracted pose). They
+Jacobian pseudo-inverse at the stance, the least-norm ones that keep the retracted start pose
+within the joint limits when it would leave them, :func:`approach_joint_velocity`; positions
+integrated from the retracted pose). They
 go on past the stance if the servos lag, and stop where they are once the impact force
 appears (a kinematic controller stops at contact). Every other joint holds the stance. The
 limb is the chain of joints that leads to the impact frame and carries nothing else (Talos'
@@ -31,7 +33,7 @@ from ..exceptions import SimulationError
 from ..numeric_limits import MAX_APPROACH_SPEED, check_approach_speed
 from .model import SimModel
 
-__all__ = ["TrialOptions", "TrialRecord", "run_trial", "impact_limb", "MAX_APPROACH_SPEED"]
+__all__ = ["TrialOptions", "TrialRecord", "run_trial", "impact_limb", "approach_joint_velocity", "MAX_APPROACH_SPEED"]
 
 
 @dataclass(frozen=True)
@@ -114,6 +116,52 @@ def impact_limb(sim: SimModel) -> list[str]:
     return [n for n in names if n in sim.joint_names]
 
 
+def approach_joint_velocity(sim: SimModel, limb: list[str], normal: np.ndarray, gap: float) -> np.ndarray:
+    """Joint velocity (pinocchio ``nv``) of the ``limb`` that moves the impact point at unit speed along
+    ``-normal`` at the stance, such that the retracted start pose ``q - gap dq`` is within the joints' limits.
+
+    The smallest such ``dq``: the Jacobian's pseudo-inverse solution when its start pose is within the
+    limits (MuJoCo's joint ranges), else the least-norm solution with the start pose bounded by them (a QP).
+    A start pose beyond a limit is not a pose the servos can hold: MuJoCo's limit constraint snaps the
+    joint back while the robot settles, and the limb may hit the surface before the approach begins
+    (iCub's right shoulder pitch, at 0.085 rad from its limit in ``icub_two_feet``). When no such ``dq``
+    exists the approach cannot be commanded along a straight joint path from this stance: SimulationError.
+    """
+    import qpsolvers
+
+    spec = sim.scenario.impact.spec()
+    model = sim.stance.model
+    _, J6 = sim.stance.point(spec.frame, spec.offset)
+    slots = [sim.robot.joint_slot(j) for j in limb]
+    v_cols = np.array([model.joints[s.id].idx_v for s in slots])
+    J = J6[:3, v_cols]
+    dq = np.linalg.pinv(J) @ (-normal)
+    mj_joints = [sim.model.joint(j).id for j in limb]
+    limited = sim.model.jnt_limited[mj_joints].astype(bool)
+    low, high = sim.model.jnt_range[mj_joints].T
+    q = sim.stance.q[[model.joints[s.id].idx_q for s in slots]]
+    start = q - gap * dq
+    # A start pose within the limits (or a joint already beyond its limit at the stance, kept as it is).
+    outside = limited & (((start < low) & (dq > 0)) | ((start > high) & (dq < 0)))
+    if outside.any():
+        big = 1e6  # rad/m: no bound
+        lower = np.where(limited, np.minimum((q - high) / gap, 0.0), -big)  # q - gap dq <= high
+        upper = np.where(limited, np.maximum((q - low) / gap, 0.0), big)  # q - gap dq >= low
+        solution = qpsolvers.solve_qp(np.eye(len(limb)), np.zeros(len(limb)), A=J, b=-normal,
+                                      lb=lower, ub=upper, solver="daqp")
+        if solution is None or not np.allclose(J @ solution, -normal, atol=1e-6):
+            names = ", ".join(f"{j} ({q_j:+.3f} rad, range [{lo:+.3f}, {hi:+.3f}])"
+                              for j, q_j, lo, hi, bad in zip(limb, q, low, high, outside) if bad)
+            raise SimulationError(
+                "impact", spec.frame,
+                f"the limb cannot start {gap:.3f} m back from the surface within its joint limits: a straight "
+                f"joint path that moves the impact point along the normal would take {names} beyond its limit")
+        dq = solution
+    out = np.zeros(model.nv)
+    out[v_cols] = dq
+    return out
+
+
 def _point_velocity(sim: SimModel, normal: np.ndarray) -> np.ndarray:
     """World velocity of the impact point (the sphere's surface point along -n)."""
     out = np.zeros(6)
@@ -154,10 +202,7 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
         if not limb:
             raise SimulationError("impact.frame", spec.frame,
                                   "no joint moves the impact point without moving a contact")
-        _, J6 = sim.stance.point(spec.frame, spec.offset)
-        v_cols = np.array([sim.robot.model.joints[sim.robot.joint_slot(j).id].idx_v for j in limb])
-        limb_dq = np.zeros(sim.stance.model.nv)
-        limb_dq[v_cols] = np.linalg.pinv(J6[:3, v_cols]) @ (-n)  # joint velocity per unit approach speed
+        limb_dq = approach_joint_velocity(sim, limb, n, gap)  # joint velocity per unit approach speed
         q_start = pin.integrate(sim.stance.model, sim.stance.q, -gap * limb_dq)
         sim.set_state(q_start)
         sim.set_servo_targets(q_start)
