@@ -494,3 +494,28 @@ def test_velocity_area_halfplanes_from_the_compiled_pipeline_are_the_polygons_ow
     assert len(G) >= 3
     np.testing.assert_array_equal(G, G2)
     np.testing.assert_array_equal(h, h2)
+
+
+@pytest.mark.parametrize("name", ["palm_push_ramp", "g1_two_feet", "kick_one_foot"])
+@pytest.mark.parametrize("margin", [0.0, 0.01])
+def test_areas_from_arrays_is_areas_from_polytope_number_for_number(name, margin):
+    """The governor's one-call path (assembly and projection in one compiled call) gives the
+    areas analyze() gets from the assembled polytope, exactly; plain lists are accepted."""
+    from impact_balance.areas import areas_from_arrays
+    from impact_balance.cwc import _local_faces
+
+    scenario = load_scenario(name)
+    stance = scenario.build_stance()
+    want = areas_from_polytope(wrench_polytope(stance), scenario.plane_height, margin)
+    faces = np.array([_local_faces(float(c.spec.friction), c.half_length, c.half_width)
+                      for c in stance.contacts]).reshape(-1, 16, 6)
+    idx, limit = stance.robot.effort_limits
+    arms = np.array([c.local_position for c in stance.contacts]) - stance.com_local
+    got = areas_from_arrays(faces, [c.rotation for c in stance.contacts], [list(c.position) for c in stance.contacts],
+                            arms.tolist(), stance.mass, stance.com, 9.81,
+                            np.concatenate([c.jacobian for c in stance.contacts]), list(idx), list(limit),
+                            list(stance.gravity_torques), scenario.plane_height, margin)
+    for which in ("force_area", "zmp_area", "com_velocity_area"):
+        np.testing.assert_array_equal(getattr(got, which).vertices, getattr(want, which).vertices)
+        assert getattr(got, which).bounded == getattr(want, which).bounded
+    assert (got.omega, got.mass, got.n_lp) == (want.omega, want.mass, want.n_lp)

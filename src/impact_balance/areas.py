@@ -131,14 +131,16 @@ def areas_from_arrays(
     most 1 (no friction scaling), in one compiled call: a governor's every tick.
 
     The arguments are :func:`~impact_balance.constraints.assemble_polytope`'s (``faces`` (m,
-    16, 6), contiguous float64 arrays; ``com`` (3,) world, m), then the plane height (m) and
-    the ZMP margin (m).
+    16, 6); ``com`` (3,) world, m), then the plane height (m) and the ZMP margin (m).
     """
     w = omega(float(com[2]), plane_height, gravity)
     depth = plane_height - float(com[2])
-    out = _assembled_areas(face_blocks(faces, rotations), positions, arms, jacobians, torque_indices,
-                           torque_limits, gravity_torques, mass * gravity, FORCE_BOX, MAX_PIVOTS, MERGE_TOLERANCE,
-                           MERGE_AREA_TOLERANCE, depth, float(com[0]), float(com[1]), w, float(zmp_margin))
+    positions, arms, jacobians, torque_limits, gravity_torques = (
+        np.ascontiguousarray(x, dtype=np.float64) for x in (positions, arms, jacobians, torque_limits, gravity_torques))
+    out = _assembled_areas(face_blocks(faces, rotations), positions, arms, jacobians,
+                           np.ascontiguousarray(torque_indices, dtype=np.int64), torque_limits, gravity_torques,
+                           mass * gravity, FORCE_BOX, MAX_PIVOTS, MERGE_TOLERANCE, MERGE_AREA_TOLERANCE, depth,
+                           float(com[0]), float(com[1]), w, float(zmp_margin))
     return _balance_areas(out[5:], out[:5], com, w, plane_height, mass, gravity, float(zmp_margin))
 
 
