@@ -20,6 +20,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -35,7 +36,8 @@ from .projection._kernel import LINE, OK
 from .projection.walk import MAX_PIVOTS, certified_walk
 from .stance import Stance
 
-__all__ = ["BalanceAreas", "balance_areas", "areas_from_polytope", "areas_from_arrays", "omega", "with_reason"]
+__all__ = ["BalanceAreas", "Projected", "balance_areas", "areas_from_polytope", "areas_from_arrays", "projected_from_arrays",
+           "omega", "with_reason"]
 
 #: Projection tolerance on the resultant horizontal force, as a fraction of m g.
 FORCE_TOLERANCE = 1e-8
@@ -119,7 +121,7 @@ def areas_from_polytope(polytope: WrenchPolytope, plane_height: float = 0.0, zmp
     # The walk, its certificate and both maps in one compiled call (a governor's every tick).
     walked = _walk_areas(*data, FORCE_BOX, MAX_PIVOTS, MERGE_TOLERANCE, MERGE_AREA_TOLERANCE, depth, float(com[0]),
                          float(com[1]), w, float(zmp_margin))
-    return _balance_areas(walked, data, com, w, plane_height, polytope.mass, polytope.gravity, float(zmp_margin))
+    return _projected(walked, data, com, w, plane_height, polytope.mass, polytope.gravity, float(zmp_margin)).areas()
 
 
 def areas_from_arrays(
@@ -133,6 +135,17 @@ def areas_from_arrays(
     The arguments are :func:`~impact_balance.constraints.assemble_polytope`'s (``faces`` (m,
     16, 6); ``com`` (3,) world, m), then the plane height (m) and the ZMP margin (m).
     """
+    return projected_from_arrays(faces, rotations, positions, arms, mass, com, gravity, jacobians, torque_indices,
+                                 torque_limits, gravity_torques, plane_height, zmp_margin).areas()
+
+
+def projected_from_arrays(
+    faces: np.ndarray, rotations: np.ndarray, positions: np.ndarray, arms: np.ndarray, mass: float, com: np.ndarray,
+    gravity: float, jacobians: np.ndarray, torque_indices: np.ndarray, torque_limits: np.ndarray,
+    gravity_torques: np.ndarray, plane_height: float = 0.0, zmp_margin: float = 0.0,
+) -> Projected:
+    """:func:`areas_from_arrays` before its :class:`BalanceAreas` is built (a governor's tick
+    reads only the CoM velocity area; :meth:`Projected.areas` builds the rest on demand)."""
     w = omega(float(com[2]), plane_height, gravity)
     depth = plane_height - float(com[2])
     positions, arms, jacobians, torque_limits, gravity_torques = (
@@ -141,11 +154,40 @@ def areas_from_arrays(
                            np.ascontiguousarray(torque_indices, dtype=np.int64), torque_limits, gravity_torques,
                            mass * gravity, FORCE_BOX, MAX_PIVOTS, MERGE_TOLERANCE, MERGE_AREA_TOLERANCE, depth,
                            float(com[0]), float(com[1]), w, float(zmp_margin))
-    return _balance_areas(out[5:], out[:5], com, w, plane_height, mass, gravity, float(zmp_margin))
+    return _projected(out[5:], out[:5], com, w, plane_height, mass, gravity, float(zmp_margin))
 
 
-def _balance_areas(walked: tuple, data: tuple, com: np.ndarray, w: float, plane_height: float, mass: float,
-                   gravity: float, margin: float) -> BalanceAreas:
+class Projected(NamedTuple):
+    """One projection's areas as arrays, the CoM velocity area (with its half-planes) as a
+    :class:`Polygon`, and what :meth:`areas` needs to build the :class:`BalanceAreas`.
+
+    ``force``, ``zmp`` (k, 2): the force area (units of m g) and the ZMP support area (world,
+    m) vertices; ``w`` omega (1/s); ``com`` (3,) m; ``plane_height`` m; ``mass`` kg;
+    ``gravity`` m/s^2; ``margin`` the ZMP margin, m.
+    """
+
+    force: np.ndarray
+    bounded: bool
+    zmp: np.ndarray
+    zmp_bounded: bool
+    com_velocity_area: Polygon
+    n_lp: int
+    w: float
+    com: np.ndarray
+    plane_height: float
+    mass: float
+    gravity: float
+    margin: float
+
+    def areas(self) -> BalanceAreas:
+        """The :class:`BalanceAreas` (the same CoM velocity area object)."""
+        return BalanceAreas(Polygon(self.force, self.bounded), Polygon(self.zmp, self.zmp_bounded),
+                            self.com_velocity_area, self.w, np.array(self.com, dtype=float), self.plane_height,
+                            self.mass, self.gravity, self.n_lp, zmp_margin=self.margin)
+
+
+def _projected(walked: tuple, data: tuple, com: np.ndarray, w: float, plane_height: float, mass: float,
+               gravity: float, margin: float) -> Projected:
     """The areas from :func:`_walk_areas`' answer ``walked`` on the projection data ``data``
     ``(A, b, C, d, E)``: where the walk cannot answer, project_polytope chooses as it always
     does, and the same compiled maps make the ZMP and CoM velocity areas."""
@@ -161,8 +203,8 @@ def _balance_areas(walked: tuple, data: tuple, com: np.ndarray, w: float, plane_
     # The criterion reads the CoM velocity area's half-planes: the compiled call made them.
     velocity_area = (Polygon.with_halfplanes(vel, bool(vel_bounded), G, h) if len(G)
                      else Polygon(vel, bool(vel_bounded)))
-    return BalanceAreas(Polygon(force, bool(bounded)), Polygon(zmp, bool(zmp_bounded)), velocity_area,
-                        w, np.array(com, dtype=float), plane_height, mass, gravity, n_lp, zmp_margin=margin)
+    return Projected(force, bool(bounded), zmp, bool(zmp_bounded), velocity_area, n_lp, w, com, plane_height, mass,
+                     gravity, margin)
 
 
 @njit(cache=True)

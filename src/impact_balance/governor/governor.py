@@ -251,7 +251,7 @@ class Governor:
                 if self._support_posture != posture.key:  # a posture evaluated since: the rates may be due
                     self._support.new_posture(lambda: posture.stance)
                     self._support_posture = posture.key
-                aware = self._support.answer(posture.areas.com_velocity_area, com_velocity)
+                aware = self._support.answer(posture.com_criterion.area, com_velocity)
                 interval = combine(interval, aware.interval)
                 if aware.limit.max_approach_speed < limit.max_approach_speed:
                     limit, binding = aware.limit, "contact_aware"

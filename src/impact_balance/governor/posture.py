@@ -19,12 +19,12 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
 
-from ..areas import BalanceAreas, areas_from_arrays, areas_from_polytope
+from ..areas import BalanceAreas, Projected, areas_from_polytope, projected_from_arrays
 from ..constraints import assemble_polytope, friction_scaling
 from ..criteria import ComCriterion, VelocityLimit, zmp_max_contact_velocity
 from ..cwc import _local_faces
@@ -80,7 +80,9 @@ class Posture:
         q: The configuration (nq; read-only).
         robot: The robot. settings: What it was evaluated with.
         com: The CoM, m. mass: kg.
-        areas: The ZMP support area (shrunk by the ZMP margin) and the CoM velocity area.
+        areas: The ZMP support area (shrunk by the ZMP margin) and the CoM velocity area (a
+            :class:`~impact_balance.areas.BalanceAreas`, built on first access: a tick reads
+            only the CoM velocity area, ``com_criterion.area``).
         impact: The impact model at this posture.
         com_jacobian: (3, nv) map from the generalized velocity (pinocchio's convention: the
             free flyer's linear and angular velocity in the base frame, then the joints) to
@@ -96,11 +98,17 @@ class Posture:
     settings: PostureSettings
     com: np.ndarray
     mass: float
-    areas: BalanceAreas
+    projected: BalanceAreas | Projected = field(repr=False)
     impact: ImpactModel
     com_jacobian: np.ndarray
     com_criterion: ComCriterion | None
     zmp_limit: VelocityLimit | None
+
+    @functools.cached_property
+    def areas(self) -> BalanceAreas:
+        """See the class docstring."""
+        projected = self.projected
+        return projected.areas() if isinstance(projected, Projected) else projected
 
     @functools.cached_property
     def stance(self) -> Stance:
@@ -195,14 +203,16 @@ class PostureEvaluator:
                                              friction_scaling(self._frictions, rotations))
                 areas = areas_from_polytope(polytope, settings.plane_height, settings.zmp_margin)
             else:  # the same numbers, assembled and projected in one compiled call
-                areas = areas_from_arrays(self._faces, rotations, local + origin, local - com_local, mass, com,
-                                          settings.gravity, jacobians, self._idx, self._limit, gravity_torques,
-                                          settings.plane_height, settings.zmp_margin)
+                areas = projected_from_arrays(self._faces, rotations, local + origin, local - com_local, mass, com,
+                                              settings.gravity, jacobians, self._idx, self._limit, gravity_torques,
+                                              settings.plane_height, settings.zmp_margin)
         except SolverError as exc:
             raise exc.within("contacts (projection of the contact wrench polytope)") from None
         impact = self._impact(q, q_local, origin, com_local, mass, np.array(Ig.inertia, dtype=float))
         com_criterion = zmp = None
         if settings.criterion == "zmp":
+            if isinstance(areas, Projected):
+                areas = areas.areas()
             zmp = zmp_max_contact_velocity(areas.zmp_area, impact, com, settings.plane_height,
                                            settings.gravity, settings.impact.duration)
         else:
