@@ -93,14 +93,15 @@ def test_extreme_friction_matches_bretl(frictions):
     _same_polygon(auto.polygon, bretl.polygon)
 
 
-@pytest.mark.parametrize("frictions", [(1e-9, 1e-9, 0.7), (1e-6, 0.7, 1e6)])
+@pytest.mark.parametrize("frictions", [(1e-9, 1e-9, 0.7), (0.7, 0.7, 1e9)])
 def test_walk_rejects_a_bad_walk(frictions):
     """method='walk' refuses (rather than answers) where the walk loses its way: on these
-    badly scaled rows (the unnormalised polytope) its vertices violate constraints by 1e-5
-    to 1.4 (units of the unit rows), which the certificate catches. Whether the walk keeps
-    its way on such rows changes with rounding (a wall hand at 1e8 or 1e9 went either way
-    while the kernel changed); where it does, its answer agrees with Bretl's
-    (test_extreme_friction_matches_bretl)."""
+    badly scaled rows (the unnormalised polytope) its vertices violate constraints or it
+    backtracks into a non-convex polygon, which the certificate catches. Whether the walk
+    keeps its way on such rows changes with rounding and with the kernel (feet at 1e-6 beside
+    a hand at 1e6 was refused until the walk made a fresh inverse wherever its carried one
+    drifted; it now answers, within 2e-9 of Bretl's area); where it does, its answer agrees
+    with Bretl's (test_extreme_friction_matches_bretl)."""
     from impact_balance.exceptions import SolverError
 
     with pytest.raises(SolverError):
@@ -238,3 +239,17 @@ def test_carried_inverse_check_accepts_a_fresh_inverse_and_refuses_a_drifted_one
     drifted[rng.integers(n), rng.integers(n)] += 1e-9 * np.abs(Binv).max()
     assert not _accurate(H, h, W, drifted, z, buffer)
     assert not _accurate(H, h, W, Binv, z + 1e-9 * max(1.0, np.abs(z).max()) * rng.choice([-1.0, 1.0], size=n), buffer)
+
+
+def test_bretl_answers_where_the_warm_simplex_stopped_undecided():
+    """Found by test_area_is_monotone_in_friction: on the ramp with its left foot at friction
+    10^4.406 (the unnormalised polytope), HiGHS's warm-started primal simplex ended one of
+    Bretl's LPs with status Unknown and the projection raised. The LP is now solved again from
+    scratch (HiGHS's defaults), and Bretl's polygon is the walk's."""
+    _, _, specs = _base("palm_push_ramp")
+    frictions = [s.friction for s in specs]
+    frictions[0] = 10.0 ** 4.405863216728498
+    bretl = _project("palm_push_ramp", frictions, method="bretl")
+    walk = _project("palm_push_ramp", frictions, method="walk")
+    _check_polygon(bretl.polygon)
+    _same_polygon(walk.polygon, bretl.polygon)

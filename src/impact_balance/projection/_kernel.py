@@ -400,6 +400,11 @@ def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work):
         if j < 0:
             return FAILED, pivots  # unbounded edge: the box is missing
         stalled = stalled + 1 if t == 0.0 else 0
+        if stalled > 3 * n + H.shape[0]:
+            # Bland's rule has had m + n zero steps and not left the vertex: its multipliers'
+            # tolerance let it cycle (rows 1, 2 and 8 in turn on a G1 posture, until the
+            # 5000-pivot cap: 75 ms). The caller falls back to Bretl.
+            return FAILED, pivots
         active[j] = True
         since = _pivot(H, h, W, Binv, z, leave, j, since, work)
 
@@ -542,6 +547,8 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst):
     pivots += piv
     if status != OK:
         return status, vertices, 0, pivots
+    if piv and not _accurate(H, h, W, Binv, z, work[2]) and not _refactor(H, h, W, Binv, z, work):
+        return FAILED, vertices, 0, pivots
     vertices = np.empty((max_pivots + 2, 2))
     _min_slack(H, h, z, worst)
     _point(g0, GT, z, vertices, 0)
@@ -571,6 +578,14 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst):
         since += piv
         if status != OK or count > max_pivots:
             return FAILED, vertices, count, pivots
+        # The vertex from a fresh inverse when the pivots' rank-one updates left the inverse
+        # off: through a small pivot element (a basis at condition 4e6 on G1) the inverse was
+        # 1e-5 off and its vertex violated a row by 2e-6, which made the walk refuse and fall
+        # back to Bretl (5 ms) on 5 % of G1's postures; the basis's own vertex is within 1e-11.
+        if piv and not _accurate(H, h, W, Binv, z, work[2]):
+            if not _refactor(H, h, W, Binv, z, work):
+                return FAILED, vertices, count, pivots
+            since = 0
         # piv == 0: the crossing multiplier was within the tolerance of zero; the next
         # breakpoint search starts past it. A vertex reached by zero steps (a new basis of it)
         # is recorded too: on an ill-conditioned stance each basis gives it to within ~1e-8,

@@ -11,6 +11,9 @@ from .lp import LinearProgram, LPSolution
 __all__ = ["HighsLP"]
 
 _INF = highspy.kHighsInf
+#: The statuses that answer the LP; any other is retried from scratch once.
+_DECIDED = (highspy.HighsModelStatus.kOptimal, highspy.HighsModelStatus.kInfeasible,
+            highspy.HighsModelStatus.kUnbounded, highspy.HighsModelStatus.kUnboundedOrInfeasible)
 
 try:
     # highspy.Highs() enables its Python callbacks in its constructor, and that first call into
@@ -71,6 +74,7 @@ class HighsLP:
         lp.a_matrix_.value_ = M.data
         lp.sense_ = highspy.ObjSense.kMaximize
         self._n = n
+        self._warm = bool(warm)
         self._h = _Solver()
         h = self._h
         h.setOptionValue("output_flag", False)
@@ -99,6 +103,8 @@ class HighsLP:
         h.changeColsCost(self._n, self._cols, np.asarray(c, dtype=float))
         h.run()
         status = h.getModelStatus()
+        if status not in _DECIDED:
+            status = self._rerun_cold()
         if status == highspy.HighsModelStatus.kOptimal:
             x = np.array(h.getSolution().col_value, dtype=float)
             return LPSolution("optimal", x, float(np.dot(c, x)))
@@ -110,6 +116,22 @@ class HighsLP:
                 return LPSolution("infeasible", None, float("nan"))
             return LPSolution("unbounded", None, float("inf"))
         raise SolverError("HiGHS", h.modelStatusToString(status))
+
+    def _rerun_cold(self):
+        """The same LP from scratch with HiGHS's default strategy (presolve on, no basis): the
+        warm-started primal simplex stopped undecided ("Unknown") on a ramp foot at friction
+        2.5e4 (the unnormalised polytope), where a cold solve answers."""
+        h = self._h
+        h.clearSolver()
+        h.setOptionValue("presolve", "on")
+        h.setOptionValue("simplex_strategy", 1)  # dual simplex, HiGHS's default
+        try:
+            h.run()
+            return h.getModelStatus()
+        finally:
+            if self._warm:
+                h.setOptionValue("presolve", "off")
+                h.setOptionValue("simplex_strategy", 4)
 
     def _feasible(self) -> bool:
         h = self._h
