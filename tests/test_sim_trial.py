@@ -10,6 +10,7 @@ pipeline from pinocchio) contains the rigid robot's measured jump.
 from __future__ import annotations
 
 import json
+import warnings
 
 import mujoco
 import numpy as np
@@ -22,7 +23,7 @@ from impact_balance.logs import read_log, write_log
 from impact_balance.sim import SimOptions, build_model
 from impact_balance.sim.log import log_frame
 from impact_balance.sim.measure import distance_to_hull, measure
-from impact_balance.exceptions import SimulationError
+from impact_balance.exceptions import ModelRepairWarning, SimulationError
 from impact_balance.sim.trial import TrialOptions, approach_joint_velocity, impact_limb, run_trial
 
 LIGHT = SimOptions(meshes=False)
@@ -34,7 +35,9 @@ def models():
 
     def get(name: str, joints: str):
         if (name, joints) not in cache:
-            cache[(name, joints)] = build_model(name, joints, LIGHT)
+            with warnings.catch_warnings():  # Romeo's and iCub's documented repairs (test_robots_sim checks them)
+                warnings.simplefilter("ignore", ModelRepairWarning)
+                cache[(name, joints)] = build_model(name, joints, LIGHT)
         return cache[(name, joints)]
 
     return get
