@@ -12,7 +12,7 @@ import pinocchio as pin
 
 from ..criteria import VelocityLimit
 from ..exceptions import GovernorError, ScenarioError
-from ..projection import project_bretl
+from ..projection.bretl import warm_up as warm_up_bretl
 from ..projection.walk import warm_up
 from ..robot import Robot
 from ..scenario import BasePose, Scenario, load_scenario, scenario_from_dict, with_source
@@ -121,7 +121,7 @@ class Governor:
         self._posture: Posture | None = None
         self._last: SpeedLimit | None = None
         warm_up()  # the projection kernel's one-time load, not in the first tick
-        _warm_up_fallback()
+        warm_up_bretl()  # the fallback's (HiGHS), so that a tick that falls back pays 5 ms, not 71
         try:  # a check of the frames, the normal and the friction, at the scenario's posture
             self._posture = self._evaluator.evaluate(self.configuration)
         except ScenarioError as exc:
@@ -265,21 +265,6 @@ class Governor:
                             limit.limiting_edge, interval, com_velocity, model.normal, model.point, reused, binding)
         self._last = answer
         return answer
-
-
-_fallback_warm = False
-
-
-def _warm_up_fallback() -> None:
-    """One Bretl projection (HiGHS), once per process: the first one costs ~0.3 s (loading and
-    setting up HiGHS), and a tick whose walk falls back to Bretl (about 1 in 300 on G1's
-    approach) would otherwise pay it: 71 ms instead of 5."""
-    global _fallback_warm
-    if _fallback_warm:
-        return
-    eye = np.eye(2)
-    project_bretl(np.vstack([eye, -eye]), np.ones(4), np.zeros((0, 2)), np.zeros(0), eye)
-    _fallback_warm = True
 
 
 def _zmp_interval(limit: VelocityLimit) -> tuple[float, float] | None:

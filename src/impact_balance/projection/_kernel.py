@@ -564,12 +564,13 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst):
         _times_into(GT, u, c)
         _times_into(GT, du, dc)
         # The inverse is carried across breakpoints by rank-one updates only while it still
-        # solves its system to 1e-14 and for at most _CARRY pivots; then a fresh one (15 %
-        # less time on the governor's postures than one per breakpoint). Carried unchecked
-        # (a fresh one every 16 pivots), the walk lost a vertex on an ill-conditioned stance
-        # (a hand at friction 1e8: area -0.3 %, every vertex certified feasible and convex);
-        # checked to 1e-12 only, its area at foot friction 1e6 was 1.2e-9 off Bretl's.
-        if since >= _CARRY or not _accurate(H, h, W, Binv, z, work[2]):
+        # solves its system to 1e-14 (checked after the pivots that changed it, below) and for
+        # at most _CARRY pivots; then a fresh one (15 % less time on the governor's postures
+        # than one per breakpoint). Carried unchecked (a fresh one every 16 pivots), the walk
+        # lost a vertex on an ill-conditioned stance (a hand at friction 1e8: area -0.3 %,
+        # every vertex certified feasible and convex); checked to 1e-12 only, its area at foot
+        # friction 1e6 was 1.2e-9 off Bretl's.
+        if since >= _CARRY:
             if not _refactor(H, h, W, Binv, z, work):
                 return FAILED, vertices, count, pivots
             since = 0
@@ -660,9 +661,8 @@ def project(A, b, E, x0, N, box, max_pivots):
     status, vertices, count, pivots = walk(H[:m].copy(), h[:m].copy(), G.T.copy(), g0, 0.0, max_pivots, worst)
     if status != OK:
         return status, none, pivots, worst[0]
-    # The caller merges near-duplicate vertices and checks convexity
-    # (polygon.simplify_convex): the merge is compiled in its own module, and numba's cache of
-    # this kernel would not notice a change there (it hashes this file only).
+    # The caller merges near-duplicate vertices and checks convexity (walk._certify, with the
+    # polygon module's compiled merge; its cache is stamped with both files).
     return OK, vertices[:count].copy(), pivots, worst[0]
 
 

@@ -26,7 +26,7 @@ from ..polygon import Polygon, simplify
 from ..solvers import HighsLP, LinearProgram
 from .result import ProjectionResult
 
-__all__ = ["project_bretl"]
+__all__ = ["project_bretl", "warm_up"]
 
 #: First ray directions (rad).
 INITIAL_ANGLES = (0.0, 2.0 * np.pi / 3.0, 4.0 * np.pi / 3.0)
@@ -118,3 +118,18 @@ def project_bretl(
     polygon_vertices = Polygon.from_points(np.array(vertices), tol if merge_tol is None else merge_tol).vertices
     bounded = bool(np.all(np.abs(polygon_vertices) < box * (1 - 1e-9)))
     return ProjectionResult(Polygon(polygon_vertices, bounded), "bretl", n_lp=count)
+
+
+_warm = False
+
+
+def warm_up() -> None:
+    """One projection of a square, once per process: the first Bretl projection costs ~0.3 s
+    (loading and setting up HiGHS). A governor calls this when it is built, so that a tick
+    whose walk falls back to Bretl (about 1 in 300 on G1's approach) pays ~5 ms, not 71."""
+    global _warm
+    if _warm:
+        return
+    eye = np.eye(2)
+    project_bretl(np.vstack([eye, -eye]), np.ones(4), np.zeros((0, 2)), np.zeros(0), eye)
+    _warm = True
