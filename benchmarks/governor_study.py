@@ -26,7 +26,7 @@ from impact_balance.governor import Governor
 from impact_balance.scenario import load_scenario
 from impact_balance.sim.balance_trial import TRIAL_VERSION, BalanceSetup, BalanceTrialOptions, controller_margin
 from impact_balance.sim.journal import TrialJournal, journal_digest
-from impact_balance.sim.wall import WallOptions, run_wall_trial
+from impact_balance.sim.wall import APPROACH_VERSION, WallOptions, run_wall_trial
 
 SCENARIOS = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot", "g1_two_feet")
 
@@ -55,7 +55,8 @@ def study(args, out: Path) -> list[dict]:
         for impact in args.impacts:
             options, margin, governed, setup = governed_setup(name, impact == "rigid")
             governors = {g: (None if g == "none" else Governor(governed, criterion=g)) for g in args.governors}
-            digest = journal_digest({"trial_version": TRIAL_VERSION, "scenario": name, "impact": impact, "margin": margin})
+            digest = journal_digest({"trial_version": TRIAL_VERSION, "approach_version": APPROACH_VERSION,
+                                     "scenario": name, "impact": impact, "margin": margin})
             journal = TrialJournal.open(out / "journals" / f"approach_{name}_{impact}_{digest[:12]}.jsonl", digest)
             for g in args.governors:
                 for reference in args.references:

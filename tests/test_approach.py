@@ -34,6 +34,27 @@ def test_com_governor_caps_the_speed_at_contact(capsys, tmp_path):
     assert any(p.name.endswith("_approach_com_0.8_15cm.png") for p in tmp_path.iterdir())
 
 
+def test_the_id_controller_holds_the_point_under_a_falling_cap():
+    """On the ramp the cap falls as the arm extends; with the cap as a bound in the controller's
+    QP the point hits at the cap in force (to the next tick's change of it), where the reference
+    alone lets the torque controller's lag carry it past."""
+    from impact_balance.governor import Governor
+    from impact_balance.sim.balance_trial import BalanceSetup, BalanceTrialOptions, controller_margin
+    from impact_balance.sim.wall import WallOptions, run_wall_trial
+
+    options = BalanceTrialOptions(controller="id", rigid_impact=True)
+    scenario = load_scenario("palm_push_ramp")
+    governor = Governor(scenario.model_copy(update={"zmp_margin": controller_margin(options)}))
+    setup = BalanceSetup.create(scenario, "servo", options)
+    ratio = {}
+    for bound in (True, False):
+        trial = run_wall_trial(setup, WallOptions(reference=1.0, wall_distance=0.12, cap_constraint=bound),
+                               options, governor=governor)
+        ratio[bound] = trial.speed_at_contact / trial.cap_at_contact
+    assert ratio[True] <= 1.003
+    assert ratio[False] > ratio[True] + 0.01  # the lag the bound removes
+
+
 def test_without_a_governor_the_reference_is_reached(capsys):
     out = run_json(capsys, "palm_push_two_feet", "--reference", "0.5", "--governor", "none",
                    "--wall-distance-range", "0.12", "0.18")

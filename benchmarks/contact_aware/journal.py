@@ -12,6 +12,7 @@ from typing import Any
 
 from impact_balance.sim.balance_trial import TRIAL_VERSION
 from impact_balance.sim.journal import TrialJournal, journal_digest
+from impact_balance.sim.wall import APPROACH_VERSION
 
 __all__ = ["journalled", "open_journal", "slim"]
 
@@ -39,7 +40,8 @@ def journalled(journal: TrialJournal, keys: Iterable[dict], run: Callable[[dict]
 def open_journal(out: Path, command: str, name: str, parts: dict[str, Any]) -> TrialJournal:
     """The journal of ``command`` on scenario ``name`` under ``out/journals``; ``parts``: what
     else decides the trials' outcome (a rerun with other parts starts another journal)."""
-    digest = journal_digest({"trial_version": TRIAL_VERSION, "benchmark": "contact_aware_governor",
+    digest = journal_digest({"trial_version": TRIAL_VERSION, "approach_version": APPROACH_VERSION,
+                             "benchmark": "contact_aware_governor",
                              "command": command, "scenario": name, **parts})
     return TrialJournal.open(out / "journals" / f"{command}_{name}_{digest[:12]}.jsonl", digest)
 

@@ -23,6 +23,11 @@ free-flyer velocity in the base frame):
      (friction and rectangle shrunk by margins, see :class:`InverseDynamicsGains`) with a
      minimum normal force, the joint position limits (as acceleration bounds), and
      ``|tau| <= effort`` with ``tau`` the actuated rows of ``M a + h - sum J_i^T w_i``;
+     with a governed approach (a task whose ``speed_bound()`` is finite, :class:`~.wall.GovernedApproach`),
+     the impact point's approach speed one control period ahead, ``-n . (J_p (v + a dt) + J_p_dot v dt)``,
+     at most the governor's cap: the paper's "track the maximum contact velocity with a whole-body QP"
+     as a hard bound, so that the torque controller's tracking lag cannot carry the point past a
+     falling cap;
    - cost (weighted least squares): the CoM acceleration of the LIPM, ``c_dd_xy = omega^2 (c_xy - p)``,
      with a PD on the CoM height; angular momentum damping ``L_dot = -K_L L``; the impact point's
      acceleration (the :class:`~.approach.ImpactTask` reference's acceleration, plus a PD to its
@@ -30,7 +35,8 @@ free-flyer velocity in the base frame):
      PD to the start configuration (joints) and one on the base orientation; a small regularisation.
 
    If the torque limits make the QP infeasible, it is solved without them and the torques are
-   clipped (MuJoCo clips them too); then, if need be, without the joint limits.
+   clipped (MuJoCo clips them too); then, if need be, without the joint limits, then without
+   the approach speed's bound.
 4. The torques ``tau`` go to MuJoCo's motors.
 
 The measured ZMP is not needed (the wrenches are chosen, not admitted); the argument is kept so
@@ -244,7 +250,9 @@ class InverseDynamicsController:
         self._limit_v = np.array([j.idx_v for j in one_dof], dtype=int)
         self._q_lower = model.lowerPositionLimit[self._limit_q].copy()
         self._q_upper = model.upperPositionLimit[self._limit_q].copy()
-        m = 6 + 6 * nc + 17 * nc + self._limit_q.size + self._limited.size
+        # One row bounds the impact point's approach speed when the task is governed (see step()).
+        self._speed_rows = int(impact is not None and callable(getattr(impact, "speed_bound", None)))
+        m = 6 + 6 * nc + 17 * nc + self._speed_rows + self._limit_q.size + self._limited.size
         self._C = np.zeros((m, n))
         self._upper = np.zeros(m)
         self._lower = np.full(m, -1e30)
@@ -311,6 +319,7 @@ class InverseDynamicsController:
         task(J_base[3:], g.base_orientation_stiffness * rot_error - g.base_orientation_damping * (J_base[3:] @ v)
              - base_drift, g.base_orientation_weight)
         # Impact point: PD to the impact task's target and its velocity.
+        speed_row = None
         if self.impact is not None:
             placement, Ji, drift = _point_jacobian(model, data, self._impact_frame, self.impact.offset)
             target, target_velocity, target_acceleration = self.impact.reference(t, impact_force)
@@ -321,6 +330,13 @@ class InverseDynamicsController:
                    - g.impact_damping * vel[3:])
             task(Ji[:3], lin - drift[:3], g.impact_weight)
             task(Ji[3:], ang - drift[3:], g.impact_orientation_weight)
+            if self._speed_rows:
+                # Approach speed one control period ahead (torques are held for dt):
+                # -n . (vel + (Ji a + drift) dt) <= cap. Linear in a; inactive when unbounded.
+                cap = float(self.impact.speed_bound())
+                n_dir = np.asarray(self.impact.normal, dtype=float)
+                if np.isfinite(cap):
+                    speed_row = (-self.dt * (n_dir @ Ji[:3]), cap + n_dir @ vel[:3] + self.dt * (n_dir @ drift[:3]))
         A_t, b_t, w_t = np.vstack(rows), np.concatenate(targets), np.concatenate(weights)
         P = self._P
         P[:] = self._P_diag
@@ -355,11 +371,19 @@ class InverseDynamicsController:
             C[k + i, nv + 6 * i:nv + 6 * i + 3] = data.oMf[fid].rotation[:, 2]
         lower[k:k + nc] = g.min_normal_force
         upper[k:k + nc] = 1e30
+        # The governed approach speed (one row, after the minimum normal forces; 1e30: inactive).
+        ms = ne + 17 * nc
+        if self._speed_rows:
+            C[ms, :] = 0.0
+            if speed_row is None:
+                upper[ms] = 1e30
+            else:
+                C[ms, :nv], upper[ms] = speed_row
         # tau = M[6:] a + h[6:] - Jw[:, 6:]^T w (actuated rows)
         T = np.hstack([M[6:], -self._Jw[:, 6:].T])
         t0 = h[6:]
         limited = self._limited
-        m0 = ne + 17 * nc
+        m0 = ms + self._speed_rows
         # Joint position limits (rows after the minimum normal forces), then the torque limits.
         T2 = g.joint_limit_horizon
         qj, vj = q[self._limit_q], v[self._limit_v]
@@ -374,7 +398,7 @@ class InverseDynamicsController:
         x, _, exitflag, _ = daqp.solve(P, c, C, upper, lower, self._sense)
         torque_limited = False
         # Infeasible: drop the torque limits (the torques are clipped below), then the joint limits.
-        for rows in ((m1,) if limited.size else ()) + (m0,):
+        for rows in ((m1,) if limited.size else ()) + (m0,) + ((ms,) if self._speed_rows else ()):
             if exitflag >= 1:
                 break
             torque_limited = True

@@ -28,7 +28,11 @@ from .balance_trial import BalanceSetup, BalanceTrialOptions, run_balance_trial
 from .trial import TrialRecord, _point_velocity
 from .trial_result import BalanceTrialResult
 
-__all__ = ["GOVERNORS", "WallOptions", "GovernedApproach", "WallTrial", "run_wall_trial", "write_wall_video"]
+__all__ = ["APPROACH_VERSION", "GOVERNORS", "WallOptions", "GovernedApproach", "WallTrial", "run_wall_trial", "write_wall_video"]
+
+#: Version of the approach trial, for journals (with the balance trial's): 2 = the ``id``
+#: controller bounds the point's speed by the cap (``WallOptions.cap_constraint``).
+APPROACH_VERSION = 2
 
 #: Governors of the approach: the CoM criterion's, the ZMP criterion's, or none (the reference alone).
 GOVERNORS = ("com", "zmp", "none")
@@ -45,6 +49,11 @@ class WallOptions:
         standoff: How far the start posture backs the point off the scenario's impact point (m).
         acceleration: Bound on the reference speed's rate (m/s^2).
         max_time: Longest approach before the trial gives up (s): a slow governor may not arrive.
+        cap_constraint: With the ``id`` controller, bound the point's approach speed one control
+            period ahead by the cap in its QP (a hard constraint; the paper's "track the maximum
+            contact velocity with a whole-body QP"). False: the cap only lowers the reference's
+            speed, and the controller's tracking lag may carry the point past a falling cap (up to
+            5 %, docs/validation.md); kept for that comparison.
     """
 
     reference: float
@@ -53,6 +62,7 @@ class WallOptions:
     standoff: float = 0.15
     acceleration: float = 20.0
     max_time: float = 30.0
+    cap_constraint: bool = True
 
 
 @dataclass
@@ -63,6 +73,8 @@ class GovernedApproach:
     ``speed_limit(t)`` is called by the trial loop before each control step with the governor's
     ceiling (m/s, ``inf`` without a governor); the reference's own speed follows a
     bounded-acceleration profile to ``speed``; the command is the smaller of the two.
+    :meth:`speed_bound` gives a torque controller the cap as a bound on the point's speed
+    (``bound_speed``; the ``id`` controller's QP enforces it).
     """
 
     frame: str
@@ -75,6 +87,7 @@ class GovernedApproach:
     force_threshold: float = 15.0
     retract: float = 0.05
     withdraw_speed: float = 0.3
+    bound_speed: bool = True
     contact_time: float | None = field(default=None, init=False)
     ceiling: float = field(default=np.inf, init=False)
     commanded: float = field(default=0.0, init=False)
@@ -112,6 +125,14 @@ class GovernedApproach:
     def target(self, t: float, normal_force: float = 0.0) -> np.ndarray:
         return self.reference(t, normal_force)[0]
 
+    def speed_bound(self) -> float:
+        """The largest approach speed (m/s, along ``-normal``) a controller should allow the point
+        now: the governor's cap until the contact, ``inf`` after it, without a governor or when
+        ``bound_speed`` is off."""
+        if not self.bound_speed or self.contact_time is not None:
+            return np.inf
+        return float(self.ceiling)
+
 
 @dataclass
 class WallTrial:
@@ -138,6 +159,7 @@ class WallTrial:
         s = self.result.summary()
         o = self.options
         return {"governor": o.governor, "reference": o.reference, "wall_distance": o.wall_distance,
+                "cap_constraint": o.cap_constraint,
                 "speed_at_contact": self.speed_at_contact, "cap_at_contact": self.cap_at_contact,
                 "time_to_contact": self.time_to_contact, "outcome": s["outcome"], "reason": s["reason"],
                 "detail": s["detail"], "events": s["events"], "tick_us": self.tick_us, "trial": s}
@@ -170,7 +192,8 @@ def run_wall_trial(setup: BalanceSetup, options: WallOptions, trial_options: Bal
     n = np.asarray(im.normal, dtype=float)
     start = im.point + options.standoff * n
     task = GovernedApproach(im.spec.frame, im.spec.offset, start, n, options.reference,
-                            start_time=trial_options.settle, acceleration=options.acceleration)
+                            start_time=trial_options.settle, acceleration=options.acceleration,
+                            bound_speed=options.cap_constraint)
     wall = start - options.wall_distance * n
     ticks: list[float] = []
     caps: list[tuple[float, float, float]] = []
