@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """The contact-aware governor option (experimental): every table of docs/contact_aware_governor.md.
 
-    python benchmarks/contact_aware_governor.py score --out DIR [--variant aware|cold|off]
+    python benchmarks/contact_aware_governor.py score --out DIR [--variant union|warm|cold|off]
             [--scenarios ...] [--references 0.5 1 2] [--distances 0.12 0.15 0.18]
     python benchmarks/contact_aware_governor.py sweep --out DIR [--scenarios ...] [--references ...]
     python benchmarks/contact_aware_governor.py bounds [--scenarios ...] [--margins 0 0.01]
@@ -16,11 +16,15 @@ through the impact: ``--rigid-impact``; the governor uses the areas inset by the
 
 - ``score``: the governed trials, ``impact-balance approach SCEN --reference R --governor com
   --rigid-impact --contact-aware --wall-distance-range 0.12 0.18 --json`` for the wall study's
-  four stances and references 0.5, 1, 2 m/s (36 trials, ~2 min). One governor serves the three
-  walls of a reference, in order, as in that command (the option's warm start carries over).
-  ``--variant cold``: the post hoc cold start (the contact-aware fixed point starts from gauges 0
+  four stances and references 0.5, 1, 2 m/s (36 trials, ~2 min). One governor serves the walls
+  of a reference, in order, as in that command (the option's kept solutions carry over); any
+  list of walls (``--distances``, m) and references. ``--variant union`` (default): the option
+  as frozen for section 5 (the union of the LCP's solutions from the kept solutions and the cold
+  start); ``--variant warm``: as frozen in commit 5e477e6 (section 4's, one fixed point
+  warm-started from the previous answer); ``--variant cold``: the post hoc cold start (gauges 0
   at every recomputation, a new governor per wall; not frozen); ``--variant off``: without the
-  option (the study's ``com`` governor).
+  option (the study's ``com`` governor). Each trial also records its recomputations' cost (ms)
+  and the most rows (solutions) of the rates.
 - ``sweep``: ungoverned approaches (``--governor none``, wall 15 cm) over references around each
   stance's fall (33 trials on four stances, ~2 min): the outcome against the post-impact CoM
   velocity's margin (m/s) in the CoM velocity area ("raw", the trial's own) and in the area inset
@@ -38,7 +42,8 @@ through the impact: ``--rigid-impact``; the governor uses the areas inset by the
   from the contact on, each support's force, the CoM velocity, the desired and measured ZMP and
   the DCM margin; with ``--branches``, along the approach before the contact, the floating cap
   and the contact-aware jump and cap with the fixed point warm-started from the previous posture
-  and cold (the frictional LCP's two solutions near the ramp's wall).
+  and cold (the frictional LCP's two solutions near the ramp's wall), and the union's solutions
+  and cap (every posture a recomputation) with its cost per recomputation (ms).
 
 Trials go to journals under ``--out`` (``DIR/journals/``) as they finish: a crash or one failing
 trial loses nothing else (the failure is printed, the exit status is 1) and the same command
@@ -61,7 +66,7 @@ from governor_study import SCENARIOS, _load
 # The benchmark's modules live in contact_aware/, beside this file (on sys.path as the script's folder).
 from contact_aware.preload import TRAINING, bounds, bounds_table, preload, preload_table, ramp_jumps
 from contact_aware.trace import trace
-from contact_aware.trials import SWEEP_REFERENCES, score, score_table, sweep, sweep_table
+from contact_aware.trials import SWEEP_REFERENCES, VARIANTS, score, score_table, sweep, sweep_table
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -69,8 +74,9 @@ def main(argv: list[str] | None = None) -> int:
     sub = p.add_subparsers(dest="command", required=True)
     s = sub.add_parser("score", help="the governed trials (36 with the defaults)")
     s.add_argument("--out", default="contact-aware-governor", help="folder of the journals and score.json")
-    s.add_argument("--variant", choices=("aware", "cold", "off"), default="aware",
-                   help="aware: --contact-aware as frozen (default); cold: post hoc cold start; off: without it")
+    s.add_argument("--variant", choices=VARIANTS, default="union",
+                   help="union: --contact-aware, the union of the LCP's solutions (default, section 5); warm: as "
+                        "frozen in 5e477e6 (section 4's 'aware'); cold: post hoc cold start; off: without it")
     s.add_argument("--scenarios", nargs="+", default=list(SCENARIOS))
     s.add_argument("--references", type=float, nargs="+", default=[0.5, 1.0, 2.0], help="m/s")
     s.add_argument("--distances", type=float, nargs="+", default=[0.12, 0.15, 0.18], help="walls, m, in this order")

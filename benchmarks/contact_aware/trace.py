@@ -77,36 +77,52 @@ def after_impact_table(summary: dict, log, series: dict, step_ms: float, span: f
 def branches_table(args: argparse.Namespace, summary: dict, log, window: float = 0.2, every: int = 5) -> str:
     """Along the logged approach up to the contact: the floating cap, and the contact-aware jump
     per m/s (upper restitution bound) and cap with the fixed point warm-started from the
-    previous logged posture (continued from the first) or cold (gauges 0), computed at every
-    logged posture; printed for the last ``window`` s before the contact, every ``every``-th
-    logged posture counted back from the contact."""
+    previous logged posture (continued from the first) or cold (gauges 0), and the union's
+    (``starts="union"``: its distinct solutions at the upper bound, its cap and the time of its
+    recomputation, ms), computed at every logged posture; printed for the last ``window`` s before
+    the contact, every ``every``-th logged posture counted back from the contact."""
+    import time
+
     from impact_balance.governor.support import ContactAwareLimit
 
     _, _, governed, _ = governed_setup(args.scenario, rigid=True)
     floating = Governor(governed, criterion="com")
     spec = governed.impact.spec()
-    warm, cold = ContactAwareLimit(spec, every=1), ContactAwareLimit(spec, every=1)
+    upper = float(spec.restitution[-1])
+    warm, cold, union = (ContactAwareLimit(spec, every=1, starts=s) for s in ("warm", "cold", "union"))
     contact = summary["trial"]["impact"]["contact_time"]
     lines = ["| t - contact (s) | floating cap (m/s) | cold: jump per m/s x, y | cold cap | warm: jump per m/s x, y "
-             "| warm cap |", "|---|---|---|---|---|---|"]
+             "| warm cap | union: jumps per m/s x, y (upper c_r) | union cap | union ms |",
+             "|---|---|---|---|---|---|---|---|---|"]
     rows: list[str] = []
+    costs: list[float] = []  # the union's recomputation, ms
+    warm_costs: list[float] = []  # the frozen warm start's, ms
     for row in log.to_dict("records"):
         dt = row["time"] - contact
         if dt >= 0.0:
             break
         answer = floating.limit_com(configuration(floating.robot, row), (row["comd_x"], row["comd_y"]))
         posture = floating.posture
+        t0 = time.perf_counter()
         warm.new_posture(lambda: posture.stance)
+        t1 = time.perf_counter()
+        union.new_posture(lambda: posture.stance)
+        warm_costs.append(1e3 * (t1 - t0))
+        costs.append(1e3 * (time.perf_counter() - t1))
         if dt < -window:
             continue
-        cold._warm = None
         cold.new_posture(lambda: posture.stance)
         area = posture.areas.com_velocity_area
-        a, b = (s.answer(area, answer.com_velocity) for s in (cold, warm))
+        a, b, u = (s.answer(area, answer.com_velocity) for s in (cold, warm, union))
+        jumps = "; ".join(f"{x:+.3f}, {y:+.3f}" for (x, y), c in zip(u.rates, u.restitution) if c == upper)
         rows.append(f"| {dt:+.3f} | {answer.max_approach_speed:.3f} | {a.rates[-1][0]:+.3f}, {a.rates[-1][1]:+.3f} "
                     f"| {a.limit.max_approach_speed:.3f} | {b.rates[-1][0]:+.3f}, {b.rates[-1][1]:+.3f} "
-                    f"| {b.limit.max_approach_speed:.3f} |")
-    return "\n".join(lines + rows[::-every][::-1])
+                    f"| {b.limit.max_approach_speed:.3f} | {jumps} | {u.limit.max_approach_speed:.3f} "
+                    f"| {costs[-1]:.1f} |")
+    tail = (f"\nThe union's recomputation over the {len(costs)} logged postures of the approach: median "
+            f"{np.median(costs):.1f} ms, p99 {np.percentile(costs, 99):.1f} ms, max {max(costs):.1f} ms (the warm "
+            f"start's: median {np.median(warm_costs):.1f} ms, p99 {np.percentile(warm_costs, 99):.1f} ms).")
+    return "\n".join(lines + rows[::-every][::-1]) + "\n" + tail
 
 
 def contact_posture_table(args: argparse.Namespace, summary: dict, log) -> str:

@@ -1,11 +1,11 @@
-"""The simulated trials of ``score`` (governed, with or without the option, warm or cold start)
+"""The simulated trials of ``score`` (governed, with or without the option: union, warm or cold starts)
 and ``sweep`` (ungoverned, wall 15 cm, the inset rule), and their tables."""
 
 from __future__ import annotations
 
 import argparse
 import sys
-from collections.abc import Callable
+import time
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +17,7 @@ from impact_balance.stance import Stance
 
 from .journal import journalled, open_journal, slim
 
-__all__ = ["OUTCOMES", "SWEEP_REFERENCES", "SWEEP_WALL", "score", "score_table", "sweep", "sweep_table"]
+__all__ = ["OUTCOMES", "SWEEP_REFERENCES", "SWEEP_WALL", "VARIANTS", "score", "score_table", "sweep", "sweep_table"]
 
 SWEEP_WALL = 0.15  # m
 #: The ungoverned sweeps' commanded references (m/s), around each stance's fall.
@@ -31,18 +31,24 @@ OUTCOMES = ("balanced", "contact_broken", "fell")
 
 
 # -- score: the governed trials -------------------------------------------------------------------
-def _cold_start(governor: Governor) -> Governor:
-    """``governor`` with the contact-aware fixed point started from gauges 0 at every
-    recomputation (no continuation from the previous posture; the post hoc variant)."""
-    support = governor._support
-    inner = support.new_posture
+#: ``--variant``: the option's starts (governor/support.py), or "off" (without the option).
+VARIANTS = ("union", "warm", "cold", "off")
 
-    def cold(stance_of: Callable[[], Stance]) -> None:
-        support._warm = None
-        inner(stance_of)
 
-    support.new_posture = cold
-    return governor
+def _timed(governor: Governor) -> list[tuple[float, int, int]]:
+    """Record, for every recomputation of ``governor``'s contact-aware rates, ``(ms, rows of
+    the rates, QP solves)``; returns the (live) list, which the caller empties per trial."""
+    support, record = governor._support, []
+    inner = support._solve
+
+    def solve(stance: Stance):
+        t0 = time.perf_counter()
+        solutions = inner(stance)
+        record.append((1e3 * (time.perf_counter() - t0), len(solutions.rates), solutions.iterations))
+        return solutions
+
+    support._solve = solve
+    return record
 
 
 def score(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
@@ -53,17 +59,26 @@ def score(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
         journal = open_journal(out, "score", name, {"variant": args.variant, "margin": margin})
 
         def new_governor() -> Governor:
-            governor = Governor(governed, criterion="com", contact_aware=args.variant != "off")
-            return _cold_start(governor) if args.variant == "cold" else governor
+            if args.variant == "off":
+                return Governor(governed, criterion="com")
+            return Governor(governed, criterion="com", contact_aware=True, contact_aware_starts=args.variant)
 
         def run(key: dict) -> dict:
             governor, trials = new_governor(), []  # one governor for the walls of a reference, as the command
+            record = [] if governor._support is None else _timed(governor)
             for distance in key["distances"]:
                 if args.variant == "cold":
-                    governor = new_governor()
+                    governor = new_governor()  # as the post hoc cold variant of section 4 was run
+                    record = _timed(governor)
+                del record[:]  # this trial's recomputations only
                 wall = WallOptions(reference=key["reference"], governor="com", wall_distance=distance)
                 trials.append(slim(run_wall_trial(setup, wall, options, governor=governor).to_dict()))
                 d = trials[-1]
+                ms = np.array([r[0] for r in record]) if record else np.zeros(0)
+                d["recompute"] = None if not record else {
+                    "count": len(record), "ms_median": float(np.median(ms)), "ms_max": float(ms.max()),
+                    "ms_p90": float(np.percentile(ms, 90)), "rows_max": max(r[1] for r in record),
+                    "solves_median": float(np.median([r[2] for r in record]))}
                 print(f"  {name} {key['reference']:g} m/s {100 * distance:g} cm: {d['outcome']} speed "
                       f"{_f(d['speed_at_contact'])} cap {_f(d['cap_at_contact'])}", file=sys.stderr, flush=True)
             return {"trials": trials}
@@ -87,8 +102,9 @@ def _span(values: list[float], digits: int = 3) -> str:
 def score_table(rows: list[dict]) -> str:
     """Outcome counts and ranges per scenario (the table of docs/contact_aware_governor.md)."""
     lines = ["| scenario | variant | trials | balanced / contact broken / fell | measured speed at contact (m/s) "
-             "| cap at contact (m/s) | speed / min(ref, cap) | tick median (us) | tick p99 (us) |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "| cap at contact (m/s) | speed / min(ref, cap) | tick median (us) | tick p99 (us) "
+             "| recomputation median / max (ms) | rows of the rates (most) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for name in dict.fromkeys(r["scenario"] for r in rows):
         group = [r for r in rows if r["scenario"] == name]
         counts = " / ".join(str(sum(r["outcome"] == o for r in group)) for o in OUTCOMES)
@@ -97,15 +113,24 @@ def score_table(rows: list[dict]) -> str:
         ratios = [r["speed_at_contact"] / min(r["reference"], r["cap_at_contact"]) for r in group
                   if r["speed_at_contact"] is not None and r["cap_at_contact"] is not None]
         ticks = [r["tick_us"] for r in group if r["tick_us"]["median"] is not None]
+        recomputes = [r["recompute"] for r in group if r.get("recompute")]
+        costs = "-" if not recomputes else (f"{np.median([c['ms_median'] for c in recomputes]):.1f} / "
+                                            f"{max(c['ms_max'] for c in recomputes):.1f}")
+        most = "-" if not recomputes else str(max(c["rows_max"] for c in recomputes))
         lines.append(f"| {name} | {group[0]['variant']} | {len(group)} | {counts} | {_span(speeds)} | {_span(caps)} "
                      f"| {_span(ratios, 2)} | {_span([t['median'] for t in ticks], 0)} "
-                     f"| {_span([t['p99'] for t in ticks], 0)} |")
+                     f"| {_span([t['p99'] for t in ticks], 0)} | {costs} | {most} |")
     lines += ["", "| scenario | reference (m/s) | wall (cm) | outcome | speed at contact (m/s) | cap at contact (m/s) "
-              "| raw margin at end (m/s) | slip (cm) |", "|---|---|---|---|---|---|---|---|"]
+              "| speed / cap | raw margin at end (m/s) | slip (cm) | tick median / p99 (us) |",
+              "|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
+        ratio = ("-" if r["speed_at_contact"] is None or r["cap_at_contact"] is None
+                 else f"{r['speed_at_contact'] / r['cap_at_contact']:.4f}")
+        tick = r["tick_us"]
+        ticks = "-" if tick["median"] is None else f"{tick['median']:.0f} / {tick['p99']:.0f}"
         lines.append(f"| {r['scenario']} | {r['reference']:g} | {100 * r['wall_distance']:g} | {r['outcome']} "
-                     f"| {_f(r['speed_at_contact'])} | {_f(r['cap_at_contact'])} | {r['margin_raw']:+.3f} "
-                     f"| {100 * r['max_slip']:.1f} |")
+                     f"| {_f(r['speed_at_contact'])} | {_f(r['cap_at_contact'])} | {ratio} | {r['margin_raw']:+.3f} "
+                     f"| {100 * r['max_slip']:.1f} | {ticks} |")
     return "\n".join(lines)
 
 

@@ -75,6 +75,10 @@ class Governor:
             criterion for the union of both models' post-impact CoM velocities, the smaller
             maximum). "com" criterion, composite inertia only. Its jump rates are recomputed
             every ``contact_aware_every`` posture evaluations (default 5), not every posture.
+            ``contact_aware_starts``: "union" (default: the criterion holds for every solution
+            of the frictional impact LCP reached from the kept solutions and the cold start),
+            "warm" (the option as frozen in commit 5e477e6: one fixed point, warm-started from
+            the previous answer) or "cold" (one, from gauges 0); see :mod:`.support`.
 
     Raises:
         ScenarioError: no impact, an unknown frame, an impact model that cannot be built at
@@ -83,7 +87,7 @@ class Governor:
     """
 
     def __init__(self, scenario: Scenario | str | os.PathLike, criterion: str = "com", posture_tolerance: float = 0.0,
-                 contact_aware: bool = False, contact_aware_every: int = 5):
+                 contact_aware: bool = False, contact_aware_every: int = 5, contact_aware_starts: str = "union"):
         if criterion not in CRITERIA:
             raise GovernorError("criterion", criterion, f"must be one of {', '.join(CRITERIA)}")
         try:
@@ -117,7 +121,7 @@ class Governor:
         if contact_aware:
             if criterion != "com":
                 raise GovernorError("contact_aware", criterion, "bounds the CoM criterion only")
-            self._support = ContactAwareLimit(settings.impact, contact_aware_every)
+            self._support = ContactAwareLimit(settings.impact, contact_aware_every, contact_aware_starts)
         self._posture: Posture | None = None
         self._last: SpeedLimit | None = None
         warm_up()  # the projection kernel's one-time load, not in the first tick

@@ -44,7 +44,9 @@ class SpeedLimit:
             ``posture_tolerance``) and only the CoM velocity was new (the fast path).
         binding: Which impact model gave the maximum: "floating" (the paper's set; the only
             one unless the governor is ``contact_aware``) or "contact_aware" (then
-            ``limiting_vertex`` 0 / 1 is its jump at the lower / upper restitution bound).
+            ``limiting_vertex`` is the row of its jump rates, ``ContactAwareAnswer.rates``:
+            0 / 1 the lower / upper restitution bound with one start, else one row per
+            solution found, ``ContactAwareAnswer.restitution`` giving each row's bound).
     """
 
     criterion: str
