@@ -29,14 +29,20 @@ over all of them, the safe interval the intersection. Nothing here depends on an
 outcome. ``starts="warm"`` is the option as frozen in commit 5e477e6 (one start, the previous
 answer) and ``starts="cold"`` the post hoc cold start, both kept for the record.
 
+Scored (docs/contact_aware_governor.md, section 5; frozen in commit e0ce502): the union changes
+no outcome on the four stances of the wall study. It lowers the ramp's cap by 2 to 2.5 % where
+the cold start finds a second branch before the contact (trials that stood either way); where the
+ramp falls (walls 12 and 13.5 cm) the LCP has one solution at the contact posture, the cap is
+honoured to 0.1 %, and the model's residual at the inset edge (-0.008 to +0.005 m/s) decides.
+
 Cost. The contact-aware jump is a fixed point of small QPs (2 to 40 ms per start and posture);
 it changes slowly with the posture, so it is recomputed on the first posture and then every
 ``every``-th posture evaluation (default 5: every 10 ms at 500 Hz) and, in between, the last jump
 rates are used with the current posture's area and CoM velocity. The jump is linear in the
 approach speed (no preload), so one solve per start and restitution bound at 1 m/s gives the
-rates. The union costs one fixed point per start, the cold start the slowest: on the training
-stances' governed approaches (1 m/s, wall 15 cm), median 29 and 47 ms per recomputation (p99 63
-and 55 ms) against the warm start's 9 and 20 ms (docs/contact_aware_governor.md, section 5).
+rates. The union costs one fixed point per start, the cold start the slowest: median 8 to 67 ms
+per recomputation on the wall study's stances (up to 164 ms on the ramp with two solutions kept),
+2.2 to 2.8 times the warm start's (docs/contact_aware_governor.md, section 5).
 """
 
 from __future__ import annotations
