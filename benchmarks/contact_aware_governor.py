@@ -80,6 +80,8 @@ def main(argv: list[str] | None = None) -> int:
     s.add_argument("--scenarios", nargs="+", default=list(SCENARIOS))
     s.add_argument("--references", type=float, nargs="+", default=[0.5, 1.0, 2.0], help="m/s")
     s.add_argument("--distances", type=float, nargs="+", default=[0.12, 0.15, 0.18], help="walls, m, in this order")
+    s.add_argument("--velocity-margin", type=float, default=0.0,
+                   help="the governor's velocity margin, m/s (default 0; docs/governor.md)")
     w = sub.add_parser("sweep", help="ungoverned approaches at wall 15 cm (33 with the defaults)")
     w.add_argument("--out", default="contact-aware-governor", help="folder of the journals and sweep.json")
     w.add_argument("--scenarios", nargs="+", default=list(SWEEP_REFERENCES))
@@ -87,6 +89,7 @@ def main(argv: list[str] | None = None) -> int:
     b = sub.add_parser("bounds", help="the caps at the scenario postures (no simulation)")
     b.add_argument("--scenarios", nargs="+", default=list(SCENARIOS))
     b.add_argument("--margins", type=float, nargs="+", default=[0.0, 0.01], help="ZMP margins, m, ascending")
+    b.add_argument("--velocity-margin", type=float, default=0.0, help="the governors' velocity margin, m/s")
     r = sub.add_parser("preload", help="the preload model against the training stances' trials, the ramp's jumps")
     r.add_argument("--out", default="contact-aware-governor", help="folder of the journals and preload.json")
     r.add_argument("--scenarios", nargs="+", default=list(TRAINING))
@@ -119,7 +122,8 @@ def main(argv: list[str] | None = None) -> int:
         print("\nThe ramp (palm_push_ramp, scenario posture, 10 mm inset):\n")
         print(ramp_jumps())
     print(f"\n{_load()} at the end; {len(rows)} trials, {failures} failed")
-    (out / f"{args.command}{'_' + args.variant if args.command == 'score' else ''}.json").write_text(
+    tag = "" if args.command != "score" else f"_{args.variant}" + (f"_v{args.velocity_margin:g}" if args.velocity_margin else "")
+    (out / f"{args.command}{tag}.json").write_text(
         json.dumps(rows, allow_nan=False, default=float))
     return 1 if failures else 0
 

@@ -125,7 +125,8 @@ def ramp_jumps(speeds: Iterable[float] = (0.66, 0.7), margin: float = 0.01) -> s
 # -- bounds: no simulation ------------------------------------------------------------------------
 def bounds(args: argparse.Namespace) -> list[dict]:
     """The governor's maximum approach speed at each scenario's posture without and with the
-    option, per ZMP margin, and the preload model's bound at the largest margin."""
+    option, per ZMP margin (and ``args.velocity_margin``), and the preload model's bound at the
+    largest ZMP margin (without the velocity margin)."""
     from impact_balance.cli._options import with_zmp_margin
 
     rows = []
@@ -134,9 +135,9 @@ def bounds(args: argparse.Namespace) -> list[dict]:
         row: dict[str, Any] = {"scenario": name}
         for margin in args.margins:
             governed = with_zmp_margin(scenario, margin)
-            floating = Governor(governed, criterion="com")
+            floating = Governor(governed, criterion="com", velocity_margin=args.velocity_margin)
             q, v = floating.configuration, np.zeros(floating.robot.model.nv)
-            union = Governor(governed, criterion="com", contact_aware=True).limit(q, v)
+            union = Governor(governed, criterion="com", contact_aware=True, velocity_margin=args.velocity_margin).limit(q, v)
             row[f"{1e3 * margin:g} mm"] = {"floating": floating.limit(q, v).max_approach_speed,
                                            "union": union.max_approach_speed, "binding": union.binding}
         analysis = ib.analyze(name)

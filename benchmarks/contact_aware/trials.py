@@ -56,12 +56,16 @@ def score(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
     rows, failures = [], 0
     for name in args.scenarios:
         options, margin, governed, setup = governed_setup(name, rigid=True)
-        journal = open_journal(out, "score", name, {"variant": args.variant, "margin": margin})
+        parts = {"variant": args.variant, "margin": margin}
+        if args.velocity_margin:  # keeps the journals of the runs without one
+            parts["velocity_margin"] = args.velocity_margin
+        journal = open_journal(out, "score", name, parts)
 
         def new_governor() -> Governor:
             if args.variant == "off":
-                return Governor(governed, criterion="com")
-            return Governor(governed, criterion="com", contact_aware=True, contact_aware_starts=args.variant)
+                return Governor(governed, criterion="com", velocity_margin=args.velocity_margin)
+            return Governor(governed, criterion="com", contact_aware=True, contact_aware_starts=args.variant,
+                            velocity_margin=args.velocity_margin)
 
         def run(key: dict) -> dict:
             governor, trials = new_governor(), []  # one governor for the walls of a reference, as the command
@@ -87,7 +91,8 @@ def score(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
         pairs, failed = journalled(journal, keys, run, f"score {name}")
         journal.close()
         failures += failed
-        rows += [{"scenario": name, "variant": args.variant, **t} for _, e in pairs for t in e["trials"]]
+        rows += [{"scenario": name, "variant": args.variant, "velocity_margin": args.velocity_margin, **t}
+                 for _, e in pairs for t in e["trials"]]
     return rows, failures
 
 

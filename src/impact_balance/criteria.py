@@ -169,24 +169,33 @@ class ComCriterion:
     then cost a few microseconds per CoM velocity (a governor's velocity-only tick).
     :func:`max_contact_velocity` and :func:`safe_interval` are these two methods.
 
+    With a ``velocity_margin`` d > 0 (m/s), every post-impact CoM velocity must lie at least d
+    inside the area (the area eroded by a disc of radius d: each half-plane moved in by d), a
+    margin for the impact model's error; 0 is the paper's criterion.
+
     Attributes:
         area: The CoM velocity area (world x, y), m/s.
         impact: The impact model.
+        velocity_margin: d, m/s.
     """
 
-    __slots__ = ("area", "impact", "G", "h", "rates")
+    __slots__ = ("area", "impact", "velocity_margin", "G", "h", "rates")
 
-    def __init__(self, area: Polygon, impact: ImpactModel):
+    def __init__(self, area: Polygon, impact: ImpactModel, velocity_margin: float = 0.0):
         self.area = area
         self.impact = impact
+        self.velocity_margin = float(velocity_margin)
         if area.is_empty:
             self.G = self.h = self.rates = None
             return
-        self.G, self.h = area.halfplanes
+        self.G, self.h = area.halfplanes  # unit rows: h - G x is the distance inside each edge
+        if self.velocity_margin:
+            self.h = self.h - self.velocity_margin
         self.rates = _jump_rates(impact.impulse_rates, float(impact.mass), self.G)
 
     def margins(self, com_velocity: Sequence[float]) -> np.ndarray:
-        """``h - G c0``: the slack of the pre-impact CoM velocity in each half-plane, m/s."""
+        """``h - G c0``: the slack of the pre-impact CoM velocity in each half-plane (less the
+        velocity margin), m/s."""
         return self.h - self.G @ np.asarray(com_velocity, dtype=float)[:2]
 
     def limit(self, com_velocity: Sequence[float]) -> VelocityLimit:

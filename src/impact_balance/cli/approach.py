@@ -32,6 +32,9 @@ def add_parser(sub) -> list[str]:
     a.add_argument("--contact-aware", action="store_true",
                    help="com governor: also bound the speed by the contact-aware impact model (the robot standing "
                         "on its supports; experimental, see docs/contact_aware_governor.md)")
+    a.add_argument("--velocity-margin", type=number("--velocity-margin", 0.0, 10.0, "m/s"), default=0.0, metavar="V",
+                   help="com governor: every post-impact CoM velocity must lie V m/s inside the CoM velocity area "
+                        "(a margin for the impact model's error; default 0, the paper's criterion)")
     a.add_argument("--rigid-impact", action="store_true",
                    help="hold every joint's velocity through the impact (the paper's rigid robot)")
     add_controller_option(a, "id", "it puts the ZMP anywhere in the support area after the impact")
@@ -74,7 +77,8 @@ def run(args: argparse.Namespace) -> int:
     if args.governor != "none":
         from ..governor import Governor
 
-        governor = Governor(governed, criterion=args.governor, contact_aware=args.contact_aware)
+        governor = Governor(governed, criterion=args.governor, contact_aware=args.contact_aware,
+                            velocity_margin=args.velocity_margin)
     trials, written = [], []
     for distance in distances:
         wall = WallOptions(reference=args.reference, governor=args.governor, wall_distance=distance,
@@ -91,6 +95,7 @@ def run(args: argparse.Namespace) -> int:
         d["rigid_impact"] = args.rigid_impact
         d["zmp_margin"] = margin
         d["contact_aware"] = bool(args.contact_aware and governor is not None)
+        d["velocity_margin"] = args.velocity_margin if governor is not None else None
     out = docs[0] if len(docs) == 1 else {"governor": args.governor, "reference": args.reference, "trials": docs}
     if args.json:
         print_json(out)

@@ -79,6 +79,11 @@ class Governor:
             of the frictional impact LCP reached from the kept solutions and the cold start),
             "warm" (the option as frozen in commit 5e477e6: one fixed point, warm-started from
             the previous answer) or "cold" (one, from gauges 0); see :mod:`.support`.
+        velocity_margin: Every post-impact CoM velocity must lie this far (m/s) inside the
+            CoM velocity area ("com" criterion, both models): a margin for the impact model's
+            error, as ``zmp_margin`` is one for the controller's. Default 0, the paper's
+            criterion (and ``analyze()``'s answer, which has no such margin). See
+            docs/governor.md, "A margin for the impact model's error".
 
     Raises:
         ScenarioError: no impact, an unknown frame, an impact model that cannot be built at
@@ -87,9 +92,18 @@ class Governor:
     """
 
     def __init__(self, scenario: Scenario | str | os.PathLike, criterion: str = "com", posture_tolerance: float = 0.0,
-                 contact_aware: bool = False, contact_aware_every: int = 5, contact_aware_starts: str = "union"):
+                 contact_aware: bool = False, contact_aware_every: int = 5, contact_aware_starts: str = "union",
+                 velocity_margin: float = 0.0):
         if criterion not in CRITERIA:
             raise GovernorError("criterion", criterion, f"must be one of {', '.join(CRITERIA)}")
+        try:
+            velocity_margin = float(velocity_margin)
+        except (TypeError, ValueError):
+            velocity_margin = math.nan
+        if not (math.isfinite(velocity_margin) and 0.0 <= velocity_margin <= 10.0):
+            raise GovernorError("velocity_margin", velocity_margin, "must be a number in [0, 10] m/s")
+        if velocity_margin and criterion != "com":
+            raise GovernorError("velocity_margin", velocity_margin, "applies to the com criterion only")
         try:
             tolerance = float(posture_tolerance)
         except (TypeError, ValueError):
@@ -111,7 +125,9 @@ class Governor:
         settings = PostureSettings(
             tuple(c.spec() for c in scenario.contacts), scenario.impact.spec(), float(scenario.plane_height),
             float(scenario.gravity), bool(scenario.torque_limits), float(scenario.zmp_margin), criterion,
+            velocity_margin,
         )
+        self.velocity_margin = velocity_margin
         #: The scenario's own configuration (lifted onto the ground as ``analyze`` does): a
         #: posture to start from.
         self.configuration: np.ndarray = scenario.build_stance(self.robot).q.copy()
@@ -182,7 +198,8 @@ class Governor:
         return cap_approach(reference_velocity, limit.normal, limit.safe_interval)
 
     def scenario_at(self, q: Sequence[float], com_velocity: Sequence[float]) -> Scenario:
-        """The scenario :func:`~impact_balance.analyze` answers the same for: this governor's,
+        """The scenario :func:`~impact_balance.analyze` answers the same for (without a
+        ``velocity_margin``, which scenarios do not have): this governor's,
         at configuration ``q`` (every joint by name, an explicit ``base`` pose) with
         ``com_velocity`` (world, m/s; e.g. a :class:`SpeedLimit`'s). To replay or save a tick.
 
@@ -257,7 +274,7 @@ class Governor:
                 if self._support_posture != posture.key:  # a posture evaluated since: the rates may be due
                     self._support.new_posture(lambda: posture.stance)
                     self._support_posture = posture.key
-                aware = self._support.answer(posture.com_criterion.area, com_velocity)
+                aware = self._support.answer(posture.com_criterion.area, com_velocity, self.velocity_margin)
                 interval = combine(interval, aware.interval)
                 if aware.limit.max_approach_speed < limit.max_approach_speed:
                     limit, binding = aware.limit, "contact_aware"

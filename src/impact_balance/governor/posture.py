@@ -58,6 +58,8 @@ class PostureSettings:
         torque_limits: Whether the joint torque limits bound the contact wrenches.
         zmp_margin: The ZMP support area is shrunk by this margin, m.
         criterion: "com" or "zmp".
+        velocity_margin: The post-impact CoM velocities must lie this far inside the CoM
+            velocity area, m/s ("com" criterion; :class:`~impact_balance.criteria.ComCriterion`).
     """
 
     contacts: Sequence[ContactSpec]
@@ -67,6 +69,7 @@ class PostureSettings:
     torque_limits: bool
     zmp_margin: float
     criterion: str
+    velocity_margin: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -216,7 +219,7 @@ class PostureEvaluator:
             zmp = zmp_max_contact_velocity(areas.zmp_area, impact, com, settings.plane_height,
                                            settings.gravity, settings.impact.duration)
         else:
-            com_criterion = ComCriterion(areas.com_velocity_area, impact)
+            com_criterion = ComCriterion(areas.com_velocity_area, impact, settings.velocity_margin)
         q = q.copy()
         q.setflags(write=False)
         return Posture(q.tobytes(), q, robot, settings, com, mass, areas, impact, com_jacobian,

@@ -246,10 +246,11 @@ class ContactAwareLimit:
             self._age += 1
         self._count += 1
 
-    def answer(self, area: Polygon, com_velocity: np.ndarray) -> ContactAwareAnswer:
+    def answer(self, area: Polygon, com_velocity: np.ndarray, velocity_margin: float = 0.0) -> ContactAwareAnswer:
         """The limit and interval (m/s of approach speed) for the CoM velocity area ``area``
         (world xy, m/s) and the pre-impact CoM velocity (world, m/s): the first exit over every
-        row of the rates (the smallest speed), the intersection of their safe intervals."""
+        row of the rates (the smallest speed), the intersection of their safe intervals. With a
+        ``velocity_margin`` (m/s), the post-impact CoM velocities must lie that far inside."""
         s = self._solutions
         if s is None:
             raise GovernorError("contact_aware", None, "no posture evaluated yet")
@@ -259,7 +260,7 @@ class ContactAwareLimit:
             return ContactAwareAnswer(VelocityLimit(0.0, "cannot_balance"), None, s.rates, self._age, converged,
                                       **common)
         G, h = area.halfplanes
-        margins = h - G @ np.asarray(com_velocity, dtype=float)[:2]
+        margins = h - velocity_margin - G @ np.asarray(com_velocity, dtype=float)[:2]  # unit rows: distances
         rates = s.rates @ G.T  # (k, edges): m/s of margin used per m/s of approach speed, per solution
         return ContactAwareAnswer(first_exit(margins, rates), speed_interval(margins, rates), s.rates,
                                   self._age, converged, **common)

@@ -1,0 +1,72 @@
+"""The velocity margin: every post-impact CoM velocity at least d (m/s) inside the CoM velocity area."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import impact_balance as ib
+from impact_balance.criteria import ComCriterion
+from impact_balance.exceptions import GovernorError
+from impact_balance.governor import Governor
+
+ANALYSES = {name: ib.analyze(name) for name in ("palm_push_two_feet", "palm_push_ramp")}
+
+
+def inside_distance(vertices: np.ndarray, x: np.ndarray) -> float:
+    """Signed distance from ``x`` to the boundary of the convex CCW polygon ``vertices``
+    (positive inside), from the vertices alone: the smallest distance to an edge's line."""
+    best = math.inf
+    for a, b in zip(vertices, np.roll(vertices, -1, axis=0)):
+        edge = b - a
+        best = min(best, float(edge[0] * (x[1] - a[1]) - edge[1] * (x[0] - a[0])) / float(np.hypot(*edge)))
+    return best
+
+
+@settings(max_examples=40, deadline=None)
+@given(name=st.sampled_from(sorted(ANALYSES)), d=st.floats(0.0, 0.05),
+       cx=st.floats(-0.05, 0.05), cy=st.floats(-0.05, 0.05))
+def test_the_limit_puts_the_worst_vertex_d_inside(name, d, cx, cy):
+    analysis = ANALYSES[name]
+    area, model = analysis.areas.com_velocity_area, analysis.impact.model
+    c0 = np.array([cx, cy])
+    if inside_distance(area.vertices, c0) <= d:
+        return  # already within d of the edge: no speed is safe with that margin
+    limit = ComCriterion(area, model, d).limit(c0)
+    assert limit.status == "ok"
+    s = limit.max_approach_speed
+    worst = min(inside_distance(area.vertices, p) for p in model.post_impact_com_velocities(c0, s))
+    assert worst == pytest.approx(d, abs=1e-9)
+    beyond = min(inside_distance(area.vertices, p) for p in model.post_impact_com_velocities(c0, s * 1.001 + 1e-6))
+    assert beyond < d
+    assert s <= ComCriterion(area, model).limit(c0).max_approach_speed + 1e-12
+
+
+def test_the_governor_applies_it_to_both_models():
+    plain = Governor("palm_push_two_feet", contact_aware=True, contact_aware_starts="warm")
+    margin = Governor("palm_push_two_feet", contact_aware=True, contact_aware_starts="warm", velocity_margin=0.02)
+    q, v = plain.configuration, np.zeros(plain.nv)
+    a, b = plain.limit(q, v), margin.limit(q, v)
+    assert b.max_approach_speed < a.max_approach_speed
+    posture = margin.posture
+    floating = ComCriterion(posture.com_criterion.area, posture.impact, 0.02).limit(b.com_velocity)
+    assert b.max_approach_speed <= floating.max_approach_speed + 1e-12
+    # The contact-aware jump with the margin: the point it predicts at the limit is 0.02 inside (or the floating set binds).
+    aware = margin._support.answer(posture.com_criterion.area, b.com_velocity, 0.02)
+    assert b.max_approach_speed == pytest.approx(min(floating.max_approach_speed, aware.limit.max_approach_speed))
+    rates = aware.rates
+    vertices = posture.com_criterion.area.vertices
+    s = aware.limit.max_approach_speed
+    worst = min(inside_distance(vertices, b.com_velocity[:2] + s * r) for r in rates)
+    assert worst == pytest.approx(0.02, abs=1e-9)
+
+
+@pytest.mark.parametrize("kwargs", [{"velocity_margin": -0.01}, {"velocity_margin": float("nan")},
+                                    {"velocity_margin": "fast"}, {"velocity_margin": 0.02, "criterion": "zmp"}])
+def test_bad_margins_name_the_field(kwargs):
+    with pytest.raises(GovernorError, match="velocity_margin"):
+        Governor("palm_push_two_feet", **kwargs)
