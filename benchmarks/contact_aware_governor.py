@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """The contact-aware governor option (experimental): every table of docs/contact_aware_governor.md.
 
-    python benchmarks/contact_aware_governor.py score --out DIR [--variant union|warm|cold|off]
+    python benchmarks/contact_aware_governor.py score --out DIR [--variant union|warm|cold|off|async]
             [--scenarios ...] [--references 0.5 1 2] [--distances 0.12 0.15 0.18]
     python benchmarks/contact_aware_governor.py sweep --out DIR [--scenarios ...] [--references ...]
     python benchmarks/contact_aware_governor.py bounds [--scenarios ...] [--margins 0 0.01]
@@ -23,7 +23,10 @@ through the impact: ``--rigid-impact``; the governor uses the areas inset by the
   start); ``--variant warm``: as frozen in commit 5e477e6 (section 4's, one fixed point
   warm-started from the previous answer); ``--variant cold``: the post hoc cold start (gauges 0
   at every recomputation, a new governor per wall; not frozen); ``--variant off``: without the
-  option (the study's ``com`` governor). Each trial also records its recomputations' cost (ms)
+  option (the study's ``com`` governor); ``--variant async``: the union's starts computed by a
+  worker process off the tick (``contact_aware_async``; trials record the rates' age, in
+  postures, when the worker's answer replaced them). ``--velocity-margin D``: the governor's
+  margin (m/s, docs/velocity_margin.md). Each trial also records its recomputations' cost (ms)
   and the most rows (solutions) of the rates.
 - ``sweep``: ungoverned approaches (``--governor none``, wall 15 cm) over references around each
   stance's fall (33 trials on four stances, ~2 min): the outcome against the post-impact CoM
@@ -75,7 +78,8 @@ def main(argv: list[str] | None = None) -> int:
     s = sub.add_parser("score", help="the governed trials (36 with the defaults)")
     s.add_argument("--out", default="contact-aware-governor", help="folder of the journals and score.json")
     s.add_argument("--variant", choices=VARIANTS, default="union",
-                   help="union: --contact-aware, the union of the LCP's solutions (default, section 5); warm: as "
+                   help="union: --contact-aware, the union of the LCP's solutions (default, section 5); async: the same "
+                        "computed off the tick (--contact-aware-async); warm: as "
                         "frozen in 5e477e6 (section 4's 'aware'); cold: post hoc cold start; off: without it")
     s.add_argument("--scenarios", nargs="+", default=list(SCENARIOS))
     s.add_argument("--references", type=float, nargs="+", default=[0.5, 1.0, 2.0], help="m/s")

@@ -70,3 +70,40 @@ def test_the_governor_applies_it_to_both_models():
 def test_bad_margins_name_the_field(kwargs):
     with pytest.raises(GovernorError, match="velocity_margin"):
         Governor("palm_push_two_feet", **kwargs)
+
+
+def test_async_rates_are_the_workers_answer_for_the_posture_it_was_sent():
+    """With contact_aware_async the tick adopts the worker's rates for an earlier posture: the
+    same numbers a synchronous solve gives there (cold start: nothing carried)."""
+    from impact_balance.governor.support import ContactAwareLimit
+    from impact_balance.stance import Stance
+
+    with Governor("g1_two_feet", contact_aware=True, contact_aware_starts="cold", contact_aware_async=True,
+                  velocity_margin=0.01) as governor:
+        worker = governor._worker
+        assert worker is not None and worker.alive
+        q1 = governor.configuration.copy()
+        q1[7:] += 0.01
+        v = np.zeros(governor.nv)
+        first = governor.limit(q1, v)  # the scenario posture's rates; q1 sent to the worker
+        assert worker.submitted == governor.posture.key
+        solutions = worker.wait(120.0)
+        assert solutions is not None
+        expected = ContactAwareLimit(governor.scenario.impact.spec(), 1, "cold").solve(
+            Stance(governor.robot, q1, tuple(c.spec() for c in governor.scenario.contacts)))
+        np.testing.assert_allclose(solutions.rates, expected.rates, rtol=0, atol=1e-12)
+        governor._support.adopt(solutions)  # what the next tick's poll does
+        q2 = q1.copy()
+        q2[7:] += 0.005
+        second = governor.limit(q2, v)
+        aware = governor._support.answer(governor.posture.com_criterion.area, second.com_velocity, 0.01)
+        floating = governor.posture.com_criterion.limit(second.com_velocity)
+        assert second.max_approach_speed == pytest.approx(min(aware.limit.max_approach_speed,
+                                                             floating.max_approach_speed))
+        assert first.binding == "contact_aware"
+    assert governor._worker is None and not worker.alive  # closed by the with block
+
+
+def test_async_needs_the_contact_aware_option():
+    with pytest.raises(GovernorError, match="contact_aware_async"):
+        Governor("palm_push_two_feet", contact_aware_async=True)

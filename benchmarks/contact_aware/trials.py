@@ -32,7 +32,7 @@ OUTCOMES = ("balanced", "contact_broken", "fell")
 
 # -- score: the governed trials -------------------------------------------------------------------
 #: ``--variant``: the option's starts (governor/support.py), or "off" (without the option).
-VARIANTS = ("union", "warm", "cold", "off")
+VARIANTS = ("union", "warm", "cold", "off", "async")
 
 
 def _timed(governor: Governor) -> list[tuple[float, int, int]]:
@@ -51,6 +51,20 @@ def _timed(governor: Governor) -> list[tuple[float, int, int]]:
     return record
 
 
+def _adoptions(governor: Governor) -> list[int]:
+    """Record the age (postures) of the rates each time the worker's answer replaces them
+    (``contact_aware_async``); returns the (live) list."""
+    support, ages = governor._support, []
+    inner = support.adopt
+
+    def adopt(solutions):
+        ages.append(support._age)
+        inner(solutions)
+
+    support.adopt = adopt
+    return ages
+
+
 def score(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
     """The governed trials of ``args.variant`` (module docstring); rows and failures."""
     rows, failures = [], 0
@@ -64,17 +78,22 @@ def score(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
         def new_governor() -> Governor:
             if args.variant == "off":
                 return Governor(governed, criterion="com", velocity_margin=args.velocity_margin)
+            if args.variant == "async":  # the union's starts, recomputed by a worker process off the tick
+                return Governor(governed, criterion="com", contact_aware=True, contact_aware_async=True,
+                                velocity_margin=args.velocity_margin)
             return Governor(governed, criterion="com", contact_aware=True, contact_aware_starts=args.variant,
                             velocity_margin=args.velocity_margin)
 
         def run(key: dict) -> dict:
             governor, trials = new_governor(), []  # one governor for the walls of a reference, as the command
             record = [] if governor._support is None else _timed(governor)
+            ages = [] if governor._worker is None else _adoptions(governor)
             for distance in key["distances"]:
                 if args.variant == "cold":
                     governor = new_governor()  # as the post hoc cold variant of section 4 was run
                     record = _timed(governor)
                 del record[:]  # this trial's recomputations only
+                del ages[:]
                 wall = WallOptions(reference=key["reference"], governor="com", wall_distance=distance)
                 trials.append(slim(run_wall_trial(setup, wall, options, governor=governor).to_dict()))
                 d = trials[-1]
@@ -83,8 +102,11 @@ def score(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
                     "count": len(record), "ms_median": float(np.median(ms)), "ms_max": float(ms.max()),
                     "ms_p90": float(np.percentile(ms, 90)), "rows_max": max(r[1] for r in record),
                     "solves_median": float(np.median([r[2] for r in record]))}
+                if ages:  # async: postures between two answers of the worker (the rates' age when replaced)
+                    d["rates_age"] = {"median": float(np.median(ages)), "max": int(max(ages)), "answers": len(ages)}
                 print(f"  {name} {key['reference']:g} m/s {100 * distance:g} cm: {d['outcome']} speed "
                       f"{_f(d['speed_at_contact'])} cap {_f(d['cap_at_contact'])}", file=sys.stderr, flush=True)
+            governor.close()  # a worker process, with "async"
             return {"trials": trials}
 
         keys = [{"reference": r, "distances": list(args.distances)} for r in args.references]

@@ -32,6 +32,9 @@ def add_parser(sub) -> list[str]:
     a.add_argument("--contact-aware", action="store_true",
                    help="com governor: also bound the speed by the contact-aware impact model (the robot standing "
                         "on its supports; experimental, see docs/contact_aware_governor.md)")
+    a.add_argument("--contact-aware-async", action="store_true",
+                   help="with --contact-aware: compute its rates in a worker process, off the tick (the tick never "
+                        "waits; the rates are one recomputation old)")
     a.add_argument("--velocity-margin", type=number("--velocity-margin", 0.0, 10.0, "m/s"), default=0.0, metavar="V",
                    help="com governor: every post-impact CoM velocity must lie V m/s inside the CoM velocity area "
                         "(a margin for the impact model's error; default 0, the paper's criterion)")
@@ -78,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
         from ..governor import Governor
 
         governor = Governor(governed, criterion=args.governor, contact_aware=args.contact_aware,
-                            velocity_margin=args.velocity_margin)
+                            velocity_margin=args.velocity_margin, contact_aware_async=args.contact_aware_async)
     trials, written = [], []
     for distance in distances:
         wall = WallOptions(reference=args.reference, governor=args.governor, wall_distance=distance,
@@ -89,6 +92,8 @@ def run(args: argparse.Namespace) -> int:
             written.append(_plot(trial, setup, Path(args.plots), margin))
         if args.video:
             written.append(write_wall_video(setup, trial, args.video, title=f"{scenario.name}: {args.governor} governor"))
+    if governor is not None:
+        governor.close()  # its worker process, if any
     docs = [t.to_dict() for t in trials]
     for d in docs:
         d["controller"] = args.controller
@@ -96,6 +101,7 @@ def run(args: argparse.Namespace) -> int:
         d["zmp_margin"] = margin
         d["contact_aware"] = bool(args.contact_aware and governor is not None)
         d["velocity_margin"] = args.velocity_margin if governor is not None else None
+        d["contact_aware_async"] = bool(args.contact_aware_async and governor is not None)
     out = docs[0] if len(docs) == 1 else {"governor": args.governor, "reference": args.reference, "trials": docs}
     if args.json:
         print_json(out)

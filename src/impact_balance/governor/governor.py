@@ -20,6 +20,7 @@ from ..stance import _has_free_flyer
 from .limit import SpeedLimit, cap_approach
 from .posture import Posture, PostureEvaluator, PostureSettings
 from .support import ContactAwareLimit, combine
+from .worker import ContactAwareWorker
 
 __all__ = ["Governor", "CRITERIA"]
 
@@ -74,7 +75,9 @@ class Governor:
             jump (:mod:`.support`: the robot standing on its supports; the answer is then the
             criterion for the union of both models' post-impact CoM velocities, the smaller
             maximum). "com" criterion, composite inertia only. Its jump rates are recomputed
-            every ``contact_aware_every`` posture evaluations (default 5), not every posture.
+            every ``contact_aware_every`` posture evaluations (default 5), not every posture;
+            with ``contact_aware_async``, by a worker process off the tick instead (:mod:`.worker`:
+            the tick never waits for them; rates one recomputation old; :meth:`close` stops it).
             ``contact_aware_starts``: "union" (default: the criterion holds for every solution
             of the frictional impact LCP reached from the kept solutions and the cold start),
             "warm" (the option as frozen in commit 5e477e6: one fixed point, warm-started from
@@ -93,7 +96,7 @@ class Governor:
 
     def __init__(self, scenario: Scenario | str | os.PathLike, criterion: str = "com", posture_tolerance: float = 0.0,
                  contact_aware: bool = False, contact_aware_every: int = 5, contact_aware_starts: str = "union",
-                 velocity_margin: float = 0.0):
+                 velocity_margin: float = 0.0, contact_aware_async: bool = False):
         if criterion not in CRITERIA:
             raise GovernorError("criterion", criterion, f"must be one of {', '.join(CRITERIA)}")
         try:
@@ -138,6 +141,9 @@ class Governor:
             if criterion != "com":
                 raise GovernorError("contact_aware", criterion, "bounds the CoM criterion only")
             self._support = ContactAwareLimit(settings.impact, contact_aware_every, contact_aware_starts)
+        elif contact_aware_async:
+            raise GovernorError("contact_aware_async", contact_aware_async, "needs contact_aware=True")
+        self._worker: ContactAwareWorker | None = None
         self._posture: Posture | None = None
         self._last: SpeedLimit | None = None
         warm_up()  # the projection kernel's one-time load, not in the first tick
@@ -147,6 +153,25 @@ class Governor:
         except ScenarioError as exc:
             raise with_source(exc, scenario.source) from None
         self._support_posture: bytes | None = None
+        if self._support is not None and contact_aware_async:
+            # The first rates here (the scenario's posture), then a worker keeps them fresh.
+            self._support.adopt(self._support.solve(self._posture.stance))
+            self._worker = ContactAwareWorker(scenario, contact_aware_starts)
+            self._worker.warm_up(self._posture.q, self._support._solutions)
+
+    def close(self) -> None:
+        """Stop the contact-aware worker process, if any (``contact_aware_async``); the
+        governor then recomputes the rates in the tick, as without it. Idempotent."""
+        with self._lock:
+            if self._worker is not None:
+                self._worker.close()
+                self._worker = None
+
+    def __enter__(self) -> Governor:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
 
     # -- per tick ---------------------------------------------------------------------------
     def limit(self, q: Sequence[float], v: Sequence[float]) -> SpeedLimit:
@@ -272,7 +297,16 @@ class Governor:
             interval = posture.com_criterion.interval(com_velocity, limit)
             if self._support is not None:
                 if self._support_posture != posture.key:  # a posture evaluated since: the rates may be due
-                    self._support.new_posture(lambda: posture.stance)
+                    if self._worker is None:
+                        self._support.new_posture(lambda: posture.stance)
+                    else:  # collect a finished answer, hand the worker this posture; never wait
+                        done = self._worker.poll()
+                        if done is None:
+                            self._support.aged()
+                        else:
+                            self._support.adopt(done)
+                        if self._worker.idle:
+                            self._worker.submit(posture.key, posture.q, self._support._solutions)
                     self._support_posture = posture.key
                 aware = self._support.answer(posture.com_criterion.area, com_velocity, self.velocity_margin)
                 interval = combine(interval, aware.interval)

@@ -236,6 +236,26 @@ class ContactAwareLimit:
         rates, restitution, states, converged = (np.array(x) for x in zip(*rows))
         return ContactAwareSolutions(rates, restitution, states, converged.astype(bool), iterations, len(rows))
 
+    def solve(self, stance: Stance, kept: ContactAwareSolutions | None = None) -> ContactAwareSolutions:
+        """The rates at ``stance`` from the option's starts, continuing ``kept`` (the solutions
+        to start from; default: this limit's own), without adopting them (:meth:`adopt`): what
+        a worker process computes for its governor (:mod:`.worker`)."""
+        own = self._solutions
+        self._solutions = own if kept is None else kept
+        try:
+            return self._solve(stance)
+        finally:
+            self._solutions = own
+
+    def adopt(self, solutions: ContactAwareSolutions) -> None:
+        """Use ``solutions`` from now on (age 0), e.g. a worker's answer."""
+        self._solutions = solutions
+        self._age = 0
+
+    def aged(self) -> None:
+        """A posture was evaluated and the rates were not recomputed for it (age + 1)."""
+        self._age += 1
+
     def new_posture(self, stance_of: Callable[[], Stance]) -> None:
         """A posture was evaluated; ``stance_of()`` builds its :class:`Stance` (called only when
         the rates are due)."""
@@ -262,8 +282,11 @@ class ContactAwareLimit:
         G, h = area.halfplanes
         margins = h - velocity_margin - G @ np.asarray(com_velocity, dtype=float)[:2]  # unit rows: distances
         rates = s.rates @ G.T  # (k, edges): m/s of margin used per m/s of approach speed, per solution
-        return ContactAwareAnswer(first_exit(margins, rates), speed_interval(margins, rates), s.rates,
-                                  self._age, converged, **common)
+        limit = first_exit(margins, rates)
+        # From inside the area the safe speeds are [0, limit] (as ComCriterion.interval); only a
+        # start outside needs the general interval.
+        interval = (0.0, limit.max_approach_speed) if limit.status in ("ok", "unbounded") else speed_interval(margins, rates)
+        return ContactAwareAnswer(limit, interval, s.rates, self._age, converged, **common)
 
 
 def combine(floating: tuple[float, float] | None, aware: tuple[float, float] | None) -> tuple[float, float] | None:

@@ -1,0 +1,172 @@
+"""The contact-aware rates in a process of their own, off the control tick.
+
+``Governor(..., contact_aware=True, contact_aware_async=True)``: the contact-aware impact's jump
+rates (:mod:`.support`, 3 to 170 ms per recomputation) are computed by a worker process while
+the governor keeps ticking with the last rates it received. Each tick the governor collects a
+finished answer if there is one (a pipe poll, microseconds) and, when the worker is idle, sends
+it the current posture with the solutions to continue from; the tick itself never waits. The
+rates in use are therefore those of a posture one recomputation old (tens of ms: the age in
+postures is :attr:`~.support.ContactAwareAnswer.age`), where the synchronous option recomputes
+every 5th posture inside the tick.
+
+The worker builds its own robot from the scenario once and answers until the governor closes
+it (:meth:`Governor.close`, the end of a ``with`` block, or the governor's collection).
+"""
+
+from __future__ import annotations
+
+import os
+import select
+import socket
+import subprocess
+import sys
+import weakref
+from multiprocessing.connection import Connection
+from typing import Any
+
+import numpy as np
+
+from ..exceptions import GovernorError
+from .support import ContactAwareLimit, ContactAwareSolutions
+
+__all__ = ["ContactAwareWorker"]
+
+#: Seconds to wait for the worker's start (a fresh interpreter, its imports and the robot, ~2 s).
+START_TIMEOUT = 120.0
+
+
+def _serve(conn: Connection) -> None:
+    """The worker's loop: first ``(scenario dict, source, starts)``, then ``(key, q, kept)`` in
+    and ``(key, solutions, error)`` out; None or a closed pipe stops it."""
+    from ..scenario import scenario_from_dict
+    from ..stance import Stance
+
+    raw, source, starts = conn.recv()
+    try:
+        scenario = scenario_from_dict(raw, source)
+        robot = scenario.load_robot()
+        contacts = tuple(c.spec() for c in scenario.contacts)
+        limit = ContactAwareLimit(scenario.impact.spec(), 1, starts)
+    except Exception as exc:
+        conn.send(("ready", None, f"{type(exc).__name__}: {exc}"))
+        return
+    conn.send(("ready", None, None))
+    while True:
+        try:
+            message = conn.recv()
+        except (EOFError, OSError):  # the governor went away
+            return
+        if message is None:
+            return
+        key, q, kept = message
+        try:
+            conn.send((key, limit.solve(Stance(robot, np.asarray(q, dtype=float), contacts), kept), None))
+        except Exception as exc:  # reported to the governor, which raises it on its next tick
+            conn.send((key, None, f"{type(exc).__name__}: {exc}"))
+
+
+def _stop(conn: Connection, process: subprocess.Popen) -> None:
+    try:
+        conn.send(None)
+    except (OSError, ValueError):
+        pass
+    try:
+        process.wait(timeout=2.0)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.wait(timeout=2.0)
+    conn.close()
+
+
+class ContactAwareWorker:
+    """One worker process computing contact-aware rates for one governor (module docstring);
+    not thread-safe (its governor calls it under its lock).
+
+    The worker is a fresh interpreter (``python -m impact_balance.governor.worker``) joined by a
+    socket pair, not a :mod:`multiprocessing` child: a spawned child re-imports the user's main
+    script, and a forked one inherits pinocchio's, numba's and BLAS's threads.
+    """
+
+    def __init__(self, scenario, starts: str):
+        parent, child = socket.socketpair()
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)  # the same impact_balance
+        try:
+            self._process = subprocess.Popen(
+                [sys.executable, "-m", "impact_balance.governor.worker", str(child.fileno())],
+                pass_fds=(child.fileno(),), stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL, env=env, close_fds=True)
+        except OSError as exc:
+            parent.close()
+            raise GovernorError("contact_aware_async", None, f"could not start the worker ({exc.strerror})") from None
+        finally:
+            child.close()
+        self._conn = Connection(parent.detach())
+        self._poller = select.poll()  # a tick's check for an answer: ~1 us, where Connection.poll takes ~10
+        self._poller.register(self._conn.fileno(), select.POLLIN)
+        self._finalizer = weakref.finalize(self, _stop, self._conn, self._process)
+        self._busy = True  # until "ready"
+        self.submitted: bytes | None = None
+        self._conn.send((scenario.model_dump(exclude_none=True), scenario.source, starts))
+        if not self._conn.poll(START_TIMEOUT):
+            self.close()
+            raise GovernorError("contact_aware_async", None, "the worker process did not start")
+        try:
+            self._receive()
+        except GovernorError:
+            self.close()
+            raise
+
+    def warm_up(self, q: np.ndarray, kept: ContactAwareSolutions | None) -> ContactAwareSolutions:
+        """Solve once at ``q`` and wait: the worker's first solve loads its compiled code
+        (~150 ms), which the governor pays at construction rather than in its first ticks."""
+        self.submit(b"warm-up", q, kept)
+        solutions = self.wait(START_TIMEOUT)
+        if solutions is None:
+            self.close()
+            raise GovernorError("contact_aware_async", None, "the worker did not answer")
+        return solutions
+
+    def _receive(self) -> tuple[Any, ContactAwareSolutions | None]:
+        try:
+            key, solutions, error = self._conn.recv()
+        except (EOFError, OSError):
+            raise GovernorError("contact_aware_async", None, "the worker process ended") from None
+        self._busy = False
+        if error is not None:
+            raise GovernorError("contact_aware_async", error[:200], "the worker failed")
+        return key, solutions
+
+    def poll(self) -> ContactAwareSolutions | None:
+        """A finished answer, if the worker has one (never waits)."""
+        if self._busy and self._poller.poll(0):
+            return self._receive()[1]
+        return None
+
+    @property
+    def idle(self) -> bool:
+        return not self._busy
+
+    def submit(self, key: bytes, q: np.ndarray, kept: ContactAwareSolutions | None) -> None:
+        """Ask for the rates at configuration ``q`` (nq), continuing ``kept``."""
+        self._conn.send((key, np.asarray(q), kept))
+        self._busy = True
+        self.submitted = key
+
+    def wait(self, timeout: float | None = None) -> ContactAwareSolutions | None:
+        """The answer to the request in flight (waits; None after ``timeout`` s)."""
+        if self._busy and self._conn.poll(timeout):
+            return self._receive()[1]
+        return None
+
+    def close(self) -> None:
+        """Stop the worker process (idempotent)."""
+        self._finalizer()
+
+    @property
+    def alive(self) -> bool:
+        return self._process.poll() is None
+
+
+if __name__ == "__main__":  # the worker process (started by ContactAwareWorker)
+    _serve(Connection(int(sys.argv[1])))
