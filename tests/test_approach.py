@@ -117,3 +117,34 @@ def test_meshes_are_visual_only():
     assert drawn.sim.model.ngeom > bare.sim.model.ngeom
     extra = drawn.sim.model.geom_contype[drawn.sim.model.geom_group == drawn.sim.model.geom_group.max()]
     assert (extra == 0).all() and drawn.sim.model.nv == bare.sim.model.nv
+
+
+def test_the_contact_aware_governor_off_the_tick_stands_g1_and_leaves_no_process(capsys):
+    """End to end: G1's governed approach with the contact-aware rates from a worker process and
+    the velocity margin stands where the default governor lets it fall (docs/velocity_margin.md),
+    and the worker is gone when the command returns."""
+    from pathlib import Path
+
+    out = run_json(capsys, "g1_two_feet", "--reference", "1", "--governor", "com", "--rigid-impact",
+                   "--contact-aware", "--contact-aware-async", "--velocity-margin", "0.022", "--wall-distance", "0.15")
+    assert out["contact_aware_async"] is True and out["velocity_margin"] == 0.022
+    assert out["outcome"] != "fell" and out["speed_at_contact"] <= out["cap_at_contact"] * 1.003
+    assert out["tick_us"]["count"] > 10
+    def workers() -> list[str]:
+        found = []
+        for cmdline in Path("/proc").glob("[0-9]*/cmdline"):
+            try:
+                if b"impact_balance.governor.worker" in cmdline.read_bytes():
+                    found.append(cmdline.parent.name)
+            except OSError:  # a process that ended while we looked
+                pass
+        return found
+
+    if Path("/proc/self/cmdline").exists():  # Linux: no worker process left behind
+        assert workers() == []
+
+
+def test_off_the_tick_needs_the_contact_aware_option(capsys):
+    assert main(["approach", "g1_two_feet", "--reference", "1", "--contact-aware-async"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "contact_aware_async" in err
