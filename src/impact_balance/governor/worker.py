@@ -10,7 +10,8 @@ postures is :attr:`~.support.ContactAwareAnswer.age`), where the synchronous opt
 every 5th posture inside the tick.
 
 The worker builds its own robot from the scenario once and answers until the governor closes
-it (:meth:`Governor.close`, the end of a ``with`` block, or the governor's collection).
+it (:meth:`Governor.close`, the end of a ``with`` block, or the governor's collection). POSIX
+only (the worker inherits one end of a socket pair).
 """
 
 from __future__ import annotations
@@ -96,9 +97,9 @@ class ContactAwareWorker:
                 [sys.executable, "-m", "impact_balance.governor.worker", str(child.fileno())],
                 pass_fds=(child.fileno(),), stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                 stderr=subprocess.DEVNULL, env=env, close_fds=True)
-        except OSError as exc:
+        except (OSError, ValueError) as exc:  # ValueError: no pass_fds (Windows); the option is POSIX-only
             parent.close()
-            raise GovernorError("contact_aware_async", None, f"could not start the worker ({exc.strerror})") from None
+            raise GovernorError("contact_aware_async", None, f"could not start the worker ({exc})") from None
         finally:
             child.close()
         self._conn = Connection(parent.detach())
