@@ -82,6 +82,10 @@ class Governor:
             of the frictional impact LCP reached from the kept solutions and the cold start),
             "warm" (the option as frozen in commit 5e477e6: one fixed point, warm-started from
             the previous answer) or "cold" (one, from gauges 0); see :mod:`.support`.
+        contact_aware_async: With ``contact_aware``, recompute its rates in a worker process
+            (:mod:`.worker`, POSIX) instead of in the tick: each posture tick polls for a
+            finished answer (~1 us) and hands the worker the current posture when it is idle;
+            it never waits. Call :meth:`close` (or use ``with``) to stop the worker.
         velocity_margin: Every post-impact CoM velocity must lie this far (m/s) inside the
             CoM velocity area ("com" criterion, both models): a margin for the impact model's
             error, as ``zmp_margin`` is one for the controller's. Default 0, the paper's
@@ -157,7 +161,7 @@ class Governor:
             # The first rates here (the scenario's posture), then a worker keeps them fresh.
             self._support.adopt(self._support.solve(self._posture.stance))
             self._worker = ContactAwareWorker(scenario, contact_aware_starts)
-            self._worker.warm_up(self._posture.q, self._support._solutions)
+            self._worker.warm_up(self._posture.q, self._support.solutions)
 
     def close(self) -> None:
         """Stop the contact-aware worker process, if any (``contact_aware_async``); the
@@ -180,7 +184,8 @@ class Governor:
 
         Raises:
             GovernorError: ``q`` or ``v`` of the wrong size, not finite, or a base
-                quaternion that is not unit (within 1e-6).
+                quaternion that is not unit (within 1e-6); with ``contact_aware_async``, a
+                worker that failed on an earlier posture or ended.
             ScenarioError, ImpactModelError, SolverError: a posture the pipeline cannot
                 evaluate (see :meth:`~impact_balance.governor.posture.PostureEvaluator.evaluate`).
         """
@@ -306,7 +311,7 @@ class Governor:
                         else:
                             self._support.adopt(done)
                         if self._worker.idle:
-                            self._worker.submit(posture.key, posture.q, self._support._solutions)
+                            self._worker.submit(posture.key, posture.q, self._support.solutions)
                     self._support_posture = posture.key
                 aware = self._support.answer(posture.com_criterion.area, com_velocity, self.velocity_margin)
                 interval = combine(interval, aware.interval)

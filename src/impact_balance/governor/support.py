@@ -215,6 +215,11 @@ class ContactAwareLimit:
         self._count = 0
 
     @property
+    def solutions(self) -> ContactAwareSolutions | None:
+        """The solutions in use (None before the first posture)."""
+        return self._solutions
+
+    @property
     def _rates(self) -> np.ndarray | None:
         return None if self._solutions is None else self._solutions.rates
 
