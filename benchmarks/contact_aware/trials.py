@@ -41,9 +41,9 @@ def _timed(governor: Governor) -> list[tuple[float, int, int]]:
     support, record = governor._support, []
     inner = support._solve
 
-    def solve(stance: Stance):
+    def solve(stance: Stance, kept):
         t0 = time.perf_counter()
-        solutions = inner(stance)
+        solutions = inner(stance, kept)
         record.append((1e3 * (time.perf_counter() - t0), len(solutions.rates), solutions.iterations))
         return solutions
 

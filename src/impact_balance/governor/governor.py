@@ -158,10 +158,10 @@ class Governor:
             raise with_source(exc, scenario.source) from None
         self._support_posture: bytes | None = None
         if self._support is not None and contact_aware_async:
-            # The first rates here (the scenario's posture), then a worker keeps them fresh.
-            self._support.adopt(self._support.solve(self._posture.stance))
+            # The worker's first answer (the scenario's posture, which loads its compiled code)
+            # gives the first rates; then it keeps them fresh.
             self._worker = ContactAwareWorker(scenario, contact_aware_starts)
-            self._worker.warm_up(self._posture.q, self._support.solutions)
+            self._support.adopt(self._worker.warm_up(self._posture.q, None))
 
     def close(self) -> None:
         """Stop the contact-aware worker process, if any (``contact_aware_async``); the

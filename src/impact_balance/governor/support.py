@@ -80,14 +80,8 @@ def contact_aware_rates(stance: Stance, spec: ImpactSpec, warm: list[np.ndarray]
     contact-aware CoM velocity jump per m/s of approach speed, world xy, at the lower and the
     upper restitution bound: ``(rates (2, 2), body velocity changes (6,) per m/s: (dv_c, dw),
     world, for a warm start, converged)``. ``warm``: one such change per bound, or None (cold)."""
-    rates, states, converged = [], [], True
-    for k, c_r in enumerate(spec.restitution):
-        guess = None if warm is None else warm[k]
-        r = contact_impact(stance, spec, 1.0, restitution=float(c_r), initial_dxi=guess)
-        rates.append(r.com_velocity_jump.copy())
-        states.append(np.concatenate([r.com_velocity_jump_3d, r.angular_velocity_jump]))
-        converged &= r.converged
-    return np.array(rates), states, converged
+    solutions = _one_per_bound(stance, spec, warm)
+    return solutions.rates, list(solutions.states), bool(solutions.converged.all())
 
 
 @dataclass(frozen=True)
@@ -158,6 +152,20 @@ def contact_aware_solutions(stance: Stance, spec: ImpactSpec, previous: ContactA
                                  np.array(converged, dtype=bool), iterations, starts)
 
 
+def _one_per_bound(stance: Stance, spec: ImpactSpec, guesses) -> ContactAwareSolutions:
+    """One fixed point per restitution bound, from ``guesses[k]`` (a body velocity change (6,)
+    per m/s) or, without guesses, gauges 0: 2 rows even when both bounds give the same jump
+    (the frozen option's ``starts="warm"`` and the post hoc ``"cold"``)."""
+    rows, iterations = [], 0
+    for k, c_r in enumerate(float(c) for c in spec.restitution):
+        r = contact_impact(stance, spec, 1.0, restitution=c_r, initial_dxi=None if guesses is None else guesses[k])
+        rows.append((r.com_velocity_jump.copy(), c_r, np.concatenate([r.com_velocity_jump_3d, r.angular_velocity_jump]),
+                     r.converged))
+        iterations += r.iterations
+    rates, restitution, states, converged = (np.array(x) for x in zip(*rows))
+    return ContactAwareSolutions(rates, restitution, states, converged.astype(bool), iterations, len(rows))
+
+
 @dataclass(frozen=True)
 class ContactAwareAnswer:
     """The contact-aware model's part of one tick's answer.
@@ -223,34 +231,18 @@ class ContactAwareLimit:
     def _rates(self) -> np.ndarray | None:
         return None if self._solutions is None else self._solutions.rates
 
-    def _solve(self, stance: Stance) -> ContactAwareSolutions:
-        """This posture's rates from the option's starts."""
+    def _solve(self, stance: Stance, kept: ContactAwareSolutions | None) -> ContactAwareSolutions:
+        """The rates at ``stance`` from the option's starts, continuing ``kept``."""
         if self.starts == "union":
-            return contact_aware_solutions(stance, self.spec, self._solutions, cold=True)
-        # "warm": the previous answer per bound (row k of the previous 2 rows); "cold": none. The
-        # same fixed points as contact_aware_rates (the frozen option), kept as 2 rows even when
-        # both bounds give the same jump.
-        previous = self._solutions if self.starts == "warm" else None
-        rows, iterations = [], 0
-        for k, c_r in enumerate(float(c) for c in self.spec.restitution):
-            guess = None if previous is None else previous.states[k]
-            r = contact_impact(stance, self.spec, 1.0, restitution=c_r, initial_dxi=guess)
-            rows.append((r.com_velocity_jump.copy(), c_r, np.concatenate([r.com_velocity_jump_3d,
-                                                                           r.angular_velocity_jump]), r.converged))
-            iterations += r.iterations
-        rates, restitution, states, converged = (np.array(x) for x in zip(*rows))
-        return ContactAwareSolutions(rates, restitution, states, converged.astype(bool), iterations, len(rows))
+            return contact_aware_solutions(stance, self.spec, kept, cold=True)
+        # "warm": the previous answer per bound (row k of the previous 2 rows); "cold": none.
+        return _one_per_bound(stance, self.spec, kept.states if self.starts == "warm" and kept is not None else None)
 
     def solve(self, stance: Stance, kept: ContactAwareSolutions | None = None) -> ContactAwareSolutions:
         """The rates at ``stance`` from the option's starts, continuing ``kept`` (the solutions
         to start from; default: this limit's own), without adopting them (:meth:`adopt`): what
         a worker process computes for its governor (:mod:`.worker`)."""
-        own = self._solutions
-        self._solutions = own if kept is None else kept
-        try:
-            return self._solve(stance)
-        finally:
-            self._solutions = own
+        return self._solve(stance, self._solutions if kept is None else kept)
 
     def adopt(self, solutions: ContactAwareSolutions) -> None:
         """Use ``solutions`` from now on (age 0), e.g. a worker's answer."""
@@ -265,7 +257,7 @@ class ContactAwareLimit:
         """A posture was evaluated; ``stance_of()`` builds its :class:`Stance` (called only when
         the rates are due)."""
         if self._solutions is None or self._count % self.every == 0:
-            self._solutions = self._solve(stance_of())
+            self._solutions = self._solve(stance_of(), self._solutions)
             self._age = 0
         else:
             self._age += 1

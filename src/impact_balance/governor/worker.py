@@ -119,8 +119,9 @@ class ContactAwareWorker:
             raise
 
     def warm_up(self, q: np.ndarray, kept: ContactAwareSolutions | None) -> ContactAwareSolutions:
-        """Solve once at ``q`` and wait: the worker's first solve loads its compiled code
-        (~150 ms), which the governor pays at construction rather than in its first ticks."""
+        """Solve once at ``q`` and wait, returning the answer: the worker's first solve loads
+        its compiled code (~150 ms), which the governor pays at construction (and takes as its
+        first rates) rather than in its first ticks."""
         self.submit(b"warm-up", q, kept)
         solutions = self.wait(START_TIMEOUT)
         if solutions is None:
