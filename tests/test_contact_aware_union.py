@@ -55,7 +55,7 @@ def answers(path):
         row = {}
         for name, limit in limits.items():
             limit.new_posture(lambda: posture.stance)
-            row[name] = limit.answer(posture.areas.com_velocity_area, np.zeros(3))
+            row[name] = limit.answer(posture.com_criterion, np.zeros(3))
         out.append(row)
     return out
 

@@ -72,7 +72,7 @@ def test_rates_are_reused_between_recomputations():
         q[7:] += 0.001 * k
         aware.limit(q, v)
         aware.limit(q, v)  # velocity-only: same posture
-        ages.append(aware._support.answer(aware.posture.areas.com_velocity_area, np.zeros(3)).age)
+        ages.append(aware._support.answer(aware.posture.com_criterion, np.zeros(3)).age)
     assert ages == [0, 1, 2, 0, 1]
 
 

@@ -56,7 +56,7 @@ def test_the_governor_applies_it_to_both_models():
     floating = ComCriterion(posture.com_criterion.area, posture.impact, 0.02).limit(b.com_velocity)
     assert b.max_approach_speed <= floating.max_approach_speed + 1e-12
     # The contact-aware jump with the margin: the point it predicts at the limit is 0.02 inside (or the floating set binds).
-    aware = margin._support.answer(posture.com_criterion.area, b.com_velocity, 0.02)
+    aware = margin._support.answer(posture.com_criterion, b.com_velocity)
     assert b.max_approach_speed == pytest.approx(min(floating.max_approach_speed, aware.limit.max_approach_speed))
     rates = aware.rates
     vertices = posture.com_criterion.area.vertices
@@ -96,7 +96,7 @@ def test_async_rates_are_the_workers_answer_for_the_posture_it_was_sent():
         q2 = q1.copy()
         q2[7:] += 0.005
         second = governor.limit(q2, v)
-        aware = governor._support.answer(governor.posture.com_criterion.area, second.com_velocity, 0.01)
+        aware = governor._support.answer(governor.posture.com_criterion, second.com_velocity)
         floating = governor.posture.com_criterion.limit(second.com_velocity)
         assert second.max_approach_speed == pytest.approx(min(aware.limit.max_approach_speed,
                                                              floating.max_approach_speed))

@@ -112,8 +112,7 @@ def branches_table(args: argparse.Namespace, summary: dict, log, window: float =
         if dt < -window:
             continue
         cold.new_posture(lambda: posture.stance)
-        area = posture.areas.com_velocity_area
-        a, b, u = (s.answer(area, answer.com_velocity) for s in (cold, warm, union))
+        a, b, u = (s.answer(posture.com_criterion, answer.com_velocity) for s in (cold, warm, union))
         jumps = "; ".join(f"{x:+.3f}, {y:+.3f}" for (x, y), c in zip(u.rates, u.restitution) if c == upper)
         rows.append(f"| {dt:+.3f} | {answer.max_approach_speed:.3f} | {a.rates[-1][0]:+.3f}, {a.rates[-1][1]:+.3f} "
                     f"| {a.limit.max_approach_speed:.3f} | {b.rates[-1][0]:+.3f}, {b.rates[-1][1]:+.3f} "

@@ -13,6 +13,7 @@ import impact_balance as ib
 from impact_balance.areas import FORCE_BOX
 from impact_balance.constraints import wrench_polytope
 from impact_balance.projection import project_polytope
+from impact_balance.projection.walk import NO_HINT
 from impact_balance.stance import Stance
 
 from .projection import projection_cases
@@ -100,7 +101,7 @@ def profile_report(args) -> dict[str, Any]:
         "wrench_polytope": _median_us(lambda: wrench_polytope(stance, sc.torque_limits, sc.gravity), n),
         "numpy SVD of the LIPM equalities (in project_walk)": _median_us(lambda: np.linalg.svd(C), n),
         "compiled kernel project() alone": _median_us(
-            lambda: _kernel.project(A, b, F, x0, N, FORCE_BOX, 5000), n),
+            lambda: _kernel.project(A, b, F, x0, N, FORCE_BOX, 5000, NO_HINT), n),
         "project_walk": _median_us(lambda: project_walk(A, b, C, d, F, box=FORCE_BOX, merge_tol=1e-6), n),
         "areas_from_polytope (walk + affine maps)": _median_us(lambda: ib.areas_from_polytope(poly, sc.plane_height), n),
         "project_polytope(method='bretl') (HiGHS, for comparison)": _median_us(

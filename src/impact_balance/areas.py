@@ -33,7 +33,7 @@ from .exceptions import ScenarioError, SolverError
 from .polygon import MERGE_AREA_TOLERANCE, Polygon, _edge_halfplanes, _inset_polygon
 from .projection import _kernel, project_polytope, walk
 from .projection._kernel import LINE, OK
-from .projection.walk import MAX_PIVOTS, certified_walk
+from .projection.walk import MAX_PIVOTS, NO_HINT, certified_walk
 from .stance import Stance
 
 __all__ = ["BalanceAreas", "Projected", "balance_areas", "areas_from_polytope", "areas_from_arrays", "projected_from_arrays",
@@ -120,7 +120,7 @@ def areas_from_polytope(polytope: WrenchPolytope, plane_height: float = 0.0, zmp
     data = tuple(np.ascontiguousarray(x, dtype=np.float64) for x in polytope.projection_data())
     # The walk, its certificate and both maps in one compiled call (a governor's every tick).
     walked = _walk_areas(*data, FORCE_BOX, MAX_PIVOTS, MERGE_TOLERANCE, MERGE_AREA_TOLERANCE, depth, float(com[0]),
-                         float(com[1]), w, float(zmp_margin))
+                         float(com[1]), w, float(zmp_margin), NO_HINT)
     return _projected(walked, data, com, w, plane_height, polytope.mass, polytope.gravity, float(zmp_margin)).areas()
 
 
@@ -142,10 +142,16 @@ def areas_from_arrays(
 def projected_from_arrays(
     faces: np.ndarray, rotations: np.ndarray, positions: np.ndarray, arms: np.ndarray, mass: float, com: np.ndarray,
     gravity: float, jacobians: np.ndarray, torque_indices: np.ndarray, torque_limits: np.ndarray,
-    gravity_torques: np.ndarray, plane_height: float = 0.0, zmp_margin: float = 0.0,
+    gravity_torques: np.ndarray, plane_height: float = 0.0, zmp_margin: float = 0.0, hint: np.ndarray | None = None,
 ) -> Projected:
     """:func:`areas_from_arrays` before its :class:`BalanceAreas` is built (a governor's tick
-    reads only the CoM velocity area; :meth:`Projected.areas` builds the rest on demand)."""
+    reads only the CoM velocity area; :meth:`Projected.areas` builds the rest on demand).
+
+    ``hint``: an int64 array (2 + the number of wrench variables, e.g. 2 + 6 per contact) the
+    walk reads its start from and writes its optimal basis to: one caller that projects
+    postures in a row (a governor) keeps it between calls and saves the walk's crash start;
+    the polygon is the same either way (to rounding).
+    """
     w = omega(float(com[2]), plane_height, gravity)
     depth = plane_height - float(com[2])
     positions, arms, jacobians, torque_limits, gravity_torques = (
@@ -153,7 +159,7 @@ def projected_from_arrays(
     out = _assembled_areas(face_blocks(faces, rotations), positions, arms, jacobians,
                            np.ascontiguousarray(torque_indices, dtype=np.int64), torque_limits, gravity_torques,
                            mass * gravity, FORCE_BOX, MAX_PIVOTS, MERGE_TOLERANCE, MERGE_AREA_TOLERANCE, depth,
-                           float(com[0]), float(com[1]), w, float(zmp_margin))
+                           float(com[0]), float(com[1]), w, float(zmp_margin), NO_HINT if hint is None else hint)
     return _projected(out[5:], out[:5], com, w, plane_height, mass, gravity, float(zmp_margin))
 
 
@@ -236,11 +242,11 @@ def _maps(force, bounded, depth, cx, cy, w, margin):
 
 
 @njit(cache=True)
-def _walk_areas(A, b, C, d, E, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, margin):
+def _walk_areas(A, b, C, d, E, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, margin, hint):
     """:func:`~impact_balance.projection.walk.certified_walk` and :func:`_maps` in one call:
     ``(status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h)``, ``G, h`` the CoM
     velocity area's half-planes when it has 3 vertices or more (else none)."""
-    status, force, bounded, _, _, _ = certified_walk(A, b, C, d, E, box, max_pivots, merge_tol, area_tol)
+    status, force, bounded, _, _, _ = certified_walk(A, b, C, d, E, box, max_pivots, merge_tol, area_tol, hint)
     zmp, zmp_bounded, vel, vel_bounded = _maps(force, bounded, depth, cx, cy, w, margin)
     if vel.shape[0] >= 3:
         G, h = _edge_halfplanes(vel)
@@ -251,7 +257,7 @@ def _walk_areas(A, b, C, d, E, box, max_pivots, merge_tol, area_tol, depth, cx, 
 
 @njit(cache=True)
 def _assembled_areas(blocks, positions, arms, jacobians, torque_indices, torque_limits, gravity_torques,
-                     weight, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, margin):
+                     weight, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, margin, hint):
     """The polytope's arrays (as :func:`~impact_balance.constraints.assemble_polytope`) in
     units of m g (as ``WrenchPolytope.projection_data`` without scaling) and
     :func:`_walk_areas` on them: ``(A, b, C, d, E) + _walk_areas(...)``."""
@@ -261,7 +267,7 @@ def _assembled_areas(blocks, positions, arms, jacobians, torque_indices, torque_
     d[0] = weight / weight  # (m g, 0, 0, 0) / (m g)
     E = G[:2].copy()
     status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, Gv, hv = _walk_areas(
-        A, b, C, d, E, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, margin)
+        A, b, C, d, E, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, margin, hint)
     return A, b, C, d, E, status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, Gv, hv
 
 

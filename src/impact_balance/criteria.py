@@ -135,6 +135,22 @@ def _com_exit(G, h, c0x, c0y, rates, tol):
     return _first_exit(margins, rates, tol)
 
 
+@njit(cache=True)
+def _com_exits(G, h, c0x, c0y, rates, jumps, tol):
+    """:func:`_com_exit` for ``rates`` and for the jumps ``jumps`` (k, 2), whose rates per
+    edge are ``jumps G^T``: the two answers' 8 numbers."""
+    margins = np.empty(h.size)
+    for k in range(h.size):
+        margins[k] = h[k] - (G[k, 0] * c0x + G[k, 1] * c0y)
+    edge = np.empty((jumps.shape[0], h.size))
+    for j in range(jumps.shape[0]):
+        for k in range(h.size):
+            edge[j, k] = jumps[j, 0] * G[k, 0] + jumps[j, 1] * G[k, 1]
+    a = _first_exit(margins, rates, tol)
+    b = _first_exit(margins, edge, tol)
+    return a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]
+
+
 def speed_interval(margins: np.ndarray, rates: np.ndarray, tol: float = BOUNDARY_TOLERANCE) -> tuple[float, float] | None:
     """All s >= 0 with ``margins[k] - s * rates[j, k] >= 0`` for all j, k: ``(lo, hi)`` or None.
 
@@ -204,6 +220,18 @@ class ComCriterion:
             return VelocityLimit(0.0, "cannot_balance")
         c0x, c0y = float(com_velocity[0]), float(com_velocity[1])
         return _limit(*_com_exit(self.G, self.h, c0x, c0y, self.rates, BOUNDARY_TOLERANCE))
+
+    def limits(self, com_velocity: Sequence[float], jumps: np.ndarray) -> tuple[VelocityLimit, VelocityLimit]:
+        """:meth:`limit`, and the same limit for other post-impact jumps ``jumps`` (k, 2: the
+        CoM velocity jumps per m/s of approach speed, world xy, e.g. another impact model's;
+        its vertex j is row j), in one compiled call (a governor's tick)."""
+        if self.G is None:
+            cannot = VelocityLimit(0.0, "cannot_balance")
+            return cannot, cannot
+        c0x, c0y = float(com_velocity[0]), float(com_velocity[1])
+        out = _com_exits(self.G, self.h, c0x, c0y, self.rates, np.ascontiguousarray(jumps, dtype=float),
+                         BOUNDARY_TOLERANCE)
+        return _limit(*out[:4]), _limit(*out[4:])
 
     def interval(self, com_velocity: Sequence[float], limit: VelocityLimit | None = None) -> tuple[float, float] | None:
         """The safe approach speeds ``(lo, hi)`` (see :func:`safe_interval`); ``limit``,

@@ -156,6 +156,9 @@ class Governor:
             self._posture = self._evaluator.evaluate(self.configuration)
         except ScenarioError as exc:
             raise with_source(exc, scenario.source) from None
+        if self._posture.com_criterion is not None:  # load the criterion's compiled code (1-3 ms) here too
+            self._posture.com_criterion.limit(np.zeros(3))
+            self._posture.com_criterion.limits(np.zeros(3), np.zeros((1, 2)))
         self._support_posture: bytes | None = None
         if self._support is not None and contact_aware_async:
             # The worker's first answer (the scenario's posture, which loads its compiled code)
@@ -297,26 +300,27 @@ class Governor:
 
     def _answer(self, posture: Posture, com_velocity: np.ndarray, reused: bool) -> SpeedLimit:
         binding = "floating"
-        if posture.com_criterion is not None:
-            limit = posture.com_criterion.limit(com_velocity)
-            interval = posture.com_criterion.interval(com_velocity, limit)
-            if self._support is not None:
-                if self._support_posture != posture.key:  # a posture evaluated since: the rates may be due
-                    if self._worker is None:
-                        self._support.new_posture(lambda: posture.stance)
-                    else:  # collect a finished answer, hand the worker this posture; never wait
-                        done = self._worker.poll()
-                        if done is None:
-                            self._support.aged()
-                        else:
-                            self._support.adopt(done)
-                        if self._worker.idle:
-                            self._worker.submit(posture.key, posture.q, self._support.solutions)
-                    self._support_posture = posture.key
-                aware = self._support.answer(posture.com_criterion.area, com_velocity, self.velocity_margin)
-                interval = combine(interval, aware.interval)
-                if aware.limit.max_approach_speed < limit.max_approach_speed:
-                    limit, binding = aware.limit, "contact_aware"
+        criterion = posture.com_criterion
+        if criterion is not None and self._support is None:
+            limit = criterion.limit(com_velocity)
+            interval = criterion.interval(com_velocity, limit)
+        elif criterion is not None:
+            if self._support_posture != posture.key:  # a posture evaluated since: the rates may be due
+                if self._worker is None:
+                    self._support.new_posture(lambda: posture.stance)
+                else:  # collect a finished answer, hand the worker this posture; never wait
+                    done = self._worker.poll()
+                    if done is None:
+                        self._support.aged()
+                    else:
+                        self._support.adopt(done)
+                    if self._worker.idle:
+                        self._worker.submit(posture.key, posture.q, self._support.solutions)
+                self._support_posture = posture.key
+            limit, aware = self._support.answers(criterion, com_velocity)
+            interval = combine(criterion.interval(com_velocity, limit), aware.interval)
+            if aware.limit.max_approach_speed < limit.max_approach_speed:
+                limit, binding = aware.limit, "contact_aware"
         else:
             limit = posture.zmp_limit
             interval = _zmp_interval(limit)

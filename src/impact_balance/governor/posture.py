@@ -157,6 +157,9 @@ class PostureEvaluator:
         self._q_local = np.zeros(model.nq)
         self._zero_velocity = np.zeros(model.nv)
         self._gravity = np.array(model.gravity.linear, dtype=float)  # m/s^2, world
+        # The projection's warm start, carried from one posture to the next (see
+        # projected_from_arrays): 2 + the wrench variables at most.
+        self._hint = np.full(2 + 6 * m, -1, dtype=np.int64)
 
     def evaluate(self, q: np.ndarray) -> Posture:
         """Everything the governor needs at configuration ``q`` (nq, float64, contiguous).
@@ -208,7 +211,7 @@ class PostureEvaluator:
             else:  # the same numbers, assembled and projected in one compiled call
                 areas = projected_from_arrays(self._faces, rotations, local + origin, local - com_local, mass, com,
                                               settings.gravity, jacobians, self._idx, self._limit, gravity_torques,
-                                              settings.plane_height, settings.zmp_margin)
+                                              settings.plane_height, settings.zmp_margin, self._hint)
         except SolverError as exc:
             raise exc.within("contacts (projection of the contact wrench polytope)") from None
         impact = self._impact(q, q_local, origin, com_local, mass, np.array(Ig.inertia, dtype=float))

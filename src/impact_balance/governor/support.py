@@ -53,10 +53,9 @@ from typing import Callable
 import numpy as np
 
 from ..contact_impact import contact_impact
-from ..criteria import VelocityLimit, first_exit, speed_interval
+from ..criteria import ComCriterion, VelocityLimit, speed_interval
 from ..exceptions import GovernorError
 from ..impact import ImpactSpec
-from ..polygon import Polygon
 from ..stance import Stance
 
 __all__ = ["ContactAwareLimit", "ContactAwareAnswer", "ContactAwareSolutions", "STARTS", "contact_aware_rates",
@@ -219,6 +218,7 @@ class ContactAwareLimit:
         self.every = int(every)
         self.starts = starts
         self._solutions: ContactAwareSolutions | None = None
+        self._converged = False  # whether every fixed point of _solutions was reached
         self._age = 0
         self._count = 0
 
@@ -247,6 +247,7 @@ class ContactAwareLimit:
     def adopt(self, solutions: ContactAwareSolutions) -> None:
         """Use ``solutions`` from now on (age 0), e.g. a worker's answer."""
         self._solutions = solutions
+        self._converged = bool(solutions.converged.all())
         self._age = 0
 
     def aged(self) -> None:
@@ -257,33 +258,35 @@ class ContactAwareLimit:
         """A posture was evaluated; ``stance_of()`` builds its :class:`Stance` (called only when
         the rates are due)."""
         if self._solutions is None or self._count % self.every == 0:
-            self._solutions = self._solve(stance_of(), self._solutions)
+            self.adopt(self._solve(stance_of(), self._solutions))
             self._age = 0
         else:
             self._age += 1
         self._count += 1
 
-    def answer(self, area: Polygon, com_velocity: np.ndarray, velocity_margin: float = 0.0) -> ContactAwareAnswer:
-        """The limit and interval (m/s of approach speed) for the CoM velocity area ``area``
-        (world xy, m/s) and the pre-impact CoM velocity (world, m/s): the first exit over every
-        row of the rates (the smallest speed), the intersection of their safe intervals. With a
-        ``velocity_margin`` (m/s), the post-impact CoM velocities must lie that far inside."""
+    def answer(self, criterion: ComCriterion, com_velocity: np.ndarray) -> ContactAwareAnswer:
+        """The limit and interval (m/s of approach speed) for the CoM velocity area of
+        ``criterion`` (world xy, m/s; the posture's :class:`~impact_balance.criteria.ComCriterion`,
+        its velocity margin included) and the pre-impact CoM velocity (world, m/s): the first
+        exit over every row of the rates (the smallest speed), the intersection of their safe
+        intervals."""
+        return self.answers(criterion, com_velocity)[1]
+
+    def answers(self, criterion: ComCriterion, com_velocity: np.ndarray) -> tuple[VelocityLimit, ContactAwareAnswer]:
+        """``criterion.limit(com_velocity)`` (the floating model's limit) and :meth:`answer`,
+        in one compiled call: a governor's tick."""
         s = self._solutions
         if s is None:
             raise GovernorError("contact_aware", None, "no posture evaluated yet")
-        common = dict(restitution=s.restitution, starts=self.starts, solves=s.iterations)
-        converged = bool(s.converged.all())
-        if area.is_empty:
-            return ContactAwareAnswer(VelocityLimit(0.0, "cannot_balance"), None, s.rates, self._age, converged,
-                                      **common)
-        G, h = area.halfplanes
-        margins = h - velocity_margin - G @ np.asarray(com_velocity, dtype=float)[:2]  # unit rows: distances
-        rates = s.rates @ G.T  # (k, edges): m/s of margin used per m/s of approach speed, per solution
-        limit = first_exit(margins, rates)
-        # From inside the area the safe speeds are [0, limit] (as ComCriterion.interval); only a
-        # start outside needs the general interval.
-        interval = (0.0, limit.max_approach_speed) if limit.status in ("ok", "unbounded") else speed_interval(margins, rates)
-        return ContactAwareAnswer(limit, interval, s.rates, self._age, converged, **common)
+        floating, limit = criterion.limits(com_velocity, s.rates)
+        if criterion.G is None:
+            interval = None
+        elif limit.status in ("ok", "unbounded"):  # from inside: [0, limit] (as ComCriterion.interval)
+            interval = (0.0, limit.max_approach_speed)
+        else:
+            interval = speed_interval(criterion.margins(com_velocity), s.rates @ criterion.G.T)
+        return floating, ContactAwareAnswer(limit, interval, s.rates, self._age, self._converged, s.restitution,
+                                            self.starts, s.iterations)
 
 
 def combine(floating: tuple[float, float] | None, aware: tuple[float, float] | None) -> tuple[float, float] | None:

@@ -50,8 +50,17 @@ _RANK = 1e-12
 _REFACTOR = 16
 #: In the walk around the polygon: pivots after which a breakpoint recomputes the inverse
 #: whatever its residuals, and the relative residual above which it does (see _accurate).
-_CARRY = 4
+_CARRY = 8
 _EPS_CARRY = 1e-14
+#: Degenerate vertices (more than n rows at zero slack: a contact's 16 faces at its zero
+#: wrench) cost several zero steps each, and each one scanned every row. The rows with a slack
+#: up to _D_SLACK at a recorded vertex are listed; while z stays within _D_MOVE of it, every
+#: other (unit) row keeps a slack above _D_SLACK - _D_MOVE > _D_STEP, so a ratio-test step up
+#: to _D_STEP (with its ties) and a negative slack can only come from a listed row: scanning
+#: the list gives the same numbers (9 % less time on G1's walks).
+_D_SLACK = 1e-8
+_D_MOVE = 1e-10
+_D_STEP = 1e-9
 
 
 @njit(cache=True)
@@ -130,6 +139,76 @@ def _ratio_test(H, h, z, p, active, hp, slack):
         if not active[j] and hp[j] > _EPS_PIVOT and max(slack[j], 0.0) / hp[j] <= bound:
             return j, best
     return -1, 0.0  # unreachable
+
+
+@njit(cache=True)
+def _near(z, zd):
+    """Whether |z - zd| <= _D_MOVE (Euclidean)."""
+    acc = 0.0
+    for k in range(z.shape[0]):
+        d = z[k] - zd[k]
+        acc += d * d
+    return acc <= _D_MOVE * _D_MOVE
+
+
+@njit(cache=True)
+def _ratio_test_near(H, h, z, p, active, hp, slack, zd, dset):
+    """:func:`_ratio_test`, over the rows near z only when that gives its answer exactly."""
+    count = dset[0]
+    if count >= 0 and _near(z, zd):
+        n = H.shape[1]
+        best = math.inf
+        for i in range(count):
+            j = dset[1 + i]
+            if active[j]:
+                continue
+            a = 0.0
+            b = h[j]
+            for k in range(n):
+                a += H[j, k] * p[k]
+                b -= H[j, k] * z[k]
+            hp[j] = a
+            slack[j] = b
+            if a > _EPS_PIVOT:
+                t = max(b, 0.0) / a
+                if t < best:
+                    best = t
+        if best <= _D_STEP:
+            bound = best + _EPS_TIE * (1.0 + best)
+            for i in range(count):
+                j = dset[1 + i]
+                if not active[j] and hp[j] > _EPS_PIVOT and max(slack[j], 0.0) / hp[j] <= bound:
+                    return j, best
+    return _ratio_test(H, h, z, p, active, hp, slack)
+
+
+@njit(cache=True)
+def _min_slack_near(H, h, z, worst, zd, dset):
+    """:func:`_min_slack`, over the rows near z when z is within _D_MOVE of where they were
+    listed (the others' slacks are positive there); else over every row, listing them again."""
+    m, n = H.shape
+    count = dset[0]
+    if count >= 0 and _near(z, zd):
+        for i in range(count):
+            j = dset[1 + i]
+            b = h[j]
+            for k in range(n):
+                b -= H[j, k] * z[k]
+            if b < worst[0]:
+                worst[0] = b
+        return
+    count = 0
+    for j in range(m):
+        b = h[j]
+        for k in range(n):
+            b -= H[j, k] * z[k]
+        if b < worst[0]:
+            worst[0] = b
+        if b <= _D_SLACK:
+            dset[1 + count] = j
+            count += 1
+    dset[0] = count
+    zd[:] = z
 
 
 @njit(cache=True)
@@ -266,7 +345,10 @@ def _workspace(m, n):
     """The walk's work buffers, made once per walk (an allocation per pivot would cost as much
     as the pivot): (p, col, alpha) of n, (hp, slack) of m, an n x n basis copy and a 3 x n
     buffer for the breakpoints."""
-    return np.empty(n), np.empty(n), np.empty(n), np.empty(m), np.empty(m), np.empty((n, n)), np.empty((3, n))
+    dset = np.empty(m + 1, dtype=np.int64)  # [0]: count (-1: none yet), then the rows
+    dset[0] = -1
+    return (np.empty(n), np.empty(n), np.empty(n), np.empty(m), np.empty(m), np.empty((n, n)), np.empty((3, n)),
+            np.empty(n), dset)
 
 
 @njit(cache=True)
@@ -396,7 +478,7 @@ def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work):
         for r in range(n):
             p[r] = -Binv[r, leave] / norm
         active[W[leave]] = False
-        j, t = _ratio_test(H, h, z, p, active, work[3], work[4])
+        j, t = _ratio_test_near(H, h, z, p, active, work[3], work[4], work[7], work[8])
         if j < 0:
             return FAILED, pivots  # unbounded edge: the box is missing
         stalled = stalled + 1 if t == 0.0 else 0
@@ -469,6 +551,39 @@ def _breakpoint(Binv, GT, theta, cos_t, sin_t, scale, ab):
 
 
 @njit(cache=True)
+def _warm_start(H, h, W, Binv, z, active, work, hint):
+    """Start from the basis in ``hint`` when it is a feasible vertex basis here: ``hint`` =
+    (m, n, the n rows), written by the previous walk of the same caller (a governor's last
+    posture, whose optimal basis at theta0 is one or two pivots from this one's). Replaces
+    the crash, which costs n ratio tests over every row (~10 % of a walk on the governor's
+    postures). Any feasible vertex basis is a valid simplex start, so the walk's answer is
+    the same polygon (its vertices to rounding). Returns False otherwise, z back at 0 (the
+    crash's start: the caller tries only where 0 is feasible)."""
+    m, n = H.shape
+    if hint.shape[0] < n + 2 or hint[0] != m or hint[1] != n:
+        return False
+    for i in range(n):
+        W[i] = hint[2 + i]
+        if W[i] < 0 or W[i] >= m:
+            return False
+    # A singular basis (a row twice, say) can pass _invert's pivot test at condition 1e16:
+    # _accurate refuses its inverse, whose vertex is not the basis's.
+    if not (_refactor(H, h, W, Binv, z, work) and _accurate(H, h, W, Binv, z, work[2])):
+        z[:] = 0.0
+        return False
+    for j in range(m):  # feasible to the rounding of a fresh vertex, as the crash's are
+        b = h[j]
+        for k in range(n):
+            b -= H[j, k] * z[k]
+        if b < -_EPS_CARRY * max(1.0, abs(h[j])):
+            z[:] = 0.0
+            return False
+    for i in range(n):
+        active[W[i]] = True
+    return True
+
+
+@njit(cache=True)
 def _phase_one(H, h, z, W, active, max_pivots):
     """A feasible point of ``{H z <= h}`` into ``z`` (and, when the phase-1 optimum is a vertex
     basis of it, its rows into ``W[:k]``, flagged in ``active``). Returns (status, pivots, k).
@@ -513,13 +628,14 @@ def _phase_one(H, h, z, W, active, max_pivots):
 
 
 @njit(cache=True)
-def walk(H, h, GT, g0, theta0, max_pivots, worst):
+def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
     """Vertices of ``g0 + G {z : H z <= h}`` (rows of H unit norm; ``GT`` = G^T, n x 2).
 
     Returns (status, vertices, count, pivots): ``vertices[:count]`` are the support points
     in counter-clockwise order, consecutive duplicates removed (the last may equal the first).
     ``worst[0]`` receives the smallest slack of the recorded vertices (>= -rounding for a
-    sound walk; the caller rejects the walk otherwise).
+    sound walk; the caller rejects the walk otherwise). ``hint`` (int64): see :func:`_warm_start`;
+    an empty one is neither read nor written.
     """
     m, n = H.shape
     vertices = np.empty((0, 2))
@@ -535,13 +651,14 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst):
     u = np.array([math.cos(theta0), math.sin(theta0)])
     du = np.array([-math.sin(theta0), math.cos(theta0)])
     c, dc = _times(GT, u), _times(GT, du)
-    status, k = _crash(H, h, z, W, k, active, c, dc)
-    if status != OK:
-        return status, vertices, 0, pivots
     Binv = np.empty((n, n))
     work = _workspace(m, n)
-    if not _refactor(H, h, W, Binv, z, work):
-        return FAILED, vertices, 0, pivots
+    if not (k == 0 and h.min() >= 0.0 and _warm_start(H, h, W, Binv, z, active, work, hint)):
+        status, k = _crash(H, h, z, W, k, active, c, dc)
+        if status != OK:
+            return status, vertices, 0, pivots
+        if not _refactor(H, h, W, Binv, z, work):
+            return FAILED, vertices, 0, pivots
     scale = _norm(GT.ravel())  # sqrt(|G^T u|^2 + |G^T u'|^2), the same for every theta
     status, piv = _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work)
     pivots += piv
@@ -549,8 +666,11 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst):
         return status, vertices, 0, pivots
     if piv and not _accurate(H, h, W, Binv, z, work[2]) and not _refactor(H, h, W, Binv, z, work):
         return FAILED, vertices, 0, pivots
+    if hint.shape[0] >= n + 2:  # the optimal basis at theta0: the next call's start
+        hint[0], hint[1] = m, n
+        hint[2 : n + 2] = W
     vertices = np.empty((max_pivots + 2, 2))
-    _min_slack(H, h, z, worst)
+    _min_slack_near(H, h, z, worst, work[7], work[8])
     _point(g0, GT, z, vertices, 0)
     count = 1
     theta = theta0
@@ -566,7 +686,8 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst):
         # The inverse is carried across breakpoints by rank-one updates only while it still
         # solves its system to 1e-14 (checked after the pivots that changed it, below) and for
         # at most _CARRY pivots; then a fresh one (15 % less time on the governor's postures
-        # than one per breakpoint). Carried unchecked (a fresh one every 16 pivots), the walk
+        # than one per breakpoint at _CARRY = 4, 6 % less again at 8 on G1's walks; the check,
+        # not the count, is what guards the precision). Carried unchecked (a fresh one every 16 pivots), the walk
         # lost a vertex on an ill-conditioned stance (a hand at friction 1e8: area -0.3 %,
         # every vertex certified feasible and convex); checked to 1e-12 only, its area at foot
         # friction 1e6 was 1.2e-9 off Bretl's.
@@ -592,7 +713,7 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst):
         # is recorded too: on an ill-conditioned stance each basis gives it to within ~1e-8,
         # not to rounding, and the merge keeps the outermost (skipping them lost 5e-7 of the
         # area at a hand friction of 1.6e-6).
-        _min_slack(H, h, z, worst)
+        _min_slack_near(H, h, z, worst, work[7], work[8])
         _point(g0, GT, z, vertices, count)  # kept when it differs from the last one
         if abs(vertices[count, 0] - vertices[count - 1, 0]) + abs(vertices[count, 1] - vertices[count - 1, 1]) > 0.0:
             count += 1
@@ -600,7 +721,7 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst):
 
 
 @njit(cache=True)
-def project(A, b, E, x0, N, box, max_pivots):
+def project(A, b, E, x0, N, box, max_pivots, hint):
     """Projection of ``{x : A x <= b, x = x0 + N z}`` onto ``y = E x``, clipped to ``|y_k| <= box``.
 
     Drops zero rows of ``A N`` (checking them), scales the rows to unit norm, adds the box as
@@ -658,7 +779,7 @@ def project(A, b, E, x0, N, box, max_pivots):
             h[m + 1] = (box + g0[i]) / gk
             m += 2
     worst = np.zeros(1)
-    status, vertices, count, pivots = walk(H[:m].copy(), h[:m].copy(), G.T.copy(), g0, 0.0, max_pivots, worst)
+    status, vertices, count, pivots = walk(H[:m].copy(), h[:m].copy(), G.T.copy(), g0, 0.0, max_pivots, worst, hint)
     if status != OK:
         return status, none, pivots, worst[0]
     # The caller merges near-duplicate vertices and checks convexity (walk._certify, with the
@@ -716,7 +837,7 @@ def equality_basis(C, d):
 
 
 @njit(cache=True)
-def project_equalities(A, b, C, d, E, box, max_pivots):
+def project_equalities(A, b, C, d, E, box, max_pivots, hint):
     """:func:`project` of ``{x : A x <= b, C x = d}``, the equalities eliminated by
     :func:`equality_basis` in the same compiled call (a governor pays each call's dispatch
     every tick). Returns (status, vertices, pivots, worst, x0, N); status INCONSISTENT for
@@ -724,5 +845,5 @@ def project_equalities(A, b, C, d, E, box, max_pivots):
     status, x0, N = equality_basis(C, d)
     if status == INFEASIBLE:
         return INCONSISTENT, np.empty((0, 2)), 0, 0.0, x0, N
-    status, vertices, pivots, worst = project(A, b, E, x0, N, box, max_pivots)
+    status, vertices, pivots, worst = project(A, b, E, x0, N, box, max_pivots, hint)
     return status, vertices, pivots, worst, x0, N

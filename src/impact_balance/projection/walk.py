@@ -42,6 +42,8 @@ SLACK_TOLERANCE = 1e-7
 CHECK_MERGE = 1e-9
 #: Safety cap on the pivots of one walk.
 MAX_PIVOTS = 5000
+#: The kernel's warm-start hint when there is none (a one-off projection): never read or written.
+NO_HINT = np.zeros(0, dtype=np.int64)
 
 def project_walk(
     A: np.ndarray,
@@ -64,14 +66,14 @@ def project_walk(
     n = E.shape[1]
     A, C, b, d = _array(A, 2, n), _array(C, 2, n), _array(b, 1), _array(d, 1)
     status, vertices, bounded, pivots, x0, N = certified_walk(A, b, C, d, E, float(box), int(max_pivots),
-                                                              float(merge_tol), MERGE_AREA_TOLERANCE)
+                                                              float(merge_tol), MERGE_AREA_TOLERANCE, NO_HINT)
     if status == LINE:
         # Lines of the polytope are the null space of [A N; E N] (a line along which E x
         # changed would have met the box rows); keep z in its orthogonal complement.
         _, S, Vt = np.linalg.svd(np.vstack([A @ N, E @ N]))
         r = int(np.sum(S > RANK_TOLERANCE * max(float(S[0]) if S.size else 0.0, 1.0)))
         N = np.ascontiguousarray(N @ Vt[:r].T)
-        status, raw, more, worst = project(A, b, E, x0, N, float(box), int(max_pivots))
+        status, raw, more, worst = project(A, b, E, x0, N, float(box), int(max_pivots), NO_HINT)
         pivots += more
         status, vertices, bounded = _certify(status, raw, worst, b, float(merge_tol), MERGE_AREA_TOLERANCE, float(box))
     if status == INCONSISTENT:
@@ -116,16 +118,17 @@ def _certify(status, vertices, worst, b, merge_tol, area_tol, box):
 
 
 @njit(cache=True)
-def certified_walk(A, b, C, d, E, box, max_pivots, merge_tol, area_tol):
+def certified_walk(A, b, C, d, E, box, max_pivots, merge_tol, area_tol, hint):
     """The walk of :func:`project_walk` in one compiled call, its certificate and merge
     included (a governor pays each call's dispatch every tick).
 
     Returns ``(status, vertices, bounded, pivots, x0, N)`` with a kernel status: OK (the
     certified polygon), INFEASIBLE or INCONSISTENT (empty), FAILED (the walk cannot answer),
     LINE (the polytope holds a line: :func:`project_walk` quotients it out; ``x0 + N z``
-    spans the equalities).
+    spans the equalities). ``hint``: the kernel's warm start, kept by a caller that projects
+    postures in a row (:func:`~impact_balance.projection._kernel.walk`); :data:`NO_HINT` for none.
     """
-    status, raw, pivots, worst, x0, N = project_equalities(A, b, C, d, E, box, max_pivots)
+    status, raw, pivots, worst, x0, N = project_equalities(A, b, C, d, E, box, max_pivots, hint)
     if status == LINE or status == INCONSISTENT:
         return status, np.empty((0, 2)), True, pivots, x0, N
     status, vertices, bounded = _certify(status, raw, worst, b, merge_tol, area_tol, box)
