@@ -164,7 +164,7 @@ class Governor:
             # The worker's first answer (the scenario's posture, which loads its compiled code)
             # gives the first rates; then it keeps them fresh.
             self._worker = ContactAwareWorker(scenario, contact_aware_starts)
-            self._support.adopt(self._worker.warm_up(self._posture.q, None))
+            self._support.adopt(self._worker.warm_up(self._posture.q))
 
     def close(self) -> None:
         """Stop the contact-aware worker process, if any (``contact_aware_async``); the
@@ -315,7 +315,7 @@ class Governor:
                     else:
                         self._support.adopt(done)
                     if self._worker.idle:
-                        self._worker.submit(posture.key, posture.q, self._support.solutions)
+                        self._worker.submit(posture.key, posture.q)
                 self._support_posture = posture.key
             limit, aware = self._support.answers(criterion, com_velocity)
             interval = combine(criterion.interval(com_velocity, limit), aware.interval)

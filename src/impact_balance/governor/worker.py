@@ -4,7 +4,9 @@
 rates (:mod:`.support`, 3 to 170 ms per recomputation) are computed by a worker process while
 the governor keeps ticking with the last rates it received. Each tick the governor collects a
 finished answer if there is one (a pipe poll, microseconds) and, when the worker is idle, sends
-it the current posture with the solutions to continue from; the tick itself never waits. The
+it the current posture; the tick itself never waits. The worker continues from its own last
+answer, which is the one the governor uses (it adopts every answer it receives), so a request is
+the posture only: sending the solutions back cost 60 to 150 us on the ticks that sent one. The
 rates in use are therefore those of a posture one recomputation old (tens of ms: the age in
 postures is :attr:`~.support.ContactAwareAnswer.age`), where the synchronous option recomputes
 every 5th posture inside the tick.
@@ -37,8 +39,9 @@ START_TIMEOUT = 120.0
 
 
 def _serve(conn: Connection) -> None:
-    """The worker's loop: first ``(scenario dict, source, starts)``, then ``(key, q, kept)`` in
-    and ``(key, solutions, error)`` out; None or a closed pipe stops it."""
+    """The worker's loop: first ``(scenario dict, source, starts)``, then ``(key, q)`` in and
+    ``(key, solutions, error)`` out, each solve continuing the last answer; None or a closed
+    pipe stops it."""
     from ..scenario import scenario_from_dict
     from ..stance import Stance
 
@@ -52,6 +55,7 @@ def _serve(conn: Connection) -> None:
         conn.send(("ready", None, f"{type(exc).__name__}: {exc}"))
         return
     conn.send(("ready", None, None))
+    last: ContactAwareSolutions | None = None  # the answer the governor uses: the next start
     while True:
         try:
             message = conn.recv()
@@ -59,9 +63,10 @@ def _serve(conn: Connection) -> None:
             return
         if message is None:
             return
-        key, q, kept = message
+        key, q = message
         try:
-            conn.send((key, limit.solve(Stance(robot, np.asarray(q, dtype=float), contacts), kept), None))
+            last = limit.solve(Stance(robot, np.asarray(q, dtype=float), contacts), last)
+            conn.send((key, last, None))
         except Exception as exc:  # reported to the governor, which raises it on its next tick
             conn.send((key, None, f"{type(exc).__name__}: {exc}"))
 
@@ -118,11 +123,11 @@ class ContactAwareWorker:
             self.close()
             raise
 
-    def warm_up(self, q: np.ndarray, kept: ContactAwareSolutions | None) -> ContactAwareSolutions:
+    def warm_up(self, q: np.ndarray) -> ContactAwareSolutions:
         """Solve once at ``q`` and wait, returning the answer: the worker's first solve loads
         its compiled code (~150 ms), which the governor pays at construction (and takes as its
         first rates) rather than in its first ticks."""
-        self.submit(b"warm-up", q, kept)
+        self.submit(b"warm-up", q)
         solutions = self.wait(START_TIMEOUT)
         if solutions is None:
             self.close()
@@ -149,9 +154,9 @@ class ContactAwareWorker:
     def idle(self) -> bool:
         return not self._busy
 
-    def submit(self, key: bytes, q: np.ndarray, kept: ContactAwareSolutions | None) -> None:
-        """Ask for the rates at configuration ``q`` (nq), continuing ``kept``."""
-        self._conn.send((key, np.asarray(q), kept))
+    def submit(self, key: bytes, q: np.ndarray) -> None:
+        """Ask for the rates at configuration ``q`` (nq), continuing the worker's last answer."""
+        self._conn.send((key, np.asarray(q)))
         self._busy = True
         self.submitted = key
 
