@@ -190,3 +190,53 @@ def test_the_governor_loads_its_criterion_code_before_the_first_tick():
 
     Governor("palm_push_two_feet")
     assert criteria._com_exit.signatures and criteria._com_exits.signatures
+
+
+# A G1 posture of the wall study (reference 0.8 m/s, wall 17 cm, 1.9 s in) where the walk's
+# simplex cycles through 4 vertices with real steps (0.1 to 0.25) whose multipliers are within
+# the tolerance of zero: Bland's rule does not break it either, and the caller falls back to
+# Bretl. The walk used to run to its 5000-pivot cap first (3.3 ms of a 6 ms tick, 20 ms with
+# the first load of the fallback's compiled map).
+G1_CYCLE = [
+    -0.03219221031075935, -0.004988224506426797, 0.7698711775785513, 0.0013834443295910157, 0.01027549787989299,
+    0.012435679150228888, 0.9998689184634059, -0.2694202835015543, -0.006333308441799225, -0.024354110123499396,
+    0.52116030619674, -0.272377902516348, -0.007266514362196788, -0.2641335708155025, -0.007784604361771792,
+    -0.02374101418517601, 0.5300341586963578, -0.28650134785021475, -0.005560567783511484, -0.2635033715723783,
+    -0.08635030486376054, -0.09659816984866619, 0.12161047449464814, -0.02941163338840707, -0.013962263719116203,
+    0.029412333747104773, 1.1121955155513435e-06, 0.005638440126555487, -0.0011339678455517892, -0.2509309006211736,
+    -0.2224619002108893, 0.483773200814152, 0.09100599239609793, -1.155579025762308, 0.28504224799064953,
+    -1.5247268177348186,
+]
+
+
+def test_a_cycling_walk_gives_up_early_and_the_answer_is_bretls():
+    import impact_balance.areas as areas
+    from impact_balance import analyze
+    from impact_balance.areas import FORCE_BOX, MERGE_TOLERANCE
+    from impact_balance.projection.walk import MAX_PIVOTS, MERGE_AREA_TOLERANCE, certified_walk
+
+    governor = Governor("g1_two_feet")
+    q = np.array(G1_CYCLE)
+    refused = []
+    original = areas._projected
+
+    def spy(walked, data, *rest):
+        if walked[0] != K.OK:
+            refused.append(data)
+        return original(walked, data, *rest)
+
+    areas._projected = spy
+    try:
+        answer = governor.limit(q, np.zeros(governor.nv))
+    finally:
+        areas._projected = original
+    assert len(refused) == 1  # this posture's walk is refused (and no other projection's)
+    A, b, C, d, E = refused[0]
+    status, _, _, pivots, _, N = certified_walk(A, b, C, d, E, FORCE_BOX, MAX_PIVOTS, MERGE_TOLERANCE,
+                                                MERGE_AREA_TOLERANCE, NO_HINT)
+    assert status == K.FAILED
+    n, m = N.shape[1], A.shape[0] + 4  # the rows of A (some dropped as zero) and the box's 4
+    assert pivots <= 5 * (n + m) < MAX_PIVOTS
+    # The fallback's answer is analyze()'s for the same state (which falls back the same way).
+    reference = analyze(governor.scenario_at(q, answer.com_velocity))
+    assert answer.max_approach_speed == pytest.approx(reference.impact.max_contact_velocity, abs=1e-9)

@@ -213,6 +213,13 @@ def _projected(walked: tuple, data: tuple, com: np.ndarray, w: float, plane_heig
                      gravity, margin)
 
 
+def warm_up() -> None:
+    """Load the compiled map that the fallback path (a walk refused, Bretl's polygon mapped in
+    :func:`_projected`) calls from Python: numba loads a cached function on its first call
+    (12 ms in a G1 tick). A governor calls this when it is built."""
+    _maps(np.zeros((0, 2)), True, -1.0, 0.0, 0.0, 1.0, 0.0)
+
+
 @njit(cache=True)
 def _affine(v, scale, ox, oy):
     """:meth:`Polygon.affine`'s vertices ``v * scale + (ox, oy)``, the same numbers."""

@@ -10,6 +10,7 @@ from collections.abc import Sequence
 import numpy as np
 import pinocchio as pin
 
+from ..areas import warm_up as warm_up_maps
 from ..criteria import VelocityLimit
 from ..exceptions import GovernorError, ScenarioError
 from ..projection.bretl import warm_up as warm_up_bretl
@@ -152,6 +153,7 @@ class Governor:
         self._last: SpeedLimit | None = None
         warm_up()  # the projection kernel's one-time load, not in the first tick
         warm_up_bretl()  # the fallback's (HiGHS), so that a tick that falls back pays 5 ms, not 71
+        warm_up_maps()  # and the fallback's compiled map (12 ms on its first call)
         try:  # a check of the frames, the normal and the friction, at the scenario's posture
             self._posture = self._evaluator.evaluate(self.configuration)
         except ScenarioError as exc:

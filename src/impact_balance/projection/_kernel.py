@@ -444,8 +444,10 @@ def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work):
     while True:
         # Entering candidates: multipliers negative at theta+. Steepest edge (most negative
         # lambda_i / |Binv[:, i]|, the objective's rate along the unit edge direction), with
-        # the theta-derivative as a tie-break tier; Bland's rule once zero steps pile up.
-        bland = stalled > 2 * n
+        # the theta-derivative as a tie-break tier; Bland's rule once zero steps pile up, or
+        # pivots (a cycle of real steps through multipliers within the tolerance of zero: 4
+        # vertices in turn, steps of 0.1 to 0.25, on a G1 posture of the wall study).
+        bland = stalled > 2 * n or pivots > 2 * (n + H.shape[0])
         leave = -1
         tier = 2
         best = 0.0
@@ -472,7 +474,10 @@ def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work):
         if leave < 0:
             return OK, pivots
         pivots += 1
-        if pivots > max_pivots:
+        # A breakpoint takes a pivot or two; 4 (n + m) is a cycle that Bland's rule did not
+        # break either (that G1 posture: the walk ran to the 5000-pivot cap, 3.3 ms, before
+        # the caller fell back to Bretl; now 292 pivots).
+        if pivots > max_pivots or pivots > 4 * (n + H.shape[0]):
             return FAILED, pivots
         norm = _column_norm(Binv, leave)
         for r in range(n):
