@@ -109,6 +109,27 @@ def _point(g0, GT, z, out, i):
     out[i, 0], out[i, 1] = y0, y1
 
 
+@njit(cache=True, inline="always")
+def _step(H, h, z, p, j, hp, slack):
+    """Row j's step along ``p`` in the ratio test (inf if it does not block); its ``H_j p`` and
+    slack go to ``hp[j]`` and ``slack[j]``. Inlined by numba: called per row, as a function of
+    its own it made the walk 20 % slower."""
+    a = 0.0
+    b = h[j]
+    for k in range(H.shape[1]):
+        a += H[j, k] * p[k]
+        b -= H[j, k] * z[k]
+    hp[j] = a
+    slack[j] = b
+    return max(b, 0.0) / a if a > _EPS_PIVOT else math.inf
+
+
+@njit(cache=True, inline="always")
+def _ties(j, active, hp, slack, bound):
+    """Whether row j (its :func:`_step` made) blocks within ``bound``."""
+    return not active[j] and hp[j] > _EPS_PIVOT and max(slack[j], 0.0) / hp[j] <= bound
+
+
 @njit(cache=True)
 def _ratio_test(H, h, z, p, active, hp, slack):
     """Largest step along unit ``p`` that keeps ``H z <= h``: (row, step), row -1 if none.
@@ -116,27 +137,18 @@ def _ratio_test(H, h, z, p, active, hp, slack):
     Ties (within a relative 1e-12) go to the smallest row index (Bland). ``hp`` and ``slack``
     (m) are work buffers.
     """
-    m, n = H.shape
+    m = H.shape[0]
     best = math.inf
     for j in range(m):
-        if active[j]:
-            continue
-        a = 0.0
-        b = h[j]
-        for k in range(n):
-            a += H[j, k] * p[k]
-            b -= H[j, k] * z[k]
-        hp[j] = a
-        slack[j] = b
-        if a > _EPS_PIVOT:
-            t = max(b, 0.0) / a
+        if not active[j]:
+            t = _step(H, h, z, p, j, hp, slack)
             if t < best:
                 best = t
     if best == math.inf:
         return -1, 0.0
     bound = best + _EPS_TIE * (1.0 + best)
     for j in range(m):
-        if not active[j] and hp[j] > _EPS_PIVOT and max(slack[j], 0.0) / hp[j] <= bound:
+        if _ties(j, active, hp, slack, bound):
             return j, best
     return -1, 0.0  # unreachable
 
@@ -153,32 +165,22 @@ def _near(z, zd):
 
 @njit(cache=True)
 def _ratio_test_near(H, h, z, p, active, hp, slack, zd, dset):
-    """:func:`_ratio_test`, over the rows near z only when that gives its answer exactly."""
+    """:func:`_ratio_test`, over the rows listed near z (``dset``, at ``zd``) when that gives
+    its answer exactly: z still within _D_MOVE of ``zd`` and a step up to _D_STEP."""
     count = dset[0]
     if count >= 0 and _near(z, zd):
-        n = H.shape[1]
         best = math.inf
         for i in range(count):
             j = dset[1 + i]
-            if active[j]:
-                continue
-            a = 0.0
-            b = h[j]
-            for k in range(n):
-                a += H[j, k] * p[k]
-                b -= H[j, k] * z[k]
-            hp[j] = a
-            slack[j] = b
-            if a > _EPS_PIVOT:
-                t = max(b, 0.0) / a
+            if not active[j]:
+                t = _step(H, h, z, p, j, hp, slack)
                 if t < best:
                     best = t
         if best <= _D_STEP:
             bound = best + _EPS_TIE * (1.0 + best)
-            for i in range(count):
-                j = dset[1 + i]
-                if not active[j] and hp[j] > _EPS_PIVOT and max(slack[j], 0.0) / hp[j] <= bound:
-                    return j, best
+            for i in range(count):  # ascending rows: the first tie is the full scan's
+                if _ties(dset[1 + i], active, hp, slack, bound):
+                    return dset[1 + i], best
     return _ratio_test(H, h, z, p, active, hp, slack)
 
 
