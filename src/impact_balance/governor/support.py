@@ -259,7 +259,6 @@ class ContactAwareLimit:
         the rates are due)."""
         if self._solutions is None or self._count % self.every == 0:
             self.adopt(self._solve(stance_of(), self._solutions))
-            self._age = 0
         else:
             self._age += 1
         self._count += 1
