@@ -36,6 +36,13 @@ def _degenerate(rng, n: int, extra: int, far: int):
     return np.ascontiguousarray(H), H @ z + slack, z
 
 
+def _full_scan(H, h, z, worst):
+    """``_min_slack_near`` with nothing listed yet: the scan over every row."""
+    dset = np.empty(len(H) + 1, dtype=np.int64)
+    dset[0] = -1
+    K._min_slack_near(H, h, z, worst, np.empty(H.shape[1]), dset)
+
+
 @settings(max_examples=200, deadline=None)
 @given(st.integers(min_value=2, max_value=9), st.integers(min_value=0, max_value=12),
        st.integers(min_value=1, max_value=60), st.integers(min_value=0, max_value=2**32 - 1))
@@ -48,14 +55,14 @@ def test_near_scans_give_the_full_scans_numbers(n, extra, far, seed):
     dset[0] = -1
     listed, full = np.zeros(1), np.zeros(1)
     K._min_slack_near(H, h, z, listed, zd, dset)  # lists the rows near z
-    K._min_slack(H, h, z, full)
+    _full_scan(H, h, z, full)
     assert listed[0] == full[0]
     assert n + extra <= dset[0] <= m  # the rows through z, and far ones within _D_SLACK
     # Within _D_MOVE of where the rows were listed (a zero step's rounding): the same numbers.
     moved = z + rng.normal(size=n) * (0.5 * K._D_MOVE / np.sqrt(n))
     listed[0] = full[0] = 0.0
     K._min_slack_near(H, h, moved, listed, zd, dset)
-    K._min_slack(H, h, moved, full)
+    _full_scan(H, h, moved, full)
     assert listed[0] == full[0]
     active = np.zeros(m, dtype=np.bool_)
     active[rng.permutation(m)[: rng.integers(0, n)]] = True
@@ -177,6 +184,14 @@ def test_warm_start_takes_a_feasible_vertex_basis_only():
             assert sorted(np.flatnonzero(active)) == sorted(rows)
         else:
             assert not active.any() and not z.any()  # the crash starts from 0 as before
+
+
+@pytest.mark.parametrize("hint", [[-1] * 14, np.zeros(14), np.zeros((2, 7), dtype=np.int64)])
+def test_a_hint_of_the_wrong_kind_is_a_clear_error(g1_path, hint):
+    governor, postures = g1_path
+    args = _capture(governor, postures[:1])[0]
+    with pytest.raises(ValueError, match="hint must be a writable 1-D int64 numpy array"):
+        projected_from_arrays(*args, hint)
 
 
 def test_one_off_projections_take_no_hint():

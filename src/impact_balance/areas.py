@@ -152,6 +152,11 @@ def projected_from_arrays(
     postures in a row (a governor) keeps it between calls and saves the walk's crash start;
     the polygon is the same either way (to rounding).
     """
+    if hint is None:
+        hint = NO_HINT
+    elif not (isinstance(hint, np.ndarray) and hint.dtype == np.int64 and hint.ndim == 1 and hint.flags.writeable):
+        raise ValueError(f"hint must be a writable 1-D int64 numpy array, not {type(hint).__name__} "
+                         f"{getattr(hint, 'dtype', '')}".rstrip())
     w = omega(float(com[2]), plane_height, gravity)
     depth = plane_height - float(com[2])
     positions, arms, jacobians, torque_limits, gravity_torques = (
@@ -159,7 +164,7 @@ def projected_from_arrays(
     out = _assembled_areas(face_blocks(faces, rotations), positions, arms, jacobians,
                            np.ascontiguousarray(torque_indices, dtype=np.int64), torque_limits, gravity_torques,
                            mass * gravity, FORCE_BOX, MAX_PIVOTS, MERGE_TOLERANCE, MERGE_AREA_TOLERANCE, depth,
-                           float(com[0]), float(com[1]), w, float(zmp_margin), NO_HINT if hint is None else hint)
+                           float(com[0]), float(com[1]), w, float(zmp_margin), hint)
     return _projected(out[5:], out[:5], com, w, plane_height, mass, gravity, float(zmp_margin))
 
 

@@ -222,15 +222,6 @@ class ContactAwareLimit:
         self._age = 0
         self._count = 0
 
-    @property
-    def solutions(self) -> ContactAwareSolutions | None:
-        """The solutions in use (None before the first posture)."""
-        return self._solutions
-
-    @property
-    def _rates(self) -> np.ndarray | None:
-        return None if self._solutions is None else self._solutions.rates
-
     def _solve(self, stance: Stance, kept: ContactAwareSolutions | None) -> ContactAwareSolutions:
         """The rates at ``stance`` from the option's starts, continuing ``kept``."""
         if self.starts == "union":

@@ -13,8 +13,9 @@ every 5th posture inside the tick.
 
 The worker runs at the lowest scheduling priority (nice 19: it computes on a core the control
 loop leaves free, and its wake-up never preempts the loop), builds its own robot from the
-scenario once and answers until the governor closes it (:meth:`Governor.close`, the end of a ``with`` block, or the governor's collection). POSIX
-only (the worker inherits one end of a socket pair).
+scenario once and answers until the governor closes it (:meth:`Governor.close`, the end of a
+``with`` block, or the governor's collection). POSIX only (the worker inherits one end of a
+socket pair).
 """
 
 from __future__ import annotations

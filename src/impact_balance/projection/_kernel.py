@@ -186,8 +186,10 @@ def _ratio_test_near(H, h, z, p, active, hp, slack, zd, dset):
 
 @njit(cache=True)
 def _min_slack_near(H, h, z, worst, zd, dset):
-    """:func:`_min_slack`, over the rows near z when z is within _D_MOVE of where they were
-    listed (the others' slacks are positive there); else over every row, listing them again."""
+    """``worst[0]`` = min(worst[0], min_j h_j - H_j z) (``worst[0]`` <= 0): a vertex's
+    feasibility check. Over the rows listed near z (``dset``) when z is within _D_MOVE of where
+    they were listed (``zd``: the others' slacks are positive there); else over every row,
+    listing them again at z."""
     m, n = H.shape
     count = dset[0]
     if count >= 0 and _near(z, zd):
@@ -496,17 +498,6 @@ def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work):
             return FAILED, pivots
         active[j] = True
         since = _pivot(H, h, W, Binv, z, leave, j, since, work)
-
-
-@njit(cache=True)
-def _min_slack(H, h, z, worst):
-    """``worst[0]`` = min(worst[0], min_j h_j - H_j z): a vertex's feasibility check."""
-    for j in range(H.shape[0]):
-        b = h[j]
-        for k in range(H.shape[1]):
-            b -= H[j, k] * z[k]
-        if b < worst[0]:
-            worst[0] = b
 
 
 @njit(cache=True)
