@@ -22,11 +22,11 @@ from pathlib import Path
 
 import numpy as np
 
-from impact_balance.sim.balance_trial import (TRIAL_VERSION, BalanceSetup, BalanceTrialOptions, Push,
+from impact_balance.sim.trials.balance_trial import (TRIAL_VERSION, BalanceSetup, BalanceTrialOptions, Push,
                                               controller_margin, run_balance_trial)
-from impact_balance.sim.journal import TrialJournal, journal_digest
-from impact_balance.sim.push import push_test
-from impact_balance.sim.validate import validate
+from impact_balance.sim.studies.journal import TrialJournal, journal_digest
+from impact_balance.sim.studies.push import push_test
+from impact_balance.sim.studies.validate import validate
 
 IMPACT_SCENARIOS = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot", "g1_two_feet", "talos_three_contacts",
                     "talos_side_slope")

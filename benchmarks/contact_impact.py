@@ -1,4 +1,4 @@
-"""The contact-aware impact model (``impact_balance.contact_impact``) against MuJoCo.
+"""The contact-aware impact model (``impact_balance.impact.contact_aware``) against MuJoCo.
 
     python benchmarks/contact_impact.py [--speeds 0.25,0.5,0.75] [--out rows.jsonl] [--resume]
                                         [--scenarios NAME ...]
@@ -6,7 +6,7 @@
 For every bundled scenario with an impact and every commanded approach speed: one ``servo``
 trial with ``--rigid-impact`` (every joint keeps its velocity from the contact to the end of the
 compression: the composite model's robot, standing on its contacts), measured by
-``impact_balance.sim.measure`` (the trial ``impact-balance simulate SCENARIO --joints servo
+``impact_balance.sim.trials.measure`` (the trial ``impact-balance simulate SCENARIO --joints servo
 --rigid-impact`` runs). Reported per row:
 
 - the measured CoM velocity jump (xy) and the impulse the sustained contacts took (force before
@@ -36,13 +36,13 @@ from pathlib import Path
 
 import numpy as np
 
-from impact_balance.contact_impact import contact_impact
-from impact_balance.criteria import max_contact_velocity
+from impact_balance.impact.contact_aware import contact_impact
+from impact_balance.criteria.com import max_contact_velocity
 from impact_balance.scenario import bundled_scenarios, load_scenario
 from impact_balance.sim import SimOptions, build_model
-from impact_balance.sim.measure import measure
-from impact_balance.sim.trial import TrialOptions, run_trial
-from impact_balance.stance import Stance
+from impact_balance.sim.trials.measure import measure
+from impact_balance.sim.trials.impact_trial import TrialOptions, run_trial
+from impact_balance.contacts.stance import Stance
 
 
 def impact_scenarios() -> list[str]:

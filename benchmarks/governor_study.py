@@ -24,9 +24,9 @@ import numpy as np
 
 from impact_balance.governor import Governor
 from impact_balance.scenario import load_scenario
-from impact_balance.sim.balance_trial import TRIAL_VERSION, BalanceSetup, BalanceTrialOptions, controller_margin
-from impact_balance.sim.journal import TrialJournal, journal_digest
-from impact_balance.sim.wall import APPROACH_VERSION, WallOptions, run_wall_trial
+from impact_balance.sim.trials.balance_trial import TRIAL_VERSION, BalanceSetup, BalanceTrialOptions, controller_margin
+from impact_balance.sim.studies.journal import TrialJournal, journal_digest
+from impact_balance.sim.studies.wall import APPROACH_VERSION, WallOptions, run_wall_trial
 
 SCENARIOS = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot", "g1_two_feet")
 

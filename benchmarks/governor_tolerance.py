@@ -23,7 +23,7 @@ import numpy as np
 
 from governor_study import SCENARIOS, governed_setup
 from impact_balance.governor import Governor
-from impact_balance.sim.wall import WallOptions, run_wall_trial
+from impact_balance.sim.studies.wall import WallOptions, run_wall_trial
 
 
 class _Paired:

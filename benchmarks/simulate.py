@@ -31,8 +31,8 @@ import numpy as np
 
 from impact_balance.scenario import bundled_scenarios, load_scenario
 from impact_balance.sim import ServoOptions, SimOptions, build_model
-from impact_balance.sim.measure import measure
-from impact_balance.sim.trial import TrialOptions, run_trial
+from impact_balance.sim.trials.measure import measure
+from impact_balance.sim.trials.impact_trial import TrialOptions, run_trial
 
 
 def impact_scenarios() -> list[str]:

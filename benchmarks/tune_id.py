@@ -21,9 +21,9 @@ import os
 import sys
 import time
 
-from impact_balance.sim.balance_trial import BalanceSetup, BalanceTrialOptions
-from impact_balance.sim.inverse_dynamics import InverseDynamicsGains
-from impact_balance.sim.push import push_test
+from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions
+from impact_balance.sim.control.torque import InverseDynamicsGains
+from impact_balance.sim.studies.push import push_test
 
 MARGINS = (0.0, 0.005, 0.01)
 

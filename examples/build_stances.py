@@ -5,7 +5,7 @@ Run from the repository root:
     PYTHONPATH=src python examples/build_stances.py            # every stance
     PYTHONPATH=src python examples/build_stances.py palm_push_ramp
 
-For each stance it solves whole-body inverse kinematics with :mod:`impact_balance.ik`
+For each stance it solves whole-body inverse kinematics with :mod:`impact_balance.robot.ik`
 (pink, daqp) and prints a YAML snippet (``base`` and the ``joints`` that differ from the
 scenario's reference configuration) to paste into ``src/impact_balance/scenarios/<name>.yaml``.
 The output is deterministic: same library versions, same numbers. Values are rounded to
@@ -25,8 +25,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from impact_balance.ik import solve_stance, stance_residuals
-from impact_balance.robot import Robot, load_robot
+from impact_balance.robot.ik import solve_stance, stance_residuals
+from impact_balance.robot.robot import Robot, load_robot
 from impact_balance.scenario import scenario_from_dict
 
 DIGITS = 6

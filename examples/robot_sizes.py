@@ -5,7 +5,7 @@ Run from the repository root:
     PYTHONPATH=src python examples/robot_sizes.py
 
 For each robot it reads the URDF's collision and visual geometry with pinocchio, the mesh files with
-:func:`impact_balance.mesh_files.read_mesh`, and expresses every vertex of the links that move
+:func:`impact_balance.robot.meshes.read_mesh`, and expresses every vertex of the links that move
 with the foot (or hand) frame in that frame, at the robot's standing configuration:
 
 - sole: the vertices within 5 mm of the lowest one (along the frame's z axis) form the
@@ -19,8 +19,8 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from impact_balance.mesh_files import read_mesh
-from impact_balance.robot import BUNDLED_ROBOTS, load_robot
+from impact_balance.robot.meshes import read_mesh
+from impact_balance.robot.robot import BUNDLED_ROBOTS, load_robot
 
 #: (sole frame, hand frame) of each bundled robot (left side; the right side is symmetric).
 FRAMES = {

@@ -14,7 +14,7 @@ GRAVITY = 9.81  # CONVENTIONS.md: g = 9.81 m/s^2 along -z
 
 def _make_contact(position, rotation=None, friction=0.7, size=(0.2, 0.1)):
     """A synthetic contact (no robot): only spec, rotation and position matter."""
-    from impact_balance.stance import Contact, ContactSpec
+    from impact_balance.contacts.stance import Contact, ContactSpec
 
     rotation = np.eye(3) if rotation is None else np.asarray(rotation, dtype=float)
     return Contact(
@@ -120,8 +120,8 @@ def make_contact():
 @pytest.fixture(scope="session")
 def talos_stance():
     """Talos half_sitting on both soles (mu 0.7, 0.2 x 0.1 m), the README's standard stance."""
-    from impact_balance.robot import load_robot
-    from impact_balance.stance import ContactSpec, Stance
+    from impact_balance.robot.robot import load_robot
+    from impact_balance.contacts.stance import ContactSpec, Stance
 
     robot = load_robot("talos")
     return Stance(
@@ -136,7 +136,7 @@ def _trial_journals_in_tmp(tmp_path, monkeypatch):
     """The simulation commands' default journals (``impact-balance-trials/`` in the current
     directory) go to the test's own folder, not into the source tree."""
     try:
-        from impact_balance.sim import journal
+        from impact_balance.sim.studies import journal
     except ImportError:  # no sim extra: nothing writes journals
         return
     monkeypatch.setattr(journal, "JOURNAL_FOLDER", str(tmp_path / "impact-balance-trials"))

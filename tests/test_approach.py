@@ -39,8 +39,8 @@ def test_the_id_controller_holds_the_point_under_a_falling_cap():
     QP the point hits at the cap in force (to the next tick's change of it), where the reference
     alone lets the torque controller's lag carry it past."""
     from impact_balance.governor import Governor
-    from impact_balance.sim.balance_trial import BalanceSetup, BalanceTrialOptions, controller_margin
-    from impact_balance.sim.wall import WallOptions, run_wall_trial
+    from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions, controller_margin
+    from impact_balance.sim.studies.wall import WallOptions, run_wall_trial
 
     options = BalanceTrialOptions(controller="id", rigid_impact=True)
     scenario = load_scenario("palm_push_ramp")
@@ -92,7 +92,7 @@ def test_a_video_loads_the_robots_meshes_and_picks_egl_first(monkeypatch, tmp_pa
     """The video's robot is drawn from its meshes (visual only), and MuJoCo's offscreen backend is
     chosen before anything imports MuJoCo (``MUJOCO_GL`` left as the user set it)."""
     from impact_balance.exceptions import SimulationError
-    from impact_balance.sim.trial_setup import BalanceSetup
+    from impact_balance.sim.trials.setup import BalanceSetup
 
     seen = {}
 
@@ -110,7 +110,7 @@ def test_a_video_loads_the_robots_meshes_and_picks_egl_first(monkeypatch, tmp_pa
 
 
 def test_meshes_are_visual_only():
-    from impact_balance.sim.trial_setup import BalanceSetup
+    from impact_balance.sim.trials.setup import BalanceSetup
 
     bare = BalanceSetup.create("kick_one_foot")
     drawn = BalanceSetup.create("kick_one_foot", meshes=True)

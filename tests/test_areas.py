@@ -19,8 +19,8 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from scipy.optimize import linprog
 
-from impact_balance.areas import MERGE_TOLERANCE, areas_from_polytope, balance_areas
-from impact_balance.constraints import contact_polytope, torque_limit_rows, wrench_polytope
+from impact_balance.balance.areas import MERGE_TOLERANCE, areas_from_polytope, balance_areas
+from impact_balance.contacts.wrench_polytope import contact_polytope, torque_limit_rows, wrench_polytope
 from impact_balance.exceptions import ScenarioError
 from impact_balance.projection import project_polytope
 from impact_balance.scenario import bundled_scenarios, load_scenario
@@ -213,12 +213,12 @@ def test_tighter_torque_limits_are_nested_and_empty_iff_infeasible(geo, talos_st
 
 
 def _independent_talos_polytope(stance, scale):
-    """Talos wrench polytope rebuilt without impact_balance.constraints: joint torques from
+    """Talos wrench polytope rebuilt without impact_balance.contacts.wrench_polytope: joint torques from
     pinocchio's RNEA with the contact wrenches as external forces, LIPM rows by hand.
     Returns (A, b, C, d, F) in units of m g."""
     import pinocchio as pin
 
-    from impact_balance.cwc import cwc_faces_world
+    from impact_balance.contacts.cwc import cwc_faces_world
 
     model = stance.robot.model
     data = model.createData()
@@ -461,8 +461,8 @@ def test_single_level_contact_matches_statics(geo, make_contact, u, v, cz, mu, y
 def test_compiled_maps_give_the_polygon_methods_numbers(points, depth, cx, cy, w, margin, bounded):
     """The compiled areas pipeline's maps (``areas._maps``) are Polygon.affine and
     Polygon.inset, number for number: the governor and analyze() read the same areas."""
-    from impact_balance.areas import _maps
-    from impact_balance.polygon import Polygon
+    from impact_balance.balance.areas import _maps
+    from impact_balance.geometry.polygon import Polygon
 
     force = Polygon(Polygon.from_points(np.array(points)).vertices, bounded)
     zmp, zmp_bounded, vel, vel_bounded = _maps(np.ascontiguousarray(force.vertices), bounded, depth, cx, cy, w, margin)
@@ -484,7 +484,7 @@ def test_compiled_maps_give_the_polygon_methods_numbers(points, depth, cx, cy, w
 def test_velocity_area_halfplanes_from_the_compiled_pipeline_are_the_polygons_own(name, margin):
     """The CoM velocity area comes with the half-planes the compiled pipeline computed; they
     are the ones the polygon computes itself from its vertices."""
-    from impact_balance.polygon import Polygon
+    from impact_balance.geometry.polygon import Polygon
 
     scenario = load_scenario(name)
     stance = scenario.build_stance()
@@ -501,8 +501,8 @@ def test_velocity_area_halfplanes_from_the_compiled_pipeline_are_the_polygons_ow
 def test_areas_from_arrays_is_areas_from_polytope_number_for_number(name, margin):
     """The governor's one-call path (assembly and projection in one compiled call) gives the
     areas analyze() gets from the assembled polytope, exactly; plain lists are accepted."""
-    from impact_balance.areas import areas_from_arrays
-    from impact_balance.cwc import _local_faces
+    from impact_balance.balance.areas import areas_from_arrays
+    from impact_balance.contacts.cwc import _local_faces
 
     scenario = load_scenario(name)
     stance = scenario.build_stance()

@@ -19,7 +19,7 @@ import pytest
 import yaml
 
 from impact_balance import cli
-from impact_balance.analysis import analyze
+from impact_balance.analysis.analyze import analyze
 from impact_balance.exceptions import (
     ScenarioError,
     UnknownConfigurationError,

@@ -7,11 +7,11 @@ import pinocchio as pin
 import pytest
 
 import impact_balance as ib
-from impact_balance.polygon import Polygon
-from impact_balance.sim.approach import ImpactTask
-from impact_balance.sim.balance import BalanceController, retracted_stance
-from impact_balance.sim.outcomes import OutcomeCriteria, OutcomeMonitor
-from impact_balance.sim.zmp import DcmFeedback, clamp_to_polygon, dcm
+from impact_balance.geometry.polygon import Polygon
+from impact_balance.sim.control.approach import ImpactTask
+from impact_balance.sim.control.kinematic import BalanceController, retracted_stance
+from impact_balance.sim.trials.outcomes import OutcomeCriteria, OutcomeMonitor
+from impact_balance.sim.control.zmp import DcmFeedback, clamp_to_polygon, dcm
 
 SQUARE = Polygon(np.array([[-0.1, -0.05], [0.1, -0.05], [0.1, 0.05], [-0.1, 0.05]]))
 

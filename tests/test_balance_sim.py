@@ -9,8 +9,8 @@ import pytest
 
 from impact_balance.cli import main
 from impact_balance.logs import check_log, read_log, write_log
-from impact_balance.sim.balance_trial import BalanceSetup, BalanceTrialOptions, Push, run_balance_trial
-from impact_balance.sim.validate import validate
+from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions, Push, run_balance_trial
+from impact_balance.sim.studies.validate import validate
 
 SCENARIO = "palm_push_two_feet"
 
@@ -48,7 +48,7 @@ def test_large_push_falls_and_the_com_criterion_saw_it(setup):
 
 def test_validate_brackets_the_threshold_in_measured_speed(tmp_path):
     """The paper's robot at the impact (joints held) with the torque controller: a bracket near the prediction."""
-    from impact_balance.sim.journal import TrialJournal
+    from impact_balance.sim.studies.journal import TrialJournal
 
     options = BalanceTrialOptions(after=1.0, controller="id", rigid_impact=True)
     setup = BalanceSetup.create(SCENARIO, options=options)

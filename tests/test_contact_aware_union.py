@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import impact_balance as ib
-from impact_balance.contact_impact import contact_impact
+from impact_balance.impact.contact_aware import contact_impact
 from impact_balance.exceptions import GovernorError
 from impact_balance.governor import Governor
 from impact_balance.governor.support import (SAME_SOLUTION, ContactAwareLimit, contact_aware_rates,
@@ -32,7 +32,7 @@ def path():
     interpolation) from the 15 cm start posture to the scenario's, each evaluated once."""
     import pinocchio as pin
 
-    from impact_balance.sim.balance import retracted_stance
+    from impact_balance.sim.control.kinematic import retracted_stance
 
     analysis = ib.analyze(NAME)
     governor = Governor(NAME)

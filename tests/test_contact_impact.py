@@ -10,13 +10,13 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from impact_balance.contact_impact import contact_impact, corner_contacts
+from impact_balance.impact.contact_aware import contact_impact, corner_contacts
 from impact_balance.exceptions import ImpactModelError
-from impact_balance.impact import ImpactSpec, impact_model
-from impact_balance.robot import Robot
-from impact_balance.sim.measure import distance_to_hull
-from impact_balance.spatial import skew
-from impact_balance.stance import ContactSpec, Stance
+from impact_balance.impact.model import ImpactSpec, impact_model
+from impact_balance.robot.robot import Robot
+from impact_balance.sim.trials.measure import distance_to_hull
+from impact_balance.geometry.spatial import skew
+from impact_balance.contacts.stance import ContactSpec, Stance
 
 MASS = 10.0
 LENGTH, WIDTH, HEIGHT = 0.4, 0.3, 1.0  # box extents along x, y, z, m

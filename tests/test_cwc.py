@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 from scipy.optimize import linprog, nnls
 from scipy.spatial.transform import Rotation
 
-from impact_balance.cwc import cwc_faces, cwc_faces_world, cwc_span, rotate_wrench_matrix
+from impact_balance.contacts.cwc import cwc_faces, cwc_faces_world, cwc_span, rotate_wrench_matrix
 
 MU = st.floats(0.1, 1.5)
 HALF = st.floats(0.01, 0.3)

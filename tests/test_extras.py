@@ -162,7 +162,7 @@ def test_one_shot_analyze_is_interpreted_and_answers_as_the_compiled_kernel():
     assert r.returncode == 0, r.stderr
     interpreted = json.loads(r.stdout)
     from impact_balance import _jit
-    from impact_balance.analysis import analyze
+    from impact_balance.analysis.analyze import analyze
 
     assert _jit.HAVE_NUMBA  # this process compiles
     compiled = analyze("talos_three_contacts").to_dict()
@@ -209,7 +209,7 @@ def test_compiled_pipeline_cache_is_stamped_with_the_modules_it_embeds(tmp_path)
 
     if not HAVE_NUMBA:
         pytest.skip("numba turned off")
-    from impact_balance import areas
+    from impact_balance.balance import areas
 
     cache_file = getattr(getattr(areas._walk_areas, "_cache", None), "_cache_file", None)
     if cache_file is None:

@@ -9,7 +9,7 @@ import pytest
 
 import impact_balance as ib
 from impact_balance.cli import main
-from impact_balance.criteria import safe_contact_velocity
+from impact_balance.criteria.com import safe_contact_velocity
 
 
 @pytest.fixture

@@ -21,7 +21,7 @@ from impact_balance.plots import (
     plot_stance,
     save_figures,
 )
-from impact_balance.robot import example_robot_data_root
+from impact_balance.robot.robot import example_robot_data_root
 
 SCENARIOS = ["palm_push_ramp", "kick_one_foot", "talos_three_contacts", "g1_two_feet", "palm_push_two_feet"]
 SIMPLE = example_robot_data_root() / "simple_humanoid_description"
@@ -132,7 +132,7 @@ def test_phase_portrait(analyses, name, tmp_path):
 
 
 def test_phase_portrait_paper_gravity():
-    from impact_balance.lipm import phase_portrait
+    from impact_balance.balance.lipm import phase_portrait
 
     fig = plot_phase_portrait(phase_portrait(0.78, (-0.13, 0.13), 9.8))
     assert_layout(fig)
@@ -159,8 +159,8 @@ def test_friction_comparison():
 def trials():
     pytest.importorskip("mujoco")
     from impact_balance.sim import build_model
-    from impact_balance.sim.measure import measure
-    from impact_balance.sim.trial import TrialOptions, run_trial
+    from impact_balance.sim.trials.measure import measure
+    from impact_balance.sim.trials.impact_trial import TrialOptions, run_trial
 
     out = {}
     for joints in ("rigid", "servo"):
@@ -207,7 +207,7 @@ def test_video_frame(trials, tmp_path):
     import subprocess
     import sys
 
-    from impact_balance.sim.video import frame_caption
+    from impact_balance.sim.trials.video import frame_caption
 
     lines = frame_caption(0.103, 0.1, 10.0, True)
     assert lines[0].startswith("t =") and "+3.0 ms" in lines[0]
@@ -231,8 +231,8 @@ def test_video_frame(trials, tmp_path):
 _PROJECTION_SCRIPT = """
 import mujoco, numpy as np
 from impact_balance.sim import build_model
-from impact_balance.sim.trial import TrialOptions, run_trial
-from impact_balance.sim.video import project
+from impact_balance.sim.trials.impact_trial import TrialOptions, run_trial
+from impact_balance.sim.trials.video import project
 sim = build_model("kick_one_foot", "rigid")
 record = run_trial(sim, TrialOptions(0.5, after=0.01))
 renderer = mujoco.Renderer(sim.model, 240, 320)
@@ -330,9 +330,9 @@ def balance_results():
     from types import SimpleNamespace
 
     from impact_balance.scenario import load_scenario
-    from impact_balance.sim.balance_trial import Push
-    from impact_balance.sim.push import PushOutcome, PushTestResult, boundary_impulse, predict_push
-    from impact_balance.sim.validate import ValidationResult, ValidationTrial, predictions
+    from impact_balance.sim.trials.balance_trial import Push
+    from impact_balance.sim.studies.push import PushOutcome, PushTestResult, boundary_impulse, predict_push
+    from impact_balance.sim.studies.validate import ValidationResult, ValidationTrial, predictions
 
     analysis = ib.analyze("palm_push_ramp")
     scenario = load_scenario("palm_push_ramp")

@@ -4,7 +4,7 @@ The contract is the command line's: for any input, either the command's answer (
 or one line ``...: error: ...`` with exit status 2 (1 for a failure of the machine), never a
 traceback (an exception escaping ``cli.main`` fails the test), never a hang. The simulation
 commands are driven with their simulators replaced by a sentinel: an option that passes the
-checks must lie within the documented limits (:mod:`impact_balance.numeric_limits`).
+checks must lie within the documented limits (:mod:`impact_balance.ranges`).
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from hypothesis import strategies as st
 
 from impact_balance import cli
 from impact_balance.exceptions import MESSAGE_CHARS
-from impact_balance.numeric_limits import MAX_APPROACH_SPEED, MIN_APPROACH_SPEED, TOLERANCE_RANGE
+from impact_balance.ranges import MAX_APPROACH_SPEED, MIN_APPROACH_SPEED, TOLERANCE_RANGE
 
 sys.path.insert(0, str(Path(__file__).parent))
 from test_fuzz_scenarios import HOSTILE_NUMBERS, _apply, _paths, values  # noqa: E402
@@ -151,8 +151,8 @@ class Simulated(Exception):
 
 
 def _patched():
-    import impact_balance.sim.balance_trial as balance_trial
-    import impact_balance.sim.trial as trial
+    import impact_balance.sim.trials.balance_trial as balance_trial
+    import impact_balance.sim.trials.impact_trial as trial
 
     def sentinel(*args, **kwargs):
         raise Simulated

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import impact_balance as ib
-from impact_balance.contact_impact import contact_impact
+from impact_balance.impact.contact_aware import contact_impact
 from impact_balance.exceptions import GovernorError
 from impact_balance.governor import Governor
 from impact_balance.governor.support import combine

@@ -22,7 +22,7 @@ import pytest
 import yaml
 
 from impact_balance import cli
-from impact_balance.analysis import analyze
+from impact_balance.analysis.analyze import analyze
 from impact_balance.exceptions import ScenarioError
 from impact_balance.gui import (
     DEFAULT_SCENARIO,
@@ -40,7 +40,7 @@ from impact_balance.gui import (
     svg_view,
 )
 from impact_balance.gui.scene import CONE_LENGTH, PLANE_LIFT
-from impact_balance.robot import example_robot_data_root, load_robot
+from impact_balance.robot.robot import example_robot_data_root, load_robot
 from impact_balance.scenario import load_scenario
 
 TOL = 1e-9

@@ -27,9 +27,9 @@ from impact_balance.exceptions import WorkspaceError
 from impact_balance.gui import DEFAULT_SCENARIO, GuiState, Session
 from impact_balance.gui.files import GuiFiles, describe
 from impact_balance.gui.guard import AccessPolicy, OriginError, guarded_start, normalize_origin
-from impact_balance.robot import example_robot_data_root
+from impact_balance.robot.robot import example_robot_data_root
 from impact_balance.scenario import load_scenario
-from impact_balance.workspace import MAX_FILE_BYTES, Workspace
+from impact_balance.gui.workspace import MAX_FILE_BYTES, Workspace
 
 SECRET = "hunter2-very-secret-token"
 

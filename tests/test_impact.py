@@ -10,9 +10,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import impact_balance as ib
-from impact_balance.criteria import capped_velocity, max_contact_velocity
-from impact_balance.impact import cone_tangents, friction_cone, impact_model
-from impact_balance.qp import QPOptions, solve_contact_velocity_qp
+from impact_balance.criteria.com import capped_velocity, max_contact_velocity
+from impact_balance.impact.model import cone_tangents, friction_cone, impact_model
+from impact_balance.criteria.qp import QPOptions, solve_contact_velocity_qp
 
 BUNDLED_IMPACTS = ["palm_push_two_feet", "palm_push_ramp", "kick_one_foot", "talos_three_contacts", "g1_two_feet"]
 
@@ -67,8 +67,8 @@ def test_composite_W_is_the_rigid_body_response(analyses):
 def test_composite_W_matches_lapack():
     """W's compiled 3 x 3 Cholesky solve agrees with LAPACK's; an inertia that is not positive
     definite goes to LAPACK (which refuses a singular one)."""
-    from impact_balance.impact import composite_inertia_map
-    from impact_balance.spatial import skew
+    from impact_balance.impact.model import composite_inertia_map
+    from impact_balance.geometry.spatial import skew
 
     rng = np.random.default_rng(3)
     for _ in range(200):

@@ -15,10 +15,10 @@ import pinocchio as pin
 import pytest
 
 import impact_balance as ib
-from impact_balance.areas import balance_areas
-from impact_balance.infeasibility import explain_cannot_balance
-from impact_balance.robot import example_robot_data_root
-from impact_balance.stance import ContactSpec, Stance
+from impact_balance.balance.areas import balance_areas
+from impact_balance.balance.infeasibility import explain_cannot_balance
+from impact_balance.robot.robot import example_robot_data_root
+from impact_balance.contacts.stance import ContactSpec, Stance
 
 SIMPLE = example_robot_data_root() / "simple_humanoid_description"
 FEET = [ContactSpec("l_ankle", 0.7, (0.2, 0.1)), ContactSpec("r_ankle", 0.7, (0.2, 0.1))]
@@ -74,7 +74,7 @@ def test_simple_humanoid_through_analyze(tmp_path):
     r = d["cannot_balance_reason"]
     assert r["kind"] == "torque_limits"
     assert {"joint", "effort", "min_scale"} <= set(r["binding_joints"][0])
-    from impact_balance.report import format_analysis
+    from impact_balance.analysis.report import format_analysis
 
     assert "reason: the joint torque limits" in format_analysis(analysis)
 

@@ -2,7 +2,7 @@
 
 The QP's output is checked against independent computations: pinocchio's RNEA for the dynamics,
 pinocchio's forward kinematics with the QP's accelerations for the contacts, and the contact wrench
-cones of :mod:`impact_balance.cwc`. The trials simulate 1-1.5 s each.
+cones of :mod:`impact_balance.contacts.cwc`. The trials simulate 1-1.5 s each.
 """
 
 from __future__ import annotations
@@ -13,12 +13,12 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from impact_balance.analysis import analyze
+from impact_balance.analysis.analyze import analyze
 from impact_balance.cli import main
-from impact_balance.cwc import cwc_faces_world
+from impact_balance.contacts.cwc import cwc_faces_world
 from impact_balance.scenario import load_scenario
-from impact_balance.sim.balance_trial import BalanceSetup, BalanceTrialOptions, Push, run_balance_trial
-from impact_balance.sim.inverse_dynamics import InverseDynamicsController, InverseDynamicsGains
+from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions, Push, run_balance_trial
+from impact_balance.sim.control.torque import InverseDynamicsController, InverseDynamicsGains
 
 SCENARIO = "palm_push_two_feet"
 ID = BalanceTrialOptions(controller="id")

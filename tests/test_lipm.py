@@ -5,7 +5,7 @@ import math
 import pytest
 
 from impact_balance import ScenarioError
-from impact_balance.lipm import com_velocity_bounds, lipm_omega, phase_portrait
+from impact_balance.balance.lipm import com_velocity_bounds, lipm_omega, phase_portrait
 
 
 def test_paper_bounds():

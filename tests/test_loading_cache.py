@@ -7,9 +7,9 @@ import os
 import shutil
 
 import impact_balance as ib
-from impact_balance.report import format_timings
-from impact_balance.robot import example_robot_data_root
-from impact_balance.input_limits import parse_yaml as _parse
+from impact_balance.analysis.report import format_timings
+from impact_balance.robot.robot import example_robot_data_root
+from impact_balance.scenario.reader import parse_yaml as _parse
 from impact_balance.scenario import load_scenario
 
 SIMPLE = example_robot_data_root() / "simple_humanoid_description"

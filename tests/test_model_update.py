@@ -15,10 +15,10 @@ import pinocchio as pin
 import pytest
 
 import impact_balance as ib
-from impact_balance.constraints import grasp_matrix
+from impact_balance.contacts.wrench_polytope import grasp_matrix
 from impact_balance.exceptions import ScenarioError
-from impact_balance.robot import load_robot
-from impact_balance.stance import ContactSpec, Stance
+from impact_balance.robot.robot import load_robot
+from impact_balance.contacts.stance import ContactSpec, Stance
 
 FEET = [ContactSpec("left_sole_link", 0.7, (0.2, 0.1)), ContactSpec("right_sole_link", 0.7, (0.2, 0.1))]
 PALM = pin.SE3(np.eye(3), np.array([0.051, 0.0, -0.045]))

@@ -14,7 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial import HalfspaceIntersection
 
-from impact_balance.polygon import Polygon
+from impact_balance.geometry.polygon import Polygon
 
 
 def rectangle(a: float, b: float, centre=(0.0, 0.0)) -> Polygon:

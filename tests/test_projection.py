@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 from scipy.optimize import linprog
 
 from impact_balance.exceptions import SolverError
-from impact_balance.polygon import Polygon
+from impact_balance.geometry.polygon import Polygon
 from impact_balance.projection import project_bretl, project_polytope, project_walk
 
 

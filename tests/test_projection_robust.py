@@ -21,13 +21,13 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from impact_balance.areas import FORCE_BOX, FORCE_TOLERANCE, MERGE_TOLERANCE
-from impact_balance.constraints import wrench_polytope
-from impact_balance.polygon import Polygon, simplify
+from impact_balance.balance.areas import FORCE_BOX, FORCE_TOLERANCE, MERGE_TOLERANCE
+from impact_balance.contacts.wrench_polytope import wrench_polytope
+from impact_balance.geometry.polygon import Polygon, simplify
 from impact_balance.projection import project_polytope
 from impact_balance.projection.walk import SLACK_TOLERANCE
 from impact_balance.scenario import bundled_scenarios, load_scenario
-from impact_balance.stance import ContactSpec, Stance
+from impact_balance.contacts.stance import ContactSpec, Stance
 
 STANCES = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot", "talos_three_contacts")
 
@@ -194,7 +194,7 @@ def test_certificate_refuses_a_spike_along_an_edge():
     products are rounding of either sign) is refused, not certified convex: its half-planes
     would carry a reversed edge normal (drawn by a variant of the walk, since dropped, on
     talos_three_contacts with a hand at mu 1e6)."""
-    from impact_balance.polygon import simplify_convex
+    from impact_balance.geometry.polygon import simplify_convex
 
     square = np.array([[1.0, -1.0], [1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0]])
     assert simplify_convex(square, 1e-9, 1e-8, 1e3) is not None

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from impact_balance.sim import SimOptions, build_model
-from impact_balance.sim.measure import measure
-from impact_balance.sim.trial import TrialOptions, run_trial
+from impact_balance.sim.trials.measure import measure
+from impact_balance.sim.trials.impact_trial import TrialOptions, run_trial
 
 SCENARIO = "palm_push_two_feet"
 

@@ -1,7 +1,7 @@
 """Every robot simulates: the four bundled ones, simple_humanoid and the Solo12 quadruped.
 
 Romeo (24 massless finger links) and iCub (point-mass legs, singular ankle inertias) are
-refused by MuJoCo as their URDFs stand; :mod:`impact_balance.sim.inertia` repairs them. The
+refused by MuJoCo as their URDFs stand; :mod:`impact_balance.sim.model.inertia` repairs them. The
 checks here are independent of that repair: the compiled MuJoCo model's total mass and
 composite inertia are compared with pinocchio's (which reads the URDF unrepaired), and the
 rigid robot's measured CoM velocity jump with the impact model's prediction.
@@ -22,12 +22,12 @@ from test_sim_model import mujoco_composite_inertia
 
 from impact_balance.cli import main
 from impact_balance.exceptions import ModelRepairWarning
-from impact_balance.robot import example_robot_data_root
+from impact_balance.robot.robot import example_robot_data_root
 from impact_balance.sim import SimOptions, build_model
-from impact_balance.sim.balance_trial import BalanceTrialOptions
-from impact_balance.sim.outcomes import OUTCOMES
-from impact_balance.sim.push import push_test
-from impact_balance.sim.validate import validate
+from impact_balance.sim.trials.balance_trial import BalanceTrialOptions
+from impact_balance.sim.trials.outcomes import OUTCOMES
+from impact_balance.sim.studies.push import push_test
+from impact_balance.sim.studies.validate import validate
 
 ROOT = example_robot_data_root()
 BUNDLED = {"talos": "palm_push_two_feet", "g1": "g1_two_feet", "romeo": "romeo_two_feet", "icub": "icub_two_feet"}

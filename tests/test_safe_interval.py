@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 import impact_balance as ib
-from impact_balance.criteria import max_contact_velocity, safe_interval
-from impact_balance.impact import ImpactModel, ImpactSpec
-from impact_balance.polygon import Polygon
+from impact_balance.criteria.com import max_contact_velocity, safe_interval
+from impact_balance.impact.model import ImpactModel, ImpactSpec
+from impact_balance.geometry.polygon import Polygon
 
 SQUARE = Polygon(np.array([[1.0, -1.0], [1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0]]))
 MASS = 2.0

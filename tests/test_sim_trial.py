@@ -21,10 +21,10 @@ import pytest
 from impact_balance import cli
 from impact_balance.logs import read_log, write_log
 from impact_balance.sim import SimOptions, build_model
-from impact_balance.sim.log import log_frame
-from impact_balance.sim.measure import distance_to_hull, measure
+from impact_balance.sim.trials.log import log_frame
+from impact_balance.sim.trials.measure import distance_to_hull, measure
 from impact_balance.exceptions import ModelRepairWarning, SimulationError
-from impact_balance.sim.trial import TrialOptions, approach_joint_velocity, impact_limb, run_trial
+from impact_balance.sim.trials.impact_trial import TrialOptions, approach_joint_velocity, impact_limb, run_trial
 
 LIGHT = SimOptions(meshes=False)
 
@@ -242,9 +242,9 @@ def test_armature_enters_gains_and_joint_space_prediction():
     import pinocchio as pin
 
     from impact_balance.sim import ServoOptions
-    from impact_balance.sim.measure import _stance_with_armature
+    from impact_balance.sim.trials.measure import _stance_with_armature
 
-    from impact_balance.robot import load_robot
+    from impact_balance.robot.robot import load_robot
 
     shared = load_robot("talos").model.armature.copy()
     sim = build_model("kick_one_foot", "servo", SimOptions(meshes=False, servo=ServoOptions(armature=0.3)))

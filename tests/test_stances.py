@@ -10,9 +10,9 @@ import pytest
 
 import impact_balance as ib
 from impact_balance.exceptions import ImpactBalanceError
-from impact_balance.ik import IKError, solve_stance, stance_residuals
-from impact_balance.polygon import Polygon
-from impact_balance.robot import load_robot
+from impact_balance.robot.ik import IKError, solve_stance, stance_residuals
+from impact_balance.geometry.polygon import Polygon
+from impact_balance.robot.robot import load_robot
 from impact_balance.scenario import load_scenario
 
 STANCES = [

@@ -27,7 +27,7 @@ import yaml
 
 from impact_balance import analyze, cli
 from impact_balance.exceptions import EnvironmentFailure, OptionError
-from impact_balance.robot import load_robot
+from impact_balance.robot.robot import load_robot
 from impact_balance.scenario import _read, scenario_from_dict, scenario_path
 from impact_balance.sweep import Evaluator, make_plan, read_results, run_sweep, sweep_spec_from_dict
 from impact_balance.sweep.cluster import check_scheduler_address, connect

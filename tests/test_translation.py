@@ -16,12 +16,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import impact_balance as ib
-from impact_balance.areas import balance_areas
-from impact_balance.criteria import max_contact_velocity, zmp_max_contact_velocity
+from impact_balance.balance.areas import balance_areas
+from impact_balance.criteria.com import max_contact_velocity, zmp_max_contact_velocity
 from impact_balance.exceptions import NonFiniteResultError
-from impact_balance.impact import impact_model
+from impact_balance.impact.model import impact_model
 from impact_balance.scenario import load_scenario
-from impact_balance.stance import Stance
+from impact_balance.contacts.stance import Stance
 
 NAMES = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot", "talos_three_contacts")
 

@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 
 from impact_balance.exceptions import SimulationError
-from impact_balance.polygon import Polygon
-from impact_balance.sim.journal import TrialJournal
-from impact_balance.sim.push import PushOutcome, PushPrediction, boundary_impulse
-from impact_balance.sim.balance_trial import Push
-from impact_balance.sim.scores import confusion, wilson
-from impact_balance.sim.trial_result import finite_or_null
+from impact_balance.geometry.polygon import Polygon
+from impact_balance.sim.studies.journal import TrialJournal
+from impact_balance.sim.studies.push import PushOutcome, PushPrediction, boundary_impulse
+from impact_balance.sim.trials.balance_trial import Push
+from impact_balance.sim.studies.scores import confusion, wilson
+from impact_balance.sim.trials.result import finite_or_null
 
 
 @pytest.mark.parametrize("k, n, lo, hi", [
@@ -92,8 +92,8 @@ def test_journal_round_trip_cut_line_and_foreign_digest(tmp_path):
 
 
 def test_an_interrupted_push_test_resumes_with_the_same_answers(tmp_path):
-    from impact_balance.sim.balance_trial import BalanceSetup, BalanceTrialOptions
-    from impact_balance.sim.push import push_test
+    from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions
+    from impact_balance.sim.studies.push import push_test
 
     options = BalanceTrialOptions(controller="id", after=0.5)
     setup = BalanceSetup.create("palm_push_two_feet", options=options)

@@ -25,10 +25,10 @@ import pytest
 import yaml
 
 from impact_balance import cli
-from impact_balance.errors import describe_error
+from impact_balance.exit_status import describe_error
 from impact_balance.exceptions import MESSAGE_CHARS, EnvironmentFailure, ImpactBalanceError, ScenarioError, SweepError
-from impact_balance.input_limits import MAX_LOG_ROWS, parse_yaml
-from impact_balance.numeric_limits import MAX_SWEEP_POINTS
+from impact_balance.scenario.reader import MAX_LOG_ROWS, parse_yaml
+from impact_balance.ranges import MAX_SWEEP_POINTS
 from impact_balance.scenario import scenario_from_dict
 from impact_balance.sweep import make_plan, sweep_spec_from_dict
 
@@ -127,7 +127,7 @@ def test_a_number_is_not_a_boolean():
 
 # -- outputs: checked before anything runs, no folder left -----------------------------------------
 def test_unwritable_plots_folder_is_one_line_exit_1_before_the_analysis(capsys, in_tmp, monkeypatch):
-    import impact_balance.analysis as analysis
+    import impact_balance.analysis.analyze as analysis
 
     monkeypatch.setattr(analysis, "analyze", lambda *a, **k: pytest.fail("analyzed before the output was checked"))
     rc, out, err = run_cli(capsys, "analyze", "palm_push_two_feet", "--plots", UNWRITABLE)
@@ -241,8 +241,8 @@ def test_an_unexpected_exception_in_a_command_is_one_line_exit_1(capsys, monkeyp
     (["validate", "palm_push_two_feet", "--tolerance", "nan"], "--tolerance"),
 ])
 def test_numbers_outside_what_the_simulation_can_do_are_refused(capsys, monkeypatch, argv, needle):
-    import impact_balance.sim.balance_trial as balance_trial
-    import impact_balance.sim.trial as trial
+    import impact_balance.sim.trials.balance_trial as balance_trial
+    import impact_balance.sim.trials.impact_trial as trial
 
     monkeypatch.setattr(trial, "run_trial", lambda *a, **k: pytest.fail("simulated"))
     monkeypatch.setattr(balance_trial, "run_balance_trial", lambda *a, **k: pytest.fail("simulated"))

@@ -21,7 +21,7 @@ import pytest
 import yaml
 
 from impact_balance import cli
-from impact_balance.analysis import analyze
+from impact_balance.analysis.analyze import analyze
 from impact_balance.exceptions import (
     MESSAGE_CHARS,
     RobotLoadError,
@@ -32,8 +32,8 @@ from impact_balance.exceptions import (
     UnknownKeyError,
     short_repr,
 )
-from impact_balance.input_limits import MAX_BYTES, MAX_DEPTH, MAX_VALUES, parse_yaml
-from impact_balance.robot import load_robot
+from impact_balance.scenario.reader import MAX_BYTES, MAX_DEPTH, MAX_VALUES, parse_yaml
+from impact_balance.robot.robot import load_robot
 from impact_balance.scenario import load_scenario, scenario_from_dict
 
 TWO_FEET = {
@@ -476,7 +476,7 @@ def test_phase_portrait_refuses_non_finite_gravity(capsys):
 
 def test_solo12_foot_frames_are_tilted(tmp_path):
     """The case a user met: solo12's *_FOOT frames have their z axis 45 degrees off the vertical."""
-    from impact_balance.robot import example_robot_data_root
+    from impact_balance.robot.robot import example_robot_data_root
 
     root = example_robot_data_root() / "solo_description"
     feet = ["FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"]

@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import impact_balance as ib
-from impact_balance.criteria import ComCriterion
+from impact_balance.criteria.com import ComCriterion
 from impact_balance.exceptions import GovernorError
 from impact_balance.governor import Governor
 
@@ -76,7 +76,7 @@ def test_async_rates_are_the_workers_answer_for_the_posture_it_was_sent():
     """With contact_aware_async the tick adopts the worker's rates for an earlier posture: the
     same numbers a synchronous solve gives there (cold start: nothing carried)."""
     from impact_balance.governor.support import ContactAwareLimit
-    from impact_balance.stance import Stance
+    from impact_balance.contacts.stance import Stance
 
     with Governor("g1_two_feet", contact_aware=True, contact_aware_starts="cold", contact_aware_async=True,
                   velocity_margin=0.01) as governor:

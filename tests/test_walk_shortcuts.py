@@ -15,7 +15,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from impact_balance.areas import projected_from_arrays
+from impact_balance.balance.areas import projected_from_arrays
 from impact_balance.governor import Governor
 from impact_balance.governor.posture import PostureEvaluator
 from impact_balance.projection import _kernel as K
@@ -201,7 +201,7 @@ def test_one_off_projections_take_no_hint():
 def test_the_governor_loads_its_criterion_code_before_the_first_tick():
     """numba loads a cached function on its first call (1-3 ms): the governor's constructor
     makes that call, so the first tick is not the one that pays it."""
-    from impact_balance import criteria
+    from impact_balance.criteria import com as criteria
 
     Governor("palm_push_two_feet")
     assert criteria._com_exit.signatures and criteria._com_exits.signatures
@@ -225,9 +225,9 @@ G1_CYCLE = [
 
 
 def test_a_cycling_walk_gives_up_early_and_the_answer_is_bretls():
-    import impact_balance.areas as areas
+    import impact_balance.balance.areas as areas
     from impact_balance import analyze
-    from impact_balance.areas import FORCE_BOX, MERGE_TOLERANCE
+    from impact_balance.balance.areas import FORCE_BOX, MERGE_TOLERANCE
     from impact_balance.projection.walk import MAX_PIVOTS, MERGE_AREA_TOLERANCE, certified_walk
 
     governor = Governor("g1_two_feet")

@@ -10,9 +10,9 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
-from impact_balance.sim.balance_trial import TRIAL_VERSION
-from impact_balance.sim.journal import TrialJournal, journal_digest
-from impact_balance.sim.wall import APPROACH_VERSION
+from impact_balance.sim.trials.balance_trial import TRIAL_VERSION
+from impact_balance.sim.studies.journal import TrialJournal, journal_digest
+from impact_balance.sim.studies.wall import APPROACH_VERSION
 
 __all__ = ["journalled", "open_journal", "slim"]
 

@@ -15,12 +15,12 @@ import numpy as np
 
 import impact_balance as ib
 from contact_impact import one_row
-from impact_balance.contact_impact import PointContact, _unique_columns, corner_contacts, rigid_body_impact
+from impact_balance.impact.contact_aware import PointContact, _unique_columns, corner_contacts, rigid_body_impact
 from impact_balance.governor import Governor
-from impact_balance.impact import ImpactSpec, impact_cone
+from impact_balance.impact.model import ImpactSpec, impact_cone
 from impact_balance.scenario import load_scenario
 from impact_balance.sim import SimOptions, build_model
-from impact_balance.stance import Stance
+from impact_balance.contacts.stance import Stance
 
 from .journal import journalled, open_journal
 

@@ -13,7 +13,7 @@ import numpy as np
 
 from governor_study import _f, governed_setup
 from impact_balance.governor import Governor
-from impact_balance.sim.wall import WallOptions, run_wall_trial
+from impact_balance.sim.studies.wall import WallOptions, run_wall_trial
 
 __all__ = ["after_impact_table", "branches_table", "configuration", "contact_posture_table", "logged_trial", "trace"]
 
@@ -129,7 +129,7 @@ def contact_posture_table(args: argparse.Namespace, summary: dict, log) -> str:
     logged CoM velocity before the impact: the margin (m/s) in the CoM velocity area inset by the
     controller's margin of the measured post-impact CoM velocity, of the floating set's worst
     vertex and of the contact-aware jump (cold start) at both restitution bounds."""
-    from impact_balance.contact_impact import contact_impact
+    from impact_balance.impact.contact_aware import contact_impact
 
     impact = summary["trial"]["impact"]
     speed = summary["speed_at_contact"]

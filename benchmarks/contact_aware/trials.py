@@ -12,8 +12,8 @@ import numpy as np
 
 from governor_study import _f, governed_setup
 from impact_balance.governor import Governor
-from impact_balance.sim.wall import WallOptions, run_wall_trial
-from impact_balance.stance import Stance
+from impact_balance.sim.studies.wall import WallOptions, run_wall_trial
+from impact_balance.contacts.stance import Stance
 
 from .journal import journalled, open_journal, slim
 

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 import impact_balance as ib
-from impact_balance.constraints import wrench_polytope
+from impact_balance.contacts.wrench_polytope import wrench_polytope
 
 from .timing import Case, measure, stats
 

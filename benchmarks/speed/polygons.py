@@ -1,4 +1,4 @@
-"""Polygon comparison for the answer checks, independent of ``impact_balance.polygon``:
+"""Polygon comparison for the answer checks, independent of ``impact_balance.geometry.polygon``:
 hull (monotone chain), area (shoelace), intersection (Sutherland-Hodgman) and the relative
 area of the symmetric difference."""
 

@@ -10,11 +10,11 @@ from typing import Any
 import numpy as np
 
 import impact_balance as ib
-from impact_balance.areas import FORCE_BOX
-from impact_balance.constraints import wrench_polytope
+from impact_balance.balance.areas import FORCE_BOX
+from impact_balance.contacts.wrench_polytope import wrench_polytope
 from impact_balance.projection import project_polytope
 from impact_balance.projection.walk import NO_HINT
-from impact_balance.stance import Stance
+from impact_balance.contacts.stance import Stance
 
 from .projection import projection_cases
 from .targets import TARGET_PIPELINE_SCENARIO
@@ -57,7 +57,7 @@ def profile_report(args) -> dict[str, Any]:
     """
     import pinocchio as pin
 
-    from impact_balance.criteria import first_exit
+    from impact_balance.criteria.com import first_exit
     from impact_balance.projection import _kernel, project_walk
 
     out: dict[str, Any] = {}

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 import impact_balance as ib
-from impact_balance.areas import FORCE_BOX, FORCE_TOLERANCE
+from impact_balance.balance.areas import FORCE_BOX, FORCE_TOLERANCE
 from impact_balance.projection import project_polytope
 
 from .polygons import compare

@@ -10,8 +10,8 @@ from typing import Any
 import numpy as np
 
 import impact_balance as ib
-from impact_balance.constraints import wrench_polytope
-from impact_balance.stance import ContactSpec, Stance
+from impact_balance.contacts.wrench_polytope import wrench_polytope
+from impact_balance.contacts.stance import ContactSpec, Stance
 
 from .projection import bench_projection
 from .timing import Case, measure, progress, stats

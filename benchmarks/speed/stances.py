@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 import impact_balance as ib
-from impact_balance.constraints import wrench_polytope
+from impact_balance.contacts.wrench_polytope import wrench_polytope
 
 from .pipeline import bench_max_velocity, bench_pipeline
 from .projection import bench_projection

@@ -16,22 +16,23 @@ from typing import TYPE_CHECKING, Any
 #: Where each public name lives: imported on first use (PEP 562), so that `import impact_balance`
 #: costs only what the names a program touches need (the command line lists robots in ~0.2 s).
 _EXPORTS: dict[str, str] = {
-    "Analysis": ".analysis", "ImpactAnswer": ".analysis", "analyze": ".analysis",
-    "BalanceAreas": ".areas", "areas_from_polytope": ".areas", "balance_areas": ".areas",
+    "Analysis": ".analysis.analyze", "ImpactAnswer": ".analysis.analyze", "analyze": ".analysis.analyze",
+    "BalanceAreas": ".balance.areas", "areas_from_polytope": ".balance.areas", "balance_areas": ".balance.areas",
     "GRAVITY": ".constants",
-    "WrenchPolytope": ".constraints", "contact_polytope": ".constraints", "wrench_polytope": ".constraints",
-    "VelocityLimit": ".criteria", "capped_velocity": ".criteria", "max_contact_velocity": ".criteria", "zmp_max_contact_velocity": ".criteria",
-    "cwc_faces": ".cwc", "cwc_faces_world": ".cwc", "cwc_span": ".cwc",
-    "Diagnostic": ".diagnostics",
+    "WrenchPolytope": ".contacts.wrench_polytope", "contact_polytope": ".contacts.wrench_polytope", "wrench_polytope": ".contacts.wrench_polytope",
+    "VelocityLimit": ".criteria.com", "capped_velocity": ".criteria.com", "max_contact_velocity": ".criteria.com", "zmp_max_contact_velocity": ".criteria.com",
+    "cwc_faces": ".contacts.cwc", "cwc_faces_world": ".contacts.cwc", "cwc_span": ".contacts.cwc",
+    "Diagnostic": ".analysis.result",
     "ImpactBalanceError": ".exceptions", "ImpactModelError": ".exceptions", "RobotLoadError": ".exceptions", "ScenarioError": ".exceptions", "SolverError": ".exceptions", "StrictWarningsError": ".exceptions", "UnknownConfigurationError": ".exceptions", "UnknownFrameError": ".exceptions", "UnknownJointError": ".exceptions", "UnknownKeyError": ".exceptions", "UnknownRobotError": ".exceptions", "UnknownScenarioError": ".exceptions",
-    "ImpactModel": ".impact", "ImpactSpec": ".impact", "friction_cone": ".impact", "impact_model": ".impact",
-    "PhasePortrait": ".lipm", "com_velocity_bounds": ".lipm", "lipm_omega": ".lipm", "phase_portrait": ".lipm",
-    "Polygon": ".polygon",
+    "ImpactModel": ".impact.model", "ImpactSpec": ".impact.model", "friction_cone": ".impact.model", "impact_model": ".impact.model",
+    "PhasePortrait": ".balance.lipm", "com_velocity_bounds": ".balance.lipm", "lipm_omega": ".balance.lipm", "phase_portrait": ".balance.lipm",
+    "Polygon": ".geometry.polygon",
     "project_polytope": ".projection",
-    "QPOptions": ".qp", "QPResult": ".qp", "solve_contact_velocity_qp": ".qp",
-    "BUNDLED_ROBOTS": ".robot", "Robot": ".robot", "load_robot": ".robot",
+    "QPOptions": ".criteria.qp", "QPResult": ".criteria.qp", "solve_contact_velocity_qp": ".criteria.qp",
+    "BUNDLED_ROBOTS": ".robot.robot", "Robot": ".robot.robot", "load_robot": ".robot.robot",
     "Scenario": ".scenario", "bundled_scenarios": ".scenario", "load_scenario": ".scenario",
-    "Contact": ".stance", "ContactSpec": ".stance", "Stance": ".stance",
+    "Governor": ".governor", "SpeedLimit": ".governor",
+    "Contact": ".contacts.stance", "ContactSpec": ".contacts.stance", "Stance": ".contacts.stance",
 }
 
 __version__ = "0.1.0"
@@ -54,6 +55,7 @@ __all__ = [
     "BUNDLED_ROBOTS", "Robot", "load_robot",
     "Scenario", "bundled_scenarios", "load_scenario",
     "Contact", "ContactSpec", "Stance",
+    "Governor", "SpeedLimit",
 ]
 
 
@@ -74,14 +76,14 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # static analysers and IDEs see the plain imports
-    from .analysis import Analysis, ImpactAnswer, analyze
-    from .areas import BalanceAreas, areas_from_polytope, balance_areas
-    from .constants import GRAVITY
-    from .constraints import WrenchPolytope, contact_polytope, wrench_polytope
-    from .criteria import VelocityLimit, capped_velocity, max_contact_velocity, zmp_max_contact_velocity
-    from .cwc import cwc_faces, cwc_faces_world, cwc_span
-    from .diagnostics import Diagnostic
-    from .exceptions import (
+    from impact_balance.analysis.analyze import Analysis, ImpactAnswer, analyze
+    from impact_balance.balance.areas import BalanceAreas, areas_from_polytope, balance_areas
+    from impact_balance.constants import GRAVITY
+    from impact_balance.contacts.wrench_polytope import WrenchPolytope, contact_polytope, wrench_polytope
+    from impact_balance.criteria.com import VelocityLimit, capped_velocity, max_contact_velocity, zmp_max_contact_velocity
+    from impact_balance.contacts.cwc import cwc_faces, cwc_faces_world, cwc_span
+    from impact_balance.analysis.result import Diagnostic
+    from impact_balance.exceptions import (
         ImpactBalanceError,
         ImpactModelError,
         RobotLoadError,
@@ -95,11 +97,12 @@ if TYPE_CHECKING:  # static analysers and IDEs see the plain imports
         UnknownRobotError,
         UnknownScenarioError,
     )
-    from .impact import ImpactModel, ImpactSpec, friction_cone, impact_model
-    from .lipm import PhasePortrait, com_velocity_bounds, lipm_omega, phase_portrait
-    from .polygon import Polygon
-    from .projection import project_polytope
-    from .qp import QPOptions, QPResult, solve_contact_velocity_qp
-    from .robot import BUNDLED_ROBOTS, Robot, load_robot
-    from .scenario import Scenario, bundled_scenarios, load_scenario
-    from .stance import Contact, ContactSpec, Stance
+    from impact_balance.impact.model import ImpactModel, ImpactSpec, friction_cone, impact_model
+    from impact_balance.balance.lipm import PhasePortrait, com_velocity_bounds, lipm_omega, phase_portrait
+    from impact_balance.geometry.polygon import Polygon
+    from impact_balance.projection import project_polytope
+    from impact_balance.criteria.qp import QPOptions, QPResult, solve_contact_velocity_qp
+    from impact_balance.robot.robot import BUNDLED_ROBOTS, Robot, load_robot
+    from impact_balance.scenario import Scenario, bundled_scenarios, load_scenario
+    from impact_balance.contacts.stance import Contact, ContactSpec, Stance
+    from impact_balance.governor import Governor, SpeedLimit

@@ -216,7 +216,7 @@ class UnknownScenarioError(UnknownNameError):
 
 
 class WorkspaceError(ScenarioError):
-    """A file name outside what the workspace allows (see :mod:`impact_balance.workspace`).
+    """A file name outside what the workspace allows (see :mod:`impact_balance.gui.workspace`).
 
     Attributes:
         field: What named the file ("file", "extends", "robot.urdf", "workspace").
@@ -299,7 +299,7 @@ class StrictWarningsError(ImpactBalanceError):
     """Warnings were raised while warnings are errors (``--strict``).
 
     Attributes:
-        warnings: The diagnostics (:class:`impact_balance.diagnostics.Diagnostic`).
+        warnings: The diagnostics (:class:`impact_balance.analysis.diagnostics.Diagnostic`).
     """
 
     def __init__(self, warnings: Sequence[Any]):
@@ -369,7 +369,7 @@ class ImpactBalanceWarning(UserWarning):
 
 
 class ModelRepairWarning(ImpactBalanceWarning):
-    """A robot model was changed to be simulated (see :mod:`impact_balance.sim.inertia`).
+    """A robot model was changed to be simulated (see :mod:`impact_balance.sim.model.inertia`).
 
     Attributes:
         robot: The robot's name.

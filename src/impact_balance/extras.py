@@ -20,7 +20,7 @@ import argparse
 import importlib.util
 import sys
 
-from .exceptions import MissingExtraError
+from impact_balance.exceptions import MissingExtraError
 
 __all__ = ["EXTRAS", "COMMAND_EXTRAS", "OPTION_EXTRAS", "installed", "require", "require_for"]
 

@@ -12,8 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from ..robot import Robot
-from ..stance import Stance
+from impact_balance.robot.robot import Robot
+from impact_balance.contacts.stance import Stance
 
 __all__ = ["FramePose", "frame_poses", "contact_poses"]
 

@@ -12,7 +12,7 @@
 - A frame on a chain of fewer than 6 joints from the base (a quadruped's 3-joint leg) cannot
   hold an orientation: its position alone is placed or kept (a point foot).
 
-The IK is :func:`impact_balance.ik.solve_stance` (pink, as the GUI's drags), started from the
+The IK is :func:`impact_balance.robot.ik.solve_stance` (pink, as the GUI's drags), started from the
 scenario's stance and pulled towards it. The result is the scenario with an explicit ``base``
 and the joints that differ from its reference configuration; a contact given by its world
 normal gets the new normal.
@@ -30,10 +30,10 @@ import numpy as np
 import pinocchio as pin
 import yaml
 
-from ..exceptions import ScenarioError
-from ..ik import chain_dofs, solve_stance, stance_residuals
-from ..scenario import Scenario
-from ..spatial import aligning_rotation, unit
+from impact_balance.exceptions import ScenarioError
+from impact_balance.robot.ik import chain_dofs, solve_stance, stance_residuals
+from impact_balance.scenario import Scenario
+from impact_balance.geometry.spatial import aligning_rotation, unit
 
 __all__ = ["Placement", "PoseResult", "pose_scenario", "posed_mapping", "scenario_yaml", "DIGITS"]
 

@@ -2,7 +2,7 @@
 
 One module per command (``demo``, ``analyze``, ...), each with ``add_parser(sub)`` and
 ``run(args) -> int``; this module assembles them and applies the one error rule of
-:mod:`impact_balance.errors` to whatever a command raises (the project, the operating system,
+:mod:`impact_balance.exit_status` to whatever a command raises (the project, the operating system,
 PyYAML, pyarrow, Dask, numpy): one line on stderr, exit status 2 for bad input and 1 for a
 failure of the machine, no traceback unless ``--debug`` (anywhere on the line) or
 ``IMPACT_BALANCE_DEBUG=1``. A closed stdout (``analyze --json | head -c 10``) ends quietly
@@ -19,12 +19,12 @@ import traceback
 import warnings
 from types import ModuleType
 
-from ..errors import EXIT_BROKEN_PIPE, debug_requested, describe_error
-from ..exceptions import EnvironmentFailure, ImpactBalanceWarning, one_line
-from ..extras import require_for
-from . import (analyze, approach, check_log, demo, frames, gui, listing, phase_portrait, pose, push_test, simulate, sweep,
+from impact_balance.exit_status import EXIT_BROKEN_PIPE, debug_requested, describe_error
+from impact_balance.exceptions import EnvironmentFailure, ImpactBalanceWarning, one_line
+from impact_balance.extras import require_for
+from impact_balance.cli import (analyze, approach, check_log, demo, frames, gui, listing, phase_portrait, pose, push_test, simulate, sweep,
                validate)
-from .demo import DEMO_SCENARIOS, FRICTION_SWEEP
+from impact_balance.cli.demo import DEMO_SCENARIOS, FRICTION_SWEEP
 
 __all__ = ["main", "DEMO_SCENARIOS", "FRICTION_SWEEP", "COMMANDS", "EXIT_BROKEN_PIPE"]
 
@@ -35,7 +35,7 @@ COMMANDS: tuple[ModuleType, ...] = (demo, analyze, phase_portrait, listing, fram
 
 def _kernel_is_compiled() -> bool:
     # Imported here: the kernel's module brings numba and scipy, which `robots` does not need.
-    from ..projection.walk import kernel_is_compiled
+    from impact_balance.projection.walk import kernel_is_compiled
 
     return kernel_is_compiled()
 

@@ -14,7 +14,7 @@ import math
 import os
 from collections.abc import Callable, Sequence
 
-from ..exceptions import ImpactBalanceError, OptionError, short_repr
+from impact_balance.exceptions import ImpactBalanceError, OptionError, short_repr
 
 __all__ = [
     "add_controller_option",
@@ -55,10 +55,10 @@ def _refused(exc: OptionError) -> CommandLineError:
 
 
 def output_folder(field: str) -> Callable[[str], str]:
-    """argparse type: a folder the command will write in (see :mod:`impact_balance.outputs`)."""
+    """argparse type: a folder the command will write in (see :mod:`impact_balance.cli.output_paths`)."""
 
     def check(text: str) -> str:
-        from ..outputs import check_output_folder
+        from impact_balance.cli.output_paths import check_output_folder
 
         try:
             check_output_folder(text, field)
@@ -74,7 +74,7 @@ def output_file(field: str, suffixes: Sequence[str] = ()) -> Callable[[str], str
     """argparse type: a file the command will write (its folder checked, its suffix among ``suffixes``)."""
 
     def check(text: str) -> str:
-        from ..outputs import check_output_file
+        from impact_balance.cli.output_paths import check_output_file
 
         try:
             check_output_file(text, field, tuple(suffixes))
@@ -143,7 +143,7 @@ def add_output_options(parser: argparse.ArgumentParser, log_help: str) -> None:
 
 def add_zmp_margin_option(parser: argparse.ArgumentParser, default_help: str) -> None:
     """``--zmp-margin M``: the ZMP support area shrunk by M metres (``default_help``: what it defaults to)."""
-    from ..constants import MAX_SIZE
+    from impact_balance.constants import MAX_SIZE
 
     parser.add_argument("--zmp-margin", type=number("--zmp-margin", 0.0, MAX_SIZE, "m"), default=None, metavar="M",
                         help=f"shrink the ZMP support area by M metres, and the CoM velocity area with it "
@@ -154,8 +154,8 @@ def with_zmp_margin(scenario, margin: float | None):
     """``scenario`` with its ``zmp_margin`` replaced by ``margin`` (m) when given, checked like the key."""
     if margin is None:
         return scenario
-    from ..constants import MAX_SIZE
-    from ..exceptions import ScenarioError
+    from impact_balance.constants import MAX_SIZE
+    from impact_balance.exceptions import ScenarioError
 
     if not (margin == margin and 0.0 <= margin <= MAX_SIZE):  # NaN fails the first test
         raise ScenarioError("--zmp-margin", margin, f"must be in [0, {MAX_SIZE:g}] m")
@@ -178,14 +178,14 @@ def add_trial_options(parser: argparse.ArgumentParser, impact: bool) -> None:
 
 
 def open_journal(args: argparse.Namespace, command: str, scenario, joints: str, options, extra: dict):
-    """The trials journal of a command (:class:`impact_balance.sim.journal.TrialJournal`), by the digest of
+    """The trials journal of a command (:class:`impact_balance.sim.studies.journal.TrialJournal`), by the digest of
     everything its trials depend on (the scoring margin excluded: scores are recomputed from the trials)."""
     import dataclasses
     import sys
     from pathlib import Path
 
-    from ..sim.balance_trial import TRIAL_VERSION
-    from ..sim.journal import TrialJournal, default_journal_path, journal_digest
+    from impact_balance.sim.trials.balance_trial import TRIAL_VERSION
+    from impact_balance.sim.studies.journal import TrialJournal, default_journal_path, journal_digest
 
     parts = {"command": command, "trial_version": TRIAL_VERSION,
              "scenario": scenario.model_dump(mode="json", exclude={"zmp_margin", "name", "description"}),
@@ -207,7 +207,7 @@ def import_mujoco(video: bool) -> None:
     """Import MuJoCo for a simulation command; with ``video``, offscreen rendering first picks
     EGL (it works headless, and must be chosen before MuJoCo is imported) unless ``MUJOCO_GL``
     says otherwise. An unusable backend is one :class:`~impact_balance.exceptions.SimulationError`."""
-    from ..exceptions import SimulationError
+    from impact_balance.exceptions import SimulationError
 
     if video:
         os.environ.setdefault("MUJOCO_GL", "egl")

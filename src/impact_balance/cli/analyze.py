@@ -6,7 +6,7 @@ import argparse
 import dataclasses
 from pathlib import Path
 
-from ._options import add_zmp_margin_option, output_folder, with_zmp_margin
+from impact_balance.cli._options import add_zmp_margin_option, output_folder, with_zmp_margin
 
 __all__ = ["add_parser", "run", "USES_KERNEL", "INTERPRETED"]
 
@@ -27,15 +27,15 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..analysis import analyze
-    from ..report import format_analysis
+    from impact_balance.analysis.analyze import analyze
+    from impact_balance.analysis.report import format_analysis
 
-    from ..exceptions import StrictWarningsError
-    from .output import print_json
+    from impact_balance.exceptions import StrictWarningsError
+    from impact_balance.cli.output import print_json
 
     scenario = args.scenario
     if args.zmp_margin is not None:
-        from ..scenario import load_scenario
+        from impact_balance.scenario import load_scenario
 
         scenario = with_zmp_margin(load_scenario(scenario), args.zmp_margin)
     analysis = analyze(scenario, solve_qp=True if args.qp else None)
@@ -43,7 +43,7 @@ def run(args: argparse.Namespace) -> int:
         raise StrictWarningsError(analysis.warnings)
     written = []
     if args.plots:
-        from ..plots import save_figures
+        from impact_balance.plots import save_figures
 
         skipped: list = []
         written = save_figures(analysis, Path(args.plots), skipped=skipped)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._options import (add_controller_option, add_zmp_margin_option, import_mujoco, number, output_file, output_folder,
+from impact_balance.cli._options import (add_controller_option, add_zmp_margin_option, import_mujoco, number, output_file, output_folder,
                        with_zmp_margin)
 
 __all__ = ["add_parser", "run", "USES_KERNEL"]
@@ -52,15 +52,15 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..exceptions import SimulationError
+    from impact_balance.exceptions import SimulationError
 
     if args.video and args.wall_distance_range is not None:
         raise SimulationError("--video", args.video, "one .mp4 for one trial (give --wall-distance, not a range)")
     import_mujoco(bool(args.video))  # before anything imports MuJoCo: the GL backend is read then
-    from ..scenario import load_scenario
-    from ..sim.balance_trial import BalanceSetup, BalanceTrialOptions, controller_margin
-    from ..sim.wall import WallOptions, run_wall_trial, write_wall_video
-    from .output import print_json
+    from impact_balance.scenario import load_scenario
+    from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions, controller_margin
+    from impact_balance.sim.studies.wall import WallOptions, run_wall_trial, write_wall_video
+    from impact_balance.cli.output import print_json
 
     scenario = load_scenario(args.scenario)
     if scenario.impact is None:
@@ -78,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
     setup = BalanceSetup.create(scenario, "servo", options, meshes=bool(args.video))  # meshes: visual only
     governor = None
     if args.governor != "none":
-        from ..governor import Governor
+        from impact_balance.governor import Governor
 
         governor = Governor(governed, criterion=args.governor, contact_aware=args.contact_aware,
                             velocity_margin=args.velocity_margin, contact_aware_async=args.contact_aware_async)
@@ -128,8 +128,8 @@ def _s(x) -> str:
 
 
 def _plot(trial, setup, out: Path, zmp_margin: float) -> Path:
-    from ..plots.approach import plot_approach
-    from ..plots.save import figure_prefix
+    from impact_balance.plots.approach import plot_approach
+    from impact_balance.plots.save import figure_prefix
 
     out.mkdir(parents=True, exist_ok=True)
     margin = setup.analysis.areas.com_velocity_area_inset(zmp_margin) if zmp_margin > 0 else None

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._options import output_folder
+from impact_balance.cli._options import output_folder
 
 __all__ = ["add_parser", "run", "USES_KERNEL"]
 
@@ -23,8 +23,8 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..logs import check_log, read_log
-    from .output import print_json
+    from impact_balance.logs import check_log, read_log
+    from impact_balance.cli.output import print_json
 
     notes: list = []
     frame = read_log(args.log, warnings=notes)
@@ -65,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _plots(check, out: Path) -> list[Path]:
-    from ..plots.balance import plot_log_margins
+    from impact_balance.plots.balance import plot_log_margins
 
     out.mkdir(parents=True, exist_ok=True)
     s = check.samples

@@ -23,12 +23,12 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..analysis import analyze
-    from ..report import format_analysis, format_speed
+    from impact_balance.analysis.analyze import analyze
+    from impact_balance.analysis.report import format_analysis, format_speed
 
     out = Path(args.out)
     if not args.no_plots:
-        from ..outputs import check_output_folder
+        from impact_balance.cli.output_paths import check_output_folder
 
         check_output_folder(out, "--out")  # before the studies run, not after
     print("impact-balance demo: the paper's studies on Talos (bundled scenarios)\n")
@@ -37,7 +37,7 @@ def run(args: argparse.Namespace) -> int:
         analysis = analyze(name, solve_qp=True)
         print(format_analysis(analysis) + "\n")
         if not args.no_plots:
-            from ..plots import save_figures
+            from impact_balance.plots import save_figures
 
             written += save_figures(analysis, out)
     sweep = [analyze(name) for name in FRICTION_SWEEP]
@@ -48,8 +48,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"  {im.model.spec.friction:>5.2f}  {format_speed(im.max_contact_velocity):>14}  "
               f"{format_speed(im.zmp_max_contact_velocity):>14}")
     if not args.no_plots:
-        from ..lipm import phase_portrait
-        from ..plots import plot_friction_comparison, plot_phase_portrait
+        from impact_balance.balance.lipm import phase_portrait
+        from impact_balance.plots import plot_friction_comparison, plot_phase_portrait
 
         out.mkdir(parents=True, exist_ok=True)
         for fig, fname in ((plot_friction_comparison(sweep), "friction_comparison.png"),
@@ -57,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
             fig.savefig(out / fname, dpi=120)
             written.append(out / fname)
         print(f"\n{len(written)} figures written to {out}/")
-    from ..lipm import com_velocity_bounds
+    from impact_balance.balance.lipm import com_velocity_bounds
 
     bounds = [round(float(b), 4) for b in com_velocity_bounds(0.78, (-0.13, 0.13))]
     print(f"LIPM check (paper sec. III-B): c_z 0.78 m, ZMP in [-0.13, 0.13] m -> CoM velocity in [{bounds[0]}, {bounds[1]}] m/s")

@@ -22,9 +22,9 @@ def add_parser(sub) -> list[str]:
 
 def _robot_and_stance(name: str):
     """(robot, configuration, configuration label, stance or None)."""
-    from ..exceptions import UnknownRobotError, UnknownScenarioError
-    from ..robot import BUNDLED_ROBOTS, load_robot
-    from ..scenario import load_scenario
+    from impact_balance.exceptions import UnknownRobotError, UnknownScenarioError
+    from impact_balance.robot.robot import BUNDLED_ROBOTS, load_robot
+    from impact_balance.scenario import load_scenario
 
     if name in BUNDLED_ROBOTS or name.endswith(".urdf"):
         robot = load_robot(name) if name in BUNDLED_ROBOTS else load_robot(None, name)
@@ -39,7 +39,7 @@ def _robot_and_stance(name: str):
 
 def robot_listing(robot, q=None, frames: list[str] | None = None) -> dict:
     """Frames (name, type, parent joint, world pose at ``q``) and actuated joints (limits) of a robot."""
-    from ..authoring import frame_poses
+    from impact_balance.authoring import frame_poses
 
     q = robot.configuration() if q is None else q
     effort = dict(zip(*(list(x) for x in robot.effort_limits)))
@@ -68,11 +68,11 @@ def run(args: argparse.Namespace) -> int:
     listing = robot_listing(robot, q, args.frame)
     listing["configuration"] = label
     if stance is not None:
-        from ..authoring import contact_poses
+        from impact_balance.authoring import contact_poses
 
         listing["contacts"] = contact_poses(stance)
     if args.json:
-        from .output import print_json
+        from impact_balance.cli.output import print_json
 
         print_json(listing)
         return 0

@@ -26,14 +26,14 @@ def add_parser(sub) -> list[str]:
 
 def run(args: argparse.Namespace) -> int:
     try:
-        from ..gui.app import run as run_app
-        from ..gui.state import DEFAULT_SCENARIO
+        from impact_balance.gui.app import run as run_app
+        from impact_balance.gui.state import DEFAULT_SCENARIO
     except ImportError as exc:  # pragma: no cover - viser is a dependency
         print(f"impact-balance: error: the GUI needs viser ({exc})", file=sys.stderr)
         return 2
 
-    from ..gui.guard import normalize_origin
-    from ..workspace import Workspace
+    from impact_balance.gui.guard import normalize_origin
+    from impact_balance.gui.workspace import Workspace
 
     # Check the flags before anything loads or listens (errors: one line, exit 2).
     workspace = Workspace(args.workspace)

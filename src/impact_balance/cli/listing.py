@@ -15,14 +15,14 @@ def add_parser(sub) -> list[str]:
 
 def run(args: argparse.Namespace) -> int:
     if args.command == "scenarios":
-        from ..scenario import bundled_scenarios
+        from impact_balance.scenario import bundled_scenarios
 
         items = bundled_scenarios()
         width = max(map(len, items), default=0)
         for name, description in items.items():
             print(f"{name:<{width}}  {description}")
     else:
-        from ..robot import BUNDLED_ROBOTS
+        from impact_balance.robot.robot import BUNDLED_ROBOTS
 
         for name, spec in BUNDLED_ROBOTS.items():
             print(f"{name:<6}  {spec.description}")

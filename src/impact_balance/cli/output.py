@@ -12,7 +12,7 @@ import math
 import sys
 from typing import Any
 
-from ..exceptions import ImpactBalanceError
+from impact_balance.exceptions import ImpactBalanceError
 
 __all__ = ["print_json", "progress_bar", "NonFiniteOutputError"]
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._options import output_file
+from impact_balance.cli._options import output_file
 
 __all__ = ["add_parser", "run"]
 
@@ -22,17 +22,17 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..lipm import phase_portrait
+    from impact_balance.balance.lipm import phase_portrait
 
     portrait = phase_portrait(args.com_height, tuple(args.zmp_range), args.gravity)
     if args.plot:
-        from ..plots import plot_phase_portrait
+        from impact_balance.plots import plot_phase_portrait
 
         fig = plot_phase_portrait(portrait)
         Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
         fig.savefig(args.plot, dpi=120)
     if args.json:
-        from .output import print_json
+        from impact_balance.cli.output import print_json
 
         print_json({"omega": portrait.omega, "com_height": args.com_height, "zmp_range": list(portrait.zmp_range),
                           "gravity": args.gravity, "com_velocity_bounds": list(portrait.com_velocity_bounds)})

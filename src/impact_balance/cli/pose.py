@@ -55,10 +55,10 @@ def add_parser(sub) -> list[str]:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from ..authoring import Placement, pose_scenario, posed_mapping, scenario_yaml
-    from ..exceptions import ScenarioError, WorkspaceError
-    from ..scenario import _read, load_scenario, scenario_from_dict, scenario_path
-    from ..workspace import Workspace
+    from impact_balance.authoring import Placement, pose_scenario, posed_mapping, scenario_yaml
+    from impact_balance.exceptions import ScenarioError, WorkspaceError
+    from impact_balance.scenario import _read, load_scenario, scenario_from_dict, scenario_path
+    from impact_balance.gui.workspace import Workspace
 
     places = getattr(args, "places", None) or []
     if not places and args.com is None:
@@ -84,7 +84,7 @@ def run(args: argparse.Namespace) -> int:
     written = workspace.write_text(out.name, text, overwrite=args.force, field="--out")
     worst = max(result.residuals.values(), default=0.0)
     if args.json:
-        from .output import print_json
+        from impact_balance.cli.output import print_json
 
         print_json({"out": str(written), "residuals": result.residuals, "largest_residual": worst,
                     "com": result.com.tolist(), "base": mapping["base"], "joints": mapping["joints"]})

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._options import add_controller_option, add_output_options, add_trial_options, open_journal, with_zmp_margin
+from impact_balance.cli._options import add_controller_option, add_output_options, add_trial_options, open_journal, with_zmp_margin
 
 __all__ = ["add_parser", "run", "USES_KERNEL"]
 
@@ -31,11 +31,11 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..logs import check_log_path
-    from ..scenario import load_scenario
-    from ..sim.balance_trial import BalanceTrialOptions, write_trial_log
-    from ..sim.push import check_push_arguments, push_test
-    from .output import print_json, progress_bar
+    from impact_balance.logs import check_log_path
+    from impact_balance.scenario import load_scenario
+    from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, write_trial_log
+    from impact_balance.sim.studies.push import check_push_arguments, push_test
+    from impact_balance.cli.output import print_json, progress_bar
 
     scenario = load_scenario(args.scenario)
     if args.log:
@@ -137,8 +137,8 @@ def _telling(result):
 
 
 def _plots(result, out: Path) -> list[Path]:
-    from ..plots.balance import plot_push_trajectories
-    from ..plots.save import figure_prefix
+    from impact_balance.plots.balance import plot_push_trajectories
+    from impact_balance.plots.save import figure_prefix
 
     out.mkdir(parents=True, exist_ok=True)
     prefix = figure_prefix(result.setup.analysis)

@@ -6,8 +6,8 @@ import argparse
 import math
 from pathlib import Path
 
-from ._options import LOG_SUFFIXES, import_mujoco, number, output_file, output_folder
-from .output import print_json
+from impact_balance.cli._options import LOG_SUFFIXES, import_mujoco, number, output_file, output_folder
+from impact_balance.cli.output import print_json
 
 __all__ = ["add_parser", "run", "parse_speeds", "MAX_SPEEDS"]
 
@@ -43,9 +43,9 @@ def add_parser(sub) -> list[str]:
 
 def parse_speeds(text: str) -> list[float]:
     """Approach speeds from ``"0.1,0.3"``; :class:`SimulationError` on a bad one (see
-    :mod:`impact_balance.numeric_limits` for the range)."""
-    from ..exceptions import SimulationError
-    from ..numeric_limits import check_approach_speed
+    :mod:`impact_balance.ranges` for the range)."""
+    from impact_balance.exceptions import SimulationError
+    from impact_balance.ranges import check_approach_speed
 
     parts = str(text).split(",")
     if len(parts) > MAX_SPEEDS:
@@ -98,15 +98,15 @@ def _table(name: str, r) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..exceptions import SimulationError
+    from impact_balance.exceptions import SimulationError
 
     speeds = parse_speeds(args.speed)  # before MuJoCo loads: a bad speed is refused at once
     import_mujoco(bool(args.video))
-    from ..logs import check_log_path
-    from ..scenario import load_scenario
-    from ..sim import JOINT_MODELS, build_model
-    from ..sim.measure import measure
-    from ..sim.trial import TrialOptions, run_trial
+    from impact_balance.logs import check_log_path
+    from impact_balance.scenario import load_scenario
+    from impact_balance.sim import JOINT_MODELS, build_model
+    from impact_balance.sim.trials.measure import measure
+    from impact_balance.sim.trials.impact_trial import TrialOptions, run_trial
 
     if args.joints not in JOINT_MODELS:
         raise SimulationError("--joints", args.joints, f"unknown joint model; valid: {', '.join(JOINT_MODELS)}")
@@ -115,7 +115,7 @@ def run(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
     if scenario.impact is None:
         raise SimulationError("impact", None, f"scenario {args.scenario!r} has no impact to simulate")
-    from ..sim import ServoOptions, SimOptions
+    from impact_balance.sim import ServoOptions, SimOptions
 
     options = SimOptions(meshes=bool(args.video), servo=ServoOptions(armature=args.armature))
     sim = build_model(scenario, args.joints, options)
@@ -127,18 +127,18 @@ def run(args: argparse.Namespace) -> int:
         result = measure(sim, record, speed)
         results.append(result)
         if args.log:
-            from ..logs import write_log
-            from ..sim.log import log_frame
+            from impact_balance.logs import write_log
+            from impact_balance.sim.trials.log import log_frame
 
             written.append(write_log(log_frame(sim, record), _per_speed(args.log, speed, several),
                                      {"scenario": name, "joints": args.joints, "approach_speed": speed}))
         if args.video:
-            from ..sim.video import write_video
+            from impact_balance.sim.trials.video import write_video
 
             written.append(write_video(sim, record, _per_speed(args.video, speed, several)))
         if args.plots:
-            from ..plots._common import DPI
-            from ..plots.simulation import plot_jump_on_sets, plot_time_series
+            from impact_balance.plots._common import DPI
+            from impact_balance.plots.simulation import plot_jump_on_sets, plot_time_series
 
             title = f"{name}: {args.joints} joints, approach {speed:g} m/s, restitution {result.restitution_measured:.2f}"
             out = Path(args.plots)

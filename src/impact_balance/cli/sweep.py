@@ -16,8 +16,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from ._options import CommandLineError, output_folder
-from .output import print_json
+from impact_balance.cli._options import CommandLineError, output_folder
+from impact_balance.cli.output import print_json
 
 __all__ = ["add_parser", "run", "USES_KERNEL"]
 
@@ -35,8 +35,8 @@ def _positive(text: str) -> int:
 
 
 def _scheduler(text: str) -> str:
-    from ..exceptions import OptionError
-    from ..sweep.cluster import check_scheduler_address
+    from impact_balance.exceptions import OptionError
+    from impact_balance.sweep.cluster import check_scheduler_address
 
     try:
         return check_scheduler_address(text)
@@ -71,7 +71,7 @@ def add_parser(sub) -> list[str]:
 
 
 def _print(summary: dict, as_json: bool) -> None:
-    from ..sweep.summary import format_summary
+    from impact_balance.sweep.summary import format_summary
 
     if as_json:
         print_json(summary)
@@ -84,7 +84,7 @@ def _warn(line: str) -> None:
 
 
 def _verify(args: argparse.Namespace) -> int:
-    from ..sweep.store import check_folder
+    from impact_balance.sweep.store import check_folder
 
     check = check_folder(args.verify)
     if args.json:
@@ -100,10 +100,10 @@ def _verify(args: argparse.Namespace) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..exceptions import SweepError
-    from ..sweep import bundled_sweeps, load_sweep_spec, make_plan, run_sweep
-    from ..sweep.figures import save_sweep_figures
-    from ..sweep.summary import summarize
+    from impact_balance.exceptions import SweepError
+    from impact_balance.sweep import bundled_sweeps, load_sweep_spec, make_plan, run_sweep
+    from impact_balance.sweep.figures import save_sweep_figures
+    from impact_balance.sweep.summary import summarize
 
     if args.list:
         for name, description in bundled_sweeps().items():
@@ -131,7 +131,7 @@ def run(args: argparse.Namespace) -> int:
     if args.out:
         out = Path(args.out)
     else:
-        from ..outputs import check_output_folder
+        from impact_balance.cli.output_paths import check_output_folder
 
         out = check_output_folder(f"sweep-{Path(spec.source).stem}", "--out")
     report = run_sweep(plan, out, workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._options import add_controller_option, add_output_options, add_trial_options, open_journal, with_zmp_margin
+from impact_balance.cli._options import add_controller_option, add_output_options, add_trial_options, open_journal, with_zmp_margin
 
 __all__ = ["add_parser", "run", "USES_KERNEL"]
 
@@ -26,13 +26,13 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..exceptions import SimulationError
-    from ..logs import check_log_path
-    from ..numeric_limits import check_tolerance
-    from ..scenario import load_scenario
-    from ..sim.balance_trial import BalanceTrialOptions, write_trial_log
-    from ..sim.validate import validate
-    from .output import print_json, progress_bar
+    from impact_balance.exceptions import SimulationError
+    from impact_balance.logs import check_log_path
+    from impact_balance.ranges import check_tolerance
+    from impact_balance.scenario import load_scenario
+    from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, write_trial_log
+    from impact_balance.sim.studies.validate import validate
+    from impact_balance.cli.output import print_json, progress_bar
 
     scenario = load_scenario(args.scenario)
     if scenario.impact is None:
@@ -116,8 +116,8 @@ def _text(out: dict, args: argparse.Namespace, n: int) -> str:
 
 
 def _plots(result, out: Path) -> list[Path]:
-    from ..plots.balance import plot_impact_trajectories, plot_validation
-    from ..plots.save import figure_prefix
+    from impact_balance.plots.balance import plot_impact_trajectories, plot_validation
+    from impact_balance.plots.save import figure_prefix
 
     out.mkdir(parents=True, exist_ok=True)
     setup = result.extra["setup"]

@@ -16,8 +16,8 @@ A :class:`Governor` gives that maximum every control tick, from the measured sta
 See docs/governor.md for the conventions and how pink, mink or any QP controller uses it.
 """
 
-from .governor import CRITERIA, Governor
-from .limit import SpeedLimit, cap_approach
-from .posture import Posture, PostureEvaluator, PostureSettings
+from impact_balance.governor.governor import CRITERIA, Governor
+from impact_balance.governor.limit import SpeedLimit, cap_approach
+from impact_balance.governor.posture import Posture, PostureEvaluator, PostureSettings
 
 __all__ = ["Governor", "CRITERIA", "SpeedLimit", "cap_approach", "Posture", "PostureEvaluator", "PostureSettings"]

@@ -10,18 +10,18 @@ from collections.abc import Sequence
 import numpy as np
 import pinocchio as pin
 
-from ..areas import warm_up as warm_up_maps
-from ..criteria import VelocityLimit
-from ..exceptions import GovernorError, ScenarioError
-from ..projection.bretl import warm_up as warm_up_bretl
-from ..projection.walk import warm_up
-from ..robot import Robot
-from ..scenario import BasePose, Scenario, load_scenario, scenario_from_dict, with_source
-from ..stance import _has_free_flyer
-from .limit import SpeedLimit, cap_approach
-from .posture import Posture, PostureEvaluator, PostureSettings
-from .support import ContactAwareLimit, combine
-from .worker import ContactAwareWorker
+from impact_balance.balance.areas import warm_up as warm_up_maps
+from impact_balance.criteria.com import VelocityLimit
+from impact_balance.exceptions import GovernorError, ScenarioError
+from impact_balance.projection.bretl import warm_up as warm_up_bretl
+from impact_balance.projection.walk import warm_up
+from impact_balance.robot.robot import Robot
+from impact_balance.scenario import BasePose, Scenario, load_scenario, scenario_from_dict, with_source
+from impact_balance.contacts.stance import _has_free_flyer
+from impact_balance.governor.limit import SpeedLimit, cap_approach
+from impact_balance.governor.posture import Posture, PostureEvaluator, PostureSettings
+from impact_balance.governor.support import ContactAwareLimit, combine
+from impact_balance.governor.worker import ContactAwareWorker
 
 __all__ = ["Governor", "CRITERIA"]
 

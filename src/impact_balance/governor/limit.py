@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..exceptions import GovernorError
+from impact_balance.exceptions import GovernorError
 
 __all__ = ["SpeedLimit", "cap_approach"]
 
@@ -27,7 +27,7 @@ class SpeedLimit:
             is unsafe; 0 when the robot is already falling or cannot balance), the number
             ``impact-balance analyze`` reports as ``max_contact_velocity``.
         status: "ok", "unbounded", "already_falling" or "cannot_balance"
-            (see :class:`~impact_balance.criteria.VelocityLimit`).
+            (see :class:`~impact_balance.criteria.com.VelocityLimit`).
         limiting_vertex: Index of the post-impact vertex (CoM) or impulse vertex (ZMP) that
             reaches the area's boundary first (None unless "ok").
         limiting_edge: Index of the area's edge it reaches (None unless "ok"; None also for
@@ -35,7 +35,7 @@ class SpeedLimit:
         safe_interval: The approach speeds ``(lo, hi)`` (m/s) that keep the robot balanced,
             or None when there are none. With the CoM velocity inside its area it is
             ``(0, max_approach_speed)``; outside (a falling start) it is the range of impacts
-            that bring it back inside (``lo > 0``), as :func:`~impact_balance.criteria.safe_interval`.
+            that bring it back inside (``lo > 0``), as :func:`~impact_balance.criteria.com.safe_interval`.
             The ZMP criterion has no falling start: ``(0, max)`` or None.
         com_velocity: The CoM velocity the answer is for (3,), world, m/s.
         normal: The impact surface's unit normal (3,), world, pointing into the robot.
@@ -79,7 +79,7 @@ def cap_approach(reference_velocity: Sequence[float], normal: np.ndarray,
 
     Only the component along ``normal`` changes (the tangential part is kept): this is the
     minimiser of ``||u - u_ref||`` under the speed bounds, the paper's QP objective, and
-    :func:`~impact_balance.criteria.capped_velocity` when the robot is balanced. With
+    :func:`~impact_balance.criteria.com.capped_velocity` when the robot is balanced. With
     ``s = -normal . u_ref``:
 
     - ``s <= 0`` (moving away or along the surface: no impact): unchanged;

@@ -6,12 +6,12 @@ polytope and its projection (the ZMP support area and the CoM velocity area), th
 model at the impacting frame, and the criterion's data that do not depend on the CoM velocity.
 
 The steps are the pipeline's own functions at the array level
-(:func:`~impact_balance.stance.frame_point`, :func:`~impact_balance.constraints.assemble_polytope`,
-:func:`~impact_balance.areas.areas_from_polytope`, :func:`~impact_balance.impact.model_from_inertia_map`,
-:class:`~impact_balance.criteria.ComCriterion`), so a governor answers what
+(:func:`~impact_balance.contacts.stance.frame_point`, :func:`~impact_balance.contacts.wrench_polytope.assemble_polytope`,
+:func:`~impact_balance.balance.areas.areas_from_polytope`, :func:`~impact_balance.impact.model.model_from_inertia_map`,
+:class:`~impact_balance.criteria.com.ComCriterion`), so a governor answers what
 :func:`~impact_balance.analyze` answers for the same posture (the tests check it to 1e-9);
-what a control loop does not read is skipped: the :class:`~impact_balance.stance.Stance`
-and :class:`~impact_balance.stance.Contact` objects (:attr:`Posture.stance` builds one on
+what a control loop does not read is skipped: the :class:`~impact_balance.contacts.stance.Stance`
+and :class:`~impact_balance.contacts.stance.Contact` objects (:attr:`Posture.stance` builds one on
 demand), the ZMP criterion in "com" mode, the diagnostics, the cannot-balance diagnosis.
 """
 
@@ -24,12 +24,12 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from ..areas import BalanceAreas, Projected, areas_from_polytope, projected_from_arrays
-from ..constraints import assemble_polytope, friction_scaling
-from ..criteria import ComCriterion, VelocityLimit, zmp_max_contact_velocity
-from ..cwc import _local_faces
-from ..exceptions import SolverError
-from ..impact import (
+from impact_balance.balance.areas import BalanceAreas, Projected, areas_from_polytope, projected_from_arrays
+from impact_balance.contacts.wrench_polytope import assemble_polytope, friction_scaling
+from impact_balance.criteria.com import ComCriterion, VelocityLimit, zmp_max_contact_velocity
+from impact_balance.contacts.cwc import _local_faces
+from impact_balance.exceptions import SolverError
+from impact_balance.impact.model import (
     ImpactModel,
     ImpactSpec,
     composite_inertia_map,
@@ -37,8 +37,8 @@ from ..impact import (
     joint_space_inertia_map,
     model_from_inertia_map,
 )
-from ..robot import Robot, Scratch
-from ..stance import ContactSpec, Stance, _has_free_flyer, frame_point
+from impact_balance.robot.robot import Robot, Scratch
+from impact_balance.contacts.stance import ContactSpec, Stance, _has_free_flyer, frame_point
 
 __all__ = ["PostureSettings", "Posture", "PostureEvaluator"]
 
@@ -59,7 +59,7 @@ class PostureSettings:
         zmp_margin: The ZMP support area is shrunk by this margin, m.
         criterion: "com" or "zmp".
         velocity_margin: The post-impact CoM velocities must lie this far inside the CoM
-            velocity area, m/s ("com" criterion; :class:`~impact_balance.criteria.ComCriterion`).
+            velocity area, m/s ("com" criterion; :class:`~impact_balance.criteria.com.ComCriterion`).
     """
 
     contacts: Sequence[ContactSpec]
@@ -84,7 +84,7 @@ class Posture:
         robot: The robot. settings: What it was evaluated with.
         com: The CoM, m. mass: kg.
         areas: The ZMP support area (shrunk by the ZMP margin) and the CoM velocity area (a
-            :class:`~impact_balance.areas.BalanceAreas`, built on first access: a tick reads
+            :class:`~impact_balance.balance.areas.BalanceAreas`, built on first access: a tick reads
             only the CoM velocity area, ``com_criterion.area``).
         impact: The impact model at this posture.
         com_jacobian: (3, nv) map from the generalized velocity (pinocchio's convention: the
@@ -115,7 +115,7 @@ class Posture:
 
     @functools.cached_property
     def stance(self) -> Stance:
-        """The :class:`~impact_balance.stance.Stance` at ``q`` (built on first access, in the
+        """The :class:`~impact_balance.contacts.stance.Stance` at ``q`` (built on first access, in the
         robot's per-thread Data, ~50 us): for plots and displays."""
         return Stance(self.robot, self.q, self.settings.contacts)
 
@@ -230,7 +230,7 @@ class PostureEvaluator:
 
     def _impact(self, q: np.ndarray, q_local: np.ndarray, origin: np.ndarray, com_local: np.ndarray, mass: float,
                 inertia: np.ndarray) -> ImpactModel:
-        """The impact model at the kinematics held in the Data (as :func:`~impact_balance.impact.impact_model`)."""
+        """The impact model at the kinematics held in the Data (as :func:`~impact_balance.impact.model.impact_model`)."""
         spec, data, model = self.settings.impact, self.scratch.data, self.model
         placement, J6 = frame_point(model, data, self._impact_frame, None)
         point_local = placement.translation.copy()

@@ -5,7 +5,7 @@ CoM velocities form a set, one vertex per friction-cone edge and restitution bou
 stances the supports change the jump: G1's feet keep it from turning about its CoM, so its
 CoM velocity jump is larger than any vertex of the floating set (docs/validation.md, "A
 contact-aware impact model"). :class:`ContactAwareLimit` adds, to the criterion's post-impact
-set, the jumps of :func:`impact_balance.contact_impact.contact_impact` (every support corner a
+set, the jumps of :func:`impact_balance.impact.contact_aware.contact_impact` (every support corner a
 unilateral, frictional, plastic point contact; no preload) at both ends of the restitution
 range: the governor then answers for the union of the two models' post-impact CoM velocities,
 i.e. the smaller of the two maximum approach speeds (``Governor(..., contact_aware=True)``).
@@ -52,11 +52,11 @@ from typing import Callable
 
 import numpy as np
 
-from ..contact_impact import contact_impact
-from ..criteria import ComCriterion, VelocityLimit, speed_interval
-from ..exceptions import GovernorError
-from ..impact import ImpactSpec
-from ..stance import Stance
+from impact_balance.impact.contact_aware import contact_impact
+from impact_balance.criteria.com import ComCriterion, VelocityLimit, speed_interval
+from impact_balance.exceptions import GovernorError
+from impact_balance.impact.model import ImpactSpec
+from impact_balance.contacts.stance import Stance
 
 __all__ = ["ContactAwareLimit", "ContactAwareAnswer", "ContactAwareSolutions", "STARTS", "contact_aware_rates",
            "contact_aware_solutions"]
@@ -171,7 +171,7 @@ class ContactAwareAnswer:
 
     Attributes:
         limit: Largest approach speed (m/s) keeping every contact-aware post-impact CoM velocity
-            in the area, as :class:`~impact_balance.criteria.VelocityLimit` (its vertex j: row j
+            in the area, as :class:`~impact_balance.criteria.com.VelocityLimit` (its vertex j: row j
             of ``rates``).
         interval: The approach speeds ``(lo, hi)`` (m/s) that keep them all in (the
             intersection over the rows), or None.
@@ -256,7 +256,7 @@ class ContactAwareLimit:
 
     def answer(self, criterion: ComCriterion, com_velocity: np.ndarray) -> ContactAwareAnswer:
         """The limit and interval (m/s of approach speed) for the CoM velocity area of
-        ``criterion`` (world xy, m/s; the posture's :class:`~impact_balance.criteria.ComCriterion`,
+        ``criterion`` (world xy, m/s; the posture's :class:`~impact_balance.criteria.com.ComCriterion`,
         its velocity margin included) and the pre-impact CoM velocity (world, m/s): the first
         exit over every row of the rates (the smallest speed), the intersection of their safe
         intervals."""

@@ -31,8 +31,8 @@ from typing import Any
 
 import numpy as np
 
-from ..exceptions import GovernorError
-from .support import ContactAwareLimit, ContactAwareSolutions
+from impact_balance.exceptions import GovernorError
+from impact_balance.governor.support import ContactAwareLimit, ContactAwareSolutions
 
 __all__ = ["ContactAwareWorker"]
 
@@ -44,8 +44,8 @@ def _serve(conn: Connection) -> None:
     """The worker's loop: first ``(scenario dict, source, starts)``, then ``(key, q)`` in and
     ``(key, solutions, error)`` out, each solve continuing the last answer; None or a closed
     pipe stops it."""
-    from ..scenario import scenario_from_dict
-    from ..stance import Stance
+    from impact_balance.scenario import scenario_from_dict
+    from impact_balance.contacts.stance import Stance
 
     raw, source, starts = conn.recv()
     # The lowest priority: woken by a request, the worker must not take the CPU from the

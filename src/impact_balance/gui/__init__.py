@@ -14,12 +14,12 @@
   :mod:`.scenario_tab` (settings and file controls), :mod:`.results` (the numbers as HTML).
 """
 
-from .drag import DragResult, DragTarget, drag_changes, handle_pose
-from .limbs import JointSlider, joint_groups, joint_values
-from .scene import Arrows, Label, Points, SceneObject, Segments, Surface, scene_objects
-from .session import Session, Summary, format_speed
-from .state import DEFAULT_SCENARIO, FieldPath, GuiState
-from .view2d import svg_view
+from impact_balance.gui.drag import DragResult, DragTarget, drag_changes, handle_pose
+from impact_balance.gui.limbs import JointSlider, joint_groups, joint_values
+from impact_balance.gui.scene import Arrows, Label, Points, SceneObject, Segments, Surface, scene_objects
+from impact_balance.gui.session import Session, Summary, format_speed
+from impact_balance.gui.state import DEFAULT_SCENARIO, FieldPath, GuiState
+from impact_balance.gui.view2d import svg_view
 
 __all__ = [
     "DragResult", "DragTarget", "drag_changes", "handle_pose",
@@ -35,7 +35,7 @@ __all__ = [
 def __getattr__(name: str):
     # viser is only needed to serve: keep `import impact_balance.gui` light for tests.
     if name in ("GuiApp", "run"):
-        from . import app
+        from impact_balance.gui import app
 
         return getattr(app, name)
     raise AttributeError(name)

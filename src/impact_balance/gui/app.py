@@ -18,19 +18,19 @@ from typing import Any
 
 import numpy as np
 
-from ..workspace import Workspace
-from .gizmos import GizmoMixin
-from .guard import AccessPolicy, guarded_start
-from .meshes import RobotMeshes
-from .panels import PanelsMixin
-from .results import results_html
-from .scenario_tab import ScenarioTabMixin
-from .server import GuiError, check_listen_address
-from .session import Session
-from .uploads import limit_uploads
-from .state import DEFAULT_SCENARIO, GuiState
-from .view2d import svg_view
-from .viser_scene import SceneMixin
+from impact_balance.gui.workspace import Workspace
+from impact_balance.gui.gizmos import GizmoMixin
+from impact_balance.gui.guard import AccessPolicy, guarded_start
+from impact_balance.gui.meshes import RobotMeshes
+from impact_balance.gui.panels import PanelsMixin
+from impact_balance.gui.results import results_html
+from impact_balance.gui.scenario_tab import ScenarioTabMixin
+from impact_balance.gui.server import GuiError, check_listen_address
+from impact_balance.gui.session import Session
+from impact_balance.gui.uploads import limit_uploads
+from impact_balance.gui.state import DEFAULT_SCENARIO, GuiState
+from impact_balance.gui.view2d import svg_view
+from impact_balance.gui.viser_scene import SceneMixin
 
 __all__ = ["GuiApp", "GuiError", "run"]
 

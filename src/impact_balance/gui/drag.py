@@ -1,7 +1,7 @@
 """Gizmo drags: move one contact or the impact point, inverse kinematics moves the robot.
 
 The dragged frame goes to the gizmo's pose while every other contact frame stays where it is
-(whole-body IK of :func:`impact_balance.ik.solve_stance`, pink). The answer is a set of
+(whole-body IK of :func:`impact_balance.robot.ik.solve_stance`, pink). The answer is a set of
 scenario changes (an explicit ``base`` pose and every joint value), so the dragged stance can
 be saved and analysed like any other.
 """
@@ -14,11 +14,11 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ..exceptions import ScenarioError
-from ..ik import IKError, solve_stance
-from ..stance import Stance
-from .limbs import joint_values
-from .state import FieldPath, GuiState
+from impact_balance.exceptions import ScenarioError
+from impact_balance.robot.ik import IKError, solve_stance
+from impact_balance.contacts.stance import Stance
+from impact_balance.gui.limbs import joint_values
+from impact_balance.gui.state import FieldPath, GuiState
 
 __all__ = ["DragTarget", "DragResult", "drag_changes", "handle_pose", "FIXED_TOLERANCE"]
 
@@ -58,7 +58,7 @@ class DragResult:
 
 
 def _offset(state: GuiState, path: FieldPath) -> pin.SE3:
-    from ..spatial import pose
+    from impact_balance.geometry.spatial import pose
 
     offset = state.get(path + ("offset",)) or {}
     return pose(offset.get("position", (0.0, 0.0, 0.0)), offset.get("rpy", (0.0, 0.0, 0.0)))

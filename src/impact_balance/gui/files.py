@@ -1,9 +1,9 @@
-"""Every file the GUI reads or writes, through the workspace rule (:mod:`impact_balance.workspace`).
+"""Every file the GUI reads or writes, through the workspace rule (:mod:`impact_balance.gui.workspace`).
 
 - load: a bundled scenario by name, or a ``.yaml`` file of the workspace;
 - ``extends:`` in a loaded or uploaded file: a bundled name or a workspace file;
 - ``robot: {urdf, srdf}`` in a loaded or uploaded file: workspace files (``.urdf``/``.srdf``);
-- upload: at most :data:`~impact_balance.workspace.MAX_FILE_BYTES`, parsed like a file;
+- upload: at most :data:`~impact_balance.gui.workspace.MAX_FILE_BYTES`, parsed like a file;
 - save: a workspace name, an existing file replaced only with ``overwrite``.
 
 :func:`describe` turns an error into the line the browser shows: the file, the field, the
@@ -19,10 +19,10 @@ import tempfile
 from importlib import resources
 from pathlib import Path
 
-from ..exceptions import ImpactBalanceError, ScenarioError, UnknownScenarioError, WorkspaceError
-from ..scenario import ExtendsResolver, RobotFiles, Scenario, bundled_scenarios, load_scenario
-from ..workspace import MAX_FILE_BYTES, Workspace
-from .state import GuiState
+from impact_balance.exceptions import ImpactBalanceError, ScenarioError, UnknownScenarioError, WorkspaceError
+from impact_balance.scenario import ExtendsResolver, RobotFiles, Scenario, bundled_scenarios, load_scenario
+from impact_balance.gui.workspace import MAX_FILE_BYTES, Workspace
+from impact_balance.gui.state import GuiState
 
 __all__ = ["GuiFiles", "describe", "bundled_path", "MAX_MESSAGE"]
 
@@ -65,8 +65,8 @@ def describe(exc: BaseException, workspace: Workspace | None = None) -> str:
         text = " ".join(text.split())  # one line
     elif isinstance(exc, ImpactBalanceError):
         text = " ".join(str(exc).split())
-    else:  # the command line's rule (impact_balance.errors): a YAML, OS or other error as one line
-        from ..errors import describe_error
+    else:  # the command line's rule (impact_balance.exit_status): a YAML, OS or other error as one line
+        from impact_balance.exit_status import describe_error
 
         line, _ = describe_error(exc, quote=False)  # never a third party's text: it may quote a file
         text = line.split("; rerun with --debug")[0]

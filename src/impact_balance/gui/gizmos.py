@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from .drag import DragTarget, handle_pose
+from impact_balance.gui.drag import DragTarget, handle_pose
 
 __all__ = ["GizmoMixin"]
 

@@ -37,7 +37,7 @@ from dataclasses import dataclass
 from typing import Any
 from urllib.parse import urlsplit
 
-from ..exceptions import ImpactBalanceError
+from impact_balance.exceptions import ImpactBalanceError
 
 __all__ = ["AccessPolicy", "OriginError", "LOCAL_NAMES", "guarded_start", "normalize_origin"]
 
@@ -209,7 +209,7 @@ def guarded_start(policy: AccessPolicy) -> Iterator[list[int]]:
     def serve(handler: Any, *args: Any, process_request: Any = None, **kwargs: Any) -> Any:
         if inspect.iscoroutinefunction(process_request):  # pragma: no cover - viser's is a function
             raise RuntimeError("impact-balance's GUI guard expects a synchronous process_request")
-        from .uploads import MAX_MESSAGE_BYTES, MAX_QUEUED_MESSAGES
+        from impact_balance.gui.uploads import MAX_MESSAGE_BYTES, MAX_QUEUED_MESSAGES
 
         started.append(1)
         kwargs["max_size"] = min(kwargs.get("max_size") or MAX_MESSAGE_BYTES, MAX_MESSAGE_BYTES)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import pinocchio as pin
 
-from ..robot import Robot
+from impact_balance.robot.robot import Robot
 
 __all__ = ["JointSlider", "joint_groups", "joint_values"]
 

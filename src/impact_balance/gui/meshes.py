@@ -1,7 +1,7 @@
 """The robot's visual meshes (URDF ``<visual>`` geometry) in the viser scene.
 
 The meshes are read once per robot with pinocchio's visual ``GeometryModel`` and
-:func:`impact_balance.mesh_files.read_mesh` (trimesh; COLLADA ``.dae`` through pycollada, as
+:func:`impact_balance.robot.meshes.read_mesh` (trimesh; COLLADA ``.dae`` through pycollada, as
 Romeo's and iCub's meshes are); an update only moves them (one pose per mesh), which is what
 keeps redraws cheap. Meshes that cannot be read are skipped with one warning naming them.
 """
@@ -16,9 +16,9 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ..exceptions import RobotLoadError
-from ..mesh_files import read_mesh
-from ..robot import Robot
+from impact_balance.exceptions import RobotLoadError
+from impact_balance.robot.meshes import read_mesh
+from impact_balance.robot.robot import Robot
 
 __all__ = ["VisualMesh", "load_visual_meshes", "RobotMeshes"]
 

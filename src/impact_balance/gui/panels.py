@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from .limbs import joint_groups, joint_values
+from impact_balance.gui.limbs import joint_groups, joint_values
 
 __all__ = ["PanelsMixin"]
 

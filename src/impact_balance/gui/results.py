@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import html
 
-from .session import Session, format_speed
+from impact_balance.gui.session import Session, format_speed
 
 __all__ = ["results_html"]
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..scenario import bundled_scenarios
-from .state import DEFAULT_SCENARIO
+from impact_balance.scenario import bundled_scenarios
+from impact_balance.gui.state import DEFAULT_SCENARIO
 
 __all__ = ["ScenarioTabMixin"]
 

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis import Analysis
-from ..polygon import Polygon
+from impact_balance.analysis.analyze import Analysis
+from impact_balance.geometry.polygon import Polygon
 
 __all__ = [
     "Segments",

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..exceptions import ImpactBalanceError
+from impact_balance.exceptions import ImpactBalanceError
 
 __all__ = ["GuiError", "check_listen_address"]
 

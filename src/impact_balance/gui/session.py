@@ -21,12 +21,12 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ..analysis import Analysis, analyze
-from ..exceptions import ImpactBalanceError
-from ..workspace import Workspace
-from .drag import DragTarget, drag_changes
-from .files import GuiFiles, describe
-from .state import DEFAULT_SCENARIO, FieldPath, GuiState
+from impact_balance.analysis.analyze import Analysis, analyze
+from impact_balance.exceptions import ImpactBalanceError
+from impact_balance.gui.workspace import Workspace
+from impact_balance.gui.drag import DragTarget, drag_changes
+from impact_balance.gui.files import GuiFiles, describe
+from impact_balance.gui.state import DEFAULT_SCENARIO, FieldPath, GuiState
 
 __all__ = ["Summary", "Governed", "Session", "format_speed"]
 
@@ -71,7 +71,7 @@ class Summary:
         zmp_max_contact_velocity: The same by the ZMP criterion, m/s.
         reference_speed: Approach speed of the reference velocity, m/s (None without one).
         falls_at_reference: Whether the reference approach speed exceeds the maximum.
-        warnings: The analysis' warnings, one line each (see :mod:`impact_balance.diagnostics`).
+        warnings: The analysis' warnings, one line each (see :mod:`impact_balance.analysis.diagnostics`).
     """
 
     verdict: str
@@ -166,7 +166,7 @@ class Session:
         if scenario.impact is None or not self.analysis.areas.can_balance:
             self.governed = None
             return
-        from ..governor import Governor
+        from impact_balance.governor import Governor
 
         key = scenario.model_dump_json(exclude={"configuration", "joints", "base", "com_velocity", "name",
                                                 "description"})

@@ -19,8 +19,8 @@ from typing import Any
 import numpy as np
 import yaml
 
-from ..exceptions import ScenarioError
-from ..scenario import RobotFiles, Scenario, load_scenario, scenario_from_dict
+from impact_balance.exceptions import ScenarioError
+from impact_balance.scenario import RobotFiles, Scenario, load_scenario, scenario_from_dict
 
 __all__ = ["FieldPath", "GuiState", "DEFAULT_SCENARIO", "plain"]
 

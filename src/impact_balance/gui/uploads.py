@@ -29,7 +29,7 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
-from ..workspace import MAX_FILE_BYTES
+from impact_balance.gui.workspace import MAX_FILE_BYTES
 
 __all__ = ["limit_uploads", "UploadLimit", "MAX_UPLOAD_BYTES", "MAX_UPLOAD_PARTS", "MAX_TRANSFERS_PER_CLIENT",
            "MAX_MESSAGE_BYTES", "MAX_QUEUED_MESSAGES"]

@@ -17,9 +17,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..analysis import Analysis
-from ..polygon import Polygon
-from .session import Summary, format_speed
+from impact_balance.analysis.analyze import Analysis
+from impact_balance.geometry.polygon import Polygon
+from impact_balance.gui.session import Summary, format_speed
 
 __all__ = ["svg_view", "PANEL_COLORS"]
 

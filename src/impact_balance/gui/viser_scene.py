@@ -7,8 +7,8 @@ from typing import Any
 
 import numpy as np
 
-from .meshes import RobotMeshes
-from .scene import Arrows, Label, Points, Segments, Surface, scene_objects
+from impact_balance.gui.meshes import RobotMeshes
+from impact_balance.gui.scene import Arrows, Label, Points, Segments, Surface, scene_objects
 
 __all__ = ["SceneMixin", "add_object", "update_object"]
 

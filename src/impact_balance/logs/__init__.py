@@ -4,9 +4,9 @@ A log is a table, one row per sample, stored as Parquet (``.parquet``) or CSV (`
 See :mod:`impact_balance.logs.schema` for the columns.
 """
 
-from .check import LogCheck, Violation, check_log
-from .io import check_log_columns, check_log_path, read_log, write_log
-from .schema import LOG_VERSION, LogColumns, joint_position_column, joint_velocity_column, force_columns
+from impact_balance.logs.check import LogCheck, Violation, check_log
+from impact_balance.logs.io import check_log_columns, check_log_path, read_log, write_log
+from impact_balance.logs.schema import LOG_VERSION, LogColumns, joint_position_column, joint_velocity_column, force_columns
 
 __all__ = ["check_log", "LogCheck", "Violation", "read_log", "write_log", "check_log_path", "check_log_columns", "LOG_VERSION", "LogColumns", "joint_position_column",
            "joint_velocity_column", "force_columns"]

@@ -35,13 +35,13 @@ import numpy as np
 import pandas as pd
 import pinocchio as pin
 
-from ..areas import balance_areas
-from ..exceptions import ScenarioError
-from ..polygon import Polygon
-from ..scenario import Scenario, load_scenario
-from ..stance import Stance
-from .io import check_log_columns
-from .schema import LogColumns, force_columns, joint_position_column, joint_velocity_column
+from impact_balance.balance.areas import balance_areas
+from impact_balance.exceptions import ScenarioError
+from impact_balance.geometry.polygon import Polygon
+from impact_balance.scenario import Scenario, load_scenario
+from impact_balance.contacts.stance import Stance
+from impact_balance.logs.io import check_log_columns
+from impact_balance.logs.schema import LogColumns, force_columns, joint_position_column, joint_velocity_column
 
 __all__ = ["StanceSegment", "Violation", "LogCheck", "check_log", "log_state"]
 

@@ -1,6 +1,6 @@
 """Write and read logs (Parquet or CSV, chosen by the file's suffix) through pandas/pyarrow.
 
-Reading is bounded and strict (see :mod:`impact_balance.input_limits` for the limits):
+Reading is bounded and strict (see :mod:`impact_balance.scenario.reader` for the limits):
 
 - the file's size, row count, column count and value count are checked before it is read
   (a Parquet file's from its metadata; a CSV file is read up to the first row past the limit);
@@ -22,10 +22,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..diagnostics import Diagnostic
-from ..exceptions import ScenarioError, short_repr
-from ..input_limits import MAX_LOG_BYTES, MAX_LOG_COLUMNS, MAX_LOG_ROWS, MAX_LOG_VALUES
-from .schema import LOG_VERSION, LogColumns
+from impact_balance.analysis.result import Diagnostic
+from impact_balance.exceptions import ScenarioError, short_repr
+from impact_balance.scenario.reader import MAX_LOG_BYTES, MAX_LOG_COLUMNS, MAX_LOG_ROWS, MAX_LOG_VALUES
+from impact_balance.logs.schema import LOG_VERSION, LogColumns
 
 __all__ = ["write_log", "read_log", "check_log_path", "check_log_columns", "SUFFIXES"]
 

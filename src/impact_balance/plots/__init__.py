@@ -14,12 +14,12 @@ the figures of one analysis as PNG files named after its scenario.
 - :func:`plot_stance`: top and side views of the stance.
 """
 
-from .areas import plot_areas
-from .friction import plot_friction_comparison
-from .impulse import plot_impulse_set
-from .phase import analysis_phase_portrait, plot_phase_portrait
-from .save import save_figures
-from .stance import plot_stance
+from impact_balance.plots.areas import plot_areas
+from impact_balance.plots.friction import plot_friction_comparison
+from impact_balance.plots.impulse import plot_impulse_set
+from impact_balance.plots.phase import analysis_phase_portrait, plot_phase_portrait
+from impact_balance.plots.save import save_figures
+from impact_balance.plots.stance import plot_stance
 
 __all__ = [
     "plot_areas",

@@ -11,7 +11,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Polygon as PolygonPatch
 
-from ..polygon import Polygon
+from impact_balance.geometry.polygon import Polygon
 
 #: Colours used consistently across the figures.
 ZMP_COLOR = "#8fbc8f"  # ZMP support area

@@ -11,14 +11,14 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from ._common import AREA_COLOR, draw_polygon, new_figure, set_limits
-from .balance import OUTCOME_COLORS
+from impact_balance.plots._common import AREA_COLOR, draw_polygon, new_figure, set_limits
+from impact_balance.plots.balance import OUTCOME_COLORS
 
 __all__ = ["plot_approach"]
 
 
 def plot_approach(trial, analysis, margin_area=None) -> Figure:
-    """The figure of a :class:`~impact_balance.sim.wall.WallTrial` (see the module docstring);
+    """The figure of a :class:`~impact_balance.sim.studies.wall.WallTrial` (see the module docstring);
     ``margin_area``: the CoM velocity area the governor used, when it differs (a ZMP margin)."""
     fig = new_figure(11.0, 4.8)
     left, right = fig.subplots(1, 2, width_ratios=[1.3, 1.0])

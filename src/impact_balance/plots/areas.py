@@ -11,8 +11,8 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
-from ..analysis import Analysis
-from ._common import (
+from impact_balance.analysis.analyze import Analysis
+from impact_balance.plots._common import (
     AREA_COLOR,
     COM_COLOR,
     CONTACT_COLOR,

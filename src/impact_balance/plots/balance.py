@@ -17,8 +17,8 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from ..polygon import Polygon
-from ._common import AREA_COLOR, FALL_COLOR, OK_COLOR, ZMP_COLOR, draw_polygon, new_figure, set_limits
+from impact_balance.geometry.polygon import Polygon
+from impact_balance.plots._common import AREA_COLOR, FALL_COLOR, OK_COLOR, ZMP_COLOR, draw_polygon, new_figure, set_limits
 
 __all__ = ["OUTCOME_COLORS", "plot_validation", "plot_impact_trajectories", "plot_push_trajectories", "plot_log_margins"]
 

@@ -8,9 +8,9 @@ import numpy as np
 from matplotlib import colormaps
 from matplotlib.figure import Figure
 
-from ..analysis import Analysis
-from ._common import AREA_COLOR, COM_COLOR, area_view_points, draw_polygon, fmt_speed, hull, new_figure, set_limits
-from .impulse import impulse_set_speed
+from impact_balance.analysis.analyze import Analysis
+from impact_balance.plots._common import AREA_COLOR, COM_COLOR, area_view_points, draw_polygon, fmt_speed, hull, new_figure, set_limits
+from impact_balance.plots.impulse import impulse_set_speed
 
 __all__ = ["plot_friction_comparison"]
 

@@ -9,9 +9,9 @@ from matplotlib.ticker import MaxNLocator
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 from scipy.spatial import ConvexHull, QhullError
 
-from ..analysis import Analysis
-from ..impact import ImpactModel
-from ._common import IMPACT_COLOR, centre_message, draw_polygon, hull, new_figure, scenario_title, set_limits
+from impact_balance.analysis.analyze import Analysis
+from impact_balance.impact.model import ImpactModel
+from impact_balance.plots._common import IMPACT_COLOR, centre_message, draw_polygon, hull, new_figure, scenario_title, set_limits
 
 __all__ = ["plot_impulse_set", "impulse_set_speed"]
 

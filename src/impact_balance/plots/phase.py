@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..analysis import Analysis
-from ..lipm import PhasePortrait, phase_portrait
-from ._common import new_figure
+from impact_balance.analysis.analyze import Analysis
+from impact_balance.balance.lipm import PhasePortrait, phase_portrait
+from impact_balance.plots._common import new_figure
 
 __all__ = ["plot_phase_portrait", "analysis_phase_portrait"]
 

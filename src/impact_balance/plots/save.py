@@ -7,13 +7,13 @@ from pathlib import Path
 
 from matplotlib.figure import Figure
 
-from ..analysis import Analysis
-from ..diagnostics import Diagnostic
-from ._common import DPI
-from .areas import plot_areas
-from .impulse import plot_impulse_set
-from .phase import analysis_phase_portrait, plot_phase_portrait
-from .stance import plot_stance
+from impact_balance.analysis.analyze import Analysis
+from impact_balance.analysis.result import Diagnostic
+from impact_balance.plots._common import DPI
+from impact_balance.plots.areas import plot_areas
+from impact_balance.plots.impulse import plot_impulse_set
+from impact_balance.plots.phase import analysis_phase_portrait, plot_phase_portrait
+from impact_balance.plots.stance import plot_stance
 
 __all__ = ["save_figures", "figure_prefix"]
 

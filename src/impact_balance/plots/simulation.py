@@ -7,7 +7,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MaxNLocator
 
-from ._common import IMPACT_COLOR, draw_polygon, hull, new_figure, text_box, trim_height
+from impact_balance.plots._common import IMPACT_COLOR, draw_polygon, hull, new_figure, text_box, trim_height
 
 __all__ = ["plot_jump_on_sets", "plot_time_series"]
 

@@ -6,8 +6,8 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from ..analysis import Analysis
-from ._common import (
+from impact_balance.analysis.analyze import Analysis
+from impact_balance.plots._common import (
     COM_COLOR,
     CONTACT_COLOR,
     IMPACT_COLOR,

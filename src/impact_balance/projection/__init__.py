@@ -16,10 +16,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..exceptions import SolverError
-from .bretl import project_bretl
-from .result import ProjectionResult
-from .walk import project_walk
+from impact_balance.exceptions import SolverError
+from impact_balance.projection.bretl import project_bretl
+from impact_balance.projection.result import ProjectionResult
+from impact_balance.projection.walk import project_walk
 
 __all__ = ["ProjectionResult", "project_polytope", "project_bretl", "project_walk", "METHODS"]
 

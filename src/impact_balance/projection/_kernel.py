@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 
-from .._jit import njit
+from impact_balance._jit import njit
 
 __all__ = ["project", "project_equalities", "equality_basis", "walk", "OK", "INFEASIBLE", "FAILED", "LINE", "INCONSISTENT"]
 

@@ -21,10 +21,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..exceptions import SolverError
-from ..polygon import Polygon, simplify
-from ..solvers import HighsLP, LinearProgram
-from .result import ProjectionResult
+from impact_balance.exceptions import SolverError
+from impact_balance.geometry.polygon import Polygon, simplify
+from impact_balance.solvers import HighsLP, LinearProgram
+from impact_balance.projection.result import ProjectionResult
 
 __all__ = ["project_bretl", "warm_up"]
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..polygon import Polygon
+from impact_balance.geometry.polygon import Polygon
 
 __all__ = ["ProjectionResult"]
 

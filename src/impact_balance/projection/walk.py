@@ -22,12 +22,12 @@ import os
 
 import numpy as np
 
-from .. import polygon
-from .._jit import HAVE_NUMBA, cache_depends_on, njit
-from ..polygon import MERGE_AREA_TOLERANCE, Polygon, _simplify_convex
-from . import _kernel
-from ._kernel import FAILED, INCONSISTENT, INFEASIBLE, LINE, OK, project, project_equalities
-from .result import ProjectionResult
+from impact_balance.geometry import polygon
+from impact_balance._jit import HAVE_NUMBA, cache_depends_on, njit
+from impact_balance.geometry.polygon import MERGE_AREA_TOLERANCE, Polygon, _simplify_convex
+from impact_balance.projection import _kernel
+from impact_balance.projection._kernel import FAILED, INCONSISTENT, INFEASIBLE, LINE, OK, project, project_equalities
+from impact_balance.projection.result import ProjectionResult
 
 __all__ = ["project_walk", "certified_walk", "kernel_is_compiled", "warm_up", "MAX_PIVOTS"]
 

@@ -39,10 +39,10 @@ def __getattr__(name: str) -> Any:
 
 
 if TYPE_CHECKING:
-    from .bundled import bundled_scenarios, scenario_path
-    from .load import ExtendsResolver, _merge, _read, load_scenario
-    from .schema import BasePose, ContactConfig, ImpactConfig, Offset, QPConfig, RobotFiles, Scenario, with_source
-    from .validate import _field, scenario_from_dict
+    from impact_balance.scenario.bundled import bundled_scenarios, scenario_path
+    from impact_balance.scenario.load import ExtendsResolver, _merge, _read, load_scenario
+    from impact_balance.scenario.schema import BasePose, ContactConfig, ImpactConfig, Offset, QPConfig, RobotFiles, Scenario, with_source
+    from impact_balance.scenario.validate import _field, scenario_from_dict
 
 __all__ = [
     "Offset",

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import yaml
 
-from ..exceptions import ScenarioError, UnknownScenarioError
-from ..input_limits import check_path_text
+from impact_balance.exceptions import ScenarioError, UnknownScenarioError
+from impact_balance.scenario.reader import check_path_text
 
 __all__ = ["bundled_descriptions", "bundled_scenarios", "scenario_path"]
 

@@ -12,7 +12,7 @@ from typing import Annotated, Any
 import numpy as np
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict
 
-from ..constants import MAX_ANGLE, MAX_FRICTION, MAX_POSITION, MAX_SPEED
+from impact_balance.constants import MAX_ANGLE, MAX_FRICTION, MAX_POSITION, MAX_SPEED
 
 __all__ = ["Number", "Integer", "Flag", "Vec2", "Vec3", "Position", "Angles", "Friction"]
 

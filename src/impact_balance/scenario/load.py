@@ -2,7 +2,7 @@
 
 A scenario may ``extends:`` another (a bundled name or a path): mappings are merged
 recursively, everything else is replaced. Files are read through
-:func:`impact_balance.input_limits.read_text` (size limits) and parsed with a cache keyed by
+:func:`impact_balance.scenario.reader.read_text` (size limits) and parsed with a cache keyed by
 content; the validated :class:`Scenario` is cached too, keyed by the text of every file of its
 ``extends`` chain, so loading an unchanged file again costs its reads only (~20 us a file).
 """
@@ -14,11 +14,11 @@ import typing
 from collections import OrderedDict
 from pathlib import Path
 
-from ..exceptions import ScenarioError, UnknownScenarioError
-from ..input_limits import MAX_EXTENDS, _parse_cached, check_path_text, parse_yaml, read_text
-from .bundled import _is_file, scenario_path
-from .schema import Scenario
-from .validate import scenario_from_dict
+from impact_balance.exceptions import ScenarioError, UnknownScenarioError
+from impact_balance.scenario.reader import MAX_EXTENDS, _parse_cached, check_path_text, parse_yaml, read_text
+from impact_balance.scenario.bundled import _is_file, scenario_path
+from impact_balance.scenario.schema import Scenario
+from impact_balance.scenario.validate import scenario_from_dict
 
 __all__ = ["ExtendsResolver", "load_scenario"]
 

@@ -1,7 +1,7 @@
 """The scenario YAML schema: one pydantic model per mapping, strict and bounded.
 
 Every model refuses unknown keys, NaN and infinities; :class:`Scenario` resolves itself
-against a robot model into a :class:`~impact_balance.stance.Stance`.
+against a robot model into a :class:`~impact_balance.contacts.stance.Stance`.
 """
 
 from __future__ import annotations
@@ -14,15 +14,15 @@ import numpy as np
 import pinocchio as pin
 from pydantic import AfterValidator, Field, ValidationInfo, field_validator
 
-from ..constants import GRAVITY_RANGE, MAX_ANGLE, MAX_DESCRIPTION, MAX_DURATION, MAX_FRICTION, MAX_NAME, MAX_PEAK_FACTOR, MAX_POSITION, MAX_SIZE
-from ..exceptions import ScenarioError
-from ..impact import ImpactSpec
-from ..input_limits import check_path_text
-from ..robot import Robot, load_robot
-from ..spatial import pose, surface_rotation
-from ..stance import ContactSpec, Stance
-from .fields import Angles, Flag, Friction, Integer, Number, Position, Vec2, Vec3, _coordinates, _finite, _Model, _scalar, _speed
-from .specs import _contact_spec, _impact_spec, _quaternion
+from impact_balance.constants import GRAVITY_RANGE, MAX_ANGLE, MAX_DESCRIPTION, MAX_DURATION, MAX_FRICTION, MAX_NAME, MAX_PEAK_FACTOR, MAX_POSITION, MAX_SIZE
+from impact_balance.exceptions import ScenarioError
+from impact_balance.impact.model import ImpactSpec
+from impact_balance.scenario.reader import check_path_text
+from impact_balance.robot.robot import Robot, load_robot
+from impact_balance.geometry.spatial import pose, surface_rotation
+from impact_balance.contacts.stance import ContactSpec, Stance
+from impact_balance.scenario.fields import Angles, Flag, Friction, Integer, Number, Position, Vec2, Vec3, _coordinates, _finite, _Model, _scalar, _speed
+from impact_balance.scenario.specs import _contact_spec, _impact_spec, _quaternion
 
 __all__ = ["Offset", "ContactConfig", "QPConfig", "ImpactConfig", "RobotFiles", "BasePose", "Scenario", "with_source"]
 
@@ -38,11 +38,11 @@ class Offset(_Model):
 
 
 class ContactConfig(_Model):
-    """A sustained rectangular contact (see :class:`impact_balance.stance.ContactSpec`).
+    """A sustained rectangular contact (see :class:`impact_balance.contacts.stance.ContactSpec`).
 
     Its orientation is either ``offset.rpy`` (in the frame) or ``normal`` (the surface
     normal in the world, from the surface into the robot) with an optional ``angle`` (rad)
-    about it: see :func:`impact_balance.spatial.surface_rotation`. The normal form is
+    about it: see :func:`impact_balance.geometry.spatial.surface_rotation`. The normal form is
     resolved at the scenario's configuration (:meth:`Scenario.contact_specs`).
     """
 
@@ -109,7 +109,7 @@ class QPConfig(_Model):
 
 
 class ImpactConfig(_Model):
-    """The intended impact (see :class:`impact_balance.impact.ImpactSpec`)."""
+    """The intended impact (see :class:`impact_balance.impact.model.ImpactSpec`)."""
 
     frame: str
     offset: Offset = Offset()

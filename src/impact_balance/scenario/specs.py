@@ -1,7 +1,7 @@
 """Library objects built from scenario values, cached by content.
 
-The schema's models hand out :class:`~impact_balance.stance.ContactSpec`,
-:class:`~impact_balance.impact.ImpactSpec` and base quaternions through these functions.
+The schema's models hand out :class:`~impact_balance.contacts.stance.ContactSpec`,
+:class:`~impact_balance.impact.model.ImpactSpec` and base quaternions through these functions.
 """
 
 from __future__ import annotations
@@ -11,10 +11,10 @@ import functools
 import numpy as np
 import pinocchio as pin
 
-from ..impact import ImpactSpec
-from ..spatial import pose
-from ..stance import ContactSpec
-from .fields import Vec2, Vec3
+from impact_balance.impact.model import ImpactSpec
+from impact_balance.geometry.spatial import pose
+from impact_balance.contacts.stance import ContactSpec
+from impact_balance.scenario.fields import Vec2, Vec3
 
 __all__: list[str] = []
 

@@ -8,9 +8,9 @@ from typing import Any
 
 from pydantic import BaseModel, ValidationError
 
-from ..exceptions import ScenarioError, UnknownKeyError
-from ..input_limits import check_structure
-from .schema import Scenario
+from impact_balance.exceptions import ScenarioError, UnknownKeyError
+from impact_balance.scenario.reader import check_structure
+from impact_balance.scenario.schema import Scenario
 
 __all__ = ["scenario_from_dict"]
 
@@ -31,7 +31,7 @@ def scenario_from_dict(raw: dict, source: str | None = None, check_size: bool = 
     """Validate a scenario mapping; raises :class:`ScenarioError` on the first bad field.
 
     ``check_size=False`` skips the nesting and expanded-size check of
-    :func:`~impact_balance.input_limits.check_structure`, for a mapping the library built from
+    :func:`~impact_balance.scenario.reader.check_structure`, for a mapping the library built from
     input that already passed it (a sweep's points: its base scenario and its file were
     checked once, when the sweep was planned).
     """

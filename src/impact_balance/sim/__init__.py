@@ -4,11 +4,11 @@ an impact trial (:mod:`.trial`) and its measurement against the impact model (:m
 See :func:`build_model`, :class:`SimModel` and :func:`simulate`.
 """
 
-from .environment import ContactParameters
-from .joints import JOINT_MODELS, ServoOptions
-from .measure import Prediction, TrialResult, measure
-from .model import SimModel, SimOptions, build_model
-from .trial import TrialOptions, TrialRecord, run_trial
+from impact_balance.sim.model.environment import ContactParameters
+from impact_balance.sim.model.joints import JOINT_MODELS, ServoOptions
+from impact_balance.sim.trials.measure import Prediction, TrialResult, measure
+from impact_balance.sim.model.build import SimModel, SimOptions, build_model
+from impact_balance.sim.trials.impact_trial import TrialOptions, TrialRecord, run_trial
 
 __all__ = ["build_model", "SimModel", "SimOptions", "ContactParameters", "ServoOptions", "JOINT_MODELS",
            "TrialOptions", "TrialRecord", "run_trial", "Prediction", "TrialResult", "measure", "simulate"]

@@ -1,6 +1,6 @@
 """Numerical backends: linear programs (HiGHS) and quadratic programs (qpsolvers)."""
 
-from .highs import HighsLP
-from .lp import LinearProgram, LPSolution
+from impact_balance.solvers.highs import HighsLP
+from impact_balance.solvers.lp import LinearProgram, LPSolution
 
 __all__ = ["HighsLP", "LinearProgram", "LPSolution"]

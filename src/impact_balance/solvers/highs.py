@@ -5,8 +5,8 @@ from __future__ import annotations
 import highspy
 import numpy as np
 
-from ..exceptions import SolverError
-from .lp import LinearProgram, LPSolution
+from impact_balance.exceptions import SolverError
+from impact_balance.solvers.lp import LinearProgram, LPSolution
 
 __all__ = ["HighsLP"]
 

@@ -7,11 +7,11 @@ the runner (:mod:`.runner`) spreads chunks over processes or a Dask cluster and 
 :mod:`.summary` and :mod:`.figures` read the results back.
 """
 
-from .evaluate import RESULT_COLUMNS, STATUSES, Evaluator, result_schema
-from .plan import Dimension, SweepPlan, make_plan, plan_sweep
-from .runner import RunReport, default_workers, run_sweep
-from .spec import SweepSpec, bundled_sweeps, load_sweep_spec, sweep_path, sweep_spec_from_dict
-from .store import ResultStore, read_manifest, read_results
+from impact_balance.sweep.evaluate import RESULT_COLUMNS, STATUSES, Evaluator, result_schema
+from impact_balance.sweep.plan import Dimension, SweepPlan, make_plan, plan_sweep
+from impact_balance.sweep.runner import RunReport, default_workers, run_sweep
+from impact_balance.sweep.spec import SweepSpec, bundled_sweeps, load_sweep_spec, sweep_path, sweep_spec_from_dict
+from impact_balance.sweep.store import ResultStore, read_manifest, read_results
 
 __all__ = [
     "RESULT_COLUMNS", "STATUSES", "Evaluator", "result_schema",

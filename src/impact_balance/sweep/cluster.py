@@ -15,7 +15,7 @@ import re
 import socket
 from typing import Any
 
-from ..exceptions import EnvironmentFailure, OptionError
+from impact_balance.exceptions import EnvironmentFailure, OptionError
 
 __all__ = ["check_scheduler_address", "connect", "CONNECT_TIMEOUT_S", "SCHEMES"]
 

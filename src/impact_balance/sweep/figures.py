@@ -20,8 +20,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ..plots._common import DPI, new_figure
-from .summary import EVALUATED, load_frame
+from impact_balance.plots._common import DPI, new_figure
+from impact_balance.sweep.summary import EVALUATED, load_frame
 
 __all__ = ["sweep_figures", "save_sweep_figures", "axis_label"]
 

@@ -12,7 +12,7 @@ import re
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from ..exceptions import SweepError, UnknownPathError
+from impact_balance.exceptions import SweepError, UnknownPathError
 
 __all__ = ["parse_path", "format_path", "check_path", "get_path", "set_path", "STANCE_FREE_ROOTS"]
 

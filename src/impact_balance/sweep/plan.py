@@ -28,12 +28,12 @@ from typing import Any
 import numpy as np
 from scipy.stats import qmc
 
-from ..exceptions import ImpactBalanceError, ScenarioError, SweepError
-from ..numeric_limits import MAX_SWEEP_POINTS
-from ..robot import Robot
-from ..scenario import _merge, _read, scenario_from_dict, scenario_path
-from .paths import STANCE_FREE_ROOTS, Token, check_path, format_path, parse_path, set_path
-from .spec import Dim, DirectionAxis, PathAxis, PostureAxis, SweepSpec, _check_size, load_sweep_spec
+from impact_balance.exceptions import ImpactBalanceError, ScenarioError, SweepError
+from impact_balance.ranges import MAX_SWEEP_POINTS
+from impact_balance.robot.robot import Robot
+from impact_balance.scenario import _merge, _read, scenario_from_dict, scenario_path
+from impact_balance.sweep.paths import STANCE_FREE_ROOTS, Token, check_path, format_path, parse_path, set_path
+from impact_balance.sweep.spec import Dim, DirectionAxis, PathAxis, PostureAxis, SweepSpec, _check_size, load_sweep_spec
 
 __all__ = ["Dimension", "SweepPlan", "make_plan", "plan_sweep", "PLAN_VERSION"]
 
@@ -223,7 +223,7 @@ def _dimensions(spec: SweepSpec, base: dict[str, Any], robot: Robot) -> list[Dim
     for name in names:
         if names.count(name) > 1:
             raise SweepError("axes", name, "appears in two axes")
-    from .evaluate import RESULT_COLUMNS  # the result columns' names are taken
+    from impact_balance.sweep.columns import RESULT_COLUMNS  # the result columns' names are taken
 
     taken = {"point", "chunk"} | {c[0] for c in RESULT_COLUMNS}
     for d in dims:

@@ -46,12 +46,12 @@ from typing import Any
 import pyarrow as pa
 from tqdm import tqdm
 
-from ..areas import areas_from_polytope
-from ..constraints import wrench_polytope
-from ..scenario import scenario_from_dict
-from .evaluate import Evaluator
-from .plan import SweepPlan
-from .store import ResultStore
+from impact_balance.balance.areas import areas_from_polytope
+from impact_balance.contacts.wrench_polytope import wrench_polytope
+from impact_balance.scenario import scenario_from_dict
+from impact_balance.sweep.evaluate import Evaluator
+from impact_balance.sweep.plan import SweepPlan
+from impact_balance.sweep.store import ResultStore
 
 __all__ = ["RunReport", "run_sweep", "default_workers", "STOP_GRACE_S"]
 
@@ -285,7 +285,7 @@ class _Dask:
     name = "dask"
 
     def __init__(self, plan: SweepPlan, scheduler: Any):
-        from .cluster import connect
+        from impact_balance.sweep.cluster import connect
 
         self.own = isinstance(scheduler, str)
         self.client = connect(scheduler) if self.own else scheduler

@@ -23,7 +23,7 @@ axes:
 Every problem becomes a :class:`~impact_balance.exceptions.SweepError` naming the field and
 the value. Numbers are strict (a bool or a quoted number is refused), finite, and a range's
 width must be finite too; the number of points is computed exactly (Python integers) from the
-file alone and refused above :data:`~impact_balance.numeric_limits.MAX_SWEEP_POINTS` before the
+file alone and refused above :data:`~impact_balance.ranges.MAX_SWEEP_POINTS` before the
 robot is loaded or anything is allocated. The content of a file that is not a sweep file (a
 link to a system file, say) is never quoted: only its name and the key.
 """
@@ -37,12 +37,12 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from ..exceptions import ScenarioError, SweepError, UnknownNameError
-from ..input_limits import read_yaml
-from ..numeric_limits import MAX_SWEEP_CHUNKS, MAX_SWEEP_POINTS
-from ..scenario import Offset, _field
-from ..scenario.fields import Integer, Number
-from ..scenario.bundled import bundled_descriptions
+from impact_balance.exceptions import ScenarioError, SweepError, UnknownNameError
+from impact_balance.scenario.reader import read_yaml
+from impact_balance.ranges import MAX_SWEEP_CHUNKS, MAX_SWEEP_POINTS
+from impact_balance.scenario import Offset, _field
+from impact_balance.scenario.fields import Integer, Number
+from impact_balance.scenario.bundled import bundled_descriptions
 
 __all__ = [
     "Dim",

@@ -42,8 +42,8 @@ import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
-from ..exceptions import SweepError
-from .plan import PLAN_VERSION, SweepPlan
+from impact_balance.exceptions import SweepError
+from impact_balance.sweep.plan import PLAN_VERSION, SweepPlan
 
 __all__ = [
     "ResultStore",

@@ -17,8 +17,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .evaluate import STATUSES
-from .store import FolderCheck, load_results
+from impact_balance.sweep.evaluate import STATUSES
+from impact_balance.sweep.store import FolderCheck, load_results
 
 __all__ = ["summarize", "format_summary", "load_frame", "EVALUATED"]
 

@@ -1,0 +1,1 @@
+"""The whole pipeline as one call (:mod:`.analyze`), its warnings (:mod:`.diagnostics`) and text report (:mod:`.report`)."""

@@ -1,0 +1,135 @@
+"""The whole pipeline: scenario -> stance -> constraints -> areas -> impact -> answer."""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+
+from impact_balance.balance.areas import BalanceAreas, areas_from_polytope, with_reason
+from impact_balance.contacts.wrench_polytope import wrench_polytope
+from impact_balance.criteria.com import max_contact_velocity, safe_contact_velocity, safe_interval, zmp_max_contact_velocity
+from impact_balance.analysis.diagnostics import diagnose
+from impact_balance.analysis.result import Analysis, ImpactAnswer
+from impact_balance.impact.model import ImpactModel, impact_model
+from impact_balance.projection.walk import warm_up
+from impact_balance.criteria.qp import QPOptions, solve_contact_velocity_qp, static_torques
+from impact_balance.exceptions import NonFiniteResultError, ScenarioError, SolverError
+from impact_balance.scenario import Scenario, load_scenario, with_source
+from impact_balance.contacts.stance import Stance
+
+__all__ = ["ImpactAnswer", "Analysis", "analyze"]
+
+
+def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
+    """Run the whole pipeline on a scenario (object, file path or bundled name).
+
+    ``solve_qp`` overrides the scenario's ``impact.qp.solve``.
+    """
+    timings: dict[str, float] = {}
+    if not isinstance(scenario, Scenario):
+        t = time.perf_counter()
+        scenario = load_scenario(scenario)
+        timings["scenario_loading"] = time.perf_counter() - t
+    t = time.perf_counter()
+    try:
+        robot = scenario.load_robot()  # cached after the first use of a robot
+    except ScenarioError as exc:
+        raise with_source(exc, scenario.source) from None
+    robot.workspace()  # its scratch pinocchio Data (~2-7 ms, first use per thread): loading too
+    timings["robot_loading"] = time.perf_counter() - t
+    kernel = warm_up()  # the compiled projection kernel's one-time load, timed apart
+    if kernel:
+        timings["kernel_loading"] = kernel
+    t0 = time.perf_counter()
+    stance = scenario.build_stance(robot)
+    t1 = time.perf_counter()
+    polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
+    t2 = time.perf_counter()
+    try:
+        areas = areas_from_polytope(polytope, scenario.plane_height, scenario.zmp_margin)
+    except SolverError as exc:
+        raise exc.within("contacts (projection of the contact wrench polytope)") from None
+    t3 = time.perf_counter()
+    timings.update(stance=t1 - t0, constraints=t2 - t1, areas=t3 - t2)
+    if not areas.can_balance:  # explain why (LPs; only for a stance that cannot balance)
+        areas = with_reason(areas, stance, scenario.torque_limits, scenario.gravity)
+        timings["diagnosis"] = time.perf_counter() - t3
+        t3 = time.perf_counter()
+    _check_finite(_area_checks(stance, areas))
+    answer = None
+    if scenario.impact is not None:
+        cfg = scenario.impact
+        try:
+            model = impact_model(stance, cfg.spec())
+        except ScenarioError as exc:
+            raise with_source(exc, scenario.source) from None
+        _check_finite(_impact_checks(model))
+        com_limit = max_contact_velocity(areas.com_velocity_area, model, scenario.com_velocity)
+        zmp_limit = zmp_max_contact_velocity(
+            areas.zmp_area, model, stance.com, scenario.plane_height, scenario.gravity, cfg.duration
+        )
+        interval = safe_interval(areas.com_velocity_area, model, scenario.com_velocity, com_limit)
+        contact_velocity = None
+        if cfg.reference_velocity is not None:
+            contact_velocity = safe_contact_velocity(cfg.reference_velocity, model.normal, interval)
+        qp = None
+        if (cfg.qp.solve if solve_qp is None else solve_qp) and cfg.reference_velocity is not None:
+            tau0 = static_torques(stance, polytope) if cfg.qp.impulsive_torque_limits else None
+            options = QPOptions(
+                cfg.qp.joint_velocity_limits, cfg.qp.impulsive_torque_limits, cfg.qp.peak_factor, cfg.duration, cfg.qp.solver
+            )
+            try:
+                qp = solve_contact_velocity_qp(
+                    model, areas.com_velocity_area, scenario.com_velocity, cfg.reference_velocity, stance.robot, tau0,
+                    options,
+                )
+            except SolverError as exc:
+                raise exc.within("impact.qp") from None
+        answer = ImpactAnswer(model, com_limit, zmp_limit, contact_velocity, qp, interval)
+        timings["impact"] = time.perf_counter() - t3
+    timings["total"] = time.perf_counter() - t0
+    return Analysis(scenario, stance, areas, answer, timings, diagnose(scenario, stance, answer))
+
+
+def _area_checks(stance: Stance, areas: BalanceAreas) -> list[tuple[str, Any, tuple[str, ...]]]:
+    """(result field, value, scenario fields that can make it overflow) of the areas step."""
+    return [
+        ("com", stance.com, ("base.position",)),
+        ("omega", areas.omega, ("plane_height", "gravity")),
+        # The squared sizes: their overflow is that of the areas and of the edge normals.
+        ("zmp_area", _squared_size(areas.zmp_area), ("plane_height", "base.position")),
+        ("com_velocity_area", _squared_size(areas.com_velocity_area), ("plane_height", "gravity")),
+    ]
+
+
+def _squared_size(polygon) -> float:
+    """Sum of the squared vertex coordinates (inf when they overflow, NaN with a NaN)."""
+    v = polygon.vertices.ravel()
+    with np.errstate(over="ignore", invalid="ignore"):
+        return float(v @ v)
+
+
+def _impact_checks(model: ImpactModel) -> list[tuple[str, Any, tuple[str, ...]]]:
+    """Like :func:`_area_checks`, for the impact model."""
+    return [
+        ("impact.point", model.point, ("impact.offset", "base.position")),
+        ("impact.W", model.W, ("impact.offset",)),
+        ("impact.impulse_vertices", model.impulse_rates, ("impact.offset", "impact.friction")),
+    ]
+
+
+def _check_finite(checks: list[tuple[str, Any, tuple[str, ...]]]) -> None:
+    """Raise :class:`NonFiniteResultError` naming the first non-finite result (never NaN out).
+
+    One sum over everything first (a NaN or an infinity anywhere makes it non-finite), so the
+    common case costs a few microseconds; the field is looked for only on failure.
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        if np.isfinite(sum(float(np.sum(value)) for _, value, _ in checks)):
+            return
+        for name, value, inputs in checks:
+            if not np.isfinite(value).all():
+                raise NonFiniteResultError(name, inputs)
+        # every part finite: only their sum overflowed

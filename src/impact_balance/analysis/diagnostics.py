@@ -1,0 +1,113 @@
+"""Warnings: valid input that is probably not what the user meant, or an answer with a caveat.
+
+An analysis never refuses these (they can be deliberate), but it says so: each is a
+:class:`Diagnostic` in ``Analysis.warnings``, a line of the text report, an entry of the
+JSON's ``warnings`` list, and an error under ``--strict``.
+
+The rules (codes):
+
+- ``contact_normal_down``: a contact normal (the frame's z axis after its offset, which must
+  point from the surface into the robot) has a negative world z, i.e. the surface would be
+  above the contact, like a ceiling. Usually a flipped offset (``rpy: [3.14159, 0, 0]``).
+- ``contact_normal_tilted``: a contact normal between :data:`FLOOR_TILT` (40°) and
+  :data:`WALL_TILT` (70°) from the vertical. Plausible surfaces are floors and ramps (tilt
+  up to 40°, steeper than any walkable ramp) and walls (tilt 70° to 90°); in between is usually
+  a frame whose z axis is not the sole's normal (some robots' foot frames are tilted 45°).
+- ``impact_moving_away``: the reference velocity does not move towards the impacted surface
+  (approach speed ``-n . v <= 0``): there is no impact to cap. Usually ``impact.normal``
+  has the wrong sign (it points from the surface into the robot).
+- ``qp_capped_by_reference``: the paper's QP tracks the reference velocity, so its approach
+  speed never exceeds the reference's; when that is below the maximum contact velocity, the
+  QP's answer is the reference, not the limit.
+- ``figure_skipped``: ``--plots`` could not draw one of the figures (reported by
+  :func:`impact_balance.plots.save_figures`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from impact_balance.analysis.result import Diagnostic, ImpactAnswer
+
+if TYPE_CHECKING:
+    from impact_balance.scenario import Scenario
+    from impact_balance.contacts.stance import Stance
+
+__all__ = ["Diagnostic", "FLOOR_TILT", "WALL_TILT", "diagnose", "contact_diagnostics", "impact_diagnostics"]
+
+#: Steepest floor or ramp, degrees from the vertical.
+FLOOR_TILT = 40.0
+#: Least steep wall, degrees from the vertical.
+WALL_TILT = 70.0
+#: Relative tolerance under which the QP's approach speed "equals" the reference's.
+_CAP_TOLERANCE = 1e-6
+
+
+def _tilt_degrees(normal: np.ndarray) -> float:
+    """Angle between a unit vector and the world's up axis, degrees."""
+    return math.degrees(math.acos(max(-1.0, min(1.0, float(normal[2])))))
+
+
+def contact_diagnostics(stance: Stance) -> list[Diagnostic]:
+    """Contact normals pointing down or tilted between a floor and a wall."""
+    out = []
+    for i, contact in enumerate(stance.contacts):
+        tilt = _tilt_degrees(contact.normal)
+        field = f"contacts[{i}]"
+        frame = contact.spec.frame
+        if contact.normal[2] < 0.0:
+            out.append(Diagnostic(
+                "contact_normal_down", field,
+                f"the normal of {frame} points down ({tilt:.0f}° from vertical): the surface would be above "
+                "the contact; the frame's z axis (after offset) must point from the surface into the robot",
+            ))
+        elif FLOOR_TILT < tilt < WALL_TILT:
+            out.append(Diagnostic(
+                "contact_normal_tilted", field,
+                f"the normal of {frame} is {tilt:.0f}° from vertical, neither a floor or ramp "
+                f"(<= {FLOOR_TILT:.0f}°) nor a wall (>= {WALL_TILT:.0f}°): is its z axis the surface normal? "
+                "(set offset.rpy to align it)",
+            ))
+    return out
+
+
+def impact_diagnostics(answer: ImpactAnswer, reference_velocity: Sequence[float] | None) -> list[Diagnostic]:
+    """An impact that does not approach its surface, a QP capped by its reference."""
+    out = []
+    if reference_velocity is None:
+        return out
+    approach = answer.model.approach_speed(reference_velocity)
+    if approach <= 0.0:
+        out.append(Diagnostic(
+            "impact_moving_away", "impact.reference_velocity",
+            f"the reference velocity does not move towards the impacted surface (approach speed -n.v = "
+            f"{approach:.3g} m/s <= 0), so there is no impact and nothing to cap; impact.normal must point from "
+            "the surface into the robot (is its sign flipped?)",
+        ))
+    qp = answer.qp
+    limit = answer.max_contact_velocity
+    if (qp is not None and qp.status == "optimal" and approach > 0.0 and math.isfinite(qp.approach_speed)
+            and approach < limit and abs(qp.approach_speed - approach) <= _CAP_TOLERANCE * max(1.0, approach)):
+        out.append(Diagnostic(
+            "qp_capped_by_reference", "impact.qp",
+            f"the paper's QP gives the reference approach speed {approach:.3f} m/s, not the maximum "
+            f"{limit:.3f} m/s: it tracks the reference velocity and never exceeds it",
+        ))
+    return out
+
+
+def diagnose(scenario: Scenario, stance: Stance, impact: ImpactAnswer | None) -> tuple[Diagnostic, ...]:
+    """Every warning of one analysis, in scenario order."""
+    out = contact_diagnostics(stance)
+    if impact is not None and scenario.impact is not None:
+        out += impact_diagnostics(impact, scenario.impact.reference_velocity)
+    return tuple(out)
+
+
+def diagnostics_to_json(diagnostics: Sequence[Diagnostic]) -> list[dict[str, Any]]:
+    """The JSON form: a list of {code, field, message}."""
+    return [d.to_dict() for d in diagnostics]

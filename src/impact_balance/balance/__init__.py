@@ -1,0 +1,1 @@
+"""Balance areas: the LIPM (:mod:`.lipm`), the ZMP support area and CoM velocity area (:mod:`.areas`), and why a stance cannot balance (:mod:`.infeasibility`)."""

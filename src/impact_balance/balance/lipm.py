@@ -1,0 +1,100 @@
+"""LIPM phase portrait along one axis (paper sec. III-B).
+
+With the ZMP z limited to [z_lo, z_hi], the stable standing region is the set of states
+(c, cd) whose DCM c + cd / omega lies in [z_lo, z_hi]. At c = c_ref the CoM velocity bounds
+are omega (z_lo - c), omega (z_hi - c): for c_z = 0.78 m and z in [-0.13, 0.13] m,
++-0.4610 m/s with g = 9.81 (the paper's 0.4608 corresponds to g = 9.8).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from impact_balance.constants import GRAVITY, GRAVITY_RANGE, MAX_POSITION
+from impact_balance.exceptions import ScenarioError
+
+__all__ = ["PhasePortrait", "phase_portrait", "lipm_omega", "com_velocity_bounds"]
+
+
+def lipm_omega(com_height: float, plane_height: float = 0.0, gravity: float = GRAVITY) -> float:
+    """omega = sqrt(g / (c_z - h)), 1/s."""
+    if not (math.isfinite(com_height) and 0 < com_height - plane_height <= 2 * MAX_POSITION):
+        raise ScenarioError(
+            "com_height", com_height, f"must be above the plane height {plane_height} m (at most {2 * MAX_POSITION:g} m above)"
+        )
+    if not GRAVITY_RANGE[0] <= gravity <= GRAVITY_RANGE[1]:
+        raise ScenarioError("gravity", gravity, f"must be in [{GRAVITY_RANGE[0]:g}, {GRAVITY_RANGE[1]:g}] m/s^2")
+    return math.sqrt(gravity / (com_height - plane_height))
+
+
+def com_velocity_bounds(
+    com_height: float, zmp_range: tuple[float, float], com_position: float = 0.0, gravity: float = GRAVITY
+) -> tuple[float, float]:
+    """CoM velocity interval (m/s) from which the CoM can be brought to rest at ``com_position``."""
+    lo, hi = zmp_range
+    if not -MAX_POSITION <= lo <= hi <= MAX_POSITION:
+        raise ScenarioError("zmp_range", [lo, hi], f"must be [lo, hi] with lo <= hi, within [{-MAX_POSITION:g}, {MAX_POSITION:g}] m")
+    w = lipm_omega(com_height, 0.0, gravity)
+    return w * (lo - com_position), w * (hi - com_position)
+
+
+@dataclass(frozen=True)
+class PhasePortrait:
+    """Phase portrait data of the saturated-ZMP LIPM along one axis.
+
+    Attributes:
+        omega: 1/s.  zmp_range: (lo, hi), m.  com_velocity_bounds: (lo, hi) at c = 0, m/s.
+        trajectories: list of (T, 2) arrays of (c, cd) under a ZMP that brakes as hard as
+            allowed (saturated), for plotting.
+    """
+
+    omega: float
+    com_height: float
+    zmp_range: tuple[float, float]
+    com_velocity_bounds: tuple[float, float]
+    trajectories: list[np.ndarray]
+
+    def is_capturable(self, com: float, com_velocity: float) -> bool:
+        """Whether the DCM c + cd / omega lies in the ZMP range (stable standing region)."""
+        dcm = com + com_velocity / self.omega
+        return self.zmp_range[0] <= dcm <= self.zmp_range[1]
+
+
+def phase_portrait(
+    com_height: float,
+    zmp_range: tuple[float, float],
+    gravity: float = GRAVITY,
+    n_trajectories: int = 9,
+    gain: float = 1.0,
+    horizon: float = 2.0,
+) -> PhasePortrait:
+    """LIPM phase portrait with a saturated ZMP (paper Fig. lipm-pplane, after Sugihara 2009).
+
+    Trajectories follow the capture feedback ``z = clip((1 + gain) xi, z_lo, z_hi)`` on the
+    DCM xi = c + cd / omega: inside the stable standing region they converge to rest at the
+    origin, outside it they diverge whatever the (bounded) ZMP does.
+    """
+    w = lipm_omega(com_height, 0.0, gravity)
+    bounds = com_velocity_bounds(com_height, zmp_range, 0.0, gravity)
+    lo, hi = zmp_range
+    width = max(hi - lo, 1e-3)
+    limit = 3.0 * width + max(abs(lo), abs(hi))
+    starts = [(c0, v0) for c0 in np.linspace(lo - 0.5 * width, hi + 0.5 * width, n_trajectories)
+              for v0 in (1.4 * bounds[0], 1.4 * bounds[1])]
+    dt = 1e-3
+    trajectories = []
+    for c0, v0 in starts:
+        c, cd, path = c0, v0, [(c0, v0)]
+        for _ in range(int(horizon / dt)):
+            xi = c + cd / w
+            z = min(max((1.0 + gain) * xi, lo), hi)
+            cd += dt * w * w * (c - z)
+            c += dt * cd
+            path.append((c, cd))
+            if abs(c) > limit:
+                break
+        trajectories.append(np.array(path))
+    return PhasePortrait(w, com_height, (lo, hi), bounds, trajectories)

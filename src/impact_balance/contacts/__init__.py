@@ -1,0 +1,1 @@
+"""Sustained contacts: the stance (:mod:`.stance`), contact wrench cones (:mod:`.cwc`) and the linear constraints on the stacked contact wrenches (:mod:`.wrench_polytope`)."""

@@ -1,0 +1,1 @@
+"""Plane and space geometry: convex polygons (:mod:`.polygon`) and spatial helpers (:mod:`.spatial`)."""

@@ -1,0 +1,1 @@
+"""Impact models: the paper's frictional impact at a point contact (:mod:`.model`) and the experimental contact-aware model (:mod:`.contact_aware`)."""

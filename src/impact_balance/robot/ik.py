@@ -1,0 +1,258 @@
+"""Whole-body inverse kinematics for building stances, on top of pink.
+
+This module is a thin, deterministic wrapper around pink's differential IK
+(:class:`pink.Configuration`, :class:`pink.tasks.FrameTask`, :class:`pink.tasks.ComTask`,
+:class:`pink.tasks.PostureTask`, :func:`pink.solve_ik` with the ``daqp`` QP solver). It is
+used offline to compute the joint values and base poses of the bundled scenarios
+(``examples/build_stances.py``); the analysis pipeline itself never runs IK.
+
+Frames and units: every target is expressed in the world frame (z up), positions in metres,
+orientations as rotation matrices (pinocchio ``SE3``), configurations in pinocchio's
+convention for a free-flyer model: ``q = [base position (m), base quaternion (x, y, z, w),
+joint angles (rad)]``. Residuals are reported in metres (positions, CoM) and radians
+(orientation: angle of ``R_target^T R``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+
+import numpy as np
+import pink
+import pinocchio as pin
+from pink.exceptions import PinkError
+from pink.limits import ConfigurationLimit
+from pink.tasks import ComTask, FrameTask, PostureTask
+
+from impact_balance.exceptions import ImpactBalanceError
+from impact_balance.robot.robot import Robot
+
+__all__ = ["IKError", "solve_stance", "stance_residuals", "chain_dofs"]
+
+#: Residual (m or rad) below which the regularisation is scaled down by ``_FINISH_SCALE``.
+_FINISH_THRESHOLD = 1e-3
+_FINISH_SCALE = 1e-3
+
+
+class IKError(ImpactBalanceError):
+    """Inverse kinematics did not reach its targets.
+
+    Attributes:
+        residuals: Remaining errors by target: ``"<frame>.position"`` (m),
+            ``"<frame>.orientation"`` (rad) and ``"com_xy"`` (m).
+        iterations: Number of IK steps taken.
+        q: The last configuration (full model, nq).
+        reason: Why the iterations stopped.
+    """
+
+    def __init__(self, reason: str, residuals: Mapping[str, float], iterations: int, q: np.ndarray):
+        self.reason = reason
+        self.residuals = dict(residuals)
+        self.iterations = iterations
+        self.q = np.asarray(q, dtype=float).copy()
+        worst = sorted(self.residuals.items(), key=lambda kv: -kv[1])[:3]
+        detail = ", ".join(f"{k} = {v:.3g}" for k, v in worst)
+        super().__init__(f"inverse kinematics failed after {iterations} iterations ({reason}); largest residuals: {detail}")
+
+
+def _reduced(robot: Robot, locked_joints: Iterable[str], q0: np.ndarray) -> tuple[pin.Model, list[tuple[int, int, int]]]:
+    """A private copy of the model with ``locked_joints`` fixed at ``q0``, and the index map.
+
+    The map lists ``(full idx_q, reduced idx_q, nq)`` for every joint kept, root included.
+    """
+    model = robot.model
+    locked = [robot.joint_id(name, field="locked_joints") for name in locked_joints]
+    reduced = pin.buildReducedModel(model, sorted(set(locked)), q0) if locked else pin.Model(model)
+    index = []
+    for jid in range(1, reduced.njoints):
+        joint = reduced.joints[jid]
+        full = model.joints[model.getJointId(reduced.names[jid])]
+        index.append((full.idx_q, joint.idx_q, joint.nq))
+    return reduced, index
+
+
+def chain_dofs(robot: Robot, frame: str) -> int:
+    """Degrees of freedom of the joints between the floating base and ``frame`` (the base's excluded)."""
+    model = robot.model
+    joint = model.frames[robot.frame_id(frame)].parentJoint
+    count = 0
+    while joint > 1:
+        count += model.joints[joint].nv
+        joint = model.parents[joint]
+    return count
+
+
+def stance_residuals(
+    robot: Robot,
+    q: np.ndarray,
+    frame_targets: Mapping[str, pin.SE3],
+    com_target_xy: Sequence[float] | None = None,
+    position_only: Iterable[str] = (),
+) -> dict[str, float]:
+    """Errors of configuration ``q`` with respect to world-frame targets.
+
+    Returns ``"<frame>.position"`` (m, Euclidean), ``"<frame>.orientation"`` (rad, rotation
+    angle between target and actual; omitted for ``position_only`` frames) and ``"com_xy"``
+    (m, horizontal CoM error) when ``com_target_xy`` is given.
+    """
+    model = robot.model
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q)
+    free = set(position_only)
+    out: dict[str, float] = {}
+    for name, target in frame_targets.items():
+        actual = data.oMf[robot.frame_id(name, field="frame_targets")]
+        out[f"{name}.position"] = float(np.linalg.norm(actual.translation - target.translation))
+        if name not in free:
+            out[f"{name}.orientation"] = float(np.linalg.norm(pin.log3(target.rotation.T @ actual.rotation)))
+    if com_target_xy is not None:
+        com = pin.centerOfMass(model, data, q, False)
+        out["com_xy"] = float(np.linalg.norm(com[:2] - np.asarray(com_target_xy, dtype=float)))
+    return out
+
+
+def solve_stance(
+    robot: Robot,
+    q0: np.ndarray,
+    frame_targets: Mapping[str, pin.SE3] | None = None,
+    com_target_xy: Sequence[float] | None = None,
+    *,
+    fixed_frames: Iterable[str] = (),
+    position_only: Iterable[str] = (),
+    locked_joints: Iterable[str] = (),
+    posture_target: np.ndarray | None = None,
+    posture_cost: float = 1e-3,
+    joint_costs: Mapping[str, float] | None = None,
+    base_orientation_cost: float = 1e-2,
+    max_iterations: int = 500,
+    tolerance: float = 1e-6,
+    damping: float = 1e-9,
+    solver: str = "daqp",
+) -> np.ndarray:
+    """Configuration that places frames and the CoM at world targets, within joint limits.
+
+    Iterates pink's differential IK (one QP per step, dead-beat gains, ``dt`` = 1) from
+    ``q0`` until every target is met within ``tolerance``. The floating base is free: the
+    solver moves it together with the joints. Targets are soft tasks of unit cost (per metre
+    and per radian); a posture task of cost ``posture_cost`` (per radian) pulls the actuated
+    joints towards ``posture_target`` (default ``q0``), and a base task of cost
+    ``base_orientation_cost`` the base orientation towards that of ``posture_target``: they
+    select one solution among the many of a redundant robot. Once every residual is below
+    1e-3 (m, rad) these two are scaled down by 1e-3, so that they no longer bias the targets.
+    Joint limits are hard constraints of every step (pink's
+    :class:`~pink.limits.ConfigurationLimit`), so the result is always within limits; a ``q0``
+    outside them (some SRDF configurations are) is first clamped into them.
+    A frame on a chain of fewer than 6 joints from the base (a quadruped's 3-joint leg)
+    cannot hold an orientation: its target is a position only (as in ``position_only``).
+    The result only depends on the inputs (no randomness).
+
+    Args:
+        robot: Robot with a free-flyer root (e.g. ``load_robot("talos")``).
+        q0: Initial configuration (nq), within the joint limits.
+        frame_targets: World poses to reach, by frame name (m, rotation matrices).
+        com_target_xy: World horizontal CoM position to reach (m); the CoM height is free.
+        fixed_frames: Frames kept at their pose in ``q0`` (e.g. feet on the ground).
+        position_only: Frames of ``frame_targets`` whose orientation is left free.
+        locked_joints: Joints kept at their ``q0`` value (e.g. grippers, head).
+        posture_target: Preferred configuration (nq); only its joint part is used.
+        posture_cost: Posture-task cost, [cost]/rad. The smaller, the more exactly targets
+            are met, the larger, the closer the result stays to the preferred posture.
+        joint_costs: Posture-task cost of individual joints, by name, overriding
+            ``posture_cost`` (e.g. a stiffer torso).
+        base_orientation_cost: Cost, [cost]/rad, pulling the floating base's orientation
+            towards the preferred one (keeps the pelvis upright).
+        max_iterations: Maximum number of IK steps.
+        tolerance: Convergence threshold on every residual, m and rad.
+        damping: Tikhonov regularisation of each step's QP.
+        solver: QP solver name for qpsolvers (default ``"daqp"``).
+
+    Returns:
+        The configuration (nq) of the full model.
+
+    Raises:
+        IKError: if the targets are not met within ``tolerance`` after ``max_iterations``
+            steps (unreachable targets, joint limits), or a step's QP fails. The error carries
+            the residuals, the iteration count and the last configuration.
+        UnknownFrameError, UnknownJointError: for names that are not in the model.
+    """
+    q0 = np.asarray(q0, dtype=float).copy()
+    model_full = robot.model
+    if q0.shape != (model_full.nq,):
+        raise ValueError(f"q0 must have {model_full.nq} coordinates, got shape {q0.shape}")
+    for slot in (robot.joint_slot(name) for name in robot.joint_names):
+        if slot.nq == 1 and np.isfinite(slot.lower) and np.isfinite(slot.upper) and slot.lower < slot.upper:
+            q0[slot.idx_q] = min(max(q0[slot.idx_q], slot.lower), slot.upper)
+    data_full = model_full.createData()
+    pin.framesForwardKinematics(model_full, data_full, q0)
+
+    targets: dict[str, pin.SE3] = {}
+    for name in fixed_frames:
+        targets[name] = pin.SE3(data_full.oMf[robot.frame_id(name, field="fixed_frames")])
+    for name, target in (frame_targets or {}).items():
+        robot.frame_id(name, field="frame_targets")
+        targets[name] = pin.SE3(target)
+    free = set(position_only) | {name for name in targets if chain_dofs(robot, name) < 6}
+
+    model, index = _reduced(robot, locked_joints, q0)
+
+    def to_reduced(q_full: np.ndarray) -> np.ndarray:
+        q = np.empty(model.nq)
+        for i_full, i_red, n in index:
+            q[i_red : i_red + n] = q_full[i_full : i_full + n]
+        return q
+
+    def to_full(q_red: np.ndarray) -> np.ndarray:
+        q = q0.copy()
+        for i_full, i_red, n in index:
+            q[i_full : i_full + n] = q_red[i_red : i_red + n]
+        return q
+
+    tasks: list = []
+    for name, target in targets.items():
+        task = FrameTask(name, position_cost=1.0, orientation_cost=0.0 if name in free else 1.0)
+        task.set_target(target)
+        tasks.append(task)
+    if com_target_xy is not None:
+        com_task = ComTask(cost=np.array([1.0, 1.0, 0.0]))
+        com_task.set_target(np.array([*np.asarray(com_target_xy, dtype=float)[:2], 0.0]))
+        tasks.append(com_task)
+    costs = np.full(model.nv - 6, float(posture_cost))
+    for name, cost in (joint_costs or {}).items():
+        robot.joint_id(name, field="joint_costs")
+        if model.existJointName(name):
+            joint = model.joints[model.getJointId(name)]
+            costs[joint.idx_v - 6 : joint.idx_v - 6 + joint.nv] = float(cost)
+    preferred = to_reduced(q0 if posture_target is None else np.asarray(posture_target, dtype=float))
+    base_frame = model.names[1]  # the free-flyer's joint frame
+    base_target = pin.SE3(pin.Quaternion(preferred[3:7]).normalized().matrix(), np.zeros(3))
+
+    def regularisation(scale: float) -> list:
+        posture = PostureTask(cost=scale * costs)
+        posture.set_target(preferred)
+        base = FrameTask(base_frame, position_cost=0.0, orientation_cost=scale * float(base_orientation_cost))
+        base.set_target(base_target)
+        return [posture, base]
+
+    # Two phases: the regularisation (posture, base orientation) selects the solution while
+    # far from the targets, then is scaled down so that it no longer biases them.
+    phases = [tasks + regularisation(1.0), tasks + regularisation(_FINISH_SCALE)]
+    limits = [ConfigurationLimit(model)]
+
+    def residuals(q_full: np.ndarray) -> dict[str, float]:
+        return stance_residuals(robot, q_full, targets, com_target_xy, free)
+
+    configuration = pink.Configuration(model, model.createData(), to_reduced(q0))
+    res = residuals(q0)
+    for iteration in range(1, max_iterations + 1):
+        worst = max(res.values(), default=0.0)
+        step_tasks = phases[1] if worst <= _FINISH_THRESHOLD else phases[0]
+        try:
+            velocity = pink.solve_ik(configuration, step_tasks, dt=1.0, solver=solver, damping=damping, limits=limits)
+        except PinkError as exc:
+            raise IKError(f"{exc.__class__.__name__}: {exc}", res, iteration - 1, to_full(configuration.q)) from None
+        configuration.integrate_inplace(velocity, 1.0)
+        q = to_full(configuration.q)
+        res = residuals(q)
+        if max(res.values(), default=0.0) <= tolerance:
+            return q
+    raise IKError("not converged", res, max_iterations, to_full(configuration.q))

@@ -1,0 +1,485 @@
+"""Robot models: bundled humanoids from example-robot-data, or any URDF + SRDF.
+
+Models are loaded with pinocchio, with a free-flyer root joint (the robot is floating).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import math
+import os
+import sys
+import tempfile
+import threading
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+import pinocchio as pin
+
+from impact_balance.exceptions import (
+    RobotLoadError,
+    ScenarioError,
+    UnknownConfigurationError,
+    UnknownFrameError,
+    UnknownJointError,
+    UnknownRobotError,
+)
+
+__all__ = ["RobotSpec", "Robot", "JointSlot", "Scratch", "Workspace", "BUNDLED_ROBOTS", "load_robot", "example_robot_data_root"]
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    """Where a bundled robot's files live, relative to the example-robot-data root.
+
+    Attributes:
+        urdf: URDF path.
+        srdf: SRDF path (reference configurations), or None.
+        standing: Name of the default standing configuration ("neutral" if no SRDF has one).
+        description: One line for listings.
+    """
+
+    urdf: str
+    srdf: str | None
+    standing: str
+    description: str
+
+
+BUNDLED_ROBOTS: dict[str, RobotSpec] = {
+    "talos": RobotSpec(
+        "talos_data/robots/talos_reduced.urdf",
+        "talos_data/srdf/talos.srdf",
+        "half_sitting",
+        "PAL Robotics TALOS, 90 kg humanoid (reduced model, 32 actuated joints)",
+    ),
+    "g1": RobotSpec(
+        "g1_description/urdf/g1_29dof_rev_1_0.urdf",
+        None,
+        "neutral",
+        "Unitree G1, 33 kg humanoid (29 actuated joints); no SRDF: neutral configuration",
+    ),
+    "romeo": RobotSpec(
+        "romeo_description/urdf/romeo.urdf",
+        "romeo_description/srdf/romeo.srdf",
+        "half_sitting",
+        "Aldebaran Romeo, 41 kg humanoid",
+    ),
+    "icub": RobotSpec(
+        "icub_description/robots/icub_reduced.urdf",
+        "icub_description/srdf/icub.srdf",
+        "half_sitting",
+        "IIT iCub, 28 kg humanoid (reduced model)",
+    ),
+}
+
+
+def example_robot_data_root() -> Path:
+    """Folder holding example-robot-data's ``robots/`` tree (installed by its wheel)."""
+    import importlib.metadata  # here: `impact-balance robots` lists names without it
+
+    try:
+        dist = importlib.metadata.distribution("example-robot-data")
+    except importlib.metadata.PackageNotFoundError as exc:  # pragma: no cover - install issue
+        raise RobotLoadError("example-robot-data", "package not installed") from exc
+    root = Path(str(dist.locate_file("cmeel.prefix/share/example-robot-data/robots")))
+    if not root.is_dir():  # pragma: no cover - install issue
+        raise RobotLoadError(str(root), "example-robot-data's robots folder not found")
+    return root
+
+
+class JointSlot(NamedTuple):
+    """Where a non-root joint sits in the configuration vector.
+
+    Attributes:
+        id: Joint index in the model.
+        idx_q: First configuration index; nq, nv: configuration and velocity sizes.
+        lower, upper: Position limits of its first configuration coordinate (rad or m).
+    """
+
+    id: int
+    idx_q: int
+    nq: int
+    nv: int
+    lower: float
+    upper: float
+
+
+class Scratch:
+    """One pinocchio ``Data`` for one owner, and the key of the configuration it holds.
+
+    What :class:`Workspace` is per thread, for an owner that serialises its own calls (a
+    :class:`~impact_balance.governor.Governor` and its lock): :class:`~impact_balance.contacts.stance.Stance`
+    computes in it when given one.
+
+    Attributes:
+        data: The Data.
+        holder: Key of the configuration whose joint placements (``oMi``) and joint
+            Jacobians (``J``) ``data`` holds, or None when unknown.
+    """
+
+    def __init__(self, model: pin.Model):
+        self.data = model.createData()
+        self.holder: bytes | None = None
+
+
+class Workspace(threading.local):
+    """One pinocchio ``Data`` per robot and per thread, reused by every :class:`Stance`.
+
+    ``model.createData()`` allocates ~1.6 MB (0.2-1.9 ms) while the kinematics themselves
+    take ~15 us, so stances compute in this scratch Data and copy out what they keep.
+    Thread-local so that concurrent analyses never overwrite each other's kinematics.
+
+    Attributes:
+        data: The scratch Data.
+        holder: Key of the configuration whose joint placements (``oMi``) and joint
+            Jacobians (``J``) ``data`` holds, or None when unknown.
+    """
+
+    def __init__(self, model: pin.Model):
+        self.data = model.createData()
+        self.holder: bytes | None = None
+
+
+@dataclass
+class Robot:
+    """A floating-base robot model.
+
+    Name, joint and limit look-ups are computed once from the model and cached: treat the
+    model as read-only once loaded.
+
+    Attributes:
+        name: Bundled name, or the URDF file stem.
+        model: pinocchio model with a free-flyer root (nq = 7 + joints, nv = 6 + joints).
+        reference_configurations: Named configurations from the SRDF, plus "neutral".
+        standing: Name of the default standing configuration.
+        urdf_path, srdf_path: Source files (meshes are resolved relative to the URDF's package).
+        armature_source: Where ``model.armature`` (the reflected rotor inertia of each joint,
+            kg m^2, which pinocchio's mass matrix includes) comes from: the SRDF's
+            ``rotor_params`` (armature = gear ratio^2 x rotor inertia), or None when the robot
+            files declare none (armature 0).
+    """
+
+    name: str
+    model: pin.Model
+    reference_configurations: dict[str, np.ndarray]
+    standing: str
+    urdf_path: Path
+    srdf_path: Path | None = None
+    package_dirs: list[str] = field(default_factory=list)
+    armature_source: str | None = None
+
+    def __getstate__(self) -> dict:
+        # The caches (thread-local Data, look-up tables) are rebuilt on demand, never copied.
+        return {f.name: self.__dict__[f.name] for f in fields(self)}
+
+    @property
+    def mass(self) -> float:
+        """Total mass, kg."""
+        return float(sum(inertia.mass for inertia in self.model.inertias))
+
+    @property
+    def frame_names(self) -> list[str]:
+        """Names of all frames of the model."""
+        return [f.name for f in self.model.frames]
+
+    @property
+    def joint_names(self) -> list[str]:
+        """Names of the actuated (non-root) joints."""
+        return list(self._joint_slots)
+
+    @property
+    def listing_command(self) -> str:
+        """The command that lists this robot's frames and joints (named in error messages)."""
+        bundled = self.name in BUNDLED_ROBOTS and self.urdf_path == _bundled_urdf(self.name)
+        return f"impact-balance frames {self.name if bundled else self.urdf_path}"
+
+    @functools.cached_property
+    def _frame_ids(self) -> dict[str, int]:
+        ids: dict[str, int] = {}
+        for i, f in enumerate(self.model.frames):
+            ids.setdefault(f.name, i)  # first of duplicate names, as model.getFrameId
+        return ids
+
+    @functools.cached_property
+    def _joint_slots(self) -> dict[str, JointSlot]:
+        model = self.model
+        lower, upper = np.asarray(model.lowerPositionLimit), np.asarray(model.upperPositionLimit)
+        slots = {}
+        for jid in range(2, model.njoints):  # 0 = universe, 1 = free-flyer root
+            joint = model.joints[jid]
+            slots[model.names[jid]] = JointSlot(
+                jid, joint.idx_q, joint.nq, joint.nv, float(lower[joint.idx_q]), float(upper[joint.idx_q])
+            )
+        return slots
+
+    def frame_id(self, name: str, field: str = "frame") -> int:
+        """Index of frame ``name``; :class:`UnknownFrameError` naming the valid ones if absent."""
+        fid = self._frame_ids.get(name) if isinstance(name, str) else None
+        if fid is None:
+            raise UnknownFrameError(field, name, set(self.frame_names), listing=self.listing_command)
+        return fid
+
+    def joint_id(self, name: str, field: str = "joint") -> int:
+        """Index of a non-root joint; :class:`UnknownJointError` if absent."""
+        return self.joint_slot(name, field).id
+
+    def joint_slot(self, name: str, field: str = "joint") -> JointSlot:
+        """Configuration slot and position limits of a non-root joint; :class:`UnknownJointError` if absent."""
+        slot = self._joint_slots.get(name) if isinstance(name, str) else None
+        if slot is None:
+            raise UnknownJointError(field, name, self.joint_names, listing=self.listing_command)
+        return slot
+
+    def joint_assignment(self, joints: Mapping[str, float], field: str = "joints") -> tuple[np.ndarray, np.ndarray]:
+        """Configuration indices and values (``q[idx] = values``) that set joints by name.
+
+        A 1-dof joint takes its value (rad or m), checked against its finite position limits
+        (1e-9 slack); a continuous joint takes (cos, sin) of its angle. Errors are
+        :class:`ScenarioError` on ``field.NAME``, for the first bad joint in order. Results
+        are cached by content (a stance is rebuilt from the same overrides many times):
+        do not modify the returned read-only arrays.
+        """
+        key = (field, tuple(joints.items()))
+        cached = self._assignments.get(key)
+        if cached is not None:
+            return cached
+        indices, values = [], []
+        for name, value in joints.items():
+            slot = self.joint_slot(name, field=f"{field}.{name}")
+            if slot.nq == 1:
+                lo, hi = slot.lower, slot.upper
+                if math.isfinite(lo) and math.isfinite(hi) and lo < hi and not (lo - 1e-9 <= value <= hi + 1e-9):
+                    raise ScenarioError(f"{field}.{name}", value, f"outside the joint limits [{lo:.4g}, {hi:.4g}] rad")
+                indices.append(slot.idx_q)
+                values.append(value)
+            elif slot.nq == 2 and slot.nv == 1:  # continuous joint: (cos, sin)
+                indices += [slot.idx_q, slot.idx_q + 1]
+                values += [math.cos(value), math.sin(value)]
+            else:
+                raise ScenarioError(f"{field}.{name}", value, "only 1-dof joints can be set by a single value")
+        result = np.asarray(indices, dtype=int), np.asarray(values, dtype=float)
+        for array in result:
+            array.setflags(write=False)
+        if len(self._assignments) >= 64:  # bounded: interactive use creates many
+            self._assignments.clear()
+        self._assignments[key] = result
+        return result
+
+    @functools.cached_property
+    def _assignments(self) -> dict[tuple, tuple[np.ndarray, np.ndarray]]:
+        return {}
+
+    def joint_values(self, q: np.ndarray) -> dict[str, float]:
+        """Values of the 1-dof joints at configuration ``q``, rad or m (continuous joints by their angle)."""
+        model = self.model
+        out = {}
+        for jid in range(2, model.njoints):
+            joint = model.joints[jid]
+            if joint.nq == 1:
+                out[model.names[jid]] = float(q[joint.idx_q])
+            elif joint.nq == 2 and joint.nv == 1:
+                out[model.names[jid]] = math.atan2(float(q[joint.idx_q + 1]), float(q[joint.idx_q]))
+        return out
+
+    def configuration(self, name: str | None = None, field: str = "configuration") -> np.ndarray:
+        """A copy of the named reference configuration (default: the standing one)."""
+        key = self.standing if name is None else name
+        if key not in self.reference_configurations:
+            raise UnknownConfigurationError(field, key, self.reference_configurations)
+        return self.reference_configurations[key].copy()
+
+    def actuated_effort_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """Velocity indices of the torque-limited actuated joints and their effort limits (N m).
+
+        A joint whose URDF effort limit is 0, missing or infinite is unlimited and left out.
+        """
+        idx, lim = self.effort_limits
+        return idx.copy(), lim.copy()
+
+    def actuated_velocity_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """Velocity indices of the velocity-limited actuated joints and their limits (rad/s)."""
+        idx, lim = self._velocity_limits
+        return idx.copy(), lim.copy()
+
+    @functools.cached_property
+    def effort_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`actuated_effort_limits`, computed once (read-only arrays: do not copy per call)."""
+        return self._limited(self.model.effortLimit)
+
+    @functools.cached_property
+    def _velocity_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        return self._limited(self.model.velocityLimit)
+
+    def _limited(self, limits: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        limits = np.asarray(limits, dtype=float)
+        offset = self.model.nv - limits.size  # some versions store nu entries, not nv
+        indices, values = [], []
+        for joint in list(self.model.joints)[2:]:
+            for k in range(joint.idx_v, joint.idx_v + joint.nv):
+                value = limits[k - offset] if 0 <= k - offset < limits.size else 0.0
+                if math.isfinite(value) and value > 0.0:
+                    indices.append(k)
+                    values.append(value)
+        idx, val = np.asarray(indices, dtype=int), np.asarray(values, dtype=float)
+        idx.setflags(write=False)
+        val.setflags(write=False)
+        return idx, val
+
+    @functools.cached_property
+    def _workspace(self) -> Workspace:
+        return Workspace(self.model)
+
+    def workspace(self) -> Workspace:
+        """This thread's scratch pinocchio Data for the model (see :class:`Workspace`)."""
+        return self._workspace
+
+
+def _is_file(path: Path) -> bool:
+    try:
+        return path.is_file()
+    except (OSError, ValueError):  # a name too long for the file system, a NUL character
+        return False
+
+
+_FD_LOCK = threading.Lock()
+
+
+@contextlib.contextmanager
+def _native_stderr(lines: list[str]):
+    """Collect what C++ code writes to file descriptor 2 (urdfdom's "Error: ..." lines) into
+    ``lines`` instead of the terminal: a failure is reported once, as one line naming the file.
+
+    Redirecting a descriptor is process-wide, so loads are serialised; another thread's
+    writes to stderr during a load (a few ms) are collected too, and dropped.
+    """
+    with _FD_LOCK, tempfile.TemporaryFile(mode="w+b") as sink:
+        sys.stderr.flush()
+        saved = os.dup(2)
+        try:
+            os.dup2(sink.fileno(), 2)
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            sink.seek(0)
+            text = sink.read(20_000).decode("utf-8", "replace")
+            lines += [ln.strip() for ln in text.splitlines() if ln.strip()]
+
+
+def _native_reason(lines: list[str], fallback: str) -> str:
+    """The first urdfdom "Error:" line (the cause), else ``fallback``."""
+    for line in lines:
+        if line.startswith("Error:"):
+            return f"{fallback} ({line.removeprefix('Error:').strip()})"
+    return fallback
+
+
+def _load(urdf: Path, srdf: Path | None, name: str, standing: str | None) -> Robot:
+    package_dirs = [str(urdf.parent.parent.parent), str(urdf.parent.parent)]
+    native: list[str] = []
+    try:
+        with _native_stderr(native):
+            model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
+    except (RuntimeError, ValueError, OSError) as exc:
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else "invalid URDF"
+        if str(urdf) in first:  # pinocchio repeats the path
+            first = "not a valid URDF model"
+        raise RobotLoadError(str(urdf), _native_reason(native, first)) from None
+    configurations = {"neutral": pin.neutral(model)}
+    armature_source = None
+    if srdf is not None:
+        if not _is_file(srdf):
+            raise RobotLoadError(str(srdf), "no such file")
+        try:
+            with _native_stderr(native):
+                pin.loadReferenceConfigurations(model, str(srdf), False)
+        except (RuntimeError, ValueError, OSError) as exc:
+            raise RobotLoadError(str(srdf), _native_reason(native, str(exc).strip() or "invalid SRDF")) from None
+        for entry in model.referenceConfigurations:
+            configurations[entry.key()] = np.array(entry.data(), dtype=float)
+        armature_source = _load_rotor_parameters(model, srdf, native)
+    if standing is None:
+        standing = "half_sitting" if "half_sitting" in configurations else "neutral"
+    if standing not in configurations:
+        raise UnknownConfigurationError("robot.standing", standing, configurations)
+    return Robot(name, model, configurations, standing, urdf, srdf, package_dirs, armature_source)
+
+
+def _load_rotor_parameters(model: pin.Model, srdf: Path, native: list[str]) -> str | None:
+    """Read the SRDF's ``rotor_params`` into the model (rotor inertia and gear ratio per joint) and set
+    ``model.armature`` = gear ratio^2 x rotor inertia, the rotor inertia reflected at the joint. Returns
+    where it came from, or None when the SRDF declares none."""
+    try:
+        declared = "rotor_params" in srdf.read_text(errors="replace")
+    except OSError:
+        return None
+    if not declared:
+        return None
+    try:
+        with _native_stderr(native):
+            pin.loadRotorParameters(model, str(srdf), False)
+    except (RuntimeError, ValueError, OSError) as exc:
+        raise RobotLoadError(str(srdf), _native_reason(native, str(exc).strip() or "invalid rotor_params")) from None
+    # pinocchio >= 3.? sets the armature itself; older versions only fill the rotor fields.
+    model.armature = np.asarray(model.rotorGearRatio) ** 2 * np.asarray(model.rotorInertia)
+    return f"{srdf.name} rotor_params (armature = gear ratio^2 x rotor inertia)"
+
+
+def _bundled_urdf(name: str) -> Path:
+    return example_robot_data_root() / BUNDLED_ROBOTS[name].urdf
+
+
+@functools.lru_cache(maxsize=16)
+def _load_bundled(name: str) -> Robot:
+    spec = BUNDLED_ROBOTS[name]
+    root = example_robot_data_root()
+    return _load(root / spec.urdf, root / spec.srdf if spec.srdf else None, name, spec.standing)
+
+
+def load_robot(
+    robot: str | None = None,
+    urdf: str | Path | None = None,
+    srdf: str | Path | None = None,
+    standing: str | None = None,
+) -> Robot:
+    """Load a bundled robot by name, or any URDF (+ optional SRDF) that pinocchio reads.
+
+    Models are cached (bundled ones by name, files by path, modification time and size):
+    the returned :class:`Robot` is shared, do not mutate its model (copy it:
+    ``dataclasses.replace(robot, model=pinocchio.Model(robot.model))``).
+    """
+    if urdf is None:
+        name = robot or "talos"
+        if name not in BUNDLED_ROBOTS:
+            raise UnknownRobotError("robot", name, BUNDLED_ROBOTS)
+        return _load_bundled(name)
+    urdf = Path(urdf)
+    if not _is_file(urdf):
+        raise RobotLoadError(str(urdf), "no such file")
+    srdf_path = Path(srdf) if srdf else None
+    # Cached by the files' identity and modification: an edited URDF or SRDF is reloaded.
+    key = (_file_key(urdf), _file_key(srdf_path) if srdf_path else None, robot or urdf.stem, standing)
+    cached = _FILE_ROBOTS.get(key)
+    if cached is None:
+        cached = _load(urdf, srdf_path, robot or urdf.stem, standing)
+        if len(_FILE_ROBOTS) >= 16:  # bounded
+            _FILE_ROBOTS.pop(next(iter(_FILE_ROBOTS)))
+        _FILE_ROBOTS[key] = cached
+    return cached
+
+
+#: Robots loaded from files, by :func:`_file_key` of their URDF and SRDF.
+_FILE_ROBOTS: dict[tuple, Robot] = {}
+
+
+def _file_key(path: Path) -> tuple[str, int, int]:
+    """(resolved path, modification time in ns, size) of a file; (path, -1, -1) if absent."""
+    try:
+        st = path.stat()
+    except OSError:
+        return (str(path), -1, -1)
+    return (str(path.resolve()), st.st_mtime_ns, st.st_size)

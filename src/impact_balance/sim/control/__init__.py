@@ -1,0 +1,1 @@
+"""Controllers of the simulated robot: kinematic (pink IK to position servos, :mod:`.kinematic`), torque (inverse-dynamics QP, :mod:`.torque`), the impacting reference (:mod:`.approach`), the desired ZMP (:mod:`.zmp`) and how joints are driven (:mod:`.actuation`)."""

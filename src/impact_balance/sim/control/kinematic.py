@@ -1,0 +1,221 @@
+"""Whole-body balance controller: DCM feedback + pink IK, for MuJoCo position servos.
+
+Choice (documented in ``docs/validation.md``): a *kinematic* controller, as the paper assumes
+("the robot is kinematically controlled"). At every control step (500 Hz by default):
+
+1. The measured CoM ``c`` and CoM velocity ``c_d`` (pinocchio, from the measured base pose and
+   velocity and the joints) give the DCM ``xi = c + c_d / omega``.
+2. :class:`~.zmp.DcmFeedback` picks the desired ZMP ``p = xi + (k / omega)(xi - xi_ref)`` and
+   clamps it to the scenario's own ZMP support area (shrunk by a margin).
+3. ZMP feedback through the CoM (the admittance of position-controlled humanoids, Kajita et al.
+   2010): the commanded CoM moves at ``c_cmd_d = K_zmp (p_measured - p)``. If the measured ZMP is
+   ahead of the desired one, the CoM is accelerated forward, which moves the ZMP back. With ideal
+   tracking the closed loop ``s^2 + (omega + k + omega^2/K_zmp) s + omega k`` is stable for any
+   positive gains. The measured ZMP comes from the contact forces (force sensors); without it
+   (no vertical force) the CoM command holds. The measured ZMP is filtered, the command's speed
+   bounded, and the commanded CoM kept over the ZMP support area.
+4. pink's differential IK moves a reference configuration so that its CoM follows ``c_cmd``,
+   every contact frame stays at its initial pose, the impacting point follows the impact task,
+   and a posture task holds the rest. The reference joint angles go to the joint position servos
+   (the trial adds the reference velocities as feed-forward on the free limbs).
+
+The impact task (:class:`~.approach.ImpactTask`): hold; then the impact point's target accelerates
+towards the surface along ``-n`` (bounded acceleration) to the commanded approach speed, which it
+reaches before the surface; once the measured normal force exceeds a threshold (15 N, as the
+paper's experiment) the target stops pushing and withdraws along ``n``.
+
+Everything here is pinocchio and pink; MuJoCo is only seen through the measured ``(q, v)`` and
+the impact force passed to :meth:`BalanceController.step`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import pink
+import pinocchio as pin
+from pink.tasks import ComTask, FrameTask, PostureTask
+
+from impact_balance.analysis.analyze import Analysis
+from impact_balance.robot.ik import solve_stance
+from impact_balance.sim.control.approach import ImpactTask
+from impact_balance.sim.control.zmp import DcmFeedback, clamp_to_polygon
+
+__all__ = ["BalanceGains", "ImpactTask", "BalanceController", "ControlOutput", "retracted_stance"]
+
+
+@dataclass(frozen=True)
+class BalanceGains:
+    """Gains and rates of :class:`BalanceController` (units in brackets).
+
+    Attributes:
+        rate: Control rate [Hz].
+        dcm_gain: DCM error decay rate k [1/s] (p = xi + k/omega (xi - xi_ref)).
+        zmp_margin: Desired ZMP kept this far inside the ZMP support area [m].
+        zmp_admittance: K_zmp, CoM command velocity per metre of ZMP error [1/s].
+        zmp_filter: Time constant of the first-order filter on the measured ZMP [s].
+        max_com_speed: Bound on the CoM command's speed [m/s].
+        com_cost: Weight of the CoM task [1/m].
+        contact_cost: Weight of each contact frame task (position [1/m] and orientation [1/rad]).
+        impact_cost: Weight of the impact point task [1/m] (its orientation: a tenth).
+        posture_cost: Weight of the posture task [1/rad].
+        damping: Levenberg-Marquardt regularisation of the IK step's QP.
+        solver: QP solver of pink (qpsolvers name).
+    """
+
+    rate: float = 500.0
+    dcm_gain: float = 1.0
+    zmp_margin: float = 0.01
+    zmp_admittance: float = 1.0
+    zmp_filter: float = 0.01
+    max_com_speed: float = 0.3
+    com_cost: float = 10.0
+    contact_cost: float = 10.0
+    impact_cost: float = 1.0
+    posture_cost: float = 1e-2
+    damping: float = 1e-6
+    solver: str = "daqp"
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class ControlOutput:
+    """One control step's command and what the controller saw.
+
+    Attributes:
+        q: Reference configuration (nq, pinocchio order); joint part goes to the servos.
+        v: Reference velocity (nv).
+        zmp: Clamped desired ZMP (m, world).
+        dcm: Measured DCM (m, world).
+        clamped: Whether the desired ZMP was clamped to the area.
+        com: Measured CoM (m, world).
+        com_velocity: Measured CoM velocity (m/s, world).
+    """
+
+    q: np.ndarray
+    v: np.ndarray
+    zmp: np.ndarray
+    dcm: np.ndarray
+    clamped: bool
+    com: np.ndarray
+    com_velocity: np.ndarray
+
+
+def retracted_stance(analysis: Analysis, standoff: float) -> np.ndarray:
+    """The stance's configuration with the impact point backed off ``standoff`` (m) along the normal.
+
+    Whole-body IK (pink, :func:`impact_balance.robot.ik.solve_stance`): contacts fixed, CoM xy fixed.
+    """
+    stance, impact = analysis.stance, analysis.impact
+    if impact is None or standoff <= 0:
+        return stance.q.copy()
+    spec = impact.model.spec
+    frame_pose = stance.frame_pose(spec.frame)
+    target = pin.SE3(frame_pose.rotation, frame_pose.translation + standoff * impact.model.normal)
+    return solve_stance(
+        stance.robot, stance.q, {spec.frame: target}, stance.com[:2],
+        fixed_frames=[c.spec.frame for c in stance.contacts], tolerance=1e-5, max_iterations=300,
+    )
+
+
+class BalanceController:
+    """DCM-feedback balance with whole-body IK (see the module docstring).
+
+    Args:
+        analysis: The scenario's analysis (stance, areas; the impact if any).
+        q0: Initial reference configuration (nq); default the stance's.
+        gains: Gains and rates.
+        impact: The impact task, if any.
+    """
+
+    name = "dcm-zmp-clamp + pink IK -> joint position servos"
+
+    def __init__(self, analysis: Analysis, q0: np.ndarray | None = None, gains: BalanceGains = BalanceGains(),
+                 impact: ImpactTask | None = None):
+        self.analysis = analysis
+        self.gains = gains
+        self.impact = impact
+        stance = analysis.stance
+        self.model = stance.robot.model
+        self.data = self.model.createData()  # measured state
+        q0 = stance.q.copy() if q0 is None else np.asarray(q0, dtype=float).copy()
+        self.configuration = pink.Configuration(self.model, self.model.createData(), q0)
+        self.dt = 1.0 / gains.rate
+        areas = analysis.areas
+        self.plane_height = areas.plane_height
+        self.gravity = areas.gravity
+        com0 = np.array(pin.centerOfMass(self.model, self.configuration.data, q0), dtype=float)
+        self.com_height = float(com0[2])
+        self.omega = float(np.sqrt(self.gravity / (com0[2] - self.plane_height)))
+        self.feedback = DcmFeedback(areas.zmp_area, self.omega, com0[:2].copy(), gains.dcm_gain, gains.zmp_margin)
+        self.com_command = com0[:2].copy()
+        self._zmp_filtered: np.ndarray | None = None
+        self.contact_tasks = []
+        for c in stance.contacts:
+            task = FrameTask(c.spec.frame, gains.contact_cost, gains.contact_cost)
+            task.set_target(self.configuration.get_transform_frame_to_world(c.spec.frame))
+            self.contact_tasks.append(task)
+        self.com_task = ComTask(cost=gains.com_cost)
+        self.com_task.set_target(com0)
+        self.posture_task = PostureTask(cost=gains.posture_cost)
+        self.posture_task.set_target(q0)
+        self.impact_task = None
+        if impact is not None:
+            self.impact_task = FrameTask(impact.frame, gains.impact_cost, 0.1 * gains.impact_cost)
+            self._impact_rotation = self.configuration.get_transform_frame_to_world(impact.frame).rotation.copy()
+        self.v_ref = np.zeros(self.model.nv)
+        self._lower = self.model.lowerPositionLimit[7:].copy()
+        self._upper = self.model.upperPositionLimit[7:].copy()
+
+    @property
+    def q_ref(self) -> np.ndarray:
+        return self.configuration.q
+
+    def measure(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Measured CoM and CoM velocity (m, m/s, world) from pinocchio's ``(q, v)``."""
+        pin.centerOfMass(self.model, self.data, q, v, False)
+        return self.data.com[0].copy(), self.data.vcom[0].copy()
+
+    def step(self, t: float, q: np.ndarray, v: np.ndarray, zmp_measured: np.ndarray | None = None,
+             impact_force: float = 0.0) -> ControlOutput:
+        """One control step from the measured state (pinocchio ``q``, ``v``; free-flyer velocity local).
+
+        ``zmp_measured`` is the ZMP of the measured contact forces on the plane (m, world; None or NaN
+        when unknown); ``impact_force`` the measured normal force at the impact point (N).
+        """
+        g, dt = self.gains, self.dt
+        com, com_velocity = self.measure(q, v)
+        zmp, xi, clamped = self.feedback.desired_zmp(com[:2], com_velocity[:2])
+        if zmp_measured is not None and np.all(np.isfinite(zmp_measured)):
+            zmp_measured = np.asarray(zmp_measured, dtype=float)[:2]
+            if self._zmp_filtered is None:
+                self._zmp_filtered = zmp_measured.copy()
+            self._zmp_filtered += min(1.0, dt / g.zmp_filter) * (zmp_measured - self._zmp_filtered)
+            speed = g.zmp_admittance * (self._zmp_filtered - zmp)
+            norm = float(np.linalg.norm(speed))
+            if norm > g.max_com_speed:
+                speed *= g.max_com_speed / norm
+            # The commanded CoM stays over the ZMP support area: a reference that could stand still.
+            self.com_command = clamp_to_polygon(self.feedback.zmp_area, self.com_command + dt * speed, g.zmp_margin)
+        self.com_task.set_target(np.array([*self.com_command, self.com_height]))
+        tasks = [self.com_task, *self.contact_tasks, self.posture_task]
+        if self.impact is not None:
+            point = self.impact.target(t, impact_force)
+            frame_origin = point - self._impact_rotation @ self.impact.offset.translation
+            self.impact_task.set_target(pin.SE3(self._impact_rotation, frame_origin))
+            tasks.append(self.impact_task)
+        velocity = pink.solve_ik(self.configuration, tasks, dt, solver=g.solver, damping=g.damping,
+                                 safety_break=False)
+        q_next = pin.integrate(self.model, self.configuration.q, velocity * dt)
+        # pink's limits keep the step within bounds up to round-off; clip that round-off away.
+        q_next[7:] = np.clip(q_next[7:], self._lower, self._upper)
+        self.configuration.update(q_next)
+        self.v_ref = velocity
+        return ControlOutput(self.configuration.q.copy(), velocity, zmp, xi, clamped, com, com_velocity)
+
+    def describe(self) -> dict:
+        """Name and gains (the ``controller`` object of ``validate --json``)."""
+        return {"name": self.name, "gains": self.gains.to_dict(), "omega": self.omega}

@@ -1,0 +1,1 @@
+"""The MuJoCo model of a scenario: URDF to MJCF (:mod:`.urdf`), inertia repair (:mod:`.inertia`), collision geometry and environment (:mod:`.environment`), joint models (:mod:`.joints`), and the build (:mod:`.build`)."""

@@ -1,0 +1,280 @@
+"""An impact trial: the impacting end-effector reaches the surface at a commanded approach speed.
+
+``rigid`` joints: gravity off, the sustained contacts off (the robot floats), the whole robot
+starts ``gap`` away from the surface (along the impact normal) with a pure translation
+velocity ``-v_n n``, so the impact point approaches at ``v_n``. This is exactly the paper's
+impact of one rigid body.
+
+``servo`` joints: gravity on, the robot stands on its contacts. It first settles for
+``settle`` seconds with the impacting limb retracted by ``gap``; then the limb's servo
+targets move the impact point along ``-n`` at ``v_n`` (joint velocities from the limb's
+Jacobian pseudo-inverse at the stance, the least-norm ones that keep the retracted start pose
+within the joint limits when it would leave them, :func:`approach_joint_velocity`; positions
+integrated from the retracted pose). They
+go on past the stance if the servos lag, and stop where they are once the impact force
+appears (a kinematic controller stops at contact). Every other joint holds the stance. The
+limb is the chain of joints that leads to the impact frame and carries nothing else (Talos'
+right arm for a palm push, the left leg for a kick).
+
+The recorded time series (:class:`TrialRecord`) is what :mod:`.measure` reads and what the
+log and the figures show.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+import pinocchio as pin
+
+from impact_balance.exceptions import SimulationError
+from impact_balance.ranges import MAX_APPROACH_SPEED, check_approach_speed
+from impact_balance.sim.model.build import SimModel
+
+__all__ = ["TrialOptions", "TrialRecord", "run_trial", "impact_limb", "approach_joint_velocity", "MAX_APPROACH_SPEED"]
+
+
+@dataclass(frozen=True)
+class TrialOptions:
+    """How an impact trial runs.
+
+    Attributes:
+        approach_speed: Commanded approach speed v_n of the impact point along -n, m/s.
+        after: Simulated time kept after the impact begins, s.
+        gap: Initial distance of the impact point from the surface, m (default: the larger
+            of 2 cm and 0.1 s of travel, so the servos reach the commanded speed).
+        settle: ``servo`` only: time standing still before the approach, s.
+        rigid_impact: ``servo`` only: hold every joint's velocity from the contact to the end of the
+            compression (:mod:`.rigid_impact`), the paper's rigid robot at the impact.
+    """
+
+    approach_speed: float
+    after: float = 0.15
+    gap: float | None = None
+    settle: float = 0.2
+    rigid_impact: bool = False
+
+    def resolved_gap(self) -> float:
+        return self.gap if self.gap is not None else max(0.02, 0.1 * self.approach_speed)
+
+
+@dataclass
+class TrialRecord:
+    """Time series of a trial, one row per integration step (world axes, SI units).
+
+    Attributes:
+        time: s, from the start of the trial (settling included).
+        qpos, qvel: MuJoCo state (free joint: position, quaternion wxyz, world linear and
+            base-frame angular velocity).
+        com, com_velocity: CoM position and velocity, m and m/s.
+        forces: Force on the robot per name (each contact's frame, and ``impact``), N, (T, 3).
+        impact_velocity: Velocity of the impact point, m/s, (T, 3).
+        approach_start: Time the approach begins (end of settling), s.
+        hold: The rigid-impact hold (:meth:`.rigid_impact.RigidImpactHold.to_dict`), or None.
+        contact_positions: Centre of each sustained-contact box, world, m, (T, k, 3).
+        actuator_force: Servo torques (N m), (T, nu), aligned with ``SimModel.joint_names``.
+        wall_time: Wall-clock time of the simulation loop (recording included), s.
+    """
+
+    time: np.ndarray
+    qpos: np.ndarray
+    qvel: np.ndarray
+    com: np.ndarray
+    com_velocity: np.ndarray
+    forces: dict[str, np.ndarray]
+    impact_velocity: np.ndarray
+    approach_start: float
+    wall_time: float
+    contact_positions: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 3)))
+    actuator_force: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    hold: dict | None = None
+
+    @property
+    def simulated_time(self) -> float:
+        return float(self.time[-1] - self.time[0]) if self.time.size else 0.0
+
+
+def impact_limb(sim: SimModel) -> list[str]:
+    """Joints of the impacting limb: on the chain to the impact frame, carrying nothing else.
+
+    A joint belongs to the limb when every joint it carries (its subtree) is on the chain to
+    the impact frame's joint or beyond it.
+    """
+    spec = sim.scenario.impact
+    model = sim.stance.model
+    joint = model.frames[sim.robot.frame_id(spec.frame, "impact.frame")].parentJoint
+    chain = []
+    j = joint
+    while j > 1:
+        chain.append(j)
+        j = model.parents[j]
+    beyond = set(model.subtrees[joint])
+    limb = [j for j in chain if set(model.subtrees[j]) <= beyond | set(chain)]
+    names = [model.names[j] for j in reversed(limb)]
+    return [n for n in names if n in sim.joint_names]
+
+
+def approach_joint_velocity(sim: SimModel, limb: list[str], normal: np.ndarray, gap: float) -> np.ndarray:
+    """Joint velocity (pinocchio ``nv``) of the ``limb`` that moves the impact point at unit speed along
+    ``-normal`` at the stance, such that the retracted start pose ``q - gap dq`` is within the joints' limits.
+
+    The smallest such ``dq``: the Jacobian's pseudo-inverse solution when its start pose is within the
+    limits (MuJoCo's joint ranges), else the least-norm solution with the start pose bounded by them (a QP).
+    A start pose beyond a limit is not a pose the servos can hold: MuJoCo's limit constraint snaps the
+    joint back while the robot settles, and the limb may hit the surface before the approach begins
+    (iCub's right shoulder pitch, at 0.085 rad from its limit in ``icub_two_feet``). When no such ``dq``
+    exists the approach cannot be commanded along a straight joint path from this stance: SimulationError.
+    """
+    import qpsolvers
+
+    spec = sim.scenario.impact.spec()
+    model = sim.stance.model
+    _, J6 = sim.stance.point(spec.frame, spec.offset)
+    slots = [sim.robot.joint_slot(j) for j in limb]
+    v_cols = np.array([model.joints[s.id].idx_v for s in slots])
+    J = J6[:3, v_cols]
+    dq = np.linalg.pinv(J) @ (-normal)
+    mj_joints = [sim.model.joint(j).id for j in limb]
+    limited = sim.model.jnt_limited[mj_joints].astype(bool)
+    low, high = sim.model.jnt_range[mj_joints].T
+    q = sim.stance.q[[model.joints[s.id].idx_q for s in slots]]
+    start = q - gap * dq
+    # A start pose within the limits (or a joint already beyond its limit at the stance, kept as it is).
+    outside = limited & (((start < low) & (dq > 0)) | ((start > high) & (dq < 0)))
+    if outside.any():
+        big = 1e6  # rad/m: no bound
+        lower = np.where(limited, np.minimum((q - high) / gap, 0.0), -big)  # q - gap dq <= high
+        upper = np.where(limited, np.maximum((q - low) / gap, 0.0), big)  # q - gap dq >= low
+        solution = qpsolvers.solve_qp(np.eye(len(limb)), np.zeros(len(limb)), A=J, b=-normal,
+                                      lb=lower, ub=upper, solver="daqp")
+        if solution is None or not np.allclose(J @ solution, -normal, atol=1e-6):
+            names = ", ".join(f"{j} ({q_j:+.3f} rad, range [{lo:+.3f}, {hi:+.3f}])"
+                              for j, q_j, lo, hi, bad in zip(limb, q, low, high, outside) if bad)
+            raise SimulationError(
+                "impact", spec.frame,
+                f"the limb cannot start {gap:.3f} m back from the surface within its joint limits: a straight "
+                f"joint path that moves the impact point along the normal would take {names} beyond its limit")
+        dq = solution
+    out = np.zeros(model.nv)
+    out[v_cols] = dq
+    return out
+
+
+def _point_velocity(sim: SimModel, normal: np.ndarray) -> np.ndarray:
+    """World velocity of the impact point (the sphere's surface point along -n)."""
+    out = np.zeros(6)
+    mujoco.mj_objectVelocity(sim.model, sim.data, mujoco.mjtObj.mjOBJ_GEOM, sim.impact_geom, out, 0)
+    r = -sim.model.geom_size[sim.impact_geom][0] * normal
+    (wx, wy, wz), (rx, ry, rz) = out[:3].tolist(), r.tolist()
+    return out[3:] + np.array((wy * rz - wz * ry, wz * rx - wx * rz, wx * ry - wy * rx))
+
+
+def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
+    """Run one impact trial on ``sim`` (reset to the stance first); see the module docstring."""
+    if sim.scenario.impact is None or sim.impact_geom is None:
+        raise SimulationError("impact", None, "the scenario has no impact to simulate")
+    v_n = options.approach_speed
+    check_approach_speed(v_n)
+    m, d = sim.model, sim.data
+    spec = sim.scenario.impact.spec()
+    n = np.asarray(spec.normal, dtype=float) / np.linalg.norm(spec.normal)
+    gap = options.resolved_gap()
+    travel = gap / v_n
+    q0 = sim.stance.q.copy()
+    gravity = m.opt.gravity.copy()
+    dt = m.opt.timestep
+
+    if sim.joints == "rigid":
+        m.opt.gravity[:] = 0.0
+        sim.enable_supports(False)
+        q0[:3] += gap * n
+        R = pin.Quaternion(q0[6], q0[3], q0[4], q0[5]).toRotationMatrix()
+        v0 = np.zeros(sim.stance.model.nv)
+        v0[:3] = R.T @ (-v_n * n)
+        sim.set_state(q0, v0)
+        settle = 0.0
+        limb_dq = None
+    else:
+        sim.enable_supports(True)
+        limb = impact_limb(sim)
+        if not limb:
+            raise SimulationError("impact.frame", spec.frame,
+                                  "no joint moves the impact point without moving a contact")
+        limb_dq = approach_joint_velocity(sim, limb, n, gap)  # joint velocity per unit approach speed
+        q_start = pin.integrate(sim.stance.model, sim.stance.q, -gap * limb_dq)
+        sim.set_state(q_start)
+        sim.set_servo_targets(q_start)
+        settle = options.settle
+    total = settle + 1.5 * travel + options.after
+    steps = int(round(total / dt))
+    frames = [c.spec.frame for c in sim.stance.contacts]
+    # Log names: the contact's frame, made unique with its index when two contacts share a frame.
+    names = [f if frames.count(f) == 1 else f"{f}_{i}" for i, f in enumerate(frames)] + ["impact"]
+    geoms = [*sim.contact_geoms, sim.impact_geom]
+    T = steps
+    rec_t = np.empty(T)
+    qpos, qvel = np.empty((T, m.nq)), np.empty((T, m.nv))
+    com, comd = np.empty((T, 3)), np.empty((T, 3))
+    forces = np.empty((T, len(geoms), 3))
+    point_v = np.empty((T, 3))
+    contact_pos = np.empty((T, len(sim.contact_geoms), 3))
+    torques = np.empty((T, m.nu))
+
+    # mj_step computes the kinematics, contacts and forces of the state it starts from, then
+    # integrates: sample k is the state before step k, with what mj_step computed from it
+    # (its contact forces act from sample k to sample k + 1).
+    d.time = 0.0
+    start = time.perf_counter()
+    frozen = None  # servo targets once the impact begins
+    hold = None
+    if options.rigid_impact and sim.joints == "servo":
+        from impact_balance.sim.trials.rigid_impact import RigidImpactHold
+
+        hold = RigidImpactHold(sim)
+    surface = float(n @ np.asarray(sim.stance.point(spec.frame, spec.offset)[0].translation))
+    radius = float(m.geom_size[sim.impact_geom][0])
+    try:
+        for k in range(T):
+            if hold is not None and hold.start is None:
+                # Hold from the step in which the point will touch: its gap closes within one step.
+                approach = float(-n @ _point_velocity(sim, n))
+                gap = float(n @ (d.geom_xpos[sim.impact_geom] - radius * n)) - surface
+                if gap - max(0.0, approach) * dt <= 0.0:
+                    hold.begin(d.time)
+            if limb_dq is not None:
+                s = d.time - settle  # time into the approach
+                if frozen is None and s > 0.0 and k > 0 and forces[k - 1, -1].any():
+                    # A kinematic controller stops the limb at contact: hold the targets there.
+                    frozen = pin.integrate(sim.stance.model, q_start, s * v_n * limb_dq)
+                if frozen is not None:
+                    sim.set_servo_targets(frozen)
+                elif s > 0.0:
+                    # Past the stance if need be: the servos lag, the surface is where the stance touches it.
+                    sim.set_servo_targets(pin.integrate(sim.stance.model, q_start, s * v_n * limb_dq), v_n * limb_dq)
+            rec_t[k] = d.time
+            qpos[k], qvel[k] = d.qpos, d.qvel
+            mujoco.mj_step(m, d)
+            mujoco.mj_subtreeVel(m, d)
+            com[k] = d.subtree_com[sim.root_body]
+            comd[k] = d.subtree_linvel[sim.root_body]
+            forces[k] = sim.contact_forces(geoms)
+            point_v[k] = _point_velocity(sim, n)
+            contact_pos[k] = d.geom_xpos[list(sim.contact_geoms)]
+            torques[k] = d.actuator_force
+            if hold is not None:
+                hold.update(d.time, float(-n @ point_v[k]))
+    finally:
+        wall = time.perf_counter() - start
+        m.opt.gravity[:] = gravity
+        sim.enable_supports(True)
+        if hold is not None:
+            hold.release(d.time)
+    return TrialRecord(
+        time=rec_t, qpos=qpos, qvel=qvel, com=com, com_velocity=comd,
+        forces={name: forces[:, i] for i, name in enumerate(names)}, impact_velocity=point_v,
+        approach_start=settle, wall_time=wall, contact_positions=contact_pos,
+        actuator_force=torques[:, sim.actuator_ids] if m.nu else torques,
+        hold=None if hold is None else hold.to_dict(),
+    )
