@@ -22,17 +22,40 @@ from pathlib import Path
 
 import numpy as np
 
-from impact_balance.sim.trials.balance_trial import (TRIAL_VERSION, BalanceSetup, BalanceTrialOptions, Push,
-                                              controller_margin, run_balance_trial)
 from impact_balance.sim.studies.journal import TrialJournal, journal_digest
 from impact_balance.sim.studies.push import push_test
 from impact_balance.sim.studies.validate import validate
+from impact_balance.sim.trials.balance_trial import (
+    TRIAL_VERSION,
+    BalanceSetup,
+    BalanceTrialOptions,
+    Push,
+    controller_margin,
+    run_balance_trial,
+)
 
-IMPACT_SCENARIOS = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot", "g1_two_feet", "talos_three_contacts",
-                    "talos_side_slope")
-PUSH_SCENARIOS = ("palm_push_two_feet", "palm_push_ramp", "g1_two_feet", "talos_three_contacts", "talos_side_slope")
+IMPACT_SCENARIOS = (
+    "palm_push_two_feet",
+    "palm_push_ramp",
+    "kick_one_foot",
+    "g1_two_feet",
+    "talos_three_contacts",
+    "talos_side_slope",
+)
+PUSH_SCENARIOS = (
+    "palm_push_two_feet",
+    "palm_push_ramp",
+    "g1_two_feet",
+    "talos_three_contacts",
+    "talos_side_slope",
+)
 #: (controller, joints, rigid impact) of the impact rows.
-IMPACT_SETUPS = (("id", "servo", True), ("id", "servo", False), ("ik", "rigid", True), ("ik", "servo", False))
+IMPACT_SETUPS = (
+    ("id", "servo", True),
+    ("id", "servo", False),
+    ("ik", "rigid", True),
+    ("ik", "servo", False),
+)
 
 
 def _load() -> str:
@@ -53,7 +76,9 @@ def _ci(c) -> str:
 
 def _journal(out: Path, name: str, parts: dict) -> TrialJournal:
     digest = journal_digest({"trial_version": TRIAL_VERSION, **parts})
-    return TrialJournal.open(out / "journals" / f"{name}_{digest[:12]}.jsonl", digest, {"name": name})
+    return TrialJournal.open(
+        out / "journals" / f"{name}_{digest[:12]}.jsonl", digest, {"name": name}
+    )
 
 
 def speed(controller: str, repeats: int = 3) -> dict:
@@ -64,57 +89,107 @@ def speed(controller: str, repeats: int = 3) -> dict:
     for _ in range(repeats):
         r = run_balance_trial(setup, push=Push(0.0, 1e-6, 0.01, start=0.0), options=options)
         ratios.append(r.sim_time / r.wall_time)
-    return {"controller": controller, "real_time_factor": ratios, "median": float(np.median(ratios)), "load": _load()}
+    return {
+        "controller": controller,
+        "real_time_factor": ratios,
+        "median": float(np.median(ratios)),
+        "load": _load(),
+    }
 
 
 def impacts(names, out: Path) -> list[dict]:
     rows = []
     print("\n## Impacts: fall threshold in measured approach speed (m/s)\n")
-    print("| scenario | controller, joints | impact | CoM crit. (0 / margin) | stood / fell, measured | commanded | "
-          "fell / predicted | first contact break | palm impulse at 'fell' (N s) | sustained contacts' impulse | trials |")
+    print(
+        "| scenario | controller, joints | impact | CoM crit. (0 / margin) | stood / fell, measured | commanded | "
+        "fell / predicted | first contact break | palm impulse at 'fell' (N s) | sustained contacts' impulse | trials |"
+    )
     print("|---|---|---|---|---|---|---|---|---|---|---|", flush=True)
     for name in names:
         for controller, joints, rigid in IMPACT_SETUPS:
             options = BalanceTrialOptions(controller=controller, rigid_impact=rigid)
-            journal = _journal(out, f"validate_{name}_{controller}_{joints}_{'rigid' if rigid else 'free'}",
-                               {"scenario": name, "controller": controller, "joints": joints, "rigid": rigid})
+            journal = _journal(
+                out,
+                f"validate_{name}_{controller}_{joints}_{'rigid' if rigid else 'free'}",
+                {"scenario": name, "controller": controller, "joints": joints, "rigid": rigid},
+            )
             r = validate(name, joints, options=options, journal=journal)
             journal.close()
             d = r.to_dict()
             rows.append(d)
-            e, p, pm = d["empirical"], d["predicted"]["com_criterion"], d["predicted_with_margin"]["com_criterion"]
+            e, p, pm = (
+                d["empirical"],
+                d["predicted"]["com_criterion"],
+                d["predicted_with_margin"]["com_criterion"],
+            )
             ratio = None if e["fell"] is None or not p["composite"] else e["fell"] / p["composite"]
             brk = d["contact_break"]
-            brk_text = "-" if brk is None else f"{brk['contact']} {brk['kind']} at {brk['measured']:.2f} ({brk['outcome']})"
-            at_fell = [t for t in d["trials"] if t["fell"] and t["approach_speed_measured"] == e["fell"]]
+            brk_text = (
+                "-"
+                if brk is None
+                else f"{brk['contact']} {brk['kind']} at {brk['measured']:.2f} ({brk['outcome']})"
+            )
+            at_fell = [
+                t for t in d["trials"] if t["fell"] and t["approach_speed_measured"] == e["fell"]
+            ]
             imp = at_fell[0]["trial"].get("impact") if at_fell else None
-            palm = "-" if imp is None or imp["impulse"] is None else f"{np.linalg.norm(imp['impulse']):.1f}"
-            sustained = "-" if imp is None else ", ".join(
-                f"{np.linalg.norm(v):.1f}" for v in imp["sustained_impulses"].values() if v is not None)
+            palm = (
+                "-"
+                if imp is None or imp["impulse"] is None
+                else f"{np.linalg.norm(imp['impulse']):.1f}"
+            )
+            sustained = (
+                "-"
+                if imp is None
+                else ", ".join(
+                    f"{np.linalg.norm(v):.1f}"
+                    for v in imp["sustained_impulses"].values()
+                    if v is not None
+                )
+            )
             stood = _f(e["survived"]) + ("" if e["monotonic"] else " (non-monotonic)")
-            print(f"| {name} | {controller}, {joints} | {'rigid' if rigid else 'free'} | {_f(p['composite'])} / "
-                  f"{_f(pm['composite'])} | {stood} / {_f(e['fell'])} | {_f(e['survived_commanded'])} / "
-                  f"{_f(e['fell_commanded'])} | {_f(ratio, 2)} | {brk_text} | {palm} | {sustained} | {len(d['trials'])} |",
-                  flush=True)
+            print(
+                f"| {name} | {controller}, {joints} | {'rigid' if rigid else 'free'} | {_f(p['composite'])} / "
+                f"{_f(pm['composite'])} | {stood} / {_f(e['fell'])} | {_f(e['survived_commanded'])} / "
+                f"{_f(e['fell_commanded'])} | {_f(ratio, 2)} | {brk_text} | {palm} | {sustained} | {len(d['trials'])} |",
+                flush=True,
+            )
     return rows
 
 
-def pushes(names, directions: int, relative: list[float], out: Path, bodies: list[str]) -> list[dict]:
+def pushes(
+    names, directions: int, relative: list[float], out: Path, bodies: list[str]
+) -> list[dict]:
     rows = []
     options = BalanceTrialOptions(controller="id")
     own = controller_margin(options)
-    print(f"\n## Pushes (id controller, {directions} directions x {relative} of the boundary impulse, 50 ms)\n")
-    print("| scenario | body | pushes | balanced / contact broken / fell / aborted | margin (mm) | CoM criterion before: "
-          "right / safe & fell (%) | CoM in trial | ZMP before | ZMP in trial | smallest margin (CoM, <= 5 %) |")
+    print(
+        f"\n## Pushes (id controller, {directions} directions x {relative} of the boundary impulse, 50 ms)\n"
+    )
+    print(
+        "| scenario | body | pushes | balanced / contact broken / fell / aborted | margin (mm) | CoM criterion before: "
+        "right / safe & fell (%) | CoM in trial | ZMP before | ZMP in trial | smallest margin (CoM, <= 5 %) |"
+    )
     print("|---|---|---|---|---|---|---|---|---|---|", flush=True)
     for name, which in ((n, b) for n in names for b in bodies):
         setup = BalanceSetup.create(name, "servo", options)
         # "torso": the push-test default; "base": the root body (Talos' base_link, G1's pelvis), near the CoM.
         body = None if which == "torso" else setup.sim.model.body(setup.sim.root_body).name
-        journal = _journal(out, f"push_{name}_{which}_id", {"scenario": name, "controller": "id",
-                                                           "directions": directions, "body": body})
+        journal = _journal(
+            out,
+            f"push_{name}_{which}_id",
+            {"scenario": name, "controller": "id", "directions": directions, "body": body},
+        )
         t0 = time.perf_counter()
-        r = push_test(name, directions, relative=relative, options=options, journal=journal, body=body, setup=setup)
+        r = push_test(
+            name,
+            directions,
+            relative=relative,
+            options=options,
+            journal=journal,
+            body=body,
+            setup=setup,
+        )
         journal.close()
         d = r.to_dict()
         d["body"] = body or "torso"
@@ -126,13 +201,19 @@ def pushes(names, directions: int, relative: list[float], out: Path, bodies: lis
         smallest = study["smallest_margin"]["com"]
         for m in study["margins"]:
             s = study["scores"][f"{m:g}"]
-            cells = [f"{_pct(s[k]['accuracy'])}{_ci(s[k]['accuracy_ci95'])} / {_pct(s[k]['safe_fell_rate'])}"
-                     f"{_ci(s[k]['safe_fell_rate_ci95'])}" for k in ("com", "com_in_trial", "zmp", "zmp_in_trial")]
+            cells = [
+                f"{_pct(s[k]['accuracy'])}{_ci(s[k]['accuracy_ci95'])} / {_pct(s[k]['safe_fell_rate'])}"
+                f"{_ci(s[k]['safe_fell_rate_ci95'])}"
+                for k in ("com", "com_in_trial", "zmp", "zmp_in_trial")
+            ]
             first = m == study["margins"][0]
-            print(f"| {name if first else ''} | {d['body'] if first else ''} | {len(r.outcomes) if first else ''} | "
-                  f"{(str(o['balanced']) + ' / ' + str(o['contact_broken']) + ' / ' + str(o['fell']) + ' / ' + str(o['aborted'])) if first else ''} | "
-                  f"{1e3 * m:g}{' (own)' if m == own else ''} | {' | '.join(cells)} | "
-                  f"{('-' if smallest is None else f'{1e3 * smallest:g} mm') if first else ''} |", flush=True)
+            print(
+                f"| {name if first else ''} | {d['body'] if first else ''} | {len(r.outcomes) if first else ''} | "
+                f"{(str(o['balanced']) + ' / ' + str(o['contact_broken']) + ' / ' + str(o['fell']) + ' / ' + str(o['aborted'])) if first else ''} | "
+                f"{1e3 * m:g}{' (own)' if m == own else ''} | {' | '.join(cells)} | "
+                f"{('-' if smallest is None else f'{1e3 * smallest:g} mm') if first else ''} |",
+                flush=True,
+            )
     print("\nContact breaks (no fall) and falls by fraction of the boundary impulse:\n")
     print("| scenario | body | fraction | pushes | contact broken | fell | first event (count) |")
     print("|---|---|---|---|---|---|---|")
@@ -149,19 +230,35 @@ def pushes(names, directions: int, relative: list[float], out: Path, bodies: lis
                 row["first"][key] = row["first"].get(key, 0) + 1
         for frac in sorted(by):
             row = by[frac]
-            first = ", ".join(f"{k} ({v})" for k, v in sorted(row["first"].items(), key=lambda kv: -kv[1])) or "-"
-            print(f"| {d['scenario']} | {d['body']} | {frac:g} | {row['n']} | {row['broken']} | {row['fell']} | {first} |")
+            first = (
+                ", ".join(
+                    f"{k} ({v})" for k, v in sorted(row["first"].items(), key=lambda kv: -kv[1])
+                )
+                or "-"
+            )
+            print(
+                f"| {d['scenario']} | {d['body']} | {frac:g} | {row['n']} | {row['broken']} | {row['fell']} | {first} |"
+            )
     return rows
 
 
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--parts", nargs="+", default=["speed", "impacts", "pushes"], choices=["speed", "impacts", "pushes"])
-    p.add_argument("--out", default="balance-benchmark", help="folder of the journals and of balance.json")
+    p.add_argument(
+        "--parts",
+        nargs="+",
+        default=["speed", "impacts", "pushes"],
+        choices=["speed", "impacts", "pushes"],
+    )
+    p.add_argument(
+        "--out", default="balance-benchmark", help="folder of the journals and of balance.json"
+    )
     p.add_argument("--scenarios", nargs="+", default=list(IMPACT_SCENARIOS))
     p.add_argument("--push-scenarios", nargs="+", default=list(PUSH_SCENARIOS))
     p.add_argument("--directions", type=int, default=8)
-    p.add_argument("--relative", type=float, nargs="+", default=[0.5, 0.7, 0.85, 0.95, 1.05, 1.15, 1.3, 1.5])
+    p.add_argument(
+        "--relative", type=float, nargs="+", default=[0.5, 0.7, 0.85, 0.95, 1.05, 1.15, 1.3, 1.5]
+    )
     p.add_argument("--bodies", nargs="+", default=["torso", "base"], choices=["torso", "base"])
     args = p.parse_args()
     out = Path(args.out)
@@ -171,12 +268,17 @@ def main() -> int:
     if "speed" in args.parts:
         result["speed"] = [speed(c) for c in ("ik", "id")]
         for s in result["speed"]:
-            print(f"3 s trial, {s['controller']} controller: {s['median']:.2f}x real time "
-                  f"(runs {', '.join(f'{x:.2f}' for x in s['real_time_factor'])}; {s['load']})", flush=True)
+            print(
+                f"3 s trial, {s['controller']} controller: {s['median']:.2f}x real time "
+                f"(runs {', '.join(f'{x:.2f}' for x in s['real_time_factor'])}; {s['load']})",
+                flush=True,
+            )
     if "impacts" in args.parts:
         result["impacts"] = impacts(args.scenarios, out)
     if "pushes" in args.parts:
-        result["pushes"] = pushes(args.push_scenarios, args.directions, args.relative, out, args.bodies)
+        result["pushes"] = pushes(
+            args.push_scenarios, args.directions, args.relative, out, args.bodies
+        )
     result["finished"] = _load()
     print(f"\n{_load()} at the end")
     (out / "balance.json").write_text(json.dumps(result, allow_nan=False, default=float))

@@ -64,49 +64,91 @@ import json
 import sys
 from pathlib import Path
 
-from governor_study import SCENARIOS, _load
-
 # The benchmark's modules live in contact_aware/, beside this file (on sys.path as the script's folder).
 from contact_aware.preload import TRAINING, bounds, bounds_table, preload, preload_table, ramp_jumps
 from contact_aware.trace import trace
 from contact_aware.trials import SWEEP_REFERENCES, VARIANTS, score, score_table, sweep, sweep_table
+from governor_study import SCENARIOS, _load
 
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = p.add_subparsers(dest="command", required=True)
     s = sub.add_parser("score", help="the governed trials (36 with the defaults)")
-    s.add_argument("--out", default="contact-aware-governor", help="folder of the journals and score.json")
-    s.add_argument("--variant", choices=VARIANTS, default="union",
-                   help="union: --contact-aware, the union of the LCP's solutions (default, section 5); async: the same "
-                        "computed off the tick (--contact-aware-async); warm: as "
-                        "frozen in 5e477e6 (section 4's 'aware'); cold: post hoc cold start; off: without it")
+    s.add_argument(
+        "--out", default="contact-aware-governor", help="folder of the journals and score.json"
+    )
+    s.add_argument(
+        "--variant",
+        choices=VARIANTS,
+        default="union",
+        help="union: --contact-aware, the union of the LCP's solutions (default, section 5); async: the same "
+        "computed off the tick (--contact-aware-async); warm: as "
+        "frozen in 5e477e6 (section 4's 'aware'); cold: post hoc cold start; off: without it",
+    )
     s.add_argument("--scenarios", nargs="+", default=list(SCENARIOS))
     s.add_argument("--references", type=float, nargs="+", default=[0.5, 1.0, 2.0], help="m/s")
-    s.add_argument("--distances", type=float, nargs="+", default=[0.12, 0.15, 0.18], help="walls, m, in this order")
-    s.add_argument("--velocity-margin", type=float, default=0.0,
-                   help="the governor's velocity margin, m/s (default 0; docs/governor.md)")
+    s.add_argument(
+        "--distances",
+        type=float,
+        nargs="+",
+        default=[0.12, 0.15, 0.18],
+        help="walls, m, in this order",
+    )
+    s.add_argument(
+        "--velocity-margin",
+        type=float,
+        default=0.0,
+        help="the governor's velocity margin, m/s (default 0; docs/governor.md)",
+    )
     w = sub.add_parser("sweep", help="ungoverned approaches at wall 15 cm (33 with the defaults)")
-    w.add_argument("--out", default="contact-aware-governor", help="folder of the journals and sweep.json")
+    w.add_argument(
+        "--out", default="contact-aware-governor", help="folder of the journals and sweep.json"
+    )
     w.add_argument("--scenarios", nargs="+", default=list(SWEEP_REFERENCES))
-    w.add_argument("--references", type=float, nargs="+", help="m/s (default: each stance's own, SWEEP_REFERENCES)")
+    w.add_argument(
+        "--references",
+        type=float,
+        nargs="+",
+        help="m/s (default: each stance's own, SWEEP_REFERENCES)",
+    )
     b = sub.add_parser("bounds", help="the caps at the scenario postures (no simulation)")
     b.add_argument("--scenarios", nargs="+", default=list(SCENARIOS))
-    b.add_argument("--margins", type=float, nargs="+", default=[0.0, 0.01], help="ZMP margins, m, ascending")
-    b.add_argument("--velocity-margin", type=float, default=0.0, help="the governors' velocity margin, m/s")
-    r = sub.add_parser("preload", help="the preload model against the training stances' trials, the ramp's jumps")
-    r.add_argument("--out", default="contact-aware-governor", help="folder of the journals and preload.json")
+    b.add_argument(
+        "--margins", type=float, nargs="+", default=[0.0, 0.01], help="ZMP margins, m, ascending"
+    )
+    b.add_argument(
+        "--velocity-margin", type=float, default=0.0, help="the governors' velocity margin, m/s"
+    )
+    r = sub.add_parser(
+        "preload", help="the preload model against the training stances' trials, the ramp's jumps"
+    )
+    r.add_argument(
+        "--out", default="contact-aware-governor", help="folder of the journals and preload.json"
+    )
     r.add_argument("--scenarios", nargs="+", default=list(TRAINING))
-    r.add_argument("--speeds", type=float, nargs="+", default=[0.25, 0.5, 0.75], help="commanded, m/s")
-    t = sub.add_parser("trace", help="one logged approach: after the impact, and the warm/cold branches")
-    t.add_argument("--out", default="contact-aware-governor", help="folder of the trial's log and summary")
+    r.add_argument(
+        "--speeds", type=float, nargs="+", default=[0.25, 0.5, 0.75], help="commanded, m/s"
+    )
+    t = sub.add_parser(
+        "trace", help="one logged approach: after the impact, and the warm/cold branches"
+    )
+    t.add_argument(
+        "--out", default="contact-aware-governor", help="folder of the trial's log and summary"
+    )
     t.add_argument("--scenario", default="palm_push_ramp")
     t.add_argument("--governor", choices=("com", "none"), default="com")
     t.add_argument("--contact-aware", action="store_true", help="the governor with the option")
     t.add_argument("--reference", type=float, default=1.0, help="m/s")
     t.add_argument("--wall", type=float, default=0.12, help="m")
-    t.add_argument("--every", type=float, default=50.0, help="rows of the table after the impact, ms")
-    t.add_argument("--branches", action="store_true", help="warm and cold contact-aware answers before the contact")
+    t.add_argument(
+        "--every", type=float, default=50.0, help="rows of the table after the impact, ms"
+    )
+    t.add_argument(
+        "--branches",
+        action="store_true",
+        help="warm and cold contact-aware answers before the contact",
+    )
     args = p.parse_args(argv)
     print(f"{_load()} at the start", file=sys.stderr, flush=True)
     if args.command == "bounds":
@@ -118,17 +160,23 @@ def main(argv: list[str] | None = None) -> int:
     if args.command == "trace":
         trace(args, out)
         return 0
-    run, table = {"score": (score, score_table), "sweep": (sweep, sweep_table),
-                  "preload": (preload, preload_table)}[args.command]
+    run, table = {
+        "score": (score, score_table),
+        "sweep": (sweep, sweep_table),
+        "preload": (preload, preload_table),
+    }[args.command]
     rows, failures = run(args, out)
     print(table(rows))
     if args.command == "preload":
         print("\nThe ramp (palm_push_ramp, scenario posture, 10 mm inset):\n")
         print(ramp_jumps())
     print(f"\n{_load()} at the end; {len(rows)} trials, {failures} failed")
-    tag = "" if args.command != "score" else f"_{args.variant}" + (f"_v{args.velocity_margin:g}" if args.velocity_margin else "")
-    (out / f"{args.command}{tag}.json").write_text(
-        json.dumps(rows, allow_nan=False, default=float))
+    tag = (
+        ""
+        if args.command != "score"
+        else f"_{args.variant}" + (f"_v{args.velocity_margin:g}" if args.velocity_margin else "")
+    )
+    (out / f"{args.command}{tag}.json").write_text(json.dumps(rows, allow_nan=False, default=float))
     return 1 if failures else 0
 
 

@@ -36,13 +36,13 @@ from pathlib import Path
 
 import numpy as np
 
-from impact_balance.impact.contact_aware import contact_impact
+from impact_balance.contacts.stance import Stance
 from impact_balance.criteria.com import max_contact_velocity
+from impact_balance.impact.contact_aware import contact_impact
 from impact_balance.scenario import bundled_scenarios, load_scenario
 from impact_balance.sim import SimOptions, build_model
-from impact_balance.sim.trials.measure import measure
 from impact_balance.sim.trials.impact_trial import TrialOptions, run_trial
-from impact_balance.contacts.stance import Stance
+from impact_balance.sim.trials.measure import measure
 
 
 def impact_scenarios() -> list[str]:
@@ -59,33 +59,56 @@ def one_row(sim, name: str, speed: float) -> dict:
     model = contact_impact(sim.stance, sim.scenario.impact.spec(), v_n, restitution=e)
     error = float(np.linalg.norm(model.com_velocity_jump - measured))
     # The same Coulomb impact without the sustained contacts: what the contacts change, at equal friction law.
-    free = contact_impact(Stance(sim.stance.robot, sim.stance.q, []), sim.scenario.impact.spec(), v_n, restitution=e)
-    sustained = np.sum(list(result.sustained_impulses.values()), axis=0) if result.sustained_impulses else np.zeros(3)
+    free = contact_impact(
+        Stance(sim.stance.robot, sim.stance.q, []), sim.scenario.impact.spec(), v_n, restitution=e
+    )
+    sustained = (
+        np.sum(list(result.sustained_impulses.values()), axis=0)
+        if result.sustained_impulses
+        else np.zeros(3)
+    )
     return {
-        "scenario": name, "speed": speed, "approach_measured": v_n, "restitution_measured": e,
-        "slip": result.slip_speed, "contacts_kept": result.contacts_kept,
-        "jump_measured": measured.tolist(), "impact_impulse_measured": result.impulse_measured.tolist(),
+        "scenario": name,
+        "speed": speed,
+        "approach_measured": v_n,
+        "restitution_measured": e,
+        "slip": result.slip_speed,
+        "contacts_kept": result.contacts_kept,
+        "jump_measured": measured.tolist(),
+        "impact_impulse_measured": result.impulse_measured.tolist(),
         "sustained_impulse_measured": sustained.tolist(),
-        "sustained_impulses_measured": {k: v.tolist() for k, v in result.sustained_impulses.items()},
+        "sustained_impulses_measured": {
+            k: v.tolist() for k, v in result.sustained_impulses.items()
+        },
         "floating_distance": floating.distance,
-        "floating_jump_x_range": [float(floating.com_velocity_jumps[:, 0].min()),
-                                  float(floating.com_velocity_jumps[:, 0].max())],
-        "contact_jump": model.com_velocity_jump.tolist(), "contact_error": error,
-        "contact_relative_error": error / float(np.linalg.norm(measured)) if np.linalg.norm(measured) > 0 else None,
+        "floating_jump_x_range": [
+            float(floating.com_velocity_jumps[:, 0].min()),
+            float(floating.com_velocity_jumps[:, 0].max()),
+        ],
+        "contact_jump": model.com_velocity_jump.tolist(),
+        "contact_error": error,
+        "contact_relative_error": error / float(np.linalg.norm(measured))
+        if np.linalg.norm(measured) > 0
+        else None,
         "contact_impact_impulse": model.impact_impulse.tolist(),
         "contact_sustained_impulse": model.contact_impulses.sum(axis=0).tolist(),
         "contact_impulses": model.contact_impulses.tolist(),
         "free_jump": free.com_velocity_jump.tolist(),
         "free_error": float(np.linalg.norm(free.com_velocity_jump - measured)),
-        "contact_converged": model.converged, "contact_iterations": model.iterations,
-        "hold": result.hold, "wall_time": time.perf_counter() - start, "loadavg": os.getloadavg(),
+        "contact_converged": model.converged,
+        "contact_iterations": model.iterations,
+        "hold": result.hold,
+        "wall_time": time.perf_counter() - start,
+        "loadavg": os.getloadavg(),
     }
 
 
 def table(rows: list[dict]) -> str:
-    head = ("| scenario | v cmd | v_n meas. | e meas. | jump measured x, y | floating: distance (x range) "
-            "| same law, no sustained contacts: jump x, y (error) | contact-aware: jump x, y | error (rel.) "
-            "| sustained impulse x, z: measured / predicted (N s) |")
+    head = (
+        "| scenario | v cmd | v_n meas. | e meas. | jump measured x, y | floating: distance (x range) "
+        "| same law, no sustained contacts: jump x, y (error) | contact-aware: jump x, y | error (rel.) "
+        "| sustained impulse x, z: measured / predicted (N s) |"
+    )
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
         jm, jc = r["jump_measured"], r["contact_jump"]
@@ -118,8 +141,10 @@ def criterion_table(names: list[str], margin: float) -> str:
     balance controller's ZMP margin, m)."""
     import impact_balance as ib
 
-    lines = [f"| scenario | floating: max v_n, m/s (no margin / {1e3 * margin:g} mm) | contact-aware (no margin / {1e3 * margin:g} mm) |",
-             "|---|---|---|"]
+    lines = [
+        f"| scenario | floating: max v_n, m/s (no margin / {1e3 * margin:g} mm) | contact-aware (no margin / {1e3 * margin:g} mm) |",
+        "|---|---|---|",
+    ]
     for name in names:
         a = ib.analyze(name)
         spec, c0 = a.scenario.impact.spec(), np.asarray(a.com_velocity, dtype=float)
@@ -127,19 +152,38 @@ def criterion_table(names: list[str], margin: float) -> str:
         inset = a.areas.com_velocity_area_inset(margin)
 
         floating.append(max_contact_velocity(inset, a.impact.model, c0).max_approach_speed)
-        rates = [contact_impact(a.stance, spec, 1.0, restitution=c).com_velocity_jump for c in spec.restitution]
-        aware = [min(_first_exit(area, c0, r) for r in rates) for area in (a.areas.com_velocity_area, inset)]
-        lines.append(f"| {name} | {floating[0]:.3f} / {floating[1]:.3f} | {aware[0]:.3f} / {aware[1]:.3f} |")
+        rates = [
+            contact_impact(a.stance, spec, 1.0, restitution=c).com_velocity_jump
+            for c in spec.restitution
+        ]
+        aware = [
+            min(_first_exit(area, c0, r) for r in rates)
+            for area in (a.areas.com_velocity_area, inset)
+        ]
+        lines.append(
+            f"| {name} | {floating[0]:.3f} / {floating[1]:.3f} | {aware[0]:.3f} / {aware[1]:.3f} |"
+        )
     return "\n".join(lines)
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--speeds", default="0.25,0.5,0.75", help="commanded approach speeds, m/s")
-    parser.add_argument("--out", default="contact_impact_rows.jsonl", help="JSON lines, appended as rows finish")
-    parser.add_argument("--resume", action="store_true", help="skip the (scenario, speed) rows already in --out")
-    parser.add_argument("--scenarios", nargs="*", help="default: every bundled scenario with an impact")
-    parser.add_argument("--margin", type=float, default=0.01, help="ZMP margin of the criterion table, m (default 0.01)")
+    parser.add_argument(
+        "--out", default="contact_impact_rows.jsonl", help="JSON lines, appended as rows finish"
+    )
+    parser.add_argument(
+        "--resume", action="store_true", help="skip the (scenario, speed) rows already in --out"
+    )
+    parser.add_argument(
+        "--scenarios", nargs="*", help="default: every bundled scenario with an impact"
+    )
+    parser.add_argument(
+        "--margin",
+        type=float,
+        default=0.01,
+        help="ZMP margin of the criterion table, m (default 0.01)",
+    )
     args = parser.parse_args()
     speeds = [float(s) for s in args.speeds.split(",")]
     out = Path(args.out)
@@ -160,7 +204,7 @@ def main() -> None:
         for speed in todo:
             try:
                 row = one_row(sim, name, speed)
-            except Exception as exc:  # noqa: BLE001 - a failed trial is a row too, not a lost run
+            except Exception as exc:
                 row = {"scenario": name, "speed": speed, "error": f"{type(exc).__name__}: {exc}"}
             with out.open("a") as f:
                 f.write(json.dumps(row) + "\n")
@@ -175,9 +219,11 @@ def main() -> None:
         print(f"\nfailed: {r['scenario']} {r['speed']:g}: {r['error']}")
     print("\nThe maximum contact velocity with each model's jump (no simulation):\n")
     print(criterion_table(args.scenarios or impact_scenarios(), args.margin))
-    print(f"\nload average (1, 5, 15 min) before: {', '.join(f'{x:.2f}' for x in load_before)}; "
-          f"after: {', '.join(f'{x:.2f}' for x in os.getloadavg())}; {os.cpu_count()} cores; "
-          f"run {time.perf_counter() - start:.0f} s")
+    print(
+        f"\nload average (1, 5, 15 min) before: {', '.join(f'{x:.2f}' for x in load_before)}; "
+        f"after: {', '.join(f'{x:.2f}' for x in os.getloadavg())}; {os.cpu_count()} cores; "
+        f"run {time.perf_counter() - start:.0f} s"
+    )
 
 
 if __name__ == "__main__":

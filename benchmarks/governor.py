@@ -35,12 +35,12 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-import impact_balance as ib
-from impact_balance.governor import Governor
-
 # The benchmark's modules live in speed/, beside this file (on sys.path as the script's folder).
 from speed.machine import machine_info
 from speed.timing import Case, measure, progress
+
+import impact_balance as ib
+from impact_balance.governor import Governor
 
 #: The wall study's scenarios (issue 15, item 3).
 SCENARIOS = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot", "g1_two_feet")
@@ -92,13 +92,23 @@ def bench_scenario(name: str, ticks: int, criterion: str) -> dict[str, Any]:
     steady = Governor(name, criterion=criterion)
     steady.limit(q_fixed, vs[0])
     cases = {
-        "posture": Case(lambda: governor.limit(qs[k["i"]], vs[k["i"]]), setup=at,
-                        keep=lambda r: (r.max_approach_speed, r.posture_reused)),
-        "velocity": Case(lambda: steady.limit(q_fixed, vs[k["i"]]), setup=at,
-                         keep=lambda r: r.posture_reused),
-        "analyze": Case(lambda: ib.analyze(scenarios[k["i"]]), setup=at,
-                        keep=lambda a: (a.impact.max_contact_velocity if criterion == "com"
-                                        else a.impact.zmp_max_contact_velocity)),
+        "posture": Case(
+            lambda: governor.limit(qs[k["i"]], vs[k["i"]]),
+            setup=at,
+            keep=lambda r: (r.max_approach_speed, r.posture_reused),
+        ),
+        "velocity": Case(
+            lambda: steady.limit(q_fixed, vs[k["i"]]), setup=at, keep=lambda r: r.posture_reused
+        ),
+        "analyze": Case(
+            lambda: ib.analyze(scenarios[k["i"]]),
+            setup=at,
+            keep=lambda a: (
+                a.impact.max_contact_velocity
+                if criterion == "com"
+                else a.impact.zmp_max_contact_velocity
+            ),
+        ),
     }
     load_before = _loadavg()
     times, results = measure(cases, ticks, warmup=3)
@@ -110,14 +120,25 @@ def bench_scenario(name: str, ticks: int, criterion: str) -> dict[str, Any]:
     agree = bool(np.array_equal(np.isfinite(got), finite) and worst <= 1e-9)
     reused_posture = sum(r[1] for r in results["posture"])
     reused_velocity = sum(results["velocity"])
-    out: dict[str, Any] = {"scenario": name, "criterion": criterion, "ticks": ticks,
-                           "loadavg_before": load_before, "loadavg_after": load_after,
-                           "agree": agree, "worst_difference": worst,
-                           "posture_reused": int(reused_posture), "velocity_reused": int(reused_velocity)}
+    out: dict[str, Any] = {
+        "scenario": name,
+        "criterion": criterion,
+        "ticks": ticks,
+        "loadavg_before": load_before,
+        "loadavg_after": load_after,
+        "agree": agree,
+        "worst_difference": worst,
+        "posture_reused": int(reused_posture),
+        "velocity_reused": int(reused_velocity),
+    }
     for case, samples in times.items():
         a = np.asarray(samples)
-        out[case] = {"median": float(np.median(a)), "p99": float(np.percentile(a, 99)),
-                     "p90": float(np.percentile(a, 90)), "min": float(a.min())}
+        out[case] = {
+            "median": float(np.median(a)),
+            "p99": float(np.percentile(a, 99)),
+            "p90": float(np.percentile(a, 90)),
+            "min": float(a.min()),
+        }
     out["ratio_analyze_over_posture"] = out["analyze"]["median"] / out["posture"]["median"]
     return out
 
@@ -131,19 +152,25 @@ def _loadavg() -> str:
 
 
 def text_report(result: dict[str, Any]) -> str:
-    lines = [f"Machine: {result['machine']['cpu']}, {result['machine']['cpu_count']} CPUs; "
-             f"Python {result['machine']['python']}",
-             f"Ticks per scenario: {result['ticks']} at {RATE:g} Hz, criterion {result['criterion']}; "
-             "times in us per tick, median / p99", ""]
-    head = (f"{'scenario':20s}  {'posture med':>11s}  {'p99':>7s}  {'velocity med':>12s}  {'p99':>6s}  "
-            f"{'analyze med':>11s}  {'p99':>7s}  {'analyze/posture':>15s}  {'check':>5s}  load avg (before; after)")
+    lines = [
+        f"Machine: {result['machine']['cpu']}, {result['machine']['cpu_count']} CPUs; "
+        f"Python {result['machine']['python']}",
+        f"Ticks per scenario: {result['ticks']} at {RATE:g} Hz, criterion {result['criterion']}; "
+        "times in us per tick, median / p99",
+        "",
+    ]
+    head = (
+        f"{'scenario':20s}  {'posture med':>11s}  {'p99':>7s}  {'velocity med':>12s}  {'p99':>6s}  "
+        f"{'analyze med':>11s}  {'p99':>7s}  {'analyze/posture':>15s}  {'check':>5s}  load avg (before; after)"
+    )
     lines += [head, "-" * len(head)]
     for r in result["scenarios"]:
         lines.append(
             f"{r['scenario']:20s}  {r['posture']['median']:11.1f}  {r['posture']['p99']:7.0f}  "
             f"{r['velocity']['median']:12.1f}  {r['velocity']['p99']:6.0f}  {r['analyze']['median']:11.1f}  "
             f"{r['analyze']['p99']:7.0f}  {r['ratio_analyze_over_posture']:15.2f}  "
-            f"{'ok' if r['agree'] else 'FAIL':>5s}  {r['loadavg_before']}; {r['loadavg_after']}")
+            f"{'ok' if r['agree'] else 'FAIL':>5s}  {r['loadavg_before']}; {r['loadavg_after']}"
+        )
     lines.append("")
     lines.append("Targets (informative; they do not change the exit status)")
     for line in result["targets"]:
@@ -154,14 +181,18 @@ def text_report(result: dict[str, Any]) -> str:
 
 def evaluate_targets(rows: list[dict[str, Any]]) -> list[str]:
     out = []
-    for key, label, bound in (("posture", "posture-changing ticks, median", TARGETS["posture_median"]),
-                              ("posture_p99", "posture-changing ticks, p99", TARGETS["posture_p99"]),
-                              ("velocity", "velocity-only ticks, median", TARGETS["velocity_median"])):
+    for key, label, bound in (
+        ("posture", "posture-changing ticks, median", TARGETS["posture_median"]),
+        ("posture_p99", "posture-changing ticks, p99", TARGETS["posture_p99"]),
+        ("velocity", "velocity-only ticks, median", TARGETS["velocity_median"]),
+    ):
         case, stat = (key, "median") if not key.endswith("_p99") else (key[:-4], "p99")
         worst = max(rows, key=lambda r: r[case][stat])
         value = worst[case][stat]
-        out.append(f"[{'PASS' if value <= bound else 'FAIL'}] {label} <= {bound:g} us: worst {value:.1f} us "
-                   f"({worst['scenario']})")
+        out.append(
+            f"[{'PASS' if value <= bound else 'FAIL'}] {label} <= {bound:g} us: worst {value:.1f} us "
+            f"({worst['scenario']})"
+        )
     return out
 
 
@@ -171,24 +202,42 @@ def main(argv: list[str] | None = None) -> int:
         import governor_study
 
         return governor_study.main(argv[1:])
-    if argv[:1] == ["--tolerance"]:  # posture_tolerance in the wall experiment: benchmarks/governor_tolerance.py
+    if argv[:1] == [
+        "--tolerance"
+    ]:  # posture_tolerance in the wall experiment: benchmarks/governor_tolerance.py
         import governor_tolerance
 
         return governor_tolerance.main(argv[1:])
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
-    ap.add_argument("--ticks", type=int, default=2000, help="ticks per scenario (default 2000: 4 s at 500 Hz)")
-    ap.add_argument("--scenarios", nargs="*", default=list(SCENARIOS), help="bundled scenario names")
-    ap.add_argument("--criterion", choices=("com", "zmp"), default="com", help="the governor's criterion")
+    ap.add_argument(
+        "--json", action="store_true", help="print one JSON object instead of the table"
+    )
+    ap.add_argument(
+        "--ticks", type=int, default=2000, help="ticks per scenario (default 2000: 4 s at 500 Hz)"
+    )
+    ap.add_argument(
+        "--scenarios", nargs="*", default=list(SCENARIOS), help="bundled scenario names"
+    )
+    ap.add_argument(
+        "--criterion", choices=("com", "zmp"), default="com", help="the governor's criterion"
+    )
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
     rows = []
     for name in args.scenarios:
         progress(f"{name}: {args.ticks} ticks")
         rows.append(bench_scenario(name, max(2, args.ticks), args.criterion))
-    result = {"benchmark": "impact_balance benchmarks/governor.py", "machine": machine_info(),
-              "ticks": args.ticks, "criterion": args.criterion, "rate_hz": RATE, "unit": "us",
-              "scenarios": rows, "targets": evaluate_targets(rows), "wall_time_s": time.perf_counter() - t0}
+    result = {
+        "benchmark": "impact_balance benchmarks/governor.py",
+        "machine": machine_info(),
+        "ticks": args.ticks,
+        "criterion": args.criterion,
+        "rate_hz": RATE,
+        "unit": "us",
+        "scenarios": rows,
+        "targets": evaluate_targets(rows),
+        "wall_time_s": time.perf_counter() - t0,
+    }
     if args.json:
         print(json.dumps(result, allow_nan=False))
     else:

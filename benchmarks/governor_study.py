@@ -24,9 +24,14 @@ import numpy as np
 
 from impact_balance.governor import Governor
 from impact_balance.scenario import load_scenario
-from impact_balance.sim.trials.balance_trial import TRIAL_VERSION, BalanceSetup, BalanceTrialOptions, controller_margin
 from impact_balance.sim.studies.journal import TrialJournal, journal_digest
 from impact_balance.sim.studies.wall import APPROACH_VERSION, WallOptions, run_wall_trial
+from impact_balance.sim.trials.balance_trial import (
+    TRIAL_VERSION,
+    BalanceSetup,
+    BalanceTrialOptions,
+    controller_margin,
+)
 
 SCENARIOS = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot", "g1_two_feet")
 
@@ -46,7 +51,12 @@ def governed_setup(name: str, rigid: bool):
     options = BalanceTrialOptions(controller="id", rigid_impact=rigid)
     margin = controller_margin(options)
     scenario = load_scenario(name)
-    return options, margin, scenario.model_copy(update={"zmp_margin": margin}), BalanceSetup.create(scenario, "servo", options)
+    return (
+        options,
+        margin,
+        scenario.model_copy(update={"zmp_margin": margin}),
+        BalanceSetup.create(scenario, "servo", options),
+    )
 
 
 def study(args, out: Path) -> list[dict]:
@@ -54,50 +64,93 @@ def study(args, out: Path) -> list[dict]:
     for name in args.scenarios:
         for impact in args.impacts:
             options, margin, governed, setup = governed_setup(name, impact == "rigid")
-            governors = {g: (None if g == "none" else Governor(governed, criterion=g)) for g in args.governors}
-            digest = journal_digest({"trial_version": TRIAL_VERSION, "approach_version": APPROACH_VERSION,
-                                     "scenario": name, "impact": impact, "margin": margin})
-            journal = TrialJournal.open(out / "journals" / f"approach_{name}_{impact}_{digest[:12]}.jsonl", digest)
+            governors = {
+                g: (None if g == "none" else Governor(governed, criterion=g))
+                for g in args.governors
+            }
+            digest = journal_digest(
+                {
+                    "trial_version": TRIAL_VERSION,
+                    "approach_version": APPROACH_VERSION,
+                    "scenario": name,
+                    "impact": impact,
+                    "margin": margin,
+                }
+            )
+            journal = TrialJournal.open(
+                out / "journals" / f"approach_{name}_{impact}_{digest[:12]}.jsonl", digest
+            )
             for g in args.governors:
                 for reference in args.references:
                     for distance in args.distances:
                         key = {"governor": g, "reference": reference, "distance": distance}
                         entry = journal.get(key)
                         if entry is None:
-                            wall = WallOptions(reference=reference, governor=g, wall_distance=distance, max_time=args.max_time)
+                            wall = WallOptions(
+                                reference=reference,
+                                governor=g,
+                                wall_distance=distance,
+                                max_time=args.max_time,
+                            )
                             trial = run_wall_trial(setup, wall, options, governor=governors[g])
                             entry = trial.to_dict()
                             entry.pop("trial", None)
                             journal.add(key, entry)
                         rows.append({"scenario": name, "impact": impact, **entry})
                         d = rows[-1]
-                        print(f"  {name} {impact} {g} {reference:g} m/s {100 * distance:g} cm: {d['outcome']} "
-                              f"speed {_f(d['speed_at_contact'])} cap {_f(d['cap_at_contact'])} "
-                              f"t {_f(d['time_to_contact'], 2)}", file=sys.stderr, flush=True)
+                        print(
+                            f"  {name} {impact} {g} {reference:g} m/s {100 * distance:g} cm: {d['outcome']} "
+                            f"speed {_f(d['speed_at_contact'])} cap {_f(d['cap_at_contact'])} "
+                            f"t {_f(d['time_to_contact'], 2)}",
+                            file=sys.stderr,
+                            flush=True,
+                        )
             journal.close()
     return rows
 
 
 def tables(rows: list[dict]) -> None:
     print("\n## Outcomes per governor (all references and wall distances)\n")
-    print("| scenario | impact | governor | trials | balanced / contact broken / fell / aborted | measured speed at contact (m/s) "
-          "| cap at contact (m/s) | time to contact (s) | speed / min(reference, cap): worst | governor tick median / p99 (us) |")
+    print(
+        "| scenario | impact | governor | trials | balanced / contact broken / fell / aborted | measured speed at contact (m/s) "
+        "| cap at contact (m/s) | time to contact (s) | speed / min(reference, cap): worst | governor tick median / p99 (us) |"
+    )
     print("|---|---|---|---|---|---|---|---|---|---|")
-    keys = sorted({(r["scenario"], r["impact"], r["governor"]) for r in rows}, key=lambda k: (k[0], k[1], "czn".index(k[2][0])))
+    keys = sorted(
+        {(r["scenario"], r["impact"], r["governor"]) for r in rows},
+        key=lambda k: (k[0], k[1], "czn".index(k[2][0])),
+    )
     for scenario, impact, g in keys:
-        group = [r for r in rows if (r["scenario"], r["impact"], r["governor"]) == (scenario, impact, g)]
-        counts = {o: sum(r["outcome"] == o for r in group) for o in ("balanced", "contact_broken", "fell", "aborted")}
+        group = [
+            r for r in rows if (r["scenario"], r["impact"], r["governor"]) == (scenario, impact, g)
+        ]
+        counts = {
+            o: sum(r["outcome"] == o for r in group)
+            for o in ("balanced", "contact_broken", "fell", "aborted")
+        }
         speeds = [r["speed_at_contact"] for r in group if r["speed_at_contact"] is not None]
         caps = [r["cap_at_contact"] for r in group if r["cap_at_contact"] is not None]
         times = [r["time_to_contact"] for r in group if r["time_to_contact"] is not None]
-        ratios = [r["speed_at_contact"] / min(r["reference"], r["cap_at_contact"] if r["cap_at_contact"] is not None else np.inf)
-                  for r in group if r["speed_at_contact"] is not None]
+        ratios = [
+            r["speed_at_contact"]
+            / min(
+                r["reference"], r["cap_at_contact"] if r["cap_at_contact"] is not None else np.inf
+            )
+            for r in group
+            if r["speed_at_contact"] is not None
+        ]
         ticks = [r["tick_us"] for r in group if r["tick_us"]["median"] is not None]
-        tick = (f"{np.median([t['median'] for t in ticks]):.0f} / {max(t['p99'] for t in ticks):.0f}" if ticks else "-")
+        tick = (
+            f"{np.median([t['median'] for t in ticks]):.0f} / {max(t['p99'] for t in ticks):.0f}"
+            if ticks
+            else "-"
+        )
         span = lambda v, d=3: "-" if not v else f"{min(v):.{d}f} to {max(v):.{d}f}"  # noqa: E731
-        print(f"| {scenario} | {impact} | {g} | {len(group)} | {counts['balanced']} / {counts['contact_broken']} / "
-              f"{counts['fell']} / {counts['aborted']} | {span(speeds)} | {span(caps)} | {span(times, 2)} | "
-              f"{_f(min(ratios) if ratios else None, 2)} | {tick} |")
+        print(
+            f"| {scenario} | {impact} | {g} | {len(group)} | {counts['balanced']} / {counts['contact_broken']} / "
+            f"{counts['fell']} / {counts['aborted']} | {span(speeds)} | {span(caps)} | {span(times, 2)} | "
+            f"{_f(min(ratios) if ratios else None, 2)} | {tick} |"
+        )
 
 
 def figures(args, out: Path) -> list[Path]:
@@ -109,8 +162,12 @@ def figures(args, out: Path) -> list[Path]:
     margin_area = setup.analysis.areas.com_velocity_area_inset(margin)
     for g in args.governors:
         governor = None if g == "none" else Governor(governed, criterion=g)
-        trial = run_wall_trial(setup, WallOptions(reference=0.8, governor=g, wall_distance=0.15, max_time=args.max_time),
-                               options, governor=governor)
+        trial = run_wall_trial(
+            setup,
+            WallOptions(reference=0.8, governor=g, wall_distance=0.15, max_time=args.max_time),
+            options,
+            governor=governor,
+        )
         path = out / f"{name}_approach_{g}_0.8_15cm.png"
         plot_approach(trial, setup.analysis, margin_area).savefig(path)
         paths.append(path)
@@ -123,7 +180,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--scenarios", nargs="+", default=list(SCENARIOS))
     p.add_argument("--references", type=float, nargs="+", default=[0.2, 0.5, 1.0, 2.0])
     p.add_argument("--distances", type=float, nargs="+", default=[0.12, 0.15, 0.18])
-    p.add_argument("--governors", nargs="+", default=["com", "zmp", "none"], choices=["com", "zmp", "none"])
+    p.add_argument(
+        "--governors", nargs="+", default=["com", "zmp", "none"], choices=["com", "zmp", "none"]
+    )
     p.add_argument("--impacts", nargs="+", default=["rigid", "free"], choices=["rigid", "free"])
     p.add_argument("--max-time", type=float, default=30.0)
     p.add_argument("--no-figures", action="store_true")

@@ -20,8 +20,8 @@ import sys
 import time
 
 import numpy as np
-
 from governor_study import SCENARIOS, governed_setup
+
 from impact_balance.governor import Governor
 from impact_balance.sim.studies.wall import WallOptions, run_wall_trial
 
@@ -51,16 +51,32 @@ def run(scenarios, tolerances) -> list[dict]:
         options, _, governed, setup = governed_setup(name, True)
         for tolerance in tolerances:
             paired = _Paired(Governor(governed, posture_tolerance=tolerance), Governor(governed))
-            trial = run_wall_trial(setup, WallOptions(reference=2.0, governor="com", wall_distance=0.15), options,
-                                   governor=paired)
+            trial = run_wall_trial(
+                setup,
+                WallOptions(reference=2.0, governor="com", wall_distance=0.15),
+                options,
+                governor=paired,
+            )
             us, errors = np.asarray(paired.us), 100.0 * np.asarray(paired.errors)
-            rows.append({"scenario": name, "tolerance": tolerance, "ticks": int(us.size),
-                         "median_us": float(np.median(us)), "p99_us": float(np.percentile(us, 99)),
-                         "cap_error_pct": [float(errors.min()), float(errors.max())],
-                         "outcome": trial.result.summary()["outcome"], "speed_at_contact": trial.speed_at_contact})
+            rows.append(
+                {
+                    "scenario": name,
+                    "tolerance": tolerance,
+                    "ticks": int(us.size),
+                    "median_us": float(np.median(us)),
+                    "p99_us": float(np.percentile(us, 99)),
+                    "cap_error_pct": [float(errors.min()), float(errors.max())],
+                    "outcome": trial.result.summary()["outcome"],
+                    "speed_at_contact": trial.speed_at_contact,
+                }
+            )
             r = rows[-1]
-            print(f"  {name} tolerance {tolerance:g}: median {r['median_us']:.0f} us, p99 {r['p99_us']:.0f} us, cap "
-                  f"{r['cap_error_pct'][0]:+.2f} to {r['cap_error_pct'][1]:+.2f} % of the exact", file=sys.stderr, flush=True)
+            print(
+                f"  {name} tolerance {tolerance:g}: median {r['median_us']:.0f} us, p99 {r['p99_us']:.0f} us, cap "
+                f"{r['cap_error_pct'][0]:+.2f} to {r['cap_error_pct'][1]:+.2f} % of the exact",
+                file=sys.stderr,
+                flush=True,
+            )
     return rows
 
 
@@ -76,11 +92,15 @@ def main(argv: list[str] | None = None) -> int:
     if args.json:
         print(json.dumps({"rows": rows, "load": load}, allow_nan=False))
         return 0
-    print("| scenario | posture_tolerance | ticks | median / p99 (us) | cap minus the exact cap (%) | outcome, speed at contact (m/s) |")
+    print(
+        "| scenario | posture_tolerance | ticks | median / p99 (us) | cap minus the exact cap (%) | outcome, speed at contact (m/s) |"
+    )
     print("|---|---|---|---|---|---|")
     for r in rows:
-        print(f"| {r['scenario']} | {r['tolerance']:g} | {r['ticks']} | {r['median_us']:.0f} / {r['p99_us']:.0f} | "
-              f"{r['cap_error_pct'][0]:+.2f} to {r['cap_error_pct'][1]:+.2f} | {r['outcome']}, {r['speed_at_contact']:.3f} |")
+        print(
+            f"| {r['scenario']} | {r['tolerance']:g} | {r['ticks']} | {r['median_us']:.0f} / {r['p99_us']:.0f} | "
+            f"{r['cap_error_pct'][0]:+.2f} to {r['cap_error_pct'][1]:+.2f} | {r['outcome']}, {r['speed_at_contact']:.3f} |"
+        )
     print(f"\n{load}")
     return 0
 

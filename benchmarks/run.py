@@ -35,8 +35,6 @@ import time
 import warnings
 from typing import Any
 
-import impact_balance as ib
-
 # The benchmark's modules live in speed/, beside this file (on sys.path as the script's folder).
 from speed.checks import answer_checks
 from speed.machine import load_average, machine_info
@@ -48,20 +46,50 @@ from speed.stances import bench_stance
 from speed.targets import evaluate_targets
 from speed.timing import progress
 
+import impact_balance as ib
+
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--json", action="store_true", help="print one JSON object instead of the text tables")
-    ap.add_argument("--repeat", type=int, default=50, help="timed repetitions per case (default 50)")
-    ap.add_argument("--warmup", type=int, default=3, help="untimed warm-up calls per case (default 3)")
+    ap = argparse.ArgumentParser(
+        description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    ap.add_argument(
+        "--json", action="store_true", help="print one JSON object instead of the text tables"
+    )
+    ap.add_argument(
+        "--repeat", type=int, default=50, help="timed repetitions per case (default 50)"
+    )
+    ap.add_argument(
+        "--warmup", type=int, default=3, help="untimed warm-up calls per case (default 3)"
+    )
     ap.add_argument("--scenarios", nargs="*", help="bundled scenario names (default: all)")
     ap.add_argument("--no-scaling", action="store_true", help="skip the scaling part")
-    ap.add_argument("--pypoman-scale", type=float, default=1e3,
-                    help="pypoman projects onto SCALE*F (its tolerances are absolute: 1e-4, 1e-2); default 1e3")
-    ap.add_argument("--tol", type=float, default=1e-6, help="max relative area of the symmetric difference (default 1e-6)")
-    ap.add_argument("--profile", action="store_true", help="also profile analyze() and the projection (cProfile + micro-breakdown)")
-    ap.add_argument("--seed", type=int, default=0, help="seed of numpy's global RNG for pypoman (seed + repetition)")
-    ap.add_argument("--no-sweep", action="store_true", help="skip the sweep rates (benchmarks/sweep.py --quick)")
+    ap.add_argument(
+        "--pypoman-scale",
+        type=float,
+        default=1e3,
+        help="pypoman projects onto SCALE*F (its tolerances are absolute: 1e-4, 1e-2); default 1e3",
+    )
+    ap.add_argument(
+        "--tol",
+        type=float,
+        default=1e-6,
+        help="max relative area of the symmetric difference (default 1e-6)",
+    )
+    ap.add_argument(
+        "--profile",
+        action="store_true",
+        help="also profile analyze() and the projection (cProfile + micro-breakdown)",
+    )
+    ap.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="seed of numpy's global RNG for pypoman (seed + repetition)",
+    )
+    ap.add_argument(
+        "--no-sweep", action="store_true", help="skip the sweep rates (benchmarks/sweep.py --quick)"
+    )
     args = ap.parse_args(argv)
     args.repeat = max(1, args.repeat)
     args.repeat_cheap = 10 * args.repeat
@@ -75,8 +103,15 @@ def main(argv: list[str] | None = None) -> int:
     result: dict[str, Any] = {
         "benchmark": "impact_balance benchmarks/run.py",
         "machine": machine_info(),
-        "settings": {"repeat": args.repeat, "repeat_cheap": args.repeat_cheap, "warmup": args.warmup,
-                     "pypoman_scale": args.pypoman_scale, "tol": args.tol, "seed": args.seed, "unit": "us"},
+        "settings": {
+            "repeat": args.repeat,
+            "repeat_cheap": args.repeat_cheap,
+            "warmup": args.warmup,
+            "pypoman_scale": args.pypoman_scale,
+            "tol": args.tol,
+            "seed": args.seed,
+            "unit": "us",
+        },
         "stances": stances,
     }
     if not args.no_scaling:
@@ -105,8 +140,10 @@ def main(argv: list[str] | None = None) -> int:
         if args.profile:
             print(profile_text(result["profile"]))
         m = result["machine"]
-        print(f"\n(wall time {result['wall_time_s']:.0f} s; load average before "
-              f"{' '.join(map(str, m['load_average_before']))}, after {' '.join(map(str, m['load_average_after']))})")
+        print(
+            f"\n(wall time {result['wall_time_s']:.0f} s; load average before "
+            f"{' '.join(map(str, m['load_average_before']))}, after {' '.join(map(str, m['load_average_after']))})"
+        )
     return 0 if result["checks"]["ok"] else 1
 
 

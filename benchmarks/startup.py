@@ -47,7 +47,9 @@ def load_average() -> list[float]:
 
 def _env(**extra: str) -> dict[str, str]:
     env = dict(os.environ)
-    env["PYTHONPATH"] = str(ROOT / "src") + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
+    env["PYTHONPATH"] = str(ROOT / "src") + (
+        os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else ""
+    )
     env.update(extra)
     return env
 
@@ -63,14 +65,19 @@ def _wall(argv: list[str], env: dict[str, str]) -> float:
 
 def command_times(runs: int) -> dict[str, dict[str, float]]:
     env = _env()
-    argv = {name: [sys.executable, "-m", "impact_balance", *args] for name, args in COMMANDS.items()}
+    argv = {
+        name: [sys.executable, "-m", "impact_balance", *args] for name, args in COMMANDS.items()
+    }
     for a in argv.values():  # warm: the kernel cached, the files in the page cache
         _wall(a, env)
     times: dict[str, list[float]] = {name: [] for name in argv}
     for _ in range(runs):
         for name, a in argv.items():
             times[name].append(_wall(a, env))
-    return {name: {"median_s": statistics.median(t), "min_s": min(t), "max_s": max(t)} for name, t in times.items()}
+    return {
+        name: {"median_s": statistics.median(t), "min_s": min(t), "max_s": max(t)}
+        for name, t in times.items()
+    }
 
 
 _CACHE_SCRIPT = """
@@ -94,8 +101,13 @@ print(json.dumps({"analyze_name_ms": 1e3 * statistics.median(by_name),
 
 
 def scenario_cache(name: str = "palm_push_ramp", n: int = 2000) -> dict[str, float]:
-    proc = subprocess.run([sys.executable, "-c", _CACHE_SCRIPT, name, str(n)], capture_output=True, text=True,
-                          env=_env(), check=True)
+    proc = subprocess.run(
+        [sys.executable, "-c", _CACHE_SCRIPT, name, str(n)],
+        capture_output=True,
+        text=True,
+        env=_env(),
+        check=True,
+    )
     out = json.loads(proc.stdout)
     out["difference_ms"] = out["analyze_name_ms"] - out["analyze_loaded_ms"]
     return out
@@ -107,21 +119,39 @@ _KERNEL_SCRIPT = "from impact_balance.projection.walk import warm_up; print(warm
 def kernel_compile() -> dict[str, float]:
     with tempfile.TemporaryDirectory() as cache:
         env = _env(NUMBA_CACHE_DIR=cache)
-        first = subprocess.run([sys.executable, "-c", _KERNEL_SCRIPT], capture_output=True, text=True, env=env,
-                               check=True)
-        second = subprocess.run([sys.executable, "-c", _KERNEL_SCRIPT], capture_output=True, text=True, env=env,
-                                check=True)
-    return {"compile_s": float(first.stdout.split()[-1]), "cached_load_s": float(second.stdout.split()[-1])}
+        first = subprocess.run(
+            [sys.executable, "-c", _KERNEL_SCRIPT],
+            capture_output=True,
+            text=True,
+            env=env,
+            check=True,
+        )
+        second = subprocess.run(
+            [sys.executable, "-c", _KERNEL_SCRIPT],
+            capture_output=True,
+            text=True,
+            env=env,
+            check=True,
+        )
+    return {
+        "compile_s": float(first.stdout.split()[-1]),
+        "cached_load_s": float(second.stdout.split()[-1]),
+    }
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--runs", type=int, default=10, help="runs per command (default 10)")
-    ap.add_argument("--no-compile", action="store_true", help="skip the from-scratch kernel compile")
+    ap.add_argument(
+        "--no-compile", action="store_true", help="skip the from-scratch kernel compile"
+    )
     ap.add_argument("--json", action="store_true", help="one JSON object on stdout")
     args = ap.parse_args(argv)
-    result: dict = {"load_average_before": load_average(), "cpu_count": os.cpu_count(),
-                    "python": sys.version.split()[0]}
+    result: dict = {
+        "load_average_before": load_average(),
+        "cpu_count": os.cpu_count(),
+        "python": sys.version.split()[0],
+    }
     result["commands"] = command_times(args.runs)
     result["scenario_cache"] = scenario_cache()
     if not args.no_compile:
@@ -130,18 +160,26 @@ def main(argv: list[str] | None = None) -> int:
     if args.json:
         print(json.dumps(result, indent=1))
         return 0
-    print(f"load average before: {' '.join(map(str, result['load_average_before']))} "
-          f"({result['cpu_count']} cores, Python {result['python']})")
+    print(
+        f"load average before: {' '.join(map(str, result['load_average_before']))} "
+        f"({result['cpu_count']} cores, Python {result['python']})"
+    )
     print(f"\ncommand wall time, a new process each ({args.runs} runs, round-robin):")
     for name, t in result["commands"].items():
-        print(f"  impact-balance {name:<16} median {t['median_s']:.3f} s   min {t['min_s']:.3f} s   max {t['max_s']:.3f} s")
+        print(
+            f"  impact-balance {name:<16} median {t['median_s']:.3f} s   min {t['min_s']:.3f} s   max {t['max_s']:.3f} s"
+        )
     c = result["scenario_cache"]
-    print(f"\nib.analyze('palm_push_ramp') {c['analyze_name_ms']:.3f} ms, analyze(loaded scenario) "
-          f"{c['analyze_loaded_ms']:.3f} ms: difference {c['difference_ms']:.3f} ms "
-          f"(load_scenario from the cache {c['load_scenario_cached_ms']:.3f} ms)")
+    print(
+        f"\nib.analyze('palm_push_ramp') {c['analyze_name_ms']:.3f} ms, analyze(loaded scenario) "
+        f"{c['analyze_loaded_ms']:.3f} ms: difference {c['difference_ms']:.3f} ms "
+        f"(load_scenario from the cache {c['load_scenario_cached_ms']:.3f} ms)"
+    )
     if "kernel" in result:
         k = result["kernel"]
-        print(f"\nprojection kernel: first compile {k['compile_s']:.1f} s, load from numba's cache {k['cached_load_s']:.2f} s")
+        print(
+            f"\nprojection kernel: first compile {k['compile_s']:.1f} s, load from numba's cache {k['cached_load_s']:.2f} s"
+        )
     print(f"\nload average after: {' '.join(map(str, result['load_average_after']))}")
     return 0
 

@@ -42,14 +42,22 @@ from impact_balance.sweep import Evaluator, make_plan, read_results, run_sweep, 
 from impact_balance.sweep.plan import plan_sweep
 
 #: Targets of issue 11.
-TARGETS = {"impact_only_per_s_per_core": 2000.0, "joints_per_s_per_core": 1000.0, "ik_per_s_per_core": 50.0,
-           "speedup_2_workers": 1.7}
+TARGETS = {
+    "impact_only_per_s_per_core": 2000.0,
+    "joints_per_s_per_core": 1000.0,
+    "ik_per_s_per_core": 50.0,
+    "speedup_2_workers": 1.7,
+}
 
 BASE = "palm_push_two_feet"
 IMPACT_AXES = [
     {"path": "impact.friction", "range": [0.0, 0.6], "count": 50},
     {"path": "impact.restitution[1]", "range": [0.0, 1.0], "count": 40},
-    {"direction": "impact.normal", "azimuth": {"range": [150.0, 210.0], "count": 50}, "elevation": {"values": [0.0]}},
+    {
+        "direction": "impact.normal",
+        "azimuth": {"range": [150.0, 210.0], "count": 50},
+        "elevation": {"values": [0.0]},
+    },
 ]
 JOINT_AXES = [
     {"path": "joints.arm_right_4_joint", "range": [-1.8, -1.0], "count": 40},
@@ -62,7 +70,9 @@ def progress(msg: str) -> None:
 
 
 def _plan(axes, chunk_size=1000, **extra):
-    return make_plan(sweep_spec_from_dict({"base": BASE, "axes": axes, "chunk_size": chunk_size, **extra}))
+    return make_plan(
+        sweep_spec_from_dict({"base": BASE, "axes": axes, "chunk_size": chunk_size, **extra})
+    )
 
 
 def per_core_rate(plan, chunks: list[int]) -> dict[str, float]:
@@ -79,7 +89,10 @@ def per_core_rate(plan, chunks: list[int]) -> dict[str, float]:
 def speedup(tmp: Path, quick: bool, rounds: int = 3) -> dict[str, Any]:
     """1 worker against 2, alternated ``rounds`` times; the best rate of each (the machine is
     shared: the best round is the one least slowed down by other processes)."""
-    plan = _plan(IMPACT_AXES[:2] + [{"direction": "impact.normal", "azimuth": {"range": [150.0, 210.0], "count": 10}}])
+    plan = _plan(
+        IMPACT_AXES[:2]
+        + [{"direction": "impact.normal", "azimuth": {"range": [150.0, 210.0], "count": 10}}]
+    )
     rates: dict[int, list[float]] = {1: [], 2: []}
     startup = []
     same = True
@@ -94,8 +107,16 @@ def speedup(tmp: Path, quick: bool, rounds: int = 3) -> dict[str, Any]:
             shutil.rmtree(out) if workers == 2 else None
         shutil.rmtree(tmp / f"speed-1-{r}")
     best1, best2 = max(rates[1]), max(rates[2])
-    return {"points": plan.n_points, "rates_1": rates[1], "rates_2": rates[2], "rate_1": best1, "rate_2": best2,
-            "speedup": best2 / best1, "startup_2_s": max(startup), "rows_identical": same}
+    return {
+        "points": plan.n_points,
+        "rates_1": rates[1],
+        "rates_2": rates[2],
+        "rate_1": best1,
+        "rate_2": best2,
+        "speedup": best2 / best1,
+        "startup_2_s": max(startup),
+        "rows_identical": same,
+    }
 
 
 def identical(tmp: Path) -> dict[str, Any]:
@@ -104,23 +125,54 @@ def identical(tmp: Path) -> dict[str, Any]:
     plan = _plan(JOINT_AXES[:1] + IMPACT_AXES[:1], chunk_size=100)
     run_sweep(plan, tmp / "i1", workers=1, progress=False)
     run_sweep(plan, tmp / "i2", workers=2, progress=False)
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
-            Client(cluster) as client:
+    with (
+        LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        Client(cluster) as client,
+    ):
         run_sweep(plan, tmp / "id", scheduler=client, progress=False)
     one = read_results(tmp / "i1")
-    return {"points": plan.n_points, "two_workers": read_results(tmp / "i2").equals(one),
-            "dask_local_cluster": read_results(tmp / "id").equals(one)}
+    return {
+        "points": plan.n_points,
+        "two_workers": read_results(tmp / "i2").equals(one),
+        "dask_local_cluster": read_results(tmp / "id").equals(one),
+    }
 
 
 def big_sweep(tmp: Path, kill: bool) -> dict[str, Any]:
     """100 000 impact-parameter points through the CLI; SIGKILL part-way, then the same command."""
     spec = tmp / "big.yaml"
-    spec.write_text(yaml.safe_dump({"description": "100 000 impact-parameter points", "base": BASE, "chunk_size": 1000,
-                                    "axes": [{"path": "impact.friction", "range": [0.0, 0.6], "count": 100},
-                                             {"path": "impact.restitution[1]", "range": [0.0, 1.0], "count": 25},
-                                             {"direction": "impact.normal", "azimuth": {"range": [150.0, 210.0], "count": 40}}]}))
+    spec.write_text(
+        yaml.safe_dump(
+            {
+                "description": "100 000 impact-parameter points",
+                "base": BASE,
+                "chunk_size": 1000,
+                "axes": [
+                    {"path": "impact.friction", "range": [0.0, 0.6], "count": 100},
+                    {"path": "impact.restitution[1]", "range": [0.0, 1.0], "count": 25},
+                    {
+                        "direction": "impact.normal",
+                        "azimuth": {"range": [150.0, 210.0], "count": 40},
+                    },
+                ],
+            }
+        )
+    )
     out = tmp / "big"
-    cmd = [sys.executable, "-m", "impact_balance", "sweep", str(spec), "--out", str(out), "--no-progress", "--no-plots", "--json"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "impact_balance",
+        "sweep",
+        str(spec),
+        "--out",
+        str(out),
+        "--no-progress",
+        "--no-plots",
+        "--json",
+    ]
     env = dict(os.environ)
     result: dict[str, Any] = {"points": 100_000}
     parts = out / "parts"
@@ -128,10 +180,20 @@ def big_sweep(tmp: Path, kill: bool) -> dict[str, Any]:
     mtimes: dict[str, float] = {}
     t0 = time.perf_counter()
     if kill:
-        proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env, start_new_session=True)
-        while proc.poll() is None and (not parts.is_dir() or len(list(parts.glob("part-*.parquet"))) < 30):
+        proc = subprocess.Popen(
+            cmd,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            env=env,
+            start_new_session=True,
+        )
+        while proc.poll() is None and (
+            not parts.is_dir() or len(list(parts.glob("part-*.parquet"))) < 30
+        ):
             time.sleep(0.05)
-        os.killpg(proc.pid, signal.SIGKILL)  # the whole group: the CLI and its workers, as a crash would
+        os.killpg(
+            proc.pid, signal.SIGKILL
+        )  # the whole group: the CLI and its workers, as a crash would
         proc.wait()
         first = time.perf_counter() - t0
         files = sorted(parts.glob("part-*.parquet"))
@@ -150,8 +212,9 @@ def big_sweep(tmp: Path, kill: bool) -> dict[str, Any]:
         rows=table.num_rows,
         unique_points=len(set(table.column("point").to_pylist())),
         complete=bool(summary["complete"]),
-        finished_chunks_recomputed=0 if untouched else sum(
-            (parts / n).stat().st_mtime_ns != m for n, m in mtimes.items()),
+        finished_chunks_recomputed=0
+        if untouched
+        else sum((parts / n).stat().st_mtime_ns != m for n, m in mtimes.items()),
         stderr=done.stderr.strip().splitlines()[-1:] if done.stderr else [],
     )
     return result
@@ -188,13 +251,24 @@ def measure(quick: bool = False, kill: bool = True) -> dict[str, Any]:
         joints_per_s_per_core=joints["per_cpu_s"],
         ik_per_s_per_core=ik["per_cpu_s"],
         speedup_2_workers=sp["speedup"],
-        rows_identical=bool(same["two_workers"] and same["dask_local_cluster"] and sp["rows_identical"]),
-        details={"impact_only": impact, "joints": joints, "ik": ik, "speedup": sp, "identical": same, "sweep_100k": big},
+        rows_identical=bool(
+            same["two_workers"] and same["dask_local_cluster"] and sp["rows_identical"]
+        ),
+        details={
+            "impact_only": impact,
+            "joints": joints,
+            "ik": ik,
+            "speedup": sp,
+            "identical": same,
+            "sweep_100k": big,
+        },
         load_average_before=list(load_before),
         load_average_after=list(os.getloadavg()),
         cores=len(os.sched_getaffinity(0)),
     )
-    out["targets"] = {k: {"target": t, "measured": out[k], "pass": out[k] >= t} for k, t in TARGETS.items()}
+    out["targets"] = {
+        k: {"target": t, "measured": out[k], "pass": out[k] >= t} for k, t in TARGETS.items()
+    }
     return out
 
 
@@ -202,28 +276,43 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--json", action="store_true", help="print one JSON object")
     ap.add_argument("--quick", action="store_true", help="fewer points, no 100 000-point run")
-    ap.add_argument("--no-kill", action="store_true", help="run the 100 000-point sweep without killing it")
+    ap.add_argument(
+        "--no-kill", action="store_true", help="run the 100 000-point sweep without killing it"
+    )
     args = ap.parse_args(argv)
     result = measure(args.quick, not args.no_kill)
     if args.json:
         print(json.dumps(result, indent=1))
         return 0
     d = result["details"]
-    print(f"load average before {result['load_average_before'][0]:.2f}, after {result['load_average_after'][0]:.2f} "
-          f"({result['cores']} cores)")
+    print(
+        f"load average before {result['load_average_before'][0]:.2f}, after {result['load_average_after'][0]:.2f} "
+        f"({result['cores']} cores)"
+    )
     for key, t in result["targets"].items():
-        print(f"{key:28s} {t['measured']:10.1f}   target >= {t['target']:g}   {'PASS' if t['pass'] else 'FAIL'}")
-    print(f"{'rows_identical':28s} {result['rows_identical']}  (1 worker, 2 workers, Dask LocalCluster)")
+        print(
+            f"{key:28s} {t['measured']:10.1f}   target >= {t['target']:g}   {'PASS' if t['pass'] else 'FAIL'}"
+        )
+    print(
+        f"{'rows_identical':28s} {result['rows_identical']}  (1 worker, 2 workers, Dask LocalCluster)"
+    )
     sp = d["speedup"]
-    print(f"speed-up on {sp['points']} points (best of {len(sp['rates_1'])}): {sp['rate_1']:.0f} -> {sp['rate_2']:.0f} points/s "
-          f"(2 workers start in {sp['startup_2_s']:.1f} s, not counted)")
+    print(
+        f"speed-up on {sp['points']} points (best of {len(sp['rates_1'])}): {sp['rate_1']:.0f} -> {sp['rate_2']:.0f} points/s "
+        f"(2 workers start in {sp['startup_2_s']:.1f} s, not counted)"
+    )
     big = d["sweep_100k"]
     if big:
-        print(f"100 000 points via the CLI: {big['wall_s']:.1f} s in all"
-              + (f" (killed after {big['killed_after_s']:.1f} s with {big['chunks_done_at_kill']} of 100 chunks written; "
-                 f"resumed in {big['resume_s']:.1f} s; finished chunks computed again: {big['finished_chunks_recomputed']})"
-                 if "killed_after_s" in big else "")
-              + f"; {big['unique_points']} distinct points, complete {big['complete']}")
+        print(
+            f"100 000 points via the CLI: {big['wall_s']:.1f} s in all"
+            + (
+                f" (killed after {big['killed_after_s']:.1f} s with {big['chunks_done_at_kill']} of 100 chunks written; "
+                f"resumed in {big['resume_s']:.1f} s; finished chunks computed again: {big['finished_chunks_recomputed']})"
+                if "killed_after_s" in big
+                else ""
+            )
+            + f"; {big['unique_points']} distinct points, complete {big['complete']}"
+        )
     return 0
 
 

@@ -21,9 +21,9 @@ import os
 import sys
 import time
 
-from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions
 from impact_balance.sim.control.torque import InverseDynamicsGains
 from impact_balance.sim.studies.push import push_test
+from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions
 
 MARGINS = (0.0, 0.005, 0.01)
 
@@ -46,15 +46,30 @@ def main() -> int:
         setup = BalanceSetup.create(args.scenario, "servo", options)
         fell = broken = n = 0
         for body in args.bodies:
-            r = push_test(args.scenario, args.directions, relative=args.relative, options=options, setup=setup,
-                          body=None if body == "torso" else body)
+            r = push_test(
+                args.scenario,
+                args.directions,
+                relative=args.relative,
+                options=options,
+                setup=setup,
+                body=None if body == "torso" else body,
+            )
             counts = r.counts()["outcomes"]
-            fell, broken, n = fell + counts["fell"], broken + counts["contact_broken"], n + len(r.outcomes)
+            fell, broken, n = (
+                fell + counts["fell"],
+                broken + counts["contact_broken"],
+                n + len(r.outcomes),
+            )
         rows.append((fell, broken, cop + zmp, cop, zmp))
-        print(f"| {1e3 * cop:g} | {1e3 * zmp:g} | {n} | {fell} | {broken} | {time.perf_counter() - t0:.0f} |", flush=True)
+        print(
+            f"| {1e3 * cop:g} | {1e3 * zmp:g} | {n} | {fell} | {broken} | {time.perf_counter() - t0:.0f} |",
+            flush=True,
+        )
     best = min(rows)
-    print(f"\nchosen: CoP margin {1e3 * best[3]:g} mm, ZMP margin {1e3 * best[4]:g} mm "
-          f"({best[0]} falls, {best[1]} contact breaks)")
+    print(
+        f"\nchosen: CoP margin {1e3 * best[3]:g} mm, ZMP margin {1e3 * best[4]:g} mm "
+        f"({best[0]} falls, {best[1]} contact breaks)"
+    )
     print(f"load average after: {os.getloadavg()[0]:.2f}")
     return 0
 

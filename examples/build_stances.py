@@ -70,7 +70,9 @@ def _set(robot: Robot, q: np.ndarray, values: dict[str, float]) -> np.ndarray:
 
 def _talos_arm_forward(robot: Robot, q: np.ndarray) -> np.ndarray:
     # Initial guess: right shoulder yawed and raised forward, elbow bent.
-    return _set(robot, q, {"arm_right_1_joint": 1.2, "arm_right_2_joint": -1.0, "arm_right_4_joint": -0.8})
+    return _set(
+        robot, q, {"arm_right_1_joint": 1.2, "arm_right_2_joint": -1.0, "arm_right_4_joint": -0.8}
+    )
 
 
 def _talos_both_arms(robot: Robot, q: np.ndarray) -> np.ndarray:
@@ -87,8 +89,12 @@ def _mid(a, b) -> tuple[float, float]:
 RAMP_ANGLE = math.radians(30.0)
 RAMP_SOLE = (0.10, -0.085, 0.10)  # right sole centre on the ramp
 WALL_Y = 0.60  # wall plane on Talos' left (world y), for the three-contact stance
-HAND_CONTACT_OFFSET = se3((-0.057, 0.0, -0.045), (0.0, math.pi / 2, 0.0))  # gripper -x face, z_c = +x_g
-HAND_CONTACT_TARGET = se3((0.05, WALL_Y, 1.00), (math.pi / 2, 0.0, 0.0))  # contact z axis = world -y
+HAND_CONTACT_OFFSET = se3(
+    (-0.057, 0.0, -0.045), (0.0, math.pi / 2, 0.0)
+)  # gripper -x face, z_c = +x_g
+HAND_CONTACT_TARGET = se3(
+    (0.05, WALL_Y, 1.00), (math.pi / 2, 0.0, 0.0)
+)  # contact z axis = world -y
 TALOS_STAGGER_LEFT = (0.08, 0.10, 0.0)
 TALOS_STAGGER_RIGHT = (-0.08, -0.10, 0.0)
 SIDE_SLOPE_ANGLE = math.radians(15.0)
@@ -97,7 +103,9 @@ G1_SOLE_OFFSET = (0.035, 0.0, -0.035)  # sole centre in *_ankle_roll_link (colli
 G1_LEFT_SOLE = (0.0, 0.119, 0.0)
 G1_RIGHT_SOLE = (0.0, -0.119, 0.0)
 # G1 right hand in front of the chest, fingers up, palm (+y of right_rubber_hand) facing +x.
-G1_HAND = pin.SE3(np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]]), np.array([0.25, -0.15, 0.95]))
+G1_HAND = pin.SE3(
+    np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]]), np.array([0.25, -0.15, 0.95])
+)
 
 
 def _g1_ankle(sole) -> pin.SE3:
@@ -107,7 +115,11 @@ def _g1_ankle(sole) -> pin.SE3:
 def _g1_knees(robot: Robot, q: np.ndarray) -> np.ndarray:
     bent = {}
     for side in ("left", "right"):
-        bent |= {f"{side}_hip_pitch_joint": -0.15, f"{side}_knee_joint": 0.35, f"{side}_ankle_pitch_joint": -0.2}
+        bent |= {
+            f"{side}_hip_pitch_joint": -0.15,
+            f"{side}_knee_joint": 0.35,
+            f"{side}_ankle_pitch_joint": -0.2,
+        }
     return _set(robot, q, bent)
 
 
@@ -215,7 +227,13 @@ PROBLEMS = [
         _mid(G1_LEFT_SOLE, G1_RIGHT_SOLE),
         "soles flat at y = +-0.119; knees bent; right hand at (0.25, -0.15, 0.95), palm forward; CoM between the soles",
         _g1_knees,
-        {"joint_costs": {"waist_yaw_joint": 1e-2, "waist_roll_joint": 1e-2, "waist_pitch_joint": 1e-2}},
+        {
+            "joint_costs": {
+                "waist_yaw_joint": 1e-2,
+                "waist_roll_joint": 1e-2,
+                "waist_pitch_joint": 1e-2,
+            }
+        },
     ),
 ]
 LOCKED = {"talos": TALOS_LOCKED, "g1": ()}
@@ -236,7 +254,10 @@ def _snippet(problem: StanceProblem, robot: Robot, q: np.ndarray) -> tuple[str, 
             continue
         if round(q[joint.idx_q], DIGITS) != round(reference[joint.idx_q], DIGITS):
             joints[name] = round(float(q[joint.idx_q]), DIGITS)
-    base = {"position": [round(float(v), DIGITS) for v in q[:3]], "rpy": [round(float(v), DIGITS) for v in rpy]}
+    base = {
+        "position": [round(float(v), DIGITS) for v in q[:3]],
+        "rpy": [round(float(v), DIGITS) for v in rpy],
+    }
     lines = [
         "base:",
         f"  position: [{', '.join(_fmt(v) for v in q[:3])}]",
@@ -265,8 +286,14 @@ def build(problem: StanceProblem) -> str:
     text, data = _snippet(problem, robot, q)
     # Check the rounded values, loaded the way a scenario file is.
     scenario = scenario_from_dict(
-        {"robot": problem.robot, "configuration": problem.configuration, **data,
-         "contacts": [{"frame": next(iter(problem.frame_targets)), "friction": 1.0, "size": [0.1, 0.1]}]}
+        {
+            "robot": problem.robot,
+            "configuration": problem.configuration,
+            **data,
+            "contacts": [
+                {"frame": next(iter(problem.frame_targets)), "friction": 1.0, "size": [0.1, 0.1]}
+            ],
+        }
     )
     q_rounded = scenario.configuration_vector(robot)
     residuals = stance_residuals(robot, q_rounded, problem.frame_targets, problem.com_target_xy)
@@ -285,7 +312,9 @@ def main(argv: list[str]) -> int:
     known = {p.name: p for p in PROBLEMS}
     unknown = [n for n in names if n not in known]
     if unknown:
-        print(f"unknown stance(s): {', '.join(unknown)}; known: {', '.join(known)}", file=sys.stderr)
+        print(
+            f"unknown stance(s): {', '.join(unknown)}; known: {', '.join(known)}", file=sys.stderr
+        )
         return 2
     for name in names:
         print(build(known[name]))

@@ -27,8 +27,13 @@ from impact_balance.governor import Governor
 from impact_balance.scenario import load_scenario
 
 
-def run(scenario_name: str = "palm_push_two_feet", reference: float = 0.8, ticks: int = 150, rate: float = 500.0,
-        criterion: str = "com") -> dict:
+def run(
+    scenario_name: str = "palm_push_two_feet",
+    reference: float = 0.8,
+    ticks: int = 150,
+    rate: float = 500.0,
+    criterion: str = "com",
+) -> dict:
     """Drive the impact frame at ``reference`` m/s towards the scenario's wall for ``ticks`` ticks.
 
     Returns the per-tick arrays: ``commanded`` and ``cap`` (approach speeds, m/s), ``measured`` (the
@@ -61,7 +66,9 @@ def run(scenario_name: str = "palm_push_two_feet", reference: float = 0.8, ticks
     u_ref = -reference * n  # the reference end-effector velocity (world): straight at the wall
     for _ in range(ticks):
         t0 = time.perf_counter()
-        limit = governor.limit(configuration.q, v)  # the state: pinocchio q, v (base velocity in the base frame)
+        limit = governor.limit(
+            configuration.q, v
+        )  # the state: pinocchio q, v (base velocity in the base frame)
         u = limit.cap(u_ref)  # the reference, its approach speed within the safe interval
         out["tick_us"].append(1e6 * (time.perf_counter() - t0))
         out["commanded"].append(float(-u @ n))
@@ -69,14 +76,20 @@ def run(scenario_name: str = "palm_push_two_feet", reference: float = 0.8, ticks
         # The frame task follows the capped velocity: its target moves by u dt each tick.
         pose = pin.SE3(pose.rotation, pose.translation + u * dt)
         hand.set_target(pose)
-        v = pink.solve_ik(configuration, [hand, com, posture, *contacts], dt, solver="daqp", safety_break=False)
+        v = pink.solve_ik(
+            configuration, [hand, com, posture, *contacts], dt, solver="daqp", safety_break=False
+        )
         q_next = pin.integrate(model, configuration.q, v * dt)
         # pink's limits keep the step inside up to round-off: clip that round-off away.
         q_next[7:] = np.clip(q_next[7:], model.lowerPositionLimit[7:], model.upperPositionLimit[7:])
         configuration.update(q_next)
         pin.forwardKinematics(model, configuration.data, configuration.q, v)
-        frame_velocity = pin.getFrameVelocity(model, configuration.data, model.getFrameId(impact.frame),
-                                              pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        frame_velocity = pin.getFrameVelocity(
+            model,
+            configuration.data,
+            model.getFrameId(impact.frame),
+            pin.ReferenceFrame.LOCAL_WORLD_ALIGNED,
+        )
         arm = configuration.get_transform_frame_to_world(impact.frame).rotation @ offset.translation
         point_velocity = frame_velocity.linear + np.cross(frame_velocity.angular, arm)
         out["measured"].append(float(-point_velocity @ n))
@@ -93,9 +106,13 @@ def main(argv: list[str] | None = None) -> int:
     r = run(args.scenario, args.reference, args.ticks, criterion=args.criterion)
     late = slice(len(r["measured"]) // 2, None)
     print(f"{args.scenario}: reference {args.reference:g} m/s, {args.criterion} governor")
-    print(f"  cap {r['cap'][-1]:.3f} m/s; commanded {r['commanded'][-1]:.3f} m/s; "
-          f"the IK's approach speed {np.median(r['measured'][late]):.3f} m/s (median, second half)")
-    print(f"  governor: {np.median(r['tick_us']):.0f} us per tick (median), {np.percentile(r['tick_us'], 99):.0f} (p99)")
+    print(
+        f"  cap {r['cap'][-1]:.3f} m/s; commanded {r['commanded'][-1]:.3f} m/s; "
+        f"the IK's approach speed {np.median(r['measured'][late]):.3f} m/s (median, second half)"
+    )
+    print(
+        f"  governor: {np.median(r['tick_us']):.0f} us per tick (median), {np.percentile(r['tick_us'], 99):.0f} (p99)"
+    )
     return 0
 
 

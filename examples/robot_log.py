@@ -18,7 +18,14 @@ import numpy as np
 import pandas as pd
 
 import impact_balance as ib
-from impact_balance.logs import LogColumns, check_log, joint_position_column, joint_velocity_column, read_log, write_log
+from impact_balance.logs import (
+    LogColumns,
+    check_log,
+    joint_position_column,
+    joint_velocity_column,
+    read_log,
+    write_log,
+)
 
 
 def record(scenario: ib.Scenario, duration: float = 2.0, rate: float = 200.0, peak: float = 0.5):
@@ -56,7 +63,9 @@ def to_log(robot: ib.Robot, time: np.ndarray, q: np.ndarray, v: np.ndarray) -> p
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="sway.parquet", help="the log to write (.parquet or .csv)")
-    parser.add_argument("--scenario", default="palm_push_two_feet", help="the stance (bundled name or YAML file)")
+    parser.add_argument(
+        "--scenario", default="palm_push_two_feet", help="the stance (bundled name or YAML file)"
+    )
     args = parser.parse_args(argv)
 
     scenario = ib.load_scenario(args.scenario)
@@ -67,11 +76,14 @@ def main(argv: list[str] | None = None) -> int:
     print(f"{path}: {len(time)} samples over {time[-1]:.2f} s")
     for violation in check.violations:
         unit = "m/s" if violation.kind == "com_velocity" else "m"
-        print(f"  {violation.kind} outside its area from {violation.start:.3f} s to {violation.end:.3f} s, "
-              f"worst margin {violation.worst_margin:.3f} {unit}")
+        print(
+            f"  {violation.kind} outside its area from {violation.start:.3f} s to {violation.end:.3f} s, "
+            f"worst margin {violation.worst_margin:.3f} {unit}"
+        )
     if not check.violations:
         print("  the CoM velocity stayed inside the CoM velocity area")
     return 0
+
 
 if __name__ == "__main__":
     raise SystemExit(main())

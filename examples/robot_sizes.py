@@ -35,8 +35,12 @@ SOLE_BAND = 0.005
 def _vertices_in(robot, frame: str, kind: pin.GeometryType) -> np.ndarray:
     """Every collision vertex of the bodies moved by ``frame``'s parent joint, in ``frame``, m."""
     model = robot.model
-    geometry = pin.buildGeomFromUrdf(model, str(robot.urdf_path), kind,
-                                     package_dirs=[str(p) for p in robot.urdf_path.resolve().parents])
+    geometry = pin.buildGeomFromUrdf(
+        model,
+        str(robot.urdf_path),
+        kind,
+        package_dirs=[str(p) for p in robot.urdf_path.resolve().parents],
+    )
     data, gdata = model.createData(), geometry.createData()
     q = robot.configuration()
     pin.framesForwardKinematics(model, data, q)
@@ -73,16 +77,28 @@ def sizes(name: str, kind: pin.GeometryType = pin.GeometryType.COLLISION) -> dic
 
 
 def main() -> None:
-    for name, kind in ((n, k) for k in (pin.GeometryType.COLLISION, pin.GeometryType.VISUAL) for n in BUNDLED_ROBOTS):
+    for name, kind in (
+        (n, k)
+        for k in (pin.GeometryType.COLLISION, pin.GeometryType.VISUAL)
+        for n in BUNDLED_ROBOTS
+    ):
         print(f"[{str(kind).rsplit('.', 1)[-1].lower()}] ", end="")
         s = sizes(name, kind)
-        sole = (f"sole {s['sole_size'][0]:.3f} x {s['sole_size'][1]:.3f} m, centre "
-                f"({', '.join(f'{x:+.3f}' for x in s['sole_centre'])}) in {s['sole_frame']}") if "sole_size" in s else "sole: no mesh"
+        sole = (
+            (
+                f"sole {s['sole_size'][0]:.3f} x {s['sole_size'][1]:.3f} m, centre "
+                f"({', '.join(f'{x:+.3f}' for x in s['sole_centre'])}) in {s['sole_frame']}"
+            )
+            if "sole_size" in s
+            else "sole: no mesh"
+        )
         hand = ""
         if "hand_box" in s:
             lo, hi = map(np.asarray, s["hand_box"])
-            hand = (f"; hand box {' x '.join(f'{x:.3f}' for x in hi - lo)} m, x [{lo[0]:+.3f}, {hi[0]:+.3f}] "
-                    f"y [{lo[1]:+.3f}, {hi[1]:+.3f}] z [{lo[2]:+.3f}, {hi[2]:+.3f}] in {s['hand_frame']}")
+            hand = (
+                f"; hand box {' x '.join(f'{x:.3f}' for x in hi - lo)} m, x [{lo[0]:+.3f}, {hi[0]:+.3f}] "
+                f"y [{lo[1]:+.3f}, {hi[1]:+.3f}] z [{lo[2]:+.3f}, {hi[2]:+.3f}] in {s['hand_frame']}"
+            )
         print(f"{name} ({s['mass']:.2f} kg): {sole}{hand}")
 
 

@@ -120,14 +120,17 @@ def make_contact():
 @pytest.fixture(scope="session")
 def talos_stance():
     """Talos half_sitting on both soles (mu 0.7, 0.2 x 0.1 m), the README's standard stance."""
-    from impact_balance.robot.robot import load_robot
     from impact_balance.contacts.stance import ContactSpec, Stance
+    from impact_balance.robot.robot import load_robot
 
     robot = load_robot("talos")
     return Stance(
         robot,
         robot.configuration(),
-        [ContactSpec("left_sole_link", 0.7, (0.2, 0.1)), ContactSpec("right_sole_link", 0.7, (0.2, 0.1))],
+        [
+            ContactSpec("left_sole_link", 0.7, (0.2, 0.1)),
+            ContactSpec("right_sole_link", 0.7, (0.2, 0.1)),
+        ],
     )
 
 

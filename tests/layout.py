@@ -75,8 +75,13 @@ def _shown_ticks(axis) -> list[Text]:
     """The major tick labels matplotlib draws: those within the view (it lists others too)."""
     lo, hi = sorted(axis.get_view_interval())
     eps = 1e-9 * max(abs(hi - lo), 1e-300)
-    return [t.label1 for t in axis.get_major_ticks()
-            if lo - eps <= t.get_loc() <= hi + eps and t.label1.get_visible() and _visible_text(t.label1)]
+    return [
+        t.label1
+        for t in axis.get_major_ticks()
+        if lo - eps <= t.get_loc() <= hi + eps
+        and t.label1.get_visible()
+        and _visible_text(t.label1)
+    ]
 
 
 def _axes_axis(ax: Axes):
@@ -91,7 +96,9 @@ def _box(artist, renderer):
 
 
 def _overlap(a, b) -> bool:
-    return a.x0 < b.x1 - SLACK and b.x0 < a.x1 - SLACK and a.y0 < b.y1 - SLACK and b.y0 < a.y1 - SLACK
+    return (
+        a.x0 < b.x1 - SLACK and b.x0 < a.x1 - SLACK and a.y0 < b.y1 - SLACK and b.y0 < a.y1 - SLACK
+    )
 
 
 def _name(kind: str, artist) -> str:
@@ -132,7 +139,11 @@ def data_points(ax: Axes) -> list[tuple[str, np.ndarray]]:
                 if hasattr(artist, "get_xydata"):  # a Line2D: its data, markers included
                     pts = artist.get_transform().transform(artist.get_xydata())
                     path = artist.get_path()
-                    pts = np.vstack([pts, _samples(path, artist.get_transform())]) if artist.get_linestyle() not in ("None", "", " ") else pts
+                    pts = (
+                        np.vstack([pts, _samples(path, artist.get_transform())])
+                        if artist.get_linestyle() not in ("None", "", " ")
+                        else pts
+                    )
                 else:
                     pts = _samples(artist.get_path(), artist.get_transform())
             else:
@@ -141,11 +152,20 @@ def data_points(ax: Axes) -> list[tuple[str, np.ndarray]]:
                 if offsets is not None and len(offsets) and len(paths) <= 1:  # scatter markers
                     pts = artist.get_offset_transform().transform(offsets)
                 else:
-                    pts = np.vstack([_samples(p, artist.get_transform()) for p in paths]) if paths else np.zeros((0, 2))
-        except Exception:  # noqa: BLE001 - an artist whose geometry we cannot read is skipped
+                    pts = (
+                        np.vstack([_samples(p, artist.get_transform()) for p in paths])
+                        if paths
+                        else np.zeros((0, 2))
+                    )
+        except Exception:
             continue
         pts = pts[np.all(np.isfinite(pts), axis=1)]
-        inside = ((pts[:, 0] >= clip.x0) & (pts[:, 0] <= clip.x1) & (pts[:, 1] >= clip.y0) & (pts[:, 1] <= clip.y1))
+        inside = (
+            (pts[:, 0] >= clip.x0)
+            & (pts[:, 0] <= clip.x1)
+            & (pts[:, 1] >= clip.y0)
+            & (pts[:, 1] <= clip.y1)
+        )
         out.append((label, pts[inside]))
     return out
 
@@ -162,11 +182,15 @@ def layout_problems(fig: Figure, units: bool = True, dpi: float = 120) -> list[s
     boxes = [(kind, owner, artist, _box(artist, renderer)) for kind, owner, artist in texts]
     for kind, _, artist, b in boxes:  # inside by a pixel: a frame on the edge loses its line
         if b.x0 < SLACK or b.y0 < SLACK or b.x1 > W - SLACK or b.y1 > H - SLACK:
-            problems.append(f"{_name(kind, artist)} is outside the canvas ({b.x0:.0f}, {b.y0:.0f}, {b.x1:.0f}, "
-                            f"{b.y1:.0f}) of {W:.0f} x {H:.0f} px")
+            problems.append(
+                f"{_name(kind, artist)} is outside the canvas ({b.x0:.0f}, {b.y0:.0f}, {b.x1:.0f}, "
+                f"{b.y1:.0f}) of {W:.0f} x {H:.0f} px"
+            )
     for ax in fig.axes:
         b = ax.get_window_extent(renderer)
-        if ax.get_visible() and (b.x0 < -SLACK or b.y0 < -SLACK or b.x1 > W + SLACK or b.y1 > H + SLACK):
+        if ax.get_visible() and (
+            b.x0 < -SLACK or b.y0 < -SLACK or b.x1 > W + SLACK or b.y1 > H + SLACK
+        ):
             problems.append(f"axes {ax.get_title()[:30]!r} is outside the canvas")
     for (k1, o1, a1, b1), (k2, o2, a2, b2) in itertools.combinations(boxes, 2):
         if _overlap(b1, b2):  # tick labels of one axis too: a narrow panel crowds them
@@ -181,10 +205,18 @@ def layout_problems(fig: Figure, units: bool = True, dpi: float = 120) -> list[s
         for box_artist in legends + notes:
             lb = _box(box_artist, renderer)
             for label, pts in data_points(ax):
-                hit = ((pts[:, 0] > lb.x0 + SLACK) & (pts[:, 0] < lb.x1 - SLACK)
-                       & (pts[:, 1] > lb.y0 + SLACK) & (pts[:, 1] < lb.y1 - SLACK))
+                hit = (
+                    (pts[:, 0] > lb.x0 + SLACK)
+                    & (pts[:, 0] < lb.x1 - SLACK)
+                    & (pts[:, 1] > lb.y0 + SLACK)
+                    & (pts[:, 1] < lb.y1 - SLACK)
+                )
                 if hit.any():
-                    what = "legend" if isinstance(box_artist, Legend) else f"text {box_artist.get_text()[:30]!r}"
+                    what = (
+                        "legend"
+                        if isinstance(box_artist, Legend)
+                        else f"text {box_artist.get_text()[:30]!r}"
+                    )
                     problems.append(f"{what} covers {int(hit.sum())} points of {label!r}")
     if units:
         for ax in fig.axes:
@@ -216,7 +248,9 @@ def largest_gap(fig: Figure) -> tuple[float, float]:
     boxes += [_box(artist, renderer) for _, _, artist in _texts(fig)]
     out = []
     for lo_attr, hi_attr, size in (("x0", "x1", fig.bbox.width), ("y0", "y1", fig.bbox.height)):
-        spans = sorted((max(0.0, getattr(b, lo_attr)), min(size, getattr(b, hi_attr))) for b in boxes)
+        spans = sorted(
+            (max(0.0, getattr(b, lo_attr)), min(size, getattr(b, hi_attr))) for b in boxes
+        )
         gap, reach = 0.0, 0.0
         for lo, hi in spans:
             gap = max(gap, lo - reach)

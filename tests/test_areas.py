@@ -20,7 +20,11 @@ from hypothesis import strategies as st
 from scipy.optimize import linprog
 
 from impact_balance.balance.areas import MERGE_TOLERANCE, areas_from_polytope, balance_areas
-from impact_balance.contacts.wrench_polytope import contact_polytope, torque_limit_rows, wrench_polytope
+from impact_balance.contacts.wrench_polytope import (
+    contact_polytope,
+    torque_limit_rows,
+    wrench_polytope,
+)
 from impact_balance.exceptions import ScenarioError
 from impact_balance.projection import project_polytope
 from impact_balance.scenario import bundled_scenarios, load_scenario
@@ -42,22 +46,28 @@ def Ry(a):
 # name: list of (position, rotation, mu, size), com
 SYNTHETIC = {
     "two_level": (
-        [((0.0, 0.1, 0.0), Rz(math.radians(10)), 0.7, (0.2, 0.1)),
-         ((0.05, -0.1, 0.0), Rz(math.radians(-5)), 0.7, (0.2, 0.1))],
+        [
+            ((0.0, 0.1, 0.0), Rz(math.radians(10)), 0.7, (0.2, 0.1)),
+            ((0.05, -0.1, 0.0), Rz(math.radians(-5)), 0.7, (0.2, 0.1)),
+        ],
         (0.02, 0.01, 0.8),
     ),
     "one_foot": ([((0.0, 0.0, 0.0), np.eye(3), 0.7, (0.2, 0.1))], (0.01, 0.01, 0.8)),
     # right foot on a 30 degree ramp rising along +x, 10 cm higher
     "ramp": (
-        [((0.0, 0.1, 0.0), np.eye(3), 0.7, (0.2, 0.1)),
-         ((0.3, -0.1, 0.1), Ry(math.radians(-30)), 0.7, (0.2, 0.1))],
+        [
+            ((0.0, 0.1, 0.0), np.eye(3), 0.7, (0.2, 0.1)),
+            ((0.3, -0.1, 0.1), Ry(math.radians(-30)), 0.7, (0.2, 0.1)),
+        ],
         (0.1, 0.0, 0.8),
     ),
     # two level feet and a hand on a wall in front (contact normal -x), above the CoM
     "wall": (
-        [((0.0, 0.1, 0.0), np.eye(3), 0.7, (0.2, 0.1)),
-         ((0.0, -0.1, 0.0), np.eye(3), 0.7, (0.2, 0.1)),
-         ((0.4, 0.2, 1.3), Ry(math.radians(-90)), 0.2, (0.1, 0.1))],
+        [
+            ((0.0, 0.1, 0.0), np.eye(3), 0.7, (0.2, 0.1)),
+            ((0.0, -0.1, 0.0), np.eye(3), 0.7, (0.2, 0.1)),
+            ((0.4, 0.2, 1.3), Ry(math.radians(-90)), 0.2, (0.1, 0.1)),
+        ],
         (0.05, 0.0, 0.85),
     ),
     # single foot, CoM 1 m in front: friction decides (see test_far_com_*)
@@ -70,7 +80,12 @@ def synthetic(make_contact, name, mu_scale=1.0, size_scale=1.0, yaw=0.0, shift=(
     specs, com = SYNTHETIC[name]
     T = Rz(yaw)
     contacts = [
-        make_contact(T @ np.asarray(p) + shift, T @ R, mu * mu_scale, (size[0] * size_scale, size[1] * size_scale))
+        make_contact(
+            T @ np.asarray(p) + shift,
+            T @ R,
+            mu * mu_scale,
+            (size[0] * size_scale, size[1] * size_scale),
+        )
         for p, R, mu, size in specs
     ]
     return contacts, T @ np.asarray(com) + shift
@@ -112,7 +127,11 @@ def assert_nested(geo, inner, outer, tol=1e-8):
 # (a) analytic: level coplanar contacts, ample friction -----------------------------------
 @pytest.mark.parametrize("height", [0.0, 0.1])
 def test_level_coplanar_zmp_area_is_hull_of_sole_corners(geo, make_contact, height):
-    feet = [((0.0, 0.1), math.radians(10)), ((0.05, -0.1), math.radians(-5)), ((-0.02, 0.35), math.radians(30))]
+    feet = [
+        ((0.0, 0.1), math.radians(10)),
+        ((0.05, -0.1), math.radians(-5)),
+        ((-0.02, 0.35), math.radians(30)),
+    ]
     size = (0.2, 0.1)
     contacts = [make_contact((x, y, height), Rz(a), 5.0, size) for (x, y), a in feet]
     com = np.array([0.02, 0.08, height + 0.8])
@@ -124,9 +143,13 @@ def test_level_coplanar_zmp_area_is_hull_of_sole_corners(geo, make_contact, heig
     assert len(res.zmp_area.vertices) == len(hull)
     assert_same_polygon(geo, res.zmp_area.vertices, hull, tol=1e-7)
     assert res.zmp_area.area == pytest.approx(geo.area(hull), rel=1e-6)
-    assert_same_polygon(geo, res.com_velocity_area.vertices, omega * (hull - com[:2]), tol=1e-7 * omega)
+    assert_same_polygon(
+        geo, res.com_velocity_area.vertices, omega * (hull - com[:2]), tol=1e-7 * omega
+    )
     # force / (m g) = (zmp - c_xy) / (h - c_z)
-    assert_same_polygon(geo, res.force_area.vertices, (hull - com[:2]) / (height - com[2]), tol=1e-7)
+    assert_same_polygon(
+        geo, res.force_area.vertices, (hull - com[:2]) / (height - com[2]), tol=1e-7
+    )
 
 
 def test_areas_are_affine_images_of_the_force_area(geo, make_contact):
@@ -201,8 +224,15 @@ def test_tighter_torque_limits_are_nested_and_empty_iff_infeasible(geo, talos_st
     for scale in (1.0, 0.5, 0.35, 0.25, 0.15):
         P = _talos_polytope(talos_stance, scale)
         force = areas_from_polytope(P).force_area
-        lp = linprog(np.zeros(P.dim), A_ub=P.A, b_ub=P.b / P.weight, A_eq=P.C, b_eq=P.d / P.weight,
-                     bounds=(None, None), method="highs")
+        lp = linprog(
+            np.zeros(P.dim),
+            A_ub=P.A,
+            b_ub=P.b / P.weight,
+            A_eq=P.C,
+            b_eq=P.d / P.weight,
+            bounds=(None, None),
+            method="highs",
+        )
         assert lp.status in (0, 2)
         assert force.is_empty == (lp.status == 2), f"scale {scale}"
         if previous.is_empty:  # once infeasible, tighter limits stay infeasible
@@ -251,13 +281,17 @@ def _independent_talos_polytope(stance, scale):
     b_tau = np.concatenate([lim - g[act] / mg, lim + g[act] / mg])
     A_cwc = np.zeros((32, 12))
     for k, pose in enumerate(poses):
-        A_cwc[16 * k : 16 * k + 16, 6 * k : 6 * k + 6] = cwc_faces_world(0.7, 0.1, 0.05, pose.rotation)
+        A_cwc[16 * k : 16 * k + 16, 6 * k : 6 * k + 6] = cwc_faces_world(
+            0.7, 0.1, 0.05, pose.rotation
+        )
     C = np.zeros((4, 12))
     F = np.zeros((2, 12))
     for k, pose in enumerate(poses):
         r = pose.translation - com
         C[0, 6 * k + 2] = 1.0  # total f_z = m g
-        C[1:, 6 * k : 6 * k + 3] = np.array([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])  # r x f
+        C[1:, 6 * k : 6 * k + 3] = np.array(
+            [[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]]
+        )  # r x f
         C[1:, 6 * k + 3 : 6 * k + 6] = np.eye(3)
         F[:, 6 * k : 6 * k + 2] = np.eye(2)
     d = np.array([1.0, 0, 0, 0])
@@ -280,8 +314,15 @@ def test_talos_force_area_matches_an_independent_rnea_model(geo, talos_stance, s
         c = np.zeros(13)
         c[-1] = 1
         A_ub = np.block([[A, np.zeros((len(A), 1))], [F, -np.ones((2, 1))], [-F, -np.ones((2, 1))]])
-        r = linprog(c, A_ub=A_ub, b_ub=np.concatenate([b, y, -y]), A_eq=np.hstack([C, np.zeros((4, 1))]), b_eq=d,
-                    bounds=(None, None), method="highs")
+        r = linprog(
+            c,
+            A_ub=A_ub,
+            b_ub=np.concatenate([b, y, -y]),
+            A_eq=np.hstack([C, np.zeros((4, 1))]),
+            b_eq=d,
+            bounds=(None, None),
+            method="highs",
+        )
         assert r.status == 0 and r.fun <= 1e-7
     edges = np.roll(v, -1, axis=0) - v
     normals = np.column_stack([edges[:, 1], -edges[:, 0]])
@@ -299,8 +340,11 @@ def test_talos_force_area_matches_an_independent_rnea_model(geo, talos_stance, s
 def test_yaw_rotates_the_areas(geo, make_contact, name, yaw):
     ref = areas_of(make_contact, name)
     rot = areas_of(make_contact, name, yaw=yaw)
-    for a, b in [(ref.force_area, rot.force_area), (ref.zmp_area, rot.zmp_area),
-                 (ref.com_velocity_area, rot.com_velocity_area)]:
+    for a, b in [
+        (ref.force_area, rot.force_area),
+        (ref.zmp_area, rot.zmp_area),
+        (ref.com_velocity_area, rot.com_velocity_area),
+    ]:
         scale = max(1.0, float(np.max(np.abs(a.vertices))))
         assert_same_polygon(geo, b.vertices, rotate2(a.vertices, yaw), tol=1e-7 * scale)
         assert b.area == pytest.approx(a.area, rel=1e-6)
@@ -313,7 +357,9 @@ def test_horizontal_translation_moves_only_the_zmp_area(geo, make_contact, name)
     moved = areas_of(make_contact, name, shift=shift)
     assert_same_polygon(geo, moved.zmp_area.vertices, ref.zmp_area.vertices + shift[:2], tol=1e-7)
     assert_same_polygon(geo, moved.force_area.vertices, ref.force_area.vertices, tol=1e-7)
-    assert_same_polygon(geo, moved.com_velocity_area.vertices, ref.com_velocity_area.vertices, tol=1e-7)
+    assert_same_polygon(
+        geo, moved.com_velocity_area.vertices, ref.com_velocity_area.vertices, tol=1e-7
+    )
 
 
 # (d) against pypoman -----------------------------------------------------------------------
@@ -323,13 +369,18 @@ def pypoman_force_area(P, scale=1e3):
     np.random.seed(12345)  # pypoman draws its first ray with numpy's global generator
     w = P.weight
     V = pypoman.project_polytope(
-        proj=(scale * P.F, np.zeros(2)), ineq=(P.A, P.b / w), eq=(P.C, P.d / w),
-        method="bretl", max_radius=1e4 * scale,
+        proj=(scale * P.F, np.zeros(2)),
+        ineq=(P.A, P.b / w),
+        eq=(P.C, P.d / w),
+        method="bretl",
+        max_radius=1e4 * scale,
     )
     return np.array(V) / scale
 
 
-@pytest.fixture(scope="module", params=["two_level", "one_foot", "ramp", "wall", "talos", "talos_tight"])
+@pytest.fixture(
+    scope="module", params=["two_level", "one_foot", "ramp", "wall", "talos", "talos_tight"]
+)
 def stance_polytope(request, make_contact, talos_stance):
     if request.param == "talos":
         return wrench_polytope(talos_stance, torque_limits=True)
@@ -388,7 +439,10 @@ def single_foot_zmp_area(position, yaw, size, mu, com, slack=0.0):
     CoM and the ZMP z has f_xy = m g (c - z)_xy / c_z, and |f_x|, |f_y| <= mu m g in sole axes."""
     poly = sole_corners_xy(position, yaw, size)
     height = com[2] - position[2]
-    for axis in (np.array([math.cos(yaw), math.sin(yaw)]), np.array([-math.sin(yaw), math.cos(yaw)])):
+    for axis in (
+        np.array([math.cos(yaw), math.sin(yaw)]),
+        np.array([-math.sin(yaw), math.cos(yaw)]),
+    ):
         for sign in (1, -1):  # sign * axis . (z - c) <= mu height
             poly = clip(poly, sign * axis, sign * axis @ com[:2] + mu * height + slack)
             if len(poly) == 0:
@@ -412,7 +466,9 @@ def test_far_com_with_ample_friction_zmp_area_is_the_sole(geo, make_contact):
     assert_same_polygon(geo, res.com_velocity_area.vertices, omega * (rect - com), tol=1e-7 * omega)
     assert res.can_balance  # a nonempty area ...
     assert not res.com_velocity_area.contains(np.zeros(2))  # ... but not from rest at this CoM
-    assert geo.distance(np.zeros(2), geo.hull(omega * (rect - com))) == pytest.approx(omega * 0.9, rel=1e-7)
+    assert geo.distance(np.zeros(2), geo.hull(omega * (rect - com))) == pytest.approx(
+        omega * 0.9, rel=1e-7
+    )
 
 
 def test_far_com_with_limited_friction_clips_the_sole(geo, make_contact):
@@ -424,9 +480,13 @@ def test_far_com_with_limited_friction_clips_the_sole(geo, make_contact):
 
 @settings(max_examples=40, deadline=None)
 @given(
-    u=st.floats(-6, 6), v=st.floats(-6, 6), cz=st.floats(0.4, 1.0),
-    mu=st.floats(0.1, 1.5), yaw=st.floats(-math.pi, math.pi),
-    length=st.floats(0.05, 0.3), width=st.floats(0.05, 0.3),
+    u=st.floats(-6, 6),
+    v=st.floats(-6, 6),
+    cz=st.floats(0.4, 1.0),
+    mu=st.floats(0.1, 1.5),
+    yaw=st.floats(-math.pi, math.pi),
+    length=st.floats(0.05, 0.3),
+    width=st.floats(0.05, 0.3),
 )
 def test_single_level_contact_matches_statics(geo, make_contact, u, v, cz, mu, yaw, length, width):
     """CoM at (u, v) half-sizes from the sole centre in sole axes: inside, near or far."""
@@ -444,8 +504,13 @@ def test_single_level_contact_matches_statics(geo, make_contact, u, v, cz, mu, y
         return
     assert_same_polygon(geo, res.zmp_area.vertices, expected, tol=1e-7, rel_area=1e-5)
     omega = math.sqrt(G / cz)
-    assert_same_polygon(geo, res.com_velocity_area.vertices, omega * (expected - com[:2]), tol=1e-7 * omega,
-                        rel_area=1e-5)
+    assert_same_polygon(
+        geo,
+        res.com_velocity_area.vertices,
+        omega * (expected - com[:2]),
+        tol=1e-7 * omega,
+        rel_area=1e-5,
+    )
     margin = geo.distance(com[:2], geo.hull(expected))
     com_inside = margin == 0.0
     if com_inside or margin > 1e-6:  # from rest iff the CoM is above the ZMP area
@@ -455,8 +520,12 @@ def test_single_level_contact_matches_statics(geo, make_contact, u, v, cz, mu, y
 @settings(max_examples=60, deadline=None)
 @given(
     st.lists(st.tuples(st.floats(-2, 2), st.floats(-2, 2)), min_size=1, max_size=12),
-    st.floats(-1.5, -0.2), st.floats(-3, 3), st.floats(-3, 3), st.floats(1.0, 8.0),
-    st.sampled_from([0.0, 1e-3, 0.02, 0.3]), st.booleans(),
+    st.floats(-1.5, -0.2),
+    st.floats(-3, 3),
+    st.floats(-3, 3),
+    st.floats(1.0, 8.0),
+    st.sampled_from([0.0, 1e-3, 0.02, 0.3]),
+    st.booleans(),
 )
 def test_compiled_maps_give_the_polygon_methods_numbers(points, depth, cx, cy, w, margin, bounded):
     """The compiled areas pipeline's maps (``areas._maps``) are Polygon.affine and
@@ -465,12 +534,16 @@ def test_compiled_maps_give_the_polygon_methods_numbers(points, depth, cx, cy, w
     from impact_balance.geometry.polygon import Polygon
 
     force = Polygon(Polygon.from_points(np.array(points)).vertices, bounded)
-    zmp, zmp_bounded, vel, vel_bounded = _maps(np.ascontiguousarray(force.vertices), bounded, depth, cx, cy, w, margin)
+    zmp, zmp_bounded, vel, vel_bounded = _maps(
+        np.ascontiguousarray(force.vertices), bounded, depth, cx, cy, w, margin
+    )
     if force.is_empty:
         want_zmp = want_vel = Polygon.empty()
     elif margin > 0.0:
         want_zmp = force.affine(depth, np.array([cx, cy])).inset(margin)
-        want_vel = Polygon.empty() if want_zmp.is_empty else want_zmp.affine(w, -w * np.array([cx, cy]))
+        want_vel = (
+            Polygon.empty() if want_zmp.is_empty else want_zmp.affine(w, -w * np.array([cx, cy]))
+        )
     else:
         want_zmp = force.affine(depth, np.array([cx, cy]))
         want_vel = force.affine(w * depth, np.zeros(2))
@@ -490,7 +563,9 @@ def test_velocity_area_halfplanes_from_the_compiled_pipeline_are_the_polygons_ow
     stance = scenario.build_stance()
     areas = areas_from_polytope(wrench_polytope(stance), scenario.plane_height, margin)
     G, h = areas.com_velocity_area.halfplanes
-    G2, h2 = Polygon(areas.com_velocity_area.vertices.copy(), areas.com_velocity_area.bounded).halfplanes
+    G2, h2 = Polygon(
+        areas.com_velocity_area.vertices.copy(), areas.com_velocity_area.bounded
+    ).halfplanes
     assert len(G) >= 3
     np.testing.assert_array_equal(G, G2)
     np.testing.assert_array_equal(h, h2)
@@ -507,14 +582,26 @@ def test_areas_from_arrays_is_areas_from_polytope_number_for_number(name, margin
     scenario = load_scenario(name)
     stance = scenario.build_stance()
     want = areas_from_polytope(wrench_polytope(stance), scenario.plane_height, margin)
-    faces = np.array([_local_faces(float(c.spec.friction), c.half_length, c.half_width)
-                      for c in stance.contacts]).reshape(-1, 16, 6)
+    faces = np.array(
+        [_local_faces(float(c.spec.friction), c.half_length, c.half_width) for c in stance.contacts]
+    ).reshape(-1, 16, 6)
     idx, limit = stance.robot.effort_limits
     arms = np.array([c.local_position for c in stance.contacts]) - stance.com_local
-    got = areas_from_arrays(faces, [c.rotation for c in stance.contacts], [list(c.position) for c in stance.contacts],
-                            arms.tolist(), stance.mass, stance.com, 9.81,
-                            np.concatenate([c.jacobian for c in stance.contacts]), list(idx), list(limit),
-                            list(stance.gravity_torques), scenario.plane_height, margin)
+    got = areas_from_arrays(
+        faces,
+        [c.rotation for c in stance.contacts],
+        [list(c.position) for c in stance.contacts],
+        arms.tolist(),
+        stance.mass,
+        stance.com,
+        9.81,
+        np.concatenate([c.jacobian for c in stance.contacts]),
+        list(idx),
+        list(limit),
+        list(stance.gravity_torques),
+        scenario.plane_height,
+        margin,
+    )
     for which in ("force_area", "zmp_area", "com_velocity_area"):
         np.testing.assert_array_equal(getattr(got, which).vertices, getattr(want, which).vertices)
         assert getattr(got, which).bounded == getattr(want, which).bounded

@@ -109,33 +109,118 @@ def test_base_scenario_is_valid(base_analysis):
 # -- bad fields: (mutation, exception class, field, value) ----------------------------------
 CASES = {
     "unknown_robot": (mutated(robot="atlas"), UnknownRobotError, "robot", "atlas"),
-    "unknown_contact_frame": (mutated(contacts__0__frame="left_sole"), UnknownFrameError, "contacts[0].frame", "left_sole"),
-    "unknown_impact_frame": (mutated(impact__frame="nope_link"), UnknownFrameError, "impact.frame", "nope_link"),
-    "unknown_configuration": (mutated(configuration="squat"), UnknownConfigurationError, "configuration", "squat"),
-    "unknown_joint": (mutated(joints={"knee_joint": 0.3}), UnknownJointError, "joints.knee_joint", "knee_joint"),
-    "joint_out_of_limits": (mutated(joints={"leg_left_4_joint": 5.0}), ScenarioError, "joints.leg_left_4_joint", 5.0),
+    "unknown_contact_frame": (
+        mutated(contacts__0__frame="left_sole"),
+        UnknownFrameError,
+        "contacts[0].frame",
+        "left_sole",
+    ),
+    "unknown_impact_frame": (
+        mutated(impact__frame="nope_link"),
+        UnknownFrameError,
+        "impact.frame",
+        "nope_link",
+    ),
+    "unknown_configuration": (
+        mutated(configuration="squat"),
+        UnknownConfigurationError,
+        "configuration",
+        "squat",
+    ),
+    "unknown_joint": (
+        mutated(joints={"knee_joint": 0.3}),
+        UnknownJointError,
+        "joints.knee_joint",
+        "knee_joint",
+    ),
+    "joint_out_of_limits": (
+        mutated(joints={"leg_left_4_joint": 5.0}),
+        ScenarioError,
+        "joints.leg_left_4_joint",
+        5.0,
+    ),
     "friction_zero": (mutated(contacts__0__friction=0), ScenarioError, "contacts[0].friction", 0),
-    "friction_negative": (mutated(contacts__1__friction=-0.7), ScenarioError, "contacts[1].friction", -0.7),
-    "size_zero": (mutated(contacts__0__size=[0.0, 0.1]), ScenarioError, "contacts[0].size", [0.0, 0.1]),
-    "size_negative": (mutated(contacts__1__size=[0.2, -0.1]), ScenarioError, "contacts[1].size", [0.2, -0.1]),
-    "size_three_entries": (mutated(contacts__0__size=[0.2, 0.1, 0.3]), ScenarioError, "contacts[0].size", [0.2, 0.1, 0.3]),
-    "restitution_above_one": (mutated(impact__restitution=[0.0, 1.5]), ScenarioError, "impact.restitution", [0.0, 1.5]),
-    "restitution_negative": (mutated(impact__restitution=[-0.1, 0.2]), ScenarioError, "impact.restitution", [-0.1, 0.2]),
-    "restitution_reversed": (mutated(impact__restitution=[0.3, 0.1]), ScenarioError, "impact.restitution", [0.3, 0.1]),
+    "friction_negative": (
+        mutated(contacts__1__friction=-0.7),
+        ScenarioError,
+        "contacts[1].friction",
+        -0.7,
+    ),
+    "size_zero": (
+        mutated(contacts__0__size=[0.0, 0.1]),
+        ScenarioError,
+        "contacts[0].size",
+        [0.0, 0.1],
+    ),
+    "size_negative": (
+        mutated(contacts__1__size=[0.2, -0.1]),
+        ScenarioError,
+        "contacts[1].size",
+        [0.2, -0.1],
+    ),
+    "size_three_entries": (
+        mutated(contacts__0__size=[0.2, 0.1, 0.3]),
+        ScenarioError,
+        "contacts[0].size",
+        [0.2, 0.1, 0.3],
+    ),
+    "restitution_above_one": (
+        mutated(impact__restitution=[0.0, 1.5]),
+        ScenarioError,
+        "impact.restitution",
+        [0.0, 1.5],
+    ),
+    "restitution_negative": (
+        mutated(impact__restitution=[-0.1, 0.2]),
+        ScenarioError,
+        "impact.restitution",
+        [-0.1, 0.2],
+    ),
+    "restitution_reversed": (
+        mutated(impact__restitution=[0.3, 0.1]),
+        ScenarioError,
+        "impact.restitution",
+        [0.3, 0.1],
+    ),
     "zero_normal": (mutated(impact__normal=[0, 0, 0]), ScenarioError, "impact.normal", [0, 0, 0]),
     "no_contacts": (mutated(contacts=[]), ScenarioError, "contacts", []),
     "plane_height_above_com": (mutated(plane_height=5.0), ScenarioError, "plane_height", 5.0),
-    "friction_not_a_number": (mutated(contacts__0__friction="abc"), ScenarioError, "contacts[0].friction", "abc"),
+    "friction_not_a_number": (
+        mutated(contacts__0__friction="abc"),
+        ScenarioError,
+        "contacts[0].friction",
+        "abc",
+    ),
     "contacts_not_a_list": (mutated(contacts=3), ScenarioError, "contacts", 3),
     "com_velocity_not_a_pair": (mutated(com_velocity="abc"), ScenarioError, "com_velocity", "abc"),
-    "com_velocity_three_entries": (mutated(com_velocity=[1, 2, 3]), ScenarioError, "com_velocity", [1, 2, 3]),
+    "com_velocity_three_entries": (
+        mutated(com_velocity=[1, 2, 3]),
+        ScenarioError,
+        "com_velocity",
+        [1, 2, 3],
+    ),
     "unknown_key": (mutated(plane_hieght=0.0), ScenarioError, "plane_hieght", 0.0),
     "cone_edges_two": (mutated(impact__cone_edges=2), ScenarioError, "impact.cone_edges", 2),
     "duration_zero": (mutated(impact__duration=0), ScenarioError, "impact.duration", 0),
-    "duration_negative": (mutated(impact__duration=-0.005), ScenarioError, "impact.duration", -0.005),
+    "duration_negative": (
+        mutated(impact__duration=-0.005),
+        ScenarioError,
+        "impact.duration",
+        -0.005,
+    ),
     "gravity_zero": (mutated(gravity=0), ScenarioError, "gravity", 0),
-    "inertia_unknown": (mutated(impact__inertia="lumped"), ScenarioError, "impact.inertia", "lumped"),
-    "joint_value_not_a_number": (mutated(joints={"leg_left_4_joint": "bent"}), ScenarioError, "joints.leg_left_4_joint", "bent"),
+    "inertia_unknown": (
+        mutated(impact__inertia="lumped"),
+        ScenarioError,
+        "impact.inertia",
+        "lumped",
+    ),
+    "joint_value_not_a_number": (
+        mutated(joints={"leg_left_4_joint": "bent"}),
+        ScenarioError,
+        "joints.leg_left_4_joint",
+        "bent",
+    ),
 }
 
 
@@ -339,13 +424,23 @@ def test_extends_bundled_name_works(tmp_path):
 
 # -- real processes: exit status and no traceback ----------------------------------------------
 @pytest.mark.parametrize(
-    "case", ["unknown_contact_frame", "friction_zero", "size_three_entries", "plane_height_above_com", "unknown_robot"]
+    "case",
+    [
+        "unknown_contact_frame",
+        "friction_zero",
+        "size_three_entries",
+        "plane_height_above_com",
+        "unknown_robot",
+    ],
 )
 def test_subprocess_exit_2_no_traceback(tmp_path, case):
     data, _, field, value = CASES[case]
     path = write(tmp_path, data)
     proc = subprocess.run(
-        [sys.executable, "-m", "impact_balance", "analyze", str(path)], capture_output=True, text=True, timeout=120
+        [sys.executable, "-m", "impact_balance", "analyze", str(path)],
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     assert proc.stdout == ""
     assert_one_line_error(proc.returncode, proc.stderr, field, str(value))
@@ -354,7 +449,10 @@ def test_subprocess_exit_2_no_traceback(tmp_path, case):
 def test_subprocess_not_yaml_exit_2(tmp_path):
     path = write(tmp_path, "a: [1, 2\n")
     proc = subprocess.run(
-        [sys.executable, "-m", "impact_balance", "analyze", str(path)], capture_output=True, text=True, timeout=120
+        [sys.executable, "-m", "impact_balance", "analyze", str(path)],
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     assert_one_line_error(proc.returncode, proc.stderr, str(path))
 
@@ -362,7 +460,14 @@ def test_subprocess_not_yaml_exit_2(tmp_path):
 # -- infeasible but valid: answers, not errors -------------------------------------------------
 INFEASIBLE = {
     # One sole contact moved 1 m ahead of the foot, low friction: the CoM is far outside.
-    "far_contact": [{"frame": "left_sole_link", "friction": 0.1, "size": [0.2, 0.1], "offset": {"position": [1.0, 0.0, 0.0]}}],
+    "far_contact": [
+        {
+            "frame": "left_sole_link",
+            "friction": 0.1,
+            "size": [0.2, 0.1],
+            "offset": {"position": [1.0, 0.0, 0.0]},
+        }
+    ],
     # The left hand alone, slippery.
     "hand_only": [{"frame": "gripper_left_base_link", "friction": 0.05, "size": [0.05, 0.05]}],
 }

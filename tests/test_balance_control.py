@@ -10,8 +10,8 @@ import impact_balance as ib
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.sim.control.approach import ImpactTask
 from impact_balance.sim.control.kinematic import BalanceController, retracted_stance
-from impact_balance.sim.trials.outcomes import OutcomeCriteria, OutcomeMonitor
 from impact_balance.sim.control.zmp import DcmFeedback, clamp_to_polygon, dcm
+from impact_balance.sim.trials.outcomes import OutcomeCriteria, OutcomeMonitor
 
 SQUARE = Polygon(np.array([[-0.1, -0.05], [0.1, -0.05], [0.1, 0.05], [-0.1, 0.05]]))
 
@@ -97,7 +97,9 @@ def test_ik_keeps_contacts_and_drives_the_impact_point_at_the_commanded_speed(an
     assert travel == pytest.approx(expected, abs=3e-3)
     pin.framesForwardKinematics(model, data, q)
     for c in analysis.stance.contacts:
-        assert np.linalg.norm(data.oMf[model.getFrameId(c.spec.frame)].translation - c.position) < 1e-4
+        assert (
+            np.linalg.norm(data.oMf[model.getFrameId(c.spec.frame)].translation - c.position) < 1e-4
+        )
     com = pin.centerOfMass(model, data, q)
     assert np.linalg.norm(com[:2] - analysis.stance.com[:2]) < 5e-3
 
@@ -106,7 +108,9 @@ def test_ik_keeps_contacts_and_drives_the_impact_point_at_the_commanded_speed(an
 def test_approach_reaches_the_speed_before_the_surface_with_bounded_acceleration(speed):
     n = np.array([-1.0, 0.0, 0.0])
     task = ImpactTask("f", pin.SE3.Identity(), np.zeros(3), n, speed=speed, start_time=0.1)
-    assert task.standoff == pytest.approx(max(0.05, speed ** 2 / (2 * task.acceleration) + task.cruise))
+    assert task.standoff == pytest.approx(
+        max(0.05, speed**2 / (2 * task.acceleration) + task.cruise)
+    )
     times = np.arange(0.0, task.arrival_time + 0.05, 1e-4)
     p, v, a = (np.array(x) for x in zip(*(task.reference(t) for t in times)))
     assert np.all(np.abs(a @ n) <= task.acceleration + 1e-9)
@@ -116,7 +120,9 @@ def test_approach_reaches_the_speed_before_the_surface_with_bounded_acceleration
     assert times[at_surface] == pytest.approx(task.arrival_time, abs=2e-4)
     assert -v[at_surface] @ n == pytest.approx(speed)
     cruise_start = task.start_time + speed / task.acceleration
-    assert (p[times.searchsorted(cruise_start)] @ n) >= task.cruise - 1e-3  # full speed 3 cm before the surface
+    assert (
+        p[times.searchsorted(cruise_start)] @ n
+    ) >= task.cruise - 1e-3  # full speed 3 cm before the surface
     # Past the surface the reference keeps going at the speed until the contact is felt.
     beyond = task.reference(task.arrival_time + 0.01)
     assert beyond[0] @ n < 0 and -beyond[1] @ n == pytest.approx(speed)
@@ -139,10 +145,21 @@ def _monitor():
     return OutcomeMonitor(["a", "b"], np.zeros((2, 3)), np.stack([R, R]), 1.0, R, OutcomeCriteria())
 
 
-def _feed(mon, t, P=None, R=None, forces=(400.0, 400.0), base=1.0, base_R=None, dcm=0.05, impulsive=False):
+def _feed(
+    mon, t, P=None, R=None, forces=(400.0, 400.0), base=1.0, base_R=None, dcm=0.05, impulsive=False
+):
     P = np.zeros((2, 3)) if P is None else P
     R = np.stack([np.eye(3)] * 2) if R is None else R
-    mon.update(t, P, R, np.asarray(forces, dtype=float), base, np.eye(3) if base_R is None else base_R, dcm, impulsive)
+    mon.update(
+        t,
+        P,
+        R,
+        np.asarray(forces, dtype=float),
+        base,
+        np.eye(3) if base_R is None else base_R,
+        dcm,
+        impulsive,
+    )
 
 
 def test_short_unloading_is_no_event_but_a_long_one_is_lifted():
@@ -156,7 +173,11 @@ def test_short_unloading_is_no_event_but_a_long_one_is_lifted():
         _feed(mon, 0.02 + 0.001 * k, forces=(400.0, 0.5))
     assert [(e.contact, e.kind) for e in mon.events] == [("b", "lifted")]
     out = mon.finish(3.0, np.zeros(3))
-    assert out.outcome == "contact_broken" and out.reason == "lifted" and out.time == pytest.approx(0.02)
+    assert (
+        out.outcome == "contact_broken"
+        and out.reason == "lifted"
+        and out.time == pytest.approx(0.02)
+    )
 
 
 @pytest.mark.parametrize("kind", ["tilted", "slipped"])
@@ -209,7 +230,11 @@ def test_events_or_falls_before_the_disturbance_abort():
     _feed(mon, 0.1, P=np.array([[0.02, 0, 0], [0, 0, 0]]))
     mon.start_disturbance(0.3)
     out = mon.finish(3.0, np.zeros(3))
-    assert out.outcome == "aborted" and out.reason == "before_disturbance" and "a slipped" in out.detail
+    assert (
+        out.outcome == "aborted"
+        and out.reason == "before_disturbance"
+        and "a slipped" in out.detail
+    )
     never = _monitor()
     never.abort("no_contact", 2.0, "the impact point never reached the surface")
     assert never.finish(3.0, np.zeros(3)).outcome == "aborted"

@@ -9,8 +9,13 @@ import pytest
 
 from impact_balance.cli import main
 from impact_balance.logs import check_log, read_log, write_log
-from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions, Push, run_balance_trial
 from impact_balance.sim.studies.validate import validate
+from impact_balance.sim.trials.balance_trial import (
+    BalanceSetup,
+    BalanceTrialOptions,
+    Push,
+    run_balance_trial,
+)
 
 SCENARIO = "palm_push_two_feet"
 
@@ -21,7 +26,9 @@ def setup():
 
 
 def test_small_push_is_recovered_and_logged(setup, tmp_path):
-    result = run_balance_trial(setup, push=Push(0.0, 5.0, 0.05), options=BalanceTrialOptions(after=1.0, record=True))
+    result = run_balance_trial(
+        setup, push=Push(0.0, 5.0, 0.05), options=BalanceTrialOptions(after=1.0, record=True)
+    )
     assert result.outcome == "balanced", result.detail
     assert result.com_velocity_margin_at_end > 0 and result.min_com_velocity_margin > 0
     # A 5 N s push changes the CoM velocity by about 5 / 90 m/s; the controller brings it back.
@@ -34,13 +41,21 @@ def test_small_push_is_recovered_and_logged(setup, tmp_path):
     ours = check.samples[["comd_x", "comd_y", "comd_z"]].to_numpy()
     mujoco_com = frame[["comd_x", "comd_y", "comd_z"]].to_numpy()
     assert np.abs(ours - mujoco_com).max() < 1e-6
-    assert np.abs(check.samples[["com_x", "com_y", "com_z"]].to_numpy() - frame[["com_x", "com_y", "com_z"]].to_numpy()).max() < 1e-6
+    assert (
+        np.abs(
+            check.samples[["com_x", "com_y", "com_z"]].to_numpy()
+            - frame[["com_x", "com_y", "com_z"]].to_numpy()
+        ).max()
+        < 1e-6
+    )
     late = check.samples["time"] > 0.2
     assert check.samples.loc[late, "com_velocity_inside"].all()
 
 
 def test_large_push_falls_and_the_com_criterion_saw_it(setup):
-    result = run_balance_trial(setup, push=Push(0.0, 100.0, 0.05), options=BalanceTrialOptions(after=1.5))
+    result = run_balance_trial(
+        setup, push=Push(0.0, 100.0, 0.05), options=BalanceTrialOptions(after=1.5)
+    )
     assert result.fell and result.reason in ("base_dropped", "trunk_tipped")
     assert result.com_velocity_margin_at_end < 0  # ~1.1 m/s is far outside the CoM velocity area
     json.dumps(result.summary(), allow_nan=False)
@@ -61,13 +76,18 @@ def test_validate_brackets_the_threshold_in_measured_speed(tmp_path):
     e = out["empirical"]
     s, f = e["survived"], e["fell"]
     assert s is not None and f is not None and s < f
-    assert e["survived_commanded"] < e["fell_commanded"] and e["fell_commanded"] - e["survived_commanded"] <= 0.5 * e["fell_commanded"]
+    assert (
+        e["survived_commanded"] < e["fell_commanded"]
+        and e["fell_commanded"] - e["survived_commanded"] <= 0.5 * e["fell_commanded"]
+    )
     measured = {t["speed"]: t["approach_speed_measured"] for t in out["trials"]}
     assert s in measured.values() and f in measured.values()  # the bracket is in measured speed
     for t in out["trials"]:
         assert t["outcome"] in ("balanced", "contact_broken", "fell", "aborted")
         assert t["fell"] == (t["outcome"] == "fell")
-        assert t["approach_speed_measured"] == pytest.approx(t["speed"], rel=0.35)  # reached before the surface
+        assert t["approach_speed_measured"] == pytest.approx(
+            t["speed"], rel=0.35
+        )  # reached before the surface
     assert any(t["fell"] for t in out["trials"]) and any(not t["fell"] for t in out["trials"])
     assert out["controller"]["name"] and out["rigid_impact"] is True
     predicted = out["predicted"]["com_criterion"]["composite"]
@@ -76,8 +96,13 @@ def test_validate_brackets_the_threshold_in_measured_speed(tmp_path):
         hold = t["trial"]["impact"]["rigid_hold"]
         assert hold["duration"] is not None and hold["max_joint_velocity_change"] < 0.01
     # The same search again reuses every trial from the journal and gives the same answer.
-    again = validate(SCENARIO, tolerance=0.5, options=options, setup=setup,
-                     journal=TrialJournal.open(tmp_path / "v.jsonl", "digest"))
+    again = validate(
+        SCENARIO,
+        tolerance=0.5,
+        options=options,
+        setup=setup,
+        journal=TrialJournal.open(tmp_path / "v.jsonl", "digest"),
+    )
     assert again.reused == len(result.trials) and again.bracket() == result.bracket()
 
 
@@ -93,13 +118,33 @@ def test_cli_errors_are_one_line(capsys, tmp_path):
 
 
 def test_push_test_json(capsys, tmp_path):
-    argv = ["push-test", SCENARIO, "--controller", "ik", "--directions", "1", "--magnitudes", "5", "--json",
-            "--journal", str(tmp_path / "j.jsonl")]
+    argv = [
+        "push-test",
+        SCENARIO,
+        "--controller",
+        "ik",
+        "--directions",
+        "1",
+        "--magnitudes",
+        "5",
+        "--json",
+        "--journal",
+        str(tmp_path / "j.jsonl"),
+    ]
     assert main(argv) == 0
     out = json.loads(capsys.readouterr().out, parse_constant=lambda c: pytest.fail(c))
     (push,) = out["pushes"]
-    assert set(push) >= {"direction", "magnitude", "outcome", "fell", "reason", "com_criterion_safe",
-                         "com_criterion_safe_in_trial", "zmp_criterion_safe", "com_velocity_margin"}
+    assert set(push) >= {
+        "direction",
+        "magnitude",
+        "outcome",
+        "fell",
+        "reason",
+        "com_criterion_safe",
+        "com_criterion_safe_in_trial",
+        "zmp_criterion_safe",
+        "com_velocity_margin",
+    }
     assert push["magnitude"] == 5.0 and push["fell"] is False and push["outcome"] == "balanced"
     assert push["com_criterion_safe"] is True and push["com_velocity_margin"] > 0
     assert out["zmp_margin"] == pytest.approx(0.01)  # the ik controller's own margin, by default
@@ -113,7 +158,9 @@ def test_push_test_json(capsys, tmp_path):
 def test_checker_reads_simulate_logs(tmp_path, capsys):
     """`simulate --log` (servo joints, a palm impact) writes a log the checker reads; its CoM is MuJoCo's."""
     path = tmp_path / "simulate.csv"
-    assert main(["simulate", SCENARIO, "--speed", "0.2", "--joints", "servo", "--log", str(path)]) == 0
+    assert (
+        main(["simulate", SCENARIO, "--speed", "0.2", "--joints", "servo", "--log", str(path)]) == 0
+    )
     capsys.readouterr()
     frame = read_log(path)
     check = check_log(frame, SCENARIO)
@@ -125,16 +172,32 @@ def test_checker_reads_simulate_logs(tmp_path, capsys):
 
 
 def test_validate_cli_json_keys_and_text(capsys, tmp_path):
-    argv = ["validate", SCENARIO, "--controller", "id", "--rigid-impact", "--max-speed", "0.3",
-            "--journal", str(tmp_path / "v.jsonl")]
+    argv = [
+        "validate",
+        SCENARIO,
+        "--controller",
+        "id",
+        "--rigid-impact",
+        "--max-speed",
+        "0.3",
+        "--journal",
+        str(tmp_path / "v.jsonl"),
+    ]
     assert main(argv + ["--json"]) == 0
     cap = capsys.readouterr()
     out = json.loads(cap.out, parse_constant=lambda c: pytest.fail(c))
     assert "trials journal" in cap.err
     e = out["empirical"]
     assert set(e) >= {"survived", "fell", "survived_commanded", "fell_commanded", "monotonic"}
-    assert e["survived_commanded"] == 0.3 and e["fell"] is None and e["survived"] == pytest.approx(0.3, rel=0.1)
-    assert out["predicted"]["com_criterion"]["composite"] > out["predicted_with_margin"]["com_criterion"]["composite"]
+    assert (
+        e["survived_commanded"] == 0.3
+        and e["fell"] is None
+        and e["survived"] == pytest.approx(0.3, rel=0.1)
+    )
+    assert (
+        out["predicted"]["com_criterion"]["composite"]
+        > out["predicted_with_margin"]["com_criterion"]["composite"]
+    )
     assert out["zmp_margin"] == pytest.approx(0.01) and out["rigid_impact"] is True
     (trial,) = out["trials"]
     assert trial["outcome"] == "balanced" and trial["com_criterion_safe"] is True
@@ -142,4 +205,8 @@ def test_validate_cli_json_keys_and_text(capsys, tmp_path):
     assert set(impact["sustained_impulses"]) == {"left_sole_link", "right_sole_link"}
     assert main(argv) == 0  # text, from the journal
     text = capsys.readouterr().out
-    assert "measured approach speed: stood at" in text and "CoM criterion" in text and "(1 reused)" in text
+    assert (
+        "measured approach speed: stood at" in text
+        and "CoM criterion" in text
+        and "(1 reused)" in text
+    )

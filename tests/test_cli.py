@@ -109,12 +109,18 @@ def test_unknown_command_is_argparse_error(capsys):
     assert "invalid choice" in err and "Traceback" not in err
 
 
-@pytest.mark.parametrize("argv, needle", [
-    (["bogus"], "invalid choice: 'bogus'"),
-    (["analyze"], "required: scenario"),
-    (["validate", "kick_one_foot", "--joints", "foo"], "--joints: invalid choice"),
-    (["push-test", "palm_push_ramp", "--directions", "many"], "--directions: invalid int value"),
-])
+@pytest.mark.parametrize(
+    "argv, needle",
+    [
+        (["bogus"], "invalid choice: 'bogus'"),
+        (["analyze"], "required: scenario"),
+        (["validate", "kick_one_foot", "--joints", "foo"], "--joints: invalid choice"),
+        (
+            ["push-test", "palm_push_ramp", "--directions", "many"],
+            "--directions: invalid int value",
+        ),
+    ],
+)
 def test_usage_errors_are_one_line(capsys, argv, needle):
     """A usage error follows the project's rule too: one line naming the option, exit 2."""
     with pytest.raises(SystemExit) as info:
@@ -162,12 +168,23 @@ def test_analyze_json_is_one_object(palm_json):
 
 def test_analyze_json_keys_and_shapes(palm_json):
     _, d = palm_json
-    for key in ("omega", "mass", "com", "com_velocity_area", "zmp_area", "impact", "verdict", "can_balance"):
+    for key in (
+        "omega",
+        "mass",
+        "com",
+        "com_velocity_area",
+        "zmp_area",
+        "impact",
+        "verdict",
+        "can_balance",
+    ):
         assert key in d, key
     assert d["verdict"] == "balanced" and d["can_balance"] is True
     assert 80 < d["mass"] < 100  # Talos, ~90 kg
     assert len(d["com"]) == 3
-    assert d["omega"] == pytest.approx(math.sqrt(d["gravity"] / (d["com"][2] - d["plane_height"])), rel=1e-9)
+    assert d["omega"] == pytest.approx(
+        math.sqrt(d["gravity"] / (d["com"][2] - d["plane_height"])), rel=1e-9
+    )
 
     area = d["com_velocity_area"]
     V = np.asarray(area["vertices"])
@@ -180,8 +197,13 @@ def test_analyze_json_keys_and_shapes(palm_json):
     im = d["impact"]
     n_edges = im["cone_edges"]
     assert n_edges == 16
-    for key in ("max_contact_velocity", "contact_velocity", "impulse_vertices", "post_impact_com_velocities",
-                "zmp_max_contact_velocity"):
+    for key in (
+        "max_contact_velocity",
+        "contact_velocity",
+        "impulse_vertices",
+        "post_impact_com_velocities",
+        "zmp_max_contact_velocity",
+    ):
         assert key in im, key
     assert len(im["contact_velocity"]) == 3
     assert np.asarray(im["impulse_vertices"]).shape == (2 * n_edges, 3)
@@ -270,7 +292,9 @@ def test_analyze_unknown_scenario_exit_2(capsys):
 
 # -- phase-portrait ---------------------------------------------------------------------------
 def test_phase_portrait_json_bounds(capsys):
-    rc, out, err = run(capsys, "phase-portrait", "--com-height", "0.78", "--zmp-range", "-0.13", "0.13", "--json")
+    rc, out, err = run(
+        capsys, "phase-portrait", "--com-height", "0.78", "--zmp-range", "-0.13", "0.13", "--json"
+    )
     assert rc == 0 and err == ""
     d = strict_json(out)
     assert d["omega"] == pytest.approx(math.sqrt(9.81 / 0.78), rel=1e-12)
@@ -283,7 +307,16 @@ def test_phase_portrait_json_bounds(capsys):
 def test_phase_portrait_paper_gravity(capsys):
     """The paper's +-0.4608 m/s corresponds to g = 9.8."""
     rc, out, _ = run(
-        capsys, "phase-portrait", "--com-height", "0.78", "--zmp-range", "-0.13", "0.13", "--gravity", "9.8", "--json"
+        capsys,
+        "phase-portrait",
+        "--com-height",
+        "0.78",
+        "--zmp-range",
+        "-0.13",
+        "0.13",
+        "--gravity",
+        "9.8",
+        "--json",
     )
     assert rc == 0
     d = strict_json(out)
@@ -293,7 +326,9 @@ def test_phase_portrait_paper_gravity(capsys):
 
 
 def test_phase_portrait_text(capsys):
-    rc, out, _ = run(capsys, "phase-portrait", "--com-height", "0.78", "--zmp-range", "-0.13", "0.13")
+    rc, out, _ = run(
+        capsys, "phase-portrait", "--com-height", "0.78", "--zmp-range", "-0.13", "0.13"
+    )
     assert rc == 0
     assert "-0.4610" in out and "0.4610" in out
 
@@ -305,7 +340,10 @@ def test_phase_portrait_text(capsys):
         (["--com-height", "-0.5", "--zmp-range", "-0.13", "0.13"], ["com_height", "-0.5"]),
         (["--com-height", "nan", "--zmp-range", "-0.13", "0.13"], ["com_height", "nan"]),
         (["--com-height", "0.78", "--zmp-range", "0.13", "-0.13"], ["zmp_range", "[0.13, -0.13]"]),
-        (["--com-height", "0.78", "--zmp-range", "-0.13", "0.13", "--gravity", "0"], ["gravity", "0.0"]),
+        (
+            ["--com-height", "0.78", "--zmp-range", "-0.13", "0.13", "--gravity", "0"],
+            ["gravity", "0.0"],
+        ),
     ],
 )
 def test_phase_portrait_bad_values_exit_2(capsys, argv, needles):
@@ -321,7 +359,17 @@ def test_phase_portrait_bad_value_subprocess():
 
 def test_phase_portrait_plot(tmp_path, capsys):
     target = tmp_path / "sub" / "pp.png"
-    rc, out, _ = run(capsys, "phase-portrait", "--com-height", "0.78", "--zmp-range", "-0.13", "0.13", "--plot", str(target))
+    rc, out, _ = run(
+        capsys,
+        "phase-portrait",
+        "--com-height",
+        "0.78",
+        "--zmp-range",
+        "-0.13",
+        "0.13",
+        "--plot",
+        str(target),
+    )
     assert rc == 0
     assert_png(target)
     assert str(target) in out
@@ -338,7 +386,9 @@ def test_demo(tmp_path, capsys):
     # friction sweep table: header then one row per friction
     assert "impact-friction sweep" in out
     for mu in ("0.10", "0.24", "0.40"):
-        assert re.search(rf"^\s+{re.escape(mu)}\s+\d+\.\d{{3}} m/s\s+\d+\.\d{{3}} m/s$", out, re.M), mu
+        assert re.search(
+            rf"^\s+{re.escape(mu)}\s+\d+\.\d{{3}} m/s\s+\d+\.\d{{3}} m/s$", out, re.M
+        ), mu
     assert re.search(r"CoM velocity in \[-0\.461\d*, 0\.461\d*\] m/s", out)
     pngs = sorted(tmp_path.glob("*.png"))
     assert (tmp_path / "friction_comparison.png") in pngs

@@ -13,11 +13,15 @@ import numpy as np
 import pytest
 
 import impact_balance as ib
-from impact_balance.impact.contact_aware import contact_impact
 from impact_balance.exceptions import GovernorError
 from impact_balance.governor import Governor
-from impact_balance.governor.support import (SAME_SOLUTION, ContactAwareLimit, contact_aware_rates,
-                                             contact_aware_solutions)
+from impact_balance.governor.support import (
+    SAME_SOLUTION,
+    ContactAwareLimit,
+    contact_aware_rates,
+    contact_aware_solutions,
+)
+from impact_balance.impact.contact_aware import contact_impact
 
 NAME = "palm_push_two_feet"
 STEPS = 11
@@ -76,14 +80,19 @@ def test_union_limit_is_at_most_each_single_start(answers):
             lo, hi = union.interval
             assert single.interval[0] <= lo + FIXED_POINT and hi <= single.interval[1] + FIXED_POINT
         assert union.limit.max_approach_speed == pytest.approx(
-            min(row["warm"].limit.max_approach_speed, row["cold"].limit.max_approach_speed), abs=FIXED_POINT)
+            min(row["warm"].limit.max_approach_speed, row["cold"].limit.max_approach_speed),
+            abs=FIXED_POINT,
+        )
 
 
 def test_two_branches_are_both_kept(answers):
     """Where the continued answer and the cold start's differ (two LCP solutions), the union has
     both at each restitution bound, and the rate bound is the worse of the two."""
-    split = [row for row in answers
-             if np.abs(row["warm"].rates - row["cold"].rates).max() > 100 * SAME_SOLUTION]
+    split = [
+        row
+        for row in answers
+        if np.abs(row["warm"].rates - row["cold"].rates).max() > 100 * SAME_SOLUTION
+    ]
     assert split, "the path has postures with two solutions"
     for row in split:
         union = row["union"]
@@ -91,7 +100,11 @@ def test_two_branches_are_both_kept(answers):
             assert np.sum(union.restitution == c_r) >= 2
         assert len(union.rates) >= 4 and union.converged
     # Where the two agree, the union is that one solution per bound (no duplicate rows).
-    single = [row for row in answers if np.abs(row["warm"].rates - row["cold"].rates).max() <= SAME_SOLUTION]
+    single = [
+        row
+        for row in answers
+        if np.abs(row["warm"].rates - row["cold"].rates).max() <= SAME_SOLUTION
+    ]
     assert single
     for row in single:
         assert len(row["union"].rates) == len(np.unique(row["union"].restitution))
@@ -108,12 +121,14 @@ def test_each_kept_row_is_a_fixed_point(path):
         previous = contact_aware_solutions(posture.stance, spec, previous)
         if len(previous.rates) > len(spec.restitution):
             for rate, c_r, state in zip(previous.rates, previous.restitution, previous.states):
-                again = contact_impact(posture.stance, spec, 1.0, restitution=float(c_r), initial_dxi=state)
+                again = contact_impact(
+                    posture.stance, spec, 1.0, restitution=float(c_r), initial_dxi=state
+                )
                 assert again.converged
                 assert np.abs(again.com_velocity_jump - rate).max() <= 1e-7
             for c_r in np.unique(previous.restitution):
                 s = previous.states[previous.restitution == c_r]
-                gaps = [np.abs(a - b).max() for i, a in enumerate(s) for b in s[i + 1:]]
+                gaps = [np.abs(a - b).max() for i, a in enumerate(s) for b in s[i + 1 :]]
                 assert min(gaps) > SAME_SOLUTION
             checked += 1
     assert checked

@@ -10,13 +10,13 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from impact_balance.impact.contact_aware import contact_impact, corner_contacts
+from impact_balance.contacts.stance import ContactSpec, Stance
 from impact_balance.exceptions import ImpactModelError
+from impact_balance.geometry.spatial import skew
+from impact_balance.impact.contact_aware import contact_impact, corner_contacts
 from impact_balance.impact.model import ImpactSpec, impact_model
 from impact_balance.robot.robot import Robot
 from impact_balance.sim.trials.measure import distance_to_hull
-from impact_balance.geometry.spatial import skew
-from impact_balance.contacts.stance import ContactSpec, Stance
 
 MASS = 10.0
 LENGTH, WIDTH, HEIGHT = 0.4, 0.3, 1.0  # box extents along x, y, z, m
@@ -29,12 +29,23 @@ def _box(arm: tuple[float, float, float]) -> Robot:
     "left" and "right" 0.1 m to either side of it, and frame "hit" at ``arm`` from the CoM."""
     model = pin.Model()
     joint = model.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), "root")
-    inertia = MASS / 12 * np.diag([WIDTH**2 + HEIGHT**2, LENGTH**2 + HEIGHT**2, LENGTH**2 + WIDTH**2])
+    inertia = (
+        MASS / 12 * np.diag([WIDTH**2 + HEIGHT**2, LENGTH**2 + HEIGHT**2, LENGTH**2 + WIDTH**2])
+    )
     model.appendBodyToJoint(joint, pin.Inertia(MASS, np.zeros(3), inertia), pin.SE3.Identity())
     body = model.addBodyFrame("box", joint, pin.SE3.Identity(), 0)
-    frames = (("sole", (0.0, 0.0, -HALF)), ("left", (0.0, 0.1, -HALF)), ("right", (0.0, -0.1, -HALF)), ("hit", arm))
+    frames = (
+        ("sole", (0.0, 0.0, -HALF)),
+        ("left", (0.0, 0.1, -HALF)),
+        ("right", (0.0, -0.1, -HALF)),
+        ("hit", arm),
+    )
     for name, position in frames:
-        model.addFrame(pin.Frame(name, joint, body, pin.SE3(np.eye(3), np.array(position)), pin.FrameType.OP_FRAME))
+        model.addFrame(
+            pin.Frame(
+                name, joint, body, pin.SE3(np.eye(3), np.array(position)), pin.FrameType.OP_FRAME
+            )
+        )
     q = pin.neutral(model)
     q[2] = HALF  # the sole on z = 0
     return Robot("box", model, {"neutral": q}, "neutral", Path("box.urdf"))
@@ -43,11 +54,15 @@ def _box(arm: tuple[float, float, float]) -> Robot:
 def _stance(arm, ground_friction: float | None) -> Stance:
     """The box on flat ground (``ground_friction``), or floating (None)."""
     robot = _box(arm)
-    contacts = [] if ground_friction is None else [ContactSpec("sole", ground_friction, (LENGTH, WIDTH))]
+    contacts = (
+        [] if ground_friction is None else [ContactSpec("sole", ground_friction, (LENGTH, WIDTH))]
+    )
     return Stance(robot, robot.reference_configurations["neutral"], contacts)
 
 
-def _push(friction: float = 0.0, restitution: tuple[float, float] = (0.0, 0.0), normal=(-1.0, 0.0, 0.0)) -> ImpactSpec:
+def _push(
+    friction: float = 0.0, restitution: tuple[float, float] = (0.0, 0.0), normal=(-1.0, 0.0, 0.0)
+) -> ImpactSpec:
     """A wall at +x pushes the box along -x at frame "hit"."""
     return ImpactSpec("hit", normal, friction=friction, restitution=restitution)
 
@@ -76,7 +91,9 @@ def test_floating_robot_lies_in_the_floating_composite_set(scenario):
     assert distance_to_hull(result.com_velocity_jump, model.com_velocity_jumps(0.5)[:, :2]) < 1e-8
     normal_velocity = -0.5 + model.normal @ model.W @ result.impact_impulse
     assert normal_velocity == pytest.approx(0.1 * 0.5, abs=1e-8)  # Newton's restitution
-    np.testing.assert_allclose(result.com_velocity_jump_3d, result.impact_impulse / stance.mass, atol=1e-12)
+    np.testing.assert_allclose(
+        result.com_velocity_jump_3d, result.impact_impulse / stance.mass, atol=1e-12
+    )
 
 
 @pytest.mark.parametrize("restitution", [0.0, 0.2])
@@ -107,7 +124,9 @@ def test_two_symmetric_feet_share_the_impulse():
     a, v_n, k = 0.3, 0.6, LENGTH / 2
     robot = _box((LENGTH / 2, 0.0, a))
     feet = [ContactSpec(name, 0.0, (LENGTH, 0.1)) for name in ("left", "right")]
-    result = contact_impact(Stance(robot, robot.reference_configurations["neutral"], feet), _push(0.0), v_n)
+    result = contact_impact(
+        Stance(robot, robot.reference_configurations["neutral"], feet), _push(0.0), v_n
+    )
     expected = -v_n / (1 + MASS * a**2 / (INERTIA_Y + MASS * k**2))
     assert result.com_velocity_jump[0] == pytest.approx(expected, rel=1e-7)
     rear = result.corner_impulses[:, 2:, 2]  # (-X, +-Y) corners of both feet, vertical impulse
@@ -122,7 +141,9 @@ def test_sticking_pivot_about_the_rear_edge():
     a, v_n = 0.3, 0.5
     zp = HALF + a
     result = contact_impact(_stance((LENGTH / 2, 0.0, a), 5.0), _push(0.0), v_n)
-    np.testing.assert_allclose(result.com_velocity_jump_3d, [-v_n * HALF / zp, 0.0, v_n * (LENGTH / 2) / zp], atol=1e-8)
+    np.testing.assert_allclose(
+        result.com_velocity_jump_3d, [-v_n * HALF / zp, 0.0, v_n * (LENGTH / 2) / zp], atol=1e-8
+    )
     assert result.angular_velocity_jump[1] == pytest.approx(-v_n / zp, rel=1e-7)
     impulse = result.contact_impulses[0]
     assert abs(impulse[0]) <= 5.0 * impulse[2] and impulse[2] > 0  # inside the friction cone
@@ -151,15 +172,23 @@ def _complementarity(stance: Stance, spec: ImpactSpec, v_n: float, e: float) -> 
     model = impact_model(stance, spec)
     arm = model.point - stance.com
     moment = np.cross(arm, result.impact_impulse)
-    for contact, corners, impulses in zip(stance.contacts, corner_contacts(stance), result.corner_impulses):
+    for contact, corners, impulses in zip(
+        stance.contacts, corner_contacts(stance), result.corner_impulses
+    ):
         for corner, impulse in zip(corners, impulses):
             moment += np.cross(corner.arm, impulse)
             local = contact.rotation.T @ impulse  # in the contact frame: z normal
             mu = contact.spec.friction
-            assert local[2] >= -tol and abs(local[0]) <= mu * local[2] + tol and abs(local[1]) <= mu * local[2] + tol
+            assert (
+                local[2] >= -tol
+                and abs(local[0]) <= mu * local[2] + tol
+                and abs(local[1]) <= mu * local[2] + tol
+            )
             velocity = dxi[:3] + np.cross(dxi[3:], corner.arm)
             assert velocity @ corner.normal >= -1e-7 * v_n  # no penetration
-            assert local[2] * (velocity @ corner.normal) == pytest.approx(0.0, abs=1e-6 * v_n * scale)
+            assert local[2] * (velocity @ corner.normal) == pytest.approx(
+                0.0, abs=1e-6 * v_n * scale
+            )
     np.testing.assert_allclose(stance.com_inertia @ dxi[3:], moment, atol=tol)
     n, iota = model.normal, result.impact_impulse
     after = -v_n * n + dxi[:3] + np.cross(dxi[3:], arm)
@@ -189,7 +218,9 @@ def test_linear_in_the_approach_speed_and_added_to_the_com_velocity():
     two = contact_impact(stance, spec, 0.6)
     np.testing.assert_allclose(two.com_velocity_jump, 2 * one.com_velocity_jump, atol=1e-9)
     np.testing.assert_allclose(two.contact_impulses, 2 * one.contact_impulses, atol=1e-7)
-    np.testing.assert_allclose(one.post_impact_com_velocity, np.array([0.1, -0.2]) + one.com_velocity_jump, atol=1e-15)
+    np.testing.assert_allclose(
+        one.post_impact_com_velocity, np.array([0.1, -0.2]) + one.com_velocity_jump, atol=1e-15
+    )
     assert one.restitution == 0.2  # the upper end by default
     np.testing.assert_allclose(contact_impact(stance, spec, 0.0).com_velocity_jump, 0.0, atol=1e-15)
 

@@ -51,7 +51,9 @@ def column_set_equal(A: np.ndarray, B: np.ndarray, tol: float = 1e-12) -> bool:
         return False
     used = set()
     for a in A.T:
-        match = [j for j, b in enumerate(B.T) if j not in used and np.allclose(a, b, atol=tol, rtol=0)]
+        match = [
+            j for j, b in enumerate(B.T) if j not in used and np.allclose(a, b, atol=tol, rtol=0)
+        ]
         if not match:
             return False
         used.add(match[0])
@@ -127,7 +129,9 @@ def test_points_clearly_outside_are_not_in_span_linprog():
     checked = 0
     while checked < 30:
         w = rng.normal(size=6)
-        feasible = linprog(np.zeros(16), A_eq=S, b_eq=w, bounds=(0, None), method="highs").status == 0
+        feasible = (
+            linprog(np.zeros(16), A_eq=S, b_eq=w, bounds=(0, None), method="highs").status == 0
+        )
         if np.max(C @ w) > 1e-6:
             assert not feasible
             checked += 1
@@ -179,7 +183,14 @@ def test_yaw_torque_bound_is_mu_times_half_perimeter(mu, X, Y):
     fixed = np.eye(6)[:5]
     target = np.array([0, 0, 1.0, 0, 0])
     for sign in (1, -1):
-        r = linprog(-sign * np.eye(6)[5], A_ub=C, b_ub=np.zeros(16), A_eq=fixed, b_eq=target, bounds=(None, None))
+        r = linprog(
+            -sign * np.eye(6)[5],
+            A_ub=C,
+            b_ub=np.zeros(16),
+            A_eq=fixed,
+            b_eq=target,
+            bounds=(None, None),
+        )
         assert r.status == 0 and sign * r.x[5] == pytest.approx(mu * (X + Y), rel=1e-9)
         r = linprog(-sign * S[5], A_eq=S[:5], b_eq=target, bounds=(0, None))
         assert r.status == 0 and sign * (S[5] @ r.x) == pytest.approx(mu * (X + Y), rel=1e-9)
@@ -234,4 +245,6 @@ def test_cached_faces_are_handed_out_as_copies():
     Cw[:] = 0.0
     np.testing.assert_array_equal(cwc_faces(mu, X, Y), expected_C)
     np.testing.assert_array_equal(cwc_faces_world(mu, X, Y, R), expected_Cw)
-    np.testing.assert_allclose(expected_Cw, expected_C @ rotate_wrench_matrix(R).T, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(
+        expected_Cw, expected_C @ rotate_wrench_matrix(R).T, rtol=0, atol=1e-15
+    )

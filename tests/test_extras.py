@@ -12,10 +12,10 @@ import json
 import subprocess
 import sys
 import textwrap
-import tomllib
 from pathlib import Path
 
 import pytest
+import tomllib
 
 from impact_balance.cli import main
 from impact_balance.exceptions import ImpactBalanceError, MissingExtraError
@@ -24,7 +24,9 @@ from impact_balance.extras import COMMAND_EXTRAS, EXTRAS, installed
 ROOT = Path(__file__).resolve().parents[1]
 SRC = ROOT / "src"
 #: Every module of every extra: the core must run with all of them missing.
-OPTIONAL = sorted({m for modules in EXTRAS.values() for m in modules} | {"dask", "viser", "imageio"})
+OPTIONAL = sorted(
+    {m for modules in EXTRAS.values() for m in modules} | {"dask", "viser", "imageio"}
+)
 #: Heavy parts no light command may import.
 HEAVY = ("mujoco", "dask", "distributed", "viser", "matplotlib", "pandas", "pyarrow", "imageio")
 
@@ -50,25 +52,47 @@ def test_missing_extra_is_one_line_naming_it(command, monkeypatch, capsys):
     extra = COMMAND_EXTRAS[command]
     _block(monkeypatch, EXTRAS[extra][:1])
     assert not installed(EXTRAS[extra][0])
-    assert main(COMMAND_ARGS[command]) == 1  # a missing package is the machine's, not the input's: exit 1
+    assert (
+        main(COMMAND_ARGS[command]) == 1
+    )  # a missing package is the machine's, not the input's: exit 1
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err
-    assert err.startswith(f"impact-balance: error: {command} needs the '{extra}' extra: "
-                          f"pip install 'impact-balance[{extra}]'"), err
+    assert err.startswith(
+        f"impact-balance: error: {command} needs the '{extra}' extra: "
+        f"pip install 'impact-balance[{extra}]'"
+    ), err
     assert EXTRAS[extra][0] in err
 
 
-@pytest.mark.parametrize("argv, option", [
-    (["analyze", "kick_one_foot", "--plots", "figs"], "analyze --plots"),
-    (["phase-portrait", "--com-height", "0.8", "--zmp-range", "-0.1", "0.1", "--plot", "p.png"], "phase-portrait --plot"),
-    (["demo"], "demo"),
-])
+@pytest.mark.parametrize(
+    "argv, option",
+    [
+        (["analyze", "kick_one_foot", "--plots", "figs"], "analyze --plots"),
+        (
+            [
+                "phase-portrait",
+                "--com-height",
+                "0.8",
+                "--zmp-range",
+                "-0.1",
+                "0.1",
+                "--plot",
+                "p.png",
+            ],
+            "phase-portrait --plot",
+        ),
+        (["demo"], "demo"),
+    ],
+)
 def test_missing_plots_extra(argv, option, monkeypatch, capsys, tmp_path):
     monkeypatch.chdir(tmp_path)
     _block(monkeypatch, ["matplotlib"])
     assert main(argv) == 1
     err = capsys.readouterr().err
-    assert err.startswith(f"impact-balance: error: {option}") and "pip install 'impact-balance[plots]'" in err, err
+    assert (
+        err.startswith(f"impact-balance: error: {option}")
+        and "pip install 'impact-balance[plots]'" in err
+    ), err
     assert not list(tmp_path.iterdir())  # refused before writing anything
 
 
@@ -84,7 +108,10 @@ def test_pyproject_extras_match_the_checked_modules():
     extras = project["optional-dependencies"]
     dist = {"imageio_ffmpeg": "imageio-ffmpeg", "distributed": "dask"}
     for extra, modules in EXTRAS.items():
-        names = {r.split("[")[0].split(">")[0].split("<")[0].split("=")[0].strip().lower() for r in extras[extra]}
+        names = {
+            r.split("[")[0].split(">")[0].split("<")[0].split("=")[0].strip().lower()
+            for r in extras[extra]
+        }
         assert {dist.get(m, m) for m in modules} <= names, extra
     assert extras["all"] == [f"impact-balance[{','.join(EXTRAS)}]"]
     core = " ".join(project["dependencies"]).lower()
@@ -108,8 +135,13 @@ _BLOCKER = textwrap.dedent("""
 
 def _run(code: str, blocked=OPTIONAL) -> subprocess.CompletedProcess:
     script = _BLOCKER.format(blocked=set(blocked)) + textwrap.dedent(code)
-    return subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300,
-                          env={"PYTHONPATH": str(SRC), "PATH": "/usr/bin:/bin", "HOME": str(Path.home())})
+    return subprocess.run(
+        [sys.executable, "-c", script],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={"PYTHONPATH": str(SRC), "PATH": "/usr/bin:/bin", "HOME": str(Path.home())},
+    )
 
 
 def test_core_runs_without_any_extra():
@@ -128,20 +160,26 @@ def test_core_runs_without_any_extra():
     assert first == "0.788"
 
 
-@pytest.mark.parametrize("argv, absent", [
-    (["robots"], HEAVY + ("numba", "scipy", "pydantic")),
-    (["scenarios"], HEAVY + ("numba", "scipy", "pinocchio", "pydantic", "numpy")),
-    (["analyze", "palm_push_two_feet", "--json"], HEAVY + ("qpsolvers", "numba")),
-])
+@pytest.mark.parametrize(
+    "argv, absent",
+    [
+        (["robots"], HEAVY + ("numba", "scipy", "pydantic")),
+        (["scenarios"], HEAVY + ("numba", "scipy", "pinocchio", "pydantic", "numpy")),
+        (["analyze", "palm_push_two_feet", "--json"], HEAVY + ("qpsolvers", "numba")),
+    ],
+)
 def test_light_commands_import_no_heavy_part(argv, absent):
     """Nothing blocked: the command simply never imports these."""
-    r = _run(f"""
+    r = _run(
+        f"""
         import io, contextlib
         from impact_balance.cli import main
         with contextlib.redirect_stdout(io.StringIO()) as out:
             assert main({argv!r}) == 0
         print(sorted(name for name in {absent!r} if name in sys.modules))
-    """, blocked=())
+    """,
+        blocked=(),
+    )
     assert r.returncode == 0, r.stderr
     assert r.stdout.strip() == "[]", r.stdout
 
@@ -149,7 +187,8 @@ def test_light_commands_import_no_heavy_part(argv, absent):
 def test_one_shot_analyze_is_interpreted_and_answers_as_the_compiled_kernel():
     """``analyze`` in a fresh process runs the kernels as Python (numba never imported, the
     variable not left behind); its answer is the compiled kernels' to the last digit."""
-    r = _run("""
+    r = _run(
+        """
         import io, json, os, contextlib
         from impact_balance.cli import main
         with contextlib.redirect_stdout(io.StringIO()) as out:
@@ -158,7 +197,9 @@ def test_one_shot_analyze_is_interpreted_and_answers_as_the_compiled_kernel():
         from impact_balance._jit import HAVE_NUMBA
         assert not HAVE_NUMBA
         print(out.getvalue())
-    """, blocked=())
+    """,
+        blocked=(),
+    )
     assert r.returncode == 0, r.stderr
     interpreted = json.loads(r.stdout)
     from impact_balance import _jit
@@ -192,7 +233,9 @@ def test_readme_test_command_is_what_ci_runs():
     block = readme.split("```bash", 1)[1].split("```", 1)[0]
     lines = [line for line in block.splitlines() if line and not line.startswith("#")]
     assert 'pip install ".[all]"' in lines[0]  # the first command installs everything
-    test_command = lines[1].split("&& ", 2)[2]  # after "python3 -m venv .venv && . .venv/bin/activate &&"
+    test_command = lines[1].split("&& ", 2)[
+        2
+    ]  # after "python3 -m venv .venv && . .venv/bin/activate &&"
     ci = (ROOT / ".ci" / "run").read_text()
     assert test_command.strip() in ci
 

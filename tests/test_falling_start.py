@@ -34,7 +34,11 @@ def test_reference_inside_the_interval_is_kept(falling, capsys):
     assert main(["analyze", str(falling), "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)["impact"]
     assert doc["contact_velocity"] == pytest.approx([0.8, 0.0, 0.0])
-    assert doc["safe_interval"][0] <= -np.dot(doc["normal"], doc["contact_velocity"]) <= doc["safe_interval"][1]
+    assert (
+        doc["safe_interval"][0]
+        <= -np.dot(doc["normal"], doc["contact_velocity"])
+        <= doc["safe_interval"][1]
+    )
     assert main(["analyze", str(falling)]) == 0
     text = capsys.readouterr().out
     assert "already falling" in text and "(x0.0)" not in text and "contact velocity (0.800" in text

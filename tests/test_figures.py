@@ -23,7 +23,13 @@ from impact_balance.plots import (
 )
 from impact_balance.robot.robot import example_robot_data_root
 
-SCENARIOS = ["palm_push_ramp", "kick_one_foot", "talos_three_contacts", "g1_two_feet", "palm_push_two_feet"]
+SCENARIOS = [
+    "palm_push_ramp",
+    "kick_one_foot",
+    "talos_three_contacts",
+    "g1_two_feet",
+    "palm_push_two_feet",
+]
 SIMPLE = example_robot_data_root() / "simple_humanoid_description"
 
 
@@ -40,7 +46,8 @@ def cannot_balance(tmp_path_factory):
         f"name: simple_ankles\nrobot: {{urdf: {SIMPLE / 'urdf' / 'simple_humanoid.urdf'}, "
         f"srdf: {SIMPLE / 'srdf' / 'simple_humanoid.srdf'}, standing: half_sitting}}\n"
         "contacts:\n  - {frame: l_ankle, friction: 0.7, size: [0.2, 0.1]}\n"
-        "  - {frame: r_ankle, friction: 0.7, size: [0.2, 0.1]}\n")
+        "  - {frame: r_ankle, friction: 0.7, size: [0.2, 0.1]}\n"
+    )
     return ib.analyze(str(path))
 
 
@@ -143,8 +150,11 @@ def test_phase_portrait_paper_gravity():
 def test_saved_figures_titles_give_gravity(analyses, tmp_path):
     save_figures(analyses["kick_one_foot"], tmp_path)
     assert sorted(p.name for p in tmp_path.iterdir()) == [
-        "kick_one_foot_areas.png", "kick_one_foot_impulse_set.png", "kick_one_foot_phase_portrait.png",
-        "kick_one_foot_stance.png"]
+        "kick_one_foot_areas.png",
+        "kick_one_foot_impulse_set.png",
+        "kick_one_foot_phase_portrait.png",
+        "kick_one_foot_stance.png",
+    ]
 
 
 def test_friction_comparison():
@@ -159,8 +169,8 @@ def test_friction_comparison():
 def trials():
     pytest.importorskip("mujoco")
     from impact_balance.sim import build_model
-    from impact_balance.sim.trials.measure import measure
     from impact_balance.sim.trials.impact_trial import TrialOptions, run_trial
+    from impact_balance.sim.trials.measure import measure
 
     out = {}
     for joints in ("rigid", "servo"):
@@ -213,8 +223,24 @@ def test_video_frame(trials, tmp_path):
     assert lines[0].startswith("t =") and "+3.0 ms" in lines[0]
     assert "10x slower than real time" in lines[1] and lines[2].startswith("IMPACT")
     video = tmp_path / "v.mp4"
-    proc = subprocess.run([sys.executable, "-m", "impact_balance", "simulate", "kick_one_foot", "--speed", "0.6",
-                           "--duration", "0.01", "--video", str(video)], capture_output=True, text=True, timeout=300)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "impact_balance",
+            "simulate",
+            "kick_one_foot",
+            "--speed",
+            "0.6",
+            "--duration",
+            "0.01",
+            "--video",
+            str(video),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     if proc.returncode != 0:
         assert proc.returncode == 2 and "Traceback" not in proc.stderr
         pytest.skip(f"no offscreen GL here: {proc.stderr.strip()}")
@@ -266,8 +292,13 @@ def test_video_projection_matches_mujoco(trials, tmp_path):
     import sys
 
     env = dict(os.environ, MUJOCO_GL="egl")
-    proc = subprocess.run([sys.executable, "-c", _PROJECTION_SCRIPT], capture_output=True, text=True, timeout=300,
-                          env=env)
+    proc = subprocess.run(
+        [sys.executable, "-c", _PROJECTION_SCRIPT],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
+    )
     if proc.returncode != 0 and ("OpenGL" in proc.stderr or "EGL" in proc.stderr):
         pytest.skip("no offscreen GL here")
     assert proc.returncode == 0, proc.stderr[-2000:]
@@ -282,7 +313,9 @@ def test_sweep_axis_labels():
     from impact_balance.sweep.figures import axis_label
 
     assert axis_label("impact.friction").startswith("impact friction coefficient (-)")
-    assert axis_label("impact.restitution[1]").startswith("impact restitution coefficient, upper bound (-)")
+    assert axis_label("impact.restitution[1]").startswith(
+        "impact restitution coefficient, upper bound (-)"
+    )
     assert axis_label("com_velocity[0]").startswith("pre-impact CoM velocity x (m/s)")
     assert axis_label("contacts[1].friction").startswith("contact 1 friction coefficient (-)")
     assert axis_label("posture.z").startswith("target z of the impact frame by IK, world (m)")
@@ -296,15 +329,25 @@ def test_sweep_heatmap_marks_falling_points(tmp_path):
     from impact_balance.sweep import make_plan, run_sweep, sweep_spec_from_dict
     from impact_balance.sweep.figures import sweep_figures
 
-    plan = make_plan(sweep_spec_from_dict({
-        "base": "palm_push_two_feet", "sampling": "grid",
-        "axes": [{"path": "com_velocity[0]", "values": [0.0, 0.2, 0.9]},
-                 {"path": "impact.friction", "values": [0.1, 0.3]}]}))
+    plan = make_plan(
+        sweep_spec_from_dict(
+            {
+                "base": "palm_push_two_feet",
+                "sampling": "grid",
+                "axes": [
+                    {"path": "com_velocity[0]", "values": [0.0, 0.2, 0.9]},
+                    {"path": "impact.friction", "values": [0.1, 0.3]},
+                ],
+            }
+        )
+    )
     run_sweep(plan, tmp_path / "res", workers=1, progress=False)
     [(name, fig)] = sweep_figures(tmp_path / "res")
     assert_layout(fig)
     ax = fig.axes[0]
-    falling = [line for line in ax.lines if str(line.get_label()).startswith("falling before the impact")]
+    falling = [
+        line for line in ax.lines if str(line.get_label()).startswith("falling before the impact")
+    ]
     assert falling and len(falling[0].get_xdata()) == 2  # c_x = 0.9 m/s is outside the area
     lowest = [line for line in ax.lines if str(line.get_label()).startswith("lowest maximum")]
     assert lowest and float(lowest[0].get_xdata()[0]) < 0.9
@@ -320,7 +363,7 @@ def test_gui_view_labels_both_axes_with_units(analyses):
     svg = svg_view(analyses["palm_push_two_feet"])
     for label in ("CoM velocity x (m/s)", "CoM velocity y (m/s)", "x (m)", "y (m)"):
         assert f">{label}<" in svg or f", {label}<" in svg, label
-    assert 'rotate(-90' in svg  # the y labels run along their axes
+    assert "rotate(-90" in svg  # the y labels run along their axes
     assert "padding-right" in svg  # kept clear of the panel's scroll bar
 
 
@@ -330,34 +373,83 @@ def balance_results():
     from types import SimpleNamespace
 
     from impact_balance.scenario import load_scenario
-    from impact_balance.sim.trials.balance_trial import Push
-    from impact_balance.sim.studies.push import PushOutcome, PushTestResult, boundary_impulse, predict_push
+    from impact_balance.sim.studies.push import (
+        PushOutcome,
+        PushTestResult,
+        boundary_impulse,
+        predict_push,
+    )
     from impact_balance.sim.studies.validate import ValidationResult, ValidationTrial, predictions
+    from impact_balance.sim.trials.balance_trial import Push
 
     analysis = ib.analyze("palm_push_ramp")
     scenario = load_scenario("palm_push_ramp")
     trials = []
     times = np.linspace(0.4, 1.9, 80)
-    for v, outcome in ((0.2, "balanced"), (0.4, "balanced"), (0.6, "contact_broken"), (0.69, "fell"), (0.77, "fell")):
+    for v, outcome in (
+        (0.2, "balanced"),
+        (0.4, "balanced"),
+        (0.6, "contact_broken"),
+        (0.69, "fell"),
+        (0.77, "fell"),
+    ):
         grow = 4.0 if outcome == "fell" else 1.0
-        path = [[-0.58 * v * np.exp(-(t - 0.41)) * (1 + grow * (t - 0.41)), 0.04 * v] for t in times]
-        summary = {"outcome": outcome, "approach_speed_measured": v, "events": [], "reason": None, "detail": ""}
-        trials.append(ValidationTrial(speed=0.98 * v, summary=summary, trajectory={"time": list(times), "com_velocity": path}))
-    validation = ValidationResult("palm_push_ramp", "servo", True, predictions(scenario), predictions(scenario, 0.01),
-                                  0.01, analysis.areas.omega, trials, {}, {}, 0.05, 4.0)
+        path = [
+            [-0.58 * v * np.exp(-(t - 0.41)) * (1 + grow * (t - 0.41)), 0.04 * v] for t in times
+        ]
+        summary = {
+            "outcome": outcome,
+            "approach_speed_measured": v,
+            "events": [],
+            "reason": None,
+            "detail": "",
+        }
+        trials.append(
+            ValidationTrial(
+                speed=0.98 * v,
+                summary=summary,
+                trajectory={"time": list(times), "com_velocity": path},
+            )
+        )
+    validation = ValidationResult(
+        "palm_push_ramp",
+        "servo",
+        True,
+        predictions(scenario),
+        predictions(scenario, 0.01),
+        0.01,
+        analysis.areas.omega,
+        trials,
+        {},
+        {},
+        0.05,
+        4.0,
+    )
     setup = SimpleNamespace(analysis=analysis, controller="id")
     outcomes = []
     for fraction in (0.5, 0.85, 1.05, 1.5):
         for k in range(8):
             angle = 2 * np.pi * k / 8
-            push = Push(angle, fraction * boundary_impulse(analysis.areas.com_velocity_area, analysis.stance.mass, angle))
+            push = Push(
+                angle,
+                fraction
+                * boundary_impulse(analysis.areas.com_velocity_area, analysis.stance.mass, angle),
+            )
             prediction = predict_push(setup, push, 1.2)
             path = [list(prediction.com_velocity * s) for s in np.linspace(0, 1, 20)]
             zmp = [list(analysis.stance.com[:2] + 0.1 * np.array(p)) for p in path]
-            outcomes.append(PushOutcome(push=push, relative=fraction, prediction=prediction,
-                                        summary={"outcome": "fell" if fraction > 1 else "balanced", "events": []},
-                                        trajectory={"com_velocity": path, "zmp": zmp}))
-    pushes = PushTestResult("palm_push_ramp", outcomes, {"name": "id"}, {}, setup, 0.01, 0.01, analysis.areas.omega, 0.0)
+            outcomes.append(
+                PushOutcome(
+                    push=push,
+                    relative=fraction,
+                    prediction=prediction,
+                    summary={"outcome": "fell" if fraction > 1 else "balanced", "events": []},
+                    trajectory={"com_velocity": path, "zmp": zmp},
+                )
+            )
+    pushes = PushTestResult(
+        "palm_push_ramp", outcomes, {"name": "id"}, {}, setup, 0.01, 0.01, analysis.areas.omega, 0.0
+    )
     return analysis, validation, pushes
 
 
@@ -369,10 +461,18 @@ def test_validation_figure_in_measured_speed(balance_results):
     assert_layout(fig, units=False)  # the y axis is the outcome (a category)
     ax = fig.axes[0]
     assert ax.get_xlabel() == "approach speed (m/s)"
-    assert [t.get_text() for t in ax.get_yticklabels()] == ["balanced", "contact broken", "fell", "aborted"]
+    assert [t.get_text() for t in ax.get_yticklabels()] == [
+        "balanced",
+        "contact broken",
+        "fell",
+        "aborted",
+    ]
     labels = [t.get_text() for t in fig.legends[0].get_texts()]
     assert "measured at first contact" in labels and "commanded" in labels
-    assert any("ZMP margin 10 mm" in t for t in labels) and "stood 0.600 m/s, fell 0.690 m/s (measured)" in ax.get_title()
+    assert (
+        any("ZMP margin 10 mm" in t for t in labels)
+        and "stood 0.600 m/s, fell 0.690 m/s (measured)" in ax.get_title()
+    )
 
 
 @pytest.mark.parametrize("kind", ["com_velocity", "zmp"])
@@ -384,11 +484,17 @@ def test_push_figures_label_directions_and_keep_survivors_on_top(balance_results
     assert_layout(fig)
     note = fig.legends[0].get_title().get_text()
     assert "push direction from world x" in note and "0°:" in note and "315°:" in note
-    lines = [line for line in fig.axes[0].get_lines() if line.get_linestyle() == "-" and len(line.get_xdata()) > 1]
+    lines = [
+        line
+        for line in fig.axes[0].get_lines()
+        if line.get_linestyle() == "-" and len(line.get_xdata()) > 1
+    ]
     colors = [line.get_color() for line in lines]
     last_fall = max(i for i, c in enumerate(colors) if c == OUTCOME_COLORS["fell"])
     first_ok = min(i for i, c in enumerate(colors) if c == OUTCOME_COLORS["balanced"])
-    assert last_fall < first_ok  # falls drawn first: the pushes that did not fall stay visible on top
+    assert (
+        last_fall < first_ok
+    )  # falls drawn first: the pushes that did not fall stay visible on top
 
 
 def test_impact_trajectories_name_each_trial(balance_results):

@@ -29,14 +29,20 @@ from impact_balance.exceptions import MESSAGE_CHARS
 from impact_balance.ranges import MAX_APPROACH_SPEED, MIN_APPROACH_SPEED, TOLERANCE_RANGE
 
 sys.path.insert(0, str(Path(__file__).parent))
-from test_fuzz_scenarios import HOSTILE_NUMBERS, _apply, _paths, values  # noqa: E402
+from test_fuzz_scenarios import HOSTILE_NUMBERS, _apply, _paths, values
 
 #: Multiplies the number of examples: IMPACT_BALANCE_FUZZ_SCALE=20 for a deeper search (minutes).
 SCALE = float(os.environ.get("IMPACT_BALANCE_FUZZ_SCALE", "1"))
-SPEC = {"base": "palm_push_two_feet", "chunk_size": 5, "sampling": "grid",
-        "axes": [{"path": "impact.friction", "range": [0.1, 0.5], "count": 3},
-                 {"path": "impact.restitution", "values": [[0.0, 0.2], [0.1, 0.5]]},
-                 {"direction": "impact.normal", "azimuth": {"values": [170, 190]}}]}
+SPEC = {
+    "base": "palm_push_two_feet",
+    "chunk_size": 5,
+    "sampling": "grid",
+    "axes": [
+        {"path": "impact.friction", "range": [0.1, 0.5], "count": 3},
+        {"path": "impact.restitution", "values": [[0.0, 0.2], [0.1, 0.5]]},
+        {"direction": "impact.normal", "azimuth": {"values": [170, 190]}},
+    ],
+}
 
 
 def run(argv: list[str]) -> tuple[int, str, str]:
@@ -51,7 +57,11 @@ def run(argv: list[str]) -> tuple[int, str, str]:
 
 def assert_one_line(rc: int, err: str) -> None:
     assert "Traceback" not in err, err
-    lines = [ln for ln in err.splitlines() if "compiling the projection kernel" not in ln and "warning:" not in ln]
+    lines = [
+        ln
+        for ln in err.splitlines()
+        if "compiling the projection kernel" not in ln and "warning:" not in ln
+    ]
     assert rc in (1, 2), (rc, err)
     assert len(lines) == 1 and ": error: " in lines[0], err[-2000:]
     assert len(lines[0]) <= 60 + MESSAGE_CHARS
@@ -62,8 +72,14 @@ def assert_one_line(rc: int, err: str) -> None:
 def mutated_specs(draw):
     data = copy.deepcopy(SPEC)
     for _ in range(draw(st.integers(1, 3))):
-        op = draw(st.sampled_from(["number", "number", "set", "set", "delete", "wrap", "unknown_key", "count"]))
-        numbers = [p for p, v in _paths(data) if isinstance(v, (int, float)) and not isinstance(v, bool)]
+        op = draw(
+            st.sampled_from(
+                ["number", "number", "set", "set", "delete", "wrap", "unknown_key", "count"]
+            )
+        )
+        numbers = [
+            p for p, v in _paths(data) if isinstance(v, (int, float)) and not isinstance(v, bool)
+        ]
         if op == "count":  # a grid of any size, up to past 64 bits
             axes = data.get("axes")
             if isinstance(axes, list) and axes and isinstance(axes[0], dict):
@@ -71,7 +87,9 @@ def mutated_specs(draw):
             continue
         if op == "number" and numbers:
             path = draw(st.sampled_from(numbers))
-            data = _apply(data, path, "set", draw(st.sampled_from(HOSTILE_NUMBERS + [0.3, 1, 2, -1])))
+            data = _apply(
+                data, path, "set", draw(st.sampled_from(HOSTILE_NUMBERS + [0.3, 1, 2, -1]))
+            )
             continue
         paths = [p for p, _ in _paths(data)]
         path = draw(st.sampled_from(paths))
@@ -89,19 +107,36 @@ def warm_up():
     assert rc == 0, err
 
 
-@settings(max_examples=int(80 * SCALE), deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@settings(
+    max_examples=int(80 * SCALE),
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
 @given(data=mutated_specs())
 def test_mutated_sweep_file_gives_one_line_or_a_summary(data):
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "fuzz.yaml"
         path.write_text(yaml.safe_dump(data, allow_unicode=True))
         out = Path(tmp) / "out"
-        rc, stdout, err = run(["sweep", str(path), "--out", str(out), "--workers", "1", "--no-progress", "--no-plots",
-                               "--json"])
+        rc, stdout, err = run(
+            [
+                "sweep",
+                str(path),
+                "--out",
+                str(out),
+                "--workers",
+                "1",
+                "--no-progress",
+                "--no-plots",
+                "--json",
+            ]
+        )
         if rc == 0:
             import json
 
-            summary = json.loads(stdout, parse_constant=lambda c: pytest.fail(f"not strict JSON: {c}"))
+            summary = json.loads(
+                stdout, parse_constant=lambda c: pytest.fail(f"not strict JSON: {c}")
+            )
             assert summary["complete"] and summary["rows"] == summary["n_points"] <= 10**6
         else:
             assert_one_line(rc, err)
@@ -117,13 +152,38 @@ def log_text():
     return frame.to_csv(index=False)
 
 
-CELLS = ["abc", "", "nan", "inf", "-inf", "1e999", "True", "0x10", "1,5", '"', "1e-320", "9" * 400, "\x00", "é"]
+CELLS = [
+    "abc",
+    "",
+    "nan",
+    "inf",
+    "-inf",
+    "1e999",
+    "True",
+    "0x10",
+    "1,5",
+    '"',
+    "1e-320",
+    "9" * 400,
+    "\x00",
+    "é",
+]
 
 
-@settings(max_examples=int(60 * SCALE), deadline=None, suppress_health_check=[HealthCheck.too_slow,
-                                                                                  HealthCheck.function_scoped_fixture])
-@given(edits=st.lists(st.tuples(st.integers(0, 10_000), st.integers(0, 10_000), st.sampled_from(CELLS)), max_size=3),
-       cut=st.one_of(st.none(), st.integers(1, 5000)), header=st.booleans(), shuffle=st.booleans())
+@settings(
+    max_examples=int(60 * SCALE),
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
+)
+@given(
+    edits=st.lists(
+        st.tuples(st.integers(0, 10_000), st.integers(0, 10_000), st.sampled_from(CELLS)),
+        max_size=3,
+    ),
+    cut=st.one_of(st.none(), st.integers(1, 5000)),
+    header=st.booleans(),
+    shuffle=st.booleans(),
+)
 def test_mutated_log_gives_one_line_or_a_check(log_text, edits, cut, header, shuffle):
     lines = log_text.splitlines()
     rows = [ln.split(",") for ln in lines]
@@ -138,7 +198,9 @@ def test_mutated_log_gives_one_line_or_a_check(log_text, edits, cut, header, shu
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "log.csv"
         path.write_text(text, encoding="utf-8", errors="surrogateescape")
-        rc, stdout, err = run(["check-log", str(path), "--scenario", "palm_push_two_feet", "--json"])
+        rc, stdout, err = run(
+            ["check-log", str(path), "--scenario", "palm_push_two_feet", "--json"]
+        )
         if rc != 0:
             assert_one_line(rc, err)
             assert rc == 2
@@ -160,24 +222,58 @@ def _patched():
     patch = pytest.MonkeyPatch()
     patch.setattr(trial, "run_trial", sentinel)
     patch.setattr(balance_trial, "run_balance_trial", sentinel)
-    patch.setattr(balance_trial.BalanceSetup, "create", classmethod(lambda cls, *a, **k: sentinel()))
+    patch.setattr(
+        balance_trial.BalanceSetup, "create", classmethod(lambda cls, *a, **k: sentinel())
+    )
     return patch
 
 
-OPTION_VALUES = st.one_of(st.sampled_from(["0", "-1", "1e-300", "1e300", "nan", "inf", "-0", "0.3", "5", "5.0001",
-                                           "0.01", "0.0099", "1000", "1000.1", "abc", "", "1,2", "0.1,0.2,nan",
-                                           "1e-3", "0.5", "0.50001", "16", "361", "2.5e-2"]),
-                          st.floats(allow_nan=True, allow_infinity=True).map(repr),
-                          st.integers(-(10**6), 10**6).map(str), st.text(max_size=12))
+OPTION_VALUES = st.one_of(
+    st.sampled_from(
+        [
+            "0",
+            "-1",
+            "1e-300",
+            "1e300",
+            "nan",
+            "inf",
+            "-0",
+            "0.3",
+            "5",
+            "5.0001",
+            "0.01",
+            "0.0099",
+            "1000",
+            "1000.1",
+            "abc",
+            "",
+            "1,2",
+            "0.1,0.2,nan",
+            "1e-3",
+            "0.5",
+            "0.50001",
+            "16",
+            "361",
+            "2.5e-2",
+        ]
+    ),
+    st.floats(allow_nan=True, allow_infinity=True).map(repr),
+    st.integers(-(10**6), 10**6).map(str),
+    st.text(max_size=12),
+)
 
 
 @settings(max_examples=int(80 * SCALE), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(command=st.sampled_from(["simulate", "validate", "push-test"]), data=st.data())
 def test_simulation_options_are_refused_in_one_line_or_within_the_limits(command, data):
-    options = {"simulate": ["--speed", "--duration", "--armature"],
-               "validate": ["--tolerance", "--max-speed"],
-               "push-test": ["--directions", "--magnitudes", "--duration"]}[command]
-    chosen = data.draw(st.lists(st.sampled_from(options), min_size=1, max_size=len(options), unique=True))
+    options = {
+        "simulate": ["--speed", "--duration", "--armature"],
+        "validate": ["--tolerance", "--max-speed"],
+        "push-test": ["--directions", "--magnitudes", "--duration"],
+    }[command]
+    chosen = data.draw(
+        st.lists(st.sampled_from(options), min_size=1, max_size=len(options), unique=True)
+    )
     argv = [command, "palm_push_two_feet"]
     given_values = {}
     for option in chosen:
@@ -189,7 +285,9 @@ def test_simulation_options_are_refused_in_one_line_or_within_the_limits(command
         rc, _, err = run(argv)
     finally:
         patch.undo()
-    if rc == 1 and f"{Simulated.__module__}.Simulated" in err:  # accepted: every value within the documented limits
+    if (
+        rc == 1 and f"{Simulated.__module__}.Simulated" in err
+    ):  # accepted: every value within the documented limits
         if "--speed" in given_values:
             speeds = [float(v) for v in given_values["--speed"].split(",")]
             assert all(MIN_APPROACH_SPEED <= v <= MAX_APPROACH_SPEED for v in speeds)

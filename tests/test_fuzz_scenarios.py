@@ -39,14 +39,49 @@ from impact_balance.exceptions import MESSAGE_CHARS
 
 #: Multiplies the number of examples: IMPACT_BALANCE_FUZZ_SCALE=20 for a deeper search (minutes).
 SCALE = float(os.environ.get("IMPACT_BALANCE_FUZZ_SCALE", "1"))
-BUNDLED = sorted(p.name for p in (resources.files("impact_balance") / "scenarios").iterdir() if p.name.endswith(".yaml"))
+BUNDLED = sorted(
+    p.name
+    for p in (resources.files("impact_balance") / "scenarios").iterdir()
+    if p.name.endswith(".yaml")
+)
 #: The parsed bundled files (extends unresolved: a mutation may remove it or point it elsewhere).
-RAW = {name: yaml.safe_load((resources.files("impact_balance") / "scenarios" / name).read_text()) for name in BUNDLED}
+RAW = {
+    name: yaml.safe_load((resources.files("impact_balance") / "scenarios" / name).read_text())
+    for name in BUNDLED
+}
 
-HOSTILE_NUMBERS = [math.nan, math.inf, -math.inf, 1e300, -1e300, 1e160, -1e160, 1e-300, 0.0, -0.0, -1.0, 1e6, 1e7,
-                   10**400, -(10**30), 2**63]
-HOSTILE_STRINGS = ["", " ", "x" * 300, "a/" * 200, "../../../../etc/passwd", "/dev/zero", "\u00e9\u4e2d\U0001f600",
-                   "nan", "1e999", "~", "left_sole_link" * 30, "C:\\\\Windows"]
+HOSTILE_NUMBERS = [
+    math.nan,
+    math.inf,
+    -math.inf,
+    1e300,
+    -1e300,
+    1e160,
+    -1e160,
+    1e-300,
+    0.0,
+    -0.0,
+    -1.0,
+    1e6,
+    1e7,
+    10**400,
+    -(10**30),
+    2**63,
+]
+HOSTILE_STRINGS = [
+    "",
+    " ",
+    "x" * 300,
+    "a/" * 200,
+    "../../../../etc/passwd",
+    "/dev/zero",
+    "\u00e9\u4e2d\U0001f600",
+    "nan",
+    "1e999",
+    "~",
+    "left_sole_link" * 30,
+    "C:\\\\Windows",
+]
 
 
 def _deep(depth: int):
@@ -104,8 +139,14 @@ def mutated_scenarios(draw):
     name = draw(st.sampled_from(BUNDLED))
     data = copy.deepcopy(RAW[name])
     for _ in range(draw(st.integers(1, 3))):
-        op = draw(st.sampled_from(["number", "number", "number", "set", "set", "delete", "wrap", "unknown_key"]))
-        numbers = [p for p, v in _paths(data) if isinstance(v, (int, float)) and not isinstance(v, bool)]
+        op = draw(
+            st.sampled_from(
+                ["number", "number", "number", "set", "set", "delete", "wrap", "unknown_key"]
+            )
+        )
+        numbers = [
+            p for p, v in _paths(data) if isinstance(v, (int, float)) and not isinstance(v, bool)
+        ]
         if op == "number" and numbers:
             # A plausible-looking number of any magnitude: often valid, so the analysis runs
             # (and its numerics are exercised) far more often than with arbitrary values.
@@ -133,8 +174,11 @@ def _strict_json(text: str):
 def _run(argv: list[str]) -> tuple[int, str, str]:
     """``cli.main`` in process, stdout and stderr captured, RuntimeWarnings recorded."""
     out, err = io.StringIO(), io.StringIO()
-    with warnings.catch_warnings(record=True) as caught, contextlib.redirect_stdout(out), \
-            contextlib.redirect_stderr(err):
+    with (
+        warnings.catch_warnings(record=True) as caught,
+        contextlib.redirect_stdout(out),
+        contextlib.redirect_stderr(err),
+    ):
         warnings.simplefilter("always")
         rc = cli.main(argv)
     runtime = [w for w in caught if issubclass(w.category, RuntimeWarning)]
@@ -166,7 +210,11 @@ def warm_up():
         assert rc == 0, err
 
 
-@settings(max_examples=int(300 * SCALE), deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@settings(
+    max_examples=int(300 * SCALE),
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
 @given(data=mutated_scenarios())
 def test_mutated_scenario_gives_clean_error_or_strict_json(data):
     with tempfile.TemporaryDirectory() as tmp:
@@ -187,8 +235,19 @@ def _alias_text(base: str, fan: int, levels: int) -> str:
 @settings(max_examples=int(60 * SCALE), deadline=None)
 @given(
     name=st.sampled_from(BUNDLED),
-    kind=st.sampled_from(["alias_tree", "alias_as_value", "cycle", "extends_cycle", "extends_chain", "long_extends",
-                          "deep_flow", "deep_block", "merge_key"]),
+    kind=st.sampled_from(
+        [
+            "alias_tree",
+            "alias_as_value",
+            "cycle",
+            "extends_cycle",
+            "extends_chain",
+            "long_extends",
+            "deep_flow",
+            "deep_block",
+            "merge_key",
+        ]
+    ),
     size=st.integers(1, 40),
 )
 def test_text_mutation_gives_clean_error_or_strict_json(name, kind, size):
@@ -199,8 +258,12 @@ def test_text_mutation_gives_clean_error_or_strict_json(name, kind, size):
         if kind == "alias_tree":
             text = _alias_text(base, fan=size + 1, levels=min(size, 9))
         elif kind == "alias_as_value":  # the contacts themselves are a shared alias tree
-            text = _alias_text(base.replace("contacts:", "contacts_original:", 1), size + 1, min(size, 9)) + \
-                f"contacts: *l{min(size, 9) - 1}\n"
+            text = (
+                _alias_text(
+                    base.replace("contacts:", "contacts_original:", 1), size + 1, min(size, 9)
+                )
+                + f"contacts: *l{min(size, 9) - 1}\n"
+            )
         elif kind == "cycle":
             text = base + "\ncyclic: &c [1, *c]\n"
         elif kind == "extends_cycle":
@@ -208,17 +271,27 @@ def test_text_mutation_gives_clean_error_or_strict_json(name, kind, size):
             text = "extends: other.yaml\n" + base.replace("extends:", "# extends:")
         elif kind == "extends_chain":
             for i in range(size):
-                (tmp / f"c{i}.yaml").write_text(f"extends: c{i + 1}.yaml\n" if i + 1 < size else f"extends: {name[:-5]}\n")
+                (tmp / f"c{i}.yaml").write_text(
+                    f"extends: c{i + 1}.yaml\n" if i + 1 < size else f"extends: {name[:-5]}\n"
+                )
             text = "extends: c0.yaml\n"
         elif kind == "long_extends":
             text = f"extends: {'e' * (200 + 10 * size)}\n"
         elif kind == "deep_flow":
             text = base + "\nextra: " + "[" * (10 * size) + "]" * (10 * size) + "\n"
         elif kind == "deep_block":
-            text = base + "\n" + "".join(f"{'  ' * i}k{i}:\n" for i in range(5 * size)) + f"{'  ' * 5 * size}v: 1\n"
+            text = (
+                base
+                + "\n"
+                + "".join(f"{'  ' * i}k{i}:\n" for i in range(5 * size))
+                + f"{'  ' * 5 * size}v: 1\n"
+            )
         else:  # merge keys over an anchored contact
-            text = base + "\ndefaults: &d {friction: 0.7, size: [0.2, 0.1]}\n" + \
-                "contacts: [{<<: *d, frame: left_sole_link}, {<<: *d, frame: right_sole_link}]\n"
+            text = (
+                base
+                + "\ndefaults: &d {friction: 0.7, size: [0.2, 0.1]}\n"
+                + "contacts: [{<<: *d, frame: left_sole_link}, {<<: *d, frame: right_sole_link}]\n"
+            )
         path.write_text(text)
         assert_clean(*_run(["analyze", str(path), "--json"]))
 
@@ -247,9 +320,14 @@ def test_alias_bomb_in_a_real_process_is_refused_quickly(tmp_path, argv):
     assert len(ALIAS_BOMB) < 500
     proc = subprocess.run(
         [sys.executable, "-m", "impact_balance", *(a.format(path=path) for a in argv)],
-        capture_output=True, text=True, timeout=60, preexec_fn=_limited_memory,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        preexec_fn=_limited_memory,
     )
-    err = [line for line in proc.stderr.splitlines() if "compiling the projection kernel" not in line]
+    err = [
+        line for line in proc.stderr.splitlines() if "compiling the projection kernel" not in line
+    ]
     assert proc.returncode == 2, proc.stderr[-2000:]
     assert proc.stdout == ""
     assert len(err) == 1 and err[0].startswith("impact-balance: error: "), proc.stderr[-2000:]

@@ -26,7 +26,9 @@ def states(governor: Governor, count: int, seed: int = 0):
         for name in governor.robot.joint_names:
             slot = governor.robot.joint_slot(name)
             if slot.nq == 1:
-                q[slot.idx_q] = np.clip(q[slot.idx_q] + rng.uniform(-0.05, 0.05), slot.lower, slot.upper)
+                q[slot.idx_q] = np.clip(
+                    q[slot.idx_q] + rng.uniform(-0.05, 0.05), slot.lower, slot.upper
+                )
         q[:3] += rng.uniform(-0.03, 0.03, 3)
         v = rng.normal(0.0, 0.3, model.nv)
         v[:3] = rng.normal(0.0, 0.1, 3)
@@ -42,19 +44,35 @@ def analyze_at(governor: Governor, q, v):
     return ib.analyze(governor.scenario_at(q, data.vcom[0]))
 
 
-@pytest.mark.parametrize("name, inertia, margin, friction", [
-    ("palm_push_two_feet", "composite", 0.0, None),
-    ("palm_push_ramp", "composite", 0.01, None),
-    ("kick_one_foot", "joint_space", 0.0, None),
-    ("g1_two_feet", "composite", 0.005, None),
-    ("palm_push_ramp", "composite", 0.01, 2.5),  # a friction above 1: the friction-normalised path
-])
+@pytest.mark.parametrize(
+    "name, inertia, margin, friction",
+    [
+        ("palm_push_two_feet", "composite", 0.0, None),
+        ("palm_push_ramp", "composite", 0.01, None),
+        ("kick_one_foot", "joint_space", 0.0, None),
+        ("g1_two_feet", "composite", 0.005, None),
+        (
+            "palm_push_ramp",
+            "composite",
+            0.01,
+            2.5,
+        ),  # a friction above 1: the friction-normalised path
+    ],
+)
 def test_each_tick_is_analyze_of_the_same_state(name, inertia, margin, friction):
     scenario = load_scenario(name)
-    contacts = scenario.contacts if friction is None else [
-        c.model_copy(update={"friction": friction}) for c in scenario.contacts]
-    scenario = scenario.model_copy(update={"zmp_margin": margin, "contacts": contacts,
-                                           "impact": scenario.impact.model_copy(update={"inertia": inertia})})
+    contacts = (
+        scenario.contacts
+        if friction is None
+        else [c.model_copy(update={"friction": friction}) for c in scenario.contacts]
+    )
+    scenario = scenario.model_copy(
+        update={
+            "zmp_margin": margin,
+            "contacts": contacts,
+            "impact": scenario.impact.model_copy(update={"inertia": inertia}),
+        }
+    )
     governor = Governor(scenario)
     for q, v in states(governor, 6):
         limit = governor.limit(q, v)
@@ -76,7 +94,9 @@ def test_zmp_governor_is_analyzes_zmp_criterion():
         limit = governor.limit(q, v)
         a = analyze_at(governor, q, v)
         assert limit.criterion == "zmp"
-        assert limit.max_approach_speed == pytest.approx(a.impact.zmp_max_contact_velocity, abs=1e-9)
+        assert limit.max_approach_speed == pytest.approx(
+            a.impact.zmp_max_contact_velocity, abs=1e-9
+        )
 
 
 def test_velocity_only_ticks_reuse_the_posture_and_agree_with_a_fresh_governor():
@@ -136,7 +156,7 @@ def test_one_instance_from_several_threads_gives_the_serial_answers():
             for i in indices:
                 q, v = inputs[i]
                 results[i] = governor.limit(q, v).max_approach_speed
-        except Exception as exc:  # noqa: BLE001 - reported below
+        except Exception as exc:
             errors.append(exc)
 
     threads = [threading.Thread(target=work, args=(list(range(k, 12, 4)),)) for k in range(4)]
@@ -148,9 +168,14 @@ def test_one_instance_from_several_threads_gives_the_serial_answers():
     assert [results[i] for i in range(12)] == pytest.approx(serial, abs=1e-12)
 
 
-@pytest.mark.parametrize("q, v, field", [
-    ("short", None, "q"), (None, "nan", "v"), ("quaternion", None, "q"),
-])
+@pytest.mark.parametrize(
+    "q, v, field",
+    [
+        ("short", None, "q"),
+        (None, "nan", "v"),
+        ("quaternion", None, "q"),
+    ],
+)
 def test_bad_arguments_are_one_line_errors(q, v, field):
     governor = Governor("palm_push_two_feet")
     q0, v0 = governor.configuration.copy(), np.zeros(governor.nv)
@@ -177,20 +202,28 @@ def test_gui_shows_the_governors_cap_for_the_stance_being_edited(tmp_path):
     g = session.governed
     a = session.analysis
     assert g.ceiling == pytest.approx(a.impact.max_contact_velocity, abs=1e-9)
-    assert g.reference == pytest.approx(0.8) and g.capped == pytest.approx(min(0.8, g.ceiling), abs=1e-9)
+    assert g.reference == pytest.approx(0.8) and g.capped == pytest.approx(
+        min(0.8, g.ceiling), abs=1e-9
+    )
     first = session._governor
     html = results_html(session, 1.0)
     assert 'id="ib-governor-cap"' in html and f"{g.ceiling:.3f} m/s" in html
     # A posture or CoM velocity edit reuses the governor; the numbers follow.
     assert session.set(("com_velocity",), [0.1, 0.0])
     assert session._governor is first
-    assert session.governed.ceiling == pytest.approx(session.analysis.impact.max_contact_velocity, abs=1e-9)
+    assert session.governed.ceiling == pytest.approx(
+        session.analysis.impact.max_contact_velocity, abs=1e-9
+    )
     assert session.set(("joints", "arm_right_4_joint"), -1.2)
     assert session._governor is first
-    assert session.governed.ceiling == pytest.approx(session.analysis.impact.max_contact_velocity, abs=1e-9)
+    assert session.governed.ceiling == pytest.approx(
+        session.analysis.impact.max_contact_velocity, abs=1e-9
+    )
     # A change of the impact or the contacts builds a new one.
     assert session.set(("impact", "friction"), 0.4)
     assert session._governor is not first
-    assert session.governed.ceiling == pytest.approx(session.analysis.impact.max_contact_velocity, abs=1e-9)
+    assert session.governed.ceiling == pytest.approx(
+        session.analysis.impact.max_contact_velocity, abs=1e-9
+    )
     assert session.set(("impact",), None)
     assert session.governed is None and 'id="ib-governor-cap"' not in results_html(session, 1.0)

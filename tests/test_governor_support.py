@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 import impact_balance as ib
-from impact_balance.impact.contact_aware import contact_impact
 from impact_balance.exceptions import GovernorError
 from impact_balance.governor import Governor
 from impact_balance.governor.support import combine
+from impact_balance.impact.contact_aware import contact_impact
 from impact_balance.scenario import load_scenario
 
 
@@ -42,7 +42,9 @@ def test_g1_is_bounded_by_its_feet():
     q, v = aware.configuration, np.zeros(aware.nv)
     floating, limit = plain.limit(q, v), aware.limit(q, v)
     assert limit.binding == "contact_aware"
-    assert limit.max_approach_speed == pytest.approx(contact_aware_maximum("g1_two_feet", 0.01), abs=1e-6)
+    assert limit.max_approach_speed == pytest.approx(
+        contact_aware_maximum("g1_two_feet", 0.01), abs=1e-6
+    )
     assert 0.38 < limit.max_approach_speed < 0.43 < 0.6 < floating.max_approach_speed
     assert limit.safe_interval == pytest.approx((0.0, limit.max_approach_speed))
     assert limit.ceiling == pytest.approx(limit.max_approach_speed)
@@ -80,8 +82,12 @@ def test_warm_start_reaches_the_same_fixed_point():
     a = ib.analyze("palm_push_ramp")
     spec = a.scenario.impact.spec()
     cold = contact_impact(a.stance, spec, 1.0)
-    warm = contact_impact(a.stance, spec, 1.0, initial_dxi=np.concatenate([cold.com_velocity_jump_3d,
-                                                                           cold.angular_velocity_jump]))
+    warm = contact_impact(
+        a.stance,
+        spec,
+        1.0,
+        initial_dxi=np.concatenate([cold.com_velocity_jump_3d, cold.angular_velocity_jump]),
+    )
     assert cold.converged and warm.converged
     assert warm.iterations < cold.iterations
     assert np.allclose(warm.com_velocity_jump, cold.com_velocity_jump, atol=1e-8)
@@ -94,10 +100,13 @@ def test_combine_intersects_the_safe_intervals():
     assert combine(None, (0.0, 0.4)) is None
 
 
-@pytest.mark.parametrize("kwargs, field", [
-    ({"criterion": "zmp", "contact_aware": True}, "contact_aware"),
-    ({"contact_aware": True, "contact_aware_every": 0}, "contact_aware_every"),
-])
+@pytest.mark.parametrize(
+    "kwargs, field",
+    [
+        ({"criterion": "zmp", "contact_aware": True}, "contact_aware"),
+        ({"contact_aware": True, "contact_aware_every": 0}, "contact_aware_every"),
+    ],
+)
 def test_bad_options_are_governor_errors(kwargs, field):
     with pytest.raises(GovernorError) as info:
         Governor("palm_push_two_feet", **kwargs)

@@ -58,7 +58,10 @@ def by_name(objects) -> dict:
 # -- state: edits, validation, load and save ------------------------------------------------
 def test_default_scenario_is_the_demo_two_foot_push(session):
     assert session.state.scenario.name == "palm_push_two_feet"
-    assert [c.frame for c in session.state.scenario.contacts] == ["left_sole_link", "right_sole_link"]
+    assert [c.frame for c in session.state.scenario.contacts] == [
+        "left_sole_link",
+        "right_sole_link",
+    ]
     assert session.summary.headline == "balanced"
     # README's demo table: 0.481 m/s by the CoM criterion.
     assert session.summary.max_contact_velocity == pytest.approx(0.481, abs=5e-4)
@@ -77,10 +80,14 @@ def test_recompute_changes_the_numbers(session):
 
 def test_joint_edit_moves_the_robot(session):
     q0 = session.analysis.stance.q.copy()
-    joint = session.analysis.stance.robot.model.joints[session.analysis.stance.robot.model.getJointId("arm_right_1_joint")]
+    joint = session.analysis.stance.robot.model.joints[
+        session.analysis.stance.robot.model.getJointId("arm_right_1_joint")
+    ]
     assert session.set(("joints", "arm_right_1_joint"), 0.8)
     assert session.analysis.stance.q[joint.idx_q] == 0.8
-    assert not np.allclose(session.analysis.impact.model.point, analyze(DEFAULT_SCENARIO).impact.model.point)
+    assert not np.allclose(
+        session.analysis.impact.model.point, analyze(DEFAULT_SCENARIO).impact.model.point
+    )
     assert np.linalg.norm(session.analysis.stance.q - q0) > 0.1
 
 
@@ -125,14 +132,20 @@ def test_state_edits_do_not_mutate_the_previous_state():
     state = GuiState.from_file(DEFAULT_SCENARIO)
     edited = state.with_changes({("contacts", 0, "offset", "position"): np.array([0.01, 0.0, 0.0])})
     assert state.get(("contacts", 0, "offset")) is None
-    assert edited.get(("contacts", 0, "offset", "position")) == [0.01, 0.0, 0.0]  # numpy became plain data
+    assert edited.get(("contacts", 0, "offset", "position")) == [
+        0.01,
+        0.0,
+        0.0,
+    ]  # numpy became plain data
     assert edited.scenario.contacts[0].offset.position == (0.01, 0.0, 0.0)
     assert edited.with_value(("base",), None).get(("base",)) is None
     with pytest.raises(ScenarioError, match="gravity"):
         state.with_value(("gravity",), float("inf"))
 
 
-@pytest.mark.parametrize("name", ["palm_push_two_feet", "palm_push_mu040", "talos_three_contacts", "g1_two_feet"])
+@pytest.mark.parametrize(
+    "name", ["palm_push_two_feet", "palm_push_mu040", "talos_three_contacts", "g1_two_feet"]
+)
 def test_save_load_round_trip_equals_the_original(tmp_path, name):
     original = load_scenario(name)
     state = GuiState.from_file(name)
@@ -145,12 +158,18 @@ def test_save_load_round_trip_equals_the_original(tmp_path, name):
 
 def test_saved_edits_are_analysed_like_the_gui(tmp_path):
     session = Session(DEFAULT_SCENARIO, workspace=tmp_path)
-    assert session.apply({("impact", "friction"): 0.1, ("com_velocity",): [0.05, -0.02], ("torque_limits",): False})
+    assert session.apply(
+        {("impact", "friction"): 0.1, ("com_velocity",): [0.05, -0.02], ("torque_limits",): False}
+    )
     (tmp_path / "tuned").mkdir()
     path = session.save("tuned/stance.yaml")
-    assert path == tmp_path / "tuned" / "stance.yaml" and session.message == "saved tuned/stance.yaml"
+    assert (
+        path == tmp_path / "tuned" / "stance.yaml" and session.message == "saved tuned/stance.yaml"
+    )
     loaded = analyze(str(path))
-    assert loaded.impact.max_contact_velocity == pytest.approx(session.summary.max_contact_velocity, rel=1e-12)
+    assert loaded.impact.max_contact_velocity == pytest.approx(
+        session.summary.max_contact_velocity, rel=1e-12
+    )
     assert loaded.scenario.torque_limits is False and loaded.scenario.com_velocity == (0.05, -0.02)
     # Upload path: the same text loads back into a session.
     other = Session("kick_one_foot")
@@ -186,7 +205,11 @@ def test_robot_files_made_absolute_so_a_saved_state_still_finds_them(tmp_path):
     src = tmp_path / "a"
     src.mkdir()
     raw = yaml.safe_load(load_scenario("palm_push_two_feet").model_dump_json(exclude_unset=True))
-    raw["robot"] = {"urdf": os.path.relpath(urdf, src), "srdf": os.path.relpath(srdf, src), "standing": "half_sitting"}
+    raw["robot"] = {
+        "urdf": os.path.relpath(urdf, src),
+        "srdf": os.path.relpath(srdf, src),
+        "standing": "half_sitting",
+    }
     (src / "files.yaml").write_text(yaml.safe_dump(raw))
     state = GuiState.from_file(src / "files.yaml")
     saved = state.save(tmp_path / "elsewhere" / "b" / "files.yaml")
@@ -198,8 +221,17 @@ def test_robot_files_made_absolute_so_a_saved_state_still_finds_them(tmp_path):
 @pytest.mark.parametrize(
     "contacts",
     [
-        [{"frame": "gripper_left_base_link", "friction": 0.7, "size": [0.1, 0.08]}],  # one hand, nothing under the feet
-        [{"frame": "left_sole_link", "friction": 0.7, "size": [0.2, 0.1], "offset": {"rpy": [math.pi, 0.0, 0.0]}}],
+        [
+            {"frame": "gripper_left_base_link", "friction": 0.7, "size": [0.1, 0.08]}
+        ],  # one hand, nothing under the feet
+        [
+            {
+                "frame": "left_sole_link",
+                "friction": 0.7,
+                "size": [0.2, 0.1],
+                "offset": {"rpy": [math.pi, 0.0, 0.0]},
+            }
+        ],
     ],
 )
 def test_infeasible_stance_shows_cannot_balance(session, contacts):
@@ -225,9 +257,21 @@ def test_tiny_friction_is_still_an_answer(session):
 def test_scene_objects_of_the_default_stance(session):
     analysis = session.analysis
     objects = by_name(scene_objects(analysis))
-    kinds = {"contacts/0/outline": Segments, "com/label": Label, "impact/label": Label, "contacts/1/outline": Segments, "contacts/0/normal": Arrows,
-             "com/point": Points, "com/projection": Points, "zmp_area/outline": Segments, "zmp_area/fill": Surface,
-             "impact/point": Points, "impact/normal": Arrows, "impact/cone": Surface, "impact/impulses": Segments}
+    kinds = {
+        "contacts/0/outline": Segments,
+        "com/label": Label,
+        "impact/label": Label,
+        "contacts/1/outline": Segments,
+        "contacts/0/normal": Arrows,
+        "com/point": Points,
+        "com/projection": Points,
+        "zmp_area/outline": Segments,
+        "zmp_area/fill": Surface,
+        "impact/point": Points,
+        "impact/normal": Arrows,
+        "impact/cone": Surface,
+        "impact/impulses": Segments,
+    }
     for name, kind in kinds.items():
         assert isinstance(objects[name], kind), name
     # Contact rectangles: their 4 corners, closed.
@@ -239,7 +283,9 @@ def test_scene_objects_of_the_default_stance(session):
     # CoM and its projection on the ZMP plane.
     com = analysis.stance.com
     np.testing.assert_allclose(objects["com/point"].points[0], com, atol=TOL)
-    np.testing.assert_allclose(objects["com/projection"].points[0], [com[0], com[1], PLANE_LIFT], atol=TOL)
+    np.testing.assert_allclose(
+        objects["com/projection"].points[0], [com[0], com[1], PLANE_LIFT], atol=TOL
+    )
     # ZMP area on its plane, with the area's vertices.
     outline = objects["zmp_area/outline"].segments
     np.testing.assert_allclose(outline[:, 0, :2], analysis.areas.zmp_area.vertices, atol=TOL)
@@ -270,8 +316,12 @@ def test_scene_objects_follow_the_state(session):
     assert not any(n.startswith("impact/") for n in names)
     vel = names["com/velocity"]
     np.testing.assert_allclose(vel.ends[0] - vel.starts[0], [0.1, 0.0, 0.0], atol=TOL)
-    assert session.apply({("contacts",): session.state.get(("contacts",)) + [
-        {"frame": "gripper_left_base_link", "friction": 0.5, "size": [0.1, 0.08]}]})
+    assert session.apply(
+        {
+            ("contacts",): session.state.get(("contacts",))
+            + [{"frame": "gripper_left_base_link", "friction": 0.5, "size": [0.1, 0.08]}]
+        }
+    )
     assert "contacts/2/outline" in by_name(scene_objects(session.analysis))
 
 
@@ -299,8 +349,17 @@ def test_joint_groups_by_limb():
     knee = next(s for s in groups["left leg"] if s.name == "leg_left_4_joint")
     model = robot.model
     idx = model.joints[model.getJointId("leg_left_4_joint")].idx_q
-    assert (knee.lower, knee.upper) == (model.lowerPositionLimit[idx], model.upperPositionLimit[idx])
-    assert list(joint_groups(load_robot("g1"))) == ["left leg", "right leg", "torso", "left arm", "right arm"]
+    assert (knee.lower, knee.upper) == (
+        model.lowerPositionLimit[idx],
+        model.upperPositionLimit[idx],
+    )
+    assert list(joint_groups(load_robot("g1"))) == [
+        "left leg",
+        "right leg",
+        "torso",
+        "left arm",
+        "right arm",
+    ]
 
 
 # -- gizmo drags (IK) ---------------------------------------------------------------------------
@@ -383,8 +442,14 @@ def test_app_serves_the_page(app):
 def test_app_draws_the_scene(app):
     reset(app)
     names = set(app._scene_handles)
-    for name in ("contacts/0/outline", "contacts/1/outline", "com/point", "zmp_area/fill", "impact/cone",
-                 "impact/impulses"):
+    for name in (
+        "contacts/0/outline",
+        "contacts/1/outline",
+        "com/point",
+        "zmp_area/fill",
+        "impact/cone",
+        "impact/impulses",
+    ):
         assert f"/analysis/{name}" in names
     assert app._meshes is not None and len(app._meshes.handles) > 40  # Talos' visual meshes
     assert set(app._gizmos) == {"contact0", "contact1", "impact"}
@@ -400,13 +465,20 @@ def test_app_slider_updates_numbers_and_time(app):
     for i in range(20):  # the same path as a browser's slider change, minus the network
         slider.value = start + 0.002 * (i + 1)
         times.append(app.last_update_ms)
-        assert app.session.state.get(("joints", "arm_right_1_joint")) == pytest.approx(start + 0.002 * (i + 1))
+        assert app.session.state.get(("joints", "arm_right_1_joint")) == pytest.approx(
+            start + 0.002 * (i + 1)
+        )
     assert app.session.message is None
-    assert f'id="ib-vmax-com">{app.session.summary.max_contact_velocity:.3f} m/s' in app.w_results.content
+    assert (
+        f'id="ib-vmax-com">{app.session.summary.max_contact_velocity:.3f} m/s'
+        in app.w_results.content
+    )
     assert app.session.summary.max_contact_velocity != pytest.approx(0.481, abs=5e-4)
     median, p90 = statistics.median(times), statistics.quantiles(times, n=10)[-1]
-    print(f"\nGUI update time (analysis + redraw), two-foot stance, 20 slider changes: "
-          f"median {median:.1f} ms, p90 {p90:.1f} ms")
+    print(
+        f"\nGUI update time (analysis + redraw), two-foot stance, 20 slider changes: "
+        f"median {median:.1f} ms, p90 {p90:.1f} ms"
+    )
     assert median < 200.0  # the target is 50 ms; this only catches a gross regression
 
 
@@ -432,10 +504,14 @@ def test_app_contacts_impact_and_load(app, tmp_path):
     assert app.session.state.scenario.contacts[2].friction == 0.3
     app._on_remove_contact(None)
     assert len(app.session.state.scenario.contacts) == 2
-    assert "/analysis/contacts/2/outline" not in app._scene_handles and "contact2" not in app._gizmos
+    assert (
+        "/analysis/contacts/2/outline" not in app._scene_handles and "contact2" not in app._gizmos
+    )
     # Impact off and on again: the same impact comes back.
     app.w_impact_on.value = False
-    assert app.session.state.scenario.impact is None and 'id="ib-vmax-com">-' in app.w_results.content
+    assert (
+        app.session.state.scenario.impact is None and 'id="ib-vmax-com">-' in app.w_results.content
+    )
     assert not any(n.startswith("/analysis/impact/") for n in app._scene_handles)
     app.w_impact_on.value = True
     assert app.session.summary.max_contact_velocity == pytest.approx(0.481, abs=5e-4)
@@ -483,12 +559,17 @@ def test_app_gizmo_drag_moves_the_robot(app):
         np.testing.assert_allclose(a.position, b.position, atol=1e-4)
     np.testing.assert_allclose(app._gizmos["impact"].position, goal, atol=1e-4)
     assert app._dragging is None and not app._drag_pending
-    assert f'id="ib-vmax-com">{app.session.summary.max_contact_velocity:.3f} m/s' in app.w_results.content
+    assert (
+        f'id="ib-vmax-com">{app.session.summary.max_contact_velocity:.3f} m/s'
+        in app.w_results.content
+    )
     # Out of reach: the robot goes part of the way, the gizmo snaps back onto the hand.
     gizmo.position = goal + np.array([3.0, 0.0, 0.0])
     asyncio.run(callback(SimpleNamespace(target=gizmo, phase="end")))
     assert "out of reach" in app.session.message
-    np.testing.assert_allclose(app._gizmos["impact"].position, app.session.analysis.impact.model.point, atol=1e-6)
+    np.testing.assert_allclose(
+        app._gizmos["impact"].position, app.session.analysis.impact.model.point, atol=1e-6
+    )
 
 
 # -- command line -------------------------------------------------------------------------------
@@ -508,8 +589,12 @@ def test_cli_gui_bad_host_exit_2(capsys):
 
 
 def test_cli_gui_serves_and_stops_on_ctrl_c():
-    proc = subprocess.Popen([sys.executable, "-m", "impact_balance", "gui", "--port", "0"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "impact_balance", "gui", "--port", "0"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         deadline = time.time() + 240
         url = None
@@ -519,7 +604,9 @@ def test_cli_gui_serves_and_stops_on_ctrl_c():
                 break
             if line.startswith("impact-balance gui:"):
                 url = line.split(" at ")[1].split()[0]
-        assert url is not None and url.startswith("http://127.0.0.1:"), proc.stderr.read() if proc.poll() else url
+        assert url is not None and url.startswith("http://127.0.0.1:"), (
+            proc.stderr.read() if proc.poll() else url
+        )
         assert "palm_push_two_feet" in line
         with urllib.request.urlopen(url, timeout=10) as response:
             assert response.status == 200

@@ -27,14 +27,23 @@ REQUIRED = os.environ.get("IMPACT_BALANCE_E2E", "") not in ("", "0")
 #: Flags for a closed network and no GPU: no background connections (they would be refused
 #: and slow the start), software WebGL for the 3D view.
 FLAGS = [
-    "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
-    "--disable-component-update", "--disable-sync", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
 ]
 TIMEOUT_MS = 120_000
 
 if not CHROMIUM.exists() and not REQUIRED:
-    pytest.skip(f"{CHROMIUM} not found (apt-get install chromium); set IMPACT_BALANCE_E2E=1 to make this a failure",
-                allow_module_level=True)
+    pytest.skip(
+        f"{CHROMIUM} not found (apt-get install chromium); set IMPACT_BALANCE_E2E=1 to make this a failure",
+        allow_module_level=True,
+    )
 
 
 @pytest.fixture(scope="module")
@@ -48,7 +57,9 @@ def app():
 
 @pytest.fixture(scope="module")
 def page(app, tmp_path_factory):
-    assert CHROMIUM.exists(), f"IMPACT_BALANCE_E2E is set but {CHROMIUM} is missing: apt-get install chromium"
+    assert CHROMIUM.exists(), (
+        f"IMPACT_BALANCE_E2E is set but {CHROMIUM} is missing: apt-get install chromium"
+    )
     from playwright.sync_api import sync_playwright
 
     with sync_playwright() as p:
@@ -102,7 +113,8 @@ def test_editing_a_field_recomputes_and_redraws(page, app, tmp_path):
     field = page.get_by_label("impact friction")
     field.fill("0.4", force=True)  # force: no wait for animation frames (slow without a GPU)
     page.wait_for_function(
-        "before => document.querySelector('#ib-vmax-com').textContent.trim() !== before", arg=before,
+        "before => document.querySelector('#ib-vmax-com').textContent.trim() !== before",
+        arg=before,
         polling=100,  # the default polls each animation frame: slow under software WebGL
     )
     after = vmax_text(page)
@@ -135,7 +147,8 @@ def test_a_bad_value_is_refused_and_the_page_lives_on(page, app):
     expect(field).to_have_value("0.4")
     field.fill("0.1", force=True)
     page.wait_for_function(
-        "before => document.querySelector('#ib-vmax-com').textContent.trim() !== before", arg=before,
+        "before => document.querySelector('#ib-vmax-com').textContent.trim() !== before",
+        arg=before,
         polling=100,  # the default polls each animation frame: slow under software WebGL
     )
     assert vmax_text(page) == f"{app.session.summary.max_contact_velocity:.3f} m/s"
@@ -153,7 +166,7 @@ OPEN_WEBSOCKET = """([url, protocol]) => new Promise((resolve) => {
 class _OtherSite(http.server.BaseHTTPRequestHandler):
     """Another web site on this machine (any local server the user's browser visits)."""
 
-    def do_GET(self):  # noqa: N802 - http.server's name
+    def do_GET(self):
         body = b"<html><body>another site</body></html>"
         self.send_response(200)
         self.send_header("Content-Type", "text/html")
@@ -205,7 +218,9 @@ def test_romeo_is_drawn_from_its_collada_meshes(page, tmp_path):
     from impact_balance.gui.app import GuiApp
 
     romeo = GuiApp("romeo_two_feet", host="127.0.0.1", port=0)
-    other = page.context.browser.new_page(viewport={"width": 1100, "height": 700})  # smaller: software WebGL
+    other = page.context.browser.new_page(
+        viewport={"width": 1100, "height": 700}
+    )  # smaller: software WebGL
     other.set_default_timeout(TIMEOUT_MS)
     try:
         assert len(romeo._meshes.meshes) == len(romeo._meshes.geometry_model.geometryObjects) == 44

@@ -27,9 +27,9 @@ from impact_balance.exceptions import WorkspaceError
 from impact_balance.gui import DEFAULT_SCENARIO, GuiState, Session
 from impact_balance.gui.files import GuiFiles, describe
 from impact_balance.gui.guard import AccessPolicy, OriginError, guarded_start, normalize_origin
+from impact_balance.gui.workspace import MAX_FILE_BYTES, Workspace
 from impact_balance.robot.robot import example_robot_data_root
 from impact_balance.scenario import load_scenario
-from impact_balance.gui.workspace import MAX_FILE_BYTES, Workspace
 
 SECRET = "hunter2-very-secret-token"
 
@@ -54,7 +54,10 @@ def test_workspace_names_resolve_inside(ws):
     w = Workspace(ws)
     assert w.resolve("a.yaml") == ws / "a.yaml"
     assert w.resolve("sub/new.yml", for_write=True) == ws / "sub" / "new.yml"
-    assert w.relative(ws / "sub" / "x.yaml") == "sub/x.yaml" and w.relative(ws.parent / "x.yaml") is None
+    assert (
+        w.relative(ws / "sub" / "x.yaml") == "sub/x.yaml"
+        and w.relative(ws.parent / "x.yaml") is None
+    )
 
 
 @pytest.mark.parametrize(
@@ -115,7 +118,11 @@ def test_workspace_write_never_overwrites_silently_nor_creates_folders(ws):
     (ws / "dir.yaml").mkdir()
     with pytest.raises(WorkspaceError, match="not a regular file"):
         w.write_text("dir.yaml", "x: 1\n", overwrite=True)
-    assert sorted(p.name for p in ws.iterdir()) == ["a.yaml", "dir.yaml", "sub"]  # no temporary left
+    assert sorted(p.name for p in ws.iterdir()) == [
+        "a.yaml",
+        "dir.yaml",
+        "sub",
+    ]  # no temporary left
 
 
 def test_workspace_read_limits(ws):
@@ -138,7 +145,9 @@ def test_load_save_round_trip_in_the_workspace(session, ws):
     assert session.message == "saved sub/tuned.yaml"
     assert session.load("g1_two_feet") and session.analysis.stance.robot.name == "g1"
     assert session.load("sub/tuned.yaml") and session.state == edited
-    assert load_scenario(ws / "sub" / "tuned.yaml").impact.friction == 0.3  # an ordinary scenario file
+    assert (
+        load_scenario(ws / "sub" / "tuned.yaml").impact.friction == 0.3
+    )  # an ordinary scenario file
 
 
 def test_overwrite_needs_the_confirmation(session, ws):
@@ -150,7 +159,9 @@ def test_overwrite_needs_the_confirmation(session, ws):
     assert yaml.safe_load((ws / "a.yaml").read_text())["impact"]["friction"] == 0.3
 
 
-@pytest.mark.parametrize("name", ["../outside.yaml", str(Path("/tmp") / "x.yaml"), "~/x.yaml", "/etc/passwd"])
+@pytest.mark.parametrize(
+    "name", ["../outside.yaml", str(Path("/tmp") / "x.yaml"), "~/x.yaml", "/etc/passwd"]
+)
 def test_session_load_and_save_refuse_outside_names(session, ws, name):
     state = session.state
     assert not session.load(name) and session.refused and session.state is state
@@ -191,7 +202,10 @@ def test_upload_is_confined_and_bounded(session, ws):
     assert session.state.scenario.plane_height == 0.03 and session.state.source == "up.yaml"
     assert session.upload("../../evil/up.yaml", b"extends: kick_one_foot\n")
     assert session.state.source == "up.yaml"
-    assert not session.upload("big.yaml", b"#" * (MAX_FILE_BYTES + 1)) and "larger than" in session.message
+    assert (
+        not session.upload("big.yaml", b"#" * (MAX_FILE_BYTES + 1))
+        and "larger than" in session.message
+    )
     assert not session.upload("bin.yaml", b"\xff\xfe") and "UTF-8" in session.message
 
 
@@ -202,8 +216,11 @@ ALIAS_BOMB = "\n".join(
 ).encode()  # 370 bytes that expand to 9^9 items
 
 
-@pytest.mark.parametrize("content", [ALIAS_BOMB, b"contacts: " + b"[" * 600 + b"]" * 600 + b"\n"],
-                         ids=["alias-bomb", "deep-nesting"])
+@pytest.mark.parametrize(
+    "content",
+    [ALIAS_BOMB, b"contacts: " + b"[" * 600 + b"]" * 600 + b"\n"],
+    ids=["alias-bomb", "deep-nesting"],
+)
 def test_hostile_uploads_are_refused_without_hanging(session, content):
     import threading
 
@@ -217,7 +234,11 @@ def test_hostile_uploads_are_refused_without_hanging(session, content):
     threading.Thread(target=upload, daemon=True).start()
     assert done.wait(60), "the upload hangs"  # a hang guard, not a speed test
     assert session.refused and session.state is state
-    assert session.message.startswith("hostile.yaml") and len(session.message) <= 300 and "lol" not in session.message
+    assert (
+        session.message.startswith("hostile.yaml")
+        and len(session.message) <= 300
+        and "lol" not in session.message
+    )
 
 
 def test_robot_files_must_be_in_the_workspace(session, ws):
@@ -226,11 +247,18 @@ def test_robot_files_must_be_in_the_workspace(session, ws):
     raw = yaml.safe_load((ws / "a.yaml").read_text())
     raw["robot"] = {"urdf": str(urdf), "srdf": str(srdf)}
     (ws / "out.yaml").write_text(yaml.safe_dump(raw))
-    assert not session.load("out.yaml") and "robot.urdf" in session.message and "outside" in session.message
+    assert (
+        not session.load("out.yaml")
+        and "robot.urdf" in session.message
+        and "outside" in session.message
+    )
     raw["robot"] = {"urdf": "/etc/passwd"}
     (ws / "passwd.yaml").write_text(yaml.safe_dump(raw))
     assert not session.load("passwd.yaml") and "robot.urdf" in session.message
-    assert not session.upload("passwd.yaml", yaml.safe_dump(raw).encode()) and "robot.urdf" in session.message
+    assert (
+        not session.upload("passwd.yaml", yaml.safe_dump(raw).encode())
+        and "robot.urdf" in session.message
+    )
     # Copied into the workspace, the same files load (relative to the scenario's folder).
     shutil.copy(urdf, ws / "sub" / "talos.urdf")
     shutil.copy(srdf, ws / "sub" / "talos.srdf")
@@ -251,7 +279,9 @@ def test_messages_never_quote_file_content(session, ws):
     (ws / "secret.yaml").write_text(f"password: {SECRET}\ntoken: {'x' * 5000}\n")
     assert not session.load("secret.yaml")
     assert SECRET not in session.message and "xxxxx" not in session.message
-    assert session.message.startswith(("secret.yaml: password: unknown key", "secret.yaml: token: unknown key"))
+    assert session.message.startswith(
+        ("secret.yaml: password: unknown key", "secret.yaml: token: unknown key")
+    )
     (ws / "broken.yaml").write_text(f"contacts: [\n  {SECRET}: [\n")
     assert not session.load("broken.yaml")
     assert SECRET not in session.message and "not valid YAML" in session.message
@@ -271,7 +301,9 @@ def test_upload_rename_does_not_leak_the_temporary_path(session):
 # -- Host and Origin -----------------------------------------------------------------------------
 def test_policy_for_a_localhost_bind():
     policy = AccessPolicy.for_bind("127.0.0.1")
-    ok = dict(bound_port=8080, host=["127.0.0.1:8080"], origin=["http://127.0.0.1:8080"], websocket=True)
+    ok = dict(
+        bound_port=8080, host=["127.0.0.1:8080"], origin=["http://127.0.0.1:8080"], websocket=True
+    )
     assert policy.refusal(**ok) is None
     for origin in ("http://localhost:8080", "http://[::1]:8080"):
         assert policy.refusal(**{**ok, "origin": [origin]}) is None
@@ -292,11 +324,16 @@ def test_policy_for_a_localhost_bind():
         assert policy.refusal(**{**ok, **change}) is not None, change
     # A plain HTTP request needs no Origin, but a foreign one is refused.
     assert policy.refusal(8080, ["127.0.0.1:8080"], [], websocket=False) is None
-    assert policy.refusal(8080, ["127.0.0.1:8080"], ["http://evil.example"], websocket=False) is not None
+    assert (
+        policy.refusal(8080, ["127.0.0.1:8080"], ["http://evil.example"], websocket=False)
+        is not None
+    )
 
 
 def test_policy_allow_origin():
-    policy = AccessPolicy.for_bind("127.0.0.1", ["HTTPS://GUI.Example.org:443/", "http://10.0.0.5:9000"])
+    policy = AccessPolicy.for_bind(
+        "127.0.0.1", ["HTTPS://GUI.Example.org:443/", "http://10.0.0.5:9000"]
+    )
     assert policy.origins == {"https://gui.example.org", "http://10.0.0.5:9000"}
     assert policy.refusal(8080, ["gui.example.org"], ["https://gui.example.org"], True) is None
     assert policy.refusal(8080, ["10.0.0.5:9000"], ["http://10.0.0.5:9000"], True) is None
@@ -355,8 +392,14 @@ def _websocket(app, origin: str | None, host: str | None = None):
     extra = {"origin": origin} if origin else {}
     headers = {"Host": host} if host else None
     try:
-        with connect(f"ws://127.0.0.1:{port}", subprotocols=[f"viser-v{viser.__version__}"], max_size=None,
-                     open_timeout=10, additional_headers=headers, **extra) as ws:
+        with connect(
+            f"ws://127.0.0.1:{port}",
+            subprotocols=[f"viser-v{viser.__version__}"],
+            max_size=None,
+            open_timeout=10,
+            additional_headers=headers,
+            **extra,
+        ) as ws:
             return ws.recv(timeout=20)
     except InvalidStatus as exc:
         return exc.response.status_code
@@ -376,7 +419,9 @@ def test_http_with_a_foreign_host_is_refused(app):
 def test_websocket_with_a_foreign_origin_is_refused(app):
     port = app.server.get_port()
     assert _websocket(app, "http://evil.example") == 403
-    assert _websocket(app, f"http://evil.example:{port}", host=f"evil.example:{port}") == 403  # DNS rebinding
+    assert (
+        _websocket(app, f"http://evil.example:{port}", host=f"evil.example:{port}") == 403
+    )  # DNS rebinding
     assert _websocket(app, f"http://localhost:{port + 1}") == 403  # another local page
     assert _websocket(app, None) == 403  # no Origin: not the GUI's page
     for origin in (f"http://127.0.0.1:{port}", f"http://localhost:{port}"):
@@ -396,7 +441,11 @@ def test_warnings_are_shown_in_the_numbers_panel(app):
     try:
         app.session.analysis = WithWarnings()
         html = app._results_html()
-        assert 'id="ib-warnings"' in html and "reference &lt;b&gt;" in html and "<li>second</li>" in html
+        assert (
+            'id="ib-warnings"' in html
+            and "reference &lt;b&gt;" in html
+            and "<li>second</li>" in html
+        )
     finally:
         app.session.analysis = real
     if not getattr(real, "warnings", ()):
@@ -430,8 +479,22 @@ def test_cli_refuses_bad_flags(capsys, tmp_path):
 
 def test_cli_prints_the_workspace_and_stops_on_sigterm(tmp_path):
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[1] / "src")}
-    proc = subprocess.Popen([sys.executable, "-m", "impact_balance", "gui", "--port", "0", "--workspace",
-                             str(tmp_path)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "impact_balance",
+            "gui",
+            "--port",
+            "0",
+            "--workspace",
+            str(tmp_path),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     try:
         lines = []
         deadline = time.time() + 240
@@ -440,7 +503,10 @@ def test_cli_prints_the_workspace_and_stops_on_sigterm(tmp_path):
             if not line:
                 break
             lines.append(line)
-        assert any(f"workspace: {tmp_path.resolve()}" in line for line in lines), (lines, proc.poll())
+        assert any(f"workspace: {tmp_path.resolve()}" in line for line in lines), (
+            lines,
+            proc.poll(),
+        )
         proc.send_signal(signal.SIGTERM)
         assert proc.wait(timeout=10) == -signal.SIGTERM
     finally:
@@ -452,4 +518,6 @@ def test_cli_prints_the_workspace_and_stops_on_sigterm(tmp_path):
 def test_state_of_a_file_in_the_workspace_names_it_relatively(ws):
     files = GuiFiles(ws)
     state = files.load("a.yaml")
-    assert Path(state.source) == ws / "a.yaml" and files.workspace.relative(state.source) == "a.yaml"
+    assert (
+        Path(state.source) == ws / "a.yaml" and files.workspace.relative(state.source) == "a.yaml"
+    )

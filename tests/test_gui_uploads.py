@@ -41,8 +41,13 @@ app.stop()
 
 class Server:
     def __init__(self, workspace: Path):
-        self.proc = subprocess.Popen([sys.executable, "-c", SERVER, str(workspace)], stdin=subprocess.PIPE,
-                                     stdout=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": SRC})
+        self.proc = subprocess.Popen(
+            [sys.executable, "-c", SERVER, str(workspace)],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+            env={**os.environ, "PYTHONPATH": SRC},
+        )
         line = ""
         deadline = time.time() + 240
         while not line.startswith("READY") and time.time() < deadline:
@@ -84,11 +89,25 @@ def _send(server: Server, messages, until=lambda: True) -> tuple[float, float]:
     from viser import _messages as m
     from websockets.sync.client import connect
 
-    with connect(f"ws://127.0.0.1:{server.port}", subprotocols=[f"viser-v{viser.__version__}"],
-                 origin=f"http://127.0.0.1:{server.port}", max_size=None, open_timeout=30) as ws:
+    with connect(
+        f"ws://127.0.0.1:{server.port}",
+        subprotocols=[f"viser-v{viser.__version__}"],
+        origin=f"http://127.0.0.1:{server.port}",
+        max_size=None,
+        open_timeout=30,
+    ) as ws:
         # viser counts a page as a client once it reports its camera (upload callbacks need one).
-        camera = m.ViewerCameraMessage((1.0, 0.0, 0.0, 0.0), (3.0, 0.0, 1.0), 1.0, 0.01, 100.0, 480, 640,
-                                       (0.0, 0.0, 1.0), (0.0, 0.0, 1.0))
+        camera = m.ViewerCameraMessage(
+            (1.0, 0.0, 0.0, 0.0),
+            (3.0, 0.0, 1.0),
+            1.0,
+            0.01,
+            100.0,
+            480,
+            640,
+            (0.0, 0.0, 1.0),
+            (0.0, 0.0, 1.0),
+        )
         ws.send(msgspec.msgpack.encode(camera.as_serializable_dict()))
         time.sleep(1.0)  # the scene and the panels arrive
         base = peak = server.process.memory_info().rss
@@ -125,9 +144,13 @@ def _upload(server: Server, transfer: str, name: str, declared: int, parts: int,
 
 def test_a_200_mb_upload_is_refused_before_a_byte_is_kept(server):
     total = 200 << 20
-    grew, base = _send(server, _upload(server, "t1", "big.yaml", total, total // PART, [PART] * (total // PART)))
+    grew, base = _send(
+        server, _upload(server, "t1", "big.yaml", total, total // PART, [PART] * (total // PART))
+    )
     refused, peak, message, _ = server.state()
-    print(f"\n200 MB declared: server RSS {base:.0f} MB, +{grew:.1f} MB at its peak; load {open('/proc/loadavg').read().split()[0]}")
+    print(
+        f"\n200 MB declared: server RSS {base:.0f} MB, +{grew:.1f} MB at its peak; load {open('/proc/loadavg').read().split()[0]}"
+    )
     assert "larger than 1024 KiB" in message and "big.yaml" in message
     assert peak == 0 and grew < BOUND_MB
 
@@ -136,7 +159,10 @@ def test_a_lying_upload_is_cut_at_the_limit_as_it_arrives(server):
     """Declares 1 MiB in 2 parts, sends 200 MB: cut once it passes what it declared."""
     total = 200 << 20
     before = server.state()[0]
-    grew, base = _send(server, _upload(server, "t2", "liar.yaml", 1 << 20, 2, [PART + 1] + [PART] * (total // PART - 1)))
+    grew, base = _send(
+        server,
+        _upload(server, "t2", "liar.yaml", 1 << 20, 2, [PART + 1] + [PART] * (total // PART - 1)),
+    )
     refused, peak, message, _ = server.state()
     print(f"\n1 MiB declared, 200 MB sent: server RSS {base:.0f} MB, +{grew:.1f} MB at its peak")
     assert refused == before + 1 and "cut at" in message and peak <= 1 << 20
@@ -145,8 +171,13 @@ def test_a_lying_upload_is_cut_at_the_limit_as_it_arrives(server):
 
 def test_a_40_gb_declaration_and_too_many_parts_are_refused(server):
     before = server.state()[0]
-    grew, _ = _send(server, [*_upload(server, "t3", "huge.yaml", 40 << 30, 80_000, [PART] * 4),
-                             *_upload(server, "t4", "many.yaml", 1 << 20, 1 << 20, [1] * 1000)])
+    grew, _ = _send(
+        server,
+        [
+            *_upload(server, "t3", "huge.yaml", 40 << 30, 80_000, [PART] * 4),
+            *_upload(server, "t4", "many.yaml", 1 << 20, 1 << 20, [1] * 1000),
+        ],
+    )
     refused, _, message, _ = server.state()
     assert refused == before + 2 and "not a valid upload" in message and grew < BOUND_MB
 
@@ -156,7 +187,13 @@ def test_an_upload_within_the_limit_is_loaded(server):
 
     text = b"extends: kick_one_foot\nplane_height: 0.01\n"
     revision = server.state()[3]
-    _send(server, [m.FileTransferStartUpload(server.uuid, "t5", "ok.yaml", "text/yaml", 1, len(text)),
-                   m.FileTransferPart(server.uuid, "t5", 0, text)], until=lambda: server.state()[3] > revision)
+    _send(
+        server,
+        [
+            m.FileTransferStartUpload(server.uuid, "t5", "ok.yaml", "text/yaml", 1, len(text)),
+            m.FileTransferPart(server.uuid, "t5", 0, text),
+        ],
+        until=lambda: server.state()[3] > revision,
+    )
     _, _, message, after = server.state()
     assert after == revision + 1 and message == "None"  # accepted: the refusal shown before is gone

@@ -11,10 +11,16 @@ from hypothesis import strategies as st
 
 import impact_balance as ib
 from impact_balance.criteria.com import capped_velocity, max_contact_velocity
-from impact_balance.impact.model import cone_tangents, friction_cone, impact_model
 from impact_balance.criteria.qp import QPOptions, solve_contact_velocity_qp
+from impact_balance.impact.model import cone_tangents, friction_cone, impact_model
 
-BUNDLED_IMPACTS = ["palm_push_two_feet", "palm_push_ramp", "kick_one_foot", "talos_three_contacts", "g1_two_feet"]
+BUNDLED_IMPACTS = [
+    "palm_push_two_feet",
+    "palm_push_ramp",
+    "kick_one_foot",
+    "talos_three_contacts",
+    "g1_two_feet",
+]
 
 
 @pytest.fixture(scope="module")
@@ -67,8 +73,8 @@ def test_composite_W_is_the_rigid_body_response(analyses):
 def test_composite_W_matches_lapack():
     """W's compiled 3 x 3 Cholesky solve agrees with LAPACK's; an inertia that is not positive
     definite goes to LAPACK (which refuses a singular one)."""
-    from impact_balance.impact.model import composite_inertia_map
     from impact_balance.geometry.spatial import skew
+    from impact_balance.impact.model import composite_inertia_map
 
     rng = np.random.default_rng(3)
     for _ in range(200):
@@ -79,8 +85,10 @@ def test_composite_W_matches_lapack():
         np.testing.assert_allclose(composite_inertia_map(r, m, A), expected, rtol=0, atol=bound)
     indefinite = np.diag([1.0, -2.0, 4.0])
     r = np.array([0.3, -0.2, 0.5])
-    np.testing.assert_allclose(composite_inertia_map(r, 2.0, indefinite),
-                               np.eye(3) / 2.0 - skew(r) @ np.diag([1.0, -0.5, 0.25]) @ skew(r))
+    np.testing.assert_allclose(
+        composite_inertia_map(r, 2.0, indefinite),
+        np.eye(3) / 2.0 - skew(r) @ np.diag([1.0, -0.5, 0.25]) @ skew(r),
+    )
     with pytest.raises(np.linalg.LinAlgError):
         composite_inertia_map(r, 2.0, np.zeros((3, 3)))
 
@@ -131,7 +139,11 @@ def test_overlap_condition_at_the_maximum(analyses, name):
 
 
 @settings(max_examples=30, deadline=None)
-@given(frac=st.tuples(st.floats(-0.8, 0.8), st.floats(-0.8, 0.8)), theta=st.floats(-1.2, 1.2), mu=st.floats(0.0, 0.6))
+@given(
+    frac=st.tuples(st.floats(-0.8, 0.8), st.floats(-0.8, 0.8)),
+    theta=st.floats(-1.2, 1.2),
+    mu=st.floats(0.0, 0.6),
+)
 def test_overlap_condition_random_impacts(analyses, frac, theta, mu):
     """Random pre-impact CoM velocities inside the area and random impact directions."""
     a = analyses["palm_push_ramp"]
@@ -208,7 +220,12 @@ def test_zmp_criterion_against_direct_zmp(analyses, name):
     weight = a.stance.mass * a.areas.gravity
 
     def zmps(speed):
-        return np.array([_zmp(f, m.point, a.stance.com, weight, a.areas.plane_height) for f in m.impulse_vertices(speed) / dt])
+        return np.array(
+            [
+                _zmp(f, m.point, a.stance.com, weight, a.areas.plane_height)
+                for f in m.impulse_vertices(speed) / dt
+            ]
+        )
 
     area = a.areas.zmp_area
     assert np.all(area.margins(zmps(s * (1 - 1e-6))) > -1e-12)
@@ -216,7 +233,9 @@ def test_zmp_criterion_against_direct_zmp(analyses, name):
 
 
 @pytest.mark.parametrize(
-    "reference", [(2.5, 0.0, 0.0), (2.0, 0.4, -0.3), (0.2, 0.1, 0.0)], ids=["above", "oblique", "below"]
+    "reference",
+    [(2.5, 0.0, 0.0), (2.0, 0.4, -0.3), (0.2, 0.1, 0.0)],
+    ids=["above", "oblique", "below"],
 )
 def test_qp_matches_the_exact_answer(analyses, reference):
     a = analyses["palm_push_two_feet"]
@@ -241,12 +260,16 @@ def test_qp_extra_bounds_only_lower_the_answer(analyses):
     model, area = a.impact.model, a.areas.com_velocity_area
     free = solve_contact_velocity_qp(model, area, a.com_velocity, (2.5, 0, 0))
     for opts in (QPOptions(joint_velocity_limits=True), QPOptions(impulsive_torque_limits=True)):
-        bounded = solve_contact_velocity_qp(model, area, a.com_velocity, (2.5, 0, 0), a.stance.robot, None, opts)
+        bounded = solve_contact_velocity_qp(
+            model, area, a.com_velocity, (2.5, 0, 0), a.stance.robot, None, opts
+        )
         assert bounded.status == "optimal"
         assert bounded.approach_speed <= free.approach_speed + 1e-7
 
 
 def test_friction_sweep_shape():
     """Paper Fig. miu-compare: the maximum falls as the impact friction grows (on these stances)."""
-    speeds = [ib.analyze(f"palm_push_mu0{k}").impact.max_contact_velocity for k in ("10", "24", "40")]
+    speeds = [
+        ib.analyze(f"palm_push_mu0{k}").impact.max_contact_velocity for k in ("10", "24", "40")
+    ]
     assert speeds[0] > speeds[1] > speeds[2] > 0

@@ -17,16 +17,20 @@ import pytest
 import impact_balance as ib
 from impact_balance.balance.areas import balance_areas
 from impact_balance.balance.infeasibility import explain_cannot_balance
-from impact_balance.robot.robot import example_robot_data_root
 from impact_balance.contacts.stance import ContactSpec, Stance
+from impact_balance.robot.robot import example_robot_data_root
 
 SIMPLE = example_robot_data_root() / "simple_humanoid_description"
 FEET = [ContactSpec("l_ankle", 0.7, (0.2, 0.1)), ContactSpec("r_ankle", 0.7, (0.2, 0.1))]
 
 
 def _simple_humanoid():
-    robot = ib.load_robot(None, SIMPLE / "urdf" / "simple_humanoid.urdf", SIMPLE / "srdf" / "simple_humanoid.srdf",
-                          "half_sitting")
+    robot = ib.load_robot(
+        None,
+        SIMPLE / "urdf" / "simple_humanoid.urdf",
+        SIMPLE / "srdf" / "simple_humanoid.srdf",
+        "half_sitting",
+    )
     # A private copy of the model: the test edits its effort limits.
     return dataclasses.replace(robot, model=pin.Model(robot.model))
 
@@ -55,7 +59,9 @@ def test_simple_humanoid_torque_limits():
     k = robot.model.joints[robot.model.getJointId(first.joint)].idx_v
     for factor, expected in ((0.99, False), (1.01, True)):
         edited = dataclasses.replace(robot, model=pin.Model(robot.model))
-        edited.model.effortLimit[k - (edited.model.nv - edited.model.effortLimit.size)] *= factor * first.min_scale
+        edited.model.effortLimit[k - (edited.model.nv - edited.model.effortLimit.size)] *= (
+            factor * first.min_scale
+        )
         assert balance_areas(_stance(edited), torque_limits=True).can_balance == expected, factor
 
 
@@ -107,7 +113,9 @@ def test_upside_down_foot_is_com_outside():
     can carry the weight."""
     robot = ib.load_robot("talos")
     q = ib.load_scenario("kick_one_foot").build_stance().q
-    flipped = ContactSpec("right_sole_link", 0.7, (0.2, 0.1), pin.SE3(pin.rpy.rpyToMatrix(np.pi, 0, 0), np.zeros(3)))
+    flipped = ContactSpec(
+        "right_sole_link", 0.7, (0.2, 0.1), pin.SE3(pin.rpy.rpyToMatrix(np.pi, 0, 0), np.zeros(3))
+    )
     stance = Stance(robot, q, [flipped])
     assert not balance_areas(stance, torque_limits=False).can_balance
     reason = explain_cannot_balance(stance, torque_limits=True)
@@ -117,8 +125,10 @@ def test_upside_down_foot_is_com_outside():
 def test_both_feet_flipped_through_analyze():
     """Both soles upside down (what a GUI user did): an explained answer, not a solver error."""
     scenario = ib.load_scenario("palm_push_two_feet")
-    contacts = [c.model_copy(update={"offset": c.offset.model_copy(update={"rpy": (np.pi, 0.0, 0.0)})})
-                for c in scenario.contacts]
+    contacts = [
+        c.model_copy(update={"offset": c.offset.model_copy(update={"rpy": (np.pi, 0.0, 0.0)})})
+        for c in scenario.contacts
+    ]
     analysis = ib.analyze(scenario.model_copy(update={"contacts": contacts}))
     assert not analysis.areas.can_balance
     assert analysis.cannot_balance_reason.kind == "com_outside"

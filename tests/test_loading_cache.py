@@ -9,8 +9,8 @@ import shutil
 import impact_balance as ib
 from impact_balance.analysis.report import format_timings
 from impact_balance.robot.robot import example_robot_data_root
-from impact_balance.scenario.reader import parse_yaml as _parse
 from impact_balance.scenario import load_scenario
+from impact_balance.scenario.reader import parse_yaml as _parse
 
 SIMPLE = example_robot_data_root() / "simple_humanoid_description"
 
@@ -47,9 +47,14 @@ def test_timings_say_what_they_measure():
     assert {"scenario_loading", "robot_loading", "total"} <= set(t)
     steps = sum(t[k] for k in ("stance", "constraints", "areas", "impact"))
     assert t["total"] >= steps  # the analysis only: loading is apart
-    text = format_timings({"total": 0.0008, "scenario_loading": 0.0003, "robot_loading": 0.25, "kernel_loading": 0.4})
+    text = format_timings(
+        {"total": 0.0008, "scenario_loading": 0.0003, "robot_loading": 0.25, "kernel_loading": 0.4}
+    )
     assert text.startswith("analysis 0.8 ms; not included: scenario loading 0.3 ms")
-    assert "robot model loading 250 ms (first use)" in text and "kernel loading 400 ms (first call)" in text
+    assert (
+        "robot model loading 250 ms (first use)" in text
+        and "kernel loading 400 ms (first call)" in text
+    )
     assert format_timings({"total": 0.0008, "robot_loading": 1e-6}) == "analysis 0.8 ms"
 
 
@@ -79,4 +84,7 @@ def test_bundled_name_and_loaded_scenario_analyse_alike():
     by_name = ib.analyze("palm_push_ramp")
     loaded = ib.analyze(ib.load_scenario("palm_push_ramp"))
     assert ib.load_scenario("palm_push_ramp") is ib.load_scenario("palm_push_ramp")
-    assert by_name.to_dict()["impact"]["max_contact_velocity"] == loaded.to_dict()["impact"]["max_contact_velocity"]
+    assert (
+        by_name.to_dict()["impact"]["max_contact_velocity"]
+        == loaded.to_dict()["impact"]["max_contact_velocity"]
+    )

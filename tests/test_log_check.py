@@ -16,7 +16,9 @@ from impact_balance.logs.schema import LogColumns, joint_position_column, joint_
 SCENARIO = "palm_push_two_feet"
 
 
-def synthetic_log(com_velocity_of_base: np.ndarray, T: float = 0.4, rate: float = 500.0, wiggle: float = 0.05):
+def synthetic_log(
+    com_velocity_of_base: np.ndarray, T: float = 0.4, rate: float = 500.0, wiggle: float = 0.05
+):
     """The stance translated at a constant base velocity while the arms swing: a log and its pinocchio states."""
     scenario = ib.load_scenario(SCENARIO)
     stance = scenario.build_stance()
@@ -77,7 +79,9 @@ def test_inside_agrees_with_the_analysis(speed, inside):
     assert bool(check.samples["com_velocity_inside"].iloc[0]) is inside
     # The margin is the distance of the CoM velocity to the area's boundary (the area is a polygon in m/s).
     area = reference.areas.com_velocity_area
-    assert check.samples["com_velocity_margin"].iloc[0] == pytest.approx(area.margins(np.array([speed, 0.0]))[0], abs=1e-6)
+    assert check.samples["com_velocity_margin"].iloc[0] == pytest.approx(
+        area.margins(np.array([speed, 0.0]))[0], abs=1e-6
+    )
     assert check.ok is inside
     if not inside:
         (v,) = check.violations
@@ -94,7 +98,12 @@ def test_violation_times_and_zmp_column(tmp_path):
     path = write_log(frame, tmp_path / "log.csv")
     check = check_log(read_log(path), scenario)
     (v,) = check.violations
-    assert v.kind == "zmp" and v.start == pytest.approx(0.05) and v.end == pytest.approx(0.098) and v.worst_margin < 0
+    assert (
+        v.kind == "zmp"
+        and v.start == pytest.approx(0.05)
+        and v.end == pytest.approx(0.098)
+        and v.worst_margin < 0
+    )
 
 
 def test_bad_logs_name_what_is_missing(tmp_path, capsys):

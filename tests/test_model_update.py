@@ -15,12 +15,15 @@ import pinocchio as pin
 import pytest
 
 import impact_balance as ib
+from impact_balance.contacts.stance import ContactSpec, Stance
 from impact_balance.contacts.wrench_polytope import grasp_matrix
 from impact_balance.exceptions import ScenarioError
 from impact_balance.robot.robot import load_robot
-from impact_balance.contacts.stance import ContactSpec, Stance
 
-FEET = [ContactSpec("left_sole_link", 0.7, (0.2, 0.1)), ContactSpec("right_sole_link", 0.7, (0.2, 0.1))]
+FEET = [
+    ContactSpec("left_sole_link", 0.7, (0.2, 0.1)),
+    ContactSpec("right_sole_link", 0.7, (0.2, 0.1)),
+]
 PALM = pin.SE3(np.eye(3), np.array([0.051, 0.0, -0.045]))
 LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -71,8 +74,13 @@ def reference(robot, q: np.ndarray, frame: str, offset: pin.SE3) -> dict[str, np
 def held(stance: Stance, frame: str, offset: pin.SE3) -> dict[str, np.ndarray]:
     """The same quantities, as the stance gives them."""
     placement, J = stance.point(frame, offset)
-    out = {"com": stance.com, "com_inertia": stance.com_inertia, "gravity": stance.gravity_torques,
-           "point": placement.translation, "point_J": J}
+    out = {
+        "com": stance.com,
+        "com_inertia": stance.com_inertia,
+        "gravity": stance.gravity_torques,
+        "point": placement.translation,
+        "point_J": J,
+    }
     for i, c in enumerate(stance.contacts):
         out[f"R{i}"], out[f"p{i}"], out[f"J{i}"] = c.rotation, c.position, c.jacobian
     return out
@@ -98,8 +106,12 @@ def test_stances_of_one_robot_do_not_alias(robot):
     Stance(robot, q2, FEET)
     data = robot.model.createData()
     pin.framesForwardKinematics(robot.model, data, q1)
-    np.testing.assert_allclose(a.frame_pose("torso_2_link").homogeneous,
-                               data.oMf[robot.model.getFrameId("torso_2_link")].homogeneous, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(
+        a.frame_pose("torso_2_link").homogeneous,
+        data.oMf[robot.model.getFrameId("torso_2_link")].homogeneous,
+        rtol=0,
+        atol=1e-12,
+    )
 
 
 def test_stance_data_is_a_data_of_its_own(robot):
@@ -108,14 +120,20 @@ def test_stance_data_is_a_data_of_its_own(robot):
     data = a.data
     assert data is not robot.workspace().data
     Stance(robot, q2, FEET)
-    np.testing.assert_allclose(np.array([data.oMi[j].homogeneous for j in range(robot.model.njoints)]),
-                               reference(robot, q1, "torso_2_link", PALM)["oMi"], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(
+        np.array([data.oMi[j].homogeneous for j in range(robot.model.njoints)]),
+        reference(robot, q1, "torso_2_link", PALM)["oMi"],
+        rtol=0,
+        atol=1e-12,
+    )
 
 
 def test_joint_space_impact_does_not_leave_stale_kinematics(robot):
     q1, q2 = configurations(robot)
     a, b = Stance(robot, q1, FEET), Stance(robot, q2, FEET)
-    spec = ib.ImpactSpec("gripper_right_base_link", (-1.0, 0.0, 0.0), offset=PALM, inertia="joint_space")
+    spec = ib.ImpactSpec(
+        "gripper_right_base_link", (-1.0, 0.0, 0.0), offset=PALM, inertia="joint_space"
+    )
     model = ib.impact_model(b, spec)  # runs crba on the scratch Data at q2
     data = robot.model.createData()
     M = pin.crba(robot.model, data, q2)
@@ -123,7 +141,10 @@ def test_joint_space_impact_does_not_leave_stale_kinematics(robot):
     J = reference(robot, q2, "gripper_right_base_link", PALM)["point_J"][:3]
     np.testing.assert_allclose(model.W, J @ np.linalg.solve(M, J.T), rtol=1e-12, atol=0)
     for stance, q in ((a, q1), (b, q2)):
-        assert_matches(held(stance, "gripper_right_base_link", PALM), reference(robot, q, "gripper_right_base_link", PALM))
+        assert_matches(
+            held(stance, "gripper_right_base_link", PALM),
+            reference(robot, q, "gripper_right_base_link", PALM),
+        )
 
 
 def test_stances_in_threads_match_a_fresh_data(robot):
@@ -186,8 +207,11 @@ def test_joint_assignment_matches_setting_joints_one_by_one(robot):
 
 
 @pytest.mark.parametrize(
-    "joints, field", [({"torso_2_joint": 0.1, "arm_left_4_joint": 5.0}, "joints.arm_left_4_joint"),
-                      ({"nope_joint": 0.0, "arm_left_4_joint": 5.0}, "joints.nope_joint")],
+    "joints, field",
+    [
+        ({"torso_2_joint": 0.1, "arm_left_4_joint": 5.0}, "joints.arm_left_4_joint"),
+        ({"nope_joint": 0.0, "arm_left_4_joint": 5.0}, "joints.nope_joint"),
+    ],
 )
 def test_joint_assignment_reports_the_first_bad_joint_every_time(robot, joints, field):
     for _ in range(2):  # a refused assignment is not cached
@@ -203,7 +227,9 @@ def test_grasp_matrix_blocks():
     for i, p in enumerate(positions):
         w = np.zeros(6 * len(positions))
         w[6 * i : 6 * i + 6] = np.concatenate([f, tau])
-        np.testing.assert_allclose(G @ w, np.concatenate([f, tau + np.cross(p, f)]), rtol=0, atol=1e-15)
+        np.testing.assert_allclose(
+            G @ w, np.concatenate([f, tau + np.cross(p, f)]), rtol=0, atol=1e-15
+        )
 
 
 def test_scenario_specs_follow_the_scenario_content():

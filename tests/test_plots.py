@@ -11,6 +11,8 @@ from matplotlib.figure import Figure
 import impact_balance as ib
 from impact_balance.plots import (
     __all__ as plots_all,
+)
+from impact_balance.plots import (
     analysis_phase_portrait,
     plot_areas,
     plot_friction_comparison,
@@ -67,8 +69,14 @@ def _line(ax, label: str):
 
 
 def test_exports() -> None:
-    for name in ("plot_areas", "plot_impulse_set", "plot_friction_comparison", "plot_phase_portrait",
-                 "plot_stance", "save_figures"):
+    for name in (
+        "plot_areas",
+        "plot_impulse_set",
+        "plot_friction_comparison",
+        "plot_phase_portrait",
+        "plot_stance",
+        "save_figures",
+    ):
         assert name in plots_all
 
 
@@ -84,10 +92,14 @@ def test_plot_areas(analysis: ib.Analysis) -> None:
     assert sum("post-impact set" in t for t in labels) == 5
     assert any("falls" in t for t in labels), "the reference speed 0.8 m/s exceeds v_max"
     # The limiting vertex is marked where the model puts it, on the area's boundary.
-    star = next(line for line in vel_ax.get_lines() if line.get_label().startswith("limiting vertex"))
+    star = next(
+        line for line in vel_ax.get_lines() if line.get_label().startswith("limiting vertex")
+    )
     point = np.array([star.get_xdata()[0], star.get_ydata()[0]])
     lim = analysis.impact.com_limit
-    expected = analysis.impact.model.post_impact_com_velocities(analysis.com_velocity, vmax)[lim.limiting_vertex]
+    expected = analysis.impact.model.post_impact_com_velocities(analysis.com_velocity, vmax)[
+        lim.limiting_vertex
+    ]
     np.testing.assert_allclose(point, expected)
     assert abs(analysis.areas.com_velocity_area.margins(point)[0]) < 1e-8
     text = " ".join(t.get_text() for t in _side(fig).texts)
@@ -146,7 +158,9 @@ def test_analysis_phase_portrait(analysis: ib.Analysis) -> None:
     portrait = analysis_phase_portrait(analysis)
     area = analysis.areas.com_velocity_area.vertices
     # Along x through the CoM, the bounds are the CoM velocity area's chord (rectangular here).
-    np.testing.assert_allclose(portrait.com_velocity_bounds, [area[:, 0].min(), area[:, 0].max()], atol=1e-6)
+    np.testing.assert_allclose(
+        portrait.com_velocity_bounds, [area[:, 0].min(), area[:, 0].max()], atol=1e-6
+    )
 
 
 @pytest.mark.parametrize("fixture", ["analysis", "no_impact"])
@@ -164,10 +178,14 @@ def test_plot_stance(fixture: str, request: pytest.FixtureRequest) -> None:
 def test_save_figures(analysis: ib.Analysis, no_impact: ib.Analysis, tmp_path) -> None:
     written = save_figures(analysis, tmp_path / "out")
     names = sorted(p.name for p in written)
-    assert names == sorted(f"palm_push_two_feet_{k}.png" for k in ("areas", "stance", "impulse_set", "phase_portrait"))
+    assert names == sorted(
+        f"palm_push_two_feet_{k}.png" for k in ("areas", "stance", "impulse_set", "phase_portrait")
+    )
     for path in written:
         data = path.read_bytes()
         assert path.parent == tmp_path / "out" and data.startswith(PNG) and len(data) > 10_000
     written = save_figures(no_impact, tmp_path / "out")
-    assert sorted(p.name for p in written) == sorted(f"no_impact_{k}.png" for k in ("areas", "stance", "phase_portrait"))
+    assert sorted(p.name for p in written) == sorted(
+        f"no_impact_{k}.png" for k in ("areas", "stance", "phase_portrait")
+    )
     assert all(p.stat().st_size > 10_000 for p in written)

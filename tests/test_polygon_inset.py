@@ -19,8 +19,16 @@ from impact_balance.geometry.polygon import Polygon
 
 def rectangle(a: float, b: float, centre=(0.0, 0.0)) -> Polygon:
     cx, cy = centre
-    return Polygon(np.array([[cx - a / 2, cy - b / 2], [cx + a / 2, cy - b / 2], [cx + a / 2, cy + b / 2],
-                             [cx - a / 2, cy + b / 2]]))
+    return Polygon(
+        np.array(
+            [
+                [cx - a / 2, cy - b / 2],
+                [cx + a / 2, cy - b / 2],
+                [cx + a / 2, cy + b / 2],
+                [cx - a / 2, cy + b / 2],
+            ]
+        )
+    )
 
 
 def regular(k: int, inradius: float) -> Polygon:
@@ -34,20 +42,26 @@ def test_rectangle_shrinks_by_twice_the_distance(a, b, d):
     inset = rectangle(a, b, centre=(5.0, -3.0)).inset(d)
     assert len(inset.vertices) == 4
     assert inset.area == pytest.approx((a - 2 * d) * (b - 2 * d), rel=1e-12)
-    assert inset.vertices.min(axis=0) == pytest.approx([5.0 - a / 2 + d, -3.0 - b / 2 + d], abs=1e-12)
+    assert inset.vertices.min(axis=0) == pytest.approx(
+        [5.0 - a / 2 + d, -3.0 - b / 2 + d], abs=1e-12
+    )
 
 
 @pytest.mark.parametrize("k", [3, 5, 8, 17])
 def test_regular_polygon_scales_about_its_centre(k):
     p = regular(k, 1.0)
     inset = p.inset(0.25)
-    assert inset.area == pytest.approx(0.75 ** 2 * p.area, rel=1e-12)
-    assert regular(k, 1.0).inset(1.0).is_empty  # at the inradius only the centre is left: no interior
+    assert inset.area == pytest.approx(0.75**2 * p.area, rel=1e-12)
+    assert (
+        regular(k, 1.0).inset(1.0).is_empty
+    )  # at the inradius only the centre is left: no interior
 
 
 def test_short_edges_leave_first():
     # A thin pentagon: its short top edge collapses long before the polygon does.
-    p = Polygon(np.array([[0.0, 0.0], [4.0, 0.0], [4.0, 1.0], [2.05, 1.5], [1.95, 1.5], [0.0, 1.0]]))
+    p = Polygon(
+        np.array([[0.0, 0.0], [4.0, 0.0], [4.0, 1.0], [2.05, 1.5], [1.95, 1.5], [0.0, 1.0]])
+    )
     # Its edge shrinks at 2 tan(7 deg) per unit inset (turning angle 14 deg): gone at d = 0.40.
     for d, corners in ((0.3, 6), (0.5, 5), (0.6, 3)):
         inset = p.inset(d)
@@ -88,7 +102,7 @@ def _halfspace_reference(p: Polygon, d: float) -> float:
 )
 def test_inset_is_the_erosion(points, fraction, scale):
     p = Polygon.from_points(scale * np.array(points))
-    if len(p.vertices) < 3 or p.area < 1e-6 * scale ** 2:
+    if len(p.vertices) < 3 or p.area < 1e-6 * scale**2:
         return
     # The inradius is at most the largest margin of any vertex mean; use the polygon size for d.
     size = float(np.ptp(p.vertices, axis=0).min())
@@ -108,4 +122,4 @@ def test_inset_is_the_erosion(points, fraction, scale):
     assert np.array_equal((inside >= 0)[clear], (deep >= d)[clear])
     reference = _halfspace_reference(p, d)
     if reference > 0:
-        assert inset.area == pytest.approx(reference, rel=1e-9, abs=1e-12 * scale ** 2)
+        assert inset.area == pytest.approx(reference, rel=1e-9, abs=1e-12 * scale**2)

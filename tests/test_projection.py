@@ -30,8 +30,14 @@ def project(A, b, E, C=None, d=None, **kw):
     n = np.asarray(E).shape[1]
     C = np.zeros((0, n)) if C is None else C
     d = np.zeros(0) if d is None else d
-    return project_polytope(np.asarray(A, float), np.asarray(b, float), np.asarray(C, float), np.asarray(d, float),
-                            np.asarray(E, float), **kw)
+    return project_polytope(
+        np.asarray(A, float),
+        np.asarray(b, float),
+        np.asarray(C, float),
+        np.asarray(d, float),
+        np.asarray(E, float),
+        **kw,
+    )
 
 
 def box_rows(lo, hi):
@@ -50,8 +56,15 @@ def assert_ccw_convex(v):
 
 def lp_support(A, b, C, d, E, u):
     """max u . E x over the polytope (scipy HiGHS); None if infeasible."""
-    r = linprog(-(E.T @ u), A_ub=A, b_ub=b, A_eq=C if len(C) else None, b_eq=d if len(C) else None,
-                bounds=(None, None), method="highs")
+    r = linprog(
+        -(E.T @ u),
+        A_ub=A,
+        b_ub=b,
+        A_eq=C if len(C) else None,
+        b_eq=d if len(C) else None,
+        bounds=(None, None),
+        method="highs",
+    )
     assert r.status in (0, 2), r.message
     return None if r.status == 2 else float(u @ E @ r.x)
 
@@ -65,7 +78,15 @@ def lp_distance(A, b, C, d, E, y):
     A_ub = np.block([[A, np.zeros((len(A), 1))], [E, -np.ones((2, 1))], [-E, -np.ones((2, 1))]])
     b_ub = np.concatenate([b, y, -y])
     A_eq = np.hstack([C, np.zeros((len(C), 1))]) if len(C) else None
-    r = linprog(c, A_ub=A_ub, b_ub=b_ub, A_eq=A_eq, b_eq=d if len(C) else None, bounds=(None, None), method="highs")
+    r = linprog(
+        c,
+        A_ub=A_ub,
+        b_ub=b_ub,
+        A_eq=A_eq,
+        b_eq=d if len(C) else None,
+        bounds=(None, None),
+        method="highs",
+    )
     assert r.status == 0, r.message
     return float(r.fun)
 
@@ -149,7 +170,9 @@ def test_simplex_with_inequalities_and_with_an_equality(geo, method):
     assert poly.area == pytest.approx(0.5, rel=1e-12)
     # {x >= 0, sum x = 1} in R^3: same triangle, and the map E sends vertex e_i to E[:, i]
     E = np.array([[2.0, -1.0, 0.5], [0.0, 1.0, 3.0]])
-    poly = project(-np.eye(3), np.zeros(3), E, C=np.ones((1, 3)), d=np.array([1.0]), method=method).polygon
+    poly = project(
+        -np.eye(3), np.zeros(3), E, C=np.ones((1, 3)), d=np.array([1.0]), method=method
+    ).polygon
     assert len(poly.vertices) == 3 and geo.hausdorff(poly.vertices, E.T) <= 1e-9
 
 
@@ -177,7 +200,9 @@ def test_infeasible_polytope_gives_the_empty_polygon(method):
     assert poly.is_empty and len(poly.vertices) == 0 and poly.area == 0.0
     # feasible inequalities, inconsistent equality
     A, b = box_rows(np.zeros(3), np.ones(3))
-    poly = project(A, b, np.eye(3)[:2], C=np.array([[1.0, 1, 1]]), d=np.array([4.0]), method=method).polygon
+    poly = project(
+        A, b, np.eye(3)[:2], C=np.array([[1.0, 1, 1]]), d=np.array([4.0]), method=method
+    ).polygon
     assert poly.is_empty
     G, h = poly.halfplanes
     assert not np.any(G @ np.zeros(2) <= h)  # the empty set's half-planes exclude everything
@@ -192,7 +217,9 @@ def test_degenerate_projections_segment_and_point(geo, method):
     assert len(poly.vertices) == 2 and poly.area == 0.0
     assert geo.hausdorff(poly.vertices, [[0, 0], [2, 4]]) <= 1e-9
     # segment by an equality: x1 = x2 within the unit box, projected on (x1, x2)
-    poly = project(A, b, np.eye(3)[:2], C=np.array([[1.0, -1, 0]]), d=np.zeros(1), method=method).polygon
+    poly = project(
+        A, b, np.eye(3)[:2], C=np.array([[1.0, -1, 0]]), d=np.zeros(1), method=method
+    ).polygon
     assert len(poly.vertices) == 2 and geo.hausdorff(poly.vertices, [[0, 0], [1, 1]]) <= 1e-9
     # point: zero map, and a fully pinned polytope
     poly = project(A, b, np.zeros((2, 3)), method=method).polygon
@@ -220,7 +247,10 @@ def _random_polytope(rng, n, m, with_eq):
 
 def test_determinism(method):
     A, b, C, d, E = _random_polytope(np.random.default_rng(7), 5, 12, True)
-    r1, r2 = project_polytope(A, b, C, d, E, method=method), project_polytope(A, b, C, d, E, method=method)
+    r1, r2 = (
+        project_polytope(A, b, C, d, E, method=method),
+        project_polytope(A, b, C, d, E, method=method),
+    )
     assert len(r1.polygon.vertices) >= 3
     assert np.array_equal(r1.polygon.vertices, r2.polygon.vertices)
     assert r1.method == r2.method == method
@@ -228,7 +258,9 @@ def test_determinism(method):
 
 
 @settings(max_examples=30, deadline=None)
-@given(n=st.integers(2, 5), m=st.integers(3, 12), with_eq=st.booleans(), seed=st.integers(0, 2**32 - 1))
+@given(
+    n=st.integers(2, 5), m=st.integers(3, 12), with_eq=st.booleans(), seed=st.integers(0, 2**32 - 1)
+)
 def test_random_polytopes_against_linprog(n, m, with_eq, seed, method):
     A, b, C, d, E = _random_polytope(np.random.default_rng(seed), n, m, with_eq)
     poly = project_polytope(A, b, C, d, E, method=method).polygon
@@ -250,14 +282,14 @@ def _cone_polytope(rng, n_contacts, faces):
     n = k * n_contacts
     A = np.zeros((faces * n_contacts, n))
     for i, F in enumerate(blocks):
-        A[i * faces:(i + 1) * faces, i * k:(i + 1) * k] = F
+        A[i * faces : (i + 1) * faces, i * k : (i + 1) * k] = F
     b = np.zeros(len(A))
     C = np.zeros((1, n))
-    C[0, k - 1::k] = 1.0
+    C[0, k - 1 :: k] = 1.0
     d = np.ones(1)
     E = np.zeros((2, n))
     for i in range(n_contacts):  # resultant horizontal force, plus a random twist
-        E[:, i * k:i * k + 2] = np.eye(2) + 0.3 * rng.normal(size=(2, 2))
+        E[:, i * k : i * k + 2] = np.eye(2) + 0.3 * rng.normal(size=(2, 2))
     return A, b, C, d, E
 
 

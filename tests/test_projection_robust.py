@@ -22,12 +22,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from impact_balance.balance.areas import FORCE_BOX, FORCE_TOLERANCE, MERGE_TOLERANCE
+from impact_balance.contacts.stance import ContactSpec, Stance
 from impact_balance.contacts.wrench_polytope import wrench_polytope
 from impact_balance.geometry.polygon import Polygon, simplify
 from impact_balance.projection import project_polytope
 from impact_balance.projection.walk import SLACK_TOLERANCE
 from impact_balance.scenario import bundled_scenarios, load_scenario
-from impact_balance.contacts.stance import ContactSpec, Stance
 
 STANCES = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot", "talos_three_contacts")
 
@@ -46,7 +46,10 @@ def _project(name: str, frictions, method: str = "auto"):
     polytope = wrench_polytope(Stance(robot, q, specs))
     return project_polytope(
         *polytope.projection_data(),
-        tol=FORCE_TOLERANCE, box=FORCE_BOX, merge_tol=MERGE_TOLERANCE, method=method,
+        tol=FORCE_TOLERANCE,
+        box=FORCE_BOX,
+        merge_tol=MERGE_TOLERANCE,
+        method=method,
     )
 
 
@@ -59,7 +62,10 @@ def _check_polygon(polygon):
     if len(v) >= 3:
         e = np.roll(v, -1, axis=0) - v
         cross = e[:, 0] * np.roll(e[:, 1], -1) - e[:, 1] * np.roll(e[:, 0], -1)
-        assert (cross >= -1e-9 * np.linalg.norm(e, axis=1) * np.linalg.norm(np.roll(e, -1, axis=0), axis=1)).all()
+        assert (
+            cross
+            >= -1e-9 * np.linalg.norm(e, axis=1) * np.linalg.norm(np.roll(e, -1, axis=0), axis=1)
+        ).all()
         f = np.roll(e, -1, axis=0)
         turning = np.arctan2(cross, (e * f).sum(axis=1)).sum()
         assert turning == pytest.approx(2 * np.pi, abs=1e-6)  # one lap, not two
@@ -74,7 +80,9 @@ def _same_polygon(p, q, rel=1e-6):
     angles = np.linspace(0, 2 * np.pi, 64, endpoint=False)
     U = np.column_stack([np.cos(angles), np.sin(angles)])
     np.testing.assert_allclose(
-        (p.vertices @ U.T).max(axis=0), (q.vertices @ U.T).max(axis=0), atol=max(rel * size, MERGE_TOLERANCE)
+        (p.vertices @ U.T).max(axis=0),
+        (q.vertices @ U.T).max(axis=0),
+        atol=max(rel * size, MERGE_TOLERANCE),
     )
 
 
@@ -183,10 +191,14 @@ def test_merge_is_within_its_tolerance_of_every_input_vertex():
     t = np.linspace(-1.0, 1.0, 201)
     bulge = 4e-7 * (1.0 - t**2)  # a side bulging by up to 4e-7, concave down: still convex
     side = np.column_stack([np.ones_like(t), t]) + np.column_stack([bulge, np.zeros_like(t)])
-    ring = np.vstack([[[1.0, -1.0]] * 3, side[1:-1], [[1.0, 1.0]], [[-1.0, 1.0]], [[-1.0, -1.0]], [[1.0, -1.0]]])
+    ring = np.vstack(
+        [[[1.0, -1.0]] * 3, side[1:-1], [[1.0, 1.0]], [[-1.0, 1.0]], [[-1.0, -1.0]], [[1.0, -1.0]]]
+    )
     merged = Polygon(simplify(ring, 1e-7))
     assert merged.contains(ring, tol=1e-7 * (1 + 1e-9)).all()
-    assert merged.contains(np.array([[1.0, -1.0], [1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0]]), tol=0.0).all()
+    assert merged.contains(
+        np.array([[1.0, -1.0], [1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0]]), tol=0.0
+    ).all()
 
 
 def test_certificate_refuses_a_spike_along_an_edge():
@@ -199,7 +211,9 @@ def test_certificate_refuses_a_spike_along_an_edge():
     square = np.array([[1.0, -1.0], [1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0]])
     assert simplify_convex(square, 1e-9, 1e-8, 1e3) is not None
     for eps in (0.0, 1e-17, -1e-17):  # the tip's cross product: zero or rounding either way
-        spiked = np.array([[1.0, -1.0], [1.0, 1.0], [0.0, 1.0], [0.5, 1.0 + eps], [-1.0, 1.0], [-1.0, -1.0]])
+        spiked = np.array(
+            [[1.0, -1.0], [1.0, 1.0], [0.0, 1.0], [0.5, 1.0 + eps], [-1.0, 1.0], [-1.0, -1.0]]
+        )
         assert simplify_convex(spiked, 1e-9, 1e-8, 1e3) is None
 
 
@@ -238,7 +252,14 @@ def test_carried_inverse_check_accepts_a_fresh_inverse_and_refuses_a_drifted_one
     drifted = Binv.copy()
     drifted[rng.integers(n), rng.integers(n)] += 1e-9 * np.abs(Binv).max()
     assert not _accurate(H, h, W, drifted, z, buffer)
-    assert not _accurate(H, h, W, Binv, z + 1e-9 * max(1.0, np.abs(z).max()) * rng.choice([-1.0, 1.0], size=n), buffer)
+    assert not _accurate(
+        H,
+        h,
+        W,
+        Binv,
+        z + 1e-9 * max(1.0, np.abs(z).max()) * rng.choice([-1.0, 1.0], size=n),
+        buffer,
+    )
 
 
 def test_bretl_answers_where_the_warm_simplex_stopped_undecided():
@@ -248,7 +269,7 @@ def test_bretl_answers_where_the_warm_simplex_stopped_undecided():
     scratch (HiGHS's defaults), and Bretl's polygon is the walk's."""
     _, _, specs = _base("palm_push_ramp")
     frictions = [s.friction for s in specs]
-    frictions[0] = 10.0 ** 4.405863216728498
+    frictions[0] = 10.0**4.405863216728498
     bretl = _project("palm_push_ramp", frictions, method="bretl")
     walk = _project("palm_push_ramp", frictions, method="walk")
     _check_polygon(bretl.polygon)

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from impact_balance.sim import SimOptions, build_model
-from impact_balance.sim.trials.measure import measure
 from impact_balance.sim.trials.impact_trial import TrialOptions, run_trial
+from impact_balance.sim.trials.measure import measure
 
 SCENARIO = "palm_push_two_feet"
 
@@ -48,9 +48,14 @@ def test_held_impact_is_the_composite_one_up_to_the_sustained_contacts(sim, tria
     # A servo-held arm gives way (joint_space); held joints transmit the rigid body's impulse (composite).
     assert np.linalg.norm(held.impulse_measured) > 10 * np.linalg.norm(free.impulse_measured)
     assert held.predicted["composite"].relative_distance < 0.1
-    assert free.predicted["joint_space"].relative_distance < held.predicted["joint_space"].relative_distance
+    assert (
+        free.predicted["joint_space"].relative_distance
+        < held.predicted["joint_space"].relative_distance
+    )
     # Momentum: the CoM velocity jump is the impact's impulse plus the sustained contacts' (gravity and the
     # contacts' forces before the impact subtracted), over the mass.
     total = held.impulse_measured + sum(held.sustained_impulses.values())
     mass = sim.stance.mass
-    np.testing.assert_allclose(held.com_velocity_jump_measured, total[:2] / mass, atol=0.02 * np.linalg.norm(total) / mass)
+    np.testing.assert_allclose(
+        held.com_velocity_jump_measured, total[:2] / mass, atol=0.02 * np.linalg.norm(total) / mass
+    )

@@ -24,13 +24,18 @@ from impact_balance.cli import main
 from impact_balance.exceptions import ModelRepairWarning
 from impact_balance.robot.robot import example_robot_data_root
 from impact_balance.sim import SimOptions, build_model
-from impact_balance.sim.trials.balance_trial import BalanceTrialOptions
-from impact_balance.sim.trials.outcomes import OUTCOMES
 from impact_balance.sim.studies.push import push_test
 from impact_balance.sim.studies.validate import validate
+from impact_balance.sim.trials.balance_trial import BalanceTrialOptions
+from impact_balance.sim.trials.outcomes import OUTCOMES
 
 ROOT = example_robot_data_root()
-BUNDLED = {"talos": "palm_push_two_feet", "g1": "g1_two_feet", "romeo": "romeo_two_feet", "icub": "icub_two_feet"}
+BUNDLED = {
+    "talos": "palm_push_two_feet",
+    "g1": "g1_two_feet",
+    "romeo": "romeo_two_feet",
+    "icub": "icub_two_feet",
+}
 LIGHT = SimOptions(meshes=False)
 # Short trials: 0.2 s standing, 0.6 s after the disturbance.
 SHORT = BalanceTrialOptions(after=0.6, settle=0.2)
@@ -45,24 +50,65 @@ def extra_scenarios(tmp_path_factory):
     """simple_humanoid and Solo12 scenarios, posed with the `pose` command from drafts."""
     folder = tmp_path_factory.mktemp("robots")
     simple = ROOT / "simple_humanoid_description"
-    _draft(folder / "simple_draft.yaml",
-           f"{{urdf: {simple / 'urdf' / 'simple_humanoid.urdf'}, srdf: {simple / 'srdf' / 'simple_humanoid.srdf'}, "
-           "standing: neutral}",  # its SRDF half_sitting is outside its own joint limits
-           "  - {frame: l_ankle, friction: 0.7, size: [0.2, 0.1]}\n  - {frame: r_ankle, friction: 0.7, size: [0.2, 0.1]}\n",
-           "  {frame: r_wrist, normal: [-1, 0, 0], reference_velocity: [0.5, 0, 0]}\n")
+    _draft(
+        folder / "simple_draft.yaml",
+        f"{{urdf: {simple / 'urdf' / 'simple_humanoid.urdf'}, srdf: {simple / 'srdf' / 'simple_humanoid.srdf'}, "
+        "standing: neutral}",  # its SRDF half_sitting is outside its own joint limits
+        "  - {frame: l_ankle, friction: 0.7, size: [0.2, 0.1]}\n  - {frame: r_ankle, friction: 0.7, size: [0.2, 0.1]}\n",
+        "  {frame: r_wrist, normal: [-1, 0, 0], reference_velocity: [0.5, 0, 0]}\n",
+    )
     solo = ROOT / "solo_description"
-    feet = "".join(f"  - {{frame: {f}_FOOT, friction: 0.7, size: [0.02, 0.02], normal: [0, 0, 1]}}\n"
-                   for f in ("FR", "HL", "HR"))  # the *_FOOT frames are tilted 45 degrees: give the normal
-    _draft(folder / "solo_draft.yaml",
-           f"{{urdf: {solo / 'robots' / 'solo12.urdf'}, srdf: {solo / 'srdf' / 'solo.srdf'}, standing: straight_standing}}",
-           feet, "  {frame: FL_FOOT, normal: [-1, 0, 0], reference_velocity: [0.5, 0, 0]}\n")
+    feet = "".join(
+        f"  - {{frame: {f}_FOOT, friction: 0.7, size: [0.02, 0.02], normal: [0, 0, 1]}}\n"
+        for f in ("FR", "HL", "HR")
+    )  # the *_FOOT frames are tilted 45 degrees: give the normal
+    _draft(
+        folder / "solo_draft.yaml",
+        f"{{urdf: {solo / 'robots' / 'solo12.urdf'}, srdf: {solo / 'srdf' / 'solo.srdf'}, standing: straight_standing}}",
+        feet,
+        "  {frame: FL_FOOT, normal: [-1, 0, 0], reference_velocity: [0.5, 0, 0]}\n",
+    )
     # The arm forward (the neutral arm hangs straight, a singular start); the front left foot
     # lifted for a kick, the CoM inside the three other feet.
-    assert main(["pose", str(folder / "simple_draft.yaml"), "--place", "r_wrist", "0.25", "-0.25", "0.9",
-                 "--out", str(folder / "simple_humanoid.yaml")]) == 0
-    assert main(["pose", str(folder / "solo_draft.yaml"), "--place", "FL_FOOT", "0.22", "0.147", "0.05",
-                 "--com", "-0.04", "-0.04", "--out", str(folder / "solo12.yaml")]) == 0
-    return {"simple_humanoid": str(folder / "simple_humanoid.yaml"), "solo12": str(folder / "solo12.yaml")}
+    assert (
+        main(
+            [
+                "pose",
+                str(folder / "simple_draft.yaml"),
+                "--place",
+                "r_wrist",
+                "0.25",
+                "-0.25",
+                "0.9",
+                "--out",
+                str(folder / "simple_humanoid.yaml"),
+            ]
+        )
+        == 0
+    )
+    assert (
+        main(
+            [
+                "pose",
+                str(folder / "solo_draft.yaml"),
+                "--place",
+                "FL_FOOT",
+                "0.22",
+                "0.147",
+                "0.05",
+                "--com",
+                "-0.04",
+                "-0.04",
+                "--out",
+                str(folder / "solo12.yaml"),
+            ]
+        )
+        == 0
+    )
+    return {
+        "simple_humanoid": str(folder / "simple_humanoid.yaml"),
+        "solo12": str(folder / "solo12.yaml"),
+    }
 
 
 ROBOTS = [*BUNDLED, "simple_humanoid", "solo12"]
@@ -109,7 +155,17 @@ def test_repairs_are_named_in_one_warning():
 
 @pytest.mark.parametrize("robot", ROBOTS)
 def test_simulate_rigid_impact_matches_the_composite_model(extra_scenarios, robot, capsys):
-    rc = main(["simulate", scenario_of(robot, extra_scenarios), "--speed", "0.3", "--duration", "0.05", "--json"])
+    rc = main(
+        [
+            "simulate",
+            scenario_of(robot, extra_scenarios),
+            "--speed",
+            "0.3",
+            "--duration",
+            "0.05",
+            "--json",
+        ]
+    )
     out = capsys.readouterr().out
     assert rc == 0
     result = json.loads(out)
@@ -127,8 +183,12 @@ def _finite(x) -> bool:
 def test_push_and_validate_run(extra_scenarios, robot):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ModelRepairWarning)
-        pushed = push_test(scenario_of(robot, extra_scenarios), directions=1, magnitudes=[5.0], options=SHORT)
-        bracket = validate(scenario_of(robot, extra_scenarios), tolerance=0.5, max_speed=0.4, options=SHORT)
+        pushed = push_test(
+            scenario_of(robot, extra_scenarios), directions=1, magnitudes=[5.0], options=SHORT
+        )
+        bracket = validate(
+            scenario_of(robot, extra_scenarios), tolerance=0.5, max_speed=0.4, options=SHORT
+        )
     (outcome,) = pushed.outcomes
     summary = outcome.summary
     json.dumps(summary, allow_nan=False)  # every number finite or null
@@ -136,8 +196,11 @@ def test_push_and_validate_run(extra_scenarios, robot):
     assert summary["outcome"] == "balanced" or summary["reason"] is not None
     assert summary["sim_time"] > 0 and _finite(summary["worst_com_velocity_margin"])
     b = bracket.bracket()
-    assert bracket.trials and (b["survived_commanded"] is not None or b["fell_commanded"] is not None
-                               or all(t.outcome == "aborted" for t in bracket.trials))
+    assert bracket.trials and (
+        b["survived_commanded"] is not None
+        or b["fell_commanded"] is not None
+        or all(t.outcome == "aborted" for t in bracket.trials)
+    )
     for trial in bracket.trials:
         s = trial.summary
         assert 0 < trial.speed <= 0.4 and s["outcome"] in OUTCOMES and s["sim_time"] > 0

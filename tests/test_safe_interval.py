@@ -11,8 +11,8 @@ import pytest
 
 import impact_balance as ib
 from impact_balance.criteria.com import max_contact_velocity, safe_interval
-from impact_balance.impact.model import ImpactModel, ImpactSpec
 from impact_balance.geometry.polygon import Polygon
+from impact_balance.impact.model import ImpactModel, ImpactSpec
 
 SQUARE = Polygon(np.array([[1.0, -1.0], [1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0]]))
 MASS = 2.0
@@ -23,8 +23,16 @@ def _model(jumps) -> ImpactModel:
     jumps = np.atleast_2d(np.asarray(jumps, dtype=float))
     rates = np.column_stack([MASS * jumps, np.zeros(len(jumps))])
     spec = ImpactSpec("synthetic", normal=(0.0, 0.0, 1.0))
-    return ImpactModel(spec, np.zeros(3), np.array([0.0, 0.0, 1.0]), np.zeros((3, 1)), np.eye(3), MASS,
-                       np.zeros((3, 1)), rates)
+    return ImpactModel(
+        spec,
+        np.zeros(3),
+        np.array([0.0, 0.0, 1.0]),
+        np.zeros((3, 1)),
+        np.eye(3),
+        MASS,
+        np.zeros((3, 1)),
+        rates,
+    )
 
 
 @pytest.mark.parametrize(

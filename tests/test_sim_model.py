@@ -42,7 +42,9 @@ def mujoco_composite_inertia(sim) -> tuple[float, np.ndarray, np.ndarray]:
     for b in range(1, m.nbody):
         R = d.ximat[b].reshape(3, 3)
         r = d.xipos[b] - com
-        inertia += R @ np.diag(m.body_inertia[b]) @ R.T + m.body_mass[b] * (r @ r * np.eye(3) - np.outer(r, r))
+        inertia += R @ np.diag(m.body_inertia[b]) @ R.T + m.body_mass[b] * (
+            r @ r * np.eye(3) - np.outer(r, r)
+        )
     return mass, com, inertia
 
 
@@ -55,7 +57,9 @@ def test_mass_com_inertia_match_pinocchio(models, name, joints):
     assert mass == pytest.approx(stance.mass, rel=1e-12)
     np.testing.assert_allclose(com, stance.com, atol=1e-12)
     np.testing.assert_allclose(sim.com(), stance.com, atol=1e-12)
-    np.testing.assert_allclose(inertia, stance.com_inertia, atol=1e-10 * np.abs(stance.com_inertia).max())
+    np.testing.assert_allclose(
+        inertia, stance.com_inertia, atol=1e-10 * np.abs(stance.com_inertia).max()
+    )
     if joints == "rigid":
         assert sim.model.nv == 6 and sim.model.nu == 0
     else:
@@ -69,7 +73,9 @@ def test_body_masses_match_pinocchio_joints(models, name):
     pmodel = sim.stance.model
     for jid in range(1, pmodel.njoints):
         body = sim.root_body if jid == 1 else sim.model.joint(pmodel.names[jid]).bodyid[0]
-        assert sim.model.body_mass[body] == pytest.approx(pmodel.inertias[jid].mass, rel=1e-12), pmodel.names[jid]
+        assert sim.model.body_mass[body] == pytest.approx(pmodel.inertias[jid].mass, rel=1e-12), (
+            pmodel.names[jid]
+        )
 
 
 @pytest.mark.parametrize("joints", ["servo", "rigid"])
@@ -83,11 +89,16 @@ def test_contact_boxes_and_impact_sphere_at_the_stance(models, name, joints):
         face_centre = d.geom_xpos[geom] - t * R[:, 2]
         np.testing.assert_allclose(face_centre, contact.position, atol=1e-12)
         np.testing.assert_allclose(R, contact.rotation, atol=1e-12)
-        np.testing.assert_allclose(sim.model.geom_size[geom][:2], [contact.half_length, contact.half_width])
+        np.testing.assert_allclose(
+            sim.model.geom_size[geom][:2], [contact.half_length, contact.half_width]
+        )
         assert sim.model.geom_friction[geom][0] == contact.spec.friction
     # Explicit pairs only: each box with its support (and the ground), the sphere with the surface.
     m = sim.model
-    pairs = {(int(a), int(b)): float(mu) for a, b, mu in zip(m.pair_geom1, m.pair_geom2, m.pair_friction[:, 0])}
+    pairs = {
+        (int(a), int(b)): float(mu)
+        for a, b, mu in zip(m.pair_geom1, m.pair_geom2, m.pair_friction[:, 0])
+    }
     for contact, geom, support in zip(sim.stance.contacts, sim.contact_geoms, sim.support_geoms):
         assert pairs[(support, geom)] == contact.spec.friction
         assert pairs[(sim.ground_geom, geom)] == contact.spec.friction
@@ -109,7 +120,9 @@ def test_contact_boxes_and_impact_sphere_at_the_stance(models, name, joints):
     np.testing.assert_allclose(d.geom_xpos[sim.impact_geom] - r * n, point, atol=1e-12)
     R = d.geom_xmat[sim.surface_geom].reshape(3, 3)
     np.testing.assert_allclose(R[:, 2], n, atol=1e-12)
-    assert (point - d.geom_xpos[sim.surface_geom]) @ n == pytest.approx(sim.model.geom_size[sim.surface_geom][2])
+    assert (point - d.geom_xpos[sim.surface_geom]) @ n == pytest.approx(
+        sim.model.geom_size[sim.surface_geom][2]
+    )
     assert sim.model.geom_friction[sim.impact_geom][0] == spec.friction
 
 
@@ -128,7 +141,11 @@ def test_state_round_trip_and_com_velocity_against_pinocchio(models, name):
     pdata = pmodel.createData()
     rng = np.random.default_rng(3)
     for _ in range(5):
-        q = pin.randomConfiguration(pmodel, np.maximum(pmodel.lowerPositionLimit, -3), np.minimum(pmodel.upperPositionLimit, 3))
+        q = pin.randomConfiguration(
+            pmodel,
+            np.maximum(pmodel.lowerPositionLimit, -3),
+            np.minimum(pmodel.upperPositionLimit, 3),
+        )
         v = rng.normal(size=pmodel.nv)
         sim.set_state(q, v)
         np.testing.assert_allclose(sim.configuration(), q, atol=1e-14)
@@ -144,7 +161,9 @@ def test_state_round_trip_and_com_velocity_against_pinocchio(models, name):
     sim.set_state(sim.stance.q)
 
 
-@pytest.mark.parametrize("name", ["palm_push_two_feet", "talos_three_contacts", "palm_push_ramp", "kick_one_foot"])
+@pytest.mark.parametrize(
+    "name", ["palm_push_two_feet", "talos_three_contacts", "palm_push_ramp", "kick_one_foot"]
+)
 def test_servo_holds_the_stance_under_gravity(name):
     sim = build_model(name, "servo", LIGHT)
     com0 = sim.com()

@@ -19,12 +19,17 @@ import pinocchio as pin
 import pytest
 
 from impact_balance import cli
+from impact_balance.exceptions import ModelRepairWarning, SimulationError
 from impact_balance.logs import read_log, write_log
 from impact_balance.sim import SimOptions, build_model
+from impact_balance.sim.trials.impact_trial import (
+    TrialOptions,
+    approach_joint_velocity,
+    impact_limb,
+    run_trial,
+)
 from impact_balance.sim.trials.log import log_frame
 from impact_balance.sim.trials.measure import distance_to_hull, measure
-from impact_balance.exceptions import ModelRepairWarning, SimulationError
-from impact_balance.sim.trials.impact_trial import TrialOptions, approach_joint_velocity, impact_limb, run_trial
 
 LIGHT = SimOptions(meshes=False)
 
@@ -35,7 +40,9 @@ def models():
 
     def get(name: str, joints: str):
         if (name, joints) not in cache:
-            with warnings.catch_warnings():  # Romeo's and iCub's documented repairs (test_robots_sim checks them)
+            with (
+                warnings.catch_warnings()
+            ):  # Romeo's and iCub's documented repairs (test_robots_sim checks them)
                 warnings.simplefilter("ignore", ModelRepairWarning)
                 cache[(name, joints)] = build_model(name, joints, LIGHT)
         return cache[(name, joints)]
@@ -55,7 +62,9 @@ def test_distance_to_hull():
     assert distance_to_hull([0.5, 0.5], square) == 0.0
     assert distance_to_hull([2.0, 0.5], square) == pytest.approx(1.0)
     assert distance_to_hull([2.0, 2.0], square) == pytest.approx(np.sqrt(2))
-    assert distance_to_hull([0.5, 1.0], np.array([[0, 0], [1, 0]], dtype=float)) == pytest.approx(1.0)
+    assert distance_to_hull([0.5, 1.0], np.array([[0, 0], [1, 0]], dtype=float)) == pytest.approx(
+        1.0
+    )
 
 
 def test_rigid_jump_is_impulse_over_mass_and_inside_composite_set(rigid_push):
@@ -79,7 +88,9 @@ def test_rigid_jump_is_impulse_over_mass_and_inside_composite_set(rigid_push):
     assert result.contacts_kept is None
 
 
-@pytest.mark.parametrize("name,speed", [("kick_one_foot", 0.6), ("g1_two_feet", 0.1), ("palm_push_ramp", 0.6)])
+@pytest.mark.parametrize(
+    "name,speed", [("kick_one_foot", 0.6), ("g1_two_feet", 0.1), ("palm_push_ramp", 0.6)]
+)
 def test_rigid_trial_other_scenarios(models, name, speed):
     sim = models(name, "rigid")
     result = measure(sim, run_trial(sim, TrialOptions(speed, after=0.05)), speed)
@@ -100,7 +111,9 @@ def test_servo_trial_falls_near_the_joint_space_model(models):
     assert result.predicted["joint_space"].distance < result.predicted["composite"].distance
 
 
-@pytest.mark.parametrize("name,speed", [("g1_two_feet", 0.75), ("romeo_two_feet", 0.75), ("palm_push_two_feet", 0.5)])
+@pytest.mark.parametrize(
+    "name,speed", [("g1_two_feet", 0.75), ("romeo_two_feet", 0.75), ("palm_push_two_feet", 0.5)]
+)
 def test_servo_approach_starts_within_joint_limits_and_hits_after_it_begins(models, name, speed):
     """The retracted start pose is within the joints' ranges (G1's right wrist yaw and Romeo's right elbow yaw
     left them with the Jacobian's pseudo-inverse alone), and the impact is the commanded approach's: after the
@@ -113,7 +126,9 @@ def test_servo_approach_starts_within_joint_limits_and_hits_after_it_begins(mode
     dq = approach_joint_velocity(sim, limb, n, options.resolved_gap())
     _, J6 = sim.stance.point(spec.frame, spec.offset)
     assert J6[:3] @ dq == pytest.approx(-n, abs=1e-9)  # unit approach speed along -n at the stance
-    start = pin.integrate(sim.stance.model, sim.stance.q, -options.resolved_gap() * dq)  # the trial's start pose
+    start = pin.integrate(
+        sim.stance.model, sim.stance.q, -options.resolved_gap() * dq
+    )  # the trial's start pose
     ids = [sim.model.joint(j).id for j in limb]
     q_index = [sim.q_index[sim.joint_names.index(j)] for j in limb]
     low, high = sim.model.jnt_range[ids].T
@@ -140,8 +155,10 @@ def test_log_frame_matches_finite_differences(rigid_push, tmp_path):
     frame = log_frame(sim, record)
     dt = sim.model.opt.timestep
     # Base linear velocity (world) and CoM velocity against the differences of the positions.
-    for pos, vel in ((("base_x", "base_y", "base_z"), ("base_vx", "base_vy", "base_vz")),
-                     (("com_x", "com_y", "com_z"), ("comd_x", "comd_y", "comd_z"))):
+    for pos, vel in (
+        (("base_x", "base_y", "base_z"), ("base_vx", "base_vy", "base_vz")),
+        (("com_x", "com_y", "com_z"), ("comd_x", "comd_y", "comd_z")),
+    ):
         p, v = frame[list(pos)].to_numpy(), frame[list(vel)].to_numpy()
         np.testing.assert_allclose(np.diff(p, axis=0) / dt, v[1:], atol=2e-3)
     # Base angular velocity (world axes): R_{k+1} = exp([w dt]) R_k after the impact (the robot spins).
@@ -171,7 +188,9 @@ def run(capsys, *argv):
 
 
 def test_cli_json_single_and_list(capsys):
-    rc, out, err = run(capsys, "simulate", "kick_one_foot", "--speed", "0.3", "--duration", "0.03", "--json")
+    rc, out, err = run(
+        capsys, "simulate", "kick_one_foot", "--speed", "0.3", "--duration", "0.03", "--json"
+    )
     assert rc == 0, err
     doc = json.loads(out, parse_constant=lambda c: pytest.fail(c))
     assert doc["joints"] == "rigid" and doc["approach_speed"] == 0.3
@@ -180,14 +199,25 @@ def test_cli_json_single_and_list(capsys):
         assert jumps.shape == (32, 2)
     assert len(doc["impulse_measured"]) == 3 and len(doc["com_velocity_jump_measured"]) == 2
     assert doc["contacts_kept"] is None and doc["sim_time_ratio"] > 0
-    rc, out, _ = run(capsys, "simulate", "kick_one_foot", "--speed", "0.1,0.2", "--duration", "0.03", "--json")
+    rc, out, _ = run(
+        capsys, "simulate", "kick_one_foot", "--speed", "0.1,0.2", "--duration", "0.03", "--json"
+    )
     docs = json.loads(out)
     assert [d["approach_speed"] for d in docs] == [0.1, 0.2]
 
 
 def test_cli_text_plots_and_log(capsys, tmp_path):
-    rc, out, err = run(capsys, "simulate", "palm_push_two_feet", "--duration", "0.03", "--plots", str(tmp_path),
-                       "--log", str(tmp_path / "log.parquet"))
+    rc, out, err = run(
+        capsys,
+        "simulate",
+        "palm_push_two_feet",
+        "--duration",
+        "0.03",
+        "--plots",
+        str(tmp_path),
+        "--log",
+        str(tmp_path / "log.parquet"),
+    )
     assert rc == 0, err
     assert "composite (predicted)" in out and "joint_space (predicted)" in out
     pngs = sorted(tmp_path.glob("*.png"))
@@ -195,16 +225,19 @@ def test_cli_text_plots_and_log(capsys, tmp_path):
     assert "force_impact_z" in read_log(tmp_path / "log.parquet")
 
 
-@pytest.mark.parametrize("argv,needles", [
-    (["--speed", "0"], ["--speed", "approach speed"]),
-    (["--speed", "-1"], ["--speed"]),
-    (["--speed", "100"], ["--speed"]),
-    (["--speed", "fast"], ["--speed", "not a number"]),
-    (["--joints", "springy"], ["--joints", "rigid, servo"]),
-    (["--duration", "0"], ["--duration"]),
-    (["--log", "x.txt"], ["--log"]),
-    (["--video", "x.avi"], ["--video"]),
-])
+@pytest.mark.parametrize(
+    "argv,needles",
+    [
+        (["--speed", "0"], ["--speed", "approach speed"]),
+        (["--speed", "-1"], ["--speed"]),
+        (["--speed", "100"], ["--speed"]),
+        (["--speed", "fast"], ["--speed", "not a number"]),
+        (["--joints", "springy"], ["--joints", "rigid, servo"]),
+        (["--duration", "0"], ["--duration"]),
+        (["--log", "x.txt"], ["--log"]),
+        (["--video", "x.avi"], ["--video"]),
+    ],
+)
 def test_cli_bad_input_is_one_line(capsys, argv, needles):
     rc, out, err = run(capsys, "simulate", "palm_push_two_feet", *argv)
     assert rc == 2 and "Traceback" not in err and len(err.strip().splitlines()) == 1
@@ -225,8 +258,24 @@ def test_cli_video(tmp_path):
     import sys
 
     video = tmp_path / "trial.mp4"
-    proc = subprocess.run([sys.executable, "-m", "impact_balance", "simulate", "kick_one_foot", "--speed", "0.6",
-                           "--duration", "0.01", "--video", str(video)], capture_output=True, text=True, timeout=300)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "impact_balance",
+            "simulate",
+            "kick_one_foot",
+            "--speed",
+            "0.6",
+            "--duration",
+            "0.01",
+            "--video",
+            str(video),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     if proc.returncode != 0:
         # Without a GL backend: one clear line, no traceback.
         assert proc.returncode == 2 and "Traceback" not in proc.stderr and "--video" in proc.stderr
@@ -241,13 +290,14 @@ def test_cli_video(tmp_path):
 def test_armature_enters_gains_and_joint_space_prediction():
     import pinocchio as pin
 
+    from impact_balance.robot.robot import load_robot
     from impact_balance.sim import ServoOptions
     from impact_balance.sim.trials.measure import _stance_with_armature
 
-    from impact_balance.robot.robot import load_robot
-
     shared = load_robot("talos").model.armature.copy()
-    sim = build_model("kick_one_foot", "servo", SimOptions(meshes=False, servo=ServoOptions(armature=0.3)))
+    sim = build_model(
+        "kick_one_foot", "servo", SimOptions(meshes=False, servo=ServoOptions(armature=0.3))
+    )
     bare = pin.Model(sim.stance.model)
     bare.armature[:] = 0.0
     M = pin.crba(bare, bare.createData(), sim.stance.q)
@@ -258,7 +308,9 @@ def test_armature_enters_gains_and_joint_space_prediction():
     stance = _stance_with_armature(sim)
     M2 = pin.crba(stance.model, stance.model.createData(), stance.q)
     np.testing.assert_allclose(np.diag(M2 - M)[sim.v_index], 0.3, atol=1e-12)
-    np.testing.assert_array_equal(sim.robot.model.armature, shared)  # the shared robot model keeps its own
+    np.testing.assert_array_equal(
+        sim.robot.model.armature, shared
+    )  # the shared robot model keeps its own
 
 
 def test_declared_rotor_inertia_is_the_default_armature():
@@ -267,8 +319,11 @@ def test_declared_rotor_inertia_is_the_default_armature():
 
     sim = build_model("palm_push_two_feet", "servo", SimOptions(meshes=False))
     root = ET.parse(sim.robot.srdf_path).getroot()
-    declared = {j.get("name"): float(j.get("gear_ratio")) ** 2 * float(j.get("mass"))
-                for j in root.iter("joint") if j.get("gear_ratio") is not None}
+    declared = {
+        j.get("name"): float(j.get("gear_ratio")) ** 2 * float(j.get("mass"))
+        for j in root.iter("joint")
+        if j.get("gear_ratio") is not None
+    }
     expected = [declared.get(name, 0.0) for name in sim.joint_names]
     np.testing.assert_allclose(sim.model.dof_armature[sim.dof_adr], expected, rtol=1e-12)
     np.testing.assert_allclose(sim.armature, expected, rtol=1e-12)
@@ -283,8 +338,23 @@ def test_cli_unusable_gl_backend_is_one_line(tmp_path):
     import sys
 
     env = dict(os.environ, MUJOCO_GL="no-such-backend")
-    proc = subprocess.run([sys.executable, "-m", "impact_balance", "simulate", "kick_one_foot", "--duration", "0.01",
-                           "--video", str(tmp_path / "v.mp4")], capture_output=True, text=True, timeout=300, env=env)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "impact_balance",
+            "simulate",
+            "kick_one_foot",
+            "--duration",
+            "0.01",
+            "--video",
+            str(tmp_path / "v.mp4"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
+    )
     assert proc.returncode == 2
     assert proc.stderr.strip().splitlines() == [proc.stderr.strip()] and "MUJOCO_GL" in proc.stderr
     assert "Traceback" not in proc.stderr

@@ -10,8 +10,8 @@ import pytest
 
 import impact_balance as ib
 from impact_balance.exceptions import ImpactBalanceError
-from impact_balance.robot.ik import IKError, solve_stance, stance_residuals
 from impact_balance.geometry.polygon import Polygon
+from impact_balance.robot.ik import IKError, solve_stance, stance_residuals
 from impact_balance.robot.robot import load_robot
 from impact_balance.scenario import load_scenario
 
@@ -33,7 +33,9 @@ def _stance(name: str) -> ib.Stance:
 
 
 def _angle_deg(a: np.ndarray, b: np.ndarray) -> float:
-    return math.degrees(math.acos(float(np.clip(np.dot(a, b) / np.linalg.norm(a) / np.linalg.norm(b), -1, 1))))
+    return math.degrees(
+        math.acos(float(np.clip(np.dot(a, b) / np.linalg.norm(a) / np.linalg.norm(b), -1, 1)))
+    )
 
 
 def _support(stance: ib.Stance) -> Polygon:
@@ -75,7 +77,9 @@ def test_ramp_stance() -> None:
     assert abs(left.position[2]) < 1e-5
     assert np.all(right.corners()[:, 2] > 0.01)  # the ramp foot is off the ground plane
     # CoM over the midpoint of the two sole centres, inside the support.
-    np.testing.assert_allclose(stance.com[:2], 0.5 * (left.position[:2] + right.position[:2]), atol=1e-5)
+    np.testing.assert_allclose(
+        stance.com[:2], 0.5 * (left.position[:2] + right.position[:2]), atol=1e-5
+    )
     assert _support(stance).contains(stance.com[:2], 1e-9)
 
 
@@ -102,7 +106,9 @@ def test_three_contact_stance() -> None:
     hand = stance.contacts[2]
     assert hand.spec.frame == "gripper_left_base_link"
     assert abs(hand.normal[2]) < 1e-3  # horizontal normal: a wall
-    np.testing.assert_allclose(hand.normal, [0.0, -1.0, 0.0], atol=1e-3)  # wall on the left, normal into the robot
+    np.testing.assert_allclose(
+        hand.normal, [0.0, -1.0, 0.0], atol=1e-3
+    )  # wall on the left, normal into the robot
     for foot in stance.contacts[:2]:
         assert _angle_deg(foot.normal, Z) < 0.05
 
@@ -119,7 +125,10 @@ def test_palm_push_gripper_in_front_of_chest() -> None:
 
 
 def test_impact_friction_sweep_is_monotonic() -> None:
-    limits = [ib.analyze(f"palm_push_mu{tag}").impact.max_contact_velocity for tag in ("010", "024", "040")]
+    limits = [
+        ib.analyze(f"palm_push_mu{tag}").impact.max_contact_velocity
+        for tag in ("010", "024", "040")
+    ]
     assert limits[0] > limits[1] > limits[2]
     assert limits[1] == pytest.approx(ib.analyze("palm_push_two_feet").impact.max_contact_velocity)
 
@@ -147,7 +156,11 @@ def test_solve_stance_reports_unreachable_targets() -> None:
     far = pin.SE3(np.eye(3), np.array([2.0, -0.25, 1.0]))
     with pytest.raises(IKError) as info:
         solve_stance(
-            robot, q0, {"gripper_right_base_link": far}, fixed_frames=["left_sole_link", "right_sole_link"], max_iterations=30
+            robot,
+            q0,
+            {"gripper_right_base_link": far},
+            fixed_frames=["left_sole_link", "right_sole_link"],
+            max_iterations=30,
         )
     err = info.value
     assert isinstance(err, ImpactBalanceError)

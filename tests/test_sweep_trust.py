@@ -35,9 +35,14 @@ from impact_balance.sweep.store import LEDGER, check_folder, table_checksum
 
 SRC = str(Path(__file__).parents[1] / "src")
 BASE = "palm_push_two_feet"
-SPEC = {"base": BASE, "chunk_size": 4,
-        "axes": [{"path": "impact.friction", "range": [0.0, 0.6], "count": 5},
-                 {"path": "impact.restitution[1]", "values": [0.0, 0.5, 1.0]}]}  # 15 points, 4 chunks
+SPEC = {
+    "base": BASE,
+    "chunk_size": 4,
+    "axes": [
+        {"path": "impact.friction", "range": [0.0, 0.6], "count": 5},
+        {"path": "impact.restitution[1]", "values": [0.0, 0.5, 1.0]},
+    ],
+}  # 15 points, 4 chunks
 
 
 def main(argv: list[str]) -> int:
@@ -57,7 +62,10 @@ def clean(tmp_path_factory):
     """An uninterrupted run (the reference) and another sweep's folder (for foreign parts)."""
     root = tmp_path_factory.mktemp("clean")
     run_sweep(plan_of(), root / "whole", workers=1, progress=False)
-    other = {**SPEC, "axes": [SPEC["axes"][0], {"path": "impact.restitution[1]", "values": [0.1, 0.2, 0.3]}]}
+    other = {
+        **SPEC,
+        "axes": [SPEC["axes"][0], {"path": "impact.restitution[1]", "values": [0.1, 0.2, 0.3]}],
+    }
     run_sweep(plan_of(other), root / "other", workers=1, progress=False)
     return root
 
@@ -81,17 +89,49 @@ def _without_metadata(path: Path) -> None:
 
 
 DAMAGE = {
-    "cut in half": (lambda p, o: _cut(p / "parts/part-000001.parquet"), "part-000001", "damaged", {1}),
-    "emptied": (lambda p, o: (p / "parts/part-000002.parquet").write_bytes(b""), "part-000002", "damaged", {2}),
-    "foreign": (lambda p, o: shutil.copy(o / "parts/part-000000.parquet", p / "parts/part-000000.parquet"),
-                "part-000000", "foreign", {0}),
-    "extra": (lambda p, o: shutil.copy(p / "parts/part-000001.parquet", p / "parts/part-000009.parquet"),
-              "part-000009", "extra", set()),
-    "renamed": (lambda p, o: os.replace(p / "parts/part-000003.parquet", p / "parts/part-000002.parquet"),
-                "part-000002", "renamed", {2, 3}),
+    "cut in half": (
+        lambda p, o: _cut(p / "parts/part-000001.parquet"),
+        "part-000001",
+        "damaged",
+        {1},
+    ),
+    "emptied": (
+        lambda p, o: (p / "parts/part-000002.parquet").write_bytes(b""),
+        "part-000002",
+        "damaged",
+        {2},
+    ),
+    "foreign": (
+        lambda p, o: shutil.copy(o / "parts/part-000000.parquet", p / "parts/part-000000.parquet"),
+        "part-000000",
+        "foreign",
+        {0},
+    ),
+    "extra": (
+        lambda p, o: shutil.copy(p / "parts/part-000001.parquet", p / "parts/part-000009.parquet"),
+        "part-000009",
+        "extra",
+        set(),
+    ),
+    "renamed": (
+        lambda p, o: os.replace(p / "parts/part-000003.parquet", p / "parts/part-000002.parquet"),
+        "part-000002",
+        "renamed",
+        {2, 3},
+    ),
     "edited": (lambda p, o: _edit(p / "parts/part-000003.parquet"), "part-000003", "damaged", {3}),
-    "metadata stripped": (lambda p, o: _without_metadata(p / "parts/part-000000.parquet"), "part-000000", "foreign", {0}),
-    "deleted": (lambda p, o: (p / "parts/part-000001.parquet").unlink(), "part-000001", "missing", {1}),
+    "metadata stripped": (
+        lambda p, o: _without_metadata(p / "parts/part-000000.parquet"),
+        "part-000000",
+        "foreign",
+        {0},
+    ),
+    "deleted": (
+        lambda p, o: (p / "parts/part-000001.parquet").unlink(),
+        "part-000001",
+        "missing",
+        {1},
+    ),
 }
 
 
@@ -114,8 +154,14 @@ def test_a_damaged_folder_is_named_left_out_and_recomputed(tmp_path, capsys, cle
     assert good.rows == 15 - sum(4 if c < 3 else 3 for c in recomputed)
     # a resume recomputes exactly the bad chunks: same rows as an uninterrupted run, no duplicate
     computed = []
-    report = run_sweep(plan_of(), out, workers=1, progress=False, on_chunk=computed.append,
-                       notify=lambda line: computed.append(line))
+    report = run_sweep(
+        plan_of(),
+        out,
+        workers=1,
+        progress=False,
+        on_chunk=computed.append,
+        notify=lambda line: computed.append(line),
+    )
     assert {c for c in computed if isinstance(c, int)} == recomputed
     assert any(file in str(c) for c in computed if isinstance(c, str))
     resumed, whole = read_results(out), read_results(clean / "whole")
@@ -134,8 +180,11 @@ def test_a_part_of_the_same_chunk_with_edited_metadata_is_caught_by_the_manifest
     meta = dict(table.schema.metadata)
     values = table["max_contact_velocity"].to_pylist()
     values[0] *= 2
-    edited = table.set_column(table.schema.get_field_index("max_contact_velocity"), "max_contact_velocity",
-                              pa.array(values)).replace_schema_metadata(None)
+    edited = table.set_column(
+        table.schema.get_field_index("max_contact_velocity"),
+        "max_contact_velocity",
+        pa.array(values),
+    ).replace_schema_metadata(None)
     meta[b"impact_balance.checksum"] = table_checksum(edited).encode()
     pq.write_table(edited.replace_schema_metadata(meta), path)
     problems = check_folder(out).problems
@@ -146,11 +195,18 @@ def test_the_checksum_survives_parquet_and_sees_one_bit(tmp_path, clean):
     table = read_results(clean / "whole")
     pq.write_table(table, tmp_path / "t.parquet")
     back = pq.read_table(tmp_path / "t.parquet")
-    assert table_checksum(back.replace_schema_metadata(None)) == table_checksum(table.replace_schema_metadata(None))
+    assert table_checksum(back.replace_schema_metadata(None)) == table_checksum(
+        table.replace_schema_metadata(None)
+    )
     values = table["zmp_max_contact_velocity"].to_pylist()
-    values[7] = float.fromhex(values[7].hex()[:-1] + ("0" if values[7].hex()[-1] != "0" else "1"))  # flip the last bit
-    other = table.set_column(table.schema.get_field_index("zmp_max_contact_velocity"), "zmp_max_contact_velocity",
-                             pa.array(values))
+    values[7] = float.fromhex(
+        values[7].hex()[:-1] + ("0" if values[7].hex()[-1] != "0" else "1")
+    )  # flip the last bit
+    other = table.set_column(
+        table.schema.get_field_index("zmp_max_contact_velocity"),
+        "zmp_max_contact_velocity",
+        pa.array(values),
+    )
     assert table_checksum(other) != table_checksum(table)
 
 
@@ -168,8 +224,12 @@ def test_rows_say_what_was_evaluated_and_match_analyze():
     plan = plan_of({"base": BASE, "axes": [{"path": "impact.friction", "values": [0.2]}]})
     row = Evaluator(plan).evaluate_chunk(0).to_pylist()[0]
     stance = analyze(BASE).stance
-    assert row["robot_name"] == "talos" and row["contact_frames"] == ",".join(c.spec.frame for c in stance.contacts)
-    assert row["q"] == pytest.approx(stance.q.tolist(), abs=1e-12) and len(row["stance_digest"]) == 12
+    assert row["robot_name"] == "talos" and row["contact_frames"] == ",".join(
+        c.spec.frame for c in stance.contacts
+    )
+    assert (
+        row["q"] == pytest.approx(stance.q.tolist(), abs=1e-12) and len(row["stance_digest"]) == 12
+    )
 
 
 def test_a_robot_axis_varies_the_robot(tmp_path):
@@ -179,10 +239,17 @@ def test_a_robot_axis_varies_the_robot(tmp_path):
     start = text.index('<link name="torso_2_link">')
     mass = text.index("<mass value=", start)
     heavy = tmp_path / "talos_heavy.urdf"
-    heavy.write_text(text[:mass] + '<mass value="40.0"/>' + text[text.index("/>", mass) + 2:])
+    heavy.write_text(text[:mass] + '<mass value="40.0"/>' + text[text.index("/>", mass) + 2 :])
     files = {"urdf": str(heavy), "srdf": str(talos.srdf_path)}
-    plan = plan_of({"base": BASE, "axes": [{"path": "robot", "values": ["talos", files]},
-                                           {"path": "impact.friction", "values": [0.1]}]})
+    plan = plan_of(
+        {
+            "base": BASE,
+            "axes": [
+                {"path": "robot", "values": ["talos", files]},
+                {"path": "impact.friction", "values": [0.1]},
+            ],
+        }
+    )
     rows = Evaluator(plan).evaluate_chunk(0).to_pylist()
     assert [r["robot_name"] for r in rows] == ["talos", str(heavy)]
     assert rows[0]["stance_digest"] != rows[1]["stance_digest"]
@@ -190,8 +257,12 @@ def test_a_robot_axis_varies_the_robot(tmp_path):
         raw = _read(scenario_path(BASE))
         raw["robot"], raw["impact"]["friction"] = robot, 0.1
         expected = analyze(scenario_from_dict(raw)).impact.max_contact_velocity
-        assert row["status"] == "ok" and row["max_contact_velocity"] == pytest.approx(expected, rel=1e-9)
-    assert rows[0]["max_contact_velocity"] != pytest.approx(rows[1]["max_contact_velocity"], rel=1e-3)
+        assert row["status"] == "ok" and row["max_contact_velocity"] == pytest.approx(
+            expected, rel=1e-9
+        )
+    assert rows[0]["max_contact_velocity"] != pytest.approx(
+        rows[1]["max_contact_velocity"], rel=1e-3
+    )
 
 
 # -- nothing created for bad input ----------------------------------------------------------------
@@ -201,16 +272,21 @@ def _closed_port() -> int:
         return s.getsockname()[1]
 
 
-@pytest.mark.parametrize("out, scheduler, status, needle", [
-    ("/proc/nope/out", None, 1, "--out"),
-    ("AFILE", None, 2, "--out"),
-    ("o", "tcp://", 2, "no host"),
-    ("o", "not-an-address", 2, "no port"),
-    ("o", "http://127.0.0.1:8787", 2, "not Dask's protocol"),
-    ("o", "tcp://127.0.0.1:{port}", 1, "cannot connect"),
-    ("o", "tcp://no-such-host.invalid:8786", 1, "unknown host"),
-])
-def test_bad_out_or_scheduler_is_one_line_and_creates_nothing(tmp_path, capsys, monkeypatch, out, scheduler, status, needle):
+@pytest.mark.parametrize(
+    "out, scheduler, status, needle",
+    [
+        ("/proc/nope/out", None, 1, "--out"),
+        ("AFILE", None, 2, "--out"),
+        ("o", "tcp://", 2, "no host"),
+        ("o", "not-an-address", 2, "no port"),
+        ("o", "http://127.0.0.1:8787", 2, "not Dask's protocol"),
+        ("o", "tcp://127.0.0.1:{port}", 1, "cannot connect"),
+        ("o", "tcp://no-such-host.invalid:8786", 1, "unknown host"),
+    ],
+)
+def test_bad_out_or_scheduler_is_one_line_and_creates_nothing(
+    tmp_path, capsys, monkeypatch, out, scheduler, status, needle
+):
     monkeypatch.chdir(tmp_path)
     Path("AFILE").write_text("x")
     Path("s.yaml").write_text(yaml.safe_dump(SPEC))
@@ -222,14 +298,25 @@ def test_bad_out_or_scheduler_is_one_line_and_creates_nothing(tmp_path, capsys, 
     err = capsys.readouterr().err
     assert rc == status and len(err.splitlines()) == 1 and needle in err and "Traceback" not in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["AFILE", "s.yaml"]
-    assert time.perf_counter() - start < 30  # the closed port answers at once, not after Dask's 30 s
+    assert (
+        time.perf_counter() - start < 30
+    )  # the closed port answers at once, not after Dask's 30 s
 
 
 def test_scheduler_addresses():
     assert check_scheduler_address("tcp://10.0.0.5:8786") == "tcp://10.0.0.5:8786"
     assert check_scheduler_address("localhost:8786") == "tcp://localhost:8786"
     assert check_scheduler_address("tls://[::1]:8786") == "tls://[::1]:8786"
-    for bad in ("", "tcp://", "tcp://host", "host:0", "host:99999", "ucx://h:1", "tcp://h:1/path", "a b:1"):
+    for bad in (
+        "",
+        "tcp://",
+        "tcp://host",
+        "host:0",
+        "host:99999",
+        "ucx://h:1",
+        "tcp://h:1/path",
+        "a b:1",
+    ):
         with pytest.raises(OptionError):
             check_scheduler_address(bad)
     with pytest.raises(EnvironmentFailure, match="cannot connect"):
@@ -239,21 +326,58 @@ def test_scheduler_addresses():
 def test_a_scheduler_given_by_address_runs_the_sweep(tmp_path, clean):
     from distributed import LocalCluster
 
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp://", host="127.0.0.1",
-                      dashboard_address=None) as cluster:
-        report = run_sweep(plan_of(), tmp_path / "d", scheduler=cluster.scheduler_address, progress=False)
-    assert report.backend == "dask" and read_results(tmp_path / "d").equals(read_results(clean / "whole"))
+    with LocalCluster(
+        n_workers=1,
+        threads_per_worker=1,
+        processes=False,
+        protocol="tcp://",
+        host="127.0.0.1",
+        dashboard_address=None,
+    ) as cluster:
+        report = run_sweep(
+            plan_of(), tmp_path / "d", scheduler=cluster.scheduler_address, progress=False
+        )
+    assert report.backend == "dask" and read_results(tmp_path / "d").equals(
+        read_results(clean / "whole")
+    )
 
 
 # -- workers die with their sweep -----------------------------------------------------------------
 @pytest.mark.parametrize("how", ["SIGKILL", "SIGTERM", "Ctrl-C"])
 def test_no_process_is_left_five_seconds_after_a_killed_sweep(tmp_path, how):
-    spec = {"base": BASE, "chunk_size": 8, "axes": [{"posture": {"y": {"range": [-0.5, 0.0], "count": 12},
-                                                                 "z": {"range": [0.8, 1.2], "count": 12}}}]}
+    spec = {
+        "base": BASE,
+        "chunk_size": 8,
+        "axes": [
+            {
+                "posture": {
+                    "y": {"range": [-0.5, 0.0], "count": 12},
+                    "z": {"range": [0.8, 1.2], "count": 12},
+                }
+            }
+        ],
+    }
     (tmp_path / "s.yaml").write_text(yaml.safe_dump(spec))
-    proc = subprocess.Popen([sys.executable, "-m", "impact_balance", "sweep", "s.yaml", "--out", "out", "--workers", "2",
-                             "--no-progress", "--no-plots"], cwd=tmp_path, env={**os.environ, "PYTHONPATH": SRC},
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "impact_balance",
+            "sweep",
+            "s.yaml",
+            "--out",
+            "out",
+            "--workers",
+            "2",
+            "--no-progress",
+            "--no-plots",
+        ],
+        cwd=tmp_path,
+        env={**os.environ, "PYTHONPATH": SRC},
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        start_new_session=True,
+    )
     descendants: list[psutil.Process] = []
     try:
         command = psutil.Process(proc.pid)

@@ -17,11 +17,11 @@ from hypothesis import strategies as st
 
 import impact_balance as ib
 from impact_balance.balance.areas import balance_areas
+from impact_balance.contacts.stance import Stance
 from impact_balance.criteria.com import max_contact_velocity, zmp_max_contact_velocity
 from impact_balance.exceptions import NonFiniteResultError
 from impact_balance.impact.model import impact_model
 from impact_balance.scenario import load_scenario
-from impact_balance.contacts.stance import Stance
 
 NAMES = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot", "talos_three_contacts")
 
@@ -42,7 +42,9 @@ def _answer(name: str, shift: np.ndarray):
     areas = balance_areas(stance, plane_height=h)
     model = impact_model(stance, scenario.impact.spec())
     com_limit = max_contact_velocity(areas.com_velocity_area, model, scenario.com_velocity)
-    zmp_limit = zmp_max_contact_velocity(areas.zmp_area, model, stance.com, h, scenario.gravity, scenario.impact.duration)
+    zmp_limit = zmp_max_contact_velocity(
+        areas.zmp_area, model, stance.com, h, scenario.gravity, scenario.impact.duration
+    )
     return stance, areas, model, com_limit, zmp_limit
 
 

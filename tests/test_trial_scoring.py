@@ -13,16 +13,22 @@ from impact_balance.exceptions import SimulationError
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.sim.studies.journal import TrialJournal
 from impact_balance.sim.studies.push import PushOutcome, PushPrediction, boundary_impulse
-from impact_balance.sim.trials.balance_trial import Push
 from impact_balance.sim.studies.scores import confusion, wilson
+from impact_balance.sim.trials.balance_trial import Push
 from impact_balance.sim.trials.result import finite_or_null
 
 
-@pytest.mark.parametrize("k, n, lo, hi", [
-    # Reference values (Wilson 1927 score interval, z = 1.96), e.g. Newcombe 1998, table I.
-    (0, 10, 0.0, 0.2775), (1, 10, 0.0179, 0.4042), (5, 10, 0.2366, 0.7634), (10, 10, 0.7225, 1.0),
-    (81, 263, 0.2553, 0.3662),
-])
+@pytest.mark.parametrize(
+    "k, n, lo, hi",
+    [
+        # Reference values (Wilson 1927 score interval, z = 1.96), e.g. Newcombe 1998, table I.
+        (0, 10, 0.0, 0.2775),
+        (1, 10, 0.0179, 0.4042),
+        (5, 10, 0.2366, 0.7634),
+        (10, 10, 0.7225, 1.0),
+        (81, 263, 0.2553, 0.3662),
+    ],
+)
 def test_wilson_interval(k, n, lo, hi):
     got = wilson(k, n)
     assert got[0] == pytest.approx(lo, abs=5e-4) and got[1] == pytest.approx(hi, abs=5e-4)
@@ -33,9 +39,16 @@ def test_confusion_counts_and_rates():
     safe = [True, True, True, False, False, True]
     fell = [False, True, False, True, False, False]
     c = confusion(safe, fell)
-    assert (c["safe_survived"], c["safe_fell"], c["unsafe_survived"], c["unsafe_fell"]) == (3, 1, 1, 1)
+    assert (c["safe_survived"], c["safe_fell"], c["unsafe_survived"], c["unsafe_fell"]) == (
+        3,
+        1,
+        1,
+        1,
+    )
     assert c["accuracy"] == pytest.approx(4 / 6) and c["safe_fell_rate"] == pytest.approx(1 / 6)
-    assert c["fell_given_safe"] == pytest.approx(1 / 4) and c["survived_given_unsafe"] == pytest.approx(1 / 2)
+    assert c["fell_given_safe"] == pytest.approx(1 / 4) and c[
+        "survived_given_unsafe"
+    ] == pytest.approx(1 / 2)
     assert c["accuracy_ci95"][0] < 4 / 6 < c["accuracy_ci95"][1]
 
 
@@ -53,10 +66,22 @@ def test_boundary_impulse_puts_the_predicted_velocity_on_the_boundary():
 def test_push_calls_at_a_margin_are_the_inset_area():
     """Safe at margin M exactly when the prediction lies in the area shrunk by M (omega M in CoM velocity)."""
     omega = 3.3
-    summary = {"outcome": "balanced", "com_velocity_margin_at_end": 0.02, "min_zmp_margin_during": None}
-    o = PushOutcome(push=Push(0.0, 10.0), relative=None, summary=summary,
-                    prediction=PushPrediction(np.zeros(2), 0.033, np.zeros(2), 0.004))
-    assert o.safe("com", 0.0, omega) and o.safe("com", 0.01, omega) and not o.safe("com", 0.0101, omega)
+    summary = {
+        "outcome": "balanced",
+        "com_velocity_margin_at_end": 0.02,
+        "min_zmp_margin_during": None,
+    }
+    o = PushOutcome(
+        push=Push(0.0, 10.0),
+        relative=None,
+        summary=summary,
+        prediction=PushPrediction(np.zeros(2), 0.033, np.zeros(2), 0.004),
+    )
+    assert (
+        o.safe("com", 0.0, omega)
+        and o.safe("com", 0.01, omega)
+        and not o.safe("com", 0.0101, omega)
+    )
     assert o.safe("zmp", 0.004, omega) and not o.safe("zmp", 0.005, omega)
     assert o.safe("com_in_trial", 0.006, omega) and not o.safe("com_in_trial", 0.007, omega)
     assert not o.safe("zmp_in_trial", 0.0, omega)  # no ZMP (a foot carried nothing): not safe
@@ -92,8 +117,8 @@ def test_journal_round_trip_cut_line_and_foreign_digest(tmp_path):
 
 
 def test_an_interrupted_push_test_resumes_with_the_same_answers(tmp_path):
-    from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions
     from impact_balance.sim.studies.push import push_test
+    from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions
 
     options = BalanceTrialOptions(controller="id", after=0.5)
     setup = BalanceSetup.create("palm_push_two_feet", options=options)
@@ -106,13 +131,29 @@ def test_an_interrupted_push_test_resumes_with_the_same_answers(tmp_path):
 
     journal = TrialJournal.open(path, "d")
     with pytest.raises(KeyboardInterrupt):
-        push_test("palm_push_two_feet", 4, magnitudes=[5.0], options=options, setup=setup, journal=journal,
-                  progress=crash_after_two)
+        push_test(
+            "palm_push_two_feet",
+            4,
+            magnitudes=[5.0],
+            options=options,
+            setup=setup,
+            journal=journal,
+            progress=crash_after_two,
+        )
     journal.close()
-    resumed = push_test("palm_push_two_feet", 4, magnitudes=[5.0], options=options, setup=setup,
-                        journal=TrialJournal.open(path, "d"))
+    resumed = push_test(
+        "palm_push_two_feet",
+        4,
+        magnitudes=[5.0],
+        options=options,
+        setup=setup,
+        journal=TrialJournal.open(path, "d"),
+    )
     assert resumed.reused == 2 and len(resumed.outcomes) == 4
     fresh = push_test("palm_push_two_feet", 4, magnitudes=[5.0], options=options, setup=setup)
-    assert [o.summary["outcome"] for o in resumed.outcomes] == [o.summary["outcome"] for o in fresh.outcomes]
+    assert [o.summary["outcome"] for o in resumed.outcomes] == [
+        o.summary["outcome"] for o in fresh.outcomes
+    ]
     assert [o.summary["com_velocity_margin_at_end"] for o in resumed.outcomes] == pytest.approx(
-        [o.summary["com_velocity_margin_at_end"] for o in fresh.outcomes], abs=1e-12)
+        [o.summary["com_velocity_margin_at_end"] for o in fresh.outcomes], abs=1e-12
+    )

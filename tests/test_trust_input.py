@@ -32,9 +32,9 @@ from impact_balance.exceptions import (
     UnknownKeyError,
     short_repr,
 )
-from impact_balance.scenario.reader import MAX_BYTES, MAX_DEPTH, MAX_VALUES, parse_yaml
 from impact_balance.robot.robot import load_robot
 from impact_balance.scenario import load_scenario, scenario_from_dict
+from impact_balance.scenario.reader import MAX_BYTES, MAX_DEPTH, MAX_VALUES, parse_yaml
 
 TWO_FEET = {
     "robot": "talos",
@@ -72,8 +72,13 @@ def strict_json(text: str):
 
 
 def run_process(*argv: str, **kwargs) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "impact_balance", *argv], capture_output=True, text=True,
-                          timeout=120, **kwargs)
+    return subprocess.run(
+        [sys.executable, "-m", "impact_balance", *argv],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        **kwargs,
+    )
 
 
 def without_compile_notice(stderr: str) -> list[str]:
@@ -89,7 +94,9 @@ def alias_tree(fan: int, levels: int) -> str:
 
 def test_alias_bomb_is_refused_in_milliseconds(tmp_path):
     # 9**9 strings from ~400 bytes, as the value of the first field validated (`name`)
-    text = "impact:\n" + "".join(f"  - {line.split(': ', 1)[1]}\n" for line in alias_tree(9, 9).splitlines())
+    text = "impact:\n" + "".join(
+        f"  - {line.split(': ', 1)[1]}\n" for line in alias_tree(9, 9).splitlines()
+    )
     text += "name: *l8\ncontacts: []\n"
     start = time.perf_counter()
     with pytest.raises(ScenarioError) as info:
@@ -101,8 +108,10 @@ def test_alias_bomb_is_refused_in_milliseconds(tmp_path):
 
 def test_small_alias_use_is_accepted(tmp_path):
     """Control: anchors and merge keys that expand to a few values are ordinary YAML."""
-    text = ("robot: talos\nx-contact: &c {friction: 0.7, size: [0.2, 0.1]}\n"
-            "contacts: [{<<: *c, frame: left_sole_link}, {<<: *c, frame: right_sole_link}]\n")
+    text = (
+        "robot: talos\nx-contact: &c {friction: 0.7, size: [0.2, 0.1]}\n"
+        "contacts: [{<<: *c, frame: left_sole_link}, {<<: *c, frame: right_sole_link}]\n"
+    )
     raw = parse_yaml(text)
     raw.pop("x-contact")
     scenario = scenario_from_dict(raw)
@@ -181,7 +190,11 @@ def test_nul_in_a_name_is_a_clear_error(capsys):
 
 def test_extends_chain_limit(tmp_path):
     for i in range(20):
-        write(tmp_path, f"extends: c{i + 1}.yaml\n" if i < 19 else "extends: palm_push_two_feet\n", f"c{i}.yaml")
+        write(
+            tmp_path,
+            f"extends: c{i + 1}.yaml\n" if i < 19 else "extends: palm_push_two_feet\n",
+            f"c{i}.yaml",
+        )
     with pytest.raises(ScenarioError, match="chain of more than"):
         load_scenario(tmp_path / "c0.yaml")
     assert load_scenario(tmp_path / "c10.yaml").impact is not None  # 10 levels: accepted
@@ -199,34 +212,68 @@ def test_short_repr_never_expands_a_shared_structure():
     assert short_repr("s" * 10_000).count("s") < 80
     assert short_repr(10**400) == repr(10**400)[:77] + "..."
     assert short_repr(10**5000) == "<a very large integer>"  # Python refuses to convert it
-    assert short_repr(0.7) == "0.7" and short_repr([0.2, 0.1]) == "[0.2, 0.1]"  # short values unchanged
+    assert (
+        short_repr(0.7) == "0.7" and short_repr([0.2, 0.1]) == "[0.2, 0.1]"
+    )  # short values unchanged
 
 
 def test_unknown_frame_message_is_short_with_closest_names_and_count(tmp_path):
     robot = load_robot("talos")
     with pytest.raises(UnknownFrameError) as info:
-        analyze(write(tmp_path, {**TWO_FEET, "contacts": [{"frame": "left_sole", "friction": 0.7, "size": [0.2, 0.1]}]}))
+        analyze(
+            write(
+                tmp_path,
+                {
+                    **TWO_FEET,
+                    "contacts": [{"frame": "left_sole", "friction": 0.7, "size": [0.2, 0.1]}],
+                },
+            )
+        )
     message = str(info.value)
     assert len(message) < 400  # was 2.7 KB: every frame name
     assert "did you mean left_sole_link" in message
-    assert f"{robot.model.nframes} valid frames" in message and "impact-balance frames talos" in message
-    assert set(info.value.valid) == {f.name for f in robot.model.frames}  # the data still has them all
+    assert (
+        f"{robot.model.nframes} valid frames" in message
+        and "impact-balance frames talos" in message
+    )
+    assert set(info.value.valid) == {
+        f.name for f in robot.model.frames
+    }  # the data still has them all
 
 
 def test_huge_unknown_name_is_cut(tmp_path):
     with pytest.raises(UnknownFrameError) as info:
-        analyze(write(tmp_path, {**TWO_FEET, "contacts": [{"frame": "f" * 100_000, "friction": 0.7, "size": [0.2, 0.1]}]}))
+        analyze(
+            write(
+                tmp_path,
+                {
+                    **TWO_FEET,
+                    "contacts": [{"frame": "f" * 100_000, "friction": 0.7, "size": [0.2, 0.1]}],
+                },
+            )
+        )
     assert len(str(info.value)) <= MESSAGE_CHARS
 
 
 @pytest.mark.parametrize(
     "path, typo, suggestion",
-    [((), "plane_hieght", "plane_height"), (("impact",), "frition", "friction"), (("contacts", 0), "frictoin", "friction"),
-     ((), "contact", "contacts"), (("impact", "qp"), "solver_name", "solver")],
+    [
+        ((), "plane_hieght", "plane_height"),
+        (("impact",), "frition", "friction"),
+        (("contacts", 0), "frictoin", "friction"),
+        ((), "contact", "contacts"),
+        (("impact", "qp"), "solver_name", "solver"),
+    ],
 )
 def test_unknown_key_suggests_the_nearest(tmp_path, capsys, path, typo, suggestion):
-    data = json.loads(json.dumps({**TWO_FEET, "impact": {"frame": "gripper_right_base_link", "normal": [-1, 0, 0],
-                                                         "qp": {}}}))
+    data = json.loads(
+        json.dumps(
+            {
+                **TWO_FEET,
+                "impact": {"frame": "gripper_right_base_link", "normal": [-1, 0, 0], "qp": {}},
+            }
+        )
+    )
     node = data
     for part in path:
         node = node[part]
@@ -260,7 +307,12 @@ RANGES = [
     (("impact", "friction"), 1e7, 0.0, "[0, 1e+06]"),
     (("contacts", 0, "size"), [11.0, 0.1], [10.0, 0.1], "(0, 10] m"),
     (("base",), {"position": [1e160, 0, 1]}, {"position": [1e4, 0, 1]}, "[-10000, 10000] m"),
-    (("impact", "offset"), {"position": [0, 0, -2e4]}, {"position": [0, 0, 0.01]}, "[-10000, 10000] m"),
+    (
+        ("impact", "offset"),
+        {"position": [0, 0, -2e4]},
+        {"position": [0, 0, 0.01]},
+        "[-10000, 10000] m",
+    ),
     (("contacts", 0, "offset"), {"rpy": [20.0, 0, 0]}, {"rpy": [0.1, 0, 0]}, "rad"),
     (("plane_height",), -1e160, -1.0, "[-10000, 10000] m"),
     (("gravity",), 1000.0, 1.62, "[0.1, 100] m/s^2"),
@@ -280,30 +332,50 @@ def with_value(path, value) -> dict:
     return data
 
 
-@pytest.mark.parametrize("path, bad, good, text", RANGES, ids=[".".join(map(str, r[0])) for r in RANGES])
+@pytest.mark.parametrize(
+    "path, bad, good, text", RANGES, ids=[".".join(map(str, r[0])) for r in RANGES]
+)
 def test_out_of_range_value_is_refused_with_the_range(path, bad, good, text):
     with pytest.raises(ScenarioError) as info:
         scenario_from_dict(with_value(path, bad))
-    assert info.value.field.startswith(".".join(str(p) for p in path if not isinstance(p, int)).split(".")[0])
+    assert info.value.field.startswith(
+        ".".join(str(p) for p in path if not isinstance(p, int)).split(".")[0]
+    )
     assert text in str(info.value)
     scenario_from_dict(with_value(path, good))  # control: the range's own boundary is accepted
 
 
-@pytest.mark.parametrize("path", [("com_velocity",), ("plane_height",), ("base",), ("impact", "normal"),
-                                  ("contacts", 0, "friction"), ("joints",), ("impact", "reference_velocity")])
+@pytest.mark.parametrize(
+    "path",
+    [
+        ("com_velocity",),
+        ("plane_height",),
+        ("base",),
+        ("impact", "normal"),
+        ("contacts", 0, "friction"),
+        ("joints",),
+        ("impact", "reference_velocity"),
+    ],
+)
 def test_nan_is_refused_everywhere(path):
-    value = {("com_velocity",): [math.nan, 0.0], ("base",): {"position": [math.nan, 0, 1]},
-             ("impact", "normal"): [math.nan, 0, 1], ("joints",): {"leg_left_4_joint": math.nan},
-             ("impact", "reference_velocity"): [math.nan, 0, 0]}.get(path, math.nan)
+    value = {
+        ("com_velocity",): [math.nan, 0.0],
+        ("base",): {"position": [math.nan, 0, 1]},
+        ("impact", "normal"): [math.nan, 0, 1],
+        ("joints",): {"leg_left_4_joint": math.nan},
+        ("impact", "reference_velocity"): [math.nan, 0, 0],
+    }.get(path, math.nan)
     with pytest.raises(ScenarioError, match="finite"):
         scenario_from_dict(with_value(path, value))
 
 
 # -- stdout: one strict JSON document, quiet pipes, no native chatter ---------------------------
 def test_highs_prints_nothing():
-    code = ("import numpy as np\nfrom impact_balance.solvers import HighsLP, LinearProgram\n"
-            "lp = HighsLP(LinearProgram(np.eye(2), np.ones(2), np.zeros((0, 2)), np.zeros(0)))\n"
-            "assert lp.maximize(np.ones(2)).objective == 2.0\n")
+    code = (
+        "import numpy as np\nfrom impact_balance.solvers import HighsLP, LinearProgram\n"
+        "lp = HighsLP(LinearProgram(np.eye(2), np.ones(2), np.zeros((0, 2)), np.zeros(0)))\n"
+        "assert lp.maximize(np.ones(2)).objective == 2.0\n"
+    )
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout == "" and proc.stderr == ""  # the "Running HiGHS ..." banner went to stdout
@@ -319,8 +391,11 @@ def test_analyze_json_stdout_is_one_strict_document():
 
 def test_closed_stdout_ends_quietly():
     """``analyze --json | head -c 10``: the reader is gone before the JSON is written."""
-    proc = subprocess.Popen([sys.executable, "-m", "impact_balance", "analyze", "palm_push_two_feet", "--json"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "impact_balance", "analyze", "palm_push_two_feet", "--json"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
     proc.stdout.close()
     _, err = proc.communicate(timeout=120)
     assert without_compile_notice(err.decode()) == []  # was a BrokenPipeError traceback
@@ -328,8 +403,10 @@ def test_closed_stdout_ends_quietly():
 
 
 def test_urdf_errors_are_one_line_with_the_cause(tmp_path):
-    (tmp_path / "bad.urdf").write_text('<robot name="r"><link name="a"/><joint name="j" type="revolute">'
-                                       '<parent link="a"/><child link="b"/></joint></robot>')
+    (tmp_path / "bad.urdf").write_text(
+        '<robot name="r"><link name="a"/><joint name="j" type="revolute">'
+        '<parent link="a"/><child link="b"/></joint></robot>'
+    )
     path = write(tmp_path, {**TWO_FEET, "robot": {"urdf": "bad.urdf"}})
     with pytest.raises(RobotLoadError, match="does not specify limits"):
         analyze(path)
@@ -365,7 +442,9 @@ def test_flipped_sole_warns_normal_down(tmp_path):
     assert analysis.stance.contacts[0].normal[2] < -0.99  # independent: the frame's z axis
 
 
-@pytest.mark.parametrize("roll, warned", [(0.0, False), (0.6, False), (math.radians(45), True), (1.3, False)])
+@pytest.mark.parametrize(
+    "roll, warned", [(0.0, False), (0.6, False), (math.radians(45), True), (1.3, False)]
+)
 def test_tilted_contact_warns_between_floor_and_wall(tmp_path, roll, warned):
     contacts = json.loads(json.dumps(TWO_FEET["contacts"]))
     contacts[1]["offset"] = {"rpy": [roll, 0.0, 0.0]}
@@ -375,16 +454,27 @@ def test_tilted_contact_warns_between_floor_and_wall(tmp_path, roll, warned):
 
 
 def test_impact_moving_away_warns(tmp_path, capsys):
-    path = write(tmp_path, scenario_with(impact=dict(IMPACT, normal=[1.0, 0.0, 0.0], reference_velocity=[0.8, 0.0, 0.0])))
+    path = write(
+        tmp_path,
+        scenario_with(
+            impact=dict(IMPACT, normal=[1.0, 0.0, 0.0], reference_velocity=[0.8, 0.0, 0.0])
+        ),
+    )
     analysis = analyze(path)
     assert codes(analysis) == ["impact_moving_away"]
     assert analysis.impact.model.approach_speed([0.8, 0.0, 0.0]) < 0  # independent: -n.v = -0.8
     rc, out, err = run_cli(capsys, "analyze", str(path))
-    assert rc == 0 and "warning: impact.reference_velocity:" in out and "[impact_moving_away]" in out
+    assert (
+        rc == 0 and "warning: impact.reference_velocity:" in out and "[impact_moving_away]" in out
+    )
     rc, out, err = run_cli(capsys, "analyze", str(path), "--json")
     assert rc == 0 and strict_json(out)["warnings"][0]["code"] == "impact_moving_away"
     # control: the same reference towards the surface is capped, no warning
-    control = write(tmp_path, scenario_with(impact=dict(IMPACT, reference_velocity=[0.8, 0.0, 0.0])), "control.yaml")
+    control = write(
+        tmp_path,
+        scenario_with(impact=dict(IMPACT, reference_velocity=[0.8, 0.0, 0.0])),
+        "control.yaml",
+    )
     assert codes(analyze(control)) == []
 
 
@@ -392,13 +482,19 @@ def test_qp_capped_by_the_reference_warns():
     analysis = analyze("kick_one_foot", solve_qp=True)
     assert codes(analysis) == ["qp_capped_by_reference"]
     qp, limit = analysis.impact.qp.approach_speed, analysis.impact.max_contact_velocity
-    assert qp == pytest.approx(1.0, abs=1e-6) and limit > 1.2  # the reference (1 m/s) below the maximum
+    assert (
+        qp == pytest.approx(1.0, abs=1e-6) and limit > 1.2
+    )  # the reference (1 m/s) below the maximum
     assert codes(analyze("kick_one_foot")) == []  # without the QP, nothing to say
 
 
 def test_skipped_figure_warns(tmp_path, capsys):
-    path = write(tmp_path, {"robot": "talos", "contacts": [TWO_FEET["contacts"][0]]})  # CoM beside the only sole
-    rc, out, err = run_cli(capsys, "analyze", str(path), "--json", "--plots", str(tmp_path / "figures"))
+    path = write(
+        tmp_path, {"robot": "talos", "contacts": [TWO_FEET["contacts"][0]]}
+    )  # CoM beside the only sole
+    rc, out, err = run_cli(
+        capsys, "analyze", str(path), "--json", "--plots", str(tmp_path / "figures")
+    )
     assert rc == 0, err
     (warning,) = strict_json(out)["warnings"]
     assert warning["code"] == "figure_skipped" and "phase_portrait" in warning["message"]
@@ -407,7 +503,12 @@ def test_skipped_figure_warns(tmp_path, capsys):
 
 
 def test_strict_turns_warnings_into_one_error_line(tmp_path, capsys):
-    path = write(tmp_path, scenario_with(impact=dict(IMPACT, normal=[1.0, 0.0, 0.0], reference_velocity=[0.8, 0.0, 0.0])))
+    path = write(
+        tmp_path,
+        scenario_with(
+            impact=dict(IMPACT, normal=[1.0, 0.0, 0.0], reference_velocity=[0.8, 0.0, 0.0])
+        ),
+    )
     line = one_error_line(*run_cli(capsys, "analyze", str(path), "--json", "--strict"))
     assert "(--strict)" in line and "impact_moving_away" in line
     exc = StrictWarningsError(analyze(path).warnings)
@@ -443,7 +544,10 @@ def test_version(capsys):
     with pytest.raises(SystemExit) as info:
         cli.main(["--version"])
     assert info.value.code == 0
-    assert capsys.readouterr().out.strip() == f"impact-balance {importlib.metadata.version('impact-balance')}"
+    assert (
+        capsys.readouterr().out.strip()
+        == f"impact-balance {importlib.metadata.version('impact-balance')}"
+    )
 
 
 def test_pinocchio_frame_count_is_independent():
@@ -455,11 +559,22 @@ def test_pinocchio_frame_count_is_independent():
 def test_gui_shows_the_warnings(tmp_path):
     from impact_balance.gui.app import GuiApp
 
-    path = write(tmp_path, scenario_with(impact=dict(IMPACT, normal=[1.0, 0.0, 0.0], reference_velocity=[0.8, 0.0, 0.0])))
+    path = write(
+        tmp_path,
+        scenario_with(
+            impact=dict(IMPACT, normal=[1.0, 0.0, 0.0], reference_velocity=[0.8, 0.0, 0.0])
+        ),
+    )
     app = GuiApp(str(path), port=0)
     try:
-        assert app.session.summary.warnings and "[impact_moving_away]" in app.session.summary.warnings[0]
-        assert 'class="ib-warning"' in app.w_results.content and "impact_moving_away" in app.w_results.content
+        assert (
+            app.session.summary.warnings
+            and "[impact_moving_away]" in app.session.summary.warnings[0]
+        )
+        assert (
+            'class="ib-warning"' in app.w_results.content
+            and "impact_moving_away" in app.w_results.content
+        )
         app.edit(lambda: app.session.load("palm_push_two_feet"))  # control: no warning, no line
         assert 'class="ib-warning"' not in app.w_results.content
     finally:
@@ -467,11 +582,27 @@ def test_gui_shows_the_warnings(tmp_path):
 
 
 def test_phase_portrait_refuses_non_finite_gravity(capsys):
-    line = one_error_line(*run_cli(capsys, "phase-portrait", "--com-height", "0.8", "--zmp-range", "-0.1", "0.1",
-                                   "--gravity", "inf", "--json"))
+    line = one_error_line(
+        *run_cli(
+            capsys,
+            "phase-portrait",
+            "--com-height",
+            "0.8",
+            "--zmp-range",
+            "-0.1",
+            "0.1",
+            "--gravity",
+            "inf",
+            "--json",
+        )
+    )
     assert "gravity = inf" in line and "[0.1, 100]" in line
-    rc, out, _ = run_cli(capsys, "phase-portrait", "--com-height", "0.78", "--zmp-range", "-0.13", "0.13", "--json")
-    assert rc == 0 and strict_json(out)["com_velocity_bounds"][1] == pytest.approx(0.13 * math.sqrt(9.81 / 0.78))
+    rc, out, _ = run_cli(
+        capsys, "phase-portrait", "--com-height", "0.78", "--zmp-range", "-0.13", "0.13", "--json"
+    )
+    assert rc == 0 and strict_json(out)["com_velocity_bounds"][1] == pytest.approx(
+        0.13 * math.sqrt(9.81 / 0.78)
+    )
 
 
 def test_solo12_foot_frames_are_tilted(tmp_path):
@@ -480,10 +611,15 @@ def test_solo12_foot_frames_are_tilted(tmp_path):
 
     root = example_robot_data_root() / "solo_description"
     feet = ["FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"]
-    data = {"robot": {"urdf": str(root / "robots" / "solo12.urdf"), "srdf": str(root / "srdf" / "solo.srdf"),
-                      "standing": "straight_standing"},
-            "torque_limits": False,
-            "contacts": [{"frame": f, "friction": 0.7, "size": [0.02, 0.02]} for f in feet]}
+    data = {
+        "robot": {
+            "urdf": str(root / "robots" / "solo12.urdf"),
+            "srdf": str(root / "srdf" / "solo.srdf"),
+            "standing": "straight_standing",
+        },
+        "torque_limits": False,
+        "contacts": [{"frame": f, "friction": 0.7, "size": [0.02, 0.02]} for f in feet],
+    }
     analysis = analyze(write(tmp_path, data))
     assert codes(analysis) == ["contact_normal_tilted"] * 4
     # independent: the frames' z axes from pinocchio's forward kinematics at the same q

@@ -23,13 +23,19 @@ def inside_distance(vertices: np.ndarray, x: np.ndarray) -> float:
     best = math.inf
     for a, b in zip(vertices, np.roll(vertices, -1, axis=0)):
         edge = b - a
-        best = min(best, float(edge[0] * (x[1] - a[1]) - edge[1] * (x[0] - a[0])) / float(np.hypot(*edge)))
+        best = min(
+            best, float(edge[0] * (x[1] - a[1]) - edge[1] * (x[0] - a[0])) / float(np.hypot(*edge))
+        )
     return best
 
 
 @settings(max_examples=40, deadline=None)
-@given(name=st.sampled_from(sorted(ANALYSES)), d=st.floats(0.0, 0.05),
-       cx=st.floats(-0.05, 0.05), cy=st.floats(-0.05, 0.05))
+@given(
+    name=st.sampled_from(sorted(ANALYSES)),
+    d=st.floats(0.0, 0.05),
+    cx=st.floats(-0.05, 0.05),
+    cy=st.floats(-0.05, 0.05),
+)
 def test_the_limit_puts_the_worst_vertex_d_inside(name, d, cx, cy):
     analysis = ANALYSES[name]
     area, model = analysis.areas.com_velocity_area, analysis.impact.model
@@ -41,14 +47,19 @@ def test_the_limit_puts_the_worst_vertex_d_inside(name, d, cx, cy):
     s = limit.max_approach_speed
     worst = min(inside_distance(area.vertices, p) for p in model.post_impact_com_velocities(c0, s))
     assert worst == pytest.approx(d, abs=1e-9)
-    beyond = min(inside_distance(area.vertices, p) for p in model.post_impact_com_velocities(c0, s * 1.001 + 1e-6))
+    beyond = min(
+        inside_distance(area.vertices, p)
+        for p in model.post_impact_com_velocities(c0, s * 1.001 + 1e-6)
+    )
     assert beyond < d
     assert s <= ComCriterion(area, model).limit(c0).max_approach_speed + 1e-12
 
 
 def test_the_governor_applies_it_to_both_models():
     plain = Governor("palm_push_two_feet", contact_aware=True, contact_aware_starts="warm")
-    margin = Governor("palm_push_two_feet", contact_aware=True, contact_aware_starts="warm", velocity_margin=0.02)
+    margin = Governor(
+        "palm_push_two_feet", contact_aware=True, contact_aware_starts="warm", velocity_margin=0.02
+    )
     q, v = plain.configuration, np.zeros(plain.nv)
     a, b = plain.limit(q, v), margin.limit(q, v)
     assert b.max_approach_speed < a.max_approach_speed
@@ -57,7 +68,9 @@ def test_the_governor_applies_it_to_both_models():
     assert b.max_approach_speed <= floating.max_approach_speed + 1e-12
     # The contact-aware jump with the margin: the point it predicts at the limit is 0.02 inside (or the floating set binds).
     aware = margin._support.answer(posture.com_criterion, b.com_velocity)
-    assert b.max_approach_speed == pytest.approx(min(floating.max_approach_speed, aware.limit.max_approach_speed))
+    assert b.max_approach_speed == pytest.approx(
+        min(floating.max_approach_speed, aware.limit.max_approach_speed)
+    )
     rates = aware.rates
     vertices = posture.com_criterion.area.vertices
     s = aware.limit.max_approach_speed
@@ -65,8 +78,15 @@ def test_the_governor_applies_it_to_both_models():
     assert worst == pytest.approx(0.02, abs=1e-9)
 
 
-@pytest.mark.parametrize("kwargs", [{"velocity_margin": -0.01}, {"velocity_margin": float("nan")},
-                                    {"velocity_margin": "fast"}, {"velocity_margin": 0.02, "criterion": "zmp"}])
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"velocity_margin": -0.01},
+        {"velocity_margin": float("nan")},
+        {"velocity_margin": "fast"},
+        {"velocity_margin": 0.02, "criterion": "zmp"},
+    ],
+)
 def test_bad_margins_name_the_field(kwargs):
     with pytest.raises(GovernorError, match="velocity_margin"):
         Governor("palm_push_two_feet", **kwargs)
@@ -75,11 +95,16 @@ def test_bad_margins_name_the_field(kwargs):
 def test_async_rates_are_the_workers_answer_for_the_posture_it_was_sent():
     """With contact_aware_async the tick adopts the worker's rates for an earlier posture: the
     same numbers a synchronous solve gives there (cold start: nothing carried)."""
-    from impact_balance.governor.support import ContactAwareLimit
     from impact_balance.contacts.stance import Stance
+    from impact_balance.governor.support import ContactAwareLimit
 
-    with Governor("g1_two_feet", contact_aware=True, contact_aware_starts="cold", contact_aware_async=True,
-                  velocity_margin=0.01) as governor:
+    with Governor(
+        "g1_two_feet",
+        contact_aware=True,
+        contact_aware_starts="cold",
+        contact_aware_async=True,
+        velocity_margin=0.01,
+    ) as governor:
         worker = governor._worker
         assert worker is not None and worker.alive
         q1 = governor.configuration.copy()
@@ -90,7 +115,8 @@ def test_async_rates_are_the_workers_answer_for_the_posture_it_was_sent():
         solutions = worker.wait(120.0)
         assert solutions is not None
         expected = ContactAwareLimit(governor.scenario.impact.spec(), 1, "cold").solve(
-            Stance(governor.robot, q1, tuple(c.spec() for c in governor.scenario.contacts)))
+            Stance(governor.robot, q1, tuple(c.spec() for c in governor.scenario.contacts))
+        )
         np.testing.assert_allclose(solutions.rates, expected.rates, rtol=0, atol=1e-12)
         governor._support.adopt(solutions)  # what the next tick's poll does
         q2 = q1.copy()
@@ -98,8 +124,9 @@ def test_async_rates_are_the_workers_answer_for_the_posture_it_was_sent():
         second = governor.limit(q2, v)
         aware = governor._support.answer(governor.posture.com_criterion, second.com_velocity)
         floating = governor.posture.com_criterion.limit(second.com_velocity)
-        assert second.max_approach_speed == pytest.approx(min(aware.limit.max_approach_speed,
-                                                             floating.max_approach_speed))
+        assert second.max_approach_speed == pytest.approx(
+            min(aware.limit.max_approach_speed, floating.max_approach_speed)
+        )
         assert first.binding == "contact_aware"
     assert governor._worker is None and not worker.alive  # closed by the with block
 

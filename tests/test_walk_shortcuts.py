@@ -30,7 +30,9 @@ def _degenerate(rng, n: int, extra: int, far: int):
     other = rng.normal(size=(far, n))
     H = np.vstack([near, other])
     H /= np.linalg.norm(H, axis=1)[:, None]
-    slack = np.concatenate([rng.choice([0.0, 1e-13, -1e-13], size=n + extra), 10.0 ** rng.uniform(-9, 0, size=far)])
+    slack = np.concatenate(
+        [rng.choice([0.0, 1e-13, -1e-13], size=n + extra), 10.0 ** rng.uniform(-9, 0, size=far)]
+    )
     order = rng.permutation(len(H))
     H, slack = H[order], slack[order]
     return np.ascontiguousarray(H), H @ z + slack, z
@@ -44,8 +46,12 @@ def _full_scan(H, h, z, worst):
 
 
 @settings(max_examples=200, deadline=None)
-@given(st.integers(min_value=2, max_value=9), st.integers(min_value=0, max_value=12),
-       st.integers(min_value=1, max_value=60), st.integers(min_value=0, max_value=2**32 - 1))
+@given(
+    st.integers(min_value=2, max_value=9),
+    st.integers(min_value=0, max_value=12),
+    st.integers(min_value=1, max_value=60),
+    st.integers(min_value=0, max_value=2**32 - 1),
+)
 def test_near_scans_give_the_full_scans_numbers(n, extra, far, seed):
     rng = np.random.default_rng(seed)
     H, h, z = _degenerate(rng, n, extra, far)
@@ -129,7 +135,9 @@ def test_a_warm_started_walk_gives_the_cold_walks_polygon(g1_path):
     for args in _capture(governor, postures):
         cold = projected_from_arrays(*args)
         warm = projected_from_arrays(*args, hint)
-        assert hint[0] > 0 and hint[1] == 8  # written: G1's 60 rows, 12 wrench variables less 4 equalities
+        assert (
+            hint[0] > 0 and hint[1] == 8
+        )  # written: G1's 60 rows, 12 wrench variables less 4 equalities
         a, b = cold.com_velocity_area, warm.com_velocity_area
         assert a.vertices.shape == b.vertices.shape
         np.testing.assert_allclose(b.vertices, a.vertices, rtol=0, atol=1e-12)
@@ -154,12 +162,16 @@ def test_a_hint_that_does_not_fit_changes_nothing(g1_path, bad):
     elif bad == "singular":
         hint[3] = hint[2]  # the same row twice
     elif bad == "infeasible":
-        hint[2 : n + 2] = np.arange(m - n, m)  # the last rows: the box's, not a vertex of this polytope
+        hint[2 : n + 2] = np.arange(
+            m - n, m
+        )  # the last rows: the box's, not a vertex of this polytope
     else:
         hint[2] = m + 5
     before = hint.copy()
     warm = projected_from_arrays(*args, hint)
-    np.testing.assert_allclose(warm.com_velocity_area.vertices, cold.com_velocity_area.vertices, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(
+        warm.com_velocity_area.vertices, cold.com_velocity_area.vertices, rtol=0, atol=1e-12
+    )
     if bad == "size":
         np.testing.assert_array_equal(hint, before)
     else:
@@ -173,8 +185,12 @@ def test_warm_start_takes_a_feasible_vertex_basis_only():
     H /= np.linalg.norm(H, axis=1)[:, None]
     h = np.array([1.0, 1, 1, 1, 1.5]) / np.array([1, 1, 1, 1, np.sqrt(2)])
     m, n = H.shape
-    for rows, feasible, vertex in (([0, 1], False, None), ([0, 4], True, (1.0, 0.5)), ([0, 0], False, None),
-                                   ([0, 2], False, None)):
+    for rows, feasible, vertex in (
+        ([0, 1], False, None),
+        ([0, 4], True, (1.0, 0.5)),
+        ([0, 0], False, None),
+        ([0, 2], False, None),
+    ):
         W, Binv, z = np.zeros(n, dtype=np.int64), np.empty((n, n)), np.zeros(n)
         active = np.zeros(m, dtype=np.bool_)
         hint = np.array([m, n, *rows], dtype=np.int64)
@@ -213,13 +229,41 @@ def test_the_governor_loads_its_criterion_code_before_the_first_tick():
 # Bretl. The walk used to run to its 5000-pivot cap first (3.3 ms of a 6 ms tick, 20 ms with
 # the first load of the fallback's compiled map).
 G1_CYCLE = [
-    -0.03219221031075935, -0.004988224506426797, 0.7698711775785513, 0.0013834443295910157, 0.01027549787989299,
-    0.012435679150228888, 0.9998689184634059, -0.2694202835015543, -0.006333308441799225, -0.024354110123499396,
-    0.52116030619674, -0.272377902516348, -0.007266514362196788, -0.2641335708155025, -0.007784604361771792,
-    -0.02374101418517601, 0.5300341586963578, -0.28650134785021475, -0.005560567783511484, -0.2635033715723783,
-    -0.08635030486376054, -0.09659816984866619, 0.12161047449464814, -0.02941163338840707, -0.013962263719116203,
-    0.029412333747104773, 1.1121955155513435e-06, 0.005638440126555487, -0.0011339678455517892, -0.2509309006211736,
-    -0.2224619002108893, 0.483773200814152, 0.09100599239609793, -1.155579025762308, 0.28504224799064953,
+    -0.03219221031075935,
+    -0.004988224506426797,
+    0.7698711775785513,
+    0.0013834443295910157,
+    0.01027549787989299,
+    0.012435679150228888,
+    0.9998689184634059,
+    -0.2694202835015543,
+    -0.006333308441799225,
+    -0.024354110123499396,
+    0.52116030619674,
+    -0.272377902516348,
+    -0.007266514362196788,
+    -0.2641335708155025,
+    -0.007784604361771792,
+    -0.02374101418517601,
+    0.5300341586963578,
+    -0.28650134785021475,
+    -0.005560567783511484,
+    -0.2635033715723783,
+    -0.08635030486376054,
+    -0.09659816984866619,
+    0.12161047449464814,
+    -0.02941163338840707,
+    -0.013962263719116203,
+    0.029412333747104773,
+    1.1121955155513435e-06,
+    0.005638440126555487,
+    -0.0011339678455517892,
+    -0.2509309006211736,
+    -0.2224619002108893,
+    0.483773200814152,
+    0.09100599239609793,
+    -1.155579025762308,
+    0.28504224799064953,
     -1.5247268177348186,
 ]
 
@@ -247,11 +291,14 @@ def test_a_cycling_walk_gives_up_early_and_the_answer_is_bretls():
         areas._projected = original
     assert len(refused) == 1  # this posture's walk is refused (and no other projection's)
     A, b, C, d, E = refused[0]
-    status, _, _, pivots, _, N = certified_walk(A, b, C, d, E, FORCE_BOX, MAX_PIVOTS, MERGE_TOLERANCE,
-                                                MERGE_AREA_TOLERANCE, NO_HINT)
+    status, _, _, pivots, _, N = certified_walk(
+        A, b, C, d, E, FORCE_BOX, MAX_PIVOTS, MERGE_TOLERANCE, MERGE_AREA_TOLERANCE, NO_HINT
+    )
     assert status == K.FAILED
     n, m = N.shape[1], A.shape[0] + 4  # the rows of A (some dropped as zero) and the box's 4
     assert pivots <= 5 * (n + m) < MAX_PIVOTS
     # The fallback's answer is analyze()'s for the same state (which falls back the same way).
     reference = analyze(governor.scenario_at(q, answer.com_velocity))
-    assert answer.max_approach_speed == pytest.approx(reference.impact.max_contact_velocity, abs=1e-9)
+    assert answer.max_approach_speed == pytest.approx(
+        reference.impact.max_contact_velocity, abs=1e-9
+    )

@@ -29,7 +29,9 @@ def test_areas_are_the_inset_of_the_unshrunk_ones(name):
     # Every ZMP of the shrunk area is 1 cm inside the full one, and the CoM velocity area is omega (Z - c).
     assert np.all(a.zmp_area.margins(b.zmp_area.vertices) >= 0.01 - 1e-12)
     c = b.com[:2]
-    assert np.allclose(b.com_velocity_area.vertices, b.omega * (b.zmp_area.vertices - c), atol=1e-12)
+    assert np.allclose(
+        b.com_velocity_area.vertices, b.omega * (b.zmp_area.vertices - c), atol=1e-12
+    )
 
 
 def test_both_criteria_fall_as_the_margin_grows():
@@ -55,19 +57,28 @@ def test_cli_option_overrides_the_scenario(capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["zmp_margin"] == 0.01
     assert out["impact"]["max_contact_velocity"] == pytest.approx(
-        analyze(with_margin("palm_push_two_feet", 0.01)).impact.max_contact_velocity, rel=1e-12)
+        analyze(with_margin("palm_push_two_feet", 0.01)).impact.max_contact_velocity, rel=1e-12
+    )
     assert cli.main(["analyze", "palm_push_two_feet", "--zmp-margin", "-0.1"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--zmp-margin = '-0.1'" in err
 
 
 def test_sweep_axis_over_the_margin():
-    plan = make_plan(sweep_spec_from_dict({"base": "palm_push_two_feet",
-                                           "axes": [{"path": "zmp_margin", "values": [0.0, 0.01, 0.02]}]}))
+    plan = make_plan(
+        sweep_spec_from_dict(
+            {
+                "base": "palm_push_two_feet",
+                "axes": [{"path": "zmp_margin", "values": [0.0, 0.01, 0.02]}],
+            }
+        )
+    )
     ev = Evaluator(plan)
     df = pa.concat_tables([ev.evaluate_chunk(c) for c in range(plan.n_chunks)]).to_pandas()
     for _, r in df.iterrows():
-        expected = analyze(with_margin("palm_push_two_feet", float(r["zmp_margin"]))).impact.max_contact_velocity
+        expected = analyze(
+            with_margin("palm_push_two_feet", float(r["zmp_margin"]))
+        ).impact.max_contact_velocity
         assert r["max_contact_velocity"] == pytest.approx(expected, rel=1e-12)
 
 
@@ -84,11 +95,15 @@ def test_gui_edit_of_the_margin(tmp_path):
     assert session.analysis.areas.zmp_margin == 0.01
 
 
-@pytest.mark.parametrize("name, margin", [("palm_push_ramp", 0.01), ("kick_one_foot", 0.02), ("kick_one_foot", 0.5)])
+@pytest.mark.parametrize(
+    "name, margin", [("palm_push_ramp", 0.01), ("kick_one_foot", 0.02), ("kick_one_foot", 0.5)]
+)
 def test_com_velocity_area_inset_is_the_area_analyze_gives_with_that_margin(name, margin):
     """The plots' and the governor's dashed outline is the area of the scenario with that margin."""
     plain = analyze(name).areas.com_velocity_area_inset(margin)
-    margined = analyze(load_scenario(name).model_copy(update={"zmp_margin": margin})).areas.com_velocity_area
+    margined = analyze(
+        load_scenario(name).model_copy(update={"zmp_margin": margin})
+    ).areas.com_velocity_area
     assert plain.is_empty == margined.is_empty
     if not plain.is_empty:
         np.testing.assert_allclose(plain.vertices, margined.vertices, atol=1e-12)

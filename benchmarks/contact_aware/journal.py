@@ -10,14 +10,16 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
-from impact_balance.sim.trials.balance_trial import TRIAL_VERSION
 from impact_balance.sim.studies.journal import TrialJournal, journal_digest
 from impact_balance.sim.studies.wall import APPROACH_VERSION
+from impact_balance.sim.trials.balance_trial import TRIAL_VERSION
 
 __all__ = ["journalled", "open_journal", "slim"]
 
 
-def journalled(journal: TrialJournal, keys: Iterable[dict], run: Callable[[dict], dict], label: str) -> tuple[list, int]:
+def journalled(
+    journal: TrialJournal, keys: Iterable[dict], run: Callable[[dict], dict], label: str
+) -> tuple[list, int]:
     """``[(key, entry)]`` for every key: the journal's entry, else ``run(key)``'s, journalled at once.
 
     A key whose run raises is printed and left out (a rerun tries it again). Returns the pairs
@@ -28,9 +30,13 @@ def journalled(journal: TrialJournal, keys: Iterable[dict], run: Callable[[dict]
         if entry is None:
             try:
                 entry = run(key)
-            except Exception:  # noqa: BLE001 - one bad trial must not lose the others
+            except Exception:
                 failed += 1
-                print(f"  FAILED {label} {key}:\n{traceback.format_exc()}", file=sys.stderr, flush=True)
+                print(
+                    f"  FAILED {label} {key}:\n{traceback.format_exc()}",
+                    file=sys.stderr,
+                    flush=True,
+                )
                 continue
             journal.add(key, entry)
         pairs.append((key, entry))
@@ -40,9 +46,16 @@ def journalled(journal: TrialJournal, keys: Iterable[dict], run: Callable[[dict]
 def open_journal(out: Path, command: str, name: str, parts: dict[str, Any]) -> TrialJournal:
     """The journal of ``command`` on scenario ``name`` under ``out/journals``; ``parts``: what
     else decides the trials' outcome (a rerun with other parts starts another journal)."""
-    digest = journal_digest({"trial_version": TRIAL_VERSION, "approach_version": APPROACH_VERSION,
-                             "benchmark": "contact_aware_governor",
-                             "command": command, "scenario": name, **parts})
+    digest = journal_digest(
+        {
+            "trial_version": TRIAL_VERSION,
+            "approach_version": APPROACH_VERSION,
+            "benchmark": "contact_aware_governor",
+            "command": command,
+            "scenario": name,
+            **parts,
+        }
+    )
     return TrialJournal.open(out / "journals" / f"{command}_{name}_{digest[:12]}.jsonl", digest)
 
 

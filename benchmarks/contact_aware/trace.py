@@ -10,12 +10,19 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-
 from governor_study import _f, governed_setup
+
 from impact_balance.governor import Governor
 from impact_balance.sim.studies.wall import WallOptions, run_wall_trial
 
-__all__ = ["after_impact_table", "branches_table", "configuration", "contact_posture_table", "logged_trial", "trace"]
+__all__ = [
+    "after_impact_table",
+    "branches_table",
+    "configuration",
+    "contact_posture_table",
+    "logged_trial",
+    "trace",
+]
 
 
 def configuration(robot, row: dict) -> np.ndarray:
@@ -43,7 +50,11 @@ def logged_trial(args: argparse.Namespace, out: Path) -> tuple[dict, Any, dict]:
         return saved["summary"], pd.read_parquet(log_path), saved["series"]
     options, _, governed, setup = governed_setup(args.scenario, rigid=True)
     options = dataclasses.replace(options, record=True)
-    governor = None if args.governor == "none" else Governor(governed, criterion="com", contact_aware=args.contact_aware)
+    governor = (
+        None
+        if args.governor == "none"
+        else Governor(governed, criterion="com", contact_aware=args.contact_aware)
+    )
     wall = WallOptions(reference=args.reference, governor=args.governor, wall_distance=args.wall)
     trial = run_wall_trial(setup, wall, options, governor=governor)
     summary = trial.to_dict()
@@ -59,22 +70,33 @@ def after_impact_table(summary: dict, log, series: dict, step_ms: float, span: f
     (omega times the DCM's distance to the ZMP area's edge, m/s)."""
     contact = summary["trial"]["impact"]["contact_time"]
     t_series = np.asarray(series["time"], dtype=float)
-    supports = sorted({c[len("force_"):-2] for c in log.columns if c.startswith("force_")} - {"impact"})
-    lines = [f"| t - contact (s) | {' | '.join(f'{n} force x, y, z (N)' for n in supports)} | CoM velocity x, y "
-             "| ZMP desired x, y | ZMP measured x, y | DCM margin (m/s) |", "|---" * (5 + len(supports)) + "|"]
+    supports = sorted(
+        {c[len("force_") : -2] for c in log.columns if c.startswith("force_")} - {"impact"}
+    )
+    lines = [
+        f"| t - contact (s) | {' | '.join(f'{n} force x, y, z (N)' for n in supports)} | CoM velocity x, y "
+        "| ZMP desired x, y | ZMP measured x, y | DCM margin (m/s) |",
+        "|---" * (5 + len(supports)) + "|",
+    ]
     records = [r for r in log.to_dict("records") if 0.0 <= r["time"] - contact <= span]
     stride = max(1, round(1e-3 * step_ms / float(np.median(np.diff(log["time"])))))
     for row in records[::stride]:
         dt = row["time"] - contact
         k = int(np.argmin(np.abs(t_series - row["time"])))
-        forces = " | ".join(", ".join(f"{row[f'force_{n}_{c}']:+.0f}" for c in "xyz") for n in supports)
+        forces = " | ".join(
+            ", ".join(f"{row[f'force_{n}_{c}']:+.0f}" for c in "xyz") for n in supports
+        )
         zd, zm = series["zmp_desired"][k], series["zmp"][k]
-        lines.append(f"| {dt:+.3f} | {forces} | {row['comd_x']:+.3f}, {row['comd_y']:+.3f} "
-                     f"| {zd[0]:+.3f}, {zd[1]:+.3f} | {zm[0]:+.3f}, {zm[1]:+.3f} | {series['com_velocity_margin'][k]:+.3f} |")
+        lines.append(
+            f"| {dt:+.3f} | {forces} | {row['comd_x']:+.3f}, {row['comd_y']:+.3f} "
+            f"| {zd[0]:+.3f}, {zd[1]:+.3f} | {zm[0]:+.3f}, {zm[1]:+.3f} | {series['com_velocity_margin'][k]:+.3f} |"
+        )
     return "\n".join(lines)
 
 
-def branches_table(args: argparse.Namespace, summary: dict, log, window: float = 0.2, every: int = 5) -> str:
+def branches_table(
+    args: argparse.Namespace, summary: dict, log, window: float = 0.2, every: int = 5
+) -> str:
     """Along the logged approach up to the contact: the floating cap, and the contact-aware jump
     per m/s (upper restitution bound) and cap with the fixed point warm-started from the
     previous logged posture (continued from the first) or cold (gauges 0), and the union's
@@ -89,11 +111,15 @@ def branches_table(args: argparse.Namespace, summary: dict, log, window: float =
     floating = Governor(governed, criterion="com")
     spec = governed.impact.spec()
     upper = float(spec.restitution[-1])
-    warm, cold, union = (ContactAwareLimit(spec, every=1, starts=s) for s in ("warm", "cold", "union"))
+    warm, cold, union = (
+        ContactAwareLimit(spec, every=1, starts=s) for s in ("warm", "cold", "union")
+    )
     contact = summary["trial"]["impact"]["contact_time"]
-    lines = ["| t - contact (s) | floating cap (m/s) | cold: jump per m/s x, y | cold cap | warm: jump per m/s x, y "
-             "| warm cap | union: jumps per m/s x, y (upper c_r) | union cap | union ms |",
-             "|---|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "| t - contact (s) | floating cap (m/s) | cold: jump per m/s x, y | cold cap | warm: jump per m/s x, y "
+        "| warm cap | union: jumps per m/s x, y (upper c_r) | union cap | union ms |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
     rows: list[str] = []
     costs: list[float] = []  # the union's recomputation, ms
     warm_costs: list[float] = []  # the frozen warm start's, ms
@@ -101,7 +127,9 @@ def branches_table(args: argparse.Namespace, summary: dict, log, window: float =
         dt = row["time"] - contact
         if dt >= 0.0:
             break
-        answer = floating.limit_com(configuration(floating.robot, row), (row["comd_x"], row["comd_y"]))
+        answer = floating.limit_com(
+            configuration(floating.robot, row), (row["comd_x"], row["comd_y"])
+        )
         posture = floating.posture
         t0 = time.perf_counter()
         warm.new_posture(lambda: posture.stance)
@@ -112,15 +140,23 @@ def branches_table(args: argparse.Namespace, summary: dict, log, window: float =
         if dt < -window:
             continue
         cold.new_posture(lambda: posture.stance)
-        a, b, u = (s.answer(posture.com_criterion, answer.com_velocity) for s in (cold, warm, union))
-        jumps = "; ".join(f"{x:+.3f}, {y:+.3f}" for (x, y), c in zip(u.rates, u.restitution) if c == upper)
-        rows.append(f"| {dt:+.3f} | {answer.max_approach_speed:.3f} | {a.rates[-1][0]:+.3f}, {a.rates[-1][1]:+.3f} "
-                    f"| {a.limit.max_approach_speed:.3f} | {b.rates[-1][0]:+.3f}, {b.rates[-1][1]:+.3f} "
-                    f"| {b.limit.max_approach_speed:.3f} | {jumps} | {u.limit.max_approach_speed:.3f} "
-                    f"| {costs[-1]:.1f} |")
-    tail = (f"\nThe union's recomputation over the {len(costs)} logged postures of the approach: median "
-            f"{np.median(costs):.1f} ms, p99 {np.percentile(costs, 99):.1f} ms, max {max(costs):.1f} ms (the warm "
-            f"start's: median {np.median(warm_costs):.1f} ms, p99 {np.percentile(warm_costs, 99):.1f} ms).")
+        a, b, u = (
+            s.answer(posture.com_criterion, answer.com_velocity) for s in (cold, warm, union)
+        )
+        jumps = "; ".join(
+            f"{x:+.3f}, {y:+.3f}" for (x, y), c in zip(u.rates, u.restitution) if c == upper
+        )
+        rows.append(
+            f"| {dt:+.3f} | {answer.max_approach_speed:.3f} | {a.rates[-1][0]:+.3f}, {a.rates[-1][1]:+.3f} "
+            f"| {a.limit.max_approach_speed:.3f} | {b.rates[-1][0]:+.3f}, {b.rates[-1][1]:+.3f} "
+            f"| {b.limit.max_approach_speed:.3f} | {jumps} | {u.limit.max_approach_speed:.3f} "
+            f"| {costs[-1]:.1f} |"
+        )
+    tail = (
+        f"\nThe union's recomputation over the {len(costs)} logged postures of the approach: median "
+        f"{np.median(costs):.1f} ms, p99 {np.percentile(costs, 99):.1f} ms, max {max(costs):.1f} ms (the warm "
+        f"start's: median {np.median(warm_costs):.1f} ms, p99 {np.percentile(warm_costs, 99):.1f} ms)."
+    )
     return "\n".join(lines + rows[::-every][::-1]) + "\n" + tail
 
 
@@ -142,13 +178,29 @@ def contact_posture_table(args: argparse.Namespace, summary: dict, log) -> str:
     area, spec = posture.areas.com_velocity_area, governed.impact.spec()
     floating = posture.impact.post_impact_com_velocities(before, speed)
     worst = floating[int(np.argmin(area.margins(floating)))]
-    cases = [("measured", np.asarray(impact["com_velocity_after"], dtype=float)), ("floating, worst vertex", worst)]
-    cases += [(f"contact-aware, c_r {c:g}", contact_impact(posture.stance, spec, speed, com_velocity=before,
-                                                          restitution=float(c)).post_impact_com_velocity)
-              for c in spec.restitution]
-    lines = [f"At the contact posture (t = {row['time']:.3f} s), v_n {speed:.3f} m/s, area inset by the controller's margin:",
-             "", "| post-impact CoM velocity | x, y (m/s) | inset margin (m/s) |", "|---|---|---|"]
-    lines += [f"| {name} | {v[0]:+.3f}, {v[1]:+.3f} | {area.margins(v[:2])[0]:+.4f} |" for name, v in cases]
+    cases = [
+        ("measured", np.asarray(impact["com_velocity_after"], dtype=float)),
+        ("floating, worst vertex", worst),
+    ]
+    cases += [
+        (
+            f"contact-aware, c_r {c:g}",
+            contact_impact(
+                posture.stance, spec, speed, com_velocity=before, restitution=float(c)
+            ).post_impact_com_velocity,
+        )
+        for c in spec.restitution
+    ]
+    lines = [
+        f"At the contact posture (t = {row['time']:.3f} s), v_n {speed:.3f} m/s, area inset by the controller's margin:",
+        "",
+        "| post-impact CoM velocity | x, y (m/s) | inset margin (m/s) |",
+        "|---|---|---|",
+    ]
+    lines += [
+        f"| {name} | {v[0]:+.3f}, {v[1]:+.3f} | {area.margins(v[:2])[0]:+.4f} |"
+        for name, v in cases
+    ]
     return "\n".join(lines)
 
 
@@ -157,9 +209,11 @@ def trace(args: argparse.Namespace, out: Path) -> None:
     contact-aware jump's warm and cold answers along the approach."""
     summary, log, series = logged_trial(args, out)
     trial = summary["trial"]
-    print(f"{args.scenario} {args.governor} {args.reference:g} m/s, wall {100 * args.wall:g} cm: {summary['outcome']} "
-          f"({summary['reason']}), speed at contact {_f(summary['speed_at_contact'])}, cap at contact "
-          f"{_f(summary['cap_at_contact'])}, raw margin at the end {trial['com_velocity_margin_at_end']:+.3f} m/s\n")
+    print(
+        f"{args.scenario} {args.governor} {args.reference:g} m/s, wall {100 * args.wall:g} cm: {summary['outcome']} "
+        f"({summary['reason']}), speed at contact {_f(summary['speed_at_contact'])}, cap at contact "
+        f"{_f(summary['cap_at_contact'])}, raw margin at the end {trial['com_velocity_margin_at_end']:+.3f} m/s\n"
+    )
     print(after_impact_table(summary, log, series, args.every))
     if summary["speed_at_contact"] is not None:
         print("\n" + contact_posture_table(args, summary, log))

@@ -9,15 +9,24 @@ import time
 from pathlib import Path
 
 import numpy as np
-
 from governor_study import _f, governed_setup
+
+from impact_balance.contacts.stance import Stance
 from impact_balance.governor import Governor
 from impact_balance.sim.studies.wall import WallOptions, run_wall_trial
-from impact_balance.contacts.stance import Stance
 
 from .journal import journalled, open_journal, slim
 
-__all__ = ["OUTCOMES", "SWEEP_REFERENCES", "SWEEP_WALL", "VARIANTS", "score", "score_table", "sweep", "sweep_table"]
+__all__ = [
+    "OUTCOMES",
+    "SWEEP_REFERENCES",
+    "SWEEP_WALL",
+    "VARIANTS",
+    "score",
+    "score_table",
+    "sweep",
+    "sweep_table",
+]
 
 SWEEP_WALL = 0.15  # m
 #: The ungoverned sweeps' commanded references (m/s), around each stance's fall.
@@ -44,7 +53,9 @@ def _timed(governor: Governor) -> list[tuple[float, int, int]]:
     def solve(stance: Stance, kept):
         t0 = time.perf_counter()
         solutions = inner(stance, kept)
-        record.append((1e3 * (time.perf_counter() - t0), len(solutions.rates), solutions.iterations))
+        record.append(
+            (1e3 * (time.perf_counter() - t0), len(solutions.rates), solutions.iterations)
+        )
         return solutions
 
     support._solve = solve
@@ -78,14 +89,29 @@ def score(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
         def new_governor() -> Governor:
             if args.variant == "off":
                 return Governor(governed, criterion="com", velocity_margin=args.velocity_margin)
-            if args.variant == "async":  # the union's starts, recomputed by a worker process off the tick
-                return Governor(governed, criterion="com", contact_aware=True, contact_aware_async=True,
-                                velocity_margin=args.velocity_margin)
-            return Governor(governed, criterion="com", contact_aware=True, contact_aware_starts=args.variant,
-                            velocity_margin=args.velocity_margin)
+            if (
+                args.variant == "async"
+            ):  # the union's starts, recomputed by a worker process off the tick
+                return Governor(
+                    governed,
+                    criterion="com",
+                    contact_aware=True,
+                    contact_aware_async=True,
+                    velocity_margin=args.velocity_margin,
+                )
+            return Governor(
+                governed,
+                criterion="com",
+                contact_aware=True,
+                contact_aware_starts=args.variant,
+                velocity_margin=args.velocity_margin,
+            )
 
         def run(key: dict) -> dict:
-            governor, trials = new_governor(), []  # one governor for the walls of a reference, as the command
+            governor, trials = (
+                new_governor(),
+                [],
+            )  # one governor for the walls of a reference, as the command
             record = [] if governor._support is None else _timed(governor)
             ages = [] if governor._worker is None else _adoptions(governor)
             for distance in key["distances"]:
@@ -94,18 +120,38 @@ def score(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
                     record = _timed(governor)
                 del record[:]  # this trial's recomputations only
                 del ages[:]
-                wall = WallOptions(reference=key["reference"], governor="com", wall_distance=distance)
-                trials.append(slim(run_wall_trial(setup, wall, options, governor=governor).to_dict()))
+                wall = WallOptions(
+                    reference=key["reference"], governor="com", wall_distance=distance
+                )
+                trials.append(
+                    slim(run_wall_trial(setup, wall, options, governor=governor).to_dict())
+                )
                 d = trials[-1]
                 ms = np.array([r[0] for r in record]) if record else np.zeros(0)
-                d["recompute"] = None if not record else {
-                    "count": len(record), "ms_median": float(np.median(ms)), "ms_max": float(ms.max()),
-                    "ms_p90": float(np.percentile(ms, 90)), "rows_max": max(r[1] for r in record),
-                    "solves_median": float(np.median([r[2] for r in record]))}
+                d["recompute"] = (
+                    None
+                    if not record
+                    else {
+                        "count": len(record),
+                        "ms_median": float(np.median(ms)),
+                        "ms_max": float(ms.max()),
+                        "ms_p90": float(np.percentile(ms, 90)),
+                        "rows_max": max(r[1] for r in record),
+                        "solves_median": float(np.median([r[2] for r in record])),
+                    }
+                )
                 if ages:  # async: postures between two answers of the worker (the rates' age when replaced)
-                    d["rates_age"] = {"median": float(np.median(ages)), "max": int(max(ages)), "answers": len(ages)}
-                print(f"  {name} {key['reference']:g} m/s {100 * distance:g} cm: {d['outcome']} speed "
-                      f"{_f(d['speed_at_contact'])} cap {_f(d['cap_at_contact'])}", file=sys.stderr, flush=True)
+                    d["rates_age"] = {
+                        "median": float(np.median(ages)),
+                        "max": int(max(ages)),
+                        "answers": len(ages),
+                    }
+                print(
+                    f"  {name} {key['reference']:g} m/s {100 * distance:g} cm: {d['outcome']} speed "
+                    f"{_f(d['speed_at_contact'])} cap {_f(d['cap_at_contact'])}",
+                    file=sys.stderr,
+                    flush=True,
+                )
             governor.close()  # a worker process, with "async"
             return {"trials": trials}
 
@@ -113,8 +159,16 @@ def score(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
         pairs, failed = journalled(journal, keys, run, f"score {name}")
         journal.close()
         failures += failed
-        rows += [{"scenario": name, "variant": args.variant, "velocity_margin": args.velocity_margin, **t}
-                 for _, e in pairs for t in e["trials"]]
+        rows += [
+            {
+                "scenario": name,
+                "variant": args.variant,
+                "velocity_margin": args.velocity_margin,
+                **t,
+            }
+            for _, e in pairs
+            for t in e["trials"]
+        ]
     return rows, failures
 
 
@@ -128,36 +182,57 @@ def _span(values: list[float], digits: int = 3) -> str:
 
 def score_table(rows: list[dict]) -> str:
     """Outcome counts and ranges per scenario (the table of docs/contact_aware_governor.md)."""
-    lines = ["| scenario | variant | trials | balanced / contact broken / fell | measured speed at contact (m/s) "
-             "| cap at contact (m/s) | speed / min(ref, cap) | tick median (us) | tick p99 (us) "
-             "| recomputation median / max (ms) | rows of the rates (most) |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "| scenario | variant | trials | balanced / contact broken / fell | measured speed at contact (m/s) "
+        "| cap at contact (m/s) | speed / min(ref, cap) | tick median (us) | tick p99 (us) "
+        "| recomputation median / max (ms) | rows of the rates (most) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
     for name in dict.fromkeys(r["scenario"] for r in rows):
         group = [r for r in rows if r["scenario"] == name]
         counts = " / ".join(str(sum(r["outcome"] == o for r in group)) for o in OUTCOMES)
         speeds = [r["speed_at_contact"] for r in group if r["speed_at_contact"] is not None]
         caps = [r["cap_at_contact"] for r in group if r["cap_at_contact"] is not None]
-        ratios = [r["speed_at_contact"] / min(r["reference"], r["cap_at_contact"]) for r in group
-                  if r["speed_at_contact"] is not None and r["cap_at_contact"] is not None]
+        ratios = [
+            r["speed_at_contact"] / min(r["reference"], r["cap_at_contact"])
+            for r in group
+            if r["speed_at_contact"] is not None and r["cap_at_contact"] is not None
+        ]
         ticks = [r["tick_us"] for r in group if r["tick_us"]["median"] is not None]
         recomputes = [r["recompute"] for r in group if r.get("recompute")]
-        costs = "-" if not recomputes else (f"{np.median([c['ms_median'] for c in recomputes]):.1f} / "
-                                            f"{max(c['ms_max'] for c in recomputes):.1f}")
+        costs = (
+            "-"
+            if not recomputes
+            else (
+                f"{np.median([c['ms_median'] for c in recomputes]):.1f} / "
+                f"{max(c['ms_max'] for c in recomputes):.1f}"
+            )
+        )
         most = "-" if not recomputes else str(max(c["rows_max"] for c in recomputes))
-        lines.append(f"| {name} | {group[0]['variant']} | {len(group)} | {counts} | {_span(speeds)} | {_span(caps)} "
-                     f"| {_span(ratios, 2)} | {_span([t['median'] for t in ticks], 0)} "
-                     f"| {_span([t['p99'] for t in ticks], 0)} | {costs} | {most} |")
-    lines += ["", "| scenario | reference (m/s) | wall (cm) | outcome | speed at contact (m/s) | cap at contact (m/s) "
-              "| speed / cap | raw margin at end (m/s) | slip (cm) | tick median / p99 (us) |",
-              "|---|---|---|---|---|---|---|---|---|---|"]
+        lines.append(
+            f"| {name} | {group[0]['variant']} | {len(group)} | {counts} | {_span(speeds)} | {_span(caps)} "
+            f"| {_span(ratios, 2)} | {_span([t['median'] for t in ticks], 0)} "
+            f"| {_span([t['p99'] for t in ticks], 0)} | {costs} | {most} |"
+        )
+    lines += [
+        "",
+        "| scenario | reference (m/s) | wall (cm) | outcome | speed at contact (m/s) | cap at contact (m/s) "
+        "| speed / cap | raw margin at end (m/s) | slip (cm) | tick median / p99 (us) |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
-        ratio = ("-" if r["speed_at_contact"] is None or r["cap_at_contact"] is None
-                 else f"{r['speed_at_contact'] / r['cap_at_contact']:.4f}")
+        ratio = (
+            "-"
+            if r["speed_at_contact"] is None or r["cap_at_contact"] is None
+            else f"{r['speed_at_contact'] / r['cap_at_contact']:.4f}"
+        )
         tick = r["tick_us"]
         ticks = "-" if tick["median"] is None else f"{tick['median']:.0f} / {tick['p99']:.0f}"
-        lines.append(f"| {r['scenario']} | {r['reference']:g} | {100 * r['wall_distance']:g} | {r['outcome']} "
-                     f"| {_f(r['speed_at_contact'])} | {_f(r['cap_at_contact'])} | {ratio} | {r['margin_raw']:+.3f} "
-                     f"| {100 * r['max_slip']:.1f} | {ticks} |")
+        lines.append(
+            f"| {r['scenario']} | {r['reference']:g} | {100 * r['wall_distance']:g} | {r['outcome']} "
+            f"| {_f(r['speed_at_contact'])} | {_f(r['cap_at_contact'])} | {ratio} | {r['margin_raw']:+.3f} "
+            f"| {100 * r['max_slip']:.1f} | {ticks} |"
+        )
     return "\n".join(lines)
 
 
@@ -171,16 +246,26 @@ def sweep(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
         journal = open_journal(out, "sweep", name, {"wall": SWEEP_WALL, "margin": margin})
 
         def run(key: dict) -> dict:
-            wall = WallOptions(reference=key["reference"], governor="none", wall_distance=SWEEP_WALL)
+            wall = WallOptions(
+                reference=key["reference"], governor="none", wall_distance=SWEEP_WALL
+            )
             d = slim(run_wall_trial(setup, wall, options).to_dict())
-            after = np.asarray(d["com_velocity_after"] if d["com_velocity_after"] is not None else [np.nan] * 2)
+            after = np.asarray(
+                d["com_velocity_after"] if d["com_velocity_after"] is not None else [np.nan] * 2
+            )
             d["margin_inset"] = float(inset.margins(after)[0]) if np.isfinite(after).all() else None
-            print(f"  {name} {key['reference']:g} m/s: {d['outcome']} speed {_f(d['speed_at_contact'])} "
-                  f"inset margin {_signed(d['margin_inset'])}", file=sys.stderr, flush=True)
+            print(
+                f"  {name} {key['reference']:g} m/s: {d['outcome']} speed {_f(d['speed_at_contact'])} "
+                f"inset margin {_signed(d['margin_inset'])}",
+                file=sys.stderr,
+                flush=True,
+            )
             return d
 
         references = args.references or SWEEP_REFERENCES[name]
-        pairs, failed = journalled(journal, [{"reference": r} for r in references], run, f"sweep {name}")
+        pairs, failed = journalled(
+            journal, [{"reference": r} for r in references], run, f"sweep {name}"
+        )
         journal.close()
         failures += failed
         rows += [{"scenario": name, **e} for _, e in pairs]
@@ -189,24 +274,42 @@ def sweep(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
 
 def sweep_table(rows: list[dict]) -> str:
     """Every trial, then per stance the fastest that did not fall and the slowest that fell."""
-    lines = ["| scenario | reference (m/s) | measured v_n (m/s) | outcome | raw margin | inset margin | slip (cm) "
-             "| sustained impulse z per contact (N s) |", "|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "| scenario | reference (m/s) | measured v_n (m/s) | outcome | raw margin | inset margin | slip (cm) "
+        "| sustained impulse z per contact (N s) |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
-        sustained = ", ".join(f"{k} {v[2]:+.2f}" for k, v in (r["sustained_impulses"] or {}).items())
-        lines.append(f"| {r['scenario']} | {r['reference']:g} | {_f(r['speed_at_contact'])} | {r['outcome']} "
-                     f"| {r['margin_raw']:+.3f} | {_signed(r['margin_inset'])} | {100 * r['max_slip']:.2f} | {sustained} |")
-    lines += ["", "| scenario | trials | stood: largest v_n (inset margin) | fell: smallest v_n (inset margin) |",
-              "|---|---|---|---|"]
+        sustained = ", ".join(
+            f"{k} {v[2]:+.2f}" for k, v in (r["sustained_impulses"] or {}).items()
+        )
+        lines.append(
+            f"| {r['scenario']} | {r['reference']:g} | {_f(r['speed_at_contact'])} | {r['outcome']} "
+            f"| {r['margin_raw']:+.3f} | {_signed(r['margin_inset'])} | {100 * r['max_slip']:.2f} | {sustained} |"
+        )
+    lines += [
+        "",
+        "| scenario | trials | stood: largest v_n (inset margin) | fell: smallest v_n (inset margin) |",
+        "|---|---|---|---|",
+    ]
     for name in dict.fromkeys(r["scenario"] for r in rows):
         group = [r for r in rows if r["scenario"] == name and r["speed_at_contact"] is not None]
         stood = [r for r in group if r["outcome"] != "fell"]
         fell = [r for r in group if r["outcome"] == "fell"]
         best = max(stood, key=lambda r: r["speed_at_contact"], default=None)
         worst = min(fell, key=lambda r: r["speed_at_contact"], default=None)
-        cell = (lambda r: "-" if r is None else f"{r['speed_at_contact']:.3f} ({_signed(r['margin_inset'])})")  # noqa: E731
+        cell = lambda r: (
+            "-" if r is None else f"{r['speed_at_contact']:.3f} ({_signed(r['margin_inset'])})"
+        )
         lines.append(f"| {name} | {len(group)} | {cell(best)} | {cell(worst)} |")
-    stood = [r["margin_inset"] for r in rows if r["outcome"] != "fell" and r["margin_inset"] is not None]
-    fell = [r["margin_inset"] for r in rows if r["outcome"] == "fell" and r["margin_inset"] is not None]
-    lines.append(f"\nThe inset rule over {len(rows)} trials: the trials that did not fall end with inset margins "
-                 f">= {_signed(min(stood, default=None))} m/s; those that fell <= {_signed(max(fell, default=None))} m/s.")
+    stood = [
+        r["margin_inset"] for r in rows if r["outcome"] != "fell" and r["margin_inset"] is not None
+    ]
+    fell = [
+        r["margin_inset"] for r in rows if r["outcome"] == "fell" and r["margin_inset"] is not None
+    ]
+    lines.append(
+        f"\nThe inset rule over {len(rows)} trials: the trials that did not fall end with inset margins "
+        f">= {_signed(min(stood, default=None))} m/s; those that fell <= {_signed(max(fell, default=None))} m/s."
+    )
     return "\n".join(lines)

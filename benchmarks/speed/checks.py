@@ -13,7 +13,10 @@ def answer_checks(result: dict[str, Any], tol: float) -> dict[str, Any]:
     stances = result["stances"]
     failures, worst = [], 0.0
     entries = [(n, e["projection"]) for n, e in stances.items()]
-    entries += [(f"scaling {e['contacts']} (torque limits {e['torque_limits']})", e) for e in result.get("scaling", {}).get("contacts", [])]
+    entries += [
+        (f"scaling {e['contacts']} (torque limits {e['torque_limits']})", e)
+        for e in result.get("scaling", {}).get("contacts", [])
+    ]
     for label, p in entries:
         if "match" not in p:
             continue
@@ -22,7 +25,9 @@ def answer_checks(result: dict[str, Any], tol: float) -> dict[str, Any]:
             why = "; ".join(p["pypoman_errors"][:2]) or (
                 f"symmetric difference {p.get('symdiff_rel', float('nan')):.2e} (pypoman),"
                 f" {p.get('bretl_highs_symdiff_rel', float('nan')):.2e} (Bretl/HiGHS) > {tol:g}"
-                if p["ours_deterministic"] else "ours not deterministic across repeats")
+                if p["ours_deterministic"]
+                else "ours not deterministic across repeats"
+            )
             failures.append(f"{label}: {why}")
     for name, e in stances.items():
         if not e["pipeline"]["consistent"]:

@@ -8,7 +8,7 @@ import platform
 import sys
 from typing import Any
 
-__all__ = ["machine_info", "load_average"]
+__all__ = ["load_average", "machine_info"]
 
 
 def load_average() -> list[float]:
@@ -40,7 +40,19 @@ def machine_info() -> dict[str, Any]:
         "affinity": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else None,
         "python": sys.version.split()[0],
         "load_average_before": load_average(),
-        "versions": {d: version(d) for d in ("impact-balance", "numpy", "scipy", "numba", "highspy", "pin", "pypoman", "cvxopt")},
+        "versions": {
+            d: version(d)
+            for d in (
+                "impact-balance",
+                "numpy",
+                "scipy",
+                "numba",
+                "highspy",
+                "pin",
+                "pypoman",
+                "cvxopt",
+            )
+        },
     }
     try:  # pypoman is a test extra of the project
         from pypoman.lp import GLPK_IF_AVAILABLE

@@ -15,7 +15,14 @@ from .timing import Case, measure, stats
 
 __all__ = ["PIPELINE_STAGES", "bench_max_velocity", "bench_pipeline"]
 
-PIPELINE_STAGES = ("stance", "constraints", "areas", "impact_model", "max_velocity", "zmp_max_velocity")
+PIPELINE_STAGES = (
+    "stance",
+    "constraints",
+    "areas",
+    "impact_model",
+    "max_velocity",
+    "zmp_max_velocity",
+)
 
 
 def bench_pipeline(sc: ib.Scenario, args) -> dict[str, Any]:
@@ -33,20 +40,35 @@ def bench_pipeline(sc: ib.Scenario, args) -> dict[str, Any]:
         cfg = sc.impact
         model = ib.impact_model(stance, cfg.spec())
         cases["impact_model"] = Case(lambda: ib.impact_model(stance, cfg.spec()))
-        cases["max_velocity"] = Case(lambda: ib.max_contact_velocity(areas.com_velocity_area, model, sc.com_velocity))
+        cases["max_velocity"] = Case(
+            lambda: ib.max_contact_velocity(areas.com_velocity_area, model, sc.com_velocity)
+        )
         cases["zmp_max_velocity"] = Case(
-            lambda: ib.zmp_max_contact_velocity(areas.zmp_area, model, stance.com, sc.plane_height, sc.gravity, cfg.duration)
+            lambda: ib.zmp_max_contact_velocity(
+                areas.zmp_area, model, stance.com, sc.plane_height, sc.gravity, cfg.duration
+            )
         )
     cases["analyze"] = Case(lambda: ib.analyze(sc))
     times, _ = measure(cases, args.repeat, args.warmup)
     out: dict[str, Any] = {k: stats(v) for k, v in times.items()}
-    out["sum_of_stages"] = {"median": float(sum(out[k]["median"] for k in PIPELINE_STAGES if k in out))}
+    out["sum_of_stages"] = {
+        "median": float(sum(out[k]["median"] for k in PIPELINE_STAGES if k in out))
+    }
     # Sanity: analyze() and the staged pipeline give the same answer.
     a = ib.analyze(sc)
-    out["consistent"] = bool(np.allclose(a.areas.com_velocity_area.vertices, areas.com_velocity_area.vertices, atol=1e-12))
+    out["consistent"] = bool(
+        np.allclose(
+            a.areas.com_velocity_area.vertices, areas.com_velocity_area.vertices, atol=1e-12
+        )
+    )
     if model is not None:
-        staged = ib.max_contact_velocity(areas.com_velocity_area, model, sc.com_velocity).max_approach_speed
-        out["consistent"] &= bool(a.impact.max_contact_velocity == staged or (math.isinf(staged) and math.isinf(a.impact.max_contact_velocity)))
+        staged = ib.max_contact_velocity(
+            areas.com_velocity_area, model, sc.com_velocity
+        ).max_approach_speed
+        out["consistent"] &= bool(
+            a.impact.max_contact_velocity == staged
+            or (math.isinf(staged) and math.isinf(a.impact.max_contact_velocity))
+        )
         out["max_contact_velocity_m_s"] = None if math.isinf(staged) else staged
     return out
 
@@ -62,7 +84,9 @@ def bench_max_velocity(sc: ib.Scenario, args) -> dict[str, Any] | None:
     cases = {
         "max_velocity": Case(lambda: ib.max_contact_velocity(vel, model, sc.com_velocity)),
         "zmp_max_velocity": Case(
-            lambda: ib.zmp_max_contact_velocity(areas.zmp_area, model, stance.com, sc.plane_height, sc.gravity, sc.impact.duration)
+            lambda: ib.zmp_max_contact_velocity(
+                areas.zmp_area, model, stance.com, sc.plane_height, sc.gravity, sc.impact.duration
+            )
         ),
     }
     times, _ = measure(cases, args.repeat_cheap, max(args.warmup, 10))

@@ -71,4 +71,8 @@ def compare(reference: np.ndarray, other: np.ndarray) -> dict[str, float]:
     if a_p <= 0.0:  # degenerate reference: absolute figures
         return {"area_rel_diff": abs(a_q - a_p), "symdiff_rel": abs(a_q - a_p), "degenerate": True}
     a_i = area(intersection(P, Q)) if len(Q) >= 3 else 0.0
-    return {"area_rel_diff": (a_q - a_p) / a_p, "symdiff_rel": (a_p + a_q - 2.0 * a_i) / a_p, "degenerate": False}
+    return {
+        "area_rel_diff": (a_q - a_p) / a_p,
+        "symdiff_rel": (a_p + a_q - 2.0 * a_i) / a_p,
+        "degenerate": False,
+    }

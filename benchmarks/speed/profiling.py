@@ -11,10 +11,10 @@ import numpy as np
 
 import impact_balance as ib
 from impact_balance.balance.areas import FORCE_BOX
+from impact_balance.contacts.stance import Stance
 from impact_balance.contacts.wrench_polytope import wrench_polytope
 from impact_balance.projection import project_polytope
 from impact_balance.projection.walk import NO_HINT
-from impact_balance.contacts.stance import Stance
 
 from .projection import projection_cases
 from .targets import TARGET_PIPELINE_SCENARIO
@@ -41,9 +41,20 @@ def _cprofile(fn: Callable[[], Any], n: int, top: int) -> dict[str, Any]:
     total = st.total_tt
     rows = []
     for (file, line, func), (_cc, nc, tt, ct, _callers) in st.stats.items():
-        where = f"{os.path.relpath(file) if file.startswith('/') else file}:{line}({func})" if line else func
-        rows.append({"function": where, "calls_per_run": nc / n, "tottime_pct": 100 * tt / total,
-                     "cumtime_pct": 100 * ct / total, "tottime_us_per_run": 1e6 * tt / n})
+        where = (
+            f"{os.path.relpath(file) if file.startswith('/') else file}:{line}({func})"
+            if line
+            else func
+        )
+        rows.append(
+            {
+                "function": where,
+                "calls_per_run": nc / n,
+                "tottime_pct": 100 * tt / total,
+                "cumtime_pct": 100 * ct / total,
+                "tottime_us_per_run": 1e6 * tt / n,
+            }
+        )
     rows.sort(key=lambda r: -r["tottime_pct"])
     return {"runs": n, "total_us_per_run": 1e6 * total / n, "top": rows[:top]}
 
@@ -85,8 +96,8 @@ def profile_report(args) -> dict[str, Any]:
     poly = wrench_polytope(stance, sc.torque_limits, sc.gravity)
     A, b, C, d, F = poly.projection_data()
     U, S, Vt = np.linalg.svd(C)
-    x0 = Vt[:len(S)].T @ ((U.T @ d) / S)
-    N = np.ascontiguousarray(Vt[len(S):].T)
+    x0 = Vt[: len(S)].T @ ((U.T @ d) / S)
+    N = np.ascontiguousarray(Vt[len(S) :].T)
     areas = ib.areas_from_polytope(poly, sc.plane_height)
     model_imp = ib.impact_model(stance, sc.impact.spec())
     vel = areas.com_velocity_area
@@ -98,37 +109,65 @@ def profile_report(args) -> dict[str, Any]:
         "Scenario.configuration_vector": _median_us(lambda: sc.configuration_vector(robot), n),
         "Stance(robot, q, contacts)": _median_us(lambda: Stance(robot, q, specs), n),
         "Scenario.build_stance": _median_us(sc.build_stance, n),
-        "wrench_polytope": _median_us(lambda: wrench_polytope(stance, sc.torque_limits, sc.gravity), n),
-        "numpy SVD of the LIPM equalities (in project_walk)": _median_us(lambda: np.linalg.svd(C), n),
+        "wrench_polytope": _median_us(
+            lambda: wrench_polytope(stance, sc.torque_limits, sc.gravity), n
+        ),
+        "numpy SVD of the LIPM equalities (in project_walk)": _median_us(
+            lambda: np.linalg.svd(C), n
+        ),
         "compiled kernel project() alone": _median_us(
-            lambda: _kernel.project(A, b, F, x0, N, FORCE_BOX, 5000, NO_HINT), n),
-        "project_walk": _median_us(lambda: project_walk(A, b, C, d, F, box=FORCE_BOX, merge_tol=1e-6), n),
-        "areas_from_polytope (walk + affine maps)": _median_us(lambda: ib.areas_from_polytope(poly, sc.plane_height), n),
+            lambda: _kernel.project(A, b, F, x0, N, FORCE_BOX, 5000, NO_HINT), n
+        ),
+        "project_walk": _median_us(
+            lambda: project_walk(A, b, C, d, F, box=FORCE_BOX, merge_tol=1e-6), n
+        ),
+        "areas_from_polytope (walk + affine maps)": _median_us(
+            lambda: ib.areas_from_polytope(poly, sc.plane_height), n
+        ),
         "project_polytope(method='bretl') (HiGHS, for comparison)": _median_us(
-            lambda: project_polytope(A, b, C, d, F, box=FORCE_BOX, method="bretl"), n),
+            lambda: project_polytope(A, b, C, d, F, box=FORCE_BOX, method="bretl"), n
+        ),
         "impact_model": _median_us(lambda: ib.impact_model(stance, sc.impact.spec()), 10 * n),
         "Polygon.halfplanes (recomputed per call)": _median_us(lambda: vel.halfplanes, 10 * n),
-        "criteria.first_exit": _median_us(lambda: first_exit(h - G @ np.zeros(2), model_imp.com_jump_rates @ G.T), 10 * n),
-        "max_contact_velocity": _median_us(lambda: ib.max_contact_velocity(vel, model_imp, sc.com_velocity), 10 * n),
+        "criteria.first_exit": _median_us(
+            lambda: first_exit(h - G @ np.zeros(2), model_imp.com_jump_rates @ G.T), 10 * n
+        ),
+        "max_contact_velocity": _median_us(
+            lambda: ib.max_contact_velocity(vel, model_imp, sc.com_velocity), 10 * n
+        ),
     }
     out["micro_us"] = micro
     walk = project_walk(A, b, C, d, F, box=FORCE_BOX, merge_tol=1e-6)
-    out["walk"] = {"scenario": TARGET_PIPELINE_SCENARIO, "pivots": walk.pivots, "vertices": len(walk.polygon.vertices),
-                   "reduced_variables": int(N.shape[1]), "rows": int(A.shape[0])}
+    out["walk"] = {
+        "scenario": TARGET_PIPELINE_SCENARIO,
+        "pivots": walk.pivots,
+        "vertices": len(walk.polygon.vertices),
+        "reduced_variables": int(N.shape[1]),
+        "rows": int(A.shape[0]),
+    }
     return out
 
 
 def profile_text(p: dict[str, Any]) -> str:
-    out = ["", "Profile (cProfile; pinocchio and the compiled kernel are counted in their Python caller)"]
+    out = [
+        "",
+        "Profile (cProfile; pinocchio and the compiled kernel are counted in their Python caller)",
+    ]
     for key in ("analyze", "projection_talos_three_contacts"):
         e = p[key]
-        out.append(f"  {key}: {e['total_us_per_run']:.0f} us per run under cProfile ({e['runs']} runs); top by own time:")
+        out.append(
+            f"  {key}: {e['total_us_per_run']:.0f} us per run under cProfile ({e['runs']} runs); top by own time:"
+        )
         for r in e["top"]:
-            out.append(f"    {r['tottime_pct']:5.1f}%  {r['tottime_us_per_run']:8.0f} us  {r['calls_per_run']:6.1f} calls  {r['function']}")
+            out.append(
+                f"    {r['tottime_pct']:5.1f}%  {r['tottime_us_per_run']:8.0f} us  {r['calls_per_run']:6.1f} calls  {r['function']}"
+            )
     out.append("  micro-breakdown, median us (palm_push_two_feet):")
     for k, v in p["micro_us"].items():
         out.append(f"    {v:9.1f}  {k}")
     w = p["walk"]
-    out.append(f"  walk on {w['scenario']}: {w['pivots']} pivots for {w['vertices']} vertices"
-               f" ({w['reduced_variables']} variables after the equalities, {w['rows']} rows before dropping zero rows)")
+    out.append(
+        f"  walk on {w['scenario']}: {w['pivots']} pivots for {w['vertices']} vertices"
+        f" ({w['reduced_variables']} variables after the equalities, {w['rows']} rows before dropping zero rows)"
+    )
     return "\n".join(out)

@@ -42,15 +42,21 @@ def projection_cases(poly: ib.WrenchPolytope, scale: float, seed: int) -> dict[s
         return project_polytope(A, b, C, d, F, tol=FORCE_TOLERANCE, box=FORCE_BOX)
 
     def ours_bretl():
-        return project_polytope(A, b, C, d, F, tol=FORCE_TOLERANCE, box=FORCE_BOX, method="bretl").polygon.vertices
+        return project_polytope(
+            A, b, C, d, F, tol=FORCE_TOLERANCE, box=FORCE_BOX, method="bretl"
+        ).polygon.vertices
 
     def theirs():
         try:
             vertices = pypoman.project_polytope(
-                proj=(E, f), ineq=(A0, b0), eq=(C0, d0), method="bretl", max_radius=scale * FORCE_BOX
+                proj=(E, f),
+                ineq=(A0, b0),
+                eq=(C0, d0),
+                method="bretl",
+                max_radius=scale * FORCE_BOX,
             )
             return np.array(vertices) / scale
-        except Exception as exc:  # noqa: BLE001 - report, do not crash the benchmark
+        except Exception as exc:
             return exc
 
     def reseed(i: int) -> None:  # pypoman's first ray is random (numpy's global RNG)
@@ -68,8 +74,11 @@ def check_projection(results: dict[str, list[Any]]) -> dict[str, Any]:
     ours = results["ours"]
     ref = ours[0].polygon.vertices
     out: dict[str, Any] = {
-        "method": ours[0].method, "pivots": ours[0].pivots, "n_lp": ours[0].n_lp,
-        "n_vertices": len(ref), "bounded": bool(ours[0].polygon.bounded),
+        "method": ours[0].method,
+        "pivots": ours[0].pivots,
+        "n_lp": ours[0].n_lp,
+        "n_vertices": len(ref),
+        "bounded": bool(ours[0].polygon.bounded),
         "ours_deterministic": all(np.array_equal(r.polygon.vertices, ref) for r in ours),
     }
     if "bretl_highs" in results:  # our LP-per-edge path: same polygon
@@ -93,7 +102,9 @@ def check_projection(results: dict[str, list[Any]]) -> dict[str, Any]:
         ad = np.array([x["area_rel_diff"] for x in diffs])
         sd = np.array([x["symdiff_rel"] for x in diffs])
         out.update(
-            area_rel_diff=float(ad[np.argmax(np.abs(ad))]),  # worst over repeats, signed (pypoman - ours)
+            area_rel_diff=float(
+                ad[np.argmax(np.abs(ad))]
+            ),  # worst over repeats, signed (pypoman - ours)
             symdiff_rel=float(sd.max()),
             symdiff_rel_median=float(np.median(sd)),
             pypoman_n_vertices=int(np.median(nverts)),
@@ -102,19 +113,27 @@ def check_projection(results: dict[str, list[Any]]) -> dict[str, Any]:
 
 
 def bench_projection(poly, args) -> dict[str, Any]:
-    times, results = measure(projection_cases(poly, args.pypoman_scale, args.seed), args.repeat, args.warmup)
+    times, results = measure(
+        projection_cases(poly, args.pypoman_scale, args.seed), args.repeat, args.warmup
+    )
     entry: dict[str, Any] = {
-        "n_vars": int(poly.A.shape[1]), "n_ineq": int(poly.A.shape[0]), "n_eq": int(poly.C.shape[0]),
+        "n_vars": int(poly.A.shape[1]),
+        "n_ineq": int(poly.A.shape[0]),
+        "n_eq": int(poly.C.shape[0]),
         "project_us": stats(times["ours"]),
     }
     entry.update(check_projection(results))
     entry["bretl_highs_us"] = stats(times["bretl_highs"])
-    entry["ratio_vs_bretl_highs"] = entry["bretl_highs_us"]["median"] / entry["project_us"]["median"]
+    entry["ratio_vs_bretl_highs"] = (
+        entry["bretl_highs_us"]["median"] / entry["project_us"]["median"]
+    )
     if "pypoman" in times:
         entry["pypoman_us"] = stats(times["pypoman"])
         entry["ratio_vs_pypoman"] = entry["pypoman_us"]["median"] / entry["project_us"]["median"]
         entry["match"] = (
-            not entry["pypoman_errors"] and entry.get("symdiff_rel", math.inf) <= args.tol and entry["ours_deterministic"]
+            not entry["pypoman_errors"]
+            and entry.get("symdiff_rel", math.inf) <= args.tol
+            and entry["ours_deterministic"]
             and entry["bretl_highs_symdiff_rel"] <= args.tol
         )
     return entry

@@ -10,8 +10,8 @@ from typing import Any
 import numpy as np
 
 import impact_balance as ib
-from impact_balance.contacts.wrench_polytope import wrench_polytope
 from impact_balance.contacts.stance import ContactSpec, Stance
+from impact_balance.contacts.wrench_polytope import wrench_polytope
 
 from .projection import bench_projection
 from .timing import Case, measure, progress, stats
@@ -29,7 +29,9 @@ def talos_contact_sets() -> tuple[ib.Robot, np.ndarray, list[tuple[str, list[Con
     # Right palm (flat +x face of the gripper, as the palm_push impact point) on a wall in
     # front: contact z = gripper -x, i.e. world -x here (checked below).
     right_hand = ContactSpec(
-        "gripper_right_base_link", 0.7, (0.1, 0.08),
+        "gripper_right_base_link",
+        0.7,
+        (0.1, 0.08),
         pin.SE3(pin.rpy.rpyToMatrix(0.0, -math.pi / 2, 0.0), np.array([0.051, 0.0, -0.045])),
     )
     sets = [
@@ -46,22 +48,33 @@ def bench_contacts(args) -> list[dict[str, Any]]:
     rows = []
     for label, specs in sets:
         stance = Stance(robot, q, specs)
-        t_stance, _ = measure({"stance": Case(lambda: Stance(robot, q, specs))}, args.repeat, args.warmup)
+        t_stance, _ = measure(
+            {"stance": Case(lambda: Stance(robot, q, specs))}, args.repeat, args.warmup
+        )
         for tl in (True, False):
             poly = wrench_polytope(stance, tl)
-            t_poly, _ = measure({"constraints": Case(lambda: wrench_polytope(stance, tl))}, args.repeat, args.warmup)
+            t_poly, _ = measure(
+                {"constraints": Case(lambda: wrench_polytope(stance, tl))}, args.repeat, args.warmup
+            )
             entry = {
-                "contacts": label, "n_contacts": len(specs), "torque_limits": tl,
+                "contacts": label,
+                "n_contacts": len(specs),
+                "torque_limits": tl,
                 "normals": [np.round(c.normal, 3).tolist() for c in stance.contacts],
-                "stance_us": stats(t_stance["stance"]), "constraints_us": stats(t_poly["constraints"]),
+                "stance_us": stats(t_stance["stance"]),
+                "constraints_us": stats(t_poly["constraints"]),
             }
             entry.update(bench_projection(poly, args))
             rows.append(entry)
-            progress(f"  scaling {label}, torque limits {tl}: {entry['project_us']['median']:.0f} us, {entry['pivots']} pivots")
+            progress(
+                f"  scaling {label}, torque limits {tl}: {entry['project_us']['median']:.0f} us, {entry['pivots']} pivots"
+            )
     return rows
 
 
-def bench_cone_edges(args, names=("palm_push_two_feet", "talos_three_contacts")) -> list[dict[str, Any]]:
+def bench_cone_edges(
+    args, names=("palm_push_two_feet", "talos_three_contacts")
+) -> list[dict[str, Any]]:
     rows = []
     for name in names:
         sc = ib.load_scenario(name)
@@ -72,13 +85,30 @@ def bench_cone_edges(args, names=("palm_push_two_feet", "talos_three_contacts"))
             model = ib.impact_model(stance, spec)
             cases = {
                 "impact_model": Case(lambda: ib.impact_model(stance, spec)),
-                "max_velocity": Case(lambda: ib.max_contact_velocity(areas.com_velocity_area, model, sc.com_velocity)),
+                "max_velocity": Case(
+                    lambda: ib.max_contact_velocity(areas.com_velocity_area, model, sc.com_velocity)
+                ),
                 "zmp_max_velocity": Case(
-                    lambda: ib.zmp_max_contact_velocity(areas.zmp_area, model, stance.com, sc.plane_height, sc.gravity, spec.duration)
+                    lambda: ib.zmp_max_contact_velocity(
+                        areas.zmp_area,
+                        model,
+                        stance.com,
+                        sc.plane_height,
+                        sc.gravity,
+                        spec.duration,
+                    )
                 ),
             }
             times, _ = measure(cases, args.repeat_cheap, max(args.warmup, 10))
-            v = ib.max_contact_velocity(areas.com_velocity_area, model, sc.com_velocity).max_approach_speed
-            rows.append({"scenario": name, "cone_edges": n, "max_contact_velocity_m_s": None if math.isinf(v) else v}
-                        | {f"{k}_us": stats(t) for k, t in times.items()})
+            v = ib.max_contact_velocity(
+                areas.com_velocity_area, model, sc.com_velocity
+            ).max_approach_speed
+            rows.append(
+                {
+                    "scenario": name,
+                    "cone_edges": n,
+                    "max_contact_velocity_m_s": None if math.isinf(v) else v,
+                }
+                | {f"{k}_us": stats(t) for k, t in times.items()}
+            )
     return rows

@@ -26,11 +26,17 @@ def bench_stance(name: str, args) -> dict[str, Any]:
     pipe = bench_pipeline(sc, args)
     mv = bench_max_velocity(sc, args)
     return {
-        "robot": stance.robot.name, "n_contacts": len(stance.contacts), "torque_limits": sc.torque_limits,
-        "n_ineq": proj["n_ineq"], "project_median_us": proj["project_us"]["median"],
+        "robot": stance.robot.name,
+        "n_contacts": len(stance.contacts),
+        "torque_limits": sc.torque_limits,
+        "n_ineq": proj["n_ineq"],
+        "project_median_us": proj["project_us"]["median"],
         "pypoman_median_us": proj.get("pypoman_us", {}).get("median"),
-        "ratio_vs_pypoman": proj.get("ratio_vs_pypoman"), "area_rel_diff": proj.get("area_rel_diff"),
+        "ratio_vs_pypoman": proj.get("ratio_vs_pypoman"),
+        "area_rel_diff": proj.get("area_rel_diff"),
         "analyze_median_us": pipe["analyze"]["median"],
         "max_velocity_median_us": mv["max_velocity"]["median"] if mv else None,
-        "projection": proj, "pipeline": pipe, "max_velocity": mv,
+        "projection": proj,
+        "pipeline": pipe,
+        "max_velocity": mv,
     }

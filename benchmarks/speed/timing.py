@@ -20,8 +20,12 @@ def stats(samples_us: list[float]) -> dict[str, float]:
     a = np.asarray(samples_us, dtype=float)
     p10, p25, p50, p75, p90 = np.percentile(a, [10, 25, 50, 75, 90])
     return {
-        "median": float(p50), "p10": float(p10), "p90": float(p90), "iqr": float(p75 - p25),
-        "min": float(a.min()), "n": int(a.size),
+        "median": float(p50),
+        "p10": float(p10),
+        "p90": float(p90),
+        "iqr": float(p75 - p25),
+        "min": float(a.min()),
+        "n": int(a.size),
     }
 
 
@@ -39,7 +43,9 @@ class Case:
     keep: Callable[[Any], Any] | None = None
 
 
-def measure(cases: dict[str, Case], repeat: int, warmup: int) -> tuple[dict[str, list[float]], dict[str, list[Any]]]:
+def measure(
+    cases: dict[str, Case], repeat: int, warmup: int
+) -> tuple[dict[str, list[float]], dict[str, list[Any]]]:
     """Round-robin timing of ``cases``; returns per case the times (us) and the results."""
     for w in range(warmup):
         for case in cases.values():

@@ -16,46 +16,119 @@ from typing import TYPE_CHECKING, Any
 #: Where each public name lives: imported on first use (PEP 562), so that `import impact_balance`
 #: costs only what the names a program touches need (the command line lists robots in ~0.2 s).
 _EXPORTS: dict[str, str] = {
-    "Analysis": ".analysis.analyze", "ImpactAnswer": ".analysis.analyze", "analyze": ".analysis.analyze",
-    "BalanceAreas": ".balance.areas", "areas_from_polytope": ".balance.areas", "balance_areas": ".balance.areas",
+    "Analysis": ".analysis.analyze",
+    "ImpactAnswer": ".analysis.analyze",
+    "analyze": ".analysis.analyze",
+    "BalanceAreas": ".balance.areas",
+    "areas_from_polytope": ".balance.areas",
+    "balance_areas": ".balance.areas",
     "GRAVITY": ".constants",
-    "WrenchPolytope": ".contacts.wrench_polytope", "contact_polytope": ".contacts.wrench_polytope", "wrench_polytope": ".contacts.wrench_polytope",
-    "VelocityLimit": ".criteria.com", "capped_velocity": ".criteria.com", "max_contact_velocity": ".criteria.com", "zmp_max_contact_velocity": ".criteria.com",
-    "cwc_faces": ".contacts.cwc", "cwc_faces_world": ".contacts.cwc", "cwc_span": ".contacts.cwc",
+    "WrenchPolytope": ".contacts.wrench_polytope",
+    "contact_polytope": ".contacts.wrench_polytope",
+    "wrench_polytope": ".contacts.wrench_polytope",
+    "VelocityLimit": ".criteria.com",
+    "capped_velocity": ".criteria.com",
+    "max_contact_velocity": ".criteria.com",
+    "zmp_max_contact_velocity": ".criteria.com",
+    "cwc_faces": ".contacts.cwc",
+    "cwc_faces_world": ".contacts.cwc",
+    "cwc_span": ".contacts.cwc",
     "Diagnostic": ".analysis.result",
-    "ImpactBalanceError": ".exceptions", "ImpactModelError": ".exceptions", "RobotLoadError": ".exceptions", "ScenarioError": ".exceptions", "SolverError": ".exceptions", "StrictWarningsError": ".exceptions", "UnknownConfigurationError": ".exceptions", "UnknownFrameError": ".exceptions", "UnknownJointError": ".exceptions", "UnknownKeyError": ".exceptions", "UnknownRobotError": ".exceptions", "UnknownScenarioError": ".exceptions",
-    "ImpactModel": ".impact.model", "ImpactSpec": ".impact.model", "friction_cone": ".impact.model", "impact_model": ".impact.model",
-    "PhasePortrait": ".balance.lipm", "com_velocity_bounds": ".balance.lipm", "lipm_omega": ".balance.lipm", "phase_portrait": ".balance.lipm",
+    "ImpactBalanceError": ".exceptions",
+    "ImpactModelError": ".exceptions",
+    "RobotLoadError": ".exceptions",
+    "ScenarioError": ".exceptions",
+    "SolverError": ".exceptions",
+    "StrictWarningsError": ".exceptions",
+    "UnknownConfigurationError": ".exceptions",
+    "UnknownFrameError": ".exceptions",
+    "UnknownJointError": ".exceptions",
+    "UnknownKeyError": ".exceptions",
+    "UnknownRobotError": ".exceptions",
+    "UnknownScenarioError": ".exceptions",
+    "ImpactModel": ".impact.model",
+    "ImpactSpec": ".impact.model",
+    "friction_cone": ".impact.model",
+    "impact_model": ".impact.model",
+    "PhasePortrait": ".balance.lipm",
+    "com_velocity_bounds": ".balance.lipm",
+    "lipm_omega": ".balance.lipm",
+    "phase_portrait": ".balance.lipm",
     "Polygon": ".geometry.polygon",
     "project_polytope": ".projection",
-    "QPOptions": ".criteria.qp", "QPResult": ".criteria.qp", "solve_contact_velocity_qp": ".criteria.qp",
-    "BUNDLED_ROBOTS": ".robot.robot", "Robot": ".robot.robot", "load_robot": ".robot.robot",
-    "Scenario": ".scenario", "bundled_scenarios": ".scenario", "load_scenario": ".scenario",
-    "Governor": ".governor", "SpeedLimit": ".governor",
-    "Contact": ".contacts.stance", "ContactSpec": ".contacts.stance", "Stance": ".contacts.stance",
+    "QPOptions": ".criteria.qp",
+    "QPResult": ".criteria.qp",
+    "solve_contact_velocity_qp": ".criteria.qp",
+    "BUNDLED_ROBOTS": ".robot.robot",
+    "Robot": ".robot.robot",
+    "load_robot": ".robot.robot",
+    "Scenario": ".scenario",
+    "bundled_scenarios": ".scenario",
+    "load_scenario": ".scenario",
+    "Governor": ".governor",
+    "SpeedLimit": ".governor",
+    "Contact": ".contacts.stance",
+    "ContactSpec": ".contacts.stance",
+    "Stance": ".contacts.stance",
 }
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "Analysis", "ImpactAnswer", "analyze",
-    "BalanceAreas", "areas_from_polytope", "balance_areas",
+    "BUNDLED_ROBOTS",
     "GRAVITY",
-    "WrenchPolytope", "contact_polytope", "wrench_polytope",
-    "VelocityLimit", "capped_velocity", "max_contact_velocity", "zmp_max_contact_velocity",
-    "cwc_faces", "cwc_faces_world", "cwc_span",
+    "Analysis",
+    "BalanceAreas",
+    "Contact",
+    "ContactSpec",
     "Diagnostic",
-    "ImpactBalanceError", "ImpactModelError", "RobotLoadError", "ScenarioError", "SolverError",
-    "UnknownConfigurationError", "UnknownFrameError", "UnknownJointError", "UnknownRobotError",
-    "UnknownScenarioError", "UnknownKeyError", "StrictWarningsError",
-    "ImpactModel", "ImpactSpec", "friction_cone", "impact_model",
-    "PhasePortrait", "com_velocity_bounds", "lipm_omega", "phase_portrait",
-    "Polygon", "project_polytope",
-    "QPOptions", "QPResult", "solve_contact_velocity_qp",
-    "BUNDLED_ROBOTS", "Robot", "load_robot",
-    "Scenario", "bundled_scenarios", "load_scenario",
-    "Contact", "ContactSpec", "Stance",
-    "Governor", "SpeedLimit",
+    "Governor",
+    "ImpactAnswer",
+    "ImpactBalanceError",
+    "ImpactModel",
+    "ImpactModelError",
+    "ImpactSpec",
+    "PhasePortrait",
+    "Polygon",
+    "QPOptions",
+    "QPResult",
+    "Robot",
+    "RobotLoadError",
+    "Scenario",
+    "ScenarioError",
+    "SolverError",
+    "SpeedLimit",
+    "Stance",
+    "StrictWarningsError",
+    "UnknownConfigurationError",
+    "UnknownFrameError",
+    "UnknownJointError",
+    "UnknownKeyError",
+    "UnknownRobotError",
+    "UnknownScenarioError",
+    "VelocityLimit",
+    "WrenchPolytope",
+    "analyze",
+    "areas_from_polytope",
+    "balance_areas",
+    "bundled_scenarios",
+    "capped_velocity",
+    "com_velocity_bounds",
+    "contact_polytope",
+    "cwc_faces",
+    "cwc_faces_world",
+    "cwc_span",
+    "friction_cone",
+    "impact_model",
+    "lipm_omega",
+    "load_robot",
+    "load_scenario",
+    "max_contact_velocity",
+    "phase_portrait",
+    "project_polytope",
+    "solve_contact_velocity_qp",
+    "wrench_polytope",
+    "zmp_max_contact_velocity",
 ]
 
 
@@ -64,7 +137,9 @@ def __getattr__(name: str) -> Any:
     module = _EXPORTS.get(name)
     if module is None:
         if not name.startswith("_") and importlib.util.find_spec(f"{__name__}.{name}") is not None:
-            return importlib.import_module(f".{name}", __name__)  # a submodule, as before: ib.scenario
+            return importlib.import_module(
+                f".{name}", __name__
+            )  # a submodule, as before: ib.scenario
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     value = getattr(importlib.import_module(module, __name__), name)
     globals()[name] = value  # later accesses skip this function
@@ -77,12 +152,29 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # static analysers and IDEs see the plain imports
     from impact_balance.analysis.analyze import Analysis, ImpactAnswer, analyze
-    from impact_balance.balance.areas import BalanceAreas, areas_from_polytope, balance_areas
-    from impact_balance.constants import GRAVITY
-    from impact_balance.contacts.wrench_polytope import WrenchPolytope, contact_polytope, wrench_polytope
-    from impact_balance.criteria.com import VelocityLimit, capped_velocity, max_contact_velocity, zmp_max_contact_velocity
-    from impact_balance.contacts.cwc import cwc_faces, cwc_faces_world, cwc_span
     from impact_balance.analysis.result import Diagnostic
+    from impact_balance.balance.areas import BalanceAreas, areas_from_polytope, balance_areas
+    from impact_balance.balance.lipm import (
+        PhasePortrait,
+        com_velocity_bounds,
+        lipm_omega,
+        phase_portrait,
+    )
+    from impact_balance.constants import GRAVITY
+    from impact_balance.contacts.cwc import cwc_faces, cwc_faces_world, cwc_span
+    from impact_balance.contacts.stance import Contact, ContactSpec, Stance
+    from impact_balance.contacts.wrench_polytope import (
+        WrenchPolytope,
+        contact_polytope,
+        wrench_polytope,
+    )
+    from impact_balance.criteria.com import (
+        VelocityLimit,
+        capped_velocity,
+        max_contact_velocity,
+        zmp_max_contact_velocity,
+    )
+    from impact_balance.criteria.qp import QPOptions, QPResult, solve_contact_velocity_qp
     from impact_balance.exceptions import (
         ImpactBalanceError,
         ImpactModelError,
@@ -97,12 +189,9 @@ if TYPE_CHECKING:  # static analysers and IDEs see the plain imports
         UnknownRobotError,
         UnknownScenarioError,
     )
-    from impact_balance.impact.model import ImpactModel, ImpactSpec, friction_cone, impact_model
-    from impact_balance.balance.lipm import PhasePortrait, com_velocity_bounds, lipm_omega, phase_portrait
     from impact_balance.geometry.polygon import Polygon
+    from impact_balance.governor import Governor, SpeedLimit
+    from impact_balance.impact.model import ImpactModel, ImpactSpec, friction_cone, impact_model
     from impact_balance.projection import project_polytope
-    from impact_balance.criteria.qp import QPOptions, QPResult, solve_contact_velocity_qp
     from impact_balance.robot.robot import BUNDLED_ROBOTS, Robot, load_robot
     from impact_balance.scenario import Scenario, bundled_scenarios, load_scenario
-    from impact_balance.contacts.stance import Contact, ContactSpec, Stance
-    from impact_balance.governor import Governor, SpeedLimit

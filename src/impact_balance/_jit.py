@@ -15,7 +15,7 @@ import pickle
 from types import ModuleType
 from typing import Any
 
-__all__ = ["njit", "HAVE_NUMBA", "JIT_VARIABLE", "cache_depends_on"]
+__all__ = ["HAVE_NUMBA", "JIT_VARIABLE", "cache_depends_on", "njit"]
 
 #: The environment variable that turns compilation off ("0", "false", "no" or "off").
 JIT_VARIABLE = "IMPACT_BALANCE_JIT"

@@ -4,16 +4,16 @@ import math
 
 __all__ = [
     "GRAVITY",
-    "MAX_FRICTION",
-    "MAX_SIZE",
-    "MAX_POSITION",
-    "MAX_ANGLE",
-    "MAX_SPEED",
     "GRAVITY_RANGE",
-    "MAX_DURATION",
-    "MAX_PEAK_FACTOR",
-    "MAX_NAME",
+    "MAX_ANGLE",
     "MAX_DESCRIPTION",
+    "MAX_DURATION",
+    "MAX_FRICTION",
+    "MAX_NAME",
+    "MAX_PEAK_FACTOR",
+    "MAX_POSITION",
+    "MAX_SIZE",
+    "MAX_SPEED",
 ]
 
 #: Standard gravity, m/s^2, acting along world -z.

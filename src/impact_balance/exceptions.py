@@ -18,36 +18,36 @@ from collections.abc import Iterable, Sequence
 from typing import Any
 
 __all__ = [
-    "VALUE_CHARS",
     "MESSAGE_CHARS",
-    "short_repr",
-    "one_line",
-    "ImpactBalanceError",
+    "VALUE_CHARS",
+    "EnvironmentFailure",
     "FieldError",
+    "GovernorError",
+    "ImpactBalanceError",
+    "ImpactBalanceWarning",
+    "ImpactModelError",
+    "MissingExtraError",
+    "ModelRepairWarning",
+    "NonFiniteResultError",
+    "OptionError",
+    "OutputError",
+    "RobotLoadError",
     "ScenarioError",
-    "WorkspaceError",
-    "UnknownNameError",
-    "UnknownRobotError",
+    "SimulationError",
+    "SolverError",
+    "StrictWarningsError",
+    "SweepError",
+    "UnknownConfigurationError",
     "UnknownFrameError",
     "UnknownJointError",
-    "UnknownConfigurationError",
-    "UnknownScenarioError",
-    "RobotLoadError",
-    "ImpactModelError",
-    "SolverError",
     "UnknownKeyError",
-    "StrictWarningsError",
-    "NonFiniteResultError",
-    "SimulationError",
-    "SweepError",
+    "UnknownNameError",
     "UnknownPathError",
-    "MissingExtraError",
-    "ImpactBalanceWarning",
-    "ModelRepairWarning",
-    "OptionError",
-    "EnvironmentFailure",
-    "OutputError",
-    "GovernorError",
+    "UnknownRobotError",
+    "UnknownScenarioError",
+    "WorkspaceError",
+    "one_line",
+    "short_repr",
 ]
 
 #: Longest shown repr of a value in a message (characters).
@@ -168,7 +168,12 @@ class UnknownNameError(ScenarioError, KeyError):
     kind = "name"
 
     def __init__(
-        self, field: str, value: str, valid: Iterable[str], source: str | None = None, listing: str | None = None
+        self,
+        field: str,
+        value: str,
+        valid: Iterable[str],
+        source: str | None = None,
+        listing: str | None = None,
     ):
         """``listing`` says where the full list is when it is too long to print (a command)."""
         self.valid: Sequence[str] = sorted(valid)
@@ -286,7 +291,9 @@ class UnknownKeyError(ScenarioError):
         suggestion: The nearest valid key, or None.
     """
 
-    def __init__(self, field: str, key: str, value: Any, valid: Iterable[str], source: str | None = None):
+    def __init__(
+        self, field: str, key: str, value: Any, valid: Iterable[str], source: str | None = None
+    ):
         self.key = key
         self.valid: Sequence[str] = sorted(valid)
         close = _closest(key, self.valid, n=1)
@@ -359,13 +366,16 @@ class MissingExtraError(ImpactBalanceError, ImportError):
 
     def __init__(self, what: str, extra: str, missing: Sequence[str]):
         self.what, self.extra, self.missing = what, extra, tuple(missing)
-        super().__init__(f"{what} needs the {extra!r} extra: pip install 'impact-balance[{extra}]' "
-                         f"({', '.join(self.missing)} not installed)")
+        super().__init__(
+            f"{what} needs the {extra!r} extra: pip install 'impact-balance[{extra}]' "
+            f"({', '.join(self.missing)} not installed)"
+        )
 
 
 class ImpactBalanceWarning(UserWarning):
     """Base class of the warnings impact-balance emits through :mod:`warnings` (the command
-    line prints each as one ``impact-balance: warning:`` line)."""
+    line prints each as one ``impact-balance: warning:`` line).
+    """
 
 
 class ModelRepairWarning(ImpactBalanceWarning):

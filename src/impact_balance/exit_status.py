@@ -22,8 +22,15 @@ import sys
 
 from impact_balance.exceptions import ImpactBalanceError, one_line, short_repr
 
-__all__ = ["describe_error", "debug_requested", "DEBUG_ENV", "EXIT_INPUT", "EXIT_ENVIRONMENT",
-           "EXIT_INTERRUPTED", "EXIT_BROKEN_PIPE"]
+__all__ = [
+    "DEBUG_ENV",
+    "EXIT_BROKEN_PIPE",
+    "EXIT_ENVIRONMENT",
+    "EXIT_INPUT",
+    "EXIT_INTERRUPTED",
+    "debug_requested",
+    "describe_error",
+]
 
 #: Environment variable that turns on tracebacks (any value but "", "0", "no", "false").
 DEBUG_ENV = "IMPACT_BALANCE_DEBUG"
@@ -46,16 +53,25 @@ def debug_requested(argv: list[str] | None = None) -> bool:
 def _qualified(exc: BaseException) -> str:
     cls = type(exc)
     module = cls.__module__
-    return cls.__qualname__ if module in ("builtins", "__main__") else f"{module}.{cls.__qualname__}"
+    return (
+        cls.__qualname__ if module in ("builtins", "__main__") else f"{module}.{cls.__qualname__}"
+    )
 
 
 def _os_line(exc: OSError) -> str:
-    reason = exc.strerror or (os.strerror(exc.errno) if exc.errno else None) or str(exc) or type(exc).__name__
+    reason = (
+        exc.strerror
+        or (os.strerror(exc.errno) if exc.errno else None)
+        or str(exc)
+        or type(exc).__name__
+    )
     if isinstance(exc, TimeoutError) and not exc.strerror:
         reason = f"timed out{f' ({exc})' if str(exc) else ''}"
     names = [n for n in (exc.filename, exc.filename2) if n is not None]
-    where = " -> ".join(short_repr(os.fsdecode(n) if isinstance(n, bytes) else str(n), 120).strip("'\"")
-                        for n in names)
+    where = " -> ".join(
+        short_repr(os.fsdecode(n) if isinstance(n, bytes) else str(n), 120).strip("'\"")
+        for n in names
+    )
     return f"{where}: {reason}" if where else reason
 
 
@@ -71,7 +87,10 @@ def describe_error(exc: BaseException, quote: bool = True) -> tuple[str, int]:
     if isinstance(exc, KeyboardInterrupt):
         return "interrupted", EXIT_INTERRUPTED
     if isinstance(exc, MemoryError):
-        return "out of memory: the input asks for more memory than this machine has", EXIT_ENVIRONMENT
+        return (
+            "out of memory: the input asks for more memory than this machine has",
+            EXIT_ENVIRONMENT,
+        )
     if isinstance(exc, OSError):
         line = _os_line(exc)
         if exc.errno == errno.ENOSPC and "space" not in line:
@@ -79,7 +98,9 @@ def describe_error(exc: BaseException, quote: bool = True) -> tuple[str, int]:
         return one_line(line), EXIT_ENVIRONMENT
     if isinstance(exc, ImportError):
         name = exc.name or str(exc)
-        return one_line(f"cannot import {name}: {exc} (a package is missing or broken)"), EXIT_ENVIRONMENT
+        return one_line(
+            f"cannot import {name}: {exc} (a package is missing or broken)"
+        ), EXIT_ENVIRONMENT
     yaml = sys.modules.get("yaml")
     if yaml is not None and isinstance(exc, yaml.YAMLError):
         problem = getattr(exc, "problem", None) or str(exc)
@@ -88,5 +109,7 @@ def describe_error(exc: BaseException, quote: bool = True) -> tuple[str, int]:
         return "input nested too deeply for this program", EXIT_INPUT
     text = str(exc) if quote else ""
     detail = f": {text}" if text else ""
-    return one_line(f"internal error ({_qualified(exc)}{detail}); rerun with --debug for the traceback "
-                    "and please report it"), EXIT_ENVIRONMENT
+    return one_line(
+        f"internal error ({_qualified(exc)}{detail}); rerun with --debug for the traceback "
+        "and please report it"
+    ), EXIT_ENVIRONMENT

@@ -22,7 +22,7 @@ import sys
 
 from impact_balance.exceptions import MissingExtraError
 
-__all__ = ["EXTRAS", "COMMAND_EXTRAS", "OPTION_EXTRAS", "installed", "require", "require_for"]
+__all__ = ["COMMAND_EXTRAS", "EXTRAS", "OPTION_EXTRAS", "installed", "require", "require_for"]
 
 #: Modules each extra installs (import names), as declared in pyproject.toml.
 EXTRAS: dict[str, tuple[str, ...]] = {
@@ -55,7 +55,8 @@ OPTION_EXTRAS: dict[str, tuple[str, str]] = {
 
 def installed(module: str) -> bool:
     """Whether ``module`` can be imported, without importing it (a blocked import, a ``None``
-    in ``sys.modules``, counts as missing)."""
+    in ``sys.modules``, counts as missing).
+    """
     if module in sys.modules:
         return sys.modules[module] is not None
     try:
@@ -67,7 +68,8 @@ def installed(module: str) -> bool:
 def require(extra: str, what: str) -> None:
     """:class:`MissingExtraError` naming ``extra`` if one of its modules is not installed.
 
-    Checked without importing them: ``sweep --list`` must not pay for importing Dask."""
+    Checked without importing them: ``sweep --list`` must not pay for importing Dask.
+    """
     missing = [name for name in EXTRAS[extra] if not installed(name)]
     if missing:
         raise MissingExtraError(what, extra, missing)

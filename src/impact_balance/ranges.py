@@ -25,11 +25,11 @@ import math
 from impact_balance.exceptions import SimulationError
 
 __all__ = [
-    "MIN_APPROACH_SPEED",
     "MAX_APPROACH_SPEED",
-    "TOLERANCE_RANGE",
-    "MAX_SWEEP_POINTS",
     "MAX_SWEEP_CHUNKS",
+    "MAX_SWEEP_POINTS",
+    "MIN_APPROACH_SPEED",
+    "TOLERANCE_RANGE",
     "check_approach_speed",
     "check_tolerance",
     "finite_or_none",
@@ -49,25 +49,43 @@ MAX_SWEEP_CHUNKS = 100_000
 
 def check_approach_speed(value: float, field: str = "--speed") -> float:
     """``value`` if it is a usable approach speed (m/s); :class:`SimulationError` naming ``field`` otherwise."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
-            or not MIN_APPROACH_SPEED <= value <= MAX_APPROACH_SPEED:
-        raise SimulationError(field, value, f"approach speed must be in [{MIN_APPROACH_SPEED:g}, {MAX_APPROACH_SPEED:g}] m/s "
-                                            f"(slower never reaches the surface in a simulation of sensible length)")
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, (int, float))
+        or not math.isfinite(value)
+        or not MIN_APPROACH_SPEED <= value <= MAX_APPROACH_SPEED
+    ):
+        raise SimulationError(
+            field,
+            value,
+            f"approach speed must be in [{MIN_APPROACH_SPEED:g}, {MAX_APPROACH_SPEED:g}] m/s "
+            f"(slower never reaches the surface in a simulation of sensible length)",
+        )
     return float(value)
 
 
 def check_tolerance(value: float, field: str = "--tolerance") -> float:
     """``value`` if it is a usable relative bracket width; :class:`SimulationError` naming ``field`` otherwise."""
     lo, hi = TOLERANCE_RANGE
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or not lo <= value <= hi:
-        raise SimulationError(field, value, f"must be in [{lo:g}, {hi:g}] (each halving of the bracket is one more "
-                                            f"trial; a tighter bracket is below the simulator's repeatability)")
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, (int, float))
+        or not math.isfinite(value)
+        or not lo <= value <= hi
+    ):
+        raise SimulationError(
+            field,
+            value,
+            f"must be in [{lo:g}, {hi:g}] (each halving of the bracket is one more "
+            f"trial; a tighter bracket is below the simulator's repeatability)",
+        )
     return float(value)
 
 
 def finite_or_none(value: float | None) -> float | None:
     """``value`` as a float, or None when it is None, NaN or infinite (a result that is
-    undefined, such as the ZMP of a robot off the ground, is ``null`` in JSON)."""
+    undefined, such as the ZMP of a robot off the ground, is ``null`` in JSON).
+    """
     if value is None:
         return None
     value = float(value)

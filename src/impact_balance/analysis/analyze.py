@@ -7,19 +7,24 @@ from typing import Any
 
 import numpy as np
 
-from impact_balance.balance.areas import BalanceAreas, areas_from_polytope, with_reason
-from impact_balance.contacts.wrench_polytope import wrench_polytope
-from impact_balance.criteria.com import max_contact_velocity, safe_contact_velocity, safe_interval, zmp_max_contact_velocity
 from impact_balance.analysis.diagnostics import diagnose
 from impact_balance.analysis.result import Analysis, ImpactAnswer
-from impact_balance.impact.model import ImpactModel, impact_model
-from impact_balance.projection.walk import warm_up
+from impact_balance.balance.areas import BalanceAreas, areas_from_polytope, with_reason
+from impact_balance.contacts.stance import Stance
+from impact_balance.contacts.wrench_polytope import wrench_polytope
+from impact_balance.criteria.com import (
+    max_contact_velocity,
+    safe_contact_velocity,
+    safe_interval,
+    zmp_max_contact_velocity,
+)
 from impact_balance.criteria.qp import QPOptions, solve_contact_velocity_qp, static_torques
 from impact_balance.exceptions import NonFiniteResultError, ScenarioError, SolverError
+from impact_balance.impact.model import ImpactModel, impact_model
+from impact_balance.projection.walk import warm_up
 from impact_balance.scenario import Scenario, load_scenario, with_source
-from impact_balance.contacts.stance import Stance
 
-__all__ = ["ImpactAnswer", "Analysis", "analyze"]
+__all__ = ["Analysis", "ImpactAnswer", "analyze"]
 
 
 def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
@@ -78,11 +83,20 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
         if (cfg.qp.solve if solve_qp is None else solve_qp) and cfg.reference_velocity is not None:
             tau0 = static_torques(stance, polytope) if cfg.qp.impulsive_torque_limits else None
             options = QPOptions(
-                cfg.qp.joint_velocity_limits, cfg.qp.impulsive_torque_limits, cfg.qp.peak_factor, cfg.duration, cfg.qp.solver
+                cfg.qp.joint_velocity_limits,
+                cfg.qp.impulsive_torque_limits,
+                cfg.qp.peak_factor,
+                cfg.duration,
+                cfg.qp.solver,
             )
             try:
                 qp = solve_contact_velocity_qp(
-                    model, areas.com_velocity_area, scenario.com_velocity, cfg.reference_velocity, stance.robot, tau0,
+                    model,
+                    areas.com_velocity_area,
+                    scenario.com_velocity,
+                    cfg.reference_velocity,
+                    stance.robot,
+                    tau0,
                     options,
                 )
             except SolverError as exc:

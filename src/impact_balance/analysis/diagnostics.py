@@ -34,10 +34,17 @@ import numpy as np
 from impact_balance.analysis.result import Diagnostic, ImpactAnswer
 
 if TYPE_CHECKING:
-    from impact_balance.scenario import Scenario
     from impact_balance.contacts.stance import Stance
+    from impact_balance.scenario import Scenario
 
-__all__ = ["Diagnostic", "FLOOR_TILT", "WALL_TILT", "diagnose", "contact_diagnostics", "impact_diagnostics"]
+__all__ = [
+    "FLOOR_TILT",
+    "WALL_TILT",
+    "Diagnostic",
+    "contact_diagnostics",
+    "diagnose",
+    "impact_diagnostics",
+]
 
 #: Steepest floor or ramp, degrees from the vertical.
 FLOOR_TILT = 40.0
@@ -60,47 +67,69 @@ def contact_diagnostics(stance: Stance) -> list[Diagnostic]:
         field = f"contacts[{i}]"
         frame = contact.spec.frame
         if contact.normal[2] < 0.0:
-            out.append(Diagnostic(
-                "contact_normal_down", field,
-                f"the normal of {frame} points down ({tilt:.0f}° from vertical): the surface would be above "
-                "the contact; the frame's z axis (after offset) must point from the surface into the robot",
-            ))
+            out.append(
+                Diagnostic(
+                    "contact_normal_down",
+                    field,
+                    f"the normal of {frame} points down ({tilt:.0f}° from vertical): the surface would be above "
+                    "the contact; the frame's z axis (after offset) must point from the surface into the robot",
+                )
+            )
         elif FLOOR_TILT < tilt < WALL_TILT:
-            out.append(Diagnostic(
-                "contact_normal_tilted", field,
-                f"the normal of {frame} is {tilt:.0f}° from vertical, neither a floor or ramp "
-                f"(<= {FLOOR_TILT:.0f}°) nor a wall (>= {WALL_TILT:.0f}°): is its z axis the surface normal? "
-                "(set offset.rpy to align it)",
-            ))
+            out.append(
+                Diagnostic(
+                    "contact_normal_tilted",
+                    field,
+                    f"the normal of {frame} is {tilt:.0f}° from vertical, neither a floor or ramp "
+                    f"(<= {FLOOR_TILT:.0f}°) nor a wall (>= {WALL_TILT:.0f}°): is its z axis the surface normal? "
+                    "(set offset.rpy to align it)",
+                )
+            )
     return out
 
 
-def impact_diagnostics(answer: ImpactAnswer, reference_velocity: Sequence[float] | None) -> list[Diagnostic]:
+def impact_diagnostics(
+    answer: ImpactAnswer, reference_velocity: Sequence[float] | None
+) -> list[Diagnostic]:
     """An impact that does not approach its surface, a QP capped by its reference."""
     out = []
     if reference_velocity is None:
         return out
     approach = answer.model.approach_speed(reference_velocity)
     if approach <= 0.0:
-        out.append(Diagnostic(
-            "impact_moving_away", "impact.reference_velocity",
-            f"the reference velocity does not move towards the impacted surface (approach speed -n.v = "
-            f"{approach:.3g} m/s <= 0), so there is no impact and nothing to cap; impact.normal must point from "
-            "the surface into the robot (is its sign flipped?)",
-        ))
+        out.append(
+            Diagnostic(
+                "impact_moving_away",
+                "impact.reference_velocity",
+                f"the reference velocity does not move towards the impacted surface (approach speed -n.v = "
+                f"{approach:.3g} m/s <= 0), so there is no impact and nothing to cap; impact.normal must point from "
+                "the surface into the robot (is its sign flipped?)",
+            )
+        )
     qp = answer.qp
     limit = answer.max_contact_velocity
-    if (qp is not None and qp.status == "optimal" and approach > 0.0 and math.isfinite(qp.approach_speed)
-            and approach < limit and abs(qp.approach_speed - approach) <= _CAP_TOLERANCE * max(1.0, approach)):
-        out.append(Diagnostic(
-            "qp_capped_by_reference", "impact.qp",
-            f"the paper's QP gives the reference approach speed {approach:.3f} m/s, not the maximum "
-            f"{limit:.3f} m/s: it tracks the reference velocity and never exceeds it",
-        ))
+    if (
+        qp is not None
+        and qp.status == "optimal"
+        and approach > 0.0
+        and math.isfinite(qp.approach_speed)
+        and approach < limit
+        and abs(qp.approach_speed - approach) <= _CAP_TOLERANCE * max(1.0, approach)
+    ):
+        out.append(
+            Diagnostic(
+                "qp_capped_by_reference",
+                "impact.qp",
+                f"the paper's QP gives the reference approach speed {approach:.3f} m/s, not the maximum "
+                f"{limit:.3f} m/s: it tracks the reference velocity and never exceeds it",
+            )
+        )
     return out
 
 
-def diagnose(scenario: Scenario, stance: Stance, impact: ImpactAnswer | None) -> tuple[Diagnostic, ...]:
+def diagnose(
+    scenario: Scenario, stance: Stance, impact: ImpactAnswer | None
+) -> tuple[Diagnostic, ...]:
     """Every warning of one analysis, in scenario order."""
     out = contact_diagnostics(stance)
     if impact is not None and scenario.impact is not None:

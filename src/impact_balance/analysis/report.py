@@ -6,7 +6,7 @@ import numpy as np
 
 from impact_balance.analysis.analyze import Analysis
 
-__all__ = ["format_analysis", "format_speed", "format_safe_interval", "format_timings"]
+__all__ = ["format_analysis", "format_safe_interval", "format_speed", "format_timings"]
 
 
 def format_speed(value: float) -> str:
@@ -24,7 +24,9 @@ def format_timings(timings: dict[str, float]) -> str:
     if robot > 1e-3:  # a cached model takes microseconds: only the first use is worth a word
         extra.append(f"robot model loading {1e3 * robot:.0f} ms (first use)")
     if "kernel_loading" in timings:
-        extra.append(f"projection kernel loading {1e3 * timings['kernel_loading']:.0f} ms (first call)")
+        extra.append(
+            f"projection kernel loading {1e3 * timings['kernel_loading']:.0f} ms (first call)"
+        )
     return text + (f"; not included: {', '.join(extra)}" if extra else "")
 
 
@@ -33,7 +35,9 @@ def format_safe_interval(interval: tuple[float, float] | None, inside: bool) -> 
     if interval is None:
         return "safe approach speeds: none (no impact speed brings the CoM velocity into the area)"
     lo, hi = interval
-    text = f"safe approach speeds: [{lo:.3f}, {f'{hi:.3f}' if np.isfinite(hi) else 'unbounded'}] m/s"
+    text = (
+        f"safe approach speeds: [{lo:.3f}, {f'{hi:.3f}' if np.isfinite(hi) else 'unbounded'}] m/s"
+    )
     if not inside:
         text += " (the CoM velocity is outside the area: an impact in this range would bring it back inside)"
     return text
@@ -79,20 +83,29 @@ def format_analysis(analysis: Analysis) -> str:
         com_v, zmp_v = im.max_contact_velocity, im.zmp_max_contact_velocity
         if im.com_limit.status == "already_falling":
             # The ZMP criterion ignores the CoM velocity: its number is not comparable here.
-            lines.append(f"  max contact velocity: none, the robot is already falling (CoM criterion 0); "
-                         f"ZMP criterion {format_speed(zmp_v)} (it ignores the CoM velocity)")
+            lines.append(
+                f"  max contact velocity: none, the robot is already falling (CoM criterion 0); "
+                f"ZMP criterion {format_speed(zmp_v)} (it ignores the CoM velocity)"
+            )
         else:
-            ratio = f" (x{com_v / zmp_v:.1f})" if np.isfinite(com_v) and com_v > 0 and zmp_v > 0 else ""
+            ratio = (
+                f" (x{com_v / zmp_v:.1f})" if np.isfinite(com_v) and com_v > 0 and zmp_v > 0 else ""
+            )
             lines.append(
                 f"  max contact velocity: CoM criterion {format_speed(com_v)}, ZMP criterion {format_speed(zmp_v)}{ratio}"
             )
         lines.append("  " + format_safe_interval(im.safe_interval, analysis.com_velocity_inside))
         if spec.reference_velocity is not None:
-            target = (f"contact velocity {_vec(im.contact_velocity)} m/s (approach speed "
-                      f"{im.model.approach_speed(im.contact_velocity):.3f}, in the safe interval)"
-                      if im.contact_velocity is not None else "no safe contact velocity (no approach speed is safe)")
+            target = (
+                f"contact velocity {_vec(im.contact_velocity)} m/s (approach speed "
+                f"{im.model.approach_speed(im.contact_velocity):.3f}, in the safe interval)"
+                if im.contact_velocity is not None
+                else "no safe contact velocity (no approach speed is safe)"
+            )
             lines.append(f"  reference velocity {_vec(spec.reference_velocity)} m/s -> {target}")
         if im.qp is not None:
-            lines.append(f"  paper's QP ({im.qp.status}): approach speed {format_speed(im.qp.approach_speed)}")
+            lines.append(
+                f"  paper's QP ({im.qp.status}): approach speed {format_speed(im.qp.approach_speed)}"
+            )
     lines.append(f"  {format_timings(analysis.timings)}")
     return "\n".join(lines + warnings)

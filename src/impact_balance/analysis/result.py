@@ -111,7 +111,10 @@ class Analysis:
     @property
     def com_velocity_inside(self) -> bool:
         """Whether the pre-impact CoM velocity can be brought to rest on these contacts."""
-        return bool(self.areas.can_balance and self.areas.com_velocity_area.contains(self.com_velocity, 1e-10))
+        return bool(
+            self.areas.can_balance
+            and self.areas.com_velocity_area.contains(self.com_velocity, 1e-10)
+        )
 
     @property
     def cannot_balance_reason(self) -> CannotBalanceReason | None:
@@ -145,8 +148,13 @@ class Analysis:
             "com_velocity_area": a.com_velocity_area.to_dict(),
             "zmp_area": a.zmp_area.to_dict(),
             "contacts": [
-                {"frame": c.spec.frame, "position": c.position.tolist(), "normal": c.normal.tolist(),
-                 "friction": c.spec.friction, "size": list(c.spec.size)}
+                {
+                    "frame": c.spec.frame,
+                    "position": c.position.tolist(),
+                    "normal": c.normal.tolist(),
+                    "friction": c.spec.friction,
+                    "size": list(c.spec.size),
+                }
                 for c in self.stance.contacts
             ],
             "timings_ms": {k: 1e3 * v for k, v in self.timings.items()},
@@ -164,12 +172,20 @@ class Analysis:
                 "cone_edges": im.model.spec.cone_edges,
                 "max_contact_velocity": _num(im.max_contact_velocity),
                 "status": im.com_limit.status,
-                "reference_velocity": None if im.model.spec.reference_velocity is None else list(im.model.spec.reference_velocity),
-                "contact_velocity": None if im.contact_velocity is None else im.contact_velocity.tolist(),
+                "reference_velocity": None
+                if im.model.spec.reference_velocity is None
+                else list(im.model.spec.reference_velocity),
+                "contact_velocity": None
+                if im.contact_velocity is None
+                else im.contact_velocity.tolist(),
                 "evaluated_at_approach_speed": s,
                 "impulse_vertices": im.model.impulse_vertices(s).tolist(),
-                "post_impact_com_velocities": im.model.post_impact_com_velocities(self.com_velocity, s).tolist(),
-                "safe_interval": None if im.safe_interval is None else [_num(x) for x in im.safe_interval],
+                "post_impact_com_velocities": im.model.post_impact_com_velocities(
+                    self.com_velocity, s
+                ).tolist(),
+                "safe_interval": None
+                if im.safe_interval is None
+                else [_num(x) for x in im.safe_interval],
                 "zmp_max_contact_velocity": _num(im.zmp_max_contact_velocity),
                 "zmp_status": im.zmp_limit.status,
                 "W": im.model.W.tolist(),
@@ -178,6 +194,8 @@ class Analysis:
                 out["impact"]["qp"] = {
                     "status": im.qp.status,
                     "approach_speed": _num(im.qp.approach_speed),
-                    "contact_velocity": None if im.qp.contact_velocity is None else im.qp.contact_velocity.tolist(),
+                    "contact_velocity": None
+                    if im.qp.contact_velocity is None
+                    else im.qp.contact_velocity.tolist(),
                 }
         return out

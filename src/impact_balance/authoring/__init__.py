@@ -6,7 +6,21 @@
 """
 
 from impact_balance.authoring.frames import FramePose, contact_poses, frame_poses
-from impact_balance.authoring.pose import Placement, PoseResult, pose_scenario, posed_mapping, scenario_yaml
+from impact_balance.authoring.pose import (
+    Placement,
+    PoseResult,
+    pose_scenario,
+    posed_mapping,
+    scenario_yaml,
+)
 
-__all__ = ["FramePose", "frame_poses", "contact_poses", "Placement", "PoseResult", "pose_scenario", "posed_mapping",
-           "scenario_yaml"]
+__all__ = [
+    "FramePose",
+    "Placement",
+    "PoseResult",
+    "contact_poses",
+    "frame_poses",
+    "pose_scenario",
+    "posed_mapping",
+    "scenario_yaml",
+]

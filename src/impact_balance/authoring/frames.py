@@ -12,10 +12,10 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from impact_balance.robot.robot import Robot
 from impact_balance.contacts.stance import Stance
+from impact_balance.robot.robot import Robot
 
-__all__ = ["FramePose", "frame_poses", "contact_poses"]
+__all__ = ["FramePose", "contact_poses", "frame_poses"]
 
 
 @dataclass(frozen=True)
@@ -48,10 +48,13 @@ class FramePose:
     def to_dict(self) -> dict:
         R = self.rotation
         return {
-            "name": self.name, "type": self.kind, "parent_joint": self.parent_joint,
+            "name": self.name,
+            "type": self.kind,
+            "parent_joint": self.parent_joint,
             "position": self.position.tolist(),
             "axes": {"x": R[:, 0].tolist(), "y": R[:, 1].tolist(), "z": R[:, 2].tolist()},
-            "rpy": self.rpy.tolist(), "z_tilt_deg": self.tilt,
+            "rpy": self.rpy.tolist(),
+            "z_tilt_deg": self.tilt,
         }
 
 
@@ -69,8 +72,15 @@ def frame_poses(robot: Robot, q: np.ndarray, names: list[str] | None = None) -> 
     for fid in ids:
         frame = model.frames[fid]
         placement = data.oMf[fid]
-        out.append(FramePose(frame.name, str(frame.type).rsplit(".", 1)[-1], model.names[frame.parentJoint],
-                             np.array(placement.translation), np.array(placement.rotation)))
+        out.append(
+            FramePose(
+                frame.name,
+                str(frame.type).rsplit(".", 1)[-1],
+                model.names[frame.parentJoint],
+                np.array(placement.translation),
+                np.array(placement.rotation),
+            )
+        )
     return out
 
 
@@ -79,6 +89,14 @@ def contact_poses(stance: Stance) -> list[dict]:
     out = []
     for c in stance.contacts:
         tilt = float(np.degrees(np.arccos(np.clip(c.normal[2], -1.0, 1.0))))
-        out.append({"frame": c.spec.frame, "centre": c.position.tolist(), "normal": c.normal.tolist(),
-                    "x_axis": c.rotation[:, 0].tolist(), "size": list(c.spec.size), "normal_tilt_deg": tilt})
+        out.append(
+            {
+                "frame": c.spec.frame,
+                "centre": c.position.tolist(),
+                "normal": c.normal.tolist(),
+                "x_axis": c.rotation[:, 0].tolist(),
+                "size": list(c.spec.size),
+                "normal_tilt_deg": tilt,
+            }
+        )
     return out

@@ -31,11 +31,11 @@ import pinocchio as pin
 import yaml
 
 from impact_balance.exceptions import ScenarioError
+from impact_balance.geometry.spatial import aligning_rotation, unit
 from impact_balance.robot.ik import chain_dofs, solve_stance, stance_residuals
 from impact_balance.scenario import Scenario
-from impact_balance.geometry.spatial import aligning_rotation, unit
 
-__all__ = ["Placement", "PoseResult", "pose_scenario", "posed_mapping", "scenario_yaml", "DIGITS"]
+__all__ = ["DIGITS", "Placement", "PoseResult", "pose_scenario", "posed_mapping", "scenario_yaml"]
 
 #: Decimals kept in the written base pose and joint values (1e-6 m, 1e-6 rad).
 DIGITS = 6
@@ -77,7 +77,6 @@ class PoseResult:
     position_only: tuple[str, ...] = ()
 
 
-
 def pose_scenario(
     scenario: Scenario,
     placements: Sequence[Placement],
@@ -112,7 +111,9 @@ def pose_scenario(
             try:
                 n = unit(p.normal)
             except ValueError:
-                raise ScenarioError("--normal", list(p.normal), "must be a non-zero vector") from None
+                raise ScenarioError(
+                    "--normal", list(p.normal), "must be a non-zero vector"
+                ) from None
             rotation = aligning_rotation(rotation[:, 2], n) @ rotation
             if index is not None and scenario.contacts[index].normal is not None:
                 normals[index] = tuple(float(x) for x in n)
@@ -123,10 +124,22 @@ def pose_scenario(
     free = tuple(f for f in all_targets if chain_dofs(robot, f) < 6)
     for p in placements:
         if p.normal is not None and p.frame in free:
-            raise ScenarioError("--normal", list(p.normal), f"{p.frame} is on a chain of {chain_dofs(robot, p.frame)} "
-                                "joints from the base: it cannot be turned, only placed")
-    q = solve_stance(robot, stance.q, all_targets, com_xy, position_only=free, posture_target=stance.q,
-                     tolerance=tolerance, max_iterations=max_iterations)
+            raise ScenarioError(
+                "--normal",
+                list(p.normal),
+                f"{p.frame} is on a chain of {chain_dofs(robot, p.frame)} "
+                "joints from the base: it cannot be turned, only placed",
+            )
+    q = solve_stance(
+        robot,
+        stance.q,
+        all_targets,
+        com_xy,
+        position_only=free,
+        posture_target=stance.q,
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+    )
     residuals = stance_residuals(robot, q, all_targets, com_xy, free)
     com = pin.centerOfMass(robot.model, robot.model.createData(), q)
     return PoseResult(q, all_targets, residuals, np.array(com), normals, free)
@@ -137,8 +150,12 @@ def _rounded(x: float) -> float:
     return 0.0 if value == 0 else value
 
 
-def posed_mapping(raw: Mapping[str, Any], scenario: Scenario, result: PoseResult,
-                  out_dir: str | Path | None = None) -> dict[str, Any]:
+def posed_mapping(
+    raw: Mapping[str, Any],
+    scenario: Scenario,
+    result: PoseResult,
+    out_dir: str | Path | None = None,
+) -> dict[str, Any]:
     """The scenario mapping ``raw`` (as read, ``extends`` merged) with the posed base and joints.
 
     Joint values are rounded to 1e-6 rad and kept within their limits; robot file paths are
@@ -146,7 +163,9 @@ def posed_mapping(raw: Mapping[str, Any], scenario: Scenario, result: PoseResult
     """
     robot = scenario.load_robot()
     out: dict[str, Any] = {}
-    for key, value in dict(raw).items():  # base and joints right after the configuration, as in bundled files
+    for key, value in dict(
+        raw
+    ).items():  # base and joints right after the configuration, as in bundled files
         if key in ("base", "joints", "name"):
             continue
         out[key] = value
@@ -159,7 +178,12 @@ def posed_mapping(raw: Mapping[str, Any], scenario: Scenario, result: PoseResult
     joints = {}
     for name, value in robot.joint_values(q).items():
         slot = robot.joint_slot(name)
-        if slot.nq == 1 and np.isfinite(slot.lower) and np.isfinite(slot.upper) and slot.lower < slot.upper:
+        if (
+            slot.nq == 1
+            and np.isfinite(slot.lower)
+            and np.isfinite(slot.upper)
+            and slot.lower < slot.upper
+        ):
             value = min(max(value, slot.lower), slot.upper)
         if abs(value - reference[name]) > 0.5 * 10.0**-DIGITS:
             rounded = _rounded(value)
@@ -179,7 +203,11 @@ def posed_mapping(raw: Mapping[str, Any], scenario: Scenario, result: PoseResult
         for key in ("urdf", "srdf"):
             if entry.get(key):
                 path = (source_dir / entry[key]).resolve()
-                entry[key] = os.path.relpath(path, Path(out_dir).resolve()) if out_dir is not None else str(path)
+                entry[key] = (
+                    os.path.relpath(path, Path(out_dir).resolve())
+                    if out_dir is not None
+                    else str(path)
+                )
         out["robot"] = entry
     return out
 
@@ -188,12 +216,20 @@ class _Dumper(yaml.SafeDumper):
     """YAML as the bundled scenarios are written: mappings in block style, vectors on one line."""
 
 
-_Dumper.add_representer(list, lambda dumper, data: dumper.represent_sequence(
-    "tag:yaml.org,2002:seq", data, flow_style=all(not isinstance(x, (dict, list)) for x in data)))
-_Dumper.add_representer(tuple, lambda dumper, data: _Dumper.yaml_representers[list](dumper, list(data)))
+_Dumper.add_representer(
+    list,
+    lambda dumper, data: dumper.represent_sequence(
+        "tag:yaml.org,2002:seq", data, flow_style=all(not isinstance(x, (dict, list)) for x in data)
+    ),
+)
+_Dumper.add_representer(
+    tuple, lambda dumper, data: _Dumper.yaml_representers[list](dumper, list(data))
+)
 
 
 def scenario_yaml(mapping: Mapping[str, Any], header: str = "") -> str:
     """A scenario mapping as YAML text (block mappings, one-line vectors), after ``header`` comment lines."""
     comment = "".join(f"# {line}\n" for line in header.splitlines())
-    return comment + yaml.dump(dict(mapping), Dumper=_Dumper, sort_keys=False, width=100, allow_unicode=True)
+    return comment + yaml.dump(
+        dict(mapping), Dumper=_Dumper, sort_keys=False, width=100, allow_unicode=True
+    )

@@ -24,21 +24,39 @@ from typing import NamedTuple
 
 import numpy as np
 
-from impact_balance.contacts import wrench_polytope as constraints
-from impact_balance.geometry import polygon
 from impact_balance._jit import cache_depends_on, njit
-from impact_balance.constants import GRAVITY
-from impact_balance.contacts.wrench_polytope import WrenchPolytope, _assemble_arrays, face_blocks, wrench_polytope
 from impact_balance.balance.infeasibility import CannotBalanceReason, explain_cannot_balance
+from impact_balance.constants import GRAVITY
+from impact_balance.contacts import wrench_polytope as constraints
+from impact_balance.contacts.stance import Stance
+from impact_balance.contacts.wrench_polytope import (
+    WrenchPolytope,
+    _assemble_arrays,
+    face_blocks,
+    wrench_polytope,
+)
 from impact_balance.exceptions import ScenarioError, SolverError
-from impact_balance.geometry.polygon import MERGE_AREA_TOLERANCE, Polygon, _edge_halfplanes, _inset_polygon
+from impact_balance.geometry import polygon
+from impact_balance.geometry.polygon import (
+    MERGE_AREA_TOLERANCE,
+    Polygon,
+    _edge_halfplanes,
+    _inset_polygon,
+)
 from impact_balance.projection import _kernel, project_polytope, walk
 from impact_balance.projection._kernel import LINE, OK
 from impact_balance.projection.walk import MAX_PIVOTS, NO_HINT, certified_walk
-from impact_balance.contacts.stance import Stance
 
-__all__ = ["BalanceAreas", "Projected", "balance_areas", "areas_from_polytope", "areas_from_arrays", "projected_from_arrays",
-           "omega", "with_reason"]
+__all__ = [
+    "BalanceAreas",
+    "Projected",
+    "areas_from_arrays",
+    "areas_from_polytope",
+    "balance_areas",
+    "omega",
+    "projected_from_arrays",
+    "with_reason",
+]
 
 #: Projection tolerance on the resultant horizontal force, as a fraction of m g.
 FORCE_TOLERANCE = 1e-8
@@ -53,7 +71,9 @@ FORCE_BOX = 1e3
 def omega(com_height: float, plane_height: float = 0.0, gravity: float = GRAVITY) -> float:
     """LIPM natural frequency sqrt(g / (c_z - h)), 1/s; the plane must be below the CoM."""
     if not com_height > plane_height:
-        raise ScenarioError("plane_height", plane_height, f"must be below the CoM height {com_height:.4g} m")
+        raise ScenarioError(
+            "plane_height", plane_height, f"must be below the CoM height {com_height:.4g} m"
+        )
     return math.sqrt(gravity / (com_height - plane_height))
 
 
@@ -94,7 +114,8 @@ class BalanceAreas:
 
     def com_velocity_area_inset(self, margin: float) -> Polygon:
         """The CoM velocity area of ``zmp_area`` shrunk by ``margin`` more metres (what a
-        controller that keeps its ZMP that far inside can use); empty when nothing is left."""
+        controller that keeps its ZMP that far inside can use); empty when nothing is left.
+        """
         return _velocity_area(self.zmp_area.inset(margin), self.omega, self.com)
 
     @property
@@ -110,9 +131,12 @@ def _velocity_area(zmp: Polygon, w: float, com: np.ndarray) -> Polygon:
     return Polygon.empty() if zmp.is_empty else zmp.affine(w, -w * com[:2])
 
 
-def areas_from_polytope(polytope: WrenchPolytope, plane_height: float = 0.0, zmp_margin: float = 0.0) -> BalanceAreas:
+def areas_from_polytope(
+    polytope: WrenchPolytope, plane_height: float = 0.0, zmp_margin: float = 0.0
+) -> BalanceAreas:
     """Project a contact-wrench polytope and map it to the ZMP and CoM velocity areas, the ZMP
-    support area shrunk by ``zmp_margin`` (m)."""
+    support area shrunk by ``zmp_margin`` (m).
+    """
     com = polytope.com
     w = omega(float(com[2]), plane_height, polytope.gravity)
     depth = plane_height - float(com[2])  # < 0
@@ -120,15 +144,38 @@ def areas_from_polytope(polytope: WrenchPolytope, plane_height: float = 0.0, zmp
     # friction-normalised variables so that a large or small friction keeps full precision.
     data = tuple(np.ascontiguousarray(x, dtype=np.float64) for x in polytope.projection_data())
     # The walk, its certificate and both maps in one compiled call (a governor's every tick).
-    walked = _walk_areas(*data, FORCE_BOX, MAX_PIVOTS, MERGE_TOLERANCE, MERGE_AREA_TOLERANCE, depth, float(com[0]),
-                         float(com[1]), w, float(zmp_margin), NO_HINT)
-    return _projected(walked, data, com, w, plane_height, polytope.mass, polytope.gravity, float(zmp_margin)).areas()
+    walked = _walk_areas(
+        *data,
+        FORCE_BOX,
+        MAX_PIVOTS,
+        MERGE_TOLERANCE,
+        MERGE_AREA_TOLERANCE,
+        depth,
+        float(com[0]),
+        float(com[1]),
+        w,
+        float(zmp_margin),
+        NO_HINT,
+    )
+    return _projected(
+        walked, data, com, w, plane_height, polytope.mass, polytope.gravity, float(zmp_margin)
+    ).areas()
 
 
 def areas_from_arrays(
-    faces: np.ndarray, rotations: np.ndarray, positions: np.ndarray, arms: np.ndarray, mass: float, com: np.ndarray,
-    gravity: float, jacobians: np.ndarray, torque_indices: np.ndarray, torque_limits: np.ndarray,
-    gravity_torques: np.ndarray, plane_height: float = 0.0, zmp_margin: float = 0.0,
+    faces: np.ndarray,
+    rotations: np.ndarray,
+    positions: np.ndarray,
+    arms: np.ndarray,
+    mass: float,
+    com: np.ndarray,
+    gravity: float,
+    jacobians: np.ndarray,
+    torque_indices: np.ndarray,
+    torque_limits: np.ndarray,
+    gravity_torques: np.ndarray,
+    plane_height: float = 0.0,
+    zmp_margin: float = 0.0,
 ) -> BalanceAreas:
     """``areas_from_polytope(assemble_polytope(...))`` for contacts whose frictions are all at
     most 1 (no friction scaling), in one compiled call: a governor's every tick.
@@ -136,14 +183,38 @@ def areas_from_arrays(
     The arguments are :func:`~impact_balance.contacts.wrench_polytope.assemble_polytope`'s (``faces`` (m,
     16, 6); ``com`` (3,) world, m), then the plane height (m) and the ZMP margin (m).
     """
-    return projected_from_arrays(faces, rotations, positions, arms, mass, com, gravity, jacobians, torque_indices,
-                                 torque_limits, gravity_torques, plane_height, zmp_margin).areas()
+    return projected_from_arrays(
+        faces,
+        rotations,
+        positions,
+        arms,
+        mass,
+        com,
+        gravity,
+        jacobians,
+        torque_indices,
+        torque_limits,
+        gravity_torques,
+        plane_height,
+        zmp_margin,
+    ).areas()
 
 
 def projected_from_arrays(
-    faces: np.ndarray, rotations: np.ndarray, positions: np.ndarray, arms: np.ndarray, mass: float, com: np.ndarray,
-    gravity: float, jacobians: np.ndarray, torque_indices: np.ndarray, torque_limits: np.ndarray,
-    gravity_torques: np.ndarray, plane_height: float = 0.0, zmp_margin: float = 0.0, hint: np.ndarray | None = None,
+    faces: np.ndarray,
+    rotations: np.ndarray,
+    positions: np.ndarray,
+    arms: np.ndarray,
+    mass: float,
+    com: np.ndarray,
+    gravity: float,
+    jacobians: np.ndarray,
+    torque_indices: np.ndarray,
+    torque_limits: np.ndarray,
+    gravity_torques: np.ndarray,
+    plane_height: float = 0.0,
+    zmp_margin: float = 0.0,
+    hint: np.ndarray | None = None,
 ) -> Projected:
     """:func:`areas_from_arrays` before its :class:`BalanceAreas` is built (a governor's tick
     reads only the CoM velocity area; :meth:`Projected.areas` builds the rest on demand).
@@ -155,17 +226,42 @@ def projected_from_arrays(
     """
     if hint is None:
         hint = NO_HINT
-    elif not (isinstance(hint, np.ndarray) and hint.dtype == np.int64 and hint.ndim == 1 and hint.flags.writeable):
-        raise ValueError(f"hint must be a writable 1-D int64 numpy array, not {type(hint).__name__} "
-                         f"{getattr(hint, 'dtype', '')}".rstrip())
+    elif not (
+        isinstance(hint, np.ndarray)
+        and hint.dtype == np.int64
+        and hint.ndim == 1
+        and hint.flags.writeable
+    ):
+        raise ValueError(
+            f"hint must be a writable 1-D int64 numpy array, not {type(hint).__name__} "
+            f"{getattr(hint, 'dtype', '')}".rstrip()
+        )
     w = omega(float(com[2]), plane_height, gravity)
     depth = plane_height - float(com[2])
     positions, arms, jacobians, torque_limits, gravity_torques = (
-        np.ascontiguousarray(x, dtype=np.float64) for x in (positions, arms, jacobians, torque_limits, gravity_torques))
-    out = _assembled_areas(face_blocks(faces, rotations), positions, arms, jacobians,
-                           np.ascontiguousarray(torque_indices, dtype=np.int64), torque_limits, gravity_torques,
-                           mass * gravity, FORCE_BOX, MAX_PIVOTS, MERGE_TOLERANCE, MERGE_AREA_TOLERANCE, depth,
-                           float(com[0]), float(com[1]), w, float(zmp_margin), hint)
+        np.ascontiguousarray(x, dtype=np.float64)
+        for x in (positions, arms, jacobians, torque_limits, gravity_torques)
+    )
+    out = _assembled_areas(
+        face_blocks(faces, rotations),
+        positions,
+        arms,
+        jacobians,
+        np.ascontiguousarray(torque_indices, dtype=np.int64),
+        torque_limits,
+        gravity_torques,
+        mass * gravity,
+        FORCE_BOX,
+        MAX_PIVOTS,
+        MERGE_TOLERANCE,
+        MERGE_AREA_TOLERANCE,
+        depth,
+        float(com[0]),
+        float(com[1]),
+        w,
+        float(zmp_margin),
+        hint,
+    )
     return _projected(out[5:], out[:5], com, w, plane_height, mass, gravity, float(zmp_margin))
 
 
@@ -193,36 +289,82 @@ class Projected(NamedTuple):
 
     def areas(self) -> BalanceAreas:
         """The :class:`BalanceAreas` (the same CoM velocity area object)."""
-        return BalanceAreas(Polygon(self.force, self.bounded), Polygon(self.zmp, self.zmp_bounded),
-                            self.com_velocity_area, self.w, np.array(self.com, dtype=float), self.plane_height,
-                            self.mass, self.gravity, self.n_lp, zmp_margin=self.margin)
+        return BalanceAreas(
+            Polygon(self.force, self.bounded),
+            Polygon(self.zmp, self.zmp_bounded),
+            self.com_velocity_area,
+            self.w,
+            np.array(self.com, dtype=float),
+            self.plane_height,
+            self.mass,
+            self.gravity,
+            self.n_lp,
+            zmp_margin=self.margin,
+        )
 
 
-def _projected(walked: tuple, data: tuple, com: np.ndarray, w: float, plane_height: float, mass: float,
-               gravity: float, margin: float) -> Projected:
+def _projected(
+    walked: tuple,
+    data: tuple,
+    com: np.ndarray,
+    w: float,
+    plane_height: float,
+    mass: float,
+    gravity: float,
+    margin: float,
+) -> Projected:
     """The areas from :func:`_walk_areas`' answer ``walked`` on the projection data ``data``
     ``(A, b, C, d, E)``: where the walk cannot answer, project_polytope chooses as it always
-    does, and the same compiled maps make the ZMP and CoM velocity areas."""
+    does, and the same compiled maps make the ZMP and CoM velocity areas.
+    """
     status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h = walked
     n_lp = 1
     if status != OK or force.shape[0] == 0:
-        result = project_polytope(*data, tol=FORCE_TOLERANCE, box=FORCE_BOX, merge_tol=MERGE_TOLERANCE,
-                                  method="auto" if status == LINE else "bretl")
+        result = project_polytope(
+            *data,
+            tol=FORCE_TOLERANCE,
+            box=FORCE_BOX,
+            merge_tol=MERGE_TOLERANCE,
+            method="auto" if status == LINE else "bretl",
+        )
         force, bounded, n_lp = result.polygon.vertices, result.polygon.bounded, result.n_lp
-        zmp, zmp_bounded, vel, vel_bounded = _maps(np.ascontiguousarray(force), bounded, plane_height - float(com[2]),
-                                                   float(com[0]), float(com[1]), w, margin)
+        zmp, zmp_bounded, vel, vel_bounded = _maps(
+            np.ascontiguousarray(force),
+            bounded,
+            plane_height - float(com[2]),
+            float(com[0]),
+            float(com[1]),
+            w,
+            margin,
+        )
         G = np.empty((0, 2))
     # The criterion reads the CoM velocity area's half-planes: the compiled call made them.
-    velocity_area = (Polygon.with_halfplanes(vel, bool(vel_bounded), G, h) if len(G)
-                     else Polygon(vel, bool(vel_bounded)))
-    return Projected(force, bool(bounded), zmp, bool(zmp_bounded), velocity_area, n_lp, w, com, plane_height, mass,
-                     gravity, margin)
+    velocity_area = (
+        Polygon.with_halfplanes(vel, bool(vel_bounded), G, h)
+        if len(G)
+        else Polygon(vel, bool(vel_bounded))
+    )
+    return Projected(
+        force,
+        bool(bounded),
+        zmp,
+        bool(zmp_bounded),
+        velocity_area,
+        n_lp,
+        w,
+        com,
+        plane_height,
+        mass,
+        gravity,
+        margin,
+    )
 
 
 def warm_up() -> None:
     """Load the compiled map that the fallback path (a walk refused, Bretl's polygon mapped in
     :func:`_projected`) calls from Python: numba loads a cached function on its first call
-    (12 ms in a G1 tick). A governor calls this when it is built."""
+    (12 ms in a G1 tick). A governor calls this when it is built.
+    """
     _maps(np.zeros((0, 2)), True, -1.0, 0.0, 0.0, 1.0, 0.0)
 
 
@@ -240,7 +382,8 @@ def _affine(v, scale, ox, oy):
 def _maps(force, bounded, depth, cx, cy, w, margin):
     """The ZMP support area (shrunk by ``margin``) and the CoM velocity area of the force area
     ``force`` (vertices, units of m g): ``(zmp, zmp_bounded, vel, vel_bounded)``, the numbers
-    :class:`Polygon`'s ``affine`` and ``inset`` give (``depth`` = h - c_z, CoM ``(cx, cy)``)."""
+    :class:`Polygon`'s ``affine`` and ``inset`` give (``depth`` = h - c_z, CoM ``(cx, cy)``).
+    """
     empty = np.empty((0, 2))
     if force.shape[0] == 0:
         return empty, True, empty, True
@@ -255,11 +398,16 @@ def _maps(force, bounded, depth, cx, cy, w, margin):
 
 
 @njit(cache=True)
-def _walk_areas(A, b, C, d, E, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, margin, hint):
+def _walk_areas(
+    A, b, C, d, E, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, margin, hint
+):
     """:func:`~impact_balance.projection.walk.certified_walk` and :func:`_maps` in one call:
     ``(status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h)``, ``G, h`` the CoM
-    velocity area's half-planes when it has 3 vertices or more (else none)."""
-    status, force, bounded, _, _, _ = certified_walk(A, b, C, d, E, box, max_pivots, merge_tol, area_tol, hint)
+    velocity area's half-planes when it has 3 vertices or more (else none).
+    """
+    status, force, bounded, _, _, _ = certified_walk(
+        A, b, C, d, E, box, max_pivots, merge_tol, area_tol, hint
+    )
     zmp, zmp_bounded, vel, vel_bounded = _maps(force, bounded, depth, cx, cy, w, margin)
     if vel.shape[0] >= 3:
         G, h = _edge_halfplanes(vel)
@@ -269,18 +417,40 @@ def _walk_areas(A, b, C, d, E, box, max_pivots, merge_tol, area_tol, depth, cx, 
 
 
 @njit(cache=True)
-def _assembled_areas(blocks, positions, arms, jacobians, torque_indices, torque_limits, gravity_torques,
-                     weight, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, margin, hint):
+def _assembled_areas(
+    blocks,
+    positions,
+    arms,
+    jacobians,
+    torque_indices,
+    torque_limits,
+    gravity_torques,
+    weight,
+    box,
+    max_pivots,
+    merge_tol,
+    area_tol,
+    depth,
+    cx,
+    cy,
+    w,
+    margin,
+    hint,
+):
     """The polytope's arrays (as :func:`~impact_balance.contacts.wrench_polytope.assemble_polytope`) in
     units of m g (as ``WrenchPolytope.projection_data`` without scaling) and
-    :func:`_walk_areas` on them: ``(A, b, C, d, E) + _walk_areas(...)``."""
-    A, b, C, G = _assemble_arrays(blocks, positions, arms, jacobians, torque_indices, torque_limits, gravity_torques)
+    :func:`_walk_areas` on them: ``(A, b, C, d, E) + _walk_areas(...)``.
+    """
+    A, b, C, G = _assemble_arrays(
+        blocks, positions, arms, jacobians, torque_indices, torque_limits, gravity_torques
+    )
     b = b / weight
     d = np.zeros(4)
     d[0] = weight / weight  # (m g, 0, 0, 0) / (m g)
     E = G[:2].copy()
     status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, Gv, hv = _walk_areas(
-        A, b, C, d, E, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, margin, hint)
+        A, b, C, d, E, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, margin, hint
+    )
     return A, b, C, d, E, status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, Gv, hv
 
 
@@ -291,22 +461,34 @@ cache_depends_on(_assembled_areas, polygon, walk, _kernel, constraints)
 
 
 def balance_areas(
-    stance: Stance, plane_height: float = 0.0, torque_limits: bool = True, gravity: float = GRAVITY,
+    stance: Stance,
+    plane_height: float = 0.0,
+    torque_limits: bool = True,
+    gravity: float = GRAVITY,
     zmp_margin: float = 0.0,
 ) -> BalanceAreas:
     """ZMP support area (shrunk by ``zmp_margin``, m) and CoM velocity area of ``stance``."""
     omega(float(stance.com[2]), plane_height, gravity)  # validate the plane before any work
-    areas = areas_from_polytope(wrench_polytope(stance, torque_limits, gravity), plane_height, zmp_margin)
+    areas = areas_from_polytope(
+        wrench_polytope(stance, torque_limits, gravity), plane_height, zmp_margin
+    )
     return with_reason(areas, stance, torque_limits, gravity)
 
 
-def with_reason(areas: BalanceAreas, stance: Stance, torque_limits: bool, gravity: float) -> BalanceAreas:
+def with_reason(
+    areas: BalanceAreas, stance: Stance, torque_limits: bool, gravity: float
+) -> BalanceAreas:
     """``areas`` with :attr:`BalanceAreas.reason` filled in when they are empty."""
     if areas.can_balance or areas.reason is not None:
         return areas
     if not areas.force_area.is_empty:  # the stance balances; the margin leaves nothing
-        return dataclasses.replace(areas, reason=CannotBalanceReason(
-            "zmp_margin", f"no point of the ZMP support area is {areas.zmp_margin:g} m (the ZMP margin) inside its edges"))
+        return dataclasses.replace(
+            areas,
+            reason=CannotBalanceReason(
+                "zmp_margin",
+                f"no point of the ZMP support area is {areas.zmp_margin:g} m (the ZMP margin) inside its edges",
+            ),
+        )
     try:
         reason = explain_cannot_balance(stance, torque_limits, gravity)
     except SolverError as exc:  # the areas are the answer; an explanation is a bonus

@@ -29,11 +29,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from impact_balance.constants import GRAVITY
+from impact_balance.contacts.stance import Stance
 from impact_balance.contacts.wrench_polytope import contact_polytope, wrench_polytope
 from impact_balance.solvers import HighsLP, LinearProgram
-from impact_balance.contacts.stance import Stance
 
-__all__ = ["BindingJoint", "CannotBalanceReason", "explain_cannot_balance", "HIGH_FRICTION"]
+__all__ = ["HIGH_FRICTION", "BindingJoint", "CannotBalanceReason", "explain_cannot_balance"]
 
 #: Friction coefficient taken as "as much friction as one wants" (the polytope is then
 #: already the limit one up to 1e-6 of the weight for any practical geometry).
@@ -133,7 +133,9 @@ def _joint_names(stance: Stance, velocity_indices: np.ndarray) -> list[str]:
     return [owner.get(int(k), f"v[{int(k)}]") for k in velocity_indices]
 
 
-def explain_cannot_balance(stance: Stance, torque_limits: bool = True, gravity: float = GRAVITY) -> CannotBalanceReason:
+def explain_cannot_balance(
+    stance: Stance, torque_limits: bool = True, gravity: float = GRAVITY
+) -> CannotBalanceReason:
     """Why ``stance`` cannot balance (call it only when its areas are empty).
 
     See the module docstring for what is computed.
@@ -147,7 +149,10 @@ def explain_cannot_balance(stance: Stance, torque_limits: bool = True, gravity: 
         if _feasible(A[:n_cwc], b[:n_cwc], C, d):
             return _torque_reason(stance, A, b, C, d, n_cwc, weight)
     contacts = stance.contacts
-    loose = [dataclasses.replace(c, spec=dataclasses.replace(c.spec, friction=HIGH_FRICTION)) for c in contacts]
+    loose = [
+        dataclasses.replace(c, spec=dataclasses.replace(c.spec, friction=HIGH_FRICTION))
+        for c in contacts
+    ]
     if contacts and _contacts_feasible(stance, loose, gravity):
         mu = _min_friction(stance, gravity)
         return CannotBalanceReason(
@@ -166,7 +171,8 @@ def explain_cannot_balance(stance: Stance, torque_limits: bool = True, gravity: 
 def _contacts_feasible(stance: Stance, contacts, gravity: float) -> bool:
     """Whether CWC + LIPM (no torque limits) is feasible for ``contacts`` at this stance.
 
-    Uses the stance-frame lever arms (contact positions relative to the CoM)."""
+    Uses the stance-frame lever arms (contact positions relative to the CoM).
+    """
     local = [dataclasses.replace(c, position=c.local_position - stance.com_local) for c in contacts]
     P = contact_polytope(local, stance.mass, np.zeros(3), gravity)
     weight = stance.mass * gravity
@@ -175,9 +181,14 @@ def _contacts_feasible(stance: Stance, contacts, gravity: float) -> bool:
 
 def _min_friction(stance: Stance, gravity: float) -> float:
     """Smallest common friction coefficient that makes CWC + LIPM feasible (bisection in
-    log scale between the largest current friction and :data:`HIGH_FRICTION`)."""
+    log scale between the largest current friction and :data:`HIGH_FRICTION`).
+    """
+
     def ok(mu: float) -> bool:
-        cs = [dataclasses.replace(c, spec=dataclasses.replace(c.spec, friction=mu)) for c in stance.contacts]
+        cs = [
+            dataclasses.replace(c, spec=dataclasses.replace(c.spec, friction=mu))
+            for c in stance.contacts
+        ]
         return _contacts_feasible(stance, cs, gravity)
 
     lo = max(c.spec.friction for c in stance.contacts)
@@ -211,8 +222,12 @@ def _torque_reason(stance, A, b, C, d, n_cwc, weight) -> CannotBalanceReason:
     joints.sort(key=lambda jt: jt.min_scale)
     if not joints and uniform is not None:
         # No joint alone: list those at their (scaled) limit at the common optimum.
-        joints = [BindingJoint(n, float(lim), None) for n, lim in _active_at_uniform(
-            A, b0, C, d, all_rows, np.concatenate([scaled, scaled]), uniform, names, limits)]
+        joints = [
+            BindingJoint(n, float(lim), None)
+            for n, lim in _active_at_uniform(
+                A, b0, C, d, all_rows, np.concatenate([scaled, scaled]), uniform, names, limits
+            )
+        ]
     if joints and joints[0].min_scale is not None:
         alone = ", ".join(f"{j.joint} x{j.min_scale:.3g} (limit {j.effort:g})" for j in joints[:3])
         more = f" (+{len(joints) - 3} more)" if len(joints) > 3 else ""
@@ -234,7 +249,9 @@ def _active_at_uniform(A, b0, C, d, rows, L, t, names, limits):
     """Joints whose torque is at t times its limit at a solution with the common factor t."""
     Lfull = np.zeros(A.shape[0])
     Lfull[rows] = L
-    sol = HighsLP(LinearProgram(A, b0 + t * (1 + 1e-9) * Lfull, C, d), warm=False).maximize(np.zeros(A.shape[1]))
+    sol = HighsLP(LinearProgram(A, b0 + t * (1 + 1e-9) * Lfull, C, d), warm=False).maximize(
+        np.zeros(A.shape[1])
+    )
     if not sol.optimal:
         return []
     slack = (b0 + t * Lfull - A @ sol.x)[rows]

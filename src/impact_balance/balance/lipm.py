@@ -16,27 +16,38 @@ import numpy as np
 from impact_balance.constants import GRAVITY, GRAVITY_RANGE, MAX_POSITION
 from impact_balance.exceptions import ScenarioError
 
-__all__ = ["PhasePortrait", "phase_portrait", "lipm_omega", "com_velocity_bounds"]
+__all__ = ["PhasePortrait", "com_velocity_bounds", "lipm_omega", "phase_portrait"]
 
 
 def lipm_omega(com_height: float, plane_height: float = 0.0, gravity: float = GRAVITY) -> float:
-    """omega = sqrt(g / (c_z - h)), 1/s."""
+    """Omega = sqrt(g / (c_z - h)), 1/s."""
     if not (math.isfinite(com_height) and 0 < com_height - plane_height <= 2 * MAX_POSITION):
         raise ScenarioError(
-            "com_height", com_height, f"must be above the plane height {plane_height} m (at most {2 * MAX_POSITION:g} m above)"
+            "com_height",
+            com_height,
+            f"must be above the plane height {plane_height} m (at most {2 * MAX_POSITION:g} m above)",
         )
     if not GRAVITY_RANGE[0] <= gravity <= GRAVITY_RANGE[1]:
-        raise ScenarioError("gravity", gravity, f"must be in [{GRAVITY_RANGE[0]:g}, {GRAVITY_RANGE[1]:g}] m/s^2")
+        raise ScenarioError(
+            "gravity", gravity, f"must be in [{GRAVITY_RANGE[0]:g}, {GRAVITY_RANGE[1]:g}] m/s^2"
+        )
     return math.sqrt(gravity / (com_height - plane_height))
 
 
 def com_velocity_bounds(
-    com_height: float, zmp_range: tuple[float, float], com_position: float = 0.0, gravity: float = GRAVITY
+    com_height: float,
+    zmp_range: tuple[float, float],
+    com_position: float = 0.0,
+    gravity: float = GRAVITY,
 ) -> tuple[float, float]:
     """CoM velocity interval (m/s) from which the CoM can be brought to rest at ``com_position``."""
     lo, hi = zmp_range
     if not -MAX_POSITION <= lo <= hi <= MAX_POSITION:
-        raise ScenarioError("zmp_range", [lo, hi], f"must be [lo, hi] with lo <= hi, within [{-MAX_POSITION:g}, {MAX_POSITION:g}] m")
+        raise ScenarioError(
+            "zmp_range",
+            [lo, hi],
+            f"must be [lo, hi] with lo <= hi, within [{-MAX_POSITION:g}, {MAX_POSITION:g}] m",
+        )
     w = lipm_omega(com_height, 0.0, gravity)
     return w * (lo - com_position), w * (hi - com_position)
 
@@ -82,8 +93,11 @@ def phase_portrait(
     lo, hi = zmp_range
     width = max(hi - lo, 1e-3)
     limit = 3.0 * width + max(abs(lo), abs(hi))
-    starts = [(c0, v0) for c0 in np.linspace(lo - 0.5 * width, hi + 0.5 * width, n_trajectories)
-              for v0 in (1.4 * bounds[0], 1.4 * bounds[1])]
+    starts = [
+        (c0, v0)
+        for c0 in np.linspace(lo - 0.5 * width, hi + 0.5 * width, n_trajectories)
+        for v0 in (1.4 * bounds[0], 1.4 * bounds[1])
+    ]
     dt = 1e-3
     trajectories = []
     for c0, v0 in starts:

@@ -19,18 +19,44 @@ import traceback
 import warnings
 from types import ModuleType
 
-from impact_balance.exit_status import EXIT_BROKEN_PIPE, debug_requested, describe_error
-from impact_balance.exceptions import EnvironmentFailure, ImpactBalanceWarning, one_line
-from impact_balance.extras import require_for
-from impact_balance.cli import (analyze, approach, check_log, demo, frames, gui, listing, phase_portrait, pose, push_test, simulate, sweep,
-               validate)
+from impact_balance.cli import (
+    analyze,
+    approach,
+    check_log,
+    demo,
+    frames,
+    gui,
+    listing,
+    phase_portrait,
+    pose,
+    push_test,
+    simulate,
+    sweep,
+    validate,
+)
 from impact_balance.cli.demo import DEMO_SCENARIOS, FRICTION_SWEEP
+from impact_balance.exceptions import EnvironmentFailure, ImpactBalanceWarning, one_line
+from impact_balance.exit_status import EXIT_BROKEN_PIPE, debug_requested, describe_error
+from impact_balance.extras import require_for
 
-__all__ = ["main", "DEMO_SCENARIOS", "FRICTION_SWEEP", "COMMANDS", "EXIT_BROKEN_PIPE"]
+__all__ = ["COMMANDS", "DEMO_SCENARIOS", "EXIT_BROKEN_PIPE", "FRICTION_SWEEP", "main"]
 
 #: Command modules, in the order of ``--help``.
-COMMANDS: tuple[ModuleType, ...] = (demo, analyze, phase_portrait, listing, frames, pose, gui, simulate, validate, push_test,
-                                     approach, check_log, sweep)
+COMMANDS: tuple[ModuleType, ...] = (
+    demo,
+    analyze,
+    phase_portrait,
+    listing,
+    frames,
+    pose,
+    gui,
+    simulate,
+    validate,
+    push_test,
+    approach,
+    check_log,
+    sweep,
+)
 
 
 def _kernel_is_compiled() -> bool:
@@ -47,7 +73,8 @@ _JIT_VARIABLE = "IMPACT_BALANCE_JIT"
 def _interpret_kernels() -> None:
     """A one-shot command (``INTERPRETED = True``) runs the kernels as Python: numba's import and
     cached-kernel load (0.4 to 0.8 s) cost more than one interpreted analysis. Only in a fresh
-    process (``_jit`` not yet imported) and only when ``IMPACT_BALANCE_JIT`` is unset."""
+    process (``_jit`` not yet imported) and only when ``IMPACT_BALANCE_JIT`` is unset.
+    """
     if _JIT_VARIABLE in os.environ or "impact_balance._jit" in sys.modules:
         return
     os.environ[_JIT_VARIABLE] = "0"
@@ -79,13 +106,18 @@ def _silence_stdout() -> None:
 class _Stdout:
     """stdout for the time of a command: a write that fails (a full disk, a closed stream, ``>&-``)
     becomes :class:`~impact_balance.exceptions.EnvironmentFailure` naming standard output, so
-    the error rule says what failed; a closed pipe stays a ``BrokenPipeError`` (quiet, 141)."""
+    the error rule says what failed; a closed pipe stays a ``BrokenPipeError`` (quiet, 141).
+    """
 
     def __init__(self, stream):
         self._stream = stream
 
     def _failed(self, exc: OSError) -> EnvironmentFailure:
-        reason = "it is closed" if self._stream is None else (exc.strerror or str(exc) or type(exc).__name__)
+        reason = (
+            "it is closed"
+            if self._stream is None
+            else (exc.strerror or str(exc) or type(exc).__name__)
+        )
         return EnvironmentFailure("standard output", None, f"cannot write the output: {reason}")
 
     def write(self, text: str) -> int:
@@ -135,9 +167,16 @@ def _report(exc: BaseException, debug: bool) -> int:
 class _VersionAction(argparse.Action):
     """``--version``, looked up only when asked for."""
 
-    def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS, help=None):
-        super().__init__(option_strings, dest, default=default, nargs=0,
-                         help=help or "show the program's version number and exit")
+    def __init__(
+        self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS, help=None
+    ):
+        super().__init__(
+            option_strings,
+            dest,
+            default=default,
+            nargs=0,
+            help=help or "show the program's version number and exit",
+        )
 
     def __call__(self, parser, namespace, values, option_string=None):
         print(f"impact-balance {_version()}")  # on stdout, as argparse's own version action
@@ -146,9 +185,10 @@ class _VersionAction(argparse.Action):
 
 class _Parser(argparse.ArgumentParser):
     """argparse, with the project's error rule: a usage error is one line on stderr, exit 2
-    (argparse's default prints the whole usage block first)."""
+    (argparse's default prints the whole usage block first).
+    """
 
-    def error(self, message: str):  # noqa: D102 - argparse's hook
+    def error(self, message: str):
         self.exit(2, one_line(f"{self.prog}: error: {message} (see {self.prog} --help)") + "\n")
 
 
@@ -158,8 +198,11 @@ def _parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
         description="Impact-aware multi-contact balance: CoM velocity area and maximum contact velocity.",
     )
     p.add_argument("--version", action=_VersionAction)
-    p.add_argument("--debug", action="store_true",
-                   help="show the traceback of an error (also anywhere after the command, or IMPACT_BALANCE_DEBUG=1)")
+    p.add_argument(
+        "--debug",
+        action="store_true",
+        help="show the traceback of an error (also anywhere after the command, or IMPACT_BALANCE_DEBUG=1)",
+    )
     sub = p.add_subparsers(dest="command", required=True)
     owners: dict[str, ModuleType] = {}
     for module in COMMANDS:
@@ -174,7 +217,10 @@ _show_warning = warnings.showwarning
 def _warning_line(message, category, filename, lineno, file=None, line=None):
     """The library's own warnings as one ``impact-balance: warning:`` line (no source location)."""
     if issubclass(category, ImpactBalanceWarning):
-        print(f"impact-balance: warning: {' '.join(str(message).split())}", file=sys.stderr if file is None else file)
+        print(
+            f"impact-balance: warning: {' '.join(str(message).split())}",
+            file=sys.stderr if file is None else file,
+        )
     else:
         _show_warning(message, category, filename, lineno, file, line)
 
@@ -195,14 +241,17 @@ def main(argv: list[str] | None = None) -> int:
         if getattr(module, "INTERPRETED", False):
             _interpret_kernels()
         if getattr(module, "USES_KERNEL", False) and not _kernel_is_compiled():
-            print("impact-balance: compiling the projection kernel (first run only, 0.5 to 1.5 min; cached afterwards) ...",
-                  file=sys.stderr, flush=True)
+            print(
+                "impact-balance: compiling the projection kernel (first run only, 0.5 to 1.5 min; cached afterwards) ...",
+                file=sys.stderr,
+                flush=True,
+            )
         status = module.run(args)
         sys.stdout.flush()  # a closed or full stdout shows here, inside the rule, not at exit
         return status
     except SystemExit:  # argparse's --help, --version and usage errors: already one line
         raise
-    except BaseException as exc:  # noqa: BLE001 - the one error rule
+    except BaseException as exc:
         return _report(exc, debug)
     finally:
         sys.stdout = stdout

@@ -17,18 +17,18 @@ from collections.abc import Callable, Sequence
 from impact_balance.exceptions import ImpactBalanceError, OptionError, short_repr
 
 __all__ = [
-    "add_controller_option",
-    "add_output_options",
-    "add_zmp_margin_option",
-    "with_zmp_margin",
-    "add_trial_options",
-    "open_journal",
-    "output_folder",
-    "output_file",
-    "number",
-    "integer",
     "LOG_SUFFIXES",
     "CommandLineError",
+    "add_controller_option",
+    "add_output_options",
+    "add_trial_options",
+    "add_zmp_margin_option",
+    "integer",
+    "number",
+    "open_journal",
+    "output_file",
+    "output_folder",
+    "with_zmp_margin",
 ]
 
 #: Suffixes of a log file (``--log``).
@@ -55,7 +55,7 @@ def _refused(exc: OptionError) -> CommandLineError:
 
 
 def output_folder(field: str) -> Callable[[str], str]:
-    """argparse type: a folder the command will write in (see :mod:`impact_balance.cli.output_paths`)."""
+    """Argparse type: a folder the command will write in (see :mod:`impact_balance.cli.output_paths`)."""
 
     def check(text: str) -> str:
         from impact_balance.cli.output_paths import check_output_folder
@@ -71,7 +71,7 @@ def output_folder(field: str) -> Callable[[str], str]:
 
 
 def output_file(field: str, suffixes: Sequence[str] = ()) -> Callable[[str], str]:
-    """argparse type: a file the command will write (its folder checked, its suffix among ``suffixes``)."""
+    """Argparse type: a file the command will write (its folder checked, its suffix among ``suffixes``)."""
 
     def check(text: str) -> str:
         from impact_balance.cli.output_paths import check_output_file
@@ -90,9 +90,12 @@ def _interval(lo: float, hi: float, lo_open: bool, unit: str) -> str:
     return f"{'(' if lo_open else '['}{lo:g}, {hi:g}]{f' {unit}' if unit else ''}"
 
 
-def number(field: str, lo: float, hi: float, unit: str = "", lo_open: bool = False, why: str = "") -> Callable[[str], float]:
-    """argparse type: a finite number in ``[lo, hi]`` (``(lo, hi]`` with ``lo_open``) for option
-    ``field``; ``why`` says where the limit comes from (shown in the error)."""
+def number(
+    field: str, lo: float, hi: float, unit: str = "", lo_open: bool = False, why: str = ""
+) -> Callable[[str], float]:
+    """Argparse type: a finite number in ``[lo, hi]`` (``(lo, hi]`` with ``lo_open``) for option
+    ``field``; ``why`` says where the limit comes from (shown in the error).
+    """
     span = _interval(lo, hi, lo_open, unit)
 
     def check(text: str) -> float:
@@ -110,7 +113,7 @@ def number(field: str, lo: float, hi: float, unit: str = "", lo_open: bool = Fal
 
 
 def integer(field: str, lo: int, hi: int, why: str = "") -> Callable[[str], int]:
-    """argparse type: an integer in ``[lo, hi]`` for option ``field``."""
+    """Argparse type: an integer in ``[lo, hi]`` for option ``field``."""
 
     def check(text: str) -> int:
         try:
@@ -118,7 +121,9 @@ def integer(field: str, lo: int, hi: int, why: str = "") -> Callable[[str], int]
         except ValueError:
             raise CommandLineError(field, text, "not an integer") from None
         if not lo <= value <= hi:
-            raise CommandLineError(field, text, f"must be in [{lo}, {hi}]{f' ({why})' if why else ''}")
+            raise CommandLineError(
+                field, text, f"must be in [{lo}, {hi}]{f' ({why})' if why else ''}"
+            )
         return value
 
     check.__name__ = "integer"
@@ -127,27 +132,43 @@ def integer(field: str, lo: int, hi: int, why: str = "") -> Callable[[str], int]
 
 def add_controller_option(parser: argparse.ArgumentParser, default: str, why: str) -> None:
     """``--controller ik|id``: the balance controller of the trials (``why``: the default's reason)."""
-    parser.add_argument("--controller", default=default, choices=("ik", "id"),
-                        help=f"ik: pink IK -> position servos; id: inverse-dynamics QP -> torque motors "
-                             f"(default: {default}, {why})")
+    parser.add_argument(
+        "--controller",
+        default=default,
+        choices=("ik", "id"),
+        help=f"ik: pink IK -> position servos; id: inverse-dynamics QP -> torque motors "
+        f"(default: {default}, {why})",
+    )
 
 
 def add_output_options(parser: argparse.ArgumentParser, log_help: str) -> None:
     """``--json``, ``--plots DIR`` and ``--log FILE`` (what the log holds: ``log_help``); the
-    places are checked when the line is read, before any simulation runs."""
+    places are checked when the line is read, before any simulation runs.
+    """
     parser.add_argument("--json", action="store_true", help="print one JSON object")
-    parser.add_argument("--plots", metavar="DIR", type=output_folder("--plots"), help="write the figures to DIR")
-    parser.add_argument("--log", metavar="FILE", type=output_file("--log", LOG_SUFFIXES),
-                        help=f"write the time series (.parquet or .csv) {log_help}")
+    parser.add_argument(
+        "--plots", metavar="DIR", type=output_folder("--plots"), help="write the figures to DIR"
+    )
+    parser.add_argument(
+        "--log",
+        metavar="FILE",
+        type=output_file("--log", LOG_SUFFIXES),
+        help=f"write the time series (.parquet or .csv) {log_help}",
+    )
 
 
 def add_zmp_margin_option(parser: argparse.ArgumentParser, default_help: str) -> None:
     """``--zmp-margin M``: the ZMP support area shrunk by M metres (``default_help``: what it defaults to)."""
     from impact_balance.constants import MAX_SIZE
 
-    parser.add_argument("--zmp-margin", type=number("--zmp-margin", 0.0, MAX_SIZE, "m"), default=None, metavar="M",
-                        help=f"shrink the ZMP support area by M metres, and the CoM velocity area with it "
-                             f"({default_help}; 0 is the paper's criterion)")
+    parser.add_argument(
+        "--zmp-margin",
+        type=number("--zmp-margin", 0.0, MAX_SIZE, "m"),
+        default=None,
+        metavar="M",
+        help=f"shrink the ZMP support area by M metres, and the CoM velocity area with it "
+        f"({default_help}; 0 is the paper's criterion)",
+    )
 
 
 def with_zmp_margin(scenario, margin: float | None):
@@ -164,36 +185,64 @@ def with_zmp_margin(scenario, margin: float | None):
 
 def add_trial_options(parser: argparse.ArgumentParser, impact: bool) -> None:
     """Options of the balance-trial commands (``validate``, ``push-test``): ``--rigid-impact`` (impacts only),
-    ``--zmp-margin``, and the trials journal (``--journal FILE``, ``--fresh``, ``--no-journal``)."""
+    ``--zmp-margin``, and the trials journal (``--journal FILE``, ``--fresh``, ``--no-journal``).
+    """
     if impact:
-        parser.add_argument("--rigid-impact", action="store_true",
-                            help="hold every joint's velocity through the impact (the paper's rigid robot), "
-                                 "until the contact's normal velocity reaches zero")
+        parser.add_argument(
+            "--rigid-impact",
+            action="store_true",
+            help="hold every joint's velocity through the impact (the paper's rigid robot), "
+            "until the contact's normal velocity reaches zero",
+        )
     add_zmp_margin_option(parser, "default: the ZMP margin the trials' controller keeps")
-    parser.add_argument("--journal", metavar="FILE", type=output_file("--journal", (".jsonl",)),
-                        help="JSON-lines file of the finished trials, written as they end; running the same "
-                             "command again resumes from it (default: impact-balance-trials/<command>_<scenario>_<digest>.jsonl)")
-    parser.add_argument("--fresh", action="store_true", help="discard the journal's trials and run them all again")
-    parser.add_argument("--no-journal", action="store_true", help="keep no journal (nothing resumes)")
+    parser.add_argument(
+        "--journal",
+        metavar="FILE",
+        type=output_file("--journal", (".jsonl",)),
+        help="JSON-lines file of the finished trials, written as they end; running the same "
+        "command again resumes from it (default: impact-balance-trials/<command>_<scenario>_<digest>.jsonl)",
+    )
+    parser.add_argument(
+        "--fresh", action="store_true", help="discard the journal's trials and run them all again"
+    )
+    parser.add_argument(
+        "--no-journal", action="store_true", help="keep no journal (nothing resumes)"
+    )
 
 
-def open_journal(args: argparse.Namespace, command: str, scenario, joints: str, options, extra: dict):
+def open_journal(
+    args: argparse.Namespace, command: str, scenario, joints: str, options, extra: dict
+):
     """The trials journal of a command (:class:`impact_balance.sim.studies.journal.TrialJournal`), by the digest of
-    everything its trials depend on (the scoring margin excluded: scores are recomputed from the trials)."""
+    everything its trials depend on (the scoring margin excluded: scores are recomputed from the trials).
+    """
     import dataclasses
     import sys
     from pathlib import Path
 
+    from impact_balance.sim.studies.journal import (
+        TrialJournal,
+        default_journal_path,
+        journal_digest,
+    )
     from impact_balance.sim.trials.balance_trial import TRIAL_VERSION
-    from impact_balance.sim.studies.journal import TrialJournal, default_journal_path, journal_digest
 
-    parts = {"command": command, "trial_version": TRIAL_VERSION,
-             "scenario": scenario.model_dump(mode="json", exclude={"zmp_margin", "name", "description"}),
-             "joints": joints, "options": dataclasses.asdict(dataclasses.replace(options, record=False)), **extra}
+    parts = {
+        "command": command,
+        "trial_version": TRIAL_VERSION,
+        "scenario": scenario.model_dump(mode="json", exclude={"zmp_margin", "name", "description"}),
+        "joints": joints,
+        "options": dataclasses.asdict(dataclasses.replace(options, record=False)),
+        **extra,
+    }
     digest = journal_digest(parts)
     if args.no_journal:
         return TrialJournal.open(None, digest)
-    path = Path(args.journal) if args.journal else default_journal_path(command, scenario.name or "scenario", digest)
+    path = (
+        Path(args.journal)
+        if args.journal
+        else default_journal_path(command, scenario.name or "scenario", digest)
+    )
     if args.fresh and path.exists():
         path.unlink()
     journal = TrialJournal.open(path, digest, {"command": command, "scenario": scenario.name})
@@ -206,7 +255,8 @@ def open_journal(args: argparse.Namespace, command: str, scenario, joints: str, 
 def import_mujoco(video: bool) -> None:
     """Import MuJoCo for a simulation command; with ``video``, offscreen rendering first picks
     EGL (it works headless, and must be chosen before MuJoCo is imported) unless ``MUJOCO_GL``
-    says otherwise. An unusable backend is one :class:`~impact_balance.exceptions.SimulationError`."""
+    says otherwise. An unusable backend is one :class:`~impact_balance.exceptions.SimulationError`.
+    """
     from impact_balance.exceptions import SimulationError
 
     if video:
@@ -214,5 +264,9 @@ def import_mujoco(video: bool) -> None:
     try:
         import mujoco  # noqa: F401  (reads MUJOCO_GL when imported)
     except Exception as exc:  # an unusable backend fails inside MuJoCo's import, with various types
-        raise SimulationError("MUJOCO_GL", os.environ.get("MUJOCO_GL"), f"MuJoCo cannot start with this OpenGL "
-                              f"backend ({type(exc).__name__}); use MUJOCO_GL=egl, or unset it") from None
+        raise SimulationError(
+            "MUJOCO_GL",
+            os.environ.get("MUJOCO_GL"),
+            f"MuJoCo cannot start with this OpenGL "
+            f"backend ({type(exc).__name__}); use MUJOCO_GL=egl, or unset it",
+        ) from None

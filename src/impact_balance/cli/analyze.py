@@ -8,7 +8,7 @@ from pathlib import Path
 
 from impact_balance.cli._options import add_zmp_margin_option, output_folder, with_zmp_margin
 
-__all__ = ["add_parser", "run", "USES_KERNEL", "INTERPRETED"]
+__all__ = ["INTERPRETED", "USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
 #: One analysis per process: interpreted kernels beat loading numba's cache (see ``impact_balance._jit``).
@@ -17,10 +17,20 @@ INTERPRETED = True
 
 def add_parser(sub) -> list[str]:
     a = sub.add_parser("analyze", help="analyze one scenario (file or bundled name)")
-    a.add_argument("scenario", help="YAML file, or the name of a bundled scenario (see `impact-balance scenarios`)")
+    a.add_argument(
+        "scenario",
+        help="YAML file, or the name of a bundled scenario (see `impact-balance scenarios`)",
+    )
     a.add_argument("--json", action="store_true", help="print one JSON object")
-    a.add_argument("--plots", metavar="DIR", type=output_folder("--plots"), help="write the scenario's figures to DIR")
-    a.add_argument("--qp", action="store_true", help="also solve the paper's QP in joint velocities")
+    a.add_argument(
+        "--plots",
+        metavar="DIR",
+        type=output_folder("--plots"),
+        help="write the scenario's figures to DIR",
+    )
+    a.add_argument(
+        "--qp", action="store_true", help="also solve the paper's QP in joint velocities"
+    )
     a.add_argument("--strict", action="store_true", help="treat warnings as errors (exit status 2)")
     add_zmp_margin_option(a, "default: the scenario's zmp_margin, 0 unless set")
     return ["analyze"]
@@ -29,9 +39,8 @@ def add_parser(sub) -> list[str]:
 def run(args: argparse.Namespace) -> int:
     from impact_balance.analysis.analyze import analyze
     from impact_balance.analysis.report import format_analysis
-
-    from impact_balance.exceptions import StrictWarningsError
     from impact_balance.cli.output import print_json
+    from impact_balance.exceptions import StrictWarningsError
 
     scenario = args.scenario
     if args.zmp_margin is not None:

@@ -1,53 +1,110 @@
 """``impact-balance approach SCENARIO``: the impacting point sent at an unknown wall, its speed
-capped every tick by a governor (the paper's Experiment 1, in MuJoCo)."""
+capped every tick by a governor (the paper's Experiment 1, in MuJoCo).
+"""
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
 
-from impact_balance.cli._options import (add_controller_option, add_zmp_margin_option, import_mujoco, number, output_file, output_folder,
-                       with_zmp_margin)
+from impact_balance.cli._options import (
+    add_controller_option,
+    add_zmp_margin_option,
+    import_mujoco,
+    number,
+    output_file,
+    output_folder,
+    with_zmp_margin,
+)
 
-__all__ = ["add_parser", "run", "USES_KERNEL"]
+__all__ = ["USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
 
 
 def add_parser(sub) -> list[str]:
-    a = sub.add_parser("approach", help="send the impact point at an unknown wall, its speed capped by a governor (MuJoCo)")
+    a = sub.add_parser(
+        "approach",
+        help="send the impact point at an unknown wall, its speed capped by a governor (MuJoCo)",
+    )
     a.add_argument("scenario", help="YAML file or bundled scenario name (must have an impact)")
-    a.add_argument("--reference", type=number("--reference", 0.0, 5.0, "m/s", lo_open=True), required=True, metavar="V",
-                   help="reference approach speed, m/s (the paper's 0.8)")
-    a.add_argument("--governor", default="com", choices=("com", "zmp", "none"),
-                   help="com: the CoM criterion's maximum contact velocity (default); zmp: the ZMP criterion's; "
-                        "none: the reference alone")
+    a.add_argument(
+        "--reference",
+        type=number("--reference", 0.0, 5.0, "m/s", lo_open=True),
+        required=True,
+        metavar="V",
+        help="reference approach speed, m/s (the paper's 0.8)",
+    )
+    a.add_argument(
+        "--governor",
+        default="com",
+        choices=("com", "zmp", "none"),
+        help="com: the CoM criterion's maximum contact velocity (default); zmp: the ZMP criterion's; "
+        "none: the reference alone",
+    )
     where = a.add_mutually_exclusive_group()
-    where.add_argument("--wall-distance", type=number("--wall-distance", 0.0, 1.0, "m", lo_open=True), default=None,
-                       metavar="D",
-                       help="distance of the wall from the point's start, m (default 0.15: the scenario's impact point)")
-    where.add_argument("--wall-distance-range", type=number("--wall-distance-range", 0.0, 1.0, "m", lo_open=True), nargs=2,
-                       default=None, metavar=("LO", "HI"),
-                       help="one trial at LO, the middle and HI, m")
-    a.add_argument("--contact-aware", action="store_true",
-                   help="com governor: also bound the speed by the contact-aware impact model (the robot standing "
-                        "on its supports; experimental, see docs/contact_aware_governor.md)")
-    a.add_argument("--contact-aware-async", action="store_true",
-                   help="with --contact-aware: compute its rates in a worker process, off the tick (the tick never "
-                        "waits; the rates are one recomputation old)")
-    a.add_argument("--velocity-margin", type=number("--velocity-margin", 0.0, 10.0, "m/s"), default=0.0, metavar="V",
-                   help="com governor: every post-impact CoM velocity must lie V m/s inside the CoM velocity area "
-                        "(a margin for the impact model's error; default 0, the paper's criterion)")
-    a.add_argument("--rigid-impact", action="store_true",
-                   help="hold every joint's velocity through the impact (the paper's rigid robot)")
+    where.add_argument(
+        "--wall-distance",
+        type=number("--wall-distance", 0.0, 1.0, "m", lo_open=True),
+        default=None,
+        metavar="D",
+        help="distance of the wall from the point's start, m (default 0.15: the scenario's impact point)",
+    )
+    where.add_argument(
+        "--wall-distance-range",
+        type=number("--wall-distance-range", 0.0, 1.0, "m", lo_open=True),
+        nargs=2,
+        default=None,
+        metavar=("LO", "HI"),
+        help="one trial at LO, the middle and HI, m",
+    )
+    a.add_argument(
+        "--contact-aware",
+        action="store_true",
+        help="com governor: also bound the speed by the contact-aware impact model (the robot standing "
+        "on its supports; experimental, see docs/contact_aware_governor.md)",
+    )
+    a.add_argument(
+        "--contact-aware-async",
+        action="store_true",
+        help="with --contact-aware: compute its rates in a worker process, off the tick (the tick never "
+        "waits; the rates are one recomputation old)",
+    )
+    a.add_argument(
+        "--velocity-margin",
+        type=number("--velocity-margin", 0.0, 10.0, "m/s"),
+        default=0.0,
+        metavar="V",
+        help="com governor: every post-impact CoM velocity must lie V m/s inside the CoM velocity area "
+        "(a margin for the impact model's error; default 0, the paper's criterion)",
+    )
+    a.add_argument(
+        "--rigid-impact",
+        action="store_true",
+        help="hold every joint's velocity through the impact (the paper's rigid robot)",
+    )
     add_controller_option(a, "id", "it puts the ZMP anywhere in the support area after the impact")
     add_zmp_margin_option(a, "the governor's; default: the ZMP margin the trial's controller keeps")
-    a.add_argument("--max-time", type=number("--max-time", 0.0, 120.0, "s", lo_open=True), default=30.0, metavar="S",
-                   help="longest approach before giving up, s (default 30: a ZMP governor is slow)")
+    a.add_argument(
+        "--max-time",
+        type=number("--max-time", 0.0, 120.0, "s", lo_open=True),
+        default=30.0,
+        metavar="S",
+        help="longest approach before giving up, s (default 30: a ZMP governor is slow)",
+    )
     a.add_argument("--json", action="store_true", help="print one JSON object")
-    a.add_argument("--plots", metavar="DIR", type=output_folder("--plots"), help="write the figure of each trial to DIR")
-    a.add_argument("--video", metavar="FILE", type=output_file("--video", (".mp4",)),
-                   help="render an MP4 of the trial (one trial: give --wall-distance)")
+    a.add_argument(
+        "--plots",
+        metavar="DIR",
+        type=output_folder("--plots"),
+        help="write the figure of each trial to DIR",
+    )
+    a.add_argument(
+        "--video",
+        metavar="FILE",
+        type=output_file("--video", (".mp4",)),
+        help="render an MP4 of the trial (one trial: give --wall-distance)",
+    )
     return ["approach"]
 
 
@@ -55,16 +112,24 @@ def run(args: argparse.Namespace) -> int:
     from impact_balance.exceptions import SimulationError
 
     if args.video and args.wall_distance_range is not None:
-        raise SimulationError("--video", args.video, "one .mp4 for one trial (give --wall-distance, not a range)")
+        raise SimulationError(
+            "--video", args.video, "one .mp4 for one trial (give --wall-distance, not a range)"
+        )
     import_mujoco(bool(args.video))  # before anything imports MuJoCo: the GL backend is read then
-    from impact_balance.scenario import load_scenario
-    from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions, controller_margin
-    from impact_balance.sim.studies.wall import WallOptions, run_wall_trial, write_wall_video
     from impact_balance.cli.output import print_json
+    from impact_balance.scenario import load_scenario
+    from impact_balance.sim.studies.wall import WallOptions, run_wall_trial, write_wall_video
+    from impact_balance.sim.trials.balance_trial import (
+        BalanceSetup,
+        BalanceTrialOptions,
+        controller_margin,
+    )
 
     scenario = load_scenario(args.scenario)
     if scenario.impact is None:
-        raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact: approach needs one")
+        raise SimulationError(
+            "impact", None, f"scenario {scenario.name!r} has no impact: approach needs one"
+        )
     if args.wall_distance_range is not None:
         lo, hi = args.wall_distance_range
         if lo > hi:
@@ -74,24 +139,41 @@ def run(args: argparse.Namespace) -> int:
         distances = [0.15 if args.wall_distance is None else args.wall_distance]
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
     margin = controller_margin(options) if args.zmp_margin is None else args.zmp_margin
-    governed = with_zmp_margin(scenario, margin)  # the governor's view: the area the controller can use
-    setup = BalanceSetup.create(scenario, "servo", options, meshes=bool(args.video))  # meshes: visual only
+    governed = with_zmp_margin(
+        scenario, margin
+    )  # the governor's view: the area the controller can use
+    setup = BalanceSetup.create(
+        scenario, "servo", options, meshes=bool(args.video)
+    )  # meshes: visual only
     governor = None
     if args.governor != "none":
         from impact_balance.governor import Governor
 
-        governor = Governor(governed, criterion=args.governor, contact_aware=args.contact_aware,
-                            velocity_margin=args.velocity_margin, contact_aware_async=args.contact_aware_async)
+        governor = Governor(
+            governed,
+            criterion=args.governor,
+            contact_aware=args.contact_aware,
+            velocity_margin=args.velocity_margin,
+            contact_aware_async=args.contact_aware_async,
+        )
     trials, written = [], []
     for distance in distances:
-        wall = WallOptions(reference=args.reference, governor=args.governor, wall_distance=distance,
-                           max_time=args.max_time)
+        wall = WallOptions(
+            reference=args.reference,
+            governor=args.governor,
+            wall_distance=distance,
+            max_time=args.max_time,
+        )
         trial = run_wall_trial(setup, wall, options, governor=governor, frames=bool(args.video))
         trials.append(trial)
         if args.plots:
             written.append(_plot(trial, setup, Path(args.plots), margin))
         if args.video:
-            written.append(write_wall_video(setup, trial, args.video, title=f"{scenario.name}: {args.governor} governor"))
+            written.append(
+                write_wall_video(
+                    setup, trial, args.video, title=f"{scenario.name}: {args.governor} governor"
+                )
+            )
     if governor is not None:
         governor.close()  # its worker process, if any
     docs = [t.to_dict() for t in trials]
@@ -102,18 +184,30 @@ def run(args: argparse.Namespace) -> int:
         d["contact_aware"] = bool(args.contact_aware and governor is not None)
         d["velocity_margin"] = args.velocity_margin if governor is not None else None
         d["contact_aware_async"] = bool(args.contact_aware_async and governor is not None)
-    out = docs[0] if len(docs) == 1 else {"governor": args.governor, "reference": args.reference, "trials": docs}
+    out = (
+        docs[0]
+        if len(docs) == 1
+        else {"governor": args.governor, "reference": args.reference, "trials": docs}
+    )
     if args.json:
         print_json(out)
         return 0
-    print(f"{scenario.name}: approach at {args.reference:g} m/s reference, {args.governor} governor, "
-          f"{args.controller} controller{', rigid impact' if args.rigid_impact else ''}")
+    print(
+        f"{scenario.name}: approach at {args.reference:g} m/s reference, {args.governor} governor, "
+        f"{args.controller} controller{', rigid impact' if args.rigid_impact else ''}"
+    )
     for d in docs:
         tick = d["tick_us"]
-        ticks = "" if tick["median"] is None else f"; governor {tick['median']:.0f} us per tick (p99 {tick['p99']:.0f})"
-        print(f"  wall {100 * d['wall_distance']:g} cm: speed at contact {_f(d['speed_at_contact'])}, cap at contact "
-              f"{_f(d['cap_at_contact'])}, time to contact {_s(d['time_to_contact'])}: {d['outcome']}"
-              f"{'' if d['reason'] is None else ' (' + str(d['reason']) + ')'}{ticks}")
+        ticks = (
+            ""
+            if tick["median"] is None
+            else f"; governor {tick['median']:.0f} us per tick (p99 {tick['p99']:.0f})"
+        )
+        print(
+            f"  wall {100 * d['wall_distance']:g} cm: speed at contact {_f(d['speed_at_contact'])}, cap at contact "
+            f"{_f(d['cap_at_contact'])}, time to contact {_s(d['time_to_contact'])}: {d['outcome']}"
+            f"{'' if d['reason'] is None else ' (' + str(d['reason']) + ')'}{ticks}"
+        )
     for path in written:
         print(f"  wrote {path}")
     return 0
@@ -134,6 +228,9 @@ def _plot(trial, setup, out: Path, zmp_margin: float) -> Path:
     out.mkdir(parents=True, exist_ok=True)
     margin = setup.analysis.areas.com_velocity_area_inset(zmp_margin) if zmp_margin > 0 else None
     o = trial.options
-    path = out / f"{figure_prefix(setup.analysis)}_approach_{o.governor}_{o.reference:g}_{100 * o.wall_distance:g}cm.png"
+    path = (
+        out
+        / f"{figure_prefix(setup.analysis)}_approach_{o.governor}_{o.reference:g}_{100 * o.wall_distance:g}cm.png"
+    )
     plot_approach(trial, setup.analysis, margin).savefig(path)
     return path

@@ -7,24 +7,32 @@ from pathlib import Path
 
 from impact_balance.cli._options import output_folder
 
-__all__ = ["add_parser", "run", "USES_KERNEL"]
+__all__ = ["USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
 
 
 def add_parser(sub) -> list[str]:
-    a = sub.add_parser("check-log", help="check a recorded time series (.parquet or .csv) against both criteria")
+    a = sub.add_parser(
+        "check-log", help="check a recorded time series (.parquet or .csv) against both criteria"
+    )
     a.add_argument("log", help="the log file (columns: see impact_balance.logs.schema)")
-    a.add_argument("--scenario", required=True, help="YAML file or bundled scenario name (robot and contacts)")
+    a.add_argument(
+        "--scenario", required=True, help="YAML file or bundled scenario name (robot and contacts)"
+    )
     a.add_argument("--json", action="store_true", help="print one JSON object")
-    a.add_argument("--samples", action="store_true", help="with --json, include every sample's values")
-    a.add_argument("--plots", metavar="DIR", type=output_folder("--plots"), help="write the figures to DIR")
+    a.add_argument(
+        "--samples", action="store_true", help="with --json, include every sample's values"
+    )
+    a.add_argument(
+        "--plots", metavar="DIR", type=output_folder("--plots"), help="write the figures to DIR"
+    )
     return ["check-log"]
 
 
 def run(args: argparse.Namespace) -> int:
-    from impact_balance.logs import check_log, read_log
     from impact_balance.cli.output import print_json
+    from impact_balance.logs import check_log, read_log
 
     notes: list = []
     frame = read_log(args.log, warnings=notes)
@@ -36,8 +44,10 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(out)
         return 0
-    print(f"{args.log}: {out['samples']} samples over {out['duration']:.3f} s, scenario {check.scenario},"
-          f" {len(check.segments)} stance(s)")
+    print(
+        f"{args.log}: {out['samples']} samples over {out['duration']:.3f} s, scenario {check.scenario},"
+        f" {len(check.segments)} stance(s)"
+    )
     if check.floating:
         print(f"  {check.note}")
         if args.plots:
@@ -50,13 +60,18 @@ def run(args: argparse.Namespace) -> int:
     else:
         print("  no ZMP columns: ZMP criterion not checked")
     if check.ok:
-        print("  no violation: the CoM velocity stayed in the CoM velocity area" + (" and the ZMP in its area" if check.has_zmp else ""))
+        print(
+            "  no violation: the CoM velocity stayed in the CoM velocity area"
+            + (" and the ZMP in its area" if check.has_zmp else "")
+        )
     else:
         print(f"  {len(check.violations)} violation(s):")
         for v in check.violations:
             unit = "m/s" if v.kind == "com_velocity" else "m"
-            print(f"    {v.kind:12s} {v.start:8.3f} s to {v.end:8.3f} s ({v.samples} samples), worst {v.worst_margin:.4g} {unit}"
-                  f" at {v.worst_time:.3f} s")
+            print(
+                f"    {v.kind:12s} {v.start:8.3f} s to {v.end:8.3f} s ({v.samples} samples), worst {v.worst_margin:.4g} {unit}"
+                f" at {v.worst_time:.3f} s"
+            )
     for note in notes:
         print(f"  warning: {note}")
     for path in written:
@@ -69,8 +84,12 @@ def _plots(check, out: Path) -> list[Path]:
 
     out.mkdir(parents=True, exist_ok=True)
     s = check.samples
-    fig = plot_log_margins(s["time"].to_numpy(), s["com_velocity_margin"].to_numpy(),
-                           s["zmp_margin"].to_numpy() if check.has_zmp else None, f"{check.scenario}: margins")
+    fig = plot_log_margins(
+        s["time"].to_numpy(),
+        s["com_velocity_margin"].to_numpy(),
+        s["zmp_margin"].to_numpy() if check.has_zmp else None,
+        f"{check.scenario}: margins",
+    )
     path = out / "log_margins.png"
     fig.savefig(path)
     return [path]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-__all__ = ["add_parser", "run", "DEMO_SCENARIOS", "FRICTION_SWEEP", "USES_KERNEL"]
+__all__ = ["DEMO_SCENARIOS", "FRICTION_SWEEP", "USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
 
@@ -16,8 +16,12 @@ FRICTION_SWEEP = ("palm_push_mu010", "palm_push_mu024", "palm_push_mu040")
 
 
 def add_parser(sub) -> list[str]:
-    d = sub.add_parser("demo", help="run the bundled studies on the default robot, print a report, write figures")
-    d.add_argument("--out", default="impact-balance-demo", help="folder for the figures (default: %(default)s)")
+    d = sub.add_parser(
+        "demo", help="run the bundled studies on the default robot, print a report, write figures"
+    )
+    d.add_argument(
+        "--out", default="impact-balance-demo", help="folder for the figures (default: %(default)s)"
+    )
     d.add_argument("--no-plots", action="store_true", help="skip the figures")
     return ["demo"]
 
@@ -45,20 +49,26 @@ def run(args: argparse.Namespace) -> int:
     print(f"  {'mu':>5}  {'CoM criterion':>14}  {'ZMP criterion':>14}")
     for a in sweep:
         im = a.impact
-        print(f"  {im.model.spec.friction:>5.2f}  {format_speed(im.max_contact_velocity):>14}  "
-              f"{format_speed(im.zmp_max_contact_velocity):>14}")
+        print(
+            f"  {im.model.spec.friction:>5.2f}  {format_speed(im.max_contact_velocity):>14}  "
+            f"{format_speed(im.zmp_max_contact_velocity):>14}"
+        )
     if not args.no_plots:
         from impact_balance.balance.lipm import phase_portrait
         from impact_balance.plots import plot_friction_comparison, plot_phase_portrait
 
         out.mkdir(parents=True, exist_ok=True)
-        for fig, fname in ((plot_friction_comparison(sweep), "friction_comparison.png"),
-                           (plot_phase_portrait(phase_portrait(0.78, (-0.13, 0.13))), "phase_portrait.png")):
+        for fig, fname in (
+            (plot_friction_comparison(sweep), "friction_comparison.png"),
+            (plot_phase_portrait(phase_portrait(0.78, (-0.13, 0.13))), "phase_portrait.png"),
+        ):
             fig.savefig(out / fname, dpi=120)
             written.append(out / fname)
         print(f"\n{len(written)} figures written to {out}/")
     from impact_balance.balance.lipm import com_velocity_bounds
 
     bounds = [round(float(b), 4) for b in com_velocity_bounds(0.78, (-0.13, 0.13))]
-    print(f"LIPM check (paper sec. III-B): c_z 0.78 m, ZMP in [-0.13, 0.13] m -> CoM velocity in [{bounds[0]}, {bounds[1]}] m/s")
+    print(
+        f"LIPM check (paper sec. III-B): c_z 0.78 m, ZMP in [-0.13, 0.13] m -> CoM velocity in [{bounds[0]}, {bounds[1]}] m/s"
+    )
     return 0

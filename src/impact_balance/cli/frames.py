@@ -9,12 +9,14 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-__all__ = ["add_parser", "run", "robot_listing"]
+__all__ = ["add_parser", "robot_listing", "run"]
 
 
 def add_parser(sub) -> list[str]:
     f = sub.add_parser("frames", help="list a robot's frames (world position and axes) and joints")
-    f.add_argument("robot", help="a bundled robot (see `impact-balance robots`), a URDF file, or a scenario")
+    f.add_argument(
+        "robot", help="a bundled robot (see `impact-balance robots`), a URDF file, or a scenario"
+    )
     f.add_argument("--frame", action="append", metavar="NAME", help="only this frame (repeatable)")
     f.add_argument("--json", action="store_true", help="print one JSON object")
     return ["frames"]
@@ -48,15 +50,21 @@ def robot_listing(robot, q=None, frames: list[str] | None = None) -> dict:
         slot = robot.joint_slot(name)
         joint = robot.model.joints[slot.id]
         finite = slot.lower < slot.upper and abs(slot.lower) < 1e30 and abs(slot.upper) < 1e30
-        joints.append({
-            "name": name,
-            "nq": slot.nq,
-            "lower": slot.lower if finite and slot.nq == 1 else None,
-            "upper": slot.upper if finite and slot.nq == 1 else None,
-            "effort": effort.get(joint.idx_v),
-        })
-    return {"robot": robot.name, "urdf": str(Path(robot.urdf_path)),
-            "frames": [f.to_dict() for f in frame_poses(robot, q, frames)], "joints": joints}
+        joints.append(
+            {
+                "name": name,
+                "nq": slot.nq,
+                "lower": slot.lower if finite and slot.nq == 1 else None,
+                "upper": slot.upper if finite and slot.nq == 1 else None,
+                "effort": effort.get(joint.idx_v),
+            }
+        )
+    return {
+        "robot": robot.name,
+        "urdf": str(Path(robot.urdf_path)),
+        "frames": [f.to_dict() for f in frame_poses(robot, q, frames)],
+        "joints": joints,
+    }
 
 
 def _vec(v) -> str:
@@ -76,26 +84,36 @@ def run(args: argparse.Namespace) -> int:
 
         print_json(listing)
         return 0
-    print(f"{listing['robot']}: {len(listing['frames'])} frames, {len(listing['joints'])} joints ({listing['urdf']})")
+    print(
+        f"{listing['robot']}: {len(listing['frames'])} frames, {len(listing['joints'])} joints ({listing['urdf']})"
+    )
     print(f"poses at the {label}; world axes, m; each axis is a unit vector in world coordinates")
     rows = listing["frames"]
     width = max((len(f["name"]) for f in rows), default=4)
-    print(f"  {'frame':<{width}}  {'type':<12} {'position':<22}  {'x axis':<22}  {'z axis':<22}  "
-          f"{'z tilt':>6}  parent joint")
+    print(
+        f"  {'frame':<{width}}  {'type':<12} {'position':<22}  {'x axis':<22}  {'z axis':<22}  "
+        f"{'z tilt':>6}  parent joint"
+    )
     for f in rows:
-        print(f"  {f['name']:<{width}}  {f['type']:<12} {_vec(f['position']):<22}  {_vec(f['axes']['x']):<22}  "
-              f"{_vec(f['axes']['z']):<22}  {f['z_tilt_deg']:5.1f}°  {f['parent_joint']}")
+        print(
+            f"  {f['name']:<{width}}  {f['type']:<12} {_vec(f['position']):<22}  {_vec(f['axes']['x']):<22}  "
+            f"{_vec(f['axes']['z']):<22}  {f['z_tilt_deg']:5.1f}°  {f['parent_joint']}"
+        )
     for i, c in enumerate(listing.get("contacts", [])):
         if i == 0:
             print("contacts (centre, normal, tilt from vertical):")
-        print(f"  [{i}] {c['frame']}: centre {_vec(c['centre'])}, normal {_vec(c['normal'])}, "
-              f"{c['normal_tilt_deg']:.1f}°, size {c['size'][0]:g} x {c['size'][1]:g} m")
+        print(
+            f"  [{i}] {c['frame']}: centre {_vec(c['centre'])}, normal {_vec(c['normal'])}, "
+            f"{c['normal_tilt_deg']:.1f}°, size {c['size'][0]:g} x {c['size'][1]:g} m"
+        )
     if args.frame:
         return 0
     print("joints (name, position limits, effort limit):")
     width = max((len(j["name"]) for j in listing["joints"]), default=0)
     for j in listing["joints"]:
-        limits = f"[{j['lower']:+.4g}, {j['upper']:+.4g}]" if j["lower"] is not None else "unlimited"
+        limits = (
+            f"[{j['lower']:+.4g}, {j['upper']:+.4g}]" if j["lower"] is not None else "unlimited"
+        )
         effort = f"{j['effort']:g} N m" if j["effort"] is not None else "no effort limit"
         print(f"  {j['name']:<{width}}  {limits:<20} {effort}")
     return 0

@@ -5,22 +5,46 @@ from __future__ import annotations
 import argparse
 import sys
 
-__all__ = ["add_parser", "run", "USES_KERNEL"]
+__all__ = ["USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
 
 
 def add_parser(sub) -> list[str]:
-    g = sub.add_parser("gui", help="interactive web GUI: edit a stance, see its areas and limits live")
-    g.add_argument("scenario", nargs="?", default=None,
-                   help="YAML file or bundled scenario name (default: palm_push_two_feet)")
-    g.add_argument("--host", default="127.0.0.1", help="interface to listen on (default: %(default)s, this machine only)")
-    g.add_argument("--port", type=int, default=8080, help="TCP port (default: %(default)s; the next free one if taken)")
-    g.add_argument("--workspace", default=".", metavar="DIR",
-                   help="the only folder the GUI loads and saves .yaml files in (default: the current folder)")
-    g.add_argument("--allow-origin", action="append", default=[], metavar="ORIGIN",
-                   help="also accept pages from ORIGIN (scheme://host[:port], e.g. a reverse proxy); repeatable. "
-                        "By default only the GUI's own page may connect")
+    g = sub.add_parser(
+        "gui", help="interactive web GUI: edit a stance, see its areas and limits live"
+    )
+    g.add_argument(
+        "scenario",
+        nargs="?",
+        default=None,
+        help="YAML file or bundled scenario name (default: palm_push_two_feet)",
+    )
+    g.add_argument(
+        "--host",
+        default="127.0.0.1",
+        help="interface to listen on (default: %(default)s, this machine only)",
+    )
+    g.add_argument(
+        "--port",
+        type=int,
+        default=8080,
+        help="TCP port (default: %(default)s; the next free one if taken)",
+    )
+    g.add_argument(
+        "--workspace",
+        default=".",
+        metavar="DIR",
+        help="the only folder the GUI loads and saves .yaml files in (default: the current folder)",
+    )
+    g.add_argument(
+        "--allow-origin",
+        action="append",
+        default=[],
+        metavar="ORIGIN",
+        help="also accept pages from ORIGIN (scheme://host[:port], e.g. a reverse proxy); repeatable. "
+        "By default only the GUI's own page may connect",
+    )
     return ["gui"]
 
 
@@ -40,11 +64,20 @@ def run(args: argparse.Namespace) -> int:
     origins = tuple(normalize_origin(o) for o in args.allow_origin)
 
     def ready(app) -> None:
-        print(f"impact-balance gui: {app.session.state.scenario.name or 'scenario'} at {app.url}  (Ctrl-C to stop)\n"
-              f"  workspace: {app.workspace.root}  (the GUI loads and saves .yaml files here only)", flush=True)
+        print(
+            f"impact-balance gui: {app.session.state.scenario.name or 'scenario'} at {app.url}  (Ctrl-C to stop)\n"
+            f"  workspace: {app.workspace.root}  (the GUI loads and saves .yaml files here only)",
+            flush=True,
+        )
         if origins:
             print(f"  also accepting pages from: {', '.join(origins)}", flush=True)
 
-    run_app(args.scenario or DEFAULT_SCENARIO, host=args.host, port=args.port, ready=ready,
-            workspace=workspace, allow_origins=origins)
+    run_app(
+        args.scenario or DEFAULT_SCENARIO,
+        host=args.host,
+        port=args.port,
+        ready=ready,
+        workspace=workspace,
+        allow_origins=origins,
+    )
     return 0

@@ -14,7 +14,7 @@ from typing import Any
 
 from impact_balance.exceptions import ImpactBalanceError
 
-__all__ = ["print_json", "progress_bar", "NonFiniteOutputError"]
+__all__ = ["NonFiniteOutputError", "print_json", "progress_bar"]
 
 
 class NonFiniteOutputError(ImpactBalanceError):
@@ -27,7 +27,9 @@ class NonFiniteOutputError(ImpactBalanceError):
 
     def __init__(self, field: str):
         self.field = field
-        super().__init__(f"{field}: the result is not a finite number (please report this scenario)")
+        super().__init__(
+            f"{field}: the result is not a finite number (please report this scenario)"
+        )
 
 
 def _non_finite_path(obj: Any, path: str = "") -> str | None:
@@ -44,7 +46,7 @@ def _non_finite_path(obj: Any, path: str = "") -> str | None:
 
 
 def _plain(obj: Any) -> Any:
-    """numpy arrays and scalars as plain lists and numbers (json knows neither)."""
+    """Numpy arrays and scalars as plain lists and numbers (json knows neither)."""
     import numpy as np  # here: `impact-balance scenarios` imports this module and needs no numpy
 
     if isinstance(obj, np.ndarray):
@@ -68,4 +70,12 @@ def progress_bar(desc: str, total: int | None = None, unit: str = "trial"):
     from tqdm import tqdm
 
     # disable=None: drawn on a terminal only, so logs and pipes get no carriage-return noise.
-    return tqdm(total=total, desc=desc, file=sys.stderr, unit=unit, leave=False, dynamic_ncols=True, disable=None)
+    return tqdm(
+        total=total,
+        desc=desc,
+        file=sys.stderr,
+        unit=unit,
+        leave=False,
+        dynamic_ncols=True,
+        disable=None,
+    )

@@ -19,7 +19,7 @@ from pathlib import Path
 from impact_balance.exceptions import OptionError, OutputError
 from impact_balance.scenario.reader import MAX_NAME_CHARS, MAX_PATH_CHARS
 
-__all__ = ["check_output_folder", "check_output_file"]
+__all__ = ["check_output_file", "check_output_folder"]
 
 
 def _text(field: str, path: str | os.PathLike[str]) -> Path:
@@ -29,10 +29,16 @@ def _text(field: str, path: str | os.PathLike[str]) -> Path:
     if "\x00" in text:
         raise OptionError(field, text, "a file name cannot contain a NUL character")
     if len(text) > MAX_PATH_CHARS:
-        raise OptionError(field, text, f"too long for a path ({len(text)} characters, at most {MAX_PATH_CHARS})")
+        raise OptionError(
+            field, text, f"too long for a path ({len(text)} characters, at most {MAX_PATH_CHARS})"
+        )
     longest = max((len(part) for part in text.split("/")), default=0)
     if longest > MAX_NAME_CHARS:
-        raise OptionError(field, text, f"a file or folder name has at most {MAX_NAME_CHARS} characters (this one has {longest})")
+        raise OptionError(
+            field,
+            text,
+            f"a file or folder name has at most {MAX_NAME_CHARS} characters (this one has {longest})",
+        )
     return Path(text).expanduser()
 
 
@@ -47,7 +53,8 @@ def _probe(field: str, shown: str, folder: Path) -> None:
 
 def _existing_ancestor(field: str, shown: str, path: Path, is_target: bool = True) -> Path:
     """The nearest folder of ``path`` (itself included) that exists; refuses a file on the way
-    (``is_target``: ``path`` is the output folder itself, not the folder of an output file)."""
+    (``is_target``: ``path`` is the output folder itself, not the folder of an output file).
+    """
     here = path
     while True:
         try:
@@ -59,7 +66,9 @@ def _existing_ancestor(field: str, shown: str, path: Path, is_target: bool = Tru
                     raise OptionError(field, shown, f"exists and is {what}: give a folder")
                 raise OptionError(field, shown, f"cannot be created: {here} is {what}")
         except OSError as exc:  # a name too long for the file system, a loop of links...
-            raise OutputError(field, shown, f"cannot be examined: {exc.strerror or type(exc).__name__}") from None
+            raise OutputError(
+                field, shown, f"cannot be examined: {exc.strerror or type(exc).__name__}"
+            ) from None
         parent = here.parent
         if parent == here:  # pragma: no cover - the root always exists
             return here
@@ -79,17 +88,26 @@ def check_output_folder(path: str | os.PathLike[str], field: str) -> Path:
     return folder
 
 
-def check_output_file(path: str | os.PathLike[str], field: str, suffixes: Sequence[str] = ()) -> Path:
+def check_output_file(
+    path: str | os.PathLike[str], field: str, suffixes: Sequence[str] = ()
+) -> Path:
     """Check that ``path`` names a file this process can write (its folder checked as by
-    :func:`check_output_folder`, ``suffixes`` if given); return it. Nothing is created."""
+    :func:`check_output_folder`, ``suffixes`` if given); return it. Nothing is created.
+    """
     shown = os.fspath(path)
     file = _text(field, path)
     if suffixes and file.suffix.lower() not in suffixes:
-        raise OptionError(field, shown, f"must end with {' or '.join(suffixes)}, not {file.suffix or 'no suffix'!r}")
+        raise OptionError(
+            field,
+            shown,
+            f"must end with {' or '.join(suffixes)}, not {file.suffix or 'no suffix'!r}",
+        )
     try:
         is_dir = file.is_dir()
     except OSError as exc:
-        raise OutputError(field, shown, f"cannot be examined: {exc.strerror or type(exc).__name__}") from None
+        raise OutputError(
+            field, shown, f"cannot be examined: {exc.strerror or type(exc).__name__}"
+        ) from None
     if is_dir:
         raise OptionError(field, shown, "is a folder: give a file name")
     parent = file.parent if str(file.parent) else Path(".")

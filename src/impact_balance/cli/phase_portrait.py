@@ -11,13 +11,32 @@ __all__ = ["add_parser", "run"]
 
 
 def add_parser(sub) -> list[str]:
-    pp = sub.add_parser("phase-portrait", help="LIPM phase portrait and CoM velocity bounds (paper sec. III-B)")
-    pp.add_argument("--com-height", type=float, required=True, metavar="H", help="CoM height above the ZMP plane, m")
-    pp.add_argument("--zmp-range", type=float, nargs=2, required=True, metavar=("LO", "HI"), help="ZMP interval, m")
+    pp = sub.add_parser(
+        "phase-portrait", help="LIPM phase portrait and CoM velocity bounds (paper sec. III-B)"
+    )
+    pp.add_argument(
+        "--com-height",
+        type=float,
+        required=True,
+        metavar="H",
+        help="CoM height above the ZMP plane, m",
+    )
+    pp.add_argument(
+        "--zmp-range",
+        type=float,
+        nargs=2,
+        required=True,
+        metavar=("LO", "HI"),
+        help="ZMP interval, m",
+    )
     pp.add_argument("--gravity", type=float, default=9.81, help="m/s^2 (default: %(default)s)")
     pp.add_argument("--json", action="store_true", help="print one JSON object")
-    pp.add_argument("--plot", metavar="FILE", type=output_file("--plot", (".png", ".pdf", ".svg")),
-                    help="write the phase portrait figure (.png, .pdf or .svg)")
+    pp.add_argument(
+        "--plot",
+        metavar="FILE",
+        type=output_file("--plot", (".png", ".pdf", ".svg")),
+        help="write the phase portrait figure (.png, .pdf or .svg)",
+    )
     return ["phase-portrait"]
 
 
@@ -34,11 +53,20 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         from impact_balance.cli.output import print_json
 
-        print_json({"omega": portrait.omega, "com_height": args.com_height, "zmp_range": list(portrait.zmp_range),
-                          "gravity": args.gravity, "com_velocity_bounds": list(portrait.com_velocity_bounds)})
+        print_json(
+            {
+                "omega": portrait.omega,
+                "com_height": args.com_height,
+                "zmp_range": list(portrait.zmp_range),
+                "gravity": args.gravity,
+                "com_velocity_bounds": list(portrait.com_velocity_bounds),
+            }
+        )
     else:
         lo, hi = portrait.com_velocity_bounds
-        print(f"omega = {portrait.omega:.4f} 1/s; CoM velocity bounds at c = 0: [{lo:.4f}, {hi:.4f}] m/s")
+        print(
+            f"omega = {portrait.omega:.4f} 1/s; CoM velocity bounds at c = 0: [{lo:.4f}, {hi:.4f}] m/s"
+        )
         if args.plot:
             print(f"figure: {args.plot}")
     return 0

@@ -18,7 +18,9 @@ class _Place(argparse.Action):
         places = list(getattr(namespace, "places", None) or [])
         if option_string == "--place":
             frame, *xyz = values
-            places.append({"frame": frame, "position": _numbers(parser, "--place", xyz), "normal": None})
+            places.append(
+                {"frame": frame, "position": _numbers(parser, "--place", xyz), "normal": None}
+            )
         else:
             if not places:
                 parser.error("--normal comes after the --place it turns")
@@ -39,13 +41,29 @@ def _numbers(parser, option: str, texts) -> tuple[float, ...]:
 
 
 def add_parser(sub) -> list[str]:
-    p = sub.add_parser("pose", help="place frames by whole-body IK (contacts kept) and write the scenario")
+    p = sub.add_parser(
+        "pose", help="place frames by whole-body IK (contacts kept) and write the scenario"
+    )
     p.add_argument("scenario", help="YAML file, or the name of a bundled scenario")
-    p.add_argument("--place", nargs=4, action=_Place, dest="places", metavar=("FRAME", "X", "Y", "Z"),
-                   help="put FRAME's contact centre (or origin) at world X Y Z, m (repeatable)")
-    p.add_argument("--normal", nargs=3, action=_Place, dest="places", metavar=("NX", "NY", "NZ"),
-                   help="after --place: turn that contact's normal (or the frame's z axis) to this world direction")
-    p.add_argument("--com", nargs=2, type=float, metavar=("X", "Y"), help="horizontal CoM target, world, m")
+    p.add_argument(
+        "--place",
+        nargs=4,
+        action=_Place,
+        dest="places",
+        metavar=("FRAME", "X", "Y", "Z"),
+        help="put FRAME's contact centre (or origin) at world X Y Z, m (repeatable)",
+    )
+    p.add_argument(
+        "--normal",
+        nargs=3,
+        action=_Place,
+        dest="places",
+        metavar=("NX", "NY", "NZ"),
+        help="after --place: turn that contact's normal (or the frame's z axis) to this world direction",
+    )
+    p.add_argument(
+        "--com", nargs=2, type=float, metavar=("X", "Y"), help="horizontal CoM target, world, m"
+    )
     p.add_argument("--out", required=True, metavar="FILE", help="scenario file to write (.yaml)")
     p.add_argument("--force", action="store_true", help="replace FILE if it exists")
     p.add_argument("--json", action="store_true", help="print one JSON object")
@@ -57,17 +75,21 @@ def run(args: argparse.Namespace) -> int:
 
     from impact_balance.authoring import Placement, pose_scenario, posed_mapping, scenario_yaml
     from impact_balance.exceptions import ScenarioError, WorkspaceError
-    from impact_balance.scenario import _read, load_scenario, scenario_from_dict, scenario_path
     from impact_balance.gui.workspace import Workspace
+    from impact_balance.scenario import _read, load_scenario, scenario_from_dict, scenario_path
 
     places = getattr(args, "places", None) or []
     if not places and args.com is None:
-        raise ScenarioError("--place", None, "nothing to do: give --place FRAME X Y Z and/or --com X Y")
+        raise ScenarioError(
+            "--place", None, "nothing to do: give --place FRAME X Y Z and/or --com X Y"
+        )
     if args.com is not None and not all(math.isfinite(v) and abs(v) <= 1e4 for v in args.com):
         raise ScenarioError("--com", list(args.com), "must be finite, within +-1e4 m")
     out = Path(args.out)
     workspace = Workspace(out.parent if str(out.parent) else ".")
-    workspace.resolve(out.name, for_write=True, overwrite=True, field="--out")  # a bad name fails before the IK
+    workspace.resolve(
+        out.name, for_write=True, overwrite=True, field="--out"
+    )  # a bad name fails before the IK
     if not args.force and (out.exists() or out.is_symlink()):
         raise WorkspaceError("--out", str(out), "the file exists (--force replaces it)")
     scenario = load_scenario(args.scenario)
@@ -75,30 +97,56 @@ def run(args: argparse.Namespace) -> int:
     result = pose_scenario(scenario, placements, args.com)
     mapping = posed_mapping(_read(scenario_path(args.scenario)), scenario, result, out.parent)
     scenario_from_dict(mapping, str(out)).build_stance()  # what is written loads
-    argv = " ".join(f"--place {p.frame} {' '.join(f'{x:g}' for x in p.position)}"
-                    + (f" --normal {' '.join(f'{x:g}' for x in p.normal)}" if p.normal else "") for p in placements)
+    argv = " ".join(
+        f"--place {p.frame} {' '.join(f'{x:g}' for x in p.position)}"
+        + (f" --normal {' '.join(f'{x:g}' for x in p.normal)}" if p.normal else "")
+        for p in placements
+    )
     if args.com is not None:
         argv += f" --com {args.com[0]:g} {args.com[1]:g}"
-    text = scenario_yaml(mapping, f"Posed by `impact-balance pose {scenario.name or args.scenario} {argv.strip()}`\n"
-                                  "(whole-body IK, the other contacts kept).")
+    text = scenario_yaml(
+        mapping,
+        f"Posed by `impact-balance pose {scenario.name or args.scenario} {argv.strip()}`\n"
+        "(whole-body IK, the other contacts kept).",
+    )
     written = workspace.write_text(out.name, text, overwrite=args.force, field="--out")
     worst = max(result.residuals.values(), default=0.0)
     if args.json:
         from impact_balance.cli.output import print_json
 
-        print_json({"out": str(written), "residuals": result.residuals, "largest_residual": worst,
-                    "com": result.com.tolist(), "base": mapping["base"], "joints": mapping["joints"]})
+        print_json(
+            {
+                "out": str(written),
+                "residuals": result.residuals,
+                "largest_residual": worst,
+                "com": result.com.tolist(),
+                "base": mapping["base"],
+                "joints": mapping["joints"],
+            }
+        )
         return 0
     for p in placements:
         target = result.targets[p.frame]
-        print(f"{p.frame}: placed, residual {result.residuals[p.frame + '.position']:.1e} m"
-              + (f", {result.residuals[p.frame + '.orientation']:.1e} rad" if p.frame + ".orientation" in
-                 result.residuals else "") + f" (frame origin at [{', '.join(f'{x:.4f}' for x in target.translation)}])")
+        print(
+            f"{p.frame}: placed, residual {result.residuals[p.frame + '.position']:.1e} m"
+            + (
+                f", {result.residuals[p.frame + '.orientation']:.1e} rad"
+                if p.frame + ".orientation" in result.residuals
+                else ""
+            )
+            + f" (frame origin at [{', '.join(f'{x:.4f}' for x in target.translation)}])"
+        )
     kept = [f for f in result.targets if f not in {p.frame for p in placements}]
     if kept:
         drift = max(result.residuals[f + ".position"] for f in kept)
         print(f"contacts kept: {', '.join(kept)} (largest drift {drift:.1e} m)")
-    print(f"CoM at [{', '.join(f'{x:.4f}' for x in result.com)}] m"
-          + (f", {result.residuals['com_xy']:.1e} m from the --com target" if "com_xy" in result.residuals else ""))
+    print(
+        f"CoM at [{', '.join(f'{x:.4f}' for x in result.com)}] m"
+        + (
+            f", {result.residuals['com_xy']:.1e} m from the --com target"
+            if "com_xy" in result.residuals
+            else ""
+        )
+    )
     print(f"wrote: {written}")
     return 0

@@ -5,37 +5,61 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from impact_balance.cli._options import add_controller_option, add_output_options, add_trial_options, open_journal, with_zmp_margin
+from impact_balance.cli._options import (
+    add_controller_option,
+    add_output_options,
+    add_trial_options,
+    open_journal,
+    with_zmp_margin,
+)
 
-__all__ = ["add_parser", "run", "USES_KERNEL"]
+__all__ = ["USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
 
 
 def add_parser(sub) -> list[str]:
     # No import of the simulation here: mujoco is imported only when a simulation command runs.
-    a = sub.add_parser("push-test", help="push the simulated robot in every direction; score both criteria")
+    a = sub.add_parser(
+        "push-test", help="push the simulated robot in every direction; score both criteria"
+    )
     a.add_argument("scenario", help="YAML file or bundled scenario name")
-    a.add_argument("--directions", type=int, default=16, help="number of push directions (default 16)")
-    a.add_argument("--magnitudes", type=float, nargs="+", default=None, metavar="NS",
-                   help="impulses, N s (default 5 10 15 20 25 30)")
-    a.add_argument("--relative", type=float, nargs="+", default=None, metavar="F",
-                   help="impulses as fractions of each direction's boundary impulse (the one that puts the "
-                        "predicted CoM velocity on the CoM velocity area's boundary), e.g. 0.6 0.8 1.0 1.2 1.4")
+    a.add_argument(
+        "--directions", type=int, default=16, help="number of push directions (default 16)"
+    )
+    a.add_argument(
+        "--magnitudes",
+        type=float,
+        nargs="+",
+        default=None,
+        metavar="NS",
+        help="impulses, N s (default 5 10 15 20 25 30)",
+    )
+    a.add_argument(
+        "--relative",
+        type=float,
+        nargs="+",
+        default=None,
+        metavar="F",
+        help="impulses as fractions of each direction's boundary impulse (the one that puts the "
+        "predicted CoM velocity on the CoM velocity area's boundary), e.g. 0.6 0.8 1.0 1.2 1.4",
+    )
     a.add_argument("--duration", type=float, default=0.05, help="push duration, s (default 0.05)")
     a.add_argument("--body", help="MuJoCo body pushed (default: the torso)")
-    add_controller_option(a, "id", "it places the ZMP anywhere in the support area, as the criterion assumes")
+    add_controller_option(
+        a, "id", "it places the ZMP anywhere in the support area, as the criterion assumes"
+    )
     add_trial_options(a, impact=False)
     add_output_options(a, "of one telling push")
     return ["push-test"]
 
 
 def run(args: argparse.Namespace) -> int:
+    from impact_balance.cli.output import print_json, progress_bar
     from impact_balance.logs import check_log_path
     from impact_balance.scenario import load_scenario
-    from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, write_trial_log
     from impact_balance.sim.studies.push import check_push_arguments, push_test
-    from impact_balance.cli.output import print_json, progress_bar
+    from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, write_trial_log
 
     scenario = load_scenario(args.scenario)
     if args.log:
@@ -52,8 +76,18 @@ def run(args: argparse.Namespace) -> int:
         bar.set_postfix_str(f"{outcome.push.magnitude:.1f} N s {outcome.outcome}")
 
     try:
-        result = push_test(scenario, args.directions, args.magnitudes, args.duration, args.body, progress=progress,
-                           options=options, relative=args.relative, zmp_margin=args.zmp_margin, journal=journal)
+        result = push_test(
+            scenario,
+            args.directions,
+            args.magnitudes,
+            args.duration,
+            args.body,
+            progress=progress,
+            options=options,
+            relative=args.relative,
+            zmp_margin=args.zmp_margin,
+            journal=journal,
+        )
     finally:
         bar.close()
         journal.close()
@@ -61,9 +95,20 @@ def run(args: argparse.Namespace) -> int:
     written = []
     if args.log:
         chosen = _telling(result)
-        written.append(write_trial_log(result.setup, args.log, args.controller, {
-            "push_direction": chosen.push.direction, "push_magnitude": chosen.push.magnitude}, push=chosen.push))
-        out["log"] = {"file": str(args.log), "direction": chosen.push.direction, "magnitude": chosen.push.magnitude}
+        written.append(
+            write_trial_log(
+                result.setup,
+                args.log,
+                args.controller,
+                {"push_direction": chosen.push.direction, "push_magnitude": chosen.push.magnitude},
+                push=chosen.push,
+            )
+        )
+        out["log"] = {
+            "file": str(args.log),
+            "direction": chosen.push.direction,
+            "magnitude": chosen.push.magnitude,
+        }
     if args.plots:
         written += _plots(result, Path(args.plots))
     if args.json:
@@ -87,27 +132,43 @@ def _text(result, out: dict, args: argparse.Namespace) -> str:
     counts = out["counts"]
     o = counts["outcomes"]
     controller = out["controller"].get("name", args.controller)
-    lines = [f"{result.scenario}: {len(result.outcomes)} pushes ({args.directions} directions, {args.duration * 1e3:.0f} ms) "
-             f"with the {args.controller} controller ({controller})",
-             f"  outcomes: {o['balanced']} balanced, {o['contact_broken']} contact broken (came to rest), "
-             f"{o['fell']} fell, {o['aborted']} aborted"]
+    lines = [
+        f"{result.scenario}: {len(result.outcomes)} pushes ({args.directions} directions, {args.duration * 1e3:.0f} ms) "
+        f"with the {args.controller} controller ({controller})",
+        f"  outcomes: {o['balanced']} balanced, {o['contact_broken']} contact broken (came to rest), "
+        f"{o['fell']} fell, {o['aborted']} aborted",
+    ]
     if counts["reasons"]:
         lines.append("  " + ", ".join(f"{k}: {v}" for k, v in sorted(counts["reasons"].items())))
     margin = 1000 * out["zmp_margin"]
-    lines.append(f"  {'magnitude':>14s} {'balanced':>8s} {'broken':>6s} {'fell':>5s} {'CoM safe':>8s} {'ZMP safe':>8s}")
+    lines.append(
+        f"  {'magnitude':>14s} {'balanced':>8s} {'broken':>6s} {'fell':>5s} {'CoM safe':>8s} {'ZMP safe':>8s}"
+    )
     for row in _by_level(result):
-        lines.append(f"  {row['label']:>14s} {row['balanced']:8d} {row['contact_broken']:6d} {row['fell']:5d} "
-                     f"{row['com']:8d} {row['zmp']:8d}")
-    lines.append(f"  scores (fell against the rest; {len(result.scored)} pushes, ZMP margin {margin:g} mm; "
-                 f"95 % Wilson intervals):")
-    for key, label in (("com", "CoM criterion, before the trial"), ("com_in_trial", "CoM criterion, in the trial"),
-                       ("zmp", "ZMP criterion, before the trial"), ("zmp_in_trial", "ZMP criterion, in the trial")):
+        lines.append(
+            f"  {row['label']:>14s} {row['balanced']:8d} {row['contact_broken']:6d} {row['fell']:5d} "
+            f"{row['com']:8d} {row['zmp']:8d}"
+        )
+    lines.append(
+        f"  scores (fell against the rest; {len(result.scored)} pushes, ZMP margin {margin:g} mm; "
+        f"95 % Wilson intervals):"
+    )
+    for key, label in (
+        ("com", "CoM criterion, before the trial"),
+        ("com_in_trial", "CoM criterion, in the trial"),
+        ("zmp", "ZMP criterion, before the trial"),
+        ("zmp_in_trial", "ZMP criterion, in the trial"),
+    ):
         k = out["scores"][key]
-        lines.append(f"    {label:32s} right {_pct(k['accuracy'])}{_ci(k['accuracy_ci95'])}, "
-                     f"predicted safe and fell {_pct(k['safe_fell_rate'])}{_ci(k['safe_fell_rate_ci95'])}")
+        lines.append(
+            f"    {label:32s} right {_pct(k['accuracy'])}{_ci(k['accuracy_ci95'])}, "
+            f"predicted safe and fell {_pct(k['safe_fell_rate'])}{_ci(k['safe_fell_rate_ci95'])}"
+        )
     smallest = out["margin_study"]["smallest_margin"]["com"]
-    lines.append("  smallest ZMP margin that brings the CoM criterion's 'predicted safe, fell' to 5 % or less: "
-                 + ("none up to 6 cm" if smallest is None else f"{1000 * smallest:g} mm"))
+    lines.append(
+        "  smallest ZMP margin that brings the CoM criterion's 'predicted safe, fell' to 5 % or less: "
+        + ("none up to 6 cm" if smallest is None else f"{1000 * smallest:g} mm")
+    )
     if out["journal"]:
         lines.append(f"  trials journal: {out['journal']} ({out['reused_trials']} reused)")
     return "\n".join(lines)
@@ -117,8 +178,13 @@ def _by_level(result) -> list[dict]:
     rows: dict[float, dict] = {}
     for o in result.outcomes:
         level = o.relative if o.relative is not None else o.push.magnitude
-        label = f"x{o.relative:g} boundary" if o.relative is not None else f"{o.push.magnitude:g} N s"
-        row = rows.setdefault(level, {"label": label, "balanced": 0, "contact_broken": 0, "fell": 0, "com": 0, "zmp": 0})
+        label = (
+            f"x{o.relative:g} boundary" if o.relative is not None else f"{o.push.magnitude:g} N s"
+        )
+        row = rows.setdefault(
+            level,
+            {"label": label, "balanced": 0, "contact_broken": 0, "fell": 0, "com": 0, "zmp": 0},
+        )
         if o.outcome in row:
             row[o.outcome] += 1
         row["com"] += o.safe("com", result.zmp_margin, result.omega)
@@ -128,7 +194,8 @@ def _by_level(result) -> list[dict]:
 
 def _telling(result):
     """The push of the paper's Exp. 2 if there is one (ZMP outside in the trial, no fall), else the largest
-    that did not fall, else the first."""
+    that did not fall, else the first.
+    """
     stood = [o for o in result.scored if not o.fell]
     exp2 = [o for o in stood if not o.safe("zmp_in_trial", 0.0, result.omega)]
     if exp2:

@@ -19,7 +19,7 @@ from pathlib import Path
 from impact_balance.cli._options import CommandLineError, output_folder
 from impact_balance.cli.output import print_json
 
-__all__ = ["add_parser", "run", "USES_KERNEL"]
+__all__ = ["USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
 
@@ -51,21 +51,54 @@ def add_parser(sub) -> list[str]:
         description="Evaluate every point of a sweep file and write one Parquet row per point. Finished chunks "
         "are written at once: after Ctrl-C or a crash, the same command resumes.",
     )
-    s.add_argument("spec", nargs="?", help="sweep YAML file, or the name of a bundled sweep (see --list)")
-    s.add_argument("--out", metavar="DIR", type=output_folder("--out"),
-                   help="output folder (default: sweep-<name> in the current folder)")
-    s.add_argument("--workers", type=_positive, metavar="N", help="local worker processes (default: every core)")
-    s.add_argument("--scheduler", metavar="ADDRESS", type=_scheduler,
-                   help="Dask scheduler address, tcp://HOST:PORT (e.g. tcp://10.0.0.5:8786)")
+    s.add_argument(
+        "spec", nargs="?", help="sweep YAML file, or the name of a bundled sweep (see --list)"
+    )
+    s.add_argument(
+        "--out",
+        metavar="DIR",
+        type=output_folder("--out"),
+        help="output folder (default: sweep-<name> in the current folder)",
+    )
+    s.add_argument(
+        "--workers",
+        type=_positive,
+        metavar="N",
+        help="local worker processes (default: every core)",
+    )
+    s.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        type=_scheduler,
+        help="Dask scheduler address, tcp://HOST:PORT (e.g. tcp://10.0.0.5:8786)",
+    )
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
-    s.add_argument("--no-plots", action="store_true", help="do not write the figures when the sweep completes")
-    s.add_argument("--summary", metavar="DIR", help="print the best and worst points of a sweep folder, and exit")
-    s.add_argument("--verify", metavar="DIR",
-                   help="check every part of a sweep folder (digest, chunk, rows, checksum), and exit")
-    s.add_argument("--plots", metavar="DIR", dest="plots_dir", type=output_folder("--plots"),
-                   help="with --summary: write the figures to DIR; after a run: instead of OUT/figures")
-    s.add_argument("--top", type=_positive, default=5, help="best and worst points shown (default 5)")
-    s.add_argument("--json", action="store_true", help="print one JSON object (the summary) on stdout")
+    s.add_argument(
+        "--no-plots", action="store_true", help="do not write the figures when the sweep completes"
+    )
+    s.add_argument(
+        "--summary",
+        metavar="DIR",
+        help="print the best and worst points of a sweep folder, and exit",
+    )
+    s.add_argument(
+        "--verify",
+        metavar="DIR",
+        help="check every part of a sweep folder (digest, chunk, rows, checksum), and exit",
+    )
+    s.add_argument(
+        "--plots",
+        metavar="DIR",
+        dest="plots_dir",
+        type=output_folder("--plots"),
+        help="with --summary: write the figures to DIR; after a run: instead of OUT/figures",
+    )
+    s.add_argument(
+        "--top", type=_positive, default=5, help="best and worst points shown (default 5)"
+    )
+    s.add_argument(
+        "--json", action="store_true", help="print one JSON object (the summary) on stdout"
+    )
     s.add_argument("--list", action="store_true", help="list the bundled sweep files")
     return ["sweep"]
 
@@ -92,10 +125,16 @@ def _verify(args: argparse.Namespace) -> int:
     else:
         for problem in check.problems:
             print(problem.line())
-        state = "complete" if not check.missing else f"{len(check.missing)} of {check.n_chunks} chunks not computed yet"
+        state = (
+            "complete"
+            if not check.missing
+            else f"{len(check.missing)} of {check.n_chunks} chunks not computed yet"
+        )
         verdict = "ok" if check.ok else f"{len(check.problems)} bad part(s)"
-        print(f"{args.verify}: {verdict}; {len(check.good)} good parts, {check.rows} of {check.manifest['n_points']} "
-              f"points; {state}")
+        print(
+            f"{args.verify}: {verdict}; {len(check.good)} good parts, {check.rows} of {check.manifest['n_points']} "
+            f"points; {state}"
+        )
     return 0 if check.ok else 2
 
 
@@ -110,7 +149,11 @@ def run(args: argparse.Namespace) -> int:
             print(f"{name:32s} {description}")
         return 0
     if sum(bool(x) for x in (args.spec, args.summary, args.verify)) > 1:
-        raise SweepError("SPEC", args.spec or args.summary, "give one of a sweep file, --summary DIR or --verify DIR")
+        raise SweepError(
+            "SPEC",
+            args.spec or args.summary,
+            "give one of a sweep file, --summary DIR or --verify DIR",
+        )
     if args.verify:
         return _verify(args)
     if args.summary:
@@ -125,7 +168,9 @@ def run(args: argparse.Namespace) -> int:
                 print(f"  figure: {path}")
         return 0
     if not args.spec:
-        raise SweepError("SPEC", None, "give a sweep file (or a bundled name: see --list), or --summary DIR")
+        raise SweepError(
+            "SPEC", None, "give a sweep file (or a bundled name: see --list), or --summary DIR"
+        )
     spec = load_sweep_spec(args.spec)
     plan = make_plan(spec)
     if args.out:
@@ -134,15 +179,26 @@ def run(args: argparse.Namespace) -> int:
         from impact_balance.cli.output_paths import check_output_folder
 
         out = check_output_folder(f"sweep-{Path(spec.source).stem}", "--out")
-    report = run_sweep(plan, out, workers=args.workers, scheduler=args.scheduler, progress=not args.no_progress,
-                       notify=lambda line: _warn(f"{out}/{line}"))
+    report = run_sweep(
+        plan,
+        out,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        progress=not args.no_progress,
+        notify=lambda line: _warn(f"{out}/{line}"),
+    )
     where = args.scheduler or f"{report.workers} worker{'s' if report.workers != 1 else ''}"
-    print(f"impact-balance sweep: {report.points_computed} points in {report.elapsed_s:.1f} s on {where} "
-          f"({report.rate:.0f} points/s; {report.chunks_before} of {report.n_chunks} chunks were already done) -> {out}",
-          file=sys.stderr)
+    print(
+        f"impact-balance sweep: {report.points_computed} points in {report.elapsed_s:.1f} s on {where} "
+        f"({report.rate:.0f} points/s; {report.chunks_before} of {report.n_chunks} chunks were already done) -> {out}",
+        file=sys.stderr,
+    )
     if report.interrupted:
-        print(f"impact-balance sweep: interrupted; {report.chunks_before + report.chunks_computed} of {report.n_chunks} "
-              "chunks are written: run the same command to resume", file=sys.stderr)
+        print(
+            f"impact-balance sweep: interrupted; {report.chunks_before + report.chunks_computed} of {report.n_chunks} "
+            "chunks are written: run the same command to resume",
+            file=sys.stderr,
+        )
         return 130
     summary = summarize(out, args.top)
     if not args.no_plots:

@@ -5,38 +5,58 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from impact_balance.cli._options import add_controller_option, add_output_options, add_trial_options, open_journal, with_zmp_margin
+from impact_balance.cli._options import (
+    add_controller_option,
+    add_output_options,
+    add_trial_options,
+    open_journal,
+    with_zmp_margin,
+)
 
-__all__ = ["add_parser", "run", "USES_KERNEL"]
+__all__ = ["USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
 
 
 def add_parser(sub) -> list[str]:
-    a = sub.add_parser("validate", help="bisect the approach speed at which the simulated robot falls (MuJoCo)")
+    a = sub.add_parser(
+        "validate", help="bisect the approach speed at which the simulated robot falls (MuJoCo)"
+    )
     a.add_argument("scenario", help="YAML file or bundled scenario name (must have an impact)")
-    a.add_argument("--joints", default="servo", choices=("rigid", "servo"),
-                   help="servo: URDF effort limits, 15 Hz servos; rigid: stiff 30 Hz servos, no effort limits")
-    add_controller_option(a, "ik", "a kinematically controlled robot, as the paper's impact model assumes")
-    a.add_argument("--tolerance", type=float, default=0.05, help="relative width of the bracket (default 0.05)")
-    a.add_argument("--max-speed", type=float, default=4.0, help="largest approach speed tried, m/s (default 4)")
+    a.add_argument(
+        "--joints",
+        default="servo",
+        choices=("rigid", "servo"),
+        help="servo: URDF effort limits, 15 Hz servos; rigid: stiff 30 Hz servos, no effort limits",
+    )
+    add_controller_option(
+        a, "ik", "a kinematically controlled robot, as the paper's impact model assumes"
+    )
+    a.add_argument(
+        "--tolerance", type=float, default=0.05, help="relative width of the bracket (default 0.05)"
+    )
+    a.add_argument(
+        "--max-speed", type=float, default=4.0, help="largest approach speed tried, m/s (default 4)"
+    )
     add_trial_options(a, impact=True)
     add_output_options(a, "of the fastest trial survived")
     return ["validate"]
 
 
 def run(args: argparse.Namespace) -> int:
+    from impact_balance.cli.output import print_json, progress_bar
     from impact_balance.exceptions import SimulationError
     from impact_balance.logs import check_log_path
     from impact_balance.ranges import check_tolerance
     from impact_balance.scenario import load_scenario
-    from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, write_trial_log
     from impact_balance.sim.studies.validate import validate
-    from impact_balance.cli.output import print_json, progress_bar
+    from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, write_trial_log
 
     scenario = load_scenario(args.scenario)
     if scenario.impact is None:
-        raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact: validate needs one")
+        raise SimulationError(
+            "impact", None, f"scenario {scenario.name!r} has no impact: validate needs one"
+        )
     if not (0 < args.max_speed <= 5.0):
         raise SimulationError("--max-speed", args.max_speed, "must be in (0, 5] m/s")
     check_tolerance(args.tolerance)
@@ -44,19 +64,35 @@ def run(args: argparse.Namespace) -> int:
     if args.log:
         check_log_path(args.log)
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
-    journal = open_journal(args, "validate", scenario, args.joints, options,
-                           {"tolerance": args.tolerance, "max_speed": args.max_speed})
+    journal = open_journal(
+        args,
+        "validate",
+        scenario,
+        args.joints,
+        options,
+        {"tolerance": args.tolerance, "max_speed": args.max_speed},
+    )
     bar = progress_bar(f"validate {scenario.name}")
 
     def progress(trial, stood, fell):
         bar.update(1)
         lo = "?" if stood is None else f"{stood:.3f}"
         hi = "?" if fell is None else f"{fell:.3f}"
-        bar.set_postfix_str(f"{trial.speed:.3f} m/s {trial.outcome}; bracket (commanded) [{lo}, {hi}]")
+        bar.set_postfix_str(
+            f"{trial.speed:.3f} m/s {trial.outcome}; bracket (commanded) [{lo}, {hi}]"
+        )
 
     try:
-        result = validate(scenario, args.joints, tolerance=args.tolerance, max_speed=args.max_speed, progress=progress,
-                          options=options, zmp_margin=args.zmp_margin, journal=journal)
+        result = validate(
+            scenario,
+            args.joints,
+            tolerance=args.tolerance,
+            max_speed=args.max_speed,
+            progress=progress,
+            options=options,
+            zmp_margin=args.zmp_margin,
+            journal=journal,
+        )
     finally:
         bar.close()
         journal.close()
@@ -64,11 +100,20 @@ def run(args: argparse.Namespace) -> int:
     written = []
     e = out["empirical"]
     if args.log:
-        speed = e["survived_commanded"] if e["survived_commanded"] is not None else e["fell_commanded"]
+        speed = (
+            e["survived_commanded"] if e["survived_commanded"] is not None else e["fell_commanded"]
+        )
         if speed is not None:
-            written.append(write_trial_log(result.extra["setup"], args.log, args.controller,
-                                           {"approach_speed": speed, "joints": args.joints}, impact_speed=speed,
-                                           rigid_impact=args.rigid_impact))
+            written.append(
+                write_trial_log(
+                    result.extra["setup"],
+                    args.log,
+                    args.controller,
+                    {"approach_speed": speed, "joints": args.joints},
+                    impact_speed=speed,
+                    rigid_impact=args.rigid_impact,
+                )
+            )
             out["log"] = {"file": str(args.log), "approach_speed": speed}
     if args.plots:
         written += _plots(result, Path(args.plots))
@@ -87,29 +132,45 @@ def _f(x) -> str:
 
 def _text(out: dict, args: argparse.Namespace, n: int) -> str:
     e, p, pm = out["empirical"], out["predicted"], out["predicted_with_margin"]
-    impact = "rigid impact (joints held through the impact)" if out["rigid_impact"] else "free impact"
-    lines = [f"{out['scenario']}: fall threshold of the impact ({args.joints} joints, {args.controller} controller, "
-             f"{impact}, {n} trials)",
-             f"  measured approach speed: stood at {_f(e['survived'])}, fell at {_f(e['fell'])}"
-             f" (commanded {_f(e['survived_commanded'])} / {_f(e['fell_commanded'])})"
-             + ("" if e["monotonic"] else "; NOT monotonic in measured speed")]
+    impact = (
+        "rigid impact (joints held through the impact)" if out["rigid_impact"] else "free impact"
+    )
+    lines = [
+        f"{out['scenario']}: fall threshold of the impact ({args.joints} joints, {args.controller} controller, "
+        f"{impact}, {n} trials)",
+        f"  measured approach speed: stood at {_f(e['survived'])}, fell at {_f(e['fell'])}"
+        f" (commanded {_f(e['survived_commanded'])} / {_f(e['fell_commanded'])})"
+        + ("" if e["monotonic"] else "; NOT monotonic in measured speed"),
+    ]
     brk = out["contact_break"]
     if brk is not None:
-        lines.append(f"  first contact break: {brk['contact']} {brk['kind']} at {_f(brk['measured'])} measured "
-                     f"({brk['outcome']})")
+        lines.append(
+            f"  first contact break: {brk['contact']} {brk['kind']} at {_f(brk['measured'])} measured "
+            f"({brk['outcome']})"
+        )
     else:
         lines.append("  no contact broke")
-    lines.append(f"  predicted maximum contact velocity (ZMP margin 0 / {1000 * out['zmp_margin']:g} mm):")
+    lines.append(
+        f"  predicted maximum contact velocity (ZMP margin 0 / {1000 * out['zmp_margin']:g} mm):"
+    )
     for crit, label in (("com_criterion", "CoM criterion"), ("zmp_criterion", "ZMP criterion")):
-        lines.append(f"    {label:14s} composite {_f(p[crit]['composite'])} / {_f(pm[crit]['composite'])}, "
-                     f"joint_space {_f(p[crit]['joint_space'])} / {_f(pm[crit]['joint_space'])}")
+        lines.append(
+            f"    {label:14s} composite {_f(p[crit]['composite'])} / {_f(pm[crit]['composite'])}, "
+            f"joint_space {_f(p[crit]['joint_space'])} / {_f(pm[crit]['joint_space'])}"
+        )
     lines.append("  trials (commanded -> measured: outcome):")
     for t in out["trials"]:
         why = f" {t['reason']}" if t["reason"] else ""
-        call = {True: "CoM criterion: safe", False: "CoM criterion: unsafe", None: ""}[t["com_criterion_safe"]]
-        lines.append(f"    {t['speed']:.3f} -> {_f(t['approach_speed_measured'])}: {t['outcome']}{why}   {call}")
-    lines.append(f"  controller: {out['controller'].get('name', args.controller)}; joint armature: "
-                 f"{out['controller'].get('armature')}")
+        call = {True: "CoM criterion: safe", False: "CoM criterion: unsafe", None: ""}[
+            t["com_criterion_safe"]
+        ]
+        lines.append(
+            f"    {t['speed']:.3f} -> {_f(t['approach_speed_measured'])}: {t['outcome']}{why}   {call}"
+        )
+    lines.append(
+        f"  controller: {out['controller'].get('name', args.controller)}; joint armature: "
+        f"{out['controller'].get('armature')}"
+    )
     if out["journal"]:
         lines.append(f"  trials journal: {out['journal']} ({out['reused_trials']} reused)")
     return "\n".join(lines)

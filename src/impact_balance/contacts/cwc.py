@@ -63,7 +63,9 @@ def rotate_wrench_matrix(rotation: np.ndarray) -> np.ndarray:
     return T
 
 
-def cwc_faces_world(mu: float, half_length: float, half_width: float, rotation: np.ndarray) -> np.ndarray:
+def cwc_faces_world(
+    mu: float, half_length: float, half_width: float, rotation: np.ndarray
+) -> np.ndarray:
     """Face matrix acting on the wrench at the contact point in WORLD-aligned axes.
 
     ``rotation`` maps contact-frame vectors to world vectors (pinocchio's ``oMf.rotation``).

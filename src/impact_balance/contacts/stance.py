@@ -14,10 +14,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from impact_balance.robot.robot import Robot, Scratch
 from impact_balance.geometry.spatial import skew
+from impact_balance.robot.robot import Robot, Scratch
 
-__all__ = ["ContactSpec", "Contact", "Stance", "frame_point"]
+__all__ = ["Contact", "ContactSpec", "Stance", "frame_point"]
 
 _IDENTITY = pin.SE3.Identity()
 
@@ -27,14 +27,20 @@ def _has_free_flyer(model: pin.Model) -> bool:
     return model.njoints > 1 and model.joints[1].shortname() == "JointModelFreeFlyer"
 
 
-def frame_point(model: pin.Model, data: pin.Data, fid: int, offset: pin.SE3 | None,
-                jacobian: bool = True) -> tuple[pin.SE3, np.ndarray | None]:
+def frame_point(
+    model: pin.Model, data: pin.Data, fid: int, offset: pin.SE3 | None, jacobian: bool = True
+) -> tuple[pin.SE3, np.ndarray | None]:
     """Pose of frame ``fid`` times ``offset`` and its 6 x nv Jacobian in world-aligned axes
     (linear rows first, at the offset point), from ``data`` holding the joint placements and
     joint Jacobians (in the frame of those placements); the Jacobian is skipped (None)
-    without ``jacobian``. The pose may be ``data``'s own: copy what you keep."""
+    without ``jacobian``. The pose may be ``data``'s own: copy what you keep.
+    """
     frame_pose = pin.updateFramePlacement(model, data, fid)
-    J = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED) if jacobian else None
+    J = (
+        pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        if jacobian
+        else None
+    )
     if offset is None or offset == _IDENTITY:  # exact test: contacts mostly have no offset
         return frame_pose, J
     placement = frame_pose * offset
@@ -134,8 +140,13 @@ class Stance:
         com_inertia: Composite rotational inertia about the CoM, world axes, kg m^2.
     """
 
-    def __init__(self, robot: Robot, q: np.ndarray, contacts: Sequence[ContactSpec] = (),
-                 workspace: Scratch | None = None):
+    def __init__(
+        self,
+        robot: Robot,
+        q: np.ndarray,
+        contacts: Sequence[ContactSpec] = (),
+        workspace: Scratch | None = None,
+    ):
         model = robot.model
         self.robot = robot
         # An explicit scratch Data is kept; else the robot's per-thread one is looked up at
@@ -154,19 +165,25 @@ class Stance:
         # computeJointJacobians does) and data.Ig, the centroidal composite inertia in world axes.
         pin.ccrba(model, data, self._q_local, np.zeros(model.nv))
         workspace.holder = self._q_local.tobytes()
-        self.com_local = np.array(pin.centerOfMass(model, data, pin.KinematicLevel.POSITION, False), dtype=float)
+        self.com_local = np.array(
+            pin.centerOfMass(model, data, pin.KinematicLevel.POSITION, False), dtype=float
+        )
         self.com = self.com_local + self.origin
         Ig = data.Ig
         self.mass = float(Ig.mass)
         self.com_inertia = np.array(Ig.inertia, dtype=float)
         # g(q) does not depend on the base position (its base rows are moments about the base).
-        self.gravity_torques = np.array(pin.computeGeneralizedGravity(model, data, self._q_local), dtype=float)
+        self.gravity_torques = np.array(
+            pin.computeGeneralizedGravity(model, data, self._q_local), dtype=float
+        )
         self.contacts: list[Contact] = []
         for i, spec in enumerate(contacts):
             fid = robot.frame_id(spec.frame, f"contacts[{i}].frame")
             placement, jacobian = self._point(data, fid, spec.offset)
             local = placement.translation.copy()
-            self.contacts.append(Contact(spec, placement.rotation.copy(), local + self.origin, jacobian, local))
+            self.contacts.append(
+                Contact(spec, placement.rotation.copy(), local + self.origin, jacobian, local)
+            )
 
     @property
     def model(self) -> pin.Model:
@@ -190,7 +207,8 @@ class Stance:
 
     def workspace(self) -> Scratch:
         """The scratch Data this stance computes in: the one it was given, else the robot's
-        (per thread, :meth:`impact_balance.robot.robot.Robot.workspace`)."""
+        (per thread, :meth:`impact_balance.robot.robot.Robot.workspace`).
+        """
         return self._scratch if self._scratch is not None else self.robot.workspace()
 
     def _kinematics(self) -> pin.Data:
@@ -202,17 +220,23 @@ class Stance:
             workspace.holder = key
         return workspace.data
 
-    def point(self, frame: str, offset: pin.SE3 | None = None, field: str = "frame") -> tuple[pin.SE3, np.ndarray]:
+    def point(
+        self, frame: str, offset: pin.SE3 | None = None, field: str = "frame"
+    ) -> tuple[pin.SE3, np.ndarray]:
         """World pose of ``frame * offset`` and its 6 x nv world-aligned Jacobian (linear first)."""
         placement, J = self.local_point(frame, offset, field)
         return pin.SE3(placement.rotation, placement.translation + self.origin), J
 
-    def local_point(self, frame: str, offset: pin.SE3 | None = None, field: str = "frame") -> tuple[pin.SE3, np.ndarray]:
+    def local_point(
+        self, frame: str, offset: pin.SE3 | None = None, field: str = "frame"
+    ) -> tuple[pin.SE3, np.ndarray]:
         """:meth:`point` in the stance frame (world axes, origin at :attr:`origin`)."""
         fid = self.robot.frame_id(frame, field)
         return self._point(self._kinematics(), fid, offset)
 
-    def _point(self, data: pin.Data, fid: int, offset: pin.SE3 | None) -> tuple[pin.SE3, np.ndarray]:
+    def _point(
+        self, data: pin.Data, fid: int, offset: pin.SE3 | None
+    ) -> tuple[pin.SE3, np.ndarray]:
         """:meth:`point` of frame ``fid`` from ``data`` holding this stance's kinematics (copies)."""
         return frame_point(self.model, data, fid, offset)
 

@@ -22,13 +22,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from impact_balance.constants import GRAVITY
 from impact_balance._jit import njit
+from impact_balance.constants import GRAVITY
 from impact_balance.contacts.cwc import _local_faces
 from impact_balance.contacts.stance import Contact, Stance
 
-__all__ = ["WrenchPolytope", "grasp_matrix", "contact_polytope", "torque_limit_rows", "wrench_polytope", "assemble_polytope",
-           "friction_scaling"]
+__all__ = [
+    "WrenchPolytope",
+    "assemble_polytope",
+    "contact_polytope",
+    "friction_scaling",
+    "grasp_matrix",
+    "torque_limit_rows",
+    "wrench_polytope",
+]
 
 
 #: Grasp-matrix block entries [p]x: rows, columns, and the component of p and sign of each.
@@ -53,7 +60,8 @@ def grasp_matrix(positions: np.ndarray) -> np.ndarray:
 @functools.lru_cache(maxsize=16)
 def _grasp_pattern(m: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The grasp matrix's constant part for m contacts (identity blocks, read-only) and the
-    (row, column) indices of its skew entries, in the order of ``_SKEW_COMPONENTS``."""
+    (row, column) indices of its skew entries, in the order of ``_SKEW_COMPONENTS``.
+    """
     identity = np.zeros((6, 6 * m))
     for r in range(6):
         identity[r, r::6] = 1.0
@@ -119,7 +127,7 @@ class WrenchPolytope:
 
     @property
     def weight(self) -> float:
-        """m g, N."""
+        """M g, N."""
         return self.mass * self.gravity
 
 
@@ -148,11 +156,18 @@ def torque_limit_rows(stance: Stance) -> tuple[np.ndarray, np.ndarray]:
     return A, b
 
 
-def wrench_polytope(stance: Stance, torque_limits: bool = True, gravity: float = GRAVITY) -> WrenchPolytope:
+def wrench_polytope(
+    stance: Stance, torque_limits: bool = True, gravity: float = GRAVITY
+) -> WrenchPolytope:
     """Assemble the contact-wrench polytope of ``stance`` (CWC + torque limits + LIPM)."""
     # Lever arms from stance-frame positions: exact however far from the origin the stance is.
-    arms = np.array([c.local_position for c in stance.contacts], dtype=float).reshape(-1, 3) - stance.com_local
-    return _assemble(stance.contacts, stance.mass, stance.com, arms, gravity, stance if torque_limits else None)
+    arms = (
+        np.array([c.local_position for c in stance.contacts], dtype=float).reshape(-1, 3)
+        - stance.com_local
+    )
+    return _assemble(
+        stance.contacts, stance.mass, stance.com, arms, gravity, stance if torque_limits else None
+    )
 
 
 def _n_torque_rows(stance: Stance) -> int:
@@ -184,7 +199,9 @@ def _assemble(
     world positions, so that they keep their precision far from the origin.
     """
     m = len(contacts)
-    faces = np.array([_local_faces(float(c.spec.friction), c.half_length, c.half_width) for c in contacts]).reshape(m, 16, 6)
+    faces = np.array(
+        [_local_faces(float(c.spec.friction), c.half_length, c.half_width) for c in contacts]
+    ).reshape(m, 16, 6)
     rotations = np.array([c.rotation for c in contacts], dtype=float).reshape(m, 3, 3)
     positions = np.array([c.position for c in contacts], dtype=float).reshape(m, 3)
     if torque_stance is not None and _n_torque_rows(torque_stance):
@@ -193,7 +210,9 @@ def _assemble(
         g = torque_stance.gravity_torques
     else:
         idx, limit, J, g = _NO_ROWS, _NO_LIMITS, np.zeros((0, 0)), _NO_LIMITS
-    return assemble_polytope(faces, rotations, positions, arms, mass, com, gravity, J, idx, limit, g, _scaling(contacts))
+    return assemble_polytope(
+        faces, rotations, positions, arms, mass, com, gravity, J, idx, limit, g, _scaling(contacts)
+    )
 
 
 _NO_ROWS = np.zeros(0, dtype=np.int64)
@@ -201,9 +220,18 @@ _NO_LIMITS = np.zeros(0)
 
 
 def assemble_polytope(
-    faces: np.ndarray, rotations: np.ndarray, positions: np.ndarray, arms: np.ndarray, mass: float,
-    com: np.ndarray, gravity: float, jacobians: np.ndarray, torque_indices: np.ndarray,
-    torque_limits: np.ndarray, gravity_torques: np.ndarray, scaling: np.ndarray | None = None,
+    faces: np.ndarray,
+    rotations: np.ndarray,
+    positions: np.ndarray,
+    arms: np.ndarray,
+    mass: float,
+    com: np.ndarray,
+    gravity: float,
+    jacobians: np.ndarray,
+    torque_indices: np.ndarray,
+    torque_limits: np.ndarray,
+    gravity_torques: np.ndarray,
+    scaling: np.ndarray | None = None,
 ) -> WrenchPolytope:
     """The polytope from arrays (what :func:`wrench_polytope` builds from a stance).
 
@@ -220,9 +248,15 @@ def assemble_polytope(
         scaling: See :attr:`WrenchPolytope.scaling`.
     """
     m = len(faces)
-    A, b, C, G = _assemble_arrays(face_blocks(faces, rotations), np.ascontiguousarray(positions, dtype=float),
-                                  np.ascontiguousarray(arms, dtype=float), jacobians, torque_indices, torque_limits,
-                                  gravity_torques)
+    A, b, C, G = _assemble_arrays(
+        face_blocks(faces, rotations),
+        np.ascontiguousarray(positions, dtype=float),
+        np.ascontiguousarray(arms, dtype=float),
+        jacobians,
+        torque_indices,
+        torque_limits,
+        gravity_torques,
+    )
     d = np.array([mass * gravity, 0.0, 0.0, 0.0])
     com = np.array(com, dtype=float)
     return WrenchPolytope(A, b, C, d, G[:2].copy(), G, 16 * m, float(mass), com, gravity, scaling)
@@ -237,13 +271,19 @@ def face_blocks(faces: np.ndarray, rotations: np.ndarray) -> np.ndarray:
     the two-feet-and-two-walls stance and returned a polygon 72 % off.
     """
     m = len(faces)
-    return np.matmul(np.asarray(faces, dtype=float).reshape(m, 32, 3), np.asarray(rotations, dtype=float).transpose(0, 2, 1))
+    return np.matmul(
+        np.asarray(faces, dtype=float).reshape(m, 32, 3),
+        np.asarray(rotations, dtype=float).transpose(0, 2, 1),
+    )
 
 
 @njit(cache=True)
-def _assemble_arrays(blocks, positions, arms, jacobians, torque_indices, torque_limits, gravity_torques):
+def _assemble_arrays(
+    blocks, positions, arms, jacobians, torque_indices, torque_limits, gravity_torques
+):
     """The arrays ``(A, b, C, G)`` of :func:`assemble_polytope` in one compiled call (a
-    governor's every tick), from the contacts' :func:`face_blocks`."""
+    governor's every tick), from the contacts' :func:`face_blocks`.
+    """
     m = blocks.shape[0]
     k = torque_indices.size if jacobians.size else 0
     A = np.zeros((16 * m + 2 * k, 6 * m))
@@ -252,7 +292,9 @@ def _assemble_arrays(blocks, positions, arms, jacobians, torque_indices, torque_
     G = np.zeros((6, 6 * m))
     _fill(blocks, positions, arms, A, C, G)
     if k:
-        _torque_rows(jacobians, torque_indices, torque_limits, gravity_torques, A[16 * m :], b[16 * m :])
+        _torque_rows(
+            jacobians, torque_indices, torque_limits, gravity_torques, A[16 * m :], b[16 * m :]
+        )
     return A, b, C, G
 
 
@@ -262,7 +304,8 @@ def _fill(blocks, positions, arms, A, C, G):
     world-axes wrenches as (force, torque) halves (:func:`~impact_balance.contacts.cwc.cwc_faces_world`
     reshaped), the LIPM rows ``C`` (rows 2-5 of the grasp matrix at the arms) and the grasp
     matrix ``G`` at the world positions (:func:`grasp_matrix`). Compiled: numpy spent ~40 us
-    of call overhead per stance on these copies."""
+    of call overhead per stance on these copies.
+    """
     m = blocks.shape[0]
     for i in range(m):
         for r in range(16):
@@ -297,7 +340,8 @@ def _grasp_block(G, row0, i, p):
 @njit(cache=True)
 def _torque_rows(J, idx, limit, g, A, b):
     """:func:`torque_limit_rows` into ``A`` (2k x 6m) and ``b`` (2k): row r is the limited
-    joint idx[r]'s column of every contact Jacobian, ``(J_a^T)[r]``, then its negative."""
+    joint idx[r]'s column of every contact Jacobian, ``(J_a^T)[r]``, then its negative.
+    """
     k = idx.size
     for r in range(k):
         j = idx[r]
@@ -317,12 +361,15 @@ def _scaling(contacts: Sequence[Contact]) -> np.ndarray | None:
     return friction_scaling([c.spec.friction for c in contacts], [c.rotation for c in contacts])
 
 
-def friction_scaling(frictions: Sequence[float], rotations: Sequence[np.ndarray]) -> np.ndarray | None:
+def friction_scaling(
+    frictions: Sequence[float], rotations: Sequence[np.ndarray]
+) -> np.ndarray | None:
     """Block-diagonal ``S`` (6m x 6m), block i = ``diag(R_i, R_i) diag(s_i)``: ``s_i`` is mu_i
     on f_x, f_y, tau_z and 1 elsewhere, or 1 everywhere when mu_i <= 1 (None when every
     mu_i is; :meth:`WrenchPolytope.projection_data` then skips the products): a small mu needs
     no help (HiGHS, in Bretl's path, was less precise with it divided out: 1e-5 relative on a
-    2 mu-wide area). See :meth:`WrenchPolytope.projection_data`."""
+    2 mu-wide area). See :meth:`WrenchPolytope.projection_data`.
+    """
     if all(float(mu) <= 1.0 for mu in frictions):
         return None  # the identity: no work on the hot path of common stances
     m = len(frictions)

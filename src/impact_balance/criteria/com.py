@@ -21,19 +21,19 @@ from dataclasses import dataclass
 import numpy as np
 
 from impact_balance._jit import njit
-from impact_balance.impact.model import ImpactModel
 from impact_balance.geometry.polygon import Polygon
+from impact_balance.impact.model import ImpactModel
 
 __all__ = [
-    "VelocityLimit",
     "ComCriterion",
-    "max_contact_velocity",
-    "zmp_max_contact_velocity",
+    "VelocityLimit",
     "capped_velocity",
-    "safe_contact_velocity",
     "first_exit",
+    "max_contact_velocity",
+    "safe_contact_velocity",
     "safe_interval",
     "speed_interval",
+    "zmp_max_contact_velocity",
 ]
 
 #: Margin under which a point counts as on the boundary (same units as the area).
@@ -62,7 +62,9 @@ class VelocityLimit:
         return math.isfinite(self.max_approach_speed)
 
 
-def first_exit(margins: np.ndarray, rates: np.ndarray, tol: float = BOUNDARY_TOLERANCE) -> VelocityLimit:
+def first_exit(
+    margins: np.ndarray, rates: np.ndarray, tol: float = BOUNDARY_TOLERANCE
+) -> VelocityLimit:
     """Largest s >= 0 with ``margins[k] - s * rates[j, k] >= 0`` for all j, k.
 
     Args:
@@ -90,7 +92,8 @@ def _first_exit(margins, rates, tol):
     """:func:`first_exit` compiled: ``(code, speed, vertex, edge)``, code an index of
     ``_STATUSES``. The smallest ratio ``max(margin_k, 0) / rate_jk`` over the rates above
     ``tol`` times the largest one (and 1), the first in row-major order on a tie (numpy's
-    ``argmin``): a few hundred flops, which numpy spent ~15 us of call overhead on."""
+    ``argmin``): a few hundred flops, which numpy spent ~15 us of call overhead on.
+    """
     n_v, n_c = rates.shape
     for k in range(n_c):
         if margins[k] < -tol:
@@ -117,7 +120,8 @@ def _first_exit(margins, rates, tol):
 def _jump_rates(impulse_rates, mass, G):
     """``rates[j, k] = (iota_j,xy / m) . G_k``: the rate (m/s per m/s of approach speed) at which
     post-impact vertex j uses up half-plane k's margin (``ImpactModel.com_jump_rates @ G.T``,
-    compiled: a governor builds it every posture)."""
+    compiled: a governor builds it every posture).
+    """
     rates = np.empty((impulse_rates.shape[0], G.shape[0]))
     for j in range(impulse_rates.shape[0]):
         x, y = impulse_rates[j, 0] / mass, impulse_rates[j, 1] / mass
@@ -138,7 +142,8 @@ def _com_exit(G, h, c0x, c0y, rates, tol):
 @njit(cache=True)
 def _com_exits(G, h, c0x, c0y, rates, jumps, tol):
     """:func:`_com_exit` for ``rates`` and for the jumps ``jumps`` (k, 2), whose rates per
-    edge are ``jumps G^T``: the two answers' 8 numbers."""
+    edge are ``jumps G^T``: the two answers' 8 numbers.
+    """
     margins = np.empty(h.size)
     for k in range(h.size):
         margins[k] = h[k] - (G[k, 0] * c0x + G[k, 1] * c0y)
@@ -151,7 +156,9 @@ def _com_exits(G, h, c0x, c0y, rates, jumps, tol):
     return a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]
 
 
-def speed_interval(margins: np.ndarray, rates: np.ndarray, tol: float = BOUNDARY_TOLERANCE) -> tuple[float, float] | None:
+def speed_interval(
+    margins: np.ndarray, rates: np.ndarray, tol: float = BOUNDARY_TOLERANCE
+) -> tuple[float, float] | None:
     """All s >= 0 with ``margins[k] - s * rates[j, k] >= 0`` for all j, k: ``(lo, hi)`` or None.
 
     Each constraint is linear in s, so the solutions form an interval: a positive rate caps
@@ -169,7 +176,9 @@ def speed_interval(margins: np.ndarray, rates: np.ndarray, tol: float = BOUNDARY
     inside = bool((margins >= -tol).all())
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = m / rates
-    hi = float(np.min(np.maximum(ratio[positive], 0.0) if inside else ratio[positive], initial=np.inf))
+    hi = float(
+        np.min(np.maximum(ratio[positive], 0.0) if inside else ratio[positive], initial=np.inf)
+    )
     lo = 0.0 if inside else max(0.0, float(np.max(ratio[negative], initial=0.0)))
     if lo > hi * (1.0 + 1e-12) + tol:
         return None
@@ -195,7 +204,7 @@ class ComCriterion:
         velocity_margin: d, m/s.
     """
 
-    __slots__ = ("area", "impact", "velocity_margin", "G", "h", "rates")
+    __slots__ = ("G", "area", "h", "impact", "rates", "velocity_margin")
 
     def __init__(self, area: Polygon, impact: ImpactModel, velocity_margin: float = 0.0):
         self.area = area
@@ -211,7 +220,8 @@ class ComCriterion:
 
     def margins(self, com_velocity: Sequence[float]) -> np.ndarray:
         """``h - G c0``: the slack of the pre-impact CoM velocity in each half-plane (less the
-        velocity margin), m/s."""
+        velocity margin), m/s.
+        """
         return self.h - self.G @ np.asarray(com_velocity, dtype=float)[:2]
 
     def limit(self, com_velocity: Sequence[float]) -> VelocityLimit:
@@ -221,21 +231,34 @@ class ComCriterion:
         c0x, c0y = float(com_velocity[0]), float(com_velocity[1])
         return _limit(*_com_exit(self.G, self.h, c0x, c0y, self.rates, BOUNDARY_TOLERANCE))
 
-    def limits(self, com_velocity: Sequence[float], jumps: np.ndarray) -> tuple[VelocityLimit, VelocityLimit]:
+    def limits(
+        self, com_velocity: Sequence[float], jumps: np.ndarray
+    ) -> tuple[VelocityLimit, VelocityLimit]:
         """:meth:`limit`, and the same limit for other post-impact jumps ``jumps`` (k, 2: the
         CoM velocity jumps per m/s of approach speed, world xy, e.g. another impact model's;
-        its vertex j is row j), in one compiled call (a governor's tick)."""
+        its vertex j is row j), in one compiled call (a governor's tick).
+        """
         if self.G is None:
             cannot = VelocityLimit(0.0, "cannot_balance")
             return cannot, cannot
         c0x, c0y = float(com_velocity[0]), float(com_velocity[1])
-        out = _com_exits(self.G, self.h, c0x, c0y, self.rates, np.ascontiguousarray(jumps, dtype=float),
-                         BOUNDARY_TOLERANCE)
+        out = _com_exits(
+            self.G,
+            self.h,
+            c0x,
+            c0y,
+            self.rates,
+            np.ascontiguousarray(jumps, dtype=float),
+            BOUNDARY_TOLERANCE,
+        )
         return _limit(*out[:4]), _limit(*out[4:])
 
-    def interval(self, com_velocity: Sequence[float], limit: VelocityLimit | None = None) -> tuple[float, float] | None:
+    def interval(
+        self, com_velocity: Sequence[float], limit: VelocityLimit | None = None
+    ) -> tuple[float, float] | None:
         """The safe approach speeds ``(lo, hi)`` (see :func:`safe_interval`); ``limit``,
-        :meth:`limit`'s answer for the same velocity when the caller has it."""
+        :meth:`limit`'s answer for the same velocity when the caller has it.
+        """
         if self.G is None:
             return None
         if limit is not None and limit.status in ("ok", "unbounded"):
@@ -243,8 +266,12 @@ class ComCriterion:
         return speed_interval(self.margins(com_velocity), self.rates)
 
 
-def safe_interval(area: Polygon, impact: ImpactModel, com_velocity: Sequence[float],
-                  limit: VelocityLimit | None = None) -> tuple[float, float] | None:
+def safe_interval(
+    area: Polygon,
+    impact: ImpactModel,
+    com_velocity: Sequence[float],
+    limit: VelocityLimit | None = None,
+) -> tuple[float, float] | None:
     """The approach speeds s >= 0 whose whole post-impact CoM velocity set lies in ``area``.
 
     The post-impact vertices ``c0 + s d_j`` are linear in s, so these speeds form one
@@ -263,7 +290,9 @@ def safe_interval(area: Polygon, impact: ImpactModel, com_velocity: Sequence[flo
     return ComCriterion(area, impact).interval(com_velocity)
 
 
-def max_contact_velocity(area: Polygon, impact: ImpactModel, com_velocity: Sequence[float]) -> VelocityLimit:
+def max_contact_velocity(
+    area: Polygon, impact: ImpactModel, com_velocity: Sequence[float]
+) -> VelocityLimit:
     """Largest approach speed keeping every post-impact CoM velocity in ``area`` (m/s)."""
     if area.is_empty:
         return VelocityLimit(0.0, "cannot_balance")
@@ -271,7 +300,12 @@ def max_contact_velocity(area: Polygon, impact: ImpactModel, com_velocity: Seque
 
 
 def zmp_max_contact_velocity(
-    zmp_area: Polygon, impact: ImpactModel, com: np.ndarray, plane_height: float, gravity: float, duration: float
+    zmp_area: Polygon,
+    impact: ImpactModel,
+    com: np.ndarray,
+    plane_height: float,
+    gravity: float,
+    duration: float,
 ) -> VelocityLimit:
     """Largest approach speed keeping the predicted ZMP in ``zmp_area`` (paper Experiment 1).
 
@@ -298,7 +332,9 @@ def zmp_max_contact_velocity(
     fz = impact.impulse_rates[:, 2] / duration  # N per (m/s)
     pulling = fz < 0
     if limit.status != "already_falling" and pulling.any():
-        with np.errstate(over="ignore"):  # a vanishing pull (friction ~1e-300) never lifts: inf is right
+        with np.errstate(
+            over="ignore"
+        ):  # a vanishing pull (friction ~1e-300) never lifts: inf is right
             lift = weight / -fz[pulling]
         j = int(lift.argmin())
         if lift[j] < limit.max_approach_speed:
@@ -306,7 +342,9 @@ def zmp_max_contact_velocity(
     return limit
 
 
-def capped_velocity(reference: Sequence[float], normal: np.ndarray, max_approach_speed: float) -> np.ndarray:
+def capped_velocity(
+    reference: Sequence[float], normal: np.ndarray, max_approach_speed: float
+) -> np.ndarray:
     """``reference`` with its approach component -n.v capped at ``max_approach_speed``.
 
     This is the minimiser of ||v - v_ref|| subject to -n.v <= max (the paper's QP objective).
@@ -318,8 +356,9 @@ def capped_velocity(reference: Sequence[float], normal: np.ndarray, max_approach
     return v
 
 
-def safe_contact_velocity(reference: Sequence[float], normal: np.ndarray,
-                          interval: tuple[float, float] | None) -> np.ndarray | None:
+def safe_contact_velocity(
+    reference: Sequence[float], normal: np.ndarray, interval: tuple[float, float] | None
+) -> np.ndarray | None:
     """``reference`` with its approach speed -n.v moved to the nearest speed of the safe ``interval``.
 
     With the CoM velocity inside the area the interval is ``[0, max]``, and this is

@@ -21,12 +21,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from impact_balance.exceptions import SolverError
-from impact_balance.impact.model import ImpactModel
-from impact_balance.geometry.polygon import Polygon
-from impact_balance.contacts.wrench_polytope import WrenchPolytope
-from impact_balance.robot.robot import Robot
 from impact_balance.contacts.stance import Stance
+from impact_balance.contacts.wrench_polytope import WrenchPolytope
+from impact_balance.exceptions import SolverError
+from impact_balance.geometry.polygon import Polygon
+from impact_balance.impact.model import ImpactModel
+from impact_balance.robot.robot import Robot
 
 __all__ = ["QPOptions", "QPResult", "solve_contact_velocity_qp", "static_torques"]
 
@@ -131,7 +131,11 @@ def solve_contact_velocity_qp(
             rhs += [vmax, vmax]
     if options.impulsive_torque_limits:
         idx, tmax = robot.actuated_effort_limits()
-        tau0 = np.zeros(nv) if pre_impact_torques is None else np.asarray(pre_impact_torques, dtype=float)
+        tau0 = (
+            np.zeros(nv)
+            if pre_impact_torques is None
+            else np.asarray(pre_impact_torques, dtype=float)
+        )
         gain = options.peak_factor / options.duration
         for j in range(2 * N):
             block = np.zeros((idx.size, nx))
@@ -146,7 +150,9 @@ def solve_contact_velocity_qp(
     import qpsolvers  # here: its import takes ~0.4 s, and a plain analysis does not solve this QP
 
     try:
-        x = qpsolvers.solve_qp(P, q, Gin, hin, Aeq, beq, lb, ub, solver=options.solver, **tolerances)
+        x = qpsolvers.solve_qp(
+            P, q, Gin, hin, Aeq, beq, lb, ub, solver=options.solver, **tolerances
+        )
     except (qpsolvers.SolverNotFound, qpsolvers.SolverError, ValueError) as exc:
         raise SolverError(options.solver, type(exc).__name__, str(exc)) from exc
     if x is None or not np.all(np.isfinite(x)):
@@ -173,7 +179,13 @@ def static_torques(stance: Stance, polytope: WrenchPolytope) -> np.ndarray:
 
     try:
         w = qpsolvers.solve_qp(
-            np.eye(n), np.zeros(n), polytope.A[cwc], polytope.b[cwc], polytope.grasp, target, solver="daqp"
+            np.eye(n),
+            np.zeros(n),
+            polytope.A[cwc],
+            polytope.b[cwc],
+            polytope.grasp,
+            target,
+            solver="daqp",
         )
     except (qpsolvers.SolverError, ValueError):
         w = None

@@ -10,7 +10,7 @@ import numpy as np
 
 from impact_balance._jit import njit
 
-__all__ = ["Polygon", "MERGE_AREA_TOLERANCE"]
+__all__ = ["MERGE_AREA_TOLERANCE", "Polygon"]
 
 #: Largest fraction of a polygon's area that merging its near-duplicate and near-collinear
 #: vertices may remove. Bounded so that a larger set never gets a smaller merged area by
@@ -23,7 +23,8 @@ MERGE_AREA_TOLERANCE = 1e-6
 def _chord_distance(v, p, c, n):
     """Distance from vertex c to the segment from p to n (the chord that replaces it): the
     line distance, or the distance to the nearer end when c projects outside the segment
-    (of three collinear points, only the middle one is on its chord)."""
+    (of three collinear points, only the middle one is on its chord).
+    """
     ex, ey = v[n, 0] - v[p, 0], v[n, 1] - v[p, 1]
     cx, cy = v[c, 0] - v[p, 0], v[c, 1] - v[p, 1]
     length2 = ex * ex + ey * ey
@@ -35,14 +36,17 @@ def _chord_distance(v, p, c, n):
 def _merge_cost(v, idx, k, i, total):
     """(distance, area) of dropping the vertex in position i of ``idx[:k]``: the largest
     distance from the chord between its neighbours of the original vertices it replaces
-    (dropped ones included, so that drops cannot drift), and the area of the triangle lost."""
+    (dropped ones included, so that drops cannot drift), and the area of the triangle lost.
+    """
     p, c, n = idx[(i - 1) % k], idx[i], idx[(i + 1) % k]  # idx[k:] is stale
     dist = 0.0
     j = (p + 1) % total
     while j != n:
         dist = max(dist, _chord_distance(v, p, j, n))
         j = (j + 1) % total
-    lost = 0.5 * abs((v[c, 0] - v[p, 0]) * (v[n, 1] - v[p, 1]) - (v[c, 1] - v[p, 1]) * (v[n, 0] - v[p, 0]))
+    lost = 0.5 * abs(
+        (v[c, 0] - v[p, 0]) * (v[n, 1] - v[p, 1]) - (v[c, 1] - v[p, 1]) * (v[n, 0] - v[p, 0])
+    )
     return dist, lost
 
 
@@ -73,7 +77,11 @@ def _simplify(v: np.ndarray, tol: float, area_tol: float) -> np.ndarray:
         if math.hypot(v[i, 0] - v[idx[k - 1], 0], v[i, 1] - v[idx[k - 1], 1]) > 1e-12 * size:
             idx[k] = i
             k += 1
-    while k > 1 and math.hypot(v[idx[k - 1], 0] - v[idx[0], 0], v[idx[k - 1], 1] - v[idx[0], 1]) <= 1e-12 * size:
+    while (
+        k > 1
+        and math.hypot(v[idx[k - 1], 0] - v[idx[0], 0], v[idx[k - 1], 1] - v[idx[0], 1])
+        <= 1e-12 * size
+    ):
         k -= 1
     dist = np.empty(total)
     lost = np.empty(total)
@@ -150,19 +158,29 @@ def _simplify_convex(v, check_tol, tol, area_tol, box):
     return True, out, bounded
 
 
-def simplify_convex(vertices: np.ndarray, check_tol: float, tol: float, box: float,
-                    area_tol: float = MERGE_AREA_TOLERANCE) -> tuple[np.ndarray, bool] | None:
+def simplify_convex(
+    vertices: np.ndarray,
+    check_tol: float,
+    tol: float,
+    box: float,
+    area_tol: float = MERGE_AREA_TOLERANCE,
+) -> tuple[np.ndarray, bool] | None:
     """A projection's raw vertices (k >= 1, counter-clockwise), certified and merged in one
     compiled call: merged within ``check_tol`` (rounding-level duplicates), checked convex,
     counter-clockwise and winding once (see :func:`_convex_ccw`), then merged within ``tol``
     (see :func:`simplify`). Returns ``(vertices, bounded)``, bounded when every coordinate is
-    under ``box`` (the clipping box), or None when the check fails."""
+    under ``box`` (the clipping box), or None when the check fails.
+    """
     v = np.ascontiguousarray(np.asarray(vertices, dtype=float).reshape(-1, 2))
-    ok, out, bounded = _simplify_convex(v, float(check_tol), float(tol), float(area_tol), float(box))
+    ok, out, bounded = _simplify_convex(
+        v, float(check_tol), float(tol), float(area_tol), float(box)
+    )
     return (out, bool(bounded)) if ok else None
 
 
-def simplify(vertices: np.ndarray, tol: float = 1e-9, area_tol: float = MERGE_AREA_TOLERANCE) -> np.ndarray:
+def simplify(
+    vertices: np.ndarray, tol: float = 1e-9, area_tol: float = MERGE_AREA_TOLERANCE
+) -> np.ndarray:
     """Merge duplicate and collinear consecutive vertices of a CCW convex polygon.
 
     ``tol`` is a distance: while some vertex can be dropped with every vertex dropped so far
@@ -184,7 +202,8 @@ def simplify(vertices: np.ndarray, tol: float = 1e-9, area_tol: float = MERGE_AR
 def _corner(n: np.ndarray, h: np.ndarray, a: int, b: int) -> tuple[float, float, float, float]:
     """Corner of lines ``a`` and ``b`` (``n_k . x = h_k - t``) as ``x0 + t x1``: (x0, y0, x1, y1).
 
-    Undefined (NaN) when the lines are parallel."""
+    Undefined (NaN) when the lines are parallel.
+    """
     det = n[a, 0] * n[b, 1] - n[a, 1] * n[b, 0]
     if det <= 1e-15:
         return math.nan, math.nan, math.nan, math.nan
@@ -199,7 +218,8 @@ def _corner(n: np.ndarray, h: np.ndarray, a: int, b: int) -> tuple[float, float,
 @njit(cache=True)
 def _collapse_time(n: np.ndarray, h: np.ndarray, a: int, i: int, b: int) -> float:
     """When edge ``i`` (between lines ``a`` and ``b``) shrinks to nothing as every line moves
-    inwards at unit speed (inf if it never does; -inf if its neighbours are parallel)."""
+    inwards at unit speed (inf if it never does; -inf if its neighbours are parallel).
+    """
     p = _corner(n, h, a, i)
     q = _corner(n, h, i, b)
     if math.isnan(p[0]) or math.isnan(q[0]):
@@ -270,7 +290,8 @@ def _inset(n: np.ndarray, h: np.ndarray, d: float) -> np.ndarray:
 def _edge_halfplanes(v):
     """Unit outward normals ``G`` (k, 2) and offsets ``h`` (k,) of the edges of the CCW
     polygon ``v`` (k >= 3): edge i goes from vertex i to i+1, its normal is the edge turned
-    clockwise. Compiled: numpy spent ~30 us of call overhead on these few flops."""
+    clockwise. Compiled: numpy spent ~30 us of call overhead on these few flops.
+    """
     k = v.shape[0]
     G = np.empty((k, 2))
     h = np.empty(k)
@@ -287,7 +308,8 @@ def _edge_halfplanes(v):
 @njit(cache=True)
 def _inset_polygon(v, distance):
     """Vertices of the CCW polygon ``v`` (k >= 3) shrunk by ``distance`` > 0; (0, 2) when
-    empty. One compiled call: a governor shrinks an area every tick."""
+    empty. One compiled call: a governor shrinks an area every tick.
+    """
     G, h = _edge_halfplanes(v)
     # Relative to a point inside (the vertices' mean): corners stay well conditioned far
     # from the origin.
@@ -341,9 +363,12 @@ class Polygon:
         return cls(np.zeros((0, 2)))
 
     @classmethod
-    def with_halfplanes(cls, vertices: np.ndarray, bounded: bool, G: np.ndarray, h: np.ndarray) -> Polygon:
+    def with_halfplanes(
+        cls, vertices: np.ndarray, bounded: bool, G: np.ndarray, h: np.ndarray
+    ) -> Polygon:
         """The polygon of ``vertices`` (k >= 3) whose :attr:`halfplanes` ``(G, h)`` were
-        computed with it (by ``_edge_halfplanes``, in a compiled pipeline): not computed again."""
+        computed with it (by ``_edge_halfplanes``, in a compiled pipeline): not computed again.
+        """
         polygon = cls(vertices, bounded)
         polygon.__dict__["halfplanes"] = _frozen(G, h)  # the cached_property's own slot
         return polygon
@@ -354,7 +379,10 @@ class Polygon:
         points = np.asarray(points, dtype=float).reshape(-1, 2)
         if len(points) == 0:
             return cls.empty()
-        from scipy.spatial import ConvexHull, QhullError  # here: ~0.2 s to import, not needed to analyze
+        from scipy.spatial import (
+            ConvexHull,
+            QhullError,
+        )  # here: ~0.2 s to import, not needed to analyze
 
         try:
             hull = ConvexHull(points)

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 import numpy as np
 import pinocchio as pin
 
-__all__ = ["skew", "pose", "unit", "surface_rotation", "aligning_rotation"]
+__all__ = ["aligning_rotation", "pose", "skew", "surface_rotation", "unit"]
 
 
 def skew(v: Sequence[float]) -> np.ndarray:
@@ -15,7 +15,9 @@ def skew(v: Sequence[float]) -> np.ndarray:
     return pin.skew(np.asarray(v, dtype=float))
 
 
-def pose(position: Sequence[float] = (0.0, 0.0, 0.0), rpy: Sequence[float] = (0.0, 0.0, 0.0)) -> pin.SE3:
+def pose(
+    position: Sequence[float] = (0.0, 0.0, 0.0), rpy: Sequence[float] = (0.0, 0.0, 0.0)
+) -> pin.SE3:
     """SE3 from a position (m) and roll-pitch-yaw angles (rad, R = Rz(y) Ry(p) Rx(r))."""
     return pin.SE3(pin.rpy.rpyToMatrix(*map(float, rpy)), np.asarray(position, dtype=float))
 
@@ -29,7 +31,9 @@ def unit(v: Sequence[float]) -> np.ndarray:
     return v / norm
 
 
-def surface_rotation(frame_rotation: np.ndarray, normal: Sequence[float], angle: float = 0.0) -> np.ndarray:
+def surface_rotation(
+    frame_rotation: np.ndarray, normal: Sequence[float], angle: float = 0.0
+) -> np.ndarray:
     """World rotation of a contact given by its surface normal, from its frame's world rotation.
 
     The contact's z axis is ``normal`` (normalised; from the surface into the robot). Its x

@@ -20,4 +20,12 @@ from impact_balance.governor.governor import CRITERIA, Governor
 from impact_balance.governor.limit import SpeedLimit, cap_approach
 from impact_balance.governor.posture import Posture, PostureEvaluator, PostureSettings
 
-__all__ = ["Governor", "CRITERIA", "SpeedLimit", "cap_approach", "Posture", "PostureEvaluator", "PostureSettings"]
+__all__ = [
+    "CRITERIA",
+    "Governor",
+    "Posture",
+    "PostureEvaluator",
+    "PostureSettings",
+    "SpeedLimit",
+    "cap_approach",
+]

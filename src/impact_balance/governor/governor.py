@@ -11,19 +11,25 @@ import numpy as np
 import pinocchio as pin
 
 from impact_balance.balance.areas import warm_up as warm_up_maps
+from impact_balance.contacts.stance import _has_free_flyer
 from impact_balance.criteria.com import VelocityLimit
 from impact_balance.exceptions import GovernorError, ScenarioError
-from impact_balance.projection.bretl import warm_up as warm_up_bretl
-from impact_balance.projection.walk import warm_up
-from impact_balance.robot.robot import Robot
-from impact_balance.scenario import BasePose, Scenario, load_scenario, scenario_from_dict, with_source
-from impact_balance.contacts.stance import _has_free_flyer
 from impact_balance.governor.limit import SpeedLimit, cap_approach
 from impact_balance.governor.posture import Posture, PostureEvaluator, PostureSettings
 from impact_balance.governor.support import ContactAwareLimit, combine
 from impact_balance.governor.worker import ContactAwareWorker
+from impact_balance.projection.bretl import warm_up as warm_up_bretl
+from impact_balance.projection.walk import warm_up
+from impact_balance.robot.robot import Robot
+from impact_balance.scenario import (
+    BasePose,
+    Scenario,
+    load_scenario,
+    scenario_from_dict,
+    with_source,
+)
 
-__all__ = ["Governor", "CRITERIA"]
+__all__ = ["CRITERIA", "Governor"]
 
 #: The governor's criteria: "com", the CoM velocity area (the paper's); "zmp", the predicted
 #: ZMP stays in the ZMP support area (the paper's Experiment 1 comparison).
@@ -99,9 +105,17 @@ class Governor:
         GovernorError: an unknown criterion or a bad tolerance.
     """
 
-    def __init__(self, scenario: Scenario | str | os.PathLike, criterion: str = "com", posture_tolerance: float = 0.0,
-                 contact_aware: bool = False, contact_aware_every: int = 5, contact_aware_starts: str = "union",
-                 velocity_margin: float = 0.0, contact_aware_async: bool = False):
+    def __init__(
+        self,
+        scenario: Scenario | str | os.PathLike,
+        criterion: str = "com",
+        posture_tolerance: float = 0.0,
+        contact_aware: bool = False,
+        contact_aware_every: int = 5,
+        contact_aware_starts: str = "union",
+        velocity_margin: float = 0.0,
+        contact_aware_async: bool = False,
+    ):
         if criterion not in CRITERIA:
             raise GovernorError("criterion", criterion, f"must be one of {', '.join(CRITERIA)}")
         try:
@@ -109,20 +123,28 @@ class Governor:
         except (TypeError, ValueError):
             velocity_margin = math.nan
         if not (math.isfinite(velocity_margin) and 0.0 <= velocity_margin <= 10.0):
-            raise GovernorError("velocity_margin", velocity_margin, "must be a number in [0, 10] m/s")
+            raise GovernorError(
+                "velocity_margin", velocity_margin, "must be a number in [0, 10] m/s"
+            )
         if velocity_margin and criterion != "com":
-            raise GovernorError("velocity_margin", velocity_margin, "applies to the com criterion only")
+            raise GovernorError(
+                "velocity_margin", velocity_margin, "applies to the com criterion only"
+            )
         try:
             tolerance = float(posture_tolerance)
         except (TypeError, ValueError):
             tolerance = math.nan
         if not (math.isfinite(tolerance) and tolerance >= 0.0):
-            raise GovernorError("posture_tolerance", posture_tolerance, "must be a finite number >= 0")
+            raise GovernorError(
+                "posture_tolerance", posture_tolerance, "must be a finite number >= 0"
+            )
         if not isinstance(scenario, Scenario):
             scenario = load_scenario(scenario)
         if scenario.impact is None:
-            raise with_source(ScenarioError("impact", None, "the governor needs an impact (frame, normal...)"),
-                              scenario.source)
+            raise with_source(
+                ScenarioError("impact", None, "the governor needs an impact (frame, normal...)"),
+                scenario.source,
+            )
         self.scenario = scenario
         self.criterion = criterion
         self.posture_tolerance = tolerance
@@ -131,8 +153,13 @@ class Governor:
         self.nq, self.nv = model.nq, model.nv
         self._free_flyer = _has_free_flyer(model)
         settings = PostureSettings(
-            tuple(c.spec() for c in scenario.contacts), scenario.impact.spec(), float(scenario.plane_height),
-            float(scenario.gravity), bool(scenario.torque_limits), float(scenario.zmp_margin), criterion,
+            tuple(c.spec() for c in scenario.contacts),
+            scenario.impact.spec(),
+            float(scenario.plane_height),
+            float(scenario.gravity),
+            bool(scenario.torque_limits),
+            float(scenario.zmp_margin),
+            criterion,
             velocity_margin,
         )
         self.velocity_margin = velocity_margin
@@ -145,9 +172,13 @@ class Governor:
         if contact_aware:
             if criterion != "com":
                 raise GovernorError("contact_aware", criterion, "bounds the CoM criterion only")
-            self._support = ContactAwareLimit(settings.impact, contact_aware_every, contact_aware_starts)
+            self._support = ContactAwareLimit(
+                settings.impact, contact_aware_every, contact_aware_starts
+            )
         elif contact_aware_async:
-            raise GovernorError("contact_aware_async", contact_aware_async, "needs contact_aware=True")
+            raise GovernorError(
+                "contact_aware_async", contact_aware_async, "needs contact_aware=True"
+            )
         self._worker: ContactAwareWorker | None = None
         self._posture: Posture | None = None
         self._last: SpeedLimit | None = None
@@ -158,7 +189,9 @@ class Governor:
             self._posture = self._evaluator.evaluate(self.configuration)
         except ScenarioError as exc:
             raise with_source(exc, scenario.source) from None
-        if self._posture.com_criterion is not None:  # load the criterion's compiled code (1-3 ms) here too
+        if (
+            self._posture.com_criterion is not None
+        ):  # load the criterion's compiled code (1-3 ms) here too
             self._posture.com_criterion.limit(np.zeros(3))
             self._posture.com_criterion.limits(np.zeros(3), np.zeros((1, 2)))
         self._support_posture: bytes | None = None
@@ -170,7 +203,8 @@ class Governor:
 
     def close(self) -> None:
         """Stop the contact-aware worker process, if any (``contact_aware_async``); the
-        governor then recomputes the rates in the tick, as without it. Idempotent."""
+        governor then recomputes the rates in the tick, as without it. Idempotent.
+        """
         with self._lock:
             if self._worker is not None:
                 self._worker.close()
@@ -202,17 +236,22 @@ class Governor:
 
     def limit_com(self, q: Sequence[float], com_velocity: Sequence[float]) -> SpeedLimit:
         """:meth:`limit` with the CoM velocity given (world, m/s; 2 or 3 numbers, only x and y
-        matter), for a controller with its own CoM velocity estimate."""
+        matter), for a controller with its own CoM velocity estimate.
+        """
         q = self._configuration(q)
         c = np.asarray(com_velocity, dtype=float).ravel() if _is_numeric(com_velocity) else None
         if c is None or c.size not in (2, 3) or not math.isfinite(float(c @ c)):
-            raise GovernorError("com_velocity", com_velocity, "must be 2 or 3 finite numbers (world, m/s)")
+            raise GovernorError(
+                "com_velocity", com_velocity, "must be 2 or 3 finite numbers (world, m/s)"
+            )
         c = np.append(c, 0.0) if c.size == 2 else c.copy()
         with self._lock:
             posture, reused = self._posture_at(q)
             return self._answer(posture, c, reused)
 
-    def cap(self, reference_velocity: Sequence[float] | None = None, limit: SpeedLimit | None = None) -> np.ndarray:
+    def cap(
+        self, reference_velocity: Sequence[float] | None = None, limit: SpeedLimit | None = None
+    ) -> np.ndarray:
         """The reference end-effector velocity (world, m/s) with its approach speed brought
         into the safe interval of ``limit`` (default: this governor's last answer); see
         :func:`~impact_balance.governor.limit.cap_approach`. Without ``reference_velocity``,
@@ -224,7 +263,11 @@ class Governor:
         if reference_velocity is None:
             reference_velocity = self.scenario.impact.reference_velocity
             if reference_velocity is None:
-                raise GovernorError("reference_velocity", None, "give one (the scenario has no impact.reference_velocity)")
+                raise GovernorError(
+                    "reference_velocity",
+                    None,
+                    "give one (the scenario has no impact.reference_velocity)",
+                )
         if limit is None:
             with self._lock:
                 limit = self._last
@@ -270,7 +313,8 @@ class Governor:
     @property
     def posture(self) -> Posture:
         """The last posture evaluated (the scenario's until the first call): its stance,
-        areas and impact model, for display."""
+        areas and impact model, for display.
+        """
         with self._lock:
             assert self._posture is not None
             return self._posture
@@ -281,7 +325,11 @@ class Governor:
         if self._free_flyer:
             norm = float(q[3:7] @ q[3:7])
             if abs(norm - 1.0) > 2.0 * QUATERNION_TOLERANCE:
-                raise GovernorError("q", q[3:7].tolist(), "the base quaternion (x, y, z, w) must be unit; normalise it")
+                raise GovernorError(
+                    "q",
+                    q[3:7].tolist(),
+                    "the base quaternion (x, y, z, w) must be unit; normalise it",
+                )
         return q
 
     def _posture_at(self, q: np.ndarray) -> tuple[Posture, bool]:
@@ -307,7 +355,9 @@ class Governor:
             limit = criterion.limit(com_velocity)
             interval = criterion.interval(com_velocity, limit)
         elif criterion is not None:
-            if self._support_posture != posture.key:  # a posture evaluated since: the rates may be due
+            if (
+                self._support_posture != posture.key
+            ):  # a posture evaluated since: the rates may be due
                 if self._worker is None:
                     self._support.new_posture(lambda: posture.stance)
                 else:  # collect a finished answer, hand the worker this posture; never wait
@@ -327,15 +377,27 @@ class Governor:
             limit = posture.zmp_limit
             interval = _zmp_interval(limit)
         model = posture.impact
-        answer = SpeedLimit(self.criterion, limit.max_approach_speed, limit.status, limit.limiting_vertex,
-                            limit.limiting_edge, interval, com_velocity, model.normal, model.point, reused, binding)
+        answer = SpeedLimit(
+            self.criterion,
+            limit.max_approach_speed,
+            limit.status,
+            limit.limiting_vertex,
+            limit.limiting_edge,
+            interval,
+            com_velocity,
+            model.normal,
+            model.point,
+            reused,
+            binding,
+        )
         self._last = answer
         return answer
 
 
 def _zmp_interval(limit: VelocityLimit) -> tuple[float, float] | None:
     """The ZMP criterion's safe speeds: from 0 to its maximum, or none when it is already
-    violated (the CoM's vertical outside the ZMP area) or the area is empty."""
+    violated (the CoM's vertical outside the ZMP area) or the area is empty.
+    """
     if limit.status in ("ok", "unbounded"):
         return 0.0, limit.max_approach_speed
     return None
@@ -356,7 +418,9 @@ def _vector(x: Sequence[float], size: int, field: str) -> np.ndarray:
     except (TypeError, ValueError):
         raise GovernorError(field, x, f"must be {size} numbers") from None
     if a.shape != (size,):
-        raise GovernorError(field, f"shape {a.shape}", f"must have {size} entries (the model's n{field})")
+        raise GovernorError(
+            field, f"shape {a.shape}", f"must have {size} entries (the model's n{field})"
+        )
     if not math.isfinite(float(a @ a)):
         bad = np.flatnonzero(~np.isfinite(a))
         which = f"entry {int(bad[0])}" if bad.size else "the entries are too large"

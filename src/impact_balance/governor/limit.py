@@ -64,17 +64,20 @@ class SpeedLimit:
     @property
     def ceiling(self) -> float:
         """Largest approach speed :meth:`cap` lets through, m/s: the safe interval's top,
-        0 when there is no safe speed."""
+        0 when there is no safe speed.
+        """
         return 0.0 if self.safe_interval is None else self.safe_interval[1]
 
     def cap(self, reference_velocity: Sequence[float]) -> np.ndarray:
         """``reference_velocity`` (world, m/s) with its approach speed brought into the safe
-        interval; see :func:`cap_approach`."""
+        interval; see :func:`cap_approach`.
+        """
         return cap_approach(reference_velocity, self.normal, self.safe_interval)
 
 
-def cap_approach(reference_velocity: Sequence[float], normal: np.ndarray,
-                 interval: tuple[float, float] | None) -> np.ndarray:
+def cap_approach(
+    reference_velocity: Sequence[float], normal: np.ndarray, interval: tuple[float, float] | None
+) -> np.ndarray:
     """The end-effector velocity nearest ``reference_velocity`` whose approach speed is safe.
 
     Only the component along ``normal`` changes (the tangential part is kept): this is the
@@ -97,7 +100,9 @@ def cap_approach(reference_velocity: Sequence[float], normal: np.ndarray,
     try:
         u = np.array(reference_velocity, dtype=float).reshape(3)
     except (TypeError, ValueError):
-        raise GovernorError("reference_velocity", reference_velocity, "must be 3 numbers (world, m/s)") from None
+        raise GovernorError(
+            "reference_velocity", reference_velocity, "must be 3 numbers (world, m/s)"
+        ) from None
     if not math.isfinite(float(u @ u)):
         raise GovernorError("reference_velocity", reference_velocity, "must be finite")
     s = -float(normal @ u)

@@ -24,10 +24,16 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from impact_balance.balance.areas import BalanceAreas, Projected, areas_from_polytope, projected_from_arrays
+from impact_balance.balance.areas import (
+    BalanceAreas,
+    Projected,
+    areas_from_polytope,
+    projected_from_arrays,
+)
+from impact_balance.contacts.cwc import _local_faces
+from impact_balance.contacts.stance import ContactSpec, Stance, _has_free_flyer, frame_point
 from impact_balance.contacts.wrench_polytope import assemble_polytope, friction_scaling
 from impact_balance.criteria.com import ComCriterion, VelocityLimit, zmp_max_contact_velocity
-from impact_balance.contacts.cwc import _local_faces
 from impact_balance.exceptions import SolverError
 from impact_balance.impact.model import (
     ImpactModel,
@@ -38,9 +44,8 @@ from impact_balance.impact.model import (
     model_from_inertia_map,
 )
 from impact_balance.robot.robot import Robot, Scratch
-from impact_balance.contacts.stance import ContactSpec, Stance, _has_free_flyer, frame_point
 
-__all__ = ["PostureSettings", "Posture", "PostureEvaluator"]
+__all__ = ["Posture", "PostureEvaluator", "PostureSettings"]
 
 _POSITION = pin.KinematicLevel.POSITION
 
@@ -116,7 +121,8 @@ class Posture:
     @functools.cached_property
     def stance(self) -> Stance:
         """The :class:`~impact_balance.contacts.stance.Stance` at ``q`` (built on first access, in the
-        robot's per-thread Data, ~50 us): for plots and displays."""
+        robot's per-thread Data, ~50 us): for plots and displays.
+        """
         return Stance(self.robot, self.q, self.settings.contacts)
 
 
@@ -139,19 +145,29 @@ class PostureEvaluator:
         # (made once): pinocchio then gives its pose and Jacobian directly, where shifting the
         # frame's Jacobian to the point in numpy cost ~5 us per point and tick.
         self.model = model = pin.Model(robot.model)
-        self._frames = [_point_frame(model, fid, c.offset, f"impact_balance_contact_{i}")
-                        for i, (fid, c) in enumerate(zip(frames, contacts))]
-        self._impact_frame = _point_frame(model, impact_frame, impact.offset, "impact_balance_impact")
+        self._frames = [
+            _point_frame(model, fid, c.offset, f"impact_balance_contact_{i}")
+            for i, (fid, c) in enumerate(zip(frames, contacts))
+        ]
+        self._impact_frame = _point_frame(
+            model, impact_frame, impact.offset, "impact_balance_impact"
+        )
         self.scratch = Scratch(model)
         self._free_flyer = _has_free_flyer(model)
         m = len(contacts)
-        self._faces = np.array([_local_faces(float(c.friction), 0.5 * float(c.size[0]), 0.5 * float(c.size[1]))
-                                for c in contacts]).reshape(m, 16, 6)
+        self._faces = np.array(
+            [
+                _local_faces(float(c.friction), 0.5 * float(c.size[0]), 0.5 * float(c.size[1]))
+                for c in contacts
+            ]
+        ).reshape(m, 16, 6)
         self._frictions = [float(c.friction) for c in contacts]
         self._scaled = any(mu > 1.0 for mu in self._frictions)  # else friction_scaling is None
         idx, limit = robot.effort_limits
         self._torques = bool(settings.torque_limits and m and idx.size)
-        self._idx, self._limit = (idx, limit) if self._torques else (np.zeros(0, dtype=np.int64), np.zeros(0))
+        self._idx, self._limit = (
+            (idx, limit) if self._torques else (np.zeros(0, dtype=np.int64), np.zeros(0))
+        )
         self._normal, self._cone = impact_cone(impact)
         # Buffers, overwritten every posture (the answers keep copies).
         self._q_local = np.zeros(model.nq)
@@ -204,32 +220,82 @@ class PostureEvaluator:
         com = com_local + origin
         try:
             if self._scaled:  # a friction above 1: the polytope in friction-normalised variables
-                polytope = assemble_polytope(self._faces, rotations, local + origin, local - com_local, mass, com,
-                                             settings.gravity, jacobians, self._idx, self._limit, gravity_torques,
-                                             friction_scaling(self._frictions, rotations))
+                polytope = assemble_polytope(
+                    self._faces,
+                    rotations,
+                    local + origin,
+                    local - com_local,
+                    mass,
+                    com,
+                    settings.gravity,
+                    jacobians,
+                    self._idx,
+                    self._limit,
+                    gravity_torques,
+                    friction_scaling(self._frictions, rotations),
+                )
                 areas = areas_from_polytope(polytope, settings.plane_height, settings.zmp_margin)
             else:  # the same numbers, assembled and projected in one compiled call
-                areas = projected_from_arrays(self._faces, rotations, local + origin, local - com_local, mass, com,
-                                              settings.gravity, jacobians, self._idx, self._limit, gravity_torques,
-                                              settings.plane_height, settings.zmp_margin, self._hint)
+                areas = projected_from_arrays(
+                    self._faces,
+                    rotations,
+                    local + origin,
+                    local - com_local,
+                    mass,
+                    com,
+                    settings.gravity,
+                    jacobians,
+                    self._idx,
+                    self._limit,
+                    gravity_torques,
+                    settings.plane_height,
+                    settings.zmp_margin,
+                    self._hint,
+                )
         except SolverError as exc:
             raise exc.within("contacts (projection of the contact wrench polytope)") from None
-        impact = self._impact(q, q_local, origin, com_local, mass, np.array(Ig.inertia, dtype=float))
+        impact = self._impact(
+            q, q_local, origin, com_local, mass, np.array(Ig.inertia, dtype=float)
+        )
         com_criterion = zmp = None
         if settings.criterion == "zmp":
             if isinstance(areas, Projected):
                 areas = areas.areas()
-            zmp = zmp_max_contact_velocity(areas.zmp_area, impact, com, settings.plane_height,
-                                           settings.gravity, settings.impact.duration)
+            zmp = zmp_max_contact_velocity(
+                areas.zmp_area,
+                impact,
+                com,
+                settings.plane_height,
+                settings.gravity,
+                settings.impact.duration,
+            )
         else:
             com_criterion = ComCriterion(areas.com_velocity_area, impact, settings.velocity_margin)
         q = q.copy()
         q.setflags(write=False)
-        return Posture(q.tobytes(), q, robot, settings, com, mass, areas, impact, com_jacobian,
-                       com_criterion, zmp)
+        return Posture(
+            q.tobytes(),
+            q,
+            robot,
+            settings,
+            com,
+            mass,
+            areas,
+            impact,
+            com_jacobian,
+            com_criterion,
+            zmp,
+        )
 
-    def _impact(self, q: np.ndarray, q_local: np.ndarray, origin: np.ndarray, com_local: np.ndarray, mass: float,
-                inertia: np.ndarray) -> ImpactModel:
+    def _impact(
+        self,
+        q: np.ndarray,
+        q_local: np.ndarray,
+        origin: np.ndarray,
+        com_local: np.ndarray,
+        mass: float,
+        inertia: np.ndarray,
+    ) -> ImpactModel:
         """The impact model at the kinematics held in the Data (as :func:`~impact_balance.impact.model.impact_model`)."""
         spec, data, model = self.settings.impact, self.scratch.data, self.model
         placement, J6 = frame_point(model, data, self._impact_frame, None)
@@ -241,13 +307,18 @@ class PostureEvaluator:
                 W = joint_space_inertia_map(self.scratch, model, q, J)
         else:  # compiled, in floats: an overflow is an inf, reported by the model, not a warning
             W = composite_inertia_map(arm, mass, inertia)
-        return model_from_inertia_map(spec, point_local + origin, arm, self._normal.copy(), self._cone.copy(), W, mass, J)
+        return model_from_inertia_map(
+            spec, point_local + origin, arm, self._normal.copy(), self._cone.copy(), W, mass, J
+        )
 
 
 def _point_frame(model: pin.Model, fid: int, offset: pin.SE3 | None, name: str) -> int:
     """The id of a frame of ``model`` at frame ``fid`` times ``offset``: ``fid`` itself without
-    an offset, else a new operational frame on the same joint (``model`` is modified)."""
+    an offset, else a new operational frame on the same joint (``model`` is modified).
+    """
     if offset is None or offset == pin.SE3.Identity():  # exact, as frame_point tests it
         return fid
     frame = model.frames[fid]
-    return model.addFrame(pin.Frame(name, frame.parentJoint, fid, frame.placement * offset, pin.FrameType.OP_FRAME))
+    return model.addFrame(
+        pin.Frame(name, frame.parentJoint, fid, frame.placement * offset, pin.FrameType.OP_FRAME)
+    )

@@ -47,19 +47,25 @@ per recomputation on the wall study's stances (up to 164 ms on the ramp with two
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
-from impact_balance.impact.contact_aware import contact_impact
+from impact_balance.contacts.stance import Stance
 from impact_balance.criteria.com import ComCriterion, VelocityLimit, speed_interval
 from impact_balance.exceptions import GovernorError
+from impact_balance.impact.contact_aware import contact_impact
 from impact_balance.impact.model import ImpactSpec
-from impact_balance.contacts.stance import Stance
 
-__all__ = ["ContactAwareLimit", "ContactAwareAnswer", "ContactAwareSolutions", "STARTS", "contact_aware_rates",
-           "contact_aware_solutions"]
+__all__ = [
+    "STARTS",
+    "ContactAwareAnswer",
+    "ContactAwareLimit",
+    "ContactAwareSolutions",
+    "contact_aware_rates",
+    "contact_aware_solutions",
+]
 
 #: The fixed-point starts of :class:`ContactAwareLimit` (module docstring): "union" (default:
 #: every solution reached from the kept solutions and the cold start), "warm" (the previous
@@ -73,12 +79,14 @@ STARTS = ("union", "warm", "cold")
 SAME_SOLUTION = 1e-6
 
 
-def contact_aware_rates(stance: Stance, spec: ImpactSpec, warm: list[np.ndarray] | None = None
-                        ) -> tuple[np.ndarray, list[np.ndarray], bool]:
+def contact_aware_rates(
+    stance: Stance, spec: ImpactSpec, warm: list[np.ndarray] | None = None
+) -> tuple[np.ndarray, list[np.ndarray], bool]:
     """One fixed point per restitution bound (the frozen option's ``starts="warm"``): the
     contact-aware CoM velocity jump per m/s of approach speed, world xy, at the lower and the
     upper restitution bound: ``(rates (2, 2), body velocity changes (6,) per m/s: (dv_c, dw),
-    world, for a warm start, converged)``. ``warm``: one such change per bound, or None (cold)."""
+    world, for a warm start, converged)``. ``warm``: one such change per bound, or None (cold).
+    """
     solutions = _one_per_bound(stance, spec, warm)
     return solutions.rates, list(solutions.states), bool(solutions.converged.all())
 
@@ -113,8 +121,13 @@ class ContactAwareSolutions:
         return self.states[keep]
 
 
-def contact_aware_solutions(stance: Stance, spec: ImpactSpec, previous: ContactAwareSolutions | None = None,
-                            cold: bool = True, tolerance: float = SAME_SOLUTION) -> ContactAwareSolutions:
+def contact_aware_solutions(
+    stance: Stance,
+    spec: ImpactSpec,
+    previous: ContactAwareSolutions | None = None,
+    cold: bool = True,
+    tolerance: float = SAME_SOLUTION,
+) -> ContactAwareSolutions:
     """The union of the contact-aware impact's solutions reached from several starts, per
     restitution bound (module docstring): starts are every converged solution of ``previous`` at
     that bound (in its order), then, when ``cold``, gauges 0. Fixed points within ``tolerance``
@@ -131,7 +144,9 @@ def contact_aware_solutions(stance: Stance, spec: ImpactSpec, previous: ContactA
     rates, restitution, states, converged = [], [], [], []
     iterations = starts = 0
     for c_r in (float(c) for c in spec.restitution):
-        guesses: list[np.ndarray | None] = list(previous.of_bound(c_r)) if previous is not None else []
+        guesses: list[np.ndarray | None] = (
+            list(previous.of_bound(c_r)) if previous is not None else []
+        )
         if cold or not guesses:
             guesses.append(None)
         found: list[np.ndarray] = []
@@ -147,22 +162,39 @@ def contact_aware_solutions(stance: Stance, spec: ImpactSpec, previous: ContactA
             restitution.append(c_r)
             states.append(state)
             converged.append(r.converged)
-    return ContactAwareSolutions(np.array(rates), np.array(restitution), np.array(states),
-                                 np.array(converged, dtype=bool), iterations, starts)
+    return ContactAwareSolutions(
+        np.array(rates),
+        np.array(restitution),
+        np.array(states),
+        np.array(converged, dtype=bool),
+        iterations,
+        starts,
+    )
 
 
 def _one_per_bound(stance: Stance, spec: ImpactSpec, guesses) -> ContactAwareSolutions:
     """One fixed point per restitution bound, from ``guesses[k]`` (a body velocity change (6,)
     per m/s) or, without guesses, gauges 0: 2 rows even when both bounds give the same jump
-    (the frozen option's ``starts="warm"`` and the post hoc ``"cold"``)."""
+    (the frozen option's ``starts="warm"`` and the post hoc ``"cold"``).
+    """
     rows, iterations = [], 0
     for k, c_r in enumerate(float(c) for c in spec.restitution):
-        r = contact_impact(stance, spec, 1.0, restitution=c_r, initial_dxi=None if guesses is None else guesses[k])
-        rows.append((r.com_velocity_jump.copy(), c_r, np.concatenate([r.com_velocity_jump_3d, r.angular_velocity_jump]),
-                     r.converged))
+        r = contact_impact(
+            stance, spec, 1.0, restitution=c_r, initial_dxi=None if guesses is None else guesses[k]
+        )
+        rows.append(
+            (
+                r.com_velocity_jump.copy(),
+                c_r,
+                np.concatenate([r.com_velocity_jump_3d, r.angular_velocity_jump]),
+                r.converged,
+            )
+        )
         iterations += r.iterations
     rates, restitution, states, converged = (np.array(x) for x in zip(*rows))
-    return ContactAwareSolutions(rates, restitution, states, converged.astype(bool), iterations, len(rows))
+    return ContactAwareSolutions(
+        rates, restitution, states, converged.astype(bool), iterations, len(rows)
+    )
 
 
 @dataclass(frozen=True)
@@ -209,11 +241,15 @@ class ContactAwareLimit:
 
     def __init__(self, spec: ImpactSpec, every: int = 5, starts: str = "union"):
         if spec.inertia != "composite":
-            raise GovernorError("contact_aware", spec.inertia, "the contact-aware model is the composite one")
+            raise GovernorError(
+                "contact_aware", spec.inertia, "the contact-aware model is the composite one"
+            )
         if not (isinstance(every, (int, np.integer)) and every >= 1):
             raise GovernorError("contact_aware_every", every, "must be an integer >= 1")
         if starts not in STARTS:
-            raise GovernorError("contact_aware_starts", starts, f"must be one of {', '.join(STARTS)}")
+            raise GovernorError(
+                "contact_aware_starts", starts, f"must be one of {', '.join(STARTS)}"
+            )
         self.spec = spec
         self.every = int(every)
         self.starts = starts
@@ -227,12 +263,17 @@ class ContactAwareLimit:
         if self.starts == "union":
             return contact_aware_solutions(stance, self.spec, kept, cold=True)
         # "warm": the previous answer per bound (row k of the previous 2 rows); "cold": none.
-        return _one_per_bound(stance, self.spec, kept.states if self.starts == "warm" and kept is not None else None)
+        return _one_per_bound(
+            stance, self.spec, kept.states if self.starts == "warm" and kept is not None else None
+        )
 
-    def solve(self, stance: Stance, kept: ContactAwareSolutions | None = None) -> ContactAwareSolutions:
+    def solve(
+        self, stance: Stance, kept: ContactAwareSolutions | None = None
+    ) -> ContactAwareSolutions:
         """The rates at ``stance`` from the option's starts, continuing ``kept`` (the solutions
         to start from; default: this limit's own), without adopting them (:meth:`adopt`): what
-        a worker process computes for its governor (:mod:`.worker`)."""
+        a worker process computes for its governor (:mod:`.worker`).
+        """
         return self._solve(stance, self._solutions if kept is None else kept)
 
     def adopt(self, solutions: ContactAwareSolutions) -> None:
@@ -247,7 +288,8 @@ class ContactAwareLimit:
 
     def new_posture(self, stance_of: Callable[[], Stance]) -> None:
         """A posture was evaluated; ``stance_of()`` builds its :class:`Stance` (called only when
-        the rates are due)."""
+        the rates are due).
+        """
         if self._solutions is None or self._count % self.every == 0:
             self.adopt(self._solve(stance_of(), self._solutions))
         else:
@@ -259,29 +301,47 @@ class ContactAwareLimit:
         ``criterion`` (world xy, m/s; the posture's :class:`~impact_balance.criteria.com.ComCriterion`,
         its velocity margin included) and the pre-impact CoM velocity (world, m/s): the first
         exit over every row of the rates (the smallest speed), the intersection of their safe
-        intervals."""
+        intervals.
+        """
         return self.answers(criterion, com_velocity)[1]
 
-    def answers(self, criterion: ComCriterion, com_velocity: np.ndarray) -> tuple[VelocityLimit, ContactAwareAnswer]:
+    def answers(
+        self, criterion: ComCriterion, com_velocity: np.ndarray
+    ) -> tuple[VelocityLimit, ContactAwareAnswer]:
         """``criterion.limit(com_velocity)`` (the floating model's limit) and :meth:`answer`,
-        in one compiled call: a governor's tick."""
+        in one compiled call: a governor's tick.
+        """
         s = self._solutions
         if s is None:
             raise GovernorError("contact_aware", None, "no posture evaluated yet")
         floating, limit = criterion.limits(com_velocity, s.rates)
         if criterion.G is None:
             interval = None
-        elif limit.status in ("ok", "unbounded"):  # from inside: [0, limit] (as ComCriterion.interval)
+        elif limit.status in (
+            "ok",
+            "unbounded",
+        ):  # from inside: [0, limit] (as ComCriterion.interval)
             interval = (0.0, limit.max_approach_speed)
         else:
             interval = speed_interval(criterion.margins(com_velocity), s.rates @ criterion.G.T)
-        return floating, ContactAwareAnswer(limit, interval, s.rates, self._age, self._converged, s.restitution,
-                                            self.starts, s.iterations)
+        return floating, ContactAwareAnswer(
+            limit,
+            interval,
+            s.rates,
+            self._age,
+            self._converged,
+            s.restitution,
+            self.starts,
+            s.iterations,
+        )
 
 
-def combine(floating: tuple[float, float] | None, aware: tuple[float, float] | None) -> tuple[float, float] | None:
+def combine(
+    floating: tuple[float, float] | None, aware: tuple[float, float] | None
+) -> tuple[float, float] | None:
     """The approach speeds (m/s) safe for both models: the intersection of two safe intervals
-    (or None)."""
+    (or None).
+    """
     if floating is None or aware is None:
         return None
     lo, hi = max(floating[0], aware[0]), min(floating[1], aware[1])

@@ -43,9 +43,10 @@ START_TIMEOUT = 120.0
 def _serve(conn: Connection) -> None:
     """The worker's loop: first ``(scenario dict, source, starts)``, then ``(key, q)`` in and
     ``(key, solutions, error)`` out, each solve continuing the last answer; None or a closed
-    pipe stops it."""
-    from impact_balance.scenario import scenario_from_dict
+    pipe stops it.
+    """
     from impact_balance.contacts.stance import Stance
+    from impact_balance.scenario import scenario_from_dict
 
     raw, source, starts = conn.recv()
     # The lowest priority: woken by a request, the worker must not take the CPU from the
@@ -106,15 +107,27 @@ class ContactAwareWorker:
         try:
             self._process = subprocess.Popen(
                 [sys.executable, "-m", "impact_balance.governor.worker", str(child.fileno())],
-                pass_fds=(child.fileno(),), stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                stderr=subprocess.DEVNULL, env=env, close_fds=True)
-        except (OSError, ValueError) as exc:  # ValueError: no pass_fds (Windows); the option is POSIX-only
+                pass_fds=(child.fileno(),),
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+                env=env,
+                close_fds=True,
+            )
+        except (
+            OSError,
+            ValueError,
+        ) as exc:  # ValueError: no pass_fds (Windows); the option is POSIX-only
             parent.close()
-            raise GovernorError("contact_aware_async", None, f"could not start the worker ({exc})") from None
+            raise GovernorError(
+                "contact_aware_async", None, f"could not start the worker ({exc})"
+            ) from None
         finally:
             child.close()
         self._conn = Connection(parent.detach())
-        self._poller = select.poll()  # a tick's check for an answer: ~1 us, where Connection.poll takes ~10
+        self._poller = (
+            select.poll()
+        )  # a tick's check for an answer: ~1 us, where Connection.poll takes ~10
         self._poller.register(self._conn.fileno(), select.POLLIN)
         self._finalizer = weakref.finalize(self, _stop, self._conn, self._process)
         self._busy = True  # until "ready"
@@ -132,7 +145,8 @@ class ContactAwareWorker:
     def warm_up(self, q: np.ndarray) -> ContactAwareSolutions:
         """Solve once at ``q`` and wait, returning the answer: the worker's first solve loads
         its compiled code (~150 ms), which the governor pays at construction (and takes as its
-        first rates) rather than in its first ticks."""
+        first rates) rather than in its first ticks.
+        """
         self.submit(b"warm-up", q)
         solutions = self.wait(START_TIMEOUT)
         if solutions is None:

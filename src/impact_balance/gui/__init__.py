@@ -16,19 +16,43 @@
 
 from impact_balance.gui.drag import DragResult, DragTarget, drag_changes, handle_pose
 from impact_balance.gui.limbs import JointSlider, joint_groups, joint_values
-from impact_balance.gui.scene import Arrows, Label, Points, SceneObject, Segments, Surface, scene_objects
+from impact_balance.gui.scene import (
+    Arrows,
+    Label,
+    Points,
+    SceneObject,
+    Segments,
+    Surface,
+    scene_objects,
+)
 from impact_balance.gui.session import Session, Summary, format_speed
 from impact_balance.gui.state import DEFAULT_SCENARIO, FieldPath, GuiState
 from impact_balance.gui.view2d import svg_view
 
 __all__ = [
-    "DragResult", "DragTarget", "drag_changes", "handle_pose",
-    "JointSlider", "joint_groups", "joint_values",
-    "Arrows", "Label", "Points", "SceneObject", "Segments", "Surface", "scene_objects",
-    "Session", "Summary", "format_speed",
-    "DEFAULT_SCENARIO", "FieldPath", "GuiState",
+    "DEFAULT_SCENARIO",
+    "Arrows",
+    "DragResult",
+    "DragTarget",
+    "FieldPath",
+    "GuiApp",
+    "GuiState",
+    "JointSlider",
+    "Label",
+    "Points",
+    "SceneObject",
+    "Segments",
+    "Session",
+    "Summary",
+    "Surface",
+    "drag_changes",
+    "format_speed",
+    "handle_pose",
+    "joint_groups",
+    "joint_values",
+    "run",
+    "scene_objects",
     "svg_view",
-    "GuiApp", "run",
 ]
 
 

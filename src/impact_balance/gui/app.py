@@ -18,7 +18,6 @@ from typing import Any
 
 import numpy as np
 
-from impact_balance.gui.workspace import Workspace
 from impact_balance.gui.gizmos import GizmoMixin
 from impact_balance.gui.guard import AccessPolicy, guarded_start
 from impact_balance.gui.meshes import RobotMeshes
@@ -27,10 +26,11 @@ from impact_balance.gui.results import results_html
 from impact_balance.gui.scenario_tab import ScenarioTabMixin
 from impact_balance.gui.server import GuiError, check_listen_address
 from impact_balance.gui.session import Session
-from impact_balance.gui.uploads import limit_uploads
 from impact_balance.gui.state import DEFAULT_SCENARIO, GuiState
+from impact_balance.gui.uploads import limit_uploads
 from impact_balance.gui.view2d import svg_view
 from impact_balance.gui.viser_scene import SceneMixin
+from impact_balance.gui.workspace import Workspace
 
 __all__ = ["GuiApp", "GuiError", "run"]
 
@@ -53,24 +53,34 @@ class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
         update_times_ms: Recent update times (edit + analysis + redraw), ms.
     """
 
-    def __init__(self, scenario: str | Path | GuiState = DEFAULT_SCENARIO, host: str = "127.0.0.1",
-                 port: int = 8080, verbose: bool = False, workspace: Workspace | str | Path = ".",
-                 allow_origins: tuple[str, ...] | list[str] = ()):
+    def __init__(
+        self,
+        scenario: str | Path | GuiState = DEFAULT_SCENARIO,
+        host: str = "127.0.0.1",
+        port: int = 8080,
+        verbose: bool = False,
+        workspace: Workspace | str | Path = ".",
+        allow_origins: tuple[str, ...] | list[str] = (),
+    ):
         import viser
 
         check_listen_address(host, port)
         self.policy = AccessPolicy.for_bind(host, allow_origins)
         self.session = Session(scenario, workspace)
         with guarded_start(self.policy) as started:
-            self.server = viser.ViserServer(host=host, port=port, label="impact-balance", verbose=verbose)
+            self.server = viser.ViserServer(
+                host=host, port=port, label="impact-balance", verbose=verbose
+            )
         if not started:  # a viser that starts its server another way: do not serve unguarded
             self.server.stop()
             raise GuiError(host, port, "cannot install the Host/Origin check on this viser version")
         try:  # uploads counted as they arrive (a viser without the expected handlers: do not serve)
             self.uploads = limit_uploads(self.server, self._upload_refused)
-        except Exception:  # noqa: BLE001 - any mismatch with viser's internals
+        except Exception:
             self.server.stop()
-            raise GuiError(host, port, "cannot install the upload limit on this viser version") from None
+            raise GuiError(
+                host, port, "cannot install the upload limit on this viser version"
+            ) from None
         self.update_times_ms: deque[float] = deque(maxlen=500)
         self.last_update_ms = float("nan")
         self._syncing = False
@@ -124,11 +134,17 @@ class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
             t0 = time.perf_counter()
             try:
                 apply()
-            except (ValueError, TypeError, OverflowError) as exc:  # a value that cannot even be converted
+            except (
+                ValueError,
+                TypeError,
+                OverflowError,
+            ) as exc:  # a value that cannot even be converted
                 self.session.message, self.session.refused = f"bad value: {exc}", True
             self.refresh(t0)
 
-    def _field(self, path: tuple, convert: Callable[[Any], Any] = lambda v: v) -> Callable[[Any], None]:
+    def _field(
+        self, path: tuple, convert: Callable[[Any], Any] = lambda v: v
+    ) -> Callable[[Any], None]:
         """A widget callback that sets one scenario field."""
 
         def callback(event: Any) -> None:
@@ -161,9 +177,15 @@ class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
         return results_html(self.session, self.last_update_ms)
 
 
-def run(scenario: str | Path = DEFAULT_SCENARIO, host: str = "127.0.0.1", port: int = 8080,
-        ready: Callable[[GuiApp], None] | None = None, stop: threading.Event | None = None,
-        workspace: Workspace | str | Path = ".", allow_origins: tuple[str, ...] | list[str] = ()) -> None:
+def run(
+    scenario: str | Path = DEFAULT_SCENARIO,
+    host: str = "127.0.0.1",
+    port: int = 8080,
+    ready: Callable[[GuiApp], None] | None = None,
+    stop: threading.Event | None = None,
+    workspace: Workspace | str | Path = ".",
+    allow_origins: tuple[str, ...] | list[str] = (),
+) -> None:
     """Start the GUI and serve until Ctrl-C, SIGTERM, or ``stop`` is set.
 
     Args:

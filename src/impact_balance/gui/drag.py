@@ -14,13 +14,13 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from impact_balance.exceptions import ScenarioError
-from impact_balance.robot.ik import IKError, solve_stance
 from impact_balance.contacts.stance import Stance
+from impact_balance.exceptions import ScenarioError
 from impact_balance.gui.limbs import joint_values
 from impact_balance.gui.state import FieldPath, GuiState
+from impact_balance.robot.ik import IKError, solve_stance
 
-__all__ = ["DragTarget", "DragResult", "drag_changes", "handle_pose", "FIXED_TOLERANCE"]
+__all__ = ["FIXED_TOLERANCE", "DragResult", "DragTarget", "drag_changes", "handle_pose"]
 
 #: Largest drift (m, rad) of a contact frame that must stay put for an IK answer to be kept.
 FIXED_TOLERANCE = 1e-3
@@ -97,9 +97,15 @@ def drag_changes(state: GuiState, stance: Stance, target: DragTarget, pose: pin.
         IKError: the other contacts could not be kept in place, even an eighth of the way.
     """
     frame, path = _frame_and_path(state, target)
-    fixed = [c.spec.frame for i, c in enumerate(stance.contacts) if not (target.kind == "contact" and i == target.index)]
+    fixed = [
+        c.spec.frame
+        for i, c in enumerate(stance.contacts)
+        if not (target.kind == "contact" and i == target.index)
+    ]
     if frame in fixed:
-        raise ScenarioError(".".join(map(str, path)) + ".frame", frame, "is also a contact that must stay put")
+        raise ScenarioError(
+            ".".join(map(str, path)) + ".frame", frame, "is also a contact that must stay put"
+        )
     offset_inv = _offset(state, path).inverse()
     start = stance.frame_pose(frame)
     goal = pin.SE3(pose) * offset_inv
@@ -128,10 +134,18 @@ def _interpolate(a: pin.SE3, b: pin.SE3, t: float) -> pin.SE3:
 def _solve(stance: Stance, frame: str, target: pin.SE3, fixed_frames: list[str]) -> np.ndarray:
     """IK for one target, other frames fixed; a non-converged answer is kept if they stayed put."""
     try:
-        return solve_stance(stance.robot, stance.q, {frame: target}, fixed_frames=fixed_frames,
-                            max_iterations=DRAG_ITERATIONS, tolerance=DRAG_TOLERANCE)
+        return solve_stance(
+            stance.robot,
+            stance.q,
+            {frame: target},
+            fixed_frames=fixed_frames,
+            max_iterations=DRAG_ITERATIONS,
+            tolerance=DRAG_TOLERANCE,
+        )
     except IKError as exc:
-        drift = max((v for k, v in exc.residuals.items() if k.split(".")[0] in fixed_frames), default=0.0)
+        drift = max(
+            (v for k, v in exc.residuals.items() if k.split(".")[0] in fixed_frames), default=0.0
+        )
         miss = max((v for k, v in exc.residuals.items() if k.split(".")[0] == frame), default=0.0)
         if drift > FIXED_TOLERANCE or miss > FIXED_TOLERANCE:
             raise

@@ -19,12 +19,23 @@ import tempfile
 from importlib import resources
 from pathlib import Path
 
-from impact_balance.exceptions import ImpactBalanceError, ScenarioError, UnknownScenarioError, WorkspaceError
-from impact_balance.scenario import ExtendsResolver, RobotFiles, Scenario, bundled_scenarios, load_scenario
-from impact_balance.gui.workspace import MAX_FILE_BYTES, Workspace
+from impact_balance.exceptions import (
+    ImpactBalanceError,
+    ScenarioError,
+    UnknownScenarioError,
+    WorkspaceError,
+)
 from impact_balance.gui.state import GuiState
+from impact_balance.gui.workspace import MAX_FILE_BYTES, Workspace
+from impact_balance.scenario import (
+    ExtendsResolver,
+    RobotFiles,
+    Scenario,
+    bundled_scenarios,
+    load_scenario,
+)
 
-__all__ = ["GuiFiles", "describe", "bundled_path", "MAX_MESSAGE"]
+__all__ = ["MAX_MESSAGE", "GuiFiles", "bundled_path", "describe"]
 
 #: Longest message shown in the browser, characters.
 MAX_MESSAGE = 300
@@ -68,7 +79,9 @@ def describe(exc: BaseException, workspace: Workspace | None = None) -> str:
     else:  # the command line's rule (impact_balance.exit_status): a YAML, OS or other error as one line
         from impact_balance.exit_status import describe_error
 
-        line, _ = describe_error(exc, quote=False)  # never a third party's text: it may quote a file
+        line, _ = describe_error(
+            exc, quote=False
+        )  # never a third party's text: it may quote a file
         text = line.split("; rerun with --debug")[0]
     return text if len(text) <= MAX_MESSAGE else text[: MAX_MESSAGE - 3] + "..."
 
@@ -109,9 +122,11 @@ class GuiFiles:
                 raise WorkspaceError(field, value, f"outside the workspace {self.workspace.root}")
             return str(self.workspace.resolve(name, field=field, suffixes=(suffix,)))
 
-        files = RobotFiles(urdf=check(robot.urdf, "robot.urdf", ".urdf"),
-                           srdf=check(robot.srdf, "robot.srdf", ".srdf") if robot.srdf else None,
-                           standing=robot.standing)
+        files = RobotFiles(
+            urdf=check(robot.urdf, "robot.urdf", ".urdf"),
+            srdf=check(robot.srdf, "robot.srdf", ".srdf") if robot.srdf else None,
+            standing=robot.standing,
+        )
         return scenario.model_copy(update={"robot": files})
 
     # -- loads ------------------------------------------------------------------------------
@@ -121,8 +136,11 @@ class GuiFiles:
         if not name.lower().endswith((".yaml", ".yml")):
             path = bundled_path(name)
             if path is None:
-                raise UnknownScenarioError("scenario", name if len(name) <= 80 else name[:77] + "...",
-                                           sorted(_bundled_names()))
+                raise UnknownScenarioError(
+                    "scenario",
+                    name if len(name) <= 80 else name[:77] + "...",
+                    sorted(_bundled_names()),
+                )
             return GuiState.from_file(path)
         path = self.workspace.resolve(name)
         scenario = _load(path, self._extends, name)
@@ -137,7 +155,10 @@ class GuiFiles:
             text = content.decode("utf-8")
         except UnicodeDecodeError:
             raise ScenarioError("upload", shown, "not a UTF-8 text file") from None
-        stem = "".join(c if c.isalnum() or c in "-_." else "_" for c in Path(shown).stem)[:80] or "uploaded"
+        stem = (
+            "".join(c if c.isalnum() or c in "-_." else "_" for c in Path(shown).stem)[:80]
+            or "uploaded"
+        )
         with tempfile.TemporaryDirectory() as tmp:
             # The scenario loader reads files (it resolves `extends`, reports YAML errors with
             # their line): give it one, outside the workspace, gone after the parse.

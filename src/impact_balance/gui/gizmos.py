@@ -1,5 +1,6 @@
 """Gizmo drags: a transform control on each contact and on the impact point; a drag is solved
-by whole-body IK (:mod:`.drag`) in a worker thread, and a burst of updates costs one solve."""
+by whole-body IK (:mod:`.drag`) in a worker thread, and a burst of updates costs one solve.
+"""
 
 from __future__ import annotations
 
@@ -22,7 +23,8 @@ def _wxyz(rotation: np.ndarray) -> np.ndarray:
 
 class GizmoMixin:
     """The gizmos of :class:`~.app.GuiApp` (uses its ``server``, ``session``, ``edit``, ``w_gizmos``,
-    ``_gizmos``, ``_dragging``, ``_drag_pending``, ``_drag_lock`` and ``_drag_busy``)."""
+    ``_gizmos``, ``_dragging``, ``_drag_pending``, ``_drag_lock`` and ``_drag_busy``).
+    """
 
     def _drag_targets(self) -> dict[str, DragTarget]:
         n = len(self.session.analysis.stance.contacts)
@@ -42,8 +44,13 @@ class GizmoMixin:
             gizmo = self._gizmos.get(key)
             if gizmo is None:
                 gizmo = self.server.scene.add_transform_controls(
-                    f"/gizmos/{key}", scale=0.18, line_width=2.0, depth_test=False,
-                    position=pose.translation, wxyz=_wxyz(pose.rotation))
+                    f"/gizmos/{key}",
+                    scale=0.18,
+                    line_width=2.0,
+                    depth_test=False,
+                    position=pose.translation,
+                    wxyz=_wxyz(pose.rotation),
+                )
                 gizmo.on_update(self._on_gizmo(key))
                 self._gizmos[key] = gizmo
             elif key != self._dragging:
@@ -83,6 +90,8 @@ class GizmoMixin:
         gizmo, target = self._gizmos.get(key), self._drag_targets().get(key)
         if gizmo is None or target is None:
             return False
-        pose = pin.SE3(pin.Quaternion(*np.asarray(gizmo.wxyz, dtype=float)).normalized().matrix(),
-                       np.asarray(gizmo.position, dtype=float))
+        pose = pin.SE3(
+            pin.Quaternion(*np.asarray(gizmo.wxyz, dtype=float)).normalized().matrix(),
+            np.asarray(gizmo.position, dtype=float),
+        )
         return self.session.drag(target, pose)

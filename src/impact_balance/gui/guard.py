@@ -39,7 +39,7 @@ from urllib.parse import urlsplit
 
 from impact_balance.exceptions import ImpactBalanceError
 
-__all__ = ["AccessPolicy", "OriginError", "LOCAL_NAMES", "guarded_start", "normalize_origin"]
+__all__ = ["LOCAL_NAMES", "AccessPolicy", "OriginError", "guarded_start", "normalize_origin"]
 
 #: Host names of this machine as they appear in ``Host`` and ``Origin`` headers.
 LOCAL_NAMES = ("localhost", "127.0.0.1", "[::1]")
@@ -77,11 +77,13 @@ def _split_host(value: str) -> tuple[str, int | None] | None:
         end = value.find("]")
         if end < 0:
             return None
-        host, rest = value[: end + 1], value[end + 1:]
+        host, rest = value[: end + 1], value[end + 1 :]
     else:
         host, sep, port = value.partition(":")
         rest = sep + port
-    if rest and not (rest.startswith(":") and rest[1:].isdigit() and len(rest) <= 6 and int(rest[1:]) <= 65535):
+    if rest and not (
+        rest.startswith(":") and rest[1:].isdigit() and len(rest) <= 6 and int(rest[1:]) <= 65535
+    ):
         return None
     if not host:
         return None
@@ -96,7 +98,13 @@ def normalize_origin(origin: str) -> str:
         raise OriginError(origin, "not a URL") from None
     if parts.scheme not in _DEFAULT_PORTS:
         raise OriginError(origin, "must start with http:// or https://")
-    if parts.path not in ("", "/") or parts.query or parts.fragment or parts.username or parts.password:
+    if (
+        parts.path not in ("", "/")
+        or parts.query
+        or parts.fragment
+        or parts.username
+        or parts.password
+    ):
         raise OriginError(origin, "an origin is scheme://host[:port], without a path")
     split = _split_host(parts.netloc)
     if split is None:
@@ -143,7 +151,9 @@ class AccessPolicy:
     def _own(self, host: str, port: int | None, bound_port: int, default: int) -> bool:
         return host in self.extra_hosts or (host in self.hosts and (port or default) == bound_port)
 
-    def refusal(self, bound_port: int, host: list[str], origin: list[str], websocket: bool) -> str | None:
+    def refusal(
+        self, bound_port: int, host: list[str], origin: list[str], websocket: bool
+    ) -> str | None:
         """Why a request is refused, or None to serve it.
 
         Args:
@@ -170,8 +180,12 @@ class AccessPolicy:
             return None
         parts = urlsplit(canonical)
         split = _split_host(parts.netloc)
-        if parts.scheme == "http" and split is not None and split[0] in self.hosts and \
-                (split[1] or 80) == bound_port:
+        if (
+            parts.scheme == "http"
+            and split is not None
+            and split[0] in self.hosts
+            and (split[1] or 80) == bound_port
+        ):
             return None
         return "foreign Origin (only the GUI's own page may connect; see --allow-origin)"
 
@@ -182,10 +196,16 @@ def _checker(policy: AccessPolicy, inner: Callable[..., Any] | None) -> Callable
     def process_request(connection: Any, request: Any) -> Any:
         headers = request.headers
         websocket = "websocket" in ",".join(headers.get_all("Upgrade")).lower()
-        reason = policy.refusal(int(connection.local_address[1]), headers.get_all("Host"),
-                                headers.get_all("Origin"), websocket)
+        reason = policy.refusal(
+            int(connection.local_address[1]),
+            headers.get_all("Host"),
+            headers.get_all("Origin"),
+            websocket,
+        )
         if reason is not None:
-            return connection.respond(http.HTTPStatus.FORBIDDEN, f"impact-balance gui: refused: {reason}\n")
+            return connection.respond(
+                http.HTTPStatus.FORBIDDEN, f"impact-balance gui: refused: {reason}\n"
+            )
         return inner(connection, request) if inner is not None else None
 
     return process_request

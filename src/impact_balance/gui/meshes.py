@@ -20,7 +20,7 @@ from impact_balance.exceptions import RobotLoadError
 from impact_balance.robot.meshes import read_mesh
 from impact_balance.robot.robot import Robot
 
-__all__ = ["VisualMesh", "load_visual_meshes", "RobotMeshes"]
+__all__ = ["RobotMeshes", "VisualMesh", "load_visual_meshes"]
 
 log = logging.getLogger(__name__)
 
@@ -76,8 +76,12 @@ def _triangles(obj: Any, problems: list[str]) -> tuple[np.ndarray, np.ndarray] |
 def load_visual_meshes(robot: Robot) -> tuple[pin.GeometryModel, list[VisualMesh]]:
     """The robot's visual geometry model and its meshes; unreadable meshes are skipped."""
     try:
-        gmodel = pin.buildGeomFromUrdf(robot.model, str(robot.urdf_path), pin.GeometryType.VISUAL,
-                                       package_dirs=_package_dirs(robot))
+        gmodel = pin.buildGeomFromUrdf(
+            robot.model,
+            str(robot.urdf_path),
+            pin.GeometryType.VISUAL,
+            package_dirs=_package_dirs(robot),
+        )
     except (RuntimeError, ValueError, OSError) as exc:
         raise RobotLoadError(str(robot.urdf_path), f"cannot read the visual meshes: {exc}") from exc
     meshes, problems = [], []
@@ -91,10 +95,18 @@ def load_visual_meshes(robot: Robot) -> tuple[pin.GeometryModel, list[VisualMesh
         if not np.any(rgba[:3] > 0.05):
             color = DEFAULT_COLOR
         opacity = float(rgba[3]) if 0.0 < rgba[3] <= 1.0 else 1.0
-        meshes.append(VisualMesh(obj.name, tri[0].astype(np.float32), tri[1].astype(np.uint32), color, opacity, i))
+        meshes.append(
+            VisualMesh(
+                obj.name, tri[0].astype(np.float32), tri[1].astype(np.uint32), color, opacity, i
+            )
+        )
     if problems:
-        log.warning("robot %s: %d visual geometries not drawn: %s", robot.name, len(problems), "; ".join(problems[:5])
-                    + ("; ..." if len(problems) > 5 else ""))
+        log.warning(
+            "robot %s: %d visual geometries not drawn: %s",
+            robot.name,
+            len(problems),
+            "; ".join(problems[:5]) + ("; ..." if len(problems) > 5 else ""),
+        )
     return gmodel, meshes
 
 
@@ -118,8 +130,13 @@ class RobotMeshes:
             color = tuple(int(round(255 * c)) for c in mesh.color)
             self.handles.append(
                 scene.add_mesh_simple(
-                    f"{root}/{mesh.name}", mesh.vertices, mesh.faces, color=color,
-                    opacity=self._opacity(mesh, opacity), cast_shadow=False, receive_shadow=False,
+                    f"{root}/{mesh.name}",
+                    mesh.vertices,
+                    mesh.faces,
+                    color=color,
+                    opacity=self._opacity(mesh, opacity),
+                    cast_shadow=False,
+                    receive_shadow=False,
                 )
             )
 
@@ -135,7 +152,9 @@ class RobotMeshes:
 
     def poses(self, data: pin.Data) -> list[tuple[np.ndarray, np.ndarray]]:
         """World (position, wxyz) of every mesh, from joint placements already in ``data``."""
-        pin.updateGeometryPlacements(self.robot.model, data, self.geometry_model, self.geometry_data)
+        pin.updateGeometryPlacements(
+            self.robot.model, data, self.geometry_model, self.geometry_data
+        )
         out = []
         for mesh in self.meshes:
             M = self.geometry_data.oMg[mesh.index]
@@ -151,7 +170,11 @@ class RobotMeshes:
         poses = self.poses(data)
         for k, (handle, (position, wxyz)) in enumerate(zip(self.handles, poses, strict=True)):
             last = self._last[k] if k < len(self._last) else None
-            if last is not None and np.array_equal(last[0], position) and np.array_equal(last[1], wxyz):
+            if (
+                last is not None
+                and np.array_equal(last[0], position)
+                and np.array_equal(last[1], wxyz)
+            ):
                 continue
             handle.position = position
             handle.wxyz = wxyz

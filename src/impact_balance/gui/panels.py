@@ -1,5 +1,6 @@
 """The control panels: the Impact, Contacts and Joints tabs, and putting every widget back in
-line with the session after an edit (a refused value reverts)."""
+line with the session after an edit (a refused value reverts).
+"""
 
 from __future__ import annotations
 
@@ -30,12 +31,15 @@ def _set_options(dropdown: Any, options: list[str]) -> None:
 
 class PanelsMixin:
     """The widgets of :class:`~.app.GuiApp` (uses its ``server``, ``session``, ``edit``, ``_field``,
-    ``workspace`` and the ``w_*`` widgets)."""
+    ``workspace`` and the ``w_*`` widgets).
+    """
 
     def _build_gui(self) -> None:
         gui = self.server.gui
         # No share button: sharing goes through viser's public relay, and this server is local.
-        gui.configure_theme(control_width="large", dark_mode=False, show_logo=False, show_share_button=False)
+        gui.configure_theme(
+            control_width="large", dark_mode=False, show_logo=False, show_share_button=False
+        )
         gui.set_panel_label("impact-balance")
         self.w_results = gui.add_html("")
         tabs = gui.add_tab_group()
@@ -58,7 +62,9 @@ class PanelsMixin:
 
     def _frame_options(self, current: list[str]) -> list[str]:
         model = self.session.analysis.stance.robot.model
-        names = [f.name for f in model.frames if f.type in (pin.FrameType.BODY, pin.FrameType.OP_FRAME)]
+        names = [
+            f.name for f in model.frames if f.type in (pin.FrameType.BODY, pin.FrameType.OP_FRAME)
+        ]
         return sorted(set(names) | {c for c in current if c})
 
     def _sync_widgets(self) -> None:
@@ -81,7 +87,9 @@ class PanelsMixin:
             if widget is not None:
                 widget.value = float(np.clip(value, widget.min, widget.max))
         # Contacts.
-        frames = [c.frame for c in scenario.contacts] + ([scenario.impact.frame] if scenario.impact else [])
+        frames = [c.frame for c in scenario.contacts] + (
+            [scenario.impact.frame] if scenario.impact else []
+        )
         options = self._frame_options(frames)
         labels = [f"{i}: {c.frame}" for i, c in enumerate(scenario.contacts)]
         index = self._contact_index = min(max(self._contact_index, 0), len(labels) - 1)
@@ -115,41 +123,78 @@ class PanelsMixin:
             self.w_impact_duration.value = float(impact.duration)
         # File: the workspace name of the file last loaded (not a bundled one, not an upload).
         source = state.source
-        name = self.workspace.relative(os.path.abspath(source)) if source and source.endswith((".yaml", ".yml")) else None
+        name = (
+            self.workspace.relative(os.path.abspath(source))
+            if source and source.endswith((".yaml", ".yml"))
+            else None
+        )
         if name is not None:
             self.w_file.value = name
 
     def _build_impact(self) -> None:
         gui = self.server.gui
-        self.w_impact_on = gui.add_checkbox("impact", True, hint="Analyse an impact (uncheck: areas only)")
+        self.w_impact_on = gui.add_checkbox(
+            "impact", True, hint="Analyse an impact (uncheck: areas only)"
+        )
         self.w_impact_on.on_update(self._on_impact_toggle)
-        self.w_impact_frame = gui.add_dropdown("impact frame", ["-"], hint="Robot frame of the impact point")
+        self.w_impact_frame = gui.add_dropdown(
+            "impact frame", ["-"], hint="Robot frame of the impact point"
+        )
         self.w_impact_frame.on_update(self._field(("impact", "frame")))
-        self.w_impact_offset = gui.add_vector3("impact offset (m)", (0.0, 0.0, 0.0), step=0.001,
-                                               hint="Impact point in the frame, m")
+        self.w_impact_offset = gui.add_vector3(
+            "impact offset (m)", (0.0, 0.0, 0.0), step=0.001, hint="Impact point in the frame, m"
+        )
         self.w_impact_offset.on_update(self._field(("impact", "offset", "position"), list))
-        self.w_impact_normal = gui.add_vector3("impact normal", (-1.0, 0.0, 0.0), step=0.01,
-                                               hint="World normal, from the impacted surface into the robot")
+        self.w_impact_normal = gui.add_vector3(
+            "impact normal",
+            (-1.0, 0.0, 0.0),
+            step=0.01,
+            hint="World normal, from the impacted surface into the robot",
+        )
         self.w_impact_normal.on_update(self._field(("impact", "normal"), list))
-        self.w_impact_friction = gui.add_number("impact friction", 0.24, step=0.01, hint="Friction at the impact (>= 0)")
+        self.w_impact_friction = gui.add_number(
+            "impact friction", 0.24, step=0.01, hint="Friction at the impact (>= 0)"
+        )
         self.w_impact_friction.on_update(self._field(("impact", "friction"), float))
-        self.w_impact_restitution = gui.add_vector2("restitution [lo, hi]", (0.0, 0.2), step=0.01,
-                                                    hint="Restitution range, within [0, 1]")
+        self.w_impact_restitution = gui.add_vector2(
+            "restitution [lo, hi]", (0.0, 0.2), step=0.01, hint="Restitution range, within [0, 1]"
+        )
         self.w_impact_restitution.on_update(self._field(("impact", "restitution"), list))
-        self.w_impact_edges = gui.add_number("cone edges", 16, step=1, hint="Friction cone edges N (>= 3)")
-        self.w_impact_edges.on_update(self._field(("impact", "cone_edges"), lambda v: int(round(v))))
-        self.w_impact_reference = gui.add_vector3("reference velocity (m/s)", (0.0, 0.0, 0.0), step=0.01,
-                                                  hint="Intended end-effector velocity, world, m/s")
+        self.w_impact_edges = gui.add_number(
+            "cone edges", 16, step=1, hint="Friction cone edges N (>= 3)"
+        )
+        self.w_impact_edges.on_update(
+            self._field(("impact", "cone_edges"), lambda v: int(round(v)))
+        )
+        self.w_impact_reference = gui.add_vector3(
+            "reference velocity (m/s)",
+            (0.0, 0.0, 0.0),
+            step=0.01,
+            hint="Intended end-effector velocity, world, m/s",
+        )
         self.w_impact_reference.on_update(self._field(("impact", "reference_velocity"), list))
-        self.w_impact_duration = gui.add_number("impact duration (s)", 0.005, step=0.001,
-                                                hint="Impact duration of the ZMP criterion, s")
+        self.w_impact_duration = gui.add_number(
+            "impact duration (s)", 0.005, step=0.001, hint="Impact duration of the ZMP criterion, s"
+        )
         self.w_impact_duration.on_update(self._field(("impact", "duration"), float))
-        self.w_impact_inertia = gui.add_dropdown("inertia", ["composite", "joint_space"], initial_value="composite",
-                                                 hint="composite: one rigid body; joint_space: J M^-1 J^T")
+        self.w_impact_inertia = gui.add_dropdown(
+            "inertia",
+            ["composite", "joint_space"],
+            initial_value="composite",
+            hint="composite: one rigid body; joint_space: J M^-1 J^T",
+        )
         self.w_impact_inertia.on_update(self._field(("impact", "inertia")))
-        self._impact_widgets = [self.w_impact_frame, self.w_impact_offset, self.w_impact_normal,
-                                self.w_impact_friction, self.w_impact_restitution, self.w_impact_edges,
-                                self.w_impact_reference, self.w_impact_duration, self.w_impact_inertia]
+        self._impact_widgets = [
+            self.w_impact_frame,
+            self.w_impact_offset,
+            self.w_impact_normal,
+            self.w_impact_friction,
+            self.w_impact_restitution,
+            self.w_impact_edges,
+            self.w_impact_reference,
+            self.w_impact_duration,
+            self.w_impact_inertia,
+        ]
 
     def _on_impact_toggle(self, _: Any) -> None:
         def apply() -> bool:
@@ -160,38 +205,67 @@ class PanelsMixin:
             impact = self._impact_stash
             if impact is None:
                 model = self.session.analysis.stance.robot.model
-                frame = next((f for f in _DEFAULT_IMPACT_FRAMES if model.existFrame(f)), model.frames[-1].name)
-                impact = {"frame": frame, "normal": [-1.0, 0.0, 0.0], "reference_velocity": [0.5, 0.0, 0.0]}
+                frame = next(
+                    (f for f in _DEFAULT_IMPACT_FRAMES if model.existFrame(f)),
+                    model.frames[-1].name,
+                )
+                impact = {
+                    "frame": frame,
+                    "normal": [-1.0, 0.0, 0.0],
+                    "reference_velocity": [0.5, 0.0, 0.0],
+                }
             return self.session.set(("impact",), impact)
 
         self.edit(apply)
 
     def _build_contacts(self) -> None:
         gui = self.server.gui
-        self.w_contact_select = gui.add_dropdown("contact", ["0: -"], hint="The contact the fields below edit")
+        self.w_contact_select = gui.add_dropdown(
+            "contact", ["0: -"], hint="The contact the fields below edit"
+        )
         self.w_contact_select.on_update(self._on_select_contact)
 
-        def contact_field(key: tuple, convert: Callable[[Any], Any] = lambda v: v) -> Callable[[Any], None]:
+        def contact_field(
+            key: tuple, convert: Callable[[Any], Any] = lambda v: v
+        ) -> Callable[[Any], None]:
             def callback(event: Any) -> None:
-                self.edit(lambda: self.session.set(("contacts", self._contact_index) + key, convert(event.target.value)))
+                self.edit(
+                    lambda: self.session.set(
+                        ("contacts", self._contact_index) + key, convert(event.target.value)
+                    )
+                )
+
             return callback
 
-        self.w_contact_frame = gui.add_dropdown("contact frame", ["-"], hint="Robot frame; its z axis is the surface normal")
+        self.w_contact_frame = gui.add_dropdown(
+            "contact frame", ["-"], hint="Robot frame; its z axis is the surface normal"
+        )
         self.w_contact_frame.on_update(contact_field(("frame",)))
-        self.w_contact_friction = gui.add_number("contact friction", 0.7, step=0.01, hint="Coulomb friction (> 0)")
+        self.w_contact_friction = gui.add_number(
+            "contact friction", 0.7, step=0.01, hint="Coulomb friction (> 0)"
+        )
         self.w_contact_friction.on_update(contact_field(("friction",), float))
-        self.w_contact_size = gui.add_vector2("size (m)", (0.2, 0.1), step=0.005,
-                                              hint="Full length (local x) and width (local y), m")
+        self.w_contact_size = gui.add_vector2(
+            "size (m)", (0.2, 0.1), step=0.005, hint="Full length (local x) and width (local y), m"
+        )
         self.w_contact_size.on_update(contact_field(("size",), list))
-        self.w_contact_offset = gui.add_vector3("offset (m)", (0.0, 0.0, 0.0), step=0.001, hint="Position in the frame, m")
+        self.w_contact_offset = gui.add_vector3(
+            "offset (m)", (0.0, 0.0, 0.0), step=0.001, hint="Position in the frame, m"
+        )
         self.w_contact_offset.on_update(contact_field(("offset", "position"), list))
-        self.w_contact_rpy = gui.add_vector3("offset rpy (rad)", (0.0, 0.0, 0.0), step=0.01,
-                                             hint="Roll, pitch, yaw in the frame, rad")
+        self.w_contact_rpy = gui.add_vector3(
+            "offset rpy (rad)",
+            (0.0, 0.0, 0.0),
+            step=0.01,
+            hint="Roll, pitch, yaw in the frame, rad",
+        )
         self.w_contact_rpy.on_update(contact_field(("offset", "rpy"), list))
         self.w_contact_remove = gui.add_button("Remove this contact", color="red")
         self.w_contact_remove.on_click(self._on_remove_contact)
         gui.add_divider()
-        self.w_new_frame = gui.add_dropdown("new contact on", ["-"], hint="Frame of a contact to add")
+        self.w_new_frame = gui.add_dropdown(
+            "new contact on", ["-"], hint="Frame of a contact to add"
+        )
         add = gui.add_button("Add contact")
         add.on_click(self._on_add_contact)
 
@@ -221,7 +295,9 @@ class PanelsMixin:
 
         def apply() -> bool:
             contacts = self.session.state.get(("contacts",), [])
-            ok = self.session.set(("contacts",), contacts + [{"frame": frame, "friction": 0.7, "size": [0.1, 0.1]}])
+            ok = self.session.set(
+                ("contacts",), contacts + [{"frame": frame, "friction": 0.7, "size": [0.1, 0.1]}]
+            )
             if ok:
                 self._contact_index = len(contacts)
             return ok
@@ -231,16 +307,23 @@ class PanelsMixin:
     def _build_base(self) -> None:
         gui = self.server.gui
         with gui.add_folder("Base pose"):
-            self.w_base_auto = gui.add_checkbox("auto height", True,
-                                                hint="No base pose: the robot is moved vertically so that its lowest "
-                                                     "contact corner is at z = 0")
+            self.w_base_auto = gui.add_checkbox(
+                "auto height",
+                True,
+                hint="No base pose: the robot is moved vertically so that its lowest "
+                "contact corner is at z = 0",
+            )
             self.w_base_auto.on_update(self._on_base_auto)
             self.w_base_position = gui.add_vector3("base position (m)", (0.0, 0.0, 1.0), step=0.001)
             self.w_base_position.on_update(self._on_base)
             self.w_base_rpy = gui.add_vector3("base rpy (rad)", (0.0, 0.0, 0.0), step=0.001)
             self.w_base_rpy.on_update(self._on_base)
-            reset = gui.add_button("Reset joints and base", hint="Back to the named configuration, auto height")
-            reset.on_click(lambda _: self.edit(lambda: self.session.apply({("joints",): {}, ("base",): None})))
+            reset = gui.add_button(
+                "Reset joints and base", hint="Back to the named configuration, auto height"
+            )
+            reset.on_click(
+                lambda _: self.edit(lambda: self.session.apply({("joints",): {}, ("base",): None}))
+            )
 
     def _on_base_auto(self, _: Any) -> None:
         if self.w_base_auto.value:
@@ -249,8 +332,12 @@ class PanelsMixin:
             self._on_base(None)
 
     def _on_base(self, _: Any) -> None:
-        self.edit(lambda: self.session.set(("base",), {"position": list(self.w_base_position.value),
-                                                       "rpy": list(self.w_base_rpy.value)}))
+        self.edit(
+            lambda: self.session.set(
+                ("base",),
+                {"position": list(self.w_base_position.value), "rpy": list(self.w_base_rpy.value)},
+            )
+        )
 
     def _build_joint_sliders(self) -> None:
         """(Re)build the joint sliders for the session's robot, grouped by limb."""
@@ -265,7 +352,12 @@ class PanelsMixin:
                 self._joint_folders.append(folder)
                 with folder:
                     for s in sliders:
-                        widget = gui.add_slider(s.name.removesuffix("_joint"), min=s.lower, max=s.upper, step=0.001,
-                                                initial_value=float(np.clip(0.0, s.lower, s.upper)))
+                        widget = gui.add_slider(
+                            s.name.removesuffix("_joint"),
+                            min=s.lower,
+                            max=s.upper,
+                            step=0.001,
+                            initial_value=float(np.clip(0.0, s.lower, s.upper)),
+                        )
                         widget.on_update(self._field(("joints", s.name), float))
                         self._joint_widgets[s.name] = widget

@@ -1,53 +1,87 @@
 """The Scenario tab: general settings, view options, and the file controls (bundled scenarios,
-load, save, upload, download), every file access through the session's workspace rule."""
+load, save, upload, download), every file access through the session's workspace rule.
+"""
 
 from __future__ import annotations
 
 from typing import Any
 
-from impact_balance.scenario import bundled_scenarios
 from impact_balance.gui.state import DEFAULT_SCENARIO
+from impact_balance.scenario import bundled_scenarios
 
 __all__ = ["ScenarioTabMixin"]
 
 
 class ScenarioTabMixin:
     """The Scenario tab of :class:`~.app.GuiApp` (uses its ``server``, ``session``, ``edit``,
-    ``_field``, ``workspace`` and ``_meshes``)."""
+    ``_field``, ``workspace`` and ``_meshes``).
+    """
 
     def _build_scenario(self) -> None:
         gui = self.server.gui
-        self.w_torque = gui.add_checkbox("torque limits", True, hint="Joint torque limits from the URDF efforts")
+        self.w_torque = gui.add_checkbox(
+            "torque limits", True, hint="Joint torque limits from the URDF efforts"
+        )
         self.w_torque.on_update(self._field(("torque_limits",), bool))
-        self.w_com_velocity = gui.add_vector2("CoM velocity (m/s)", (0.0, 0.0), step=0.01,
-                                              hint="Pre-impact planar CoM velocity, world, m/s")
+        self.w_com_velocity = gui.add_vector2(
+            "CoM velocity (m/s)",
+            (0.0, 0.0),
+            step=0.01,
+            hint="Pre-impact planar CoM velocity, world, m/s",
+        )
         self.w_com_velocity.on_update(self._field(("com_velocity",), list))
-        self.w_plane = gui.add_number("plane height (m)", 0.0, step=0.01, hint="Height of the ZMP plane, m")
+        self.w_plane = gui.add_number(
+            "plane height (m)", 0.0, step=0.01, hint="Height of the ZMP plane, m"
+        )
         self.w_plane.on_update(self._field(("plane_height",), float))
-        self.w_zmp_margin = gui.add_number("ZMP margin (m)", 0.0, min=0.0, step=0.005,
-                                           hint="Shrink the ZMP support area by this margin (and the CoM velocity area with it), m")
+        self.w_zmp_margin = gui.add_number(
+            "ZMP margin (m)",
+            0.0,
+            min=0.0,
+            step=0.005,
+            hint="Shrink the ZMP support area by this margin (and the CoM velocity area with it), m",
+        )
         self.w_zmp_margin.on_update(self._field(("zmp_margin",), float))
-        self.w_gizmos = gui.add_checkbox("drag gizmos", True,
-                                         hint="Gizmos on the contacts and the impact point: drag one, IK moves the robot")
+        self.w_gizmos = gui.add_checkbox(
+            "drag gizmos",
+            True,
+            hint="Gizmos on the contacts and the impact point: drag one, IK moves the robot",
+        )
         self.w_gizmos.on_update(lambda _: self.edit(lambda: None))
-        self.w_opacity = gui.add_slider("robot opacity", min=0.1, max=1.0, step=0.05, initial_value=0.7,
-                                        hint="See the CoM and the contacts through the robot")
+        self.w_opacity = gui.add_slider(
+            "robot opacity",
+            min=0.1,
+            max=1.0,
+            step=0.05,
+            initial_value=0.7,
+            hint="See the CoM and the contacts through the robot",
+        )
         self.w_opacity.on_update(self._on_opacity)
         gui.add_divider()
         names = list(bundled_scenarios())
-        self.w_bundled = gui.add_dropdown("bundled", names, initial_value=DEFAULT_SCENARIO if DEFAULT_SCENARIO in names else names[0])
+        self.w_bundled = gui.add_dropdown(
+            "bundled",
+            names,
+            initial_value=DEFAULT_SCENARIO if DEFAULT_SCENARIO in names else names[0],
+        )
         load_bundled = gui.add_button("Load bundled scenario")
         load_bundled.on_click(lambda _: self.edit(lambda: self.session.load(self.w_bundled.value)))
         root = self.workspace.root
-        self.w_file = gui.add_text("file", "scenario.yaml",
-                                   hint=f"A .yaml file in the workspace {root} (a name relative to it)")
+        self.w_file = gui.add_text(
+            "file",
+            "scenario.yaml",
+            hint=f"A .yaml file in the workspace {root} (a name relative to it)",
+        )
         load = gui.add_button("Load file", hint=f"Read the file from the workspace {root}")
         load.on_click(lambda _: self.edit(lambda: self.session.load(self.w_file.value)))
-        self.w_overwrite = gui.add_checkbox("overwrite", False,
-                                            hint="Allow the next save to replace an existing file")
+        self.w_overwrite = gui.add_checkbox(
+            "overwrite", False, hint="Allow the next save to replace an existing file"
+        )
         save = gui.add_button("Save file", hint=f"Write the scenario to the workspace {root}")
         save.on_click(lambda _: self.edit(self._save))
-        upload = gui.add_upload_button("Upload YAML", mime_type=".yaml,.yml,application/x-yaml,text/yaml")
+        upload = gui.add_upload_button(
+            "Upload YAML", mime_type=".yaml,.yml,application/x-yaml,text/yaml"
+        )
         upload.on_upload(self._on_upload)
         download = gui.add_button("Download YAML")
         download.on_click(self._on_download)

@@ -15,16 +15,16 @@ from impact_balance.analysis.analyze import Analysis
 from impact_balance.geometry.polygon import Polygon
 
 __all__ = [
-    "Segments",
-    "Points",
-    "Arrows",
-    "Surface",
-    "Label",
-    "SceneObject",
-    "scene_objects",
     "COLORS",
-    "IMPULSE_LENGTH",
     "CONE_LENGTH",
+    "IMPULSE_LENGTH",
+    "Arrows",
+    "Label",
+    "Points",
+    "SceneObject",
+    "Segments",
+    "Surface",
+    "scene_objects",
 ]
 
 #: Colours (hex), the same as the figures' (plots/_common.py).
@@ -126,7 +126,9 @@ def _on_plane(vertices: np.ndarray, height: float) -> np.ndarray:
     return np.column_stack([v, np.full(len(v), height)])
 
 
-def _area_objects(prefix: str, area: Polygon, height: float, fill: str, edge: str) -> list[SceneObject]:
+def _area_objects(
+    prefix: str, area: Polygon, height: float, fill: str, edge: str
+) -> list[SceneObject]:
     if area.is_empty:
         return []
     pts = _on_plane(area.vertices, height)
@@ -159,10 +161,24 @@ def scene_objects(analysis: Analysis) -> list[SceneObject]:
     h = areas.plane_height
     out: list[SceneObject] = []
     for i, contact in enumerate(analysis.stance.contacts):
-        out.append(Segments(f"contacts/{i}/outline", polyline_segments(contact.corners()), COLORS["contact"], 0.008))
+        out.append(
+            Segments(
+                f"contacts/{i}/outline",
+                polyline_segments(contact.corners()),
+                COLORS["contact"],
+                0.008,
+            )
+        )
         size = min(contact.spec.size)
-        out.append(Arrows(f"contacts/{i}/normal", contact.position[None], (contact.position + 0.5 * size * contact.normal)[None],
-                          COLORS["contact_normal"], 0.004))
+        out.append(
+            Arrows(
+                f"contacts/{i}/normal",
+                contact.position[None],
+                (contact.position + 0.5 * size * contact.normal)[None],
+                COLORS["contact_normal"],
+                0.004,
+            )
+        )
     com = np.asarray(areas.com, dtype=float)
     projection = np.array([com[0], com[1], h + PLANE_LIFT])
     out.append(Points("com/point", com[None], COLORS["com"], 0.035))
@@ -171,8 +187,18 @@ def scene_objects(analysis: Analysis) -> list[SceneObject]:
     out.append(Segments("com/drop", np.array([[com, projection]]), COLORS["com_projection"], 0.003))
     c0 = np.asarray(analysis.com_velocity, dtype=float)
     if np.linalg.norm(c0) > 1e-9:
-        out.append(Arrows("com/velocity", com[None], (com + np.array([c0[0], c0[1], 0.0]))[None], COLORS["com_velocity"], 0.008))
-    out += _area_objects("zmp_area", areas.zmp_area, h + PLANE_LIFT, COLORS["zmp_area"], COLORS["zmp_edge"])
+        out.append(
+            Arrows(
+                "com/velocity",
+                com[None],
+                (com + np.array([c0[0], c0[1], 0.0]))[None],
+                COLORS["com_velocity"],
+                0.008,
+            )
+        )
+    out += _area_objects(
+        "zmp_area", areas.zmp_area, h + PLANE_LIFT, COLORS["zmp_area"], COLORS["zmp_edge"]
+    )
 
     im = analysis.impact
     if im is not None:
@@ -181,21 +207,48 @@ def scene_objects(analysis: Analysis) -> list[SceneObject]:
         n = np.asarray(model.normal, dtype=float)
         out.append(Points("impact/point", p[None], COLORS["impact"], 0.018))
         out.append(Label("impact/label", "impact", p, COLORS["impact"]))
-        out.append(Arrows("impact/normal", p[None], (p + 0.25 * n)[None], COLORS["impact_normal"], 0.006))
+        out.append(
+            Arrows("impact/normal", p[None], (p + 0.25 * n)[None], COLORS["impact_normal"], 0.006)
+        )
         # Cone generators K_i = n + mu t_i: scaled to CONE_LENGTH along n.
         rim = p + CONE_LENGTH * np.asarray(model.cone, dtype=float).T
         vertices = np.vstack([p, rim])
         k = len(rim)
         faces = np.array([[0, 1 + j, 1 + (j + 1) % k] for j in range(k)], dtype=np.uint32)
-        out.append(Surface("impact/cone", vertices, np.vstack([faces, faces[:, ::-1]]), COLORS["cone"], 0.25))
-        out.append(Segments("impact/cone_edges", np.stack([np.repeat(p[None], k, 0), rim], axis=1), COLORS["cone"], 0.002))
+        out.append(
+            Surface(
+                "impact/cone", vertices, np.vstack([faces, faces[:, ::-1]]), COLORS["cone"], 0.25
+            )
+        )
+        out.append(
+            Segments(
+                "impact/cone_edges",
+                np.stack([np.repeat(p[None], k, 0), rim], axis=1),
+                COLORS["cone"],
+                0.002,
+            )
+        )
         rates = np.asarray(model.impulse_rates, dtype=float)
         longest = float(np.max(np.linalg.norm(rates, axis=1))) if len(rates) else 0.0
         if longest > 0:
             ends = p + IMPULSE_LENGTH * rates / longest
-            out.append(Segments("impact/impulses", np.stack([np.repeat(p[None], len(ends), 0), ends], axis=1),
-                                COLORS["impulse"], 0.003))
+            out.append(
+                Segments(
+                    "impact/impulses",
+                    np.stack([np.repeat(p[None], len(ends), 0), ends], axis=1),
+                    COLORS["impulse"],
+                    0.003,
+                )
+            )
             # The two restitution planes' polygons (rows 2i: c_hi, 2i+1: c_lo).
-            out.append(Segments("impact/impulse_set_hi", polyline_segments(ends[0::2]), COLORS["impulse"], 0.004))
-            out.append(Segments("impact/impulse_set_lo", polyline_segments(ends[1::2]), COLORS["impulse"], 0.004))
+            out.append(
+                Segments(
+                    "impact/impulse_set_hi", polyline_segments(ends[0::2]), COLORS["impulse"], 0.004
+                )
+            )
+            out.append(
+                Segments(
+                    "impact/impulse_set_lo", polyline_segments(ends[1::2]), COLORS["impulse"], 0.004
+                )
+            )
     return out

@@ -32,10 +32,14 @@ def check_listen_address(host: str, port: int) -> None:
     try:
         infos = socket.getaddrinfo(host, None, type=socket.SOCK_STREAM)
     except (socket.gaierror, UnicodeError) as exc:
-        raise GuiError(host, port, f"unknown host ({getattr(exc, 'strerror', None) or exc})") from None
+        raise GuiError(
+            host, port, f"unknown host ({getattr(exc, 'strerror', None) or exc})"
+        ) from None
     family, _, _, _, address = infos[0]
     with socket.socket(family, socket.SOCK_STREAM) as sock:
         try:
             sock.bind((address[0], 0))
         except OSError as exc:
-            raise GuiError(host, port, f"not an address of this machine ({exc.strerror or exc})") from None
+            raise GuiError(
+                host, port, f"not an address of this machine ({exc.strerror or exc})"
+            ) from None

@@ -23,12 +23,12 @@ import pinocchio as pin
 
 from impact_balance.analysis.analyze import Analysis, analyze
 from impact_balance.exceptions import ImpactBalanceError
-from impact_balance.gui.workspace import Workspace
 from impact_balance.gui.drag import DragTarget, drag_changes
 from impact_balance.gui.files import GuiFiles, describe
 from impact_balance.gui.state import DEFAULT_SCENARIO, FieldPath, GuiState
+from impact_balance.gui.workspace import Workspace
 
-__all__ = ["Summary", "Governed", "Session", "format_speed"]
+__all__ = ["Governed", "Session", "Summary", "format_speed"]
 
 log = logging.getLogger(__name__)
 
@@ -120,7 +120,11 @@ class Session:
         lock: Re-entrant lock held during every edit (the app holds it while redrawing).
     """
 
-    def __init__(self, state: GuiState | str | Path = DEFAULT_SCENARIO, workspace: Workspace | str | Path = "."):
+    def __init__(
+        self,
+        state: GuiState | str | Path = DEFAULT_SCENARIO,
+        workspace: Workspace | str | Path = ".",
+    ):
         self.files = GuiFiles(workspace)
         if not isinstance(state, GuiState):
             state = GuiState.from_file(state)
@@ -148,7 +152,7 @@ class Session:
             except ImpactBalanceError as exc:
                 self.message, self.refused = describe(exc, self.files.workspace), True
                 return False
-            except Exception as exc:  # noqa: BLE001 - the GUI must survive a library bug
+            except Exception as exc:
                 log.exception("unexpected error while applying an edit")
                 self.message, self.refused = describe(exc), True
                 return False
@@ -161,15 +165,17 @@ class Session:
 
     def _govern(self) -> None:
         """Ask the governor of the scenario (rebuilt when anything but the posture and the CoM velocity
-        changed) for the speed allowed from this posture and CoM velocity, and cap the reference."""
+        changed) for the speed allowed from this posture and CoM velocity, and cap the reference.
+        """
         scenario = self.state.scenario
         if scenario.impact is None or not self.analysis.areas.can_balance:
             self.governed = None
             return
         from impact_balance.governor import Governor
 
-        key = scenario.model_dump_json(exclude={"configuration", "joints", "base", "com_velocity", "name",
-                                                "description"})
+        key = scenario.model_dump_json(
+            exclude={"configuration", "joints", "base", "com_velocity", "name", "description"}
+        )
         try:
             if key != self._governor_key:
                 self._governor, self._governor_key = Governor(scenario), key
@@ -178,13 +184,19 @@ class Session:
             tick_us = 1e6 * (time.perf_counter() - t0)
             reference = scenario.impact.reference_velocity
             capped = None if reference is None else limit.cap(reference)
-        except ImpactBalanceError as exc:  # the analysis went through: the governor's failure is only a note
+        except (
+            ImpactBalanceError
+        ) as exc:  # the analysis went through: the governor's failure is only a note
             self.governed = None
             log.info("governor: %s", exc)
             return
-        self.governed = Governed(limit.ceiling, limit.status, tick_us,
-                                 None if reference is None else float(-np.dot(reference, limit.normal)),
-                                 None if capped is None else float(-np.dot(capped, limit.normal)))
+        self.governed = Governed(
+            limit.ceiling,
+            limit.status,
+            tick_us,
+            None if reference is None else float(-np.dot(reference, limit.normal)),
+            None if capped is None else float(-np.dot(capped, limit.normal)),
+        )
 
     def refuse(self, message: str) -> None:
         """Show ``message`` as a refusal (an upload cut while it arrived); the state is kept."""
@@ -238,7 +250,9 @@ class Session:
             def build() -> GuiState:
                 result = drag_changes(self.state, self.analysis.stance, target, pose)
                 if not result.reached:
-                    note.append(f"out of reach: moved as close as possible ({1e3 * result.residual:.0f} mm away)")
+                    note.append(
+                        f"out of reach: moved as close as possible ({1e3 * result.residual:.0f} mm away)"
+                    )
                 return self.state.with_changes(result.changes)
 
             ok = self._commit(build)

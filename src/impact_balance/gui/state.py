@@ -22,7 +22,7 @@ import yaml
 from impact_balance.exceptions import ScenarioError
 from impact_balance.scenario import RobotFiles, Scenario, load_scenario, scenario_from_dict
 
-__all__ = ["FieldPath", "GuiState", "DEFAULT_SCENARIO", "plain"]
+__all__ = ["DEFAULT_SCENARIO", "FieldPath", "GuiState", "plain"]
 
 #: The scenario the GUI opens when none is given (the demo's first study).
 DEFAULT_SCENARIO = "palm_push_two_feet"
@@ -163,7 +163,9 @@ class GuiState:
         """
         path = Path(path).expanduser()
         if path.suffix not in (".yaml", ".yml"):
-            raise ScenarioError("file", str(path), "a scenario file name must end with .yaml or .yml")
+            raise ScenarioError(
+                "file", str(path), "a scenario file name must end with .yaml or .yml"
+            )
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
             path.write_text(self.to_yaml())
@@ -176,7 +178,9 @@ class GuiState:
         """A new state with ``value`` at ``path`` (None removes the key)."""
         return self.with_changes({path: value})
 
-    def with_changes(self, changes: Mapping[FieldPath, Any] | Iterable[tuple[FieldPath, Any]]) -> GuiState:
+    def with_changes(
+        self, changes: Mapping[FieldPath, Any] | Iterable[tuple[FieldPath, Any]]
+    ) -> GuiState:
         """A new state with every change applied; raises :class:`ScenarioError` for a bad one.
 
         Changes are applied in order, then the whole mapping is validated once.

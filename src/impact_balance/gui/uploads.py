@@ -31,8 +31,15 @@ from typing import Any
 
 from impact_balance.gui.workspace import MAX_FILE_BYTES
 
-__all__ = ["limit_uploads", "UploadLimit", "MAX_UPLOAD_BYTES", "MAX_UPLOAD_PARTS", "MAX_TRANSFERS_PER_CLIENT",
-           "MAX_MESSAGE_BYTES", "MAX_QUEUED_MESSAGES"]
+__all__ = [
+    "MAX_MESSAGE_BYTES",
+    "MAX_QUEUED_MESSAGES",
+    "MAX_TRANSFERS_PER_CLIENT",
+    "MAX_UPLOAD_BYTES",
+    "MAX_UPLOAD_PARTS",
+    "UploadLimit",
+    "limit_uploads",
+]
 
 #: Largest upload, bytes (the workspace's file limit, 1 MiB).
 MAX_UPLOAD_BYTES = MAX_FILE_BYTES
@@ -54,7 +61,9 @@ class UploadLimit:
         peak_bytes: Largest number of bytes held for one upload.
     """
 
-    def __init__(self, server: Any, on_refused: Callable[[str, str], None], limit: int = MAX_UPLOAD_BYTES):
+    def __init__(
+        self, server: Any, on_refused: Callable[[str, str], None], limit: int = MAX_UPLOAD_BYTES
+    ):
         from viser import _messages
 
         gui = server.gui
@@ -71,8 +80,10 @@ class UploadLimit:
         self.refused = 0
         self.peak_bytes = 0
         handlers = self._iface._incoming_handlers
-        for cls, original, mine in ((_messages.FileTransferStartUpload, self._start_original, self._start),
-                                    (_messages.FileTransferPart, self._part_original, self._part)):
+        for cls, original, mine in (
+            (_messages.FileTransferStartUpload, self._start_original, self._start),
+            (_messages.FileTransferPart, self._part_original, self._part),
+        ):
             if original not in handlers.get(cls, []):
                 raise RuntimeError(f"viser's {cls.__name__} handler not found")
             self._iface.unregister_handler(cls, original)
@@ -97,7 +108,9 @@ class UploadLimit:
         if not isinstance(size, int) or not isinstance(parts, int) or size < 0 or parts < 0:
             reason = "not a valid upload"
         elif size > self._limit:
-            reason = f"larger than {kib} KiB ({size:,} bytes declared): refused before any byte was kept"
+            reason = (
+                f"larger than {kib} KiB ({size:,} bytes declared): refused before any byte was kept"
+            )
         elif parts > MAX_UPLOAD_PARTS or (size > 0 and parts == 0) or parts > max(1, size):
             reason = f"{parts} parts declared for {size:,} bytes: not a valid upload"
         elif sum(owner == client_id for owner in self._owner.values()) >= MAX_TRANSFERS_PER_CLIENT:
@@ -119,8 +132,11 @@ class UploadLimit:
             self._states.pop(uuid, None)  # frees the parts buffered so far
             self._received.pop(uuid, None)
             self._owner.pop(uuid, None)
-            self._refuse(client_id, state.get("filename"),
-                         f"larger than {self._limit >> 10} KiB or than it declared: cut at {count:,} bytes")
+            self._refuse(
+                client_id,
+                state.get("filename"),
+                f"larger than {self._limit >> 10} KiB or than it declared: cut at {count:,} bytes",
+            )
             return
         self._received[uuid] = count
         self.peak_bytes = max(self.peak_bytes, count)
@@ -130,7 +146,9 @@ class UploadLimit:
             self._owner.pop(uuid, None)
 
 
-def limit_uploads(server: Any, on_refused: Callable[[str, str], None], limit: int = MAX_UPLOAD_BYTES) -> UploadLimit:
+def limit_uploads(
+    server: Any, on_refused: Callable[[str, str], None], limit: int = MAX_UPLOAD_BYTES
+) -> UploadLimit:
     """Count the uploads of ``server`` as they arrive (see the module docstring).
 
     ``on_refused(filename, reason)`` is called (in a thread of its own) for each refused upload.

@@ -1,5 +1,6 @@
 """The 3D view in viser: lights, ground and camera, the robot meshes, and the scene objects of
-:mod:`.scene` sent as few messages as possible (unchanged objects are skipped)."""
+:mod:`.scene` sent as few messages as possible (unchanged objects are skipped).
+"""
 
 from __future__ import annotations
 
@@ -39,15 +40,35 @@ def add_object(scene: Any, name: str, obj: Any, data: tuple[np.ndarray, ...]) ->
     if isinstance(obj, Segments):
         return scene.add_line_segments(name, data[0], color, thickness=obj.width)
     if isinstance(obj, Points):
-        return scene.add_icosphere(name, radius=obj.radius, color=color, subdivisions=2,
-                                   position=tuple(data[0]), cast_shadow=False)
+        return scene.add_icosphere(
+            name,
+            radius=obj.radius,
+            color=color,
+            subdivisions=2,
+            position=tuple(data[0]),
+            cast_shadow=False,
+        )
     if isinstance(obj, Arrows):
-        return scene.add_arrows(name, data[0], color, shaft_radius=obj.radius,
-                                head_radius=2.5 * obj.radius, head_length=6 * obj.radius)
+        return scene.add_arrows(
+            name,
+            data[0],
+            color,
+            shaft_radius=obj.radius,
+            head_radius=2.5 * obj.radius,
+            head_length=6 * obj.radius,
+        )
     if isinstance(obj, Label):
         return scene.add_label(name, obj.text, position=tuple(data[0]), anchor="bottom-left")
-    return scene.add_mesh_simple(name, data[0], data[1], color=color, opacity=obj.opacity,
-                                 side="double", cast_shadow=False, receive_shadow=False)
+    return scene.add_mesh_simple(
+        name,
+        data[0],
+        data[1],
+        color=color,
+        opacity=obj.opacity,
+        side="double",
+        cast_shadow=False,
+        receive_shadow=False,
+    )
 
 
 def update_object(handle: Any, obj: Any, data: tuple[np.ndarray, ...]) -> None:
@@ -62,7 +83,8 @@ def update_object(handle: Any, obj: Any, data: tuple[np.ndarray, ...]) -> None:
 
 class SceneMixin:
     """The viser scene of :class:`~.app.GuiApp` (uses its ``server``, ``session``, ``w_opacity``,
-    ``_scene_handles``, ``_scene_data`` and ``_meshes``)."""
+    ``_scene_handles``, ``_scene_data`` and ``_meshes``).
+    """
 
     def _setup_scene(self) -> None:
         scene = self.server.scene
@@ -70,8 +92,15 @@ class SceneMixin:
         # No shadows: they cost a render pass per light, which software WebGL (no GPU, as on
         # this project's machines) pays on every redraw.
         scene.configure_default_lights(True, cast_shadow=False)
-        scene.add_grid("/ground", width=4.0, height=4.0, cell_size=0.1, section_size=0.5, plane="xy",
-                       shadow_opacity=0.0)
+        scene.add_grid(
+            "/ground",
+            width=4.0,
+            height=4.0,
+            cell_size=0.1,
+            section_size=0.5,
+            plane="xy",
+            shadow_opacity=0.0,
+        )
         self.server.initial_camera.position = (1.0, -1.9, 1.25)
         self.server.initial_camera.look_at = (0.1, 0.0, 0.6)
 
@@ -87,7 +116,10 @@ class SceneMixin:
             seen.add(name)
             previous = self._scene_data.get(name)
             if previous is not None and type(previous[0]) is type(obj):
-                if all(a.shape == b.shape and np.array_equal(a, b) for a, b in zip(previous[1], data, strict=True)):
+                if all(
+                    a.shape == b.shape and np.array_equal(a, b)
+                    for a, b in zip(previous[1], data, strict=True)
+                ):
                     continue  # most objects do not move when one joint does: send nothing
                 update_object(self._scene_handles[name], obj, data)
             else:
@@ -105,5 +137,7 @@ class SceneMixin:
         if self._meshes is None or self._meshes.robot is not stance.robot:
             if self._meshes is not None:
                 self._meshes.remove()
-            self._meshes = RobotMeshes(self.server.scene, stance.robot, opacity=self.w_opacity.value)
+            self._meshes = RobotMeshes(
+                self.server.scene, stance.robot, opacity=self.w_opacity.value
+            )
         self._meshes.update(stance.data)

@@ -27,7 +27,7 @@ from pathlib import Path, PurePosixPath, PureWindowsPath
 
 from impact_balance.exceptions import WorkspaceError
 
-__all__ = ["Workspace", "MAX_FILE_BYTES", "SCENARIO_SUFFIXES"]
+__all__ = ["MAX_FILE_BYTES", "SCENARIO_SUFFIXES", "Workspace"]
 
 #: Largest file the workspace reads, bytes. Scenario files are a few kB; the limit stops a
 #: huge file (or a device) from filling memory before the parser sees it.
@@ -62,8 +62,13 @@ class Workspace:
         return f"Workspace({str(self.root)!r})"
 
     # -- the rule ---------------------------------------------------------------------------
-    def parts(self, name: str | os.PathLike[str], *, field: str = "file",
-              suffixes: tuple[str, ...] = SCENARIO_SUFFIXES) -> tuple[str, ...]:
+    def parts(
+        self,
+        name: str | os.PathLike[str],
+        *,
+        field: str = "file",
+        suffixes: tuple[str, ...] = SCENARIO_SUFFIXES,
+    ) -> tuple[str, ...]:
         """The components of a workspace-relative ``name``, checked lexically (no disk access)."""
         text = os.fspath(name) if isinstance(name, os.PathLike) else name
         if not isinstance(text, str):
@@ -73,13 +78,25 @@ class Workspace:
         if len(text) > _MAX_NAME or "\x00" in text:
             raise WorkspaceError(field, text, "not a valid file name")
         if text.startswith("~"):
-            raise WorkspaceError(field, text, f"~ is not allowed: give a name relative to the workspace {self.root}")
-        if PurePosixPath(text).is_absolute() or PureWindowsPath(text).is_absolute() or PureWindowsPath(text).drive:
-            raise WorkspaceError(field, text, f"absolute paths are not allowed: give a name relative to the "
-                                              f"workspace {self.root}")
+            raise WorkspaceError(
+                field, text, f"~ is not allowed: give a name relative to the workspace {self.root}"
+            )
+        if (
+            PurePosixPath(text).is_absolute()
+            or PureWindowsPath(text).is_absolute()
+            or PureWindowsPath(text).drive
+        ):
+            raise WorkspaceError(
+                field,
+                text,
+                f"absolute paths are not allowed: give a name relative to the "
+                f"workspace {self.root}",
+            )
         parts = tuple(p for p in text.replace("\\", "/").split("/") if p not in ("", "."))
         if any(p == ".." for p in parts):
-            raise WorkspaceError(field, text, "'..' is not allowed: the file must be inside the workspace")
+            raise WorkspaceError(
+                field, text, "'..' is not allowed: the file must be inside the workspace"
+            )
         if not parts:
             raise WorkspaceError(field, text, "empty file name")
         if any(len(p.encode()) > 255 for p in parts):
@@ -88,8 +105,15 @@ class Workspace:
             raise WorkspaceError(field, text, f"the name must end with {' or '.join(suffixes)}")
         return parts
 
-    def resolve(self, name: str | os.PathLike[str], *, for_write: bool = False, overwrite: bool = False,
-                field: str = "file", suffixes: tuple[str, ...] = SCENARIO_SUFFIXES) -> Path:
+    def resolve(
+        self,
+        name: str | os.PathLike[str],
+        *,
+        for_write: bool = False,
+        overwrite: bool = False,
+        field: str = "file",
+        suffixes: tuple[str, ...] = SCENARIO_SUFFIXES,
+    ) -> Path:
         """The absolute path of the workspace file ``name``, or :class:`WorkspaceError`.
 
         Args:
@@ -111,20 +135,32 @@ class Workspace:
                 if last and for_write:
                     return path
                 what = "no such file" if last else "no such folder"
-                raise WorkspaceError(field, str(name), f"{what} in the workspace {self.root}") from None
+                raise WorkspaceError(
+                    field, str(name), f"{what} in the workspace {self.root}"
+                ) from None
             except OSError as exc:
-                raise WorkspaceError(field, str(name), f"cannot access ({exc.strerror or 'error'})") from None
+                raise WorkspaceError(
+                    field, str(name), f"cannot access ({exc.strerror or 'error'})"
+                ) from None
             if stat.S_ISLNK(st.st_mode):
-                raise WorkspaceError(field, str(name), "symbolic links are not followed in the workspace")
+                raise WorkspaceError(
+                    field, str(name), "symbolic links are not followed in the workspace"
+                )
             if not last and not stat.S_ISDIR(st.st_mode):
-                raise WorkspaceError(field, str(name), f"{'/'.join(parts[: i + 1])} is not a folder")
+                raise WorkspaceError(
+                    field, str(name), f"{'/'.join(parts[: i + 1])} is not a folder"
+                )
             if last:
                 if not stat.S_ISREG(st.st_mode):
                     raise WorkspaceError(field, str(name), "not a regular file")
                 if for_write and not overwrite:
-                    raise WorkspaceError(field, str(name), "the file exists (confirm to overwrite it)")
+                    raise WorkspaceError(
+                        field, str(name), "the file exists (confirm to overwrite it)"
+                    )
                 if not for_write and st.st_size > MAX_FILE_BYTES:
-                    raise WorkspaceError(field, str(name), f"larger than {MAX_FILE_BYTES >> 10} KiB")
+                    raise WorkspaceError(
+                        field, str(name), f"larger than {MAX_FILE_BYTES >> 10} KiB"
+                    )
         # Belt and braces: no link was on the way, so the real path is the lexical one.
         if os.path.commonpath([os.path.realpath(path), str(self.root)]) != str(self.root):
             raise WorkspaceError(field, str(name), "outside the workspace")  # pragma: no cover
@@ -133,11 +169,15 @@ class Workspace:
     def relative(self, path: str | os.PathLike[str]) -> str | None:
         """``path`` as a workspace name if it lies inside the workspace (lexically), else None."""
         absolute = os.path.normpath(os.path.join(self.root, os.fspath(path)))
-        if os.path.commonpath([absolute, str(self.root)]) != str(self.root) or absolute == str(self.root):
+        if os.path.commonpath([absolute, str(self.root)]) != str(self.root) or absolute == str(
+            self.root
+        ):
             return None
         return Path(os.path.relpath(absolute, self.root)).as_posix()
 
-    def extends_resolver(self, bundled: Callable[[str], Path | None]) -> Callable[[str, Path], Path]:
+    def extends_resolver(
+        self, bundled: Callable[[str], Path | None]
+    ) -> Callable[[str, Path], Path]:
         """A resolver for ``extends:``: a bundled scenario name, or a workspace file.
 
         A relative name is taken from the folder of the file that extends, when that file is in
@@ -173,7 +213,9 @@ class Workspace:
                 try:
                     child = os.open(part, flags, dir_fd=fd)
                 except OSError as exc:
-                    raise WorkspaceError(field, name, f"cannot open its folder ({exc.strerror or 'error'})") from None
+                    raise WorkspaceError(
+                        field, name, f"cannot open its folder ({exc.strerror or 'error'})"
+                    ) from None
                 os.close(fd)
                 fd = child
         except BaseException:
@@ -188,10 +230,17 @@ class Workspace:
         try:
             return os.open(name, flags, 0o666, dir_fd=folder), name
         except OSError as exc:
-            raise WorkspaceError(field, shown, f"cannot write ({exc.strerror or 'error'})") from None
+            raise WorkspaceError(
+                field, shown, f"cannot write ({exc.strerror or 'error'})"
+            ) from None
 
-    def read_text(self, name: str | os.PathLike[str], *, field: str = "file",
-                  suffixes: tuple[str, ...] = SCENARIO_SUFFIXES) -> str:
+    def read_text(
+        self,
+        name: str | os.PathLike[str],
+        *,
+        field: str = "file",
+        suffixes: tuple[str, ...] = SCENARIO_SUFFIXES,
+    ) -> str:
         """The UTF-8 text of the workspace file ``name`` (at most :data:`MAX_FILE_BYTES`)."""
         parts = self.resolve(name, field=field, suffixes=suffixes).relative_to(self.root).parts
         folder = self._open_folder(parts[:-1], field, str(name))
@@ -199,7 +248,9 @@ class Workspace:
             try:
                 fd = os.open(parts[-1], os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0), dir_fd=folder)
             except OSError as exc:
-                raise WorkspaceError(field, str(name), f"cannot read ({exc.strerror or 'error'})") from None
+                raise WorkspaceError(
+                    field, str(name), f"cannot read ({exc.strerror or 'error'})"
+                ) from None
         finally:
             os.close(folder)
         with os.fdopen(fd, "rb") as f:
@@ -213,18 +264,29 @@ class Workspace:
         except UnicodeDecodeError:
             raise WorkspaceError(field, str(name), "not a UTF-8 text file") from None
 
-    def write_text(self, name: str | os.PathLike[str], text: str, *, overwrite: bool = False,
-                   field: str = "file", suffixes: tuple[str, ...] = SCENARIO_SUFFIXES) -> Path:
+    def write_text(
+        self,
+        name: str | os.PathLike[str],
+        text: str,
+        *,
+        overwrite: bool = False,
+        field: str = "file",
+        suffixes: tuple[str, ...] = SCENARIO_SUFFIXES,
+    ) -> Path:
         """Write ``text`` to the workspace file ``name``; refuse to replace a file unless ``overwrite``.
 
         The text goes to a temporary file in the same folder, then takes the name at once: a
         reader never sees half a file, and an existing link is replaced, never followed.
         """
-        path = self.resolve(name, for_write=True, overwrite=overwrite, field=field, suffixes=suffixes)
+        path = self.resolve(
+            name, for_write=True, overwrite=overwrite, field=field, suffixes=suffixes
+        )
         parts = path.relative_to(self.root).parts
         folder = self._open_folder(parts[:-1], field, str(name))
         try:
-            tmp = self._create(folder, f".{parts[-1]}.{os.getpid()}-{secrets.token_hex(4)}.tmp", field, str(name))
+            tmp = self._create(
+                folder, f".{parts[-1]}.{os.getpid()}-{secrets.token_hex(4)}.tmp", field, str(name)
+            )
             try:
                 with os.fdopen(tmp[0], "w", encoding="utf-8") as f:
                     f.write(text)
@@ -232,11 +294,21 @@ class Workspace:
                     os.replace(tmp[1], parts[-1], src_dir_fd=folder, dst_dir_fd=folder)
                 else:
                     # link() fails if the name exists: no race can make it replace a file.
-                    os.link(tmp[1], parts[-1], src_dir_fd=folder, dst_dir_fd=folder, follow_symlinks=False)
+                    os.link(
+                        tmp[1],
+                        parts[-1],
+                        src_dir_fd=folder,
+                        dst_dir_fd=folder,
+                        follow_symlinks=False,
+                    )
             except FileExistsError:
-                raise WorkspaceError(field, str(name), "the file exists (confirm to overwrite it)") from None
+                raise WorkspaceError(
+                    field, str(name), "the file exists (confirm to overwrite it)"
+                ) from None
             except OSError as exc:
-                raise WorkspaceError(field, str(name), f"cannot write ({exc.strerror or 'error'})") from None
+                raise WorkspaceError(
+                    field, str(name), f"cannot write ({exc.strerror or 'error'})"
+                ) from None
             finally:
                 try:
                     os.unlink(tmp[1], dir_fd=folder)

@@ -54,12 +54,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from impact_balance.contacts.cwc import cwc_span
-from impact_balance.exceptions import ImpactModelError, SolverError
-from impact_balance.impact.model import ImpactSpec, impact_cone
-from impact_balance.geometry.spatial import skew
 from impact_balance.contacts.stance import Stance
+from impact_balance.exceptions import ImpactModelError, SolverError
+from impact_balance.geometry.spatial import skew
+from impact_balance.impact.model import ImpactSpec, impact_cone
 
-__all__ = ["ContactImpact", "PointContact", "contact_impact", "rigid_body_impact", "corner_contacts"]
+__all__ = [
+    "ContactImpact",
+    "PointContact",
+    "contact_impact",
+    "corner_contacts",
+    "rigid_body_impact",
+]
 
 
 @dataclass(frozen=True)
@@ -114,31 +120,41 @@ class ContactImpact:
 
 def _unique_columns(D: np.ndarray) -> np.ndarray:
     """Generators without repeats (mu = 0 makes every edge the normal): an active-set QP
-    solver dislikes identical constraint rows."""
+    solver dislikes identical constraint rows.
+    """
     _, index = np.unique(np.round(D.T, 12), axis=0, return_index=True)
     return D[:, np.sort(index)]
 
 
 def corner_contacts(stance: Stance) -> list[list[PointContact]]:
     """The 4 corners of each sustained contact of ``stance`` as plastic point contacts at rest,
-    each with the friction-pyramid edges (+-mu, +-mu, 1) of :func:`~impact_balance.contacts.cwc.cwc_span`."""
+    each with the friction-pyramid edges (+-mu, +-mu, 1) of :func:`~impact_balance.contacts.cwc.cwc_span`.
+    """
     out = []
     for c in stance.contacts:
         X, Y, mu = c.half_length, c.half_width, float(c.spec.friction)
         span = cwc_span(mu, X, Y)  # columns 4k..4k+3: the pyramid edges at corner k
-        centre = (c.local_position if c.local_position is not None else c.position - stance.origin) - stance.com_local
+        centre = (
+            c.local_position if c.local_position is not None else c.position - stance.origin
+        ) - stance.com_local
         corners = []
         for k, (px, py) in enumerate(((X, Y), (X, -Y), (-X, Y), (-X, -Y))):
             arm = centre + c.rotation @ np.array([px, py, 0.0])
-            D = _unique_columns(c.rotation @ span[:3, 4 * k:4 * k + 4])
+            D = _unique_columns(c.rotation @ span[:3, 4 * k : 4 * k + 4])
             corners.append(PointContact(arm, c.normal.copy(), D, np.zeros(3)))
         out.append(corners)
     return out
 
 
-def rigid_body_impact(mass: float, com_inertia: np.ndarray, points: Sequence[PointContact], solver: str = "daqp",
-                      tolerance: float = 1e-9, max_iterations: int = 1000,
-                      initial_dxi: np.ndarray | None = None) -> tuple[np.ndarray, list[np.ndarray], int, bool]:
+def rigid_body_impact(
+    mass: float,
+    com_inertia: np.ndarray,
+    points: Sequence[PointContact],
+    solver: str = "daqp",
+    tolerance: float = 1e-9,
+    max_iterations: int = 1000,
+    initial_dxi: np.ndarray | None = None,
+) -> tuple[np.ndarray, list[np.ndarray], int, bool]:
     """Solve the frictional impact of one rigid body on ``points`` (see the module docstring).
 
     Args:
@@ -173,8 +189,12 @@ def rigid_body_impact(mass: float, com_inertia: np.ndarray, points: Sequence[Poi
     gauges = np.zeros(len(points))
     if initial_dxi is not None:
         guess = np.asarray(initial_dxi, dtype=float).reshape(6)
-        gauges = np.array([max(0.0, float(np.max(-(p.generators - p.normal[:, None]).T @ (t + J @ guess))))
-                           for p, t, J in zip(points, targets, jacobians)])
+        gauges = np.array(
+            [
+                max(0.0, float(np.max(-(p.generators - p.normal[:, None]).T @ (t + J @ guess))))
+                for p, t, J in zip(points, targets, jacobians)
+            ]
+        )
     dxi = np.zeros(6)
     z = np.zeros(len(base))
     converged = False
@@ -183,14 +203,29 @@ def rigid_body_impact(mass: float, com_inertia: np.ndarray, points: Sequence[Poi
         problem = qpsolvers.Problem(M, np.zeros(6), G, base + gauges[owner])
         try:
             solution = qpsolvers.solve_problem(problem, solver=solver)
-        except (qpsolvers.SolverNotFound, qpsolvers.SolverError, ValueError) as exc:  # as qp.py: our error, one line
-            raise SolverError(solver, type(exc).__name__, str(exc).splitlines()[0] if str(exc) else "",
-                              field="contact_impact") from None
+        except (
+            qpsolvers.SolverNotFound,
+            qpsolvers.SolverError,
+            ValueError,
+        ) as exc:  # as qp.py: our error, one line
+            raise SolverError(
+                solver,
+                type(exc).__name__,
+                str(exc).splitlines()[0] if str(exc) else "",
+                field="contact_impact",
+            ) from None
         if not solution.found or solution.x is None or solution.z is None:
             raise SolverError(solver, "not solved", "the contact impact QP", field="contact_impact")
-        dxi, z = np.asarray(solution.x, dtype=float), np.maximum(np.asarray(solution.z, dtype=float), 0.0)
-        new = np.array([max(0.0, float(np.max(-(p.generators - p.normal[:, None]).T @ (t + J @ dxi))))
-                        for p, t, J in zip(points, targets, jacobians)])
+        dxi, z = (
+            np.asarray(solution.x, dtype=float),
+            np.maximum(np.asarray(solution.z, dtype=float), 0.0),
+        )
+        new = np.array(
+            [
+                max(0.0, float(np.max(-(p.generators - p.normal[:, None]).T @ (t + J @ dxi))))
+                for p, t, J in zip(points, targets, jacobians)
+            ]
+        )
         change = float(np.max(np.abs(new - gauges))) if len(new) else 0.0
         gauges = new
         if change <= tolerance:
@@ -200,36 +235,58 @@ def rigid_body_impact(mass: float, com_inertia: np.ndarray, points: Sequence[Poi
     impulses = []
     start = 0
     for p, size in zip(points, sizes):
-        impulses.append(p.generators @ z[start:start + size])
+        impulses.append(p.generators @ z[start : start + size])
         start += size
     return dxi, impulses, iterations, converged
 
 
-def _least_norm_multipliers(G: np.ndarray, h: np.ndarray, resultant: np.ndarray, dxi: np.ndarray, z: np.ndarray,
-                            solver: str) -> np.ndarray:
+def _least_norm_multipliers(
+    G: np.ndarray, h: np.ndarray, resultant: np.ndarray, dxi: np.ndarray, z: np.ndarray, solver: str
+) -> np.ndarray:
     """The multipliers of least norm with the same resultant ``M dxi = -G^T z`` and the same
     active rows: with more support corners than the body has freedoms (two flat feet) the
     active-set solver returns one vertex of many (one foot taking everything); this spreads
-    the impulses as evenly as the constraints allow. The solver's own multipliers if it fails."""
+    the impulses as evenly as the constraints allow. The solver's own multipliers if it fails.
+    """
     import qpsolvers
 
     slack = h - G @ dxi
     inactive = slack > 1e-9 * max(1.0, float(np.abs(h).max(initial=0.0)))
     upper = np.where(inactive, 0.0, np.inf)
     try:
-        least = qpsolvers.solve_qp(np.eye(len(z)), np.zeros(len(z)), A=-G.T, b=resultant,
-                                   lb=np.zeros(len(z)), ub=upper, solver=solver)
-    except (qpsolvers.SolverNotFound, qpsolvers.SolverError, ValueError):  # a selection among equivalent answers
+        least = qpsolvers.solve_qp(
+            np.eye(len(z)),
+            np.zeros(len(z)),
+            A=-G.T,
+            b=resultant,
+            lb=np.zeros(len(z)),
+            ub=upper,
+            solver=solver,
+        )
+    except (
+        qpsolvers.SolverNotFound,
+        qpsolvers.SolverError,
+        ValueError,
+    ):  # a selection among equivalent answers
         least = None
-    if least is None or np.abs(-G.T @ least - resultant).max() > 1e-6 * max(1.0, float(np.abs(resultant).max())):
+    if least is None or np.abs(-G.T @ least - resultant).max() > 1e-6 * max(
+        1.0, float(np.abs(resultant).max())
+    ):
         return z
     return np.maximum(least, 0.0)
 
 
-def contact_impact(stance: Stance, spec: ImpactSpec, approach_speed: float,
-                   com_velocity: Sequence[float] | None = None, restitution: float | None = None,
-                   solver: str = "daqp", tolerance: float = 1e-9, max_iterations: int = 1000,
-                   initial_dxi: np.ndarray | None = None) -> ContactImpact:
+def contact_impact(
+    stance: Stance,
+    spec: ImpactSpec,
+    approach_speed: float,
+    com_velocity: Sequence[float] | None = None,
+    restitution: float | None = None,
+    solver: str = "daqp",
+    tolerance: float = 1e-9,
+    max_iterations: int = 1000,
+    initial_dxi: np.ndarray | None = None,
+) -> ContactImpact:
     """The rigid (composite) robot's impact with its sustained contacts (module docstring).
 
     Args:
@@ -249,7 +306,9 @@ def contact_impact(stance: Stance, spec: ImpactSpec, approach_speed: float,
     The jump is linear in ``approach_speed``.
     """
     if spec.inertia != "composite":
-        raise ImpactModelError("impact.inertia", spec.inertia, "the contact-aware model is the composite one")
+        raise ImpactModelError(
+            "impact.inertia", spec.inertia, "the contact-aware model is the composite one"
+        )
     v_n = float(approach_speed)
     if not (np.isfinite(v_n) and v_n >= 0.0):
         raise ImpactModelError("approach_speed", approach_speed, "must be a finite speed >= 0")
@@ -258,17 +317,35 @@ def contact_impact(stance: Stance, spec: ImpactSpec, approach_speed: float,
         raise ImpactModelError("impact.restitution", c_r, "must be in [0, 1]")
     placement, _ = stance.local_point(spec.frame, spec.offset, field="impact.frame")
     n, K = impact_cone(spec)
-    impact = PointContact(placement.translation - stance.com_local, n, _unique_columns(K), -v_n * n, c_r)
+    impact = PointContact(
+        placement.translation - stance.com_local, n, _unique_columns(K), -v_n * n, c_r
+    )
     corners = corner_contacts(stance)
     points = [impact] + [p for contact in corners for p in contact]
-    dxi, impulses, iterations, converged = rigid_body_impact(stance.mass, stance.com_inertia, points, solver,
-                                                             tolerance * max(v_n, 1e-12), max_iterations, initial_dxi)
+    dxi, impulses, iterations, converged = rigid_body_impact(
+        stance.mass,
+        stance.com_inertia,
+        points,
+        solver,
+        tolerance * max(v_n, 1e-12),
+        max_iterations,
+        initial_dxi,
+    )
     jump = dxi[:3]
-    corner_impulses = np.array(impulses[1:]).reshape(len(corners), 4, 3) if corners else np.zeros((0, 4, 3))
+    corner_impulses = (
+        np.array(impulses[1:]).reshape(len(corners), 4, 3) if corners else np.zeros((0, 4, 3))
+    )
     before = np.zeros(2) if com_velocity is None else np.asarray(com_velocity, dtype=float)[:2]
     return ContactImpact(
-        approach_speed=v_n, restitution=c_r, com_velocity_jump=jump[:2].copy(), com_velocity_jump_3d=jump.copy(),
-        angular_velocity_jump=dxi[3:].copy(), post_impact_com_velocity=before + jump[:2],
-        impact_impulse=impulses[0], contact_impulses=corner_impulses.sum(axis=1), corner_impulses=corner_impulses,
-        iterations=iterations, converged=converged,
+        approach_speed=v_n,
+        restitution=c_r,
+        com_velocity_jump=jump[:2].copy(),
+        com_velocity_jump_3d=jump.copy(),
+        angular_velocity_jump=dxi[3:].copy(),
+        post_impact_com_velocity=before + jump[:2],
+        impact_impulse=impulses[0],
+        contact_impulses=corner_impulses.sum(axis=1),
+        corner_impulses=corner_impulses,
+        iterations=iterations,
+        converged=converged,
     )

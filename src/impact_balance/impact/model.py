@@ -23,12 +23,21 @@ import numpy as np
 import pinocchio as pin
 
 from impact_balance._jit import njit
+from impact_balance.contacts.stance import Stance
 from impact_balance.exceptions import ImpactModelError
 from impact_balance.geometry.spatial import skew, unit
-from impact_balance.contacts.stance import Stance
 
-__all__ = ["ImpactSpec", "ImpactModel", "friction_cone", "impact_model", "impact_cone", "model_from_inertia_map",
-           "composite_inertia_map", "joint_space_inertia_map", "INERTIA_MODELS"]
+__all__ = [
+    "INERTIA_MODELS",
+    "ImpactModel",
+    "ImpactSpec",
+    "composite_inertia_map",
+    "friction_cone",
+    "impact_cone",
+    "impact_model",
+    "joint_space_inertia_map",
+    "model_from_inertia_map",
+]
 
 #: "composite": the robot as one rigid body (paper, default); "joint_space": J M^-1 J^T.
 INERTIA_MODELS = ("composite", "joint_space")
@@ -86,7 +95,9 @@ def friction_cone(normal: Sequence[float], mu: float, edges: int) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=64)
-def _normal_and_cone(normal: tuple[float, float, float], mu: float, edges: int) -> tuple[np.ndarray, np.ndarray]:
+def _normal_and_cone(
+    normal: tuple[float, float, float], mu: float, edges: int
+) -> tuple[np.ndarray, np.ndarray]:
     """Unit normal and :func:`friction_cone` (read-only), cached: they do not depend on q."""
     n = unit(normal)
     K = friction_cone(n, mu, edges)
@@ -135,9 +146,13 @@ class ImpactModel:
         """(2N, 3) CoM velocity jumps iota / m, m/s."""
         return approach_speed * self.impulse_rates / self.mass
 
-    def post_impact_com_velocities(self, com_velocity: Sequence[float], approach_speed: float) -> np.ndarray:
+    def post_impact_com_velocities(
+        self, com_velocity: Sequence[float], approach_speed: float
+    ) -> np.ndarray:
         """(2N, 2) vertices of the post-impact planar CoM velocity set, m/s."""
-        return np.asarray(com_velocity, dtype=float)[None, :2] + approach_speed * self.com_jump_rates
+        return (
+            np.asarray(com_velocity, dtype=float)[None, :2] + approach_speed * self.com_jump_rates
+        )
 
     def approach_speed(self, velocity: Sequence[float]) -> float:
         """Approach speed -n . v of an end-effector velocity (m/s)."""
@@ -145,7 +160,11 @@ class ImpactModel:
 
 
 def impulse_to_velocity(
-    stance: Stance, point: np.ndarray, jacobian: np.ndarray, model: str = "composite", arm: np.ndarray | None = None
+    stance: Stance,
+    point: np.ndarray,
+    jacobian: np.ndarray,
+    model: str = "composite",
+    arm: np.ndarray | None = None,
 ) -> np.ndarray:
     """W at ``point``: composite rigid body (default) or joint space J M^-1 J^T.
 
@@ -155,7 +174,9 @@ def impulse_to_velocity(
     that such a joint moves has no finite W and is refused.
     """
     if model == "composite":
-        return composite_inertia_map(point - stance.com if arm is None else arm, stance.mass, stance.com_inertia)
+        return composite_inertia_map(
+            point - stance.com if arm is None else arm, stance.mass, stance.com_inertia
+        )
     if model == "joint_space":
         return joint_space_inertia_map(stance.workspace(), stance.model, stance.q, jacobian)
     raise ImpactModelError("impact.inertia", model, f"must be one of {', '.join(INERTIA_MODELS)}")
@@ -163,7 +184,8 @@ def impulse_to_velocity(
 
 def composite_inertia_map(arm: np.ndarray, mass: float, com_inertia: np.ndarray) -> np.ndarray:
     """W = I / m - [r]x Ic^-1 [r]x (1/kg) of the robot as one rigid body: ``arm`` r = point - CoM
-    (m), ``mass`` (kg), ``com_inertia`` Ic about the CoM in world axes (kg m^2)."""
+    (m), ``mass`` (kg), ``com_inertia`` Ic about the CoM in world axes (kg m^2).
+    """
     arm = np.ascontiguousarray(arm, dtype=float)
     com_inertia = np.ascontiguousarray(com_inertia, dtype=float)
     W = np.empty((3, 3))
@@ -178,7 +200,8 @@ def _composite_map(arm, mass, Ic, W):
     """``W`` = I / m - [r]x Ic^-1 [r]x by a 3 x 3 Cholesky of ``Ic``, in floats; False (W
     untouched) when ``Ic`` is not positive definite. Compiled: numpy's and LAPACK's set-up
     cost ~15 us per call for these few flops, and a governor builds W every tick. Python
-    floats when interpreted: an overflow gives inf (reported by the caller), not a warning."""
+    floats when interpreted: an overflow gives inf (reported by the caller), not a warning.
+    """
     a, b, c = float(Ic[0, 0]), float(Ic[0, 1]), float(Ic[0, 2])
     d, e, f = float(Ic[1, 1]), float(Ic[1, 2]), float(Ic[2, 2])
     if not a > 0.0:
@@ -214,10 +237,13 @@ def _composite_map(arm, mass, Ic, W):
     return True
 
 
-def joint_space_inertia_map(workspace, model: pin.Model, q: np.ndarray, jacobian: np.ndarray) -> np.ndarray:
+def joint_space_inertia_map(
+    workspace, model: pin.Model, q: np.ndarray, jacobian: np.ndarray
+) -> np.ndarray:
     """W = J M(q)^-1 J^T (1/kg) of the translational Jacobian ``jacobian`` (3 x nv), with M
     computed in ``workspace``'s Data (a :class:`~impact_balance.robot.robot.Scratch` or
-    :class:`~impact_balance.robot.robot.Workspace`; its held kinematics are marked stale)."""
+    :class:`~impact_balance.robot.robot.Workspace`; its held kinematics are marked stale).
+    """
     M = pin.crba(model, workspace.data, q)  # scratch Data: createData costs up to ~2 ms
     M = np.triu(M) + np.triu(M, 1).T
     workspace.holder = None  # crba rewrote the joint placements: point() recomputes them
@@ -225,8 +251,12 @@ def joint_space_inertia_map(workspace, model: pin.Model, q: np.ndarray, jacobian
     moving = diagonal > 1e-12 * diagonal.max()
     if not moving.all():  # joints that move no mass (a massless finger): no finite inertia there
         if np.abs(jacobian[:, ~moving]).max() > 1e-12:
-            raise ImpactModelError("impact.inertia", "joint_space", "the impact point is moved by a joint "
-                                   "that moves no mass: no finite joint-space inertia there (use composite)")
+            raise ImpactModelError(
+                "impact.inertia",
+                "joint_space",
+                "the impact point is moved by a joint "
+                "that moves no mass: no finite joint-space inertia there (use composite)",
+            )
         M, jacobian = M[np.ix_(moving, moving)], jacobian[:, moving]
     return jacobian @ np.linalg.solve(M, jacobian.T)
 
@@ -241,7 +271,9 @@ def impact_cone(spec: ImpactSpec) -> tuple[np.ndarray, np.ndarray]:
     try:
         n, K = _normal_and_cone(tuple(spec.normal), spec.friction, spec.cone_edges)
     except ValueError:  # from unit(): friction_cone raises nothing once n is a unit vector
-        raise ImpactModelError("impact.normal", list(spec.normal), "must be a non-zero vector") from None
+        raise ImpactModelError(
+            "impact.normal", list(spec.normal), "must be a non-zero vector"
+        ) from None
     return n.copy(), K.copy()
 
 
@@ -257,8 +289,16 @@ def impact_model(stance: Stance, spec: ImpactSpec) -> ImpactModel:
     return model_from_inertia_map(spec, point, arm, n, K, W, stance.mass, J)
 
 
-def model_from_inertia_map(spec: ImpactSpec, point: np.ndarray, arm: np.ndarray, normal: np.ndarray, cone: np.ndarray,
-                           W: np.ndarray, mass: float, jacobian: np.ndarray) -> ImpactModel:
+def model_from_inertia_map(
+    spec: ImpactSpec,
+    point: np.ndarray,
+    arm: np.ndarray,
+    normal: np.ndarray,
+    cone: np.ndarray,
+    W: np.ndarray,
+    mass: float,
+    jacobian: np.ndarray,
+) -> ImpactModel:
     """The impact model from its map W (what :func:`impact_model` computes from a stance).
 
     Args:
@@ -270,11 +310,18 @@ def model_from_inertia_map(spec: ImpactSpec, point: np.ndarray, arm: np.ndarray,
         ImpactModelError: W is not finite, or a cone edge would not separate the contact.
     """
     lo, hi = spec.restitution
-    finite, smallest, rates = _impulse_rates(np.ascontiguousarray(normal, dtype=float), np.ascontiguousarray(W, dtype=float),
-                                             np.ascontiguousarray(cone, dtype=float), float(lo), float(hi))
+    finite, smallest, rates = _impulse_rates(
+        np.ascontiguousarray(normal, dtype=float),
+        np.ascontiguousarray(W, dtype=float),
+        np.ascontiguousarray(cone, dtype=float),
+        float(lo),
+        float(hi),
+    )
     if not finite:
         raise ImpactModelError(
-            "impact.offset", _short(arm), "the impact point is too far from the CoM: W is not finite"
+            "impact.offset",
+            _short(arm),
+            "the impact point is too far from the CoM: W is not finite",
         )
     if not smallest > 1e-12:  # the kernel's own threshold
         raise ImpactModelError(
@@ -291,7 +338,8 @@ def _impulse_rates(normal, W, K, lo, hi):
     """``(W finite, min_i n^T W K_i, rates)``: rows 2i and 2i+1 of ``rates`` (2N, 3) are
     ``(1 + c) / (n^T W K_i) K_i`` for c = hi and lo (the impulse vertices per unit approach
     speed); n^T W K_i > 0 for an impulse that pushes the point back. Compiled: numpy spent
-    ~15 us of call overhead on these few multiplications."""
+    ~15 us of call overhead on these few multiplications.
+    """
     N = K.shape[1]
     rates = np.empty((2 * N, 3))
     for r in range(3):

@@ -36,14 +36,19 @@ import pandas as pd
 import pinocchio as pin
 
 from impact_balance.balance.areas import balance_areas
+from impact_balance.contacts.stance import Stance
 from impact_balance.exceptions import ScenarioError
 from impact_balance.geometry.polygon import Polygon
-from impact_balance.scenario import Scenario, load_scenario
-from impact_balance.contacts.stance import Stance
 from impact_balance.logs.io import check_log_columns
-from impact_balance.logs.schema import LogColumns, force_columns, joint_position_column, joint_velocity_column
+from impact_balance.logs.schema import (
+    LogColumns,
+    force_columns,
+    joint_position_column,
+    joint_velocity_column,
+)
+from impact_balance.scenario import Scenario, load_scenario
 
-__all__ = ["StanceSegment", "Violation", "LogCheck", "check_log", "log_state"]
+__all__ = ["LogCheck", "StanceSegment", "Violation", "check_log", "log_state"]
 
 
 @dataclass(frozen=True)
@@ -71,8 +76,14 @@ class Violation:
     def to_dict(self) -> dict:
         # -inf margin: the stance had no area at all (it cannot balance); JSON null.
         worst = self.worst_margin if np.isfinite(self.worst_margin) else None
-        return {"kind": self.kind, "start": self.start, "end": self.end, "worst_margin": worst,
-                "worst_time": self.worst_time, "samples": self.samples}
+        return {
+            "kind": self.kind,
+            "start": self.start,
+            "end": self.end,
+            "worst_margin": worst,
+            "worst_time": self.worst_time,
+            "samples": self.samples,
+        }
 
 
 @dataclass
@@ -98,23 +109,31 @@ class LogCheck:
     @property
     def gravity_seen(self) -> bool:
         """The floating CoM falls at about g (within 20 %); meaningless when a contact is loaded."""
-        return bool(np.isfinite(self.com_vertical_acceleration)
-                    and abs(self.com_vertical_acceleration + self.gravity) < 0.2 * self.gravity)
+        return bool(
+            np.isfinite(self.com_vertical_acceleration)
+            and abs(self.com_vertical_acceleration + self.gravity) < 0.2 * self.gravity
+        )
 
     @property
     def note(self) -> str | None:
         """What the check could not do, and what the log can show instead (None when all was checked)."""
         if not self.floating:
             return None
-        text = ("no contact is loaded in any sample (every logged contact force is below "
-                f"{self.settings.get('force_threshold', 5.0):g} N): the robot floats, so no balance area applies")
+        text = (
+            "no contact is loaded in any sample (every logged contact force is below "
+            f"{self.settings.get('force_threshold', 5.0):g} N): the robot floats, so no balance area applies"
+        )
         if not self.gravity_seen:
-            text += (f"; its CoM does not fall (vertical acceleration {self.com_vertical_acceleration:.2f} m/s^2, "
-                     f"not -{self.gravity:g}): gravity is off, as in `simulate --joints rigid`")
+            text += (
+                f"; its CoM does not fall (vertical acceleration {self.com_vertical_acceleration:.2f} m/s^2, "
+                f"not -{self.gravity:g}): gravity is off, as in `simulate --joints rigid`"
+            )
         dv = self.com_velocity_change
-        text += (f". What it shows: the CoM velocity changed by ({dv[0]:+.4f}, {dv[1]:+.4f}, {dv[2]:+.4f}) m/s; "
-                 "compare it with the impact model's jump (`impact-balance simulate SCENARIO --joints rigid --json`, "
-                 "`predicted`)")
+        text += (
+            f". What it shows: the CoM velocity changed by ({dv[0]:+.4f}, {dv[1]:+.4f}, {dv[2]:+.4f}) m/s; "
+            "compare it with the impact model's jump (`impact-balance simulate SCENARIO --joints rigid --json`, "
+            "`predicted`)"
+        )
         return text
 
     @property
@@ -124,6 +143,7 @@ class LogCheck:
     def to_dict(self, samples: bool = False) -> dict:
         def num(x):
             return None if x is None or not np.isfinite(x) else float(x)
+
         s = self.samples
         out = {
             "scenario": self.scenario,
@@ -131,8 +151,12 @@ class LogCheck:
             "duration": num(float(s["time"].iloc[-1] - s["time"].iloc[0])) if len(s) else 0.0,
             "ok": self.ok,
             "has_zmp": self.has_zmp,
-            "min_com_velocity_margin": num(float(s["com_velocity_margin"].min())) if len(s) else None,
-            "min_zmp_margin": num(float(s["zmp_margin"].min())) if self.has_zmp and len(s) else None,
+            "min_com_velocity_margin": num(float(s["com_velocity_margin"].min()))
+            if len(s)
+            else None,
+            "min_zmp_margin": num(float(s["zmp_margin"].min()))
+            if self.has_zmp and len(s)
+            else None,
             "violations": [v.to_dict() for v in self.violations],
             "loaded_samples": self.loaded_samples,
             "floating": self.floating,
@@ -140,9 +164,16 @@ class LogCheck:
             "gravity_seen": self.gravity_seen if self.floating else None,
             "com_velocity_change": [num(x) for x in self.com_velocity_change],
             "note": self.note,
-            "stances": [{"start": g.start, "contacts": list(g.contacts), "com": g.com.tolist(),
-                         "can_balance": g.can_balance, "zmp_area": g.zmp_area.vertices.tolist()}
-                        for g in self.segments],
+            "stances": [
+                {
+                    "start": g.start,
+                    "contacts": list(g.contacts),
+                    "com": g.com.tolist(),
+                    "can_balance": g.can_balance,
+                    "zmp_area": g.zmp_area.vertices.tolist(),
+                }
+                for g in self.segments
+            ],
             "settings": self.settings,
         }
         if samples:
@@ -159,15 +190,30 @@ def json_records(frame: pd.DataFrame) -> list[dict]:
 def _joint_columns(frame: pd.DataFrame, robot, source: str) -> None:
     """Refuse a log whose joint columns do not match the robot's joints, naming the difference."""
     names = list(robot.joint_names)
-    missing = [c for n in names for c in (joint_position_column(n), joint_velocity_column(n)) if c not in frame.columns]
+    missing = [
+        c
+        for n in names
+        for c in (joint_position_column(n), joint_velocity_column(n))
+        if c not in frame.columns
+    ]
     known = {joint_position_column(n) for n in names} | {joint_velocity_column(n) for n in names}
-    unknown = [c for c in frame.columns if (c.startswith("q_") or c.startswith("v_")) and c not in known]
+    unknown = [
+        c for c in frame.columns if (c.startswith("q_") or c.startswith("v_")) and c not in known
+    ]
     if unknown:
-        raise ScenarioError("LOG", source, f"joint columns not in robot {robot.name!r}: {', '.join(unknown[:8])}"
-                            + (" ..." if len(unknown) > 8 else ""))
+        raise ScenarioError(
+            "LOG",
+            source,
+            f"joint columns not in robot {robot.name!r}: {', '.join(unknown[:8])}"
+            + (" ..." if len(unknown) > 8 else ""),
+        )
     if missing:
-        raise ScenarioError("LOG", source, f"missing joint columns for robot {robot.name!r}: {', '.join(missing[:8])}"
-                            + (f" ... ({len(missing)} in all)" if len(missing) > 8 else ""))
+        raise ScenarioError(
+            "LOG",
+            source,
+            f"missing joint columns for robot {robot.name!r}: {', '.join(missing[:8])}"
+            + (f" ... ({len(missing)} in all)" if len(missing) > 8 else ""),
+        )
 
 
 def log_state(frame: pd.DataFrame, robot) -> tuple[np.ndarray, np.ndarray]:
@@ -185,7 +231,9 @@ def log_state(frame: pd.DataFrame, robot) -> tuple[np.ndarray, np.ndarray]:
     quat = frame[list(cols.base_quaternion)].to_numpy(float)
     norms = np.linalg.norm(quat, axis=1, keepdims=True)
     if np.any(~np.isfinite(norms)) or np.any(norms < 1e-9):
-        raise ScenarioError("LOG", "base_qx..base_qw", "the base quaternion must be finite and non-zero")
+        raise ScenarioError(
+            "LOG", "base_qx..base_qw", "the base quaternion must be finite and non-zero"
+        )
     Q[:, 3:7] = quat / norms
     lin = frame[list(cols.base_linear_velocity)].to_numpy(float)
     ang = frame[list(cols.base_angular_velocity)].to_numpy(float)
@@ -202,7 +250,9 @@ def log_state(frame: pd.DataFrame, robot) -> tuple[np.ndarray, np.ndarray]:
     return Q, V
 
 
-def _runs(times: np.ndarray, outside: np.ndarray, margins: np.ndarray, kind: str) -> list[Violation]:
+def _runs(
+    times: np.ndarray, outside: np.ndarray, margins: np.ndarray, kind: str
+) -> list[Violation]:
     out = []
     k, T = 0, len(outside)
     while k < T:
@@ -213,15 +263,35 @@ def _runs(times: np.ndarray, outside: np.ndarray, margins: np.ndarray, kind: str
         while j + 1 < T and outside[j + 1]:
             j += 1
         seg = margins[k : j + 1]
-        w = k + int(np.nanargmin(np.where(np.isfinite(seg), seg, -np.inf))) if np.any(~np.isnan(seg)) else k
-        out.append(Violation(kind, float(times[k]), float(times[j]), float(margins[w]), float(times[w]), j - k + 1))
+        w = (
+            k + int(np.nanargmin(np.where(np.isfinite(seg), seg, -np.inf)))
+            if np.any(~np.isnan(seg))
+            else k
+        )
+        out.append(
+            Violation(
+                kind,
+                float(times[k]),
+                float(times[j]),
+                float(margins[w]),
+                float(times[w]),
+                j - k + 1,
+            )
+        )
         k = j + 1
     return out
 
 
-def check_log(frame: pd.DataFrame, scenario: Scenario | str, *, force_threshold: float = 5.0,
-              move_tolerance: float = 0.01, turn_tolerance: float = np.deg2rad(3.0), com_tolerance: float = 0.01,
-              source: str = "LOG") -> LogCheck:
+def check_log(
+    frame: pd.DataFrame,
+    scenario: Scenario | str,
+    *,
+    force_threshold: float = 5.0,
+    move_tolerance: float = 0.01,
+    turn_tolerance: float = np.deg2rad(3.0),
+    com_tolerance: float = 0.01,
+    source: str = "LOG",
+) -> LogCheck:
     """Check a log (a DataFrame with the columns of :mod:`.schema`) against ``scenario``'s criteria.
 
     ``samples`` columns: ``time``, ``com_x/y/z`` (m), ``comd_x/y/z`` (m/s), ``dcm_x/y`` (m),
@@ -243,10 +313,15 @@ def check_log(frame: pd.DataFrame, scenario: Scenario | str, *, force_threshold:
     if np.any(~np.isfinite(times)) or np.any(np.diff(times) < 0):
         raise ScenarioError("LOG", source, "time must be finite and increasing")
     Q, V = log_state(frame, robot)
-    specs = [c.spec for c in scenario.build_stance(robot).contacts]  # contacts given by a normal: at the stance
+    specs = [
+        c.spec for c in scenario.build_stance(robot).contacts
+    ]  # contacts given by a normal: at the stance
     names = [s.frame for s in specs]
-    forces = {n: frame[list(force_columns(n))].to_numpy(float) for n in names
-              if all(c in frame.columns for c in force_columns(n))}
+    forces = {
+        n: frame[list(force_columns(n))].to_numpy(float)
+        for n in names
+        if all(c in frame.columns for c in force_columns(n))
+    }
     has_zmp = all(c in frame.columns for c in cols.zmp)
     zmp_logged = frame[list(cols.zmp)].to_numpy(float) if has_zmp else None
     model = robot.model
@@ -287,41 +362,72 @@ def check_log(frame: pd.DataFrame, scenario: Scenario | str, *, force_threshold:
             chosen = [s for s in specs if s.frame in active_t]
             if chosen and com[2] > h:
                 stance = Stance(robot, q, chosen)
-                zmp_area = balance_areas(stance, h, scenario.torque_limits, g, scenario.zmp_margin).zmp_area
+                zmp_area = balance_areas(
+                    stance, h, scenario.torque_limits, g, scenario.zmp_margin
+                ).zmp_area
             else:
                 zmp_area = Polygon.empty()
-            segments.append(StanceSegment(float(times[k]), active_t, zmp_area, com.copy(), not zmp_area.is_empty))
+            segments.append(
+                StanceSegment(
+                    float(times[k]), active_t, zmp_area, com.copy(), not zmp_area.is_empty
+                )
+            )
             key_poses = [pin.SE3(p) for p in poses]
             active_prev = active_t
         seg = segments[-1]
         stance_index[k] = len(segments) - 1
         omega = np.sqrt(g / (com[2] - h)) if com[2] > h else np.nan
         dcm = com[:2] + comd[:2] / omega if np.isfinite(omega) else np.full(2, np.nan)
-        vel_margin = omega * float(seg.zmp_area.margins(dcm)[0]) if seg.can_balance and np.isfinite(omega) else -np.inf
+        vel_margin = (
+            omega * float(seg.zmp_area.margins(dcm)[0])
+            if seg.can_balance and np.isfinite(omega)
+            else -np.inf
+        )
         zmp_margin = np.nan
         if has_zmp and np.all(np.isfinite(zmp_logged[k])):
-            zmp_margin = float(seg.zmp_area.margins(zmp_logged[k])[0]) if seg.can_balance else -np.inf
+            zmp_margin = (
+                float(seg.zmp_area.margins(zmp_logged[k])[0]) if seg.can_balance else -np.inf
+            )
         rows[k] = [*com, *comd, *dcm, vel_margin, zmp_margin, omega, 0.0]
-    samples = pd.DataFrame({
-        "time": times,
-        "com_x": rows[:, 0], "com_y": rows[:, 1], "com_z": rows[:, 2],
-        "comd_x": rows[:, 3], "comd_y": rows[:, 4], "comd_z": rows[:, 5],
-        "dcm_x": rows[:, 6], "dcm_y": rows[:, 7],
-        "com_velocity_margin": rows[:, 8],
-        "com_velocity_inside": rows[:, 8] >= 0.0,
-        "zmp_margin": rows[:, 9],
-        "zmp_inside": np.where(np.isnan(rows[:, 9]), np.nan, rows[:, 9] >= 0.0),
-        "omega": rows[:, 10],
-        "stance": stance_index,
-    })
-    violations = _runs(times, ~samples["com_velocity_inside"].to_numpy(bool), rows[:, 8], "com_velocity")
+    samples = pd.DataFrame(
+        {
+            "time": times,
+            "com_x": rows[:, 0],
+            "com_y": rows[:, 1],
+            "com_z": rows[:, 2],
+            "comd_x": rows[:, 3],
+            "comd_y": rows[:, 4],
+            "comd_z": rows[:, 5],
+            "dcm_x": rows[:, 6],
+            "dcm_y": rows[:, 7],
+            "com_velocity_margin": rows[:, 8],
+            "com_velocity_inside": rows[:, 8] >= 0.0,
+            "zmp_margin": rows[:, 9],
+            "zmp_inside": np.where(np.isnan(rows[:, 9]), np.nan, rows[:, 9] >= 0.0),
+            "omega": rows[:, 10],
+            "stance": stance_index,
+        }
+    )
+    violations = _runs(
+        times, ~samples["com_velocity_inside"].to_numpy(bool), rows[:, 8], "com_velocity"
+    )
     if has_zmp:
         zm = rows[:, 9]
         violations += _runs(times, np.isfinite(zm) & (zm < 0.0) | np.isneginf(zm), zm, "zmp")
     violations.sort(key=lambda v: (v.start, v.kind))
-    settings = {"force_threshold": force_threshold, "move_tolerance": move_tolerance,
-                "turn_tolerance": turn_tolerance, "com_tolerance": com_tolerance}
+    settings = {
+        "force_threshold": force_threshold,
+        "move_tolerance": move_tolerance,
+        "turn_tolerance": turn_tolerance,
+        "com_tolerance": com_tolerance,
+    }
     # The CoM's vertical acceleration, fitted over the log: -g for a falling robot, 0 with gravity off.
-    accel = float(np.polyfit(times, rows[:, 5], 1)[0]) if len(times) > 2 and np.ptp(times) > 0 else float("nan")
+    accel = (
+        float(np.polyfit(times, rows[:, 5], 1)[0])
+        if len(times) > 2 and np.ptp(times) > 0
+        else float("nan")
+    )
     change = rows[-1, 3:6] - rows[0, 3:6]
-    return LogCheck(scenario.name, samples, segments, violations, has_zmp, settings, loaded, accel, change, g)
+    return LogCheck(
+        scenario.name, samples, segments, violations, has_zmp, settings, loaded, accel, change, g
+    )

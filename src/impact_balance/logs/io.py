@@ -24,10 +24,15 @@ import pandas as pd
 
 from impact_balance.analysis.result import Diagnostic
 from impact_balance.exceptions import ScenarioError, short_repr
-from impact_balance.scenario.reader import MAX_LOG_BYTES, MAX_LOG_COLUMNS, MAX_LOG_ROWS, MAX_LOG_VALUES
 from impact_balance.logs.schema import LOG_VERSION, LogColumns
+from impact_balance.scenario.reader import (
+    MAX_LOG_BYTES,
+    MAX_LOG_COLUMNS,
+    MAX_LOG_ROWS,
+    MAX_LOG_VALUES,
+)
 
-__all__ = ["write_log", "read_log", "check_log_path", "check_log_columns", "SUFFIXES"]
+__all__ = ["SUFFIXES", "check_log_columns", "check_log_path", "read_log", "write_log"]
 
 #: Supported file types.
 SUFFIXES = (".parquet", ".csv")
@@ -37,15 +42,22 @@ _OPTIONAL = ("zmp_", "force_", "com_", "comd_")
 
 def check_log_path(path: str | Path, field: str = "--log") -> str:
     """The suffix of a log file name (``.parquet`` or ``.csv``); :class:`ScenarioError` naming
-    ``field`` otherwise. Commands call it before a long run, so a bad name fails at once."""
+    ``field`` otherwise. Commands call it before a long run, so a bad name fails at once.
+    """
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in SUFFIXES:
-        raise ScenarioError(field, str(path)[:80], f"a log is a .parquet or .csv file, not {suffix or 'no suffix'!r}")
+        raise ScenarioError(
+            field,
+            str(path)[:80],
+            f"a log is a .parquet or .csv file, not {suffix or 'no suffix'!r}",
+        )
     return suffix
 
 
-def write_log(frame: pd.DataFrame, path: str | Path, metadata: dict[str, str] | None = None) -> Path:
+def write_log(
+    frame: pd.DataFrame, path: str | Path, metadata: dict[str, str] | None = None
+) -> Path:
     """Write ``frame`` (columns of :mod:`.schema`) to ``path``; Parquet files keep ``metadata`` and the version."""
     path = Path(path)
     suffix = check_log_path(path, "--log")
@@ -74,8 +86,12 @@ def _size_limits(shown: str, rows: int, columns: int) -> int:
         raise ScenarioError("LOG", shown, f"{columns} columns: a log has at most {MAX_LOG_COLUMNS}")
     allowed = min(MAX_LOG_ROWS, MAX_LOG_VALUES // max(columns, 1))
     if rows > allowed:
-        raise ScenarioError("LOG", shown, f"{rows:,} rows of {columns} columns: a log has at most {MAX_LOG_ROWS:,} "
-                                          f"rows and {MAX_LOG_VALUES:,} values (split it)")
+        raise ScenarioError(
+            "LOG",
+            shown,
+            f"{rows:,} rows of {columns} columns: a log has at most {MAX_LOG_ROWS:,} "
+            f"rows and {MAX_LOG_VALUES:,} values (split it)",
+        )
     return allowed
 
 
@@ -111,11 +127,15 @@ def _read_csv(path: Path, shown: str, warnings: list[Diagnostic] | None) -> pd.D
         line = len(frame) + 1
         if fields < len(frame.columns):
             frame = frame.iloc[:-1]
-            note = f"the last line ({line}) has {fields} of {len(frame.columns)} fields and no line break: the " \
-                   "file was cut while written; that line is left out"
+            note = (
+                f"the last line ({line}) has {fields} of {len(frame.columns)} fields and no line break: the "
+                "file was cut while written; that line is left out"
+            )
         else:
-            note = f"the file does not end with a line break: its last line ({line}) may have been cut while " \
-                   "written (its last value may be short)"
+            note = (
+                f"the file does not end with a line break: its last line ({line}) may have been cut while "
+                "written (its last value may be short)"
+            )
         if warnings is not None:
             warnings.append(Diagnostic("log_cut", "LOG", note))
     return frame
@@ -124,7 +144,8 @@ def _read_csv(path: Path, shown: str, warnings: list[Diagnostic] | None) -> pd.D
 def read_log(path: str | Path, warnings: list[Diagnostic] | None = None) -> pd.DataFrame:
     """Read a log within the limits; refuse a file without the required columns (naming them)
     or with a value the checker cannot use (naming its column and row). ``warnings``, if given,
-    receives the caveats (a CSV file cut in its last line)."""
+    receives the caveats (a CSV file cut in its last line).
+    """
     path = Path(path)
     suffix = check_log_path(path, "LOG")
     shown = str(path)[:80]
@@ -132,7 +153,9 @@ def read_log(path: str | Path, warnings: list[Diagnostic] | None = None) -> pd.D
         raise ScenarioError("LOG", shown, "no such file")
     size = os.path.getsize(path)
     if size > MAX_LOG_BYTES:
-        raise ScenarioError("LOG", shown, f"{size:,} bytes: a log file has at most {MAX_LOG_BYTES:,}")
+        raise ScenarioError(
+            "LOG", shown, f"{size:,} bytes: a log file has at most {MAX_LOG_BYTES:,}"
+        )
     try:
         frame = _read_csv(path, shown, warnings) if suffix == ".csv" else _read_parquet(path, shown)
     except ScenarioError:
@@ -140,7 +163,9 @@ def read_log(path: str | Path, warnings: list[Diagnostic] | None = None) -> pd.D
     except MemoryError:
         raise
     except Exception as exc:  # pandas/pyarrow raise many types for a malformed file
-        raise ScenarioError("LOG", shown, f"cannot read as {suffix[1:]}: {type(exc).__name__}") from None
+        raise ScenarioError(
+            "LOG", shown, f"cannot read as {suffix[1:]}: {type(exc).__name__}"
+        ) from None
     missing = [c for c in LogColumns().required if c not in frame.columns]
     if missing:
         raise ScenarioError("LOG", shown, f"missing required columns: {', '.join(missing)}")
@@ -152,7 +177,9 @@ def _where(row: int, line_offset: int | None) -> str:
     return f"row {row + 1}" + (f" (line {row + line_offset})" if line_offset is not None else "")
 
 
-def check_log_columns(frame: pd.DataFrame, source: str = "LOG", line_offset: int | None = None) -> None:
+def check_log_columns(
+    frame: pd.DataFrame, source: str = "LOG", line_offset: int | None = None
+) -> None:
     """Refuse a value the checker cannot use, naming its column and row (see the module docstring).
 
     ``line_offset``: for a CSV file, the file line of row 0 (the header is line 1).
@@ -173,7 +200,11 @@ def check_log_columns(frame: pd.DataFrame, source: str = "LOG", line_offset: int
             if bad.any():
                 row = int(np.flatnonzero(bad.to_numpy())[0])
                 value = short_repr(column.iloc[row], 30)
-                raise ScenarioError("LOG", source, f"column {name_s}, {_where(row, line_offset)}: {value} is not a number")
+                raise ScenarioError(
+                    "LOG",
+                    source,
+                    f"column {name_s}, {_where(row, line_offset)}: {value} is not a number",
+                )
             column = numbers
         if needed:
             values = column.to_numpy(dtype=float)
@@ -182,5 +213,9 @@ def check_log_columns(frame: pd.DataFrame, source: str = "LOG", line_offset: int
                 row = int(bad_rows[0])
                 what = "empty (or NaN)" if np.isnan(values[row]) else "infinite"
                 more = f"; {bad_rows.size} such rows" if bad_rows.size > 1 else ""
-                raise ScenarioError("LOG", source, f"column {name_s}, {_where(row, line_offset)}: {what}, not a finite "
-                                                   f"number{more}")
+                raise ScenarioError(
+                    "LOG",
+                    source,
+                    f"column {name_s}, {_where(row, line_offset)}: {what}, not a finite "
+                    f"number{more}",
+                )

@@ -20,7 +20,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["LOG_VERSION", "LogColumns", "joint_position_column", "joint_velocity_column", "force_columns"]
+__all__ = [
+    "LOG_VERSION",
+    "LogColumns",
+    "force_columns",
+    "joint_position_column",
+    "joint_velocity_column",
+]
 
 #: Version of the column schema, stored in the Parquet metadata as ``impact_balance_log_version``.
 LOG_VERSION = 1
@@ -41,8 +47,13 @@ class LogColumns:
 
     @property
     def required(self) -> tuple[str, ...]:
-        return (self.time, *self.base_position, *self.base_quaternion, *self.base_linear_velocity,
-                *self.base_angular_velocity)
+        return (
+            self.time,
+            *self.base_position,
+            *self.base_quaternion,
+            *self.base_linear_velocity,
+            *self.base_angular_velocity,
+        )
 
 
 def joint_position_column(joint: str) -> str:

@@ -22,11 +22,11 @@ from impact_balance.plots.save import save_figures
 from impact_balance.plots.stance import plot_stance
 
 __all__ = [
-    "plot_areas",
-    "plot_impulse_set",
-    "plot_friction_comparison",
-    "plot_phase_portrait",
     "analysis_phase_portrait",
+    "plot_areas",
+    "plot_friction_comparison",
+    "plot_impulse_set",
+    "plot_phase_portrait",
     "plot_stance",
     "save_figures",
 ]

@@ -67,13 +67,39 @@ def draw_polygon(
     if len(v) == 1:
         ax.plot(v[:, 0], v[:, 1], "o", color=edge, ms=6, label=label, zorder=zorder + 0.5)
     elif len(v) == 2:
-        ax.plot(v[:, 0], v[:, 1], "-", color=edge, lw=max(3.0, 2 * lw), solid_capstyle="round",
-                label=label, zorder=zorder + 0.5)
+        ax.plot(
+            v[:, 0],
+            v[:, 1],
+            "-",
+            color=edge,
+            lw=max(3.0, 2 * lw),
+            solid_capstyle="round",
+            label=label,
+            zorder=zorder + 0.5,
+        )
     else:
-        ax.add_patch(PolygonPatch(v, closed=True, facecolor=color if fill else "none", alpha=alpha if fill else 1.0,
-                                  edgecolor="none", zorder=zorder))
-        ax.add_patch(PolygonPatch(v, closed=True, facecolor="none", edgecolor=edge, lw=lw, ls=ls,
-                                  zorder=zorder + 0.1, label=label))
+        ax.add_patch(
+            PolygonPatch(
+                v,
+                closed=True,
+                facecolor=color if fill else "none",
+                alpha=alpha if fill else 1.0,
+                edgecolor="none",
+                zorder=zorder,
+            )
+        )
+        ax.add_patch(
+            PolygonPatch(
+                v,
+                closed=True,
+                facecolor="none",
+                edgecolor=edge,
+                lw=lw,
+                ls=ls,
+                zorder=zorder + 0.1,
+                label=label,
+            )
+        )
 
 
 def hull(points: np.ndarray) -> Polygon:
@@ -82,7 +108,11 @@ def hull(points: np.ndarray) -> Polygon:
 
 
 def set_limits(
-    ax: Axes, points: Iterable[np.ndarray], margin: float = 0.12, min_span: float = 0.05, min_ratio: float = 0.0
+    ax: Axes,
+    points: Iterable[np.ndarray],
+    margin: float = 0.12,
+    min_span: float = 0.05,
+    min_ratio: float = 0.0,
 ) -> None:
     """Fit the axis limits to ``points`` (arrays of (k, 2)), with a relative margin.
 
@@ -104,20 +134,48 @@ def set_limits(
     ax.set_ylim(centre[1] - half[1], centre[1] + half[1])
 
 
-def text_box(ax: Axes, text: str, loc: str = "upper left", fontsize: float = 9, edgecolor: str = "0.6") -> None:
+def text_box(
+    ax: Axes, text: str, loc: str = "upper left", fontsize: float = 9, edgecolor: str = "0.6"
+) -> None:
     """A boxed note inside the axes."""
     x, ha = (0.02, "left") if "left" in loc else (0.98, "right")
     y, va = (0.98, "top") if "upper" in loc else (0.02, "bottom")
-    ax.text(x, y, text, transform=ax.transAxes, ha=ha, va=va, fontsize=fontsize, zorder=10,
-            bbox=dict(boxstyle="round,pad=0.4", facecolor="white", edgecolor=edgecolor, alpha=0.9,
-                      lw=2 if edgecolor != "0.6" else 1))
+    ax.text(
+        x,
+        y,
+        text,
+        transform=ax.transAxes,
+        ha=ha,
+        va=va,
+        fontsize=fontsize,
+        zorder=10,
+        bbox=dict(
+            boxstyle="round,pad=0.4",
+            facecolor="white",
+            edgecolor=edgecolor,
+            alpha=0.9,
+            lw=2 if edgecolor != "0.6" else 1,
+        ),
+    )
 
 
-def centre_message(ax: Axes, text: str, color: str = "tab:red", y: float = 0.5, fontsize: float = 13) -> None:
+def centre_message(
+    ax: Axes, text: str, color: str = "tab:red", y: float = 0.5, fontsize: float = 13
+) -> None:
     """A large message across the axes (e.g. "cannot balance"), at height ``y`` (axes fraction)."""
     put = getattr(ax, "text2D", ax.text)  # 3D axes place 2D text with text2D
-    put(0.5, y, text, transform=ax.transAxes, ha="center", va="center", fontsize=fontsize, color=color,
-            zorder=11, bbox=dict(boxstyle="round,pad=0.5", facecolor="white", edgecolor=color, alpha=0.9))
+    put(
+        0.5,
+        y,
+        text,
+        transform=ax.transAxes,
+        ha="center",
+        va="center",
+        fontsize=fontsize,
+        color=color,
+        zorder=11,
+        bbox=dict(boxstyle="round,pad=0.5", facecolor="white", edgecolor=color, alpha=0.9),
+    )
 
 
 def scenario_title(analysis) -> str:
@@ -142,7 +200,10 @@ def trim_height(fig: Figure, axes: Sequence[Axes], passes: int = 2) -> None:
     """
     for _ in range(passes):
         fig.canvas.draw()
-        spare = min(ax.get_position(original=True).height - ax.get_position(original=False).height for ax in axes)
+        spare = min(
+            ax.get_position(original=True).height - ax.get_position(original=False).height
+            for ax in axes
+        )
         if spare * fig.get_figheight() < 0.05:
             return
         fig.set_figheight(fig.get_figheight() * (1.0 - spare) + 0.02)

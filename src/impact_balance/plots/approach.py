@@ -19,7 +19,8 @@ __all__ = ["plot_approach"]
 
 def plot_approach(trial, analysis, margin_area=None) -> Figure:
     """The figure of a :class:`~impact_balance.sim.studies.wall.WallTrial` (see the module docstring);
-    ``margin_area``: the CoM velocity area the governor used, when it differs (a ZMP margin)."""
+    ``margin_area``: the CoM velocity area the governor used, when it differs (a ZMP margin).
+    """
     fig = new_figure(11.0, 4.8)
     left, right = fig.subplots(1, 2, width_ratios=[1.3, 1.0])
     s = trial.series
@@ -61,11 +62,26 @@ def plot_approach(trial, analysis, margin_area=None) -> Figure:
         path = series["com_velocity"][keep][:, :2]
         color = OUTCOME_COLORS[trial.result.outcome]
         right.plot(path[:, 0], path[:, 1], color=color, lw=1.0)
-        handles.append(Line2D([], [], color=color, lw=1.0, label=f"CoM velocity ({trial.result.outcome.replace('_', ' ')})"))
+        handles.append(
+            Line2D(
+                [],
+                [],
+                color=color,
+                lw=1.0,
+                label=f"CoM velocity ({trial.result.outcome.replace('_', ' ')})",
+            )
+        )
         if trial.result.impact is not None:
-            before, after = trial.result.impact.com_velocity_before, trial.result.impact.com_velocity_after
-            right.plot([before[0], after[0]], [before[1], after[1]], "o-", color="tab:red", ms=3, lw=1.2)
-            handles.append(Line2D([], [], color="tab:red", marker="o", ms=3, label="across the impact"))
+            before, after = (
+                trial.result.impact.com_velocity_before,
+                trial.result.impact.com_velocity_after,
+            )
+            right.plot(
+                [before[0], after[0]], [before[1], after[1]], "o-", color="tab:red", ms=3, lw=1.2
+            )
+            handles.append(
+                Line2D([], [], color="tab:red", marker="o", ms=3, label="across the impact")
+            )
     set_limits(right, [area.vertices, path], min_ratio=0.5)
     right.set_aspect("equal")
     right.set_xlabel("CoM velocity x (m/s)")
@@ -74,6 +90,9 @@ def plot_approach(trial, analysis, margin_area=None) -> Figure:
     right.set_title("CoM velocity through the approach and the impact", fontsize=9)
     right.legend(handles=handles, loc="upper left", fontsize=7)
     o = trial.options
-    fig.suptitle(f"{analysis.scenario.name}: approach at {o.reference:g} m/s reference, wall {100 * o.wall_distance:g} cm "
-                 f"away, {o.governor} governor: {trial.result.outcome.replace('_', ' ')}", fontsize=10)
+    fig.suptitle(
+        f"{analysis.scenario.name}: approach at {o.reference:g} m/s reference, wall {100 * o.wall_distance:g} cm "
+        f"away, {o.governor} governor: {trial.result.outcome.replace('_', ' ')}",
+        fontsize=10,
+    )
     return fig

@@ -28,7 +28,7 @@ from impact_balance.plots._common import (
     set_limits,
 )
 
-__all__ = ["plot_areas", "draw_zmp_area", "draw_com_velocity_area", "short_reason"]
+__all__ = ["draw_com_velocity_area", "draw_zmp_area", "plot_areas", "short_reason"]
 
 
 def short_reason(analysis: Analysis) -> str | None:
@@ -44,7 +44,9 @@ def short_reason(analysis: Analysis) -> str | None:
             return f"torque limits (all x{reason.uniform_scale:.2g})"
         return "torque limits"
     if reason.kind == "friction":
-        return "friction" + (f" (needs μ ≥ {reason.min_friction:.2g})" if reason.min_friction is not None else "")
+        return "friction" + (
+            f" (needs μ ≥ {reason.min_friction:.2g})" if reason.min_friction is not None else ""
+        )
     if reason.kind == "com_outside":
         return "CoM outside the static-equilibrium region"
     return reason.kind.replace("_", " ")
@@ -59,8 +61,12 @@ def _headroom(ax: Axes, fraction: float = 0.3) -> None:
 def _cannot_balance(ax: Axes, analysis: Analysis, what: str) -> None:
     why = short_reason(analysis)
     # High in the axes: the CoM projection and the contacts stay visible below it.
-    centre_message(ax, f"cannot balance: empty {what}" + (f"\nbecause of the {why}" if why else ""), y=0.9,
-                   fontsize=11)
+    centre_message(
+        ax,
+        f"cannot balance: empty {what}" + (f"\nbecause of the {why}" if why else ""),
+        y=0.9,
+        fontsize=11,
+    )
 
 
 def draw_zmp_area(ax: Axes, analysis: Analysis) -> None:
@@ -71,8 +77,16 @@ def draw_zmp_area(ax: Axes, analysis: Analysis) -> None:
     for i, contact in enumerate(analysis.stance.contacts):
         corners = contact.corners()[:, :2]
         view.append(corners)
-        draw_polygon(ax, hull(corners), color=CONTACT_COLOR, lw=1.4, ls="--", zorder=2, fill=False,
-                     label="contact rectangles (projected)" if i == 0 else None)
+        draw_polygon(
+            ax,
+            hull(corners),
+            color=CONTACT_COLOR,
+            lw=1.4,
+            ls="--",
+            zorder=2,
+            fill=False,
+            label="contact rectangles (projected)" if i == 0 else None,
+        )
     if zmp.is_empty:
         _cannot_balance(ax, analysis, "ZMP support area")
     else:
@@ -94,10 +108,19 @@ def draw_zmp_area(ax: Axes, analysis: Analysis) -> None:
     ax.set_title(f"ZMP support area (plane z = {areas.plane_height:g} m)")
     ax.grid(True, alpha=0.3)
     # Below the axes: a legend inside would cover the area's boundary.
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.0), borderaxespad=4.8, fontsize=8, framealpha=0.9, ncol=2)
+    ax.legend(
+        loc="upper center",
+        bbox_to_anchor=(0.5, 0.0),
+        borderaxespad=4.8,
+        fontsize=8,
+        framealpha=0.9,
+        ncol=2,
+    )
 
 
-def draw_com_velocity_area(ax: Axes, analysis: Analysis, n_steps: int = 5, side: Axes | None = None) -> None:
+def draw_com_velocity_area(
+    ax: Axes, analysis: Analysis, n_steps: int = 5, side: Axes | None = None
+) -> None:
     """CoM velocity area, pre-impact CoM velocity and post-impact sets for increasing speeds.
 
     The legend and the note (maxima, impact parameters, why the robot cannot balance) go in
@@ -114,7 +137,9 @@ def draw_com_velocity_area(ax: Axes, analysis: Analysis, n_steps: int = 5, side:
         label = f"CoM velocity area ({len(area.vertices)} vertices)"
         if not area.bounded:
             label += ", unbounded (clipped)"
-        draw_polygon(ax, area, color=AREA_COLOR, alpha=0.4, lw=2, edge="teal", label=label, zorder=1)
+        draw_polygon(
+            ax, area, color=AREA_COLOR, alpha=0.4, lw=2, edge="teal", label=label, zorder=1
+        )
     ax.plot(*c0, "o", color=COM_COLOR, ms=7, label="pre-impact CoM velocity", zorder=6)
 
     im = analysis.impact
@@ -138,17 +163,40 @@ def draw_com_velocity_area(ax: Axes, analysis: Analysis, n_steps: int = 5, side:
                 else:
                     lab = f"post-impact set at {s:.3g} m/s"
                 color = cmap(0.35 + 0.6 * k / n_steps)
-                draw_polygon(ax, hull(pts), color=color, alpha=0.25 if not last else 0.45,
-                             edge="navy" if last else color, lw=2.5 if last else 1.0, label=lab, zorder=3 + 0.1 * k)
+                draw_polygon(
+                    ax,
+                    hull(pts),
+                    color=color,
+                    alpha=0.25 if not last else 0.45,
+                    edge="navy" if last else color,
+                    lw=2.5 if last else 1.0,
+                    label=lab,
+                    zorder=3 + 0.1 * k,
+                )
             if limit.is_finite and limit.limiting_vertex is not None:
                 p = model.post_impact_com_velocities(c0, vmax)[limit.limiting_vertex]
-                ax.plot(*p, marker="*", color="gold", mec="black", ms=16, zorder=8,
-                        label=f"limiting vertex #{limit.limiting_vertex} (on the boundary)")
+                ax.plot(
+                    *p,
+                    marker="*",
+                    color="gold",
+                    mec="black",
+                    ms=16,
+                    zorder=8,
+                    label=f"limiting vertex #{limit.limiting_vertex} (on the boundary)",
+                )
                 if limit.limiting_edge is not None and len(area.vertices) >= 3:
                     k = limit.limiting_edge
                     e = area.vertices[[k, (k + 1) % len(area.vertices)]]
-                    ax.plot(e[:, 0], e[:, 1], "-", color="gold", lw=4, alpha=0.8, zorder=2.5,
-                            label="limiting edge of the area")
+                    ax.plot(
+                        e[:, 0],
+                        e[:, 1],
+                        "-",
+                        color="gold",
+                        lw=4,
+                        alpha=0.8,
+                        zorder=2.5,
+                        label="limiting edge of the area",
+                    )
         if v_ref is not None and limit.is_finite and v_ref > vmax + 1e-12:
             pts = model.post_impact_com_velocities(c0, v_ref)
             view.append(pts)
@@ -158,8 +206,17 @@ def draw_com_velocity_area(ax: Axes, analysis: Analysis, n_steps: int = 5, side:
             lab = f"at the reference {v_ref:.3g} m/s: falls"
             if above < 10.0:
                 lab += f"\n(only {above:.1f} % above v_max: nearly the same set)"
-            draw_polygon(ax, hull(pts), color=FALL_COLOR, fill=False, edge=FALL_COLOR, lw=1.3, ls=(0, (4, 2)),
-                         label=lab, zorder=6)
+            draw_polygon(
+                ax,
+                hull(pts),
+                color=FALL_COLOR,
+                fill=False,
+                edge=FALL_COLOR,
+                lw=1.3,
+                ls=(0, (4, 2)),
+                label=lab,
+                zorder=6,
+            )
         lines.append("maximum approach speed:")
         lines.append(f"  CoM criterion: {fmt_speed(vmax)}")
         lines.append(f"  ZMP criterion: {fmt_speed(im.zmp_max_contact_velocity)}")
@@ -183,9 +240,22 @@ def draw_com_velocity_area(ax: Axes, analysis: Analysis, n_steps: int = 5, side:
     alarm = falling or reason is not None
     where = side if side is not None else ax
     x0 = 0.0 if side is not None else 1.03
-    where.text(x0, 0.0, "\n".join(lines), transform=where.transAxes, ha="left", va="bottom", fontsize=8, zorder=10,
-               bbox=dict(boxstyle="round,pad=0.4", facecolor="white", edgecolor=FALL_COLOR if alarm else "0.6",
-                         lw=2 if alarm else 1))
+    where.text(
+        x0,
+        0.0,
+        "\n".join(lines),
+        transform=where.transAxes,
+        ha="left",
+        va="bottom",
+        fontsize=8,
+        zorder=10,
+        bbox=dict(
+            boxstyle="round,pad=0.4",
+            facecolor="white",
+            edgecolor=FALL_COLOR if alarm else "0.6",
+            lw=2 if alarm else 1,
+        ),
+    )
     set_limits(ax, area_view_points(area, view), margin=0.12, min_ratio=0.5)
     if area.is_empty:
         _headroom(ax)
@@ -197,8 +267,15 @@ def draw_com_velocity_area(ax: Axes, analysis: Analysis, n_steps: int = 5, side:
     ax.grid(True, alpha=0.3)
     handles, labels = ax.get_legend_handles_labels()
     if side is not None:
-        side.legend(handles, labels, loc="upper left", bbox_to_anchor=(0.0, 1.0), borderaxespad=0.0, fontsize=7.5,
-                    framealpha=0.9)
+        side.legend(
+            handles,
+            labels,
+            loc="upper left",
+            bbox_to_anchor=(0.0, 1.0),
+            borderaxespad=0.0,
+            fontsize=7.5,
+            framealpha=0.9,
+        )
     else:
         ax.legend(loc="upper left", bbox_to_anchor=(1.03, 1.0), fontsize=7.5, framealpha=0.9)
 
@@ -224,10 +301,16 @@ def plot_areas(analysis: Analysis, n_steps: int = 5) -> Figure:
     # figure leaves bands of blank space above and below it.
     # Panels as wide as their data at a common height: fixed ratios left a blank band beside
     # a narrow (tall) area.
-    ratio = max(_aspect(left), _aspect(right), 0.75 if analysis.cannot_balance_reason is not None else 0.0)
+    ratio = max(
+        _aspect(left), _aspect(right), 0.75 if analysis.cannot_balance_reason is not None else 0.0
+    )
     height = float(np.clip(4.2 * ratio + 2.6, 4.0, 9.0))
     axes_height = height - 2.2  # titles, tick labels and the legend below the left panel
-    widths = [axes_height / _aspect(left), axes_height / _aspect(right), 3.0]  # inches; 3 for the legend
+    widths = [
+        axes_height / _aspect(left),
+        axes_height / _aspect(right),
+        3.0,
+    ]  # inches; 3 for the legend
     left.get_gridspec().set_width_ratios(widths)
     fig.set_size_inches(float(np.clip(sum(widths) + 1.8, 10.0, 20.0)), height)
     why = short_reason(analysis)

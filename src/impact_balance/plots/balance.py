@@ -18,24 +18,51 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from impact_balance.geometry.polygon import Polygon
-from impact_balance.plots._common import AREA_COLOR, FALL_COLOR, OK_COLOR, ZMP_COLOR, draw_polygon, new_figure, set_limits
+from impact_balance.plots._common import (
+    AREA_COLOR,
+    FALL_COLOR,
+    OK_COLOR,
+    ZMP_COLOR,
+    draw_polygon,
+    new_figure,
+    set_limits,
+)
 
-__all__ = ["OUTCOME_COLORS", "plot_validation", "plot_impact_trajectories", "plot_push_trajectories", "plot_log_margins"]
+__all__ = [
+    "OUTCOME_COLORS",
+    "plot_impact_trajectories",
+    "plot_log_margins",
+    "plot_push_trajectories",
+    "plot_validation",
+]
 
 #: Colour of each trial outcome.
-OUTCOME_COLORS = {"balanced": OK_COLOR, "contact_broken": "tab:orange", "fell": FALL_COLOR, "aborted": "0.6"}
-_ORDER = {"fell": 0, "aborted": 1, "contact_broken": 2, "balanced": 3}  # drawing order: falls underneath
+OUTCOME_COLORS = {
+    "balanced": OK_COLOR,
+    "contact_broken": "tab:orange",
+    "fell": FALL_COLOR,
+    "aborted": "0.6",
+}
+_ORDER = {
+    "fell": 0,
+    "aborted": 1,
+    "contact_broken": 2,
+    "balanced": 3,
+}  # drawing order: falls underneath
 
 
 def _outcome_handles(outcomes) -> list[Line2D]:
     seen = set(outcomes)
     present = [o for o in OUTCOME_COLORS if o in seen]
-    return [Line2D([], [], color=OUTCOME_COLORS[o], lw=1.5, label=o.replace("_", " ")) for o in present]
+    return [
+        Line2D([], [], color=OUTCOME_COLORS[o], lw=1.5, label=o.replace("_", " ")) for o in present
+    ]
 
 
 def plot_validation(result) -> Figure:
     """Each impact trial's outcome against its measured approach speed (filled) and commanded speed (open),
-    with the CoM and ZMP criteria's maximum contact velocity (composite; solid without margin, dashed with it)."""
+    with the CoM and ZMP criteria's maximum contact velocity (composite; solid without margin, dashed with it).
+    """
     fig = new_figure(8.0, 3.8)
     ax = fig.add_subplot()
     rows = {"balanced": 0, "contact_broken": 1, "fell": 2, "aborted": 3}
@@ -51,19 +78,35 @@ def plot_validation(result) -> Figure:
             speeds.append(t.measured)
     top = max(speeds + [0.1])
     lines = []
-    for crit, color, name in (("com_criterion", "tab:blue", "CoM criterion"), ("zmp_criterion", "tab:green", "ZMP criterion")):
-        for values, ls, note in ((result.predicted, "-", "no margin"),
-                                 (result.predicted_with_margin, "--", f"ZMP margin {1000 * result.zmp_margin:g} mm")):
+    for crit, color, name in (
+        ("com_criterion", "tab:blue", "CoM criterion"),
+        ("zmp_criterion", "tab:green", "ZMP criterion"),
+    ):
+        for values, ls, note in (
+            (result.predicted, "-", "no margin"),
+            (result.predicted_with_margin, "--", f"ZMP margin {1000 * result.zmp_margin:g} mm"),
+        ):
             value = values[crit]["composite"]
             if value is None:
                 continue
             if value <= 1.3 * top:
                 ax.axvline(value, color=color, ls=ls, lw=1.2, zorder=1)
-            lines.append(Line2D([], [], color=color, ls=ls,
-                                label=f"{name} ({note}): {value:.3f} m/s" + ("" if value <= 1.3 * top else " (off scale)")))
+            lines.append(
+                Line2D(
+                    [],
+                    [],
+                    color=color,
+                    ls=ls,
+                    label=f"{name} ({note}): {value:.3f} m/s"
+                    + ("" if value <= 1.3 * top else " (off scale)"),
+                )
+            )
     b = result.bracket()
-    handles = [Line2D([], [], marker="o", color="0.3", ls="none", label="measured at first contact"),
-               Line2D([], [], marker="o", mfc="none", mec="0.3", ls="none", label="commanded"), *lines]
+    handles = [
+        Line2D([], [], marker="o", color="0.3", ls="none", label="measured at first contact"),
+        Line2D([], [], marker="o", mfc="none", mec="0.3", ls="none", label="commanded"),
+        *lines,
+    ]
     ax.set_yticks(list(rows.values()), [k.replace("_", " ") for k in rows])
     ax.set_ylim(-0.5, 3.6)
     ax.set_xlim(0, 1.35 * top)
@@ -71,18 +114,31 @@ def plot_validation(result) -> Figure:
     rigid = ", joints held through the impact" if result.rigid_impact else ""
     fmt = lambda x: "-" if x is None else f"{x:.3f}"  # noqa: E731
     bracket = f"stood {fmt(b['survived'])} m/s, fell {fmt(b['fell'])} m/s (measured)"
-    ax.set_title(f"{result.scenario}: impact trials ({result.joints} joints{rigid})\n{bracket}", fontsize=10)
+    ax.set_title(
+        f"{result.scenario}: impact trials ({result.joints} joints{rigid})\n{bracket}", fontsize=10
+    )
     ax.grid(alpha=0.3)
     fig.legend(handles=handles, loc="outside right center", fontsize=7, frameon=False)
     return fig
 
 
-def _area_with_margin(ax, area: Polygon, margin_area: Polygon | None, color: str, label: str, margin: float) -> list:
+def _area_with_margin(
+    ax, area: Polygon, margin_area: Polygon | None, color: str, label: str, margin: float
+) -> list:
     draw_polygon(ax, area, color=color, label=label)
     handles = [Line2D([], [], color=color, lw=6, alpha=0.5, label=label)]
     if margin_area is not None and margin > 0 and not margin_area.is_empty:
         draw_polygon(ax, margin_area, color=color, fill=False, ls="--", lw=1.0, edge="0.35")
-        handles.append(Line2D([], [], color="0.35", ls="--", lw=1.0, label=f"with the ZMP margin ({1000 * margin:g} mm)"))
+        handles.append(
+            Line2D(
+                [],
+                [],
+                color="0.35",
+                ls="--",
+                lw=1.0,
+                label=f"with the ZMP margin ({1000 * margin:g} mm)",
+            )
+        )
     return handles
 
 
@@ -91,18 +147,26 @@ _MARKERS = "os^vDP*Xph<>"
 
 def plot_impact_trajectories(result, analysis) -> Figure:
     """The CoM velocity of every impact trial (from just before the contact to 1.5 s after) over the CoM
-    velocity area; each trial's line ends with a marker that the legend names by its measured speed."""
+    velocity area; each trial's line ends with a marker that the legend names by its measured speed.
+    """
     areas = analysis.areas
     area = areas.com_velocity_area
     shrunk = areas.com_velocity_area_inset(result.zmp_margin) if result.zmp_margin > 0 else None
     fig = new_figure(6.4, 6.4)
     ax = fig.add_subplot()
-    handles = _area_with_margin(ax, area, shrunk, AREA_COLOR, "CoM velocity area", result.zmp_margin)
+    handles = _area_with_margin(
+        ax, area, shrunk, AREA_COLOR, "CoM velocity area", result.zmp_margin
+    )
     paths, trial_handles = [], []
-    ranked = sorted((t for t in result.trials if t.trajectory.get("com_velocity")), key=lambda t: t.measured or 0.0)
+    ranked = sorted(
+        (t for t in result.trials if t.trajectory.get("com_velocity")),
+        key=lambda t: t.measured or 0.0,
+    )
     marker = {id(t): _MARKERS[k % len(_MARKERS)] for k, t in enumerate(ranked)}
     for t in sorted(ranked, key=lambda t: _ORDER[t.outcome]):
-        path = np.array([p for p in t.trajectory["com_velocity"] if p is not None], dtype=float).reshape(-1, 2)
+        path = np.array(
+            [p for p in t.trajectory["com_velocity"] if p is not None], dtype=float
+        ).reshape(-1, 2)
         if not len(path):
             continue
         color = OUTCOME_COLORS[t.outcome]
@@ -111,16 +175,33 @@ def plot_impact_trajectories(result, analysis) -> Figure:
         paths.append(path)
     for t in ranked:
         speed = "no contact" if t.measured is None else f"{t.measured:.3f} m/s"
-        trial_handles.append(Line2D([], [], marker=marker[id(t)], color=OUTCOME_COLORS[t.outcome], ls="none",
-                                    label=f"{speed}: {t.outcome.replace('_', ' ')}"))
+        trial_handles.append(
+            Line2D(
+                [],
+                [],
+                marker=marker[id(t)],
+                color=OUTCOME_COLORS[t.outcome],
+                ls="none",
+                label=f"{speed}: {t.outcome.replace('_', ' ')}",
+            )
+        )
     set_limits(ax, [area.vertices, *paths], min_ratio=0.5)
     ax.set_aspect("equal")
     ax.set_xlabel("CoM velocity x (m/s)")
     ax.set_ylabel("CoM velocity y (m/s)")
-    ax.set_title(f"{result.scenario}: CoM velocity through each impact\n(from the contact to 1.5 s after; "
-                 f"markers at the end, by measured approach speed)", fontsize=9)
+    ax.set_title(
+        f"{result.scenario}: CoM velocity through each impact\n(from the contact to 1.5 s after; "
+        f"markers at the end, by measured approach speed)",
+        fontsize=9,
+    )
     ax.grid(alpha=0.3)
-    fig.legend(handles=handles + trial_handles, loc="outside lower center", ncols=3, fontsize=7, frameon=False)
+    fig.legend(
+        handles=handles + trial_handles,
+        loc="outside lower center",
+        ncols=3,
+        fontsize=7,
+        frameon=False,
+    )
     return fig
 
 
@@ -128,14 +209,27 @@ def plot_push_trajectories(result, kind: str = "com_velocity") -> Figure:
     """After every push, the CoM velocity (``kind="com_velocity"``) over the CoM velocity area, or the ZMP
     (``"zmp"``) over the ZMP support area, coloured by outcome; crosses mark each push's before-trial
     prediction (the post-push CoM velocity, or the quasi-static ZMP while it acts). The directions and
-    impulses are written under the figure."""
+    impulses are written under the figure.
+    """
     areas = result.setup.analysis.areas
     margin = result.zmp_margin
     if kind == "zmp":
-        area, color, label, unit, quantity = areas.zmp_area, ZMP_COLOR, "ZMP support area", "m", "ZMP"
+        area, color, label, unit, quantity = (
+            areas.zmp_area,
+            ZMP_COLOR,
+            "ZMP support area",
+            "m",
+            "ZMP",
+        )
         shrunk = areas.zmp_area.inset(margin) if margin > 0 else None
     else:
-        area, color, label, unit, quantity = areas.com_velocity_area, AREA_COLOR, "CoM velocity area", "m/s", "CoM velocity"
+        area, color, label, unit, quantity = (
+            areas.com_velocity_area,
+            AREA_COLOR,
+            "CoM velocity area",
+            "m/s",
+            "CoM velocity",
+        )
         shrunk = areas.com_velocity_area_inset(margin) if margin > 0 else None
     fig = new_figure(6.4, 6.6)
     ax = fig.add_subplot()
@@ -143,8 +237,10 @@ def plot_push_trajectories(result, kind: str = "com_velocity") -> Figure:
     paths, predicted = [], []
     for o in sorted(result.outcomes, key=lambda o: _ORDER[o.outcome]):
         c = OUTCOME_COLORS[o.outcome]
-        path = np.array([p if p is not None else [np.nan, np.nan] for p in o.trajectory.get(kind, [])],
-                        dtype=float).reshape(-1, 2)
+        path = np.array(
+            [p if p is not None else [np.nan, np.nan] for p in o.trajectory.get(kind, [])],
+            dtype=float,
+        ).reshape(-1, 2)
         if len(path):
             ax.plot(path[:, 0], path[:, 1], color=c, lw=0.7, alpha=0.75)
             paths.append(path)
@@ -161,18 +257,32 @@ def plot_push_trajectories(result, kind: str = "com_velocity") -> Figure:
     outside = [p[0] for p in predicted if not (x0 <= p[0, 0] <= x1 and y0 <= p[0, 1] <= y1)]
     if outside:
         far = np.linalg.norm(np.array(outside) - areas.com[:2], axis=1)
-        notes.append(f"{len(outside)} predictions lie off the view, {far.min():.2f} to {far.max():.2f} m from the CoM")
+        notes.append(
+            f"{len(outside)} predictions lie off the view, {far.min():.2f} to {far.max():.2f} m from the CoM"
+        )
     ax.set_aspect("equal")
     ax.set_xlabel(f"{quantity} x ({unit})")
     ax.set_ylabel(f"{quantity} y ({unit})")
     what = "ZMP during and after each push" if kind == "zmp" else "CoM velocity after each push"
-    fig.suptitle(f"{result.scenario}: {what}\n({len(result.outcomes)} pushes, {result.setup.controller} controller, "
-                 f"{1000 * result.outcomes[0].push.duration:.0f} ms)", fontsize=9)
+    fig.suptitle(
+        f"{result.scenario}: {what}\n({len(result.outcomes)} pushes, {result.setup.controller} controller, "
+        f"{1000 * result.outcomes[0].push.duration:.0f} ms)",
+        fontsize=9,
+    )
     ax.grid(alpha=0.3)
     handles += _outcome_handles(o.outcome for o in result.outcomes)
-    handles.append(Line2D([], [], marker="x", color="0.3", ls="none", label="predicted before the trial"))
-    legend = fig.legend(handles=handles, loc="outside lower center", ncols=3, fontsize=7, frameon=False,
-                        title="\n".join(notes), title_fontsize=6)
+    handles.append(
+        Line2D([], [], marker="x", color="0.3", ls="none", label="predicted before the trial")
+    )
+    legend = fig.legend(
+        handles=handles,
+        loc="outside lower center",
+        ncols=3,
+        fontsize=7,
+        frameon=False,
+        title="\n".join(notes),
+        title_fontsize=6,
+    )
     legend.get_title().set_color("0.3")
     return fig
 
@@ -183,17 +293,25 @@ def _directions_note(result) -> str:
     for o in result.outcomes:
         by.setdefault(round(float(np.rad2deg(o.push.direction)), 1), []).append(o.push.magnitude)
     parts = [f"{d:g}°: {min(m):.0f}–{max(m):.0f}" for d, m in sorted(by.items())]
-    lines = [", ".join(parts[i:i + 4]) for i in range(0, len(parts), 4)][:4]
+    lines = [", ".join(parts[i : i + 4]) for i in range(0, len(parts), 4)][:4]
     more = " ..." if len(parts) > 16 else ""
     return "push direction from world x: impulse (N s)\n" + "\n".join(lines) + more
 
 
-def plot_log_margins(time: np.ndarray, com_velocity_margin: np.ndarray, zmp_margin: np.ndarray | None,
-                     title: str = "") -> Figure:
+def plot_log_margins(
+    time: np.ndarray,
+    com_velocity_margin: np.ndarray,
+    zmp_margin: np.ndarray | None,
+    title: str = "",
+) -> Figure:
     """CoM velocity margin (m/s) and ZMP margin (m) against time; below zero is outside the area."""
     fig = new_figure(7.0, 4.0)
     axes = fig.subplots(2 if zmp_margin is not None else 1, 1, sharex=True, squeeze=False)[:, 0]
-    axes[0].plot(time, np.where(np.isfinite(com_velocity_margin), com_velocity_margin, np.nan), color=OK_COLOR)
+    axes[0].plot(
+        time,
+        np.where(np.isfinite(com_velocity_margin), com_velocity_margin, np.nan),
+        color=OK_COLOR,
+    )
     axes[0].axhline(0, color=FALL_COLOR, lw=0.8)
     axes[0].set_ylabel("CoM velocity margin (m/s)")
     if zmp_margin is not None:

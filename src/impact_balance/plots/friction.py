@@ -9,7 +9,16 @@ from matplotlib import colormaps
 from matplotlib.figure import Figure
 
 from impact_balance.analysis.analyze import Analysis
-from impact_balance.plots._common import AREA_COLOR, COM_COLOR, area_view_points, draw_polygon, fmt_speed, hull, new_figure, set_limits
+from impact_balance.plots._common import (
+    AREA_COLOR,
+    COM_COLOR,
+    area_view_points,
+    draw_polygon,
+    fmt_speed,
+    hull,
+    new_figure,
+    set_limits,
+)
 from impact_balance.plots.impulse import impulse_set_speed
 
 __all__ = ["plot_friction_comparison"]
@@ -30,7 +39,9 @@ def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
     Raises:
         ValueError: when no analysis has an impact.
     """
-    runs = sorted((a for a in analyses if a.impact is not None), key=lambda a: a.impact.model.spec.friction)
+    runs = sorted(
+        (a for a in analyses if a.impact is not None), key=lambda a: a.impact.model.spec.friction
+    )
     if not runs:
         raise ValueError("plot_friction_comparison needs at least one analysis with an impact")
     fig = new_figure(12, 6.2)
@@ -38,7 +49,16 @@ def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
     base = runs[0]
     area = base.areas.com_velocity_area
     if not area.is_empty:
-        draw_polygon(ax, area, color=AREA_COLOR, alpha=0.4, edge="teal", lw=2, label="CoM velocity area", zorder=1)
+        draw_polygon(
+            ax,
+            area,
+            color=AREA_COLOR,
+            alpha=0.4,
+            edge="teal",
+            lw=2,
+            label="CoM velocity area",
+            zorder=1,
+        )
     view = list(area_view_points(area))
     cmap = colormaps["plasma"]
     colors = [cmap(0.05 + 0.75 * i / max(len(runs) - 1, 1)) for i in range(len(runs))]
@@ -47,8 +67,16 @@ def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
         mu = im.model.spec.friction
         c0 = run.com_velocity[:2]
         if not _same_area(run, base) and not run.areas.com_velocity_area.is_empty:
-            draw_polygon(ax, run.areas.com_velocity_area, color=color, fill=False, lw=1.2, ls=":", zorder=1.5,
-                         label=f"μ = {mu:g}: its own CoM velocity area")
+            draw_polygon(
+                ax,
+                run.areas.com_velocity_area,
+                color=color,
+                fill=False,
+                lw=1.2,
+                ls=":",
+                zorder=1.5,
+                label=f"μ = {mu:g}: its own CoM velocity area",
+            )
             view += area_view_points(run.areas.com_velocity_area)
         speed, which = impulse_set_speed(run)
         pts = im.model.post_impact_com_velocities(c0, speed)
@@ -56,7 +84,9 @@ def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
         label = f"μ = {mu:g}: v_max = {fmt_speed(im.max_contact_velocity)}"
         if which != "v_max":
             label += f" (set at {speed:.3g} m/s)"
-        draw_polygon(ax, hull(pts), color=color, alpha=0.35, edge=color, lw=2, label=label, zorder=3)
+        draw_polygon(
+            ax, hull(pts), color=color, alpha=0.35, edge=color, lw=2, label=label, zorder=3
+        )
         lim = im.com_limit
         if lim.is_finite and lim.limiting_vertex is not None:
             ax.plot(*pts[lim.limiting_vertex], "*", color=color, mec="black", ms=13, zorder=5)
@@ -67,10 +97,19 @@ def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
     ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel(r"$\dot c_x$ (m/s)")
     ax.set_ylabel(r"$\dot c_y$ (m/s)")
-    ax.set_title("Post-impact CoM velocity sets at each maximum (stars: limiting vertices)", fontsize=10)
+    ax.set_title(
+        "Post-impact CoM velocity sets at each maximum (stars: limiting vertices)", fontsize=10
+    )
     ax.grid(True, alpha=0.3)
     # Below the axes: inside, it would cover the area's boundary.
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, 0.0), borderaxespad=4.8, fontsize=8, framealpha=0.9, ncol=2)
+    ax.legend(
+        loc="upper center",
+        bbox_to_anchor=(0.5, 0.0),
+        borderaxespad=4.8,
+        fontsize=8,
+        framealpha=0.9,
+        ncol=2,
+    )
 
     # v_max against mu, both criteria (bars with their values written on them).
     mus = [r.impact.model.spec.friction for r in runs]
@@ -81,16 +120,24 @@ def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
     finite = np.concatenate([com[np.isfinite(com)], zmp[np.isfinite(zmp)]])
     top = float(finite.max()) if finite.size else 1.0
     top = top if top > 0 else 1.0
-    for values, dx, color, name in ((com, -width / 2, "tab:blue", "CoM velocity criterion"),
-                                    (zmp, width / 2, "tab:orange", "ZMP criterion")):
+    for values, dx, color, name in (
+        (com, -width / 2, "tab:blue", "CoM velocity criterion"),
+        (zmp, width / 2, "tab:orange", "ZMP criterion"),
+    ):
         shown = np.where(np.isfinite(values), values, 1.1 * top)
         bars = bar.bar(x + dx, shown, width, color=color, label=name)
         for rect, v in zip(bars, values):
             if not np.isfinite(v):
                 rect.set_hatch("//")  # no limit: drawn above the largest finite value
             text = f"{v:.3g}" if np.isfinite(v) else "unbounded"
-            bar.text(rect.get_x() + rect.get_width() / 2, rect.get_height() + 0.01 * top, text,
-                     ha="center", va="bottom", fontsize=8)
+            bar.text(
+                rect.get_x() + rect.get_width() / 2,
+                rect.get_height() + 0.01 * top,
+                text,
+                ha="center",
+                va="bottom",
+                fontsize=8,
+            )
     bar.set_xticks(x, [f"{m:g}" for m in mus])
     bar.set_xlabel("impact friction coefficient μ (-)")
     bar.set_ylabel("maximum approach speed (m/s)")
@@ -100,5 +147,7 @@ def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
     bar.legend(loc="upper right", fontsize=8)
     names = list(dict.fromkeys(r.scenario.name or "scenario" for r in runs))
     stem = ", ".join(names) if len(names) <= 4 else f"{len(names)} scenarios"
-    fig.suptitle(f"Impact friction comparison ({stem}; robot {base.stance.robot.name})", fontsize=12)
+    fig.suptitle(
+        f"Impact friction comparison ({stem}; robot {base.stance.robot.name})", fontsize=12
+    )
     return fig

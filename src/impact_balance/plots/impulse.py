@@ -11,9 +11,17 @@ from scipy.spatial import ConvexHull, QhullError
 
 from impact_balance.analysis.analyze import Analysis
 from impact_balance.impact.model import ImpactModel
-from impact_balance.plots._common import IMPACT_COLOR, centre_message, draw_polygon, hull, new_figure, scenario_title, set_limits
+from impact_balance.plots._common import (
+    IMPACT_COLOR,
+    centre_message,
+    draw_polygon,
+    hull,
+    new_figure,
+    scenario_title,
+    set_limits,
+)
 
-__all__ = ["plot_impulse_set", "impulse_set_speed"]
+__all__ = ["impulse_set_speed", "plot_impulse_set"]
 
 
 def impulse_set_speed(analysis: Analysis) -> tuple[float, str]:
@@ -48,7 +56,9 @@ def _draw_impulse_polytope(ax: Axes, model: ImpactModel, speed: float) -> None:
     n = model.cone.shape[1]
     hi, lo = verts[0::2], verts[1::2]
     faces = _faces(verts)
-    ax.add_collection3d(Poly3DCollection(faces, facecolor=IMPACT_COLOR, edgecolor="none", alpha=0.18))
+    ax.add_collection3d(
+        Poly3DCollection(faces, facecolor=IMPACT_COLOR, edgecolor="none", alpha=0.18)
+    )
     # Structural edges: the two restitution rings and the edges joining them along the generators.
     for ring, ls in ((hi, "-"), (lo, "--")):
         closed = np.vstack([ring, ring[:1]])
@@ -56,16 +66,26 @@ def _draw_impulse_polytope(ax: Axes, model: ImpactModel, speed: float) -> None:
     for i in range(n):
         ax.plot(*np.vstack([hi[i], lo[i]]).T, "-", color="darkred", lw=0.6, alpha=0.7)
     c_lo, c_hi = model.spec.restitution
-    ax.scatter(*hi.T, color="red", s=22, depthshade=False, label=f"vertices on the plane c_r = {c_hi:g}")
-    ax.scatter(*lo.T, facecolor="white", edgecolor="red", s=22, depthshade=False,
-               label=f"vertices on the plane c_r = {c_lo:g}")
+    ax.scatter(
+        *hi.T, color="red", s=22, depthshade=False, label=f"vertices on the plane c_r = {c_hi:g}"
+    )
+    ax.scatter(
+        *lo.T,
+        facecolor="white",
+        edgecolor="red",
+        s=22,
+        depthshade=False,
+        label=f"vertices on the plane c_r = {c_lo:g}",
+    )
     # Friction-cone generators from the origin, long enough to pass through the set.
     K = model.cone
     reach = np.linalg.norm(verts, axis=1).max() if len(verts) else 1.0
     length = 1.2 * reach / max(float(np.linalg.norm(K, axis=0).min()), 1e-12)
     for i in range(n):
         seg = np.vstack([np.zeros(3), length * K[:, i]])
-        ax.plot(*seg.T, "-", color="0.45", lw=0.8, label="friction-cone generators" if i == 0 else None)
+        ax.plot(
+            *seg.T, "-", color="0.45", lw=0.8, label="friction-cone generators" if i == 0 else None
+        )
     ax.scatter([0], [0], [0], color="black", s=25, label="origin (zero impulse)")
     pts = np.vstack([verts, np.zeros((1, 3)), length * K.T])
     lo_, hi_ = pts.min(axis=0), pts.max(axis=0)
@@ -91,7 +111,11 @@ def _draw_impulse_polytope(ax: Axes, model: ImpactModel, speed: float) -> None:
     nrm = model.normal
     plane = model.W.T @ nrm
     look = nrm + plane / max(float(np.linalg.norm(plane)), 1e-12)
-    azim = float(np.degrees(np.arctan2(look[1], look[0]))) if np.linalg.norm(look[:2]) > 1e-6 else -60.0
+    azim = (
+        float(np.degrees(np.arctan2(look[1], look[0])))
+        if np.linalg.norm(look[:2]) > 1e-6
+        else -60.0
+    )
     azim = 45.0 + 90.0 * round((azim - 45.0) / 90.0)
     for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
         axis.set_major_locator(MaxNLocator(5))
@@ -101,11 +125,27 @@ def _draw_impulse_polytope(ax: Axes, model: ImpactModel, speed: float) -> None:
 
 def _draw_jump_set(ax: Axes, model: ImpactModel, speed: float) -> None:
     jumps = model.com_velocity_jumps(speed)[:, :2]
-    draw_polygon(ax, hull(jumps), color=IMPACT_COLOR, alpha=0.25, edge="darkred", lw=1.8,
-                 label="CoM velocity jump set (convex hull)", zorder=2)
+    draw_polygon(
+        ax,
+        hull(jumps),
+        color=IMPACT_COLOR,
+        alpha=0.25,
+        edge="darkred",
+        lw=1.8,
+        label="CoM velocity jump set (convex hull)",
+        zorder=2,
+    )
     c_lo, c_hi = model.spec.restitution
     ax.plot(*jumps[0::2].T, "o", color="red", ms=4.5, label=f"vertices, c_r = {c_hi:g}", zorder=4)
-    ax.plot(*jumps[1::2].T, "o", mfc="white", mec="red", ms=4.5, label=f"vertices, c_r = {c_lo:g}", zorder=4)
+    ax.plot(
+        *jumps[1::2].T,
+        "o",
+        mfc="white",
+        mec="red",
+        ms=4.5,
+        label=f"vertices, c_r = {c_lo:g}",
+        zorder=4,
+    )
     ax.plot(0, 0, "+", color="black", ms=12, mew=2, label="no jump", zorder=5)
     # Nearly square (the 3D panel beside it is): a flat set in a flat panel left most of the
     # figure blank.
@@ -150,11 +190,17 @@ def plot_impulse_set(analysis: Analysis, approach_speed: float | None = None) ->
     model = im.model
     n = model.cone.shape[1]
     _draw_impulse_polytope(ax3, model, speed)
-    ax3.set_title(f"Impulse set: {2 * n} vertices, friction cone with N = {n} edges (μ = {model.spec.friction:g})",
-                  fontsize=10)
+    ax3.set_title(
+        f"Impulse set: {2 * n} vertices, friction cone with N = {n} edges (μ = {model.spec.friction:g})",
+        fontsize=10,
+    )
     _draw_jump_set(ax2, model, speed)
     ax2.set_title(f"CoM velocity jump set (xy), mass {model.mass:.1f} kg", fontsize=10)
-    tag = {"v_max": "the maximum contact velocity", "reference": "the reference approach speed",
-           "unit speed": "unit approach speed", "given": "the given approach speed"}[which]
+    tag = {
+        "v_max": "the maximum contact velocity",
+        "reference": "the reference approach speed",
+        "unit speed": "unit approach speed",
+        "given": "the given approach speed",
+    }[which]
     fig.suptitle(f"Impulse set at {tag} {speed:.3g} m/s: {title}", fontsize=12)
     return fig

@@ -9,7 +9,7 @@ from impact_balance.analysis.analyze import Analysis
 from impact_balance.balance.lipm import PhasePortrait, phase_portrait
 from impact_balance.plots._common import new_figure
 
-__all__ = ["plot_phase_portrait", "analysis_phase_portrait"]
+__all__ = ["analysis_phase_portrait", "plot_phase_portrait"]
 
 
 def analysis_phase_portrait(analysis: Analysis, axis: int = 0) -> PhasePortrait:
@@ -37,14 +37,18 @@ def analysis_phase_portrait(analysis: Analysis, axis: int = 0) -> PhasePortrait:
     for s, r in zip(slack, rate):
         if abs(r) < 1e-12:
             if s < -1e-9:
-                raise ValueError("the CoM projection is outside the ZMP support area along this axis")
+                raise ValueError(
+                    "the CoM projection is outside the ZMP support area along this axis"
+                )
             continue
         if r > 0:
             hi = min(hi, s / r)
         else:
             lo = max(lo, s / r)
     if not (np.isfinite(lo) and np.isfinite(hi)) or lo > hi + 1e-12:
-        raise ValueError("the ZMP support area has no bounded chord through the CoM along this axis")
+        raise ValueError(
+            "the ZMP support area has no bounded chord through the CoM along this axis"
+        )
     return phase_portrait(float(com[2] - areas.plane_height), (float(lo), float(hi)), areas.gravity)
 
 
@@ -65,8 +69,15 @@ def plot_phase_portrait(portrait: PhasePortrait, title: str | None = None) -> Fi
     fig = new_figure(8.5, 7.2)
     ax = fig.subplots()
     c = np.linspace(*xlim, 200)
-    ax.fill_between(c, w * (z_lo - c), w * (z_hi - c), color="#b5e3b5", alpha=0.6, lw=0,
-                    label=r"stable standing region: $z_{lo} \leq c + \dot c/\omega \leq z_{hi}$")
+    ax.fill_between(
+        c,
+        w * (z_lo - c),
+        w * (z_hi - c),
+        color="#b5e3b5",
+        alpha=0.6,
+        lw=0,
+        label=r"stable standing region: $z_{lo} \leq c + \dot c/\omega \leq z_{hi}$",
+    )
     ax.plot(c, w * (z_lo - c), "-", color="darkgreen", lw=1.5)
     ax.plot(c, w * (z_hi - c), "-", color="darkgreen", lw=1.5)
     for z, name in ((z_lo, "lo"), (z_hi, "hi")):
@@ -76,24 +87,52 @@ def plot_phase_portrait(portrait: PhasePortrait, title: str | None = None) -> Fi
         if xlim[0] < cx < xlim[1]:
             # Written towards the middle of the view, so that it never runs out of the axes.
             right_half = cx > 0.5 * (xlim[0] + xlim[1])
-            ax.annotate(rf"$c + \dot c/\omega = {z:+.3g}$ m", (cx, cd), xytext=(-6 if right_half else 6, 0),
-                        textcoords="offset points", fontsize=8, color="darkgreen", va="center",
-                        ha="right" if right_half else "left")
+            ax.annotate(
+                rf"$c + \dot c/\omega = {z:+.3g}$ m",
+                (cx, cd),
+                xytext=(-6 if right_half else 6, 0),
+                textcoords="offset points",
+                fontsize=8,
+                color="darkgreen",
+                va="center",
+                ha="right" if right_half else "left",
+            )
     for k, traj in enumerate(portrait.trajectories):
         traj = np.asarray(traj, dtype=float)
         if len(traj) < 2:
             continue
-        ax.plot(traj[:, 0], traj[:, 1], "-", color="0.45", lw=0.8, label="LIPM trajectories, saturated ZMP feedback" if k == 0 else None)
-        inside = np.flatnonzero((traj[:, 0] > xlim[0]) & (traj[:, 0] < xlim[1]) & (np.abs(traj[:, 1]) < ylim[1]))
+        ax.plot(
+            traj[:, 0],
+            traj[:, 1],
+            "-",
+            color="0.45",
+            lw=0.8,
+            label="LIPM trajectories, saturated ZMP feedback" if k == 0 else None,
+        )
+        inside = np.flatnonzero(
+            (traj[:, 0] > xlim[0]) & (traj[:, 0] < xlim[1]) & (np.abs(traj[:, 1]) < ylim[1])
+        )
         if len(inside) > 4:
             i = inside[len(inside) // 3]
-            ax.annotate("", xy=traj[i + 1], xytext=traj[i], arrowprops=dict(arrowstyle="->", color="0.35", lw=0.9))
+            ax.annotate(
+                "",
+                xy=traj[i + 1],
+                xytext=traj[i],
+                arrowprops=dict(arrowstyle="->", color="0.35", lw=0.9),
+            )
     ax.axvline(0.0, color="tab:green", lw=1.2, ls="--", label="c = 0 (CoM at the reference)")
     ax.axhline(0.0, color="0.6", lw=0.6)
     # The values go in the legend, outside the axes: a label beside the points was crossed by
     # the trajectories that converge there.
-    ax.plot([0.0, 0.0], [v_lo, v_hi], "o", color="tab:red", ms=8, zorder=5,
-            label=f"CoM velocity bounds at c = 0: {v_lo:+.4f} and {v_hi:+.4f} m/s")
+    ax.plot(
+        [0.0, 0.0],
+        [v_lo, v_hi],
+        "o",
+        color="tab:red",
+        ms=8,
+        zorder=5,
+        label=f"CoM velocity bounds at c = 0: {v_lo:+.4f} and {v_hi:+.4f} m/s",
+    )
     ax.set_xlim(*xlim)
     ax.set_ylim(*ylim)
     ax.set_xlabel("CoM position c (m)")
@@ -102,6 +141,12 @@ def plot_phase_portrait(portrait: PhasePortrait, title: str | None = None) -> Fi
     # Below the axes: inside, the trajectories run under it wherever it goes.
     fig.legend(loc="outside lower center", ncol=2, fontsize=8.5, framealpha=0.9)
     gravity = w * w * portrait.com_height  # omega = sqrt(g / h)
-    ax.set_title(title or (f"LIPM phase portrait: CoM height {portrait.com_height:.3g} m, "
-                           f"ZMP in [{z_lo:.3g}, {z_hi:.3g}] m,\nω = {w:.4f} 1/s with g = {gravity:.4g} m/s²"), fontsize=10)
+    ax.set_title(
+        title
+        or (
+            f"LIPM phase portrait: CoM height {portrait.com_height:.3g} m, "
+            f"ZMP in [{z_lo:.3g}, {z_hi:.3g}] m,\nω = {w:.4f} 1/s with g = {gravity:.4g} m/s²"
+        ),
+        fontsize=10,
+    )
     return fig

@@ -15,7 +15,7 @@ from impact_balance.plots.impulse import plot_impulse_set
 from impact_balance.plots.phase import analysis_phase_portrait, plot_phase_portrait
 from impact_balance.plots.stance import plot_stance
 
-__all__ = ["save_figures", "figure_prefix"]
+__all__ = ["figure_prefix", "save_figures"]
 
 
 def figure_prefix(analysis: Analysis) -> str:
@@ -37,7 +37,10 @@ def save_figures(
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     prefix = figure_prefix(analysis)
-    figures: list[tuple[str, Figure]] = [("areas", plot_areas(analysis)), ("stance", plot_stance(analysis))]
+    figures: list[tuple[str, Figure]] = [
+        ("areas", plot_areas(analysis)),
+        ("stance", plot_stance(analysis)),
+    ]
     if analysis.impact is not None:
         figures.append(("impulse_set", plot_impulse_set(analysis)))
     try:
@@ -45,14 +48,18 @@ def save_figures(
     except ValueError as exc:
         portrait = None
         if skipped is not None:
-            skipped.append(Diagnostic("figure_skipped", "plots", f"no {prefix}_phase_portrait.png: {exc}"))
+            skipped.append(
+                Diagnostic("figure_skipped", "plots", f"no {prefix}_phase_portrait.png: {exc}")
+            )
     if portrait is not None:
         com = analysis.areas.com
-        title = (f"{prefix}: sagittal LIPM phase portrait, CoM height {portrait.com_height:.3g} m, "
-                 f"g = {analysis.areas.gravity:.4g} m/s², ω = {portrait.omega:.4f} 1/s\n"
-                 f"ZMP in [{portrait.zmp_range[0]:+.3g}, {portrait.zmp_range[1]:+.3g}] m about the CoM: "
-                 f"the chord of the ZMP support area along x\nthrough the CoM (at y = {com[1]:.3f} m); "
-                 f"other slices of the area give other bounds")
+        title = (
+            f"{prefix}: sagittal LIPM phase portrait, CoM height {portrait.com_height:.3g} m, "
+            f"g = {analysis.areas.gravity:.4g} m/s², ω = {portrait.omega:.4f} 1/s\n"
+            f"ZMP in [{portrait.zmp_range[0]:+.3g}, {portrait.zmp_range[1]:+.3g}] m about the CoM: "
+            f"the chord of the ZMP support area along x\nthrough the CoM (at y = {com[1]:.3f} m); "
+            f"other slices of the area give other bounds"
+        )
         figures.append(("phase_portrait", plot_phase_portrait(portrait, title=title)))
     written = []
     for name, fig in figures:

@@ -7,7 +7,14 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MaxNLocator
 
-from impact_balance.plots._common import IMPACT_COLOR, draw_polygon, hull, new_figure, text_box, trim_height
+from impact_balance.plots._common import (
+    IMPACT_COLOR,
+    draw_polygon,
+    hull,
+    new_figure,
+    text_box,
+    trim_height,
+)
 
 __all__ = ["plot_jump_on_sets", "plot_time_series"]
 
@@ -28,7 +35,9 @@ def plot_jump_on_sets(result, title: str) -> Figure:
         zoom = len(names) == 1
         points = [jump[None, :], np.zeros((1, 2))]
         if zoom:  # keep the measured jump in view unless it is far beyond the set
-            extent = float(np.linalg.norm(result.predicted[names[0]].com_velocity_jumps, axis=1).max())
+            extent = float(
+                np.linalg.norm(result.predicted[names[0]].com_velocity_jumps, axis=1).max()
+            )
             points = points[1:] if np.linalg.norm(jump) > 5.0 * extent else points
         for name in names:
             p = result.predicted[name]
@@ -36,7 +45,9 @@ def plot_jump_on_sets(result, title: str) -> Figure:
             if _flat(p.com_velocity_jumps):
                 flat.add(name)
                 label += " (flat: see below)"
-            draw_polygon(ax, hull(p.com_velocity_jumps), color=_MODEL_COLORS[name], alpha=0.3, label=label)
+            draw_polygon(
+                ax, hull(p.com_velocity_jumps), color=_MODEL_COLORS[name], alpha=0.3, label=label
+            )
             points.append(p.com_velocity_jumps)
         pts = np.vstack(points)
         lo, hi = pts.min(axis=0), pts.max(axis=0)
@@ -44,8 +55,12 @@ def plot_jump_on_sets(result, title: str) -> Figure:
         if not zoom or ((jump >= lo - pad) & (jump <= hi + pad)).all():
             ax.plot(*jump, marker="*", ms=13, color=IMPACT_COLOR, ls="", label="measured", zorder=5)
         else:
-            text_box(ax, f"measured jump off this scale: ({jump[0]:+.4f}, {jump[1]:+.4f}) m/s", loc="lower left",
-                     fontsize=8)
+            text_box(
+                ax,
+                f"measured jump off this scale: ({jump[0]:+.4f}, {jump[1]:+.4f}) m/s",
+                loc="lower left",
+                fontsize=8,
+            )
         ax.plot(0, 0, marker="+", color="k", ms=9, ls="")
         ax.set_xlim(lo[0] - pad, hi[0] + pad)
         ax.set_ylim(lo[1] - pad, hi[1] + pad)
@@ -62,10 +77,18 @@ def plot_jump_on_sets(result, title: str) -> Figure:
         for handle, label in zip(*ax.get_legend_handles_labels()):
             entries.setdefault(label, handle)
     if flat:  # why a set is a line, as the legend's last row
-        entries[f"{' and '.join(sorted(flat))} is flat: at the single measured restitution (e = "
-                f"{result.restitution_measured:.2f}) every impulse of the set lies on one plane, n·Wι = (1 + e) v,\n"
-                "and seen from above (x-y) that plane is nearly edge-on, so the set shows as a line"] = Line2D([], [], ls="")
-    fig.legend(list(entries.values()), list(entries), loc="outside lower center", ncol=3 if not flat else 1, fontsize=8)
+        entries[
+            f"{' and '.join(sorted(flat))} is flat: at the single measured restitution (e = "
+            f"{result.restitution_measured:.2f}) every impulse of the set lies on one plane, n·Wι = (1 + e) v,\n"
+            "and seen from above (x-y) that plane is nearly edge-on, so the set shows as a line"
+        ] = Line2D([], [], ls="")
+    fig.legend(
+        list(entries.values()),
+        list(entries),
+        loc="outside lower center",
+        ncol=3 if not flat else 1,
+        fontsize=8,
+    )
     fig.suptitle(title, fontsize=11)
     # Height from the data (both panels have an equal aspect): a fixed height left blank
     # bands above and below flat panels.
@@ -83,7 +106,6 @@ def _flat(points: np.ndarray) -> bool:
     return bool(s[0] == 0.0 or s[1] / s[0] < 0.03)
 
 
-
 def plot_time_series(result, title: str) -> Figure:
     """Contact forces (norm, N) and CoM velocity (x, y, m/s) against time, the impact shaded.
 
@@ -97,16 +119,31 @@ def plot_time_series(result, title: str) -> Figure:
     others = iter(("tab:blue", "tab:orange", "tab:brown", "tab:olive", "tab:cyan", "tab:pink"))
     for name, force in record.forces.items():
         label = "impact point" if name == "impact" else f"contact {name}"
-        ax_f.plot(t, np.linalg.norm(force, axis=1), label=label, color=IMPACT_COLOR if name == "impact" else next(others, None))
+        ax_f.plot(
+            t,
+            np.linalg.norm(force, axis=1),
+            label=label,
+            color=IMPACT_COLOR if name == "impact" else next(others, None),
+        )
     ax_f.set_ylabel("contact force |f| (N)")
-    for k, (axis, color) in enumerate(zip("xy", ("tab:green", "tab:purple"))):  # not the forces' colours:
-        ax_v.plot(t, record.com_velocity[:, k], label=f"CoM velocity {axis}", color=color)  # one legend
+    for k, (axis, color) in enumerate(
+        zip("xy", ("tab:green", "tab:purple"))
+    ):  # not the forces' colours:
+        ax_v.plot(
+            t, record.com_velocity[:, k], label=f"CoM velocity {axis}", color=color
+        )  # one legend
     ax_v.set_ylabel("CoM velocity (m/s)")
     ax_v.set_xlabel("time (s)")
     t0, t1 = result.impact_time
     for ax in (ax_f, ax_v):
-        ax.axvspan(t0, t1, color=IMPACT_COLOR, alpha=0.15, gid="background",
-                          label=f"impact window {1e3 * (t1 - t0):.0f} ms (impulse and jump measured over it)")
+        ax.axvspan(
+            t0,
+            t1,
+            color=IMPACT_COLOR,
+            alpha=0.15,
+            gid="background",
+            label=f"impact window {1e3 * (t1 - t0):.0f} ms (impulse and jump measured over it)",
+        )
         ax.grid(alpha=0.3)
     handles, labels = ax_f.get_legend_handles_labels()
     h2, l2 = ax_v.get_legend_handles_labels()
@@ -115,8 +152,10 @@ def plot_time_series(result, title: str) -> Figure:
     if result.joints == "rigid" and any(name != "impact" for name in record.forces):
         # Say why the sole forces are zero, in the legend (a note in the axes would cover data).
         handles.append(Line2D([], [], ls=""))
-        labels.append("rigid joints: the robot floats, gravity off (the paper's rigid\n"
-                      "impact model), so the contacts carry no force")
+        labels.append(
+            "rigid joints: the robot floats, gravity off (the paper's rigid\n"
+            "impact model), so the contacts carry no force"
+        )
     jump = result.com_velocity_jump_measured
     handles.append(Line2D([], [], ls=""))
     labels.append(f"jump measured: ({jump[0]:+.4f}, {jump[1]:+.4f}) m/s")

@@ -19,7 +19,7 @@ from impact_balance.plots._common import (
     set_limits,
 )
 
-__all__ = ["plot_stance", "joint_positions"]
+__all__ = ["joint_positions", "plot_stance"]
 
 #: Length of the contact and impact normal arrows, m.
 NORMAL_LENGTH = 0.15
@@ -35,7 +35,9 @@ def joint_positions(analysis: Analysis) -> tuple[np.ndarray, list[tuple[int, int
     stance = analysis.stance
     model, data = stance.model, stance.data
     pos = np.array([np.asarray(data.oMi[j].translation, dtype=float) for j in range(model.njoints)])
-    links = [(j, int(model.parents[j])) for j in range(1, model.njoints) if int(model.parents[j]) > 0]
+    links = [
+        (j, int(model.parents[j])) for j in range(1, model.njoints) if int(model.parents[j]) > 0
+    ]
     return pos, links
 
 
@@ -43,18 +45,38 @@ def _frame_joint(analysis: Analysis, frame: str) -> int | None:
     stance = analysis.stance
     try:
         f = stance.model.frames[stance.robot.frame_id(frame)]
-    except Exception:  # noqa: BLE001 - a missing frame only removes a stick
+    except Exception:
         return None
     return int(f.parentJoint if hasattr(f, "parentJoint") else f.parent)  # pinocchio 3 / 2
 
 
-def _arrow(ax: Axes, start: np.ndarray, delta: np.ndarray, color: str, label: str | None, width: float = 0.012,
-           zorder: float = 7, ls: str = "-") -> bool:
+def _arrow(
+    ax: Axes,
+    start: np.ndarray,
+    delta: np.ndarray,
+    color: str,
+    label: str | None,
+    width: float = 0.012,
+    zorder: float = 7,
+    ls: str = "-",
+) -> bool:
     """Arrow from ``start`` by ``delta`` (data units); nothing if it is too short to see."""
     if float(np.linalg.norm(delta)) < 1e-4:
         return False
-    ax.arrow(start[0], start[1], delta[0], delta[1], width=width * 0.35, head_width=width * 2.2,
-             head_length=width * 2.5, length_includes_head=True, color=color, zorder=zorder, label=label, ls=ls)
+    ax.arrow(
+        start[0],
+        start[1],
+        delta[0],
+        delta[1],
+        width=width * 0.35,
+        head_width=width * 2.2,
+        head_length=width * 2.5,
+        length_includes_head=True,
+        color=color,
+        zorder=zorder,
+        label=label,
+        ls=ls,
+    )
     return True
 
 
@@ -70,8 +92,15 @@ def _draw_view(ax: Axes, analysis: Analysis, axes: tuple[int, int], robot: bool)
         pos, links = joint_positions(analysis)
         for n, (j, p) in enumerate(links):
             seg = pos[[p, j]][:, [i, k]]
-            ax.plot(*seg.T, "-", color="0.55", lw=2.0, solid_capstyle="round", zorder=2,
-                    label="robot (joint origins)" if n == 0 else None)
+            ax.plot(
+                *seg.T,
+                "-",
+                color="0.55",
+                lw=2.0,
+                solid_capstyle="round",
+                zorder=2,
+                label="robot (joint origins)" if n == 0 else None,
+            )
         ax.plot(*pos[1:, [i, k]].T, "o", color="0.35", ms=3, zorder=2.1)
         view.append(pos[1:, [i, k]])
         # Sticks from the last joint to the contact and impact points.
@@ -81,20 +110,36 @@ def _draw_view(ax: Axes, analysis: Analysis, axes: tuple[int, int], robot: bool)
         for frame, point in ends:
             j = _frame_joint(analysis, frame)
             if j:
-                ax.plot(*np.vstack([pos[j], point])[:, [i, k]].T, ":", color="0.55", lw=1.5, zorder=2)
+                ax.plot(
+                    *np.vstack([pos[j], point])[:, [i, k]].T, ":", color="0.55", lw=1.5, zorder=2
+                )
 
     # ZMP support area on its plane.
     zmp = areas.zmp_area
     if not zmp.is_empty:
         if top:
-            draw_polygon(ax, zmp, color=ZMP_COLOR, alpha=0.4, lw=1.5, label="ZMP support area", zorder=1)
+            draw_polygon(
+                ax, zmp, color=ZMP_COLOR, alpha=0.4, lw=1.5, label="ZMP support area", zorder=1
+            )
         else:
             xs = zmp.vertices[:, 0] if i == 0 else zmp.vertices[:, 1]
-            ax.plot([xs.min(), xs.max()], [h, h], "-", color=ZMP_COLOR, lw=7, alpha=0.8, solid_capstyle="butt",
-                    label="ZMP support area", zorder=1)
+            ax.plot(
+                [xs.min(), xs.max()],
+                [h, h],
+                "-",
+                color=ZMP_COLOR,
+                lw=7,
+                alpha=0.8,
+                solid_capstyle="butt",
+                label="ZMP support area",
+                zorder=1,
+            )
         if zmp.bounded:
-            view.append(np.column_stack([zmp.vertices[:, 0], zmp.vertices[:, 1]]) if top
-                        else np.array([[zmp.vertices[:, 0].min(), h], [zmp.vertices[:, 0].max(), h]]))
+            view.append(
+                np.column_stack([zmp.vertices[:, 0], zmp.vertices[:, 1]])
+                if top
+                else np.array([[zmp.vertices[:, 0].min(), h], [zmp.vertices[:, 0].max(), h]])
+            )
     if not top:
         ax.axhline(h, color="0.3", lw=0.8, ls="--", zorder=0.5, label=f"ZMP plane z = {h:g} m")
 
@@ -104,16 +149,36 @@ def _draw_view(ax: Axes, analysis: Analysis, axes: tuple[int, int], robot: bool)
     for n, c in enumerate(stance.contacts):
         corners = c.corners()[:, [i, k]]
         view.append(corners)
-        draw_polygon(ax, hull(corners), color=CONTACT_COLOR, alpha=0.3, lw=1.5, zorder=1.5,
-                     label="contact rectangles" if n == 0 else None)
+        draw_polygon(
+            ax,
+            hull(corners),
+            color=CONTACT_COLOR,
+            alpha=0.3,
+            lw=1.5,
+            zorder=1.5,
+            label="contact rectangles" if n == 0 else None,
+        )
         seen = c.normal[[i, k]]
         if float(np.linalg.norm(seen)) < 0.35:  # within ~20 deg of the line of sight
             out = float(c.normal[3 - i - k]) * (1.0 if top else -1.0) > 0  # towards the viewer?
-            ax.plot(*c.position[[i, k]], marker=r"$\odot$" if out else r"$\otimes$", ms=15, color=CONTACT_COLOR,
-                    ls="", zorder=7, label=None if labelled else "contact normals (⊙ towards you)")
+            ax.plot(
+                *c.position[[i, k]],
+                marker=r"$\odot$" if out else r"$\otimes$",
+                ms=15,
+                color=CONTACT_COLOR,
+                ls="",
+                zorder=7,
+                label=None if labelled else "contact normals (⊙ towards you)",
+            )
         else:
-            _arrow(ax, c.position[[i, k]], NORMAL_LENGTH * seen, CONTACT_COLOR,
-                   None if labelled else "contact normals (⊙ towards you)", width=0.008)
+            _arrow(
+                ax,
+                c.position[[i, k]],
+                NORMAL_LENGTH * seen,
+                CONTACT_COLOR,
+                None if labelled else "contact normals (⊙ towards you)",
+                width=0.008,
+            )
         labelled = True
         view.append((c.position + NORMAL_LENGTH * c.normal)[None, [i, k]])
 
@@ -131,19 +196,43 @@ def _draw_view(ax: Axes, analysis: Analysis, axes: tuple[int, int], robot: bool)
         p = im.model.point
         ax.plot(*p[[i, k]], "o", color=IMPACT_COLOR, ms=8, zorder=9, label="impact point")
         view.append(p[None, [i, k]])
-        _arrow(ax, p[[i, k]], NORMAL_LENGTH * im.model.normal[[i, k]], IMPACT_COLOR,
-               "impact normal (impulse on the robot)", width=0.01)
+        _arrow(
+            ax,
+            p[[i, k]],
+            NORMAL_LENGTH * im.model.normal[[i, k]],
+            IMPACT_COLOR,
+            "impact normal (impulse on the robot)",
+            width=0.01,
+        )
         view.append((p + NORMAL_LENGTH * im.model.normal)[None, [i, k]])
         ref = im.model.spec.reference_velocity
         if ref is not None:
             ref = np.asarray(ref, dtype=float)
-            _arrow(ax, p[[i, k]], VELOCITY_SCALE * ref[[i, k]], "darkorange",
-                   f"reference velocity {np.linalg.norm(ref):.3g} m/s", width=0.012, zorder=7)
+            _arrow(
+                ax,
+                p[[i, k]],
+                VELOCITY_SCALE * ref[[i, k]],
+                "darkorange",
+                f"reference velocity {np.linalg.norm(ref):.3g} m/s",
+                width=0.012,
+                zorder=7,
+            )
             view.append((p + VELOCITY_SCALE * ref)[None, [i, k]])
-        if im.contact_velocity is not None and ref is not None and not np.allclose(im.contact_velocity, ref):
+        if (
+            im.contact_velocity is not None
+            and ref is not None
+            and not np.allclose(im.contact_velocity, ref)
+        ):
             v = im.contact_velocity
-            _arrow(ax, p[[i, k]], VELOCITY_SCALE * v[[i, k]], "tab:green",
-                   f"capped at v_max: {np.linalg.norm(v):.3g} m/s", width=0.007, zorder=7.5)
+            _arrow(
+                ax,
+                p[[i, k]],
+                VELOCITY_SCALE * v[[i, k]],
+                "tab:green",
+                f"capped at v_max: {np.linalg.norm(v):.3g} m/s",
+                width=0.007,
+                zorder=7.5,
+            )
 
     set_limits(ax, view, margin=0.08, min_span=0.3)
     ax.set_aspect("equal", adjustable="box")
@@ -187,5 +276,7 @@ def plot_stance(analysis: Analysis, robot: bool = True) -> Figure:
             labels.append(lab)
     ncol = max(2, min(4, int(fig.get_figwidth() / 3.3)))  # as many columns as the width holds
     fig.legend(handles, labels, loc="outside lower center", ncol=ncol, fontsize=8.5, framealpha=0.9)
-    fig.suptitle(f"Stance: {scenario_title(analysis)}, mass {analysis.stance.mass:.1f} kg", fontsize=12)
+    fig.suptitle(
+        f"Stance: {scenario_title(analysis)}, mass {analysis.stance.mass:.1f} kg", fontsize=12
+    )
     return fig

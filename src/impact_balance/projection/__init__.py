@@ -21,7 +21,7 @@ from impact_balance.projection.bretl import project_bretl
 from impact_balance.projection.result import ProjectionResult
 from impact_balance.projection.walk import project_walk
 
-__all__ = ["ProjectionResult", "project_polytope", "project_bretl", "project_walk", "METHODS"]
+__all__ = ["METHODS", "ProjectionResult", "project_bretl", "project_polytope", "project_walk"]
 
 #: Accepted values of ``method``.
 METHODS = ("auto", "walk", "bretl")
@@ -66,9 +66,15 @@ def project_polytope(
         if result is not None and (method == "walk" or not result.polygon.is_empty):
             return result
         if method == "walk":
-            raise SolverError("projection walk", "failed", "the polytope contains a line or a pivot was singular; use method='bretl'")
+            raise SolverError(
+                "projection walk",
+                "failed",
+                "the polytope contains a line or a pivot was singular; use method='bretl'",
+            )
     result = project_bretl(A, b, C, d, E, tol=tol, box=box, max_lp=max_lp, merge_tol=merge)
     polygon = result.polygon
     if not (np.isfinite(polygon.vertices).all() and polygon.area >= 0.0):  # never a wrong answer
-        raise SolverError("projection", "bretl", "the projected polygon is not finite and counter-clockwise")
+        raise SolverError(
+            "projection", "bretl", "the projected polygon is not finite and counter-clockwise"
+        )
     return result

@@ -30,7 +30,17 @@ import numpy as np
 
 from impact_balance._jit import njit
 
-__all__ = ["project", "project_equalities", "equality_basis", "walk", "OK", "INFEASIBLE", "FAILED", "LINE", "INCONSISTENT"]
+__all__ = [
+    "FAILED",
+    "INCONSISTENT",
+    "INFEASIBLE",
+    "LINE",
+    "OK",
+    "equality_basis",
+    "project",
+    "project_equalities",
+    "walk",
+]
 
 #: Kernel statuses. LINE: the polytope contains a line (no vertex); the caller can quotient
 #: it out and call again. INCONSISTENT: the equalities have no solution.
@@ -91,7 +101,7 @@ def _times(M, v):
 
 @njit(cache=True)
 def _times_into(M, v, out):
-    """out = M v (out preallocated)."""
+    """Out = M v (out preallocated)."""
     for i in range(M.shape[0]):
         acc = 0.0
         for j in range(M.shape[1]):
@@ -113,7 +123,8 @@ def _point(g0, GT, z, out, i):
 def _step(H, h, z, p, j, hp, slack):
     """Row j's step along ``p`` in the ratio test (inf if it does not block); its ``H_j p`` and
     slack go to ``hp[j]`` and ``slack[j]``. Inlined by numba: called per row, as a function of
-    its own it made the walk 20 % slower."""
+    its own it made the walk 20 % slower.
+    """
     a = 0.0
     b = h[j]
     for k in range(H.shape[1]):
@@ -166,7 +177,8 @@ def _near(z, zd):
 @njit(cache=True)
 def _ratio_test_near(H, h, z, p, active, hp, slack, zd, dset):
     """:func:`_ratio_test`, over the rows listed near z (``dset``, at ``zd``) when that gives
-    its answer exactly: z still within _D_MOVE of ``zd`` and a step up to _D_STEP."""
+    its answer exactly: z still within _D_MOVE of ``zd`` and a step up to _D_STEP.
+    """
     count = dset[0]
     if count >= 0 and _near(z, zd):
         best = math.inf
@@ -189,7 +201,8 @@ def _min_slack_near(H, h, z, worst, zd, dset):
     """``worst[0]`` = min(worst[0], min_j h_j - H_j z) (``worst[0]`` <= 0): a vertex's
     feasibility check. Over the rows listed near z (``dset``) when z is within _D_MOVE of where
     they were listed (``zd``: the others' slacks are positive there); else over every row,
-    listing them again at z."""
+    listing them again at z.
+    """
     m, n = H.shape
     count = dset[0]
     if count >= 0 and _near(z, zd):
@@ -236,7 +249,8 @@ def _project_out(Q, k, v, out):
 @njit(cache=True)
 def _longest_axis(Q, k, out):
     """``out`` = the coordinate axis that keeps most of its length once the k orthonormal rows
-    of Q are projected out (pivoted, hence well conditioned), projected; returns |out|."""
+    of Q are projected out (pivoted, hence well conditioned), projected; returns |out|.
+    """
     n = Q.shape[1]
     best, axis = -1.0, 0
     for i in range(n):
@@ -348,11 +362,21 @@ def _invert(B, out):
 def _workspace(m, n):
     """The walk's work buffers, made once per walk (an allocation per pivot would cost as much
     as the pivot): (p, col, alpha) of n, (hp, slack) of m, an n x n basis copy and a 3 x n
-    buffer for the breakpoints."""
+    buffer for the breakpoints.
+    """
     dset = np.empty(m + 1, dtype=np.int64)  # [0]: count (-1: none yet), then the rows
     dset[0] = -1
-    return (np.empty(n), np.empty(n), np.empty(n), np.empty(m), np.empty(m), np.empty((n, n)), np.empty((3, n)),
-            np.empty(n), dset)
+    return (
+        np.empty(n),
+        np.empty(n),
+        np.empty(n),
+        np.empty(m),
+        np.empty(m),
+        np.empty((n, n)),
+        np.empty((3, n)),
+        np.empty(n),
+        dset,
+    )
 
 
 @njit(cache=True)
@@ -401,7 +425,8 @@ def _pivot(H, h, W, Binv, z, leave, j, since, work):
 def _accurate(H, h, W, Binv, z, ones):
     """Whether a carried basis inverse still solves its system to near rounding: the vertex
     ``H_W z = h_W`` within 1e-14 of max(1, |h_W|), and ``H_W (Binv 1) = 1`` within 1e-14 n
-    (3 n^2 products, where a fresh inverse costs 2 n^3). ``ones`` (n): a work buffer."""
+    (3 n^2 products, where a fresh inverse costs 2 n^3). ``ones`` (n): a work buffer.
+    """
     n = Binv.shape[0]
     size = 1.0
     for i in range(n):
@@ -424,7 +449,7 @@ def _accurate(H, h, W, Binv, z, ones):
 
 @njit(cache=True)
 def _vertex(h, W, Binv, z):
-    """z = Binv h_W."""
+    """Z = Binv h_W."""
     n = Binv.shape[0]
     for r in range(n):
         acc = 0.0
@@ -556,7 +581,8 @@ def _warm_start(H, h, W, Binv, z, active, work, hint):
     the crash, which costs n ratio tests over every row (~10 % of a walk on the governor's
     postures). Any feasible vertex basis is a valid simplex start, so the walk's answer is
     the same polygon (its vertices to rounding). Returns False otherwise, z back at 0 (the
-    crash's start: the caller tries only where 0 is feasible)."""
+    crash's start: the caller tries only where 0 is feasible).
+    """
     m, n = H.shape
     if hint.shape[0] < n + 2 or hint[0] != m or hint[1] != n:
         return False
@@ -608,7 +634,9 @@ def _phase_one(H, h, z, W, active, max_pivots):
     work = _workspace(m + 1, n + 1)
     if not _refactor(Ha, ha, Wa, Binv_a, za, work):
         return FAILED, 0, 0
-    status, pivots = _optimize(Ha, ha, za, Wa, Binv_a, active_a, c1, np.zeros(n + 1), 1.0, max_pivots, work)
+    status, pivots = _optimize(
+        Ha, ha, za, Wa, Binv_a, active_a, c1, np.zeros(n + 1), 1.0, max_pivots, work
+    )
     if status != OK:
         return status, pivots, 0
     if za[n] > _EPS_FEASIBLE:
@@ -713,7 +741,11 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
         # area at a hand friction of 1.6e-6).
         _min_slack_near(H, h, z, worst, work[7], work[8])
         _point(g0, GT, z, vertices, count)  # kept when it differs from the last one
-        if abs(vertices[count, 0] - vertices[count - 1, 0]) + abs(vertices[count, 1] - vertices[count - 1, 1]) > 0.0:
+        if (
+            abs(vertices[count, 0] - vertices[count - 1, 0])
+            + abs(vertices[count, 1] - vertices[count - 1, 1])
+            > 0.0
+        ):
             count += 1
     return OK, vertices, count, pivots
 
@@ -777,7 +809,9 @@ def project(A, b, E, x0, N, box, max_pivots, hint):
             h[m + 1] = (box + g0[i]) / gk
             m += 2
     worst = np.zeros(1)
-    status, vertices, count, pivots = walk(H[:m].copy(), h[:m].copy(), G.T.copy(), g0, 0.0, max_pivots, worst, hint)
+    status, vertices, count, pivots = walk(
+        H[:m].copy(), h[:m].copy(), G.T.copy(), g0, 0.0, max_pivots, worst, hint
+    )
     if status != OK:
         return status, none, pivots, worst[0]
     # The caller merges near-duplicate vertices and checks convexity (walk._certify, with the
@@ -839,7 +873,8 @@ def project_equalities(A, b, C, d, E, box, max_pivots, hint):
     """:func:`project` of ``{x : A x <= b, C x = d}``, the equalities eliminated by
     :func:`equality_basis` in the same compiled call (a governor pays each call's dispatch
     every tick). Returns (status, vertices, pivots, worst, x0, N); status INCONSISTENT for
-    inconsistent equalities."""
+    inconsistent equalities.
+    """
     status, x0, N = equality_basis(C, d)
     if status == INFEASIBLE:
         return INCONSISTENT, np.empty((0, 2)), 0, 0.0, x0, N

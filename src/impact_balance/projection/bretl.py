@@ -23,8 +23,8 @@ import numpy as np
 
 from impact_balance.exceptions import SolverError
 from impact_balance.geometry.polygon import Polygon, simplify
-from impact_balance.solvers import HighsLP, LinearProgram
 from impact_balance.projection.result import ProjectionResult
+from impact_balance.solvers import HighsLP, LinearProgram
 
 __all__ = ["project_bretl", "warm_up"]
 
@@ -73,7 +73,9 @@ def project_bretl(
         nonlocal count
         count += 1
         if count > max_lp:
-            raise SolverError("projection", "max_lp", f"more than {max_lp} LPs; is the polytope degenerate?")
+            raise SolverError(
+                "projection", "max_lp", f"more than {max_lp} LPs; is the polytope degenerate?"
+            )
         sol = lp.maximize(E.T @ u)
         if sol.status == "infeasible":
             return None
@@ -105,7 +107,9 @@ def project_bretl(
         normal = np.array([e[1], -e[0]]) / length
         y = support(normal)
         if y is None:  # numerically lost feasibility: stop with what we have
-            raise SolverError("HiGHS", "infeasible", "a support LP became infeasible during projection")
+            raise SolverError(
+                "HiGHS", "infeasible", "a support LP became infeasible during projection"
+            )
         if normal @ (y - a) > tol:
             vertices.insert(i + 1, y)
             confirmed.insert(i + 1, False)
@@ -115,7 +119,9 @@ def project_bretl(
     # Every vertex is a support point, so their convex hull is the answer. Ordering them by
     # hull rather than by insertion matters with nearly opposite rows (a hand's friction
     # 1.6e-6): rounding then inserted a second lap, and the list wound twice (double area).
-    polygon_vertices = Polygon.from_points(np.array(vertices), tol if merge_tol is None else merge_tol).vertices
+    polygon_vertices = Polygon.from_points(
+        np.array(vertices), tol if merge_tol is None else merge_tol
+    ).vertices
     bounded = bool(np.all(np.abs(polygon_vertices) < box * (1 - 1e-9)))
     return ProjectionResult(Polygon(polygon_vertices, bounded), "bretl", n_lp=count)
 
@@ -126,7 +132,8 @@ _warm = False
 def warm_up() -> None:
     """One projection of a square, once per process: the first Bretl projection costs ~0.3 s
     (loading and setting up HiGHS). A governor calls this when it is built, so that a tick
-    whose walk falls back to Bretl (about 1 in 300 on G1's approach) pays ~5 ms, not 71."""
+    whose walk falls back to Bretl (about 1 in 300 on G1's approach) pays ~5 ms, not 71.
+    """
     global _warm
     if _warm:
         return

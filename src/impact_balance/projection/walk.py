@@ -22,14 +22,22 @@ import os
 
 import numpy as np
 
-from impact_balance.geometry import polygon
 from impact_balance._jit import HAVE_NUMBA, cache_depends_on, njit
+from impact_balance.geometry import polygon
 from impact_balance.geometry.polygon import MERGE_AREA_TOLERANCE, Polygon, _simplify_convex
 from impact_balance.projection import _kernel
-from impact_balance.projection._kernel import FAILED, INCONSISTENT, INFEASIBLE, LINE, OK, project, project_equalities
+from impact_balance.projection._kernel import (
+    FAILED,
+    INCONSISTENT,
+    INFEASIBLE,
+    LINE,
+    OK,
+    project,
+    project_equalities,
+)
 from impact_balance.projection.result import ProjectionResult
 
-__all__ = ["project_walk", "certified_walk", "kernel_is_compiled", "warm_up", "MAX_PIVOTS"]
+__all__ = ["MAX_PIVOTS", "certified_walk", "kernel_is_compiled", "project_walk", "warm_up"]
 
 #: Relative singular-value threshold for the rank of the lines of the polytope.
 RANK_TOLERANCE = 1e-12
@@ -44,6 +52,7 @@ CHECK_MERGE = 1e-9
 MAX_PIVOTS = 5000
 #: The kernel's warm-start hint when there is none (a one-off projection): never read or written.
 NO_HINT = np.zeros(0, dtype=np.int64)
+
 
 def project_walk(
     A: np.ndarray,
@@ -65,8 +74,9 @@ def project_walk(
     E = _array(E, 2)
     n = E.shape[1]
     A, C, b, d = _array(A, 2, n), _array(C, 2, n), _array(b, 1), _array(d, 1)
-    status, vertices, bounded, pivots, x0, N = certified_walk(A, b, C, d, E, float(box), int(max_pivots),
-                                                              float(merge_tol), MERGE_AREA_TOLERANCE, NO_HINT)
+    status, vertices, bounded, pivots, x0, N = certified_walk(
+        A, b, C, d, E, float(box), int(max_pivots), float(merge_tol), MERGE_AREA_TOLERANCE, NO_HINT
+    )
     if status == LINE:
         # Lines of the polytope are the null space of [A N; E N] (a line along which E x
         # changed would have met the box rows); keep z in its orthogonal complement.
@@ -75,7 +85,9 @@ def project_walk(
         N = np.ascontiguousarray(N @ Vt[:r].T)
         status, raw, more, worst = project(A, b, E, x0, N, float(box), int(max_pivots), NO_HINT)
         pivots += more
-        status, vertices, bounded = _certify(status, raw, worst, b, float(merge_tol), MERGE_AREA_TOLERANCE, float(box))
+        status, vertices, bounded = _certify(
+            status, raw, worst, b, float(merge_tol), MERGE_AREA_TOLERANCE, float(box)
+        )
     if status == INCONSISTENT:
         return ProjectionResult(Polygon.empty(), "walk")
     if status == INFEASIBLE:
@@ -88,7 +100,8 @@ def project_walk(
 @njit(cache=True)
 def _certify(status, vertices, worst, b, merge_tol, area_tol, box):
     """A walk's raw vertices certified and merged: ``(status, vertices, bounded)``, status
-    FAILED when the walk cannot answer (see :func:`project_walk`)."""
+    FAILED when the walk cannot answer (see :func:`project_walk`).
+    """
     none = np.empty((0, 2))
     if status == FAILED or status == LINE:
         return FAILED, none, True
@@ -110,8 +123,9 @@ def _certify(status, vertices, worst, b, merge_tol, area_tol, box):
     # first pass only drops rounding-level duplicates, which would fail the strict check:
     # within 1e-9, or 10 times the worst slack (a vertex's rounding shows in its slacks; 1e-8
     # with a friction of 2.5e4 on Talos's foot).
-    ok, merged, bounded = _simplify_convex(vertices, min(merge_tol, max(CHECK_MERGE, -10.0 * worst)), merge_tol,
-                                           area_tol, box)
+    ok, merged, bounded = _simplify_convex(
+        vertices, min(merge_tol, max(CHECK_MERGE, -10.0 * worst)), merge_tol, area_tol, box
+    )
     if not ok:
         return FAILED, none, True
     return OK, merged, bounded
@@ -142,9 +156,15 @@ cache_depends_on(certified_walk, polygon, _kernel)
 
 def _array(x, ndim: int, columns: int | None = None) -> np.ndarray:
     """``x`` as a C-contiguous float64 array of ``ndim`` dimensions (``columns`` columns):
-    itself when it already is one (a polytope's own arrays, every governor tick)."""
-    if (type(x) is np.ndarray and x.dtype == np.float64 and x.ndim == ndim and x.flags.c_contiguous
-            and (columns is None or x.shape[1] == columns)):
+    itself when it already is one (a polytope's own arrays, every governor tick).
+    """
+    if (
+        type(x) is np.ndarray
+        and x.dtype == np.float64
+        and x.ndim == ndim
+        and x.flags.c_contiguous
+        and (columns is None or x.shape[1] == columns)
+    ):
         return x
     a = np.asarray(x, dtype=float)
     shape = (-1,) if ndim == 1 else (-1, a.shape[-1] if columns is None else columns)
@@ -153,7 +173,8 @@ def _array(x, ndim: int, columns: int | None = None) -> np.ndarray:
 
 def kernel_is_compiled() -> bool:
     """Whether numba's on-disk cache holds the kernel; if not, the first projection compiles
-    it (0.5 to 1.5 min, once per installation). True without numba (nothing to compile)."""
+    it (0.5 to 1.5 min, once per installation). True without numba (nothing to compile).
+    """
     if not HAVE_NUMBA:
         return True
     try:  # numba's cache index of the entry point; private API, hence the guard
@@ -169,7 +190,8 @@ def warm_up() -> float:
     """Load (or compile) the kernel now, by projecting a square; returns the seconds spent
     (0.0 once done). numba loads a cached kernel on its first call (0.3-1.5 s, 0.5 to 1.5 min to
     compile after an installation): callers that time a projection call this first, so
-    that the load is not mistaken for the projection."""
+    that the load is not mistaken for the projection.
+    """
     global _warm
     if _warm:
         return 0.0

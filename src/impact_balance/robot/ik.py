@@ -27,7 +27,7 @@ from pink.tasks import ComTask, FrameTask, PostureTask
 from impact_balance.exceptions import ImpactBalanceError
 from impact_balance.robot.robot import Robot
 
-__all__ = ["IKError", "solve_stance", "stance_residuals", "chain_dofs"]
+__all__ = ["IKError", "chain_dofs", "solve_stance", "stance_residuals"]
 
 #: Residual (m or rad) below which the regularisation is scaled down by ``_FINISH_SCALE``.
 _FINISH_THRESHOLD = 1e-3
@@ -52,10 +52,14 @@ class IKError(ImpactBalanceError):
         self.q = np.asarray(q, dtype=float).copy()
         worst = sorted(self.residuals.items(), key=lambda kv: -kv[1])[:3]
         detail = ", ".join(f"{k} = {v:.3g}" for k, v in worst)
-        super().__init__(f"inverse kinematics failed after {iterations} iterations ({reason}); largest residuals: {detail}")
+        super().__init__(
+            f"inverse kinematics failed after {iterations} iterations ({reason}); largest residuals: {detail}"
+        )
 
 
-def _reduced(robot: Robot, locked_joints: Iterable[str], q0: np.ndarray) -> tuple[pin.Model, list[tuple[int, int, int]]]:
+def _reduced(
+    robot: Robot, locked_joints: Iterable[str], q0: np.ndarray
+) -> tuple[pin.Model, list[tuple[int, int, int]]]:
     """A private copy of the model with ``locked_joints`` fixed at ``q0``, and the index map.
 
     The map lists ``(full idx_q, reduced idx_q, nq)`` for every joint kept, root included.
@@ -104,7 +108,9 @@ def stance_residuals(
         actual = data.oMf[robot.frame_id(name, field="frame_targets")]
         out[f"{name}.position"] = float(np.linalg.norm(actual.translation - target.translation))
         if name not in free:
-            out[f"{name}.orientation"] = float(np.linalg.norm(pin.log3(target.rotation.T @ actual.rotation)))
+            out[f"{name}.orientation"] = float(
+                np.linalg.norm(pin.log3(target.rotation.T @ actual.rotation))
+            )
     if com_target_xy is not None:
         com = pin.centerOfMass(model, data, q, False)
         out["com_xy"] = float(np.linalg.norm(com[:2] - np.asarray(com_target_xy, dtype=float)))
@@ -180,7 +186,12 @@ def solve_stance(
     if q0.shape != (model_full.nq,):
         raise ValueError(f"q0 must have {model_full.nq} coordinates, got shape {q0.shape}")
     for slot in (robot.joint_slot(name) for name in robot.joint_names):
-        if slot.nq == 1 and np.isfinite(slot.lower) and np.isfinite(slot.upper) and slot.lower < slot.upper:
+        if (
+            slot.nq == 1
+            and np.isfinite(slot.lower)
+            and np.isfinite(slot.upper)
+            and slot.lower < slot.upper
+        ):
             q0[slot.idx_q] = min(max(q0[slot.idx_q], slot.lower), slot.upper)
     data_full = model_full.createData()
     pin.framesForwardKinematics(model_full, data_full, q0)
@@ -222,14 +233,18 @@ def solve_stance(
         if model.existJointName(name):
             joint = model.joints[model.getJointId(name)]
             costs[joint.idx_v - 6 : joint.idx_v - 6 + joint.nv] = float(cost)
-    preferred = to_reduced(q0 if posture_target is None else np.asarray(posture_target, dtype=float))
+    preferred = to_reduced(
+        q0 if posture_target is None else np.asarray(posture_target, dtype=float)
+    )
     base_frame = model.names[1]  # the free-flyer's joint frame
     base_target = pin.SE3(pin.Quaternion(preferred[3:7]).normalized().matrix(), np.zeros(3))
 
     def regularisation(scale: float) -> list:
         posture = PostureTask(cost=scale * costs)
         posture.set_target(preferred)
-        base = FrameTask(base_frame, position_cost=0.0, orientation_cost=scale * float(base_orientation_cost))
+        base = FrameTask(
+            base_frame, position_cost=0.0, orientation_cost=scale * float(base_orientation_cost)
+        )
         base.set_target(base_target)
         return [posture, base]
 
@@ -247,9 +262,13 @@ def solve_stance(
         worst = max(res.values(), default=0.0)
         step_tasks = phases[1] if worst <= _FINISH_THRESHOLD else phases[0]
         try:
-            velocity = pink.solve_ik(configuration, step_tasks, dt=1.0, solver=solver, damping=damping, limits=limits)
+            velocity = pink.solve_ik(
+                configuration, step_tasks, dt=1.0, solver=solver, damping=damping, limits=limits
+            )
         except PinkError as exc:
-            raise IKError(f"{exc.__class__.__name__}: {exc}", res, iteration - 1, to_full(configuration.q)) from None
+            raise IKError(
+                f"{exc.__class__.__name__}: {exc}", res, iteration - 1, to_full(configuration.q)
+            ) from None
         configuration.integrate_inplace(velocity, 1.0)
         q = to_full(configuration.q)
         res = residuals(q)

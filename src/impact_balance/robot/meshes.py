@@ -20,7 +20,7 @@ import numpy as np
 
 from impact_balance.exceptions import RobotLoadError
 
-__all__ = ["read_mesh", "mujoco_reads", "MUJOCO_FORMATS"]
+__all__ = ["MUJOCO_FORMATS", "mujoco_reads", "read_mesh"]
 
 #: File suffixes MuJoCo decodes itself (STL only when binary, see :func:`mujoco_reads`).
 MUJOCO_FORMATS = (".stl", ".obj", ".msh")
@@ -59,7 +59,7 @@ def _read(path: str, _stamp: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
         mesh = trimesh.load(path, force="mesh")
     except ImportError as exc:  # trimesh's optional readers (pycollada for .dae)
         raise RobotLoadError(path, f"cannot read the mesh: {exc}".splitlines()[0]) from None
-    except Exception as exc:  # noqa: BLE001 - any parser error is a bad file, said in one line
+    except Exception as exc:
         raise RobotLoadError(path, f"cannot read the mesh ({type(exc).__name__})") from None
     vertices = np.asarray(getattr(mesh, "vertices", ()), dtype=np.float64).reshape(-1, 3)
     faces = np.asarray(getattr(mesh, "faces", ()), dtype=np.int64).reshape(-1, 3)

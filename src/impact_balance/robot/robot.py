@@ -29,7 +29,16 @@ from impact_balance.exceptions import (
     UnknownRobotError,
 )
 
-__all__ = ["RobotSpec", "Robot", "JointSlot", "Scratch", "Workspace", "BUNDLED_ROBOTS", "load_robot", "example_robot_data_root"]
+__all__ = [
+    "BUNDLED_ROBOTS",
+    "JointSlot",
+    "Robot",
+    "RobotSpec",
+    "Scratch",
+    "Workspace",
+    "example_robot_data_root",
+    "load_robot",
+]
 
 
 @dataclass(frozen=True)
@@ -212,7 +221,12 @@ class Robot:
         for jid in range(2, model.njoints):  # 0 = universe, 1 = free-flyer root
             joint = model.joints[jid]
             slots[model.names[jid]] = JointSlot(
-                jid, joint.idx_q, joint.nq, joint.nv, float(lower[joint.idx_q]), float(upper[joint.idx_q])
+                jid,
+                joint.idx_q,
+                joint.nq,
+                joint.nv,
+                float(lower[joint.idx_q]),
+                float(upper[joint.idx_q]),
             )
         return slots
 
@@ -220,7 +234,9 @@ class Robot:
         """Index of frame ``name``; :class:`UnknownFrameError` naming the valid ones if absent."""
         fid = self._frame_ids.get(name) if isinstance(name, str) else None
         if fid is None:
-            raise UnknownFrameError(field, name, set(self.frame_names), listing=self.listing_command)
+            raise UnknownFrameError(
+                field, name, set(self.frame_names), listing=self.listing_command
+            )
         return fid
 
     def joint_id(self, name: str, field: str = "joint") -> int:
@@ -234,7 +250,9 @@ class Robot:
             raise UnknownJointError(field, name, self.joint_names, listing=self.listing_command)
         return slot
 
-    def joint_assignment(self, joints: Mapping[str, float], field: str = "joints") -> tuple[np.ndarray, np.ndarray]:
+    def joint_assignment(
+        self, joints: Mapping[str, float], field: str = "joints"
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Configuration indices and values (``q[idx] = values``) that set joints by name.
 
         A 1-dof joint takes its value (rad or m), checked against its finite position limits
@@ -252,15 +270,26 @@ class Robot:
             slot = self.joint_slot(name, field=f"{field}.{name}")
             if slot.nq == 1:
                 lo, hi = slot.lower, slot.upper
-                if math.isfinite(lo) and math.isfinite(hi) and lo < hi and not (lo - 1e-9 <= value <= hi + 1e-9):
-                    raise ScenarioError(f"{field}.{name}", value, f"outside the joint limits [{lo:.4g}, {hi:.4g}] rad")
+                if (
+                    math.isfinite(lo)
+                    and math.isfinite(hi)
+                    and lo < hi
+                    and not (lo - 1e-9 <= value <= hi + 1e-9)
+                ):
+                    raise ScenarioError(
+                        f"{field}.{name}",
+                        value,
+                        f"outside the joint limits [{lo:.4g}, {hi:.4g}] rad",
+                    )
                 indices.append(slot.idx_q)
                 values.append(value)
             elif slot.nq == 2 and slot.nv == 1:  # continuous joint: (cos, sin)
                 indices += [slot.idx_q, slot.idx_q + 1]
                 values += [math.cos(value), math.sin(value)]
             else:
-                raise ScenarioError(f"{field}.{name}", value, "only 1-dof joints can be set by a single value")
+                raise ScenarioError(
+                    f"{field}.{name}", value, "only 1-dof joints can be set by a single value"
+                )
         result = np.asarray(indices, dtype=int), np.asarray(values, dtype=float)
         for array in result:
             array.setflags(write=False)
@@ -398,7 +427,9 @@ def _load(urdf: Path, srdf: Path | None, name: str, standing: str | None) -> Rob
             with _native_stderr(native):
                 pin.loadReferenceConfigurations(model, str(srdf), False)
         except (RuntimeError, ValueError, OSError) as exc:
-            raise RobotLoadError(str(srdf), _native_reason(native, str(exc).strip() or "invalid SRDF")) from None
+            raise RobotLoadError(
+                str(srdf), _native_reason(native, str(exc).strip() or "invalid SRDF")
+            ) from None
         for entry in model.referenceConfigurations:
             configurations[entry.key()] = np.array(entry.data(), dtype=float)
         armature_source = _load_rotor_parameters(model, srdf, native)
@@ -412,7 +443,8 @@ def _load(urdf: Path, srdf: Path | None, name: str, standing: str | None) -> Rob
 def _load_rotor_parameters(model: pin.Model, srdf: Path, native: list[str]) -> str | None:
     """Read the SRDF's ``rotor_params`` into the model (rotor inertia and gear ratio per joint) and set
     ``model.armature`` = gear ratio^2 x rotor inertia, the rotor inertia reflected at the joint. Returns
-    where it came from, or None when the SRDF declares none."""
+    where it came from, or None when the SRDF declares none.
+    """
     try:
         declared = "rotor_params" in srdf.read_text(errors="replace")
     except OSError:
@@ -423,7 +455,9 @@ def _load_rotor_parameters(model: pin.Model, srdf: Path, native: list[str]) -> s
         with _native_stderr(native):
             pin.loadRotorParameters(model, str(srdf), False)
     except (RuntimeError, ValueError, OSError) as exc:
-        raise RobotLoadError(str(srdf), _native_reason(native, str(exc).strip() or "invalid rotor_params")) from None
+        raise RobotLoadError(
+            str(srdf), _native_reason(native, str(exc).strip() or "invalid rotor_params")
+        ) from None
     # pinocchio >= 3.? sets the armature itself; older versions only fill the rotor fields.
     model.armature = np.asarray(model.rotorGearRatio) ** 2 * np.asarray(model.rotorInertia)
     return f"{srdf.name} rotor_params (armature = gear ratio^2 x rotor inertia)"
@@ -462,7 +496,12 @@ def load_robot(
         raise RobotLoadError(str(urdf), "no such file")
     srdf_path = Path(srdf) if srdf else None
     # Cached by the files' identity and modification: an edited URDF or SRDF is reloaded.
-    key = (_file_key(urdf), _file_key(srdf_path) if srdf_path else None, robot or urdf.stem, standing)
+    key = (
+        _file_key(urdf),
+        _file_key(srdf_path) if srdf_path else None,
+        robot or urdf.stem,
+        standing,
+    )
     cached = _FILE_ROBOTS.get(key)
     if cached is None:
         cached = _load(urdf, srdf_path, robot or urdf.stem, standing)

@@ -21,11 +21,22 @@ from typing import TYPE_CHECKING, Any
 # (ExtendsResolver, with_source, _field, _merge, _read). Imported on first use (PEP 562):
 # listing the bundled scenarios needs only .bundled, not pydantic and pinocchio.
 _EXPORTS: dict[str, str] = {
-    "bundled_scenarios": ".bundled", "scenario_path": ".bundled",
-    "ExtendsResolver": ".load", "_merge": ".load", "_read": ".load", "load_scenario": ".load",
-    "BasePose": ".schema", "ContactConfig": ".schema", "ImpactConfig": ".schema", "Offset": ".schema",
-    "QPConfig": ".schema", "RobotFiles": ".schema", "Scenario": ".schema", "with_source": ".schema",
-    "_field": ".validate", "scenario_from_dict": ".validate",
+    "bundled_scenarios": ".bundled",
+    "scenario_path": ".bundled",
+    "ExtendsResolver": ".load",
+    "_merge": ".load",
+    "_read": ".load",
+    "load_scenario": ".load",
+    "BasePose": ".schema",
+    "ContactConfig": ".schema",
+    "ImpactConfig": ".schema",
+    "Offset": ".schema",
+    "QPConfig": ".schema",
+    "RobotFiles": ".schema",
+    "Scenario": ".schema",
+    "with_source": ".schema",
+    "_field": ".validate",
+    "scenario_from_dict": ".validate",
 }
 
 
@@ -41,19 +52,28 @@ def __getattr__(name: str) -> Any:
 if TYPE_CHECKING:
     from impact_balance.scenario.bundled import bundled_scenarios, scenario_path
     from impact_balance.scenario.load import ExtendsResolver, _merge, _read, load_scenario
-    from impact_balance.scenario.schema import BasePose, ContactConfig, ImpactConfig, Offset, QPConfig, RobotFiles, Scenario, with_source
+    from impact_balance.scenario.schema import (
+        BasePose,
+        ContactConfig,
+        ImpactConfig,
+        Offset,
+        QPConfig,
+        RobotFiles,
+        Scenario,
+        with_source,
+    )
     from impact_balance.scenario.validate import _field, scenario_from_dict
 
 __all__ = [
-    "Offset",
-    "ContactConfig",
-    "QPConfig",
-    "ImpactConfig",
-    "RobotFiles",
     "BasePose",
+    "ContactConfig",
+    "ImpactConfig",
+    "Offset",
+    "QPConfig",
+    "RobotFiles",
     "Scenario",
-    "load_scenario",
     "bundled_scenarios",
-    "scenario_path",
+    "load_scenario",
     "scenario_from_dict",
+    "scenario_path",
 ]

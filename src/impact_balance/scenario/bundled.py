@@ -23,7 +23,9 @@ def _scenario_dir() -> Path:
 def bundled_descriptions(folder: str) -> dict[str, str]:
     """The ``*.yaml`` files of the package data folder ``impact_balance/<folder>``: name -> one-line description."""
     out = {}
-    for entry in sorted((resources.files("impact_balance") / folder).iterdir(), key=lambda e: e.name):
+    for entry in sorted(
+        (resources.files("impact_balance") / folder).iterdir(), key=lambda e: e.name
+    ):
         if entry.name.endswith(".yaml"):
             raw = yaml.safe_load(entry.read_text()) or {}
             out[entry.name[:-5]] = str(raw.get("description", "")).strip()

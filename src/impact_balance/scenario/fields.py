@@ -14,7 +14,7 @@ from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict
 
 from impact_balance.constants import MAX_ANGLE, MAX_FRICTION, MAX_POSITION, MAX_SPEED
 
-__all__ = ["Number", "Integer", "Flag", "Vec2", "Vec3", "Position", "Angles", "Friction"]
+__all__ = ["Angles", "Flag", "Friction", "Integer", "Number", "Position", "Vec2", "Vec3"]
 
 
 def _not_bool_or_text(v: Any, what: str) -> Any:
@@ -58,7 +58,9 @@ def _interval(lo: float, hi: float, lo_open: bool = False, hi_open: bool = False
     return f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
 
 
-def _scalar(lo: float, hi: float, unit: str = "", lo_open: bool = False, hi_open: bool = False) -> AfterValidator:
+def _scalar(
+    lo: float, hi: float, unit: str = "", lo_open: bool = False, hi_open: bool = False
+) -> AfterValidator:
     """A validator keeping a number within [lo, hi] (or open ends), naming the range."""
     text = _interval(lo, hi, lo_open, hi_open) + (f" {unit}" if unit else "")
 

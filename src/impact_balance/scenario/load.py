@@ -15,8 +15,14 @@ from collections import OrderedDict
 from pathlib import Path
 
 from impact_balance.exceptions import ScenarioError, UnknownScenarioError
-from impact_balance.scenario.reader import MAX_EXTENDS, _parse_cached, check_path_text, parse_yaml, read_text
 from impact_balance.scenario.bundled import _is_file, scenario_path
+from impact_balance.scenario.reader import (
+    MAX_EXTENDS,
+    _parse_cached,
+    check_path_text,
+    parse_yaml,
+    read_text,
+)
 from impact_balance.scenario.schema import Scenario
 from impact_balance.scenario.validate import scenario_from_dict
 
@@ -39,7 +45,9 @@ def _merge(base: dict, override: dict) -> dict:
 def _parent(path: Path, parent: typing.Any, resolve_path: ExtendsResolver | None) -> Path:
     """The file that ``path``'s ``extends: parent`` names."""
     if not isinstance(parent, str):
-        raise ScenarioError("extends", parent, "must be a bundled scenario name or a file path", str(path))
+        raise ScenarioError(
+            "extends", parent, "must be a bundled scenario name or a file path", str(path)
+        )
     check_path_text("extends", parent, str(path))
     candidate = path.parent / parent
     try:
@@ -52,7 +60,9 @@ def _parent(path: Path, parent: typing.Any, resolve_path: ExtendsResolver | None
         raise ScenarioError("extends", parent, exc.reason, str(path)) from None
 
 
-def _read(path: Path, seen: tuple[Path, ...] = (), resolve_path: ExtendsResolver | None = None) -> dict:
+def _read(
+    path: Path, seen: tuple[Path, ...] = (), resolve_path: ExtendsResolver | None = None
+) -> dict:
     if path.resolve() in seen:
         raise ScenarioError("extends", str(path), "circular extends")
     if len(seen) >= MAX_EXTENDS:
@@ -61,7 +71,9 @@ def _read(path: Path, seen: tuple[Path, ...] = (), resolve_path: ExtendsResolver
     if raw is None:
         raise ScenarioError("scenario", str(path), "the file is empty")
     if not isinstance(raw, dict):
-        raise ScenarioError("scenario", str(path), f"must be a YAML mapping of keys, got {type(raw).__name__}")
+        raise ScenarioError(
+            "scenario", str(path), f"must be a YAML mapping of keys, got {type(raw).__name__}"
+        )
     parent = raw.pop("extends", None)
     if parent is not None:
         parent_path = _parent(path, parent, resolve_path)
@@ -71,7 +83,8 @@ def _read(path: Path, seen: tuple[Path, ...] = (), resolve_path: ExtendsResolver
 
 def _chain_key(path: Path, resolve_path: ExtendsResolver | None) -> tuple | None:
     """The texts of the files of ``path``'s ``extends`` chain, or None when the chain has a
-    problem (:func:`_read` then reports it). Reads the parse cache without copying it."""
+    problem (:func:`_read` then reports it). Reads the parse cache without copying it.
+    """
     texts: list[tuple[str, str]] = []
     try:
         while path is not None and len(texts) <= MAX_EXTENDS:  # a cycle ends at the cap
@@ -93,7 +106,9 @@ _LOADED_SIZE = 64
 _LOADED_LOCK = threading.Lock()
 
 
-def load_scenario(name_or_path: str | Path, resolve_path: ExtendsResolver | None = None) -> Scenario:
+def load_scenario(
+    name_or_path: str | Path, resolve_path: ExtendsResolver | None = None
+) -> Scenario:
     """Load and validate a scenario file (or a bundled scenario by name).
 
     The result is cached by the content of every file of the ``extends`` chain: an edited file

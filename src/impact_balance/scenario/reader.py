@@ -40,19 +40,19 @@ from impact_balance.exceptions import ScenarioError
 __all__ = [
     "MAX_BYTES",
     "MAX_DEPTH",
-    "MAX_VALUES",
-    "MAX_NAME_CHARS",
-    "MAX_PATH_CHARS",
     "MAX_EXTENDS",
     "MAX_LOG_BYTES",
-    "MAX_LOG_ROWS",
     "MAX_LOG_COLUMNS",
+    "MAX_LOG_ROWS",
     "MAX_LOG_VALUES",
-    "parse_yaml",
-    "read_yaml",
-    "read_text",
-    "check_structure",
+    "MAX_NAME_CHARS",
+    "MAX_PATH_CHARS",
+    "MAX_VALUES",
     "check_path_text",
+    "check_structure",
+    "parse_yaml",
+    "read_text",
+    "read_yaml",
 ]
 
 #: Largest scenario file read, bytes.
@@ -100,7 +100,9 @@ def _object_children(obj: Any) -> Iterable[Any]:
     return ()
 
 
-def _count(root: Any, children: Callable[[Any], Iterable[Any]], leaf: Callable[[Any], bool]) -> tuple[int, int]:
+def _count(
+    root: Any, children: Callable[[Any], Iterable[Any]], leaf: Callable[[Any], bool]
+) -> tuple[int, int]:
     """Expanded size and depth of a graph whose shared nodes stand for copies (iterative).
 
     Raises ``ValueError`` on a cycle or when the size exceeds :data:`MAX_VALUES`.
@@ -118,7 +120,9 @@ def _count(root: Any, children: Callable[[Any], Iterable[Any]], leaf: Callable[[
             depth[key] = 1 + max((depth[id(k)] for k in kids), default=0)
             on_path.discard(key)
             if size[key] > MAX_VALUES:
-                raise ValueError(f"expands to more than {MAX_VALUES} values (anchors and aliases included)")
+                raise ValueError(
+                    f"expands to more than {MAX_VALUES} values (anchors and aliases included)"
+                )
             continue
         if key in size:
             continue
@@ -140,16 +144,18 @@ class _BoundedLoader(yaml.SafeLoader):
         super().__init__(stream)
         self._depth = 0
 
-    def compose_node(self, parent, index):  # noqa: ANN001 - PyYAML's signature
+    def compose_node(self, parent, index):
         self._depth += 1
         try:
             if self._depth > MAX_DEPTH:
-                raise _LimitError(f"nested deeper than {MAX_DEPTH} levels", self.peek_event().start_mark)
+                raise _LimitError(
+                    f"nested deeper than {MAX_DEPTH} levels", self.peek_event().start_mark
+                )
             return super().compose_node(parent, index)
         finally:
             self._depth -= 1
 
-    def compose_document(self):  # noqa: ANN201
+    def compose_document(self):
         node = super().compose_document()
         try:
             _count(node, _node_children, lambda n: isinstance(n, yaml.ScalarNode))
@@ -189,7 +195,9 @@ def _copy_tree(node: Any) -> Any:
 @functools.lru_cache(maxsize=64)
 def _parse_cached(text: str, source: str) -> Any:
     if len(text) > MAX_BYTES:
-        raise ScenarioError("scenario", source, f"larger than {MAX_BYTES // 1000} kB, the limit for a scenario file")
+        raise ScenarioError(
+            "scenario", source, f"larger than {MAX_BYTES // 1000} kB, the limit for a scenario file"
+        )
     loader = None
     try:
         # PyYAML checks the characters when the loader is made (a control character or a NUL
@@ -201,8 +209,11 @@ def _parse_cached(text: str, source: str) -> Any:
     except yaml.reader.ReaderError as exc:
         line = text.count("\n", 0, exc.position) + 1
         what = "a NUL byte" if exc.character == 0 else f"the control character {exc.character:#04x}"
-        raise ScenarioError("scenario", source, f"not valid YAML: {what} at line {line} (YAML allows printable "
-                                                "text only)") from None
+        raise ScenarioError(
+            "scenario",
+            source,
+            f"not valid YAML: {what} at line {line} (YAML allows printable text only)",
+        ) from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
@@ -220,9 +231,15 @@ def read_text(path: Path) -> str:
         with open(path, "rb") as f:
             data = f.read(MAX_BYTES + 1)
     except OSError as exc:
-        raise ScenarioError("scenario", str(path), f"cannot read: {exc.__class__.__name__}") from None
+        raise ScenarioError(
+            "scenario", str(path), f"cannot read: {exc.__class__.__name__}"
+        ) from None
     if len(data) > MAX_BYTES:
-        raise ScenarioError("scenario", str(path), f"larger than {MAX_BYTES // 1000} kB, the limit for a scenario file")
+        raise ScenarioError(
+            "scenario",
+            str(path),
+            f"larger than {MAX_BYTES // 1000} kB, the limit for a scenario file",
+        )
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError:
@@ -236,7 +253,8 @@ def read_yaml(path: Path) -> Any:
 
 def check_structure(raw: Any, source: str | None = None) -> None:
     """Refuse a mapping nested deeper than :data:`MAX_DEPTH`, larger than :data:`MAX_VALUES`
-    values once shared parts are counted as copies, or containing itself."""
+    values once shared parts are counted as copies, or containing itself.
+    """
     try:
         _, depth = _count(raw, _object_children, lambda x: not isinstance(x, (dict, list, tuple)))
     except ValueError as exc:

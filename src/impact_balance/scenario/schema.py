@@ -14,17 +14,50 @@ import numpy as np
 import pinocchio as pin
 from pydantic import AfterValidator, Field, ValidationInfo, field_validator
 
-from impact_balance.constants import GRAVITY_RANGE, MAX_ANGLE, MAX_DESCRIPTION, MAX_DURATION, MAX_FRICTION, MAX_NAME, MAX_PEAK_FACTOR, MAX_POSITION, MAX_SIZE
-from impact_balance.exceptions import ScenarioError
-from impact_balance.impact.model import ImpactSpec
-from impact_balance.scenario.reader import check_path_text
-from impact_balance.robot.robot import Robot, load_robot
-from impact_balance.geometry.spatial import pose, surface_rotation
+from impact_balance.constants import (
+    GRAVITY_RANGE,
+    MAX_ANGLE,
+    MAX_DESCRIPTION,
+    MAX_DURATION,
+    MAX_FRICTION,
+    MAX_NAME,
+    MAX_PEAK_FACTOR,
+    MAX_POSITION,
+    MAX_SIZE,
+)
 from impact_balance.contacts.stance import ContactSpec, Stance
-from impact_balance.scenario.fields import Angles, Flag, Friction, Integer, Number, Position, Vec2, Vec3, _coordinates, _finite, _Model, _scalar, _speed
+from impact_balance.exceptions import ScenarioError
+from impact_balance.geometry.spatial import pose, surface_rotation
+from impact_balance.impact.model import ImpactSpec
+from impact_balance.robot.robot import Robot, load_robot
+from impact_balance.scenario.fields import (
+    Angles,
+    Flag,
+    Friction,
+    Integer,
+    Number,
+    Position,
+    Vec2,
+    Vec3,
+    _coordinates,
+    _finite,
+    _Model,
+    _scalar,
+    _speed,
+)
+from impact_balance.scenario.reader import check_path_text
 from impact_balance.scenario.specs import _contact_spec, _impact_spec, _quaternion
 
-__all__ = ["Offset", "ContactConfig", "QPConfig", "ImpactConfig", "RobotFiles", "BasePose", "Scenario", "with_source"]
+__all__ = [
+    "BasePose",
+    "ContactConfig",
+    "ImpactConfig",
+    "Offset",
+    "QPConfig",
+    "RobotFiles",
+    "Scenario",
+    "with_source",
+]
 
 
 class Offset(_Model):
@@ -70,8 +103,10 @@ class ContactConfig(_Model):
             raise ValueError("normal must be a non-zero vector")
         offset = info.data.get("offset")
         if offset is not None and any(offset.rpy):
-            raise ValueError("give the contact's orientation either as offset.rpy (in the frame) or as normal "
-                             "(in the world, with angle about it), not both")
+            raise ValueError(
+                "give the contact's orientation either as offset.rpy (in the frame) or as normal "
+                "(in the world, with angle about it), not both"
+            )
         return v
 
     @field_validator("angle")
@@ -89,12 +124,20 @@ class ContactConfig(_Model):
                 needed (and only used) when the contact is given by its ``normal``.
         """
         if self.normal is None:
-            return _contact_spec(self.frame, self.friction, tuple(self.size), self.offset.position, self.offset.rpy)
+            return _contact_spec(
+                self.frame, self.friction, tuple(self.size), self.offset.position, self.offset.rpy
+            )
         if frame_rotation is None:
-            raise ScenarioError("normal", self.normal, "a contact given by its world normal needs the configuration "
-                                "(use Scenario.contact_specs)")
+            raise ScenarioError(
+                "normal",
+                self.normal,
+                "a contact given by its world normal needs the configuration "
+                "(use Scenario.contact_specs)",
+            )
         world = surface_rotation(frame_rotation, self.normal, self.angle or 0.0)
-        offset = pin.SE3(np.asarray(frame_rotation).T @ world, np.asarray(self.offset.position, dtype=float))
+        offset = pin.SE3(
+            np.asarray(frame_rotation).T @ world, np.asarray(self.offset.position, dtype=float)
+        )
         return ContactSpec(self.frame, self.friction, tuple(self.size), offset)
 
 
@@ -211,7 +254,7 @@ class Scenario(_Model):
         return load_robot(self.robot)
 
     def configuration_vector(self, robot: Robot) -> np.ndarray:
-        """q from the named configuration, the joint overrides and the base override."""
+        """Q from the named configuration, the joint overrides and the base override."""
         q = robot.configuration(self.configuration)
         indices, values = robot.joint_assignment(self.joints, field="joints")
         q[indices] = values
@@ -260,7 +303,9 @@ class Scenario(_Model):
                 stance = Stance(robot, q, specs)
         if not stance.com[2] > self.plane_height:
             raise ScenarioError(
-                "plane_height", self.plane_height, f"must be below the CoM height {stance.com[2]:.4g} m"
+                "plane_height",
+                self.plane_height,
+                f"must be below the CoM height {stance.com[2]:.4g} m",
             )
         return stance
 

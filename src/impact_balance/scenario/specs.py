@@ -11,9 +11,9 @@ import functools
 import numpy as np
 import pinocchio as pin
 
-from impact_balance.impact.model import ImpactSpec
-from impact_balance.geometry.spatial import pose
 from impact_balance.contacts.stance import ContactSpec
+from impact_balance.geometry.spatial import pose
+from impact_balance.impact.model import ImpactSpec
 from impact_balance.scenario.fields import Vec2, Vec3
 
 __all__: list[str] = []
@@ -23,7 +23,9 @@ __all__: list[str] = []
 # value over to an updated copy): a scenario is analysed again and again, and building the
 # offset SE3 through pinocchio costs more than the rest of the model update's bookkeeping.
 @functools.lru_cache(maxsize=256)
-def _contact_spec(frame: str, friction: float, size: Vec2, position: Vec3, rpy: Vec3) -> ContactSpec:
+def _contact_spec(
+    frame: str, friction: float, size: Vec2, position: Vec3, rpy: Vec3
+) -> ContactSpec:
     return ContactSpec(frame, friction, size, pose(position, rpy))
 
 

@@ -1,5 +1,6 @@
 """A scenario mapping to a :class:`~.schema.Scenario`: pydantic's errors become one
-:class:`~impact_balance.exceptions.ScenarioError` naming the field, the value and the valid keys."""
+:class:`~impact_balance.exceptions.ScenarioError` naming the field, the value and the valid keys.
+"""
 
 from __future__ import annotations
 
@@ -47,10 +48,16 @@ def scenario_from_dict(raw: dict, source: str | None = None, check_size: bool = 
         reason = err["msg"].removeprefix("Value error, ")
         value = err.get("input")
         if err["type"] == "extra_forbidden" and loc:
-            raise UnknownKeyError(_field(loc), str(loc[-1]), value, _keys_at(loc[:-1]), source) from None
+            raise UnknownKeyError(
+                _field(loc), str(loc[-1]), value, _keys_at(loc[:-1]), source
+            ) from None
         elif err["type"] == "missing":
             if loc and isinstance(loc[-1], int):  # a short list/tuple: report the whole list
-                value, reason, loc = _lookup(raw, loc[:-1]), f"too few items (item {loc[-1]} is missing)", loc[:-1]
+                value, reason, loc = (
+                    _lookup(raw, loc[:-1]),
+                    f"too few items (item {loc[-1]} is missing)",
+                    loc[:-1],
+                )
             else:
                 value, reason = None, "missing required key"
         raise ScenarioError(_field(loc), value, reason, source) from None

@@ -3,4 +3,4 @@
 from impact_balance.solvers.highs import HighsLP
 from impact_balance.solvers.lp import LinearProgram, LPSolution
 
-__all__ = ["HighsLP", "LinearProgram", "LPSolution"]
+__all__ = ["HighsLP", "LPSolution", "LinearProgram"]

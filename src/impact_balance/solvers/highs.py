@@ -12,8 +12,12 @@ __all__ = ["HighsLP"]
 
 _INF = highspy.kHighsInf
 #: The statuses that answer the LP; any other is retried from scratch once.
-_DECIDED = (highspy.HighsModelStatus.kOptimal, highspy.HighsModelStatus.kInfeasible,
-            highspy.HighsModelStatus.kUnbounded, highspy.HighsModelStatus.kUnboundedOrInfeasible)
+_DECIDED = (
+    highspy.HighsModelStatus.kOptimal,
+    highspy.HighsModelStatus.kInfeasible,
+    highspy.HighsModelStatus.kUnbounded,
+    highspy.HighsModelStatus.kUnboundedOrInfeasible,
+)
 
 try:
     # highspy.Highs() enables its Python callbacks in its constructor, and that first call into
@@ -110,7 +114,10 @@ class HighsLP:
             return LPSolution("optimal", x, float(np.dot(c, x)))
         if status == highspy.HighsModelStatus.kInfeasible:
             return LPSolution("infeasible", None, float("nan"))
-        if status in (highspy.HighsModelStatus.kUnbounded, highspy.HighsModelStatus.kUnboundedOrInfeasible):
+        if status in (
+            highspy.HighsModelStatus.kUnbounded,
+            highspy.HighsModelStatus.kUnboundedOrInfeasible,
+        ):
             # Resolve the ambiguity: a zero objective tells feasibility apart.
             if status == highspy.HighsModelStatus.kUnboundedOrInfeasible and not self._feasible():
                 return LPSolution("infeasible", None, float("nan"))
@@ -120,7 +127,8 @@ class HighsLP:
     def _rerun_cold(self):
         """The same LP from scratch with HiGHS's default strategy (presolve on, no basis): the
         warm-started primal simplex stopped undecided ("Unknown") on a ramp foot at friction
-        2.5e4 (the unnormalised polytope), where a cold solve answers."""
+        2.5e4 (the unnormalised polytope), where a cold solve answers.
+        """
         h = self._h
         h.clearSolver()
         h.setOptionValue("presolve", "on")

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["LinearProgram", "LPSolution"]
+__all__ = ["LPSolution", "LinearProgram"]
 
 
 @dataclass(frozen=True)

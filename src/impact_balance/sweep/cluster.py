@@ -17,14 +17,16 @@ from typing import Any
 
 from impact_balance.exceptions import EnvironmentFailure, OptionError
 
-__all__ = ["check_scheduler_address", "connect", "CONNECT_TIMEOUT_S", "SCHEMES"]
+__all__ = ["CONNECT_TIMEOUT_S", "SCHEMES", "check_scheduler_address", "connect"]
 
 #: Longest wait for a scheduler to answer, s.
 CONNECT_TIMEOUT_S = 10.0
 #: Protocols accepted (Dask's tcp, and tcp with TLS).
 SCHEMES = ("tcp", "tls")
-_HOSTNAME = re.compile(r"^(?=.{1,253}$)[A-Za-z0-9_](?:[A-Za-z0-9_-]{0,61}[A-Za-z0-9_])?"
-                       r"(?:\.[A-Za-z0-9_](?:[A-Za-z0-9_-]{0,61}[A-Za-z0-9_])?)*\.?$")
+_HOSTNAME = re.compile(
+    r"^(?=.{1,253}$)[A-Za-z0-9_](?:[A-Za-z0-9_-]{0,61}[A-Za-z0-9_])?"
+    r"(?:\.[A-Za-z0-9_](?:[A-Za-z0-9_-]{0,61}[A-Za-z0-9_])?)*\.?$"
+)
 _FORM = "expected tcp://HOST:PORT, e.g. tcp://10.0.0.5:8786"
 
 
@@ -38,21 +40,29 @@ def _split(address: str) -> tuple[str, str, int]:
         scheme, text = text.split("://", 1)
         scheme = scheme.lower()
         if scheme in ("http", "https", "ws", "wss"):
-            raise OptionError("--scheduler", address, f"{scheme}:// is not Dask's protocol (the dashboard is http; the "
-                                                      f"scheduler listens on tcp://HOST:8786): {_FORM}")
+            raise OptionError(
+                "--scheduler",
+                address,
+                f"{scheme}:// is not Dask's protocol (the dashboard is http; the "
+                f"scheduler listens on tcp://HOST:8786): {_FORM}",
+            )
         if scheme not in SCHEMES:
-            raise OptionError("--scheduler", address, f"unknown protocol {scheme!r} (tcp or tls): {_FORM}")
+            raise OptionError(
+                "--scheduler", address, f"unknown protocol {scheme!r} (tcp or tls): {_FORM}"
+            )
     if not text:
         raise OptionError("--scheduler", address, f"no host: {_FORM}")
     if "/" in text or "@" in text or "?" in text or "#" in text:
         raise OptionError("--scheduler", address, f"an address has no path, user or query: {_FORM}")
     if text.startswith("["):
         end = text.find("]")
-        host, rest = (text[1:end], text[end + 1:]) if end > 0 else ("", "")
+        host, rest = (text[1:end], text[end + 1 :]) if end > 0 else ("", "")
         try:
             ipaddress.IPv6Address(host)
         except ValueError:
-            raise OptionError("--scheduler", address, f"not an IPv6 address in brackets: {_FORM}") from None
+            raise OptionError(
+                "--scheduler", address, f"not an IPv6 address in brackets: {_FORM}"
+            ) from None
     else:
         host, sep, port_text = text.rpartition(":")
         if not sep:
@@ -74,21 +84,30 @@ def check_scheduler_address(address: str) -> str:
 
 def connect(address: str, timeout: float = CONNECT_TIMEOUT_S) -> Any:
     """A :class:`distributed.Client` of the scheduler at ``address``, or :class:`EnvironmentFailure`
-    (exit status 1) naming ``--scheduler`` and what the network said."""
+    (exit status 1) naming ``--scheduler`` and what the network said.
+    """
     scheme, host, port = _split(address)
     canonical = check_scheduler_address(address)
     try:  # a closed port answers at once; Dask itself would retry for its whole timeout
         socket.create_connection((host, port), timeout=timeout).close()
     except socket.gaierror as exc:
-        raise EnvironmentFailure("--scheduler", canonical, f"unknown host ({exc.strerror or exc})") from None
+        raise EnvironmentFailure(
+            "--scheduler", canonical, f"unknown host ({exc.strerror or exc})"
+        ) from None
     except TimeoutError:
-        raise EnvironmentFailure("--scheduler", canonical, f"no answer within {timeout:g} s") from None
+        raise EnvironmentFailure(
+            "--scheduler", canonical, f"no answer within {timeout:g} s"
+        ) from None
     except OSError as exc:
-        raise EnvironmentFailure("--scheduler", canonical, f"cannot connect: {exc.strerror or type(exc).__name__}") from None
+        raise EnvironmentFailure(
+            "--scheduler", canonical, f"cannot connect: {exc.strerror or type(exc).__name__}"
+        ) from None
     from distributed import Client
 
     try:
         return Client(canonical, timeout=timeout)
-    except Exception as exc:  # noqa: BLE001 - Dask raises OSError, TimeoutError, CommClosedError...
+    except Exception as exc:
         text = " ".join(str(exc).split())[:160] or type(exc).__name__
-        raise EnvironmentFailure("--scheduler", canonical, f"not a Dask scheduler, or it refused the client ({text})") from None
+        raise EnvironmentFailure(
+            "--scheduler", canonical, f"not a Dask scheduler, or it refused the client ({text})"
+        ) from None

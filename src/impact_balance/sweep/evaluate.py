@@ -24,19 +24,19 @@ import pinocchio as pin
 import pyarrow as pa
 
 from impact_balance.balance.areas import BalanceAreas, areas_from_polytope
+from impact_balance.contacts.stance import Stance
 from impact_balance.contacts.wrench_polytope import wrench_polytope
 from impact_balance.criteria.com import max_contact_velocity, zmp_max_contact_velocity
 from impact_balance.exceptions import ImpactBalanceError, ScenarioError
-from impact_balance.robot.ik import IKError, solve_stance
 from impact_balance.impact.model import impact_model
+from impact_balance.robot.ik import IKError, solve_stance
 from impact_balance.robot.robot import Robot
 from impact_balance.scenario import Scenario, scenario_from_dict
-from impact_balance.contacts.stance import Stance
 from impact_balance.sweep.columns import RESULT_COLUMNS, STATUSES
 from impact_balance.sweep.paths import set_path
 from impact_balance.sweep.plan import SweepPlan
 
-__all__ = ["Evaluator", "RESULT_COLUMNS", "STATUSES", "result_schema"]
+__all__ = ["RESULT_COLUMNS", "STATUSES", "Evaluator", "result_schema"]
 
 
 def result_schema(plan: SweepPlan) -> pa.Schema:
@@ -64,7 +64,11 @@ class _StanceEntry:
 def _verdict(areas: BalanceAreas, com_velocity: tuple[float, float]) -> str:
     if not areas.can_balance:
         return "cannot balance"
-    return "balanced" if areas.com_velocity_area.contains(np.asarray(com_velocity, dtype=float), 1e-10) else "falling"
+    return (
+        "balanced"
+        if areas.com_velocity_area.contains(np.asarray(com_velocity, dtype=float), 1e-10)
+        else "falling"
+    )
 
 
 class Evaluator:
@@ -83,7 +87,11 @@ class Evaluator:
         self._path_dims = [d for d in plan.dims if d.kind == "path"]
         # Unchanged top-level keys go to the validation as the base's validated models (pydantic
         # does not revalidate model instances); only the changed ones are validated per point.
-        self._base_fields = {name: getattr(self.base_scenario, name) for name in Scenario.model_fields if name != "source"}
+        self._base_fields = {
+            name: getattr(self.base_scenario, name)
+            for name in Scenario.model_fields
+            if name != "source"
+        }
         self._roots = sorted({d.tokens[0] for d in plan.dims if d.tokens})
         self._direction = {}
         for d in plan.dims:
@@ -106,7 +114,8 @@ class Evaluator:
     def warm_up(self, points: int = 20) -> None:
         """Evaluate the first few points of the sweep and drop the rows: loads the compiled
         kernel and every lazy import and cache, so that a worker's first chunk is not slower
-        than the others."""
+        than the others.
+        """
         start, stop = self.plan.chunk_range(0)
         self._rows(0, start, min(stop, start + points))
 
@@ -126,13 +135,15 @@ class Evaluator:
             values = {name: points[name][k] for name in names}
             try:
                 row = self._evaluate_point(values, cache, warm)
-            except Exception as exc:  # noqa: BLE001 - one bad point is a row, never the end of the sweep
+            except Exception as exc:
                 row = {"status": "error", "message": f"{exc.__class__.__name__}: {exc}"}
             columns["point"].append(start + k)
             columns["chunk"].append(chunk)
             for d in self.plan.dims:
                 v = values[d.name]
-                columns[d.name].append(float(v) if d.numeric else (v if isinstance(v, str) else repr(v)))
+                columns[d.name].append(
+                    float(v) if d.numeric else (v if isinstance(v, str) else repr(v))
+                )
             for name, _, _ in RESULT_COLUMNS:
                 columns[name].append(row.get(name))
         return pa.table(columns, schema=self.schema)
@@ -147,9 +158,16 @@ class Evaluator:
         for pair in self._direction.values():
             az_dim, el_dim = pair["azimuth"], pair["elevation"]
             base_vec = np.asarray(_get(self.plan.base, az_dim.tokens), dtype=float)
-            az, el = math.radians(float(values[az_dim.name])), math.radians(float(values[el_dim.name]))
+            az, el = (
+                math.radians(float(values[az_dim.name])),
+                math.radians(float(values[el_dim.name])),
+            )
             length = float(np.linalg.norm(base_vec))
-            vec = [length * math.cos(el) * math.cos(az), length * math.cos(el) * math.sin(az), length * math.sin(el)]
+            vec = [
+                length * math.cos(el) * math.cos(az),
+                length * math.cos(el) * math.sin(az),
+                length * math.sin(el),
+            ]
             raw = set_path(raw, az_dim.tokens, vec)
         # The base and the sweep file passed the size checks when the sweep was planned.
         return scenario_from_dict(raw, None, check_size=False)
@@ -173,7 +191,9 @@ class Evaluator:
         except ImpactBalanceError as exc:
             return {**out, "status": "invalid", "message": str(exc)}
         com = max_contact_velocity(areas.com_velocity_area, model, scenario.com_velocity)
-        zmp = zmp_max_contact_velocity(areas.zmp_area, model, stance.com, scenario.plane_height, scenario.gravity, cfg.duration)
+        zmp = zmp_max_contact_velocity(
+            areas.zmp_area, model, stance.com, scenario.plane_height, scenario.gravity, cfg.duration
+        )
         verdict = entry.verdicts.get(scenario.com_velocity)
         if verdict is None:
             verdict = entry.verdicts[scenario.com_velocity] = _verdict(areas, scenario.com_velocity)
@@ -187,7 +207,9 @@ class Evaluator:
             zmp_area=entry.zmp_area,
             limiting_vertex=com.limiting_vertex,
             limiting_edge=com.limiting_edge,
-            limiting_direction=None if com.limiting_edge is None else entry.edge_directions[com.limiting_edge],
+            limiting_direction=None
+            if com.limiting_edge is None
+            else entry.edge_directions[com.limiting_edge],
             impact_x=float(model.point[0]),
             impact_y=float(model.point[1]),
             impact_z=float(model.point[2]),
@@ -218,11 +240,20 @@ class Evaluator:
             return _StanceEntry(None, None, "invalid", str(exc), residual)
         except ImpactBalanceError as exc:
             return _StanceEntry(None, None, "error", f"{exc.__class__.__name__}: {exc}", residual)
-        return _StanceEntry(stance, areas, ik_residual=residual, com_velocity_area=areas.com_velocity_area.area,
-                            zmp_area=areas.zmp_area.area, verdicts={}, edge_directions=_directions(areas),
-                            identity=_identity(scenario, stance))
+        return _StanceEntry(
+            stance,
+            areas,
+            ik_residual=residual,
+            com_velocity_area=areas.com_velocity_area.area,
+            zmp_area=areas.zmp_area.area,
+            verdicts={},
+            edge_directions=_directions(areas),
+            identity=_identity(scenario, stance),
+        )
 
-    def _place(self, scenario: Scenario, stance: Stance, values: dict[str, Any], warm: dict) -> tuple[Stance, float]:
+    def _place(
+        self, scenario: Scenario, stance: Stance, values: dict[str, Any], warm: dict
+    ) -> tuple[Stance, float]:
         """The stance with the posture point moved to its target, the contact frames kept."""
         frame, offset = self._posture_frame, self._posture_offset
         point = stance.frame_pose(frame) * offset
@@ -238,8 +269,14 @@ class Evaluator:
         base_key = tuple(_key(values[d]) for d in self._stance_dims if not d.startswith("posture."))
         q0 = warm.get(base_key, stance.q)
         posture = self._posture
-        q = solve_stance(self.robot, q0, targets, posture_target=stance.q,
-                         tolerance=posture.tolerance, max_iterations=posture.max_iterations)
+        q = solve_stance(
+            self.robot,
+            q0,
+            targets,
+            posture_target=stance.q,
+            tolerance=posture.tolerance,
+            max_iterations=posture.max_iterations,
+        )
         warm[base_key] = q
         placed = Stance(self.robot, q, [c.spec for c in stance.contacts])
         residual = _worst_pose_error(placed, targets)
@@ -248,18 +285,34 @@ class Evaluator:
 
 def _robot_key(scenario: Scenario) -> str:
     robot = scenario.robot
-    return robot if isinstance(robot, str) else json.dumps(robot.model_dump(mode="json"), sort_keys=True)
+    return (
+        robot
+        if isinstance(robot, str)
+        else json.dumps(robot.model_dump(mode="json"), sort_keys=True)
+    )
 
 
 def _identity(scenario: Scenario, stance: Stance) -> dict[str, Any]:
     """The row's robot, contacts, configuration and stance digest."""
     robot = scenario.robot if isinstance(scenario.robot, str) else scenario.robot.urdf
     q = np.asarray(stance.q, dtype=float)
-    specs = [(c.spec.frame, c.spec.friction, tuple(c.spec.size), tuple(np.round(c.position, 12)),
-              tuple(np.round(c.rotation.ravel(), 12))) for c in stance.contacts]
+    specs = [
+        (
+            c.spec.frame,
+            c.spec.friction,
+            tuple(c.spec.size),
+            tuple(np.round(c.position, 12)),
+            tuple(np.round(c.rotation.ravel(), 12)),
+        )
+        for c in stance.contacts
+    ]
     text = json.dumps([_robot_key(scenario), np.round(q, 12).tolist(), repr(specs)])
-    return {"robot_name": robot, "contact_frames": ",".join(c.spec.frame for c in stance.contacts),
-            "stance_digest": hashlib.sha256(text.encode()).hexdigest()[:12], "q": q.tolist()}
+    return {
+        "robot_name": robot,
+        "contact_frames": ",".join(c.spec.frame for c in stance.contacts),
+        "stance_digest": hashlib.sha256(text.encode()).hexdigest()[:12],
+        "q": q.tolist(),
+    }
 
 
 def _directions(areas: BalanceAreas) -> list[float]:
@@ -289,6 +342,9 @@ def _worst_pose_error(stance: Stance, targets: dict[str, pin.SE3]) -> float:
     worst = 0.0
     for name, target in targets.items():
         actual = stance.frame_pose(name)
-        worst = max(worst, float(np.linalg.norm(actual.translation - target.translation)),
-                    float(np.linalg.norm(pin.log3(target.rotation.T @ actual.rotation))))
+        worst = max(
+            worst,
+            float(np.linalg.norm(actual.translation - target.translation)),
+            float(np.linalg.norm(pin.log3(target.rotation.T @ actual.rotation))),
+        )
     return worst

@@ -23,7 +23,7 @@ import pandas as pd
 from impact_balance.plots._common import DPI, new_figure
 from impact_balance.sweep.summary import EVALUATED, load_frame
 
-__all__ = ["sweep_figures", "save_sweep_figures", "axis_label"]
+__all__ = ["axis_label", "save_sweep_figures", "sweep_figures"]
 
 
 def _varying(manifest: dict[str, Any], df: pd.DataFrame) -> list[str]:
@@ -52,12 +52,29 @@ def _mark_statuses(ax, df: pd.DataFrame, x: str, y: str | None) -> None:
         rows = df[df["status"] == status]
         if len(rows):
             ys = rows[y] if y is not None else np.zeros(len(rows))
-            ax.plot(rows[x], ys, marker, color=color, mfc="none" if y is None else color, mec="w" if y else color,
-                    ms=7, ls="", label=f"{text}: {len(rows)}")
+            ax.plot(
+                rows[x],
+                ys,
+                marker,
+                color=color,
+                mfc="none" if y is None else color,
+                mec="w" if y else color,
+                ms=7,
+                ls="",
+                label=f"{text}: {len(rows)}",
+            )
     bad = df[~df["status"].isin(EVALUATED)]
     if len(bad):
         ys = bad[y] if y is not None else np.zeros(len(bad))
-        ax.plot(bad[x], ys, "x", color="0.5", ms=5, ls="", label=f"not evaluated (invalid, unreachable, error): {len(bad)}")
+        ax.plot(
+            bad[x],
+            ys,
+            "x",
+            color="0.5",
+            ms=5,
+            ls="",
+            label=f"not evaluated (invalid, unreachable, error): {len(bad)}",
+        )
 
 
 #: Two limiting edges whose outward normals differ by more than this (deg) are different cases.
@@ -88,8 +105,15 @@ def _draw_turns(ax, xs: np.ndarray, ys: np.ndarray, E: np.ndarray) -> None:
     if segments:
         from matplotlib.collections import LineCollection
 
-        ax.add_collection(LineCollection(segments, colors="w", linewidths=1.0, linestyles=":",
-                                         label=f"limiting edge turns > {TURN_DEG:g} deg"))
+        ax.add_collection(
+            LineCollection(
+                segments,
+                colors="w",
+                linewidths=1.0,
+                linestyles=":",
+                label=f"limiting edge turns > {TURN_DEG:g} deg",
+            )
+        )
 
 
 #: Scenario keys (the last name of a key path): words and unit for an axis label.
@@ -120,7 +144,10 @@ def axis_label(name: str, frame: str | None = None) -> str:
     impact frame by IK, world (m)"; ``joints.NAME`` -> "joint NAME (rad)".
     """
     if name.startswith("posture."):
-        words, unit = f"target {name.split('.', 1)[1]} of {frame or 'the impact frame'} by IK, world", "m"
+        words, unit = (
+            f"target {name.split('.', 1)[1]} of {frame or 'the impact frame'} by IK, world",
+            "m",
+        )
     elif name.endswith((".azimuth", ".elevation")):
         words, unit = f"{name.rsplit('.', 2)[-2]} {name.rsplit('.', 1)[1]}", "deg"
     elif name.startswith("joints."):
@@ -133,7 +160,11 @@ def axis_label(name: str, frame: str | None = None) -> str:
         owners = []
         for part in parts[:-1]:
             m = _PART.fullmatch(part)
-            owners.append(f"{m.group(1).rstrip('s')} {m.group(2)}" if m and m.group(2) else part.replace("_", " "))
+            owners.append(
+                f"{m.group(1).rstrip('s')} {m.group(2)}"
+                if m and m.group(2)
+                else part.replace("_", " ")
+            )
         words = " ".join(owners + [words])
         if index is not None:
             if key == "restitution":
@@ -164,27 +195,56 @@ def _curve(df: pd.DataFrame, x: str, title: str, frame: str | None = None):
     v = _values(df)
     z = df["zmp_max_contact_velocity"].to_numpy(dtype=float).copy()
     z[np.isnan(v)] = np.nan
-    ax.plot(xs, np.where(np.isfinite(v), v, np.nan), "-o", ms=3, color="tab:blue", label="CoM criterion")
+    ax.plot(
+        xs, np.where(np.isfinite(v), v, np.nan), "-o", ms=3, color="tab:blue", label="CoM criterion"
+    )
     ax.plot(xs, np.where(np.isfinite(z), z, np.nan), "--", color="tab:gray", label="ZMP criterion")
     ok = np.isfinite(v)
     if ok.any():
-        best, worst = int(np.nanargmax(np.where(ok, v, -np.inf))), int(np.nanargmin(np.where(ok, v, np.inf)))
-        ax.plot(xs[best], v[best], "*", ms=14, color="tab:green", label=f"highest maximum {v[best]:.3g} m/s")
-        ax.plot(xs[worst], v[worst], "X", ms=10, color="tab:red", label=f"lowest maximum {v[worst]:.3g} m/s")
+        best, worst = (
+            int(np.nanargmax(np.where(ok, v, -np.inf))),
+            int(np.nanargmin(np.where(ok, v, np.inf))),
+        )
+        ax.plot(
+            xs[best],
+            v[best],
+            "*",
+            ms=14,
+            color="tab:green",
+            label=f"highest maximum {v[best]:.3g} m/s",
+        )
+        ax.plot(
+            xs[worst],
+            v[worst],
+            "X",
+            ms=10,
+            color="tab:red",
+            label=f"lowest maximum {v[worst]:.3g} m/s",
+        )
     _mark_statuses(ax, df, x, None)
     directions = df["limiting_direction"].to_numpy(dtype=float)
     changes = np.flatnonzero(_turns(directions[1:], directions[:-1]))
     for i, k in enumerate(changes):
-        ax.axvline(0.5 * (xs[k] + xs[k + 1]), ls=":", color="k", lw=0.8, label="limiting edge changes" if i == 0 else None)
+        ax.axvline(
+            0.5 * (xs[k] + xs[k + 1]),
+            ls=":",
+            color="k",
+            lw=0.8,
+            label="limiting edge changes" if i == 0 else None,
+        )
     ax.set_xlabel(axis_label(x, frame))
     ax.set_ylabel("maximum contact velocity (m/s)")
     ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
-    fig.legend(loc="outside lower center", ncol=2, fontsize=8)  # below: inside, it covered the curve
+    fig.legend(
+        loc="outside lower center", ncol=2, fontsize=8
+    )  # below: inside, it covered the curve
     return fig
 
 
-def _heatmap(df: pd.DataFrame, x: str, y: str, others: list[str], title: str, frame: str | None = None):
+def _heatmap(
+    df: pd.DataFrame, x: str, y: str, others: list[str], title: str, frame: str | None = None
+):
     fig = new_figure(6.8, 6.2)
     ax = fig.add_subplot()
     df = df.assign(_v=_values(df))
@@ -192,7 +252,11 @@ def _heatmap(df: pd.DataFrame, x: str, y: str, others: list[str], title: str, fr
     cell = df.groupby([x, y], sort=True)["_v"].min() if others else df.set_index([x, y])["_v"]
     # The limiting edge of the worst case of each cell, by the direction of its outward normal
     # (edge indices are not comparable across stances; directions are).
-    worst = df.loc[df.assign(_w=df["_v"].fillna(np.inf)).groupby([x, y], sort=True)["_w"].idxmin()] if others else df
+    worst = (
+        df.loc[df.assign(_w=df["_v"].fillna(np.inf)).groupby([x, y], sort=True)["_w"].idxmin()]
+        if others
+        else df
+    )
     edge = worst.set_index([x, y])["limiting_direction"]
     xs, ys = np.unique(df[x].to_numpy(dtype=float)), np.unique(df[y].to_numpy(dtype=float))
     grid = len(cell) == len(xs) * len(ys)
@@ -201,7 +265,15 @@ def _heatmap(df: pd.DataFrame, x: str, y: str, others: list[str], title: str, fr
     if grid:
         V = cell.unstack(level=0).reindex(index=ys, columns=xs).to_numpy(dtype=float)
         shown = np.where(np.isinf(V), vmax, V)
-        mesh = ax.pcolormesh(xs, ys, np.ma.masked_invalid(shown), shading="nearest", cmap="viridis", vmin=0.0, vmax=vmax)
+        mesh = ax.pcolormesh(
+            xs,
+            ys,
+            np.ma.masked_invalid(shown),
+            shading="nearest",
+            cmap="viridis",
+            vmin=0.0,
+            vmax=vmax,
+        )
         E = edge.unstack(level=0).reindex(index=ys, columns=xs).to_numpy(dtype=float)
         _draw_turns(ax, xs, ys, E)
         ax.set_facecolor("0.88")  # cells without a maximum (masked) show this grey
@@ -209,12 +281,32 @@ def _heatmap(df: pd.DataFrame, x: str, y: str, others: list[str], title: str, fr
         pts = df[np.isfinite(df["_v"])]
         mesh = ax.scatter(pts[x], pts[y], c=pts["_v"], cmap="viridis", vmin=0.0, vmax=vmax, s=12)
     _mark_statuses(ax, df, x, y)
-    fig.colorbar(mesh, ax=ax, label="maximum contact velocity (m/s)" + (" (min over other axes)" if others else ""))
+    fig.colorbar(
+        mesh,
+        ax=ax,
+        label="maximum contact velocity (m/s)" + (" (min over other axes)" if others else ""),
+    )
     ok = df[np.isfinite(df["_v"])]
     if len(ok):
         b, w = ok.loc[ok["_v"].idxmax()], ok.loc[ok["_v"].idxmin()]
-        ax.plot(b[x], b[y], "*", ms=16, mfc="tab:green", mec="w", label=f"highest maximum {b['_v']:.3g} m/s")
-        ax.plot(w[x], w[y], "X", ms=11, mfc="tab:red", mec="w", label=f"lowest maximum {w['_v']:.3g} m/s")
+        ax.plot(
+            b[x],
+            b[y],
+            "*",
+            ms=16,
+            mfc="tab:green",
+            mec="w",
+            label=f"highest maximum {b['_v']:.3g} m/s",
+        )
+        ax.plot(
+            w[x],
+            w[y],
+            "X",
+            ms=11,
+            mfc="tab:red",
+            mec="w",
+            label=f"lowest maximum {w['_v']:.3g} m/s",
+        )
     ax.set_xlabel(axis_label(x, frame))
     ax.set_ylabel(axis_label(y, frame))
     ax.set_title(title, fontsize=9)
@@ -231,16 +323,26 @@ def sweep_figures(root: str | Path) -> list[tuple[str, Any]]:
     dims = _varying(manifest, df)
     title = (manifest.get("description") or "").strip()
     title = textwrap.fill(title, 90)
-    frame = next((a.get("frame") for a in manifest.get("spec", {}).get("axes", []) if isinstance(a, dict)
-                  and "tolerance" in a and a.get("frame")), None)  # the posture axis' frame
+    frame = next(
+        (
+            a.get("frame")
+            for a in manifest.get("spec", {}).get("axes", [])
+            if isinstance(a, dict) and "tolerance" in a and a.get("frame")
+        ),
+        None,
+    )  # the posture axis' frame
     if len(dims) == 1:
         return [(f"curve_{dims[0]}", _curve(df, dims[0], title, frame))]
     if len(dims) >= 2:
-        return [(f"heatmap_{dims[0]}_{dims[1]}", _heatmap(df, dims[0], dims[1], dims[2:], title, frame))]
+        return [
+            (f"heatmap_{dims[0]}_{dims[1]}", _heatmap(df, dims[0], dims[1], dims[2:], title, frame))
+        ]
     return []
 
 
-def save_sweep_figures(root: str | Path, out_dir: str | Path | None = None, dpi: int = DPI) -> list[Path]:
+def save_sweep_figures(
+    root: str | Path, out_dir: str | Path | None = None, dpi: int = DPI
+) -> list[Path]:
     """Write the figures of a sweep folder as PNG files (default ``ROOT/figures``)."""
     out = Path(out_dir) if out_dir is not None else Path(root) / "figures"
     written = []

@@ -14,7 +14,7 @@ from typing import Any
 
 from impact_balance.exceptions import SweepError, UnknownPathError
 
-__all__ = ["parse_path", "format_path", "check_path", "get_path", "set_path", "STANCE_FREE_ROOTS"]
+__all__ = ["STANCE_FREE_ROOTS", "check_path", "format_path", "get_path", "parse_path", "set_path"]
 
 Token = str | int
 
@@ -42,7 +42,11 @@ def parse_path(path: str, field: str = "path") -> tuple[Token, ...]:
             pos += 1
         m = _TOKEN.match(text, pos)
         if m is None or (m.group(1) is not None and tokens and text[pos - 1] != "."):
-            raise SweepError(field, path, "not a key path (expected keys separated by '.' and [index], e.g. impact.offset.position[1])")
+            raise SweepError(
+                field,
+                path,
+                "not a key path (expected keys separated by '.' and [index], e.g. impact.offset.position[1])",
+            )
         tokens.append(m.group(1) if m.group(1) is not None else int(m.group(2)))
         pos = m.end()
     if not tokens or not isinstance(tokens[0], str) or text.endswith("."):
@@ -66,7 +70,9 @@ def _children(prefix: tuple[Token, ...], node: Any) -> list[str]:
     return []
 
 
-def check_path(base: Mapping[str, Any], tokens: Sequence[Token], field: str, joint_names: Sequence[str] = ()) -> Any:
+def check_path(
+    base: Mapping[str, Any], tokens: Sequence[Token], field: str, joint_names: Sequence[str] = ()
+) -> Any:
     """Check that ``tokens`` names a value of ``base`` (the full scenario mapping); return it.
 
     ``joints.NAME`` may name any joint in ``joint_names`` even if the base does not set it
@@ -85,19 +91,37 @@ def check_path(base: Mapping[str, Any], tokens: Sequence[Token], field: str, joi
                 raise UnknownPathError(field, path, [f"joints.{j}" for j in joint_names])
             return node.get(token) if isinstance(node, Mapping) else None
         if isinstance(node, Mapping):
-            if not isinstance(token, str) or token not in node or (depth == 0 and token in _NOT_AXES):
+            if (
+                not isinstance(token, str)
+                or token not in node
+                or (depth == 0 and token in _NOT_AXES)
+            ):
                 raise UnknownPathError(field, path, _children(prefix, node))
             node = node[token]
         elif isinstance(node, (list, tuple)):
             if not isinstance(token, int):
-                raise SweepError(field, path, f"{format_path(prefix)} is a list: use an index [0..{len(node) - 1}]")
+                raise SweepError(
+                    field,
+                    path,
+                    f"{format_path(prefix)} is a list: use an index [0..{len(node) - 1}]",
+                )
             if token >= len(node):
-                raise SweepError(field, path, f"index {token} out of range: {format_path(prefix)} has {len(node)} items")
+                raise SweepError(
+                    field,
+                    path,
+                    f"index {token} out of range: {format_path(prefix)} has {len(node)} items",
+                )
             node = node[token]
         elif node is None:
-            raise SweepError(field, path, f"{format_path(prefix)} is not set in the base scenario: set it there first")
+            raise SweepError(
+                field,
+                path,
+                f"{format_path(prefix)} is not set in the base scenario: set it there first",
+            )
         else:
-            raise SweepError(field, path, f"{format_path(prefix)} is a value ({node!r}), not a mapping or a list")
+            raise SweepError(
+                field, path, f"{format_path(prefix)} is a value ({node!r}), not a mapping or a list"
+            )
     return node
 
 

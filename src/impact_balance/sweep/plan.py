@@ -32,10 +32,25 @@ from impact_balance.exceptions import ImpactBalanceError, ScenarioError, SweepEr
 from impact_balance.ranges import MAX_SWEEP_POINTS
 from impact_balance.robot.robot import Robot
 from impact_balance.scenario import _merge, _read, scenario_from_dict, scenario_path
-from impact_balance.sweep.paths import STANCE_FREE_ROOTS, Token, check_path, format_path, parse_path, set_path
-from impact_balance.sweep.spec import Dim, DirectionAxis, PathAxis, PostureAxis, SweepSpec, _check_size, load_sweep_spec
+from impact_balance.sweep.paths import (
+    STANCE_FREE_ROOTS,
+    Token,
+    check_path,
+    format_path,
+    parse_path,
+    set_path,
+)
+from impact_balance.sweep.spec import (
+    Dim,
+    DirectionAxis,
+    PathAxis,
+    PostureAxis,
+    SweepSpec,
+    _check_size,
+    load_sweep_spec,
+)
 
-__all__ = ["Dimension", "SweepPlan", "make_plan", "plan_sweep", "PLAN_VERSION"]
+__all__ = ["PLAN_VERSION", "Dimension", "SweepPlan", "make_plan", "plan_sweep"]
 
 #: Default points per chunk, without and with a posture axis.
 DEFAULT_CHUNK, DEFAULT_CHUNK_IK = 1000, 25
@@ -82,7 +97,9 @@ class Dimension:
         if d.values is not None:
             return list(d.values)
         if d.count is None:
-            raise SweepError(f"axes[{self.axis}]", self.name, "a grid needs count with range (or values: [...])")
+            raise SweepError(
+                f"axes[{self.axis}]", self.name, "a grid needs count with range (or values: [...])"
+            )
         lo, hi = d.range
         return np.linspace(lo, hi, d.count).tolist()
 
@@ -92,7 +109,9 @@ class Dimension:
         if d.values is not None:
             return [d.values[i] for i in index]
         if d.count is None:
-            raise SweepError(f"axes[{self.axis}]", self.name, "a grid needs count with range (or values: [...])")
+            raise SweepError(
+                f"axes[{self.axis}]", self.name, "a grid needs count with range (or values: [...])"
+            )
         lo, hi = d.range
         if d.count == 1:
             return [float(lo)] * len(index)
@@ -107,7 +126,11 @@ class Dimension:
         d = self.dim
         if d.values is not None:
             idx = np.minimum((u * len(d.values)).astype(int), len(d.values) - 1)
-            return [d.values[i] for i in idx] if not d.numeric else np.asarray(d.values, dtype=float)[idx]
+            return (
+                [d.values[i] for i in idx]
+                if not d.numeric
+                else np.asarray(d.values, dtype=float)[idx]
+            )
         lo, hi = d.range
         return lo + u * (hi - lo)
 
@@ -139,7 +162,8 @@ class SweepPlan:
     @property
     def chunk_size(self) -> int:
         """Points per chunk: the file's ``chunk_size``, else 1000, or 25 with a posture axis (IK
-        takes milliseconds per point: small chunks keep every worker busy to the end)."""
+        takes milliseconds per point: small chunks keep every worker busy to the end).
+        """
         if self.spec.chunk_size is not None:
             return self.spec.chunk_size
         return DEFAULT_CHUNK_IK if self.posture is not None else DEFAULT_CHUNK
@@ -190,7 +214,11 @@ def _base_mapping(spec: SweepSpec) -> tuple[dict[str, Any], str | None]:
 
 def _args(exc: ScenarioError, field: str) -> tuple:
     valid = getattr(exc, "valid", None)
-    return (field, exc.value, valid, exc.source) if valid is not None else (field, exc.value, exc.reason, exc.source)
+    return (
+        (field, exc.value, valid, exc.source)
+        if valid is not None
+        else (field, exc.value, exc.reason, exc.source)
+    )
 
 
 def _dimensions(spec: SweepSpec, base: dict[str, Any], robot: Robot) -> list[Dimension]:
@@ -201,19 +229,44 @@ def _dimensions(spec: SweepSpec, base: dict[str, Any], robot: Robot) -> list[Dim
             tokens = parse_path(axis.path, f"axes[{i}].path")
             leaf = check_path(base, tokens, f"axes[{i}].path", joints)
             if axis.range is not None and leaf is not None and not isinstance(leaf, (int, float)):
-                raise SweepError(f"axes[{i}].path", axis.path, f"is {leaf!r}, not a number: a range needs a number (use values: [...])")
-            dims.append(Dimension(format_path(tokens), i, "path", axis, tokens, stance=tokens[0] not in STANCE_FREE_ROOTS))
+                raise SweepError(
+                    f"axes[{i}].path",
+                    axis.path,
+                    f"is {leaf!r}, not a number: a range needs a number (use values: [...])",
+                )
+            dims.append(
+                Dimension(
+                    format_path(tokens),
+                    i,
+                    "path",
+                    axis,
+                    tokens,
+                    stance=tokens[0] not in STANCE_FREE_ROOTS,
+                )
+            )
         elif isinstance(axis, DirectionAxis):
             tokens = parse_path(axis.direction, f"axes[{i}].direction")
             leaf = check_path(base, tokens, f"axes[{i}].direction", joints)
             if not (isinstance(leaf, (list, tuple)) and len(leaf) == 3):
-                raise SweepError(f"axes[{i}].direction", axis.direction, f"is {leaf!r}, not a 3-vector")
+                raise SweepError(
+                    f"axes[{i}].direction", axis.direction, f"is {leaf!r}, not a 3-vector"
+                )
             if float(np.linalg.norm(np.asarray(leaf, dtype=float))) == 0.0:
-                raise SweepError(f"axes[{i}].direction", axis.direction, "is the zero vector in the base scenario: no length to keep")
+                raise SweepError(
+                    f"axes[{i}].direction",
+                    axis.direction,
+                    "is the zero vector in the base scenario: no length to keep",
+                )
             name = format_path(tokens)
             stance = tokens[0] not in STANCE_FREE_ROOTS
-            dims.append(Dimension(f"{name}.azimuth", i, "azimuth", axis.azimuth, tokens, stance=stance))
-            dims.append(Dimension(f"{name}.elevation", i, "elevation", axis.elevation, tokens, stance=stance))
+            dims.append(
+                Dimension(f"{name}.azimuth", i, "azimuth", axis.azimuth, tokens, stance=stance)
+            )
+            dims.append(
+                Dimension(
+                    f"{name}.elevation", i, "elevation", axis.elevation, tokens, stance=stance
+                )
+            )
         else:
             for coord, key in enumerate("xyz"):
                 d = getattr(axis, key)
@@ -228,7 +281,11 @@ def _dimensions(spec: SweepSpec, base: dict[str, Any], robot: Robot) -> list[Dim
     taken = {"point", "chunk"} | {c[0] for c in RESULT_COLUMNS}
     for d in dims:
         if d.name in taken:
-            raise SweepError(f"axes[{d.axis}]", d.name, f"{d.name!r} is the name of a result column: vary a key inside it")
+            raise SweepError(
+                f"axes[{d.axis}]",
+                d.name,
+                f"{d.name!r} is the name of a result column: vary a key inside it",
+            )
     # Stance dimensions first (stable): consecutive grid points then share a stance.
     return sorted(dims, key=lambda d: not d.stance)
 
@@ -236,7 +293,9 @@ def _dimensions(spec: SweepSpec, base: dict[str, Any], robot: Robot) -> list[Dim
 def _samples(spec: SweepSpec, dims: list[Dimension]) -> dict[str, Any]:
     s = spec.sampling
     n, d = int(s.samples), len(dims)
-    engine = {"sobol": qmc.Sobol, "halton": qmc.Halton, "lhs": qmc.LatinHypercube}[s.method](d, rng=s.seed)
+    engine = {"sobol": qmc.Sobol, "halton": qmc.Halton, "lhs": qmc.LatinHypercube}[s.method](
+        d, rng=s.seed
+    )
     with warnings.catch_warnings():
         # Sobol warns when n is not a power of two (balance properties): the user chose n.
         warnings.simplefilter("ignore", UserWarning)
@@ -257,10 +316,16 @@ def make_plan(spec: SweepSpec, robot: Robot | None = None) -> SweepPlan:
     except ScenarioError as exc:
         raise type(exc)(*_args(exc, f"base: {exc.field}")) from None
     if base_scenario.impact is None:
-        raise SweepError("base", spec.base if isinstance(spec.base, str) else "(mapping)",
-                         "the base scenario has no impact: a sweep maps the maximum contact velocity", spec.source)
+        raise SweepError(
+            "base",
+            spec.base if isinstance(spec.base, str) else "(mapping)",
+            "the base scenario has no impact: a sweep maps the maximum contact velocity",
+            spec.source,
+        )
     robot = robot or base_scenario.load_robot()
-    base_scenario.build_stance(robot)  # unknown frames, plane above the CoM...: fail now, not per point
+    base_scenario.build_stance(
+        robot
+    )  # unknown frames, plane above the CoM...: fail now, not per point
     base = base_scenario.model_dump(mode="python", exclude={"source"})
     try:
         dims = _dimensions(spec, base, robot)
@@ -271,7 +336,9 @@ def make_plan(spec: SweepSpec, robot: Robot | None = None) -> SweepPlan:
     for i, axis in enumerate(spec.axes):
         if isinstance(axis, PostureAxis):
             try:
-                robot.frame_id(axis.frame or base_scenario.impact.frame, field=f"axes[{i}].posture.frame")
+                robot.frame_id(
+                    axis.frame or base_scenario.impact.frame, field=f"axes[{i}].posture.frame"
+                )
             except ScenarioError as exc:
                 raise type(exc)(*_args(exc, exc.field)[:3], spec.source) from None
     _check_robots(spec, base, source, dims)
@@ -286,26 +353,40 @@ def make_plan(spec: SweepSpec, robot: Robot | None = None) -> SweepPlan:
         n_points = int(spec.sampling.samples)
     if n_points > MAX_SWEEP_POINTS:  # pragma: no cover - _check_size refuses it first
         raise SweepError("axes", n_points, f"more than {MAX_SWEEP_POINTS} points", spec.source)
-    digest_input = {"version": PLAN_VERSION, "spec": spec.digest_data(), "base": json.loads(json.dumps(base, default=list))}
+    digest_input = {
+        "version": PLAN_VERSION,
+        "spec": spec.digest_data(),
+        "base": json.loads(json.dumps(base, default=list)),
+    }
     digest = hashlib.sha256(json.dumps(digest_input, sort_keys=True).encode()).hexdigest()[:16]
     return SweepPlan(spec, base, source, tuple(dims), shape, samples, n_points, digest)
 
 
-def _check_robots(spec: SweepSpec, base: dict[str, Any], source: str | None, dims: list[Dimension]) -> None:
+def _check_robots(
+    spec: SweepSpec, base: dict[str, Any], source: str | None, dims: list[Dimension]
+) -> None:
     """Load every robot of a robot axis and build the base stance with it (a robot that cannot
-    be read, or lacks the base scenario's frames, is refused now, naming its value)."""
+    be read, or lacks the base scenario's frames, is refused now, naming its value).
+    """
     for d in dims:
         if not d.robot:
             continue
         if d.dim.values is None:
-            raise SweepError(f"axes[{d.axis}]", d.name, "a robot axis takes values: [...] (robot names or files)", spec.source)
+            raise SweepError(
+                f"axes[{d.axis}]",
+                d.name,
+                "a robot axis takes values: [...] (robot names or files)",
+                spec.source,
+            )
         for k, value in enumerate(d.dim.values):
             field = f"axes[{d.axis}].values[{k}]"
             try:
                 scenario = scenario_from_dict(set_path(base, d.tokens, value), source)
                 scenario.build_stance()
             except ImpactBalanceError as exc:
-                raise SweepError(field, value, f"this robot cannot take the base scenario: {exc}", spec.source) from None
+                raise SweepError(
+                    field, value, f"this robot cannot take the base scenario: {exc}", spec.source
+                ) from None
 
 
 def plan_sweep(name_or_path: str | Path) -> SweepPlan:

@@ -53,7 +53,7 @@ from impact_balance.sweep.evaluate import Evaluator
 from impact_balance.sweep.plan import SweepPlan
 from impact_balance.sweep.store import ResultStore
 
-__all__ = ["RunReport", "run_sweep", "default_workers", "STOP_GRACE_S"]
+__all__ = ["STOP_GRACE_S", "RunReport", "default_workers", "run_sweep"]
 
 #: After Ctrl-C or SIGTERM, how long running chunks may finish before the workers are killed, s.
 STOP_GRACE_S = 1.0
@@ -179,13 +179,18 @@ def _warm_kernel(plan: SweepPlan) -> None:
     """Compile (or load from numba's cache) the projection kernel before workers start."""
     scenario = scenario_from_dict(plan.base, plan.base_source)
     stance = scenario.build_stance()
-    areas_from_polytope(wrench_polytope(stance, scenario.torque_limits, scenario.gravity), scenario.plane_height, scenario.zmp_margin)
+    areas_from_polytope(
+        wrench_polytope(stance, scenario.torque_limits, scenario.gravity),
+        scenario.plane_height,
+        scenario.zmp_margin,
+    )
 
 
 def _context() -> multiprocessing.context.BaseContext:
     """``forkserver`` where available (Linux): one server process imports the library once and
     forks the workers from that clean, single-threaded state, so N workers cost one import;
-    ``spawn`` elsewhere. Never a plain fork of this process (threads, open solvers)."""
+    ``spawn`` elsewhere. Never a plain fork of this process (threads, open solvers).
+    """
     if "forkserver" in multiprocessing.get_all_start_methods():
         context = multiprocessing.get_context("forkserver")
         context.set_forkserver_preload([__name__])
@@ -231,8 +236,12 @@ class _Processes:
         _warm_kernel(plan)
         context = _context()
         self.workers = workers
-        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_init_process,
-                                        initargs=(plan, os.getpid()))
+        self.pool = ProcessPoolExecutor(
+            max_workers=workers,
+            mp_context=context,
+            initializer=_init_process,
+            initargs=(plan, os.getpid()),
+        )
         self.futures: dict[Future, int] = {}
         self.processes: list[Any] = []
         # Start every worker (and its robot) before the clock of the computing loop starts.
@@ -254,14 +263,18 @@ class _Processes:
 
     def stop(self) -> list[tuple[int, pa.Table]]:
         """Cancel what has not started, give what runs :data:`STOP_GRACE_S` seconds, kill the
-        workers, and return what finished meanwhile."""
+        workers, and return what finished meanwhile.
+        """
         for f in self.futures:
             f.cancel()
         running = [f for f in self.futures if not f.done()]
         if running:
             wait_futures(running, timeout=STOP_GRACE_S)
-        done = [(c, f.result()) for f, c in self.futures.items()
-                if f.done() and not f.cancelled() and f.exception() is None]
+        done = [
+            (c, f.result())
+            for f, c in self.futures.items()
+            if f.done() and not f.cancelled() and f.exception() is None
+        ]
         self.futures = {}
         self.kill()
         return done
@@ -298,7 +311,13 @@ class _Dask:
         from distributed import as_completed as dask_completed
 
         self.futures = {
-            self.client.submit(dask_chunk, self.plan_future, c, key=f"impact-balance-sweep-{self.plan.digest}-{c}", pure=False): c
+            self.client.submit(
+                dask_chunk,
+                self.plan_future,
+                c,
+                key=f"impact-balance-sweep-{self.plan.digest}-{c}",
+                pure=False,
+            ): c
             for c in chunks
         }
         for f in dask_completed(list(self.futures)):
@@ -372,8 +391,16 @@ def run_sweep(
         raise
     done = store.finished()
     done_points = sum(plan.chunk_range(c)[1] - plan.chunk_range(c)[0] for c in done)
-    bar = tqdm(total=plan.n_points, initial=done_points, unit="pt", desc="sweep", file=sys.stderr,
-               disable=not progress, dynamic_ncols=True, smoothing=0.05)
+    bar = tqdm(
+        total=plan.n_points,
+        initial=done_points,
+        unit="pt",
+        desc="sweep",
+        file=sys.stderr,
+        disable=not progress,
+        dynamic_ncols=True,
+        smoothing=0.05,
+    )
     computed = points = 0
     interrupted = False
     t1 = time.perf_counter()
@@ -412,8 +439,20 @@ def run_sweep(
         elif hasattr(backend, "close"):
             backend.close()
         bar.close()
-    return RunReport(Path(out), backend.name, backend.workers, plan.n_points, plan.n_chunks, len(done), computed,
-                     points, interrupted, elapsed, startup, tuple(store.problems))
+    return RunReport(
+        Path(out),
+        backend.name,
+        backend.workers,
+        plan.n_points,
+        plan.n_chunks,
+        len(done),
+        computed,
+        points,
+        interrupted,
+        elapsed,
+        startup,
+        tuple(store.problems),
+    )
 
 
 @contextlib.contextmanager
@@ -423,7 +462,7 @@ def _sigterm_interrupts() -> Iterator[None]:
         yield
         return
 
-    def handler(signum, frame):  # noqa: ANN001 - signal's signature
+    def handler(signum, frame):
         raise KeyboardInterrupt
 
     previous = signal.signal(signal.SIGTERM, handler)

@@ -38,24 +38,24 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from impact_balance.exceptions import ScenarioError, SweepError, UnknownNameError
-from impact_balance.scenario.reader import read_yaml
 from impact_balance.ranges import MAX_SWEEP_CHUNKS, MAX_SWEEP_POINTS
 from impact_balance.scenario import Offset, _field
-from impact_balance.scenario.fields import Integer, Number
 from impact_balance.scenario.bundled import bundled_descriptions
+from impact_balance.scenario.fields import Integer, Number
+from impact_balance.scenario.reader import read_yaml
 
 __all__ = [
+    "QMC_METHODS",
     "Dim",
-    "PathAxis",
     "DirectionAxis",
+    "PathAxis",
     "PostureAxis",
     "Sampling",
     "SweepSpec",
-    "load_sweep_spec",
-    "sweep_spec_from_dict",
     "bundled_sweeps",
+    "load_sweep_spec",
     "sweep_path",
-    "QMC_METHODS",
+    "sweep_spec_from_dict",
 ]
 
 #: Quasi-random sampling methods (``scipy.stats.qmc``): Sobol, Halton, Latin hypercube.
@@ -78,7 +78,7 @@ class Dim(_Model):
     count: Integer | None = Field(None, ge=1, le=MAX_SWEEP_POINTS)
 
     @model_validator(mode="after")
-    def _one_of(self) -> "Dim":
+    def _one_of(self) -> Dim:
         if (self.values is None) == (self.range is None):
             raise ValueError("give either values: [...] or range: [lo, hi] (with count for a grid)")
         if self.values is not None and self.count is not None:
@@ -88,7 +88,9 @@ class Dim(_Model):
             if not (math.isfinite(lo) and math.isfinite(hi)) or lo > hi:
                 raise ValueError("range must be [lo, hi], finite, with lo <= hi")
             if not math.isfinite(hi - lo):
-                raise ValueError("range is wider than a float can hold (hi - lo overflows): narrow it")
+                raise ValueError(
+                    "range is wider than a float can hold (hi - lo overflows): narrow it"
+                )
         if self.values is not None:
             for k, v in enumerate(self.values):
                 if isinstance(v, float) and not math.isfinite(v):
@@ -102,7 +104,9 @@ class Dim(_Model):
 
     @property
     def numeric(self) -> bool:
-        return self.values is None or all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in self.values)
+        return self.values is None or all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) for v in self.values
+        )
 
 
 class PathAxis(Dim):
@@ -123,7 +127,7 @@ class DirectionAxis(_Model):
     elevation: Dim = Dim(values=[0.0])
 
     @model_validator(mode="after")
-    def _numbers(self) -> "DirectionAxis":
+    def _numbers(self) -> DirectionAxis:
         if not (self.azimuth.numeric and self.elevation.numeric):
             raise ValueError("azimuth and elevation must be numbers (degrees)")
         return self
@@ -146,7 +150,7 @@ class PostureAxis(_Model):
     max_iterations: Integer = Field(200, ge=1, le=10_000)
 
     @model_validator(mode="after")
-    def _some_target(self) -> "PostureAxis":
+    def _some_target(self) -> PostureAxis:
         dims = [d for d in (self.x, self.y, self.z) if d is not None]
         if not dims:
             raise ValueError("give at least one target coordinate: x, y or z (world, m)")
@@ -163,9 +167,11 @@ class Sampling(_Model):
     seed: Integer = Field(0, ge=0, le=2**63 - 1)
 
     @model_validator(mode="after")
-    def _samples(self) -> "Sampling":
+    def _samples(self) -> Sampling:
         if self.method == "grid" and self.samples is not None:
-            raise ValueError("samples goes with a quasi-random method (sobol, halton, lhs), not grid")
+            raise ValueError(
+                "samples goes with a quasi-random method (sobol, halton, lhs), not grid"
+            )
         if self.method != "grid" and self.samples is None:
             raise ValueError(f"{self.method} sampling needs samples: N")
         return self
@@ -210,7 +216,11 @@ class SweepSpec(_Model):
 
 def _raise(exc: ValidationError, raw: Any, prefix: str, source: str | None) -> None:
     err = exc.errors()[0]
-    loc = tuple(p for p in err["loc"] if not (isinstance(p, str) and ("[" in p or p in ("function-after", "tagged-union"))))
+    loc = tuple(
+        p
+        for p in err["loc"]
+        if not (isinstance(p, str) and ("[" in p or p in ("function-after", "tagged-union")))
+    )
     field = _field(loc)
     field = f"{prefix}.{field}" if prefix and field != "scenario" else (prefix or field)
     reason = err["msg"].removeprefix("Value error, ")
@@ -226,18 +236,29 @@ def _raise(exc: ValidationError, raw: Any, prefix: str, source: str | None) -> N
 def _axis(raw: Any, i: int, source: str | None) -> Axis:
     field = f"axes[{i}]"
     if not isinstance(raw, dict):
-        raise SweepError(field, raw, "an axis is a mapping with one of path, direction or posture", source)
+        raise SweepError(
+            field, raw, "an axis is a mapping with one of path, direction or posture", source
+        )
     kinds = [k for k in ("path", "direction", "posture") if k in raw]
     if len(kinds) != 1:
-        raise SweepError(field, raw, "an axis needs exactly one of path, direction or posture", source)
+        raise SweepError(
+            field, raw, "an axis needs exactly one of path, direction or posture", source
+        )
     try:
         if kinds[0] == "posture":
             extra = set(raw) - {"posture"}
             if extra:
-                raise SweepError(f"{field}.{sorted(extra)[0]}", raw[sorted(extra)[0]], "unknown key (posture options go under posture:)", source)
+                raise SweepError(
+                    f"{field}.{sorted(extra)[0]}",
+                    raw[sorted(extra)[0]],
+                    "unknown key (posture options go under posture:)",
+                    source,
+                )
             body = raw["posture"]
             if not isinstance(body, dict):
-                raise SweepError(f"{field}.posture", body, "must be a mapping (frame, x, y, z, ...)", source)
+                raise SweepError(
+                    f"{field}.posture", body, "must be a mapping (frame, x, y, z, ...)", source
+                )
             return PostureAxis.model_validate(body)
         return (PathAxis if kinds[0] == "path" else DirectionAxis).model_validate(raw)
     except ValidationError as exc:
@@ -249,11 +270,19 @@ def sweep_spec_from_dict(raw: Any, source: str | None = None) -> SweepSpec:
     """Validate a sweep mapping; raises :class:`SweepError` on the first bad field."""
     if not isinstance(raw, dict):
         # Name the file, not its content (a link to a system file must not be quoted).
-        raise SweepError("sweep", source or "(mapping)", f"must be a YAML mapping of keys, got {type(raw).__name__}",
-                         source)
+        raise SweepError(
+            "sweep",
+            source or "(mapping)",
+            f"must be a YAML mapping of keys, got {type(raw).__name__}",
+            source,
+        )
     axes_raw = raw.get("axes")
     if not isinstance(axes_raw, list) or not axes_raw:
-        shown = axes_raw if axes_raw is None or isinstance(axes_raw, (list, int, float)) else type(axes_raw).__name__
+        shown = (
+            axes_raw
+            if axes_raw is None or isinstance(axes_raw, (list, int, float))
+            else type(axes_raw).__name__
+        )
         raise SweepError("axes", shown, "must be a non-empty list of axes", source)
     axes = tuple(_axis(a, i, source) for i, a in enumerate(axes_raw))
     if sum(isinstance(a, PostureAxis) for a in axes) > 1:
@@ -272,22 +301,36 @@ def sweep_spec_from_dict(raw: Any, source: str | None = None) -> SweepSpec:
 
 def _check_size(spec: SweepSpec, source: str | None) -> None:
     """Refuse a sweep of more than MAX_SWEEP_POINTS points or MAX_SWEEP_CHUNKS chunks, from the
-    file alone (exact integers: no float overflow, no wrap-around), before anything is allocated."""
+    file alone (exact integers: no float overflow, no wrap-around), before anything is allocated.
+    """
     n = spec.point_count()
     if n is None:
         return  # a range without count: the plan names the axis
     if n > MAX_SWEEP_POINTS:
         field = "sampling.samples" if spec.sampling.method != "grid" else "axes"
-        how = "" if spec.sampling.method != "grid" else \
-            f" (the product of the axes' counts {' x '.join(str(s) for s in spec.dimension_sizes())})"
+        how = (
+            ""
+            if spec.sampling.method != "grid"
+            else f" (the product of the axes' counts {' x '.join(str(s) for s in spec.dimension_sizes())})"
+        )
         text = str(n) if n < 10**30 else f"about 10^{len(str(n)) - 1}"
-        raise SweepError(field, f"{text} points", f"a sweep has at most {MAX_SWEEP_POINTS:,} points{how}; "
-                                                  "split the study into several sweeps", source)
+        raise SweepError(
+            field,
+            f"{text} points",
+            f"a sweep has at most {MAX_SWEEP_POINTS:,} points{how}; "
+            "split the study into several sweeps",
+            source,
+        )
     chunk = spec.chunk_size
     if chunk is not None and -(-n // chunk) > MAX_SWEEP_CHUNKS:
-        raise SweepError("chunk_size", chunk, f"{-(-n // chunk):,} chunks for {n:,} points: at most "
-                                              f"{MAX_SWEEP_CHUNKS:,} chunks (use a chunk_size of at least "
-                                              f"{-(-n // MAX_SWEEP_CHUNKS)})", source)
+        raise SweepError(
+            "chunk_size",
+            chunk,
+            f"{-(-n // chunk):,} chunks for {n:,} points: at most "
+            f"{MAX_SWEEP_CHUNKS:,} chunks (use a chunk_size of at least "
+            f"{-(-n // MAX_SWEEP_CHUNKS)})",
+            source,
+        )
 
 
 # -- files ------------------------------------------------------------------------------

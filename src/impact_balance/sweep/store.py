@@ -46,19 +46,19 @@ from impact_balance.exceptions import SweepError
 from impact_balance.sweep.plan import PLAN_VERSION, SweepPlan
 
 __all__ = [
-    "ResultStore",
-    "PartRecord",
-    "PartProblem",
-    "FolderCheck",
-    "check_folder",
-    "read_manifest",
-    "read_results",
-    "load_results",
-    "table_checksum",
-    "MANIFEST",
     "LEDGER",
+    "MANIFEST",
     "PARTS",
     "REJECTED",
+    "FolderCheck",
+    "PartProblem",
+    "PartRecord",
+    "ResultStore",
+    "check_folder",
+    "load_results",
+    "read_manifest",
+    "read_results",
+    "table_checksum",
 ]
 
 MANIFEST = "manifest.json"
@@ -68,8 +68,12 @@ REJECTED = "rejected"
 _PART = re.compile(r"^part-(\d{6})\.parquet$")
 _TMP = re.compile(r"^\.part-\d{6}\.parquet\.\d+\.tmp$")
 #: Keys of a part's Parquet metadata.
-META_DIGEST, META_CHUNK, META_ROWS, META_CHECKSUM = (b"impact_balance.sweep", b"impact_balance.chunk",
-                                                     b"impact_balance.rows", b"impact_balance.checksum")
+META_DIGEST, META_CHUNK, META_ROWS, META_CHECKSUM = (
+    b"impact_balance.sweep",
+    b"impact_balance.chunk",
+    b"impact_balance.rows",
+    b"impact_balance.checksum",
+)
 
 
 def _part_name(chunk: int) -> str:
@@ -88,7 +92,13 @@ def _hash_array(h: Any, arr: pa.Array) -> None:
     h.update(np.packbits(arr.is_valid().to_numpy(zero_copy_only=False)).tobytes())
     t = arr.type
     if pa.types.is_list(t) or pa.types.is_large_list(t):
-        h.update(pc.list_value_length(arr).fill_null(0).to_numpy(zero_copy_only=False).astype("<i8").tobytes())
+        h.update(
+            pc.list_value_length(arr)
+            .fill_null(0)
+            .to_numpy(zero_copy_only=False)
+            .astype("<i8")
+            .tobytes()
+        )
         _hash_array(h, pc.list_flatten(arr))
     elif pa.types.is_string(t) or pa.types.is_large_string(t):
         values = arr.fill_null("").to_pylist()
@@ -102,7 +112,8 @@ def _hash_array(h: Any, arr: pa.Array) -> None:
 
 def table_checksum(table: pa.Table) -> str:
     """``sha256:...`` of a table's column names, types, validity and values (not of its file
-    encoding: the same rows read back from Parquet give the same checksum)."""
+    encoding: the same rows read back from Parquet give the same checksum).
+    """
     h = hashlib.sha256(f"rows={table.num_rows}".encode())
     for fld, column in zip(table.schema, table.columns):
         h.update(b"\x00" + fld.name.encode() + b"\x00" + _type_name(fld.type).encode() + b"\x00")
@@ -121,7 +132,12 @@ class PartRecord:
     checksum: str
 
     def to_dict(self) -> dict[str, Any]:
-        return {"chunk": self.chunk, "file": self.file, "rows": self.rows, "checksum": self.checksum}
+        return {
+            "chunk": self.chunk,
+            "file": self.file,
+            "rows": self.rows,
+            "checksum": self.checksum,
+        }
 
 
 @dataclass(frozen=True)
@@ -184,10 +200,18 @@ class FolderCheck:
         return sum(r.rows for r in self.good.values())
 
     def to_dict(self) -> dict[str, Any]:
-        return {"out": str(self.root), "digest": self.manifest.get("digest"), "n_points": self.manifest.get("n_points"),
-                "n_chunks": self.n_chunks, "good_parts": len(self.good), "rows": self.rows,
-                "missing_chunks": len(self.missing), "complete": self.ok and not self.missing, "ok": self.ok,
-                "problems": [p.to_dict() for p in self.problems]}
+        return {
+            "out": str(self.root),
+            "digest": self.manifest.get("digest"),
+            "n_points": self.manifest.get("n_points"),
+            "n_chunks": self.n_chunks,
+            "good_parts": len(self.good),
+            "rows": self.rows,
+            "missing_chunks": len(self.missing),
+            "complete": self.ok and not self.missing,
+            "ok": self.ok,
+            "problems": [p.to_dict() for p in self.problems],
+        }
 
 
 def _rows_of(manifest: dict[str, Any], chunk: int) -> tuple[int, int]:
@@ -204,7 +228,9 @@ def _read_ledger(root: Path) -> dict[int, dict[str, Any]]:
     except FileNotFoundError:
         return records
     except OSError as exc:
-        raise SweepError("DIR", str(root), f"cannot read {LEDGER} ({exc.strerror or type(exc).__name__})") from None
+        raise SweepError(
+            "DIR", str(root), f"cannot read {LEDGER} ({exc.strerror or type(exc).__name__})"
+        ) from None
     for line in text.splitlines():
         try:
             rec = json.loads(line)
@@ -216,53 +242,97 @@ def _read_ledger(root: Path) -> dict[int, dict[str, Any]]:
     return records
 
 
-def _check_part(path: Path, manifest: dict[str, Any], ledger: dict[int, dict[str, Any]],
-                keep: dict[int, pa.Table] | None) -> PartRecord | PartProblem:
+def _check_part(
+    path: Path,
+    manifest: dict[str, Any],
+    ledger: dict[int, dict[str, Any]],
+    keep: dict[int, pa.Table] | None,
+) -> PartRecord | PartProblem:
     rel = f"{PARTS}/{path.name}"
     named = int(_PART.match(path.name).group(1))
     n_chunks = int(manifest["n_chunks"])
     if path.is_symlink() or not path.is_file():
         return PartProblem(rel, "extra", "not a regular file", named)
     if named >= n_chunks:
-        return PartProblem(rel, "extra", f"chunk {named} is beyond this sweep's {n_chunks} chunks", named)
+        return PartProblem(
+            rel, "extra", f"chunk {named} is beyond this sweep's {n_chunks} chunks", named
+        )
     try:
         parquet = pq.ParquetFile(path)
         meta = parquet.schema_arrow.metadata or {}
         stored_rows = parquet.metadata.num_rows
-    except Exception:  # noqa: BLE001 - pyarrow raises several types for a damaged file
-        return PartProblem(rel, "damaged", "not a readable Parquet file (cut short, emptied or overwritten)", named)
+    except Exception:
+        return PartProblem(
+            rel, "damaged", "not a readable Parquet file (cut short, emptied or overwritten)", named
+        )
     digest = meta.get(META_DIGEST)
     if digest is None:
-        return PartProblem(rel, "foreign", "not a part of an impact-balance sweep (no sweep metadata)", named)
+        return PartProblem(
+            rel, "foreign", "not a part of an impact-balance sweep (no sweep metadata)", named
+        )
     if digest.decode(errors="replace") != manifest["digest"]:
-        return PartProblem(rel, "foreign", f"a part of another sweep (digest {digest.decode(errors='replace')[:16]}; "
-                                           f"this folder's is {manifest['digest']})", named)
+        return PartProblem(
+            rel,
+            "foreign",
+            f"a part of another sweep (digest {digest.decode(errors='replace')[:16]}; "
+            f"this folder's is {manifest['digest']})",
+            named,
+        )
     try:
-        chunk, rows, checksum = int(meta[META_CHUNK]), int(meta[META_ROWS]), meta[META_CHECKSUM].decode()
+        chunk, rows, checksum = (
+            int(meta[META_CHUNK]),
+            int(meta[META_ROWS]),
+            meta[META_CHECKSUM].decode(),
+        )
     except (KeyError, ValueError, UnicodeDecodeError):
-        return PartProblem(rel, "damaged", "its sweep metadata is incomplete (no chunk, row count or checksum)", named)
+        return PartProblem(
+            rel,
+            "damaged",
+            "its sweep metadata is incomplete (no chunk, row count or checksum)",
+            named,
+        )
     if chunk != named:
-        return PartProblem(rel, "renamed", f"holds chunk {chunk}, but its name says chunk {named}", named)
+        return PartProblem(
+            rel, "renamed", f"holds chunk {chunk}, but its name says chunk {named}", named
+        )
     start, stop = _rows_of(manifest, chunk)
     if rows != stop - start or stored_rows != stop - start:
-        return PartProblem(rel, "damaged", f"{stored_rows} rows where chunk {chunk} has {stop - start}", named)
+        return PartProblem(
+            rel, "damaged", f"{stored_rows} rows where chunk {chunk} has {stop - start}", named
+        )
     try:
         table = parquet.read()
-    except Exception:  # noqa: BLE001
-        return PartProblem(rel, "damaged", "cannot be read to the end (cut short or overwritten)", named)
+    except Exception:
+        return PartProblem(
+            rel, "damaged", "cannot be read to the end (cut short or overwritten)", named
+        )
     table = table.replace_schema_metadata(None)
     if table_checksum(table) != checksum:
-        return PartProblem(rel, "damaged", "its values are not those written (checksum mismatch: edited or corrupted)", named)
+        return PartProblem(
+            rel,
+            "damaged",
+            "its values are not those written (checksum mismatch: edited or corrupted)",
+            named,
+        )
     try:
-        points_ok = table["point"].to_numpy().tolist() == list(range(start, stop)) and \
-            pc.all(pc.equal(table["chunk"], chunk)).as_py() is not False
+        points_ok = (
+            table["point"].to_numpy().tolist() == list(range(start, stop))
+            and pc.all(pc.equal(table["chunk"], chunk)).as_py() is not False
+        )
     except (KeyError, pa.ArrowInvalid):
         points_ok = False
     if not points_ok:
-        return PartProblem(rel, "damaged", f"its rows are not the points {start}..{stop - 1} of chunk {chunk}", named)
+        return PartProblem(
+            rel,
+            "damaged",
+            f"its rows are not the points {start}..{stop - 1} of chunk {chunk}",
+            named,
+        )
     recorded = ledger.get(chunk)
     if recorded is not None and recorded.get("checksum") != checksum:
-        return PartProblem(rel, "damaged", "not the part recorded in the manifest (another checksum)", named)
+        return PartProblem(
+            rel, "damaged", "not the part recorded in the manifest (another checksum)", named
+        )
     if keep is not None:
         keep[chunk] = table
     return PartRecord(chunk, rel, rows, checksum)
@@ -282,13 +352,19 @@ def check_folder(root: str | Path, keep_tables: bool = False) -> FolderCheck:
     try:
         entries = sorted(parts.iterdir()) if parts.is_dir() else []
     except OSError as exc:
-        raise SweepError("DIR", str(root), f"cannot list {PARTS}/ ({exc.strerror or type(exc).__name__})") from None
+        raise SweepError(
+            "DIR", str(root), f"cannot list {PARTS}/ ({exc.strerror or type(exc).__name__})"
+        ) from None
     keep = check.tables if keep_tables else None
     for path in entries:
         if _TMP.match(path.name):  # a write cut short by a kill: never a part
             continue
         if not _PART.match(path.name):
-            check.problems.append(PartProblem(f"{PARTS}/{path.name}", "extra", "not a part file name (part-NNNNNN.parquet)"))
+            check.problems.append(
+                PartProblem(
+                    f"{PARTS}/{path.name}", "extra", "not a part file name (part-NNNNNN.parquet)"
+                )
+            )
             continue
         found = _check_part(path, manifest, ledger, keep)
         if isinstance(found, PartRecord):
@@ -298,8 +374,14 @@ def check_folder(root: str | Path, keep_tables: bool = False) -> FolderCheck:
     named = {p.chunk for p in check.problems if p.chunk is not None}
     for chunk, rec in sorted(ledger.items()):
         if chunk not in check.good and chunk not in named and 0 <= chunk < check.n_chunks:
-            check.problems.append(PartProblem(str(rec.get("file") or f"{PARTS}/{_part_name(chunk)}"), "missing",
-                                              "recorded in the manifest, but the file is gone", chunk))
+            check.problems.append(
+                PartProblem(
+                    str(rec.get("file") or f"{PARTS}/{_part_name(chunk)}"),
+                    "missing",
+                    "recorded in the manifest, but the file is gone",
+                    chunk,
+                )
+            )
     return check
 
 
@@ -318,7 +400,7 @@ class ResultStore:
     _good: set[int] = field(default_factory=set)
 
     @classmethod
-    def prepare(cls, root: str | Path, plan: SweepPlan) -> "ResultStore":
+    def prepare(cls, root: str | Path, plan: SweepPlan) -> ResultStore:
         """Check that ``root`` is new, empty, or a folder of the same sweep (its parts checked).
 
         Raises:
@@ -331,15 +413,25 @@ class ResultStore:
         if (root / MANIFEST).is_file():
             old = read_manifest(root)
             if old.get("digest") != plan.digest:
-                raise SweepError("--out", str(root), f"holds the results of a different sweep (digest {old.get('digest')}, "
-                                 f"this one is {plan.digest}): choose another --out, or delete the folder to start again")
+                raise SweepError(
+                    "--out",
+                    str(root),
+                    f"holds the results of a different sweep (digest {old.get('digest')}, "
+                    f"this one is {plan.digest}): choose another --out, or delete the folder to start again",
+                )
             store.check = check_folder(root)
         elif root.exists() and any(root.iterdir()):
-            raise SweepError("--out", str(root), "exists and is not a sweep folder (no manifest.json): choose another --out")
+            raise SweepError(
+                "--out",
+                str(root),
+                "exists and is not a sweep folder (no manifest.json): choose another --out",
+            )
         return store
 
     @classmethod
-    def open(cls, root: str | Path, plan: SweepPlan, notify: Callable[[str], None] | None = None) -> "ResultStore":
+    def open(
+        cls, root: str | Path, plan: SweepPlan, notify: Callable[[str], None] | None = None
+    ) -> ResultStore:
         """:meth:`prepare` then :meth:`create`."""
         store = cls.prepare(root, plan)
         store.create(notify)
@@ -352,7 +444,8 @@ class ResultStore:
     def create(self, notify: Callable[[str], None] | None = None) -> None:
         """Make the folder and its manifest, or ready it for a resume: every bad part is moved
         to ``rejected/`` (``notify`` gets one line per part) and the manifest of parts lists the
-        good ones."""
+        good ones.
+        """
         (self.root / PARTS).mkdir(parents=True, exist_ok=True)
         for stale in (self.root / PARTS).iterdir():  # writes cut short by a kill
             if _TMP.match(stale.name):
@@ -363,8 +456,13 @@ class ResultStore:
         for problem in self.problems:
             moved = _reject(self.root, problem)
             if notify is not None:
-                again = f"; chunk {problem.chunk} is computed again" if problem.chunk is not None and \
-                    problem.chunk < self.plan.n_chunks and problem.chunk not in good else ""
+                again = (
+                    f"; chunk {problem.chunk} is computed again"
+                    if problem.chunk is not None
+                    and problem.chunk < self.plan.n_chunks
+                    and problem.chunk not in good
+                    else ""
+                )
                 notify(f"{problem.line()}{f': moved to {moved}' if moved else ''}{again}")
         lines = "".join(json.dumps(good[c].to_dict()) + "\n" for c in sorted(good))
         _atomic_write_text(self.root / LEDGER, lines)
@@ -383,7 +481,10 @@ class ResultStore:
             "chunk_size": plan.chunk_size,
             "n_chunks": plan.n_chunks,
             "sampling": plan.spec.sampling.method,
-            "dimensions": [{"name": d.name, "axis": d.axis, "kind": d.kind, "stance": d.stance} for d in plan.dims],
+            "dimensions": [
+                {"name": d.name, "axis": d.axis, "kind": d.kind, "stance": d.stance}
+                for d in plan.dims
+            ],
             "spec": plan.spec.digest_data(),
         }
 
@@ -396,8 +497,12 @@ class ResultStore:
         path = self.root / PARTS / _part_name(chunk)
         data = table.replace_schema_metadata(None)
         checksum = table_checksum(data)
-        meta = {META_DIGEST: self.plan.digest.encode(), META_CHUNK: str(chunk).encode(),
-                META_ROWS: str(table.num_rows).encode(), META_CHECKSUM: checksum.encode()}
+        meta = {
+            META_DIGEST: self.plan.digest.encode(),
+            META_CHUNK: str(chunk).encode(),
+            META_ROWS: str(table.num_rows).encode(),
+            META_CHECKSUM: checksum.encode(),
+        }
         tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
         pq.write_table(data.replace_schema_metadata(meta), tmp)
         os.replace(tmp, path)
@@ -444,13 +549,24 @@ def read_manifest(root: str | Path) -> dict[str, Any]:
     except NotADirectoryError:
         raise SweepError("DIR", str(root), "is not a folder") from None
     except (OSError, ValueError) as exc:
-        raise SweepError("DIR", str(root), f"cannot read manifest.json ({exc.__class__.__name__})") from None
+        raise SweepError(
+            "DIR", str(root), f"cannot read manifest.json ({exc.__class__.__name__})"
+        ) from None
     keys = ("digest", "n_points", "chunk_size", "n_chunks", "dimensions")
-    if not isinstance(data, dict) or data.get("format") != "impact-balance sweep" or not all(k in data for k in keys):
+    if (
+        not isinstance(data, dict)
+        or data.get("format") != "impact-balance sweep"
+        or not all(k in data for k in keys)
+    ):
         raise SweepError("DIR", str(root), "manifest.json is not an impact-balance sweep manifest")
     ints = [data[k] for k in ("n_points", "chunk_size", "n_chunks")]
-    if not all(isinstance(v, int) and not isinstance(v, bool) and v >= 0 for v in ints) or data["chunk_size"] < 1:
-        raise SweepError("DIR", str(root), "manifest.json is damaged (its point and chunk counts are not counts)")
+    if (
+        not all(isinstance(v, int) and not isinstance(v, bool) and v >= 0 for v in ints)
+        or data["chunk_size"] < 1
+    ):
+        raise SweepError(
+            "DIR", str(root), "manifest.json is damaged (its point and chunk counts are not counts)"
+        )
     return data
 
 
@@ -462,7 +578,9 @@ def load_results(root: str | Path) -> tuple[FolderCheck, pa.Table]:
     if not tables:
         return check, pa.table({})
     table = pa.concat_tables(tables).sort_by("point")
-    return check, table.replace_schema_metadata({META_DIGEST: str(check.manifest["digest"]).encode()})
+    return check, table.replace_schema_metadata(
+        {META_DIGEST: str(check.manifest["digest"]).encode()}
+    )
 
 
 def read_results(root: str | Path, strict: bool = True) -> pa.Table:
@@ -475,6 +593,10 @@ def read_results(root: str | Path, strict: bool = True) -> pa.Table:
     check, table = load_results(root)
     if strict and check.problems:
         more = f" (and {len(check.problems) - 1} more)" if len(check.problems) > 1 else ""
-        raise SweepError("DIR", str(root), f"{check.problems[0].line()}{more}; `impact-balance sweep --verify DIR` "
-                                           "lists them, a resume recomputes them")
+        raise SweepError(
+            "DIR",
+            str(root),
+            f"{check.problems[0].line()}{more}; `impact-balance sweep --verify DIR` "
+            "lists them, a resume recomputes them",
+        )
     return table

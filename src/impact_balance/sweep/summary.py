@@ -20,17 +20,27 @@ import pandas as pd
 from impact_balance.sweep.evaluate import STATUSES
 from impact_balance.sweep.store import FolderCheck, load_results
 
-__all__ = ["summarize", "format_summary", "load_frame", "EVALUATED"]
+__all__ = ["EVALUATED", "format_summary", "load_frame", "summarize"]
 
 #: Statuses of points that were evaluated (the others are rows with a message).
 EVALUATED = ("ok", "unbounded", "already_falling", "cannot_balance")
 
-_SHOWN = ("status", "verdict", "max_contact_velocity", "zmp_max_contact_velocity", "limiting_vertex", "limiting_edge")
+_SHOWN = (
+    "status",
+    "verdict",
+    "max_contact_velocity",
+    "zmp_max_contact_velocity",
+    "limiting_vertex",
+    "limiting_edge",
+)
 
 
-def load_frame(root: str | Path, check: list[FolderCheck] | None = None) -> tuple[dict[str, Any], pd.DataFrame]:
+def load_frame(
+    root: str | Path, check: list[FolderCheck] | None = None
+) -> tuple[dict[str, Any], pd.DataFrame]:
     """The manifest and the rows of the good parts (a pandas DataFrame sorted by point, without
-    the configurations ``q``); ``check``, if given, receives the folder's check."""
+    the configurations ``q``); ``check``, if given, receives the folder's check.
+    """
     found, table = load_results(root)
     if check is not None:
         check.append(found)
@@ -75,11 +85,15 @@ def summarize(root: str | Path, top: int = 5) -> dict[str, Any]:
         "description": manifest.get("description"),
         "digest": manifest["digest"],
         "n_points": manifest["n_points"],
-        "rows": int(len(df)),
-        "complete": int(len(df)) == manifest["n_points"] and check.ok,
+        "rows": len(df),
+        "complete": len(df) == manifest["n_points"] and check.ok,
         "problems": [p.line() for p in check.problems],
         "dimensions": dims,
-        "status_counts": {s: int((df["status"] == s).sum()) for s in STATUSES if len(df) and (df["status"] == s).any()},
+        "status_counts": {
+            s: int((df["status"] == s).sum())
+            for s in STATUSES
+            if len(df) and (df["status"] == s).any()
+        },
     }
     evaluated = df[df["status"].isin(EVALUATED)] if len(df) else df
     columns = ["point", *dims, *_SHOWN]
@@ -101,7 +115,9 @@ def summarize(root: str | Path, top: int = 5) -> dict[str, Any]:
         out["max_contact_velocity"] = None
         out["best"] = out["worst"] = []
     failed = df[~df["status"].isin(EVALUATED)] if len(df) else df
-    out["failed_examples"] = _records(failed.head(3), ["point", *dims, "status", "message"]) if len(failed) else []
+    out["failed_examples"] = (
+        _records(failed.head(3), ["point", *dims, "status", "message"]) if len(failed) else []
+    )
     return out
 
 
@@ -116,18 +132,24 @@ def _fmt(value: Any) -> str:
 def format_summary(summary: dict[str, Any]) -> str:
     """The summary as text."""
     problems = summary.get("problems") or []
-    lines = [f"sweep {summary['out']}: {summary['rows']} of {summary['n_points']} points"
-             + ("" if summary["complete"] else " (incomplete: run the same command to resume)")]
+    lines = [
+        f"sweep {summary['out']}: {summary['rows']} of {summary['n_points']} points"
+        + ("" if summary["complete"] else " (incomplete: run the same command to resume)")
+    ]
     if problems:
-        lines.append(f"  {len(problems)} bad part(s) left out (named on stderr and by `sweep --verify`; a resume "
-                     "moves them to rejected/ and computes them again)")
+        lines.append(
+            f"  {len(problems)} bad part(s) left out (named on stderr and by `sweep --verify`; a resume "
+            "moves them to rejected/ and computes them again)"
+        )
     if summary.get("description"):
         lines.append(f"  {summary['description']}")
     lines.append("  status: " + ", ".join(f"{k} {v}" for k, v in summary["status_counts"].items()))
     stats = summary.get("max_contact_velocity")
     if stats:
-        lines.append(f"  max contact velocity (CoM criterion), m/s: min {_fmt(stats['min'])}, median {_fmt(stats['median'])}, "
-                     f"max {_fmt(stats['max']) if stats['max'] is not None else 'unbounded'} ({stats['unbounded']} unbounded)")
+        lines.append(
+            f"  max contact velocity (CoM criterion), m/s: min {_fmt(stats['min'])}, median {_fmt(stats['median'])}, "
+            f"max {_fmt(stats['max']) if stats['max'] is not None else 'unbounded'} ({stats['unbounded']} unbounded)"
+        )
     dims = summary["dimensions"]
     header = ["point", *dims, "max v (m/s)", "ZMP (m/s)", "verdict", "vertex", "edge"]
     for title in ("best", "worst"):
@@ -135,10 +157,22 @@ def format_summary(summary: dict[str, Any]) -> str:
         if not rows:
             continue
         lines.append(f"  {title}:")
-        table = [header] + [[_fmt(r["point"]), *(_fmt(r[d]) for d in dims),
-                             _fmt(r["max_contact_velocity"]) if r["max_contact_velocity"] is not None else "unbounded",
-                             _fmt(r["zmp_max_contact_velocity"]) if r["zmp_max_contact_velocity"] is not None else "unbounded",
-                             _fmt(r["verdict"]), _fmt(r["limiting_vertex"]), _fmt(r["limiting_edge"])] for r in rows]
+        table = [header] + [
+            [
+                _fmt(r["point"]),
+                *(_fmt(r[d]) for d in dims),
+                _fmt(r["max_contact_velocity"])
+                if r["max_contact_velocity"] is not None
+                else "unbounded",
+                _fmt(r["zmp_max_contact_velocity"])
+                if r["zmp_max_contact_velocity"] is not None
+                else "unbounded",
+                _fmt(r["verdict"]),
+                _fmt(r["limiting_vertex"]),
+                _fmt(r["limiting_edge"]),
+            ]
+            for r in rows
+        ]
         widths = [max(len(row[i]) for row in table) for i in range(len(header))]
         for row in table:
             lines.append("    " + "  ".join(cell.rjust(w) for cell, w in zip(row, widths)))

@@ -11,10 +11,16 @@ from __future__ import annotations
 import numpy as np
 
 from impact_balance.analysis.analyze import Analysis
-from impact_balance.sim.model.joints import ServoOptions
 from impact_balance.sim.model.build import SimModel
+from impact_balance.sim.model.joints import ServoOptions
 
-__all__ = ["SUPPORT_STIFFNESS_FACTOR", "STIFF_SERVOS", "support_joints", "stiffen_support_limbs", "use_torque_motors"]
+__all__ = [
+    "STIFF_SERVOS",
+    "SUPPORT_STIFFNESS_FACTOR",
+    "stiffen_support_limbs",
+    "support_joints",
+    "use_torque_motors",
+]
 
 #: Support-limb servo stiffness floor, in units of the robot's gravity stiffness m g h (see stiffen_support_limbs).
 SUPPORT_STIFFNESS_FACTOR = 0.4
@@ -22,6 +28,7 @@ SUPPORT_STIFFNESS_FACTOR = 0.4
 #: Servos of the ``rigid`` joint model in balance trials: 30 Hz bandwidth, no effort limits. A welded
 #: robot cannot be controlled; this is the closest a controlled robot gets to the paper's rigid body.
 STIFF_SERVOS = ServoOptions(bandwidth=2.0 * np.pi * 30.0, effort_limits=False)
+
 
 def support_joints(sim: SimModel, analysis: Analysis) -> list[str]:
     """Simulated joints on the chain from the root to any sustained contact's frame (the support limbs)."""
@@ -35,7 +42,9 @@ def support_joints(sim: SimModel, analysis: Analysis) -> list[str]:
     return [n for n in sim.joint_names if n in names]
 
 
-def stiffen_support_limbs(sim: SimModel, analysis: Analysis, factor: float = SUPPORT_STIFFNESS_FACTOR) -> None:
+def stiffen_support_limbs(
+    sim: SimModel, analysis: Analysis, factor: float = SUPPORT_STIFFNESS_FACTOR
+) -> None:
     """Raise the servo gains of the support limbs to a floor set by the robot's gravity stiffness.
 
     The servo rule of :mod:`.joints` scales each joint's gains by the inertia the joint moves with

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-__all__ = ["ImpactTask", "APPROACH_ACCELERATION", "CRUISE_DISTANCE", "MIN_STANDOFF"]
+__all__ = ["APPROACH_ACCELERATION", "CRUISE_DISTANCE", "MIN_STANDOFF", "ImpactTask"]
 
 #: Bounded acceleration of the approach and of the withdrawal, m/s^2.
 APPROACH_ACCELERATION = 20.0
@@ -87,14 +87,19 @@ class ImpactTask:
         ramp = v / a
         return self.start_time + ramp + (self.standoff - 0.5 * v * ramp) / v
 
-    def reference(self, t: float, normal_force: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def reference(
+        self, t: float, normal_force: float = 0.0
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """World position (m), velocity (m/s) and acceleration (m/s^2) of the impact point's reference at
-        ``t`` given the measured normal force (N); the first force above the threshold starts the withdrawal."""
+        ``t`` given the measured normal force (N); the first force above the threshold starts the withdrawal.
+        """
         n = self.normal
         if self.contact_time is None and normal_force > self.force_threshold:
             self.contact_time = float(t)
         if self.contact_time is not None:
-            s, ds, dds = _profile(t - self.contact_time, self.withdraw_speed, self.acceleration, self.retract)
+            s, ds, dds = _profile(
+                t - self.contact_time, self.withdraw_speed, self.acceleration, self.retract
+            )
             return self.surface_point + s * n, ds * n, dds * n
         s, ds, dds = _profile(t - self.start_time, self.speed, self.acceleration, np.inf)
         return self.start_point - s * n, -ds * n, -dds * n
@@ -104,15 +109,22 @@ class ImpactTask:
         return self.reference(t, normal_force)[0]
 
 
-def standoff(speed: float, acceleration: float = APPROACH_ACCELERATION, cruise: float = CRUISE_DISTANCE,
-             minimum: float = MIN_STANDOFF) -> float:
+def standoff(
+    speed: float,
+    acceleration: float = APPROACH_ACCELERATION,
+    cruise: float = CRUISE_DISTANCE,
+    minimum: float = MIN_STANDOFF,
+) -> float:
     """Start distance from the surface (m) that leaves ``cruise`` at full ``speed`` after the ramp."""
     return max(minimum, speed * speed / (2.0 * acceleration) + cruise)
 
 
-def _profile(tau: float, speed: float, acceleration: float, stop: float) -> tuple[float, float, float]:
+def _profile(
+    tau: float, speed: float, acceleration: float, stop: float
+) -> tuple[float, float, float]:
     """Distance, speed and acceleration after ``tau`` s of a bounded-acceleration start to ``speed``, held
-    at ``stop`` (m) once reached (a trapezoid without its braking: the point stops where it arrives)."""
+    at ``stop`` (m) once reached (a trapezoid without its braking: the point stops where it arrives).
+    """
     if tau <= 0.0:
         return 0.0, 0.0, 0.0
     ramp = speed / acceleration

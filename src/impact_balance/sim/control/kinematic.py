@@ -42,7 +42,7 @@ from impact_balance.robot.ik import solve_stance
 from impact_balance.sim.control.approach import ImpactTask
 from impact_balance.sim.control.zmp import DcmFeedback, clamp_to_polygon
 
-__all__ = ["BalanceGains", "ImpactTask", "BalanceController", "ControlOutput", "retracted_stance"]
+__all__ = ["BalanceController", "BalanceGains", "ControlOutput", "ImpactTask", "retracted_stance"]
 
 
 @dataclass(frozen=True)
@@ -116,8 +116,13 @@ def retracted_stance(analysis: Analysis, standoff: float) -> np.ndarray:
     frame_pose = stance.frame_pose(spec.frame)
     target = pin.SE3(frame_pose.rotation, frame_pose.translation + standoff * impact.model.normal)
     return solve_stance(
-        stance.robot, stance.q, {spec.frame: target}, stance.com[:2],
-        fixed_frames=[c.spec.frame for c in stance.contacts], tolerance=1e-5, max_iterations=300,
+        stance.robot,
+        stance.q,
+        {spec.frame: target},
+        stance.com[:2],
+        fixed_frames=[c.spec.frame for c in stance.contacts],
+        tolerance=1e-5,
+        max_iterations=300,
     )
 
 
@@ -133,8 +138,13 @@ class BalanceController:
 
     name = "dcm-zmp-clamp + pink IK -> joint position servos"
 
-    def __init__(self, analysis: Analysis, q0: np.ndarray | None = None, gains: BalanceGains = BalanceGains(),
-                 impact: ImpactTask | None = None):
+    def __init__(
+        self,
+        analysis: Analysis,
+        q0: np.ndarray | None = None,
+        gains: BalanceGains = BalanceGains(),
+        impact: ImpactTask | None = None,
+    ):
         self.analysis = analysis
         self.gains = gains
         self.impact = impact
@@ -150,7 +160,9 @@ class BalanceController:
         com0 = np.array(pin.centerOfMass(self.model, self.configuration.data, q0), dtype=float)
         self.com_height = float(com0[2])
         self.omega = float(np.sqrt(self.gravity / (com0[2] - self.plane_height)))
-        self.feedback = DcmFeedback(areas.zmp_area, self.omega, com0[:2].copy(), gains.dcm_gain, gains.zmp_margin)
+        self.feedback = DcmFeedback(
+            areas.zmp_area, self.omega, com0[:2].copy(), gains.dcm_gain, gains.zmp_margin
+        )
         self.com_command = com0[:2].copy()
         self._zmp_filtered: np.ndarray | None = None
         self.contact_tasks = []
@@ -165,7 +177,9 @@ class BalanceController:
         self.impact_task = None
         if impact is not None:
             self.impact_task = FrameTask(impact.frame, gains.impact_cost, 0.1 * gains.impact_cost)
-            self._impact_rotation = self.configuration.get_transform_frame_to_world(impact.frame).rotation.copy()
+            self._impact_rotation = self.configuration.get_transform_frame_to_world(
+                impact.frame
+            ).rotation.copy()
         self.v_ref = np.zeros(self.model.nv)
         self._lower = self.model.lowerPositionLimit[7:].copy()
         self._upper = self.model.upperPositionLimit[7:].copy()
@@ -179,8 +193,14 @@ class BalanceController:
         pin.centerOfMass(self.model, self.data, q, v, False)
         return self.data.com[0].copy(), self.data.vcom[0].copy()
 
-    def step(self, t: float, q: np.ndarray, v: np.ndarray, zmp_measured: np.ndarray | None = None,
-             impact_force: float = 0.0) -> ControlOutput:
+    def step(
+        self,
+        t: float,
+        q: np.ndarray,
+        v: np.ndarray,
+        zmp_measured: np.ndarray | None = None,
+        impact_force: float = 0.0,
+    ) -> ControlOutput:
         """One control step from the measured state (pinocchio ``q``, ``v``; free-flyer velocity local).
 
         ``zmp_measured`` is the ZMP of the measured contact forces on the plane (m, world; None or NaN
@@ -199,7 +219,9 @@ class BalanceController:
             if norm > g.max_com_speed:
                 speed *= g.max_com_speed / norm
             # The commanded CoM stays over the ZMP support area: a reference that could stand still.
-            self.com_command = clamp_to_polygon(self.feedback.zmp_area, self.com_command + dt * speed, g.zmp_margin)
+            self.com_command = clamp_to_polygon(
+                self.feedback.zmp_area, self.com_command + dt * speed, g.zmp_margin
+            )
         self.com_task.set_target(np.array([*self.com_command, self.com_height]))
         tasks = [self.com_task, *self.contact_tasks, self.posture_task]
         if self.impact is not None:
@@ -207,14 +229,17 @@ class BalanceController:
             frame_origin = point - self._impact_rotation @ self.impact.offset.translation
             self.impact_task.set_target(pin.SE3(self._impact_rotation, frame_origin))
             tasks.append(self.impact_task)
-        velocity = pink.solve_ik(self.configuration, tasks, dt, solver=g.solver, damping=g.damping,
-                                 safety_break=False)
+        velocity = pink.solve_ik(
+            self.configuration, tasks, dt, solver=g.solver, damping=g.damping, safety_break=False
+        )
         q_next = pin.integrate(self.model, self.configuration.q, velocity * dt)
         # pink's limits keep the step within bounds up to round-off; clip that round-off away.
         q_next[7:] = np.clip(q_next[7:], self._lower, self._upper)
         self.configuration.update(q_next)
         self.v_ref = velocity
-        return ControlOutput(self.configuration.q.copy(), velocity, zmp, xi, clamped, com, com_velocity)
+        return ControlOutput(
+            self.configuration.q.copy(), velocity, zmp, xi, clamped, com, com_velocity
+        )
 
     def describe(self) -> dict:
         """Name and gains (the ``controller`` object of ``validate --json``)."""

@@ -47,9 +47,9 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
+import daqp
 import numpy as np
 import pinocchio as pin
-import daqp
 
 from impact_balance.analysis.analyze import Analysis
 from impact_balance.contacts.cwc import cwc_faces_world
@@ -57,7 +57,7 @@ from impact_balance.geometry.spatial import skew
 from impact_balance.sim.control.approach import ImpactTask
 from impact_balance.sim.control.zmp import DcmFeedback
 
-__all__ = ["InverseDynamicsGains", "InverseDynamicsController", "TorqueOutput", "describe"]
+__all__ = ["InverseDynamicsController", "InverseDynamicsGains", "TorqueOutput", "describe"]
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
@@ -154,7 +154,9 @@ class TorqueOutput:
     torque_limited: bool = False
 
 
-def _point_jacobian(model: pin.Model, data: pin.Data, fid: int, offset: pin.SE3) -> tuple[pin.SE3, np.ndarray, np.ndarray]:
+def _point_jacobian(
+    model: pin.Model, data: pin.Data, fid: int, offset: pin.SE3
+) -> tuple[pin.SE3, np.ndarray, np.ndarray]:
     """Pose, 6 x nv Jacobian (world axes, linear first) and acceleration drift ``J_dot v`` of ``frame * offset``.
 
     Needs ``data`` from a forward kinematics with zero acceleration (so the frame acceleration is the drift).
@@ -188,9 +190,14 @@ class InverseDynamicsController:
 
     name = "dcm-zmp-clamp + inverse-dynamics QP -> joint torques"
 
-    def __init__(self, analysis: Analysis, q0: np.ndarray | None = None,
-                 gains: InverseDynamicsGains = InverseDynamicsGains(), impact: ImpactTask | None = None,
-                 effort_limits: bool = True):
+    def __init__(
+        self,
+        analysis: Analysis,
+        q0: np.ndarray | None = None,
+        gains: InverseDynamicsGains = InverseDynamicsGains(),
+        impact: ImpactTask | None = None,
+        effort_limits: bool = True,
+    ):
         self.analysis = analysis
         self.gains = gains
         self.impact = impact
@@ -208,14 +215,20 @@ class InverseDynamicsController:
         com0 = np.array(pin.centerOfMass(model, self.data, self.q0), dtype=float)
         self.com_height = float(com0[2])
         self.omega = float(np.sqrt(self.gravity / (com0[2] - self.plane_height)))
-        self.feedback = DcmFeedback(analysis.areas.zmp_area, self.omega, com0[:2].copy(), gains.dcm_gain,
-                                    gains.zmp_margin)
+        self.feedback = DcmFeedback(
+            analysis.areas.zmp_area, self.omega, com0[:2].copy(), gains.dcm_gain, gains.zmp_margin
+        )
         pin.framesForwardKinematics(model, self.data, self.q0)
         self.contact_frames = [model.getFrameId(c.spec.frame) for c in stance.contacts]
         self.contact_offsets = [c.spec.offset for c in stance.contacts]
         self.contact_specs = [c.spec for c in stance.contacts]
-        self.contact_half_sizes = [(max(c.half_length - gains.cop_margin, 0.5 * c.half_length),
-                                    max(c.half_width - gains.cop_margin, 0.5 * c.half_width)) for c in stance.contacts]
+        self.contact_half_sizes = [
+            (
+                max(c.half_length - gains.cop_margin, 0.5 * c.half_length),
+                max(c.half_width - gains.cop_margin, 0.5 * c.half_width),
+            )
+            for c in stance.contacts
+        ]
         # Torque limits on the actuated rows (velocity index >= 6); 0 or missing effort: unbounded.
         effort = np.full(nv - 6, np.inf)
         idx, values = stance.robot.effort_limits
@@ -224,7 +237,9 @@ class InverseDynamicsController:
                 effort[i - 6] = e
         self.effort = effort
         self.effort_limits = effort_limits
-        self._limited = np.flatnonzero(np.isfinite(effort)) if effort_limits else np.zeros(0, dtype=int)
+        self._limited = (
+            np.flatnonzero(np.isfinite(effort)) if effort_limits else np.zeros(0, dtype=int)
+        )
         self._impact_frame = None
         if impact is not None:
             self._impact_frame = model.getFrameId(impact.frame)
@@ -242,7 +257,8 @@ class InverseDynamicsController:
         P_diag = np.zeros((n, n))
         P_diag[np.arange(nv), np.arange(nv)] = self._posture_w + gains.acceleration_regularization
         P_diag[np.arange(nv, n), np.arange(nv, n)] = np.tile(
-            [gains.wrench_regularization] * 3 + [gains.torque_regularization] * 3, nc)
+            [gains.wrench_regularization] * 3 + [gains.torque_regularization] * 3, nc
+        )
         self._P_diag, self._P = P_diag, np.zeros((n, n))
         # Position limits of the 1-dof joints (a continuous joint has nq = 2 and no limit).
         one_dof = [j for j in model.joints[2:] if j.nq == 1 and j.nv == 1]
@@ -251,13 +267,15 @@ class InverseDynamicsController:
         self._q_lower = model.lowerPositionLimit[self._limit_q].copy()
         self._q_upper = model.upperPositionLimit[self._limit_q].copy()
         # One row bounds the impact point's approach speed when the task is governed (see step()).
-        self._speed_rows = int(impact is not None and callable(getattr(impact, "speed_bound", None)))
+        self._speed_rows = int(
+            impact is not None and callable(getattr(impact, "speed_bound", None))
+        )
         m = 6 + 6 * nc + 17 * nc + self._speed_rows + self._limit_q.size + self._limited.size
         self._C = np.zeros((m, n))
         self._upper = np.zeros(m)
         self._lower = np.full(m, -1e30)
         self._sense = np.zeros(m, dtype=np.intc)
-        self._sense[:6 + 6 * nc] = 5  # daqp: active and immutable = equality
+        self._sense[: 6 + 6 * nc] = 5  # daqp: active and immutable = equality
         self._Jw = np.zeros((6 * nc, nv))  # contact Jacobians at the contact points (world axes)
         self._x: np.ndarray | None = None
 
@@ -268,8 +286,14 @@ class InverseDynamicsController:
         return self.data.com[0].copy(), self.data.vcom[0].copy()
 
     # -- control ------------------------------------------------------------------------
-    def step(self, t: float, q: np.ndarray, v: np.ndarray, zmp_measured: np.ndarray | None = None,
-             impact_force: float = 0.0) -> TorqueOutput:
+    def step(
+        self,
+        t: float,
+        q: np.ndarray,
+        v: np.ndarray,
+        zmp_measured: np.ndarray | None = None,
+        impact_force: float = 0.0,
+    ) -> TorqueOutput:
         """One control step from the measured state; returns the joint torques (see :class:`TorqueOutput`).
 
         ``impact_force`` is the measured normal force at the impact point (N); ``zmp_measured`` is unused.
@@ -306,28 +330,47 @@ class InverseDynamicsController:
         # CoM: m c_dd = A_g[:3] a + drift; LIPM horizontally, PD on the height.
         com_dd = np.empty(3)
         com_dd[:2] = self.omega**2 * (com[:2] - zmp)
-        com_dd[2] = g.com_height_stiffness * (self.com_height - com[2]) - g.com_height_damping * com_velocity[2]
+        com_dd[2] = (
+            g.com_height_stiffness * (self.com_height - com[2])
+            - g.com_height_damping * com_velocity[2]
+        )
         task(Ag[:3] / self.mass, com_dd - drift_hg[:3] / self.mass, g.com_weight)
         # Angular momentum about the CoM (per unit mass): L_dot = -K_L L.
-        task(Ag[3:] / self.mass, (-g.angular_momentum_damping * hg[3:] - drift_hg[3:]) / self.mass,
-             g.angular_momentum_weight)
+        task(
+            Ag[3:] / self.mass,
+            (-g.angular_momentum_damping * hg[3:] - drift_hg[3:]) / self.mass,
+            g.angular_momentum_weight,
+        )
         # Base orientation (world axes): angular acceleration of the base frame.
         J_base = pin.getJointJacobian(model, data, 1, _LWA)
         base_drift = pin.getClassicalAcceleration(model, data, 1, _LWA).angular
         R = data.oMi[1].rotation
         rot_error = R @ pin.log3(R.T @ self._base_rotation)
-        task(J_base[3:], g.base_orientation_stiffness * rot_error - g.base_orientation_damping * (J_base[3:] @ v)
-             - base_drift, g.base_orientation_weight)
+        task(
+            J_base[3:],
+            g.base_orientation_stiffness * rot_error
+            - g.base_orientation_damping * (J_base[3:] @ v)
+            - base_drift,
+            g.base_orientation_weight,
+        )
         # Impact point: PD to the impact task's target and its velocity.
         speed_row = None
         if self.impact is not None:
-            placement, Ji, drift = _point_jacobian(model, data, self._impact_frame, self.impact.offset)
+            placement, Ji, drift = _point_jacobian(
+                model, data, self._impact_frame, self.impact.offset
+            )
             target, target_velocity, target_acceleration = self.impact.reference(t, impact_force)
             vel = Ji @ v
-            lin = (target_acceleration + g.impact_stiffness * (target - placement.translation)
-                   + g.impact_damping * (target_velocity - vel[:3]))
-            ang = (g.impact_stiffness * (placement.rotation @ pin.log3(placement.rotation.T @ self._impact_rotation))
-                   - g.impact_damping * vel[3:])
+            lin = (
+                target_acceleration
+                + g.impact_stiffness * (target - placement.translation)
+                + g.impact_damping * (target_velocity - vel[:3])
+            )
+            ang = (
+                g.impact_stiffness
+                * (placement.rotation @ pin.log3(placement.rotation.T @ self._impact_rotation))
+                - g.impact_damping * vel[3:]
+            )
             task(Ji[:3], lin - drift[:3], g.impact_weight)
             task(Ji[3:], ang - drift[3:], g.impact_orientation_weight)
             if self._speed_rows:
@@ -336,7 +379,10 @@ class InverseDynamicsController:
                 cap = float(self.impact.speed_bound())
                 n_dir = np.asarray(self.impact.normal, dtype=float)
                 if np.isfinite(cap):
-                    speed_row = (-self.dt * (n_dir @ Ji[:3]), cap + n_dir @ vel[:3] + self.dt * (n_dir @ drift[:3]))
+                    speed_row = (
+                        -self.dt * (n_dir @ Ji[:3]),
+                        cap + n_dir @ vel[:3] + self.dt * (n_dir @ drift[:3]),
+                    )
         A_t, b_t, w_t = np.vstack(rows), np.concatenate(targets), np.concatenate(weights)
         P = self._P
         P[:] = self._P_diag
@@ -354,23 +400,26 @@ class InverseDynamicsController:
         ne = 6 + 6 * nc
         C[:6, :nv] = M[:6]
         upper[:6] = -h[:6]
-        for i, (fid, offset, spec) in enumerate(zip(self.contact_frames, self.contact_offsets, self.contact_specs)):
+        for i, (fid, offset, spec) in enumerate(
+            zip(self.contact_frames, self.contact_offsets, self.contact_specs)
+        ):
             placement, J, drift = _point_jacobian(model, data, fid, offset)
             r = 6 + 6 * i
-            C[:6, nv + 6 * i:nv + 6 * i + 6] = -J[:, :6].T
-            C[r:r + 6, :nv] = J
-            upper[r:r + 6] = -drift - g.contact_damping * (J @ v)
-            self._Jw[6 * i:6 * i + 6] = J
+            C[:6, nv + 6 * i : nv + 6 * i + 6] = -J[:, :6].T
+            C[r : r + 6, :nv] = J
+            upper[r : r + 6] = -drift - g.contact_damping * (J @ v)
+            self._Jw[6 * i : 6 * i + 6] = J
             k = ne + 16 * i
-            C[k:k + 16, nv + 6 * i:nv + 6 * i + 6] = cwc_faces_world(g.friction_scale * spec.friction, *self.contact_half_sizes[i],
-                                                                     placement.rotation)
+            C[k : k + 16, nv + 6 * i : nv + 6 * i + 6] = cwc_faces_world(
+                g.friction_scale * spec.friction, *self.contact_half_sizes[i], placement.rotation
+            )
         lower[:ne] = upper[:ne]
         # Minimum normal force (rows after the cones): n_i . f_i >= f_min.
         k = ne + 16 * nc
         for i, fid in enumerate(self.contact_frames):
-            C[k + i, nv + 6 * i:nv + 6 * i + 3] = data.oMf[fid].rotation[:, 2]
-        lower[k:k + nc] = g.min_normal_force
-        upper[k:k + nc] = 1e30
+            C[k + i, nv + 6 * i : nv + 6 * i + 3] = data.oMf[fid].rotation[:, 2]
+        lower[k : k + nc] = g.min_normal_force
+        upper[k : k + nc] = 1e30
         # The governed approach speed (one row, after the minimum normal forces; 1e30: inactive).
         ms = ne + 17 * nc
         if self._speed_rows:
@@ -402,7 +451,9 @@ class InverseDynamicsController:
             if exitflag >= 1:
                 break
             torque_limited = True
-            x, _, exitflag, _ = daqp.solve(P, c, C[:rows], upper[:rows], lower[:rows], self._sense[:rows])
+            x, _, exitflag, _ = daqp.solve(
+                P, c, C[:rows], upper[:rows], lower[:rows], self._sense[:rows]
+            )
         if exitflag < 1:
             # Not even the cones and the contacts together: hold the last command.
             torque_limited = True
@@ -412,19 +463,30 @@ class InverseDynamicsController:
         tau = T @ x + t0
         if self.effort_limits:
             tau = np.clip(tau, -self.effort, self.effort)
-        out = TorqueOutput(tau, a, w.reshape(nc, 6), zmp, xi, clamped, com, com_velocity, torque_limited)
+        out = TorqueOutput(
+            tau, a, w.reshape(nc, 6), zmp, xi, clamped, com, com_velocity, torque_limited
+        )
         self.last = out
         return out
 
     def describe(self) -> dict:
         """Name and gains (the ``controller`` object of ``validate --json``)."""
-        return {"name": self.name, "gains": self.gains.to_dict(), "omega": self.omega,
-                "effort_limits": self.effort_limits}
+        return {
+            "name": self.name,
+            "gains": self.gains.to_dict(),
+            "omega": self.omega,
+            "effort_limits": self.effort_limits,
+        }
 
 
 def describe(gains: InverseDynamicsGains, sim_timestep: float, effort_limits: bool) -> dict:
     """The ``controller`` object of ``validate --json`` and ``push-test --json`` for the ``id`` controller."""
-    return {"name": InverseDynamicsController.name, "gains": gains.to_dict(), "control_rate_hz": gains.rate,
-            "sim_timestep": sim_timestep, "actuators": "torque motors (MuJoCo), viscous joint damping compensated",
-            "effort_limits": effort_limits,
-            "impact_task": {"force_threshold": 15.0, "retract": 0.05}}
+    return {
+        "name": InverseDynamicsController.name,
+        "gains": gains.to_dict(),
+        "control_rate_hz": gains.rate,
+        "sim_timestep": sim_timestep,
+        "actuators": "torque motors (MuJoCo), viscous joint damping compensated",
+        "effort_limits": effort_limits,
+        "impact_task": {"force_threshold": 15.0, "retract": 0.05},
+    }

@@ -27,10 +27,14 @@ __all__ = ["DcmFeedback", "clamp_to_polygon", "dcm"]
 
 def dcm(com_xy: np.ndarray, com_velocity_xy: np.ndarray, omega: float) -> np.ndarray:
     """Divergent component of motion ``c + c_d / omega`` (m, world, horizontal)."""
-    return np.asarray(com_xy, dtype=float)[:2] + np.asarray(com_velocity_xy, dtype=float)[:2] / omega
+    return (
+        np.asarray(com_xy, dtype=float)[:2] + np.asarray(com_velocity_xy, dtype=float)[:2] / omega
+    )
 
 
-def clamp_to_polygon(polygon: Polygon, point: np.ndarray, margin: float = 0.0, solver: str = "daqp") -> np.ndarray:
+def clamp_to_polygon(
+    polygon: Polygon, point: np.ndarray, margin: float = 0.0, solver: str = "daqp"
+) -> np.ndarray:
     """The point of ``polygon`` shrunk by ``margin`` (m) nearest to ``point``.
 
     A point already inside is returned unchanged. When the shrunk polygon is empty (margin larger
@@ -70,7 +74,9 @@ class DcmFeedback:
     gain: float = 3.0
     margin: float = 0.01
 
-    def desired_zmp(self, com_xy: np.ndarray, com_velocity_xy: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
+    def desired_zmp(
+        self, com_xy: np.ndarray, com_velocity_xy: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, bool]:
         """``(clamped ZMP, DCM, clamped?)`` for a CoM state (m, m/s, world)."""
         xi = dcm(com_xy, com_velocity_xy, self.omega)
         wanted = xi + (self.gain / self.omega) * (xi - self.dcm_reference)

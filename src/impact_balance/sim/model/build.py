@@ -31,16 +31,22 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from impact_balance.contacts.stance import Stance
 from impact_balance.exceptions import ModelRepairWarning, SimulationError
 from impact_balance.robot.robot import Robot
 from impact_balance.scenario import Scenario, load_scenario
-from impact_balance.contacts.stance import Stance
 from impact_balance.sim.model.environment import ContactParameters, add_geometry
 from impact_balance.sim.model.inertia import InertiaRepair, repair_message
-from impact_balance.sim.model.joints import JOINT_MODELS, ServoOptions, holding_torques, servo_gains, weld_joints
+from impact_balance.sim.model.joints import (
+    JOINT_MODELS,
+    ServoOptions,
+    holding_torques,
+    servo_gains,
+    weld_joints,
+)
 from impact_balance.sim.model.urdf import ROOT_JOINT, robot_spec
 
-__all__ = ["SimOptions", "SimModel", "build_model"]
+__all__ = ["SimModel", "SimOptions", "build_model"]
 
 
 @dataclass(frozen=True)
@@ -222,7 +228,8 @@ class SimModel:
 
     def enable_impact_surface(self, enabled: bool = True) -> None:
         """Let the impact point touch the impacted surface (default), or not (a push trial: the surface is
-        not there, so a falling robot cannot lean on it). Disabling sets the pair's margin to -1 m."""
+        not there, so a falling robot cannot lean on it). Disabling sets the pair's margin to -1 m.
+        """
         if self.surface_geom is None:
             return
         for i in range(self.model.npair):
@@ -250,16 +257,21 @@ def _joint_bodies(spec: mujoco.MjSpec, stance: Stance) -> dict[int, mujoco.MjsBo
     for jid in range(2, model.njoints):
         joint = spec.joint(model.names[jid])
         if joint is None:
-            raise SimulationError("robot", model.names[jid], "joint missing from MuJoCo's reading of the URDF")
+            raise SimulationError(
+                "robot", model.names[jid], "joint missing from MuJoCo's reading of the URDF"
+            )
         bodies[jid] = joint.parent
     return bodies
 
 
 def _armature(robot: Robot, override: float | None, v_index: list[int]) -> tuple[np.ndarray, str]:
     """Rotor inertia of each simulated joint (kg m^2) and its source: ``override`` for every joint, or
-    what the robot files declare (pinocchio's ``model.armature``, read from the SRDF's rotor_params)."""
+    what the robot files declare (pinocchio's ``model.armature``, read from the SRDF's rotor_params).
+    """
     if override is not None:
-        return np.full(len(v_index), float(override)), f"--armature {override:g} kg m^2 (every joint)"
+        return np.full(
+            len(v_index), float(override)
+        ), f"--armature {override:g} kg m^2 (every joint)"
     declared = np.asarray(robot.model.armature, dtype=float)[v_index] if v_index else np.zeros(0)
     if robot.armature_source is None:
         return declared, "none declared by the robot files (0)"
@@ -271,7 +283,9 @@ def build_model(
 ) -> SimModel:
     """The scenario's MuJoCo model with ``rigid`` or ``servo`` joints, set to the stance at rest."""
     if joints not in JOINT_MODELS:
-        raise SimulationError("--joints", joints, f"unknown joint model; valid: {', '.join(JOINT_MODELS)}")
+        raise SimulationError(
+            "--joints", joints, f"unknown joint model; valid: {', '.join(JOINT_MODELS)}"
+        )
     options = options or SimOptions()
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
@@ -282,7 +296,10 @@ def build_model(
     spec, repair = robot_spec(robot, meshes=options.meshes)
     if repair is not None:
         # Once per robot and process: the default filter shows a message once per place it is issued from.
-        warnings.warn(ModelRepairWarning(robot.name, repair.bodies, repair_message(robot.name, repair)), stacklevel=1)
+        warnings.warn(
+            ModelRepairWarning(robot.name, repair.bodies, repair_message(robot.name, repair)),
+            stacklevel=1,
+        )
     spec.option.timestep = options.timestep
     spec.option.gravity = [0.0, 0.0, -scenario.gravity]
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
@@ -303,11 +320,17 @@ def build_model(
     stance_qpos[0:3] = stance.q[0:3]
     stance_qpos[3:7] = (stance.q[6], *stance.q[3:6])
     for name, slot in slots.items():
-        value = stance.q[slot.idx_q] if slot.nq == 1 else np.arctan2(stance.q[slot.idx_q + 1], stance.q[slot.idx_q])
+        value = (
+            stance.q[slot.idx_q]
+            if slot.nq == 1
+            else np.arctan2(stance.q[slot.idx_q + 1], stance.q[slot.idx_q])
+        )
         stance_qpos[first.joint(name).qposadr[0]] = value
 
     v_of = {name: robot.model.joints[slots[name].id].idx_v for name in sim_joints}
-    armature, armature_source = _armature(robot, options.servo.armature, [v_of[n] for n in sim_joints])
+    armature, armature_source = _armature(
+        robot, options.servo.armature, [v_of[n] for n in sim_joints]
+    )
     if joints == "rigid":
         weld_joints(spec, first, stance_qpos)
         sim_joints = []
@@ -318,7 +341,10 @@ def build_model(
         mujoco.mj_forward(first, data)
         full = np.zeros((first.nv, first.nv))
         mujoco.mj_fullM(first, data, full)
-        inertia = np.array([full[first.joint(n).dofadr[0], first.joint(n).dofadr[0]] for n in sim_joints]) + armature
+        inertia = (
+            np.array([full[first.joint(n).dofadr[0], first.joint(n).dofadr[0]] for n in sim_joints])
+            + armature
+        )
         kp, kd = servo_gains(inertia, options.servo)
         efforts = dict(zip(*(a.tolist() for a in robot.effort_limits)))  # velocity index -> N m
         for name, p, d, a in zip(sim_joints, kp, kd, armature):
@@ -327,10 +353,15 @@ def build_model(
             effort = efforts.get(robot.model.joints[slots[name].id].idx_v, 0.0)
             limited = options.servo.effort_limits and effort > 0.0
             spec.add_actuator(
-                name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT,
-                gaintype=mujoco.mjtGain.mjGAIN_FIXED, gainprm=[p] + [0.0] * 9,
-                biastype=mujoco.mjtBias.mjBIAS_AFFINE, biasprm=[0.0, -p, -d] + [0.0] * 7,
-                forcelimited=bool(limited), forcerange=[-effort, effort] if limited else [0.0, 0.0],
+                name=name,
+                target=name,
+                trntype=mujoco.mjtTrn.mjTRN_JOINT,
+                gaintype=mujoco.mjtGain.mjGAIN_FIXED,
+                gainprm=[p] + [0.0] * 9,
+                biastype=mujoco.mjtBias.mjBIAS_AFFINE,
+                biasprm=[0.0, -p, -d] + [0.0] * 7,
+                forcelimited=bool(limited),
+                forcerange=[-effort, effort] if limited else [0.0, 0.0],
             )
             if not options.servo.effort_limits:
                 joint.actfrclimited = mujoco.mjtLimited.mjLIMITED_FALSE
@@ -352,13 +383,29 @@ def build_model(
     else:
         kp = kd = tau_hold = np.zeros(0)
     sim = SimModel(
-        scenario=scenario, stance=stance, joints=joints, options=options, model=model, data=data,
-        joint_names=tuple(sim_joints), qpos_adr=qpos_adr, dof_adr=dof_adr, actuator_ids=actuator_ids,
-        q_index=q_index, v_index=v_index, root_body=model.joint(ROOT_JOINT).bodyid[0],
+        scenario=scenario,
+        stance=stance,
+        joints=joints,
+        options=options,
+        model=model,
+        data=data,
+        joint_names=tuple(sim_joints),
+        qpos_adr=qpos_adr,
+        dof_adr=dof_adr,
+        actuator_ids=actuator_ids,
+        q_index=q_index,
+        v_index=v_index,
+        root_body=model.joint(ROOT_JOINT).bodyid[0],
         contact_geoms=tuple(geom_id(n) for n in names.contacts),
-        support_geoms=tuple(geom_id(n) for n in names.supports), ground_geom=geom_id(names.ground),
-        impact_geom=geom_id(names.impact), surface_geom=geom_id(names.surface),
-        kp=kp, kd=kd, tau_hold=tau_hold, armature=armature, armature_source=armature_source,
+        support_geoms=tuple(geom_id(n) for n in names.supports),
+        ground_geom=geom_id(names.ground),
+        impact_geom=geom_id(names.impact),
+        surface_geom=geom_id(names.surface),
+        kp=kp,
+        kd=kd,
+        tau_hold=tau_hold,
+        armature=armature,
+        armature_source=armature_source,
         inertia_repair=repair,
     )
     sim.set_state(stance.q)

@@ -28,16 +28,18 @@ import mujoco
 import numpy as np
 import pinocchio as pin
 
-from impact_balance.impact.model import cone_tangents
 from impact_balance.contacts.stance import Stance
+from impact_balance.impact.model import cone_tangents
 
-__all__ = ["ContactParameters", "Geometry", "add_geometry", "ENVIRONMENT_GROUP", "CONTACT_GROUP"]
+__all__ = ["CONTACT_GROUP", "ENVIRONMENT_GROUP", "ContactParameters", "Geometry", "add_geometry"]
 
 #: Geom group of the contact geometry (robot side) and of the environment.
 CONTACT_GROUP = 3
 ENVIRONMENT_GROUP = 0
 
-_HORIZONTAL = np.cos(np.radians(1.0))  # a contact within 1 degree of horizontal may rest on the ground
+_HORIZONTAL = np.cos(
+    np.radians(1.0)
+)  # a contact within 1 degree of horizontal may rest on the ground
 
 
 @dataclass(frozen=True)
@@ -93,15 +95,31 @@ def _in_joint(stance: Stance, joint_id: int, world: pin.SE3) -> pin.SE3:
     return stance.data.oMi[joint_id].actInv(world)
 
 
-def _pair(spec: mujoco.MjSpec, robot_geom: str, world_geom: str, mu: float, solref, params: ContactParameters) -> None:
+def _pair(
+    spec: mujoco.MjSpec,
+    robot_geom: str,
+    world_geom: str,
+    mu: float,
+    solref,
+    params: ContactParameters,
+) -> None:
     spec.add_pair(
-        name=f"{robot_geom}-{world_geom}", geomname1=world_geom, geomname2=robot_geom, condim=3,
-        friction=[mu, mu, 0.0, 0.0, 0.0], solref=list(solref), solimp=list(params.solimp),
+        name=f"{robot_geom}-{world_geom}",
+        geomname1=world_geom,
+        geomname2=robot_geom,
+        condim=3,
+        friction=[mu, mu, 0.0, 0.0, 0.0],
+        solref=list(solref),
+        solimp=list(params.solimp),
     )
 
 
 def add_geometry(
-    spec: mujoco.MjSpec, stance: Stance, bodies: dict[int, mujoco.MjsBody], impact, params: ContactParameters
+    spec: mujoco.MjSpec,
+    stance: Stance,
+    bodies: dict[int, mujoco.MjsBody],
+    impact,
+    params: ContactParameters,
 ) -> Geometry:
     """Add the contact boxes, the impact sphere and the environment to ``spec``.
 
@@ -120,8 +138,14 @@ def add_geometry(
     ground_z = float(min(heights)) if heights and np.isfinite(min(heights)) else 0.0
     ground = "ground"
     spec.worldbody.add_geom(
-        name=ground, type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 1.0], pos=[0.0, 0.0, ground_z],
-        contype=0, conaffinity=0, group=ENVIRONMENT_GROUP, rgba=[0.6, 0.6, 0.6, 1.0],
+        name=ground,
+        type=mujoco.mjtGeom.mjGEOM_PLANE,
+        size=[0.0, 0.0, 1.0],
+        pos=[0.0, 0.0, ground_z],
+        contype=0,
+        conaffinity=0,
+        group=ENVIRONMENT_GROUP,
+        rgba=[0.6, 0.6, 0.6, 1.0],
     )
     contacts, supports = [], []
     for i, contact in enumerate(stance.contacts):
@@ -131,10 +155,19 @@ def add_geometry(
         box = pin.SE3(joint_pose.rotation, joint_pose.act(np.array([0.0, 0.0, t])))
         name = f"contact_{i}"
         bodies[frame.parentJoint].add_geom(
-            name=name, type=mujoco.mjtGeom.mjGEOM_BOX, size=[contact.half_length, contact.half_width, t],
-            pos=box.translation, quat=_quat(box.rotation), contype=0, conaffinity=0, condim=3,
-            friction=[spec_i.friction, 0.0, 0.0], solref=list(params.contact_solref),
-            solimp=list(params.solimp), group=CONTACT_GROUP, rgba=[0.1, 0.6, 0.1, 0.8],
+            name=name,
+            type=mujoco.mjtGeom.mjGEOM_BOX,
+            size=[contact.half_length, contact.half_width, t],
+            pos=box.translation,
+            quat=_quat(box.rotation),
+            contype=0,
+            conaffinity=0,
+            condim=3,
+            friction=[spec_i.friction, 0.0, 0.0],
+            solref=list(params.contact_solref),
+            solimp=list(params.solimp),
+            group=CONTACT_GROUP,
+            rgba=[0.1, 0.6, 0.1, 0.8],
         )
         contacts.append(name)
         _pair(spec, name, ground, spec_i.friction, params.contact_solref, params)
@@ -147,10 +180,19 @@ def add_geometry(
         centre = contact.position - depth * contact.normal
         support = f"support_{i}"
         spec.worldbody.add_geom(
-            name=support, type=mujoco.mjtGeom.mjGEOM_BOX,
-            size=[contact.half_length + params.support_margin, contact.half_width + params.support_margin, depth],
-            pos=centre, quat=_quat(contact.rotation), contype=0, conaffinity=0,
-            group=ENVIRONMENT_GROUP, rgba=[0.55, 0.5, 0.45, 1.0],
+            name=support,
+            type=mujoco.mjtGeom.mjGEOM_BOX,
+            size=[
+                contact.half_length + params.support_margin,
+                contact.half_width + params.support_margin,
+                depth,
+            ],
+            pos=centre,
+            quat=_quat(contact.rotation),
+            contype=0,
+            conaffinity=0,
+            group=ENVIRONMENT_GROUP,
+            rgba=[0.55, 0.5, 0.45, 1.0],
         )
         supports.append(support)
         _pair(spec, name, support, spec_i.friction, params.contact_solref, params)
@@ -163,18 +205,32 @@ def add_geometry(
         centre = _in_joint(stance, frame.parentJoint, pin.SE3(np.eye(3), point + r * n)).translation
         impact_name = "impact"
         bodies[frame.parentJoint].add_geom(
-            name=impact_name, type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[r, 0.0, 0.0], pos=centre,
-            contype=0, conaffinity=0, condim=3, friction=[impact.friction, 0.0, 0.0],
-            solref=list(params.impact_solref), solimp=list(params.solimp), group=CONTACT_GROUP,
+            name=impact_name,
+            type=mujoco.mjtGeom.mjGEOM_SPHERE,
+            size=[r, 0.0, 0.0],
+            pos=centre,
+            contype=0,
+            conaffinity=0,
+            condim=3,
+            friction=[impact.friction, 0.0, 0.0],
+            solref=list(params.impact_solref),
+            solimp=list(params.solimp),
+            group=CONTACT_GROUP,
             rgba=[0.9, 0.1, 0.1, 1.0],
         )
         t1, t2 = cone_tangents(n)
         depth = 0.05
         surface_name = "impact_surface"
         spec.worldbody.add_geom(
-            name=surface_name, type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.25, 0.25, depth], pos=point - depth * n,
-            quat=_quat(np.column_stack([t1, t2, n])), contype=0, conaffinity=0,
-            group=ENVIRONMENT_GROUP, rgba=[0.7, 0.45, 0.3, 0.6],
+            name=surface_name,
+            type=mujoco.mjtGeom.mjGEOM_BOX,
+            size=[0.25, 0.25, depth],
+            pos=point - depth * n,
+            quat=_quat(np.column_stack([t1, t2, n])),
+            contype=0,
+            conaffinity=0,
+            group=ENVIRONMENT_GROUP,
+            rgba=[0.7, 0.45, 0.3, 0.6],
         )
         _pair(spec, impact_name, surface_name, impact.friction, params.impact_solref, params)
     return Geometry(tuple(contacts), tuple(supports), ground, impact_name, surface_name)

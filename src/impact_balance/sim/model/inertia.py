@@ -42,7 +42,7 @@ import pinocchio as pin
 
 from impact_balance.robot.robot import Robot
 
-__all__ = ["InertiaRepair", "repair_inertias", "repair_message", "FLOOR_FRACTION"]
+__all__ = ["FLOOR_FRACTION", "InertiaRepair", "repair_inertias", "repair_message"]
 
 #: Share of the total mass and of the smallest composite moment that all floors together may add.
 FLOOR_FRACTION = 1e-7
@@ -75,8 +75,13 @@ class InertiaRepair:
 
     def to_dict(self) -> dict:
         """JSON-ready: the bodies merged (with their links) and floored, the floors and the mass added."""
-        return {"merged": {name: list(links) for name, links in self.merged}, "floored": list(self.floored),
-                "mass_floor": self.mass_floor, "inertia_floor": self.inertia_floor, "added_mass": self.added_mass}
+        return {
+            "merged": {name: list(links) for name, links in self.merged},
+            "floored": list(self.floored),
+            "mass_floor": self.mass_floor,
+            "inertia_floor": self.inertia_floor,
+            "added_mass": self.added_mass,
+        }
 
 
 def _quat_matrix(quat) -> np.ndarray:
@@ -140,7 +145,9 @@ def _group(body) -> list[tuple[object, np.ndarray, np.ndarray]]:
     return out
 
 
-def _combined(parts: list[tuple[float, np.ndarray, np.ndarray]]) -> tuple[float, np.ndarray, np.ndarray]:
+def _combined(
+    parts: list[tuple[float, np.ndarray, np.ndarray]],
+) -> tuple[float, np.ndarray, np.ndarray]:
     """Sum of inertials (mass, CoM, inertia about the CoM) given in one frame."""
     mass = sum(m for m, _, _ in parts)
     if mass <= 0.0:
@@ -173,7 +180,9 @@ def _clear_inertial(body) -> None:
     body.fullinertia = [np.nan, 0.0, 0.0, 0.0, 0.0, 0.0]
 
 
-def _floored(mass: float, inertia: np.ndarray, m_floor: float, i_floor: float) -> tuple[float, np.ndarray]:
+def _floored(
+    mass: float, inertia: np.ndarray, m_floor: float, i_floor: float
+) -> tuple[float, np.ndarray]:
     moments, axes = np.linalg.eigh(0.5 * (inertia + inertia.T))
     moments = np.maximum(moments, i_floor)
     gap = moments[2] - moments[0] - moments[1]
@@ -191,8 +200,10 @@ def _floors(robot: Robot, count: int) -> tuple[float, float]:
     pin.ccrba(model, data, q, np.zeros(model.nv))
     com = data.com[0]
     i_min = float(np.linalg.eigvalsh(data.Ig.inertia)[0])
-    reach = 2.0 * max((float(np.linalg.norm(data.oMi[j].translation - com)) for j in range(1, model.njoints)),
-                      default=1.0)
+    reach = 2.0 * max(
+        (float(np.linalg.norm(data.oMi[j].translation - com)) for j in range(1, model.njoints)),
+        default=1.0,
+    )
     reach = max(reach, 1e-3)
     share = FLOOR_FRACTION / max(count, 1)
     return share * min(robot.mass, i_min / reach**2), share * i_min
@@ -239,10 +250,16 @@ def repair_message(robot_name: str, repair: InertiaRepair) -> str:
     """One line naming what was repaired, for the user."""
     parts = []
     if repair.merged:
-        parts.append("merged with the fixed links fused into them: "
-                     + ", ".join(f"{name} (+{len(links)})" for name, links in repair.merged))
+        parts.append(
+            "merged with the fixed links fused into them: "
+            + ", ".join(f"{name} (+{len(links)})" for name, links in repair.merged)
+        )
     if repair.floored:
-        parts.append(f"raised to at least {repair.mass_floor:.2g} kg and {repair.inertia_floor:.2g} kg m^2 "
-                     f"(total mass +{repair.added_mass:.2g} kg): " + ", ".join(repair.floored))
-    return (f"robot {robot_name}: MuJoCo refuses some inertias, repaired (docs/simulation.md, "
-            "\"Robots MuJoCo refuses\"): " + "; ".join(parts))
+        parts.append(
+            f"raised to at least {repair.mass_floor:.2g} kg and {repair.inertia_floor:.2g} kg m^2 "
+            f"(total mass +{repair.added_mass:.2g} kg): " + ", ".join(repair.floored)
+        )
+    return (
+        f"robot {robot_name}: MuJoCo refuses some inertias, repaired (docs/simulation.md, "
+        '"Robots MuJoCo refuses"): ' + "; ".join(parts)
+    )

@@ -39,7 +39,7 @@ from impact_balance.constants import GRAVITY
 from impact_balance.contacts.cwc import cwc_faces_world
 from impact_balance.contacts.stance import Stance
 
-__all__ = ["JOINT_MODELS", "ServoOptions", "servo_gains", "holding_torques", "weld_joints"]
+__all__ = ["JOINT_MODELS", "ServoOptions", "holding_torques", "servo_gains", "weld_joints"]
 
 #: Joint models, in the order of ``--help``.
 JOINT_MODELS = ("rigid", "servo")
@@ -63,7 +63,9 @@ class ServoOptions:
     effort_limits: bool = True
 
 
-def servo_gains(reflected_inertia: np.ndarray, options: ServoOptions) -> tuple[np.ndarray, np.ndarray]:
+def servo_gains(
+    reflected_inertia: np.ndarray, options: ServoOptions
+) -> tuple[np.ndarray, np.ndarray]:
     """``(kp, kd)`` of each joint (N m/rad, N m s/rad) from its reflected inertia (kg m^2, armature included)."""
     inertia = np.asarray(reflected_inertia, dtype=float)
     w = options.bandwidth
@@ -86,14 +88,19 @@ def holding_torques(stance: Stance, gravity: float = GRAVITY) -> np.ndarray:
     A = J[:, :6].T
     b = g[:6]
     k = len(stance.contacts)
-    blocks = [cwc_faces_world(c.spec.friction, c.half_length, c.half_width, c.rotation) for c in stance.contacts]
+    blocks = [
+        cwc_faces_world(c.spec.friction, c.half_length, c.half_width, c.rotation)
+        for c in stance.contacts
+    ]
     G = np.zeros((sum(f.shape[0] for f in blocks), 6 * k))
     row = 0
     for i, faces in enumerate(blocks):
         G[row : row + faces.shape[0], 6 * i : 6 * i + 6] = faces
         row += faces.shape[0]
     # Scale forces and torques alike: weigh wrenches so that 1 N and 1 N m cost the same.
-    w = qpsolvers.solve_qp(np.eye(6 * k), np.zeros(6 * k), G, np.zeros(G.shape[0]), A, b, solver="daqp")
+    w = qpsolvers.solve_qp(
+        np.eye(6 * k), np.zeros(6 * k), G, np.zeros(G.shape[0]), A, b, solver="daqp"
+    )
     if w is None:
         w = np.linalg.lstsq(A, b, rcond=None)[0]
     return (g - J.T @ w)[6:]

@@ -39,7 +39,7 @@ from impact_balance.robot.meshes import mujoco_reads, read_mesh
 from impact_balance.robot.robot import Robot
 from impact_balance.sim.model.inertia import InertiaRepair, repair_inertias
 
-__all__ = ["robot_spec", "resolve_package_uri", "VISUAL_GROUP", "ROOT_JOINT"]
+__all__ = ["ROOT_JOINT", "VISUAL_GROUP", "resolve_package_uri", "robot_spec"]
 
 #: Geom group of the robot's meshes (display only).
 VISUAL_GROUP = 1
@@ -111,7 +111,9 @@ def robot_spec(robot: Robot, meshes: bool = True) -> tuple[mujoco.MjSpec, Inerti
     try:
         spec = mujoco.MjSpec.from_string(text)
     except ValueError as exc:
-        raise RobotLoadError(str(robot.urdf_path), f"MuJoCo cannot read it: {str(exc).strip().splitlines()[0]}") from None
+        raise RobotLoadError(
+            str(robot.urdf_path), f"MuJoCo cannot read it: {str(exc).strip().splitlines()[0]}"
+        ) from None
     spec.meshdir = str(robot.urdf_path.parent)
     spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE
     # The parser already kept the URDF <collision> geoms only (<visual> ones are often .dae,

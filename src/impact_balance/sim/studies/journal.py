@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-__all__ = ["TrialJournal", "journal_digest", "default_journal_path"]
+__all__ = ["TrialJournal", "default_journal_path", "journal_digest"]
 
 #: Folder of the default journals (relative to the current directory).
 JOURNAL_FOLDER = "impact-balance-trials"
@@ -32,7 +32,9 @@ def journal_digest(parts: dict[str, Any]) -> str:
 
 def default_journal_path(command: str, scenario: str, digest: str) -> Path:
     """``impact-balance-trials/<command>_<scenario>_<digest[:12]>.jsonl`` in the current directory."""
-    safe = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in (scenario or "scenario"))[:80]
+    safe = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in (scenario or "scenario"))[
+        :80
+    ]
     return Path(JOURNAL_FOLDER) / f"{command}_{safe}_{digest[:12]}.jsonl"
 
 
@@ -74,7 +76,9 @@ class TrialJournal:
         try:
             journal._handle = open(journal.path, "a", encoding="utf-8")
         except OSError as exc:
-            raise SimulationError("--journal", str(journal.path), f"cannot write it ({exc.strerror})") from None
+            raise SimulationError(
+                "--journal", str(journal.path), f"cannot write it ({exc.strerror})"
+            ) from None
         if journal.path.stat().st_size == 0:
             journal._write({"journal": "impact-balance trials", "digest": digest, **journal.header})
         return journal
@@ -93,8 +97,12 @@ class TrialJournal:
                 continue
             if number == 0:
                 if record.get("digest") != self.digest:
-                    raise SimulationError("--journal", str(self.path), "holds the trials of another scenario or of "
-                                          "other options (digest differs); choose another file")
+                    raise SimulationError(
+                        "--journal",
+                        str(self.path),
+                        "holds the trials of another scenario or of "
+                        "other options (digest differs); choose another file",
+                    )
                 continue
             if isinstance(record, dict) and "key" in record and "entry" in record:
                 self.entries[_key(record["key"])] = record["entry"]

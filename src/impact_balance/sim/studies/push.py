@@ -30,13 +30,28 @@ import numpy as np
 from impact_balance.exceptions import SimulationError
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.scenario import Scenario, load_scenario
-from impact_balance.sim.trials.balance_trial import (BalanceSetup, BalanceTrialOptions, Push, _push_body, controller_margin, run_balance_trial)
 from impact_balance.sim.studies.journal import TrialJournal
 from impact_balance.sim.studies.scores import MARGIN_GRID, confusion
+from impact_balance.sim.trials.balance_trial import (
+    BalanceSetup,
+    BalanceTrialOptions,
+    Push,
+    _push_body,
+    controller_margin,
+    run_balance_trial,
+)
 from impact_balance.sim.trials.result import TrialEntry, trajectory
 
-__all__ = ["check_push_arguments", "boundary_impulse", "PushPrediction", "PushOutcome", "PushTestResult", "push_test",
-           "DEFAULT_MAGNITUDES", "CRITERIA"]
+__all__ = [
+    "CRITERIA",
+    "DEFAULT_MAGNITUDES",
+    "PushOutcome",
+    "PushPrediction",
+    "PushTestResult",
+    "boundary_impulse",
+    "check_push_arguments",
+    "push_test",
+]
 
 #: Default impulses (N s): for a 90 kg robot, CoM velocity changes of about 0.06 to 0.33 m/s.
 DEFAULT_MAGNITUDES = (5.0, 10.0, 15.0, 20.0, 25.0, 30.0)
@@ -46,25 +61,46 @@ CRITERIA = ("com", "com_in_trial", "zmp", "zmp_in_trial")
 SAFE_FELL_TARGET = 0.05
 
 
-def check_push_arguments(directions: int, magnitudes: Sequence[float] | None, duration: float,
-                         relative: Sequence[float] | None = None) -> None:
+def check_push_arguments(
+    directions: int,
+    magnitudes: Sequence[float] | None,
+    duration: float,
+    relative: Sequence[float] | None = None,
+) -> None:
     """Refuse bad push-test arguments with one clear error naming the option."""
     if not (isinstance(directions, int) and 1 <= directions <= 360):
         raise SimulationError("--directions", directions, "must be an integer in [1, 360]")
     if magnitudes is not None and relative is not None:
-        raise SimulationError("--relative", list(relative), "give impulses (--magnitudes) or fractions of the boundary "
-                              "impulse (--relative), not both")
-    if magnitudes is not None and (not magnitudes or any(not (np.isfinite(m) and 0 < m <= 1000) for m in magnitudes)):
+        raise SimulationError(
+            "--relative",
+            list(relative),
+            "give impulses (--magnitudes) or fractions of the boundary "
+            "impulse (--relative), not both",
+        )
+    if magnitudes is not None and (
+        not magnitudes or any(not (np.isfinite(m) and 0 < m <= 1000) for m in magnitudes)
+    ):
         raise SimulationError("--magnitudes", list(magnitudes), "each must be in (0, 1000] N s")
-    if relative is not None and (not relative or any(not (np.isfinite(f) and 0 < f <= 10) for f in relative)):
-        raise SimulationError("--relative", list(relative), "each must be in (0, 10] (fractions of the boundary impulse)")
+    if relative is not None and (
+        not relative or any(not (np.isfinite(f) and 0 < f <= 10) for f in relative)
+    ):
+        raise SimulationError(
+            "--relative",
+            list(relative),
+            "each must be in (0, 10] (fractions of the boundary impulse)",
+        )
     if not (np.isfinite(duration) and 0.001 <= duration <= 0.2):
-        raise SimulationError("--duration", duration, "must be in [0.001, 0.2] s (an impulsive push: 10-50 ms)")
+        raise SimulationError(
+            "--duration", duration, "must be in [0.001, 0.2] s (an impulsive push: 10-50 ms)"
+        )
 
 
-def boundary_impulse(area: Polygon, mass: float, direction: float, com_velocity=(0.0, 0.0)) -> float:
+def boundary_impulse(
+    area: Polygon, mass: float, direction: float, com_velocity=(0.0, 0.0)
+) -> float:
     """The impulse (N s) along ``direction`` (rad) that puts ``com_velocity + J u / m`` on the boundary of
-    ``area`` (m/s); 0 when ``com_velocity`` is outside, inf when the area is unbounded that way."""
+    ``area`` (m/s); 0 when ``com_velocity`` is outside, inf when the area is unbounded that way.
+    """
     G, h = area.halfplanes
     u = np.array([np.cos(direction), np.sin(direction)])
     slack = h - G @ np.asarray(com_velocity, dtype=float)
@@ -117,10 +153,17 @@ class PushOutcome(TrialEntry):
     def to_dict(self, margin: float, omega: float) -> dict:
         s = self.summary
         return {
-            "direction": float(self.push.direction), "direction_deg": float(np.rad2deg(self.push.direction)),
-            "magnitude": float(self.push.magnitude), "relative": self.relative, "duration": float(self.push.duration),
-            "outcome": s["outcome"], "fell": self.fell, "reason": s["reason"], "detail": s["detail"],
-            "events": s["events"], "outcome_time": s["outcome_time"],
+            "direction": float(self.push.direction),
+            "direction_deg": float(np.rad2deg(self.push.direction)),
+            "magnitude": float(self.push.magnitude),
+            "relative": self.relative,
+            "duration": float(self.push.duration),
+            "outcome": s["outcome"],
+            "fell": self.fell,
+            "reason": s["reason"],
+            "detail": s["detail"],
+            "events": s["events"],
+            "outcome_time": s["outcome_time"],
             "com_criterion_safe": self.safe("com", margin, omega),
             "com_criterion_safe_in_trial": self.safe("com_in_trial", margin, omega),
             "zmp_criterion_safe": self.safe("zmp", margin, omega),
@@ -158,14 +201,21 @@ class PushTestResult:
         margin = self.zmp_margin if margin is None else margin
         scored = self.scored
         fell = [o.fell for o in scored]
-        return {c: confusion([o.safe(c, margin, self.omega) for o in scored], fell) for c in CRITERIA}
+        return {
+            c: confusion([o.safe(c, margin, self.omega) for o in scored], fell) for c in CRITERIA
+        }
 
     def margin_study(self) -> dict:
         """Scores at 0, the controller's margin and twice it, and the smallest margin (of :data:`MARGIN_GRID`)
-        that brings each criterion's "predicted safe, fell" to :data:`SAFE_FELL_TARGET` or less."""
+        that brings each criterion's "predicted safe, fell" to :data:`SAFE_FELL_TARGET` or less.
+        """
         own = self.controller_margin
         margins = sorted({0.0, own, 2 * own})
-        out = {"margins": margins, "scores": {f"{m:g}": self.scores(m) for m in margins}, "smallest_margin": {}}
+        out = {
+            "margins": margins,
+            "scores": {f"{m:g}": self.scores(m) for m in margins},
+            "smallest_margin": {},
+        }
         for c in CRITERIA:
             found = None
             for m in MARGIN_GRID:
@@ -181,8 +231,17 @@ class PushTestResult:
         rows: dict[str, dict] = {}
         for o in self.scored:
             key = f"{o.push.magnitude:g}"
-            row = rows.setdefault(key, {"magnitude": o.push.magnitude, "relative": o.relative, "pushes": 0,
-                                        "contact_broken": 0, "fell": 0, "first": {}})
+            row = rows.setdefault(
+                key,
+                {
+                    "magnitude": o.push.magnitude,
+                    "relative": o.relative,
+                    "pushes": 0,
+                    "contact_broken": 0,
+                    "fell": 0,
+                    "first": {},
+                },
+            )
             row["pushes"] += 1
             row["fell"] += o.fell
             if o.outcome == "contact_broken":
@@ -191,11 +250,17 @@ class PushTestResult:
             if events:
                 first = f"{events[0]['contact']} {events[0]['kind']}"
                 row["first"][first] = row["first"].get(first, 0) + 1
-        return {"total": sum(o.outcome == "contact_broken" for o in self.scored), "by_magnitude": list(rows.values())}
+        return {
+            "total": sum(o.outcome == "contact_broken" for o in self.scored),
+            "by_magnitude": list(rows.values()),
+        }
 
     def counts(self) -> dict:
         """Outcomes counted, and the falls by reason."""
-        outcomes = {k: sum(o.outcome == k for o in self.outcomes) for k in ("balanced", "contact_broken", "fell", "aborted")}
+        outcomes = {
+            k: sum(o.outcome == k for o in self.outcomes)
+            for k in ("balanced", "contact_broken", "fell", "aborted")
+        }
         reasons: dict[str, int] = {}
         for o in self.outcomes:
             if o.outcome in ("fell", "aborted"):
@@ -204,11 +269,22 @@ class PushTestResult:
         return {"outcomes": outcomes, "reasons": reasons}
 
     def to_dict(self) -> dict:
-        return {"scenario": self.scenario, "zmp_margin": self.zmp_margin, "controller_margin": self.controller_margin,
-                "omega": self.omega, "pushes": [o.to_dict(self.zmp_margin, self.omega) for o in self.outcomes],
-                "counts": self.counts(), "scores": self.scores(), "margin_study": self.margin_study(),
-                "contact_breaks": self.contact_breaks(), "controller": self.controller, "outcome_criteria": self.criteria,
-                "journal": self.journal, "reused_trials": self.reused, "wall_time": self.wall_time}
+        return {
+            "scenario": self.scenario,
+            "zmp_margin": self.zmp_margin,
+            "controller_margin": self.controller_margin,
+            "omega": self.omega,
+            "pushes": [o.to_dict(self.zmp_margin, self.omega) for o in self.outcomes],
+            "counts": self.counts(),
+            "scores": self.scores(),
+            "margin_study": self.margin_study(),
+            "contact_breaks": self.contact_breaks(),
+            "controller": self.controller,
+            "outcome_criteria": self.criteria,
+            "journal": self.journal,
+            "reused_trials": self.reused,
+            "wall_time": self.wall_time,
+        }
 
 
 def _body_height(setup: BalanceSetup, body: int) -> float:
@@ -228,19 +304,32 @@ def predict_push(setup: BalanceSetup, push: Push, body_height: float) -> PushPre
     velocity = c0 + push.magnitude * u / mass
     force = push.magnitude / push.duration * u
     zmp = a.stance.com[:2] + (body_height - areas.plane_height) * force / (mass * g)
-    return PushPrediction(velocity, float(areas.com_velocity_area.margins(velocity)[0]), zmp,
-                          float(areas.zmp_area.margins(zmp)[0]))
+    return PushPrediction(
+        velocity,
+        float(areas.com_velocity_area.margins(velocity)[0]),
+        zmp,
+        float(areas.zmp_area.margins(zmp)[0]),
+    )
 
 
-def push_test(scenario: Scenario | str, directions: int = 16, magnitudes: Sequence[float] | None = None,
-              duration: float = 0.05, body: str | None = None, options: BalanceTrialOptions | None = None,
-              progress: Callable[[PushOutcome], None] | None = None, setup: BalanceSetup | None = None,
-              relative: Sequence[float] | None = None, zmp_margin: float | None = None,
-              journal: TrialJournal | None = None) -> PushTestResult:
+def push_test(
+    scenario: Scenario | str,
+    directions: int = 16,
+    magnitudes: Sequence[float] | None = None,
+    duration: float = 0.05,
+    body: str | None = None,
+    options: BalanceTrialOptions | None = None,
+    progress: Callable[[PushOutcome], None] | None = None,
+    setup: BalanceSetup | None = None,
+    relative: Sequence[float] | None = None,
+    zmp_margin: float | None = None,
+    journal: TrialJournal | None = None,
+) -> PushTestResult:
     """Push the robot in ``directions`` evenly spaced directions at every magnitude (N s, or fractions
     ``relative`` of each direction's boundary impulse) for ``duration`` s, and score both criteria at
     ``zmp_margin`` (m; default: the controller's own margin). Finished trials go to ``journal`` as they
-    end, and trials it already holds are not run again."""
+    end, and trials it already holds are not run again.
+    """
     wall0 = time.perf_counter()
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
@@ -261,37 +350,71 @@ def push_test(scenario: Scenario | str, directions: int = 16, magnitudes: Sequen
         for k in range(directions):
             angle = 2 * np.pi * k / directions
             if relative is not None:
-                J = float(level) * boundary_impulse(a.areas.com_velocity_area, a.stance.mass, angle, a.scenario.com_velocity)
+                J = float(level) * boundary_impulse(
+                    a.areas.com_velocity_area, a.stance.mass, angle, a.scenario.com_velocity
+                )
                 if not (np.isfinite(J) and 0 < J <= 1000):
-                    raise SimulationError("--relative", level, f"gives {J:g} N s at {np.rad2deg(angle):g} deg: "
-                                          "not in (0, 1000] N s (unbounded or empty area that way)")
+                    raise SimulationError(
+                        "--relative",
+                        level,
+                        f"gives {J:g} N s at {np.rad2deg(angle):g} deg: "
+                        "not in (0, 1000] N s (unbounded or empty area that way)",
+                    )
             else:
                 J = float(level)
             push = Push(angle, J, duration, options.settle, body)
-            key = {"direction": round(angle, 9), "magnitude": round(J, 9), "duration": duration, "body": body}
+            key = {
+                "direction": round(angle, 9),
+                "magnitude": round(J, 9),
+                "duration": duration,
+                "body": body,
+            }
             entry = journal.get(key)
             if entry is None:
                 result = run_balance_trial(setup, push=push, options=options)
-                entry = {"summary": result.summary(),
-                         "trajectory": trajectory(result, push.start - 0.02, push.start + push.duration + 0.5)}
+                entry = {
+                    "summary": result.summary(),
+                    "trajectory": trajectory(
+                        result, push.start - 0.02, push.start + push.duration + 0.5
+                    ),
+                }
                 journal.add(key, entry)
             else:
                 reused += 1
-            outcome = PushOutcome(push=push, relative=None if relative is None else float(level),
-                                  prediction=predict_push(setup, push, height), summary=entry["summary"],
-                                  trajectory=entry["trajectory"])
+            outcome = PushOutcome(
+                push=push,
+                relative=None if relative is None else float(level),
+                prediction=predict_push(setup, push, height),
+                summary=entry["summary"],
+                trajectory=entry["trajectory"],
+            )
             outcomes.append(outcome)
             if progress:
                 progress(outcome)
     if setup.controller == "id":
         from impact_balance.sim.control.torque import describe
 
-        controller = describe(options.id_gains, float(setup.sim.model.opt.timestep), setup.joints == "servo")
+        controller = describe(
+            options.id_gains, float(setup.sim.model.opt.timestep), setup.joints == "servo"
+        )
     else:
-        controller = {"name": "dcm-zmp-clamp + pink IK -> joint position servos", "gains": options.gains.to_dict()}
+        controller = {
+            "name": "dcm-zmp-clamp + pink IK -> joint position servos",
+            "gains": options.gains.to_dict(),
+        }
     controller["armature"] = setup.sim.armature_source
     repair = setup.sim.inertia_repair
     controller["inertia_repair"] = None if repair is None else repair.to_dict()
-    return PushTestResult(scenario.name, outcomes, controller, options.criteria.to_dict(), setup,
-                          own if zmp_margin is None else float(zmp_margin), own, omega,
-                          time.perf_counter() - wall0, None if journal.path is None else str(journal.path), reused)
+    return PushTestResult(
+        scenario.name,
+        outcomes,
+        controller,
+        options.criteria.to_dict(),
+        setup,
+        own if zmp_margin is None else float(zmp_margin),
+        own,
+        omega,
+        time.perf_counter() - wall0,
+        None if journal.path is None else str(journal.path),
+        reused,
+    )

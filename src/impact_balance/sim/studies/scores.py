@@ -16,10 +16,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["wilson", "confusion", "MARGIN_GRID"]
+__all__ = ["MARGIN_GRID", "confusion", "wilson"]
 
 #: ZMP margins (m) searched for the smallest one that brings "predicted safe, fell" to a target rate.
-MARGIN_GRID = tuple(round(0.001 * k, 3) for k in range(0, 61))
+MARGIN_GRID = tuple(round(0.001 * k, 3) for k in range(61))
 
 
 def wilson(successes: int, total: int, z: float = 1.959963984540054) -> list[float] | None:
@@ -42,16 +42,21 @@ def confusion(predicted_safe: Sequence[bool], fell: Sequence[bool]) -> dict:
     """
     p = np.asarray(predicted_safe, dtype=bool)
     f = np.asarray(fell, dtype=bool)
-    n = int(len(p))
+    n = len(p)
     safe_survived, safe_fell = int(np.sum(p & ~f)), int(np.sum(p & f))
     unsafe_survived, unsafe_fell = int(np.sum(~p & ~f)), int(np.sum(~p & f))
     right = safe_survived + unsafe_fell
     safe, unsafe = safe_survived + safe_fell, unsafe_survived + unsafe_fell
     return {
-        "safe_survived": safe_survived, "safe_fell": safe_fell, "unsafe_survived": unsafe_survived,
-        "unsafe_fell": unsafe_fell, "total": n,
-        "accuracy": right / n if n else None, "accuracy_ci95": wilson(right, n),
-        "safe_fell_rate": safe_fell / n if n else None, "safe_fell_rate_ci95": wilson(safe_fell, n),
+        "safe_survived": safe_survived,
+        "safe_fell": safe_fell,
+        "unsafe_survived": unsafe_survived,
+        "unsafe_fell": unsafe_fell,
+        "total": n,
+        "accuracy": right / n if n else None,
+        "accuracy_ci95": wilson(right, n),
+        "safe_fell_rate": safe_fell / n if n else None,
+        "safe_fell_rate_ci95": wilson(safe_fell, n),
         "fell_given_safe": safe_fell / safe if safe else None,
         "survived_given_unsafe": unsafe_survived / unsafe if unsafe else None,
     }

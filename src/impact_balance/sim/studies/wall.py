@@ -24,11 +24,23 @@ import numpy as np
 
 from impact_balance.exceptions import SimulationError
 from impact_balance.sim.control.approach import _profile
-from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions, run_balance_trial
+from impact_balance.sim.trials.balance_trial import (
+    BalanceSetup,
+    BalanceTrialOptions,
+    run_balance_trial,
+)
 from impact_balance.sim.trials.impact_trial import TrialRecord, _point_velocity
 from impact_balance.sim.trials.result import BalanceTrialResult
 
-__all__ = ["APPROACH_VERSION", "GOVERNORS", "WallOptions", "GovernedApproach", "WallTrial", "run_wall_trial", "write_wall_video"]
+__all__ = [
+    "APPROACH_VERSION",
+    "GOVERNORS",
+    "GovernedApproach",
+    "WallOptions",
+    "WallTrial",
+    "run_wall_trial",
+    "write_wall_video",
+]
 
 #: Version of the approach trial, for journals (with the balance trial's): 2 = the ``id``
 #: controller bounds the point's speed by the cap (``WallOptions.cap_constraint``).
@@ -103,7 +115,9 @@ class GovernedApproach:
         """The reference's own speed at ``t`` (m/s): a bounded-acceleration ramp to ``speed``."""
         return _profile(t - self.start_time, self.speed, self.acceleration, np.inf)[1]
 
-    def reference(self, t: float, normal_force: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def reference(
+        self, t: float, normal_force: float = 0.0
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """World position, velocity and acceleration of the point's reference at ``t`` (see the class docstring)."""
         n = np.asarray(self.normal, dtype=float)
         if self._point is None:
@@ -112,7 +126,9 @@ class GovernedApproach:
             self.contact_time = float(t)
             self._contact_point = self._point.copy()
         if self.contact_time is not None:
-            s, ds, dds = _profile(t - self.contact_time, self.withdraw_speed, self.acceleration, self.retract)
+            s, ds, dds = _profile(
+                t - self.contact_time, self.withdraw_speed, self.acceleration, self.retract
+            )
             return self._contact_point + s * n, ds * n, dds * n
         dt = 0.0 if self._last_t is None else max(0.0, t - self._last_t)
         self._last_t = float(t)
@@ -128,7 +144,8 @@ class GovernedApproach:
     def speed_bound(self) -> float:
         """The largest approach speed (m/s, along ``-normal``) a controller should allow the point
         now: the governor's cap until the contact, ``inf`` after it, without a governor or when
-        ``bound_speed`` is off."""
+        ``bound_speed`` is off.
+        """
         if not self.bound_speed or self.contact_time is not None:
             return np.inf
         return float(self.ceiling)
@@ -158,24 +175,42 @@ class WallTrial:
     def to_dict(self) -> dict:
         s = self.result.summary()
         o = self.options
-        return {"governor": o.governor, "reference": o.reference, "wall_distance": o.wall_distance,
-                "cap_constraint": o.cap_constraint,
-                "speed_at_contact": self.speed_at_contact, "cap_at_contact": self.cap_at_contact,
-                "time_to_contact": self.time_to_contact, "outcome": s["outcome"], "reason": s["reason"],
-                "detail": s["detail"], "events": s["events"], "tick_us": self.tick_us, "trial": s}
+        return {
+            "governor": o.governor,
+            "reference": o.reference,
+            "wall_distance": o.wall_distance,
+            "cap_constraint": o.cap_constraint,
+            "speed_at_contact": self.speed_at_contact,
+            "cap_at_contact": self.cap_at_contact,
+            "time_to_contact": self.time_to_contact,
+            "outcome": s["outcome"],
+            "reason": s["reason"],
+            "detail": s["detail"],
+            "events": s["events"],
+            "tick_us": self.tick_us,
+            "trial": s,
+        }
 
 
 def _finite(x) -> float | None:
     return None if x is None or not np.isfinite(x) else float(x)
 
 
-def run_wall_trial(setup: BalanceSetup, options: WallOptions, trial_options: BalanceTrialOptions | None = None,
-                   governor=None, frames: bool = False) -> WallTrial:
+def run_wall_trial(
+    setup: BalanceSetup,
+    options: WallOptions,
+    trial_options: BalanceTrialOptions | None = None,
+    governor=None,
+    frames: bool = False,
+) -> WallTrial:
     """Run one approach (see the module docstring). ``governor``: a
     :class:`~impact_balance.governor.Governor` of the setup's scenario and ``options.governor``'s criterion
-    (built here when None and the options ask for one); ``frames``: keep what a video needs."""
+    (built here when None and the options ask for one); ``frames``: keep what a video needs.
+    """
     if options.governor not in GOVERNORS:
-        raise SimulationError("--governor", options.governor, f"must be one of {', '.join(GOVERNORS)}")
+        raise SimulationError(
+            "--governor", options.governor, f"must be one of {', '.join(GOVERNORS)}"
+        )
     if not (np.isfinite(options.reference) and 0.0 < options.reference <= 5.0):
         raise SimulationError("--reference", options.reference, "must be in (0, 5] m/s")
     if not (np.isfinite(options.wall_distance) and 0.0 < options.wall_distance <= 1.0):
@@ -191,13 +226,26 @@ def run_wall_trial(setup: BalanceSetup, options: WallOptions, trial_options: Bal
     im = analysis.impact.model
     n = np.asarray(im.normal, dtype=float)
     start = im.point + options.standoff * n
-    task = GovernedApproach(im.spec.frame, im.spec.offset, start, n, options.reference,
-                            start_time=trial_options.settle, acceleration=options.acceleration,
-                            bound_speed=options.cap_constraint)
+    task = GovernedApproach(
+        im.spec.frame,
+        im.spec.offset,
+        start,
+        n,
+        options.reference,
+        start_time=trial_options.settle,
+        acceleration=options.acceleration,
+        bound_speed=options.cap_constraint,
+    )
     wall = start - options.wall_distance * n
     ticks: list[float] = []
     caps: list[tuple[float, float, float]] = []
-    rows: dict[str, list] = {"time": [], "reference": [], "cap": [], "commanded": [], "measured": []}
+    rows: dict[str, list] = {
+        "time": [],
+        "reference": [],
+        "cap": [],
+        "commanded": [],
+        "measured": [],
+    }
     kept: dict[str, list] = {"time": [], "qpos": [], "com": [], "impact": []}
     sim = setup.sim
 
@@ -218,24 +266,43 @@ def run_wall_trial(setup: BalanceSetup, options: WallOptions, trial_options: Bal
             caps.append((t, task.reference_speed(t), task.ceiling))
         rows["time"].append(t)
         rows["reference"].append(task.reference_speed(t) if task.contact_time is None else 0.0)
-        rows["cap"].append(_finite(task.ceiling) if governor is not None and task.contact_time is None else None)
+        rows["cap"].append(
+            _finite(task.ceiling) if governor is not None and task.contact_time is None else None
+        )
         rows["commanded"].append(task.commanded if task.contact_time is None else 0.0)
         rows["measured"].append(float(-n @ _point_velocity(sim, n)))
 
-    result = run_balance_trial(setup, impact_task=task, surface_point=wall, standoff=options.standoff,
-                               options=trial_options, before_control=before_control,
-                               max_approach_time=options.max_time)
+    result = run_balance_trial(
+        setup,
+        impact_task=task,
+        surface_point=wall,
+        standoff=options.standoff,
+        options=trial_options,
+        before_control=before_control,
+        max_approach_time=options.max_time,
+    )
     impact = result.impact
     cap_at_contact = None
     if impact is not None and caps:
         k = max(0, int(np.searchsorted([c[0] for c in caps], impact.contact_time)) - 1)
         cap_at_contact = _finite(caps[k][2])
     us = np.asarray(ticks) * 1e6
-    tick_us = ({"median": float(np.median(us)), "p99": float(np.percentile(us, 99)), "count": int(us.size)}
-               if us.size else {"median": None, "p99": None, "count": 0})
-    return WallTrial(options, result, None if impact is None else _finite(impact.approach_speed), cap_at_contact,
-                     None if impact is None else float(impact.contact_time - task.start_time), tick_us, rows, wall,
-                     {k: np.array(x) for k, x in kept.items()} if frames else None)
+    tick_us = (
+        {"median": float(np.median(us)), "p99": float(np.percentile(us, 99)), "count": int(us.size)}
+        if us.size
+        else {"median": None, "p99": None, "count": 0}
+    )
+    return WallTrial(
+        options,
+        result,
+        None if impact is None else _finite(impact.approach_speed),
+        cap_at_contact,
+        None if impact is None else float(impact.contact_time - task.start_time),
+        tick_us,
+        rows,
+        wall,
+        {k: np.array(x) for k, x in kept.items()} if frames else None,
+    )
 
 
 def write_wall_video(setup: BalanceSetup, trial: WallTrial, path, title: str | None = None):
@@ -246,9 +313,17 @@ def write_wall_video(setup: BalanceSetup, trial: WallTrial, path, title: str | N
         raise SimulationError("--video", str(path)[:80], "the trial kept no frames")
     sim, f = setup.sim, trial.frames
     k = len(f["time"])
-    record = TrialRecord(time=f["time"], qpos=f["qpos"], qvel=np.zeros((k, sim.model.nv)), com=f["com"],
-                         com_velocity=np.zeros((k, 3)), forces={"impact": f["impact"]}, impact_velocity=np.zeros((k, 3)),
-                         approach_start=float(f["time"][0]), wall_time=0.0)
+    record = TrialRecord(
+        time=f["time"],
+        qpos=f["qpos"],
+        qvel=np.zeros((k, sim.model.nv)),
+        com=f["com"],
+        com_velocity=np.zeros((k, 3)),
+        forces={"impact": f["impact"]},
+        impact_velocity=np.zeros((k, 3)),
+        approach_start=float(f["time"][0]),
+        wall_time=0.0,
+    )
     home = sim.model.geom_pos[sim.surface_geom].copy()
     sim.model.geom_pos[sim.surface_geom] = home + (trial.wall - setup.analysis.impact.model.point)
     try:

@@ -25,6 +25,7 @@ speed), the impulses at the impact point and at the sustained contacts, and the 
 from __future__ import annotations
 
 import time
+
 import mujoco
 import numpy as np
 import pinocchio as pin
@@ -32,27 +33,47 @@ import pinocchio as pin
 from impact_balance.analysis.analyze import Analysis
 from impact_balance.exceptions import SimulationError
 from impact_balance.logs import write_log
-from impact_balance.sim.control.approach import ImpactTask, standoff as approach_standoff
+from impact_balance.sim.control.approach import ImpactTask
+from impact_balance.sim.control.approach import standoff as approach_standoff
 from impact_balance.sim.control.kinematic import BalanceController
-from impact_balance.sim.trials.impact_tracker import ImpactTracker
 from impact_balance.sim.control.torque import InverseDynamicsController
-from impact_balance.sim.trials.log import LOG_START, LogRecorder
 from impact_balance.sim.model.build import SimModel
-from impact_balance.sim.trials.outcomes import OutcomeMonitor
-from impact_balance.sim.trials.rigid_impact import RigidImpactHold
+from impact_balance.sim.trials.impact_tracker import ImpactTracker
 from impact_balance.sim.trials.impact_trial import _point_velocity
+from impact_balance.sim.trials.log import LOG_START, LogRecorder
+from impact_balance.sim.trials.outcomes import OutcomeMonitor
 from impact_balance.sim.trials.result import BalanceTrialResult
-from impact_balance.sim.trials.setup import (CONTROLLERS, STIFF_SERVOS, BalanceSetup, BalanceTrialOptions, Push,
-                          controller_margin)
+from impact_balance.sim.trials.rigid_impact import RigidImpactHold
+from impact_balance.sim.trials.setup import (
+    CONTROLLERS,
+    STIFF_SERVOS,
+    BalanceSetup,
+    BalanceTrialOptions,
+    Push,
+    controller_margin,
+)
 
 #: Version of the trials' physics and measurements: journals of another version are not reused.
 TRIAL_VERSION = 3
 
-__all__ = ["TRIAL_VERSION", "CONTROLLERS", "STIFF_SERVOS", "Push", "BalanceTrialOptions", "BalanceSetup", "BalanceTrialResult",
-           "run_balance_trial", "write_trial_log", "measured_zmp", "controller_margin"]
+__all__ = [
+    "CONTROLLERS",
+    "STIFF_SERVOS",
+    "TRIAL_VERSION",
+    "BalanceSetup",
+    "BalanceTrialOptions",
+    "BalanceTrialResult",
+    "Push",
+    "controller_margin",
+    "measured_zmp",
+    "run_balance_trial",
+    "write_trial_log",
+]
 
 
-def measured_zmp(sim: SimModel, com: np.ndarray, plane_height: float) -> tuple[np.ndarray, np.ndarray]:
+def measured_zmp(
+    sim: SimModel, com: np.ndarray, plane_height: float
+) -> tuple[np.ndarray, np.ndarray]:
     """ZMP of the sustained contacts' resultant force, in the LIPM sense, and each contact's force.
 
     The ZMP support area is defined through the resultant contact force ``f``:
@@ -85,10 +106,18 @@ def _base_rotation(q: np.ndarray) -> np.ndarray:
     return pin.Quaternion(q[6], q[3], q[4], q[5]).toRotationMatrix()
 
 
-def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, push: Push | None = None,
-                      options: BalanceTrialOptions | None = None, *, impact_task=None, surface_point=None,
-                      standoff: float | None = None, before_control=None,
-                      max_approach_time: float | None = None) -> BalanceTrialResult:
+def run_balance_trial(
+    setup: BalanceSetup,
+    impact_speed: float | None = None,
+    push: Push | None = None,
+    options: BalanceTrialOptions | None = None,
+    *,
+    impact_task=None,
+    surface_point=None,
+    standoff: float | None = None,
+    before_control=None,
+    max_approach_time: float | None = None,
+) -> BalanceTrialResult:
     """Run one trial (an impact at the commanded ``impact_speed``, or a ``push``) from rest; see the module docstring.
 
     An impact may instead follow ``impact_task`` (an object with ``reference(t, normal_force)``,
@@ -109,20 +138,43 @@ def run_balance_trial(setup: BalanceSetup, impact_speed: float | None = None, pu
     moved = surface_point is not None and sim.surface_geom is not None
     if moved:
         home = sim.model.geom_pos[sim.surface_geom].copy()
-        sim.model.geom_pos[sim.surface_geom] = home + (np.asarray(surface_point, dtype=float) - analysis.impact.model.point)
+        sim.model.geom_pos[sim.surface_geom] = home + (
+            np.asarray(surface_point, dtype=float) - analysis.impact.model.point
+        )
     try:
-        return _run(setup, impact_speed, push, options, hold, impact_task, surface_point, standoff, before_control,
-                    max_approach_time)
+        return _run(
+            setup,
+            impact_speed,
+            push,
+            options,
+            hold,
+            impact_task,
+            surface_point,
+            standoff,
+            before_control,
+            max_approach_time,
+        )
     finally:
-        if hold is not None:  # the setup's model is reused: never leave a joint held, nor the wall moved
+        if (
+            hold is not None
+        ):  # the setup's model is reused: never leave a joint held, nor the wall moved
             hold.release(sim.data.time)
         if moved:
             sim.model.geom_pos[sim.surface_geom] = home
 
 
-def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, options: BalanceTrialOptions,
-         hold: RigidImpactHold | None, task, surface_point, standoff, before_control,
-         max_approach_time) -> BalanceTrialResult:
+def _run(
+    setup: BalanceSetup,
+    impact_speed: float | None,
+    push: Push | None,
+    options: BalanceTrialOptions,
+    hold: RigidImpactHold | None,
+    task,
+    surface_point,
+    standoff,
+    before_control,
+    max_approach_time,
+) -> BalanceTrialResult:
     sim, analysis = setup.sim, setup.analysis
     m, d = sim.model, sim.data
     stance = analysis.stance
@@ -135,7 +187,14 @@ def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, opt
     if impact_speed is not None and task is None:
         im = analysis.impact.model
         standoff = approach_standoff(impact_speed)
-        task = ImpactTask(im.spec.frame, im.spec.offset, im.point, im.normal, impact_speed, start_time=options.settle)
+        task = ImpactTask(
+            im.spec.frame,
+            im.spec.offset,
+            im.point,
+            im.normal,
+            impact_speed,
+            start_time=options.settle,
+        )
     if task is not None:
         n = np.asarray(analysis.impact.model.normal, dtype=float)
         tracker = ImpactTracker(n, dt)
@@ -147,14 +206,21 @@ def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, opt
     mujoco.mj_resetData(m, d)
     sim.set_state(q_start)
     if setup.controller == "id":
-        d.ctrl[sim.actuator_ids] = sim.tau_hold  # motors: the holding torques until the first control step
+        d.ctrl[sim.actuator_ids] = (
+            sim.tau_hold
+        )  # motors: the holding torques until the first control step
     else:
         sim.set_servo_targets(q_start)
 
     torque = setup.controller == "id"
     if torque:
-        controller = InverseDynamicsController(analysis, q_start, options.id_gains, task,
-                                               effort_limits=bool(sim.model.actuator_forcelimited[sim.actuator_ids].any()))
+        controller = InverseDynamicsController(
+            analysis,
+            q_start,
+            options.id_gains,
+            task,
+            effort_limits=bool(sim.model.actuator_forcelimited[sim.actuator_ids].any()),
+        )
         # MuJoCo's viscous joint damping (the URDF's) is compensated: the motors add damping * qdot.
         joint_damping = m.dof_damping[sim.dof_adr].copy()
         rate = options.id_gains.rate
@@ -168,7 +234,9 @@ def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, opt
         contact_names,
         np.array([pdata.oMf[f].translation for f in contact_frames]),
         np.array([pdata.oMf[f].rotation for f in contact_frames]),
-        float(q_start[2]), _base_rotation(q_start), options.criteria,
+        float(q_start[2]),
+        _base_rotation(q_start),
+        options.criteria,
     )
     normals = np.array([c.normal for c in stance.contacts])
     zmp_area = analysis.areas.zmp_area
@@ -189,8 +257,19 @@ def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, opt
         else:
             end_time = task.arrival_time + options.max_approach_time + options.after
     steps_per_control = max(1, int(round(1.0 / (rate * dt))))
-    series: dict[str, list] = {k: [] for k in ("time", "zmp", "zmp_desired", "com", "com_velocity", "dcm",
-                                               "zmp_margin", "com_velocity_margin")}
+    series: dict[str, list] = {
+        k: []
+        for k in (
+            "time",
+            "zmp",
+            "zmp_desired",
+            "com",
+            "com_velocity",
+            "dcm",
+            "zmp_margin",
+            "com_velocity_margin",
+        )
+    }
     surface = None if task is None else float(n @ np.asarray(surface_point, dtype=float))
     radius = 0.0 if task is None else float(m.geom_size[sim.impact_geom][0])
     wall0 = time.perf_counter()
@@ -202,7 +281,10 @@ def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, opt
     while True:
         if d.time >= end_time:
             # Still moving at the end: the robot gets extra_time more to come to rest (a slow recovery is no fall).
-            moving = len(series["com_velocity"]) and np.linalg.norm(series["com_velocity"][-1]) > options.criteria.rest_speed
+            moving = (
+                len(series["com_velocity"])
+                and np.linalg.norm(series["com_velocity"][-1]) > options.criteria.rest_speed
+            )
             if extended or disturbance is None or not moving:
                 break
             extended = True
@@ -235,7 +317,9 @@ def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, opt
             zmp, forces = measured_zmp(sim, com_now, h)
             out = controller.step(t, q, v, zmp, fn)
             if torque:
-                d.ctrl[sim.actuator_ids] = out.tau[sim.v_index - 6] + joint_damping * d.qvel[sim.dof_adr]
+                d.ctrl[sim.actuator_ids] = (
+                    out.tau[sim.v_index - 6] + joint_damping * d.qvel[sim.dof_adr]
+                )
             else:
                 # Velocity feed-forward (kd v_ref) for the free limbs only: on the stiffened support limbs
                 # it would turn the dead-beat IK's velocity noise into large torques.
@@ -246,29 +330,48 @@ def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, opt
             omega = np.sqrt(g / (com[2] - h))
             zmp_margin = float(zmp_area.margins(zmp)[0]) if np.all(np.isfinite(zmp)) else -np.inf
             dcm_margin = float(zmp_area.margins(out.dcm)[0])
-            for key, value in (("time", t), ("zmp", zmp), ("zmp_desired", out.zmp), ("com", com),
-                               ("com_velocity", com_velocity), ("dcm", out.dcm), ("zmp_margin", zmp_margin),
-                               ("com_velocity_margin", omega * dcm_margin)):
+            for key, value in (
+                ("time", t),
+                ("zmp", zmp),
+                ("zmp_desired", out.zmp),
+                ("com", com),
+                ("com_velocity", com_velocity),
+                ("dcm", out.dcm),
+                ("zmp_margin", zmp_margin),
+                ("com_velocity_margin", omega * dcm_margin),
+            ):
                 series[key].append(value)
             pin.framesForwardKinematics(model, pdata, q)
             if angular_momentum is None and disturbance_end is not None and t >= disturbance_end:
                 # What the LIPM leaves out: the angular momentum about the CoM the disturbance left.
-                angular_momentum = np.array(pin.computeCentroidalMomentum(model, pdata, q, v).angular)
+                angular_momentum = np.array(
+                    pin.computeCentroidalMomentum(model, pdata, q, v).angular
+                )
             if push is not None and t >= push.start:
                 monitor.start_disturbance(push.start)
             pushing = push is not None and push.start <= t < push.start + push.duration
-            monitor.update(t, np.array([pdata.oMf[f].translation for f in contact_frames]),
-                           np.array([pdata.oMf[f].rotation for f in contact_frames]),
-                           np.einsum("ij,ij->i", forces, normals), float(q[2]), _base_rotation(q),
-                           dcm_margin if disturbance is not None and t >= disturbance else None, impulsive=pushing)
+            monitor.update(
+                t,
+                np.array([pdata.oMf[f].translation for f in contact_frames]),
+                np.array([pdata.oMf[f].rotation for f in contact_frames]),
+                np.einsum("ij,ij->i", forces, normals),
+                float(q[2]),
+                _base_rotation(q),
+                dcm_margin if disturbance is not None and t >= disturbance else None,
+                impulsive=pushing,
+            )
             if recorder is not None and t >= LOG_START:
                 recorder.add(t, q, v, sim, zmp, forces, impact_force if task is not None else None)
             if monitor.fell:
                 if monitor.disturbance is None:
-                    monitor.abort("fell_before_disturbance", t, "the robot fell before the disturbance")
+                    monitor.abort(
+                        "fell_before_disturbance", t, "the robot fell before the disturbance"
+                    )
                 break
         if body is not None:
-            d.xfrc_applied[body, :3] = push.force if push.start <= t < push.start + push.duration else 0.0
+            d.xfrc_applied[body, :3] = (
+                push.force if push.start <= t < push.start + push.duration else 0.0
+            )
         mujoco.mj_step(m, d)
         step += 1
     wall = time.perf_counter() - wall0
@@ -276,24 +379,41 @@ def _run(setup: BalanceSetup, impact_speed: float | None, push: Push | None, opt
     t = float(d.time)
     if task is not None and disturbance is None:
         monitor.abort("no_contact", t, "the impact point never reached the surface")
-    outcome = monitor.finish(t, arrays["com_velocity"][-1] if len(arrays["com_velocity"]) else np.zeros(3))
+    outcome = monitor.finish(
+        t, arrays["com_velocity"][-1] if len(arrays["com_velocity"]) else np.zeros(3)
+    )
     result = BalanceTrialResult(
-        outcome=outcome.outcome, reason=outcome.reason, outcome_time=outcome.time, detail=outcome.detail,
-        events=outcome.events, disturbance_time=disturbance, disturbance_end=disturbance_end,
-        approach_speed=impact_speed, max_tilt=monitor.max_tilt, max_slip=monitor.max_slip,
-        max_trunk_tilt=monitor.max_trunk_tilt, max_drop=monitor.max_drop, sim_time=t, wall_time=wall,
-        contact_names=tuple(contact_names), series=arrays, log=recorder.frame() if recorder is not None else None,
+        outcome=outcome.outcome,
+        reason=outcome.reason,
+        outcome_time=outcome.time,
+        detail=outcome.detail,
+        events=outcome.events,
+        disturbance_time=disturbance,
+        disturbance_end=disturbance_end,
+        approach_speed=impact_speed,
+        max_tilt=monitor.max_tilt,
+        max_slip=monitor.max_slip,
+        max_trunk_tilt=monitor.max_trunk_tilt,
+        max_drop=monitor.max_drop,
+        sim_time=t,
+        wall_time=wall,
+        contact_names=tuple(contact_names),
+        series=arrays,
+        log=recorder.frame() if recorder is not None else None,
         angular_momentum_at_end=angular_momentum,
     )
     if tracker is not None and tracker.touched:
-        result.impact = tracker.measurement(t, sim.com_velocity(), None if hold is None else hold.to_dict())
+        result.impact = tracker.measurement(
+            t, sim.com_velocity(), None if hold is None else hold.to_dict()
+        )
     _margins(result, analysis, arrays)
     return result
 
 
 def _margins(result: BalanceTrialResult, analysis: Analysis, arrays: dict[str, np.ndarray]) -> None:
     """The CoM velocity when the disturbance ended, its margin, the worst margin after it, and the worst ZMP
-    margin during a push (all in the areas without margin)."""
+    margin during a push (all in the areas without margin).
+    """
     if result.disturbance_time is None or not len(arrays["time"]):
         return
     tt, vm, zm = arrays["time"], arrays["com_velocity_margin"], arrays["zmp_margin"]
@@ -314,12 +434,23 @@ def _margins(result: BalanceTrialResult, analysis: Analysis, arrays: dict[str, n
             result.min_zmp_margin_during = worst if np.isfinite(worst) else None
 
 
-def write_trial_log(setup: BalanceSetup, path, controller: str, metadata: dict, impact_speed: float | None = None,
-                    push: Push | None = None, rigid_impact: bool = False):
+def write_trial_log(
+    setup: BalanceSetup,
+    path,
+    controller: str,
+    metadata: dict,
+    impact_speed: float | None = None,
+    push: Push | None = None,
+    rigid_impact: bool = False,
+):
     """Run one trial again with recording on and write its log (searches run their trials unrecorded).
 
     Returns the path written; ``metadata`` goes into the Parquet metadata with the scenario's name.
     """
-    trial = run_balance_trial(setup, impact_speed=impact_speed, push=push,
-                              options=BalanceTrialOptions(record=True, controller=controller, rigid_impact=rigid_impact))
+    trial = run_balance_trial(
+        setup,
+        impact_speed=impact_speed,
+        push=push,
+        options=BalanceTrialOptions(record=True, controller=controller, rigid_impact=rigid_impact),
+    )
     return write_log(trial.log, path, {"scenario": setup.scenario.name, **metadata})

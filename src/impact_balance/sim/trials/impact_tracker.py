@@ -18,7 +18,7 @@ import numpy as np
 
 from impact_balance.sim.trials.result import ImpactMeasurement
 
-__all__ = ["ImpactTracker", "MAX_IMPACT_DURATION"]
+__all__ = ["MAX_IMPACT_DURATION", "ImpactTracker"]
 
 #: Longest impact window, s: a limb may stay on the surface after the impact.
 MAX_IMPACT_DURATION = 0.02
@@ -54,15 +54,25 @@ class ImpactTracker:
     def done(self) -> bool:
         return self.end is not None
 
-    def update(self, t: float, impact_force: np.ndarray, sustained_forces: np.ndarray, point_velocity: np.ndarray,
-               com_velocity: np.ndarray) -> None:
+    def update(
+        self,
+        t: float,
+        impact_force: np.ndarray,
+        sustained_forces: np.ndarray,
+        point_velocity: np.ndarray,
+        com_velocity: np.ndarray,
+    ) -> None:
         """One step: forces that acted over the last step (N, world, on the robot), the impact point's
-        velocity and the CoM velocity now (m/s, world)."""
+        velocity and the CoM velocity now (m/s, world).
+        """
         touching = bool(np.any(impact_force != 0.0))
         if self.start is None and touching and self._prev is not None:
             t_prev, v_prev, c_prev, f_prev = self._prev
             self.start = t_prev
-            self._before = (float(-self.normal @ v_prev), np.asarray(c_prev[:2], dtype=float).copy())
+            self._before = (
+                float(-self.normal @ v_prev),
+                np.asarray(c_prev[:2], dtype=float).copy(),
+            )
             self._baseline = f_prev.copy()
             self._sustained = np.zeros_like(sustained_forces)
         if self.start is not None and self.end is None:
@@ -72,15 +82,31 @@ class ImpactTracker:
             else:
                 self.end = float(t)
                 self._after = np.asarray(com_velocity[:2], dtype=float).copy()
-        self._prev = (float(t), np.asarray(point_velocity, dtype=float).copy(),
-                      np.asarray(com_velocity, dtype=float).copy(), np.asarray(sustained_forces, dtype=float).copy())
+        self._prev = (
+            float(t),
+            np.asarray(point_velocity, dtype=float).copy(),
+            np.asarray(com_velocity, dtype=float).copy(),
+            np.asarray(sustained_forces, dtype=float).copy(),
+        )
 
-    def measurement(self, t: float, com_velocity: np.ndarray, hold: dict | None = None) -> ImpactMeasurement | None:
+    def measurement(
+        self, t: float, com_velocity: np.ndarray, hold: dict | None = None
+    ) -> ImpactMeasurement | None:
         """The impact measured so far (None before the contact); an unfinished window ends at ``t``."""
         if self.start is None:
             return None
         end = self.end if self.end is not None else float(t)
-        after = self._after if self._after is not None else np.asarray(com_velocity[:2], dtype=float)
+        after = (
+            self._after if self._after is not None else np.asarray(com_velocity[:2], dtype=float)
+        )
         approach, before = self._before
-        return ImpactMeasurement(self.start, approach, (self.start, end), self._impulse.copy(),
-                                 self._sustained.copy(), before, after, hold)
+        return ImpactMeasurement(
+            self.start,
+            approach,
+            (self.start, end),
+            self._impulse.copy(),
+            self._sustained.copy(),
+            before,
+            after,
+            hold,
+        )

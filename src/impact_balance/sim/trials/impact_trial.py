@@ -33,7 +33,14 @@ from impact_balance.exceptions import SimulationError
 from impact_balance.ranges import MAX_APPROACH_SPEED, check_approach_speed
 from impact_balance.sim.model.build import SimModel
 
-__all__ = ["TrialOptions", "TrialRecord", "run_trial", "impact_limb", "approach_joint_velocity", "MAX_APPROACH_SPEED"]
+__all__ = [
+    "MAX_APPROACH_SPEED",
+    "TrialOptions",
+    "TrialRecord",
+    "approach_joint_velocity",
+    "impact_limb",
+    "run_trial",
+]
 
 
 @dataclass(frozen=True)
@@ -116,7 +123,9 @@ def impact_limb(sim: SimModel) -> list[str]:
     return [n for n in names if n in sim.joint_names]
 
 
-def approach_joint_velocity(sim: SimModel, limb: list[str], normal: np.ndarray, gap: float) -> np.ndarray:
+def approach_joint_velocity(
+    sim: SimModel, limb: list[str], normal: np.ndarray, gap: float
+) -> np.ndarray:
     """Joint velocity (pinocchio ``nv``) of the ``limb`` that moves the impact point at unit speed along
     ``-normal`` at the stance, such that the retracted start pose ``q - gap dq`` is within the joints' limits.
 
@@ -147,15 +156,27 @@ def approach_joint_velocity(sim: SimModel, limb: list[str], normal: np.ndarray, 
         big = 1e6  # rad/m: no bound
         lower = np.where(limited, np.minimum((q - high) / gap, 0.0), -big)  # q - gap dq <= high
         upper = np.where(limited, np.maximum((q - low) / gap, 0.0), big)  # q - gap dq >= low
-        solution = qpsolvers.solve_qp(np.eye(len(limb)), np.zeros(len(limb)), A=J, b=-normal,
-                                      lb=lower, ub=upper, solver="daqp")
+        solution = qpsolvers.solve_qp(
+            np.eye(len(limb)),
+            np.zeros(len(limb)),
+            A=J,
+            b=-normal,
+            lb=lower,
+            ub=upper,
+            solver="daqp",
+        )
         if solution is None or not np.allclose(J @ solution, -normal, atol=1e-6):
-            names = ", ".join(f"{j} ({q_j:+.3f} rad, range [{lo:+.3f}, {hi:+.3f}])"
-                              for j, q_j, lo, hi, bad in zip(limb, q, low, high, outside) if bad)
+            names = ", ".join(
+                f"{j} ({q_j:+.3f} rad, range [{lo:+.3f}, {hi:+.3f}])"
+                for j, q_j, lo, hi, bad in zip(limb, q, low, high, outside)
+                if bad
+            )
             raise SimulationError(
-                "impact", spec.frame,
+                "impact",
+                spec.frame,
                 f"the limb cannot start {gap:.3f} m back from the surface within its joint limits: a straight "
-                f"joint path that moves the impact point along the normal would take {names} beyond its limit")
+                f"joint path that moves the impact point along the normal would take {names} beyond its limit",
+            )
         dq = solution
     out = np.zeros(model.nv)
     out[v_cols] = dq
@@ -200,9 +221,14 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
         sim.enable_supports(True)
         limb = impact_limb(sim)
         if not limb:
-            raise SimulationError("impact.frame", spec.frame,
-                                  "no joint moves the impact point without moving a contact")
-        limb_dq = approach_joint_velocity(sim, limb, n, gap)  # joint velocity per unit approach speed
+            raise SimulationError(
+                "impact.frame",
+                spec.frame,
+                "no joint moves the impact point without moving a contact",
+            )
+        limb_dq = approach_joint_velocity(
+            sim, limb, n, gap
+        )  # joint velocity per unit approach speed
         q_start = pin.integrate(sim.stance.model, sim.stance.q, -gap * limb_dq)
         sim.set_state(q_start)
         sim.set_servo_targets(q_start)
@@ -252,7 +278,9 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
                     sim.set_servo_targets(frozen)
                 elif s > 0.0:
                     # Past the stance if need be: the servos lag, the surface is where the stance touches it.
-                    sim.set_servo_targets(pin.integrate(sim.stance.model, q_start, s * v_n * limb_dq), v_n * limb_dq)
+                    sim.set_servo_targets(
+                        pin.integrate(sim.stance.model, q_start, s * v_n * limb_dq), v_n * limb_dq
+                    )
             rec_t[k] = d.time
             qpos[k], qvel[k] = d.qpos, d.qvel
             mujoco.mj_step(m, d)
@@ -272,9 +300,16 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
         if hold is not None:
             hold.release(d.time)
     return TrialRecord(
-        time=rec_t, qpos=qpos, qvel=qvel, com=com, com_velocity=comd,
-        forces={name: forces[:, i] for i, name in enumerate(names)}, impact_velocity=point_v,
-        approach_start=settle, wall_time=wall, contact_positions=contact_pos,
+        time=rec_t,
+        qpos=qpos,
+        qvel=qvel,
+        com=com,
+        com_velocity=comd,
+        forces={name: forces[:, i] for i, name in enumerate(names)},
+        impact_velocity=point_v,
+        approach_start=settle,
+        wall_time=wall,
+        contact_positions=contact_pos,
         actuator_force=torques[:, sim.actuator_ids] if m.nu else torques,
         hold=None if hold is None else hold.to_dict(),
     )

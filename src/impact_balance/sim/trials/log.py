@@ -6,11 +6,16 @@ import mujoco
 import numpy as np
 import pandas as pd
 
-from impact_balance.logs import LogColumns, force_columns, joint_position_column, joint_velocity_column
+from impact_balance.logs import (
+    LogColumns,
+    force_columns,
+    joint_position_column,
+    joint_velocity_column,
+)
 from impact_balance.sim.model.build import SimModel
 from impact_balance.sim.trials.impact_trial import TrialRecord
 
-__all__ = ["log_frame", "LogRecorder", "LOG_START"]
+__all__ = ["LOG_START", "LogRecorder", "log_frame"]
 
 #: Logs start here (s): the first steps settle the model's initial contact penetration (the
 #: contacts carry nothing at t = 0, then briefly one foot carries thousands of newtons), a
@@ -21,11 +26,14 @@ LOG_START = 0.05
 def _rotations(quaternions_wxyz: np.ndarray) -> np.ndarray:
     """(T, 3, 3) rotation matrices of unit quaternions (w, x, y, z)."""
     w, x, y, z = quaternions_wxyz.T
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=-1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], axis=-1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=-1),
-    ], axis=1)
+    return np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=-1),
+            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], axis=-1),
+            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=-1),
+        ],
+        axis=1,
+    )
 
 
 def log_frame(sim: SimModel, record: TrialRecord, start: float = LOG_START) -> pd.DataFrame:
@@ -75,7 +83,8 @@ def log_frame(sim: SimModel, record: TrialRecord, start: float = LOG_START) -> p
 
 class LogRecorder:
     """A log built step by step (the balance trials' loop), from pinocchio's ``(q, v)`` and MuJoCo's
-    state; :func:`log_frame` builds the same columns from an impact trial's recorded arrays."""
+    state; :func:`log_frame` builds the same columns from an impact trial's recorded arrays.
+    """
 
     def __init__(self, sim: SimModel, contact_names: list[str], impact: bool):
         cols = LogColumns()
@@ -83,8 +92,13 @@ class LogRecorder:
         slots = [robot.joint_slot(n) for n in robot.joint_names]
         self.q_index = np.array([s.idx_q for s in slots])
         self.v_index = np.array([robot.model.joints[s.id].idx_v for s in slots])
-        self.columns = [cols.time, *cols.base_position, *cols.base_quaternion, *cols.base_linear_velocity,
-                        *cols.base_angular_velocity]
+        self.columns = [
+            cols.time,
+            *cols.base_position,
+            *cols.base_quaternion,
+            *cols.base_linear_velocity,
+            *cols.base_angular_velocity,
+        ]
         self.columns += [joint_position_column(n) for n in robot.joint_names]
         self.columns += [joint_velocity_column(n) for n in robot.joint_names]
         self.columns += list(cols.zmp) + list(cols.com) + list(cols.com_velocity)

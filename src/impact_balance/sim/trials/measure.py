@@ -25,13 +25,13 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from impact_balance.impact.model import INERTIA_MODELS, impact_model
-from impact_balance.geometry.polygon import Polygon
 from impact_balance.contacts.stance import Stance
+from impact_balance.geometry.polygon import Polygon
+from impact_balance.impact.model import INERTIA_MODELS, impact_model
 from impact_balance.sim.model.build import SimModel
 from impact_balance.sim.trials.impact_trial import TrialRecord
 
-__all__ = ["Prediction", "TrialResult", "impact_window", "measure", "distance_to_hull"]
+__all__ = ["Prediction", "TrialResult", "distance_to_hull", "impact_window", "measure"]
 
 #: A force below this fraction of the peak counts as zero.
 _FORCE_FLOOR = 1e-6
@@ -128,7 +128,9 @@ class TrialResult:
             },
             "contacts_kept": self.contacts_kept,
             "saturated_joints": list(self.saturated_joints),
-            "sustained_impulses": {k: [num(x) for x in v] for k, v in self.sustained_impulses.items()},
+            "sustained_impulses": {
+                k: [num(x) for x in v] for k, v in self.sustained_impulses.items()
+            },
             "armature": self.armature,
             "rigid_hold": self.hold,
             "sim_time_ratio": num(self.sim_time_ratio),
@@ -154,7 +156,9 @@ def distance_to_hull(point: np.ndarray, vertices: np.ndarray) -> float:
     return best
 
 
-def impact_window(record: TrialRecord, max_duration: float = MAX_IMPACT_DURATION) -> tuple[int, int]:
+def impact_window(
+    record: TrialRecord, max_duration: float = MAX_IMPACT_DURATION
+) -> tuple[int, int]:
     """Indices (before, end) of the impact: the force of sample k acts from sample k to k + 1.
 
     ``before`` is the last sample without impact force; ``end`` the first sample where it is
@@ -178,8 +182,11 @@ def impact_window(record: TrialRecord, max_duration: float = MAX_IMPACT_DURATION
 def _stance_with_armature(sim: SimModel) -> Stance:
     """The stance, on a copy of the robot model carrying the simulated joints' armature
     (pinocchio's ``crba`` adds ``model.armature`` to the mass matrix), so that ``joint_space``
-    predicts for the simulated robot. The shared robot model is never modified."""
-    if sim.joints != "servo" or np.array_equal(sim.armature, np.asarray(sim.robot.model.armature)[sim.v_index]):
+    predicts for the simulated robot. The shared robot model is never modified.
+    """
+    if sim.joints != "servo" or np.array_equal(
+        sim.armature, np.asarray(sim.robot.model.armature)[sim.v_index]
+    ):
         return sim.stance
     model = pin.Model(sim.robot.model)
     model.armature[sim.v_index] = sim.armature
@@ -197,13 +204,18 @@ def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialR
         before, end = impact_window(record)
     except ValueError:
         raise SimulationError(
-            "--duration", round(record.simulated_time, 4), "the impact point never reached the surface in that time"
+            "--duration",
+            round(record.simulated_time, 4),
+            "the impact point never reached the surface in that time",
         ) from None
     if record.time[before] < record.approach_start:
         # Not the commanded approach's impact (e.g. a joint snapped back into its range while settling).
         raise SimulationError(
-            "impact", spec.frame, f"the impact point touched the surface at {record.time[before]:.3f} s, before "
-            f"the approach began ({record.approach_start:.3f} s): the limb was not held at its start pose")
+            "impact",
+            spec.frame,
+            f"the impact point touched the surface at {record.time[before]:.3f} s, before "
+            f"the approach began ({record.approach_start:.3f} s): the limb was not held at its start pose",
+        )
     dt = sim.model.opt.timestep
     impulse = record.forces["impact"][before:end].sum(axis=0) * dt
     jump = (record.com_velocity[end] - record.com_velocity[before])[:2]
@@ -214,31 +226,56 @@ def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialR
     predicted = {}
     stance = _stance_with_armature(sim)
     for inertia in INERTIA_MODELS:
-        model_spec = dataclasses.replace(spec, restitution=(restitution, restitution), inertia=inertia)
+        model_spec = dataclasses.replace(
+            spec, restitution=(restitution, restitution), inertia=inertia
+        )
         model = impact_model(stance if inertia == "joint_space" else sim.stance, model_spec)
         jumps = model.com_velocity_jumps(approach)[:, :2]
         predicted[inertia] = Prediction(inertia, jumps, distance_to_hull(jump, jumps))
     kept = None
     if sim.joints != "rigid":
         start = int(np.searchsorted(record.time, record.approach_start))
-        contact_forces = [f for name, f in record.forces.items() if name != "impact"]  # in contact order
-        normal_forces = np.array([f[start:] @ c.normal for f, c in zip(contact_forces, sim.stance.contacts)])
-        moved = np.linalg.norm(record.contact_positions[start:] - record.contact_positions[start], axis=2).max()
+        contact_forces = [
+            f for name, f in record.forces.items() if name != "impact"
+        ]  # in contact order
+        normal_forces = np.array(
+            [f[start:] @ c.normal for f, c in zip(contact_forces, sim.stance.contacts)]
+        )
+        moved = np.linalg.norm(
+            record.contact_positions[start:] - record.contact_positions[start], axis=2
+        ).max()
         kept = bool((normal_forces > 0.0).all() and moved < 0.01)
     saturated: list[str] = []
     if sim.joints == "servo" and record.actuator_force.size:
         limits = sim.model.actuator_forcerange[sim.actuator_ids, 1]
-        peak = np.abs(record.actuator_force[before:end + 1]).max(axis=0)
+        peak = np.abs(record.actuator_force[before : end + 1]).max(axis=0)
         limited = sim.model.actuator_forcelimited[sim.actuator_ids].astype(bool)
-        saturated = [name for name, p, lim, on in zip(sim.joint_names, peak, limits, limited)
-                     if on and p >= lim * (1 - 1e-6)]
+        saturated = [
+            name
+            for name, p, lim, on in zip(sim.joint_names, peak, limits, limited)
+            if on and p >= lim * (1 - 1e-6)
+        ]
     ratio = record.simulated_time / record.wall_time if record.wall_time > 0 else float("nan")
-    sustained = {name: (f[before:end] - f[before]).sum(axis=0) * dt for name, f in record.forces.items() if name != "impact"}
+    sustained = {
+        name: (f[before:end] - f[before]).sum(axis=0) * dt
+        for name, f in record.forces.items()
+        if name != "impact"
+    }
     return TrialResult(
-        approach_speed=approach_speed, joints=sim.joints, approach_speed_measured=approach,
-        restitution_measured=restitution, impulse_measured=impulse, com_velocity_jump_measured=jump,
-        slip_speed=slip, impact_time=(float(record.time[before]), float(record.time[end])),
-        contacts_kept=kept, predicted=predicted, saturated_joints=saturated, sim_time_ratio=ratio,
-        sustained_impulses=sustained if sim.joints != "rigid" else {}, armature=sim.armature_source, hold=record.hold,
+        approach_speed=approach_speed,
+        joints=sim.joints,
+        approach_speed_measured=approach,
+        restitution_measured=restitution,
+        impulse_measured=impulse,
+        com_velocity_jump_measured=jump,
+        slip_speed=slip,
+        impact_time=(float(record.time[before]), float(record.time[end])),
+        contacts_kept=kept,
+        predicted=predicted,
+        saturated_joints=saturated,
+        sim_time_ratio=ratio,
+        sustained_impulses=sustained if sim.joints != "rigid" else {},
+        armature=sim.armature_source,
+        hold=record.hold,
         record=record,
     )

@@ -43,7 +43,15 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-__all__ = ["OUTCOMES", "FALL_REASONS", "EVENT_KINDS", "OutcomeCriteria", "ContactEvent", "Outcome", "OutcomeMonitor"]
+__all__ = [
+    "EVENT_KINDS",
+    "FALL_REASONS",
+    "OUTCOMES",
+    "ContactEvent",
+    "Outcome",
+    "OutcomeCriteria",
+    "OutcomeMonitor",
+]
 
 #: Trial outcomes.
 OUTCOMES = ("balanced", "contact_broken", "fell", "aborted")
@@ -75,7 +83,8 @@ class OutcomeCriteria:
 @dataclass(frozen=True)
 class ContactEvent:
     """A sustained contact broke: ``contact`` (its frame), ``kind`` (lifted, slipped, tilted), ``time`` (s)
-    and ``value`` (the slip in m, the tilt in rad, the unloaded time in s)."""
+    and ``value`` (the slip in m, the tilt in rad, the unloaded time in s).
+    """
 
     contact: str
     kind: str
@@ -90,7 +99,8 @@ class ContactEvent:
 class Outcome:
     """A trial's outcome: one of :data:`OUTCOMES`, its ``reason`` (a fall reason, the first contact
     event, or why it was aborted; None when balanced), when (s), a ``detail`` line, and every
-    contact ``event``."""
+    contact ``event``.
+    """
 
     outcome: str
     reason: str | None
@@ -151,15 +161,24 @@ class OutcomeMonitor:
     def start_disturbance(self, t: float) -> None:
         """The disturbance (first contact of the impact, start of the push) begins at ``t`` (s).
 
-        A fall or a contact event before it aborts the trial."""
+        A fall or a contact event before it aborts the trial.
+        """
         if self.disturbance is not None:
             return
         self.disturbance = float(t)
         if self._fall is not None:
-            self._abort = ("before_disturbance", self._fall[1], f"{self._fall[2]} before the disturbance")
+            self._abort = (
+                "before_disturbance",
+                self._fall[1],
+                f"{self._fall[2]} before the disturbance",
+            )
         elif self.events:
             e = self.events[0]
-            self._abort = ("before_disturbance", e.time, f"{e.contact} {e.kind} before the disturbance")
+            self._abort = (
+                "before_disturbance",
+                e.time,
+                f"{e.contact} {e.kind} before the disturbance",
+            )
 
     def abort(self, reason: str, t: float, detail: str) -> None:
         """Mark the trial aborted (e.g. the impact point never reached the surface)."""
@@ -171,12 +190,21 @@ class OutcomeMonitor:
             self._seen.add((i, kind))
             self.events.append(ContactEvent(self.names[i], kind, float(t), float(value)))
 
-    def update(self, t: float, positions: np.ndarray, rotations: np.ndarray, normal_forces: np.ndarray | None,
-               base_height: float, base_rotation: np.ndarray, dcm_margin: float | None = None,
-               impulsive: bool = False) -> bool:
+    def update(
+        self,
+        t: float,
+        positions: np.ndarray,
+        rotations: np.ndarray,
+        normal_forces: np.ndarray | None,
+        base_height: float,
+        base_rotation: np.ndarray,
+        dcm_margin: float | None = None,
+        impulsive: bool = False,
+    ) -> bool:
         """One sample: contact frame poses, their normal forces (N, None if unknown), the base height (m)
         and rotation, the DCM's margin in the ZMP support area (m, >= 0 inside; None if unknown);
-        ``impulsive``: a push acts now (unloading does not count). Returns :attr:`fell`."""
+        ``impulsive``: a push acts now (unloading does not count). Returns :attr:`fell`.
+        """
         c = self.criteria
         positions = np.asarray(positions, dtype=float).reshape(-1, 3)
         rotations = np.asarray(rotations, dtype=float).reshape(-1, 3, 3)
@@ -222,20 +250,35 @@ class OutcomeMonitor:
             reason, when, detail = self._abort
             return Outcome("aborted", reason, when, detail, events)
         if self.disturbance is None:
-            return Outcome("aborted", "no_disturbance", float(t), "the disturbance never began", events)
+            return Outcome(
+                "aborted", "no_disturbance", float(t), "the disturbance never began", events
+            )
         if self._fall is not None:
             reason, when, detail = self._fall
             return Outcome("fell", reason, when, detail, events)
         if self._dcm_out_since is not None:
-            return Outcome("fell", "dcm_escaped", self._dcm_out_since,
-                           "the DCM left the ZMP support area and did not come back", events)
+            return Outcome(
+                "fell",
+                "dcm_escaped",
+                self._dcm_out_since,
+                "the DCM left the ZMP support area and did not come back",
+                events,
+            )
         speed = float(np.linalg.norm(np.asarray(com_velocity, dtype=float)))
         if speed > self.criteria.rest_speed:
-            return Outcome("fell", "not_at_rest", float(t), f"CoM speed {speed:.3f} m/s at the end", events)
+            return Outcome(
+                "fell", "not_at_rest", float(t), f"CoM speed {speed:.3f} m/s at the end", events
+            )
         after = [e for e in events if e.time >= self.disturbance]
         if after:
             first = min(after, key=lambda e: e.time)
-            return Outcome("contact_broken", f"{first.kind}", first.time, f"{first.contact} {first.kind}", events)
+            return Outcome(
+                "contact_broken",
+                f"{first.kind}",
+                first.time,
+                f"{first.contact} {first.kind}",
+                events,
+            )
         return Outcome("balanced", None, None, "", events)
 
 

@@ -14,7 +14,7 @@ import pandas as pd
 
 from impact_balance.sim.trials.outcomes import ContactEvent
 
-__all__ = ["ImpactMeasurement", "BalanceTrialResult", "TrialEntry", "finite_or_null", "trajectory"]
+__all__ = ["BalanceTrialResult", "ImpactMeasurement", "TrialEntry", "finite_or_null", "trajectory"]
 
 
 def finite_or_null(nulls: dict[str, str], name: str, value, reason: str):
@@ -62,14 +62,24 @@ class ImpactMeasurement:
         nulls: dict[str, str] = {}
         out = {
             "contact_time": self.contact_time,
-            "approach_speed_measured": finite_or_null(nulls, "approach_speed_measured", self.approach_speed, "not measured"),
+            "approach_speed_measured": finite_or_null(
+                nulls, "approach_speed_measured", self.approach_speed, "not measured"
+            ),
             "window": [float(x) for x in self.window],
             "impulse": finite_or_null(nulls, "impulse", self.impulse, "not finite"),
-            "sustained_impulses": {name: finite_or_null(nulls, f"sustained_impulses.{name}", imp, "not finite")
-                                   for name, imp in zip(contact_names, self.sustained_impulses)},
-            "com_velocity_before": finite_or_null(nulls, "com_velocity_before", self.com_velocity_before, "not finite"),
-            "com_velocity_after": finite_or_null(nulls, "com_velocity_after", self.com_velocity_after, "not finite"),
-            "com_velocity_jump": finite_or_null(nulls, "com_velocity_jump", self.com_velocity_jump, "not finite"),
+            "sustained_impulses": {
+                name: finite_or_null(nulls, f"sustained_impulses.{name}", imp, "not finite")
+                for name, imp in zip(contact_names, self.sustained_impulses)
+            },
+            "com_velocity_before": finite_or_null(
+                nulls, "com_velocity_before", self.com_velocity_before, "not finite"
+            ),
+            "com_velocity_after": finite_or_null(
+                nulls, "com_velocity_after", self.com_velocity_after, "not finite"
+            ),
+            "com_velocity_jump": finite_or_null(
+                nulls, "com_velocity_jump", self.com_velocity_jump, "not finite"
+            ),
             "rigid_hold": self.hold,
         }
         if nulls:
@@ -144,27 +154,58 @@ class BalanceTrialResult:
         """JSON-ready summary (no series, no log): finite numbers or null, with ``nulls`` giving the reasons."""
         nulls: dict[str, str] = {}
         out = {
-            "outcome": self.outcome, "fell": self.fell, "reason": self.reason,
+            "outcome": self.outcome,
+            "fell": self.fell,
+            "reason": self.reason,
             "outcome_time": finite_or_null(nulls, "outcome_time", self.outcome_time, "no event"),
             "detail": self.detail,
             "events": [e.to_dict() for e in self.events],
-            "disturbance_time": finite_or_null(nulls, "disturbance_time", self.disturbance_time, "no disturbance"),
+            "disturbance_time": finite_or_null(
+                nulls, "disturbance_time", self.disturbance_time, "no disturbance"
+            ),
             "approach_speed": None if self.approach_speed is None else float(self.approach_speed),
-            "approach_speed_measured": finite_or_null(nulls, "approach_speed_measured", self.approach_speed_measured,
-                                                      "no impact" if self.approach_speed is None else "no contact"),
-            "com_velocity_at_end": finite_or_null(nulls, "com_velocity_at_end", self.com_velocity_at_end,
-                                                  "the disturbance did not end"),
-            "com_velocity_margin_at_end": finite_or_null(nulls, "com_velocity_margin_at_end",
-                                                         self.com_velocity_margin_at_end, "the disturbance did not end"),
-            "worst_com_velocity_margin": finite_or_null(nulls, "worst_com_velocity_margin", self.min_com_velocity_margin,
-                                                        "no sample after the disturbance"),
-            "min_zmp_margin_during": finite_or_null(nulls, "min_zmp_margin_during", self.min_zmp_margin_during,
-                                                    "the contacts carried no vertical force (ZMP undefined)"),
-            "angular_momentum_at_end": finite_or_null(nulls, "angular_momentum_at_end", self.angular_momentum_at_end,
-                                                      "the disturbance did not end"),
-            "max_tilt_deg": float(np.rad2deg(self.max_tilt)), "max_slip": float(self.max_slip),
-            "max_trunk_tilt_deg": float(np.rad2deg(self.max_trunk_tilt)), "max_drop": float(self.max_drop),
-            "sim_time": float(self.sim_time), "wall_time": float(self.wall_time),
+            "approach_speed_measured": finite_or_null(
+                nulls,
+                "approach_speed_measured",
+                self.approach_speed_measured,
+                "no impact" if self.approach_speed is None else "no contact",
+            ),
+            "com_velocity_at_end": finite_or_null(
+                nulls,
+                "com_velocity_at_end",
+                self.com_velocity_at_end,
+                "the disturbance did not end",
+            ),
+            "com_velocity_margin_at_end": finite_or_null(
+                nulls,
+                "com_velocity_margin_at_end",
+                self.com_velocity_margin_at_end,
+                "the disturbance did not end",
+            ),
+            "worst_com_velocity_margin": finite_or_null(
+                nulls,
+                "worst_com_velocity_margin",
+                self.min_com_velocity_margin,
+                "no sample after the disturbance",
+            ),
+            "min_zmp_margin_during": finite_or_null(
+                nulls,
+                "min_zmp_margin_during",
+                self.min_zmp_margin_during,
+                "the contacts carried no vertical force (ZMP undefined)",
+            ),
+            "angular_momentum_at_end": finite_or_null(
+                nulls,
+                "angular_momentum_at_end",
+                self.angular_momentum_at_end,
+                "the disturbance did not end",
+            ),
+            "max_tilt_deg": float(np.rad2deg(self.max_tilt)),
+            "max_slip": float(self.max_slip),
+            "max_trunk_tilt_deg": float(np.rad2deg(self.max_trunk_tilt)),
+            "max_drop": float(self.max_drop),
+            "sim_time": float(self.sim_time),
+            "wall_time": float(self.wall_time),
         }
         if self.impact is not None:
             out["impact"] = self.impact.to_dict(list(self.contact_names))
@@ -175,7 +216,8 @@ class BalanceTrialResult:
 
 def trajectory(result: BalanceTrialResult, start: float, stop: float, every: int = 2) -> dict:
     """The trial's CoM velocity, ZMP and DCM between ``start`` and ``stop`` (s), every ``every``-th control
-    step, as plain lists (a ZMP that is undefined is null): what the figures draw."""
+    step, as plain lists (a ZMP that is undefined is null): what the figures draw.
+    """
     s = result.series
     if not len(s.get("time", ())):
         return {"time": [], "com_velocity": [], "zmp": [], "dcm": []}
@@ -185,14 +227,19 @@ def trajectory(result: BalanceTrialResult, start: float, stop: float, every: int
     def rows(values: np.ndarray) -> list:
         return [[float(x) for x in row] if np.all(np.isfinite(row)) else None for row in values]
 
-    return {"time": [float(x) for x in t[keep]], "com_velocity": rows(s["com_velocity"][keep][:, :2]),
-            "zmp": rows(s["zmp"][keep]), "dcm": rows(s["dcm"][keep])}
+    return {
+        "time": [float(x) for x in t[keep]],
+        "com_velocity": rows(s["com_velocity"][keep][:, :2]),
+        "zmp": rows(s["zmp"][keep]),
+        "dcm": rows(s["dcm"][keep]),
+    }
 
 
 @dataclass
 class TrialEntry:
     """A finished trial as the commands keep it (and as the journal stores it): its JSON ``summary``
-    (:meth:`BalanceTrialResult.summary`) and a short ``trajectory`` (:func:`trajectory`) for the figures."""
+    (:meth:`BalanceTrialResult.summary`) and a short ``trajectory`` (:func:`trajectory`) for the figures.
+    """
 
     summary: dict
     trajectory: dict = field(default_factory=dict)

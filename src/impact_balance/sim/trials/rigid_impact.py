@@ -29,7 +29,7 @@ import numpy as np
 
 from impact_balance.sim.model.build import SimModel
 
-__all__ = ["RigidImpactHold", "HOLD_ARMATURE"]
+__all__ = ["HOLD_ARMATURE", "RigidImpactHold"]
 
 #: Armature of every held joint during the impact, kg m^2.
 HOLD_ARMATURE = 1e4
@@ -77,12 +77,15 @@ class RigidImpactHold:
 
     def update(self, t: float, approach_speed: float) -> None:
         """After a step: end the hold once the impact point no longer approaches the surface
-        (``approach_speed`` = ``-n . v`` <= 0, m/s) or after ``max_duration``."""
+        (``approach_speed`` = ``-n . v`` <= 0, m/s) or after ``max_duration``.
+        """
         if not self.active:
             return
         dofs = self.sim.dof_adr
         change = np.abs(self.sim.data.qvel[dofs] - self._velocity)
-        self.velocity_change = max(self.velocity_change, float(change.max()) if change.size else 0.0)
+        self.velocity_change = max(
+            self.velocity_change, float(change.max()) if change.size else 0.0
+        )
         if approach_speed <= 0.0 or t - self.start >= self.max_duration:
             self.release(t)
 
@@ -93,5 +96,10 @@ class RigidImpactHold:
             self.end = float(t)
 
     def to_dict(self) -> dict:
-        return {"start": self.start, "end": self.end, "duration": self.duration, "armature": self.armature,
-                "max_joint_velocity_change": self.velocity_change}
+        return {
+            "start": self.start,
+            "end": self.end,
+            "duration": self.duration,
+            "armature": self.armature,
+            "max_joint_velocity_change": self.velocity_change,
+        }

@@ -15,11 +15,16 @@ import numpy as np
 from impact_balance.analysis.analyze import Analysis, analyze
 from impact_balance.exceptions import SimulationError
 from impact_balance.scenario import Scenario, load_scenario
-from impact_balance.sim.control.actuation import STIFF_SERVOS, stiffen_support_limbs, support_joints, use_torque_motors
+from impact_balance.sim.control.actuation import (
+    STIFF_SERVOS,
+    stiffen_support_limbs,
+    support_joints,
+    use_torque_motors,
+)
 from impact_balance.sim.control.kinematic import BalanceGains, retracted_stance
 from impact_balance.sim.control.torque import InverseDynamicsGains
-from impact_balance.sim.model.joints import JOINT_MODELS, ServoOptions
 from impact_balance.sim.model.build import SimModel, SimOptions, build_model
+from impact_balance.sim.model.joints import JOINT_MODELS, ServoOptions
 from impact_balance.sim.trials.outcomes import OutcomeCriteria
 
 #: Iterations of MuJoCo's no-slip solver in balance trials.
@@ -29,8 +34,15 @@ NOSLIP_ITERATIONS = 10
 #: torque motors, :mod:`.inverse_dynamics`).
 CONTROLLERS = ("ik", "id")
 
-__all__ = ["CONTROLLERS", "STIFF_SERVOS", "NOSLIP_ITERATIONS", "Push", "BalanceTrialOptions", "BalanceSetup",
-           "controller_margin"]
+__all__ = [
+    "CONTROLLERS",
+    "NOSLIP_ITERATIONS",
+    "STIFF_SERVOS",
+    "BalanceSetup",
+    "BalanceTrialOptions",
+    "Push",
+    "controller_margin",
+]
 
 
 @dataclass(frozen=True)
@@ -95,7 +107,8 @@ def controller_margin(options: BalanceTrialOptions) -> float:
 @dataclass
 class BalanceSetup:
     """A scenario prepared for trials: analysis (without ZMP margin: the controller is configured on its
-    own), MuJoCo model, start configurations (one per standoff of the impacting point)."""
+    own), MuJoCo model, start configurations (one per standoff of the impacting point).
+    """
 
     scenario: Scenario
     joints: str
@@ -106,23 +119,39 @@ class BalanceSetup:
     _starts: dict[float, np.ndarray] = field(default_factory=dict)
 
     @classmethod
-    def create(cls, scenario: Scenario | str, joints: str = "servo", options: BalanceTrialOptions | None = None,
-               sim_options: SimOptions | None = None, meshes: bool = False) -> BalanceSetup:
+    def create(
+        cls,
+        scenario: Scenario | str,
+        joints: str = "servo",
+        options: BalanceTrialOptions | None = None,
+        sim_options: SimOptions | None = None,
+        meshes: bool = False,
+    ) -> BalanceSetup:
         """Analyse ``scenario`` and build its MuJoCo model for trials with ``joints`` and ``options``
         (``sim_options``: the model's own, default 1 ms steps; ``meshes``: load the robot's meshes,
-        visual only, for a video)."""
+        visual only, for a video).
+        """
         options = options or BalanceTrialOptions()
         if not isinstance(scenario, Scenario):
             scenario = load_scenario(scenario)
         if joints not in JOINT_MODELS:
-            raise SimulationError("--joints", joints, f"unknown joint model; valid: {', '.join(JOINT_MODELS)}")
+            raise SimulationError(
+                "--joints", joints, f"unknown joint model; valid: {', '.join(JOINT_MODELS)}"
+            )
         if options.controller not in CONTROLLERS:
-            raise SimulationError("--controller", options.controller, f"unknown controller; valid: {', '.join(CONTROLLERS)}")
+            raise SimulationError(
+                "--controller",
+                options.controller,
+                f"unknown controller; valid: {', '.join(CONTROLLERS)}",
+            )
         # The controller works on the areas themselves: a scoring margin is applied afterwards.
         analysis = analyze(scenario.model_copy(update={"zmp_margin": 0.0}))
         if not analysis.areas.can_balance:
-            raise SimulationError("scenario", scenario.name, f"the stance cannot balance ({analysis.areas.reason}): "
-                                  "there is nothing to test")
+            raise SimulationError(
+                "scenario",
+                scenario.name,
+                f"the stance cannot balance ({analysis.areas.reason}): there is nothing to test",
+            )
         if sim_options is None:
             # 1 ms steps: the stiffest contact (impact, time constant 4 ms) still spans 4 steps.
             servo = ServoOptions() if joints == "servo" else STIFF_SERVOS

@@ -23,7 +23,7 @@ from impact_balance.exceptions import SimulationError
 from impact_balance.sim.model.build import SimModel
 from impact_balance.sim.trials.impact_trial import TrialRecord
 
-__all__ = ["write_video", "VIDEO_SIZE", "frame_caption", "project"]
+__all__ = ["VIDEO_SIZE", "frame_caption", "project", "write_video"]
 
 #: Default frame size, pixels (width, height).
 VIDEO_SIZE = (1280, 720)
@@ -32,13 +32,17 @@ BACKGROUND = np.array([228, 234, 240], dtype=np.uint8)
 
 
 #: What the markers are, written at the bottom of every frame.
-LEGEND = "yellow: CoM, with its line down to the ground;  red: impact point, ringed while in contact"
+LEGEND = (
+    "yellow: CoM, with its line down to the ground;  red: impact point, ringed while in contact"
+)
 
 
 def frame_caption(t: float, impact_start: float, slowdown: float, in_contact: bool) -> list[str]:
     """Lines written on a frame: time from the impact, slow motion, the markers' meaning."""
-    lines = [f"t = {1e3 * (t - impact_start):+7.1f} ms from the impact (simulated)",
-             f"slow motion: {slowdown:g}x slower than real time"]
+    lines = [
+        f"t = {1e3 * (t - impact_start):+7.1f} ms from the impact (simulated)",
+        f"slow motion: {slowdown:g}x slower than real time",
+    ]
     if in_contact:
         lines.append("IMPACT: contact force acting")
     return lines
@@ -84,17 +88,33 @@ def _markers(draw, com_px, ground_px, impact_px, contact: bool, size: int) -> No
             gx, gy = ground_px
             draw.line([(gx - r, gy), (gx + r, gy)], fill=(230, 180, 0, 255), width=3)
         x, y = com_px
-        draw.ellipse([x - r, y - r, x + r, y + r], fill=(255, 215, 0, 255), outline=(0, 0, 0, 255), width=2)
-        draw.text((x + r + 4, y - size // 2), "CoM", fill=(0, 0, 0, 255), font=font, stroke_width=2,
-                  stroke_fill=(255, 255, 255, 255))
+        draw.ellipse(
+            [x - r, y - r, x + r, y + r], fill=(255, 215, 0, 255), outline=(0, 0, 0, 255), width=2
+        )
+        draw.text(
+            (x + r + 4, y - size // 2),
+            "CoM",
+            fill=(0, 0, 0, 255),
+            font=font,
+            stroke_width=2,
+            stroke_fill=(255, 255, 255, 255),
+        )
     if impact_px is not None:
         x, y = impact_px
         if contact:
             R = 2.5 * r
             draw.ellipse([x - R, y - R, x + R, y + R], outline=(220, 20, 20, 255), width=4)
-        draw.ellipse([x - r, y - r, x + r, y + r], fill=(220, 20, 20, 255), outline=(0, 0, 0, 255), width=2)
-        draw.text((x + r + 4, y + r), "impact point", fill=(150, 0, 0, 255), font=font, stroke_width=2,
-                  stroke_fill=(255, 255, 255, 255))
+        draw.ellipse(
+            [x - r, y - r, x + r, y + r], fill=(220, 20, 20, 255), outline=(0, 0, 0, 255), width=2
+        )
+        draw.text(
+            (x + r + 4, y + r),
+            "impact point",
+            fill=(150, 0, 0, 255),
+            font=font,
+            stroke_width=2,
+            stroke_fill=(255, 255, 255, 255),
+        )
 
 
 def _caption(image: np.ndarray, lines: list[str], title: str, marks: tuple = ()) -> np.ndarray:
@@ -112,15 +132,25 @@ def _caption(image: np.ndarray, lines: list[str], title: str, marks: tuple = ())
     for rows, bottom in (([title] + lines, False), ([LEGEND], True)):
         width = max(draw.textlength(r, font=font) for r in rows)
         top = height - pad - step * len(rows) - pad if bottom else pad
-        draw.rectangle([pad, top, pad + width + 2 * pad, top + step * len(rows) + pad], fill=(255, 255, 255, 200))
+        draw.rectangle(
+            [pad, top, pad + width + 2 * pad, top + step * len(rows) + pad],
+            fill=(255, 255, 255, 200),
+        )
         for i, row in enumerate(rows):
             color = (170, 0, 0) if row.startswith("IMPACT") else (20, 20, 20)
             draw.text((2 * pad, top + pad // 2 + i * step), row, fill=color, font=font)
     return np.asarray(picture)
 
 
-def write_video(sim: SimModel, record: TrialRecord, path: str | Path, fps: int = 60, slowdown: float = 10.0,
-                size: tuple[int, int] = VIDEO_SIZE, title: str | None = None) -> Path:
+def write_video(
+    sim: SimModel,
+    record: TrialRecord,
+    path: str | Path,
+    fps: int = 60,
+    slowdown: float = 10.0,
+    size: tuple[int, int] = VIDEO_SIZE,
+    title: str | None = None,
+) -> Path:
     """Render ``record`` to ``path`` (MP4), ``slowdown`` times slower than real time.
 
     The camera looks at the CoM from the side of the impact, at the robot's scale.
@@ -142,12 +172,18 @@ def write_video(sim: SimModel, record: TrialRecord, path: str | Path, fps: int =
             renderer = mujoco.Renderer(model, height, width, max_geom=20000)
     except Exception as exc:  # no GL context: the error type depends on the backend
         light.ambient[:], light.diffuse[:], light.specular[:] = saved
-        raise SimulationError("--video", str(path)[:80], f"no offscreen OpenGL here ({type(exc).__name__}); "
-                              "set MUJOCO_GL=egl on a machine with EGL") from None
+        raise SimulationError(
+            "--video",
+            str(path)[:80],
+            f"no offscreen OpenGL here ({type(exc).__name__}); "
+            "set MUJOCO_GL=egl on a machine with EGL",
+        ) from None
     try:
         import imageio.v2 as imageio
     except ImportError:  # pragma: no cover - the 'sim' extra
-        raise SimulationError("--video", str(path)[:80], "imageio is not installed: pip install 'impact-balance[sim]'") from None
+        raise SimulationError(
+            "--video", str(path)[:80], "imageio is not installed: pip install 'impact-balance[sim]'"
+        ) from None
     camera = mujoco.MjvCamera()
     camera.lookat[:] = sim.stance.com
     camera.distance = 3.0
@@ -158,7 +194,9 @@ def write_video(sim: SimModel, record: TrialRecord, path: str | Path, fps: int =
     side = side if np.linalg.norm(side) > 1e-6 else np.array([0.0, 1.0, 0.0])
     camera.azimuth = float(np.degrees(np.arctan2(side[1], side[0]))) + 180.0
     options = mujoco.MjvOption()
-    impact_force = np.linalg.norm(record.forces.get("impact", np.zeros((len(record.time), 3))), axis=1)
+    impact_force = np.linalg.norm(
+        record.forces.get("impact", np.zeros((len(record.time), 3))), axis=1
+    )
     touching = np.flatnonzero(impact_force > 0.0)
     impact_start = float(record.time[touching[0]]) if touching.size else float(record.time[-1])
     dt_frame = 1.0 / (fps * slowdown)
@@ -179,14 +217,23 @@ def write_video(sim: SimModel, record: TrialRecord, path: str | Path, fps: int =
                 com = record.com[k]
                 contact = bool(impact_force[k] > 0.0)
                 point = data.geom_xpos[sim.impact_geom] if sim.impact_geom is not None else None
-                marks = (project(scene, com, width, height), project(scene, [com[0], com[1], ground], width, height),
-                         None if point is None else project(scene, point, width, height), contact)
+                marks = (
+                    project(scene, com, width, height),
+                    project(scene, [com[0], com[1], ground], width, height),
+                    None if point is None else project(scene, point, width, height),
+                    contact,
+                )
                 renderer.enable_depth_rendering()
                 depth = renderer.render()
                 renderer.disable_depth_rendering()
                 rgb = rgb.copy()
                 rgb[depth >= far] = BACKGROUND  # nothing drawn there: the far clipping plane
-                frame = _caption(rgb, frame_caption(float(record.time[k]), impact_start, slowdown, contact), name, marks)
+                frame = _caption(
+                    rgb,
+                    frame_caption(float(record.time[k]), impact_start, slowdown, contact),
+                    name,
+                    marks,
+                )
                 writer.append_data(frame)
     finally:
         renderer.close()
