@@ -577,13 +577,13 @@ def test_areas_from_arrays_is_areas_from_polytope_number_for_number(name, margin
     """The governor's one-call path (assembly and projection in one compiled call) gives the
     areas analyze() gets from the assembled polytope, exactly; plain lists are accepted."""
     from impact_balance.balance.areas import areas_from_arrays
-    from impact_balance.contacts.cwc import _local_faces
+    from impact_balance.contacts.cwc import local_faces
 
     scenario = load_scenario(name)
     stance = scenario.build_stance()
     want = areas_from_polytope(wrench_polytope(stance), scenario.plane_height, margin)
     faces = np.array(
-        [_local_faces(float(c.spec.friction), c.half_length, c.half_width) for c in stance.contacts]
+        [local_faces(float(c.spec.friction), c.half_length, c.half_width) for c in stance.contacts]
     ).reshape(-1, 16, 6)
     idx, limit = stance.robot.effort_limits
     arms = np.array([c.local_position for c in stance.contacts]) - stance.com_local

@@ -53,7 +53,7 @@ def cannot_balance(tmp_path_factory):
 
 def test_layout_checks_catch_the_defects_they_are_for():
     """The checks fail on a figure with each defect (so a pass means something)."""
-    from impact_balance.plots._common import new_figure
+    from impact_balance.plots.style import new_figure
 
     fig = new_figure(4, 3)
     ax = fig.subplots()

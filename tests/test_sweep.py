@@ -14,7 +14,7 @@ from scipy.stats import qmc
 
 from impact_balance import analyze, cli
 from impact_balance.exceptions import ImpactBalanceError, SweepError, UnknownPathError
-from impact_balance.scenario import _read, scenario_from_dict, scenario_path
+from impact_balance.scenario import read_mapping, scenario_from_dict, scenario_path
 from impact_balance.sweep import (
     Evaluator,
     bundled_sweeps,
@@ -44,7 +44,7 @@ def rows(plan, chunk=None):
 
 
 def base_raw():
-    raw = _read(scenario_path(BASE))
+    raw = read_mapping(scenario_path(BASE))
     raw["name"] = BASE
     return raw
 

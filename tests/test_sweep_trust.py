@@ -28,7 +28,7 @@ import yaml
 from impact_balance import analyze, cli
 from impact_balance.exceptions import EnvironmentFailure, OptionError
 from impact_balance.robot.robot import load_robot
-from impact_balance.scenario import _read, scenario_from_dict, scenario_path
+from impact_balance.scenario import read_mapping, scenario_from_dict, scenario_path
 from impact_balance.sweep import Evaluator, make_plan, read_results, run_sweep, sweep_spec_from_dict
 from impact_balance.sweep.cluster import check_scheduler_address, connect
 from impact_balance.sweep.store import LEDGER, check_folder, table_checksum
@@ -254,7 +254,7 @@ def test_a_robot_axis_varies_the_robot(tmp_path):
     assert [r["robot_name"] for r in rows] == ["talos", str(heavy)]
     assert rows[0]["stance_digest"] != rows[1]["stance_digest"]
     for row, robot in zip(rows, ("talos", files)):
-        raw = _read(scenario_path(BASE))
+        raw = read_mapping(scenario_path(BASE))
         raw["robot"], raw["impact"]["friction"] = robot, 0.1
         expected = analyze(scenario_from_dict(raw)).impact.max_contact_velocity
         assert row["status"] == "ok" and row["max_contact_velocity"] == pytest.approx(

@@ -32,7 +32,6 @@ __all__ = [
     "TOLERANCE_RANGE",
     "check_approach_speed",
     "check_tolerance",
-    "finite_or_none",
 ]
 
 #: Slowest approach speed of an impact trial, m/s (2 cm of approach take 2 s at this speed).
@@ -80,13 +79,3 @@ def check_tolerance(value: float, field: str = "--tolerance") -> float:
             f"trial; a tighter bracket is below the simulator's repeatability)",
         )
     return float(value)
-
-
-def finite_or_none(value: float | None) -> float | None:
-    """``value`` as a float, or None when it is None, NaN or infinite (a result that is
-    undefined, such as the ZMP of a robot off the ground, is ``null`` in JSON).
-    """
-    if value is None:
-        return None
-    value = float(value)
-    return value if math.isfinite(value) else None

@@ -31,7 +31,7 @@ from impact_balance.contacts import wrench_polytope as constraints
 from impact_balance.contacts.stance import Stance
 from impact_balance.contacts.wrench_polytope import (
     WrenchPolytope,
-    _assemble_arrays,
+    assemble_arrays,
     face_blocks,
     wrench_polytope,
 )
@@ -40,8 +40,8 @@ from impact_balance.geometry import polygon
 from impact_balance.geometry.polygon import (
     MERGE_AREA_TOLERANCE,
     Polygon,
-    _edge_halfplanes,
-    _inset_polygon,
+    edge_halfplanes,
+    inset_polygon,
 )
 from impact_balance.projection import _kernel, project_polytope, walk
 from impact_balance.projection._kernel import LINE, OK
@@ -391,7 +391,7 @@ def _maps(force, bounded, depth, cx, cy, w, margin):
         return _affine(force, depth, cx, cy), bounded, _affine(force, w * depth, 0.0, 0.0), bounded
     if force.shape[0] < 3:  # a point or a segment: nothing is a margin inside
         return empty, True, empty, True
-    zmp = _inset_polygon(_affine(force, depth, cx, cy), margin)
+    zmp = inset_polygon(_affine(force, depth, cx, cy), margin)
     if zmp.shape[0] == 0:
         return zmp, bounded, empty, True
     return zmp, bounded, _affine(zmp, w, -w * cx, -w * cy), bounded
@@ -410,7 +410,7 @@ def _walk_areas(
     )
     zmp, zmp_bounded, vel, vel_bounded = _maps(force, bounded, depth, cx, cy, w, margin)
     if vel.shape[0] >= 3:
-        G, h = _edge_halfplanes(vel)
+        G, h = edge_halfplanes(vel)
     else:
         G, h = np.empty((0, 2)), np.empty(0)
     return status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h
@@ -441,7 +441,7 @@ def _assembled_areas(
     units of m g (as ``WrenchPolytope.projection_data`` without scaling) and
     :func:`_walk_areas` on them: ``(A, b, C, d, E) + _walk_areas(...)``.
     """
-    A, b, C, G = _assemble_arrays(
+    A, b, C, G = assemble_arrays(
         blocks, positions, arms, jacobians, torque_indices, torque_limits, gravity_torques
     )
     b = b / weight

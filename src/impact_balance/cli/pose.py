@@ -76,7 +76,12 @@ def run(args: argparse.Namespace) -> int:
     from impact_balance.authoring import Placement, pose_scenario, posed_mapping, scenario_yaml
     from impact_balance.exceptions import ScenarioError, WorkspaceError
     from impact_balance.gui.workspace import Workspace
-    from impact_balance.scenario import _read, load_scenario, scenario_from_dict, scenario_path
+    from impact_balance.scenario import (
+        load_scenario,
+        read_mapping,
+        scenario_from_dict,
+        scenario_path,
+    )
 
     places = getattr(args, "places", None) or []
     if not places and args.com is None:
@@ -95,7 +100,9 @@ def run(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
     placements = [Placement(p["frame"], p["position"], p["normal"]) for p in places]
     result = pose_scenario(scenario, placements, args.com)
-    mapping = posed_mapping(_read(scenario_path(args.scenario)), scenario, result, out.parent)
+    mapping = posed_mapping(
+        read_mapping(scenario_path(args.scenario)), scenario, result, out.parent
+    )
     scenario_from_dict(mapping, str(out)).build_stance()  # what is written loads
     argv = " ".join(
         f"--place {p.frame} {' '.join(f'{x:g}' for x in p.position)}"

@@ -200,8 +200,8 @@ def run(args: argparse.Namespace) -> int:
 
             written.append(write_video(sim, record, _per_speed(args.video, speed, several)))
         if args.plots:
-            from impact_balance.plots._common import DPI
             from impact_balance.plots.simulation import plot_jump_on_sets, plot_time_series
+            from impact_balance.plots.style import DPI
 
             title = f"{name}: {args.joints} joints, approach {speed:g} m/s, restitution {result.restitution_measured:.2f}"
             out = Path(args.plots)

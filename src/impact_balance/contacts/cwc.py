@@ -21,11 +21,11 @@ def cwc_faces(mu: float, half_length: float, half_width: float) -> np.ndarray:
     |tau_y| <= X fz (4), then the yaw-torque bounds tau_min <= tau_z <= tau_max (8), as in
     the paper's appendix with its ``[tau; f]`` columns reordered to ``[f; tau]``.
     """
-    return _local_faces(float(mu), float(half_length), float(half_width)).copy()
+    return local_faces(float(mu), float(half_length), float(half_width)).copy()
 
 
 @functools.lru_cache(maxsize=256)
-def _local_faces(m: float, X: float, Y: float) -> np.ndarray:
+def local_faces(m: float, X: float, Y: float) -> np.ndarray:
     """:func:`cwc_faces`, cached per (mu, X, Y) as a read-only array (contacts repeat)."""
     s = -(X + Y) * m
     # Columns in the paper's order: tau_x, tau_y, tau_z, f_x, f_y, f_z.
@@ -72,7 +72,7 @@ def cwc_faces_world(
     The result is ``cwc_faces @ rotate_wrench_matrix(rotation).T``, computed blockwise:
     each row's force and torque halves are rotated by one (32 x 3) @ (3 x 3) product.
     """
-    faces = _local_faces(float(mu), float(half_length), float(half_width))
+    faces = local_faces(float(mu), float(half_length), float(half_width))
     return (faces.reshape(32, 3) @ np.asarray(rotation, dtype=float).T).reshape(16, 6)
 
 

@@ -22,7 +22,7 @@ __all__ = ["Contact", "ContactSpec", "Stance", "frame_point"]
 _IDENTITY = pin.SE3.Identity()
 
 
-def _has_free_flyer(model: pin.Model) -> bool:
+def has_free_flyer(model: pin.Model) -> bool:
     """Whether the model's first joint is a free flyer (then q[:3] is the base position)."""
     return model.njoints > 1 and model.joints[1].shortname() == "JointModelFreeFlyer"
 
@@ -155,7 +155,7 @@ class Stance:
         self.q = np.array(q, dtype=float)
         self.origin = np.zeros(3)
         self._q_local = self.q
-        if _has_free_flyer(model):
+        if has_free_flyer(model):
             self.origin = self.q[:3].copy()
             self._q_local = self.q.copy()
             self._q_local[:3] = 0.0

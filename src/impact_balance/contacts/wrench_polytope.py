@@ -24,7 +24,7 @@ import numpy as np
 
 from impact_balance._jit import njit
 from impact_balance.constants import GRAVITY
-from impact_balance.contacts.cwc import _local_faces
+from impact_balance.contacts.cwc import local_faces
 from impact_balance.contacts.stance import Contact, Stance
 
 __all__ = [
@@ -200,7 +200,7 @@ def _assemble(
     """
     m = len(contacts)
     faces = np.array(
-        [_local_faces(float(c.spec.friction), c.half_length, c.half_width) for c in contacts]
+        [local_faces(float(c.spec.friction), c.half_length, c.half_width) for c in contacts]
     ).reshape(m, 16, 6)
     rotations = np.array([c.rotation for c in contacts], dtype=float).reshape(m, 3, 3)
     positions = np.array([c.position for c in contacts], dtype=float).reshape(m, 3)
@@ -248,7 +248,7 @@ def assemble_polytope(
         scaling: See :attr:`WrenchPolytope.scaling`.
     """
     m = len(faces)
-    A, b, C, G = _assemble_arrays(
+    A, b, C, G = assemble_arrays(
         face_blocks(faces, rotations),
         np.ascontiguousarray(positions, dtype=float),
         np.ascontiguousarray(arms, dtype=float),
@@ -278,7 +278,7 @@ def face_blocks(faces: np.ndarray, rotations: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True)
-def _assemble_arrays(
+def assemble_arrays(
     blocks, positions, arms, jacobians, torque_indices, torque_limits, gravity_torques
 ):
     """The arrays ``(A, b, C, G)`` of :func:`assemble_polytope` in one compiled call (a

@@ -287,7 +287,7 @@ def _inset(n: np.ndarray, h: np.ndarray, d: float) -> np.ndarray:
 
 
 @njit(cache=True)
-def _edge_halfplanes(v):
+def edge_halfplanes(v):
     """Unit outward normals ``G`` (k, 2) and offsets ``h`` (k,) of the edges of the CCW
     polygon ``v`` (k >= 3): edge i goes from vertex i to i+1, its normal is the edge turned
     clockwise. Compiled: numpy spent ~30 us of call overhead on these few flops.
@@ -306,11 +306,11 @@ def _edge_halfplanes(v):
 
 
 @njit(cache=True)
-def _inset_polygon(v, distance):
+def inset_polygon(v, distance):
     """Vertices of the CCW polygon ``v`` (k >= 3) shrunk by ``distance`` > 0; (0, 2) when
     empty. One compiled call: a governor shrinks an area every tick.
     """
-    G, h = _edge_halfplanes(v)
+    G, h = edge_halfplanes(v)
     # Relative to a point inside (the vertices' mean): corners stay well conditioned far
     # from the origin.
     k = v.shape[0]
@@ -367,7 +367,7 @@ class Polygon:
         cls, vertices: np.ndarray, bounded: bool, G: np.ndarray, h: np.ndarray
     ) -> Polygon:
         """The polygon of ``vertices`` (k >= 3) whose :attr:`halfplanes` ``(G, h)`` were
-        computed with it (by ``_edge_halfplanes``, in a compiled pipeline): not computed again.
+        computed with it (by ``edge_halfplanes``, in a compiled pipeline): not computed again.
         """
         polygon = cls(vertices, bounded)
         polygon.__dict__["halfplanes"] = _frozen(G, h)  # the cached_property's own slot
@@ -436,7 +436,7 @@ class Polygon:
             G = np.array([n, -n, e, -e])
             h = np.array([n @ v[0], -n @ v[0], e @ v[1], -e @ v[0]])
             return _frozen(G, h)
-        return _frozen(*_edge_halfplanes(np.ascontiguousarray(v)))
+        return _frozen(*edge_halfplanes(np.ascontiguousarray(v)))
 
     def margins(self, points: np.ndarray) -> np.ndarray:
         """Signed distance-like margin of each point: ``min_k (h_k - G_k p)`` (>= 0 inside)."""
@@ -469,7 +469,7 @@ class Polygon:
             return self
         if len(self.vertices) < 3:
             return Polygon.empty()
-        return Polygon(_inset_polygon(np.ascontiguousarray(self.vertices), distance), self.bounded)
+        return Polygon(inset_polygon(np.ascontiguousarray(self.vertices), distance), self.bounded)
 
     def to_dict(self) -> dict:
         G, h = self.halfplanes

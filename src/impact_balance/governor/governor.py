@@ -11,7 +11,7 @@ import numpy as np
 import pinocchio as pin
 
 from impact_balance.balance.areas import warm_up as warm_up_maps
-from impact_balance.contacts.stance import _has_free_flyer
+from impact_balance.contacts.stance import has_free_flyer
 from impact_balance.criteria.com import VelocityLimit
 from impact_balance.exceptions import GovernorError, ScenarioError
 from impact_balance.governor.limit import SpeedLimit, cap_approach
@@ -151,7 +151,7 @@ class Governor:
         self.robot: Robot = scenario.load_robot()
         model = self.robot.model
         self.nq, self.nv = model.nq, model.nv
-        self._free_flyer = _has_free_flyer(model)
+        self._free_flyer = has_free_flyer(model)
         settings = PostureSettings(
             tuple(c.spec() for c in scenario.contacts),
             scenario.impact.spec(),

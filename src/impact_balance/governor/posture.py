@@ -30,8 +30,8 @@ from impact_balance.balance.areas import (
     areas_from_polytope,
     projected_from_arrays,
 )
-from impact_balance.contacts.cwc import _local_faces
-from impact_balance.contacts.stance import ContactSpec, Stance, _has_free_flyer, frame_point
+from impact_balance.contacts.cwc import local_faces
+from impact_balance.contacts.stance import ContactSpec, Stance, frame_point, has_free_flyer
 from impact_balance.contacts.wrench_polytope import assemble_polytope, friction_scaling
 from impact_balance.criteria.com import ComCriterion, VelocityLimit, zmp_max_contact_velocity
 from impact_balance.exceptions import SolverError
@@ -153,11 +153,11 @@ class PostureEvaluator:
             model, impact_frame, impact.offset, "impact_balance_impact"
         )
         self.scratch = Scratch(model)
-        self._free_flyer = _has_free_flyer(model)
+        self._free_flyer = has_free_flyer(model)
         m = len(contacts)
         self._faces = np.array(
             [
-                _local_faces(float(c.friction), 0.5 * float(c.size[0]), 0.5 * float(c.size[1]))
+                local_faces(float(c.friction), 0.5 * float(c.size[0]), 0.5 * float(c.size[1]))
                 for c in contacts
             ]
         ).reshape(m, 16, 6)

@@ -27,7 +27,7 @@ __all__ = [
     "scene_objects",
 ]
 
-#: Colours (hex), the same as the figures' (plots/_common.py).
+#: Colours (hex), the same as the figures' (plots/style.py).
 COLORS = {
     "contact": "#8c564b",
     "contact_normal": "#8c564b",

@@ -11,8 +11,8 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from impact_balance.plots._common import AREA_COLOR, draw_polygon, new_figure, set_limits
 from impact_balance.plots.balance import OUTCOME_COLORS
+from impact_balance.plots.style import AREA_COLOR, draw_polygon, new_figure, set_limits
 
 __all__ = ["plot_approach"]
 

@@ -12,7 +12,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
 from impact_balance.analysis.analyze import Analysis
-from impact_balance.plots._common import (
+from impact_balance.plots.style import (
     AREA_COLOR,
     COM_COLOR,
     CONTACT_COLOR,

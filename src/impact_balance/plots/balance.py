@@ -18,7 +18,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from impact_balance.geometry.polygon import Polygon
-from impact_balance.plots._common import (
+from impact_balance.plots.style import (
     AREA_COLOR,
     FALL_COLOR,
     OK_COLOR,

@@ -9,7 +9,8 @@ from matplotlib import colormaps
 from matplotlib.figure import Figure
 
 from impact_balance.analysis.analyze import Analysis
-from impact_balance.plots._common import (
+from impact_balance.plots.impulse import impulse_set_speed
+from impact_balance.plots.style import (
     AREA_COLOR,
     COM_COLOR,
     area_view_points,
@@ -19,7 +20,6 @@ from impact_balance.plots._common import (
     new_figure,
     set_limits,
 )
-from impact_balance.plots.impulse import impulse_set_speed
 
 __all__ = ["plot_friction_comparison"]
 

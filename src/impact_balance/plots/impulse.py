@@ -11,7 +11,7 @@ from scipy.spatial import ConvexHull, QhullError
 
 from impact_balance.analysis.analyze import Analysis
 from impact_balance.impact.model import ImpactModel
-from impact_balance.plots._common import (
+from impact_balance.plots.style import (
     IMPACT_COLOR,
     centre_message,
     draw_polygon,

@@ -7,7 +7,7 @@ from matplotlib.figure import Figure
 
 from impact_balance.analysis.analyze import Analysis
 from impact_balance.balance.lipm import PhasePortrait, phase_portrait
-from impact_balance.plots._common import new_figure
+from impact_balance.plots.style import new_figure
 
 __all__ = ["analysis_phase_portrait", "plot_phase_portrait"]
 

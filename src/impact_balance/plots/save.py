@@ -9,11 +9,11 @@ from matplotlib.figure import Figure
 
 from impact_balance.analysis.analyze import Analysis
 from impact_balance.analysis.result import Diagnostic
-from impact_balance.plots._common import DPI
 from impact_balance.plots.areas import plot_areas
 from impact_balance.plots.impulse import plot_impulse_set
 from impact_balance.plots.phase import analysis_phase_portrait, plot_phase_portrait
 from impact_balance.plots.stance import plot_stance
+from impact_balance.plots.style import DPI
 
 __all__ = ["figure_prefix", "save_figures"]
 

@@ -7,7 +7,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MaxNLocator
 
-from impact_balance.plots._common import (
+from impact_balance.plots.style import (
     IMPACT_COLOR,
     draw_polygon,
     hull,

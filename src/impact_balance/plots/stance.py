@@ -7,7 +7,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from impact_balance.analysis.analyze import Analysis
-from impact_balance.plots._common import (
+from impact_balance.plots.style import (
     COM_COLOR,
     CONTACT_COLOR,
     IMPACT_COLOR,

@@ -18,14 +18,14 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 # Also re-exported: the helpers sweep/, gui/, analysis.py and tests import from here
-# (ExtendsResolver, with_source, _field, _merge, _read). Imported on first use (PEP 562):
+# (ExtendsResolver, with_source, field_name, merge_mappings, read_mapping). Imported on first use (PEP 562):
 # listing the bundled scenarios needs only .bundled, not pydantic and pinocchio.
 _EXPORTS: dict[str, str] = {
     "bundled_scenarios": ".bundled",
     "scenario_path": ".bundled",
     "ExtendsResolver": ".load",
-    "_merge": ".load",
-    "_read": ".load",
+    "merge_mappings": ".load",
+    "read_mapping": ".load",
     "load_scenario": ".load",
     "BasePose": ".schema",
     "ContactConfig": ".schema",
@@ -35,7 +35,7 @@ _EXPORTS: dict[str, str] = {
     "RobotFiles": ".schema",
     "Scenario": ".schema",
     "with_source": ".schema",
-    "_field": ".validate",
+    "field_name": ".validate",
     "scenario_from_dict": ".validate",
 }
 
@@ -51,7 +51,12 @@ def __getattr__(name: str) -> Any:
 
 if TYPE_CHECKING:
     from impact_balance.scenario.bundled import bundled_scenarios, scenario_path
-    from impact_balance.scenario.load import ExtendsResolver, _merge, _read, load_scenario
+    from impact_balance.scenario.load import (
+        ExtendsResolver,
+        load_scenario,
+        merge_mappings,
+        read_mapping,
+    )
     from impact_balance.scenario.schema import (
         BasePose,
         ContactConfig,
@@ -62,10 +67,15 @@ if TYPE_CHECKING:
         Scenario,
         with_source,
     )
-    from impact_balance.scenario.validate import _field, scenario_from_dict
+    from impact_balance.scenario.validate import field_name, scenario_from_dict
 
 __all__ = [
     "BasePose",
+    "ExtendsResolver",
+    "field_name",
+    "merge_mappings",
+    "read_mapping",
+    "with_source",
     "ContactConfig",
     "ImpactConfig",
     "Offset",

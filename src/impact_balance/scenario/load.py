@@ -32,11 +32,11 @@ __all__ = ["ExtendsResolver", "load_scenario"]
 ExtendsResolver = typing.Callable[[str, Path], Path]
 
 
-def _merge(base: dict, override: dict) -> dict:
+def merge_mappings(base: dict, override: dict) -> dict:
     out = dict(base)
     for key, value in override.items():
         if isinstance(value, dict) and isinstance(out.get(key), dict):
-            out[key] = _merge(out[key], value)
+            out[key] = merge_mappings(out[key], value)
         else:
             out[key] = value
     return out
@@ -60,7 +60,7 @@ def _parent(path: Path, parent: typing.Any, resolve_path: ExtendsResolver | None
         raise ScenarioError("extends", parent, exc.reason, str(path)) from None
 
 
-def _read(
+def read_mapping(
     path: Path, seen: tuple[Path, ...] = (), resolve_path: ExtendsResolver | None = None
 ) -> dict:
     if path.resolve() in seen:
@@ -77,13 +77,13 @@ def _read(
     parent = raw.pop("extends", None)
     if parent is not None:
         parent_path = _parent(path, parent, resolve_path)
-        raw = _merge(_read(parent_path, seen + (path.resolve(),), resolve_path), raw)
+        raw = merge_mappings(read_mapping(parent_path, seen + (path.resolve(),), resolve_path), raw)
     return raw
 
 
 def _chain_key(path: Path, resolve_path: ExtendsResolver | None) -> tuple | None:
     """The texts of the files of ``path``'s ``extends`` chain, or None when the chain has a
-    problem (:func:`_read` then reports it). Reads the parse cache without copying it.
+    problem (:func:`read_mapping` then reports it). Reads the parse cache without copying it.
     """
     texts: list[tuple[str, str]] = []
     try:
@@ -128,7 +128,7 @@ def load_scenario(
             if hit is not None:
                 _LOADED.move_to_end(key)
                 return hit
-    raw = _read(path, (), resolve_path)
+    raw = read_mapping(path, (), resolve_path)
     raw.setdefault("name", path.stem)
     scenario = scenario_from_dict(raw, str(path))
     if key is not None:

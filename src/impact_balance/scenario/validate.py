@@ -16,7 +16,7 @@ from impact_balance.scenario.schema import Scenario
 __all__ = ["scenario_from_dict"]
 
 
-def _field(loc: tuple) -> str:
+def field_name(loc: tuple) -> str:
     out = ""
     for part in loc:
         if isinstance(part, int):
@@ -49,7 +49,7 @@ def scenario_from_dict(raw: dict, source: str | None = None, check_size: bool = 
         value = err.get("input")
         if err["type"] == "extra_forbidden" and loc:
             raise UnknownKeyError(
-                _field(loc), str(loc[-1]), value, _keys_at(loc[:-1]), source
+                field_name(loc), str(loc[-1]), value, _keys_at(loc[:-1]), source
             ) from None
         elif err["type"] == "missing":
             if loc and isinstance(loc[-1], int):  # a short list/tuple: report the whole list
@@ -60,7 +60,7 @@ def scenario_from_dict(raw: dict, source: str | None = None, check_size: bool = 
                 )
             else:
                 value, reason = None, "missing required key"
-        raise ScenarioError(_field(loc), value, reason, source) from None
+        raise ScenarioError(field_name(loc), value, reason, source) from None
     except ScenarioError as exc:
         raise ScenarioError(exc.field, exc.value, exc.reason, source) from None
 

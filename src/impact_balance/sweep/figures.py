@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from impact_balance.plots._common import DPI, new_figure
+from impact_balance.plots.style import DPI, new_figure
 from impact_balance.sweep.summary import EVALUATED, load_frame
 
 __all__ = ["axis_label", "save_sweep_figures", "sweep_figures"]

@@ -31,7 +31,7 @@ from scipy.stats import qmc
 from impact_balance.exceptions import ImpactBalanceError, ScenarioError, SweepError
 from impact_balance.ranges import MAX_SWEEP_POINTS
 from impact_balance.robot.robot import Robot
-from impact_balance.scenario import _merge, _read, scenario_from_dict, scenario_path
+from impact_balance.scenario import merge_mappings, read_mapping, scenario_from_dict, scenario_path
 from impact_balance.sweep.paths import (
     STANCE_FREE_ROOTS,
     Token,
@@ -196,7 +196,7 @@ def _base_mapping(spec: SweepSpec) -> tuple[dict[str, Any], str | None]:
             path = candidate if candidate.is_file() else scenario_path(spec.base)
         except ScenarioError as exc:
             raise type(exc)(*_args(exc, "base")) from None
-        raw = _read(path)
+        raw = read_mapping(path)
         raw.setdefault("name", path.stem)
         return raw, str(path)
     raw = dict(spec.base)
@@ -207,7 +207,7 @@ def _base_mapping(spec: SweepSpec) -> tuple[dict[str, Any], str | None]:
             path = candidate if candidate.is_file() else scenario_path(parent)
         except ScenarioError as exc:
             raise type(exc)(*_args(exc, "base.extends")) from None
-        raw = _merge(_read(path), raw)
+        raw = merge_mappings(read_mapping(path), raw)
     raw.setdefault("name", Path(spec.source).stem if spec.source else "sweep")
     return raw, spec.source
 

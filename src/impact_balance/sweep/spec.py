@@ -39,7 +39,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from impact_balance.exceptions import ScenarioError, SweepError, UnknownNameError
 from impact_balance.ranges import MAX_SWEEP_CHUNKS, MAX_SWEEP_POINTS
-from impact_balance.scenario import Offset, _field
+from impact_balance.scenario import Offset, field_name
 from impact_balance.scenario.bundled import bundled_descriptions
 from impact_balance.scenario.fields import Integer, Number
 from impact_balance.scenario.reader import read_yaml
@@ -221,7 +221,7 @@ def _raise(exc: ValidationError, raw: Any, prefix: str, source: str | None) -> N
         for p in err["loc"]
         if not (isinstance(p, str) and ("[" in p or p in ("function-after", "tagged-union")))
     )
-    field = _field(loc)
+    field = field_name(loc)
     field = f"{prefix}.{field}" if prefix and field != "scenario" else (prefix or field)
     reason = err["msg"].removeprefix("Value error, ")
     value = err.get("input")
