@@ -1,6 +1,7 @@
 """Stance authoring without code: where every frame is, and whole-body IK that writes scenarios.
 
-- :mod:`.frames`: each frame's world position and axes at a configuration (``impact-balance frames``).
+- :mod:`.frames`: each frame's world position and axes at a configuration
+  (``impact-balance frames``).
 - :mod:`.pose`: place frames (and the CoM) by whole-body IK with the contacts kept, and the
   posed scenario as a YAML mapping (``impact-balance pose``).
 """

@@ -8,8 +8,10 @@ prints this table.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 
 from impact_balance.contacts.stance import Stance
@@ -32,20 +34,22 @@ class FramePose:
     name: str
     kind: str
     parent_joint: str
-    position: np.ndarray
-    rotation: np.ndarray
+    position: npt.NDArray[np.float64]
+    rotation: npt.NDArray[np.float64]
 
     @property
-    def rpy(self) -> np.ndarray:
+    def rpy(self) -> npt.NDArray[np.float64]:
         """Roll, pitch, yaw of ``rotation``, rad (R = Rz(y) Ry(p) Rx(r))."""
-        return pin.rpy.matrixToRpy(self.rotation)
+        rpy: npt.NDArray[np.float64] = pin.rpy.matrixToRpy(self.rotation)
+        return rpy
 
     @property
     def tilt(self) -> float:
         """Angle of the z axis from the world vertical, degrees (0: z up)."""
         return float(np.degrees(np.arccos(np.clip(self.rotation[2, 2], -1.0, 1.0))))
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
+        """The frame as JSON values: position (m), axes in world, rpy (rad), z tilt (deg)."""
         R = self.rotation
         return {
             "name": self.name,
@@ -58,8 +62,16 @@ class FramePose:
         }
 
 
-def frame_poses(robot: Robot, q: np.ndarray, names: list[str] | None = None) -> list[FramePose]:
+def frame_poses(robot: Robot, q: npt.ArrayLike, names: list[str] | None = None) -> list[FramePose]:
     """World poses of the frames ``names`` (default: all, in model order) at configuration ``q``.
+
+    Args:
+        robot: The robot.
+        q: Its configuration (nq, pinocchio's convention).
+        names: Frame names; None for every frame.
+
+    Returns:
+        One pose per frame, in the order of ``names`` (or the model's).
 
     Raises:
         UnknownFrameError: a name is not a frame of the robot (with the closest names).
@@ -84,7 +96,7 @@ def frame_poses(robot: Robot, q: np.ndarray, names: list[str] | None = None) -> 
     return out
 
 
-def contact_poses(stance: Stance) -> list[dict]:
+def contact_poses(stance: Stance) -> list[dict[str, Any]]:
     """Each contact of a stance: frame, centre (m), normal and x axis in world, tilt (deg)."""
     out = []
     for c in stance.contacts:

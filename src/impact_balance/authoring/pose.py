@@ -85,7 +85,17 @@ def pose_scenario(
     tolerance: float = 1e-6,
     max_iterations: int = 2000,
 ) -> PoseResult:
-    """Solve the whole-body IK that meets ``placements`` (and ``com_xy``) with the other contacts kept.
+    """Solve the whole-body IK that meets ``placements`` (and ``com_xy``), other contacts kept.
+
+    Args:
+        scenario: The scenario whose stance is the start and the posture target.
+        placements: Where to put frames (see the module docstring).
+        com_xy: The CoM's horizontal target (m, world); None to leave it free.
+        tolerance: The IK's convergence tolerance (m, rad).
+        max_iterations: The IK's iteration budget.
+
+    Returns:
+        The solved configuration, its targets and residuals.
 
     Raises:
         ScenarioError: a frame is placed twice, a normal is zero.
@@ -96,7 +106,7 @@ def pose_scenario(
     robot = stance.robot
     targets: dict[str, pin.SE3] = {}
     normals: dict[int, tuple[float, float, float]] = {}
-    for k, p in enumerate(placements):
+    for p in placements:
         robot.frame_id(p.frame, field="--place")
         if p.frame in targets:
             raise ScenarioError("--place", p.frame, "the frame is placed twice")
@@ -116,7 +126,7 @@ def pose_scenario(
                 ) from None
             rotation = aligning_rotation(rotation[:, 2], n) @ rotation
             if index is not None and scenario.contacts[index].normal is not None:
-                normals[index] = tuple(float(x) for x in n)
+                normals[index] = (float(n[0]), float(n[1]), float(n[2]))
         targets[p.frame] = pin.SE3(rotation, np.asarray(p.position, dtype=float)) * offset.inverse()
     kept = sorted({c.spec.frame for c in stance.contacts} - set(targets))
     all_targets = dict(targets)
@@ -212,7 +222,7 @@ def posed_mapping(
     return out
 
 
-class _Dumper(yaml.SafeDumper):
+class _Dumper(yaml.SafeDumper):  # type: ignore[misc]
     """YAML as the bundled scenarios are written: mappings in block style, vectors on one line."""
 
 
@@ -228,8 +238,17 @@ _Dumper.add_representer(
 
 
 def scenario_yaml(mapping: Mapping[str, Any], header: str = "") -> str:
-    """A scenario mapping as YAML text (block mappings, one-line vectors), after ``header`` comment lines."""
+    """A scenario mapping as YAML text (block mappings, one-line vectors).
+
+    Args:
+        mapping: The scenario, as :func:`posed_mapping` gives it.
+        header: Text written first, each line as a comment.
+
+    Returns:
+        The YAML text.
+    """
     comment = "".join(f"# {line}\n" for line in header.splitlines())
-    return comment + yaml.dump(
+    text: str = yaml.dump(
         dict(mapping), Dumper=_Dumper, sort_keys=False, width=100, allow_unicode=True
     )
+    return comment + text

@@ -204,12 +204,13 @@ def _telling(result):
 
 
 def _plots(result, out: Path) -> list[Path]:
-    from impact_balance.plots.balance import plot_push_trajectories
+    from impact_balance.plots.balance import PushView, plot_push_trajectories
     from impact_balance.plots.save import figure_prefix
 
     out.mkdir(parents=True, exist_ok=True)
     prefix = figure_prefix(result.setup.analysis)
     paths = [out / f"{prefix}_push_zmp.png", out / f"{prefix}_push_com_velocity.png"]
-    for path, kind in zip(paths, ("zmp", "com_velocity")):
+    views: tuple[PushView, ...] = ("zmp", "com_velocity")
+    for path, kind in zip(paths, views):
         plot_push_trajectories(result, kind).savefig(path)
     return paths

@@ -1,4 +1,4 @@
-"""Time-series logs of a robot's motion: one schema, written by the simulation and read by the log checker.
+"""Time-series logs of a robot's motion: one schema, written by the simulation, read by the checker.
 
 A log is a table, one row per sample, stored as Parquet (``.parquet``) or CSV (``.csv``).
 See :mod:`impact_balance.logs.schema` for the columns.

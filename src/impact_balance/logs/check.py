@@ -7,13 +7,13 @@ For every sample of a log (:mod:`.schema`), from a simulation or a real robot:
 - the CoM and the CoM velocity (pinocchio, ``centerOfMass(q, v)``);
 - the areas of the stance (the scenario's contacts at the logged configuration), recomputed when
   the stance changes: a contact is released or made (its normal force, when logged, crosses
-  ``force_threshold``), a contact frame moves by more than ``move_tolerance`` (m) or turns by more than
-  ``turn_tolerance`` (rad), or the CoM moves horizontally by more than ``com_tolerance`` (m) from where
-  the areas were computed (the LIPM constraint depends on it);
-- the CoM criterion: the CoM velocity inside the CoM velocity area ``omega (Z - c_xy)``, with ``Z`` the
-  ZMP support area, ``omega = sqrt(g / (c_z - h))`` at the sample's CoM. Equivalently the DCM
-  ``c_xy + c_d / omega`` inside ``Z``; the margin is ``omega`` times the DCM's distance to the
-  boundary (m/s, positive inside);
+  ``force_threshold``), a contact frame moves by more than ``move_tolerance`` (m) or turns by
+  more than ``turn_tolerance`` (rad), or the CoM moves horizontally by more than
+  ``com_tolerance`` (m) from where the areas were computed (the LIPM constraint depends on it);
+- the CoM criterion: the CoM velocity inside the CoM velocity area ``omega (Z - c_xy)``, with
+  ``Z`` the ZMP support area, ``omega = sqrt(g / (c_z - h))`` at the sample's CoM. Equivalently
+  the DCM ``c_xy + c_d / omega`` inside ``Z``; the margin is ``omega`` times the DCM's distance to
+  the boundary (m/s, positive inside);
 - the ZMP criterion, when the log has ``zmp_x, zmp_y``: the ZMP inside ``Z`` and its margin (m).
 
 Violations are the maximal runs of consecutive samples outside an area, with their start, end and
@@ -30,15 +30,18 @@ compared with the impact model's prediction, as ``simulate`` does).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any, Literal
 
 import numpy as np
+import numpy.typing as npt
 import pandas as pd
 import pinocchio as pin
 
 from impact_balance.balance.areas import balance_areas
-from impact_balance.contacts.stance import Stance
+from impact_balance.contacts.stance import ContactSpec, Stance
 from impact_balance.exceptions import ScenarioError
 from impact_balance.geometry.polygon import Polygon
+from impact_balance.json_values import json_number
 from impact_balance.logs.io import check_log_columns
 from impact_balance.logs.schema import (
     LogColumns,
@@ -46,41 +49,62 @@ from impact_balance.logs.schema import (
     joint_position_column,
     joint_velocity_column,
 )
+from impact_balance.robot.robot import Robot
 from impact_balance.scenario import Scenario, load_scenario
 
-__all__ = ["LogCheck", "StanceSegment", "Violation", "check_log", "log_state"]
+__all__ = [
+    "LogCheck",
+    "StanceSegment",
+    "Violation",
+    "ViolationKind",
+    "check_log",
+    "json_records",
+    "log_state",
+]
+
+FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int_]
+
+#: What a violation left: the CoM velocity area (margin in m/s) or the ZMP support area (m).
+ViolationKind = Literal["com_velocity", "zmp"]
 
 
 @dataclass(frozen=True)
 class StanceSegment:
-    """Areas in force from ``start`` (s): which contacts, the ZMP support area, where they were computed."""
+    """Areas in force from ``start`` (s).
+
+    Which contacts are loaded, the ZMP support area (m, world) and the CoM (m, world) where the
+    areas were computed.
+    """
 
     start: float
     contacts: tuple[str, ...]
     zmp_area: Polygon
-    com: np.ndarray
+    com: FloatArray
     can_balance: bool
 
 
 @dataclass(frozen=True)
 class Violation:
-    """A run of samples outside an area: ``kind`` is ``com_velocity`` or ``zmp``; margins in m/s or m."""
+    """A run of samples outside an area.
 
-    kind: str
+    ``kind`` is ``com_velocity`` or ``zmp``; times in s; margins in m/s or m.
+    """
+
+    kind: ViolationKind
     start: float
     end: float
     worst_margin: float
     worst_time: float
     samples: int
 
-    def to_dict(self) -> dict:
-        # -inf margin: the stance had no area at all (it cannot balance); JSON null.
-        worst = self.worst_margin if np.isfinite(self.worst_margin) else None
+    def to_dict(self) -> dict[str, Any]:
+        """The violation as JSON values (a -inf margin, from a stance without area, is null)."""
         return {
             "kind": self.kind,
             "start": self.start,
             "end": self.end,
-            "worst_margin": worst,
+            "worst_margin": json_number(self.worst_margin),
             "worst_time": self.worst_time,
             "samples": self.samples,
         }
@@ -88,17 +112,17 @@ class Violation:
 
 @dataclass
 class LogCheck:
-    """Result of :func:`check_log`. ``samples`` is one row per log sample (see :func:`check_log`)."""
+    """Result of :func:`check_log`: ``samples`` has one row per log sample (see there)."""
 
     scenario: str | None
     samples: pd.DataFrame
     segments: list[StanceSegment]
     violations: list[Violation]
     has_zmp: bool
-    settings: dict = field(default_factory=dict)
+    settings: dict[str, float] = field(default_factory=dict)
     loaded_samples: int = 0
     com_vertical_acceleration: float = float("nan")
-    com_velocity_change: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    com_velocity_change: FloatArray = field(default_factory=lambda: np.zeros(3))
     gravity: float = 9.81
 
     @property
@@ -116,34 +140,45 @@ class LogCheck:
 
     @property
     def note(self) -> str | None:
-        """What the check could not do, and what the log can show instead (None when all was checked)."""
+        """What the check could not do, and what the log shows instead (None: all was checked)."""
         if not self.floating:
             return None
         text = (
             "no contact is loaded in any sample (every logged contact force is below "
-            f"{self.settings.get('force_threshold', 5.0):g} N): the robot floats, so no balance area applies"
+            f"{self.settings.get('force_threshold', 5.0):g} N): the robot floats, "
+            "so no balance area applies"
         )
         if not self.gravity_seen:
             text += (
-                f"; its CoM does not fall (vertical acceleration {self.com_vertical_acceleration:.2f} m/s^2, "
+                "; its CoM does not fall (vertical acceleration "
+                f"{self.com_vertical_acceleration:.2f} m/s^2, "
                 f"not -{self.gravity:g}): gravity is off, as in `simulate --joints rigid`"
             )
         dv = self.com_velocity_change
         text += (
-            f". What it shows: the CoM velocity changed by ({dv[0]:+.4f}, {dv[1]:+.4f}, {dv[2]:+.4f}) m/s; "
-            "compare it with the impact model's jump (`impact-balance simulate SCENARIO --joints rigid --json`, "
+            ". What it shows: the CoM velocity changed by "
+            f"({dv[0]:+.4f}, {dv[1]:+.4f}, {dv[2]:+.4f}) m/s; "
+            "compare it with the impact model's jump "
+            "(`impact-balance simulate SCENARIO --joints rigid --json`, "
             "`predicted`)"
         )
         return text
 
     @property
     def ok(self) -> bool:
+        """No sample is outside an area."""
         return not self.violations
 
-    def to_dict(self, samples: bool = False) -> dict:
-        def num(x):
-            return None if x is None or not np.isfinite(x) else float(x)
+    def to_dict(self, samples: bool = False) -> dict[str, Any]:
+        """The result as JSON values (NaN and infinities as null).
 
+        Args:
+            samples: Add the per-sample table (``per_sample``).
+
+        Returns:
+            The summary, the violations, the stances and the settings.
+        """
+        num = json_number
         s = self.samples
         out = {
             "scenario": self.scenario,
@@ -181,13 +216,14 @@ class LogCheck:
         return out
 
 
-def json_records(frame: pd.DataFrame) -> list[dict]:
+def json_records(frame: pd.DataFrame) -> list[dict[str, Any]]:
     """Rows as dicts with NaN/inf turned into None (strict JSON)."""
     clean = frame.astype(object).where(np.isfinite(frame.astype(float)), None)
-    return clean.to_dict(orient="records")
+    records: list[dict[str, Any]] = clean.to_dict(orient="records")
+    return records
 
 
-def _joint_columns(frame: pd.DataFrame, robot, source: str) -> None:
+def _joint_columns(frame: pd.DataFrame, robot: Robot, source: str) -> None:
     """Refuse a log whose joint columns do not match the robot's joints, naming the difference."""
     names = list(robot.joint_names)
     missing = [
@@ -197,9 +233,7 @@ def _joint_columns(frame: pd.DataFrame, robot, source: str) -> None:
         if c not in frame.columns
     ]
     known = {joint_position_column(n) for n in names} | {joint_velocity_column(n) for n in names}
-    unknown = [
-        c for c in frame.columns if (c.startswith("q_") or c.startswith("v_")) and c not in known
-    ]
+    unknown = [c for c in frame.columns if c.startswith(("q_", "v_")) and c not in known]
     if unknown:
         raise ScenarioError(
             "LOG",
@@ -216,11 +250,22 @@ def _joint_columns(frame: pd.DataFrame, robot, source: str) -> None:
         )
 
 
-def log_state(frame: pd.DataFrame, robot) -> tuple[np.ndarray, np.ndarray]:
-    """Configurations (T x nq) and velocities (T x nv) in pinocchio's convention from a log's columns.
+def log_state(frame: pd.DataFrame, robot: Robot) -> tuple[FloatArray, FloatArray]:
+    """Configurations (T x nq) and velocities (T x nv) in pinocchio's convention from a log.
 
-    The base velocity columns are world-axis linear velocity of the base origin and world-axis angular
-    velocity; pinocchio's free-flyer velocity is in the base frame, so both are rotated by ``R^T``.
+    The base velocity columns are world-axis linear velocity of the base origin and world-axis
+    angular velocity; pinocchio's free-flyer velocity is in the base frame, so both are rotated
+    by ``R^T``.
+
+    Args:
+        frame: The log (columns of :mod:`impact_balance.logs.schema`).
+        robot: The robot whose joints the log's columns name.
+
+    Returns:
+        The configurations and the velocities, one row per sample.
+
+    Raises:
+        ScenarioError: A base quaternion is zero or not finite, or a joint has several dofs.
     """
     cols = LogColumns()
     model = robot.model
@@ -251,16 +296,27 @@ def log_state(frame: pd.DataFrame, robot) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _runs(
-    times: np.ndarray, outside: np.ndarray, margins: np.ndarray, kind: str
+    times: FloatArray, outside: npt.NDArray[np.bool_], margins: FloatArray, kind: ViolationKind
 ) -> list[Violation]:
+    """The maximal runs of consecutive ``outside`` samples, each with its worst margin.
+
+    Args:
+        times: Sample times (s).
+        outside: Whether each sample is outside the area.
+        margins: Each sample's margin (m/s or m; NaN where unknown, -inf without an area).
+        kind: What was checked.
+
+    Returns:
+        One :class:`Violation` per run, in time order.
+    """
     out = []
-    k, T = 0, len(outside)
-    while k < T:
+    k, count = 0, len(outside)
+    while k < count:
         if not outside[k]:
             k += 1
             continue
         j = k
-        while j + 1 < T and outside[j + 1]:
+        while j + 1 < count and outside[j + 1]:
             j += 1
         seg = margins[k : j + 1]
         w = (
@@ -282,24 +338,29 @@ def _runs(
     return out
 
 
-def check_log(
-    frame: pd.DataFrame,
-    scenario: Scenario | str,
-    *,
-    force_threshold: float = 5.0,
-    move_tolerance: float = 0.01,
-    turn_tolerance: float = np.deg2rad(3.0),
-    com_tolerance: float = 0.01,
-    source: str = "LOG",
-) -> LogCheck:
-    """Check a log (a DataFrame with the columns of :mod:`.schema`) against ``scenario``'s criteria.
+@dataclass(frozen=True)
+class _Tolerances:
+    """When the areas are recomputed (see :func:`check_log`)."""
 
-    ``samples`` columns: ``time``, ``com_x/y/z`` (m), ``comd_x/y/z`` (m/s), ``dcm_x/y`` (m),
-    ``com_velocity_inside``, ``com_velocity_margin`` (m/s), ``zmp_inside``, ``zmp_margin`` (m; NaN
-    without a logged ZMP), ``stance`` (index into ``segments``).
-    """
-    if not isinstance(scenario, Scenario):
-        scenario = load_scenario(scenario)
+    force_threshold: float
+    move_tolerance: float
+    turn_tolerance: float
+    com_tolerance: float
+
+    def as_dict(self) -> dict[str, float]:
+        """The settings as written in the result."""
+        return {
+            "force_threshold": self.force_threshold,
+            "move_tolerance": self.move_tolerance,
+            "turn_tolerance": self.turn_tolerance,
+            "com_tolerance": self.com_tolerance,
+        }
+
+
+def _checked_times(
+    frame: pd.DataFrame, scenario: Scenario, source: str
+) -> tuple[Robot, FloatArray]:
+    """The scenario's robot and the log's times, after the log's columns and times are checked."""
     cols = LogColumns()
     missing = [c for c in cols.required if c not in frame.columns]
     if missing:
@@ -312,84 +373,130 @@ def check_log(
     times = frame[cols.time].to_numpy(float)
     if np.any(~np.isfinite(times)) or np.any(np.diff(times) < 0):
         raise ScenarioError("LOG", source, "time must be finite and increasing")
-    Q, V = log_state(frame, robot)
-    specs = [
-        c.spec for c in scenario.build_stance(robot).contacts
-    ]  # contacts given by a normal: at the stance
-    names = [s.frame for s in specs]
-    forces = {
-        n: frame[list(force_columns(n))].to_numpy(float)
-        for n in names
-        if all(c in frame.columns for c in force_columns(n))
-    }
-    has_zmp = all(c in frame.columns for c in cols.zmp)
-    zmp_logged = frame[list(cols.zmp)].to_numpy(float) if has_zmp else None
-    model = robot.model
-    data = model.createData()
-    h, g = scenario.plane_height, scenario.gravity
+    return robot, times
 
-    segments: list[StanceSegment] = []
-    key_poses: list[pin.SE3] | None = None
-    active_prev: tuple[str, ...] | None = None
-    rows = np.full((len(frame), 12), np.nan)
-    stance_index = np.zeros(len(frame), dtype=int)
-    loaded = 0
-    for k in range(len(frame)):
-        q, v = Q[k], V[k]
-        pin.centerOfMass(model, data, q, v, False)
-        com, comd = data.com[0].copy(), data.vcom[0].copy()
-        pin.framesForwardKinematics(model, data, q)
-        poses = [data.oMf[robot.frame_id(s.frame)] * s.offset for s in specs]
+
+class _StanceTracker:
+    """The stance segments of a log, extended sample by sample (see :func:`check_log`)."""
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        robot: Robot,
+        specs: list[ContactSpec],
+        forces: dict[str, FloatArray],
+        tolerances: _Tolerances,
+    ) -> None:
+        self.scenario = scenario
+        self.robot = robot
+        self.specs = specs
+        self.forces = forces
+        self.tolerances = tolerances
+        self.segments: list[StanceSegment] = []
+        self.loaded = 0
+        self._key_poses: list[pin.SE3] = []
+        self._active: tuple[str, ...] | None = None
+
+    def _loaded_contacts(self, k: int, poses: list[pin.SE3]) -> tuple[str, ...]:
+        """The contacts loaded at sample ``k``: all but those whose logged force is too small."""
         active = []
-        for spec, pose in zip(specs, poses):
-            if spec.frame in forces:
-                f = forces[spec.frame][k]
-                if not (np.all(np.isfinite(f)) and f @ pose.rotation[:, 2] > force_threshold):
+        for spec, pose in zip(self.specs, poses, strict=True):
+            if spec.frame in self.forces:
+                f = self.forces[spec.frame][k]
+                if not (
+                    np.all(np.isfinite(f))
+                    and f @ pose.rotation[:, 2] > self.tolerances.force_threshold
+                ):
                     continue
             active.append(spec.frame)
-        active_t = tuple(active)
-        loaded += bool(active_t)
-        changed = not segments or active_t != active_prev
-        if not changed:
-            seg = segments[-1]
-            moved = any(
-                np.linalg.norm(p.translation - p0.translation) > move_tolerance
-                or np.linalg.norm(pin.log3(p0.rotation.T @ p.rotation)) > turn_tolerance
-                for p, p0 in zip(poses, key_poses)
-            )
-            changed = moved or np.linalg.norm(com[:2] - seg.com[:2]) > com_tolerance
-        if changed:
-            chosen = [s for s in specs if s.frame in active_t]
+        return tuple(active)
+
+    def _changed(self, active: tuple[str, ...], poses: list[pin.SE3], com: FloatArray) -> bool:
+        """Whether the areas must be recomputed (see :func:`check_log`)."""
+        if not self.segments or active != self._active:
+            return True
+        tol = self.tolerances
+        moved = any(
+            np.linalg.norm(p.translation - p0.translation) > tol.move_tolerance
+            or np.linalg.norm(pin.log3(p0.rotation.T @ p.rotation)) > tol.turn_tolerance
+            for p, p0 in zip(poses, self._key_poses, strict=True)
+        )
+        return bool(
+            moved or np.linalg.norm(com[:2] - self.segments[-1].com[:2]) > tol.com_tolerance
+        )
+
+    def update(
+        self, k: int, time: float, q: FloatArray, com: FloatArray, poses: list[pin.SE3]
+    ) -> StanceSegment:
+        """The segment in force at sample ``k``, a new one when the stance changed.
+
+        Args:
+            k: The sample's index.
+            time: The sample's time (s).
+            q: The configuration (pinocchio's convention).
+            com: The CoM (m, world).
+            poses: Each contact's pose (world), in the order of ``specs``.
+
+        Returns:
+            The segment in force.
+        """
+        active = self._loaded_contacts(k, poses)
+        self.loaded += bool(active)
+        if self._changed(active, poses, com):
+            scenario, h = self.scenario, self.scenario.plane_height
+            chosen = [s for s in self.specs if s.frame in active]
             if chosen and com[2] > h:
-                stance = Stance(robot, q, chosen)
+                stance = Stance(self.robot, q, chosen)
                 zmp_area = balance_areas(
-                    stance, h, scenario.torque_limits, g, scenario.zmp_margin
+                    stance, h, scenario.torque_limits, scenario.gravity, scenario.zmp_margin
                 ).zmp_area
             else:
                 zmp_area = Polygon.empty()
-            segments.append(
-                StanceSegment(
-                    float(times[k]), active_t, zmp_area, com.copy(), not zmp_area.is_empty
-                )
+            self.segments.append(
+                StanceSegment(time, active, zmp_area, com.copy(), not zmp_area.is_empty)
             )
-            key_poses = [pin.SE3(p) for p in poses]
-            active_prev = active_t
-        seg = segments[-1]
-        stance_index[k] = len(segments) - 1
-        omega = np.sqrt(g / (com[2] - h)) if com[2] > h else np.nan
-        dcm = com[:2] + comd[:2] / omega if np.isfinite(omega) else np.full(2, np.nan)
-        vel_margin = (
-            omega * float(seg.zmp_area.margins(dcm)[0])
-            if seg.can_balance and np.isfinite(omega)
-            else -np.inf
-        )
-        zmp_margin = np.nan
-        if has_zmp and np.all(np.isfinite(zmp_logged[k])):
-            zmp_margin = (
-                float(seg.zmp_area.margins(zmp_logged[k])[0]) if seg.can_balance else -np.inf
-            )
-        rows[k] = [*com, *comd, *dcm, vel_margin, zmp_margin, omega, 0.0]
-    samples = pd.DataFrame(
+            self._key_poses = [pin.SE3(p) for p in poses]
+            self._active = active
+        return self.segments[-1]
+
+
+def _sample_row(
+    seg: StanceSegment,
+    com: FloatArray,
+    comd: FloatArray,
+    zmp: FloatArray | None,
+    h: float,
+    g: float,
+) -> list[float]:
+    """One row of the samples: CoM, CoM velocity, DCM, the two margins, omega and a spare 0.
+
+    Args:
+        seg: The segment in force.
+        com: The CoM (m, world).
+        comd: The CoM velocity (m/s, world).
+        zmp: The logged ZMP (m, world), None without a ZMP column.
+        h: The contact plane's height (m).
+        g: Gravity (m/s^2).
+
+    Returns:
+        Twelve numbers (see :func:`_samples_frame`).
+    """
+    omega = np.sqrt(g / (com[2] - h)) if com[2] > h else np.nan
+    dcm = com[:2] + comd[:2] / omega if np.isfinite(omega) else np.full(2, np.nan)
+    vel_margin = (
+        omega * float(seg.zmp_area.margins(dcm)[0])
+        if seg.can_balance and np.isfinite(omega)
+        else -np.inf
+    )
+    zmp_margin = np.nan
+    if zmp is not None and np.all(np.isfinite(zmp)):
+        zmp_margin = float(seg.zmp_area.margins(zmp)[0]) if seg.can_balance else -np.inf
+    return [*com, *comd, *dcm, vel_margin, zmp_margin, omega, 0.0]
+
+
+def _samples_frame(times: FloatArray, rows: FloatArray, stance_index: IntArray) -> pd.DataFrame:
+    """The per-sample table of :class:`LogCheck` from the rows of :func:`_sample_row`."""
+    return pd.DataFrame(
         {
             "time": times,
             "com_x": rows[:, 0],
@@ -408,6 +515,12 @@ def check_log(
             "stance": stance_index,
         }
     )
+
+
+def _violations(
+    times: FloatArray, samples: pd.DataFrame, rows: FloatArray, has_zmp: bool
+) -> list[Violation]:
+    """The runs outside the CoM velocity area, then (with a logged ZMP) the ZMP area, by start."""
     violations = _runs(
         times, ~samples["com_velocity_inside"].to_numpy(bool), rows[:, 8], "com_velocity"
     )
@@ -415,19 +528,95 @@ def check_log(
         zm = rows[:, 9]
         violations += _runs(times, np.isfinite(zm) & (zm < 0.0) | np.isneginf(zm), zm, "zmp")
     violations.sort(key=lambda v: (v.start, v.kind))
-    settings = {
-        "force_threshold": force_threshold,
-        "move_tolerance": move_tolerance,
-        "turn_tolerance": turn_tolerance,
-        "com_tolerance": com_tolerance,
+    return violations
+
+
+def _vertical_acceleration(times: FloatArray, rows: FloatArray) -> float:
+    """The CoM's vertical acceleration (m/s^2) fitted over the log.
+
+    It is -g for a falling robot, 0 with gravity off.
+    """
+    if len(times) > 2 and np.ptp(times) > 0:
+        return float(np.polyfit(times, rows[:, 5], 1)[0])
+    return float("nan")
+
+
+def check_log(
+    frame: pd.DataFrame,
+    scenario: Scenario | str,
+    *,
+    force_threshold: float = 5.0,
+    move_tolerance: float = 0.01,
+    turn_tolerance: float = float(np.deg2rad(3.0)),
+    com_tolerance: float = 0.01,
+    source: str = "LOG",
+) -> LogCheck:
+    """Check a log (a DataFrame with the columns of :mod:`.schema`) against ``scenario``'s criteria.
+
+    ``samples`` columns: ``time``, ``com_x/y/z`` (m), ``comd_x/y/z`` (m/s), ``dcm_x/y`` (m),
+    ``com_velocity_inside``, ``com_velocity_margin`` (m/s), ``zmp_inside``, ``zmp_margin`` (m; NaN
+    without a logged ZMP), ``stance`` (index into ``segments``).
+
+    Args:
+        frame: The log.
+        scenario: The scenario (or its name or file) whose contacts and limits apply.
+        force_threshold: Normal force (N) above which a logged contact is loaded.
+        move_tolerance: Contact frame motion (m) that recomputes the areas.
+        turn_tolerance: Contact frame rotation (rad) that recomputes the areas.
+        com_tolerance: Horizontal CoM motion (m) that recomputes the areas.
+        source: The log's name in error messages.
+
+    Returns:
+        The samples, the stance segments and the violations.
+
+    Raises:
+        ScenarioError: The log lacks a column, has no sample, a value that is not a finite
+            number, joints that are not the robot's, or times that decrease.
+    """
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
+    robot, times = _checked_times(frame, scenario, source)
+    cols = LogColumns()
+    q_all, v_all = log_state(frame, robot)
+    # contacts given by a normal: at the stance
+    specs = [c.spec for c in scenario.build_stance(robot).contacts]
+    forces = {
+        s.frame: frame[list(force_columns(s.frame))].to_numpy(float)
+        for s in specs
+        if all(c in frame.columns for c in force_columns(s.frame))
     }
-    # The CoM's vertical acceleration, fitted over the log: -g for a falling robot, 0 with gravity off.
-    accel = (
-        float(np.polyfit(times, rows[:, 5], 1)[0])
-        if len(times) > 2 and np.ptp(times) > 0
-        else float("nan")
-    )
+    has_zmp = all(c in frame.columns for c in cols.zmp)
+    zmp_logged = frame[list(cols.zmp)].to_numpy(float) if has_zmp else None
+    model = robot.model
+    data = model.createData()
+    h, g = scenario.plane_height, scenario.gravity
+    tolerances = _Tolerances(force_threshold, move_tolerance, turn_tolerance, com_tolerance)
+    tracker = _StanceTracker(scenario, robot, specs, forces, tolerances)
+    rows = np.full((len(frame), 12), np.nan)
+    stance_index = np.zeros(len(frame), dtype=int)
+    for k in range(len(frame)):
+        q, v = q_all[k], v_all[k]
+        pin.centerOfMass(model, data, q, v, False)
+        com, comd = data.com[0].copy(), data.vcom[0].copy()
+        pin.framesForwardKinematics(model, data, q)
+        poses = [data.oMf[robot.frame_id(s.frame)] * s.offset for s in specs]
+        seg = tracker.update(k, float(times[k]), q, com, poses)
+        stance_index[k] = len(tracker.segments) - 1
+        zmp = zmp_logged[k] if zmp_logged is not None else None
+        rows[k] = _sample_row(seg, com, comd, zmp, h, g)
+    samples = _samples_frame(times, rows, stance_index)
+    violations = _violations(times, samples, rows, has_zmp)
+    accel = _vertical_acceleration(times, rows)
     change = rows[-1, 3:6] - rows[0, 3:6]
     return LogCheck(
-        scenario.name, samples, segments, violations, has_zmp, settings, loaded, accel, change, g
+        scenario.name,
+        samples,
+        tracker.segments,
+        violations,
+        has_zmp,
+        tolerances.as_dict(),
+        tracker.loaded,
+        accel,
+        change,
+        g,
     )

@@ -41,8 +41,19 @@ _OPTIONAL = ("zmp_", "force_", "com_", "comd_")
 
 
 def check_log_path(path: str | Path, field: str = "--log") -> str:
-    """The suffix of a log file name (``.parquet`` or ``.csv``); :class:`ScenarioError` naming
-    ``field`` otherwise. Commands call it before a long run, so a bad name fails at once.
+    """The suffix of a log file name (``.parquet`` or ``.csv``).
+
+    Commands call it before a long run, so a bad name fails at once.
+
+    Args:
+        path: The log file's name.
+        field: The option or argument named in the error.
+
+    Returns:
+        The suffix, in lower case.
+
+    Raises:
+        ScenarioError: The suffix is neither ``.parquet`` nor ``.csv``.
     """
     path = Path(path)
     suffix = path.suffix.lower()
@@ -58,7 +69,16 @@ def check_log_path(path: str | Path, field: str = "--log") -> str:
 def write_log(
     frame: pd.DataFrame, path: str | Path, metadata: dict[str, str] | None = None
 ) -> Path:
-    """Write ``frame`` (columns of :mod:`.schema`) to ``path``; Parquet files keep ``metadata`` and the version."""
+    """Write ``frame`` (columns of :mod:`.schema`) to ``path``.
+
+    Args:
+        frame: The log.
+        path: The file; its suffix chooses the format.
+        metadata: Key-value pairs a Parquet file keeps beside the schema's version.
+
+    Returns:
+        The path written.
+    """
     path = Path(path)
     suffix = check_log_path(path, "--log")
     missing = [c for c in LogColumns().required if c not in frame.columns]
@@ -128,13 +148,13 @@ def _read_csv(path: Path, shown: str, warnings: list[Diagnostic] | None) -> pd.D
         if fields < len(frame.columns):
             frame = frame.iloc[:-1]
             note = (
-                f"the last line ({line}) has {fields} of {len(frame.columns)} fields and no line break: the "
-                "file was cut while written; that line is left out"
+                f"the last line ({line}) has {fields} of {len(frame.columns)} fields and no "
+                "line break: the file was cut while written; that line is left out"
             )
         else:
             note = (
-                f"the file does not end with a line break: its last line ({line}) may have been cut while "
-                "written (its last value may be short)"
+                "the file does not end with a line break: its last line "
+                f"({line}) may have been cut while written (its last value may be short)"
             )
         if warnings is not None:
             warnings.append(Diagnostic("log_cut", "LOG", note))
@@ -142,9 +162,18 @@ def _read_csv(path: Path, shown: str, warnings: list[Diagnostic] | None) -> pd.D
 
 
 def read_log(path: str | Path, warnings: list[Diagnostic] | None = None) -> pd.DataFrame:
-    """Read a log within the limits; refuse a file without the required columns (naming them)
-    or with a value the checker cannot use (naming its column and row). ``warnings``, if given,
-    receives the caveats (a CSV file cut in its last line).
+    """Read a log within the limits.
+
+    Args:
+        path: A ``.parquet`` or ``.csv`` file.
+        warnings: If given, receives the caveats (a CSV file cut in its last line).
+
+    Returns:
+        The log, one row per sample.
+
+    Raises:
+        ScenarioError: The file is too large, lacks a required column (named) or holds a value
+            the checker cannot use (named with its column and row).
     """
     path = Path(path)
     suffix = check_log_path(path, "LOG")

@@ -2,18 +2,20 @@
 
 Required:
 - ``time``: s, increasing.
-- Base (free-flyer) pose: ``base_x, base_y, base_z`` (m, world), ``base_qx, base_qy, base_qz, base_qw``
-  (unit quaternion of the base orientation in the world, pinocchio's order).
-- Base velocity: ``base_vx, base_vy, base_vz`` (m/s, linear velocity of the base origin, world axes) and
-  ``base_wx, base_wy, base_wz`` (rad/s, angular velocity, world axes).
-- One ``q_<joint>`` (rad, or m for a prismatic joint) and one ``v_<joint>`` (rad/s) per actuated joint of the robot,
-  named as in its URDF.
+- Base (free-flyer) pose: ``base_x, base_y, base_z`` (m, world),
+  ``base_qx, base_qy, base_qz, base_qw`` (unit quaternion of the base orientation in the world,
+  pinocchio's order).
+- Base velocity: ``base_vx, base_vy, base_vz`` (m/s, linear velocity of the base origin, world
+  axes) and ``base_wx, base_wy, base_wz`` (rad/s, angular velocity, world axes).
+- One ``q_<joint>`` (rad, or m for a prismatic joint) and one ``v_<joint>`` (rad/s) per actuated
+  joint of the robot, named as in its URDF.
 
 Optional:
 - ``zmp_x, zmp_y``: measured ZMP on the scenario's plane (m, world).
-- ``force_<name>_x, _y, _z``: force on the robot at contact ``<name>`` (its frame name, or ``impact``), N, world.
-- ``com_x, com_y, com_z, comd_x, comd_y, comd_z``: a reference CoM and CoM velocity (e.g. the simulator's own), for
-  cross-checks.
+- ``force_<name>_x, _y, _z``: force on the robot at contact ``<name>`` (its frame name, or
+  ``impact``), N, world.
+- ``com_x, com_y, com_z, comd_x, comd_y, comd_z``: a reference CoM and CoM velocity (e.g. the
+  simulator's own), for cross-checks.
 """
 
 from __future__ import annotations
@@ -47,6 +49,7 @@ class LogColumns:
 
     @property
     def required(self) -> tuple[str, ...]:
+        """The columns every log has: time, base pose and base velocity."""
         return (
             self.time,
             *self.base_position,
@@ -67,5 +70,5 @@ def joint_velocity_column(joint: str) -> str:
 
 
 def force_columns(name: str) -> tuple[str, str, str]:
-    """Columns of the force on the robot at contact ``name`` (a frame name, or ``impact``), N, world."""
+    """Columns of the force (N, world) on the robot at contact ``name`` (a frame, or ``impact``)."""
     return (f"force_{name}_x", f"force_{name}_y", f"force_{name}_z")

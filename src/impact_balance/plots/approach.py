@@ -7,19 +7,31 @@ and the impact over the CoM velocity area (and the area shrunk by the scenario's
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
+from impact_balance.analysis.analyze import Analysis
+from impact_balance.geometry.polygon import Polygon
 from impact_balance.plots.balance import OUTCOME_COLORS
 from impact_balance.plots.style import AREA_COLOR, draw_polygon, new_figure, set_limits
 
 __all__ = ["plot_approach"]
 
 
-def plot_approach(trial, analysis, margin_area=None) -> Figure:
-    """The figure of a :class:`~impact_balance.sim.studies.wall.WallTrial` (see the module docstring);
-    ``margin_area``: the CoM velocity area the governor used, when it differs (a ZMP margin).
+def plot_approach(trial: Any, analysis: Analysis, margin_area: Polygon | None = None) -> Figure:
+    """The figure of one governed approach (see the module docstring).
+
+    Args:
+        trial: A :class:`~impact_balance.sim.studies.wall.WallTrial` (a layer above the
+            figures: read by its attributes, not imported).
+        analysis: The scenario's analysis (its CoM velocity area, m/s).
+        margin_area: The CoM velocity area the governor used, when it differs (a ZMP margin).
+
+    Returns:
+        The figure.
     """
     fig = new_figure(11.0, 4.8)
     left, right = fig.subplots(1, 2, width_ratios=[1.3, 1.0])
@@ -28,7 +40,7 @@ def plot_approach(trial, analysis, margin_area=None) -> Figure:
     start = trial.result.disturbance_time
     t0 = t[0] if len(t) else 0.0
 
-    def line(key, **kw):
+    def line(key: str, **kw: Any) -> None:
         y = np.array([np.nan if x is None else x for x in s[key]], dtype=float)
         if np.isfinite(y).any():
             left.plot(t - t0, y, **kw)
@@ -91,8 +103,9 @@ def plot_approach(trial, analysis, margin_area=None) -> Figure:
     right.legend(handles=handles, loc="upper left", fontsize=7)
     o = trial.options
     fig.suptitle(
-        f"{analysis.scenario.name}: approach at {o.reference:g} m/s reference, wall {100 * o.wall_distance:g} cm "
-        f"away, {o.governor} governor: {trial.result.outcome.replace('_', ' ')}",
+        f"{analysis.scenario.name}: approach at {o.reference:g} m/s reference, "
+        f"wall {100 * o.wall_distance:g} cm away, {o.governor} governor: "
+        f"{trial.result.outcome.replace('_', ' ')}",
         fontsize=10,
     )
     return fig

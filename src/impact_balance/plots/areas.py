@@ -1,4 +1,7 @@
-"""The ZMP support area and the CoM velocity area with the post-impact sets (paper Fig. solving-opt)."""
+"""The ZMP support area and the CoM velocity area with the post-impact sets.
+
+The figure is the paper's Fig. solving-opt.
+"""
 
 from __future__ import annotations
 
@@ -6,12 +9,15 @@ import math
 import textwrap
 
 import numpy as np
+import numpy.typing as npt
 from matplotlib import colormaps
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
 from impact_balance.analysis.analyze import Analysis
+from impact_balance.analysis.result import ImpactAnswer
+from impact_balance.geometry.polygon import Polygon
 from impact_balance.plots.style import (
     AREA_COLOR,
     COM_COLOR,
@@ -29,6 +35,8 @@ from impact_balance.plots.style import (
 )
 
 __all__ = ["draw_com_velocity_area", "draw_zmp_area", "plot_areas", "short_reason"]
+
+FloatArray = npt.NDArray[np.float64]
 
 
 def short_reason(analysis: Analysis) -> str | None:
@@ -53,12 +61,13 @@ def short_reason(analysis: Analysis) -> str | None:
 
 
 def _headroom(ax: Axes, fraction: float = 0.3) -> None:
-    """Raise the top of the view by ``fraction`` of its height: room for the message above the data."""
+    """Raise the top of the view by ``fraction`` of its height: room for a message above."""
     y0, y1 = ax.get_ylim()
     ax.set_ylim(y0, y1 + fraction * (y1 - y0))
 
 
 def _cannot_balance(ax: Axes, analysis: Analysis, what: str) -> None:
+    """The message "cannot balance" high in ``ax``, with the reason in a few words."""
     why = short_reason(analysis)
     # High in the axes: the CoM projection and the contacts stay visible below it.
     centre_message(
@@ -73,7 +82,7 @@ def draw_zmp_area(ax: Axes, analysis: Analysis) -> None:
     """ZMP support area, the contact rectangles projected on the plane and the CoM projection."""
     areas = analysis.areas
     zmp = areas.zmp_area
-    view = []
+    view: list[FloatArray] = []
     for i, contact in enumerate(analysis.stance.contacts):
         corners = contact.corners()[:, :2]
         view.append(corners)
@@ -125,11 +134,17 @@ def draw_com_velocity_area(
 
     The legend and the note (maxima, impact parameters, why the robot cannot balance) go in
     ``side``, an axes without frame beside ``ax`` (default: right of ``ax``, outside it).
+
+    Args:
+        ax: The axes of the CoM velocity plane (m/s, world x and y).
+        analysis: The analysis drawn.
+        n_steps: Post-impact sets drawn, at ``k / n_steps`` of the maximum approach speed.
+        side: The axes of the legend and the note.
     """
     areas = analysis.areas
     area = areas.com_velocity_area
-    c0 = analysis.com_velocity[:2]
-    view: list[np.ndarray] = [c0]
+    c0 = np.asarray(analysis.com_velocity[:2], dtype=float)
+    view: list[FloatArray] = [c0]
     lines = []
     if area.is_empty:
         _cannot_balance(ax, analysis, "CoM velocity area")
@@ -144,88 +159,8 @@ def draw_com_velocity_area(
 
     im = analysis.impact
     if im is not None:
-        model = im.model
-        limit = im.com_limit
-        vmax = limit.max_approach_speed
-        ref = model.spec.reference_velocity
-        v_ref = max(0.0, model.approach_speed(ref)) if ref is not None else None
-        # The series k / n * v_max (or of the reference speed when there is no limit).
-        top = vmax if limit.is_finite else v_ref
-        if top is not None and top > 0:
-            cmap = colormaps["Blues"]
-            for k in range(1, n_steps + 1):
-                s = top * k / n_steps
-                pts = model.post_impact_com_velocities(c0, s)
-                view.append(pts)
-                last = k == n_steps
-                if last and limit.is_finite:
-                    lab = f"post-impact set at v_max = {s:.3g} m/s"
-                else:
-                    lab = f"post-impact set at {s:.3g} m/s"
-                color = cmap(0.35 + 0.6 * k / n_steps)
-                draw_polygon(
-                    ax,
-                    hull(pts),
-                    color=color,
-                    alpha=0.25 if not last else 0.45,
-                    edge="navy" if last else color,
-                    lw=2.5 if last else 1.0,
-                    label=lab,
-                    zorder=3 + 0.1 * k,
-                )
-            if limit.is_finite and limit.limiting_vertex is not None:
-                p = model.post_impact_com_velocities(c0, vmax)[limit.limiting_vertex]
-                ax.plot(
-                    *p,
-                    marker="*",
-                    color="gold",
-                    mec="black",
-                    ms=16,
-                    zorder=8,
-                    label=f"limiting vertex #{limit.limiting_vertex} (on the boundary)",
-                )
-                if limit.limiting_edge is not None and len(area.vertices) >= 3:
-                    k = limit.limiting_edge
-                    e = area.vertices[[k, (k + 1) % len(area.vertices)]]
-                    ax.plot(
-                        e[:, 0],
-                        e[:, 1],
-                        "-",
-                        color="gold",
-                        lw=4,
-                        alpha=0.8,
-                        zorder=2.5,
-                        label="limiting edge of the area",
-                    )
-        if v_ref is not None and limit.is_finite and v_ref > vmax + 1e-12:
-            pts = model.post_impact_com_velocities(c0, v_ref)
-            view.append(pts)
-            # An outline on top of the v_max set (no fill): when the reference is close to
-            # v_max the two sets nearly coincide, and a filled red set would hide the other.
-            above = 100.0 * (v_ref / vmax - 1.0) if vmax > 0 else math.inf
-            lab = f"at the reference {v_ref:.3g} m/s: falls"
-            if above < 10.0:
-                lab += f"\n(only {above:.1f} % above v_max: nearly the same set)"
-            draw_polygon(
-                ax,
-                hull(pts),
-                color=FALL_COLOR,
-                fill=False,
-                edge=FALL_COLOR,
-                lw=1.3,
-                ls=(0, (4, 2)),
-                label=lab,
-                zorder=6,
-            )
-        lines.append("maximum approach speed:")
-        lines.append(f"  CoM criterion: {fmt_speed(vmax)}")
-        lines.append(f"  ZMP criterion: {fmt_speed(im.zmp_max_contact_velocity)}")
-        if v_ref is not None:
-            lines.append(f"  reference: {v_ref:.3g} m/s")
-        lines.append(f"impact friction μ = {model.spec.friction:g}")
-        lines.append(f"restitution [{model.spec.restitution[0]:g}, {model.spec.restitution[1]:g}]")
-        if limit.status == "unbounded":
-            lines.append("no approach speed can leave the area")
+        v_ref = _draw_post_impact_sets(ax, im, area, c0, n_steps, view)
+        lines += _impact_note(im, v_ref)
     else:
         lines.append("no impact in this scenario")
     falling = not area.is_empty and not analysis.com_velocity_inside
@@ -233,11 +168,158 @@ def draw_com_velocity_area(
         lines.insert(0, "FALLING: the pre-impact CoM velocity\nis outside the area (v_max = 0)")
     reason = analysis.cannot_balance_reason
     if reason is not None:
-        lines[:0] = ["CANNOT BALANCE, why:"] + textwrap.wrap(str(reason), 46) + [""]
+        lines[:0] = ["CANNOT BALANCE, why:", *textwrap.wrap(str(reason), 46), ""]
     lines.append(f"ω = {areas.omega:.3f} 1/s")
     # Outside the axes, in the side column (the legend above, this note below): nothing
     # covers the area's boundary, whatever its shape.
-    alarm = falling or reason is not None
+    _note(ax, side, lines, alarm=falling or reason is not None)
+    set_limits(ax, area_view_points(area, view), margin=0.12, min_ratio=0.5)
+    if area.is_empty:
+        _headroom(ax)
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel(r"$\dot c_x$ (m/s)")
+    ax.set_ylabel(r"$\dot c_y$ (m/s)")
+    ax.xaxis.set_major_locator(MaxNLocator(6))
+    ax.set_title("CoM velocity area and post-impact CoM velocities")
+    ax.grid(True, alpha=0.3)
+    _velocity_legend(ax, side)
+
+
+def _draw_post_impact_sets(
+    ax: Axes,
+    im: ImpactAnswer,
+    area: Polygon,
+    c0: FloatArray,
+    n_steps: int,
+    view: list[FloatArray],
+) -> float | None:
+    """The post-impact sets, the limiting vertex and edge, and the set at a falling reference.
+
+    Args:
+        ax: The axes of the CoM velocity plane.
+        im: The impact answer.
+        area: The CoM velocity area (m/s).
+        c0: The pre-impact CoM velocity (m/s, world x and y).
+        n_steps: Sets drawn, at ``k / n_steps`` of the maximum (or of the reference speed).
+        view: Receives the points the view must contain.
+
+    Returns:
+        The reference approach speed (m/s, at least 0), None without a reference velocity.
+    """
+    model = im.model
+    limit = im.com_limit
+    vmax = limit.max_approach_speed
+    ref = model.spec.reference_velocity
+    v_ref = max(0.0, model.approach_speed(ref)) if ref is not None else None
+    # The series k / n * v_max (or of the reference speed when there is no limit).
+    top = vmax if limit.is_finite else v_ref
+    if top is not None and top > 0:
+        _draw_speed_series(ax, im, c0, top, n_steps, view)
+        if limit.is_finite and limit.limiting_vertex is not None:
+            _draw_limiting(ax, im, area, c0)
+    if v_ref is not None and limit.is_finite and v_ref > vmax + 1e-12:
+        pts = model.post_impact_com_velocities(c0, v_ref)
+        view.append(pts)
+        # An outline on top of the v_max set (no fill): when the reference is close to
+        # v_max the two sets nearly coincide, and a filled red set would hide the other.
+        above = 100.0 * (v_ref / vmax - 1.0) if vmax > 0 else math.inf
+        lab = f"at the reference {v_ref:.3g} m/s: falls"
+        if above < 10.0:
+            lab += f"\n(only {above:.1f} % above v_max: nearly the same set)"
+        draw_polygon(
+            ax,
+            hull(pts),
+            color=FALL_COLOR,
+            fill=False,
+            edge=FALL_COLOR,
+            lw=1.3,
+            ls=(0, (4, 2)),
+            label=lab,
+            zorder=6,
+        )
+    return v_ref
+
+
+def _draw_speed_series(
+    ax: Axes,
+    im: ImpactAnswer,
+    c0: FloatArray,
+    top: float,
+    n_steps: int,
+    view: list[FloatArray],
+) -> None:
+    """The post-impact sets at ``k / n_steps * top`` (m/s), k = 1..n_steps, the last one bold."""
+    model, limit = im.model, im.com_limit
+    cmap = colormaps["Blues"]
+    for k in range(1, n_steps + 1):
+        s = top * k / n_steps
+        pts = model.post_impact_com_velocities(c0, s)
+        view.append(pts)
+        last = k == n_steps
+        if last and limit.is_finite:
+            lab = f"post-impact set at v_max = {s:.3g} m/s"
+        else:
+            lab = f"post-impact set at {s:.3g} m/s"
+        color = cmap(0.35 + 0.6 * k / n_steps)
+        draw_polygon(
+            ax,
+            hull(pts),
+            color=color,
+            alpha=0.25 if not last else 0.45,
+            edge="navy" if last else color,
+            lw=2.5 if last else 1.0,
+            label=lab,
+            zorder=3 + 0.1 * k,
+        )
+
+
+def _draw_limiting(ax: Axes, im: ImpactAnswer, area: Polygon, c0: FloatArray) -> None:
+    """The vertex of the post-impact set at v_max on the boundary, and the edge it reaches."""
+    limit = im.com_limit
+    if limit.limiting_vertex is None:
+        return
+    p = im.model.post_impact_com_velocities(c0, limit.max_approach_speed)[limit.limiting_vertex]
+    ax.plot(
+        *p,
+        marker="*",
+        color="gold",
+        mec="black",
+        ms=16,
+        zorder=8,
+        label=f"limiting vertex #{limit.limiting_vertex} (on the boundary)",
+    )
+    if limit.limiting_edge is not None and len(area.vertices) >= 3:
+        k = limit.limiting_edge
+        e = area.vertices[[k, (k + 1) % len(area.vertices)]]
+        ax.plot(
+            e[:, 0],
+            e[:, 1],
+            "-",
+            color="gold",
+            lw=4,
+            alpha=0.8,
+            zorder=2.5,
+            label="limiting edge of the area",
+        )
+
+
+def _impact_note(im: ImpactAnswer, v_ref: float | None) -> list[str]:
+    """The lines of the note about the impact: the maxima and the impact's parameters."""
+    model, limit = im.model, im.com_limit
+    lines = ["maximum approach speed:"]
+    lines.append(f"  CoM criterion: {fmt_speed(limit.max_approach_speed)}")
+    lines.append(f"  ZMP criterion: {fmt_speed(im.zmp_max_contact_velocity)}")
+    if v_ref is not None:
+        lines.append(f"  reference: {v_ref:.3g} m/s")
+    lines.append(f"impact friction μ = {model.spec.friction:g}")
+    lines.append(f"restitution [{model.spec.restitution[0]:g}, {model.spec.restitution[1]:g}]")
+    if limit.status == "unbounded":
+        lines.append("no approach speed can leave the area")
+    return lines
+
+
+def _note(ax: Axes, side: Axes | None, lines: list[str], alarm: bool) -> None:
+    """The note at the bottom of ``side`` (or right of ``ax``), framed in red on an alarm."""
     where = side if side is not None else ax
     x0 = 0.0 if side is not None else 1.03
     where.text(
@@ -249,22 +331,17 @@ def draw_com_velocity_area(
         va="bottom",
         fontsize=8,
         zorder=10,
-        bbox=dict(
-            boxstyle="round,pad=0.4",
-            facecolor="white",
-            edgecolor=FALL_COLOR if alarm else "0.6",
-            lw=2 if alarm else 1,
-        ),
+        bbox={
+            "boxstyle": "round,pad=0.4",
+            "facecolor": "white",
+            "edgecolor": FALL_COLOR if alarm else "0.6",
+            "lw": 2 if alarm else 1,
+        },
     )
-    set_limits(ax, area_view_points(area, view), margin=0.12, min_ratio=0.5)
-    if area.is_empty:
-        _headroom(ax)
-    ax.set_aspect("equal", adjustable="box")
-    ax.set_xlabel(r"$\dot c_x$ (m/s)")
-    ax.set_ylabel(r"$\dot c_y$ (m/s)")
-    ax.xaxis.set_major_locator(MaxNLocator(6))
-    ax.set_title("CoM velocity area and post-impact CoM velocities")
-    ax.grid(True, alpha=0.3)
+
+
+def _velocity_legend(ax: Axes, side: Axes | None) -> None:
+    """The legend of ``ax`` at the top of ``side`` (or right of ``ax``)."""
     handles, labels = ax.get_legend_handles_labels()
     if side is not None:
         side.legend(

@@ -1,22 +1,33 @@
 """Figures of the balance trials (paper Exp. 1 and 2) and of a checked log.
 
-- :func:`plot_validation`: every impact trial's outcome against the measured approach speed (the
-  commanded one beside it), with the predicted maxima of both criteria.
-- :func:`plot_impact_trajectories`: the CoM velocity of every impact trial over the CoM velocity area.
-- :func:`plot_push_trajectories`: the ZMP (or the CoM velocity) after every push over its area, with the
-  before-trial predictions.
-- :func:`plot_log_margins`: the CoM velocity margin and the ZMP margin of a checked log over time.
+- :func:`plot_validation`: every impact trial's outcome against the measured approach speed
+  (the commanded one beside it), with the predicted maxima of both criteria.
+- :func:`plot_impact_trajectories`: the CoM velocity of every impact trial over the CoM
+  velocity area.
+- :func:`plot_push_trajectories`: the ZMP (or the CoM velocity) after every push over its
+  area, with the before-trial predictions.
+- :func:`plot_log_margins`: the CoM velocity margin and the ZMP margin of a checked log over
+  time.
 
-Outcomes have one colour everywhere (:data:`OUTCOME_COLORS`); falls are drawn first, so the trials that
-did not fall stay visible on top of them.
+Outcomes have one colour everywhere (:data:`OUTCOME_COLORS`); falls are drawn first, so the
+trials that did not fall stay visible on top of them.
+
+The trial results come from :mod:`impact_balance.sim`, a layer above the figures: they are
+read by their attributes (``Any``), not imported.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+from typing import Any, Literal
+
 import numpy as np
+import numpy.typing as npt
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
+from impact_balance.analysis.analyze import Analysis
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.plots.style import (
     AREA_COLOR,
@@ -30,6 +41,7 @@ from impact_balance.plots.style import (
 
 __all__ = [
     "OUTCOME_COLORS",
+    "PushView",
     "plot_impact_trajectories",
     "plot_log_margins",
     "plot_push_trajectories",
@@ -50,8 +62,13 @@ _ORDER = {
     "balanced": 3,
 }  # drawing order: falls underneath
 
+#: What a push figure shows: the CoM velocity over the CoM velocity area, or the ZMP over the
+#: ZMP support area.
+PushView = Literal["com_velocity", "zmp"]
 
-def _outcome_handles(outcomes) -> list[Line2D]:
+
+def _outcome_handles(outcomes: Iterable[str]) -> list[Line2D]:
+    """Legend entries of the outcomes present, in the order of :data:`OUTCOME_COLORS`."""
     seen = set(outcomes)
     present = [o for o in OUTCOME_COLORS if o in seen]
     return [
@@ -59,14 +76,22 @@ def _outcome_handles(outcomes) -> list[Line2D]:
     ]
 
 
-def plot_validation(result) -> Figure:
-    """Each impact trial's outcome against its measured approach speed (filled) and commanded speed (open),
-    with the CoM and ZMP criteria's maximum contact velocity (composite; solid without margin, dashed with it).
+def plot_validation(result: Any) -> Figure:
+    """Each impact trial's outcome against its measured and commanded approach speeds.
+
+    The measured speed is filled, the commanded one open; the CoM and ZMP criteria's maximum
+    contact velocity (composite) are lines, solid without margin, dashed with it.
+
+    Args:
+        result: The impact trials of ``validate`` (``impact_balance.sim.trials``).
+
+    Returns:
+        The figure.
     """
     fig = new_figure(8.0, 3.8)
     ax = fig.add_subplot()
     rows = {"balanced": 0, "contact_broken": 1, "fell": 2, "aborted": 3}
-    speeds = []
+    speeds: list[float] = []
     for t in result.trials:
         y = rows[t.outcome]
         color = OUTCOME_COLORS[t.outcome]
@@ -76,7 +101,7 @@ def plot_validation(result) -> Figure:
             ax.plot([t.speed, t.measured], [y + 0.18, y], color=color, lw=0.6, alpha=0.6, zorder=2)
             ax.plot([t.measured], [y], "o", color=color, ms=6, zorder=4)
             speeds.append(t.measured)
-    top = max(speeds + [0.1])
+    top = max([*speeds, 0.1])
     lines = []
     for crit, color, name in (
         ("com_criterion", "tab:blue", "CoM criterion"),
@@ -112,8 +137,7 @@ def plot_validation(result) -> Figure:
     ax.set_xlim(0, 1.35 * top)
     ax.set_xlabel("approach speed (m/s)")
     rigid = ", joints held through the impact" if result.rigid_impact else ""
-    fmt = lambda x: "-" if x is None else f"{x:.3f}"  # noqa: E731
-    bracket = f"stood {fmt(b['survived'])} m/s, fell {fmt(b['fell'])} m/s (measured)"
+    bracket = f"stood {_speed(b['survived'])} m/s, fell {_speed(b['fell'])} m/s (measured)"
     ax.set_title(
         f"{result.scenario}: impact trials ({result.joints} joints{rigid})\n{bracket}", fontsize=10
     )
@@ -122,9 +146,15 @@ def plot_validation(result) -> Figure:
     return fig
 
 
+def _speed(value: float | None) -> str:
+    """A speed with three decimals, ``-`` for none."""
+    return "-" if value is None else f"{value:.3f}"
+
+
 def _area_with_margin(
-    ax, area: Polygon, margin_area: Polygon | None, color: str, label: str, margin: float
-) -> list:
+    ax: Axes, area: Polygon, margin_area: Polygon | None, color: str, label: str, margin: float
+) -> list[Line2D]:
+    """Draw an area and, with a margin, the area shrunk by it; their legend entries."""
     draw_polygon(ax, area, color=color, label=label)
     handles = [Line2D([], [], color=color, lw=6, alpha=0.5, label=label)]
     if margin_area is not None and margin > 0 and not margin_area.is_empty:
@@ -145,9 +175,18 @@ def _area_with_margin(
 _MARKERS = "os^vDP*Xph<>"
 
 
-def plot_impact_trajectories(result, analysis) -> Figure:
-    """The CoM velocity of every impact trial (from just before the contact to 1.5 s after) over the CoM
-    velocity area; each trial's line ends with a marker that the legend names by its measured speed.
+def plot_impact_trajectories(result: Any, analysis: Analysis) -> Figure:
+    """The CoM velocity of every impact trial over the CoM velocity area.
+
+    Each line runs from just before the contact to 1.5 s after, and ends with a marker that
+    the legend names by its measured speed.
+
+    Args:
+        result: The impact trials of ``validate`` (``impact_balance.sim.trials``).
+        analysis: The scenario's analysis (its CoM velocity area, m/s).
+
+    Returns:
+        The figure.
     """
     areas = analysis.areas
     area = areas.com_velocity_area
@@ -157,7 +196,8 @@ def plot_impact_trajectories(result, analysis) -> Figure:
     handles = _area_with_margin(
         ax, area, shrunk, AREA_COLOR, "CoM velocity area", result.zmp_margin
     )
-    paths, trial_handles = [], []
+    paths: list[npt.NDArray[np.float64]] = []
+    trial_handles: list[Line2D] = []
     ranked = sorted(
         (t for t in result.trials if t.trajectory.get("com_velocity")),
         key=lambda t: t.measured or 0.0,
@@ -205,11 +245,19 @@ def plot_impact_trajectories(result, analysis) -> Figure:
     return fig
 
 
-def plot_push_trajectories(result, kind: str = "com_velocity") -> Figure:
-    """After every push, the CoM velocity (``kind="com_velocity"``) over the CoM velocity area, or the ZMP
-    (``"zmp"``) over the ZMP support area, coloured by outcome; crosses mark each push's before-trial
-    prediction (the post-push CoM velocity, or the quasi-static ZMP while it acts). The directions and
-    impulses are written under the figure.
+def plot_push_trajectories(result: Any, kind: PushView = "com_velocity") -> Figure:
+    """After every push, the CoM velocity or the ZMP over its area, coloured by outcome.
+
+    Crosses mark each push's before-trial prediction (the post-push CoM velocity, or the
+    quasi-static ZMP while it acts). The directions and impulses are written under the figure.
+
+    Args:
+        result: The pushes of ``push-test`` (``impact_balance.sim.trials``).
+        kind: ``"com_velocity"`` (m/s, over the CoM velocity area) or ``"zmp"`` (m, over the
+            ZMP support area).
+
+    Returns:
+        The figure.
     """
     areas = result.setup.analysis.areas
     margin = result.zmp_margin
@@ -234,7 +282,8 @@ def plot_push_trajectories(result, kind: str = "com_velocity") -> Figure:
     fig = new_figure(6.4, 6.6)
     ax = fig.add_subplot()
     handles = _area_with_margin(ax, area, shrunk, color, label, margin)
-    paths, predicted = [], []
+    paths: list[npt.NDArray[np.float64]] = []
+    predicted: list[npt.NDArray[np.float64]] = []
     for o in sorted(result.outcomes, key=lambda o: _ORDER[o.outcome]):
         c = OUTCOME_COLORS[o.outcome]
         path = np.array(
@@ -258,14 +307,16 @@ def plot_push_trajectories(result, kind: str = "com_velocity") -> Figure:
     if outside:
         far = np.linalg.norm(np.array(outside) - areas.com[:2], axis=1)
         notes.append(
-            f"{len(outside)} predictions lie off the view, {far.min():.2f} to {far.max():.2f} m from the CoM"
+            f"{len(outside)} predictions lie off the view, "
+            f"{far.min():.2f} to {far.max():.2f} m from the CoM"
         )
     ax.set_aspect("equal")
     ax.set_xlabel(f"{quantity} x ({unit})")
     ax.set_ylabel(f"{quantity} y ({unit})")
     what = "ZMP during and after each push" if kind == "zmp" else "CoM velocity after each push"
     fig.suptitle(
-        f"{result.scenario}: {what}\n({len(result.outcomes)} pushes, {result.setup.controller} controller, "
+        f"{result.scenario}: {what}\n({len(result.outcomes)} pushes, "
+        f"{result.setup.controller} controller, "
         f"{1000 * result.outcomes[0].push.duration:.0f} ms)",
         fontsize=9,
     )
@@ -287,8 +338,8 @@ def plot_push_trajectories(result, kind: str = "com_velocity") -> Figure:
     return fig
 
 
-def _directions_note(result) -> str:
-    """The pushes' directions (from world x) and impulse ranges, one line per group of directions."""
+def _directions_note(result: Any) -> str:
+    """The pushes' directions (from world x) and impulse ranges, a few directions a line."""
     by: dict[float, list[float]] = {}
     for o in result.outcomes:
         by.setdefault(round(float(np.rad2deg(o.push.direction)), 1), []).append(o.push.magnitude)
@@ -299,12 +350,22 @@ def _directions_note(result) -> str:
 
 
 def plot_log_margins(
-    time: np.ndarray,
-    com_velocity_margin: np.ndarray,
-    zmp_margin: np.ndarray | None,
+    time: npt.ArrayLike,
+    com_velocity_margin: npt.ArrayLike,
+    zmp_margin: npt.ArrayLike | None,
     title: str = "",
 ) -> Figure:
-    """CoM velocity margin (m/s) and ZMP margin (m) against time; below zero is outside the area."""
+    """CoM velocity margin (m/s) and ZMP margin (m) against time; below zero is outside the area.
+
+    Args:
+        time: Sample times (s).
+        com_velocity_margin: The CoM velocity margin of each sample (m/s).
+        zmp_margin: The ZMP margin of each sample (m), None without a logged ZMP.
+        title: The figure's title.
+
+    Returns:
+        The figure.
+    """
     fig = new_figure(7.0, 4.0)
     axes = fig.subplots(2 if zmp_margin is not None else 1, 1, sharex=True, squeeze=False)[:, 0]
     axes[0].plot(

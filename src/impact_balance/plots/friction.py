@@ -1,14 +1,20 @@
-"""Post-impact sets and maximum contact velocities for several impact frictions (paper Fig. miu-compare)."""
+"""Post-impact sets and maximum contact velocities for several impact frictions.
+
+The figure is the paper's Fig. miu-compare.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 
 import numpy as np
+import numpy.typing as npt
 from matplotlib import colormaps
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from impact_balance.analysis.analyze import Analysis
+from impact_balance.analysis.result import ImpactAnswer
 from impact_balance.plots.impulse import impulse_set_speed
 from impact_balance.plots.style import (
     AREA_COLOR,
@@ -23,30 +29,54 @@ from impact_balance.plots.style import (
 
 __all__ = ["plot_friction_comparison"]
 
+#: An analysis with its impact answer.
+_Run = tuple[Analysis, ImpactAnswer]
+
 
 def _same_area(a: Analysis, b: Analysis) -> bool:
+    """The two analyses have the same CoM velocity area (to 1e-9 m/s)."""
     va, vb = a.areas.com_velocity_area.vertices, b.areas.com_velocity_area.vertices
     return va.shape == vb.shape and bool(np.allclose(va, vb, atol=1e-9))
 
 
 def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
-    """Post-impact CoM velocity sets at each analysis' own maximum, one colour per impact friction.
+    """Post-impact CoM velocity sets at each analysis' own maximum, one colour per friction.
 
     Left: the sets on the (common) CoM velocity area, legend ``μ = 0.1: v_max = ... m/s``; an
     analysis whose area differs from the first one also gets its area outlined in its colour.
     Right: the maximum approach speed against mu for the CoM and the ZMP criteria.
 
+    Args:
+        analyses: The analyses compared; those without an impact are left out.
+
+    Returns:
+        The figure.
+
     Raises:
         ValueError: when no analysis has an impact.
     """
     runs = sorted(
-        (a for a in analyses if a.impact is not None), key=lambda a: a.impact.model.spec.friction
+        ((a, a.impact) for a in analyses if a.impact is not None),
+        key=lambda run: run[1].model.spec.friction,
     )
     if not runs:
         raise ValueError("plot_friction_comparison needs at least one analysis with an impact")
     fig = new_figure(12, 6.2)
     ax, bar = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.1, 1]})
-    base = runs[0]
+    _draw_sets(ax, runs)
+    _draw_bars(bar, runs)
+    base = runs[0][0]
+    names = list(dict.fromkeys(r.scenario.name or "scenario" for r, _ in runs))
+    stem = ", ".join(names) if len(names) <= 4 else f"{len(names)} scenarios"
+    fig.suptitle(
+        f"Impact friction comparison ({stem}; robot {base.stance.robot.name})", fontsize=12
+    )
+    return fig
+
+
+def _draw_sets(ax: Axes, runs: list[_Run]) -> None:
+    """Left panel: each run's post-impact set at its maximum, on the CoM velocity area (m/s)."""
+    base = runs[0][0]
     area = base.areas.com_velocity_area
     if not area.is_empty:
         draw_polygon(
@@ -62,8 +92,7 @@ def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
     view = list(area_view_points(area))
     cmap = colormaps["plasma"]
     colors = [cmap(0.05 + 0.75 * i / max(len(runs) - 1, 1)) for i in range(len(runs))]
-    for run, color in zip(runs, colors):
-        im = run.impact
+    for (run, im), color in zip(runs, colors, strict=True):
         mu = im.model.spec.friction
         c0 = run.com_velocity[:2]
         if not _same_area(run, base) and not run.areas.com_velocity_area.is_empty:
@@ -91,7 +120,7 @@ def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
         if lim.is_finite and lim.limiting_vertex is not None:
             ax.plot(*pts[lim.limiting_vertex], "*", color=color, mec="black", ms=13, zorder=5)
         view.append(c0)
-    c0s = np.array([r.com_velocity[:2] for r in runs])
+    c0s = np.array([r.com_velocity[:2] for r, _ in runs])
     ax.plot(*c0s.T, "o", color=COM_COLOR, ms=7, label="pre-impact CoM velocity", zorder=6)
     set_limits(ax, view, margin=0.1, min_ratio=0.5)
     ax.set_aspect("equal", adjustable="box")
@@ -111,22 +140,25 @@ def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
         ncol=2,
     )
 
-    # v_max against mu, both criteria (bars with their values written on them).
-    mus = [r.impact.model.spec.friction for r in runs]
-    com = np.array([r.impact.max_contact_velocity for r in runs], dtype=float)
-    zmp = np.array([r.impact.zmp_max_contact_velocity for r in runs], dtype=float)
+
+def _draw_bars(bar: Axes, runs: list[_Run]) -> None:
+    """Right panel: v_max against mu, both criteria (bars with their values written on them)."""
+    mus = [im.model.spec.friction for _, im in runs]
+    com = np.array([im.max_contact_velocity for _, im in runs], dtype=np.float64)
+    zmp = np.array([im.zmp_max_contact_velocity for _, im in runs], dtype=np.float64)
     x = np.arange(len(runs))
     width = 0.38
     finite = np.concatenate([com[np.isfinite(com)], zmp[np.isfinite(zmp)]])
     top = float(finite.max()) if finite.size else 1.0
     top = top if top > 0 else 1.0
-    for values, dx, color, name in (
+    series: tuple[tuple[npt.NDArray[np.float64], float, str, str], ...] = (
         (com, -width / 2, "tab:blue", "CoM velocity criterion"),
         (zmp, width / 2, "tab:orange", "ZMP criterion"),
-    ):
+    )
+    for values, dx, color, name in series:
         shown = np.where(np.isfinite(values), values, 1.1 * top)
         bars = bar.bar(x + dx, shown, width, color=color, label=name)
-        for rect, v in zip(bars, values):
+        for rect, v in zip(bars, values, strict=True):
             if not np.isfinite(v):
                 rect.set_hatch("//")  # no limit: drawn above the largest finite value
             text = f"{v:.3g}" if np.isfinite(v) else "unbounded"
@@ -145,9 +177,3 @@ def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
     bar.set_title("Maximum contact velocity vs impact friction", fontsize=10)
     bar.grid(True, axis="y", alpha=0.3)
     bar.legend(loc="upper right", fontsize=8)
-    names = list(dict.fromkeys(r.scenario.name or "scenario" for r in runs))
-    stem = ", ".join(names) if len(names) <= 4 else f"{len(names)} scenarios"
-    fig.suptitle(
-        f"Impact friction comparison ({stem}; robot {base.stance.robot.name})", fontsize=12
-    )
-    return fig

@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+from typing import Literal, cast
+
 import numpy as np
+import numpy.typing as npt
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+from mpl_toolkits.mplot3d.axes3d import Axes3D
 from scipy.spatial import ConvexHull, QhullError
 
 from impact_balance.analysis.analyze import Analysis
@@ -21,14 +25,26 @@ from impact_balance.plots.style import (
     set_limits,
 )
 
-__all__ = ["impulse_set_speed", "plot_impulse_set"]
+__all__ = ["SetSpeed", "impulse_set_speed", "plot_impulse_set"]
+
+#: Which approach speed the sets are drawn at: the maximum contact velocity, the reference
+#: approach speed, 1 m/s, or none (no impact).
+SetSpeed = Literal["v_max", "reference", "unit speed", "no impact"]
+
+FloatArray = npt.NDArray[np.float64]
 
 
-def impulse_set_speed(analysis: Analysis) -> tuple[float, str]:
+def impulse_set_speed(analysis: Analysis) -> tuple[float, SetSpeed]:
     """Approach speed (m/s) at which to show the sets, and a label saying which one it is.
 
     The maximum contact velocity when finite and positive; otherwise the reference approach
     speed; otherwise 1 m/s (the sets scale linearly with the speed).
+
+    Args:
+        analysis: The analysis.
+
+    Returns:
+        The speed (m/s, 0 without an impact) and which one it is.
     """
     im = analysis.impact
     if im is None:
@@ -41,7 +57,7 @@ def impulse_set_speed(analysis: Analysis) -> tuple[float, str]:
     return 1.0, "unit speed"
 
 
-def _faces(vertices: np.ndarray) -> list[np.ndarray]:
+def _faces(vertices: FloatArray) -> list[FloatArray]:
     """Faces of the impulse polytope: qhull facets, or the structural faces if it is flat."""
     try:
         h = ConvexHull(vertices)
@@ -51,7 +67,8 @@ def _faces(vertices: np.ndarray) -> list[np.ndarray]:
         return [vertices[0::2], vertices[1::2]]
 
 
-def _draw_impulse_polytope(ax: Axes, model: ImpactModel, speed: float) -> None:
+def _draw_impulse_polytope(ax: Axes3D, model: ImpactModel, speed: float) -> None:
+    """The impulse set at ``speed`` (m/s, N s in world axes) with the friction cone's edges."""
     verts = model.impulse_vertices(speed)
     n = model.cone.shape[1]
     hi, lo = verts[0::2], verts[1::2]
@@ -59,7 +76,8 @@ def _draw_impulse_polytope(ax: Axes, model: ImpactModel, speed: float) -> None:
     ax.add_collection3d(
         Poly3DCollection(faces, facecolor=IMPACT_COLOR, edgecolor="none", alpha=0.18)
     )
-    # Structural edges: the two restitution rings and the edges joining them along the generators.
+    # Structural edges: the two restitution rings and the edges joining them along the
+    # generators.
     for ring, ls in ((hi, "-"), (lo, "--")):
         closed = np.vstack([ring, ring[:1]])
         ax.plot(*closed.T, ls, color="darkred", lw=1.0)
@@ -124,6 +142,7 @@ def _draw_impulse_polytope(ax: Axes, model: ImpactModel, speed: float) -> None:
 
 
 def _draw_jump_set(ax: Axes, model: ImpactModel, speed: float) -> None:
+    """The CoM velocity jump set at ``speed`` (m/s), in the world's x-y plane."""
     jumps = model.com_velocity_jumps(speed)[:, :2]
     draw_polygon(
         ax,
@@ -163,11 +182,15 @@ def plot_impulse_set(analysis: Analysis, approach_speed: float | None = None) ->
 
     Args:
         analysis: The analysis; without an impact both panels say so.
-        approach_speed: m/s; default: the maximum contact velocity (see :func:`impulse_set_speed`).
+        approach_speed: m/s; default: the maximum contact velocity (see
+            :func:`impulse_set_speed`).
+
+    Returns:
+        The figure.
     """
     fig = new_figure(13, 6.2)
     grid = fig.add_gridspec(1, 2, width_ratios=[1.15, 1])
-    ax3 = fig.add_subplot(grid[0], projection="3d")
+    ax3 = cast(Axes3D, fig.add_subplot(grid[0], projection="3d"))
     ax2 = fig.add_subplot(grid[1])
     title = scenario_title(analysis)
     im = analysis.impact
@@ -183,6 +206,7 @@ def plot_impulse_set(analysis: Analysis, approach_speed: float | None = None) ->
         ax2.set_ylabel(r"$\Delta\dot c_y$ (m/s)")
         fig.suptitle(f"Impulse set: {title}")
         return fig
+    which: SetSpeed | Literal["given"]
     if approach_speed is None:
         speed, which = impulse_set_speed(analysis)
     else:
@@ -191,16 +215,18 @@ def plot_impulse_set(analysis: Analysis, approach_speed: float | None = None) ->
     n = model.cone.shape[1]
     _draw_impulse_polytope(ax3, model, speed)
     ax3.set_title(
-        f"Impulse set: {2 * n} vertices, friction cone with N = {n} edges (μ = {model.spec.friction:g})",
+        f"Impulse set: {2 * n} vertices, friction cone with N = {n} edges "
+        f"(μ = {model.spec.friction:g})",
         fontsize=10,
     )
     _draw_jump_set(ax2, model, speed)
     ax2.set_title(f"CoM velocity jump set (xy), mass {model.mass:.1f} kg", fontsize=10)
-    tag = {
+    tags: dict[str, str] = {
         "v_max": "the maximum contact velocity",
         "reference": "the reference approach speed",
         "unit speed": "unit approach speed",
         "given": "the given approach speed",
-    }[which]
+    }
+    tag = tags[which]
     fig.suptitle(f"Impulse set at {tag} {speed:.3g} m/s: {title}", fontsize=12)
     return fig

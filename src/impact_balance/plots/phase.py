@@ -34,7 +34,7 @@ def analysis_phase_portrait(analysis: Analysis, axis: int = 0) -> PhasePortrait:
     slack = h - G @ com[:2]
     rate = G @ d
     lo, hi = -np.inf, np.inf
-    for s, r in zip(slack, rate):
+    for s, r in zip(slack, rate, strict=True):
         if abs(r) < 1e-12:
             if s < -1e-9:
                 raise ValueError(
@@ -118,7 +118,7 @@ def plot_phase_portrait(portrait: PhasePortrait, title: str | None = None) -> Fi
                 "",
                 xy=traj[i + 1],
                 xytext=traj[i],
-                arrowprops=dict(arrowstyle="->", color="0.35", lw=0.9),
+                arrowprops={"arrowstyle": "->", "color": "0.35", "lw": 0.9},
             )
     ax.axvline(0.0, color="tab:green", lw=1.2, ls="--", label="c = 0 (CoM at the reference)")
     ax.axhline(0.0, color="0.6", lw=0.6)

@@ -27,12 +27,22 @@ def figure_prefix(analysis: Analysis) -> str:
 def save_figures(
     analysis: Analysis, out_dir: str | Path, dpi: int = DPI, skipped: list[Diagnostic] | None = None
 ) -> list[Path]:
-    """Write ``<scenario>_areas.png``, ``_stance.png``, ``_phase_portrait.png`` and, with an impact,
-    ``_impulse_set.png`` to ``out_dir`` (created if needed). Returns the paths written.
+    """Write the figures of an analysis as PNG files.
 
-    The phase portrait is the sagittal one of the stance (:func:`analysis_phase_portrait`); it is
-    skipped when the ZMP support area has no chord through the CoM along x; a skipped figure is
-    appended to ``skipped`` as a ``figure_skipped`` :class:`Diagnostic` saying why.
+    The files are ``<scenario>_areas.png``, ``_stance.png``, ``_phase_portrait.png`` and, with
+    an impact, ``_impulse_set.png``. The phase portrait is the sagittal one of the stance
+    (:func:`analysis_phase_portrait`); it is skipped when the ZMP support area has no chord
+    through the CoM along x.
+
+    Args:
+        analysis: The analysis.
+        out_dir: The folder (created if needed).
+        dpi: The resolution, dots per inch.
+        skipped: If given, receives a ``figure_skipped`` :class:`Diagnostic` per figure
+            skipped, saying why.
+
+    Returns:
+        The paths written.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+import numpy.typing as npt
+from matplotlib.artist import Artist
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MaxNLocator
@@ -18,20 +22,31 @@ from impact_balance.plots.style import (
 
 __all__ = ["plot_jump_on_sets", "plot_time_series"]
 
+# The trial results come from :mod:`impact_balance.sim`, a layer above the figures: they are
+# read by their attributes (``Any``), not imported.
+
 _MODEL_COLORS = {"composite": "tab:blue", "joint_space": "tab:orange"}
 
 
-def plot_jump_on_sets(result, title: str) -> Figure:
+def plot_jump_on_sets(result: Any, title: str) -> Figure:
     """The measured CoM velocity jump on the predicted jump sets of both inertia models.
 
     Left: both sets at the measured approach speed and restitution. Right: zoom on the
     ``joint_space`` set, usually much smaller, with the measured jump.
+
+    Args:
+        result: An impact trial's result (``impact_balance.sim.trials``): its measured jump
+            (m/s, world x and y), restitution and the predicted sets by inertia model.
+        title: The figure's title.
+
+    Returns:
+        The figure.
     """
     fig = new_figure(10.0, 4.6)
     axes = fig.subplots(1, 2)
     jump = np.asarray(result.com_velocity_jump_measured)
     flat: set[str] = set()
-    for ax, names in zip(axes, (("composite", "joint_space"), ("joint_space",))):
+    for ax, names in zip(axes, (("composite", "joint_space"), ("joint_space",)), strict=True):
         zoom = len(names) == 1
         points = [jump[None, :], np.zeros((1, 2))]
         if zoom:  # keep the measured jump in view unless it is far beyond the set
@@ -72,14 +87,15 @@ def plot_jump_on_sets(result, title: str) -> Figure:
     axes[0].set_title("predicted jump sets and the measured jump", fontsize=10)
     axes[1].set_title("zoom: joint_space", fontsize=10)
     # One legend below both panels: inside, it covered the sets or the measured jump.
-    entries: dict[str, object] = {}
+    entries: dict[str, Artist] = {}
     for ax in axes:
-        for handle, label in zip(*ax.get_legend_handles_labels()):
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
             entries.setdefault(label, handle)
     if flat:  # why a set is a line, as the legend's last row
         entries[
             f"{' and '.join(sorted(flat))} is flat: at the single measured restitution (e = "
-            f"{result.restitution_measured:.2f}) every impulse of the set lies on one plane, n·Wι = (1 + e) v,\n"
+            f"{result.restitution_measured:.2f}) every impulse of the set lies on one plane, "
+            "n·Wι = (1 + e) v,\n"
             "and seen from above (x-y) that plane is nearly edge-on, so the set shows as a line"
         ] = Line2D([], [], ls="")
     fig.legend(
@@ -96,7 +112,7 @@ def plot_jump_on_sets(result, title: str) -> Figure:
     return fig
 
 
-def _flat(points: np.ndarray) -> bool:
+def _flat(points: npt.ArrayLike) -> bool:
     """Whether a planar point set is (nearly) a segment: thinner than 3 % of its length."""
     pts = np.asarray(points, dtype=float).reshape(-1, 2)
     if len(pts) < 3:
@@ -106,11 +122,19 @@ def _flat(points: np.ndarray) -> bool:
     return bool(s[0] == 0.0 or s[1] / s[0] < 0.03)
 
 
-def plot_time_series(result, title: str) -> Figure:
+def plot_time_series(result: Any, title: str) -> Figure:
     """Contact forces (norm, N) and CoM velocity (x, y, m/s) against time, the impact shaded.
 
     One legend below both panels (inside, it covered the force transient). With ``rigid``
     joints the robot floats without gravity, so its feet carry no force: a note says so.
+
+    Args:
+        result: An impact trial's result (``impact_balance.sim.trials``): its record (time,
+            forces by contact, CoM velocity), impact window and joints.
+        title: The figure's title.
+
+    Returns:
+        The figure.
     """
     record = result.record
     fig = new_figure(9.0, 6.4)
@@ -127,7 +151,7 @@ def plot_time_series(result, title: str) -> Figure:
         )
     ax_f.set_ylabel("contact force |f| (N)")
     for k, (axis, color) in enumerate(
-        zip("xy", ("tab:green", "tab:purple"))
+        zip("xy", ("tab:green", "tab:purple"), strict=True)
     ):  # not the forces' colours:
         ax_v.plot(
             t, record.com_velocity[:, k], label=f"CoM velocity {axis}", color=color

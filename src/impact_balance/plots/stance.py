@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
+import numpy.typing as npt
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from impact_balance.analysis.analyze import Analysis
+from impact_balance.analysis.result import ImpactAnswer
 from impact_balance.plots.style import (
     COM_COLOR,
     CONTACT_COLOR,
@@ -19,7 +23,9 @@ from impact_balance.plots.style import (
     set_limits,
 )
 
-__all__ = ["joint_positions", "plot_stance"]
+__all__ = ["NORMAL_LENGTH", "VELOCITY_SCALE", "joint_positions", "plot_stance"]
+
+FloatArray = npt.NDArray[np.float64]
 
 #: Length of the contact and impact normal arrows, m.
 NORMAL_LENGTH = 0.15
@@ -27,10 +33,17 @@ NORMAL_LENGTH = 0.15
 VELOCITY_SCALE = 0.3
 
 
-def joint_positions(analysis: Analysis) -> tuple[np.ndarray, list[tuple[int, int]]]:
-    """World positions of the joint origins (njoints x 3, row 0 = universe) and the parent links.
+def joint_positions(analysis: Analysis) -> tuple[FloatArray, list[tuple[int, int]]]:
+    """World positions of the joint origins and the parent links.
 
     Uses the stance's pinocchio data, already at the stance configuration (``data.oMi``).
+
+    Args:
+        analysis: The analysis whose stance is drawn.
+
+    Returns:
+        The positions (njoints x 3, m, world; row 0 the universe) and the (joint, parent)
+        pairs of the links between joints.
     """
     stance = analysis.stance
     model, data = stance.model, stance.data
@@ -42,6 +55,7 @@ def joint_positions(analysis: Analysis) -> tuple[np.ndarray, list[tuple[int, int
 
 
 def _frame_joint(analysis: Analysis, frame: str) -> int | None:
+    """The joint that moves ``frame`` (None if the robot has no such frame)."""
     stance = analysis.stance
     try:
         f = stance.model.frames[stance.robot.frame_id(frame)]
@@ -52,8 +66,8 @@ def _frame_joint(analysis: Analysis, frame: str) -> int | None:
 
 def _arrow(
     ax: Axes,
-    start: np.ndarray,
-    delta: np.ndarray,
+    start: FloatArray,
+    delta: FloatArray,
     color: str,
     label: str | None,
     width: float = 0.012,
@@ -80,41 +94,74 @@ def _arrow(
     return True
 
 
+@dataclass
+class _View:
+    """One view of the stance: its axes, the world axes it shows, the points it must contain."""
+
+    ax: Axes
+    analysis: Analysis
+    i: int
+    k: int
+    view: list[FloatArray] = field(default_factory=list)
+
+    @property
+    def top(self) -> bool:
+        """The view from above (x-y)."""
+        return (self.i, self.k) == (0, 1)
+
+
 def _draw_view(ax: Axes, analysis: Analysis, axes: tuple[int, int], robot: bool) -> None:
-    stance = analysis.stance
-    areas = analysis.areas
-    i, k = axes
-    view: list[np.ndarray] = []
-    h = areas.plane_height
-    top = axes == (0, 1)
-
+    """One view (world axes ``axes``, m): robot, ZMP support area, contacts, CoM and impact."""
+    v = _View(ax, analysis, *axes)
     if robot:
-        pos, links = joint_positions(analysis)
-        for n, (j, p) in enumerate(links):
-            seg = pos[[p, j]][:, [i, k]]
-            ax.plot(
-                *seg.T,
-                "-",
-                color="0.55",
-                lw=2.0,
-                solid_capstyle="round",
-                zorder=2,
-                label="robot (joint origins)" if n == 0 else None,
-            )
-        ax.plot(*pos[1:, [i, k]].T, "o", color="0.35", ms=3, zorder=2.1)
-        view.append(pos[1:, [i, k]])
-        # Sticks from the last joint to the contact and impact points.
-        ends = [(c.spec.frame, c.position) for c in stance.contacts]
-        if analysis.impact is not None:
-            ends.append((analysis.impact.model.spec.frame, analysis.impact.model.point))
-        for frame, point in ends:
-            j = _frame_joint(analysis, frame)
-            if j:
-                ax.plot(
-                    *np.vstack([pos[j], point])[:, [i, k]].T, ":", color="0.55", lw=1.5, zorder=2
-                )
+        _draw_robot(v)
+    _draw_zmp_area(v)
+    _draw_contacts(v)
+    _draw_com(v)
+    if analysis.impact is not None:
+        _draw_impact(v, analysis.impact)
+    i, k = axes
+    set_limits(ax, v.view, margin=0.08, min_span=0.3)
+    ax.set_aspect("equal", adjustable="box")
+    names = "xyz"
+    ax.set_xlabel(f"{names[i]} (m)")
+    ax.set_ylabel(f"{names[k]} (m)")
+    ax.grid(True, alpha=0.3)
 
-    # ZMP support area on its plane.
+
+def _draw_robot(v: _View) -> None:
+    """A stick figure of the joint origins, with sticks to the contact and impact points."""
+    ax, analysis, i, k = v.ax, v.analysis, v.i, v.k
+    pos, links = joint_positions(analysis)
+    for n, (j, p) in enumerate(links):
+        seg = pos[[p, j]][:, [i, k]]
+        ax.plot(
+            *seg.T,
+            "-",
+            color="0.55",
+            lw=2.0,
+            solid_capstyle="round",
+            zorder=2,
+            label="robot (joint origins)" if n == 0 else None,
+        )
+    ax.plot(*pos[1:, [i, k]].T, "o", color="0.35", ms=3, zorder=2.1)
+    v.view.append(pos[1:, [i, k]])
+    # Sticks from the last joint to the contact and impact points.
+    ends = [(c.spec.frame, c.position) for c in analysis.stance.contacts]
+    if analysis.impact is not None:
+        ends.append((analysis.impact.model.spec.frame, analysis.impact.model.point))
+    for frame, point in ends:
+        joint = _frame_joint(analysis, frame)
+        if joint:
+            ax.plot(
+                *np.vstack([pos[joint], point])[:, [i, k]].T, ":", color="0.55", lw=1.5, zorder=2
+            )
+
+
+def _draw_zmp_area(v: _View) -> None:
+    """The ZMP support area on its plane (a segment in a side view), and the plane."""
+    ax, areas, i, top = v.ax, v.analysis.areas, v.i, v.top
+    h = areas.plane_height
     zmp = areas.zmp_area
     if not zmp.is_empty:
         if top:
@@ -135,7 +182,7 @@ def _draw_view(ax: Axes, analysis: Analysis, axes: tuple[int, int], robot: bool)
                 zorder=1,
             )
         if zmp.bounded:
-            view.append(
+            v.view.append(
                 np.column_stack([zmp.vertices[:, 0], zmp.vertices[:, 1]])
                 if top
                 else np.array([[zmp.vertices[:, 0].min(), h], [zmp.vertices[:, 0].max(), h]])
@@ -143,12 +190,18 @@ def _draw_view(ax: Axes, analysis: Analysis, axes: tuple[int, int], robot: bool)
     if not top:
         ax.axhline(h, color="0.3", lw=0.8, ls="--", zorder=0.5, label=f"ZMP plane z = {h:g} m")
 
-    # Contacts and their normals. A normal seen end-on (a flat foot from above) would be an
-    # arrow of no length: it is drawn as the usual symbol of a vector towards the viewer.
+
+def _draw_contacts(v: _View) -> None:
+    """The contact rectangles and their normals.
+
+    A normal seen end-on (a flat foot from above) would be an arrow of no length: it is drawn
+    as the usual symbol of a vector towards the viewer.
+    """
+    ax, i, k, top = v.ax, v.i, v.k, v.top
     labelled = False
-    for n, c in enumerate(stance.contacts):
+    for n, c in enumerate(v.analysis.stance.contacts):
         corners = c.corners()[:, [i, k]]
-        view.append(corners)
+        v.view.append(corners)
         draw_polygon(
             ax,
             hull(corners),
@@ -180,66 +233,61 @@ def _draw_view(ax: Axes, analysis: Analysis, axes: tuple[int, int], robot: bool)
                 width=0.008,
             )
         labelled = True
-        view.append((c.position + NORMAL_LENGTH * c.normal)[None, [i, k]])
+        v.view.append((c.position + NORMAL_LENGTH * c.normal)[None, [i, k]])
 
-    # CoM and its projection on the ZMP plane.
+
+def _draw_com(v: _View) -> None:
+    """The CoM, and in a side view its projection on the ZMP plane."""
+    ax, areas, i, k = v.ax, v.analysis.areas, v.i, v.k
+    h = areas.plane_height
     com = areas.com
     ax.plot(*com[[i, k]], "o", color=COM_COLOR, ms=9, mfc="yellow", mew=2, zorder=9, label="CoM")
-    if not top:
+    if not v.top:
         ax.plot([com[i], com[i]], [com[2], h], "--", color=COM_COLOR, lw=1, zorder=8)
         ax.plot(com[i], h, "x", color=COM_COLOR, ms=9, mew=2, zorder=9, label="CoM projection")
-    view.append(com[None, [i, k]])
+    v.view.append(com[None, [i, k]])
 
-    # Impact point, normal, reference and capped contact velocities.
-    im = analysis.impact
-    if im is not None:
-        p = im.model.point
-        ax.plot(*p[[i, k]], "o", color=IMPACT_COLOR, ms=8, zorder=9, label="impact point")
-        view.append(p[None, [i, k]])
+
+def _draw_impact(v: _View, im: ImpactAnswer) -> None:
+    """The impact point and normal, the reference velocity and the velocity capped at v_max."""
+    ax, i, k = v.ax, v.i, v.k
+    p = im.model.point
+    ax.plot(*p[[i, k]], "o", color=IMPACT_COLOR, ms=8, zorder=9, label="impact point")
+    v.view.append(p[None, [i, k]])
+    _arrow(
+        ax,
+        p[[i, k]],
+        NORMAL_LENGTH * im.model.normal[[i, k]],
+        IMPACT_COLOR,
+        "impact normal (impulse on the robot)",
+        width=0.01,
+    )
+    v.view.append((p + NORMAL_LENGTH * im.model.normal)[None, [i, k]])
+    reference = im.model.spec.reference_velocity
+    if reference is None:
+        return
+    ref = np.asarray(reference, dtype=float)
+    _arrow(
+        ax,
+        p[[i, k]],
+        VELOCITY_SCALE * ref[[i, k]],
+        "darkorange",
+        f"reference velocity {np.linalg.norm(ref):.3g} m/s",
+        width=0.012,
+        zorder=7,
+    )
+    v.view.append((p + VELOCITY_SCALE * ref)[None, [i, k]])
+    if im.contact_velocity is not None and not np.allclose(im.contact_velocity, ref):
+        capped = im.contact_velocity
         _arrow(
             ax,
             p[[i, k]],
-            NORMAL_LENGTH * im.model.normal[[i, k]],
-            IMPACT_COLOR,
-            "impact normal (impulse on the robot)",
-            width=0.01,
+            VELOCITY_SCALE * capped[[i, k]],
+            "tab:green",
+            f"capped at v_max: {np.linalg.norm(capped):.3g} m/s",
+            width=0.007,
+            zorder=7.5,
         )
-        view.append((p + NORMAL_LENGTH * im.model.normal)[None, [i, k]])
-        ref = im.model.spec.reference_velocity
-        if ref is not None:
-            ref = np.asarray(ref, dtype=float)
-            _arrow(
-                ax,
-                p[[i, k]],
-                VELOCITY_SCALE * ref[[i, k]],
-                "darkorange",
-                f"reference velocity {np.linalg.norm(ref):.3g} m/s",
-                width=0.012,
-                zorder=7,
-            )
-            view.append((p + VELOCITY_SCALE * ref)[None, [i, k]])
-        if (
-            im.contact_velocity is not None
-            and ref is not None
-            and not np.allclose(im.contact_velocity, ref)
-        ):
-            v = im.contact_velocity
-            _arrow(
-                ax,
-                p[[i, k]],
-                VELOCITY_SCALE * v[[i, k]],
-                "tab:green",
-                f"capped at v_max: {np.linalg.norm(v):.3g} m/s",
-                width=0.007,
-                zorder=7.5,
-            )
-
-    set_limits(ax, view, margin=0.08, min_span=0.3)
-    ax.set_aspect("equal", adjustable="box")
-    names = "xyz"
-    ax.set_xlabel(f"{names[i]} (m)")
-    ax.set_ylabel(f"{names[k]} (m)")
-    ax.grid(True, alpha=0.3)
 
 
 def _aspect_width(ax: Axes) -> float:
@@ -255,6 +303,13 @@ def plot_stance(analysis: Analysis, robot: bool = True) -> Figure:
     support area on its plane, the impact point with the impact normal and the reference
     velocity (and the velocity capped at v_max), and, with ``robot``, a stick figure of the
     joint origins. Velocity arrows are drawn at 0.3 m per m/s, normals 0.15 m long.
+
+    Args:
+        analysis: The analysis whose stance is drawn.
+        robot: Draw the stick figure.
+
+    Returns:
+        The figure.
     """
     fig = new_figure(13, 7)
     top, side = fig.subplots(1, 2)
@@ -270,7 +325,7 @@ def plot_stance(analysis: Analysis, robot: bool = True) -> Figure:
     fig.set_size_inches(max(8.0, axes_height * sum(widths) + 1.6), axes_height + 2.3)
     handles, labels = side.get_legend_handles_labels()
     th, tl = top.get_legend_handles_labels()
-    for hnd, lab in zip(th, tl):
+    for hnd, lab in zip(th, tl, strict=True):
         if lab not in labels:
             handles.append(hnd)
             labels.append(lab)

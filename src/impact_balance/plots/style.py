@@ -1,27 +1,66 @@
-"""Shared helpers of the figure modules: figure creation, polygon drawing, limits, text."""
+"""The style shared by the figures: colours, resolution, figure creation, polygons, limits, text.
+
+Every figure is made by :func:`new_figure` (an Agg canvas, no pyplot), so that the figure
+modules touch no global state; the colours keep one meaning across figures.
+"""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.layout_engine import ConstrainedLayoutEngine
 from matplotlib.patches import Polygon as PolygonPatch
+from matplotlib.typing import ColorType, LineStyleType
 
 from impact_balance.geometry.polygon import Polygon
 
-#: Colours used consistently across the figures.
-ZMP_COLOR = "#8fbc8f"  # ZMP support area
-AREA_COLOR = "#7fd3e6"  # CoM velocity area (cyan, as in the paper)
+if TYPE_CHECKING:
+    from impact_balance.analysis.analyze import Analysis
+
+__all__ = [
+    "AREA_COLOR",
+    "COM_COLOR",
+    "CONTACT_COLOR",
+    "DPI",
+    "FALL_COLOR",
+    "IMPACT_COLOR",
+    "OK_COLOR",
+    "ZMP_COLOR",
+    "area_view_points",
+    "centre_message",
+    "draw_polygon",
+    "fmt_speed",
+    "hull",
+    "new_figure",
+    "scenario_title",
+    "set_limits",
+    "text_box",
+    "trim_height",
+]
+
+#: The ZMP support area.
+ZMP_COLOR = "#8fbc8f"
+#: The CoM velocity area (cyan, as in the paper).
+AREA_COLOR = "#7fd3e6"
+#: The CoM, its projection and its velocity.
 COM_COLOR = "black"
+#: The impact: its point, its force and its impulse set.
 IMPACT_COLOR = "tab:red"
+#: A balanced outcome.
 OK_COLOR = "tab:blue"
+#: A fall, or what makes the robot fall.
 FALL_COLOR = "tab:red"
+#: The contact rectangles.
 CONTACT_COLOR = "tab:brown"
 
+#: Resolution of the written figures, dots per inch.
 DPI = 120
 
 
@@ -34,12 +73,14 @@ def new_figure(width: float, height: float) -> Figure:
     fig = Figure(figsize=(width, height), layout="constrained")
     # A wider margin than the default (3 pt): a legend anchored outside its axes otherwise
     # ends on the canvas' edge, where its frame is cut.
-    fig.get_layout_engine().set(w_pad=0.06, h_pad=0.06)
+    engine = fig.get_layout_engine()
+    if isinstance(engine, ConstrainedLayoutEngine):
+        engine.set(w_pad=0.06, h_pad=0.06)
     FigureCanvasAgg(fig)
     return fig
 
 
-def fmt_speed(value: float, digits: int = 3) -> str:
+def fmt_speed(value: float | None, digits: int = 3) -> str:
     """An approach speed in m/s, ``unbounded`` for infinity."""
     if value is None or not math.isfinite(value):
         return "unbounded"
@@ -50,16 +91,29 @@ def draw_polygon(
     ax: Axes,
     polygon: Polygon,
     *,
-    color: str,
+    color: ColorType,
     alpha: float = 0.35,
     label: str | None = None,
-    edge: str | None = None,
+    edge: ColorType | None = None,
     lw: float = 1.5,
-    ls: str = "-",
+    ls: LineStyleType = "-",
     zorder: float = 1.0,
     fill: bool = True,
 ) -> None:
-    """Draw a (possibly degenerate) convex polygon: filled polygon, thick segment, or point."""
+    """Draw a (possibly degenerate) convex polygon: filled polygon, thick segment, or point.
+
+    Args:
+        ax: The axes.
+        polygon: The polygon, in the axes' data coordinates.
+        color: The fill colour.
+        alpha: The fill's opacity.
+        label: The legend entry.
+        edge: The boundary's colour (default: ``color``).
+        lw: The boundary's width, points.
+        ls: The boundary's line style.
+        zorder: The drawing order.
+        fill: Fill the polygon (else its boundary only).
+    """
     v = np.asarray(polygon.vertices, dtype=float).reshape(-1, 2)
     edge = edge or color
     if len(v) == 0:
@@ -102,22 +156,27 @@ def draw_polygon(
         )
 
 
-def hull(points: np.ndarray) -> Polygon:
+def hull(points: npt.ArrayLike) -> Polygon:
     """Convex hull of planar points as a :class:`Polygon` (point or segment when degenerate)."""
     return Polygon.from_points(np.asarray(points, dtype=float).reshape(-1, 2))
 
 
 def set_limits(
     ax: Axes,
-    points: Iterable[np.ndarray],
+    points: Iterable[npt.ArrayLike],
     margin: float = 0.12,
     min_span: float = 0.05,
     min_ratio: float = 0.0,
 ) -> None:
     """Fit the axis limits to ``points`` (arrays of (k, 2)), with a relative margin.
 
-    ``min_ratio`` keeps each span at least that fraction of the other, so that flat data
-    (a segment) does not give an unreadable sliver of an axes under an equal aspect.
+    Args:
+        ax: The axes.
+        points: Arrays of points (k, 2); non-finite points are left out.
+        margin: The margin on each side, a fraction of the span.
+        min_span: The smallest span, data units.
+        min_ratio: Keeps each span at least that fraction of the other, so that flat data
+            (a segment) does not give an unreadable sliver of an axes under an equal aspect.
     """
     pts = [np.asarray(p, dtype=float).reshape(-1, 2) for p in points]
     pts = [p[np.all(np.isfinite(p), axis=1)] for p in pts if len(p)]
@@ -149,13 +208,13 @@ def text_box(
         va=va,
         fontsize=fontsize,
         zorder=10,
-        bbox=dict(
-            boxstyle="round,pad=0.4",
-            facecolor="white",
-            edgecolor=edgecolor,
-            alpha=0.9,
-            lw=2 if edgecolor != "0.6" else 1,
-        ),
+        bbox={
+            "boxstyle": "round,pad=0.4",
+            "facecolor": "white",
+            "edgecolor": edgecolor,
+            "alpha": 0.9,
+            "lw": 2 if edgecolor != "0.6" else 1,
+        },
     )
 
 
@@ -174,17 +233,22 @@ def centre_message(
         fontsize=fontsize,
         color=color,
         zorder=11,
-        bbox=dict(boxstyle="round,pad=0.5", facecolor="white", edgecolor=color, alpha=0.9),
+        bbox={
+            "boxstyle": "round,pad=0.5",
+            "facecolor": "white",
+            "edgecolor": color,
+            "alpha": 0.9,
+        },
     )
 
 
-def scenario_title(analysis) -> str:
+def scenario_title(analysis: Analysis) -> str:
     """Scenario name and robot for figure titles."""
     name = analysis.scenario.name or "scenario"
     return f"{name} ({analysis.stance.robot.name})"
 
 
-def area_view_points(polygon: Polygon, extra: Sequence[np.ndarray] = ()) -> list[np.ndarray]:
+def area_view_points(polygon: Polygon, extra: Sequence[npt.ArrayLike] = ()) -> list[npt.ArrayLike]:
     """Points that the view must contain: the polygon if bounded, plus ``extra``."""
     out = list(extra)
     if polygon.bounded and not polygon.is_empty:

@@ -83,10 +83,19 @@ def check_scheduler_address(address: str) -> str:
 
 
 def connect(address: str, timeout: float = CONNECT_TIMEOUT_S) -> Any:
-    """A :class:`distributed.Client` of the scheduler at ``address``, or :class:`EnvironmentFailure`
-    (exit status 1) naming ``--scheduler`` and what the network said.
+    """A :class:`distributed.Client` of the scheduler at ``address``.
+
+    Args:
+        address: The scheduler's address (``tcp://host:8786``).
+        timeout: How long to wait for it, s.
+
+    Returns:
+        The client.
+
+    Raises:
+        EnvironmentFailure: (exit status 1) naming ``--scheduler`` and what the network said.
     """
-    scheme, host, port = _split(address)
+    _, host, port = _split(address)
     canonical = check_scheduler_address(address)
     try:  # a closed port answers at once; Dask itself would retry for its whole timeout
         socket.create_connection((host, port), timeout=timeout).close()
@@ -105,7 +114,7 @@ def connect(address: str, timeout: float = CONNECT_TIMEOUT_S) -> Any:
     from distributed import Client
 
     try:
-        return Client(canonical, timeout=timeout)
+        return Client(canonical, timeout=timeout)  # type: ignore[no-untyped-call]
     except Exception as exc:
         text = " ".join(str(exc).split())[:160] or type(exc).__name__
         raise EnvironmentFailure(

@@ -2,16 +2,28 @@
 
 from __future__ import annotations
 
+from typing import Literal, get_args
+
 import pyarrow as pa
 
-__all__ = ["RESULT_COLUMNS", "STATUSES"]
+__all__ = [
+    "EVALUATED",
+    "RESULT_COLUMNS",
+    "STATUSES",
+    "VERDICTS",
+    "EvaluatedStatus",
+    "Status",
+    "Verdict",
+]
 
-#: Row statuses. The first four are answers (the point was evaluated): "ok" (finite maximum),
-#: "unbounded" (no approach speed makes it fall), "already_falling" (pre-impact CoM velocity
-#: outside the area: maximum 0), "cannot_balance" (empty areas: maximum 0). The last three are
-#: points that could not be evaluated: "invalid" (a value the scenario refuses), "unreachable"
-#: (the posture IK did not reach the target with the contacts kept), "error" (anything else).
-STATUSES = (
+#: The statuses of points that were evaluated: "ok" (finite maximum), "unbounded" (no approach
+#: speed makes it fall), "already_falling" (pre-impact CoM velocity outside the area: maximum
+#: 0), "cannot_balance" (empty areas: maximum 0).
+EvaluatedStatus = Literal["ok", "unbounded", "already_falling", "cannot_balance"]
+#: Row statuses: the evaluated ones, then the points that could not be evaluated: "invalid" (a
+#: value the scenario refuses), "unreachable" (the posture IK did not reach the target with
+#: the contacts kept), "error" (anything else).
+Status = Literal[
     "ok",
     "unbounded",
     "already_falling",
@@ -19,7 +31,16 @@ STATUSES = (
     "invalid",
     "unreachable",
     "error",
-)
+]
+#: The pre-impact state of an evaluated point (the ``verdict`` column).
+Verdict = Literal["balanced", "falling", "cannot balance"]
+
+#: Every status, in the order above (counts and figures list them so).
+STATUSES: tuple[Status, ...] = get_args(Status)
+#: Statuses of points that were evaluated (the others are rows with a message).
+EVALUATED: tuple[EvaluatedStatus, ...] = get_args(EvaluatedStatus)
+#: Every verdict.
+VERDICTS: tuple[Verdict, ...] = get_args(Verdict)
 
 #: Result columns after the point index and the dimensions: name, Arrow type, meaning.
 RESULT_COLUMNS: tuple[tuple[str, pa.DataType, str], ...] = (

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 import pyarrow as pa
 
@@ -32,9 +33,10 @@ from impact_balance.impact.model import impact_model
 from impact_balance.robot.ik import IKError, solve_stance
 from impact_balance.robot.robot import Robot
 from impact_balance.scenario import Scenario, scenario_from_dict
-from impact_balance.sweep.columns import RESULT_COLUMNS, STATUSES
-from impact_balance.sweep.paths import set_path
-from impact_balance.sweep.plan import SweepPlan
+from impact_balance.sweep.columns import RESULT_COLUMNS, STATUSES, Status, Verdict
+from impact_balance.sweep.paths import get_path, set_path
+from impact_balance.sweep.plan import Dimension, SweepPlan
+from impact_balance.sweep.spec import PostureAxis
 
 __all__ = ["RESULT_COLUMNS", "STATUSES", "Evaluator", "result_schema"]
 
@@ -48,20 +50,40 @@ def result_schema(plan: SweepPlan) -> pa.Schema:
 
 
 @dataclass
+class _ReadyStance:
+    """A stance whose areas are computed, shared by the points of a chunk that have it."""
+
+    stance: Stance
+    areas: BalanceAreas
+    com_velocity_area: float
+    zmp_area: float
+    edge_directions: list[float]
+    identity: dict[str, Any]
+    verdicts: dict[tuple[float, float], Verdict]
+
+
+@dataclass
 class _StanceEntry:
-    stance: Stance | None
-    areas: BalanceAreas | None
-    status: str | None = None
+    """The stance of a group of points: ``ready``, or why not (``status`` and ``message``)."""
+
+    ready: _ReadyStance | None
+    status: Status | None = None
     message: str | None = None
     ik_residual: float | None = None
-    com_velocity_area: float | None = None
-    zmp_area: float | None = None
-    verdicts: dict[tuple[float, float], str] | None = None
-    edge_directions: list[float] | None = None
-    identity: dict[str, Any] | None = None
+
+    @property
+    def stance(self) -> Stance | None:
+        """The stance, None when it could not be computed."""
+        return self.ready.stance if self.ready is not None else None
 
 
-def _verdict(areas: BalanceAreas, com_velocity: tuple[float, float]) -> str:
+#: The stance entries of a chunk, by the values of the stance dimensions.
+_Cache = dict[tuple[Any, ...], _StanceEntry]
+#: The last configuration the posture IK reached, by the values of the other stance dimensions.
+_Warm = dict[tuple[Any, ...], npt.NDArray[np.float64]]
+
+
+def _verdict(areas: BalanceAreas, com_velocity: tuple[float, float]) -> Verdict:
     if not areas.can_balance:
         return "cannot balance"
     return (
@@ -78,7 +100,7 @@ class Evaluator:
     per thread), so one evaluator may serve the threads of a Dask worker.
     """
 
-    def __init__(self, plan: SweepPlan, robot: Robot | None = None):
+    def __init__(self, plan: SweepPlan, robot: Robot | None = None) -> None:
         self.plan = plan
         self.base_scenario = scenario_from_dict(plan.base, plan.base_source)
         self.robot = robot or self.base_scenario.load_robot()
@@ -92,8 +114,9 @@ class Evaluator:
             for name in Scenario.model_fields
             if name != "source"
         }
-        self._roots = sorted({d.tokens[0] for d in plan.dims if d.tokens})
-        self._direction = {}
+        # the first token of a path is a top-level key: a string
+        self._roots = sorted({str(d.tokens[0]) for d in plan.dims if d.tokens})
+        self._direction: dict[int, dict[str, Dimension]] = {}
         for d in plan.dims:
             if d.kind in ("azimuth", "elevation"):
                 self._direction.setdefault(d.axis, {})[d.kind] = d
@@ -103,6 +126,8 @@ class Evaluator:
         self._posture = posture
         if posture is not None:
             impact = self.base_scenario.impact
+            if impact is None:  # the plan refuses a base scenario without impact
+                raise ValueError("the base scenario has no impact")
             self._posture_frame = posture.frame or impact.frame
             if posture.offset is not None:
                 self._posture_offset = posture.offset.se3()
@@ -112,9 +137,13 @@ class Evaluator:
                 self._posture_offset = pin.SE3.Identity()
 
     def warm_up(self, points: int = 20) -> None:
-        """Evaluate the first few points of the sweep and drop the rows: loads the compiled
-        kernel and every lazy import and cache, so that a worker's first chunk is not slower
-        than the others.
+        """Evaluate the first few points of the sweep and drop the rows.
+
+        This loads the compiled kernel and every lazy import and cache, so that a worker's
+        first chunk is not slower than the others.
+
+        Args:
+            points: How many points to evaluate.
         """
         start, stop = self.plan.chunk_range(0)
         self._rows(0, start, min(stop, start + points))
@@ -129,8 +158,8 @@ class Evaluator:
         points = self.plan.points(start, stop)
         names = [d.name for d in self.plan.dims]
         columns: dict[str, list[Any]] = {f.name: [] for f in self.schema}
-        cache: dict[tuple, _StanceEntry] = {}
-        warm: dict[tuple, np.ndarray] = {}
+        cache: _Cache = {}
+        warm: _Warm = {}
         for k in range(stop - start):
             values = {name: points[name][k] for name in names}
             try:
@@ -157,7 +186,7 @@ class Evaluator:
             raw = set_path(raw, d.tokens, values[d.name])
         for pair in self._direction.values():
             az_dim, el_dim = pair["azimuth"], pair["elevation"]
-            base_vec = np.asarray(_get(self.plan.base, az_dim.tokens), dtype=float)
+            base_vec = np.asarray(get_path(self.plan.base, az_dim.tokens), dtype=float)
             az, el = (
                 math.radians(float(values[az_dim.name])),
                 math.radians(float(values[el_dim.name])),
@@ -172,7 +201,7 @@ class Evaluator:
         # The base and the sweep file passed the size checks when the sweep was planned.
         return scenario_from_dict(raw, None, check_size=False)
 
-    def _evaluate_point(self, values: dict[str, Any], cache: dict, warm: dict) -> dict[str, Any]:
+    def _evaluate_point(self, values: dict[str, Any], cache: _Cache, warm: _Warm) -> dict[str, Any]:
         try:
             scenario = self._scenario(values)
         except ScenarioError as exc:
@@ -181,11 +210,15 @@ class Evaluator:
         entry = cache.get(key)
         if entry is None:
             entry = cache[key] = self._stance_entry(scenario, values, warm)
-        out: dict[str, Any] = {"ik_residual": entry.ik_residual, **(entry.identity or {})}
-        if entry.status is not None:
+        ready = entry.ready
+        out: dict[str, Any] = {"ik_residual": entry.ik_residual}
+        if ready is None:
             return {**out, "status": entry.status, "message": entry.message}
-        stance, areas = entry.stance, entry.areas
+        out.update(ready.identity)
+        stance, areas = ready.stance, ready.areas
         cfg = scenario.impact
+        if cfg is None:  # an error row (the plan refuses a base scenario without impact)
+            raise ValueError("the scenario has no impact")
         try:
             model = impact_model(stance, cfg.spec())
         except ImpactBalanceError as exc:
@@ -194,22 +227,22 @@ class Evaluator:
         zmp = zmp_max_contact_velocity(
             areas.zmp_area, model, stance.com, scenario.plane_height, scenario.gravity, cfg.duration
         )
-        verdict = entry.verdicts.get(scenario.com_velocity)
+        verdict = ready.verdicts.get(scenario.com_velocity)
         if verdict is None:
-            verdict = entry.verdicts[scenario.com_velocity] = _verdict(areas, scenario.com_velocity)
+            verdict = ready.verdicts[scenario.com_velocity] = _verdict(areas, scenario.com_velocity)
         out.update(
             status=com.status,
             verdict=verdict,
             max_contact_velocity=com.max_approach_speed,
             zmp_max_contact_velocity=zmp.max_approach_speed,
             zmp_status=zmp.status,
-            com_velocity_area=entry.com_velocity_area,
-            zmp_area=entry.zmp_area,
+            com_velocity_area=ready.com_velocity_area,
+            zmp_area=ready.zmp_area,
             limiting_vertex=com.limiting_vertex,
             limiting_edge=com.limiting_edge,
             limiting_direction=None
             if com.limiting_edge is None
-            else entry.edge_directions[com.limiting_edge],
+            else ready.edge_directions[com.limiting_edge],
             impact_x=float(model.point[0]),
             impact_y=float(model.point[1]),
             impact_z=float(model.point[2]),
@@ -226,33 +259,36 @@ class Evaluator:
             self._robots[key] = robot
         return robot
 
-    def _stance_entry(self, scenario: Scenario, values: dict[str, Any], warm: dict) -> _StanceEntry:
+    def _stance_entry(
+        self, scenario: Scenario, values: dict[str, Any], warm: _Warm
+    ) -> _StanceEntry:
+        """The stance of a point and its areas, or why they cannot be computed."""
         residual = None
         try:
             stance = scenario.build_stance(self._robot(scenario))
             if self._posture is not None:
-                stance, residual = self._place(scenario, stance, values, warm)
+                stance, residual = self._place(self._posture, stance, values, warm)
             polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
             areas = areas_from_polytope(polytope, scenario.plane_height, scenario.zmp_margin)
         except IKError as exc:
-            return _StanceEntry(None, None, "unreachable", str(exc), _worst(exc.residuals))
+            return _StanceEntry(None, "unreachable", str(exc), _worst(exc.residuals))
         except ScenarioError as exc:
-            return _StanceEntry(None, None, "invalid", str(exc), residual)
+            return _StanceEntry(None, "invalid", str(exc), residual)
         except ImpactBalanceError as exc:
-            return _StanceEntry(None, None, "error", f"{exc.__class__.__name__}: {exc}", residual)
-        return _StanceEntry(
+            return _StanceEntry(None, "error", f"{exc.__class__.__name__}: {exc}", residual)
+        ready = _ReadyStance(
             stance,
             areas,
-            ik_residual=residual,
             com_velocity_area=areas.com_velocity_area.area,
             zmp_area=areas.zmp_area.area,
-            verdicts={},
             edge_directions=_directions(areas),
             identity=_identity(scenario, stance),
+            verdicts={},
         )
+        return _StanceEntry(ready, ik_residual=residual)
 
     def _place(
-        self, scenario: Scenario, stance: Stance, values: dict[str, Any], warm: dict
+        self, posture: PostureAxis, stance: Stance, values: dict[str, Any], warm: _Warm
     ) -> tuple[Stance, float]:
         """The stance with the posture point moved to its target, the contact frames kept."""
         frame, offset = self._posture_frame, self._posture_offset
@@ -268,7 +304,6 @@ class Evaluator:
         # neighbouring grid targets need a few IK steps instead of tens.
         base_key = tuple(_key(values[d]) for d in self._stance_dims if not d.startswith("posture."))
         q0 = warm.get(base_key, stance.q)
-        posture = self._posture
         q = solve_stance(
             self.robot,
             q0,
@@ -316,7 +351,7 @@ def _identity(scenario: Scenario, stance: Stance) -> dict[str, Any]:
 
 
 def _directions(areas: BalanceAreas) -> list[float]:
-    """Outward normal angle (deg, world, from +x about z) of each half-plane of the CoM velocity area."""
+    """Outward normal angle (deg, world, from +x about z) of each half-plane of the CoM area."""
     if areas.com_velocity_area.is_empty:
         return []
     G, _ = areas.com_velocity_area.halfplanes
@@ -326,12 +361,6 @@ def _directions(areas: BalanceAreas) -> list[float]:
 def _key(value: Any) -> Any:
     """A hashable stand-in for a dimension value (lists and mappings by their repr)."""
     return repr(value) if isinstance(value, (list, dict)) else value
-
-
-def _get(base: Any, tokens) -> Any:
-    for t in tokens:
-        base = base[t]
-    return base
 
 
 def _worst(residuals: dict[str, float]) -> float:

@@ -18,15 +18,23 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 import pandas as pd
+from matplotlib.axes import Axes
+from matplotlib.cm import ScalarMappable
+from matplotlib.figure import Figure
 
 from impact_balance.plots.style import DPI, new_figure
-from impact_balance.sweep.summary import EVALUATED, load_frame
+from impact_balance.sweep.columns import EVALUATED, Status
+from impact_balance.sweep.summary import load_frame
 
-__all__ = ["axis_label", "save_sweep_figures", "sweep_figures"]
+__all__ = ["TURN_DEG", "VALUED", "axis_label", "save_sweep_figures", "sweep_figures"]
+
+FloatArray = npt.NDArray[np.float64]
 
 
 def _varying(manifest: dict[str, Any], df: pd.DataFrame) -> list[str]:
+    """The numeric dimensions that take more than one value."""
     dims = []
     for d in manifest["dimensions"]:
         col = df[d["name"]]
@@ -35,18 +43,18 @@ def _varying(manifest: dict[str, Any], df: pd.DataFrame) -> list[str]:
     return dims
 
 
-def _values(df: pd.DataFrame) -> np.ndarray:
+def _values(df: pd.DataFrame) -> FloatArray:
     """Maximum contact velocity for plotting: NaN without one to show (unbounded stays inf).
 
     A point already falling, or a stance that cannot balance, has a "maximum" of 0 in the
     results, which is no contact velocity at all: it is drawn with its own marker, not as 0 m/s.
     """
-    v = df["max_contact_velocity"].to_numpy(dtype=float).copy()
+    v: FloatArray = df["max_contact_velocity"].to_numpy(dtype=float).copy()
     v[~df["status"].isin(VALUED).to_numpy()] = np.nan
     return v
 
 
-def _mark_statuses(ax, df: pd.DataFrame, x: str, y: str | None) -> None:
+def _mark_statuses(ax: Axes, df: pd.DataFrame, x: str, y: str | None) -> None:
     """Markers for the points without a maximum: falling, cannot balance, not evaluated."""
     for status, (marker, color, text) in _MARKS.items():
         rows = df[df["status"] == status]
@@ -81,26 +89,28 @@ def _mark_statuses(ax, df: pd.DataFrame, x: str, y: str | None) -> None:
 TURN_DEG = 10.0
 
 
-def _turns(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def _turns(a: FloatArray, b: FloatArray) -> npt.NDArray[np.bool_]:
     """Where the limiting-edge direction changes between neighbours (both evaluated)."""
     diff = np.abs((a - b + 180.0) % 360.0 - 180.0)
-    return np.isfinite(a) & np.isfinite(b) & (diff > TURN_DEG)
+    turns: npt.NDArray[np.bool_] = np.isfinite(a) & np.isfinite(b) & (diff > TURN_DEG)
+    return turns
 
 
-def _cell_edges(v: np.ndarray) -> np.ndarray:
+def _cell_edges(v: FloatArray) -> FloatArray:
+    """The edges of the cells centred on the sorted values ``v``."""
     mid = 0.5 * (v[1:] + v[:-1])
     first = v[0] - (mid[0] - v[0]) if len(v) > 1 else v[0] - 0.5
     last = v[-1] + (v[-1] - mid[-1]) if len(v) > 1 else v[-1] + 0.5
     return np.concatenate([[first], mid, [last]])
 
 
-def _draw_turns(ax, xs: np.ndarray, ys: np.ndarray, E: np.ndarray) -> None:
+def _draw_turns(ax: Axes, xs: FloatArray, ys: FloatArray, E: FloatArray) -> None:
     """White dotted lines between grid cells limited by different edges of the area."""
     bx, by = _cell_edges(xs), _cell_edges(ys)
     segments = []
-    for i, j in zip(*np.nonzero(_turns(E[:, 1:], E[:, :-1]))):  # neighbours along x
+    for i, j in zip(*np.nonzero(_turns(E[:, 1:], E[:, :-1])), strict=True):  # along x
         segments.append([(bx[j + 1], by[i]), (bx[j + 1], by[i + 1])])
-    for i, j in zip(*np.nonzero(_turns(E[1:, :], E[:-1, :]))):  # neighbours along y
+    for i, j in zip(*np.nonzero(_turns(E[1:, :], E[:-1, :])), strict=True):  # along y
         segments.append([(bx[j], by[i + 1]), (bx[j + 1], by[i + 1])])
     if segments:
         from matplotlib.collections import LineCollection
@@ -165,7 +175,7 @@ def axis_label(name: str, frame: str | None = None) -> str:
                 if m and m.group(2)
                 else part.replace("_", " ")
             )
-        words = " ".join(owners + [words])
+        words = " ".join([*owners, words])
         if index is not None:
             if key == "restitution":
                 words += ", " + ("lower" if index == "0" else "upper") + " bound"
@@ -179,15 +189,16 @@ def axis_label(name: str, frame: str | None = None) -> str:
 
 
 #: Statuses drawn with a value; the other evaluated ones have markers of their own.
-VALUED = ("ok", "unbounded")
+VALUED: tuple[Status, ...] = ("ok", "unbounded")
 #: Marker, colour and legend text of the points that have no maximum to show.
-_MARKS = {
+_MARKS: dict[Status, tuple[str, str, str]] = {
     "already_falling": ("v", "tab:red", "falling before the impact (no maximum)"),
     "cannot_balance": ("s", "black", "cannot balance (no maximum)"),
 }
 
 
-def _curve(df: pd.DataFrame, x: str, title: str, frame: str | None = None):
+def _curve(df: pd.DataFrame, x: str, title: str, frame: str | None = None) -> Figure:
+    """The maximum contact velocity against one varying dimension."""
     fig = new_figure(6.4, 4.6)
     ax = fig.add_subplot()
     df = df.sort_values([x, "point"], kind="stable")
@@ -244,7 +255,8 @@ def _curve(df: pd.DataFrame, x: str, title: str, frame: str | None = None):
 
 def _heatmap(
     df: pd.DataFrame, x: str, y: str, others: list[str], title: str, frame: str | None = None
-):
+) -> Figure:
+    """The maximum contact velocity over two dimensions (the worst case over the others)."""
     fig = new_figure(6.8, 6.2)
     ax = fig.add_subplot()
     df = df.assign(_v=_values(df))
@@ -262,6 +274,7 @@ def _heatmap(
     grid = len(cell) == len(xs) * len(ys)
     finite = np.isfinite(df["_v"].to_numpy())
     vmax = float(np.nanmax(np.where(finite, df["_v"], np.nan))) if finite.any() else 1.0
+    mesh: ScalarMappable
     if grid:
         V = cell.unstack(level=0).reindex(index=ys, columns=xs).to_numpy(dtype=float)
         shown = np.where(np.isinf(V), vmax, V)
@@ -315,7 +328,7 @@ def _heatmap(
     return fig
 
 
-def sweep_figures(root: str | Path) -> list[tuple[str, Any]]:
+def sweep_figures(root: str | Path) -> list[tuple[str, Figure]]:
     """(name, Figure) pairs for a sweep folder: a curve or a heat map (empty without data)."""
     manifest, df = load_frame(root)
     if not len(df):

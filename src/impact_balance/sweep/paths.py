@@ -45,7 +45,8 @@ def parse_path(path: str, field: str = "path") -> tuple[Token, ...]:
             raise SweepError(
                 field,
                 path,
-                "not a key path (expected keys separated by '.' and [index], e.g. impact.offset.position[1])",
+                "not a key path (expected keys separated by '.' and [index], "
+                "e.g. impact.offset.position[1])",
             )
         tokens.append(m.group(1) if m.group(1) is not None else int(m.group(2)))
         pos = m.end()
@@ -55,6 +56,7 @@ def parse_path(path: str, field: str = "path") -> tuple[Token, ...]:
 
 
 def format_path(tokens: Sequence[Token]) -> str:
+    """The key path of ``tokens`` as written in a sweep file (``impact.restitution[1]``)."""
     out = ""
     for t in tokens:
         out += f"[{t}]" if isinstance(t, int) else (f".{t}" if out else t)
@@ -64,9 +66,9 @@ def format_path(tokens: Sequence[Token]) -> str:
 def _children(prefix: tuple[Token, ...], node: Any) -> list[str]:
     if isinstance(node, Mapping):
         keys = [k for k in node if not (not prefix and k in _NOT_AXES)]
-        return [format_path(prefix + (k,)) for k in keys]
+        return [format_path((*prefix, k)) for k in keys]
     if isinstance(node, (list, tuple)):
-        return [format_path(prefix + (i,)) for i in range(len(node))]
+        return [format_path((*prefix, i)) for i in range(len(node))]
     return []
 
 
@@ -126,6 +128,7 @@ def check_path(
 
 
 def get_path(base: Any, tokens: Sequence[Token]) -> Any:
+    """The value of ``base`` (nested mappings and lists) at ``tokens``."""
     node = base
     for t in tokens:
         node = node[t]
@@ -133,7 +136,19 @@ def get_path(base: Any, tokens: Sequence[Token]) -> Any:
 
 
 def set_path(base: Any, tokens: Sequence[Token], value: Any) -> Any:
-    """A copy of ``base`` with ``value`` at ``tokens``; only the containers on the path are copied."""
+    """A copy of ``base`` with ``value`` at ``tokens``; only the containers on the path are copied.
+
+    Args:
+        base: Nested mappings and lists.
+        tokens: The key path.
+        value: The new value.
+
+    Returns:
+        The copy.
+
+    Raises:
+        TypeError: A key into a list.
+    """
     if not tokens:
         return value
     head, rest = tokens[0], tokens[1:]
@@ -141,6 +156,8 @@ def set_path(base: Any, tokens: Sequence[Token], value: Any) -> Any:
         out = dict(base)
         out[head] = set_path(base[head], rest, value) if rest else value
         return out
+    if not isinstance(head, int):
+        raise TypeError(f"list indices are integers, not {head!r}")
     out_list = list(base)
     out_list[head] = set_path(base[head], rest, value)
     return out_list

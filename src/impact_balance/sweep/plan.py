@@ -23,9 +23,10 @@ import math
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
+import numpy.typing as npt
 from scipy.stats import qmc
 
 from impact_balance.exceptions import ImpactBalanceError, ScenarioError, SweepError
@@ -50,12 +51,26 @@ from impact_balance.sweep.spec import (
     load_sweep_spec,
 )
 
-__all__ = ["PLAN_VERSION", "Dimension", "SweepPlan", "make_plan", "plan_sweep"]
+__all__ = [
+    "DEFAULT_CHUNK",
+    "DEFAULT_CHUNK_IK",
+    "PLAN_VERSION",
+    "Dimension",
+    "DimensionKind",
+    "SweepPlan",
+    "make_plan",
+    "plan_sweep",
+]
+
+#: What a dimension varies: a scenario key, a 3-vector's azimuth or elevation (degrees), or
+#: one world coordinate of the posture target (m).
+DimensionKind = Literal["path", "azimuth", "elevation", "posture"]
 
 #: Default points per chunk, without and with a posture axis.
 DEFAULT_CHUNK, DEFAULT_CHUNK_IK = 1000, 25
 
-#: Bumped when the rows of the same spec would change (columns, ordering): old results are not resumed.
+#: Bumped when the rows of the same spec would change (columns, ordering): old results are
+#: not resumed.
 #: 2: rows carry robot, contacts, stance and q; parts carry their chunk, row count and checksum.
 PLAN_VERSION = 2
 
@@ -77,7 +92,7 @@ class Dimension:
 
     name: str
     axis: int
-    kind: str
+    kind: DimensionKind
     dim: Dim
     tokens: tuple[Token, ...] = ()
     coord: int = -1
@@ -85,6 +100,7 @@ class Dimension:
 
     @property
     def numeric(self) -> bool:
+        """Every value is a number."""
         return self.dim.numeric
 
     @property
@@ -93,6 +109,11 @@ class Dimension:
         return bool(self.tokens) and self.tokens[0] == "robot"
 
     def grid_values(self) -> list[Any]:
+        """Every grid value, in order.
+
+        Raises:
+            SweepError: A range without count.
+        """
         d = self.dim
         if d.values is not None:
             return list(d.values)
@@ -100,11 +121,16 @@ class Dimension:
             raise SweepError(
                 f"axes[{self.axis}]", self.name, "a grid needs count with range (or values: [...])"
             )
-        lo, hi = d.range
-        return np.linspace(lo, hi, d.count).tolist()
+        lo, hi = d.bounds
+        values: list[Any] = np.linspace(lo, hi, d.count).tolist()
+        return values
 
-    def grid_value(self, index: np.ndarray) -> list[Any]:
-        """The grid values at ``index`` (what ``grid_values()[i]`` gives, without building the list)."""
+    def grid_value(self, index: npt.NDArray[np.intp]) -> list[Any]:
+        """The grid values at ``index`` (``grid_values()[i]``, without building the list).
+
+        Raises:
+            SweepError: A range without count.
+        """
         d = self.dim
         if d.values is not None:
             return [d.values[i] for i in index]
@@ -112,16 +138,17 @@ class Dimension:
             raise SweepError(
                 f"axes[{self.axis}]", self.name, "a grid needs count with range (or values: [...])"
             )
-        lo, hi = d.range
+        lo, hi = d.bounds
         if d.count == 1:
             return [float(lo)] * len(index)
         # numpy.linspace's own formula (start + i * step, the last value exactly hi).
         step = (hi - lo) / (d.count - 1)
         values = lo + np.asarray(index, dtype=float) * step
         values[np.asarray(index) == d.count - 1] = hi
-        return values.tolist()
+        out: list[Any] = values.tolist()
+        return out
 
-    def from_unit(self, u: np.ndarray) -> list[Any] | np.ndarray:
+    def from_unit(self, u: npt.NDArray[np.float64]) -> list[Any] | npt.NDArray[np.float64]:
         """Map quasi-random samples in [0, 1) to values."""
         d = self.dim
         if d.values is not None:
@@ -131,7 +158,7 @@ class Dimension:
                 if not d.numeric
                 else np.asarray(d.values, dtype=float)[idx]
             )
-        lo, hi = d.range
+        lo, hi = d.bounds
         return lo + u * (hi - lo)
 
 
@@ -161,8 +188,9 @@ class SweepPlan:
 
     @property
     def chunk_size(self) -> int:
-        """Points per chunk: the file's ``chunk_size``, else 1000, or 25 with a posture axis (IK
-        takes milliseconds per point: small chunks keep every worker busy to the end).
+        """Points per chunk: the file's ``chunk_size``, else 1000, or 25 with a posture axis.
+
+        IK takes milliseconds per point: small chunks keep every worker busy to the end.
         """
         if self.spec.chunk_size is not None:
             return self.spec.chunk_size
@@ -170,9 +198,11 @@ class SweepPlan:
 
     @property
     def n_chunks(self) -> int:
+        """Number of chunks."""
         return math.ceil(self.n_points / self.chunk_size)
 
     def chunk_range(self, chunk: int) -> tuple[int, int]:
+        """The points of chunk ``chunk``: ``start`` (included) and ``stop`` (excluded)."""
         start = chunk * self.chunk_size
         return start, min(self.n_points, start + self.chunk_size)
 
@@ -180,11 +210,14 @@ class SweepPlan:
         """The values of points ``start .. stop - 1``, by dimension name."""
         if self.samples is not None:
             return {d.name: list(self.samples[d.name][start:stop]) for d in self.dims}
+        if self.shape is None:
+            raise ValueError("a plan has either samples or a grid shape")
         index = np.unravel_index(np.arange(start, stop), self.shape)
-        return {d.name: d.grid_value(idx) for d, idx in zip(self.dims, index)}
+        return {d.name: d.grid_value(idx) for d, idx in zip(self.dims, index, strict=True)}
 
     @property
     def posture(self) -> PostureAxis | None:
+        """The posture axis, if any (a sweep has at most one)."""
         return next((a for a in self.spec.axes if isinstance(a, PostureAxis)), None)
 
 
@@ -212,7 +245,7 @@ def _base_mapping(spec: SweepSpec) -> tuple[dict[str, Any], str | None]:
     return raw, spec.source
 
 
-def _args(exc: ScenarioError, field: str) -> tuple:
+def _args(exc: ScenarioError, field: str) -> tuple[Any, ...]:
     valid = getattr(exc, "valid", None)
     return (
         (field, exc.value, valid, exc.source)
@@ -292,7 +325,7 @@ def _dimensions(spec: SweepSpec, base: dict[str, Any], robot: Robot) -> list[Dim
 
 def _samples(spec: SweepSpec, dims: list[Dimension]) -> dict[str, Any]:
     s = spec.sampling
-    n, d = int(s.samples), len(dims)
+    n, d = s.points, len(dims)
     engine = {"sobol": qmc.Sobol, "halton": qmc.Halton, "lhs": qmc.LatinHypercube}[s.method](
         d, rng=s.seed
     )
@@ -306,6 +339,13 @@ def _samples(spec: SweepSpec, dims: list[Dimension]) -> dict[str, Any]:
 def make_plan(spec: SweepSpec, robot: Robot | None = None) -> SweepPlan:
     """Resolve the base scenario, check every axis against it, and enumerate the points.
 
+    Args:
+        spec: The sweep file.
+        robot: The base scenario's robot, if already loaded.
+
+    Returns:
+        The plan.
+
     Raises:
         SweepError, UnknownPathError: a bad axis (the message names the path and the valid keys).
         ScenarioError: a bad base scenario.
@@ -315,7 +355,8 @@ def make_plan(spec: SweepSpec, robot: Robot | None = None) -> SweepPlan:
         base_scenario = scenario_from_dict(raw, source)
     except ScenarioError as exc:
         raise type(exc)(*_args(exc, f"base: {exc.field}")) from None
-    if base_scenario.impact is None:
+    impact = base_scenario.impact
+    if impact is None:
         raise SweepError(
             "base",
             spec.base if isinstance(spec.base, str) else "(mapping)",
@@ -336,21 +377,22 @@ def make_plan(spec: SweepSpec, robot: Robot | None = None) -> SweepPlan:
     for i, axis in enumerate(spec.axes):
         if isinstance(axis, PostureAxis):
             try:
-                robot.frame_id(
-                    axis.frame or base_scenario.impact.frame, field=f"axes[{i}].posture.frame"
-                )
+                robot.frame_id(axis.frame or impact.frame, field=f"axes[{i}].posture.frame")
             except ScenarioError as exc:
-                raise type(exc)(*_args(exc, exc.field)[:3], spec.source) from None
+                field, value, reason = _args(exc, exc.field)[:3]
+                raise type(exc)(field, value, reason, spec.source) from None
     _check_robots(spec, base, source, dims)
     _check_size(spec, spec.source)  # a spec built without sweep_spec_from_dict is bounded too
     if spec.sampling.method == "grid":
         for d in dims:
             d.grid_value(np.zeros(0, dtype=int))  # a range without count: named now
-        shape = tuple(d.dim.size for d in dims)
-        n_points, samples = math.prod(shape), None  # exact: Python integers
+        # every size is set: a range without count was refused just above
+        sizes = tuple(d.dim.size or 0 for d in dims)
+        shape: tuple[int, ...] | None = sizes
+        n_points, samples = math.prod(sizes), None  # exact: Python integers
     else:
         shape, samples = None, _samples(spec, dims)
-        n_points = int(spec.sampling.samples)
+        n_points = spec.sampling.points
     if n_points > MAX_SWEEP_POINTS:  # pragma: no cover - _check_size refuses it first
         raise SweepError("axes", n_points, f"more than {MAX_SWEEP_POINTS} points", spec.source)
     digest_input = {
@@ -365,8 +407,10 @@ def make_plan(spec: SweepSpec, robot: Robot | None = None) -> SweepPlan:
 def _check_robots(
     spec: SweepSpec, base: dict[str, Any], source: str | None, dims: list[Dimension]
 ) -> None:
-    """Load every robot of a robot axis and build the base stance with it (a robot that cannot
-    be read, or lacks the base scenario's frames, is refused now, naming its value).
+    """Load every robot of a robot axis and build the base stance with it.
+
+    A robot that cannot be read, or lacks the base scenario's frames, is refused now, naming
+    its value.
     """
     for d in dims:
         if not d.robot:

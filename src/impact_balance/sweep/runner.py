@@ -41,7 +41,8 @@ from concurrent.futures import Future, ProcessPoolExecutor, as_completed
 from concurrent.futures import wait as wait_futures
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from types import FrameType
+from typing import Any, Literal
 
 import pyarrow as pa
 from tqdm import tqdm
@@ -51,9 +52,13 @@ from impact_balance.contacts.wrench_polytope import wrench_polytope
 from impact_balance.scenario import scenario_from_dict
 from impact_balance.sweep.evaluate import Evaluator
 from impact_balance.sweep.plan import SweepPlan
-from impact_balance.sweep.store import ResultStore
+from impact_balance.sweep.store import PartProblem, ResultStore
 
-__all__ = ["STOP_GRACE_S", "RunReport", "default_workers", "run_sweep"]
+__all__ = ["STOP_GRACE_S", "BackendName", "RunReport", "dask_chunk", "default_workers", "run_sweep"]
+
+#: Where the chunks ran: nowhere (nothing was left), this process, local worker processes, or a
+#: Dask cluster.
+BackendName = Literal["none", "inline", "processes", "dask"]
 
 #: After Ctrl-C or SIGTERM, how long running chunks may finish before the workers are killed, s.
 STOP_GRACE_S = 1.0
@@ -73,7 +78,7 @@ class RunReport:
 
     Attributes:
         out: The output folder.
-        backend: "inline", "processes" or "dask".
+        backend: "inline", "processes" or "dask" ("none" when nothing was left to compute).
         workers: Worker count (Dask: the cluster's threads).
         n_points, n_chunks: Size of the sweep.
         chunks_before: Chunks already done when the run started (resumed).
@@ -86,7 +91,7 @@ class RunReport:
     """
 
     out: Path
-    backend: str
+    backend: BackendName
     workers: int
     n_points: int
     n_chunks: int
@@ -96,10 +101,11 @@ class RunReport:
     interrupted: bool
     elapsed_s: float
     startup_s: float
-    rejected: tuple = ()
+    rejected: tuple[PartProblem, ...] = ()
 
     @property
     def complete(self) -> bool:
+        """Every chunk of the sweep is written."""
         return self.chunks_before + self.chunks_computed == self.n_chunks
 
     @property
@@ -187,9 +193,11 @@ def _warm_kernel(plan: SweepPlan) -> None:
 
 
 def _context() -> multiprocessing.context.BaseContext:
-    """``forkserver`` where available (Linux): one server process imports the library once and
-    forks the workers from that clean, single-threaded state, so N workers cost one import;
-    ``spawn`` elsewhere. Never a plain fork of this process (threads, open solvers).
+    """``forkserver`` where available (Linux), ``spawn`` elsewhere.
+
+    One server process imports the library once and forks the workers from that clean,
+    single-threaded state, so N workers cost one import. Never a plain fork of this process
+    (threads, open solvers).
     """
     if "forkserver" in multiprocessing.get_all_start_methods():
         context = multiprocessing.get_context("forkserver")
@@ -199,40 +207,54 @@ def _context() -> multiprocessing.context.BaseContext:
 
 
 # -- backends: each yields (chunk, table) as chunks finish ---------------------------------
-class _Done:
-    """Nothing left to compute (a finished folder)."""
+class _Backend:
+    """A way to compute chunks; this base computes nothing (a finished folder).
 
-    name = "none"
+    ``run`` yields ``(chunk, table)`` as chunks finish; ``stop`` cancels what is left and
+    returns what finished meanwhile; ``abort`` ends the workers after an error; ``close``
+    releases them after a run.
+    """
+
+    name: BackendName = "none"
     workers = 0
 
     def run(self, chunks: list[int]) -> Iterator[tuple[int, pa.Table]]:
+        """The chunks' tables, as they finish."""
         return iter(())
 
     def stop(self) -> list[tuple[int, pa.Table]]:
+        """Cancel what is left; the chunks that finished meanwhile."""
         return []
 
+    def abort(self) -> None:
+        """End the workers at once (after an error in the parent)."""
 
-class _Inline:
-    name = "inline"
-    workers = 1
+    def close(self) -> None:
+        """Release the workers after a run."""
 
-    def __init__(self, plan: SweepPlan):
+
+class _Inline(_Backend):
+    """The chunks run in this process."""
+
+    name: BackendName = "inline"
+
+    def __init__(self, plan: SweepPlan) -> None:
         self.evaluator = Evaluator(plan)
         self.evaluator.warm_up()
         self.workers = 1
 
     def run(self, chunks: list[int]) -> Iterator[tuple[int, pa.Table]]:
+        """Each chunk's table, computed here, in order."""
         for chunk in chunks:
             yield chunk, self.evaluator.evaluate_chunk(chunk)
 
-    def stop(self) -> list[tuple[int, pa.Table]]:
-        return []
 
+class _Processes(_Backend):
+    """Local worker processes (see the module docstring)."""
 
-class _Processes:
-    name = "processes"
+    name: BackendName = "processes"
 
-    def __init__(self, plan: SweepPlan, workers: int):
+    def __init__(self, plan: SweepPlan, workers: int) -> None:
         _warm_kernel(plan)
         context = _context()
         self.workers = workers
@@ -242,7 +264,7 @@ class _Processes:
             initializer=_init_process,
             initargs=(plan, os.getpid()),
         )
-        self.futures: dict[Future, int] = {}
+        self.futures: dict[Future[pa.Table], int] = {}
         self.processes: list[Any] = []
         # Start every worker (and its robot) before the clock of the computing loop starts.
         try:
@@ -256,14 +278,16 @@ class _Processes:
             self.processes = list((getattr(self.pool, "_processes", None) or {}).values())
 
     def run(self, chunks: list[int]) -> Iterator[tuple[int, pa.Table]]:
+        """The chunks' tables, as the workers finish them."""
         self.futures = {self.pool.submit(_process_chunk, c): c for c in chunks}
         for f in as_completed(self.futures):
             chunk = self.futures.pop(f)
             yield chunk, f.result()
 
     def stop(self) -> list[tuple[int, pa.Table]]:
-        """Cancel what has not started, give what runs :data:`STOP_GRACE_S` seconds, kill the
-        workers, and return what finished meanwhile.
+        """Cancel what has not started, give what runs :data:`STOP_GRACE_S` seconds.
+
+        Then kill the workers, and return what finished meanwhile.
         """
         for f in self.futures:
             f.cancel()
@@ -290,14 +314,21 @@ class _Processes:
             with contextlib.suppress(Exception):
                 process.join(STOP_GRACE_S)
 
+    def abort(self) -> None:
+        """Kill the workers."""
+        self.kill()
+
     def close(self) -> None:
+        """Shut the pool down, waiting for its workers."""
         self.pool.shutdown(wait=True, cancel_futures=True)
 
 
-class _Dask:
-    name = "dask"
+class _Dask(_Backend):
+    """A Dask cluster, by its scheduler's address or a client."""
 
-    def __init__(self, plan: SweepPlan, scheduler: Any):
+    name: BackendName = "dask"
+
+    def __init__(self, plan: SweepPlan, scheduler: Any) -> None:
         from impact_balance.sweep.cluster import connect
 
         self.own = isinstance(scheduler, str)
@@ -308,6 +339,7 @@ class _Dask:
         self.futures: dict[Any, int] = {}
 
     def run(self, chunks: list[int]) -> Iterator[tuple[int, pa.Table]]:
+        """The chunks' tables, as the cluster finishes them."""
         from distributed import as_completed as dask_completed
 
         self.futures = {
@@ -320,19 +352,116 @@ class _Dask:
             ): c
             for c in chunks
         }
-        for f in dask_completed(list(self.futures)):
+        for f in dask_completed(list(self.futures)):  # type: ignore[no-untyped-call]
             chunk = self.futures.pop(f)
             yield chunk, f.result()
 
     def stop(self) -> list[tuple[int, pa.Table]]:
+        """Cancel the tasks left; the chunks that finished meanwhile."""
         done = [(c, f.result()) for f, c in self.futures.items() if f.status == "finished"]
         self.client.cancel(list(self.futures))
         self.futures = {}
         return done
 
+    def abort(self) -> None:
+        """Close the client (the cluster's workers are not this run's)."""
+        self.close()
+
     def close(self) -> None:
+        """Close the client if this run opened it."""
         if self.own:
             self.client.close()
+
+
+def _start_backend(
+    plan: SweepPlan, todo: list[int], workers: int | None, scheduler: Any
+) -> _Backend:
+    """The backend for the chunks ``todo`` (see :func:`run_sweep`), its workers started."""
+    n = workers or default_workers()
+    if not todo:
+        return _Backend()
+    if scheduler is not None:
+        return _Dask(plan, scheduler)
+    if n <= 1 or len(todo) <= 1:
+        return _Inline(plan)
+    return _Processes(plan, min(n, len(todo)))
+
+
+class _ChunkWriter:
+    """Writes each finished chunk to the store, counts it and moves the progress bar."""
+
+    def __init__(
+        self,
+        store: ResultStore,
+        plan: SweepPlan,
+        done: set[int],
+        progress: bool,
+        on_chunk: Callable[[int], None] | None,
+    ) -> None:
+        self.store = store
+        self.on_chunk = on_chunk
+        self.computed = self.points = 0
+        done_points = sum(plan.chunk_range(c)[1] - plan.chunk_range(c)[0] for c in done)
+        self.bar = tqdm(
+            total=plan.n_points,
+            initial=done_points,
+            unit="pt",
+            desc="sweep",
+            file=sys.stderr,
+            disable=not progress,
+            dynamic_ncols=True,
+            smoothing=0.05,
+        )
+
+    def keep(self, chunk: int, table: pa.Table) -> None:
+        """Write chunk ``chunk``'s rows and count them."""
+        self.store.write(chunk, table)
+        self.computed += 1
+        self.points += table.num_rows
+        self.bar.update(table.num_rows)
+        if self.on_chunk is not None:
+            self.on_chunk(chunk)
+
+    def close(self) -> None:
+        """Close the progress bar."""
+        self.bar.close()
+
+
+def _compute(
+    backend: _Backend, todo: list[int], writer: _ChunkWriter, stop_after: int | None
+) -> tuple[bool, float]:
+    """Compute the chunks ``todo`` and write them; whether interrupted, and the time it took (s).
+
+    Ctrl-C (or SIGTERM) stops the loop and keeps what finished; the backend is stopped,
+    aborted (after an error) or closed, whatever happens.
+    """
+    interrupted = failed = False
+    t1 = time.perf_counter()
+    try:
+        with _sigterm_interrupts():
+            try:
+                for chunk, table in backend.run(todo):
+                    writer.keep(chunk, table)
+                    if stop_after is not None and writer.computed >= stop_after:
+                        interrupted = writer.computed < len(todo)
+                        break
+            except KeyboardInterrupt:
+                interrupted = True
+                for chunk, table in backend.stop():
+                    writer.keep(chunk, table)
+    except BaseException:
+        failed = True
+        raise
+    finally:
+        elapsed = time.perf_counter() - t1
+        if interrupted and not isinstance(backend, _Inline):
+            backend.stop()
+        if failed:
+            backend.abort()  # an error in the parent (a full disk...): no worker outlives it
+        else:
+            backend.close()
+        writer.close()
+    return interrupted, elapsed
 
 
 def run_sweep(
@@ -347,6 +476,10 @@ def run_sweep(
 ) -> RunReport:
     """Compute the chunks of ``plan`` not yet in ``out``, writing each one as it finishes.
 
+    Ctrl-C (or SIGTERM, in the main thread) stops the run: chunks already written stay, chunks
+    that finish within :data:`STOP_GRACE_S` are written too, the workers are ended, and the
+    report says ``interrupted``.
+
     Args:
         plan: The sweep.
         out: Output folder (created; an existing one with the same sweep is resumed).
@@ -359,9 +492,8 @@ def run_sweep(
         notify: Called with one line per bad part found in ``out`` (moved to ``rejected/``,
             computed again).
 
-    Ctrl-C (or SIGTERM, in the main thread) stops the run: chunks already written stay, chunks
-    that finish within :data:`STOP_GRACE_S` are written too, the workers are ended, and the
-    report says ``interrupted``.
+    Returns:
+        What the run did.
 
     Raises:
         SweepError: ``out`` holds another sweep, or is not a sweep folder.
@@ -371,74 +503,16 @@ def run_sweep(
     good = set(store.check.good) if store.check is not None else set()
     todo = [c for c in range(plan.n_chunks) if c not in good]
     t0 = time.perf_counter()
-    n = workers or default_workers()
-    if not todo:
-        backend: Any = _Done()
-    elif scheduler is not None:
-        backend = _Dask(plan, scheduler)
-    elif n <= 1 or len(todo) <= 1:
-        backend = _Inline(plan)
-    else:
-        backend = _Processes(plan, min(n, len(todo)))
+    backend = _start_backend(plan, todo, workers, scheduler)
     startup = time.perf_counter() - t0
     try:
         store.create(notify)  # the inputs are good and the workers are up: now the folder
     except BaseException:
-        if hasattr(backend, "kill"):
-            backend.kill()
-        elif hasattr(backend, "close"):
-            backend.close()
+        backend.abort()
         raise
     done = store.finished()
-    done_points = sum(plan.chunk_range(c)[1] - plan.chunk_range(c)[0] for c in done)
-    bar = tqdm(
-        total=plan.n_points,
-        initial=done_points,
-        unit="pt",
-        desc="sweep",
-        file=sys.stderr,
-        disable=not progress,
-        dynamic_ncols=True,
-        smoothing=0.05,
-    )
-    computed = points = 0
-    interrupted = False
-    t1 = time.perf_counter()
-
-    def keep(chunk: int, table: pa.Table) -> None:
-        nonlocal computed, points
-        store.write(chunk, table)
-        computed += 1
-        points += table.num_rows
-        bar.update(table.num_rows)
-        if on_chunk is not None:
-            on_chunk(chunk)
-
-    failed = False
-    try:
-        with _sigterm_interrupts():
-            try:
-                for chunk, table in backend.run(todo):
-                    keep(chunk, table)
-                    if stop_after is not None and computed >= stop_after:
-                        interrupted = computed < len(todo)
-                        break
-            except KeyboardInterrupt:
-                interrupted = True
-                for chunk, table in backend.stop():
-                    keep(chunk, table)
-    except BaseException:
-        failed = True
-        raise
-    finally:
-        elapsed = time.perf_counter() - t1
-        if interrupted and not isinstance(backend, _Inline):
-            backend.stop()
-        if failed and hasattr(backend, "kill"):
-            backend.kill()  # an error in the parent (a full disk...): no worker outlives it
-        elif hasattr(backend, "close"):
-            backend.close()
-        bar.close()
+    writer = _ChunkWriter(store, plan, done, progress, on_chunk)
+    interrupted, elapsed = _compute(backend, todo, writer, stop_after)
     return RunReport(
         Path(out),
         backend.name,
@@ -446,8 +520,8 @@ def run_sweep(
         plan.n_points,
         plan.n_chunks,
         len(done),
-        computed,
-        points,
+        writer.computed,
+        writer.points,
         interrupted,
         elapsed,
         startup,
@@ -462,7 +536,7 @@ def _sigterm_interrupts() -> Iterator[None]:
         yield
         return
 
-    def handler(signum, frame):
+    def handler(signum: int, frame: FrameType | None) -> None:
         raise KeyboardInterrupt
 
     previous = signal.signal(signal.SIGTERM, handler)

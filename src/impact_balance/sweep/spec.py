@@ -2,9 +2,9 @@
 
 ```yaml
 description: "maximum contact velocity against impact friction and restitution"
-base: palm_push_two_feet          # bundled scenario name, a path (relative to this file), or a mapping
-sampling: grid                    # or {method: sobol | halton | lhs, samples: 4096, seed: 0}
-chunk_size: 1000                  # points per chunk (work, output, resume); default 1000, 25 with posture
+base: palm_push_two_feet    # bundled scenario name, a path (relative to this file), or a mapping
+sampling: grid              # or {method: sobol | halton | lhs, samples: 4096, seed: 0}
+chunk_size: 1000            # points per chunk (work, output, resume); 1000, or 25 with posture
 axes:
   - path: impact.friction         # any scenario key path
     range: [0.0, 0.6]             # with count (grid), or values: [...]
@@ -33,7 +33,7 @@ from __future__ import annotations
 import math
 from importlib import resources
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal, get_args
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
@@ -44,14 +44,22 @@ from impact_balance.scenario.bundled import bundled_descriptions
 from impact_balance.scenario.fields import Integer, Number
 from impact_balance.scenario.reader import read_yaml
 
+if TYPE_CHECKING:
+    from importlib.abc import Traversable
+
 __all__ = [
     "QMC_METHODS",
+    "SAMPLING_METHODS",
+    "Axis",
     "Dim",
     "DirectionAxis",
     "PathAxis",
     "PostureAxis",
+    "QmcMethod",
     "Sampling",
+    "SamplingMethod",
     "SweepSpec",
+    "UnknownSweepError",
     "bundled_sweeps",
     "load_sweep_spec",
     "sweep_path",
@@ -59,7 +67,11 @@ __all__ = [
 ]
 
 #: Quasi-random sampling methods (``scipy.stats.qmc``): Sobol, Halton, Latin hypercube.
-QMC_METHODS = ("sobol", "halton", "lhs")
+QmcMethod = Literal["sobol", "halton", "lhs"]
+#: How the points are drawn: ``grid`` (every combination) or a quasi-random method.
+SamplingMethod = Literal["grid", "sobol", "halton", "lhs"]
+QMC_METHODS: tuple[QmcMethod, ...] = get_args(QmcMethod)
+SAMPLING_METHODS: tuple[SamplingMethod, ...] = get_args(SamplingMethod)
 
 
 class _Model(BaseModel):
@@ -73,9 +85,9 @@ class Dim(_Model):
     quasi-random sampling draws from the range (or picks among the values).
     """
 
-    values: list[Any] | None = Field(None, min_length=1)
+    values: list[Any] | None = Field(default=None, min_length=1)
     range: tuple[Number, Number] | None = None
-    count: Integer | None = Field(None, ge=1, le=MAX_SWEEP_POINTS)
+    count: Integer | None = Field(default=None, ge=1, le=MAX_SWEEP_POINTS)
 
     @model_validator(mode="after")
     def _one_of(self) -> Dim:
@@ -103,7 +115,19 @@ class Dim(_Model):
         return len(self.values) if self.values is not None else self.count
 
     @property
+    def bounds(self) -> tuple[float, float]:
+        """The range's ends ``(lo, hi)``.
+
+        Raises:
+            ValueError: The dimension has values, not a range.
+        """
+        if self.range is None:
+            raise ValueError("the dimension has values, not a range")
+        return self.range
+
+    @property
     def numeric(self) -> bool:
+        """Every value is a number (a bool is not): always for a range."""
         return self.values is None or all(
             isinstance(v, (int, float)) and not isinstance(v, bool) for v in self.values
         )
@@ -146,8 +170,8 @@ class PostureAxis(_Model):
     x: Dim | None = None
     y: Dim | None = None
     z: Dim | None = None
-    tolerance: Number = Field(1e-4, gt=0, le=1e-2)
-    max_iterations: Integer = Field(200, ge=1, le=10_000)
+    tolerance: Number = Field(default=1e-4, gt=0, le=1e-2)
+    max_iterations: Integer = Field(default=200, ge=1, le=10_000)
 
     @model_validator(mode="after")
     def _some_target(self) -> PostureAxis:
@@ -162,9 +186,9 @@ class PostureAxis(_Model):
 class Sampling(_Model):
     """``grid`` (every combination) or quasi-random ``samples`` points (scipy.stats.qmc)."""
 
-    method: Literal["grid", "sobol", "halton", "lhs"] = "grid"
-    samples: Integer | None = Field(None, ge=1, le=MAX_SWEEP_POINTS)
-    seed: Integer = Field(0, ge=0, le=2**63 - 1)
+    method: SamplingMethod = "grid"
+    samples: Integer | None = Field(default=None, ge=1, le=MAX_SWEEP_POINTS)
+    seed: Integer = Field(default=0, ge=0, le=2**63 - 1)
 
     @model_validator(mode="after")
     def _samples(self) -> Sampling:
@@ -176,7 +200,19 @@ class Sampling(_Model):
             raise ValueError(f"{self.method} sampling needs samples: N")
         return self
 
+    @property
+    def points(self) -> int:
+        """The number of quasi-random points.
 
+        Raises:
+            ValueError: The sampling is a grid (its points come from the axes).
+        """
+        if self.samples is None:
+            raise ValueError("a grid has no samples: its points come from the axes")
+        return int(self.samples)
+
+
+#: One axis of a sweep file.
 Axis = PathAxis | DirectionAxis | PostureAxis
 
 
@@ -187,8 +223,8 @@ class SweepSpec(_Model):
     base: str | dict[str, Any]
     axes: tuple[Axis, ...]
     sampling: Sampling = Sampling()
-    chunk_size: Integer | None = Field(None, ge=1, le=MAX_SWEEP_POINTS)
-    source: str | None = Field(None, exclude=True)
+    chunk_size: Integer | None = Field(default=None, ge=1, le=MAX_SWEEP_POINTS)
+    source: str | None = Field(default=None, exclude=True)
 
     def dimension_sizes(self) -> list[int | None]:
         """Grid values per dimension, in the file's order (None: a range without count)."""
@@ -203,11 +239,11 @@ class SweepSpec(_Model):
         return sizes
 
     def point_count(self) -> int | None:
-        """The number of points, exact (Python integers; None when a grid range lacks its count)."""
+        """The number of points, exact (Python integers; None: a grid range lacks its count)."""
         if self.sampling.method != "grid":
-            return int(self.sampling.samples)
-        sizes = self.dimension_sizes()
-        return None if any(s is None for s in sizes) else math.prod(sizes)
+            return self.sampling.points
+        sizes = [s for s in self.dimension_sizes() if s is not None]
+        return None if len(sizes) < len(self.dimension_sizes()) else math.prod(sizes)
 
     def digest_data(self) -> dict[str, Any]:
         """The keys that define the results (not the description), JSON-ready."""
@@ -263,7 +299,7 @@ def _axis(raw: Any, i: int, source: str | None) -> Axis:
         return (PathAxis if kinds[0] == "path" else DirectionAxis).model_validate(raw)
     except ValidationError as exc:
         _raise(exc, raw, field + (".posture" if kinds[0] == "posture" else ""), source)
-        raise AssertionError("unreachable")  # pragma: no cover
+        raise AssertionError("unreachable") from exc  # pragma: no cover
 
 
 def sweep_spec_from_dict(raw: Any, source: str | None = None) -> SweepSpec:
@@ -294,14 +330,16 @@ def sweep_spec_from_dict(raw: Any, source: str | None = None) -> SweepSpec:
         spec = SweepSpec.model_validate({**body, "axes": axes, "source": source})
     except ValidationError as exc:
         _raise(exc, raw, "", source)
-        raise AssertionError("unreachable")  # pragma: no cover
+        raise AssertionError("unreachable") from exc  # pragma: no cover
     _check_size(spec, source)
     return spec
 
 
 def _check_size(spec: SweepSpec, source: str | None) -> None:
-    """Refuse a sweep of more than MAX_SWEEP_POINTS points or MAX_SWEEP_CHUNKS chunks, from the
-    file alone (exact integers: no float overflow, no wrap-around), before anything is allocated.
+    """Refuse a sweep of more than MAX_SWEEP_POINTS points or MAX_SWEEP_CHUNKS chunks.
+
+    The count comes from the file alone (exact integers: no float overflow, no wrap-around),
+    before anything is allocated.
     """
     n = spec.point_count()
     if n is None:
@@ -311,7 +349,8 @@ def _check_size(spec: SweepSpec, source: str | None) -> None:
         how = (
             ""
             if spec.sampling.method != "grid"
-            else f" (the product of the axes' counts {' x '.join(str(s) for s in spec.dimension_sizes())})"
+            else " (the product of the axes' counts "
+            f"{' x '.join(str(s) for s in spec.dimension_sizes())})"
         )
         text = str(n) if n < 10**30 else f"about 10^{len(str(n)) - 1}"
         raise SweepError(
@@ -334,7 +373,7 @@ def _check_size(spec: SweepSpec, source: str | None) -> None:
 
 
 # -- files ------------------------------------------------------------------------------
-def _sweep_dir():
+def _sweep_dir() -> Traversable:
     return resources.files("impact_balance") / "sweeps"
 
 

@@ -1,9 +1,9 @@
-"""The output folder of a sweep: a manifest, one Parquet part per finished chunk, checked like a database.
+"""The output folder of a sweep: a manifest, one Parquet part per chunk, checked like a database.
 
 ```
 OUT/manifest.json               what the sweep is (the plan's digest, points, chunks, columns)
 OUT/manifest-parts.jsonl        one line per part written: chunk, file, rows, checksum
-OUT/parts/part-000000.parquet   rows of chunk 0 ... (each part's metadata: digest, chunk, rows, checksum)
+OUT/parts/part-000000.parquet   rows of chunk 0 ... (metadata: digest, chunk, rows, checksum)
 OUT/rejected/                   parts a resume found bad, moved aside (never deleted)
 ```
 
@@ -35,7 +35,7 @@ import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import pyarrow as pa
@@ -53,6 +53,7 @@ __all__ = [
     "FolderCheck",
     "PartProblem",
     "PartRecord",
+    "ProblemKind",
     "ResultStore",
     "check_folder",
     "load_results",
@@ -60,6 +61,9 @@ __all__ = [
     "read_results",
     "table_checksum",
 ]
+
+#: What is wrong with a part (see the module docstring).
+ProblemKind = Literal["damaged", "foreign", "renamed", "extra", "missing"]
 
 MANIFEST = "manifest.json"
 LEDGER = "manifest-parts.jsonl"
@@ -111,11 +115,13 @@ def _hash_array(h: Any, arr: pa.Array) -> None:
 
 
 def table_checksum(table: pa.Table) -> str:
-    """``sha256:...`` of a table's column names, types, validity and values (not of its file
-    encoding: the same rows read back from Parquet give the same checksum).
+    """``sha256:...`` of a table's column names, types, validity and values.
+
+    The checksum is not of the file's encoding: the same rows read back from Parquet give the
+    same checksum.
     """
     h = hashlib.sha256(f"rows={table.num_rows}".encode())
-    for fld, column in zip(table.schema, table.columns):
+    for fld, column in zip(table.schema, table.columns, strict=True):
         h.update(b"\x00" + fld.name.encode() + b"\x00" + _type_name(fld.type).encode() + b"\x00")
         _hash_array(h, column.combine_chunks())
     return "sha256:" + h.hexdigest()
@@ -132,6 +138,7 @@ class PartRecord:
     checksum: str
 
     def to_dict(self) -> dict[str, Any]:
+        """The record as a line of the manifest of parts."""
         return {
             "chunk": self.chunk,
             "file": self.file,
@@ -152,14 +159,16 @@ class PartProblem:
     """
 
     file: str
-    kind: str
+    kind: ProblemKind
     reason: str
     chunk: int | None = None
 
     def line(self) -> str:
+        """The problem in one line: file, kind, reason."""
         return f"{self.file}: {self.kind}: {self.reason}"
 
     def to_dict(self) -> dict[str, Any]:
+        """The problem as JSON values."""
         return {"file": self.file, "kind": self.kind, "reason": self.reason, "chunk": self.chunk}
 
 
@@ -183,6 +192,7 @@ class FolderCheck:
 
     @property
     def n_chunks(self) -> int:
+        """Number of chunks of the sweep."""
         return int(self.manifest["n_chunks"])
 
     @property
@@ -197,9 +207,11 @@ class FolderCheck:
 
     @property
     def rows(self) -> int:
+        """Rows in the good parts."""
         return sum(r.rows for r in self.good.values())
 
     def to_dict(self) -> dict[str, Any]:
+        """The check as JSON values (``sweep --verify --json``)."""
         return {
             "out": str(self.root),
             "digest": self.manifest.get("digest"),
@@ -249,7 +261,10 @@ def _check_part(
     keep: dict[int, pa.Table] | None,
 ) -> PartRecord | PartProblem:
     rel = f"{PARTS}/{path.name}"
-    named = int(_PART.match(path.name).group(1))
+    match = _PART.match(path.name)
+    if match is None:
+        return PartProblem(rel, "extra", "not a part file name (part-NNNNNN.parquet)")
+    named = int(match.group(1))
     n_chunks = int(manifest["n_chunks"])
     if path.is_symlink() or not path.is_file():
         return PartProblem(rel, "extra", "not a regular file", named)
@@ -417,7 +432,8 @@ class ResultStore:
                     "--out",
                     str(root),
                     f"holds the results of a different sweep (digest {old.get('digest')}, "
-                    f"this one is {plan.digest}): choose another --out, or delete the folder to start again",
+                    f"this one is {plan.digest}): choose another --out, or delete the folder "
+                    "to start again",
                 )
             store.check = check_folder(root)
         elif root.exists() and any(root.iterdir()):
@@ -439,12 +455,17 @@ class ResultStore:
 
     @property
     def problems(self) -> list[PartProblem]:
+        """The bad parts the check found (moved aside by :meth:`create`)."""
         return list(self.check.problems) if self.check is not None else []
 
     def create(self, notify: Callable[[str], None] | None = None) -> None:
-        """Make the folder and its manifest, or ready it for a resume: every bad part is moved
-        to ``rejected/`` (``notify`` gets one line per part) and the manifest of parts lists the
-        good ones.
+        """Make the folder and its manifest, or ready it for a resume.
+
+        On a resume every bad part is moved to ``rejected/`` and the manifest of parts lists
+        the good ones.
+
+        Args:
+            notify: Gets one line per bad part.
         """
         (self.root / PARTS).mkdir(parents=True, exist_ok=True)
         for stale in (self.root / PARTS).iterdir():  # writes cut short by a kill
@@ -469,6 +490,7 @@ class ResultStore:
         self._good = set(good)
 
     def manifest(self) -> dict[str, Any]:
+        """The folder's ``manifest.json``: what the sweep is."""
         plan = self.plan
         return {
             "format": "impact-balance sweep",
@@ -493,7 +515,17 @@ class ResultStore:
         return set(self._good)
 
     def write(self, chunk: int, table: pa.Table) -> Path:
-        """Write one chunk's rows (temporary file, atomic rename), then record it in the manifest of parts."""
+        """Write one chunk's rows, then record them in the manifest of parts.
+
+        The part is written to a temporary file and renamed (atomic).
+
+        Args:
+            chunk: The chunk.
+            table: Its rows.
+
+        Returns:
+            The part's path.
+        """
         path = self.root / PARTS / _part_name(chunk)
         data = table.replace_schema_metadata(None)
         checksum = table_checksum(data)
@@ -513,7 +545,11 @@ class ResultStore:
 
 
 def _reject(root: Path, problem: PartProblem) -> str | None:
-    """Move a bad part to ``rejected/`` (a free name); its new path relative to ``root``, None if gone."""
+    """Move a bad part to ``rejected/`` (a free name).
+
+    Returns:
+        Its new path relative to ``root``, None if it is gone.
+    """
     source = root / problem.file
     if not (source.exists() or source.is_symlink()) or problem.kind == "missing":
         return None
@@ -571,7 +607,7 @@ def read_manifest(root: str | Path) -> dict[str, Any]:
 
 
 def load_results(root: str | Path) -> tuple[FolderCheck, pa.Table]:
-    """The folder's check and the rows of its good parts, sorted by point (an empty table if none)."""
+    """The folder's check and the rows of its good parts, sorted by point (empty if none)."""
     check = check_folder(root, keep_tables=True)
     tables = [check.tables[c] for c in sorted(check.tables)]
     check.tables = {}
@@ -587,6 +623,7 @@ def read_results(root: str | Path, strict: bool = True) -> pa.Table:
     """All rows of a sweep folder's good parts, sorted by point.
 
     Args:
+        root: The sweep folder.
         strict: Raise :class:`SweepError` naming the first bad part when a part is bad
             (otherwise the good parts only are returned).
     """

@@ -10,20 +10,17 @@ are read; a bad part is named in ``problems`` (and the summary is not ``complete
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from impact_balance.sweep.evaluate import STATUSES
+from impact_balance.json_values import json_number
+from impact_balance.sweep.columns import EVALUATED, STATUSES
 from impact_balance.sweep.store import FolderCheck, load_results
 
 __all__ = ["EVALUATED", "format_summary", "load_frame", "summarize"]
-
-#: Statuses of points that were evaluated (the others are rows with a message).
-EVALUATED = ("ok", "unbounded", "already_falling", "cannot_balance")
 
 _SHOWN = (
     "status",
@@ -38,8 +35,15 @@ _SHOWN = (
 def load_frame(
     root: str | Path, check: list[FolderCheck] | None = None
 ) -> tuple[dict[str, Any], pd.DataFrame]:
-    """The manifest and the rows of the good parts (a pandas DataFrame sorted by point, without
-    the configurations ``q``); ``check``, if given, receives the folder's check.
+    """The manifest and the rows of the good parts.
+
+    Args:
+        root: The sweep folder.
+        check: If given, receives the folder's check.
+
+    Returns:
+        The manifest, and the rows as a pandas DataFrame sorted by point, without the
+        configurations ``q``.
     """
     found, table = load_results(root)
     if check is not None:
@@ -57,18 +61,23 @@ def _clean(value: Any) -> Any:
     if isinstance(value, (np.integer,)):
         return int(value)
     if isinstance(value, (float, np.floating)):
-        return float(value) if math.isfinite(value) else None
+        return json_number(float(value))
     if value is pd.NA:
         return None
     return value
 
 
 def _records(df: pd.DataFrame, columns: list[str]) -> list[dict[str, Any]]:
+    """The rows of ``df`` as JSON-safe dicts of ``columns``."""
     return [{c: _clean(row[c]) for c in columns} for _, row in df[columns].iterrows()]
 
 
 def summarize(root: str | Path, top: int = 5) -> dict[str, Any]:
     """Summary of a sweep folder (JSON-ready: no NaN or infinity, ``null`` instead).
+
+    Args:
+        root: The sweep folder.
+        top: How many best and worst points to list.
 
     Returns:
         ``out``, ``description``, ``n_points``, ``rows`` (finished), ``complete``,
@@ -138,8 +147,8 @@ def format_summary(summary: dict[str, Any]) -> str:
     ]
     if problems:
         lines.append(
-            f"  {len(problems)} bad part(s) left out (named on stderr and by `sweep --verify`; a resume "
-            "moves them to rejected/ and computes them again)"
+            f"  {len(problems)} bad part(s) left out (named on stderr and by `sweep --verify`; "
+            "a resume moves them to rejected/ and computes them again)"
         )
     if summary.get("description"):
         lines.append(f"  {summary['description']}")
@@ -147,8 +156,10 @@ def format_summary(summary: dict[str, Any]) -> str:
     stats = summary.get("max_contact_velocity")
     if stats:
         lines.append(
-            f"  max contact velocity (CoM criterion), m/s: min {_fmt(stats['min'])}, median {_fmt(stats['median'])}, "
-            f"max {_fmt(stats['max']) if stats['max'] is not None else 'unbounded'} ({stats['unbounded']} unbounded)"
+            f"  max contact velocity (CoM criterion), m/s: min {_fmt(stats['min'])}, "
+            f"median {_fmt(stats['median'])}, "
+            f"max {_fmt(stats['max']) if stats['max'] is not None else 'unbounded'} "
+            f"({stats['unbounded']} unbounded)"
         )
     dims = summary["dimensions"]
     header = ["point", *dims, "max v (m/s)", "ZMP (m/s)", "verdict", "vertex", "edge"]
@@ -175,7 +186,9 @@ def format_summary(summary: dict[str, Any]) -> str:
         ]
         widths = [max(len(row[i]) for row in table) for i in range(len(header))]
         for row in table:
-            lines.append("    " + "  ".join(cell.rjust(w) for cell, w in zip(row, widths)))
+            lines.append(
+                "    " + "  ".join(cell.rjust(w) for cell, w in zip(row, widths, strict=True))
+            )
     for r in summary.get("failed_examples") or []:
         lines.append(f"  e.g. point {r['point']} {r['status']}: {r['message']}")
     return "\n".join(lines)
