@@ -14,6 +14,8 @@
   :mod:`.scenario_tab` (settings and file controls), :mod:`.results` (the numbers as HTML).
 """
 
+from typing import TYPE_CHECKING, Any
+
 from impact_balance.gui.drag import DragResult, DragTarget, drag_changes, handle_pose
 from impact_balance.gui.limbs import JointSlider, joint_groups, joint_values
 from impact_balance.gui.scene import (
@@ -28,6 +30,9 @@ from impact_balance.gui.scene import (
 from impact_balance.gui.session import Session, Summary, format_speed
 from impact_balance.gui.state import DEFAULT_SCENARIO, FieldPath, GuiState
 from impact_balance.gui.view2d import svg_view
+
+if TYPE_CHECKING:
+    from impact_balance.gui.app import GuiApp, run
 
 __all__ = [
     "DEFAULT_SCENARIO",
@@ -56,7 +61,7 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str):
+def __getattr__(name: str) -> Any:
     # viser is only needed to serve: keep `import impact_balance.gui` light for tests.
     if name in ("GuiApp", "run"):
         from impact_balance.gui import app

@@ -4,8 +4,9 @@ Wiring only: the parts (:mod:`.viser_scene`, :mod:`.gizmos`, :mod:`.panels`,
 :mod:`.scenario_tab`, on the base of :mod:`.host`) build their widgets; every control edits the
 :class:`~.session.Session` (all-or-nothing), then :meth:`GuiApp.refresh` puts the widgets back
 in line with the session (a refused value reverts), and redraws the robot, the scene objects
-of :mod:`.scene` and the SVG of :mod:`.view2d`. Callbacks come from viser's thread pool; the session's lock makes them
-one-at-a-time. Gizmo drags are coalesced: only the latest pose of a burst is solved.
+of :mod:`.scene` and the SVG of :mod:`.view2d`. Callbacks come from viser's thread pool; the
+session's lock makes them one-at-a-time. Gizmo drags are coalesced: only the latest pose of a
+burst is solved.
 """
 
 from __future__ import annotations
@@ -201,7 +202,8 @@ def run(
 
     Args:
         scenario: Scenario file or bundled name (read as given: it comes from the command line).
-        host, port: Where to listen.
+        host: Interface to bind (default: localhost only).
+        port: TCP port (0 picks a free one).
         ready: Called with the app once it serves (the CLI prints the URL there).
         stop: Optional event that ends the loop (for tests).
         workspace: The folder the GUI loads from and saves to.

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 
 from impact_balance.contacts.stance import Stance
@@ -39,6 +40,7 @@ class DragTarget:
 
     @property
     def key(self) -> str:
+        """The gizmo key: ``"impact"`` or ``"contact<index>"``."""
         return "impact" if self.kind == "impact" else f"contact{self.index}"
 
 
@@ -60,7 +62,7 @@ class DragResult:
 def _offset(state: GuiState, path: FieldPath) -> pin.SE3:
     from impact_balance.geometry.spatial import pose
 
-    offset = state.get(path + ("offset",)) or {}
+    offset = state.get((*path, "offset")) or {}
     return pose(offset.get("position", (0.0, 0.0, 0.0)), offset.get("rpy", (0.0, 0.0, 0.0)))
 
 
@@ -131,7 +133,9 @@ def _interpolate(a: pin.SE3, b: pin.SE3, t: float) -> pin.SE3:
     return pin.SE3(rotation, a.translation + t * (b.translation - a.translation))
 
 
-def _solve(stance: Stance, frame: str, target: pin.SE3, fixed_frames: list[str]) -> np.ndarray:
+def _solve(
+    stance: Stance, frame: str, target: pin.SE3, fixed_frames: list[str]
+) -> npt.NDArray[np.float64]:
     """IK for one target, other frames fixed; a non-converged answer is kept if they stayed put."""
     try:
         return solve_stance(
@@ -149,10 +153,14 @@ def _solve(stance: Stance, frame: str, target: pin.SE3, fixed_frames: list[str])
         miss = max((v for k, v in exc.residuals.items() if k.split(".")[0] == frame), default=0.0)
         if drift > FIXED_TOLERANCE or miss > FIXED_TOLERANCE:
             raise
-        return exc.q  # slow convergence, but within a millimetre: good enough for a drag
+        q: npt.NDArray[np.float64] = exc.q
+        return q  # slow convergence, but within a millimetre: good enough for a drag
 
 
-def _changes(stance: Stance, q: np.ndarray, reached: bool, residual: float) -> DragResult:
+def _changes(
+    stance: Stance, q: npt.NDArray[np.float64], reached: bool, residual: float
+) -> DragResult:
+    """The scenario changes of configuration ``q``: the base pose and every joint value."""
     rpy = pin.rpy.matrixToRpy(pin.Quaternion(np.asarray(q[3:7])).normalized().matrix())
     changes: dict[FieldPath, Any] = {
         ("base",): {"position": [float(x) for x in q[:3]], "rpy": [float(x) for x in rpy]},

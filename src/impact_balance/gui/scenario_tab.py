@@ -62,7 +62,8 @@ class ScenarioTabMixin(GuiHost):
             0.0,
             min=0.0,
             step=0.005,
-            hint="Shrink the ZMP support area by this margin (and the CoM velocity area with it), m",
+            hint="Shrink the ZMP support area by this margin (and the CoM velocity area with it), "
+            "m",
         )
         self.w_zmp_margin.on_update(self._field(("zmp_margin",), float))
         self.w_gizmos = gui.add_checkbox(

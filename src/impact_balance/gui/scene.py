@@ -57,7 +57,7 @@ class Segments:
     """Line segments, ``segments`` (N, 2, 3) m; ``width`` m."""
 
     name: str
-    segments: np.ndarray
+    segments: npt.NDArray[np.float64]
     color: str
     width: float = 0.006
 
@@ -67,7 +67,7 @@ class Points:
     """Spheres at ``points`` (N, 3) m, of radius ``radius`` m."""
 
     name: str
-    points: np.ndarray
+    points: npt.NDArray[np.float64]
     color: str
     radius: float = 0.02
 
@@ -77,8 +77,8 @@ class Arrows:
     """Arrows from ``starts`` to ``ends`` (N, 3) m."""
 
     name: str
-    starts: np.ndarray
-    ends: np.ndarray
+    starts: npt.NDArray[np.float64]
+    ends: npt.NDArray[np.float64]
     color: str
     radius: float = 0.006
 
@@ -88,8 +88,8 @@ class Surface:
     """A triangle mesh: ``vertices`` (N, 3) m, ``faces`` (M, 3) indices."""
 
     name: str
-    vertices: np.ndarray
-    faces: np.ndarray
+    vertices: npt.NDArray[np.float64]
+    faces: npt.NDArray[np.uint32]
     color: str
     opacity: float = 0.5
 
@@ -100,14 +100,14 @@ class Label:
 
     name: str
     text: str
-    position: np.ndarray
+    position: npt.NDArray[np.float64]
     color: str = "#111111"
 
 
 SceneObject = Segments | Points | Arrows | Surface | Label
 
 
-def polyline_segments(points: np.ndarray, closed: bool = True) -> np.ndarray:
+def polyline_segments(points: npt.ArrayLike, closed: bool = True) -> npt.NDArray[np.float64]:
     """(N, 2, 3) segments joining consecutive points (and the last to the first if closed)."""
     p = np.asarray(points, dtype=float).reshape(-1, 3)
     if len(p) < 2:
@@ -117,14 +117,17 @@ def polyline_segments(points: np.ndarray, closed: bool = True) -> np.ndarray:
     return np.stack([starts, ends], axis=1)
 
 
-def _fan(polygon: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _fan(
+    polygon: npt.NDArray[np.float64],
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]:
     """Triangles of a convex polygon (N, 3), both sides (so it shows from below too)."""
     n = len(polygon)
     front = np.array([[0, i, i + 1] for i in range(1, n - 1)], dtype=np.uint32).reshape(-1, 3)
     return polygon, np.vstack([front, front[:, ::-1]])
 
 
-def _on_plane(vertices: np.ndarray, height: float) -> np.ndarray:
+def _on_plane(vertices: npt.ArrayLike, height: float) -> npt.NDArray[np.float64]:
+    """Planar ``vertices`` (N, 2) lifted to ``height`` (m): (N, 3)."""
     v = np.asarray(vertices, dtype=float).reshape(-1, 2)
     return np.column_stack([v, np.full(len(v), height)])
 

@@ -148,7 +148,7 @@ class SceneMixin(GuiHost):
         self.server.initial_camera.look_at = (0.1, 0.0, 0.6)
 
     def _draw_objects(self) -> None:
-        """Draw :func:`scene_objects`: unchanged objects are skipped, changed ones updated in place."""
+        """Draw :func:`scene_objects`: skip unchanged objects, update changed ones in place."""
         scene = self.server.scene
         seen: set[str] = set()
         for obj in scene_objects(self.session.analysis):
@@ -176,7 +176,7 @@ class SceneMixin(GuiHost):
                 self._scene_data.pop(name, None)
 
     def _draw_robot(self, opacity: float) -> None:
-        """Move the robot's meshes to the stance; read them anew (at ``opacity``) for a new robot."""
+        """Move the robot's meshes to the stance; read them (at ``opacity``) for a new robot."""
         stance = self.session.analysis.stance
         if self._meshes is None or self._meshes.robot is not stance.robot:
             if self._meshes is not None:

@@ -205,7 +205,7 @@ class Workspace:
 
     # -- I/O without following links --------------------------------------------------------
     def _open_folder(self, parts: tuple[str, ...], field: str, name: str) -> int:
-        """A descriptor of the folder ``parts`` under the root, opened link by link without following."""
+        """A descriptor of the folder ``parts`` under the root, opened part by part, no link."""
         flags = os.O_RDONLY | getattr(os, "O_DIRECTORY", 0) | getattr(os, "O_NOFOLLOW", 0)
         fd = os.open(self.root, flags)
         try:
@@ -225,7 +225,7 @@ class Workspace:
 
     @staticmethod
     def _create(folder: int, name: str, field: str, shown: str) -> tuple[int, str]:
-        """A new file ``name`` in the folder descriptor (never an existing one, never through a link)."""
+        """A new file ``name`` in the folder descriptor (never an existing one, nor a link)."""
         flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
         try:
             return os.open(name, flags, 0o666, dir_fd=folder), name
@@ -273,7 +273,7 @@ class Workspace:
         field: str = "file",
         suffixes: tuple[str, ...] = SCENARIO_SUFFIXES,
     ) -> Path:
-        """Write ``text`` to the workspace file ``name``; refuse to replace a file unless ``overwrite``.
+        """Write ``text`` to the workspace file ``name``; replace a file only with ``overwrite``.
 
         The text goes to a temporary file in the same folder, then takes the name at once: a
         reader never sees half a file, and an existing link is replaced, never followed.
