@@ -1,9 +1,8 @@
 """GUI uploads counted as they arrive: cut at the limit, never held whole.
 
-viser (1.1) buffers an upload's parts in memory until the last one arrives, and the 1 MiB check
-of :meth:`~impact_balance.gui.files.GuiFiles.upload` could only run then: a 200 MB upload was
-held whole, and a client that declares 40 GB and sends slowly was held until it left. So the
-server counts an upload while it arrives:
+viser buffers an upload's parts in memory until the last one arrives, so the size check of
+:meth:`~impact_balance.gui.files.GuiFiles.upload` alone would run only once the whole upload is
+held. So the server counts an upload while it arrives:
 
 - the declared size must be at most :data:`MAX_UPLOAD_BYTES`, and the declared number of parts
   at most :data:`MAX_UPLOAD_PARTS` (viser's page sends 512 KiB parts), else the transfer is

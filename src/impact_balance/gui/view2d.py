@@ -1,7 +1,7 @@
 """The GUI's 2D view, as SVG: the CoM velocity area with the post-impact sets, and the ZMP area.
 
-SVG text is built directly (no figure library): it costs well under a millisecond, which
-keeps a full update within the GUI's budget, and the browser draws it crisply at any size.
+SVG text is built directly (no figure library): cheap enough to rebuild on every update, and
+drawn crisply by the browser at any size.
 Top panel: the CoM velocity area (m/s), the pre-impact CoM velocity, the post-impact CoM
 velocity set at the maximum contact velocity, and the set at the reference velocity (red
 when the robot would fall, green otherwise). Bottom panel: the ZMP support area (m), the
