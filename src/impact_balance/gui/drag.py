@@ -9,7 +9,7 @@ be saved and analysed like any other.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -35,7 +35,7 @@ DRAG_ITERATIONS = 60
 class DragTarget:
     """What is dragged: ``("contact", index)`` or ``("impact", None)``."""
 
-    kind: str
+    kind: Literal["contact", "impact"]
     index: int | None = None
 
     @property
@@ -60,6 +60,7 @@ class DragResult:
 
 
 def _offset(state: GuiState, path: FieldPath) -> pin.SE3:
+    """The offset (in its frame) of the contact or impact at ``path``, identity if none."""
     from impact_balance.geometry.spatial import pose
 
     offset = state.get((*path, "offset")) or {}
@@ -67,7 +68,19 @@ def _offset(state: GuiState, path: FieldPath) -> pin.SE3:
 
 
 def handle_pose(state: GuiState, stance: Stance, target: DragTarget) -> pin.SE3:
-    """World pose of a gizmo: the contact centre (or impact point) with its frame's axes."""
+    """World pose of a gizmo: the contact centre (or impact point) with its frame's axes.
+
+    Args:
+        state: The current state (the target's frame and offset).
+        stance: Its stance (the frame's world pose).
+        target: The contact or the impact point.
+
+    Returns:
+        The pose, world, m.
+
+    Raises:
+        ScenarioError: The target does not exist (no such contact, or no impact).
+    """
     frame, path = _frame_and_path(state, target)
     return stance.frame_pose(frame) * _offset(state, path)
 

@@ -131,7 +131,13 @@ class GuiFiles:
 
     # -- loads ------------------------------------------------------------------------------
     def load(self, name: str) -> GuiState:
-        """A bundled scenario (a name without suffix) or a workspace ``.yaml``/``.yml`` file."""
+        """A bundled scenario (a name without suffix) or a workspace ``.yaml``/``.yml`` file.
+
+        Raises:
+            UnknownScenarioError: No bundled scenario has that name.
+            WorkspaceError: The file, an ``extends`` or a robot file breaks the workspace rule.
+            ScenarioError: The file is not a valid scenario.
+        """
         name = str(name)
         if not name.lower().endswith((".yaml", ".yml")):
             path = bundled_path(name)

@@ -142,7 +142,14 @@ class AccessPolicy:
 
     @classmethod
     def for_bind(cls, host: str, allow_origins: Iterable[str] = ()) -> AccessPolicy:
-        """The policy of a server bound to ``host``, plus the ``allow_origins``."""
+        """The policy of a server bound to ``host``, plus the ``allow_origins``.
+
+        A localhost bind answers the localhost names too; a bind to every interface also the
+        machine's own names and addresses.
+
+        Raises:
+            OriginError: An allowed origin is not ``scheme://host[:port]``.
+        """
         name = _host_name(host)
         hosts = {name}
         if name in _WILDCARD or name in LOCAL_NAMES or name.startswith("127.") or name == "[::1]":

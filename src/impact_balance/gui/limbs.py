@@ -34,7 +34,9 @@ class JointSlider:
 
     Attributes:
         name: Joint name.
-        lower, upper: Range, rad (the URDF limits; +-pi for continuous or unlimited joints).
+        lower: Lower end of the range, rad (the URDF limit; -pi for continuous or unlimited
+            joints).
+        upper: Upper end of the range, rad (+pi for continuous or unlimited joints).
     """
 
     name: str

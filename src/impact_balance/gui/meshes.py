@@ -84,7 +84,11 @@ def _triangles(
 
 
 def load_visual_meshes(robot: Robot) -> tuple[pin.GeometryModel, list[VisualMesh]]:
-    """The robot's visual geometry model and its meshes; unreadable meshes are skipped."""
+    """The robot's visual geometry model and its meshes; unreadable meshes are skipped.
+
+    Raises:
+        RobotLoadError: pinocchio cannot read the URDF's visual geometry.
+    """
     try:
         gmodel = pin.buildGeomFromUrdf(
             robot.model,

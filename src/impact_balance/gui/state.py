@@ -132,7 +132,11 @@ class GuiState:
 
     @classmethod
     def from_file(cls, name_or_path: str | Path = DEFAULT_SCENARIO) -> GuiState:
-        """Read a scenario file or a bundled scenario by name (``extends`` resolved)."""
+        """Read a scenario file or a bundled scenario by name (``extends`` resolved).
+
+        Raises:
+            ScenarioError: The file cannot be read or is not a valid scenario.
+        """
         return cls.from_scenario(load_scenario(name_or_path))
 
     # -- reading ------------------------------------------------------------------------
@@ -157,10 +161,13 @@ class GuiState:
         return text
 
     def save(self, path: str | Path) -> Path:
-        """Write :meth:`to_yaml` to ``path`` (folders created); :class:`ScenarioError` if it cannot.
+        """Write :meth:`to_yaml` to ``path`` (folders created).
 
         For scripts: anywhere, no confirmation. The GUI never calls it; it saves through its
         workspace (:meth:`impact_balance.gui.files.GuiFiles.save`).
+
+        Raises:
+            ScenarioError: The name does not end with ``.yaml``/``.yml``, or it cannot be written.
         """
         path = Path(path).expanduser()
         if path.suffix not in (".yaml", ".yml"):
@@ -182,9 +189,19 @@ class GuiState:
     def with_changes(
         self, changes: Mapping[FieldPath, Any] | Iterable[tuple[FieldPath, Any]]
     ) -> GuiState:
-        """A new state with every change applied; raises :class:`ScenarioError` for a bad one.
+        """A new state with every change applied (None at a path removes the key).
 
         Changes are applied in order, then the whole mapping is validated once.
+
+        Args:
+            changes: ``{path: value}``, or (path, value) pairs.
+
+        Returns:
+            The new state; this one is unchanged.
+
+        Raises:
+            ScenarioError: A value is not finite, a path does not exist, or the result is not a
+                valid scenario (naming the field).
         """
         items = list(changes.items()) if isinstance(changes, Mapping) else list(changes)
         raw = copy.deepcopy(self._raw)

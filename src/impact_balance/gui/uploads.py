@@ -152,7 +152,16 @@ def limit_uploads(
 
     ``on_refused(filename, reason)`` is called (in a thread of its own) for each refused upload.
 
+    Args:
+        server: The :class:`viser.ViserServer`.
+        on_refused: Called with (file name, reason) for each refused upload.
+        limit: The largest upload, bytes.
+
+    Returns:
+        The installed counting handlers.
+
     Raises:
+        ValueError: ``limit`` is not a byte count.
         RuntimeError: viser's upload handlers are not where this viser version should have them.
     """
     if not math.isfinite(limit) or limit < 0:
