@@ -1,10 +1,12 @@
 """The web GUI: a viser server with the 3D scene, the 2D view and the controls.
 
-Wiring only: every control edits the :class:`~.session.Session` (all-or-nothing), then
-:meth:`GuiApp.refresh` puts the widgets back in line with the session (a refused value
-reverts), and redraws the robot, the scene objects of :mod:`.scene` and the SVG of
-:mod:`.view2d`. Callbacks come from viser's thread pool; the session's lock makes them
-one-at-a-time. Gizmo drags are coalesced: only the latest pose of a burst is solved.
+Wiring only: the parts (:mod:`.viser_scene`, :mod:`.gizmos`, :mod:`.panels`,
+:mod:`.scenario_tab`, on the base of :mod:`.host`) build their widgets; every control edits the
+:class:`~.session.Session` (all-or-nothing), then :meth:`GuiApp.refresh` puts the widgets back
+in line with the session (a refused value reverts), and redraws the robot, the scene objects
+of :mod:`.scene` and the SVG of :mod:`.view2d`. Callbacks come from viser's thread pool; the
+session's lock makes them one-at-a-time. Gizmo drags are coalesced: only the latest pose of a
+burst is solved.
 """
 
 from __future__ import annotations
@@ -14,13 +16,10 @@ import time
 from collections import deque
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from impact_balance.gui.gizmos import GizmoMixin
 from impact_balance.gui.guard import AccessPolicy, guarded_start
-from impact_balance.gui.meshes import RobotMeshes
 from impact_balance.gui.panels import PanelsMixin
 from impact_balance.gui.results import results_html
 from impact_balance.gui.scenario_tab import ScenarioTabMixin
@@ -31,6 +30,9 @@ from impact_balance.gui.uploads import limit_uploads
 from impact_balance.gui.view2d import svg_view
 from impact_balance.gui.viser_scene import SceneMixin
 from impact_balance.gui.workspace import Workspace
+
+if TYPE_CHECKING:
+    import viser
 
 __all__ = ["GuiApp", "GuiError", "run"]
 
@@ -50,8 +52,17 @@ class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
         session: The model (state, analysis).
         server: The :class:`viser.ViserServer`.
         policy: Which Host and Origin headers the server answers.
+        uploads: The upload limit in front of viser's upload handlers (see :mod:`.uploads`).
         update_times_ms: Recent update times (edit + analysis + redraw), ms.
+        last_update_ms: The last update's time, ms (NaN before the first).
+
+    Raises:
+        GuiError: The server cannot listen there, or this viser version does not let the
+            Host/Origin check or the upload limit be installed (it does not serve unguarded).
     """
+
+    w_results: viser.GuiHtmlHandle
+    w_view2d: viser.GuiHtmlHandle
 
     def __init__(
         self,
@@ -84,33 +95,29 @@ class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
         self.update_times_ms: deque[float] = deque(maxlen=500)
         self.last_update_ms = float("nan")
         self._syncing = False
-        self._scene_handles: dict[str, Any] = {}
-        self._scene_data: dict[str, tuple[Any, tuple[np.ndarray, ...]]] = {}
-        self._gizmos: dict[str, Any] = {}
-        self._dragging: str | None = None
-        self._drag_pending: set[str] = set()
+        self._scene_handles = {}
+        self._scene_data = {}
+        self._gizmos = {}
+        self._dragging = None
+        self._drag_pending = set()
         self._drag_lock = threading.Lock()
         self._drag_busy = threading.Lock()
-        self._impact_stash: dict | None = None
+        self._impact_stash = None
         self._contact_index = 0
-        self._meshes: RobotMeshes | None = None
+        self._meshes = None
         self._robot = None
-        self._joint_widgets: dict[str, Any] = {}
-        self._joint_folders: list[Any] = []
+        self._joint_widgets = {}
+        self._joint_folders = []
         self._setup_scene()
         self._build_gui()
         with self.session.lock:
-            self._draw_robot()  # reads the meshes (seconds): not part of an update's time
+            self._draw_robot(self.w_opacity.value)  # reads the meshes (seconds): not timed
             self.refresh()
 
     # -- life cycle -----------------------------------------------------------------------
     @property
-    def workspace(self) -> Workspace:
-        """The folder the GUI loads from and saves to."""
-        return self.session.files.workspace
-
-    @property
     def url(self) -> str:
+        """The page's address, ``http://host:port`` (127.0.0.1 for a bind to every interface)."""
         host = self.server.get_host()
         host = "127.0.0.1" if host in ("0.0.0.0", "") else host
         if ":" in host:
@@ -125,46 +132,50 @@ class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
         """An upload cut while it arrived (see :mod:`.uploads`): shown like a refused edit."""
         self.edit(lambda: self.session.refuse(f"upload {filename}: {reason}"))
 
-    # -- edits ----------------------------------------------------------------------------
-    def edit(self, apply: Callable[[], Any]) -> None:
-        """Run one edit of the session, then refresh the widgets and redraw."""
-        with self.session.lock:
-            if self._syncing:  # a callback fired by refresh() setting a widget: not an edit
-                return
-            t0 = time.perf_counter()
-            try:
-                apply()
-            except (
-                ValueError,
-                TypeError,
-                OverflowError,
-            ) as exc:  # a value that cannot even be converted
-                self.session.message, self.session.refused = f"bad value: {exc}", True
-            self.refresh(t0)
-
-    def _field(
-        self, path: tuple, convert: Callable[[Any], Any] = lambda v: v
-    ) -> Callable[[Any], None]:
-        """A widget callback that sets one scenario field."""
-
-        def callback(event: Any) -> None:
-            # Read the value when the edit runs, not when the event came: callbacks of a fast
-            # slider run in a thread pool, in any order, and the last one must apply the last value.
-            self.edit(lambda: self.session.set(path, convert(event.target.value)))
-
-        return callback
+    # -- layout ---------------------------------------------------------------------------
+    def _build_gui(self) -> None:
+        """The panels: the numbers and four tabs on the left, the 2D view on the right."""
+        gui = self.server.gui
+        # No share button: sharing goes through viser's public relay, and this server is local.
+        gui.configure_theme(
+            control_width="large", dark_mode=False, show_logo=False, show_share_button=False
+        )
+        gui.set_panel_label("impact-balance")
+        self.w_results = gui.add_html("")
+        tabs = gui.add_tab_group()
+        with tabs.add_tab("Impact"):
+            self._build_impact()
+        with tabs.add_tab("Contacts"):
+            self._build_contacts()
+        self._joints_tab = tabs.add_tab("Joints")
+        with self._joints_tab:
+            self._build_base()
+        with tabs.add_tab("Scenario"):
+            self._build_scenario()
+        panel = gui.add_panel()
+        with panel.add_tab("2D view"):
+            self.w_view2d = gui.add_html("")
+        gui.main_panel.dock_left()
+        gui.main_panel.set_width(400)
+        panel.dock_right()
+        panel.set_width(440)
 
     # -- refresh: widgets <- session, then redraw ----------------------------------------
     def refresh(self, t0: float | None = None) -> None:
-        """Put every widget in line with the session and redraw (call with the session lock held)."""
+        """Put every widget in line with the session and redraw (call with the session lock held).
+
+        Args:
+            t0: ``time.perf_counter()`` when the update began (now if None), for its timing.
+        """
         t0 = time.perf_counter() if t0 is None else t0
         self._syncing = True
         try:
             with self.server.atomic():
-                self._sync_widgets()
-                self._draw_robot()
+                self._sync_panels()
+                self._sync_scenario_tab()
+                self._draw_robot(self.w_opacity.value)
                 self._draw_objects()
-                self._draw_gizmos()
+                self._draw_gizmos(bool(self.w_gizmos.value))
                 self.w_view2d.content = svg_view(self.session.analysis)
                 self.last_update_ms = 1e3 * (time.perf_counter() - t0)
                 self.update_times_ms.append(self.last_update_ms)
@@ -174,6 +185,7 @@ class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
         self._robot = self.session.analysis.stance.robot
 
     def _results_html(self) -> str:
+        """The numbers panel for the session and the last update's time."""
         return results_html(self.session, self.last_update_ms)
 
 
@@ -190,7 +202,8 @@ def run(
 
     Args:
         scenario: Scenario file or bundled name (read as given: it comes from the command line).
-        host, port: Where to listen.
+        host: Interface to bind (default: localhost only).
+        port: TCP port (0 picks a free one).
         ready: Called with the app once it serves (the CLI prints the URL there).
         stop: Optional event that ends the loop (for tests).
         workspace: The folder the GUI loads from and saves to.

@@ -9,9 +9,10 @@ be saved and analysed like any other.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 
 from impact_balance.contacts.stance import Stance
@@ -34,11 +35,12 @@ DRAG_ITERATIONS = 60
 class DragTarget:
     """What is dragged: ``("contact", index)`` or ``("impact", None)``."""
 
-    kind: str
+    kind: Literal["contact", "impact"]
     index: int | None = None
 
     @property
     def key(self) -> str:
+        """The gizmo key: ``"impact"`` or ``"contact<index>"``."""
         return "impact" if self.kind == "impact" else f"contact{self.index}"
 
 
@@ -58,14 +60,27 @@ class DragResult:
 
 
 def _offset(state: GuiState, path: FieldPath) -> pin.SE3:
+    """The offset (in its frame) of the contact or impact at ``path``, identity if none."""
     from impact_balance.geometry.spatial import pose
 
-    offset = state.get(path + ("offset",)) or {}
+    offset = state.get((*path, "offset")) or {}
     return pose(offset.get("position", (0.0, 0.0, 0.0)), offset.get("rpy", (0.0, 0.0, 0.0)))
 
 
 def handle_pose(state: GuiState, stance: Stance, target: DragTarget) -> pin.SE3:
-    """World pose of a gizmo: the contact centre (or impact point) with its frame's axes."""
+    """World pose of a gizmo: the contact centre (or impact point) with its frame's axes.
+
+    Args:
+        state: The current state (the target's frame and offset).
+        stance: Its stance (the frame's world pose).
+        target: The contact or the impact point.
+
+    Returns:
+        The pose, world, m.
+
+    Raises:
+        ScenarioError: The target does not exist (no such contact, or no impact).
+    """
     frame, path = _frame_and_path(state, target)
     return stance.frame_pose(frame) * _offset(state, path)
 
@@ -131,7 +146,9 @@ def _interpolate(a: pin.SE3, b: pin.SE3, t: float) -> pin.SE3:
     return pin.SE3(rotation, a.translation + t * (b.translation - a.translation))
 
 
-def _solve(stance: Stance, frame: str, target: pin.SE3, fixed_frames: list[str]) -> np.ndarray:
+def _solve(
+    stance: Stance, frame: str, target: pin.SE3, fixed_frames: list[str]
+) -> npt.NDArray[np.float64]:
     """IK for one target, other frames fixed; a non-converged answer is kept if they stayed put."""
     try:
         return solve_stance(
@@ -149,10 +166,14 @@ def _solve(stance: Stance, frame: str, target: pin.SE3, fixed_frames: list[str])
         miss = max((v for k, v in exc.residuals.items() if k.split(".")[0] == frame), default=0.0)
         if drift > FIXED_TOLERANCE or miss > FIXED_TOLERANCE:
             raise
-        return exc.q  # slow convergence, but within a millimetre: good enough for a drag
+        q: npt.NDArray[np.float64] = exc.q
+        return q  # slow convergence, but within a millimetre: good enough for a drag
 
 
-def _changes(stance: Stance, q: np.ndarray, reached: bool, residual: float) -> DragResult:
+def _changes(
+    stance: Stance, q: npt.NDArray[np.float64], reached: bool, residual: float
+) -> DragResult:
+    """The scenario changes of configuration ``q``: the base pose and every joint value."""
     rpy = pin.rpy.matrixToRpy(pin.Quaternion(np.asarray(q[3:7])).normalized().matrix())
     changes: dict[FieldPath, Any] = {
         ("base",): {"position": [float(x) for x in q[:3]], "rpy": [float(x) for x in rpy]},

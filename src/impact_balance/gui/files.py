@@ -1,4 +1,4 @@
-"""Every file the GUI reads or writes, through the workspace rule (:mod:`impact_balance.gui.workspace`).
+"""Every file the GUI reads or writes, through the workspace rule (:mod:`.workspace`).
 
 - load: a bundled scenario by name, or a ``.yaml`` file of the workspace;
 - ``extends:`` in a loaded or uploaded file: a bundled name or a workspace file;
@@ -76,7 +76,7 @@ def describe(exc: BaseException, workspace: Workspace | None = None) -> str:
         text = " ".join(text.split())  # one line
     elif isinstance(exc, ImpactBalanceError):
         text = " ".join(str(exc).split())
-    else:  # the command line's rule (impact_balance.exit_status): a YAML, OS or other error as one line
+    else:  # the command line's rule (impact_balance.exit_status): a YAML, OS or other error
         from impact_balance.exit_status import describe_error
 
         line, _ = describe_error(
@@ -131,7 +131,13 @@ class GuiFiles:
 
     # -- loads ------------------------------------------------------------------------------
     def load(self, name: str) -> GuiState:
-        """A bundled scenario (a name without suffix) or a workspace ``.yaml``/``.yml`` file."""
+        """A bundled scenario (a name without suffix) or a workspace ``.yaml``/``.yml`` file.
+
+        Raises:
+            UnknownScenarioError: No bundled scenario has that name.
+            WorkspaceError: The file, an ``extends`` or a robot file breaks the workspace rule.
+            ScenarioError: The file is not a valid scenario.
+        """
         name = str(name)
         if not name.lower().endswith((".yaml", ".yml")):
             path = bundled_path(name)
@@ -147,7 +153,20 @@ class GuiFiles:
         return GuiState.from_scenario(self._robot_files(scenario, path.parent))
 
     def upload(self, filename: str, content: bytes) -> GuiState:
-        """A scenario from an uploaded file's bytes; ``extends`` and robot files from the workspace."""
+        """A scenario from an uploaded file's bytes; ``extends`` and robot files from the workspace.
+
+        Args:
+            filename: The name the browser gave (only its last part is kept, for messages).
+            content: The file's bytes (at most :data:`~.workspace.MAX_FILE_BYTES`, UTF-8).
+
+        Returns:
+            The state, its source the shown file name.
+
+        Raises:
+            ScenarioError: Too large, not UTF-8 text, or not a valid scenario.
+            WorkspaceError: An ``extends`` or robot file outside the workspace or refused by its
+                rule.
+        """
         shown = Path(str(filename).replace("\\", "/")).name[:80] or "uploaded.yaml"
         if len(content) > MAX_FILE_BYTES:
             raise ScenarioError("upload", shown, f"larger than {MAX_FILE_BYTES >> 10} KiB")
@@ -175,5 +194,18 @@ class GuiFiles:
 
     # -- saves ------------------------------------------------------------------------------
     def save(self, state: GuiState, name: str, overwrite: bool = False) -> Path:
-        """Write ``state`` as a scenario file to the workspace; refuse an existing file unless ``overwrite``."""
+        """Write ``state`` as a scenario file to the workspace.
+
+        Args:
+            state: The state to write.
+            name: The file's name, relative to the workspace (``.yaml`` or ``.yml``).
+            overwrite: Replace an existing file (else it is refused).
+
+        Returns:
+            The file's path.
+
+        Raises:
+            WorkspaceError: The name breaks the workspace rule, the file exists without
+                ``overwrite``, or it cannot be written.
+        """
         return self.workspace.write_text(name, state.to_yaml(), overwrite=overwrite)

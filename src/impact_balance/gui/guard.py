@@ -71,7 +71,10 @@ def _host_name(host: str) -> str:
 
 
 def _split_host(value: str) -> tuple[str, int | None] | None:
-    """``host[:port]`` (a ``Host`` header or a URL's netloc) -> (host name, port or None); None if malformed."""
+    """``host[:port]`` (a ``Host`` header or a URL's netloc) -> (host name, port or None).
+
+    None if it is malformed.
+    """
     value = value.strip()
     if value.startswith("["):
         end = value.find("]")
@@ -91,7 +94,14 @@ def _split_host(value: str) -> tuple[str, int | None] | None:
 
 
 def normalize_origin(origin: str) -> str:
-    """``scheme://host[:port]`` in canonical form (lower case, default port dropped), or :class:`OriginError`."""
+    """``origin`` as ``scheme://host[:port]`` in canonical form.
+
+    Lower case, IPv6 addresses in brackets, the scheme's default port dropped.
+
+    Raises:
+        OriginError: Not an ``http://`` or ``https://`` origin (a path, a query, user
+            information, a bad host or port).
+    """
     try:
         parts = urlsplit(origin.strip())
     except ValueError:
@@ -132,7 +142,14 @@ class AccessPolicy:
 
     @classmethod
     def for_bind(cls, host: str, allow_origins: Iterable[str] = ()) -> AccessPolicy:
-        """The policy of a server bound to ``host``, plus the ``allow_origins``."""
+        """The policy of a server bound to ``host``, plus the ``allow_origins``.
+
+        A localhost bind answers the localhost names too; a bind to every interface also the
+        machine's own names and addresses.
+
+        Raises:
+            OriginError: An allowed origin is not ``scheme://host[:port]``.
+        """
         name = _host_name(host)
         hosts = {name}
         if name in _WILDCARD or name in LOCAL_NAMES or name.startswith("127.") or name == "[::1]":
@@ -142,10 +159,16 @@ class AccessPolicy:
             for own in {socket.gethostname(), socket.getfqdn()}:
                 hosts.add(_host_name(own))
                 with contextlib.suppress(OSError, UnicodeError):
-                    hosts.update(_host_name(info[4][0]) for info in socket.getaddrinfo(own, None))
+                    hosts.update(
+                        _host_name(str(info[4][0])) for info in socket.getaddrinfo(own, None)
+                    )
             hosts -= {"", "0.0.0.0", "[::]"}
         origins = {normalize_origin(o) for o in allow_origins}
-        extra = {_split_host(urlsplit(o).netloc)[0] for o in origins}
+        extra = set()
+        for origin in origins:  # canonical: each has a host
+            split = _split_host(urlsplit(origin).netloc)
+            if split is not None:
+                extra.add(split[0])
         return cls(frozenset(hosts), frozenset(origins), frozenset(extra))
 
     def _own(self, host: str, port: int | None, bound_port: int, default: int) -> bool:
@@ -237,8 +260,10 @@ def guarded_start(policy: AccessPolicy) -> Iterator[list[int]]:
         return original(handler, *args, process_request=_checker(policy, process_request), **kwargs)
 
     with _PATCH_LOCK:
-        ws_server.serve = serve
+        # A patch of the module's attribute, undone on leaving: `serve` is a class there, so
+        # the wrapper function is set with setattr (an assignment would not type-check).
+        setattr(ws_server, "serve", serve)  # noqa: B010
         try:
             yield started
         finally:
-            ws_server.serve = original
+            setattr(ws_server, "serve", original)  # noqa: B010

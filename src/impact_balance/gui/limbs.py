@@ -8,10 +8,11 @@ comes from the joint names ("left leg", "torso"...), so that any URDF gets sensi
 from __future__ import annotations
 
 import math
-import os
 import re
 from dataclasses import dataclass
 
+import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 
 from impact_balance.robot.robot import Robot
@@ -33,7 +34,9 @@ class JointSlider:
 
     Attributes:
         name: Joint name.
-        lower, upper: Range, rad (the URDF limits; +-pi for continuous or unlimited joints).
+        lower: Lower end of the range, rad (the URDF limit; -pi for continuous or unlimited
+            joints).
+        upper: Upper end of the range, rad (+pi for continuous or unlimited joints).
     """
 
     name: str
@@ -58,6 +61,17 @@ def _kind(name: str) -> str | None:
     return None
 
 
+def _common_prefix(names: list[str]) -> str:
+    """The longest string every name starts with (character by character)."""
+    if not names:
+        return ""
+    first, last = min(names), max(names)
+    n = 0
+    while n < min(len(first), len(last)) and first[n] == last[n]:
+        n += 1
+    return first[:n]
+
+
 def _label(names: list[str]) -> str:
     sides = {_side(n) for n in names} - {None}
     kinds = [_kind(n) for n in names]
@@ -66,7 +80,7 @@ def _label(names: list[str]) -> str:
         kind = max(set(known), key=known.count)
         side = next(iter(sides)) if len(sides) == 1 else None
         return f"{side} {kind}" if side else kind
-    prefix = os.path.commonprefix(names).rstrip("_0123456789")
+    prefix = _common_prefix(names).rstrip("_0123456789")
     return prefix if len(prefix) >= 3 else re.sub(r"(_joint)?$", "", names[0])
 
 
@@ -112,6 +126,14 @@ def joint_groups(robot: Robot) -> dict[str, list[JointSlider]]:
     return out
 
 
-def joint_values(robot: Robot, q) -> dict[str, float]:
-    """Values of the 1-dof joints at configuration ``q``, rad (continuous joints by their angle)."""
-    return robot.joint_values(q)
+def joint_values(robot: Robot, q: npt.ArrayLike) -> dict[str, float]:
+    """Values of the 1-dof joints at configuration ``q``, rad (continuous joints by their angle).
+
+    Args:
+        robot: The robot.
+        q: Its configuration (nq), as pinocchio orders it.
+
+    Returns:
+        The value of each 1-dof joint, by joint name.
+    """
+    return robot.joint_values(np.asarray(q, dtype=float))

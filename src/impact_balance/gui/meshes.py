@@ -11,14 +11,18 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 
 from impact_balance.exceptions import RobotLoadError
 from impact_balance.robot.meshes import read_mesh
 from impact_balance.robot.robot import Robot
+
+if TYPE_CHECKING:
+    import viser
 
 __all__ = ["RobotMeshes", "VisualMesh", "load_visual_meshes"]
 
@@ -33,8 +37,8 @@ class VisualMesh:
     """One visual geometry: triangles in its own frame (m), colour, and where it is attached."""
 
     name: str
-    vertices: np.ndarray
-    faces: np.ndarray
+    vertices: npt.NDArray[np.float32]
+    faces: npt.NDArray[np.uint32]
     color: tuple[float, float, float]
     opacity: float
     index: int  # in the GeometryModel
@@ -47,8 +51,14 @@ def _package_dirs(robot: Robot) -> list[str]:
     return list(dict.fromkeys(dirs))
 
 
-def _triangles(obj: Any, problems: list[str]) -> tuple[np.ndarray, np.ndarray] | None:
-    """Vertices and faces of a geometry object, or None when it cannot be read (said in ``problems``)."""
+def _triangles(
+    obj: Any, problems: list[str]
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]] | None:
+    """Vertices and faces of a geometry object (m, its own frame), or None if unreadable.
+
+    A mesh file that cannot be read is said in ``problems``; a primitive (box, sphere, cylinder,
+    capsule) is triangulated.
+    """
     import trimesh
 
     geom = obj.geometry
@@ -74,7 +84,11 @@ def _triangles(obj: Any, problems: list[str]) -> tuple[np.ndarray, np.ndarray] |
 
 
 def load_visual_meshes(robot: Robot) -> tuple[pin.GeometryModel, list[VisualMesh]]:
-    """The robot's visual geometry model and its meshes; unreadable meshes are skipped."""
+    """The robot's visual geometry model and its meshes; unreadable meshes are skipped.
+
+    Raises:
+        RobotLoadError: pinocchio cannot read the URDF's visual geometry.
+    """
     try:
         gmodel = pin.buildGeomFromUrdf(
             robot.model,
@@ -84,14 +98,15 @@ def load_visual_meshes(robot: Robot) -> tuple[pin.GeometryModel, list[VisualMesh
         )
     except (RuntimeError, ValueError, OSError) as exc:
         raise RobotLoadError(str(robot.urdf_path), f"cannot read the visual meshes: {exc}") from exc
-    meshes, problems = [], []
+    meshes: list[VisualMesh] = []
+    problems: list[str] = []
     for i, obj in enumerate(gmodel.geometryObjects):
         tri = _triangles(obj, problems)
         if tri is None:
             problems.append(f"{obj.name} ({type(obj.geometry).__name__})")
             continue
         rgba = np.asarray(obj.meshColor, dtype=float)
-        color = tuple(float(c) for c in rgba[:3])
+        color = (float(rgba[0]), float(rgba[1]), float(rgba[2]))
         if not np.any(rgba[:3] > 0.05):
             color = DEFAULT_COLOR
         opacity = float(rgba[3]) if 0.0 < rgba[3] <= 1.0 else 1.0
@@ -120,20 +135,22 @@ class RobotMeshes:
         opacity: Opacity of the whole robot, 0..1 (below 1 the CoM shows through).
     """
 
-    def __init__(self, scene: Any, robot: Robot, root: str = "/robot", opacity: float = 1.0):
+    def __init__(
+        self, scene: viser.SceneApi, robot: Robot, root: str = "/robot", opacity: float = 1.0
+    ):
         self.robot = robot
         self.geometry_model, self.meshes = load_visual_meshes(robot)
         self.geometry_data = self.geometry_model.createData()
-        self.handles = []
-        self._last: list[tuple[np.ndarray, np.ndarray]] = []
+        self.handles: list[viser.MeshHandle] = []
+        self._last: list[tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]] = []
         for mesh in self.meshes:
-            color = tuple(int(round(255 * c)) for c in mesh.color)
+            r, g, b = (round(255 * c) for c in mesh.color)
             self.handles.append(
                 scene.add_mesh_simple(
                     f"{root}/{mesh.name}",
                     mesh.vertices,
                     mesh.faces,
-                    color=color,
+                    color=(r, g, b),
                     opacity=self._opacity(mesh, opacity),
                     cast_shadow=False,
                     receive_shadow=False,
@@ -150,7 +167,9 @@ class RobotMeshes:
         for mesh, handle in zip(self.meshes, self.handles, strict=True):
             handle.opacity = self._opacity(mesh, opacity)
 
-    def poses(self, data: pin.Data) -> list[tuple[np.ndarray, np.ndarray]]:
+    def poses(
+        self, data: pin.Data
+    ) -> list[tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]]:
         """World (position, wxyz) of every mesh, from joint placements already in ``data``."""
         pin.updateGeometryPlacements(
             self.robot.model, data, self.geometry_model, self.geometry_data
@@ -181,6 +200,7 @@ class RobotMeshes:
         self._last = poses
 
     def remove(self) -> None:
+        """Remove the meshes from the scene."""
         for handle in self.handles:
             handle.remove()
         self.handles = []

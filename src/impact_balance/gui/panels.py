@@ -1,17 +1,26 @@
-"""The control panels: the Impact, Contacts and Joints tabs, and putting every widget back in
-line with the session after an edit (a refused value reverts).
+"""The control panels: the Impact, Contacts and Joints tabs of the GUI.
+
+Each control edits the session through :meth:`~.host.GuiHost.edit` (all-or-nothing); after
+every edit :meth:`PanelsMixin._sync_panels` puts the widgets back in line with the session, so
+a refused value reverts. Positions are in metres, angles in radians, velocities in m/s, in the
+frames the scenario file uses (README, "Scenario files").
 """
 
 from __future__ import annotations
 
-import os
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
 
+from impact_balance.gui.host import GuiHost, WidgetCallback, set_value, vec2, vec3
 from impact_balance.gui.limbs import joint_groups, joint_values
+from impact_balance.gui.state import FieldPath
+from impact_balance.robot.robot import Robot
+
+if TYPE_CHECKING:
+    import viser
 
 __all__ = ["PanelsMixin"]
 
@@ -19,117 +28,124 @@ __all__ = ["PanelsMixin"]
 _DEFAULT_IMPACT_FRAMES = ("gripper_right_base_link", "right_wrist_yaw_link", "r_hand")
 
 
-def _vec(values: Any, n: int) -> tuple[float, ...]:
-    return tuple(float(v) for v in list(values)[:n])
-
-
-def _set_options(dropdown: Any, options: list[str]) -> None:
+def _set_options(dropdown: viser.GuiDropdownHandle[str], options: list[str]) -> None:
     """Set a dropdown's options only when they change (each assignment is a message)."""
     if tuple(dropdown.options) != tuple(options):
         dropdown.options = options
 
 
-class PanelsMixin:
-    """The widgets of :class:`~.app.GuiApp` (uses its ``server``, ``session``, ``edit``, ``_field``,
-    ``workspace`` and the ``w_*`` widgets).
+class PanelsMixin(GuiHost):
+    """The Impact and Contacts tabs and the Joints tab's controls, part of :class:`~.app.GuiApp`.
+
+    Each tab is built once (``_build_*``); :meth:`_sync_panels` puts its widgets back in line
+    with the session after every edit (a refused value reverts), and rebuilds the joint sliders
+    when the robot changes.
     """
 
-    def _build_gui(self) -> None:
-        gui = self.server.gui
-        # No share button: sharing goes through viser's public relay, and this server is local.
-        gui.configure_theme(
-            control_width="large", dark_mode=False, show_logo=False, show_share_button=False
-        )
-        gui.set_panel_label("impact-balance")
-        self.w_results = gui.add_html("")
-        tabs = gui.add_tab_group()
-        with tabs.add_tab("Impact"):
-            self._build_impact()
-        with tabs.add_tab("Contacts"):
-            self._build_contacts()
-        self._joints_tab = tabs.add_tab("Joints")
-        with self._joints_tab:
-            self._build_base()
-        with tabs.add_tab("Scenario"):
-            self._build_scenario()
-        panel = gui.add_panel()
-        with panel.add_tab("2D view"):
-            self.w_view2d = gui.add_html("")
-        gui.main_panel.dock_left()
-        gui.main_panel.set_width(400)
-        panel.dock_right()
-        panel.set_width(440)
+    # Impact tab.
+    w_impact_on: viser.GuiCheckboxHandle
+    w_impact_frame: viser.GuiDropdownHandle[str]
+    w_impact_offset: viser.GuiVector3Handle
+    w_impact_normal: viser.GuiVector3Handle
+    w_impact_friction: viser.GuiNumberHandle[float]
+    w_impact_restitution: viser.GuiVector2Handle
+    w_impact_edges: viser.GuiNumberHandle[int]
+    w_impact_reference: viser.GuiVector3Handle
+    w_impact_duration: viser.GuiNumberHandle[float]
+    w_impact_inertia: viser.GuiDropdownHandle[str]
+    #: The impact's fields, disabled while there is no impact.
+    _impact_widgets: list[viser.GuiInputHandle[Any]]
+    #: The impact last switched off, restored when it is switched on again.
+    _impact_stash: dict[str, Any] | None
+    # Contacts tab.
+    w_contact_select: viser.GuiDropdownHandle[str]
+    w_contact_frame: viser.GuiDropdownHandle[str]
+    w_contact_friction: viser.GuiNumberHandle[float]
+    w_contact_size: viser.GuiVector2Handle
+    w_contact_offset: viser.GuiVector3Handle
+    w_contact_rpy: viser.GuiVector3Handle
+    w_contact_remove: viser.GuiButtonHandle
+    w_new_frame: viser.GuiDropdownHandle[str]
+    #: The contact the Contacts tab edits.
+    _contact_index: int
+    # Joints tab.
+    _joints_tab: viser.GuiTabHandle
+    w_base_auto: viser.GuiCheckboxHandle
+    w_base_position: viser.GuiVector3Handle
+    w_base_rpy: viser.GuiVector3Handle
+    #: The joint sliders by joint name, in folders by limb, built for ``_robot``.
+    _joint_widgets: dict[str, viser.GuiSliderHandle[float]]
+    _joint_folders: list[viser.GuiFolderHandle]
+    _robot: Robot | None
 
     def _frame_options(self, current: list[str]) -> list[str]:
+        """The robot's body and operational frames, and the frames in ``current``, sorted."""
         model = self.session.analysis.stance.robot.model
         names = [
             f.name for f in model.frames if f.type in (pin.FrameType.BODY, pin.FrameType.OP_FRAME)
         ]
         return sorted(set(names) | {c for c in current if c})
 
-    def _sync_widgets(self) -> None:
-        state, analysis = self.session.state, self.session.analysis
-        scenario, stance = state.scenario, analysis.stance
+    def _sync_panels(self) -> None:
+        """Put the Impact, Contacts and Joints tabs in line with the session."""
+        scenario, stance = self.session.state.scenario, self.session.analysis.stance
         if self._robot is not stance.robot:
             self._build_joint_sliders()
-        # General.
-        self.w_torque.value = bool(scenario.torque_limits)
-        self.w_com_velocity.value = _vec(scenario.com_velocity, 2)
-        self.w_plane.value = float(scenario.plane_height)
-        self.w_zmp_margin.value = float(scenario.zmp_margin)
-        # Base and joints (the actual values, whether set or from the configuration).
-        self.w_base_auto.value = state.get(("base",)) is None
-        self.w_base_position.value = _vec(stance.q[:3], 3)
-        quat = pin.Quaternion(np.asarray(stance.q[3:7], dtype=float)).normalized()
-        self.w_base_rpy.value = _vec(pin.rpy.matrixToRpy(quat.matrix()), 3)
-        for name, value in joint_values(stance.robot, stance.q).items():
-            widget = self._joint_widgets.get(name)
-            if widget is not None:
-                widget.value = float(np.clip(value, widget.min, widget.max))
-        # Contacts.
+        self._sync_joints()
         frames = [c.frame for c in scenario.contacts] + (
             [scenario.impact.frame] if scenario.impact else []
         )
         options = self._frame_options(frames)
+        self._sync_contacts(options)
+        self._sync_impact(options)
+
+    def _sync_joints(self) -> None:
+        """The base pose and the joint sliders: the actual values, whether set or defaulted."""
+        state, stance = self.session.state, self.session.analysis.stance
+        set_value(self.w_base_auto, state.get(("base",)) is None)
+        set_value(self.w_base_position, vec3(stance.q[:3]))
+        quat = pin.Quaternion(np.asarray(stance.q[3:7], dtype=float)).normalized()
+        set_value(self.w_base_rpy, vec3(pin.rpy.matrixToRpy(quat.matrix())))
+        for name, value in joint_values(stance.robot, stance.q).items():
+            widget = self._joint_widgets.get(name)
+            if widget is not None:
+                set_value(widget, float(np.clip(value, widget.min, widget.max)))
+
+    def _sync_contacts(self, options: list[str]) -> None:
+        """The Contacts tab; ``options``: the frames offered."""
+        scenario = self.session.state.scenario
         labels = [f"{i}: {c.frame}" for i, c in enumerate(scenario.contacts)]
         index = self._contact_index = min(max(self._contact_index, 0), len(labels) - 1)
         _set_options(self.w_contact_select, labels)
-        self.w_contact_select.value = labels[index]
+        set_value(self.w_contact_select, labels[index])
         contact = scenario.contacts[index]
         _set_options(self.w_contact_frame, options)
-        self.w_contact_frame.value = contact.frame
-        self.w_contact_friction.value = float(contact.friction)
-        self.w_contact_size.value = _vec(contact.size, 2)
-        self.w_contact_offset.value = _vec(contact.offset.position, 3)
-        self.w_contact_rpy.value = _vec(contact.offset.rpy, 3)
+        set_value(self.w_contact_frame, contact.frame)
+        set_value(self.w_contact_friction, float(contact.friction))
+        set_value(self.w_contact_size, vec2(contact.size))
+        set_value(self.w_contact_offset, vec3(contact.offset.position))
+        set_value(self.w_contact_rpy, vec3(contact.offset.rpy))
         _set_options(self.w_new_frame, options)
         self.w_contact_remove.disabled = len(labels) <= 1
-        # Impact.
-        impact = scenario.impact
-        self.w_impact_on.value = impact is not None
+
+    def _sync_impact(self, options: list[str]) -> None:
+        """The Impact tab (its fields disabled without an impact); ``options``: the frames."""
+        impact = self.session.state.scenario.impact
+        set_value(self.w_impact_on, impact is not None)
         for w in self._impact_widgets:
             w.disabled = impact is None
         if impact is not None:
             _set_options(self.w_impact_frame, options)
-            self.w_impact_frame.value = impact.frame
-            self.w_impact_normal.value = _vec(impact.normal, 3)
-            self.w_impact_friction.value = float(impact.friction)
-            self.w_impact_restitution.value = _vec(impact.restitution, 2)
-            self.w_impact_edges.value = int(impact.cone_edges)
+            set_value(self.w_impact_frame, impact.frame)
+            set_value(self.w_impact_normal, vec3(impact.normal))
+            set_value(self.w_impact_friction, float(impact.friction))
+            set_value(self.w_impact_restitution, vec2(impact.restitution))
+            set_value(self.w_impact_edges, int(impact.cone_edges))
             ref = impact.reference_velocity
-            self.w_impact_reference.value = _vec(ref if ref is not None else (0.0, 0.0, 0.0), 3)
-            self.w_impact_offset.value = _vec(impact.offset.position, 3)
-            self.w_impact_inertia.value = impact.inertia
-            self.w_impact_duration.value = float(impact.duration)
-        # File: the workspace name of the file last loaded (not a bundled one, not an upload).
-        source = state.source
-        name = (
-            self.workspace.relative(os.path.abspath(source))
-            if source and source.endswith((".yaml", ".yml"))
-            else None
-        )
-        if name is not None:
-            self.w_file.value = name
+            set_value(self.w_impact_reference, vec3(ref if ref is not None else (0.0, 0.0, 0.0)))
+            set_value(self.w_impact_offset, vec3(impact.offset.position))
+            set_value(self.w_impact_inertia, impact.inertia)
+            set_value(self.w_impact_duration, float(impact.duration))
 
     def _build_impact(self) -> None:
         gui = self.server.gui
@@ -164,7 +180,7 @@ class PanelsMixin:
             "cone edges", 16, step=1, hint="Friction cone edges N (>= 3)"
         )
         self.w_impact_edges.on_update(
-            self._field(("impact", "cone_edges"), lambda v: int(round(v)))
+            self._field(("impact", "cone_edges"), lambda v: round(float(v)))
         )
         self.w_impact_reference = gui.add_vector3(
             "reference velocity (m/s)",
@@ -226,12 +242,12 @@ class PanelsMixin:
         self.w_contact_select.on_update(self._on_select_contact)
 
         def contact_field(
-            key: tuple, convert: Callable[[Any], Any] = lambda v: v
-        ) -> Callable[[Any], None]:
+            key: FieldPath, convert: Callable[[Any], Any] = lambda v: v
+        ) -> WidgetCallback:
             def callback(event: Any) -> None:
                 self.edit(
                     lambda: self.session.set(
-                        ("contacts", self._contact_index) + key, convert(event.target.value)
+                        ("contacts", self._contact_index, *key), convert(event.target.value)
                     )
                 )
 
@@ -295,9 +311,8 @@ class PanelsMixin:
 
         def apply() -> bool:
             contacts = self.session.state.get(("contacts",), [])
-            ok = self.session.set(
-                ("contacts",), contacts + [{"frame": frame, "friction": 0.7, "size": [0.1, 0.1]}]
-            )
+            new = {"frame": frame, "friction": 0.7, "size": [0.1, 0.1]}
+            ok = self.session.set(("contacts",), [*contacts, new])
             if ok:
                 self._contact_index = len(contacts)
             return ok
@@ -321,9 +336,12 @@ class PanelsMixin:
             reset = gui.add_button(
                 "Reset joints and base", hint="Back to the named configuration, auto height"
             )
-            reset.on_click(
-                lambda _: self.edit(lambda: self.session.apply({("joints",): {}, ("base",): None}))
-            )
+            reset.on_click(self._on_reset)
+
+    def _on_reset(self, _: Any) -> None:
+        """Back to the named configuration, auto height."""
+        changes: dict[FieldPath, Any] = {("joints",): {}, ("base",): None}
+        self.edit(lambda: self.session.apply(changes))
 
     def _on_base_auto(self, _: Any) -> None:
         if self.w_base_auto.value:

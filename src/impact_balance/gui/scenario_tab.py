@@ -1,21 +1,44 @@
-"""The Scenario tab: general settings, view options, and the file controls (bundled scenarios,
-load, save, upload, download), every file access through the session's workspace rule.
+"""The Scenario tab: general settings, view options, and the file controls.
+
+The file controls load a bundled scenario, load and save a workspace file, upload a file and
+download the scenario; every file access goes through the session's workspace rule
+(:mod:`.files`). The view options (gizmos, robot opacity) change the drawing, not the scenario.
 """
 
 from __future__ import annotations
 
-from typing import Any
+import os
+from typing import TYPE_CHECKING, Any
 
+from impact_balance.gui.host import GuiHost, set_value, vec2
 from impact_balance.gui.state import DEFAULT_SCENARIO
 from impact_balance.scenario import bundled_scenarios
+
+if TYPE_CHECKING:
+    import viser
+
+    from impact_balance.gui.meshes import RobotMeshes
 
 __all__ = ["ScenarioTabMixin"]
 
 
-class ScenarioTabMixin:
-    """The Scenario tab of :class:`~.app.GuiApp` (uses its ``server``, ``session``, ``edit``,
-    ``_field``, ``workspace`` and ``_meshes``).
-    """
+class ScenarioTabMixin(GuiHost):
+    """The Scenario tab of :class:`~.app.GuiApp`: built once, synced after every edit."""
+
+    # General settings.
+    w_torque: viser.GuiCheckboxHandle
+    w_com_velocity: viser.GuiVector2Handle
+    w_plane: viser.GuiNumberHandle[float]
+    w_zmp_margin: viser.GuiNumberHandle[float]
+    # View options.
+    w_gizmos: viser.GuiCheckboxHandle
+    w_opacity: viser.GuiSliderHandle[float]
+    # Files.
+    w_bundled: viser.GuiDropdownHandle[str]
+    w_file: viser.GuiTextHandle
+    w_overwrite: viser.GuiCheckboxHandle
+    #: The robot's meshes (drawn by the 3D scene): the opacity slider sets theirs.
+    _meshes: RobotMeshes | None
 
     def _build_scenario(self) -> None:
         gui = self.server.gui
@@ -39,7 +62,8 @@ class ScenarioTabMixin:
             0.0,
             min=0.0,
             step=0.005,
-            hint="Shrink the ZMP support area by this margin (and the CoM velocity area with it), m",
+            hint="Shrink the ZMP support area by this margin (and the CoM velocity area with it), "
+            "m",
         )
         self.w_zmp_margin.on_update(self._field(("zmp_margin",), float))
         self.w_gizmos = gui.add_checkbox(
@@ -86,11 +110,32 @@ class ScenarioTabMixin:
         download = gui.add_button("Download YAML")
         download.on_click(self._on_download)
 
+    def _sync_scenario_tab(self) -> None:
+        """Put the general settings and the file name in line with the session.
+
+        The file name becomes the workspace name of the file last loaded (not a bundled one,
+        not an upload).
+        """
+        state = self.session.state
+        scenario = state.scenario
+        set_value(self.w_torque, bool(scenario.torque_limits))
+        set_value(self.w_com_velocity, vec2(scenario.com_velocity))
+        set_value(self.w_plane, float(scenario.plane_height))
+        set_value(self.w_zmp_margin, float(scenario.zmp_margin))
+        source = state.source
+        name = (
+            self.workspace.relative(os.path.abspath(source))
+            if source and source.endswith((".yaml", ".yml"))
+            else None
+        )
+        if name is not None:
+            set_value(self.w_file, name)
+
     def _save(self) -> None:
         try:
             self.session.save(self.w_file.value, overwrite=bool(self.w_overwrite.value))
         finally:
-            self.w_overwrite.value = False  # one confirmation, one save
+            set_value(self.w_overwrite, False)  # one confirmation, one save
 
     def _on_opacity(self, event: Any) -> None:
         with self.session.lock:

@@ -11,7 +11,9 @@ class GuiError(ImpactBalanceError):
     """The GUI server cannot start (a host it cannot listen on, a bad port).
 
     Attributes:
-        host, port: Where it was asked to listen.
+        host: Where it was asked to listen.
+        port: The port asked for.
+        reason: Why it cannot.
     """
 
     def __init__(self, host: str, port: int, reason: str):
@@ -20,10 +22,14 @@ class GuiError(ImpactBalanceError):
 
 
 def check_listen_address(host: str, port: int) -> None:
-    """Raise :class:`GuiError` unless ``host`` is an address of this machine and ``port`` valid.
+    """Check that ``host`` is an address of this machine and ``port`` a valid port.
 
     viser retries the next port on any bind error, so an address that can never be bound
     would make it loop for ever: check it first.
+
+    Raises:
+        GuiError: The port is not in 0..65535, the host is unknown, or it is not an address
+            of this machine.
     """
     import socket
 

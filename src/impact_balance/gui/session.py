@@ -13,10 +13,10 @@ import logging
 import math
 import threading
 import time
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
@@ -27,6 +27,9 @@ from impact_balance.gui.drag import DragTarget, drag_changes
 from impact_balance.gui.files import GuiFiles, describe
 from impact_balance.gui.state import DEFAULT_SCENARIO, FieldPath, GuiState
 from impact_balance.gui.workspace import Workspace
+
+if TYPE_CHECKING:
+    from impact_balance.governor import Governor
 
 __all__ = ["Governed", "Session", "Summary", "format_speed"]
 
@@ -64,14 +67,16 @@ class Summary:
     """The numbers the GUI shows for an analysis.
 
     Attributes:
-        verdict: "balanced", "falling: ..." or "cannot balance: ..." (see :attr:`Analysis.verdict`).
+        verdict: "balanced", "falling: ..." or "cannot balance: ..." (see
+            :attr:`Analysis.verdict`).
         can_balance: Whether the contacts can hold the robot at rest.
         max_contact_velocity: Maximum approach speed by the CoM velocity criterion, m/s
             (``inf`` unbounded, None without an impact).
         zmp_max_contact_velocity: The same by the ZMP criterion, m/s.
         reference_speed: Approach speed of the reference velocity, m/s (None without one).
         falls_at_reference: Whether the reference approach speed exceeds the maximum.
-        warnings: The analysis' warnings, one line each (see :mod:`impact_balance.analysis.diagnostics`).
+        warnings: The analysis' warnings, one line each (see
+            :mod:`impact_balance.analysis.diagnostics`).
     """
 
     verdict: str
@@ -84,6 +89,10 @@ class Summary:
 
     @classmethod
     def of(cls, analysis: Analysis) -> Summary:
+        """The summary of ``analysis``.
+
+        The reference falls when its approach speed exceeds the maximum by more than 1e-12 m/s.
+        """
         im = analysis.impact
         vmax = zmp = ref = None
         falls = False
@@ -136,14 +145,16 @@ class Session:
         self.analysis_ms = 1e3 * self.analysis.timings.get("total", 0.0)
         #: Incremented on every accepted change (the app redraws when it moves).
         self.revision = 0
-        self._governor = None
+        self._governor: Governor | None = None
         self._governor_key: str | None = None
-        #: The governor's answer for the stance being edited (None without an impact): see :meth:`_govern`.
+        #: The governor's answer for the stance being edited (None without an impact): see
+        #: :meth:`_govern`.
         self.governed: Governed | None = None
         self._govern()
 
     # -- edits ----------------------------------------------------------------------------
-    def _commit(self, build, note: str | None = None) -> bool:
+    def _commit(self, build: Callable[[], GuiState], note: str | None = None) -> bool:
+        """Build a state, analyse it, and make it current; False (and a message) if refused."""
         with self.lock:
             t0 = time.perf_counter()
             try:
@@ -164,8 +175,11 @@ class Session:
             return True
 
     def _govern(self) -> None:
-        """Ask the governor of the scenario (rebuilt when anything but the posture and the CoM velocity
-        changed) for the speed allowed from this posture and CoM velocity, and cap the reference.
+        """Ask the scenario's governor for the speed allowed from this posture and CoM velocity.
+
+        The governor is rebuilt when anything but the posture and the CoM velocity changed; the
+        reference velocity is capped by its answer. A governor failure is only logged (the
+        analysis went through): :attr:`governed` is then None.
         """
         scenario = self.state.scenario
         if scenario.impact is None or not self.analysis.areas.can_balance:
@@ -177,16 +191,16 @@ class Session:
             exclude={"configuration", "joints", "base", "com_velocity", "name", "description"}
         )
         try:
-            if key != self._governor_key:
-                self._governor, self._governor_key = Governor(scenario), key
+            governor = self._governor
+            if governor is None or key != self._governor_key:
+                governor = Governor(scenario)
+                self._governor, self._governor_key = governor, key
             t0 = time.perf_counter()
-            limit = self._governor.limit_com(self.analysis.stance.q, scenario.com_velocity)
+            limit = governor.limit_com(self.analysis.stance.q, scenario.com_velocity)
             tick_us = 1e6 * (time.perf_counter() - t0)
             reference = scenario.impact.reference_velocity
             capped = None if reference is None else limit.cap(reference)
-        except (
-            ImpactBalanceError
-        ) as exc:  # the analysis went through: the governor's failure is only a note
+        except ImpactBalanceError as exc:  # the analysis went through: only a note
             self.governed = None
             log.info("governor: %s", exc)
             return
@@ -217,7 +231,7 @@ class Session:
         return self._commit(lambda: state)
 
     def load(self, name: str) -> bool:
-        """Load a bundled scenario by name, or a ``.yaml`` file of the workspace by its relative name."""
+        """Load a bundled scenario by name, or a workspace ``.yaml`` file by its relative name."""
         return self._commit(lambda: self.files.load(name))
 
     def upload(self, filename: str, content: bytes) -> bool:
@@ -250,9 +264,8 @@ class Session:
             def build() -> GuiState:
                 result = drag_changes(self.state, self.analysis.stance, target, pose)
                 if not result.reached:
-                    note.append(
-                        f"out of reach: moved as close as possible ({1e3 * result.residual:.0f} mm away)"
-                    )
+                    away = f"{1e3 * result.residual:.0f} mm away"
+                    note.append(f"out of reach: moved as close as possible ({away})")
                 return self.state.with_changes(result.changes)
 
             ok = self._commit(build)
@@ -263,4 +276,5 @@ class Session:
     # -- reading --------------------------------------------------------------------------
     @property
     def summary(self) -> Summary:
+        """The numbers shown for the current analysis."""
         return Summary.of(self.analysis)

@@ -52,7 +52,7 @@ def _field_name(path: FieldPath) -> str:
     return out or "scenario"
 
 
-def _set(raw: dict, path: FieldPath, value: Any) -> None:
+def _set(raw: dict[str, Any], path: FieldPath, value: Any) -> None:
     """Set ``raw[path] = value`` in place, creating missing mappings; None deletes the key."""
     if not path:
         raise ScenarioError("scenario", value, "empty field path")
@@ -89,17 +89,17 @@ def _check_finite(path: FieldPath, value: Any) -> None:
         raise ScenarioError(_field_name(path), value, "must be a finite number")
     if isinstance(value, dict):
         for key, item in value.items():
-            _check_finite(path + (key,), item)
+            _check_finite((*path, key), item)
     elif isinstance(value, list):
         for i, item in enumerate(value):
             if isinstance(item, (dict, list)):
-                _check_finite(path + (i,), item)
+                _check_finite((*path, i), item)
             elif isinstance(item, float) and not math.isfinite(item):
                 raise ScenarioError(_field_name(path), value, "must be finite numbers")
 
 
 class GuiState:
-    """A validated scenario mapping and the :class:`~impact_balance.scenario.Scenario` built from it.
+    """A validated scenario mapping and the :class:`~impact_balance.scenario.Scenario` of it.
 
     Attributes:
         scenario: The validated scenario (what :func:`impact_balance.analyze` takes).
@@ -132,7 +132,11 @@ class GuiState:
 
     @classmethod
     def from_file(cls, name_or_path: str | Path = DEFAULT_SCENARIO) -> GuiState:
-        """Read a scenario file or a bundled scenario by name (``extends`` resolved)."""
+        """Read a scenario file or a bundled scenario by name (``extends`` resolved).
+
+        Raises:
+            ScenarioError: The file cannot be read or is not a valid scenario.
+        """
         return cls.from_scenario(load_scenario(name_or_path))
 
     # -- reading ------------------------------------------------------------------------
@@ -153,13 +157,17 @@ class GuiState:
 
     def to_yaml(self) -> str:
         """The scenario as YAML, in the schema of the scenario files."""
-        return yaml.safe_dump(self._raw, sort_keys=False, default_flow_style=None, width=100)
+        text: str = yaml.safe_dump(self._raw, sort_keys=False, default_flow_style=None, width=100)
+        return text
 
     def save(self, path: str | Path) -> Path:
-        """Write :meth:`to_yaml` to ``path`` (folders created); :class:`ScenarioError` if it cannot.
+        """Write :meth:`to_yaml` to ``path`` (folders created).
 
         For scripts: anywhere, no confirmation. The GUI never calls it; it saves through its
         workspace (:meth:`impact_balance.gui.files.GuiFiles.save`).
+
+        Raises:
+            ScenarioError: The name does not end with ``.yaml``/``.yml``, or it cannot be written.
         """
         path = Path(path).expanduser()
         if path.suffix not in (".yaml", ".yml"):
@@ -181,9 +189,19 @@ class GuiState:
     def with_changes(
         self, changes: Mapping[FieldPath, Any] | Iterable[tuple[FieldPath, Any]]
     ) -> GuiState:
-        """A new state with every change applied; raises :class:`ScenarioError` for a bad one.
+        """A new state with every change applied (None at a path removes the key).
 
         Changes are applied in order, then the whole mapping is validated once.
+
+        Args:
+            changes: ``{path: value}``, or (path, value) pairs.
+
+        Returns:
+            The new state; this one is unchanged.
+
+        Raises:
+            ScenarioError: A value is not finite, a path does not exist, or the result is not a
+                valid scenario (naming the field).
         """
         items = list(changes.items()) if isinstance(changes, Mapping) else list(changes)
         raw = copy.deepcopy(self._raw)
@@ -198,4 +216,5 @@ class GuiState:
         return isinstance(other, GuiState) and self._raw == other._raw
 
     def __repr__(self) -> str:
-        return f"GuiState({self.scenario.name or 'unnamed'!r}, {len(self._raw.get('contacts', []))} contacts)"
+        contacts = len(self._raw.get("contacts", []))
+        return f"GuiState({self.scenario.name or 'unnamed'!r}, {contacts} contacts)"

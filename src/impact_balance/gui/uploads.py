@@ -1,9 +1,8 @@
 """GUI uploads counted as they arrive: cut at the limit, never held whole.
 
-viser (1.1) buffers an upload's parts in memory until the last one arrives, and the 1 MiB check
-of :meth:`~impact_balance.gui.files.GuiFiles.upload` could only run then: a 200 MB upload was
-held whole, and a client that declares 40 GB and sends slowly was held until it left. So the
-server counts an upload while it arrives:
+viser buffers an upload's parts in memory until the last one arrives, so the size check of
+:meth:`~impact_balance.gui.files.GuiFiles.upload` alone would run only once the whole upload is
+held. So the server counts an upload while it arrives:
 
 - the declared size must be at most :data:`MAX_UPLOAD_BYTES`, and the declared number of parts
   at most :data:`MAX_UPLOAD_PARTS` (viser's page sends 512 KiB parts), else the transfer is
@@ -153,7 +152,16 @@ def limit_uploads(
 
     ``on_refused(filename, reason)`` is called (in a thread of its own) for each refused upload.
 
+    Args:
+        server: The :class:`viser.ViserServer`.
+        on_refused: Called with (file name, reason) for each refused upload.
+        limit: The largest upload, bytes.
+
+    Returns:
+        The installed counting handlers.
+
     Raises:
+        ValueError: ``limit`` is not a byte count.
         RuntimeError: viser's upload handlers are not where this viser version should have them.
     """
     if not math.isfinite(limit) or limit < 0:

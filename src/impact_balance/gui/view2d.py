@@ -1,7 +1,7 @@
 """The GUI's 2D view, as SVG: the CoM velocity area with the post-impact sets, and the ZMP area.
 
-SVG text is built directly (no figure library): it costs well under a millisecond, which
-keeps a full update within the GUI's budget, and the browser draws it crisply at any size.
+SVG text is built directly (no figure library): cheap enough to rebuild on every update, and
+drawn crisply by the browser at any size.
 Top panel: the CoM velocity area (m/s), the pre-impact CoM velocity, the post-impact CoM
 velocity set at the maximum contact velocity, and the set at the reference velocity (red
 when the robot would fall, green otherwise). Bottom panel: the ZMP support area (m), the
@@ -12,12 +12,13 @@ from __future__ import annotations
 
 import html
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+import numpy.typing as npt
 
-from impact_balance.analysis.analyze import Analysis
+from impact_balance.analysis.result import Analysis, ImpactAnswer
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.gui.session import Summary, format_speed
 
@@ -40,6 +41,7 @@ PANEL_COLORS = {
 
 
 def _nice_step(span: float, target: int = 5) -> float:
+    """A round tick step (1, 2, 2.5 or 5 times a power of ten) giving about ``target`` ticks."""
     raw = max(span, 1e-12) / target
     base = 10.0 ** math.floor(math.log10(raw))
     for m in (1.0, 2.0, 2.5, 5.0, 10.0):
@@ -49,28 +51,40 @@ def _nice_step(span: float, target: int = 5) -> float:
 
 
 def _fmt_tick(v: float, step: float) -> str:
+    """Tick value ``v`` with the digits its ``step`` needs ("0", never "-0.0")."""
     digits = max(
         0,
-        -int(math.floor(math.log10(step)))
+        -math.floor(math.log10(step))
         + (1 if step / 10 ** math.floor(math.log10(step)) == 2.5 else 0),
     )
     s = f"{v:.{digits}f}"
     return "0" if s.strip("-0.") == "" else s
 
 
+#: A point of a plot, world (x, y) (m or m/s).
+_Point = Sequence[float] | npt.NDArray[np.float64]
+
+
 @dataclass
 class _Panel:
-    """An equal-aspect plot box: world (x, y) to SVG pixels."""
+    """An equal-aspect plot box: world (x, y) to SVG pixels.
+
+    Items are queued with their points, and drawn by :meth:`render` once the limits are known.
+    """
 
     x0: float
     y0: float
     width: float
     height: float
-    points: list[np.ndarray] = field(default_factory=list)
-    ops: list = field(default_factory=list)  # drawing deferred until the limits are known
+    points: list[npt.NDArray[np.float64]] = field(default_factory=list)
+    ops: list[Callable[[], str]] = field(default_factory=list)
     min_span: float = 0.2
+    scale: float = field(default=1.0, init=False)
+    cx: float = field(default=0.0, init=False)
+    cy: float = field(default=0.0, init=False)
 
     def fit(self) -> None:
+        """Fit the limits to the finite queued points, at least ``min_span`` wide, 15 % margin."""
         pts = (
             np.vstack([np.asarray(p, dtype=float).reshape(-1, 2) for p in self.points])
             if self.points
@@ -85,19 +99,21 @@ class _Panel:
         self.scale = min(self.width / span[0], self.height / span[1])
         self.cx, self.cy = centre
 
-    def px(self, p: Sequence[float]) -> tuple[float, float]:
+    def px(self, p: _Point) -> tuple[float, float]:
+        """SVG pixels of world point ``p`` (y up in the world, down in SVG)."""
         return (
             self.x0 + 0.5 * self.width + (p[0] - self.cx) * self.scale,
             self.y0 + 0.5 * self.height - (p[1] - self.cy) * self.scale,
         )
 
     def world_bounds(self) -> tuple[float, float, float, float]:
+        """World limits of the box: (xmin, xmax, ymin, ymax)."""
         hw, hh = 0.5 * self.width / self.scale, 0.5 * self.height / self.scale
         return self.cx - hw, self.cx + hw, self.cy - hh, self.cy + hh
 
     def polygon(
         self,
-        vertices: np.ndarray,
+        vertices: npt.ArrayLike,
         fill: str,
         edge: str,
         opacity: float = 0.4,
@@ -117,7 +133,7 @@ class _Panel:
 
     def _polygon(
         self,
-        v: np.ndarray,
+        v: npt.NDArray[np.float64],
         fill: str,
         edge: str,
         opacity: float,
@@ -136,58 +152,69 @@ class _Panel:
 
     def dot(
         self,
-        p: Sequence[float],
+        p: npt.ArrayLike,
         color: str,
         r: float = 4.0,
         fill: str | None = None,
         width: float = 1.5,
     ) -> None:
         """Queue a dot of radius ``r`` px at world point ``p``."""
-        p = np.asarray(p, dtype=float)[:2]
-        self.points.append(p)
+        point = np.asarray(p, dtype=float)[:2]
+        self.points.append(point)
 
         def draw() -> str:
-            x, y = self.px(p)
-            return f'<circle cx="{x:.1f}" cy="{y:.1f}" r="{r}" fill="{fill or color}" stroke="{color}" stroke-width="{width}"/>'
+            x, y = self.px(point)
+            return (
+                f'<circle cx="{x:.1f}" cy="{y:.1f}" r="{r}" fill="{fill or color}" '
+                f'stroke="{color}" stroke-width="{width}"/>'
+            )
 
         self.ops.append(draw)
 
+    def _ticks(self, axis: int, lo: float, hi: float, step: float) -> list[str]:
+        """Grid lines and tick values every ``step`` from ``lo`` to ``hi`` on ``axis`` (0: x)."""
+        out = []
+        k = math.ceil(lo / step)
+        while k * step <= hi:
+            v = k * step
+            stroke = PANEL_COLORS["grid"] if k else PANEL_COLORS["axis"]
+            if axis == 0:
+                x, _ = self.px((v, 0.0))
+                out.append(
+                    f'<line x1="{x:.1f}" y1="{self.y0}" x2="{x:.1f}" '
+                    f'y2="{self.y0 + self.height}" stroke="{stroke}" stroke-width="1"/>'
+                )
+                out.append(
+                    f'<text x="{x:.1f}" y="{self.y0 + self.height + 12}" font-size="10" '
+                    f'text-anchor="middle" fill="#555">{_fmt_tick(v, step)}</text>'
+                )
+            else:
+                _, y = self.px((0.0, v))
+                out.append(
+                    f'<line x1="{self.x0}" y1="{y:.1f}" x2="{self.x0 + self.width}" '
+                    f'y2="{y:.1f}" stroke="{stroke}" stroke-width="1"/>'
+                )
+                out.append(
+                    f'<text x="{self.x0 - 4}" y="{y + 3:.1f}" font-size="10" text-anchor="end" '
+                    f'fill="#555">{_fmt_tick(v, step)}</text>'
+                )
+            k += 1
+        return out
+
     def axes(self, unit: tuple[str, str]) -> str:
-        """Frame, grid, tick values, and the axis labels ``unit`` = (x label, y label) with units."""
+        """Frame, grid, tick values, and the axis labels ``unit`` = (x label, y label)."""
         xmin, xmax, ymin, ymax = self.world_bounds()
         step = _nice_step(max(xmax - xmin, ymax - ymin), 6)
         out = [
-            f'<rect x="{self.x0}" y="{self.y0}" width="{self.width}" height="{self.height}" fill="white" stroke="{PANEL_COLORS["axis"]}"/>'
+            f'<rect x="{self.x0}" y="{self.y0}" width="{self.width}" height="{self.height}" '
+            f'fill="white" stroke="{PANEL_COLORS["axis"]}"/>'
         ]
-        for axis, (lo, hi) in enumerate(((xmin, xmax), (ymin, ymax))):
-            k = math.ceil(lo / step)
-            while k * step <= hi:
-                v = k * step
-                if axis == 0:
-                    x, _ = self.px((v, 0.0))
-                    out.append(
-                        f'<line x1="{x:.1f}" y1="{self.y0}" x2="{x:.1f}" y2="{self.y0 + self.height}" '
-                        f'stroke="{PANEL_COLORS["grid"] if k else PANEL_COLORS["axis"]}" stroke-width="1"/>'
-                    )
-                    out.append(
-                        f'<text x="{x:.1f}" y="{self.y0 + self.height + 12}" font-size="10" text-anchor="middle" '
-                        f'fill="#555">{_fmt_tick(v, step)}</text>'
-                    )
-                else:
-                    _, y = self.px((0.0, v))
-                    out.append(
-                        f'<line x1="{self.x0}" y1="{y:.1f}" x2="{self.x0 + self.width}" y2="{y:.1f}" '
-                        f'stroke="{PANEL_COLORS["grid"] if k else PANEL_COLORS["axis"]}" stroke-width="1"/>'
-                    )
-                    out.append(
-                        f'<text x="{self.x0 - 4}" y="{y + 3:.1f}" font-size="10" text-anchor="end" '
-                        f'fill="#555">{_fmt_tick(v, step)}</text>'
-                    )
-                k += 1
+        out += self._ticks(0, xmin, xmax, step)
+        out += self._ticks(1, ymin, ymax, step)
         xlabel, ylabel = unit
         out.append(
-            f'<text x="{self.x0 + self.width / 2:.1f}" y="{self.y0 + self.height + 26}" font-size="11" '
-            f'text-anchor="middle" fill="#333">{html.escape(xlabel)}</text>'
+            f'<text x="{self.x0 + self.width / 2:.1f}" y="{self.y0 + self.height + 26}" '
+            f'font-size="11" text-anchor="middle" fill="#333">{html.escape(xlabel)}</text>'
         )
         # The y label, turned along the axis, left of the tick values.
         cx, cy = self.x0 - 40, self.y0 + self.height / 2
@@ -202,7 +229,8 @@ class _Panel:
         self.fit()
         clip = f"clip{int(self.x0)}_{int(self.y0)}"
         return (
-            f'<clipPath id="{clip}"><rect x="{self.x0}" y="{self.y0}" width="{self.width}" height="{self.height}"/></clipPath>'
+            f'<clipPath id="{clip}"><rect x="{self.x0}" y="{self.y0}" width="{self.width}" '
+            f'height="{self.height}"/></clipPath>'
             + self.axes(unit)
             + f'<g clip-path="url(#{clip})">'
             + "\n".join(op() for op in self.ops)
@@ -210,7 +238,12 @@ class _Panel:
         )
 
 
-def _hull(points: np.ndarray) -> np.ndarray:
+#: One legend row: (kind, colour, text), kind "fill", "dash" or "dot" (see :func:`_legend`).
+_LegendRow = tuple[str, str, str]
+
+
+def _hull(points: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    """Vertices of the convex hull of planar ``points``."""
     return Polygon.from_points(np.asarray(points, dtype=float).reshape(-1, 2)).vertices
 
 
@@ -223,23 +256,26 @@ def _text(
     weight: str = "normal",
     anchor: str = "start",
 ) -> str:
+    """An SVG ``<text>`` at (``x``, ``y``) px; ``s`` is escaped."""
     return (
         f'<text x="{x:.1f}" y="{y:.1f}" font-size="{size}" fill="{color}" font-weight="{weight}" '
         f'text-anchor="{anchor}">{html.escape(s)}</text>'
     )
 
 
-def _legend(x: float, y: float, items: list[tuple[str, str, str]]) -> tuple[str, float]:
+def _legend(x: float, y: float, items: list[_LegendRow]) -> tuple[str, float]:
     """Legend rows (kind, colour, text); kind: "fill", "dash", "dot". Returns SVG and the next y."""
     out = []
     for kind, color, label in items:
         if kind == "fill":
             out.append(
-                f'<rect x="{x}" y="{y - 8}" width="14" height="9" fill="{color}" fill-opacity="0.5" stroke="{color}"/>'
+                f'<rect x="{x}" y="{y - 8}" width="14" height="9" fill="{color}" '
+                f'fill-opacity="0.5" stroke="{color}"/>'
             )
         elif kind == "dash":
             out.append(
-                f'<line x1="{x}" y1="{y - 4}" x2="{x + 14}" y2="{y - 4}" stroke="{color}" stroke-width="2" stroke-dasharray="4 2"/>'
+                f'<line x1="{x}" y1="{y - 4}" x2="{x + 14}" y2="{y - 4}" stroke="{color}" '
+                f'stroke-width="2" stroke-dasharray="4 2"/>'
             )
         else:
             out.append(f'<circle cx="{x + 7}" cy="{y - 4}" r="4" fill="{color}"/>')
@@ -248,21 +284,37 @@ def _legend(x: float, y: float, items: list[tuple[str, str, str]]) -> tuple[str,
     return "\n".join(out), y
 
 
-def svg_view(analysis: Analysis, width: int = 420) -> str:
-    """The 2D view of ``analysis`` as an ``<svg>`` element (scales to its container's width)."""
-    summary = Summary.of(analysis)
-    areas = analysis.areas
-    margin_left, pad = 62, 8  # room for the tick values and the turned y label
-    plot_w = width - margin_left - pad
-    plot_h = int(0.85 * plot_w)
-    parts: list[str] = []
-    y = 18
+@dataclass(frozen=True)
+class _Layout:
+    """Where the 2D view's parts go, SVG pixels.
+
+    The view's width, the room left of the plots (tick values and the turned y label), the
+    padding, and the size of one plot box.
+    """
+
+    width: int
+    margin_left: int = 62
+    pad: int = 8
+
+    @property
+    def plot_w(self) -> int:
+        """Width of a plot box, px."""
+        return self.width - self.margin_left - self.pad
+
+    @property
+    def plot_h(self) -> int:
+        """Height of a plot box, px."""
+        return int(0.85 * self.plot_w)
+
+
+def _header(summary: Summary, layout: _Layout, y: float) -> list[str]:
+    """The verdict (left) and the maximum contact velocities (right) on the line at ``y``."""
     color = PANEL_COLORS["safe"] if summary.headline == "balanced" else PANEL_COLORS["falls"]
-    parts.append(_text(pad, y, summary.headline.upper(), 14, color, "bold"))
+    parts = [_text(layout.pad, y, summary.headline.upper(), 14, color, "bold")]
     if summary.max_contact_velocity is not None:
         parts.append(
             _text(
-                width - pad,
+                layout.width - layout.pad,
                 y,
                 f"v_max {format_speed(summary.max_contact_velocity)} (CoM), "
                 f"{format_speed(summary.zmp_max_contact_velocity)} (ZMP)",
@@ -270,94 +322,118 @@ def svg_view(analysis: Analysis, width: int = 420) -> str:
                 anchor="end",
             )
         )
-    y += 14
+    return parts
 
-    # -- CoM velocity area ----------------------------------------------------------------
-    parts.append(
-        _text(pad, y + 12, "CoM velocity area and post-impact CoM velocities", 12, weight="bold")
+
+def _cannot_balance(layout: _Layout, y: float) -> str:
+    """The words "cannot balance" across the plot box whose top is at ``y``."""
+    return _text(
+        layout.margin_left + layout.plot_w / 2,
+        y + layout.plot_h / 2,
+        "cannot balance",
+        18,
+        PANEL_COLORS["falls"],
+        "bold",
+        "middle",
     )
+
+
+def _post_impact_sets(
+    top: _Panel, impact: ImpactAnswer, summary: Summary, c0: npt.NDArray[np.float64]
+) -> list[_LegendRow]:
+    """Queue on ``top`` the post-impact CoM velocity sets (m/s) of ``impact`` from ``c0``.
+
+    The set at the maximum contact velocity (or at the reference's when the maximum is
+    unbounded), the set at the reference velocity (red when the robot falls, green otherwise)
+    and the limiting vertex. Returns their legend rows.
+    """
+    legend: list[_LegendRow] = []
+    model, limit = impact.model, impact.com_limit
+    s = impact.evaluation_speed()
+    at_max = model.post_impact_com_velocities(c0, s)
+    if s > 0:
+        top.polygon(_hull(at_max), PANEL_COLORS["at_max"], PANEL_COLORS["at_max"], 0.25, 2)
+        word = "maximum" if limit.is_finite else "reference"
+        legend.append(
+            ("fill", PANEL_COLORS["at_max"], f"post-impact set at the {word} {s:.3f} m/s")
+        )
+    reference = summary.reference_speed
+    if reference is not None and limit.is_finite and reference > 0:
+        at_ref = model.post_impact_com_velocities(c0, reference)
+        ref_color = PANEL_COLORS["falls"] if summary.falls_at_reference else PANEL_COLORS["safe"]
+        top.polygon(_hull(at_ref), ref_color, ref_color, 0.12, 1.8, dash="5 3")
+        verdict = "falls" if summary.falls_at_reference else "does not fall"
+        legend.append(("dash", ref_color, f"at the reference {reference:.3f} m/s: {verdict}"))
+    if limit.is_finite and limit.limiting_vertex is not None and s > 0:
+        top.dot(at_max[limit.limiting_vertex], "#000", 5, PANEL_COLORS["limit"], 1.0)
+        legend.append(("dot", PANEL_COLORS["limit"], f"limiting vertex #{limit.limiting_vertex}"))
+    return legend
+
+
+def _com_velocity_panel(
+    analysis: Analysis, summary: Summary, layout: _Layout, y: float
+) -> tuple[list[str], float]:
+    """The top panel from ``y`` (px) down, and the next free y.
+
+    Its title, the CoM velocity area (m/s), the pre-impact CoM velocity, the post-impact sets,
+    and its legend.
+    """
+    parts = [
+        _text(
+            layout.pad,
+            y + 12,
+            "CoM velocity area and post-impact CoM velocities",
+            12,
+            weight="bold",
+        )
+    ]
     y += 20
-    top = _Panel(margin_left, y, plot_w, plot_h, min_span=0.3)
-    area = areas.com_velocity_area
+    top = _Panel(layout.margin_left, y, layout.plot_w, layout.plot_h, min_span=0.3)
+    area = analysis.areas.com_velocity_area
     c0 = np.asarray(analysis.com_velocity, dtype=float)[:2]
-    legend: list[tuple[str, str, str]] = []
+    legend: list[_LegendRow] = []
     if not area.is_empty:
         top.polygon(area.vertices, PANEL_COLORS["area"], PANEL_COLORS["area_edge"], 0.45, 2)
+        clipped = "" if area.bounded else ", clipped"
         legend.append(
-            (
-                "fill",
-                PANEL_COLORS["area"],
-                f"CoM velocity area ({area.area:.3f} m²/s²)"
-                + ("" if area.bounded else ", clipped"),
-            )
+            ("fill", PANEL_COLORS["area"], f"CoM velocity area ({area.area:.3f} m²/s²){clipped}")
         )
-    im = analysis.impact
-    if im is not None:
-        model, limit = im.model, im.com_limit
-        s = im.evaluation_speed()
-        at_max = model.post_impact_com_velocities(c0, s)
-        if s > 0:
-            top.polygon(_hull(at_max), PANEL_COLORS["at_max"], PANEL_COLORS["at_max"], 0.25, 2)
-            word = "maximum" if limit.is_finite else "reference"
-            legend.append(
-                ("fill", PANEL_COLORS["at_max"], f"post-impact set at the {word} {s:.3f} m/s")
-            )
-        if summary.reference_speed is not None and limit.is_finite and summary.reference_speed > 0:
-            at_ref = model.post_impact_com_velocities(c0, summary.reference_speed)
-            ref_color = (
-                PANEL_COLORS["falls"] if summary.falls_at_reference else PANEL_COLORS["safe"]
-            )
-            top.polygon(_hull(at_ref), ref_color, ref_color, 0.12, 1.8, dash="5 3")
-            verdict = "falls" if summary.falls_at_reference else "does not fall"
-            legend.append(
-                (
-                    "dash",
-                    ref_color,
-                    f"at the reference {summary.reference_speed:.3f} m/s: {verdict}",
-                )
-            )
-        if limit.is_finite and limit.limiting_vertex is not None and s > 0:
-            top.dot(at_max[limit.limiting_vertex], "#000", 5, PANEL_COLORS["limit"], 1.0)
-            legend.append(
-                ("dot", PANEL_COLORS["limit"], f"limiting vertex #{limit.limiting_vertex}")
-            )
+    if analysis.impact is not None:
+        legend += _post_impact_sets(top, analysis.impact, summary, c0)
     top.dot(c0, PANEL_COLORS["com"], 4)
     legend.append(
         ("dot", PANEL_COLORS["com"], f"pre-impact CoM velocity ({c0[0]:.2f}, {c0[1]:.2f}) m/s")
     )
     parts.append(top.render(("ċx, CoM velocity x (m/s)", "ċy, CoM velocity y (m/s)")))
     if area.is_empty:
-        parts.append(
-            _text(
-                margin_left + plot_w / 2,
-                y + plot_h / 2,
-                "cannot balance",
-                18,
-                PANEL_COLORS["falls"],
-                "bold",
-                "middle",
-            )
-        )
-    y += plot_h + 40
-    svg, y = _legend(margin_left, y, legend)
+        parts.append(_cannot_balance(layout, y))
+    y += layout.plot_h + 40
+    svg, y = _legend(layout.margin_left, y, legend)
     parts.append(svg)
+    return parts, y
 
-    # -- ZMP support area -----------------------------------------------------------------
-    y += 6
+
+def _zmp_panel(analysis: Analysis, layout: _Layout, y: float) -> tuple[list[str], float]:
+    """The bottom panel from ``y`` (px) down, and the next free y.
+
+    Its title, the ZMP support area (m), the contact rectangles projected on its plane, the
+    CoM projection, and its legend.
+    """
+    areas = analysis.areas
     shrunk = f", shrunk by {areas.zmp_margin * 100:g} cm" if areas.zmp_margin > 0 else ""
-    parts.append(
+    parts = [
         _text(
-            pad,
+            layout.pad,
             y + 12,
             f"ZMP support area (plane z = {areas.plane_height:g} m{shrunk})",
             12,
             weight="bold",
         )
-    )
+    ]
     y += 20
-    bottom = _Panel(margin_left, y, plot_w, plot_h, min_span=0.3)
+    bottom = _Panel(layout.margin_left, y, layout.plot_w, layout.plot_h, min_span=0.3)
     zmp = areas.zmp_area
-    legend = []
+    legend: list[_LegendRow] = []
     for contact in analysis.stance.contacts:
         corners = contact.corners()[:, :2]
         bottom.polygon(
@@ -367,40 +443,44 @@ def svg_view(analysis: Analysis, width: int = 420) -> str:
         legend.append(("dash", PANEL_COLORS["contact"], "contact rectangles (projected)"))
     if not zmp.is_empty:
         bottom.polygon(zmp.vertices, PANEL_COLORS["zmp"], PANEL_COLORS["zmp_edge"], 0.5, 2)
+        clipped = "" if zmp.bounded else ", clipped"
         legend.append(
-            (
-                "fill",
-                PANEL_COLORS["zmp"],
-                f"ZMP support area ({zmp.area * 1e4:.0f} cm²)"
-                + ("" if zmp.bounded else ", clipped"),
-            )
+            ("fill", PANEL_COLORS["zmp"], f"ZMP support area ({zmp.area * 1e4:.0f} cm²){clipped}")
         )
     com = np.asarray(areas.com, dtype=float)[:2]
     bottom.dot(com, PANEL_COLORS["com"], 4, "white", 2)
     legend.append(("dot", PANEL_COLORS["com"], f"CoM projection ({com[0]:.3f}, {com[1]:.3f}) m"))
     parts.append(bottom.render(("x (m)", "y (m)")))
     if zmp.is_empty:
-        parts.append(
-            _text(
-                margin_left + plot_w / 2,
-                y + plot_h / 2,
-                "cannot balance",
-                18,
-                PANEL_COLORS["falls"],
-                "bold",
-                "middle",
-            )
-        )
-    y += plot_h + 40
-    svg, y = _legend(margin_left, y, legend)
+        parts.append(_cannot_balance(layout, y))
+    y += layout.plot_h + 40
+    svg, y = _legend(layout.margin_left, y, legend)
     parts.append(svg)
+    return parts, y
+
+
+def svg_view(analysis: Analysis, width: int = 420) -> str:
+    """The 2D view of ``analysis`` as an ``<svg>`` element (scales to its container's width).
+
+    Args:
+        analysis: The analysis to draw.
+        width: Width of the drawing's view box, px (the height follows).
+
+    Returns:
+        An HTML ``<div>`` holding the ``<svg>``; text from the scenario is escaped.
+    """
+    summary = Summary.of(analysis)
+    layout = _Layout(width)
+    parts = _header(summary, layout, 18)
+    top, y = _com_velocity_panel(analysis, summary, layout, 18 + 14)
+    bottom, y = _zmp_panel(analysis, layout, y + 6)
     height = int(y + 4)
-    # Inside a box that keeps clear of the panel's scroll bar (which otherwise covers the right
-    # edge of the drawing: the maxima and the x labels were cut at a 1500 px wide window).
+    # Inside a box that keeps clear of the panel's scroll bar, which would cover the right
+    # edge of the drawing (the maxima and the x labels).
     return (
         f'<div style="box-sizing: border-box; width: 100%; padding-right: 16px">'
         f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {width} {height}" width="100%" '
         f'style="font-family: sans-serif; background: white; display: block">'
-        + "\n".join(parts)
+        + "\n".join(parts + top + bottom)
         + "</svg></div>"
     )

@@ -1,26 +1,45 @@
-"""The 3D view in viser: lights, ground and camera, the robot meshes, and the scene objects of
-:mod:`.scene` sent as few messages as possible (unchanged objects are skipped).
+"""The 3D view in viser: lights, ground and camera, the robot meshes, and the scene objects.
+
+The scene objects of :mod:`.scene` (world coordinates, m) are sent as few messages as
+possible: unchanged objects are skipped, changed ones of the same kind are updated in place.
 """
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
+from impact_balance.gui.host import GuiHost
 from impact_balance.gui.meshes import RobotMeshes
-from impact_balance.gui.scene import Arrows, Label, Points, Segments, Surface, scene_objects
+from impact_balance.gui.scene import (
+    Arrows,
+    Label,
+    Points,
+    SceneObject,
+    Segments,
+    Surface,
+    scene_objects,
+)
+
+if TYPE_CHECKING:
+    import viser
 
 __all__ = ["SceneMixin", "add_object", "update_object"]
 
+#: The arrays viser gets for one scene object (float32 points, uint32 faces), as sent.
+Geometry = tuple[npt.NDArray[Any], ...]
+
 
 def _rgb(color: str) -> tuple[int, int, int]:
+    """``#rrggbb`` as (r, g, b), 0..255."""
     c = color.lstrip("#")
     return int(c[0:2], 16), int(c[2:4], 16), int(c[4:6], 16)
 
 
-def _geometry(obj: Any) -> tuple[np.ndarray, ...] | None:
-    """The arrays viser gets for a scene object (float32, as sent), None if there is nothing to draw."""
+def _geometry(obj: SceneObject) -> Geometry | None:
+    """The arrays viser gets for a scene object (as sent), None if there is nothing to draw."""
     if isinstance(obj, Segments):
         return (np.asarray(obj.segments, dtype=np.float32),) if len(obj.segments) else None
     if isinstance(obj, Points):
@@ -34,8 +53,20 @@ def _geometry(obj: Any) -> tuple[np.ndarray, ...] | None:
     return None
 
 
-def add_object(scene: Any, name: str, obj: Any, data: tuple[np.ndarray, ...]) -> Any:
-    """Add one scene object (its :func:`_geometry` arrays ``data``) to the viser ``scene``; returns the handle."""
+def add_object(
+    scene: viser.SceneApi, name: str, obj: SceneObject, data: Geometry
+) -> viser.SceneNodeHandle:
+    """Add one scene object to the viser ``scene``.
+
+    Args:
+        scene: ``server.scene``.
+        name: Its name in the scene tree.
+        obj: The object (its kind, colour and sizes).
+        data: Its arrays as sent (points, or vertices and faces), world, m.
+
+    Returns:
+        The handle of the new scene node.
+    """
     color = _rgb(obj.color)
     if isinstance(obj, Segments):
         return scene.add_line_segments(name, data[0], color, thickness=obj.width)
@@ -71,8 +102,14 @@ def add_object(scene: Any, name: str, obj: Any, data: tuple[np.ndarray, ...]) ->
     )
 
 
-def update_object(handle: Any, obj: Any, data: tuple[np.ndarray, ...]) -> None:
-    """Move an object of the same kind in place (one message, no remove and add)."""
+def update_object(handle: Any, obj: SceneObject, data: Geometry) -> None:
+    """Move an object of the same kind in place (one message, no remove and add).
+
+    Args:
+        handle: The scene node that :func:`add_object` returned for an object of that kind.
+        obj: The object.
+        data: Its new arrays as sent, world, m.
+    """
     if isinstance(obj, (Segments, Arrows)):
         handle.points = data[0]
     elif isinstance(obj, (Points, Label)):
@@ -81,12 +118,18 @@ def update_object(handle: Any, obj: Any, data: tuple[np.ndarray, ...]) -> None:
         handle.vertices, handle.faces = data
 
 
-class SceneMixin:
-    """The viser scene of :class:`~.app.GuiApp` (uses its ``server``, ``session``, ``w_opacity``,
-    ``_scene_handles``, ``_scene_data`` and ``_meshes``).
-    """
+class SceneMixin(GuiHost):
+    """The 3D view of :class:`~.app.GuiApp`: the robot and the scene objects."""
+
+    #: The drawn scene objects by scene-tree name: their nodes, and the objects with the
+    #: arrays last sent (to skip what did not change).
+    _scene_handles: dict[str, viser.SceneNodeHandle]
+    _scene_data: dict[str, tuple[SceneObject, Geometry]]
+    #: The robot's meshes (None before the first draw).
+    _meshes: RobotMeshes | None
 
     def _setup_scene(self) -> None:
+        """Up axis, lights, the ground grid and the initial camera."""
         scene = self.server.scene
         scene.set_up_direction("+z")
         # No shadows: they cost a render pass per light, which software WebGL (no GPU, as on
@@ -105,9 +148,9 @@ class SceneMixin:
         self.server.initial_camera.look_at = (0.1, 0.0, 0.6)
 
     def _draw_objects(self) -> None:
-        """Draw :func:`scene_objects`: unchanged objects are skipped, changed ones updated in place."""
+        """Draw :func:`scene_objects`: skip unchanged objects, update changed ones in place."""
         scene = self.server.scene
-        seen = set()
+        seen: set[str] = set()
         for obj in scene_objects(self.session.analysis):
             name = f"/analysis/{obj.name}"
             data = _geometry(obj)
@@ -132,12 +175,11 @@ class SceneMixin:
                 self._scene_handles.pop(name).remove()
                 self._scene_data.pop(name, None)
 
-    def _draw_robot(self) -> None:
+    def _draw_robot(self, opacity: float) -> None:
+        """Move the robot's meshes to the stance; read them (at ``opacity``) for a new robot."""
         stance = self.session.analysis.stance
         if self._meshes is None or self._meshes.robot is not stance.robot:
             if self._meshes is not None:
                 self._meshes.remove()
-            self._meshes = RobotMeshes(
-                self.server.scene, stance.robot, opacity=self.w_opacity.value
-            )
+            self._meshes = RobotMeshes(self.server.scene, stance.robot, opacity=opacity)
         self._meshes.update(stance.data)

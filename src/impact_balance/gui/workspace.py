@@ -69,7 +69,12 @@ class Workspace:
         field: str = "file",
         suffixes: tuple[str, ...] = SCENARIO_SUFFIXES,
     ) -> tuple[str, ...]:
-        """The components of a workspace-relative ``name``, checked lexically (no disk access)."""
+        """The components of a workspace-relative ``name``, checked lexically (no disk access).
+
+        Raises:
+            WorkspaceError: Empty, too long, absolute, ``~``, a ``..`` part, a part over 255
+                bytes, or a name without one of the ``suffixes``.
+        """
         text = os.fspath(name) if isinstance(name, os.PathLike) else name
         if not isinstance(text, str):
             raise WorkspaceError(field, repr(text), "must be a file name")
@@ -123,6 +128,11 @@ class Workspace:
             overwrite: Accept replacing an existing regular file (for writing).
             field: Field named in errors ("file", "extends", "robot.urdf"...).
             suffixes: Accepted name endings (lower case).
+
+        Raises:
+            WorkspaceError: The name breaks the rule (see :meth:`parts`), a link is on the way,
+                a folder is missing, the file is missing (reading) or exists (writing, without
+                ``overwrite``), is not a regular file, or is over :data:`MAX_FILE_BYTES`.
         """
         parts = self.parts(name, field=field, suffixes=suffixes)
         path = self.root
@@ -205,7 +215,7 @@ class Workspace:
 
     # -- I/O without following links --------------------------------------------------------
     def _open_folder(self, parts: tuple[str, ...], field: str, name: str) -> int:
-        """A descriptor of the folder ``parts`` under the root, opened link by link without following."""
+        """A descriptor of the folder ``parts`` under the root, opened part by part, no link."""
         flags = os.O_RDONLY | getattr(os, "O_DIRECTORY", 0) | getattr(os, "O_NOFOLLOW", 0)
         fd = os.open(self.root, flags)
         try:
@@ -225,7 +235,7 @@ class Workspace:
 
     @staticmethod
     def _create(folder: int, name: str, field: str, shown: str) -> tuple[int, str]:
-        """A new file ``name`` in the folder descriptor (never an existing one, never through a link)."""
+        """A new file ``name`` in the folder descriptor (never an existing one, nor a link)."""
         flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
         try:
             return os.open(name, flags, 0o666, dir_fd=folder), name
@@ -241,7 +251,11 @@ class Workspace:
         field: str = "file",
         suffixes: tuple[str, ...] = SCENARIO_SUFFIXES,
     ) -> str:
-        """The UTF-8 text of the workspace file ``name`` (at most :data:`MAX_FILE_BYTES`)."""
+        """The UTF-8 text of the workspace file ``name`` (at most :data:`MAX_FILE_BYTES`).
+
+        Raises:
+            WorkspaceError: Refused by :meth:`resolve`, unreadable, or not UTF-8 text.
+        """
         parts = self.resolve(name, field=field, suffixes=suffixes).relative_to(self.root).parts
         folder = self._open_folder(parts[:-1], field, str(name))
         try:
@@ -273,10 +287,17 @@ class Workspace:
         field: str = "file",
         suffixes: tuple[str, ...] = SCENARIO_SUFFIXES,
     ) -> Path:
-        """Write ``text`` to the workspace file ``name``; refuse to replace a file unless ``overwrite``.
+        """Write ``text`` to the workspace file ``name``; replace a file only with ``overwrite``.
 
         The text goes to a temporary file in the same folder, then takes the name at once: a
         reader never sees half a file, and an existing link is replaced, never followed.
+
+        Returns:
+            The file's path.
+
+        Raises:
+            WorkspaceError: Refused by :meth:`resolve` (for writing), the file appeared
+                meanwhile (without ``overwrite``), or it cannot be written.
         """
         path = self.resolve(
             name, for_write=True, overwrite=overwrite, field=field, suffixes=suffixes
