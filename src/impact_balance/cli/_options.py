@@ -13,8 +13,12 @@ import argparse
 import math
 import os
 from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 from impact_balance.exceptions import ImpactBalanceError, OptionError, short_repr
+
+if TYPE_CHECKING:
+    from impact_balance.scenario import Scenario
 
 __all__ = [
     "LOG_SUFFIXES",
@@ -22,12 +26,16 @@ __all__ = [
     "add_controller_option",
     "add_output_options",
     "add_trial_options",
+    "add_velocity_margin_option",
     "add_zmp_margin_option",
+    "a_number",
     "integer",
     "number",
     "open_journal",
     "output_file",
     "output_folder",
+    "scoring_margin",
+    "with_margins",
     "with_zmp_margin",
 ]
 
@@ -158,17 +166,107 @@ def add_output_options(parser: argparse.ArgumentParser, log_help: str) -> None:
 
 
 def add_zmp_margin_option(parser: argparse.ArgumentParser, default_help: str) -> None:
-    """``--zmp-margin M``: the ZMP support area shrunk by M metres (``default_help``: what it defaults to)."""
-    from impact_balance.constants import MAX_SIZE
+    """Add ``--zmp-margin M``: the ZMP support area shrunk by M metres.
 
+    The value is read as a number here and checked by the scenario schema, once, when the
+    command applies it (:func:`with_margins`).
+
+    Args:
+        parser: The command's parser.
+        default_help: What the option defaults to, for its help.
+    """
     parser.add_argument(
         "--zmp-margin",
-        type=number("--zmp-margin", 0.0, MAX_SIZE, "m"),
+        type=a_number("--zmp-margin"),
         default=None,
         metavar="M",
         help=f"shrink the ZMP support area by M metres, and the CoM velocity area with it "
         f"({default_help}; 0 is the paper's criterion)",
     )
+
+
+def add_velocity_margin_option(parser: argparse.ArgumentParser, what: str) -> None:
+    """Add ``--velocity-margin V``: every post-impact CoM velocity V m/s inside the area.
+
+    The value is read as a number here and checked by the scenario schema, once, when the
+    command applies it (:func:`with_margins`).
+
+    Args:
+        parser: The command's parser.
+        what: What the margin applies to, for the help (e.g. "com governor").
+    """
+    parser.add_argument(
+        "--velocity-margin",
+        type=a_number("--velocity-margin"),
+        default=None,
+        metavar="V",
+        help=f"{what}: every post-impact CoM velocity must lie V m/s inside the CoM velocity "
+        "area (a margin for the impact model's error; default: the scenario's velocity_margin, "
+        "0 unless set, the paper's criterion)",
+    )
+
+
+def a_number(field: str) -> Callable[[str], float]:
+    """Argparse type: any number (its range is the scenario schema's to check).
+
+    Args:
+        field: The option, named in the error.
+
+    Returns:
+        The type: text to float, :class:`CommandLineError` for text that is not a number.
+    """
+
+    def check(text: str) -> float:
+        try:
+            return float(text)
+        except ValueError:
+            raise CommandLineError(field, text, "not a number") from None
+
+    check.__name__ = "number"
+    return check
+
+
+def with_margins(
+    scenario: Scenario, zmp_margin: float | None = None, velocity_margin: float | None = None
+) -> Scenario:
+    """``scenario`` with the margins given on the command line (None: the scenario's own).
+
+    The values go through :meth:`~impact_balance.scenario.Scenario.replace`, so the schema
+    checks them as it checks a file's keys; its refusal names the option.
+
+    Args:
+        scenario: The command's scenario.
+        zmp_margin: ``--zmp-margin``, m.
+        velocity_margin: ``--velocity-margin``, m/s.
+
+    Returns:
+        The scenario to use (``scenario`` itself when no margin is given).
+
+    Raises:
+        ScenarioError: A margin the schema refuses, its field the option (``--zmp-margin``).
+    """
+    from impact_balance.exceptions import ScenarioError
+
+    given = {"zmp_margin": zmp_margin, "velocity_margin": velocity_margin}
+    changes = {key: value for key, value in given.items() if value is not None}
+    try:
+        return scenario.replace(**changes)
+    except ScenarioError as exc:
+        option = "--" + exc.field.replace("_", "-")
+        raise ScenarioError(option, exc.value, exc.reason) from None
+
+
+def scoring_margin(scenario: Scenario) -> float | None:
+    """The ZMP margin (m) a trial command scores with: the scenario's, when set.
+
+    Args:
+        scenario: The command's scenario, with ``--zmp-margin`` applied (:func:`with_margins`).
+
+    Returns:
+        Its ``zmp_margin`` when its file or the command line set it, else None (the trials'
+        controller's own margin).
+    """
+    return scenario.zmp_margin if "zmp_margin" in scenario.set_keys else None
 
 
 def with_zmp_margin(scenario, margin: float | None):
@@ -194,7 +292,11 @@ def add_trial_options(parser: argparse.ArgumentParser, impact: bool) -> None:
             help="hold every joint's velocity through the impact (the paper's rigid robot), "
             "until the contact's normal velocity reaches zero",
         )
-    add_zmp_margin_option(parser, "default: the ZMP margin the trials' controller keeps")
+    add_zmp_margin_option(
+        parser,
+        "default: the scenario's zmp_margin when it sets one, else the ZMP margin the trials' "
+        "controller keeps",
+    )
     parser.add_argument(
         "--journal",
         metavar="FILE",
@@ -230,7 +332,9 @@ def open_journal(
     parts = {
         "command": command,
         "trial_version": TRIAL_VERSION,
-        "scenario": scenario.model_dump(mode="json", exclude={"zmp_margin", "name", "description"}),
+        "scenario": scenario.model_dump(
+            mode="json", exclude={"zmp_margin", "velocity_margin", "name", "description"}
+        ),
         "joints": joints,
         "options": dataclasses.asdict(dataclasses.replace(options, record=False)),
         **extra,

@@ -6,7 +6,12 @@ import argparse
 import dataclasses
 from pathlib import Path
 
-from impact_balance.cli._options import add_zmp_margin_option, output_folder, with_zmp_margin
+from impact_balance.cli._options import (
+    add_velocity_margin_option,
+    add_zmp_margin_option,
+    output_folder,
+    with_margins,
+)
 
 __all__ = ["INTERPRETED", "USES_KERNEL", "add_parser", "run"]
 
@@ -33,6 +38,7 @@ def add_parser(sub) -> list[str]:
     )
     a.add_argument("--strict", action="store_true", help="treat warnings as errors (exit status 2)")
     add_zmp_margin_option(a, "default: the scenario's zmp_margin, 0 unless set")
+    add_velocity_margin_option(a, "CoM criterion")
     return ["analyze"]
 
 
@@ -43,10 +49,10 @@ def run(args: argparse.Namespace) -> int:
     from impact_balance.exceptions import StrictWarningsError
 
     scenario = args.scenario
-    if args.zmp_margin is not None:
+    if args.zmp_margin is not None or args.velocity_margin is not None:
         from impact_balance.scenario import load_scenario
 
-        scenario = with_zmp_margin(load_scenario(scenario), args.zmp_margin)
+        scenario = with_margins(load_scenario(scenario), args.zmp_margin, args.velocity_margin)
     analysis = analyze(scenario, solve_qp=True if args.qp else None)
     if args.strict and analysis.warnings:
         raise StrictWarningsError(analysis.warnings)

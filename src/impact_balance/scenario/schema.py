@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 import pinocchio as pin
@@ -24,6 +24,7 @@ from impact_balance.constants import (
     MAX_PEAK_FACTOR,
     MAX_POSITION,
     MAX_SIZE,
+    MAX_VELOCITY_MARGIN,
 )
 from impact_balance.contacts.stance import ContactSpec, Stance
 from impact_balance.exceptions import ScenarioError
@@ -227,6 +228,9 @@ class Scenario(_Model):
     plane_height: Annotated[Number, _scalar(-MAX_POSITION, MAX_POSITION, "m")] = 0.0
     #: The ZMP support area is shrunk by this margin (m), and the CoM velocity area with it.
     zmp_margin: Annotated[Number, _scalar(0.0, MAX_SIZE, "m")] = 0.0
+    #: Every post-impact CoM velocity must lie this far (m/s) inside the CoM velocity area
+    #: (the CoM criterion): a margin for the impact model's error. 0 is the paper's criterion.
+    velocity_margin: Annotated[Number, _scalar(0.0, MAX_VELOCITY_MARGIN, "m/s")] = 0.0
     torque_limits: Flag = True
     gravity: Annotated[Number, _scalar(*GRAVITY_RANGE, "m/s^2")] = 9.81
     contacts: list[ContactConfig] = Field(min_length=1)
@@ -240,6 +244,37 @@ class Scenario(_Model):
         if bad:
             raise ValueError(f"joint values must be finite (not {', '.join(bad)})")
         return joints
+
+    def replace(self, **changes: Any) -> Scenario:
+        """A copy with the top-level keys ``changes`` replaced, validated as a file's keys are.
+
+        The one way to override a scenario's value (``zmp_margin``, ``velocity_margin``,
+        ``com_velocity``...): unlike pydantic's ``model_copy``, it refuses what the schema
+        refuses. The keys the scenario set (:attr:`set_keys`) stay set, and the changed ones
+        become set.
+
+        Args:
+            **changes: Top-level keys and their new values, in the file's units.
+
+        Returns:
+            The new scenario (same ``source``); this one when ``changes`` is empty.
+
+        Raises:
+            ScenarioError: A value the schema refuses, or an unknown key, naming the field.
+        """
+        if not changes:
+            return self
+        from impact_balance.scenario.validate import scenario_from_dict
+
+        raw = self.model_dump(exclude_unset=True)
+        raw.pop("source", None)
+        raw.update(changes)
+        return scenario_from_dict(raw, self.source)
+
+    @property
+    def set_keys(self) -> frozenset[str]:
+        """The top-level keys the file (with its ``extends:`` chain) or an override set."""
+        return frozenset(self.model_fields_set - {"source"})
 
     # -- resolution against a robot model -------------------------------------------------
     def load_robot(self) -> Robot:
