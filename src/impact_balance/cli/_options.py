@@ -36,7 +36,6 @@ __all__ = [
     "output_folder",
     "scoring_margin",
     "with_margins",
-    "with_zmp_margin",
 ]
 
 #: Suffixes of a log file (``--log``).
@@ -267,18 +266,6 @@ def scoring_margin(scenario: Scenario) -> float | None:
         controller's own margin).
     """
     return scenario.zmp_margin if "zmp_margin" in scenario.set_keys else None
-
-
-def with_zmp_margin(scenario, margin: float | None):
-    """``scenario`` with its ``zmp_margin`` replaced by ``margin`` (m) when given, checked like the key."""
-    if margin is None:
-        return scenario
-    from impact_balance.constants import MAX_SIZE
-    from impact_balance.exceptions import ScenarioError
-
-    if not (margin == margin and 0.0 <= margin <= MAX_SIZE):  # NaN fails the first test
-        raise ScenarioError("--zmp-margin", margin, f"must be in [0, {MAX_SIZE:g}] m")
-    return scenario.model_copy(update={"zmp_margin": float(margin)})
 
 
 def add_trial_options(parser: argparse.ArgumentParser, impact: bool) -> None:

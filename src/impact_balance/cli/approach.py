@@ -9,12 +9,13 @@ from pathlib import Path
 
 from impact_balance.cli._options import (
     add_controller_option,
+    add_velocity_margin_option,
     add_zmp_margin_option,
     import_mujoco,
     number,
     output_file,
     output_folder,
-    with_zmp_margin,
+    with_margins,
 )
 
 __all__ = ["USES_KERNEL", "add_parser", "run"]
@@ -70,14 +71,7 @@ def add_parser(sub) -> list[str]:
         help="with --contact-aware: compute its rates in a worker process, off the tick (the tick never "
         "waits; the rates are one recomputation old)",
     )
-    a.add_argument(
-        "--velocity-margin",
-        type=number("--velocity-margin", 0.0, 10.0, "m/s"),
-        default=0.0,
-        metavar="V",
-        help="com governor: every post-impact CoM velocity must lie V m/s inside the CoM velocity area "
-        "(a margin for the impact model's error; default 0, the paper's criterion)",
-    )
+    add_velocity_margin_option(a, "com governor")
     a.add_argument(
         "--rigid-impact",
         action="store_true",
@@ -125,7 +119,7 @@ def run(args: argparse.Namespace) -> int:
         controller_margin,
     )
 
-    scenario = load_scenario(args.scenario)
+    scenario = with_margins(load_scenario(args.scenario), args.zmp_margin, args.velocity_margin)
     if scenario.impact is None:
         raise SimulationError(
             "impact", None, f"scenario {scenario.name!r} has no impact: approach needs one"
@@ -139,9 +133,8 @@ def run(args: argparse.Namespace) -> int:
         distances = [0.15 if args.wall_distance is None else args.wall_distance]
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
     margin = controller_margin(options) if args.zmp_margin is None else args.zmp_margin
-    governed = with_zmp_margin(
-        scenario, margin
-    )  # the governor's view: the area the controller can use
+    # The governor's view: the area the controller can use.
+    governed = scenario.replace(zmp_margin=margin)
     setup = BalanceSetup.create(
         scenario, "servo", options, meshes=bool(args.video)
     )  # meshes: visual only
@@ -153,7 +146,7 @@ def run(args: argparse.Namespace) -> int:
             governed,
             criterion=args.governor,
             contact_aware=args.contact_aware,
-            velocity_margin=args.velocity_margin,
+            velocity_margin=governed.velocity_margin,
             contact_aware_async=args.contact_aware_async,
         )
     trials, written = [], []
@@ -182,7 +175,7 @@ def run(args: argparse.Namespace) -> int:
         d["rigid_impact"] = args.rigid_impact
         d["zmp_margin"] = margin
         d["contact_aware"] = bool(args.contact_aware and governor is not None)
-        d["velocity_margin"] = args.velocity_margin if governor is not None else None
+        d["velocity_margin"] = governed.velocity_margin if governor is not None else None
         d["contact_aware_async"] = bool(args.contact_aware_async and governor is not None)
     out = (
         docs[0]

@@ -10,7 +10,7 @@ from impact_balance.cli._options import (
     add_output_options,
     add_trial_options,
     open_journal,
-    with_zmp_margin,
+    with_margins,
 )
 
 __all__ = ["USES_KERNEL", "add_parser", "run"]
@@ -61,11 +61,10 @@ def run(args: argparse.Namespace) -> int:
     from impact_balance.sim.studies.push import check_push_arguments, push_test
     from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, write_trial_log
 
-    scenario = load_scenario(args.scenario)
+    scenario = with_margins(load_scenario(args.scenario), args.zmp_margin)
     if args.log:
         check_log_path(args.log)
     check_push_arguments(args.directions, args.magnitudes, args.duration, args.relative)
-    with_zmp_margin(scenario, args.zmp_margin)  # checks the value before any trial
     options = BalanceTrialOptions(controller=args.controller)
     journal = open_journal(args, "push-test", scenario, "servo", options, {"body": args.body})
     levels = len(args.relative or args.magnitudes or [0] * 6)

@@ -10,7 +10,7 @@ from impact_balance.cli._options import (
     add_output_options,
     add_trial_options,
     open_journal,
-    with_zmp_margin,
+    with_margins,
 )
 
 __all__ = ["USES_KERNEL", "add_parser", "run"]
@@ -52,7 +52,7 @@ def run(args: argparse.Namespace) -> int:
     from impact_balance.sim.studies.validate import validate
     from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, write_trial_log
 
-    scenario = load_scenario(args.scenario)
+    scenario = with_margins(load_scenario(args.scenario), args.zmp_margin)
     if scenario.impact is None:
         raise SimulationError(
             "impact", None, f"scenario {scenario.name!r} has no impact: validate needs one"
@@ -60,7 +60,6 @@ def run(args: argparse.Namespace) -> int:
     if not (0 < args.max_speed <= 5.0):
         raise SimulationError("--max-speed", args.max_speed, "must be in (0, 5] m/s")
     check_tolerance(args.tolerance)
-    with_zmp_margin(scenario, args.zmp_margin)  # checks the value before any trial
     if args.log:
         check_log_path(args.log)
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
