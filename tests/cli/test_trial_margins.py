@@ -79,3 +79,35 @@ def test_approach_gives_the_governor_both_margins(monkeypatch, tmp_path: Path, c
     assert cli.main([*argv, "--velocity-margin", "11"]) == 2
     assert "--velocity-margin = 11.0: must be in [0, 10] m/s" in capsys.readouterr().err
     assert len(calls) == 1
+
+
+@pytest.mark.parametrize("command", ["validate", "push-test"])
+def test_the_scenario_files_margin_reaches_the_study(studies, command, tmp_path: Path):
+    path = tmp_path / "margin.yaml"
+    path.write_text("extends: palm_push_two_feet\nzmp_margin: 0.03\n")
+    assert cli.main([command, str(path), "--no-journal"]) == 2
+    assert cli.main([command, str(path), "--no-journal", "--zmp-margin", "0.02"]) == 2
+    assert cli.main([command, "palm_push_two_feet", "--no-journal"]) == 2
+    from_file, from_option, unset = studies[command]
+    assert from_file["zmp_margin"] == 0.03  # the file's key, as analyze honours it
+    assert from_option["zmp_margin"] == 0.02  # the option wins over the file
+    assert unset["zmp_margin"] is None  # neither: the controller's own margin
+
+
+def test_approach_honours_the_scenario_files_margins(monkeypatch, tmp_path: Path):
+    import impact_balance.governor as governor_module
+    from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions
+    from impact_balance.sim.trials.setup import controller_margin
+
+    calls: list[dict[str, Any]] = []
+    monkeypatch.setattr(BalanceSetup, "create", classmethod(lambda cls, *a, **k: None))
+    monkeypatch.setattr(governor_module, "Governor", record(calls))
+    path = tmp_path / "margins.yaml"
+    path.write_text("extends: palm_push_two_feet\nzmp_margin: 0.03\nvelocity_margin: 0.01\n")
+    assert cli.main(["approach", str(path), "--reference", "0.8"]) == 2
+    assert cli.main(["approach", "palm_push_two_feet", "--reference", "0.8"]) == 2
+    from_file, unset = calls
+    assert from_file["scenario"].zmp_margin == 0.03
+    assert from_file["scenario"].velocity_margin == 0.01
+    own = controller_margin(BalanceTrialOptions(controller="id"))  # approach's default controller
+    assert unset["scenario"].zmp_margin == own and unset["scenario"].velocity_margin == 0.0

@@ -15,6 +15,7 @@ from impact_balance.cli._options import (
     number,
     output_file,
     output_folder,
+    scoring_margin,
     with_margins,
 )
 
@@ -132,7 +133,8 @@ def run(args: argparse.Namespace) -> int:
     else:
         distances = [0.15 if args.wall_distance is None else args.wall_distance]
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
-    margin = controller_margin(options) if args.zmp_margin is None else args.zmp_margin
+    own = scoring_margin(scenario)
+    margin = controller_margin(options) if own is None else own
     # The governor's view: the area the controller can use.
     governed = scenario.replace(zmp_margin=margin)
     setup = BalanceSetup.create(

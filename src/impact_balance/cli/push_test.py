@@ -10,6 +10,7 @@ from impact_balance.cli._options import (
     add_output_options,
     add_trial_options,
     open_journal,
+    scoring_margin,
     with_margins,
 )
 
@@ -84,7 +85,7 @@ def run(args: argparse.Namespace) -> int:
             progress=progress,
             options=options,
             relative=args.relative,
-            zmp_margin=args.zmp_margin,
+            zmp_margin=scoring_margin(scenario),
             journal=journal,
         )
     finally:

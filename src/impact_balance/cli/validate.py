@@ -10,6 +10,7 @@ from impact_balance.cli._options import (
     add_output_options,
     add_trial_options,
     open_journal,
+    scoring_margin,
     with_margins,
 )
 
@@ -89,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
             max_speed=args.max_speed,
             progress=progress,
             options=options,
-            zmp_margin=args.zmp_margin,
+            zmp_margin=scoring_margin(scenario),
             journal=journal,
         )
     finally:
