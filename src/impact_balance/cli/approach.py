@@ -110,6 +110,8 @@ def run(args: argparse.Namespace) -> int:
         raise SimulationError(
             "--video", args.video, "one .mp4 for one trial (give --wall-distance, not a range)"
         )
+    if args.contact_aware_async and not args.contact_aware:
+        raise SimulationError("--contact-aware-async", True, "needs --contact-aware")
     import_mujoco(bool(args.video))  # before anything imports MuJoCo: the GL backend is read then
     from impact_balance.cli.output import print_json
     from impact_balance.scenario import load_scenario
@@ -142,14 +144,11 @@ def run(args: argparse.Namespace) -> int:
     )  # meshes: visual only
     governor = None
     if args.governor != "none":
-        from impact_balance.governor import Governor
+        from impact_balance.governor import ContactAwareOptions, Governor
 
+        aware = ContactAwareOptions(asynchronous=args.contact_aware_async)
         governor = Governor(
-            governed,
-            criterion=args.governor,
-            contact_aware=args.contact_aware,
-            velocity_margin=governed.velocity_margin,
-            contact_aware_async=args.contact_aware_async,
+            governed, args.governor, contact_aware=aware if args.contact_aware else None
         )
     trials, written = [], []
     for distance in distances:

@@ -15,6 +15,7 @@ from impact_balance.contacts.stance import has_free_flyer
 from impact_balance.criteria.com import VelocityLimit
 from impact_balance.exceptions import GovernorError, ScenarioError
 from impact_balance.governor.limit import SpeedLimit, cap_approach
+from impact_balance.governor.options import CRITERIA, ContactAwareOptions, Criterion
 from impact_balance.governor.posture import Posture, PostureEvaluator, PostureSettings
 from impact_balance.governor.support import ContactAwareLimit, combine
 from impact_balance.governor.worker import ContactAwareWorker
@@ -29,11 +30,7 @@ from impact_balance.scenario import (
     with_source,
 )
 
-__all__ = ["CRITERIA", "Governor"]
-
-#: The governor's criteria: "com", the CoM velocity area (the paper's); "zmp", the predicted
-#: ZMP stays in the ZMP support area (the paper's Experiment 1 comparison).
-CRITERIA = ("com", "zmp")
+__all__ = ["Governor"]
 
 #: Largest |norm - 1| of the base quaternion in q (pinocchio's order x, y, z, w).
 QUATERNION_TOLERANCE = 1e-6
@@ -73,85 +70,57 @@ class Governor:
     :meth:`cap` without a ``limit`` caps with the last answer of any thread; pass the
     :class:`SpeedLimit` you got (or call :meth:`SpeedLimit.cap`) to cap with your own.
 
+    Margins. The scenario's ``zmp_margin`` (m) shrinks the ZMP support area; its
+    ``velocity_margin`` (m/s) keeps every post-impact CoM velocity that far inside the CoM
+    velocity area ("com" criterion, both impact models; the "zmp" criterion has none): a margin
+    for the impact model's error, as ``zmp_margin`` is one for the controller's. Both are read
+    as :func:`~impact_balance.analyze` reads them, so ``analyze`` of the same scenario answers
+    the same maximum at the scenario's posture and CoM velocity (see :meth:`scenario_at`).
+
     Args:
         scenario: A :class:`~impact_balance.scenario.Scenario`, a scenario file or a bundled
             name; it must have an ``impact``.
-        criterion: "com" (default) or "zmp" (see :data:`CRITERIA`).
-        posture_tolerance: See "Reuse" above (>= 0).
+        criterion: "com" (default) or "zmp" (:data:`~impact_balance.governor.options.Criterion`).
+        posture_tolerance: See "Reuse" above (>= 0, in the units of q's entries).
         contact_aware: Also bound the speed by the contact-aware impact model's CoM velocity
             jump (:mod:`.support`: the robot standing on its supports; the answer is then the
             criterion for the union of both models' post-impact CoM velocities, the smaller
-            maximum). "com" criterion, composite inertia only. Its jump rates are recomputed
-            every ``contact_aware_every`` posture evaluations (default 5), not every posture;
-            with ``contact_aware_async``, by a worker process off the tick instead (:mod:`.worker`:
-            the tick never waits for them; rates one recomputation old; :meth:`close` stops it).
-            ``contact_aware_starts``: "union" (default: the criterion holds for every solution
-            of the frictional impact LCP reached from the kept solutions and the cold start),
-            "warm" (the option as frozen in commit 5e477e6: one fixed point, warm-started from
-            the previous answer) or "cold" (one, from gauges 0); see :mod:`.support`.
-        contact_aware_async: With ``contact_aware``, recompute its rates in a worker process
-            (:mod:`.worker`, POSIX) instead of in the tick: each posture tick polls for a
-            finished answer (~1 us) and hands the worker the current posture when it is idle;
-            it never waits. Call :meth:`close` (or use ``with``) to stop the worker.
-        velocity_margin: Every post-impact CoM velocity must lie this far (m/s) inside the
-            CoM velocity area ("com" criterion, both models): a margin for the impact model's
-            error, as ``zmp_margin`` is one for the controller's. Default 0, the paper's
-            criterion (and ``analyze()``'s answer, which has no such margin). See
-            docs/governor.md, "A margin for the impact model's error".
+            maximum). "com" criterion, composite inertia only. None or False: off; True: on
+            with the default :class:`~impact_balance.governor.options.ContactAwareOptions`
+            (rates recomputed every 5 posture evaluations, in the tick); or the options.
+        velocity_margin: Overrides the scenario's ``velocity_margin`` (m/s; through
+            :meth:`~impact_balance.scenario.Scenario.replace`, so checked by the schema).
+            None (default): the scenario's.
 
     Raises:
         ScenarioError: no impact, an unknown frame, an impact model that cannot be built at
             the scenario's posture (the scenario is evaluated once, as a check).
-        GovernorError: an unknown criterion or a bad tolerance.
+        GovernorError: an unknown criterion, a bad tolerance, a bad ``velocity_margin``
+            (or one with the "zmp" criterion), contact-aware options with the "zmp" criterion.
     """
 
     def __init__(
         self,
-        scenario: Scenario | str | os.PathLike,
-        criterion: str = "com",
+        scenario: Scenario | str | os.PathLike[str],
+        criterion: Criterion = "com",
+        *,
         posture_tolerance: float = 0.0,
-        contact_aware: bool = False,
-        contact_aware_every: int = 5,
-        contact_aware_starts: str = "union",
-        velocity_margin: float = 0.0,
-        contact_aware_async: bool = False,
-    ):
+        contact_aware: ContactAwareOptions | bool | None = None,
+        velocity_margin: float | None = None,
+    ) -> None:
         if criterion not in CRITERIA:
             raise GovernorError("criterion", criterion, f"must be one of {', '.join(CRITERIA)}")
-        try:
-            velocity_margin = float(velocity_margin)
-        except (TypeError, ValueError):
-            velocity_margin = math.nan
-        if not (math.isfinite(velocity_margin) and 0.0 <= velocity_margin <= 10.0):
-            raise GovernorError(
-                "velocity_margin", velocity_margin, "must be a number in [0, 10] m/s"
-            )
-        if velocity_margin and criterion != "com":
-            raise GovernorError(
-                "velocity_margin", velocity_margin, "applies to the com criterion only"
-            )
-        try:
-            tolerance = float(posture_tolerance)
-        except (TypeError, ValueError):
-            tolerance = math.nan
-        if not (math.isfinite(tolerance) and tolerance >= 0.0):
-            raise GovernorError(
-                "posture_tolerance", posture_tolerance, "must be a finite number >= 0"
-            )
-        if not isinstance(scenario, Scenario):
-            scenario = load_scenario(scenario)
-        if scenario.impact is None:
-            raise with_source(
-                ScenarioError("impact", None, "the governor needs an impact (frame, normal...)"),
-                scenario.source,
-            )
-        self.scenario = scenario
-        self.criterion = criterion
-        self.posture_tolerance = tolerance
+        self.criterion: Criterion = criterion
+        self.posture_tolerance = _tolerance(posture_tolerance)
+        aware = _contact_aware(contact_aware, criterion)
+        self.scenario = scenario = _governed(scenario, criterion, velocity_margin)
+        #: The velocity margin in use, m/s (the scenario's; 0 with the "zmp" criterion).
+        self.velocity_margin = scenario.velocity_margin if criterion == "com" else 0.0
         self.robot: Robot = scenario.load_robot()
         model = self.robot.model
         self.nq, self.nv = model.nq, model.nv
         self._free_flyer = has_free_flyer(model)
+        assert scenario.impact is not None  # _governed refuses a scenario without one
         settings = PostureSettings(
             tuple(c.spec() for c in scenario.contacts),
             scenario.impact.spec(),
@@ -160,46 +129,41 @@ class Governor:
             bool(scenario.torque_limits),
             float(scenario.zmp_margin),
             criterion,
-            velocity_margin,
+            self.velocity_margin,
         )
-        self.velocity_margin = velocity_margin
         #: The scenario's own configuration (lifted onto the ground as ``analyze`` does): a
         #: posture to start from.
         self.configuration: np.ndarray = scenario.build_stance(self.robot).q.copy()
         self._evaluator = PostureEvaluator(self.robot, settings)
         self._lock = threading.Lock()
         self._support: ContactAwareLimit | None = None
-        if contact_aware:
-            if criterion != "com":
-                raise GovernorError("contact_aware", criterion, "bounds the CoM criterion only")
-            self._support = ContactAwareLimit(
-                settings.impact, contact_aware_every, contact_aware_starts
-            )
-        elif contact_aware_async:
-            raise GovernorError(
-                "contact_aware_async", contact_aware_async, "needs contact_aware=True"
-            )
+        if aware is not None:
+            self._support = ContactAwareLimit(settings.impact, aware.every, aware.starts)
         self._worker: ContactAwareWorker | None = None
-        self._posture: Posture | None = None
         self._last: SpeedLimit | None = None
-        warm_up()  # the projection kernel's one-time load, not in the first tick
-        warm_up_bretl()  # the fallback's (HiGHS), so that a tick that falls back pays 5 ms, not 71
-        warm_up_maps()  # and the fallback's compiled map (12 ms on its first call)
-        try:  # a check of the frames, the normal and the friction, at the scenario's posture
-            self._posture = self._evaluator.evaluate(self.configuration)
-        except ScenarioError as exc:
-            raise with_source(exc, scenario.source) from None
-        if (
-            self._posture.com_criterion is not None
-        ):  # load the criterion's compiled code (1-3 ms) here too
-            self._posture.com_criterion.limit(np.zeros(3))
-            self._posture.com_criterion.limits(np.zeros(3), np.zeros((1, 2)))
+        self._posture: Posture | None = self._first_posture()
         self._support_posture: bytes | None = None
-        if self._support is not None and contact_aware_async:
+        if self._support is not None and aware is not None and aware.asynchronous:
             # The worker's first answer (the scenario's posture, which loads its compiled code)
             # gives the first rates; then it keeps them fresh.
-            self._worker = ContactAwareWorker(scenario, contact_aware_starts)
+            self._worker = ContactAwareWorker(scenario, aware.starts)
             self._support.adopt(self._worker.warm_up(self._posture.q))
+
+    def _first_posture(self) -> Posture:
+        """Load the compiled code and evaluate the scenario's posture (a check of its frames,
+        normal and friction), so that the first tick pays for neither.
+        """
+        warm_up()  # the projection kernel's one-time load
+        warm_up_bretl()  # the fallback's (HiGHS), so that a tick that falls back is not slow
+        warm_up_maps()  # and the fallback's compiled map
+        try:
+            posture = self._evaluator.evaluate(self.configuration)
+        except ScenarioError as exc:
+            raise with_source(exc, self.scenario.source) from None
+        if posture.com_criterion is not None:  # the criterion's compiled code, here too
+            posture.com_criterion.limit(np.zeros(3))
+            posture.com_criterion.limits(np.zeros(3), np.zeros((1, 2)))
+        return posture
 
     def close(self) -> None:
         """Stop the contact-aware worker process, if any (``contact_aware_async``); the
@@ -276,8 +240,8 @@ class Governor:
         return cap_approach(reference_velocity, limit.normal, limit.safe_interval)
 
     def scenario_at(self, q: Sequence[float], com_velocity: Sequence[float]) -> Scenario:
-        """The scenario :func:`~impact_balance.analyze` answers the same for (without a
-        ``velocity_margin``, which scenarios do not have): this governor's,
+        """The scenario :func:`~impact_balance.analyze` answers the same for (its margins
+        included): this governor's,
         at configuration ``q`` (every joint by name, an explicit ``base`` pose) with
         ``com_velocity`` (world, m/s; e.g. a :class:`SpeedLimit`'s). To replay or save a tick.
 
@@ -392,6 +356,60 @@ class Governor:
         )
         self._last = answer
         return answer
+
+
+def _tolerance(posture_tolerance: float) -> float:
+    """``posture_tolerance`` as a float; :class:`GovernorError` unless finite and >= 0."""
+    try:
+        tolerance = float(posture_tolerance)
+    except (TypeError, ValueError):
+        tolerance = math.nan
+    if not (math.isfinite(tolerance) and tolerance >= 0.0):
+        raise GovernorError("posture_tolerance", posture_tolerance, "must be a finite number >= 0")
+    return tolerance
+
+
+def _contact_aware(
+    option: ContactAwareOptions | bool | None, criterion: Criterion
+) -> ContactAwareOptions | None:
+    """The contact-aware options of ``option`` (None: off); :class:`GovernorError` when it is
+    not one of None, a bool or :class:`ContactAwareOptions`, or with the "zmp" criterion.
+    """
+    if option is None or option is False:
+        return None
+    aware = ContactAwareOptions() if option is True else option
+    if not isinstance(aware, ContactAwareOptions):
+        raise GovernorError(
+            "contact_aware", option, "must be True, False, None or a ContactAwareOptions"
+        )
+    if criterion != "com":
+        raise GovernorError("contact_aware", criterion, "bounds the CoM criterion only")
+    return aware
+
+
+def _governed(
+    scenario: Scenario | str | os.PathLike[str], criterion: Criterion, margin: float | None
+) -> Scenario:
+    """The scenario a governor answers for: loaded, with an impact, its ``velocity_margin``
+    replaced by ``margin`` when given (:class:`GovernorError` naming ``velocity_margin`` when the
+    schema refuses it, or when it is not 0 with the "zmp" criterion).
+    """
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
+    if scenario.impact is None:
+        raise with_source(
+            ScenarioError("impact", None, "the governor needs an impact (frame, normal...)"),
+            scenario.source,
+        )
+    if margin is None:
+        return scenario
+    try:
+        scenario = scenario.replace(velocity_margin=margin)
+    except ScenarioError as exc:
+        raise GovernorError("velocity_margin", margin, exc.reason) from None
+    if scenario.velocity_margin and criterion != "com":
+        raise GovernorError("velocity_margin", margin, "applies to the com criterion only")
+    return scenario
 
 
 def _zmp_interval(limit: VelocityLimit) -> tuple[float, float] | None:

@@ -55,6 +55,7 @@ import numpy as np
 from impact_balance.contacts.stance import Stance
 from impact_balance.criteria.com import ComCriterion, VelocityLimit, speed_interval
 from impact_balance.exceptions import GovernorError
+from impact_balance.governor.options import STARTS, ContactAwareOptions, Starts
 from impact_balance.impact.contact_aware import contact_impact
 from impact_balance.impact.model import ImpactSpec
 
@@ -66,11 +67,6 @@ __all__ = [
     "contact_aware_rates",
     "contact_aware_solutions",
 ]
-
-#: The fixed-point starts of :class:`ContactAwareLimit` (module docstring): "union" (default:
-#: every solution reached from the kept solutions and the cold start), "warm" (the previous
-#: answer only, as frozen in commit 5e477e6), "cold" (gauges 0 only, the post hoc variant).
-STARTS = ("union", "warm", "cold")
 
 #: Two fixed points are the same solution when their body velocity changes per m/s of approach
 #: speed differ by at most this (max norm; m/s and rad/s per m/s). The fixed point stops when no
@@ -239,20 +235,15 @@ class ContactAwareLimit:
             only); see :data:`STARTS`.
     """
 
-    def __init__(self, spec: ImpactSpec, every: int = 5, starts: str = "union"):
+    def __init__(self, spec: ImpactSpec, every: int = 5, starts: Starts = "union"):
         if spec.inertia != "composite":
             raise GovernorError(
                 "contact_aware", spec.inertia, "the contact-aware model is the composite one"
             )
-        if not (isinstance(every, (int, np.integer)) and every >= 1):
-            raise GovernorError("contact_aware_every", every, "must be an integer >= 1")
-        if starts not in STARTS:
-            raise GovernorError(
-                "contact_aware_starts", starts, f"must be one of {', '.join(STARTS)}"
-            )
+        options = ContactAwareOptions(every, starts)  # checks both
         self.spec = spec
-        self.every = int(every)
-        self.starts = starts
+        self.every: int = options.every
+        self.starts: Starts = options.starts
         self._solutions: ContactAwareSolutions | None = None
         self._converged = False  # whether every fixed point of _solutions was reached
         self._age = 0

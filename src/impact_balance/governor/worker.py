@@ -1,6 +1,6 @@
 """The contact-aware rates in a process of their own, off the control tick.
 
-``Governor(..., contact_aware=True, contact_aware_async=True)``: the contact-aware impact's jump
+``Governor(..., contact_aware=ContactAwareOptions(asynchronous=True))``: the contact-aware impact's jump
 rates (:mod:`.support`, 3 to 170 ms per recomputation) are computed by a worker process while
 the governor keeps ticking with the last rates it received. Each tick the governor collects a
 finished answer if there is one (a pipe poll, microseconds) and, when the worker is idle, sends
