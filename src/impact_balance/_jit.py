@@ -3,8 +3,8 @@
 numba is a dependency; the fallback keeps the library importable where its wheel is missing.
 ``IMPACT_BALANCE_JIT=0`` in the environment (read once, when this module is first imported)
 runs the same code interpreted without importing numba: loading numba and its cached kernels
-costs 0.4 to 0.8 s per process, more than one interpreted analysis (30 to 400 ms), so the
-one-shot ``impact-balance analyze`` command runs that way unless the variable says otherwise.
+costs more than one interpreted analysis, so the one-shot ``impact-balance analyze`` command
+runs that way unless the variable says otherwise.
 """
 
 from __future__ import annotations

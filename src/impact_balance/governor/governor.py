@@ -61,7 +61,7 @@ class Governor:
     exactly); otherwise only the CoM velocity is new and a tick costs a few microseconds.
     With a tolerance, the answer is that of the posture last computed. The robot model,
     the contact specifications and the impact's friction cone are built once; the governor
-    has its own pinocchio Data (made once, ~2 ms) and allocates no model per tick.
+    has its own pinocchio Data (made once) and allocates no model per tick.
 
     Thread safety. One lock per instance serialises :meth:`limit`, :meth:`limit_com` and
     :meth:`cap` (they share the Data and the cached posture): several threads may call one

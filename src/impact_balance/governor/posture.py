@@ -121,7 +121,7 @@ class Posture:
     @functools.cached_property
     def stance(self) -> Stance:
         """The :class:`~impact_balance.contacts.stance.Stance` at ``q`` (built on first access, in the
-        robot's per-thread Data, ~50 us): for plots and displays.
+        robot's per-thread Data): for plots and displays.
         """
         return Stance(self.robot, self.q, self.settings.contacts)
 

@@ -2,47 +2,36 @@
 
 The paper's impact model lets the composite robot float through the impact (the post-impact
 CoM velocities form a set, one vertex per friction-cone edge and restitution bound). On some
-stances the supports change the jump: G1's feet keep it from turning about its CoM, so its
-CoM velocity jump is larger than any vertex of the floating set (docs/validation.md, "A
-contact-aware impact model"). :class:`ContactAwareLimit` adds, to the criterion's post-impact
-set, the jumps of :func:`impact_balance.impact.contact_aware.contact_impact` (every support corner a
-unilateral, frictional, plastic point contact; no preload) at both ends of the restitution
-range: the governor then answers for the union of the two models' post-impact CoM velocities,
-i.e. the smaller of the two maximum approach speeds (``Governor(..., contact_aware=True)``).
+stances the supports change the jump (docs/validation.md, "A contact-aware impact model").
+:class:`ContactAwareLimit` adds, to the criterion's post-impact set, the jumps of
+:func:`impact_balance.impact.contact_aware.contact_impact` (every support corner a unilateral,
+frictional, plastic point contact; no preload) at both ends of the restitution range: the
+governor then answers for the union of the two models' post-impact CoM velocities, i.e. the
+smaller of the two maximum approach speeds (``Governor(..., contact_aware=True)``).
 
-Several solutions: the union (default, ``starts="union"``). The frictional impact LCP is not
-convex and may have several solutions (on ``palm_push_ramp`` near the wall, two: lateral jump
-+0.12 and +0.043 per m/s; docs/contact_aware_governor.md, section 4). The De Saxce fixed point
-reaches one of them, depending on its starting gauges. Since the model cannot say which one the
-robot will follow, the criterion must hold for every solution found: at each recomputation and
-each restitution bound, the fixed point is run from a fixed, deterministic set of starts,
+Several solutions. The frictional impact LCP is not convex and may have several solutions;
+the De Saxce fixed point reaches one of them, depending on its starting gauges. With
+``starts="union"`` (the default) the criterion holds for every solution found: at each
+recomputation and each restitution bound, the fixed point is run from a fixed, deterministic
+set of starts,
 
-1. every distinct solution kept from the previous recomputation (the first of them continues the
-   first posture's answer: the frozen warm-started option's branch). A solution of the LCP moves
-   continuously with the posture while it exists, so continuing each one tracks every branch
-   found so far; a branch that ends makes its start converge to another solution (merged);
-2. the cold start (gauges 0, Anitescu's relaxation first): the solution reached from no
-   knowledge of the past, which finds a branch that appears during the approach;
+1. every distinct converged solution kept from the previous recomputation, in order (a
+   solution moves continuously with the posture while it exists, so continuing each one
+   tracks every branch found so far; a branch that ends converges onto another: merged);
+2. the cold start (gauges 0), which finds a branch that appears during the approach;
 
 and every distinct solution reached is kept (rates (k, 2), k >= 2): the limit is the smallest
-over all of them, the safe interval the intersection. Nothing here depends on any trial's
-outcome. ``starts="warm"`` is the option as frozen in commit 5e477e6 (one start, the previous
-answer) and ``starts="cold"`` the post hoc cold start, both kept for the record.
+over all of them, the safe interval the intersection. ``starts="warm"`` runs one fixed point
+per bound from the previous answer, ``starts="cold"`` one from gauges 0
+(:data:`~impact_balance.governor.options.Starts`).
 
-Scored (docs/contact_aware_governor.md, section 5; frozen in commit e0ce502): the union changes
-no outcome on the four stances of the wall study. It lowers the ramp's cap by 2 to 2.5 % where
-the cold start finds a second branch before the contact (trials that stood either way); where the
-ramp falls (walls 12 and 13.5 cm) the LCP has one solution at the contact posture, the cap is
-honoured to 0.1 %, and the model's residual at the inset edge (-0.008 to +0.005 m/s) decides.
-
-Cost. The contact-aware jump is a fixed point of small QPs (2 to 40 ms per start and posture);
-it changes slowly with the posture, so it is recomputed on the first posture and then every
-``every``-th posture evaluation (default 5: every 10 ms at 500 Hz) and, in between, the last jump
-rates are used with the current posture's area and CoM velocity. The jump is linear in the
-approach speed (no preload), so one solve per start and restitution bound at 1 m/s gives the
-rates. The union costs one fixed point per start, the cold start the slowest: median 8 to 67 ms
-per recomputation on the wall study's stances (up to 164 ms on the ramp with two solutions kept),
-2.2 to 2.8 times the warm start's (docs/contact_aware_governor.md, section 5).
+Cost and freshness. The jump is a fixed point of small QPs (milliseconds to a few hundred
+milliseconds per recomputation, more with more starts). It is recomputed on the first posture
+and then every ``every``-th posture evaluation; in between, the last rates are used with the
+current posture's area and CoM velocity (:attr:`ContactAwareAnswer.age` counts the postures
+since). The jump is linear in the approach speed (no preload), so one solve per start and
+restitution bound at 1 m/s gives the rates. Units: rates in m/s of CoM velocity (world xy)
+per m/s of approach speed. Not thread-safe: the governor calls it under its lock.
 """
 
 from __future__ import annotations
@@ -78,7 +67,7 @@ SAME_SOLUTION = 1e-6
 def contact_aware_rates(
     stance: Stance, spec: ImpactSpec, warm: list[np.ndarray] | None = None
 ) -> tuple[np.ndarray, list[np.ndarray], bool]:
-    """One fixed point per restitution bound (the frozen option's ``starts="warm"``): the
+    """One fixed point per restitution bound (``starts="warm"``): the
     contact-aware CoM velocity jump per m/s of approach speed, world xy, at the lower and the
     upper restitution bound: ``(rates (2, 2), body velocity changes (6,) per m/s: (dv_c, dw),
     world, for a warm start, converged)``. ``warm``: one such change per bound, or None (cold).
@@ -99,7 +88,7 @@ class ContactAwareSolutions:
         states: (k, 6) each row's body velocity change per m/s, (dv_c m/s, dw rad/s) per m/s,
             world: the starts of the next recomputation.
         converged: (k,) whether each row's fixed point was reached (else its last iterate,
-            kept: the criterion answers for it too, as the frozen option did).
+            kept: the criterion answers for it too).
         iterations: QP solves of all the starts (the cost).
         starts: Fixed points run (starts times restitution bounds).
     """
@@ -171,7 +160,7 @@ def contact_aware_solutions(
 def _one_per_bound(stance: Stance, spec: ImpactSpec, guesses) -> ContactAwareSolutions:
     """One fixed point per restitution bound, from ``guesses[k]`` (a body velocity change (6,)
     per m/s) or, without guesses, gauges 0: 2 rows even when both bounds give the same jump
-    (the frozen option's ``starts="warm"`` and the post hoc ``"cold"``).
+    (``starts="warm"`` and ``"cold"``).
     """
     rows, iterations = [], 0
     for k, c_r in enumerate(float(c) for c in spec.restitution):
@@ -231,7 +220,7 @@ class ContactAwareLimit:
         spec: The scenario's impact (composite inertia model).
         every: Recompute the jump rates every this many posture evaluations (>= 1).
         starts: "union" (default: every solution reached from the kept solutions and the cold
-            start), "warm" (the frozen option: the previous answer only) or "cold" (gauges 0
+            start), "warm" (the previous answer only) or "cold" (gauges 0
             only); see :data:`STARTS`.
     """
 

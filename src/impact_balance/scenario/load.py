@@ -4,7 +4,7 @@ A scenario may ``extends:`` another (a bundled name or a path): mappings are mer
 recursively, everything else is replaced. Files are read through
 :func:`impact_balance.scenario.reader.read_text` (size limits) and parsed with a cache keyed by
 content; the validated :class:`Scenario` is cached too, keyed by the text of every file of its
-``extends`` chain, so loading an unchanged file again costs its reads only (~20 us a file).
+``extends`` chain, so loading an unchanged file again costs its reads only.
 """
 
 from __future__ import annotations

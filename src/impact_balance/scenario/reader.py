@@ -176,9 +176,9 @@ _BoundedLoader.add_implicit_resolver(
 def parse_yaml(text: str, source: str = "scenario") -> Any:
     """Parse YAML text within the limits; :class:`ScenarioError` on ``scenario`` naming ``source``.
 
-    Cached by content (PyYAML's pure-Python parser is ~95 % of loading a scenario, 5-20 ms for
-    a bundled file). The cached tree is never handed out: callers get a fresh copy of its dicts
-    and lists (scalars are immutable). Refusals are not cached.
+    Cached by content (PyYAML's pure-Python parser is most of the cost of loading a scenario).
+    The cached tree is never handed out: callers get a fresh copy of its dicts and lists
+    (scalars are immutable). Refusals are not cached.
     """
     return _copy_tree(_parse_cached(text, source))
 
