@@ -7,7 +7,8 @@ mappings are merged recursively, everything else is replaced.
 - :mod:`.fields`: value types and bounds (vectors, ranges with units, the strict base model).
 - :mod:`.schema`: the pydantic models (:class:`Scenario` and its parts) and stance building.
 - :mod:`.specs`: library specs built from scenario values, cached by content.
-- :mod:`.validate`: a mapping to a :class:`Scenario`, pydantic's errors to one ``ScenarioError``.
+- :mod:`.errors`: pydantic's errors to one ``ScenarioError`` naming the field.
+- :mod:`.validate`: a mapping to a :class:`Scenario` (:meth:`Scenario.from_mapping`).
 - :mod:`.bundled`: the scenarios shipped in ``impact_balance/scenarios/`` and name lookup.
 - :mod:`.load`: files, ``extends:`` chains and :func:`load_scenario`.
 """
@@ -35,7 +36,7 @@ _EXPORTS: dict[str, str] = {
     "RobotFiles": ".schema",
     "Scenario": ".schema",
     "with_source": ".schema",
-    "field_name": ".validate",
+    "field_name": ".errors",
     "scenario_from_dict": ".validate",
 }
 
@@ -67,7 +68,8 @@ if TYPE_CHECKING:
         Scenario,
         with_source,
     )
-    from impact_balance.scenario.validate import field_name, scenario_from_dict
+    from impact_balance.scenario.errors import field_name
+    from impact_balance.scenario.validate import scenario_from_dict
 
 __all__ = [
     "BasePose",

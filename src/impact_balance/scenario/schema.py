@@ -12,7 +12,7 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 import pinocchio as pin
-from pydantic import AfterValidator, Field, ValidationInfo, field_validator
+from pydantic import AfterValidator, Field, ValidationError, ValidationInfo, field_validator
 
 from impact_balance.constants import (
     GRAVITY_RANGE,
@@ -46,7 +46,8 @@ from impact_balance.scenario.fields import (
     _scalar,
     _speed,
 )
-from impact_balance.scenario.reader import check_path_text
+from impact_balance.scenario.errors import scenario_error
+from impact_balance.scenario.reader import check_path_text, check_structure
 from impact_balance.scenario.specs import _contact_spec, _impact_spec, _quaternion
 
 __all__ = [
@@ -245,6 +246,35 @@ class Scenario(_Model):
             raise ValueError(f"joint values must be finite (not {', '.join(bad)})")
         return joints
 
+    @classmethod
+    def from_mapping(
+        cls, raw: dict[str, Any], source: str | None = None, check_size: bool = True
+    ) -> Scenario:
+        """Validate a scenario mapping; raises :class:`ScenarioError` on the first bad field.
+
+        Args:
+            raw: The mapping (top-level keys of a scenario file, ``extends:`` merged).
+            source: The file it came from, if any (named in errors, and the base of the
+                robot files' relative paths).
+            check_size: ``False`` skips the nesting and expanded-size check of
+                :func:`~impact_balance.scenario.reader.check_structure`.
+
+        Returns:
+            The validated scenario.
+
+        Raises:
+            ScenarioError: The first bad field, naming it, its value and the reason (an
+                :class:`~impact_balance.exceptions.UnknownKeyError` for an unknown key).
+        """
+        if check_size:
+            check_structure(raw, source)
+        try:
+            return cls.model_validate({**raw, "source": source})
+        except ValidationError as exc:
+            raise scenario_error(exc, raw, cls, source) from None
+        except ScenarioError as exc:
+            raise ScenarioError(exc.field, exc.value, exc.reason, source) from None
+
     def replace(self, **changes: Any) -> Scenario:
         """A copy with the top-level keys ``changes`` replaced, validated as a file's keys are.
 
@@ -264,12 +294,10 @@ class Scenario(_Model):
         """
         if not changes:
             return self
-        from impact_balance.scenario.validate import scenario_from_dict
-
         raw = self.model_dump(exclude_unset=True)
         raw.pop("source", None)
         raw.update(changes)
-        return scenario_from_dict(raw, self.source)
+        return Scenario.from_mapping(raw, self.source)
 
     @property
     def set_keys(self) -> frozenset[str]:
