@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from impact_balance.cli._options import (
     add_controller_option,
@@ -18,6 +19,12 @@ from impact_balance.cli._options import (
     scoring_margin,
     with_margins,
 )
+
+if TYPE_CHECKING:
+    from impact_balance.governor import Governor
+    from impact_balance.scenario import Scenario
+    from impact_balance.sim.studies.wall import WallTrial
+    from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions
 
 __all__ = ["USES_KERNEL", "add_parser", "run"]
 
@@ -104,6 +111,18 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``approach``: one governed trial per wall distance, as text or JSON.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status, 0.
+
+    Raises:
+        SimulationError: Options that do not go together, a scenario without an impact.
+        ScenarioError: A margin the schema refuses (naming its option).
+    """
     from impact_balance.exceptions import SimulationError
 
     if args.video and args.wall_distance_range is not None:
@@ -115,7 +134,6 @@ def run(args: argparse.Namespace) -> int:
     import_mujoco(bool(args.video))  # before anything imports MuJoCo: the GL backend is read then
     from impact_balance.cli.output import print_json
     from impact_balance.scenario import load_scenario
-    from impact_balance.sim.studies.wall import WallOptions, run_wall_trial, write_wall_video
     from impact_balance.sim.trials.balance_trial import (
         BalanceSetup,
         BalanceTrialOptions,
@@ -127,49 +145,19 @@ def run(args: argparse.Namespace) -> int:
         raise SimulationError(
             "impact", None, f"scenario {scenario.name!r} has no impact: approach needs one"
         )
-    if args.wall_distance_range is not None:
-        lo, hi = args.wall_distance_range
-        if lo > hi:
-            raise SimulationError("--wall-distance-range", [lo, hi], "must be 0 < LO <= HI <= 1 m")
-        distances = [lo, 0.5 * (lo + hi), hi] if hi > lo else [lo]
-    else:
-        distances = [0.15 if args.wall_distance is None else args.wall_distance]
+    distances = _distances(args)
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
     own = scoring_margin(scenario)
     margin = controller_margin(options) if own is None else own
     # The governor's view: the area the controller can use.
     governed = scenario.replace(zmp_margin=margin)
-    setup = BalanceSetup.create(
-        scenario, "servo", options, meshes=bool(args.video)
-    )  # meshes: visual only
-    governor = None
-    if args.governor != "none":
-        from impact_balance.governor import ContactAwareOptions, Governor
-
-        aware = ContactAwareOptions(asynchronous=args.contact_aware_async)
-        governor = Governor(
-            governed, args.governor, contact_aware=aware if args.contact_aware else None
-        )
-    trials, written = [], []
-    for distance in distances:
-        wall = WallOptions(
-            reference=args.reference,
-            governor=args.governor,
-            wall_distance=distance,
-            max_time=args.max_time,
-        )
-        trial = run_wall_trial(setup, wall, options, governor=governor, frames=bool(args.video))
-        trials.append(trial)
-        if args.plots:
-            written.append(_plot(trial, setup, Path(args.plots), margin))
-        if args.video:
-            written.append(
-                write_wall_video(
-                    setup, trial, args.video, title=f"{scenario.name}: {args.governor} governor"
-                )
-            )
-    if governor is not None:
-        governor.close()  # its worker process, if any
+    setup = BalanceSetup.create(scenario, "servo", options, meshes=bool(args.video))  # visual
+    governor = _governor(args, governed)
+    try:
+        trials, written = _trials(args, setup, options, governor, distances, margin)
+    finally:
+        if governor is not None:
+            governor.close()  # its worker process, if any
     docs = [t.to_dict() for t in trials]
     for d in docs:
         d["controller"] = args.controller
@@ -186,8 +174,67 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(out)
         return 0
+    _print_text(scenario.name, args, docs, written)
+    return 0
+
+
+def _distances(args: argparse.Namespace) -> list[float]:
+    """The wall distances of the trials (m), from ``--wall-distance(-range)``."""
+    from impact_balance.exceptions import SimulationError
+
+    if args.wall_distance_range is None:
+        return [0.15 if args.wall_distance is None else args.wall_distance]
+    lo, hi = args.wall_distance_range
+    if lo > hi:
+        raise SimulationError("--wall-distance-range", [lo, hi], "must be 0 < LO <= HI <= 1 m")
+    return [lo, 0.5 * (lo + hi), hi] if hi > lo else [lo]
+
+
+def _governor(args: argparse.Namespace, governed: Scenario) -> Governor | None:
+    """The trials' governor (None with ``--governor none``), margins from ``governed``."""
+    if args.governor == "none":
+        return None
+    from impact_balance.governor import ContactAwareOptions, Governor
+
+    aware = ContactAwareOptions(asynchronous=args.contact_aware_async)
+    return Governor(governed, args.governor, contact_aware=aware if args.contact_aware else None)
+
+
+def _trials(
+    args: argparse.Namespace,
+    setup: BalanceSetup,
+    options: BalanceTrialOptions,
+    governor: Governor | None,
+    distances: list[float],
+    margin: float,
+) -> tuple[list[WallTrial], list[Path]]:
+    """Run one trial per wall distance; the trials and the files written (figures, video)."""
+    from impact_balance.sim.studies.wall import WallOptions, run_wall_trial, write_wall_video
+
+    trials, written = [], []
+    for distance in distances:
+        wall = WallOptions(
+            reference=args.reference,
+            governor=args.governor,
+            wall_distance=distance,
+            max_time=args.max_time,
+        )
+        trial = run_wall_trial(setup, wall, options, governor=governor, frames=bool(args.video))
+        trials.append(trial)
+        if args.plots:
+            written.append(_plot(trial, setup, Path(args.plots), margin))
+        if args.video:
+            title = f"{setup.scenario.name}: {args.governor} governor"
+            written.append(write_wall_video(setup, trial, args.video, title=title))
+    return trials, written
+
+
+def _print_text(
+    name: str | None, args: argparse.Namespace, docs: list[dict[str, Any]], written: list[Path]
+) -> None:
+    """Print the trials as text: one line per wall, then the files written."""
     print(
-        f"{scenario.name}: approach at {args.reference:g} m/s reference, {args.governor} governor, "
+        f"{name}: approach at {args.reference:g} m/s reference, {args.governor} governor, "
         f"{args.controller} controller{', rigid impact' if args.rigid_impact else ''}"
     )
     for d in docs:
@@ -197,14 +244,14 @@ def run(args: argparse.Namespace) -> int:
             if tick["median"] is None
             else f"; governor {tick['median']:.0f} us per tick (p99 {tick['p99']:.0f})"
         )
+        reason = "" if d["reason"] is None else f" ({d['reason']})"
         print(
-            f"  wall {100 * d['wall_distance']:g} cm: speed at contact {_f(d['speed_at_contact'])}, cap at contact "
-            f"{_f(d['cap_at_contact'])}, time to contact {_s(d['time_to_contact'])}: {d['outcome']}"
-            f"{'' if d['reason'] is None else ' (' + str(d['reason']) + ')'}{ticks}"
+            f"  wall {100 * d['wall_distance']:g} cm: speed at contact "
+            f"{_f(d['speed_at_contact'])}, cap at contact {_f(d['cap_at_contact'])}, "
+            f"time to contact {_s(d['time_to_contact'])}: {d['outcome']}{reason}{ticks}"
         )
     for path in written:
         print(f"  wrote {path}")
-    return 0
 
 
 def _f(x) -> str:

@@ -22,6 +22,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 
 from impact_balance.balance.areas import (
@@ -218,6 +219,61 @@ class PostureEvaluator:
         # computeGeneralizedGravity to rounding (1e-14 N m of 327 on G1), without its pass.
         gravity_torques = -(self._gravity @ data.Ag[:3]) if self._torques else self._zero_velocity
         com = com_local + origin
+        areas = self._areas(
+            rotations, local, origin, com_local, mass, com, jacobians, gravity_torques
+        )
+        impact = self._impact(
+            q, q_local, origin, com_local, mass, np.array(Ig.inertia, dtype=float)
+        )
+        com_criterion = zmp = None
+        if settings.criterion == "zmp":
+            if isinstance(areas, Projected):
+                areas = areas.areas()
+            zmp = zmp_max_contact_velocity(
+                areas.zmp_area,
+                impact,
+                com,
+                settings.plane_height,
+                settings.gravity,
+                settings.impact.duration,
+            )
+        else:
+            com_criterion = ComCriterion(areas.com_velocity_area, impact, settings.velocity_margin)
+        q = q.copy()
+        q.setflags(write=False)
+        return Posture(
+            q.tobytes(),
+            q,
+            robot,
+            settings,
+            com,
+            mass,
+            areas,
+            impact,
+            com_jacobian,
+            com_criterion,
+            zmp,
+        )
+
+    def _areas(
+        self,
+        rotations: npt.NDArray[np.float64],
+        local: npt.NDArray[np.float64],
+        origin: npt.NDArray[np.float64],
+        com_local: npt.NDArray[np.float64],
+        mass: float,
+        com: npt.NDArray[np.float64],
+        jacobians: npt.NDArray[np.float64],
+        gravity_torques: npt.NDArray[np.float64],
+    ) -> BalanceAreas | Projected:
+        """The contact wrench polytope of the contacts' poses, projected: the ZMP support area
+        and the CoM velocity area (positions in m, world axes; ``local``: the contact points
+        in the stance frame, origin at ``origin``).
+
+        Raises:
+            SolverError: The projection failed (naming the contacts).
+        """
+        settings = self.settings
         try:
             if self._scaled:  # a friction above 1: the polytope in friction-normalised variables
                 polytope = assemble_polytope(
@@ -254,38 +310,7 @@ class PostureEvaluator:
                 )
         except SolverError as exc:
             raise exc.within("contacts (projection of the contact wrench polytope)") from None
-        impact = self._impact(
-            q, q_local, origin, com_local, mass, np.array(Ig.inertia, dtype=float)
-        )
-        com_criterion = zmp = None
-        if settings.criterion == "zmp":
-            if isinstance(areas, Projected):
-                areas = areas.areas()
-            zmp = zmp_max_contact_velocity(
-                areas.zmp_area,
-                impact,
-                com,
-                settings.plane_height,
-                settings.gravity,
-                settings.impact.duration,
-            )
-        else:
-            com_criterion = ComCriterion(areas.com_velocity_area, impact, settings.velocity_margin)
-        q = q.copy()
-        q.setflags(write=False)
-        return Posture(
-            q.tobytes(),
-            q,
-            robot,
-            settings,
-            com,
-            mass,
-            areas,
-            impact,
-            com_jacobian,
-            com_criterion,
-            zmp,
-        )
+        return areas
 
     def _impact(
         self,
