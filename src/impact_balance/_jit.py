@@ -36,8 +36,9 @@ except ImportError:
 
 
 def cache_depends_on(dispatcher: Any, *modules: ModuleType) -> Any:
-    """Make numba's on-disk cache of ``dispatcher`` stale when a source file of ``modules``
-    changes, as it is when its own file does; returns ``dispatcher``.
+    """Make numba's cache of ``dispatcher`` stale when a source file of ``modules`` changes.
+
+    As it is when its own file does; returns ``dispatcher``.
 
     numba stamps a cached function with its own file only, but a compiled function keeps a
     copy of the compiled functions it calls: after an edit of a callee in another module, its

@@ -54,8 +54,9 @@ OPTION_EXTRAS: dict[str, tuple[str, str]] = {
 
 
 def installed(module: str) -> bool:
-    """Whether ``module`` can be imported, without importing it (a blocked import, a ``None``
-    in ``sys.modules``, counts as missing).
+    """Whether ``module`` can be imported, without importing it.
+
+    A blocked import (a ``None`` in ``sys.modules``) counts as missing.
     """
     if module in sys.modules:
         return sys.modules[module] is not None

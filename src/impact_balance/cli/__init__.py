@@ -71,9 +71,11 @@ _JIT_VARIABLE = "IMPACT_BALANCE_JIT"
 
 
 def _interpret_kernels() -> None:
-    """A one-shot command (``INTERPRETED = True``) runs the kernels as Python: numba's import and
-    cached-kernel load (0.4 to 0.8 s) cost more than one interpreted analysis. Only in a fresh
-    process (``_jit`` not yet imported) and only when ``IMPACT_BALANCE_JIT`` is unset.
+    """A one-shot command (``INTERPRETED = True``) runs the kernels as Python.
+
+    Numba's import and cached-kernel load (0.4 to 0.8 s) cost more than one interpreted
+    analysis. Only in a fresh process (``_jit`` not yet imported) and only when
+    ``IMPACT_BALANCE_JIT`` is unset.
     """
     if _JIT_VARIABLE in os.environ or "impact_balance._jit" in sys.modules:
         return
@@ -104,9 +106,11 @@ def _silence_stdout() -> None:
 
 
 class _Stdout:
-    """stdout for the time of a command: a write that fails (a full disk, a closed stream, ``>&-``)
-    becomes :class:`~impact_balance.exceptions.EnvironmentFailure` naming standard output, so
-    the error rule says what failed; a closed pipe stays a ``BrokenPipeError`` (quiet, 141).
+    """stdout for the time of a command.
+
+    A write that fails (a full disk, a closed stream, ``>&-``) becomes
+    :class:`~impact_balance.exceptions.EnvironmentFailure` naming standard output, so the error
+    rule says what failed; a closed pipe stays a ``BrokenPipeError`` (quiet, 141).
     """
 
     def __init__(self, stream):
@@ -184,8 +188,10 @@ class _VersionAction(argparse.Action):
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse, with the project's error rule: a usage error is one line on stderr, exit 2
-    (argparse's default prints the whole usage block first).
+    """argparse, with the project's error rule.
+
+    A usage error is one line on stderr, exit 2 (argparse's default prints the whole usage block
+    first).
     """
 
     def error(self, message: str):

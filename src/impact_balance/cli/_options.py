@@ -23,12 +23,12 @@ if TYPE_CHECKING:
 __all__ = [
     "LOG_SUFFIXES",
     "CommandLineError",
+    "a_number",
     "add_controller_option",
     "add_output_options",
     "add_trial_options",
     "add_velocity_margin_option",
     "add_zmp_margin_option",
-    "a_number",
     "integer",
     "number",
     "open_journal",
@@ -100,8 +100,10 @@ def _interval(lo: float, hi: float, lo_open: bool, unit: str) -> str:
 def number(
     field: str, lo: float, hi: float, unit: str = "", lo_open: bool = False, why: str = ""
 ) -> Callable[[str], float]:
-    """Argparse type: a finite number in ``[lo, hi]`` (``(lo, hi]`` with ``lo_open``) for option
-    ``field``; ``why`` says where the limit comes from (shown in the error).
+    """Argparse type.
+
+    A finite number in ``[lo, hi]`` (``(lo, hi]`` with ``lo_open``) for option ``field``;
+    ``why`` says where the limit comes from (shown in the error).
     """
     span = _interval(lo, hi, lo_open, unit)
 
@@ -149,8 +151,9 @@ def add_controller_option(parser: argparse.ArgumentParser, default: str, why: st
 
 
 def add_output_options(parser: argparse.ArgumentParser, log_help: str) -> None:
-    """``--json``, ``--plots DIR`` and ``--log FILE`` (what the log holds: ``log_help``); the
-    places are checked when the line is read, before any simulation runs.
+    """``--json``, ``--plots DIR`` and ``--log FILE`` (what the log holds: ``log_help``).
+
+    The places are checked when the line is read, before any simulation runs.
     """
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.add_argument(
@@ -269,8 +272,10 @@ def scoring_margin(scenario: Scenario) -> float | None:
 
 
 def add_trial_options(parser: argparse.ArgumentParser, impact: bool) -> None:
-    """Options of the balance-trial commands (``validate``, ``push-test``): ``--rigid-impact`` (impacts only),
-    ``--zmp-margin``, and the trials journal (``--journal FILE``, ``--fresh``, ``--no-journal``).
+    """Options of the balance-trial commands (``validate``, ``push-test``).
+
+    ``--rigid-impact`` (impacts only), ``--zmp-margin``, and the trials journal (``--journal
+    FILE``, ``--fresh``, ``--no-journal``).
     """
     if impact:
         parser.add_argument(
@@ -302,8 +307,12 @@ def add_trial_options(parser: argparse.ArgumentParser, impact: bool) -> None:
 def open_journal(
     args: argparse.Namespace, command: str, scenario, joints: str, options, extra: dict
 ):
-    """The trials journal of a command (:class:`impact_balance.sim.studies.journal.TrialJournal`), by the digest of
-    everything its trials depend on (the scoring margin excluded: scores are recomputed from the trials).
+    """The trials journal of a command, by the digest of everything its trials depend on.
+
+    The scoring margins are excluded: scores are recomputed from the trials.
+
+    Returns:
+        The :class:`impact_balance.sim.studies.journal.TrialJournal` to write to.
     """
     import dataclasses
     import sys
@@ -344,9 +353,11 @@ def open_journal(
 
 
 def import_mujoco(video: bool) -> None:
-    """Import MuJoCo for a simulation command; with ``video``, offscreen rendering first picks
-    EGL (it works headless, and must be chosen before MuJoCo is imported) unless ``MUJOCO_GL``
-    says otherwise. An unusable backend is one :class:`~impact_balance.exceptions.SimulationError`.
+    """Import MuJoCo for a simulation command.
+
+    With ``video``, offscreen rendering first picks EGL (it works headless, and must be chosen
+    before MuJoCo is imported) unless ``MUJOCO_GL`` says otherwise. An unusable backend is one
+    :class:`~impact_balance.exceptions.SimulationError`.
     """
     from impact_balance.exceptions import SimulationError
 

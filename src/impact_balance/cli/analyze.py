@@ -21,6 +21,14 @@ INTERPRETED = True
 
 
 def add_parser(sub) -> list[str]:
+    """Add the ``analyze`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     a = sub.add_parser("analyze", help="analyze one scenario (file or bundled name)")
     a.add_argument(
         "scenario",
@@ -43,6 +51,14 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``analyze`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     from impact_balance.analysis.analyze import analyze
     from impact_balance.analysis.report import format_analysis
     from impact_balance.cli.output import print_json

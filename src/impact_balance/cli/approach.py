@@ -1,5 +1,7 @@
-"""``impact-balance approach SCENARIO``: the impacting point sent at an unknown wall, its speed
-capped every tick by a governor (the paper's Experiment 1, in MuJoCo).
+"""``impact-balance approach SCENARIO``.
+
+The impacting point sent at an unknown wall, its speed capped every tick by a governor (the paper's
+Experiment 1, in MuJoCo).
 """
 
 from __future__ import annotations
@@ -32,6 +34,14 @@ USES_KERNEL = True
 
 
 def add_parser(sub) -> list[str]:
+    """Add the ``approach`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     a = sub.add_parser(
         "approach",
         help="send the impact point at an unknown wall, its speed capped by a governor (MuJoCo)",

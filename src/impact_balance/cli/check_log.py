@@ -13,6 +13,14 @@ USES_KERNEL = True
 
 
 def add_parser(sub) -> list[str]:
+    """Add the ``check-log`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     a = sub.add_parser(
         "check-log", help="check a recorded time series (.parquet or .csv) against both criteria"
     )
@@ -31,6 +39,14 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``check-log`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     from impact_balance.cli.output import print_json
     from impact_balance.logs import check_log, read_log
 

@@ -16,6 +16,14 @@ FRICTION_SWEEP = ("palm_push_mu010", "palm_push_mu024", "palm_push_mu040")
 
 
 def add_parser(sub) -> list[str]:
+    """Add the ``demo`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     d = sub.add_parser(
         "demo", help="run the bundled studies on the default robot, print a report, write figures"
     )
@@ -27,6 +35,14 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``demo`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     from impact_balance.analysis.analyze import analyze
     from impact_balance.analysis.report import format_analysis, format_speed
 

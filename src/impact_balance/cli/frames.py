@@ -13,6 +13,14 @@ __all__ = ["add_parser", "robot_listing", "run"]
 
 
 def add_parser(sub) -> list[str]:
+    """Add the ``frames`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     f = sub.add_parser("frames", help="list a robot's frames (world position and axes) and joints")
     f.add_argument(
         "robot", help="a bundled robot (see `impact-balance robots`), a URDF file, or a scenario"
@@ -44,7 +52,7 @@ def robot_listing(robot, q=None, frames: list[str] | None = None) -> dict:
     from impact_balance.authoring import frame_poses
 
     q = robot.configuration() if q is None else q
-    effort = dict(zip(*(list(x) for x in robot.effort_limits)))
+    effort = dict(zip(*(list(x) for x in robot.effort_limits), strict=True))
     joints = []
     for name in robot.joint_names:
         slot = robot.joint_slot(name)
@@ -72,6 +80,14 @@ def _vec(v) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``frames`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     robot, q, label, stance = _robot_and_stance(args.robot)
     listing = robot_listing(robot, q, args.frame)
     listing["configuration"] = label

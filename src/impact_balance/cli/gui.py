@@ -11,6 +11,14 @@ USES_KERNEL = True
 
 
 def add_parser(sub) -> list[str]:
+    """Add the ``gui`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     g = sub.add_parser(
         "gui", help="interactive web GUI: edit a stance, see its areas and limits live"
     )
@@ -49,6 +57,14 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``gui`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     try:
         from impact_balance.gui.app import run as run_app
         from impact_balance.gui.state import DEFAULT_SCENARIO

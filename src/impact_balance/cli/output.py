@@ -18,8 +18,9 @@ __all__ = ["NonFiniteOutputError", "print_json", "progress_bar"]
 
 
 class NonFiniteOutputError(ImpactBalanceError):
-    """A result to print holds NaN or an infinity where a number is expected (a bug, reported
-    as one line naming the field rather than printed as invalid JSON).
+    """A result to print holds NaN or an infinity where a number is expected.
+
+    A bug, reported as one line naming the field rather than printed as invalid JSON.
 
     Attributes:
         field: Dotted path of the value in the document.

@@ -11,6 +11,14 @@ __all__ = ["add_parser", "run"]
 
 
 def add_parser(sub) -> list[str]:
+    """Add the ``phase-portrait`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     pp = sub.add_parser(
         "phase-portrait", help="LIPM phase portrait and CoM velocity bounds (paper sec. III-B)"
     )
@@ -41,6 +49,14 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``phase-portrait`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     from impact_balance.balance.lipm import phase_portrait
 
     portrait = phase_portrait(args.com_height, tuple(args.zmp_range), args.gravity)

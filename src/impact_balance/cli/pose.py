@@ -41,6 +41,14 @@ def _numbers(parser, option: str, texts) -> tuple[float, ...]:
 
 
 def add_parser(sub) -> list[str]:
+    """Add the ``pose`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     p = sub.add_parser(
         "pose", help="place frames by whole-body IK (contacts kept) and write the scenario"
     )
@@ -71,6 +79,14 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``pose`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     from pathlib import Path
 
     from impact_balance.authoring import Placement, pose_scenario, posed_mapping, scenario_yaml

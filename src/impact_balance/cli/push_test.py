@@ -21,6 +21,14 @@ USES_KERNEL = True
 
 def add_parser(sub) -> list[str]:
     # No import of the simulation here: mujoco is imported only when a simulation command runs.
+    """Add the ``push-test`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     a = sub.add_parser(
         "push-test", help="push the simulated robot in every direction; score both criteria"
     )
@@ -56,6 +64,14 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``push-test`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     from impact_balance.cli.output import print_json, progress_bar
     from impact_balance.logs import check_log_path
     from impact_balance.scenario import load_scenario
@@ -193,8 +209,10 @@ def _by_level(result) -> list[dict]:
 
 
 def _telling(result):
-    """The push of the paper's Exp. 2 if there is one (ZMP outside in the trial, no fall), else the largest
-    that did not fall, else the first.
+    """The push of the paper's Exp.
+
+    2 if there is one (ZMP outside in the trial, no fall), else the largest that did not fall,
+    else the first.
     """
     stood = [o for o in result.scored if not o.fell]
     exp2 = [o for o in stood if not o.safe("zmp_in_trial", 0.0, result.omega)]
@@ -210,6 +228,6 @@ def _plots(result, out: Path) -> list[Path]:
     out.mkdir(parents=True, exist_ok=True)
     prefix = figure_prefix(result.setup.analysis)
     paths = [out / f"{prefix}_push_zmp.png", out / f"{prefix}_push_com_velocity.png"]
-    for path, kind in zip(paths, ("zmp", "com_velocity")):
+    for path, kind in zip(paths, ("zmp", "com_velocity"), strict=True):
         plot_push_trajectories(result, kind).savefig(path)
     return paths

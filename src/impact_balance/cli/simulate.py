@@ -24,6 +24,14 @@ USES_KERNEL = False
 
 
 def add_parser(sub) -> list[str]:
+    """Add the ``simulate`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     a = sub.add_parser(
         "simulate",
         help="simulate the scenario's impact in MuJoCo and compare with the impact model",
@@ -84,8 +92,9 @@ def add_parser(sub) -> list[str]:
 
 
 def parse_speeds(text: str) -> list[float]:
-    """Approach speeds from ``"0.1,0.3"``; :class:`SimulationError` on a bad one (see
-    :mod:`impact_balance.ranges` for the range).
+    """Approach speeds from ``"0.1,0.3"``.
+
+    :class:`SimulationError` on a bad one (see :mod:`impact_balance.ranges` for the range).
     """
     from impact_balance.exceptions import SimulationError
     from impact_balance.ranges import check_approach_speed
@@ -150,6 +159,14 @@ def _table(name: str, r) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``simulate`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     from impact_balance.exceptions import SimulationError
 
     speeds = parse_speeds(args.speed)  # before MuJoCo loads: a bad speed is refused at once

@@ -45,6 +45,14 @@ def _scheduler(text: str) -> str:
 
 
 def add_parser(sub) -> list[str]:
+    """Add the ``sweep`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     s = sub.add_parser(
         "sweep",
         help="evaluate a sweep file (grid or quasi-random points) on all cores or a Dask cluster",
@@ -139,6 +147,14 @@ def _verify(args: argparse.Namespace) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``sweep`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     from impact_balance.exceptions import SweepError
     from impact_balance.sweep import bundled_sweeps, load_sweep_spec, make_plan, run_sweep
     from impact_balance.sweep.figures import save_sweep_figures

@@ -20,6 +20,14 @@ USES_KERNEL = True
 
 
 def add_parser(sub) -> list[str]:
+    """Add the ``validate`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     a = sub.add_parser(
         "validate", help="bisect the approach speed at which the simulated robot falls (MuJoCo)"
     )
@@ -45,6 +53,14 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``validate`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     from impact_balance.cli.output import print_json, progress_bar
     from impact_balance.exceptions import SimulationError
     from impact_balance.logs import check_log_path

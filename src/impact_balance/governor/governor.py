@@ -150,8 +150,10 @@ class Governor:
             self._support.adopt(self._worker.warm_up(self._posture.q))
 
     def _first_posture(self) -> Posture:
-        """Load the compiled code and evaluate the scenario's posture (a check of its frames,
-        normal and friction), so that the first tick pays for neither.
+        """Load the compiled code and evaluate the scenario's posture.
+
+        The posture is a check of the scenario's frames, normal and friction; the first tick
+        then pays for neither.
         """
         warm_up()  # the projection kernel's one-time load
         warm_up_bretl()  # the fallback's (HiGHS), so that a tick that falls back is not slow
@@ -166,8 +168,9 @@ class Governor:
         return posture
 
     def close(self) -> None:
-        """Stop the contact-aware worker process, if any (``contact_aware_async``); the
-        governor then recomputes the rates in the tick, as without it. Idempotent.
+        """Stop the contact-aware worker process, if any (``contact_aware_async``).
+
+        The governor then recomputes the rates in the tick, as without it. Idempotent.
         """
         with self._lock:
             if self._worker is not None:
@@ -182,8 +185,14 @@ class Governor:
 
     # -- per tick ---------------------------------------------------------------------------
     def limit(self, q: Sequence[float], v: Sequence[float]) -> SpeedLimit:
-        """The speed limit at configuration ``q`` (nq) and generalized velocity ``v`` (nv),
-        pinocchio's order and conventions (see the class docstring).
+        """The speed limit at configuration ``q`` and generalized velocity ``v``.
+
+        Args:
+            q: The configuration (nq), pinocchio's order and conventions (class docstring).
+            v: The generalized velocity (nv), pinocchio's order and conventions.
+
+        Returns:
+            The speed limit (m/s), its limiting vertex and edge, the safe interval.
 
         Raises:
             GovernorError: ``q`` or ``v`` of the wrong size, not finite, or a base
@@ -199,8 +208,17 @@ class Governor:
             return self._answer(posture, posture.com_jacobian @ v, reused)
 
     def limit_com(self, q: Sequence[float], com_velocity: Sequence[float]) -> SpeedLimit:
-        """:meth:`limit` with the CoM velocity given (world, m/s; 2 or 3 numbers, only x and y
-        matter), for a controller with its own CoM velocity estimate.
+        """:meth:`limit` with the CoM velocity given, for a controller with its own estimate.
+
+        Args:
+            q: The configuration (nq), pinocchio's order and conventions.
+            com_velocity: The CoM velocity (world, m/s; 2 or 3 numbers, only x and y matter).
+
+        Returns:
+            The speed limit, as :meth:`limit`'s.
+
+        Raises:
+            GovernorError: A bad ``q`` (as :meth:`limit`) or ``com_velocity``.
         """
         q = self._configuration(q)
         c = np.asarray(com_velocity, dtype=float).ravel() if _is_numeric(com_velocity) else None
@@ -216,10 +234,17 @@ class Governor:
     def cap(
         self, reference_velocity: Sequence[float] | None = None, limit: SpeedLimit | None = None
     ) -> np.ndarray:
-        """The reference end-effector velocity (world, m/s) with its approach speed brought
-        into the safe interval of ``limit`` (default: this governor's last answer); see
-        :func:`~impact_balance.governor.limit.cap_approach`. Without ``reference_velocity``,
-        the scenario's ``impact.reference_velocity``.
+        """The reference velocity with its approach speed brought into the safe interval.
+
+        See :func:`~impact_balance.governor.limit.cap_approach`.
+
+        Args:
+            reference_velocity: The reference end-effector velocity (world, m/s); None: the
+                scenario's ``impact.reference_velocity``.
+            limit: The answer whose safe interval caps it (default: this governor's last).
+
+        Returns:
+            The capped velocity (world, m/s).
 
         Raises:
             GovernorError: no limit yet (call :meth:`limit` first), no reference, or a bad one.
@@ -240,10 +265,11 @@ class Governor:
         return cap_approach(reference_velocity, limit.normal, limit.safe_interval)
 
     def scenario_at(self, q: Sequence[float], com_velocity: Sequence[float]) -> Scenario:
-        """The scenario :func:`~impact_balance.analyze` answers the same for (its margins
-        included): this governor's,
-        at configuration ``q`` (every joint by name, an explicit ``base`` pose) with
-        ``com_velocity`` (world, m/s; e.g. a :class:`SpeedLimit`'s). To replay or save a tick.
+        """The scenario :func:`~impact_balance.analyze` answers the same for (its margins included).
+
+        This governor's, at configuration ``q`` (every joint by name, an explicit ``base``
+        pose) with ``com_velocity`` (world, m/s; e.g. a :class:`SpeedLimit`'s). To replay or
+        save a tick.
 
         Raises:
             ScenarioError: a joint outside its position limits (scenarios refuse those).
@@ -276,8 +302,9 @@ class Governor:
 
     @property
     def posture(self) -> Posture:
-        """The last posture evaluated (the scenario's until the first call): its stance,
-        areas and impact model, for display.
+        """The last posture evaluated (the scenario's until the first call).
+
+        Its stance, areas and impact model, for display.
         """
         with self._lock:
             assert self._posture is not None
@@ -372,8 +399,10 @@ def _tolerance(posture_tolerance: float) -> float:
 def _contact_aware(
     option: ContactAwareOptions | bool | None, criterion: Criterion
 ) -> ContactAwareOptions | None:
-    """The contact-aware options of ``option`` (None: off); :class:`GovernorError` when it is
-    not one of None, a bool or :class:`ContactAwareOptions`, or with the "zmp" criterion.
+    """The contact-aware options of ``option`` (None: off).
+
+    :class:`GovernorError` when it is not one of None, a bool or :class:`ContactAwareOptions`,
+    or with the "zmp" criterion.
     """
     if option is None or option is False:
         return None
@@ -390,9 +419,11 @@ def _contact_aware(
 def _governed(
     scenario: Scenario | str | os.PathLike[str], criterion: Criterion, margin: float | None
 ) -> Scenario:
-    """The scenario a governor answers for: loaded, with an impact, its ``velocity_margin``
-    replaced by ``margin`` when given (:class:`GovernorError` naming ``velocity_margin`` when the
-    schema refuses it, or when it is not 0 with the "zmp" criterion).
+    """The scenario a governor answers for.
+
+    Loaded, with an impact, its ``velocity_margin`` replaced by ``margin`` when given
+    (:class:`GovernorError` naming ``velocity_margin`` when the schema refuses it, or when it is
+    not 0 with the "zmp" criterion).
     """
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
@@ -413,8 +444,10 @@ def _governed(
 
 
 def _zmp_interval(limit: VelocityLimit) -> tuple[float, float] | None:
-    """The ZMP criterion's safe speeds: from 0 to its maximum, or none when it is already
-    violated (the CoM's vertical outside the ZMP area) or the area is empty.
+    """The ZMP criterion's safe speeds.
+
+    From 0 to its maximum, or none when it is already violated (the CoM's vertical outside the
+    ZMP area) or the area is empty.
     """
     if limit.status in ("ok", "unbounded"):
         return 0.0, limit.max_approach_speed

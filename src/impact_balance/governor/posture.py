@@ -121,16 +121,18 @@ class Posture:
 
     @functools.cached_property
     def stance(self) -> Stance:
-        """The :class:`~impact_balance.contacts.stance.Stance` at ``q`` (built on first access, in the
-        robot's per-thread Data): for plots and displays.
+        """The :class:`~impact_balance.contacts.stance.Stance` at ``q``, for plots and displays.
+
+        Built on first access, in the robot's per-thread Data.
         """
         return Stance(self.robot, self.q, self.settings.contacts)
 
 
 class PostureEvaluator:
-    """Evaluates postures of one robot with one set of contacts and one impact, in a Data
-    of its own (not thread-safe: its owner, a :class:`~impact_balance.governor.Governor`,
-    holds a lock around :meth:`evaluate`).
+    """Evaluates postures of one robot with one set of contacts and one impact.
+
+    It has a pinocchio Data of its own and is not thread-safe: its owner, a
+    :class:`~impact_balance.governor.Governor`, holds a lock around :meth:`evaluate`.
 
     What does not depend on q is made once here: frame indices, the contact-frame CWC faces,
     the torque-limited joints, the impact's friction cone, the buffers.
@@ -148,7 +150,7 @@ class PostureEvaluator:
         self.model = model = pin.Model(robot.model)
         self._frames = [
             _point_frame(model, fid, c.offset, f"impact_balance_contact_{i}")
-            for i, (fid, c) in enumerate(zip(frames, contacts))
+            for i, (fid, c) in enumerate(zip(frames, contacts, strict=True))
         ]
         self._impact_frame = _point_frame(
             model, impact_frame, impact.offset, "impact_balance_impact"
@@ -266,9 +268,10 @@ class PostureEvaluator:
         jacobians: npt.NDArray[np.float64],
         gravity_torques: npt.NDArray[np.float64],
     ) -> BalanceAreas | Projected:
-        """The contact wrench polytope of the contacts' poses, projected: the ZMP support area
-        and the CoM velocity area (positions in m, world axes; ``local``: the contact points
-        in the stance frame, origin at ``origin``).
+        """The contact wrench polytope of the contacts' poses, projected.
+
+        The ZMP support area and the CoM velocity area (positions in m, world axes;
+        ``local``: the contact points in the stance frame, origin at ``origin``).
 
         Raises:
             SolverError: The projection failed (naming the contacts).
@@ -338,8 +341,10 @@ class PostureEvaluator:
 
 
 def _point_frame(model: pin.Model, fid: int, offset: pin.SE3 | None, name: str) -> int:
-    """The id of a frame of ``model`` at frame ``fid`` times ``offset``: ``fid`` itself without
-    an offset, else a new operational frame on the same joint (``model`` is modified).
+    """The id of a frame of ``model`` at frame ``fid`` times ``offset``.
+
+    ``fid`` itself without an offset, else a new operational frame on the same joint (``model``
+    is modified).
     """
     if offset is None or offset == pin.SE3.Identity():  # exact, as frame_point tests it
         return fid

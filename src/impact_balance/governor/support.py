@@ -67,10 +67,12 @@ SAME_SOLUTION = 1e-6
 def contact_aware_rates(
     stance: Stance, spec: ImpactSpec, warm: list[np.ndarray] | None = None
 ) -> tuple[np.ndarray, list[np.ndarray], bool]:
-    """One fixed point per restitution bound (``starts="warm"``): the
-    contact-aware CoM velocity jump per m/s of approach speed, world xy, at the lower and the
-    upper restitution bound: ``(rates (2, 2), body velocity changes (6,) per m/s: (dv_c, dw),
-    world, for a warm start, converged)``. ``warm``: one such change per bound, or None (cold).
+    """One fixed point per restitution bound (``starts="warm"``).
+
+    The contact-aware CoM velocity jump per m/s of approach speed, world xy, at the lower and
+    the upper restitution bound: ``(rates (2, 2), body velocity changes (6,) per m/s: (dv_c,
+    dw), world, for a warm start, converged)``. ``warm``: one such change per bound, or None
+    (cold).
     """
     solutions = _one_per_bound(stance, spec, warm)
     return solutions.rates, list(solutions.states), bool(solutions.converged.all())
@@ -113,9 +115,10 @@ def contact_aware_solutions(
     cold: bool = True,
     tolerance: float = SAME_SOLUTION,
 ) -> ContactAwareSolutions:
-    """The union of the contact-aware impact's solutions reached from several starts, per
-    restitution bound (module docstring): starts are every converged solution of ``previous`` at
-    that bound (in its order), then, when ``cold``, gauges 0. Fixed points within ``tolerance``
+    """The union of the contact-aware impact's solutions reached from several starts.
+
+    Per restitution bound (module docstring), the starts are every converged solution of
+    ``previous`` at that bound (in its order), then, when ``cold``, gauges 0. Fixed points within ``tolerance``
     (max norm of the body velocity change per m/s) of a kept one are the same solution; a
     non-converged fixed point is kept as a row (flagged) but not carried as a start.
 
@@ -158,9 +161,10 @@ def contact_aware_solutions(
 
 
 def _one_per_bound(stance: Stance, spec: ImpactSpec, guesses) -> ContactAwareSolutions:
-    """One fixed point per restitution bound, from ``guesses[k]`` (a body velocity change (6,)
-    per m/s) or, without guesses, gauges 0: 2 rows even when both bounds give the same jump
-    (``starts="warm"`` and ``"cold"``).
+    """One fixed point per restitution bound (``starts="warm"`` and ``"cold"``).
+
+    From ``guesses[k]`` (a body velocity change (6,) per m/s) or, without guesses, gauges 0:
+    2 rows even when both bounds give the same jump.
     """
     rows, iterations = [], 0
     for k, c_r in enumerate(float(c) for c in spec.restitution):
@@ -176,7 +180,7 @@ def _one_per_bound(stance: Stance, spec: ImpactSpec, guesses) -> ContactAwareSol
             )
         )
         iterations += r.iterations
-    rates, restitution, states, converged = (np.array(x) for x in zip(*rows))
+    rates, restitution, states, converged = (np.array(x) for x in zip(*rows, strict=True))
     return ContactAwareSolutions(
         rates, restitution, states, converged.astype(bool), iterations, len(rows)
     )
@@ -213,8 +217,9 @@ class ContactAwareAnswer:
 
 
 class ContactAwareLimit:
-    """The contact-aware jump's speed limit for a governor (module docstring); not thread-safe
-    (its governor calls it under its lock).
+    """The contact-aware jump's speed limit for a governor (module docstring).
+
+    Not thread-safe (its governor calls it under its lock).
 
     Args:
         spec: The scenario's impact (composite inertia model).
@@ -250,9 +255,17 @@ class ContactAwareLimit:
     def solve(
         self, stance: Stance, kept: ContactAwareSolutions | None = None
     ) -> ContactAwareSolutions:
-        """The rates at ``stance`` from the option's starts, continuing ``kept`` (the solutions
-        to start from; default: this limit's own), without adopting them (:meth:`adopt`): what
-        a worker process computes for its governor (:mod:`.worker`).
+        """The rates at ``stance`` from the option's starts, without adopting them.
+
+        What a worker process computes for its governor (:mod:`.worker`); :meth:`adopt` makes
+        them this limit's.
+
+        Args:
+            stance: The posture.
+            kept: The solutions to start from (default: this limit's own).
+
+        Returns:
+            The solutions found.
         """
         return self._solve(stance, self._solutions if kept is None else kept)
 
@@ -267,8 +280,9 @@ class ContactAwareLimit:
         self._age += 1
 
     def new_posture(self, stance_of: Callable[[], Stance]) -> None:
-        """A posture was evaluated; ``stance_of()`` builds its :class:`Stance` (called only when
-        the rates are due).
+        """A posture was evaluated.
+
+        ``stance_of()`` builds its :class:`Stance` (called only when the rates are due).
         """
         if self._solutions is None or self._count % self.every == 0:
             self.adopt(self._solve(stance_of(), self._solutions))
@@ -277,19 +291,35 @@ class ContactAwareLimit:
         self._count += 1
 
     def answer(self, criterion: ComCriterion, com_velocity: np.ndarray) -> ContactAwareAnswer:
-        """The limit and interval (m/s of approach speed) for the CoM velocity area of
-        ``criterion`` (world xy, m/s; the posture's :class:`~impact_balance.criteria.com.ComCriterion`,
-        its velocity margin included) and the pre-impact CoM velocity (world, m/s): the first
-        exit over every row of the rates (the smallest speed), the intersection of their safe
-        intervals.
+        """The contact-aware limit and safe interval (m/s of approach speed).
+
+        The first exit over every row of the rates (the smallest speed), and the intersection
+        of their safe intervals.
+
+        Args:
+            criterion: The posture's :class:`~impact_balance.criteria.com.ComCriterion` (its
+                CoM velocity area, world xy, m/s, and its velocity margin).
+            com_velocity: The pre-impact CoM velocity (world, m/s).
+
+        Returns:
+            The contact-aware answer.
         """
         return self.answers(criterion, com_velocity)[1]
 
     def answers(
         self, criterion: ComCriterion, com_velocity: np.ndarray
     ) -> tuple[VelocityLimit, ContactAwareAnswer]:
-        """``criterion.limit(com_velocity)`` (the floating model's limit) and :meth:`answer`,
-        in one compiled call: a governor's tick.
+        """The floating model's limit and :meth:`answer`, in one compiled call (a tick).
+
+        Args:
+            criterion: As in :meth:`answer`.
+            com_velocity: As in :meth:`answer`.
+
+        Returns:
+            ``criterion.limit(com_velocity)`` and :meth:`answer`'s answer.
+
+        Raises:
+            GovernorError: No posture evaluated yet.
         """
         s = self._solutions
         if s is None:
@@ -319,8 +349,9 @@ class ContactAwareLimit:
 def combine(
     floating: tuple[float, float] | None, aware: tuple[float, float] | None
 ) -> tuple[float, float] | None:
-    """The approach speeds (m/s) safe for both models: the intersection of two safe intervals
-    (or None).
+    """The approach speeds (m/s) safe for both models.
+
+    The intersection of two safe intervals (or None).
     """
     if floating is None or aware is None:
         return None

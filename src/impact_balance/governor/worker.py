@@ -44,9 +44,10 @@ START_TIMEOUT = 120.0
 
 
 def _serve(conn: Connection) -> None:
-    """The worker's loop: first ``(scenario dict, source, starts)``, then ``(key, q)`` in and
-    ``(key, solutions, error)`` out, each solve continuing the last answer; None or a closed
-    pipe stops it.
+    """The worker's loop.
+
+    First ``(scenario dict, source, starts)``, then ``(key, q)`` in and ``(key, solutions,
+    error)`` out, each solve continuing the last answer; None or a closed pipe stops it.
     """
     from impact_balance.contacts.stance import Stance
     from impact_balance.scenario import scenario_from_dict
@@ -94,8 +95,9 @@ def _stop(conn: Connection, process: subprocess.Popen) -> None:
 
 
 class ContactAwareWorker:
-    """One worker process computing contact-aware rates for one governor (module docstring);
-    not thread-safe (its governor calls it under its lock).
+    """One worker process computing contact-aware rates for one governor (module docstring).
+
+    Not thread-safe (its governor calls it under its lock).
 
     The worker is a fresh interpreter (``python -m impact_balance.governor.worker``) joined by a
     socket pair, not a :mod:`multiprocessing` child: a spawned child re-imports the user's main

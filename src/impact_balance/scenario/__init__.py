@@ -52,6 +52,7 @@ def __getattr__(name: str) -> Any:
 
 if TYPE_CHECKING:
     from impact_balance.scenario.bundled import bundled_scenarios, scenario_path
+    from impact_balance.scenario.errors import field_name
     from impact_balance.scenario.load import (
         ExtendsResolver,
         load_scenario,
@@ -68,24 +69,23 @@ if TYPE_CHECKING:
         Scenario,
         with_source,
     )
-    from impact_balance.scenario.errors import field_name
     from impact_balance.scenario.validate import scenario_from_dict
 
 __all__ = [
     "BasePose",
-    "ExtendsResolver",
-    "field_name",
-    "merge_mappings",
-    "read_mapping",
-    "with_source",
     "ContactConfig",
+    "ExtendsResolver",
     "ImpactConfig",
     "Offset",
     "QPConfig",
     "RobotFiles",
     "Scenario",
     "bundled_scenarios",
+    "field_name",
     "load_scenario",
+    "merge_mappings",
+    "read_mapping",
     "scenario_from_dict",
     "scenario_path",
+    "with_source",
 ]

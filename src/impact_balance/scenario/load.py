@@ -77,13 +77,14 @@ def read_mapping(
     parent = raw.pop("extends", None)
     if parent is not None:
         parent_path = _parent(path, parent, resolve_path)
-        raw = merge_mappings(read_mapping(parent_path, seen + (path.resolve(),), resolve_path), raw)
+        raw = merge_mappings(read_mapping(parent_path, (*seen, path.resolve()), resolve_path), raw)
     return raw
 
 
 def _chain_key(path: Path, resolve_path: ExtendsResolver | None) -> tuple | None:
-    """The texts of the files of ``path``'s ``extends`` chain, or None when the chain has a
-    problem (:func:`read_mapping` then reports it). Reads the parse cache without copying it.
+    """The texts of the files of ``path``'s ``extends`` chain, or None on a problem.
+
+    :func:`read_mapping` then reports the problem. Reads the parse cache without copying it.
     """
     texts: list[tuple[str, str]] = []
     try:
@@ -115,6 +116,7 @@ def load_scenario(
     is read again, an unchanged one is not parsed or validated again (scenarios are immutable).
 
     Args:
+        name_or_path: A scenario file, or the name of a bundled scenario.
         resolve_path: Optional rule for ``extends:`` (value, path of the file that extends) ->
             path to read, raising :class:`ScenarioError` to refuse. The GUI passes its
             workspace's rule; without it, a path relative to the file or a bundled name.
@@ -122,7 +124,7 @@ def load_scenario(
     path = scenario_path(name_or_path)
     key = _chain_key(path, resolve_path)
     if key is not None:
-        key = (str(path),) + key
+        key = (str(path), *key)
         with _LOADED_LOCK:
             hit = _LOADED.get(key)
             if hit is not None:

@@ -252,8 +252,10 @@ def read_yaml(path: Path) -> Any:
 
 
 def check_structure(raw: Any, source: str | None = None) -> None:
-    """Refuse a mapping nested deeper than :data:`MAX_DEPTH`, larger than :data:`MAX_VALUES`
-    values once shared parts are counted as copies, or containing itself.
+    """Refuse a mapping too deep, too large or containing itself.
+
+    Too deep: nested deeper than :data:`MAX_DEPTH`; too large: more than :data:`MAX_VALUES`
+    values once shared parts are counted as copies.
     """
     try:
         _, depth = _count(raw, _object_children, lambda x: not isinstance(x, (dict, list, tuple)))

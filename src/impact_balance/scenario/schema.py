@@ -31,6 +31,7 @@ from impact_balance.exceptions import ScenarioError
 from impact_balance.geometry.spatial import pose, surface_rotation
 from impact_balance.impact.model import ImpactSpec
 from impact_balance.robot.robot import Robot, load_robot
+from impact_balance.scenario.errors import scenario_error
 from impact_balance.scenario.fields import (
     Angles,
     Flag,
@@ -46,7 +47,6 @@ from impact_balance.scenario.fields import (
     _scalar,
     _speed,
 )
-from impact_balance.scenario.errors import scenario_error
 from impact_balance.scenario.reader import check_path_text, check_structure
 from impact_balance.scenario.specs import _contact_spec, _impact_spec, _quaternion
 
@@ -69,6 +69,7 @@ class Offset(_Model):
     rpy: Angles = (0.0, 0.0, 0.0)
 
     def se3(self) -> pin.SE3:
+        """The pose as a pinocchio SE3 (translation m, rotation from roll-pitch-yaw)."""
         return pose(self.position, self.rpy)
 
 
@@ -223,7 +224,7 @@ class Scenario(_Model):
     description: Annotated[str, Field(max_length=MAX_DESCRIPTION)] | None = None
     robot: str | RobotFiles = "talos"
     configuration: str | None = None
-    joints: dict[str, Number] = {}
+    joints: dict[str, Number] = Field(default_factory=dict)
     base: BasePose | None = None
     com_velocity: Annotated[Vec2, AfterValidator(_speed)] = (0.0, 0.0)
     plane_height: Annotated[Number, _scalar(-MAX_POSITION, MAX_POSITION, "m")] = 0.0
@@ -306,6 +307,14 @@ class Scenario(_Model):
 
     # -- resolution against a robot model -------------------------------------------------
     def load_robot(self) -> Robot:
+        """The scenario's robot: a bundled name, or files relative to the scenario file.
+
+        Returns:
+            The robot model (cached after its first load).
+
+        Raises:
+            ScenarioError: A bad robot file path, or an unknown robot name.
+        """
         if isinstance(self.robot, RobotFiles):
             check_path_text("robot.urdf", self.robot.urdf, self.source)
             if self.robot.srdf:
@@ -377,5 +386,5 @@ def with_source(exc: ScenarioError, source: str | None) -> ScenarioError:
     """Prefix a scenario error found after loading (unknown frame...) with its file name."""
     if source and exc.source is None:
         exc.source = source
-        exc.args = (f"{source}: {exc.args[0]}",) + exc.args[1:]
+        exc.args = (f"{source}: {exc.args[0]}", *exc.args[1:])
     return exc

@@ -1,5 +1,7 @@
-"""A scenario mapping to a :class:`~.schema.Scenario`: pydantic's errors become one
-:class:`~impact_balance.exceptions.ScenarioError` naming the field, the value and the valid keys.
+"""A scenario mapping to a :class:`~.schema.Scenario`.
+
+Pydantic's errors become one :class:`~impact_balance.exceptions.ScenarioError` naming the field, the
+value and the valid keys.
 """
 
 from __future__ import annotations
