@@ -357,7 +357,9 @@ class UnknownPathError(UnknownNameError):
 
 
 class MissingExtraError(ImpactBalanceError, ImportError):
-    """An optional part of impact-balance is not installed (``pip install 'impact-balance[EXTRA]'``).
+    """An optional part of impact-balance is not installed.
+
+    It installs with ``pip install 'impact-balance[EXTRA]'``.
 
     Attributes:
         what: What needs it: a command (``simulate``) or an option (``--plots``).

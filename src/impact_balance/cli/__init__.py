@@ -152,7 +152,10 @@ class _Stdout:
 
 
 def _report(exc: BaseException, debug: bool) -> int:
-    """The one error rule: one line on stderr and the exit status (the traceback with ``--debug``)."""
+    """The one error rule: one line on stderr and the exit status.
+
+    With ``--debug``, the traceback first.
+    """
     if isinstance(exc, BrokenPipeError) or (isinstance(exc, OSError) and exc.errno == errno.EPIPE):
         _silence_stdout()
         return EXIT_BROKEN_PIPE
@@ -201,13 +204,15 @@ class _Parser(argparse.ArgumentParser):
 def _parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
     p = _Parser(
         prog="impact-balance",
-        description="Impact-aware multi-contact balance: CoM velocity area and maximum contact velocity.",
+        description="Impact-aware multi-contact balance: CoM velocity area and maximum contact "
+        "velocity.",
     )
     p.add_argument("--version", action=_VersionAction)
     p.add_argument(
         "--debug",
         action="store_true",
-        help="show the traceback of an error (also anywhere after the command, or IMPACT_BALANCE_DEBUG=1)",
+        help="show the traceback of an error (also anywhere after the command, or "
+        "IMPACT_BALANCE_DEBUG=1)",
     )
     sub = p.add_subparsers(dest="command", required=True)
     owners: dict[str, ModuleType] = {}
@@ -248,7 +253,8 @@ def main(argv: list[str] | None = None) -> int:
             _interpret_kernels()
         if getattr(module, "USES_KERNEL", False) and not _kernel_is_compiled():
             print(
-                "impact-balance: compiling the projection kernel (first run only, 0.5 to 1.5 min; cached afterwards) ...",
+                "impact-balance: compiling the projection kernel (first run only, 0.5 to 1.5 min; "
+                "cached afterwards) ...",
                 file=sys.stderr,
                 flush=True,
             )

@@ -62,7 +62,10 @@ def _refused(exc: OptionError) -> CommandLineError:
 
 
 def output_folder(field: str) -> Callable[[str], str]:
-    """Argparse type: a folder the command will write in (see :mod:`impact_balance.cli.output_paths`)."""
+    """Argparse type: a folder the command will write in.
+
+    See :mod:`impact_balance.cli.output_paths`.
+    """
 
     def check(text: str) -> str:
         from impact_balance.cli.output_paths import check_output_folder
@@ -78,7 +81,10 @@ def output_folder(field: str) -> Callable[[str], str]:
 
 
 def output_file(field: str, suffixes: Sequence[str] = ()) -> Callable[[str], str]:
-    """Argparse type: a file the command will write (its folder checked, its suffix among ``suffixes``)."""
+    """Argparse type: a file the command will write.
+
+    Its folder is checked, and its suffix must be among ``suffixes``.
+    """
 
     def check(text: str) -> str:
         from impact_balance.cli.output_paths import check_output_file
@@ -140,7 +146,13 @@ def integer(field: str, lo: int, hi: int, why: str = "") -> Callable[[str], int]
 
 
 def add_controller_option(parser: argparse.ArgumentParser, default: str, why: str) -> None:
-    """``--controller ik|id``: the balance controller of the trials (``why``: the default's reason)."""
+    """Add ``--controller ik|id``: the balance controller of the trials.
+
+    Args:
+        parser: The command's parser.
+        default: The default controller.
+        why: The default's reason, for the help.
+    """
     parser.add_argument(
         "--controller",
         default=default,
@@ -294,7 +306,8 @@ def add_trial_options(parser: argparse.ArgumentParser, impact: bool) -> None:
         metavar="FILE",
         type=output_file("--journal", (".jsonl",)),
         help="JSON-lines file of the finished trials, written as they end; running the same "
-        "command again resumes from it (default: impact-balance-trials/<command>_<scenario>_<digest>.jsonl)",
+        "command again resumes from it (default: "
+        "impact-balance-trials/<command>_<scenario>_<digest>.jsonl)",
     )
     parser.add_argument(
         "--fresh", action="store_true", help="discard the journal's trials and run them all again"

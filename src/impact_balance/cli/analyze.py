@@ -16,7 +16,8 @@ from impact_balance.cli._options import (
 __all__ = ["INTERPRETED", "USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
-#: One analysis per process: interpreted kernels beat loading numba's cache (see ``impact_balance._jit``).
+#: One analysis per process: interpreted kernels beat loading numba's cache (see
+#: ``impact_balance._jit``).
 INTERPRETED = True
 
 

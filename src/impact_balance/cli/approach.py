@@ -58,7 +58,8 @@ def add_parser(sub) -> list[str]:
         "--governor",
         default="com",
         choices=("com", "zmp", "none"),
-        help="com: the CoM criterion's maximum contact velocity (default); zmp: the ZMP criterion's; "
+        help="com: the CoM criterion's maximum contact velocity (default); zmp: the ZMP "
+        "criterion's; "
         "none: the reference alone",
     )
     where = a.add_mutually_exclusive_group()
@@ -67,7 +68,8 @@ def add_parser(sub) -> list[str]:
         type=number("--wall-distance", 0.0, 1.0, "m", lo_open=True),
         default=None,
         metavar="D",
-        help="distance of the wall from the point's start, m (default 0.15: the scenario's impact point)",
+        help="distance of the wall from the point's start, m (default 0.15: the scenario's impact "
+        "point)",
     )
     where.add_argument(
         "--wall-distance-range",
@@ -80,13 +82,15 @@ def add_parser(sub) -> list[str]:
     a.add_argument(
         "--contact-aware",
         action="store_true",
-        help="com governor: also bound the speed by the contact-aware impact model (the robot standing "
+        help="com governor: also bound the speed by the contact-aware impact model (the robot "
+        "standing "
         "on its supports; experimental, see docs/contact_aware_governor.md)",
     )
     a.add_argument(
         "--contact-aware-async",
         action="store_true",
-        help="with --contact-aware: compute its rates in a worker process, off the tick (the tick never "
+        help="with --contact-aware: compute its rates in a worker process, off the tick (the tick "
+        "never "
         "waits; the rates are one recomputation old)",
     )
     add_velocity_margin_option(a, "com governor")
@@ -280,8 +284,8 @@ def _plot(trial, setup, out: Path, zmp_margin: float) -> Path:
     margin = setup.analysis.areas.com_velocity_area_inset(zmp_margin) if zmp_margin > 0 else None
     o = trial.options
     path = (
-        out
-        / f"{figure_prefix(setup.analysis)}_approach_{o.governor}_{o.reference:g}_{100 * o.wall_distance:g}cm.png"
+        out / f"{figure_prefix(setup.analysis)}_approach_{o.governor}_{o.reference:g}_"
+        f"{100 * o.wall_distance:g}cm.png"
     )
     plot_approach(trial, setup.analysis, margin).savefig(path)
     return path

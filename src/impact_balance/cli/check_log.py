@@ -61,7 +61,8 @@ def run(args: argparse.Namespace) -> int:
         print_json(out)
         return 0
     print(
-        f"{args.log}: {out['samples']} samples over {out['duration']:.3f} s, scenario {check.scenario},"
+        f"{args.log}: {out['samples']} samples over {out['duration']:.3f} s, scenario "
+        f"{check.scenario},"
         f" {len(check.segments)} stance(s)"
     )
     if check.floating:
@@ -85,7 +86,8 @@ def run(args: argparse.Namespace) -> int:
         for v in check.violations:
             unit = "m/s" if v.kind == "com_velocity" else "m"
             print(
-                f"    {v.kind:12s} {v.start:8.3f} s to {v.end:8.3f} s ({v.samples} samples), worst {v.worst_margin:.4g} {unit}"
+                f"    {v.kind:12s} {v.start:8.3f} s to {v.end:8.3f} s ({v.samples} samples), worst "
+                f"{v.worst_margin:.4g} {unit}"
                 f" at {v.worst_time:.3f} s"
             )
     for note in notes:

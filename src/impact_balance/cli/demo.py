@@ -85,6 +85,7 @@ def run(args: argparse.Namespace) -> int:
 
     bounds = [round(float(b), 4) for b in com_velocity_bounds(0.78, (-0.13, 0.13))]
     print(
-        f"LIPM check (paper sec. III-B): c_z 0.78 m, ZMP in [-0.13, 0.13] m -> CoM velocity in [{bounds[0]}, {bounds[1]}] m/s"
+        "LIPM check (paper sec. III-B): c_z 0.78 m, ZMP in [-0.13, 0.13] m -> CoM velocity in "
+        f"[{bounds[0]}, {bounds[1]}] m/s"
     )
     return 0

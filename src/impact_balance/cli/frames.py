@@ -1,4 +1,4 @@
-"""``impact-balance frames ROBOT|SCENARIO``: every frame's pose and axes, and every joint of a robot.
+"""``impact-balance frames ROBOT|SCENARIO``: every frame's pose and axes, every joint.
 
 For a scenario, the poses are at its stance (and its contacts are listed, resolved); for a
 robot, at its standing configuration (the free-flyer as the configuration gives it).
@@ -48,7 +48,10 @@ def _robot_and_stance(name: str):
 
 
 def robot_listing(robot, q=None, frames: list[str] | None = None) -> dict:
-    """Frames (name, type, parent joint, world pose at ``q``) and actuated joints (limits) of a robot."""
+    """A robot's frames and actuated joints.
+
+    Frames: name, type, parent joint, world pose at ``q``; joints: their limits.
+    """
     from impact_balance.authoring import frame_poses
 
     q = robot.configuration() if q is None else q
@@ -101,7 +104,8 @@ def run(args: argparse.Namespace) -> int:
         print_json(listing)
         return 0
     print(
-        f"{listing['robot']}: {len(listing['frames'])} frames, {len(listing['joints'])} joints ({listing['urdf']})"
+        f"{listing['robot']}: {len(listing['frames'])} frames, {len(listing['joints'])} joints "
+        f"({listing['urdf']})"
     )
     print(f"poses at the {label}; world axes, m; each axis is a unit vector in world coordinates")
     rows = listing["frames"]
@@ -112,7 +116,8 @@ def run(args: argparse.Namespace) -> int:
     )
     for f in rows:
         print(
-            f"  {f['name']:<{width}}  {f['type']:<12} {_vec(f['position']):<22}  {_vec(f['axes']['x']):<22}  "
+            f"  {f['name']:<{width}}  {f['type']:<12} {_vec(f['position']):<22}  "
+            f"{_vec(f['axes']['x']):<22}  "
             f"{_vec(f['axes']['z']):<22}  {f['z_tilt_deg']:5.1f}°  {f['parent_joint']}"
         )
     for i, c in enumerate(listing.get("contacts", [])):

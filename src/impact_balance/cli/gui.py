@@ -50,7 +50,8 @@ def add_parser(sub) -> list[str]:
         action="append",
         default=[],
         metavar="ORIGIN",
-        help="also accept pages from ORIGIN (scheme://host[:port], e.g. a reverse proxy); repeatable. "
+        help="also accept pages from ORIGIN (scheme://host[:port], e.g. a reverse proxy); "
+        "repeatable. "
         "By default only the GUI's own page may connect",
     )
     return ["gui"]
@@ -81,7 +82,8 @@ def run(args: argparse.Namespace) -> int:
 
     def ready(app) -> None:
         print(
-            f"impact-balance gui: {app.session.state.scenario.name or 'scenario'} at {app.url}  (Ctrl-C to stop)\n"
+            f"impact-balance gui: {app.session.state.scenario.name or 'scenario'} at {app.url}  "
+            "(Ctrl-C to stop)\n"
             f"  workspace: {app.workspace.root}  (the GUI loads and saves .yaml files here only)",
             flush=True,
         )

@@ -37,7 +37,8 @@ def _text(field: str, path: str | os.PathLike[str]) -> Path:
         raise OptionError(
             field,
             text,
-            f"a file or folder name has at most {MAX_NAME_CHARS} characters (this one has {longest})",
+            f"a file or folder name has at most {MAX_NAME_CHARS} characters (this one has "
+            f"{longest})",
         )
     return Path(text).expanduser()
 

@@ -1,4 +1,7 @@
-"""``impact-balance phase-portrait``: the LIPM phase portrait and CoM velocity bounds (paper sec. III-B)."""
+"""``impact-balance phase-portrait``: the LIPM phase portrait and CoM velocity bounds.
+
+The paper's sec. III-B.
+"""
 
 from __future__ import annotations
 
@@ -81,7 +84,8 @@ def run(args: argparse.Namespace) -> int:
     else:
         lo, hi = portrait.com_velocity_bounds
         print(
-            f"omega = {portrait.omega:.4f} 1/s; CoM velocity bounds at c = 0: [{lo:.4f}, {hi:.4f}] m/s"
+            f"omega = {portrait.omega:.4f} 1/s; CoM velocity bounds at c = 0: [{lo:.4f}, {hi:.4f}] "
+            "m/s"
         )
         if args.plot:
             print(f"figure: {args.plot}")

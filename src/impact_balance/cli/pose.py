@@ -1,6 +1,7 @@
 """``impact-balance pose SCENARIO --place FRAME X Y Z [--normal NX NY NZ] [--com X Y] --out FILE``.
 
-Whole-body IK (contacts kept) that writes a new scenario file; see :mod:`impact_balance.authoring.pose`.
+Whole-body IK (contacts kept) that writes a new scenario file; see
+:mod:`impact_balance.authoring.pose`.
 """
 
 from __future__ import annotations
@@ -67,7 +68,8 @@ def add_parser(sub) -> list[str]:
         action=_Place,
         dest="places",
         metavar=("NX", "NY", "NZ"),
-        help="after --place: turn that contact's normal (or the frame's z axis) to this world direction",
+        help="after --place: turn that contact's normal (or the frame's z axis) to this world "
+        "direction",
     )
     p.add_argument(
         "--com", nargs=2, type=float, metavar=("X", "Y"), help="horizontal CoM target, world, m"

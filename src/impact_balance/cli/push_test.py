@@ -1,4 +1,7 @@
-"""``impact-balance push-test SCENARIO``: impulsive pushes, predicted before the trial and scored after."""
+"""``impact-balance push-test SCENARIO``: impulsive pushes, predicted, then scored.
+
+Each push is predicted before its trial and scored after it.
+"""
 
 from __future__ import annotations
 
@@ -149,20 +152,24 @@ def _text(result, out: dict, args: argparse.Namespace) -> str:
     o = counts["outcomes"]
     controller = out["controller"].get("name", args.controller)
     lines = [
-        f"{result.scenario}: {len(result.outcomes)} pushes ({args.directions} directions, {args.duration * 1e3:.0f} ms) "
+        f"{result.scenario}: {len(result.outcomes)} pushes ({args.directions} directions, "
+        f"{args.duration * 1e3:.0f} ms) "
         f"with the {args.controller} controller ({controller})",
-        f"  outcomes: {o['balanced']} balanced, {o['contact_broken']} contact broken (came to rest), "
+        f"  outcomes: {o['balanced']} balanced, {o['contact_broken']} contact broken (came to "
+        "rest), "
         f"{o['fell']} fell, {o['aborted']} aborted",
     ]
     if counts["reasons"]:
         lines.append("  " + ", ".join(f"{k}: {v}" for k, v in sorted(counts["reasons"].items())))
     margin = 1000 * out["zmp_margin"]
     lines.append(
-        f"  {'magnitude':>14s} {'balanced':>8s} {'broken':>6s} {'fell':>5s} {'CoM safe':>8s} {'ZMP safe':>8s}"
+        f"  {'magnitude':>14s} {'balanced':>8s} {'broken':>6s} {'fell':>5s} {'CoM safe':>8s} "
+        f"{'ZMP safe':>8s}"
     )
     for row in _by_level(result):
         lines.append(
-            f"  {row['label']:>14s} {row['balanced']:8d} {row['contact_broken']:6d} {row['fell']:5d} "
+            f"  {row['label']:>14s} {row['balanced']:8d} {row['contact_broken']:6d} "
+            f"{row['fell']:5d} "
             f"{row['com']:8d} {row['zmp']:8d}"
         )
     lines.append(
@@ -182,8 +189,8 @@ def _text(result, out: dict, args: argparse.Namespace) -> str:
         )
     smallest = out["margin_study"]["smallest_margin"]["com"]
     lines.append(
-        "  smallest ZMP margin that brings the CoM criterion's 'predicted safe, fell' to 5 % or less: "
-        + ("none up to 6 cm" if smallest is None else f"{1000 * smallest:g} mm")
+        "  smallest ZMP margin that brings the CoM criterion's 'predicted safe, fell' to 5 % or "
+        "less: " + ("none up to 6 cm" if smallest is None else f"{1000 * smallest:g} mm")
     )
     if out["journal"]:
         lines.append(f"  trials journal: {out['journal']} ({out['reused_trials']} reused)")

@@ -1,4 +1,7 @@
-"""``impact-balance simulate SCENARIO``: the scenario's impact in MuJoCo, measured against the impact model."""
+"""``impact-balance simulate SCENARIO``: the scenario's impact in MuJoCo.
+
+The simulated impact is measured against the impact model.
+"""
 
 from __future__ import annotations
 
@@ -47,20 +50,23 @@ def add_parser(sub) -> list[str]:
         "--joints",
         default="rigid",
         metavar="rigid|servo",
-        help="joint model: rigid (welded at the stance, the paper's model) or servo (position servos)",
+        help="joint model: rigid (welded at the stance, the paper's model) or servo (position "
+        "servos)",
     )
     a.add_argument(
         "--armature",
         type=number("--armature", 0.0, 100.0, "kg m^2"),
         default=None,
         metavar="KG_M2",
-        help="servo only: rotor inertia of every joint, kg m^2 (default: what the robot files declare, "
+        help="servo only: rotor inertia of every joint, kg m^2 (default: what the robot files "
+        "declare, "
         "the SRDF's rotor_params; 0 where they declare none)",
     )
     a.add_argument(
         "--rigid-impact",
         action="store_true",
-        help="servo only: hold every joint's velocity from the contact to the end of the compression "
+        help="servo only: hold every joint's velocity from the contact to the end of the "
+        "compression "
         "(the paper's rigid robot at the impact)",
     )
     a.add_argument(
@@ -122,7 +128,8 @@ def _table(name: str, r) -> str:
     size = float(math.hypot(*jump))
     lines = [
         f"{name}: {r.joints} joints, approach speed {r.approach_speed:.3f} m/s "
-        f"(measured {r.approach_speed_measured:.3f}), restitution measured {r.restitution_measured:.3f}, "
+        f"(measured {r.approach_speed_measured:.3f}), restitution measured "
+        f"{r.restitution_measured:.3f}, "
         f"slip {r.slip_speed:.3f} m/s",
         f"  {'':<26}{'CoM velocity jump x, y (m/s)':<34}{'distance to set (m/s)':>22}",
         f"  {'measured':<26}{jump[0]:+10.5f} {jump[1]:+10.5f}",
@@ -144,11 +151,13 @@ def _table(name: str, r) -> str:
             for name, v in r.sustained_impulses.items()
         ]
         lines.append(
-            f"  impulse at the sustained contacts (force before the impact subtracted), N s: {'; '.join(parts)}"
+            "  impulse at the sustained contacts (force before the impact subtracted), N s: "
+            f"{'; '.join(parts)}"
         )
     if r.hold is not None and r.hold["duration"] is not None:
         lines.append(
-            f"  joints held through the impact for {1e3 * r.hold['duration']:.1f} ms (largest joint velocity "
+            f"  joints held through the impact for {1e3 * r.hold['duration']:.1f} ms (largest "
+            "joint velocity "
             f"change {r.hold['max_joint_velocity_change']:.2g} rad/s)"
         )
     if r.joints == "servo":
@@ -220,7 +229,10 @@ def run(args: argparse.Namespace) -> int:
             from impact_balance.plots.simulation import plot_jump_on_sets, plot_time_series
             from impact_balance.plots.style import DPI
 
-            title = f"{name}: {args.joints} joints, approach {speed:g} m/s, restitution {result.restitution_measured:.2f}"
+            title = (
+                f"{name}: {args.joints} joints, approach {speed:g} m/s, "
+                f"restitution {result.restitution_measured:.2f}"
+            )
             out = Path(args.plots)
             out.mkdir(parents=True, exist_ok=True)
             for kind, fig in (

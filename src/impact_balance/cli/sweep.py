@@ -56,7 +56,8 @@ def add_parser(sub) -> list[str]:
     s = sub.add_parser(
         "sweep",
         help="evaluate a sweep file (grid or quasi-random points) on all cores or a Dask cluster",
-        description="Evaluate every point of a sweep file and write one Parquet row per point. Finished chunks "
+        description="Evaluate every point of a sweep file and write one Parquet row per point. "
+        "Finished chunks "
         "are written at once: after Ctrl-C or a crash, the same command resumes.",
     )
     s.add_argument(
@@ -140,7 +141,8 @@ def _verify(args: argparse.Namespace) -> int:
         )
         verdict = "ok" if check.ok else f"{len(check.problems)} bad part(s)"
         print(
-            f"{args.verify}: {verdict}; {len(check.good)} good parts, {check.rows} of {check.manifest['n_points']} "
+            f"{args.verify}: {verdict}; {len(check.good)} good parts, {check.rows} of "
+            f"{check.manifest['n_points']} "
             f"points; {state}"
         )
     return 0 if check.ok else 2
@@ -205,13 +207,16 @@ def run(args: argparse.Namespace) -> int:
     )
     where = args.scheduler or f"{report.workers} worker{'s' if report.workers != 1 else ''}"
     print(
-        f"impact-balance sweep: {report.points_computed} points in {report.elapsed_s:.1f} s on {where} "
-        f"({report.rate:.0f} points/s; {report.chunks_before} of {report.n_chunks} chunks were already done) -> {out}",
+        f"impact-balance sweep: {report.points_computed} points in {report.elapsed_s:.1f} s on "
+        f"{where} "
+        f"({report.rate:.0f} points/s; {report.chunks_before} of {report.n_chunks} chunks were "
+        f"already done) -> {out}",
         file=sys.stderr,
     )
     if report.interrupted:
         print(
-            f"impact-balance sweep: interrupted; {report.chunks_before + report.chunks_computed} of {report.n_chunks} "
+            f"impact-balance sweep: interrupted; {report.chunks_before + report.chunks_computed} "
+            f"of {report.n_chunks} "
             "chunks are written: run the same command to resume",
             file=sys.stderr,
         )

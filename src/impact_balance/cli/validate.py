@@ -1,4 +1,7 @@
-"""``impact-balance validate SCENARIO``: the empirical fall threshold of the impact beside the predictions."""
+"""``impact-balance validate SCENARIO``: the impact's empirical fall threshold, and predictions.
+
+The threshold is bracketed in MuJoCo and shown beside the criteria's predictions.
+"""
 
 from __future__ import annotations
 
@@ -152,7 +155,8 @@ def _text(out: dict, args: argparse.Namespace, n: int) -> str:
         "rigid impact (joints held through the impact)" if out["rigid_impact"] else "free impact"
     )
     lines = [
-        f"{out['scenario']}: fall threshold of the impact ({args.joints} joints, {args.controller} controller, "
+        f"{out['scenario']}: fall threshold of the impact ({args.joints} joints, {args.controller} "
+        "controller, "
         f"{impact}, {n} trials)",
         f"  measured approach speed: stood at {_f(e['survived'])}, fell at {_f(e['fell'])}"
         f" (commanded {_f(e['survived_commanded'])} / {_f(e['fell_commanded'])})"
@@ -161,7 +165,8 @@ def _text(out: dict, args: argparse.Namespace, n: int) -> str:
     brk = out["contact_break"]
     if brk is not None:
         lines.append(
-            f"  first contact break: {brk['contact']} {brk['kind']} at {_f(brk['measured'])} measured "
+            f"  first contact break: {brk['contact']} {brk['kind']} at {_f(brk['measured'])} "
+            "measured "
             f"({brk['outcome']})"
         )
     else:
@@ -181,7 +186,8 @@ def _text(out: dict, args: argparse.Namespace, n: int) -> str:
             t["com_criterion_safe"]
         ]
         lines.append(
-            f"    {t['speed']:.3f} -> {_f(t['approach_speed_measured'])}: {t['outcome']}{why}   {call}"
+            f"    {t['speed']:.3f} -> {_f(t['approach_speed_measured'])}: {t['outcome']}{why}   "
+            f"{call}"
         )
     lines.append(
         f"  controller: {out['controller'].get('name', args.controller)}; joint armature: "

@@ -6,8 +6,10 @@ polytope and its projection (the ZMP support area and the CoM velocity area), th
 model at the impacting frame, and the criterion's data that do not depend on the CoM velocity.
 
 The steps are the pipeline's own functions at the array level
-(:func:`~impact_balance.contacts.stance.frame_point`, :func:`~impact_balance.contacts.wrench_polytope.assemble_polytope`,
-:func:`~impact_balance.balance.areas.areas_from_polytope`, :func:`~impact_balance.impact.model.model_from_inertia_map`,
+(:func:`~impact_balance.contacts.stance.frame_point`,
+:func:`~impact_balance.contacts.wrench_polytope.assemble_polytope`,
+:func:`~impact_balance.balance.areas.areas_from_polytope`,
+:func:`~impact_balance.impact.model.model_from_inertia_map`,
 :class:`~impact_balance.criteria.com.ComCriterion`), so a governor answers what
 :func:`~impact_balance.analyze` answers for the same posture (the tests check it to 1e-9);
 what a control loop does not read is skipped: the :class:`~impact_balance.contacts.stance.Stance`
@@ -65,7 +67,8 @@ class PostureSettings:
         zmp_margin: The ZMP support area is shrunk by this margin, m.
         criterion: "com" or "zmp".
         velocity_margin: The post-impact CoM velocities must lie this far inside the CoM
-            velocity area, m/s ("com" criterion; :class:`~impact_balance.criteria.com.ComCriterion`).
+            velocity area, m/s ("com" criterion;
+            :class:`~impact_balance.criteria.com.ComCriterion`).
     """
 
     contacts: Sequence[ContactSpec]
@@ -324,7 +327,10 @@ class PostureEvaluator:
         mass: float,
         inertia: np.ndarray,
     ) -> ImpactModel:
-        """The impact model at the kinematics held in the Data (as :func:`~impact_balance.impact.model.impact_model`)."""
+        """The impact model at the kinematics held in the Data.
+
+        As :func:`~impact_balance.impact.model.impact_model` computes it.
+        """
         spec, data, model = self.settings.impact, self.scratch.data, self.model
         placement, J6 = frame_point(model, data, self._impact_frame, None)
         point_local = placement.translation.copy()

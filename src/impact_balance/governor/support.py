@@ -80,7 +80,9 @@ def contact_aware_rates(
 
 @dataclass(frozen=True)
 class ContactAwareSolutions:
-    """Every distinct contact-aware jump found from a set of starts (:func:`contact_aware_solutions`).
+    """Every distinct contact-aware jump found from a set of starts.
+
+    See :func:`contact_aware_solutions`.
 
     Attributes:
         rates: (k, 2) CoM velocity jump per m/s of approach speed, world xy (m/s per m/s), one
@@ -118,9 +120,10 @@ def contact_aware_solutions(
     """The union of the contact-aware impact's solutions reached from several starts.
 
     Per restitution bound (module docstring), the starts are every converged solution of
-    ``previous`` at that bound (in its order), then, when ``cold``, gauges 0. Fixed points within ``tolerance``
-    (max norm of the body velocity change per m/s) of a kept one are the same solution; a
-    non-converged fixed point is kept as a row (flagged) but not carried as a start.
+    ``previous`` at that bound (in its order), then, when ``cold``, gauges 0. Fixed points
+    within ``tolerance`` (max norm of the body velocity change per m/s) of a kept one are the
+    same solution; a non-converged fixed point is kept as a row (flagged) but not carried as a
+    start.
 
     Args:
         stance: The posture (its sustained contacts and composite inertia).

@@ -19,7 +19,8 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 # Also re-exported: the helpers sweep/, gui/, analysis.py and tests import from here
-# (ExtendsResolver, with_source, field_name, merge_mappings, read_mapping). Imported on first use (PEP 562):
+# (ExtendsResolver, with_source, field_name, merge_mappings, read_mapping). Imported on first use
+# (PEP 562):
 # listing the bundled scenarios needs only .bundled, not pydantic and pinocchio.
 _EXPORTS: dict[str, str] = {
     "bundled_scenarios": ".bundled",

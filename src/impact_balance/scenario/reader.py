@@ -274,5 +274,8 @@ def check_path_text(field: str, text: str, source: str | None = None) -> None:
         raise ScenarioError(field, text, reason, source)
     longest = max((len(part) for part in text.replace("\\", "/").split("/")), default=0)
     if longest > MAX_NAME_CHARS:
-        reason = f"a file or scenario name has at most {MAX_NAME_CHARS} characters (this one has {longest})"
+        reason = (
+            f"a file or scenario name has at most {MAX_NAME_CHARS} characters "
+            f"(this one has {longest})"
+        )
         raise ScenarioError(field, text, reason, source)

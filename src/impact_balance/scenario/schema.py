@@ -338,7 +338,10 @@ class Scenario(_Model):
         return q
 
     def contact_specs(self, robot: Robot, q: np.ndarray) -> list[ContactSpec]:
-        """The contacts' specs at configuration ``q`` (which resolves the contacts given by a world normal)."""
+        """The contacts' specs at configuration ``q``.
+
+        The configuration resolves the contacts given by a world normal.
+        """
         if all(c.normal is None for c in self.contacts):
             return [c.spec() for c in self.contacts]
         frames = Stance(robot, q, [])
@@ -351,7 +354,21 @@ class Scenario(_Model):
         return specs
 
     def build_stance(self, robot: Robot | None = None) -> Stance:
-        """Resolve robot, configuration and contacts into a :class:`Stance` (see ``_build_stance``)."""
+        """Resolve robot, configuration and contacts into a :class:`Stance`.
+
+        Without a ``base`` key the robot is translated vertically so that its lowest contact
+        corner touches z = 0.
+
+        Args:
+            robot: The robot (default: the scenario's, loaded).
+
+        Returns:
+            The stance.
+
+        Raises:
+            ScenarioError: An unknown frame or joint, a plane at or above the CoM (with the
+                scenario's file named).
+        """
         try:
             return self._build_stance(robot)
         except ScenarioError as exc:
