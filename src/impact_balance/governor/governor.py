@@ -5,10 +5,13 @@ from __future__ import annotations
 import math
 import os
 import threading
-from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from impact_balance.balance.areas import warm_up as warm_up_maps
 from impact_balance.contacts.stance import has_free_flyer
@@ -180,11 +183,11 @@ class Governor:
     def __enter__(self) -> Governor:
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
     # -- per tick ---------------------------------------------------------------------------
-    def limit(self, q: Sequence[float], v: Sequence[float]) -> SpeedLimit:
+    def limit(self, q: ArrayLike, v: ArrayLike) -> SpeedLimit:
         """The speed limit at configuration ``q`` and generalized velocity ``v``.
 
         Args:
@@ -201,13 +204,13 @@ class Governor:
             ScenarioError, ImpactModelError, SolverError: a posture the pipeline cannot
                 evaluate (see :meth:`~impact_balance.governor.posture.PostureEvaluator.evaluate`).
         """
-        q = self._configuration(q)
-        v = _vector(v, self.nv, "v")
+        configuration = self._configuration(q)
+        velocity = _vector(v, self.nv, "v")
         with self._lock:
-            posture, reused = self._posture_at(q)
-            return self._answer(posture, posture.com_jacobian @ v, reused)
+            posture, reused = self._posture_at(configuration)
+            return self._answer(posture, posture.com_jacobian @ velocity, reused)
 
-    def limit_com(self, q: Sequence[float], com_velocity: Sequence[float]) -> SpeedLimit:
+    def limit_com(self, q: ArrayLike, com_velocity: ArrayLike) -> SpeedLimit:
         """:meth:`limit` with the CoM velocity given, for a controller with its own estimate.
 
         Args:
@@ -220,7 +223,7 @@ class Governor:
         Raises:
             GovernorError: A bad ``q`` (as :meth:`limit`) or ``com_velocity``.
         """
-        q = self._configuration(q)
+        configuration = self._configuration(q)
         c = np.asarray(com_velocity, dtype=float).ravel() if _is_numeric(com_velocity) else None
         if c is None or c.size not in (2, 3) or not math.isfinite(float(c @ c)):
             raise GovernorError(
@@ -228,12 +231,12 @@ class Governor:
             )
         c = np.append(c, 0.0) if c.size == 2 else c.copy()
         with self._lock:
-            posture, reused = self._posture_at(q)
+            posture, reused = self._posture_at(configuration)
             return self._answer(posture, c, reused)
 
     def cap(
-        self, reference_velocity: Sequence[float] | None = None, limit: SpeedLimit | None = None
-    ) -> np.ndarray:
+        self, reference_velocity: ArrayLike | None = None, limit: SpeedLimit | None = None
+    ) -> npt.NDArray[np.float64]:
         """The reference velocity with its approach speed brought into the safe interval.
 
         See :func:`~impact_balance.governor.limit.cap_approach`.
@@ -250,6 +253,7 @@ class Governor:
             GovernorError: no limit yet (call :meth:`limit` first), no reference, or a bad one.
         """
         if reference_velocity is None:
+            assert self.scenario.impact is not None  # the constructor refuses a scenario without
             reference_velocity = self.scenario.impact.reference_velocity
             if reference_velocity is None:
                 raise GovernorError(
@@ -264,7 +268,7 @@ class Governor:
                 raise GovernorError("limit", None, "no speed limit yet: call limit(q, v) first")
         return cap_approach(reference_velocity, limit.normal, limit.safe_interval)
 
-    def scenario_at(self, q: Sequence[float], com_velocity: Sequence[float]) -> Scenario:
+    def scenario_at(self, q: ArrayLike, com_velocity: ArrayLike) -> Scenario:
         """The scenario :func:`~impact_balance.analyze` answers the same for (its margins included).
 
         This governor's, at configuration ``q`` (every joint by name, an explicit ``base``
@@ -274,20 +278,22 @@ class Governor:
         Raises:
             ScenarioError: a joint outside its position limits (scenarios refuse those).
         """
-        q = self._configuration(q)
+        configuration = self._configuration(q)
         c = np.asarray(com_velocity, dtype=float).ravel()
         robot, joints = self.robot, {}
         for name in robot.joint_names:
             slot = robot.joint_slot(name)
             if slot.nq == 1:
-                joints[name] = float(q[slot.idx_q])
+                joints[name] = float(configuration[slot.idx_q])
             elif slot.nq == 2 and slot.nv == 1:  # continuous: (cos, sin)
-                joints[name] = math.atan2(float(q[slot.idx_q + 1]), float(q[slot.idx_q]))
-        update: dict = {"joints": joints, "com_velocity": (float(c[0]), float(c[1]))}
+                cos, sin = configuration[slot.idx_q], configuration[slot.idx_q + 1]
+                joints[name] = math.atan2(float(sin), float(cos))
+        update: dict[str, Any] = {"joints": joints, "com_velocity": (float(c[0]), float(c[1]))}
         if self._free_flyer:
-            rotation = pin.Quaternion(q[3:7]).normalized().matrix()
-            rpy = pin.rpy.matrixToRpy(rotation)
-            update["base"] = BasePose(position=tuple(map(float, q[:3])), rpy=tuple(map(float, rpy)))
+            rotation = pin.Quaternion(configuration[3:7]).normalized().matrix()
+            x, y, z = (float(a) for a in configuration[:3])
+            roll, pitch, yaw = (float(a) for a in pin.rpy.matrixToRpy(rotation))
+            update["base"] = BasePose(position=(x, y, z), rpy=(roll, pitch, yaw))
         raw = self.scenario.model_dump(exclude_none=True)
         raw.update(update)
         raw["base"] = update.get("base", BasePose()).model_dump(exclude_none=True)
@@ -311,19 +317,21 @@ class Governor:
             return self._posture
 
     # -- internals ---------------------------------------------------------------------------
-    def _configuration(self, q: Sequence[float]) -> np.ndarray:
-        q = _vector(q, self.nq, "q")
+    def _configuration(self, q: ArrayLike) -> npt.NDArray[np.float64]:
+        """``q`` as a checked configuration vector (see :meth:`limit`)."""
+        configuration = _vector(q, self.nq, "q")
         if self._free_flyer:
-            norm = float(q[3:7] @ q[3:7])
+            quaternion = configuration[3:7]
+            norm = float(quaternion @ quaternion)
             if abs(norm - 1.0) > 2.0 * QUATERNION_TOLERANCE:
                 raise GovernorError(
                     "q",
-                    q[3:7].tolist(),
+                    quaternion.tolist(),
                     "the base quaternion (x, y, z, w) must be unit; normalise it",
                 )
-        return q
+        return configuration
 
-    def _posture_at(self, q: np.ndarray) -> tuple[Posture, bool]:
+    def _posture_at(self, q: npt.NDArray[np.float64]) -> tuple[Posture, bool]:
         """The posture of ``q``, reused when it is the cached one (under the lock)."""
         cached = self._posture
         if cached is not None:
@@ -339,32 +347,44 @@ class Governor:
         self._posture = posture
         return posture, False
 
-    def _answer(self, posture: Posture, com_velocity: np.ndarray, reused: bool) -> SpeedLimit:
+    def _refresh_support(self, support: ContactAwareLimit, posture: Posture) -> None:
+        """Tell the contact-aware limit a posture was evaluated (under the lock).
+
+        In the tick, it recomputes its rates when due; with a worker, a finished answer is
+        collected and the worker handed this posture when idle (never waiting).
+        """
+        if self._worker is None:
+            support.new_posture(lambda: posture.stance)
+        else:
+            done = self._worker.poll()
+            if done is None:
+                support.aged()
+            else:
+                support.adopt(done)
+            if self._worker.idle:
+                self._worker.submit(posture.key, posture.q)
+        self._support_posture = posture.key
+
+    def _answer(
+        self, posture: Posture, com_velocity: npt.NDArray[np.float64], reused: bool
+    ) -> SpeedLimit:
+        """The answer for ``posture`` and the CoM velocity (world, m/s); kept as the last."""
         binding = "floating"
         criterion = posture.com_criterion
-        if criterion is not None and self._support is None:
+        support = self._support
+        limit: VelocityLimit
+        if criterion is not None and support is None:
             limit = criterion.limit(com_velocity)
             interval = criterion.interval(com_velocity, limit)
-        elif criterion is not None:
-            if (
-                self._support_posture != posture.key
-            ):  # a posture evaluated since: the rates may be due
-                if self._worker is None:
-                    self._support.new_posture(lambda: posture.stance)
-                else:  # collect a finished answer, hand the worker this posture; never wait
-                    done = self._worker.poll()
-                    if done is None:
-                        self._support.aged()
-                    else:
-                        self._support.adopt(done)
-                    if self._worker.idle:
-                        self._worker.submit(posture.key, posture.q)
-                self._support_posture = posture.key
-            limit, aware = self._support.answers(criterion, com_velocity)
+        elif criterion is not None and support is not None:
+            if self._support_posture != posture.key:  # a posture since: the rates may be due
+                self._refresh_support(support, posture)
+            limit, aware = support.answers(criterion, com_velocity)
             interval = combine(criterion.interval(com_velocity, limit), aware.interval)
             if aware.limit.max_approach_speed < limit.max_approach_speed:
                 limit, binding = aware.limit, "contact_aware"
         else:
+            assert posture.zmp_limit is not None  # the "zmp" criterion's posture has it
             limit = posture.zmp_limit
             interval = _zmp_interval(limit)
         model = posture.impact
@@ -426,7 +446,7 @@ def _governed(
     not 0 with the "zmp" criterion).
     """
     if not isinstance(scenario, Scenario):
-        scenario = load_scenario(scenario)
+        scenario = load_scenario(scenario if isinstance(scenario, str) else Path(scenario))
     if scenario.impact is None:
         raise with_source(
             ScenarioError("impact", None, "the governor needs an impact (frame, normal...)"),
@@ -454,7 +474,8 @@ def _zmp_interval(limit: VelocityLimit) -> tuple[float, float] | None:
     return None
 
 
-def _is_numeric(x) -> bool:
+def _is_numeric(x: object) -> bool:
+    """Whether ``x`` converts to a float array."""
     try:
         np.asarray(x, dtype=float)
     except (TypeError, ValueError):
@@ -462,7 +483,7 @@ def _is_numeric(x) -> bool:
     return True
 
 
-def _vector(x: Sequence[float], size: int, field: str) -> np.ndarray:
+def _vector(x: ArrayLike, size: int, field: str) -> npt.NDArray[np.float64]:
     """``x`` as a contiguous float vector of ``size`` finite entries (a copy when converted)."""
     try:
         a = np.ascontiguousarray(x, dtype=float)

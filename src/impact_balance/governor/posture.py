@@ -171,9 +171,8 @@ class PostureEvaluator:
         self._scaled = any(mu > 1.0 for mu in self._frictions)  # else friction_scaling is None
         idx, limit = robot.effort_limits
         self._torques = bool(settings.torque_limits and m and idx.size)
-        self._idx, self._limit = (
-            (idx, limit) if self._torques else (np.zeros(0, dtype=np.int64), np.zeros(0))
-        )
+        self._idx: npt.NDArray[np.int64] = idx if self._torques else np.zeros(0, dtype=np.int64)
+        self._limit: npt.NDArray[np.float64] = limit if self._torques else np.zeros(0)
         self._normal, self._cone = impact_cone(impact)
         # Buffers, overwritten every posture (the answers keep copies).
         self._q_local = np.zeros(model.nq)
@@ -280,6 +279,7 @@ class PostureEvaluator:
             SolverError: The projection failed (naming the contacts).
         """
         settings = self.settings
+        areas: BalanceAreas | Projected
         try:
             if self._scaled:  # a friction above 1: the polytope in friction-normalised variables
                 polytope = assemble_polytope(
@@ -294,7 +294,7 @@ class PostureEvaluator:
                     self._idx,
                     self._limit,
                     gravity_torques,
-                    friction_scaling(self._frictions, rotations),
+                    friction_scaling(self._frictions, list(rotations)),
                 )
                 areas = areas_from_polytope(polytope, settings.plane_height, settings.zmp_margin)
             else:  # the same numbers, assembled and projected in one compiled call
@@ -333,6 +333,7 @@ class PostureEvaluator:
         """
         spec, data, model = self.settings.impact, self.scratch.data, self.model
         placement, J6 = frame_point(model, data, self._impact_frame, None)
+        assert J6 is not None  # frame_point gives the Jacobian unless told not to
         point_local = placement.translation.copy()
         arm = point_local - com_local
         J = J6[:3].copy()
@@ -355,6 +356,10 @@ def _point_frame(model: pin.Model, fid: int, offset: pin.SE3 | None, name: str) 
     if offset is None or offset == pin.SE3.Identity():  # exact, as frame_point tests it
         return fid
     frame = model.frames[fid]
-    return model.addFrame(
-        pin.Frame(name, frame.parentJoint, fid, frame.placement * offset, pin.FrameType.OP_FRAME)
+    return int(
+        model.addFrame(
+            pin.Frame(
+                name, frame.parentJoint, fid, frame.placement * offset, pin.FrameType.OP_FRAME
+            )
+        )
     )

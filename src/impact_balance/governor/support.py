@@ -36,10 +36,12 @@ per m/s of approach speed. Not thread-safe: the governor calls it under its lock
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance.contacts.stance import Stance
 from impact_balance.criteria.com import ComCriterion, VelocityLimit, speed_interval
@@ -104,10 +106,11 @@ class ContactAwareSolutions:
     iterations: int
     starts: int
 
-    def of_bound(self, c_r: float) -> np.ndarray:
+    def of_bound(self, c_r: float) -> npt.NDArray[np.float64]:
         """The states (m, 6) of the converged solutions at restitution ``c_r`` (the next starts)."""
         keep = (self.restitution == c_r) & self.converged
-        return self.states[keep]
+        states: npt.NDArray[np.float64] = self.states[keep]
+        return states
 
 
 def contact_aware_solutions(
@@ -163,7 +166,11 @@ def contact_aware_solutions(
     )
 
 
-def _one_per_bound(stance: Stance, spec: ImpactSpec, guesses) -> ContactAwareSolutions:
+def _one_per_bound(
+    stance: Stance,
+    spec: ImpactSpec,
+    guesses: Sequence[npt.NDArray[Any]] | npt.NDArray[Any] | None,
+) -> ContactAwareSolutions:
     """One fixed point per restitution bound (``starts="warm"`` and ``"cold"``).
 
     From ``guesses[k]`` (a body velocity change (6,) per m/s) or, without guesses, gauges 0:

@@ -30,12 +30,16 @@ import subprocess
 import sys
 import weakref
 from multiprocessing.connection import Connection
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from impact_balance.exceptions import GovernorError
+from impact_balance.exceptions import GovernorError, ScenarioError
+from impact_balance.governor.options import Starts
 from impact_balance.governor.support import ContactAwareLimit, ContactAwareSolutions
+
+if TYPE_CHECKING:
+    from impact_balance.scenario import Scenario
 
 __all__ = ["ContactAwareWorker"]
 
@@ -60,6 +64,8 @@ def _serve(conn: Connection) -> None:
         scenario = scenario_from_dict(raw, source)
         robot = scenario.load_robot()
         contacts = tuple(c.spec() for c in scenario.contacts)
+        if scenario.impact is None:
+            raise ScenarioError("impact", None, "the contact-aware worker needs an impact")
         limit = ContactAwareLimit(scenario.impact.spec(), 1, starts)
     except Exception as exc:
         conn.send(("ready", None, f"{type(exc).__name__}: {exc}"))
@@ -81,7 +87,8 @@ def _serve(conn: Connection) -> None:
             conn.send((key, None, f"{type(exc).__name__}: {exc}"))
 
 
-def _stop(conn: Connection, process: subprocess.Popen) -> None:
+def _stop(conn: Connection, process: subprocess.Popen[bytes]) -> None:
+    """Ask the worker to stop, then make sure it has (killed after a grace period)."""
     try:
         conn.send(None)
     except (OSError, ValueError):
@@ -104,7 +111,7 @@ class ContactAwareWorker:
     script, and a forked one inherits pinocchio's, numba's and BLAS's threads.
     """
 
-    def __init__(self, scenario, starts: str):
+    def __init__(self, scenario: Scenario, starts: Starts):
         parent, child = socket.socketpair()
         env = dict(os.environ)
         env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)  # the same impact_balance
