@@ -52,6 +52,8 @@ def cache_depends_on(dispatcher: Any, *modules: ModuleType) -> Any:
         cache_file = dispatcher._cache._cache_file
         stamps = [cache_file._source_stamp]
         for module in modules:
+            if module.__file__ is None:  # a namespace or built-in module: nothing to stamp
+                continue
             st = os.stat(module.__file__)
             stamps.append((os.path.basename(module.__file__), st.st_mtime, st.st_size))
         cache_file._source_stamp = hashlib.sha256(pickle.dumps(stamps)).hexdigest()

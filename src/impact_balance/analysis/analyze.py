@@ -19,6 +19,7 @@ from impact_balance.criteria.com import (
 )
 from impact_balance.criteria.qp import QPOptions, solve_contact_velocity_qp, static_torques
 from impact_balance.exceptions import NonFiniteResultError, ScenarioError, SolverError
+from impact_balance.geometry.polygon import Polygon
 from impact_balance.impact.model import ImpactModel, impact_model
 from impact_balance.projection.walk import warm_up
 from impact_balance.scenario import Scenario, load_scenario, with_source
@@ -137,7 +138,7 @@ def _area_checks(stance: Stance, areas: BalanceAreas) -> list[tuple[str, Any, tu
     ]
 
 
-def _squared_size(polygon) -> float:
+def _squared_size(polygon: Polygon) -> float:
     """Sum of the squared vertex coordinates (inf when they overflow, NaN with a NaN)."""
     v = polygon.vertices.ravel()
     with np.errstate(over="ignore", invalid="ignore"):

@@ -13,6 +13,7 @@ import threading
 import typing
 from collections import OrderedDict
 from pathlib import Path
+from typing import Any
 
 from impact_balance.exceptions import ScenarioError, UnknownScenarioError
 from impact_balance.scenario.bundled import _is_file, scenario_path
@@ -32,7 +33,8 @@ __all__ = ["ExtendsResolver", "load_scenario"]
 ExtendsResolver = typing.Callable[[str, Path], Path]
 
 
-def merge_mappings(base: dict, override: dict) -> dict:
+def merge_mappings(base: dict[str, Any], override: dict[str, Any]) -> dict[str, Any]:
+    """``override`` merged into ``base``: mappings recursively, everything else replaced."""
     out = dict(base)
     for key, value in override.items():
         if isinstance(value, dict) and isinstance(out.get(key), dict):
@@ -62,7 +64,7 @@ def _parent(path: Path, parent: typing.Any, resolve_path: ExtendsResolver | None
 
 def read_mapping(
     path: Path, seen: tuple[Path, ...] = (), resolve_path: ExtendsResolver | None = None
-) -> dict:
+) -> dict[str, Any]:
     if path.resolve() in seen:
         raise ScenarioError("extends", str(path), "circular extends")
     if len(seen) >= MAX_EXTENDS:
@@ -74,14 +76,16 @@ def read_mapping(
         raise ScenarioError(
             "scenario", str(path), f"must be a YAML mapping of keys, got {type(raw).__name__}"
         )
-    parent = raw.pop("extends", None)
+    mapping: dict[str, Any] = raw
+    parent = mapping.pop("extends", None)
     if parent is not None:
         parent_path = _parent(path, parent, resolve_path)
-        raw = merge_mappings(read_mapping(parent_path, (*seen, path.resolve()), resolve_path), raw)
-    return raw
+        parent_raw = read_mapping(parent_path, (*seen, path.resolve()), resolve_path)
+        mapping = merge_mappings(parent_raw, mapping)
+    return mapping
 
 
-def _chain_key(path: Path, resolve_path: ExtendsResolver | None) -> tuple | None:
+def _chain_key(path: Path | None, resolve_path: ExtendsResolver | None) -> tuple[Any, ...] | None:
     """The texts of the files of ``path``'s ``extends`` chain, or None on a problem.
 
     :func:`read_mapping` then reports the problem. Reads the parse cache without copying it.
@@ -102,7 +106,7 @@ def _chain_key(path: Path, resolve_path: ExtendsResolver | None) -> tuple | None
 
 
 #: Validated scenarios by the texts of their chain (and the extends rule): most recent last.
-_LOADED: OrderedDict[tuple, Scenario] = OrderedDict()
+_LOADED: OrderedDict[tuple[Any, ...], Scenario] = OrderedDict()
 _LOADED_SIZE = 64
 _LOADED_LOCK = threading.Lock()
 

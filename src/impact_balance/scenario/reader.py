@@ -77,7 +77,7 @@ MAX_LOG_COLUMNS = 2_000
 MAX_LOG_VALUES = 50_000_000
 
 
-class _LimitError(yaml.YAMLError):
+class _LimitError(yaml.YAMLError):  # type: ignore[misc]  # PyYAML ships no type stubs
     def __init__(self, problem: str, mark: yaml.Mark | None = None):
         super().__init__(problem)
         self.problem = problem
@@ -85,8 +85,10 @@ class _LimitError(yaml.YAMLError):
 
 
 def _node_children(node: yaml.Node) -> Iterable[yaml.Node]:
+    """The child nodes of a YAML node (keys and values of a mapping)."""
     if isinstance(node, yaml.SequenceNode):
-        return node.value
+        children: list[yaml.Node] = node.value
+        return children
     if isinstance(node, yaml.MappingNode):
         return [n for pair in node.value for n in pair]
     return ()
@@ -137,14 +139,15 @@ def _count(
     return size[id(root)], depth[id(root)]
 
 
-class _BoundedLoader(yaml.SafeLoader):
+class _BoundedLoader(yaml.SafeLoader):  # type: ignore[misc]  # PyYAML ships no type stubs
     """PyYAML's safe loader with a nesting limit while composing and an expanded-size limit."""
 
     def __init__(self, stream: str):
         super().__init__(stream)
         self._depth = 0
 
-    def compose_node(self, parent, index):
+    def compose_node(self, parent: yaml.Node | None, index: object) -> yaml.Node:
+        """PyYAML's node composition, with the nesting limit."""
         self._depth += 1
         try:
             if self._depth > MAX_DEPTH:
@@ -155,8 +158,9 @@ class _BoundedLoader(yaml.SafeLoader):
         finally:
             self._depth -= 1
 
-    def compose_document(self):
-        node = super().compose_document()
+    def compose_document(self) -> yaml.Node:
+        """PyYAML's document composition, with the expanded-size limit."""
+        node: yaml.Node = super().compose_document()
         try:
             _count(node, _node_children, lambda n: isinstance(n, yaml.ScalarNode))
         except ValueError as exc:

@@ -141,7 +141,8 @@ class ContactConfig(_Model):
         offset = pin.SE3(
             np.asarray(frame_rotation).T @ world, np.asarray(self.offset.position, dtype=float)
         )
-        return ContactSpec(self.frame, self.friction, tuple(self.size), offset)
+        length, width = self.size
+        return ContactSpec(self.frame, self.friction, (length, width), offset)
 
 
 class QPConfig(_Model):
