@@ -17,7 +17,9 @@ import os
 import sys
 import traceback
 import warnings
+from collections.abc import Sequence
 from types import ModuleType
+from typing import Any, NoReturn, TextIO
 
 from impact_balance.cli import (
     analyze,
@@ -113,7 +115,7 @@ class _Stdout:
     rule says what failed; a closed pipe stays a ``BrokenPipeError`` (quiet, 141).
     """
 
-    def __init__(self, stream):
+    def __init__(self, stream: TextIO | None):
         self._stream = stream
 
     def _failed(self, exc: OSError) -> EnvironmentFailure:
@@ -147,7 +149,7 @@ class _Stdout:
     def isatty(self) -> bool:
         return self._stream is not None and self._stream.isatty()
 
-    def __getattr__(self, name: str):
+    def __getattr__(self, name: str) -> Any:
         return getattr(self._stream, name)
 
 
@@ -175,8 +177,12 @@ class _VersionAction(argparse.Action):
     """``--version``, looked up only when asked for."""
 
     def __init__(
-        self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS, help=None
-    ):
+        self,
+        option_strings: Sequence[str],
+        dest: str = argparse.SUPPRESS,
+        default: Any = argparse.SUPPRESS,
+        help: str | None = None,
+    ) -> None:
         super().__init__(
             option_strings,
             dest,
@@ -185,7 +191,13 @@ class _VersionAction(argparse.Action):
             help=help or "show the program's version number and exit",
         )
 
-    def __call__(self, parser, namespace, values, option_string=None):
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: str | Sequence[Any] | None,
+        option_string: str | None = None,
+    ) -> None:
         print(f"impact-balance {_version()}")  # on stdout, as argparse's own version action
         parser.exit()
 
@@ -197,7 +209,8 @@ class _Parser(argparse.ArgumentParser):
     first).
     """
 
-    def error(self, message: str):
+    def error(self, message: str) -> NoReturn:
+        """Print ``message`` as one line and exit with status 2."""
         self.exit(2, one_line(f"{self.prog}: error: {message} (see {self.prog} --help)") + "\n")
 
 
@@ -225,7 +238,14 @@ def _parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
 _show_warning = warnings.showwarning
 
 
-def _warning_line(message, category, filename, lineno, file=None, line=None):
+def _warning_line(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: TextIO | None = None,
+    line: str | None = None,
+) -> None:
     """The library's own warnings as one ``impact-balance: warning:`` line (no source location)."""
     if issubclass(category, ImpactBalanceWarning):
         print(
@@ -258,7 +278,7 @@ def main(argv: list[str] | None = None) -> int:
                 file=sys.stderr,
                 flush=True,
             )
-        status = module.run(args)
+        status: int = module.run(args)
         sys.stdout.flush()  # a closed or full stdout shows here, inside the rule, not at exit
         return status
     except SystemExit:  # argparse's --help, --version and usage errors: already one line

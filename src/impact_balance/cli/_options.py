@@ -13,12 +13,19 @@ import argparse
 import math
 import os
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from impact_balance.exceptions import ImpactBalanceError, OptionError, short_repr
 
 if TYPE_CHECKING:
+    from typing import TypeAlias
+
     from impact_balance.scenario import Scenario
+    from impact_balance.sim.studies.journal import TrialJournal
+    from impact_balance.sim.trials.balance_trial import BalanceTrialOptions
+
+    #: The subcommands of the ``impact-balance`` parser, where each command adds its own.
+    Subcommands: TypeAlias = argparse._SubParsersAction[argparse.ArgumentParser]
 
 __all__ = [
     "LOG_SUFFIXES",
@@ -318,8 +325,13 @@ def add_trial_options(parser: argparse.ArgumentParser, impact: bool) -> None:
 
 
 def open_journal(
-    args: argparse.Namespace, command: str, scenario, joints: str, options, extra: dict
-):
+    args: argparse.Namespace,
+    command: str,
+    scenario: Scenario,
+    joints: str,
+    options: BalanceTrialOptions,
+    extra: dict[str, Any],
+) -> TrialJournal:
     """The trials journal of a command, by the digest of everything its trials depend on.
 
     The scoring margins are excluded: scores are recomputed from the trials.

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from impact_balance.cli._options import (
     add_velocity_margin_option,
@@ -12,6 +13,10 @@ from impact_balance.cli._options import (
     output_folder,
     with_margins,
 )
+
+if TYPE_CHECKING:
+    from impact_balance.analysis.result import Diagnostic
+    from impact_balance.cli._options import Subcommands
 
 __all__ = ["INTERPRETED", "USES_KERNEL", "add_parser", "run"]
 
@@ -21,7 +26,7 @@ USES_KERNEL = True
 INTERPRETED = True
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
     """Add the ``analyze`` command to the subcommands ``sub``.
 
     Args:
@@ -77,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
     if args.plots:
         from impact_balance.plots import save_figures
 
-        skipped: list = []
+        skipped: list[Diagnostic] = []
         written = save_figures(analysis, Path(args.plots), skipped=skipped)
         analysis = dataclasses.replace(analysis, warnings=analysis.warnings + tuple(skipped))
         if args.strict and skipped:

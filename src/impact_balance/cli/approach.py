@@ -23,6 +23,7 @@ from impact_balance.cli._options import (
 )
 
 if TYPE_CHECKING:
+    from impact_balance.cli._options import Subcommands
     from impact_balance.governor import Governor
     from impact_balance.scenario import Scenario
     from impact_balance.sim.studies.wall import WallTrial
@@ -33,7 +34,7 @@ __all__ = ["USES_KERNEL", "add_parser", "run"]
 USES_KERNEL = True
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
     """Add the ``approach`` command to the subcommands ``sub``.
 
     Args:
@@ -268,15 +269,15 @@ def _print_text(
         print(f"  wrote {path}")
 
 
-def _f(x) -> str:
+def _f(x: float | None) -> str:
     return "-" if x is None else f"{x:.3f} m/s"
 
 
-def _s(x) -> str:
+def _s(x: float | None) -> str:
     return "never (gave up)" if x is None else f"{x:.2f} s"
 
 
-def _plot(trial, setup, out: Path, zmp_margin: float) -> Path:
+def _plot(trial: WallTrial, setup: BalanceSetup, out: Path, zmp_margin: float) -> Path:
     from impact_balance.plots.approach import plot_approach
     from impact_balance.plots.save import figure_prefix
 

@@ -4,15 +4,21 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from impact_balance.cli._options import output_folder
+
+if TYPE_CHECKING:
+    from impact_balance.analysis.result import Diagnostic
+    from impact_balance.cli._options import Subcommands
+    from impact_balance.logs.check import LogCheck
 
 __all__ = ["USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
     """Add the ``check-log`` command to the subcommands ``sub``.
 
     Args:
@@ -50,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
     from impact_balance.cli.output import print_json
     from impact_balance.logs import check_log, read_log
 
-    notes: list = []
+    notes: list[Diagnostic] = []
     frame = read_log(args.log, warnings=notes)
     check = check_log(frame, args.scenario, source=str(args.log)[:80])
     out = check.to_dict(samples=args.samples)
@@ -97,7 +103,7 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _plots(check, out: Path) -> list[Path]:
+def _plots(check: LogCheck, out: Path) -> list[Path]:
     from impact_balance.plots.balance import plot_log_margins
 
     out.mkdir(parents=True, exist_ok=True)

@@ -4,6 +4,10 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from impact_balance.cli._options import Subcommands
 
 __all__ = ["DEMO_SCENARIOS", "FRICTION_SWEEP", "USES_KERNEL", "add_parser", "run"]
 
@@ -15,7 +19,7 @@ DEMO_SCENARIOS = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot")
 FRICTION_SWEEP = ("palm_push_mu010", "palm_push_mu024", "palm_push_mu040")
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
     """Add the ``demo`` command to the subcommands ``sub``.
 
     Args:
@@ -65,6 +69,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"  {'mu':>5}  {'CoM criterion':>14}  {'ZMP criterion':>14}")
     for a in sweep:
         im = a.impact
+        assert im is not None  # the friction sweep's scenarios have an impact
         print(
             f"  {im.model.spec.friction:>5.2f}  {format_speed(im.max_contact_velocity):>14}  "
             f"{format_speed(im.zmp_max_contact_velocity):>14}"

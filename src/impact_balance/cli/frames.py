@@ -7,12 +7,22 @@ robot, at its standing configuration (the free-flyer as the configuration gives 
 from __future__ import annotations
 
 import argparse
+from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import numpy as np
+    import numpy.typing as npt
+
+    from impact_balance.cli._options import Subcommands
+    from impact_balance.contacts.stance import Stance
+    from impact_balance.robot.robot import Robot
 
 __all__ = ["add_parser", "robot_listing", "run"]
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
     """Add the ``frames`` command to the subcommands ``sub``.
 
     Args:
@@ -30,7 +40,7 @@ def add_parser(sub) -> list[str]:
     return ["frames"]
 
 
-def _robot_and_stance(name: str):
+def _robot_and_stance(name: str) -> tuple[Robot, npt.NDArray[np.float64], str, Stance | None]:
     """(robot, configuration, configuration label, stance or None)."""
     from impact_balance.exceptions import UnknownRobotError, UnknownScenarioError
     from impact_balance.robot.robot import BUNDLED_ROBOTS, load_robot
@@ -47,7 +57,9 @@ def _robot_and_stance(name: str):
     return stance.robot, stance.q, f"stance of scenario {scenario.name or name}", stance
 
 
-def robot_listing(robot, q=None, frames: list[str] | None = None) -> dict:
+def robot_listing(
+    robot: Robot, q: npt.NDArray[np.float64] | None = None, frames: list[str] | None = None
+) -> dict[str, Any]:
     """A robot's frames and actuated joints.
 
     Frames: name, type, parent joint, world pose at ``q``; joints: their limits.
@@ -78,7 +90,7 @@ def robot_listing(robot, q=None, frames: list[str] | None = None) -> dict:
     }
 
 
-def _vec(v) -> str:
+def _vec(v: Sequence[float]) -> str:
     return "[" + " ".join(f"{x:+.3f}" for x in v) + "]"
 
 

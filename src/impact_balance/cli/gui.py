@@ -4,13 +4,18 @@ from __future__ import annotations
 
 import argparse
 import sys
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from impact_balance.cli._options import Subcommands
+    from impact_balance.gui.app import GuiApp
 
 __all__ = ["USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
     """Add the ``gui`` command to the subcommands ``sub``.
 
     Args:
@@ -80,7 +85,7 @@ def run(args: argparse.Namespace) -> int:
     workspace = Workspace(args.workspace)
     origins = tuple(normalize_origin(o) for o in args.allow_origin)
 
-    def ready(app) -> None:
+    def ready(app: GuiApp) -> None:
         print(
             f"impact-balance gui: {app.session.state.scenario.name or 'scenario'} at {app.url}  "
             "(Ctrl-C to stop)\n"

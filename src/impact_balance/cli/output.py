@@ -10,9 +10,12 @@ from __future__ import annotations
 import json
 import math
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from impact_balance.exceptions import ImpactBalanceError
+
+if TYPE_CHECKING:
+    from tqdm import tqdm
 
 __all__ = ["NonFiniteOutputError", "print_json", "progress_bar"]
 
@@ -66,7 +69,7 @@ def print_json(document: Any) -> None:
     print(text)
 
 
-def progress_bar(desc: str, total: int | None = None, unit: str = "trial"):
+def progress_bar(desc: str, total: int | None = None, unit: str = "trial") -> tqdm[Any]:
     """A tqdm progress bar on stderr (stdout stays for the answer)."""
     from tqdm import tqdm
 

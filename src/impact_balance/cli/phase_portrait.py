@@ -7,13 +7,17 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from impact_balance.cli._options import output_file
+
+if TYPE_CHECKING:
+    from impact_balance.cli._options import Subcommands
 
 __all__ = ["add_parser", "run"]
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
     """Add the ``phase-portrait`` command to the subcommands ``sub``.
 
     Args:

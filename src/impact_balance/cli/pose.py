@@ -8,6 +8,11 @@ from __future__ import annotations
 
 import argparse
 import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from impact_balance.cli._options import Subcommands
 
 __all__ = ["add_parser", "run"]
 
@@ -15,10 +20,20 @@ __all__ = ["add_parser", "run"]
 class _Place(argparse.Action):
     """``--place FRAME X Y Z`` starts a placement; ``--normal NX NY NZ`` completes the last one."""
 
-    def __call__(self, parser, namespace, values, option_string=None):
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: str | Sequence[Any] | None,
+        option_string: str | None = None,
+    ) -> None:
+        """Record ``--place`` or complete the last placement with ``--normal``."""
+        items: Sequence[Any] = (
+            [] if values is None else [values] if isinstance(values, str) else values
+        )
         places = list(getattr(namespace, "places", None) or [])
         if option_string == "--place":
-            frame, *xyz = values
+            frame, *xyz = items
             places.append(
                 {"frame": frame, "position": _numbers(parser, "--place", xyz), "normal": None}
             )
@@ -27,11 +42,14 @@ class _Place(argparse.Action):
                 parser.error("--normal comes after the --place it turns")
             if places[-1]["normal"] is not None:
                 parser.error(f"--normal given twice for --place {places[-1]['frame']}")
-            places[-1]["normal"] = _numbers(parser, "--normal", values)
+            places[-1]["normal"] = _numbers(parser, "--normal", items)
         namespace.places = places
 
 
-def _numbers(parser, option: str, texts) -> tuple[float, ...]:
+def _numbers(
+    parser: argparse.ArgumentParser, option: str, texts: Sequence[Any]
+) -> tuple[float, ...]:
+    """``texts`` as finite numbers within +-1e4 (a usage error otherwise)."""
     try:
         values = tuple(float(t) for t in texts)
     except ValueError:
@@ -41,7 +59,7 @@ def _numbers(parser, option: str, texts) -> tuple[float, ...]:
     return values
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
     """Add the ``pose`` command to the subcommands ``sub``.
 
     Args:

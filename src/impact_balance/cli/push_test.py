@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from impact_balance.cli._options import (
     add_controller_option,
@@ -17,12 +18,16 @@ from impact_balance.cli._options import (
     with_margins,
 )
 
+if TYPE_CHECKING:
+    from impact_balance.cli._options import Subcommands
+    from impact_balance.sim.studies.push import PushOutcome, PushTestResult
+
 __all__ = ["USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
     # No import of the simulation here: mujoco is imported only when a simulation command runs.
     """Add the ``push-test`` command to the subcommands ``sub``.
 
@@ -90,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
     levels = len(args.relative or args.magnitudes or [0] * 6)
     bar = progress_bar(f"push-test {scenario.name}", args.directions * levels)
 
-    def progress(outcome):
+    def progress(outcome: PushOutcome) -> None:
         bar.update(1)
         bar.set_postfix_str(f"{outcome.push.magnitude:.1f} N s {outcome.outcome}")
 
@@ -139,15 +144,15 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _pct(x) -> str:
+def _pct(x: float | None) -> str:
     return "-" if x is None else f"{100 * x:.1f} %"
 
 
-def _ci(c: list | None) -> str:
+def _ci(c: list[float] | None) -> str:
     return "" if c is None else f" [{100 * c[0]:.0f}, {100 * c[1]:.0f}]"
 
 
-def _text(result, out: dict, args: argparse.Namespace) -> str:
+def _text(result: PushTestResult, out: dict[str, Any], args: argparse.Namespace) -> str:
     counts = out["counts"]
     o = counts["outcomes"]
     controller = out["controller"].get("name", args.controller)
@@ -197,8 +202,8 @@ def _text(result, out: dict, args: argparse.Namespace) -> str:
     return "\n".join(lines)
 
 
-def _by_level(result) -> list[dict]:
-    rows: dict[float, dict] = {}
+def _by_level(result: PushTestResult) -> list[dict[str, Any]]:
+    rows: dict[float, dict[str, Any]] = {}
     for o in result.outcomes:
         level = o.relative if o.relative is not None else o.push.magnitude
         label = (
@@ -215,7 +220,7 @@ def _by_level(result) -> list[dict]:
     return [rows[k] for k in sorted(rows)]
 
 
-def _telling(result):
+def _telling(result: PushTestResult) -> PushOutcome:
     """The push of the paper's Exp.
 
     2 if there is one (ZMP outside in the trial, no fall), else the largest that did not fall,
@@ -228,7 +233,7 @@ def _telling(result):
     return max(stood, key=lambda o: o.push.magnitude) if stood else result.outcomes[0]
 
 
-def _plots(result, out: Path) -> list[Path]:
+def _plots(result: PushTestResult, out: Path) -> list[Path]:
     from impact_balance.plots.balance import plot_push_trajectories
     from impact_balance.plots.save import figure_prefix
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from impact_balance.cli._options import (
     LOG_SUFFIXES,
@@ -18,6 +19,10 @@ from impact_balance.cli._options import (
 )
 from impact_balance.cli.output import print_json
 
+if TYPE_CHECKING:
+    from impact_balance.cli._options import Subcommands
+    from impact_balance.sim.trials.measure import TrialResult
+
 __all__ = ["MAX_SPEEDS", "add_parser", "parse_speeds", "run"]
 
 #: Most approach speeds in one ``simulate`` run (each is one trial, and one file per output).
@@ -26,7 +31,7 @@ MAX_SPEEDS = 100
 USES_KERNEL = False
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
     """Add the ``simulate`` command to the subcommands ``sub``.
 
     Args:
@@ -123,7 +128,7 @@ def _per_speed(path: str, speed: float, several: bool) -> Path:
     return p.with_name(f"{p.stem}_{speed:g}{p.suffix}") if several else p
 
 
-def _table(name: str, r) -> str:
+def _table(name: str, r: TrialResult) -> str:
     jump = r.com_velocity_jump_measured
     size = float(math.hypot(*jump))
     lines = [
@@ -218,7 +223,7 @@ def run(args: argparse.Namespace) -> int:
                 write_log(
                     log_frame(sim, record),
                     _per_speed(args.log, speed, several),
-                    {"scenario": name, "joints": args.joints, "approach_speed": speed},
+                    {"scenario": name, "joints": args.joints, "approach_speed": str(speed)},
                 )
             )
         if args.video:

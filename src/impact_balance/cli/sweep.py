@@ -15,9 +15,13 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from impact_balance.cli._options import CommandLineError, output_folder
 from impact_balance.cli.output import print_json
+
+if TYPE_CHECKING:
+    from impact_balance.cli._options import Subcommands
 
 __all__ = ["USES_KERNEL", "add_parser", "run"]
 
@@ -44,7 +48,7 @@ def _scheduler(text: str) -> str:
         raise CommandLineError(exc.field, exc.value, exc.reason) from None
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
     """Add the ``sweep`` command to the subcommands ``sub``.
 
     Args:
@@ -112,7 +116,7 @@ def add_parser(sub) -> list[str]:
     return ["sweep"]
 
 
-def _print(summary: dict, as_json: bool) -> None:
+def _print(summary: dict[str, Any], as_json: bool) -> None:
     from impact_balance.sweep.summary import format_summary
 
     if as_json:
@@ -196,7 +200,8 @@ def run(args: argparse.Namespace) -> int:
     else:
         from impact_balance.cli.output_paths import check_output_folder
 
-        out = check_output_folder(f"sweep-{Path(spec.source).stem}", "--out")
+        stem = Path(spec.source).stem if spec.source else "sweep"
+        out = check_output_folder(f"sweep-{stem}", "--out")
     report = run_sweep(
         plan,
         out,

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from impact_balance.cli._options import (
     add_controller_option,
@@ -17,12 +18,16 @@ from impact_balance.cli._options import (
     with_margins,
 )
 
+if TYPE_CHECKING:
+    from impact_balance.cli._options import Subcommands
+    from impact_balance.sim.studies.validate import ValidationResult, ValidationTrial
+
 __all__ = ["USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
     """Add the ``validate`` command to the subcommands ``sub``.
 
     Args:
@@ -93,7 +98,7 @@ def run(args: argparse.Namespace) -> int:
     )
     bar = progress_bar(f"validate {scenario.name}")
 
-    def progress(trial, stood, fell):
+    def progress(trial: ValidationTrial, stood: float | None, fell: float | None) -> None:
         bar.update(1)
         lo = "?" if stood is None else f"{stood:.3f}"
         hi = "?" if fell is None else f"{fell:.3f}"
@@ -145,11 +150,11 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _f(x) -> str:
+def _f(x: float | None) -> str:
     return "-" if x is None else f"{x:.3f} m/s"
 
 
-def _text(out: dict, args: argparse.Namespace, n: int) -> str:
+def _text(out: dict[str, Any], args: argparse.Namespace, n: int) -> str:
     e, p, pm = out["empirical"], out["predicted"], out["predicted_with_margin"]
     impact = (
         "rigid impact (joints held through the impact)" if out["rigid_impact"] else "free impact"
@@ -198,7 +203,7 @@ def _text(out: dict, args: argparse.Namespace, n: int) -> str:
     return "\n".join(lines)
 
 
-def _plots(result, out: Path) -> list[Path]:
+def _plots(result: ValidationResult, out: Path) -> list[Path]:
     from impact_balance.plots.balance import plot_impact_trajectories, plot_validation
     from impact_balance.plots.save import figure_prefix
 
