@@ -38,6 +38,7 @@ from impact_balance.contacts.stance import ContactSpec, Stance, frame_point, has
 from impact_balance.contacts.wrench_polytope import assemble_polytope, friction_scaling
 from impact_balance.criteria.com import ComCriterion, VelocityLimit, zmp_max_contact_velocity
 from impact_balance.exceptions import SolverError
+from impact_balance.governor.options import Criterion
 from impact_balance.impact.model import (
     ImpactModel,
     ImpactSpec,
@@ -77,7 +78,7 @@ class PostureSettings:
     gravity: float
     torque_limits: bool
     zmp_margin: float
-    criterion: str
+    criterion: Criterion
     velocity_margin: float = 0.0
 
 

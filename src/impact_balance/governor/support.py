@@ -222,7 +222,7 @@ class ContactAwareAnswer:
     age: int
     converged: bool
     restitution: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    starts: str = "warm"
+    starts: Starts = "warm"
     solves: int = 0
 
 
