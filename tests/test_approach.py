@@ -221,4 +221,4 @@ def test_the_contact_aware_governor_off_the_tick_stands_g1_and_leaves_no_process
 def test_off_the_tick_needs_the_contact_aware_option(capsys):
     assert main(["approach", "g1_two_feet", "--reference", "1", "--contact-aware-async"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "contact_aware_async" in err
+    assert err.count("\n") == 1 and "--contact-aware-async" in err

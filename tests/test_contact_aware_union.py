@@ -14,7 +14,7 @@ import pytest
 
 import impact_balance as ib
 from impact_balance.exceptions import GovernorError
-from impact_balance.governor import Governor
+from impact_balance.governor import ContactAwareOptions, Governor
 from impact_balance.governor.support import (
     SAME_SOLUTION,
     ContactAwareLimit,
@@ -151,12 +151,12 @@ def test_the_governor_defaults_to_the_union(path):
     frozen option; along the path (every posture a recomputation) the union's cap is never above
     the warm one's."""
     governor, postures = path
-    union = Governor(NAME, contact_aware=True, contact_aware_every=1)
-    warm = Governor(NAME, contact_aware=True, contact_aware_every=1, contact_aware_starts="warm")
+    union = Governor(NAME, contact_aware=ContactAwareOptions(every=1))
+    warm = Governor(NAME, contact_aware=ContactAwareOptions(every=1, starts="warm"))
     assert union._support.starts == "union" and warm._support.starts == "warm"
     for posture in postures:
         a, b = union.limit_com(posture.q, np.zeros(3)), warm.limit_com(posture.q, np.zeros(3))
         assert a.max_approach_speed <= b.max_approach_speed + FIXED_POINT
     with pytest.raises(GovernorError) as info:
-        Governor(NAME, contact_aware=True, contact_aware_starts="several")
-    assert info.value.field == "contact_aware_starts"
+        Governor(NAME, contact_aware=ContactAwareOptions(starts="several"))  # type: ignore[arg-type]
+    assert info.value.field == "contact_aware.starts"

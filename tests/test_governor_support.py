@@ -8,7 +8,7 @@ import pytest
 
 import impact_balance as ib
 from impact_balance.exceptions import GovernorError
-from impact_balance.governor import Governor
+from impact_balance.governor import ContactAwareOptions, Governor
 from impact_balance.governor.support import combine
 from impact_balance.impact.contact_aware import contact_impact
 from impact_balance.scenario import load_scenario
@@ -32,7 +32,7 @@ def contact_aware_maximum(name: str, margin: float) -> float:
 
 def governors(name: str, margin: float, every: int = 5):
     scenario = load_scenario(name).model_copy(update={"zmp_margin": margin})
-    return Governor(scenario), Governor(scenario, contact_aware=True, contact_aware_every=every)
+    return Governor(scenario), Governor(scenario, contact_aware=ContactAwareOptions(every=every))
 
 
 def test_g1_is_bounded_by_its_feet():
@@ -104,10 +104,12 @@ def test_combine_intersects_the_safe_intervals():
     "kwargs, field",
     [
         ({"criterion": "zmp", "contact_aware": True}, "contact_aware"),
-        ({"contact_aware": True, "contact_aware_every": 0}, "contact_aware_every"),
+        ({"contact_aware": {"every": 0}}, "contact_aware.every"),
     ],
 )
 def test_bad_options_are_governor_errors(kwargs, field):
     with pytest.raises(GovernorError) as info:
+        if isinstance(kwargs.get("contact_aware"), dict):  # the options refuse it when made
+            kwargs = {**kwargs, "contact_aware": ContactAwareOptions(**kwargs["contact_aware"])}
         Governor("palm_push_two_feet", **kwargs)
     assert info.value.field == field

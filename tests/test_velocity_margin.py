@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 import impact_balance as ib
 from impact_balance.criteria.com import ComCriterion
 from impact_balance.exceptions import GovernorError
-from impact_balance.governor import Governor
+from impact_balance.governor import ContactAwareOptions, Governor
 
 ANALYSES = {name: ib.analyze(name) for name in ("palm_push_two_feet", "palm_push_ramp")}
 
@@ -56,10 +56,9 @@ def test_the_limit_puts_the_worst_vertex_d_inside(name, d, cx, cy):
 
 
 def test_the_governor_applies_it_to_both_models():
-    plain = Governor("palm_push_two_feet", contact_aware=True, contact_aware_starts="warm")
-    margin = Governor(
-        "palm_push_two_feet", contact_aware=True, contact_aware_starts="warm", velocity_margin=0.02
-    )
+    warm = ContactAwareOptions(starts="warm")
+    plain = Governor("palm_push_two_feet", contact_aware=warm)
+    margin = Governor("palm_push_two_feet", contact_aware=warm, velocity_margin=0.02)
     q, v = plain.configuration, np.zeros(plain.nv)
     a, b = plain.limit(q, v), margin.limit(q, v)
     assert b.max_approach_speed < a.max_approach_speed
@@ -100,9 +99,7 @@ def test_async_rates_are_the_workers_answer_for_the_posture_it_was_sent():
 
     with Governor(
         "g1_two_feet",
-        contact_aware=True,
-        contact_aware_starts="cold",
-        contact_aware_async=True,
+        contact_aware=ContactAwareOptions(starts="cold", asynchronous=True),
         velocity_margin=0.01,
     ) as governor:
         worker = governor._worker
@@ -131,6 +128,7 @@ def test_async_rates_are_the_workers_answer_for_the_posture_it_was_sent():
     assert governor._worker is None and not worker.alive  # closed by the with block
 
 
-def test_async_needs_the_contact_aware_option():
-    with pytest.raises(GovernorError, match="contact_aware_async"):
-        Governor("palm_push_two_feet", contact_aware_async=True)
+def test_the_contact_aware_option_is_its_options():
+    """Asynchronous rates are a contact-aware option: there is no way to ask for them alone."""
+    with pytest.raises(GovernorError, match="contact_aware"):
+        Governor("palm_push_two_feet", contact_aware="async")  # type: ignore[arg-type]

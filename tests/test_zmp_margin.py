@@ -61,7 +61,7 @@ def test_cli_option_overrides_the_scenario(capsys):
     )
     assert cli.main(["analyze", "palm_push_two_feet", "--zmp-margin", "-0.1"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "--zmp-margin = '-0.1'" in err
+    assert err.count("\n") == 1 and "--zmp-margin = -0.1" in err
 
 
 def test_sweep_axis_over_the_margin():

@@ -193,14 +193,12 @@ def bounds(args: argparse.Namespace) -> list[dict]:
     """The governor's maximum approach speed at each scenario's posture without and with the
     option, per ZMP margin (and ``args.velocity_margin``), and the preload model's bound at the
     largest ZMP margin (without the velocity margin)."""
-    from impact_balance.cli._options import with_zmp_margin
-
     rows = []
     for name in args.scenarios:
         scenario = load_scenario(name)
         row: dict[str, Any] = {"scenario": name}
         for margin in args.margins:
-            governed = with_zmp_margin(scenario, margin)
+            governed = scenario.replace(zmp_margin=margin)
             floating = Governor(governed, criterion="com", velocity_margin=args.velocity_margin)
             q, v = floating.configuration, np.zeros(floating.robot.model.nv)
             union = Governor(

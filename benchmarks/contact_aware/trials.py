@@ -12,7 +12,7 @@ import numpy as np
 from governor_study import _f, governed_setup
 
 from impact_balance.contacts.stance import Stance
-from impact_balance.governor import Governor
+from impact_balance.governor import ContactAwareOptions, Governor
 from impact_balance.sim.studies.wall import WallOptions, run_wall_trial
 
 from .journal import journalled, open_journal, slim
@@ -95,15 +95,13 @@ def score(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
                 return Governor(
                     governed,
                     criterion="com",
-                    contact_aware=True,
-                    contact_aware_async=True,
+                    contact_aware=ContactAwareOptions(asynchronous=True),
                     velocity_margin=args.velocity_margin,
                 )
             return Governor(
                 governed,
                 criterion="com",
-                contact_aware=True,
-                contact_aware_starts=args.variant,
+                contact_aware=ContactAwareOptions(starts=args.variant),
                 velocity_margin=args.velocity_margin,
             )
 

@@ -65,6 +65,7 @@ _EXPORTS: dict[str, str] = {
     "Scenario": ".scenario",
     "bundled_scenarios": ".scenario",
     "load_scenario": ".scenario",
+    "ContactAwareOptions": ".governor",
     "Governor": ".governor",
     "SpeedLimit": ".governor",
     "Contact": ".contacts.stance",
@@ -80,6 +81,7 @@ __all__ = [
     "Analysis",
     "BalanceAreas",
     "Contact",
+    "ContactAwareOptions",
     "ContactSpec",
     "Diagnostic",
     "Governor",
@@ -190,7 +192,7 @@ if TYPE_CHECKING:  # static analysers and IDEs see the plain imports
         UnknownScenarioError,
     )
     from impact_balance.geometry.polygon import Polygon
-    from impact_balance.governor import Governor, SpeedLimit
+    from impact_balance.governor import ContactAwareOptions, Governor, SpeedLimit
     from impact_balance.impact.model import ImpactModel, ImpactSpec, friction_cone, impact_model
     from impact_balance.projection import project_polytope
     from impact_balance.robot.robot import BUNDLED_ROBOTS, Robot, load_robot

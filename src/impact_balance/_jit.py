@@ -3,8 +3,8 @@
 numba is a dependency; the fallback keeps the library importable where its wheel is missing.
 ``IMPACT_BALANCE_JIT=0`` in the environment (read once, when this module is first imported)
 runs the same code interpreted without importing numba: loading numba and its cached kernels
-costs 0.4 to 0.8 s per process, more than one interpreted analysis (30 to 400 ms), so the
-one-shot ``impact-balance analyze`` command runs that way unless the variable says otherwise.
+costs more than one interpreted analysis, so the one-shot ``impact-balance analyze`` command
+runs that way unless the variable says otherwise.
 """
 
 from __future__ import annotations
@@ -36,8 +36,9 @@ except ImportError:
 
 
 def cache_depends_on(dispatcher: Any, *modules: ModuleType) -> Any:
-    """Make numba's on-disk cache of ``dispatcher`` stale when a source file of ``modules``
-    changes, as it is when its own file does; returns ``dispatcher``.
+    """Make numba's cache of ``dispatcher`` stale when a source file of ``modules`` changes.
+
+    As it is when its own file does; returns ``dispatcher``.
 
     numba stamps a cached function with its own file only, but a compiled function keeps a
     copy of the compiled functions it calls: after an edit of a callee in another module, its
@@ -51,6 +52,8 @@ def cache_depends_on(dispatcher: Any, *modules: ModuleType) -> Any:
         cache_file = dispatcher._cache._cache_file
         stamps = [cache_file._source_stamp]
         for module in modules:
+            if module.__file__ is None:  # a namespace or built-in module: nothing to stamp
+                continue
             st = os.stat(module.__file__)
             stamps.append((os.path.basename(module.__file__), st.st_mtime, st.st_size))
         cache_file._source_stamp = hashlib.sha256(pickle.dumps(stamps)).hexdigest()

@@ -14,6 +14,7 @@ __all__ = [
     "MAX_POSITION",
     "MAX_SIZE",
     "MAX_SPEED",
+    "MAX_VELOCITY_MARGIN",
 ]
 
 #: Standard gravity, m/s^2, acting along world -z.
@@ -33,6 +34,9 @@ MAX_POSITION = 1e4
 MAX_ANGLE = 4 * math.pi
 #: Largest speed (reference velocity, CoM velocity), m/s.
 MAX_SPEED = 100.0
+#: Largest velocity margin (``velocity_margin``, ``--velocity-margin``), m/s: a margin far
+#: beyond any CoM velocity area a robot has.
+MAX_VELOCITY_MARGIN = 10.0
 #: Accepted gravity, m/s^2 (the Moon's 1.62 to Jupiter's 24.8, with margin).
 GRAVITY_RANGE = (0.1, 100.0)
 #: Longest impact duration, s (impacts last milliseconds).

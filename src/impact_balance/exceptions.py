@@ -116,6 +116,7 @@ class ImpactBalanceError(Exception):
 
     @property
     def exit_status(self) -> int:
+        """The command line's exit status for this error: 1 or 2 (see the class docstring)."""
         return 1 if isinstance(self, (OSError, ImportError, MemoryError)) else 2
 
     def __str__(self) -> str:
@@ -356,7 +357,9 @@ class UnknownPathError(UnknownNameError):
 
 
 class MissingExtraError(ImpactBalanceError, ImportError):
-    """An optional part of impact-balance is not installed (``pip install 'impact-balance[EXTRA]'``).
+    """An optional part of impact-balance is not installed.
+
+    It installs with ``pip install 'impact-balance[EXTRA]'``.
 
     Attributes:
         what: What needs it: a command (``simulate``) or an option (``--plots``).
@@ -373,8 +376,9 @@ class MissingExtraError(ImpactBalanceError, ImportError):
 
 
 class ImpactBalanceWarning(UserWarning):
-    """Base class of the warnings impact-balance emits through :mod:`warnings` (the command
-    line prints each as one ``impact-balance: warning:`` line).
+    """Base class of the warnings impact-balance emits through :mod:`warnings`.
+
+    The command line prints each as one ``impact-balance: warning:`` line.
     """
 
 
@@ -403,8 +407,10 @@ class OptionError(FieldError, ValueError):
 
 
 class EnvironmentFailure(ImpactBalanceError):
-    """The machine refused what the input asked for, which was itself good: a folder that
-    cannot be written, a server that does not answer, a stream that is closed or full.
+    """The machine refused what the input asked for, which was itself good.
+
+    A folder that cannot be written, a server that does not answer, a stream that is closed or
+    full.
 
     Exit status 1 (bad input is 2).
 
@@ -429,8 +435,9 @@ class OutputError(EnvironmentFailure):
 
 
 class GovernorError(FieldError, ValueError):
-    """A governor call got a bad argument (a configuration of the wrong size, a NaN velocity,
-    an unknown criterion...); see :mod:`impact_balance.governor`.
+    """A governor call got a bad argument; see :mod:`impact_balance.governor`.
+
+    A configuration of the wrong size, a NaN velocity, an unknown criterion...
 
     Attributes:
         field: The argument at fault (``q``, ``v``, ``reference_velocity``, ``criterion``...).

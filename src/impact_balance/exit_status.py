@@ -1,6 +1,7 @@
 """The one error rule: any exception, whoever raised it, as one line and an exit status.
 
-The command line (:func:`impact_balance.cli.main`) and the GUI (:func:`impact_balance.gui.files.describe`)
+The command line (:func:`impact_balance.cli.main`) and the GUI
+(:func:`impact_balance.gui.files.describe`)
 report every failure through :func:`describe_error`, so that a new command or a new dependency
 gets the rule without code of its own:
 

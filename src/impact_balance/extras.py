@@ -1,17 +1,16 @@
-"""Optional parts of impact-balance, installed as pip extras, and the check that names a missing one.
+"""Optional parts of impact-balance (pip extras), and the check that names a missing one.
 
 The core (``import impact_balance; impact_balance.analyze(...)``, and the commands ``analyze``,
 ``demo``, ``phase-portrait``, ``scenarios``, ``robots``, ``frames`` without figures) needs none
 of them, so a controller can depend on ``impact-balance`` alone. ``pip install
 'impact-balance[all]'`` installs every extra.
 
-| extra | modules | used by |
-|---|---|---|
-| ``plots`` | matplotlib | ``--plots`` / ``--plot`` of any command |
-| ``logs`` | pandas, pyarrow | ``check-log``, ``--log`` |
-| ``sim`` | mujoco, imageio, imageio-ffmpeg, pandas, pyarrow, matplotlib | ``simulate``, ``validate``, ``push-test``, ``approach`` |
-| ``gui`` | viser (and trimesh, which it brings) | ``gui`` |
-| ``sweep`` | dask.distributed, pandas, pyarrow, matplotlib | ``sweep`` (figures included) |
+- ``plots`` (matplotlib): ``--plots`` / ``--plot`` of any command;
+- ``logs`` (pandas, pyarrow): ``check-log``, ``--log``;
+- ``sim`` (mujoco, imageio, imageio-ffmpeg, pandas, pyarrow, matplotlib): ``simulate``,
+  ``validate``, ``push-test``, ``approach``;
+- ``gui`` (viser, and trimesh, which it brings): ``gui``;
+- ``sweep`` (dask.distributed, pandas, pyarrow, matplotlib): ``sweep`` (figures included).
 """
 
 from __future__ import annotations
@@ -54,8 +53,9 @@ OPTION_EXTRAS: dict[str, tuple[str, str]] = {
 
 
 def installed(module: str) -> bool:
-    """Whether ``module`` can be imported, without importing it (a blocked import, a ``None``
-    in ``sys.modules``, counts as missing).
+    """Whether ``module`` can be imported, without importing it.
+
+    A blocked import (a ``None`` in ``sys.modules``) counts as missing.
     """
     if module in sys.modules:
         return sys.modules[module] is not None

@@ -3,9 +3,10 @@
 Each limit says why it is where it is. A value outside is refused at once, naming the option
 and the range, rather than accepted and run for ever, or answered with NaN:
 
-- **approach speed** (``simulate --speed``) in [:data:`MIN_APPROACH_SPEED`, :data:`MAX_APPROACH_SPEED`]
-  m/s: a trial starts the impact point at least 2 cm from the surface, so 0.01 m/s is already
-  2 s of simulated approach (1e-300 m/s would be 10^298 s); beyond 5 m/s MuJoCo's soft
+- **approach speed** (``simulate --speed``) in [:data:`MIN_APPROACH_SPEED`,
+  :data:`MAX_APPROACH_SPEED`] m/s: a trial starts the impact point at least 2 cm from the
+  surface, so 0.01 m/s is already 2 s of simulated approach (1e-300 m/s would be 10^298 s); beyond
+  5 m/s MuJoCo's soft
   contact at its time step is no longer an impact model;
 - **bisection tolerance** (``validate --tolerance``) in :data:`TOLERANCE_RANGE`: each halving of
   the bracket is one more simulated trial (10 trials for 0.001); below 0.001 the bracket is
@@ -36,7 +37,8 @@ __all__ = [
 
 #: Slowest approach speed of an impact trial, m/s (2 cm of approach take 2 s at this speed).
 MIN_APPROACH_SPEED = 0.01
-#: Fastest approach speed of an impact trial, m/s (beyond, MuJoCo's soft contact at this step is not an impact model).
+#: Fastest approach speed of an impact trial, m/s (beyond, MuJoCo's soft contact at this step is
+#: not an impact model).
 MAX_APPROACH_SPEED = 5.0
 #: Relative width of the fall-threshold bracket of ``validate``: [tightest, loosest].
 TOLERANCE_RANGE = (1e-3, 0.5)
@@ -47,7 +49,11 @@ MAX_SWEEP_CHUNKS = 100_000
 
 
 def check_approach_speed(value: float, field: str = "--speed") -> float:
-    """``value`` if it is a usable approach speed (m/s); :class:`SimulationError` naming ``field`` otherwise."""
+    """``value`` if it is a usable approach speed (m/s).
+
+    Raises:
+        SimulationError: Otherwise, naming ``field``.
+    """
     if (
         isinstance(value, bool)
         or not isinstance(value, (int, float))
@@ -64,7 +70,11 @@ def check_approach_speed(value: float, field: str = "--speed") -> float:
 
 
 def check_tolerance(value: float, field: str = "--tolerance") -> float:
-    """``value`` if it is a usable relative bracket width; :class:`SimulationError` naming ``field`` otherwise."""
+    """``value`` if it is a usable relative bracket width.
+
+    Raises:
+        SimulationError: Otherwise, naming ``field``.
+    """
     lo, hi = TOLERANCE_RANGE
     if (
         isinstance(value, bool)

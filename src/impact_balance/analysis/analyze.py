@@ -13,13 +13,13 @@ from impact_balance.balance.areas import BalanceAreas, areas_from_polytope, with
 from impact_balance.contacts.stance import Stance
 from impact_balance.contacts.wrench_polytope import wrench_polytope
 from impact_balance.criteria.com import (
-    max_contact_velocity,
+    ComCriterion,
     safe_contact_velocity,
-    safe_interval,
     zmp_max_contact_velocity,
 )
 from impact_balance.criteria.qp import QPOptions, solve_contact_velocity_qp, static_torques
 from impact_balance.exceptions import NonFiniteResultError, ScenarioError, SolverError
+from impact_balance.geometry.polygon import Polygon
 from impact_balance.impact.model import ImpactModel, impact_model
 from impact_balance.projection.walk import warm_up
 from impact_balance.scenario import Scenario, load_scenario, with_source
@@ -30,7 +30,26 @@ __all__ = ["Analysis", "ImpactAnswer", "analyze"]
 def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
     """Run the whole pipeline on a scenario (object, file path or bundled name).
 
-    ``solve_qp`` overrides the scenario's ``impact.qp.solve``.
+    The scenario's ``zmp_margin`` (m) shrinks the ZMP support area, and the CoM velocity
+    area with it; its ``velocity_margin`` (m/s) keeps every post-impact CoM velocity that far
+    inside the CoM velocity area (the CoM criterion, its safe interval and the QP; the ZMP
+    criterion has no velocity margin). A :class:`~impact_balance.governor.Governor` of the
+    same scenario answers the same maximum contact velocity at the scenario's posture and
+    CoM velocity.
+
+    Args:
+        scenario: A :class:`~impact_balance.scenario.Scenario`, a scenario file or the name
+            of a bundled scenario.
+        solve_qp: Overrides the scenario's ``impact.qp.solve`` when given.
+
+    Returns:
+        The stance, the areas, the impact answer (None without an impact), the timings (s)
+        and the diagnostics.
+
+    Raises:
+        ScenarioError: A bad scenario, or one the robot model refuses (unknown frame...).
+        SolverError: A projection or the QP failed (naming the step).
+        NonFiniteResultError: A result overflowed (naming it and the inputs that can cause it).
     """
     timings: dict[str, float] = {}
     if not isinstance(scenario, Scenario):
@@ -71,11 +90,12 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
         except ScenarioError as exc:
             raise with_source(exc, scenario.source) from None
         _check_finite(_impact_checks(model))
-        com_limit = max_contact_velocity(areas.com_velocity_area, model, scenario.com_velocity)
+        criterion = ComCriterion(areas.com_velocity_area, model, scenario.velocity_margin)
+        com_limit = criterion.limit(scenario.com_velocity)
         zmp_limit = zmp_max_contact_velocity(
             areas.zmp_area, model, stance.com, scenario.plane_height, scenario.gravity, cfg.duration
         )
-        interval = safe_interval(areas.com_velocity_area, model, scenario.com_velocity, com_limit)
+        interval = criterion.interval(scenario.com_velocity, com_limit)
         contact_velocity = None
         if cfg.reference_velocity is not None:
             contact_velocity = safe_contact_velocity(cfg.reference_velocity, model.normal, interval)
@@ -92,7 +112,7 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
             try:
                 qp = solve_contact_velocity_qp(
                     model,
-                    areas.com_velocity_area,
+                    areas.com_velocity_area.inset(scenario.velocity_margin),
                     scenario.com_velocity,
                     cfg.reference_velocity,
                     stance.robot,
@@ -118,7 +138,7 @@ def _area_checks(stance: Stance, areas: BalanceAreas) -> list[tuple[str, Any, tu
     ]
 
 
-def _squared_size(polygon) -> float:
+def _squared_size(polygon: Polygon) -> float:
     """Sum of the squared vertex coordinates (inf when they overflow, NaN with a NaN)."""
     v = polygon.vertices.ravel()
     with np.errstate(over="ignore", invalid="ignore"):

@@ -142,6 +142,7 @@ class Analysis:
             "omega": a.omega,
             "plane_height": a.plane_height,
             "zmp_margin": a.zmp_margin,
+            "velocity_margin": self.scenario.velocity_margin,
             "gravity": a.gravity,
             "com_velocity": self.com_velocity.tolist(),
             "com_velocity_inside": self.com_velocity_inside,

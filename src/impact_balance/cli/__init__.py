@@ -17,7 +17,9 @@ import os
 import sys
 import traceback
 import warnings
+from collections.abc import Sequence
 from types import ModuleType
+from typing import Any, NoReturn, TextIO
 
 from impact_balance.cli import (
     analyze,
@@ -71,9 +73,11 @@ _JIT_VARIABLE = "IMPACT_BALANCE_JIT"
 
 
 def _interpret_kernels() -> None:
-    """A one-shot command (``INTERPRETED = True``) runs the kernels as Python: numba's import and
-    cached-kernel load (0.4 to 0.8 s) cost more than one interpreted analysis. Only in a fresh
-    process (``_jit`` not yet imported) and only when ``IMPACT_BALANCE_JIT`` is unset.
+    """A one-shot command (``INTERPRETED = True``) runs the kernels as Python.
+
+    Numba's import and cached-kernel load (0.4 to 0.8 s) cost more than one interpreted
+    analysis. Only in a fresh process (``_jit`` not yet imported) and only when
+    ``IMPACT_BALANCE_JIT`` is unset.
     """
     if _JIT_VARIABLE in os.environ or "impact_balance._jit" in sys.modules:
         return
@@ -104,12 +108,14 @@ def _silence_stdout() -> None:
 
 
 class _Stdout:
-    """stdout for the time of a command: a write that fails (a full disk, a closed stream, ``>&-``)
-    becomes :class:`~impact_balance.exceptions.EnvironmentFailure` naming standard output, so
-    the error rule says what failed; a closed pipe stays a ``BrokenPipeError`` (quiet, 141).
+    """stdout for the time of a command.
+
+    A write that fails (a full disk, a closed stream, ``>&-``) becomes
+    :class:`~impact_balance.exceptions.EnvironmentFailure` naming standard output, so the error
+    rule says what failed; a closed pipe stays a ``BrokenPipeError`` (quiet, 141).
     """
 
-    def __init__(self, stream):
+    def __init__(self, stream: TextIO | None):
         self._stream = stream
 
     def _failed(self, exc: OSError) -> EnvironmentFailure:
@@ -143,12 +149,15 @@ class _Stdout:
     def isatty(self) -> bool:
         return self._stream is not None and self._stream.isatty()
 
-    def __getattr__(self, name: str):
+    def __getattr__(self, name: str) -> Any:
         return getattr(self._stream, name)
 
 
 def _report(exc: BaseException, debug: bool) -> int:
-    """The one error rule: one line on stderr and the exit status (the traceback with ``--debug``)."""
+    """The one error rule: one line on stderr and the exit status.
+
+    With ``--debug``, the traceback first.
+    """
     if isinstance(exc, BrokenPipeError) or (isinstance(exc, OSError) and exc.errno == errno.EPIPE):
         _silence_stdout()
         return EXIT_BROKEN_PIPE
@@ -168,8 +177,12 @@ class _VersionAction(argparse.Action):
     """``--version``, looked up only when asked for."""
 
     def __init__(
-        self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS, help=None
-    ):
+        self,
+        option_strings: Sequence[str],
+        dest: str = argparse.SUPPRESS,
+        default: Any = argparse.SUPPRESS,
+        help: str | None = None,
+    ) -> None:
         super().__init__(
             option_strings,
             dest,
@@ -178,30 +191,41 @@ class _VersionAction(argparse.Action):
             help=help or "show the program's version number and exit",
         )
 
-    def __call__(self, parser, namespace, values, option_string=None):
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: str | Sequence[Any] | None,
+        option_string: str | None = None,
+    ) -> None:
         print(f"impact-balance {_version()}")  # on stdout, as argparse's own version action
         parser.exit()
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse, with the project's error rule: a usage error is one line on stderr, exit 2
-    (argparse's default prints the whole usage block first).
+    """argparse, with the project's error rule.
+
+    A usage error is one line on stderr, exit 2 (argparse's default prints the whole usage block
+    first).
     """
 
-    def error(self, message: str):
+    def error(self, message: str) -> NoReturn:
+        """Print ``message`` as one line and exit with status 2."""
         self.exit(2, one_line(f"{self.prog}: error: {message} (see {self.prog} --help)") + "\n")
 
 
 def _parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
     p = _Parser(
         prog="impact-balance",
-        description="Impact-aware multi-contact balance: CoM velocity area and maximum contact velocity.",
+        description="Impact-aware multi-contact balance: CoM velocity area and maximum contact "
+        "velocity.",
     )
     p.add_argument("--version", action=_VersionAction)
     p.add_argument(
         "--debug",
         action="store_true",
-        help="show the traceback of an error (also anywhere after the command, or IMPACT_BALANCE_DEBUG=1)",
+        help="show the traceback of an error (also anywhere after the command, or "
+        "IMPACT_BALANCE_DEBUG=1)",
     )
     sub = p.add_subparsers(dest="command", required=True)
     owners: dict[str, ModuleType] = {}
@@ -214,7 +238,14 @@ def _parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
 _show_warning = warnings.showwarning
 
 
-def _warning_line(message, category, filename, lineno, file=None, line=None):
+def _warning_line(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: TextIO | None = None,
+    line: str | None = None,
+) -> None:
     """The library's own warnings as one ``impact-balance: warning:`` line (no source location)."""
     if issubclass(category, ImpactBalanceWarning):
         print(
@@ -242,11 +273,12 @@ def main(argv: list[str] | None = None) -> int:
             _interpret_kernels()
         if getattr(module, "USES_KERNEL", False) and not _kernel_is_compiled():
             print(
-                "impact-balance: compiling the projection kernel (first run only, 0.5 to 1.5 min; cached afterwards) ...",
+                "impact-balance: compiling the projection kernel (first run only, 0.5 to 1.5 min; "
+                "cached afterwards) ...",
                 file=sys.stderr,
                 flush=True,
             )
-        status = module.run(args)
+        status: int = module.run(args)
         sys.stdout.flush()  # a closed or full stdout shows here, inside the rule, not at exit
         return status
     except SystemExit:  # argparse's --help, --version and usage errors: already one line

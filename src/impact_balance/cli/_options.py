@@ -13,22 +13,36 @@ import argparse
 import math
 import os
 from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any
 
 from impact_balance.exceptions import ImpactBalanceError, OptionError, short_repr
+
+if TYPE_CHECKING:
+    from typing import TypeAlias
+
+    from impact_balance.scenario import Scenario
+    from impact_balance.sim.studies.journal import TrialJournal
+    from impact_balance.sim.trials.balance_trial import BalanceTrialOptions
+
+    #: The subcommands of the ``impact-balance`` parser, where each command adds its own.
+    Subcommands: TypeAlias = argparse._SubParsersAction[argparse.ArgumentParser]
 
 __all__ = [
     "LOG_SUFFIXES",
     "CommandLineError",
+    "a_number",
     "add_controller_option",
     "add_output_options",
     "add_trial_options",
+    "add_velocity_margin_option",
     "add_zmp_margin_option",
     "integer",
     "number",
     "open_journal",
     "output_file",
     "output_folder",
-    "with_zmp_margin",
+    "scoring_margin",
+    "with_margins",
 ]
 
 #: Suffixes of a log file (``--log``).
@@ -55,7 +69,10 @@ def _refused(exc: OptionError) -> CommandLineError:
 
 
 def output_folder(field: str) -> Callable[[str], str]:
-    """Argparse type: a folder the command will write in (see :mod:`impact_balance.cli.output_paths`)."""
+    """Argparse type: a folder the command will write in.
+
+    See :mod:`impact_balance.cli.output_paths`.
+    """
 
     def check(text: str) -> str:
         from impact_balance.cli.output_paths import check_output_folder
@@ -71,7 +88,10 @@ def output_folder(field: str) -> Callable[[str], str]:
 
 
 def output_file(field: str, suffixes: Sequence[str] = ()) -> Callable[[str], str]:
-    """Argparse type: a file the command will write (its folder checked, its suffix among ``suffixes``)."""
+    """Argparse type: a file the command will write.
+
+    Its folder is checked, and its suffix must be among ``suffixes``.
+    """
 
     def check(text: str) -> str:
         from impact_balance.cli.output_paths import check_output_file
@@ -93,8 +113,10 @@ def _interval(lo: float, hi: float, lo_open: bool, unit: str) -> str:
 def number(
     field: str, lo: float, hi: float, unit: str = "", lo_open: bool = False, why: str = ""
 ) -> Callable[[str], float]:
-    """Argparse type: a finite number in ``[lo, hi]`` (``(lo, hi]`` with ``lo_open``) for option
-    ``field``; ``why`` says where the limit comes from (shown in the error).
+    """Argparse type.
+
+    A finite number in ``[lo, hi]`` (``(lo, hi]`` with ``lo_open``) for option ``field``;
+    ``why`` says where the limit comes from (shown in the error).
     """
     span = _interval(lo, hi, lo_open, unit)
 
@@ -131,7 +153,13 @@ def integer(field: str, lo: int, hi: int, why: str = "") -> Callable[[str], int]
 
 
 def add_controller_option(parser: argparse.ArgumentParser, default: str, why: str) -> None:
-    """``--controller ik|id``: the balance controller of the trials (``why``: the default's reason)."""
+    """Add ``--controller ik|id``: the balance controller of the trials.
+
+    Args:
+        parser: The command's parser.
+        default: The default controller.
+        why: The default's reason, for the help.
+    """
     parser.add_argument(
         "--controller",
         default=default,
@@ -142,8 +170,9 @@ def add_controller_option(parser: argparse.ArgumentParser, default: str, why: st
 
 
 def add_output_options(parser: argparse.ArgumentParser, log_help: str) -> None:
-    """``--json``, ``--plots DIR`` and ``--log FILE`` (what the log holds: ``log_help``); the
-    places are checked when the line is read, before any simulation runs.
+    """``--json``, ``--plots DIR`` and ``--log FILE`` (what the log holds: ``log_help``).
+
+    The places are checked when the line is read, before any simulation runs.
     """
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.add_argument(
@@ -158,12 +187,18 @@ def add_output_options(parser: argparse.ArgumentParser, log_help: str) -> None:
 
 
 def add_zmp_margin_option(parser: argparse.ArgumentParser, default_help: str) -> None:
-    """``--zmp-margin M``: the ZMP support area shrunk by M metres (``default_help``: what it defaults to)."""
-    from impact_balance.constants import MAX_SIZE
+    """Add ``--zmp-margin M``: the ZMP support area shrunk by M metres.
 
+    The value is read as a number here and checked by the scenario schema, once, when the
+    command applies it (:func:`with_margins`).
+
+    Args:
+        parser: The command's parser.
+        default_help: What the option defaults to, for its help.
+    """
     parser.add_argument(
         "--zmp-margin",
-        type=number("--zmp-margin", 0.0, MAX_SIZE, "m"),
+        type=a_number("--zmp-margin"),
         default=None,
         metavar="M",
         help=f"shrink the ZMP support area by M metres, and the CoM velocity area with it "
@@ -171,21 +206,95 @@ def add_zmp_margin_option(parser: argparse.ArgumentParser, default_help: str) ->
     )
 
 
-def with_zmp_margin(scenario, margin: float | None):
-    """``scenario`` with its ``zmp_margin`` replaced by ``margin`` (m) when given, checked like the key."""
-    if margin is None:
-        return scenario
-    from impact_balance.constants import MAX_SIZE
+def add_velocity_margin_option(parser: argparse.ArgumentParser, what: str) -> None:
+    """Add ``--velocity-margin V``: every post-impact CoM velocity V m/s inside the area.
+
+    The value is read as a number here and checked by the scenario schema, once, when the
+    command applies it (:func:`with_margins`).
+
+    Args:
+        parser: The command's parser.
+        what: What the margin applies to, for the help (e.g. "com governor").
+    """
+    parser.add_argument(
+        "--velocity-margin",
+        type=a_number("--velocity-margin"),
+        default=None,
+        metavar="V",
+        help=f"{what}: every post-impact CoM velocity must lie V m/s inside the CoM velocity "
+        "area (a margin for the impact model's error; default: the scenario's velocity_margin, "
+        "0 unless set, the paper's criterion)",
+    )
+
+
+def a_number(field: str) -> Callable[[str], float]:
+    """Argparse type: any number (its range is the scenario schema's to check).
+
+    Args:
+        field: The option, named in the error.
+
+    Returns:
+        The type: text to float, :class:`CommandLineError` for text that is not a number.
+    """
+
+    def check(text: str) -> float:
+        try:
+            return float(text)
+        except ValueError:
+            raise CommandLineError(field, text, "not a number") from None
+
+    check.__name__ = "number"
+    return check
+
+
+def with_margins(
+    scenario: Scenario, zmp_margin: float | None = None, velocity_margin: float | None = None
+) -> Scenario:
+    """``scenario`` with the margins given on the command line (None: the scenario's own).
+
+    The values go through :meth:`~impact_balance.scenario.Scenario.replace`, so the schema
+    checks them as it checks a file's keys; its refusal names the option.
+
+    Args:
+        scenario: The command's scenario.
+        zmp_margin: ``--zmp-margin``, m.
+        velocity_margin: ``--velocity-margin``, m/s.
+
+    Returns:
+        The scenario to use (``scenario`` itself when no margin is given).
+
+    Raises:
+        ScenarioError: A margin the schema refuses, its field the option (``--zmp-margin``).
+    """
     from impact_balance.exceptions import ScenarioError
 
-    if not (margin == margin and 0.0 <= margin <= MAX_SIZE):  # NaN fails the first test
-        raise ScenarioError("--zmp-margin", margin, f"must be in [0, {MAX_SIZE:g}] m")
-    return scenario.model_copy(update={"zmp_margin": float(margin)})
+    given = {"zmp_margin": zmp_margin, "velocity_margin": velocity_margin}
+    changes = {key: value for key, value in given.items() if value is not None}
+    try:
+        return scenario.replace(**changes)
+    except ScenarioError as exc:
+        option = "--" + exc.field.replace("_", "-")
+        raise ScenarioError(option, exc.value, exc.reason) from None
+
+
+def scoring_margin(scenario: Scenario) -> float | None:
+    """The ZMP margin (m) a trial command scores with: the scenario's, when set.
+
+    Args:
+        scenario: The command's scenario, with ``--zmp-margin`` applied (:func:`with_margins`).
+
+    Returns:
+        Its ``zmp_margin`` when its file or the command line set it, else None (the trials'
+        controller's own margin).
+    """
+    return scenario.zmp_margin if "zmp_margin" in scenario.set_keys else None
 
 
 def add_trial_options(parser: argparse.ArgumentParser, impact: bool) -> None:
-    """Options of the balance-trial commands (``validate``, ``push-test``): ``--rigid-impact`` (impacts only),
-    ``--zmp-margin``, and the trials journal (``--journal FILE``, ``--fresh``, ``--no-journal``).
+    """Options of the balance-trial commands (``validate``, ``push-test``).
+
+    ``--rigid-impact`` (impacts only), ``--zmp-margin``, and the trials journal (``--journal
+    FILE``, ``--fresh``, ``--no-journal``).
     """
     if impact:
         parser.add_argument(
@@ -194,13 +303,18 @@ def add_trial_options(parser: argparse.ArgumentParser, impact: bool) -> None:
             help="hold every joint's velocity through the impact (the paper's rigid robot), "
             "until the contact's normal velocity reaches zero",
         )
-    add_zmp_margin_option(parser, "default: the ZMP margin the trials' controller keeps")
+    add_zmp_margin_option(
+        parser,
+        "default: the scenario's zmp_margin when it sets one, else the ZMP margin the trials' "
+        "controller keeps",
+    )
     parser.add_argument(
         "--journal",
         metavar="FILE",
         type=output_file("--journal", (".jsonl",)),
         help="JSON-lines file of the finished trials, written as they end; running the same "
-        "command again resumes from it (default: impact-balance-trials/<command>_<scenario>_<digest>.jsonl)",
+        "command again resumes from it (default: "
+        "impact-balance-trials/<command>_<scenario>_<digest>.jsonl)",
     )
     parser.add_argument(
         "--fresh", action="store_true", help="discard the journal's trials and run them all again"
@@ -211,10 +325,19 @@ def add_trial_options(parser: argparse.ArgumentParser, impact: bool) -> None:
 
 
 def open_journal(
-    args: argparse.Namespace, command: str, scenario, joints: str, options, extra: dict
-):
-    """The trials journal of a command (:class:`impact_balance.sim.studies.journal.TrialJournal`), by the digest of
-    everything its trials depend on (the scoring margin excluded: scores are recomputed from the trials).
+    args: argparse.Namespace,
+    command: str,
+    scenario: Scenario,
+    joints: str,
+    options: BalanceTrialOptions,
+    extra: dict[str, Any],
+) -> TrialJournal:
+    """The trials journal of a command, by the digest of everything its trials depend on.
+
+    The scoring margins are excluded: scores are recomputed from the trials.
+
+    Returns:
+        The :class:`impact_balance.sim.studies.journal.TrialJournal` to write to.
     """
     import dataclasses
     import sys
@@ -230,7 +353,9 @@ def open_journal(
     parts = {
         "command": command,
         "trial_version": TRIAL_VERSION,
-        "scenario": scenario.model_dump(mode="json", exclude={"zmp_margin", "name", "description"}),
+        "scenario": scenario.model_dump(
+            mode="json", exclude={"zmp_margin", "velocity_margin", "name", "description"}
+        ),
         "joints": joints,
         "options": dataclasses.asdict(dataclasses.replace(options, record=False)),
         **extra,
@@ -253,9 +378,11 @@ def open_journal(
 
 
 def import_mujoco(video: bool) -> None:
-    """Import MuJoCo for a simulation command; with ``video``, offscreen rendering first picks
-    EGL (it works headless, and must be chosen before MuJoCo is imported) unless ``MUJOCO_GL``
-    says otherwise. An unusable backend is one :class:`~impact_balance.exceptions.SimulationError`.
+    """Import MuJoCo for a simulation command.
+
+    With ``video``, offscreen rendering first picks EGL (it works headless, and must be chosen
+    before MuJoCo is imported) unless ``MUJOCO_GL`` says otherwise. An unusable backend is one
+    :class:`~impact_balance.exceptions.SimulationError`.
     """
     from impact_balance.exceptions import SimulationError
 

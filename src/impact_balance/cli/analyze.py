@@ -5,17 +5,36 @@ from __future__ import annotations
 import argparse
 import dataclasses
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from impact_balance.cli._options import add_zmp_margin_option, output_folder, with_zmp_margin
+from impact_balance.cli._options import (
+    add_velocity_margin_option,
+    add_zmp_margin_option,
+    output_folder,
+    with_margins,
+)
+
+if TYPE_CHECKING:
+    from impact_balance.analysis.result import Diagnostic
+    from impact_balance.cli._options import Subcommands
 
 __all__ = ["INTERPRETED", "USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
-#: One analysis per process: interpreted kernels beat loading numba's cache (see ``impact_balance._jit``).
+#: One analysis per process: interpreted kernels beat loading numba's cache (see
+#: ``impact_balance._jit``).
 INTERPRETED = True
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
+    """Add the ``analyze`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     a = sub.add_parser("analyze", help="analyze one scenario (file or bundled name)")
     a.add_argument(
         "scenario",
@@ -33,20 +52,29 @@ def add_parser(sub) -> list[str]:
     )
     a.add_argument("--strict", action="store_true", help="treat warnings as errors (exit status 2)")
     add_zmp_margin_option(a, "default: the scenario's zmp_margin, 0 unless set")
+    add_velocity_margin_option(a, "CoM criterion")
     return ["analyze"]
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``analyze`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     from impact_balance.analysis.analyze import analyze
     from impact_balance.analysis.report import format_analysis
     from impact_balance.cli.output import print_json
     from impact_balance.exceptions import StrictWarningsError
 
     scenario = args.scenario
-    if args.zmp_margin is not None:
+    if args.zmp_margin is not None or args.velocity_margin is not None:
         from impact_balance.scenario import load_scenario
 
-        scenario = with_zmp_margin(load_scenario(scenario), args.zmp_margin)
+        scenario = with_margins(load_scenario(scenario), args.zmp_margin, args.velocity_margin)
     analysis = analyze(scenario, solve_qp=True if args.qp else None)
     if args.strict and analysis.warnings:
         raise StrictWarningsError(analysis.warnings)
@@ -54,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
     if args.plots:
         from impact_balance.plots import save_figures
 
-        skipped: list = []
+        skipped: list[Diagnostic] = []
         written = save_figures(analysis, Path(args.plots), skipped=skipped)
         analysis = dataclasses.replace(analysis, warnings=analysis.warnings + tuple(skipped))
         if args.strict and skipped:

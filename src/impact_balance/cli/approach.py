@@ -1,28 +1,48 @@
-"""``impact-balance approach SCENARIO``: the impacting point sent at an unknown wall, its speed
-capped every tick by a governor (the paper's Experiment 1, in MuJoCo).
+"""``impact-balance approach SCENARIO``.
+
+The impacting point sent at an unknown wall, its speed capped every tick by a governor (the paper's
+Experiment 1, in MuJoCo).
 """
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from impact_balance.cli._options import (
     add_controller_option,
+    add_velocity_margin_option,
     add_zmp_margin_option,
     import_mujoco,
     number,
     output_file,
     output_folder,
-    with_zmp_margin,
+    scoring_margin,
+    with_margins,
 )
+
+if TYPE_CHECKING:
+    from impact_balance.cli._options import Subcommands
+    from impact_balance.governor import Governor
+    from impact_balance.scenario import Scenario
+    from impact_balance.sim.studies.wall import WallTrial
+    from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions
 
 __all__ = ["USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
+    """Add the ``approach`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     a = sub.add_parser(
         "approach",
         help="send the impact point at an unknown wall, its speed capped by a governor (MuJoCo)",
@@ -39,7 +59,8 @@ def add_parser(sub) -> list[str]:
         "--governor",
         default="com",
         choices=("com", "zmp", "none"),
-        help="com: the CoM criterion's maximum contact velocity (default); zmp: the ZMP criterion's; "
+        help="com: the CoM criterion's maximum contact velocity (default); zmp: the ZMP "
+        "criterion's; "
         "none: the reference alone",
     )
     where = a.add_mutually_exclusive_group()
@@ -48,7 +69,8 @@ def add_parser(sub) -> list[str]:
         type=number("--wall-distance", 0.0, 1.0, "m", lo_open=True),
         default=None,
         metavar="D",
-        help="distance of the wall from the point's start, m (default 0.15: the scenario's impact point)",
+        help="distance of the wall from the point's start, m (default 0.15: the scenario's impact "
+        "point)",
     )
     where.add_argument(
         "--wall-distance-range",
@@ -61,23 +83,18 @@ def add_parser(sub) -> list[str]:
     a.add_argument(
         "--contact-aware",
         action="store_true",
-        help="com governor: also bound the speed by the contact-aware impact model (the robot standing "
+        help="com governor: also bound the speed by the contact-aware impact model (the robot "
+        "standing "
         "on its supports; experimental, see docs/contact_aware_governor.md)",
     )
     a.add_argument(
         "--contact-aware-async",
         action="store_true",
-        help="with --contact-aware: compute its rates in a worker process, off the tick (the tick never "
+        help="with --contact-aware: compute its rates in a worker process, off the tick (the tick "
+        "never "
         "waits; the rates are one recomputation old)",
     )
-    a.add_argument(
-        "--velocity-margin",
-        type=number("--velocity-margin", 0.0, 10.0, "m/s"),
-        default=0.0,
-        metavar="V",
-        help="com governor: every post-impact CoM velocity must lie V m/s inside the CoM velocity area "
-        "(a margin for the impact model's error; default 0, the paper's criterion)",
-    )
+    add_velocity_margin_option(a, "com governor")
     a.add_argument(
         "--rigid-impact",
         action="store_true",
@@ -109,53 +126,106 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``approach``: one governed trial per wall distance, as text or JSON.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status, 0.
+
+    Raises:
+        SimulationError: Options that do not go together, a scenario without an impact.
+        ScenarioError: A margin the schema refuses (naming its option).
+    """
     from impact_balance.exceptions import SimulationError
 
     if args.video and args.wall_distance_range is not None:
         raise SimulationError(
             "--video", args.video, "one .mp4 for one trial (give --wall-distance, not a range)"
         )
+    if args.contact_aware_async and not args.contact_aware:
+        raise SimulationError("--contact-aware-async", True, "needs --contact-aware")
     import_mujoco(bool(args.video))  # before anything imports MuJoCo: the GL backend is read then
     from impact_balance.cli.output import print_json
     from impact_balance.scenario import load_scenario
-    from impact_balance.sim.studies.wall import WallOptions, run_wall_trial, write_wall_video
     from impact_balance.sim.trials.balance_trial import (
         BalanceSetup,
         BalanceTrialOptions,
         controller_margin,
     )
 
-    scenario = load_scenario(args.scenario)
+    scenario = with_margins(load_scenario(args.scenario), args.zmp_margin, args.velocity_margin)
     if scenario.impact is None:
         raise SimulationError(
             "impact", None, f"scenario {scenario.name!r} has no impact: approach needs one"
         )
-    if args.wall_distance_range is not None:
-        lo, hi = args.wall_distance_range
-        if lo > hi:
-            raise SimulationError("--wall-distance-range", [lo, hi], "must be 0 < LO <= HI <= 1 m")
-        distances = [lo, 0.5 * (lo + hi), hi] if hi > lo else [lo]
-    else:
-        distances = [0.15 if args.wall_distance is None else args.wall_distance]
+    distances = _distances(args)
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
-    margin = controller_margin(options) if args.zmp_margin is None else args.zmp_margin
-    governed = with_zmp_margin(
-        scenario, margin
-    )  # the governor's view: the area the controller can use
-    setup = BalanceSetup.create(
-        scenario, "servo", options, meshes=bool(args.video)
-    )  # meshes: visual only
-    governor = None
-    if args.governor != "none":
-        from impact_balance.governor import Governor
+    own = scoring_margin(scenario)
+    margin = controller_margin(options) if own is None else own
+    # The governor's view: the area the controller can use.
+    governed = scenario.replace(zmp_margin=margin)
+    setup = BalanceSetup.create(scenario, "servo", options, meshes=bool(args.video))  # visual
+    governor = _governor(args, governed)
+    try:
+        trials, written = _trials(args, setup, options, governor, distances, margin)
+    finally:
+        if governor is not None:
+            governor.close()  # its worker process, if any
+    docs = [t.to_dict() for t in trials]
+    for d in docs:
+        d["controller"] = args.controller
+        d["rigid_impact"] = args.rigid_impact
+        d["zmp_margin"] = margin
+        d["contact_aware"] = bool(args.contact_aware and governor is not None)
+        d["velocity_margin"] = governed.velocity_margin if governor is not None else None
+        d["contact_aware_async"] = bool(args.contact_aware_async and governor is not None)
+    out = (
+        docs[0]
+        if len(docs) == 1
+        else {"governor": args.governor, "reference": args.reference, "trials": docs}
+    )
+    if args.json:
+        print_json(out)
+        return 0
+    _print_text(scenario.name, args, docs, written)
+    return 0
 
-        governor = Governor(
-            governed,
-            criterion=args.governor,
-            contact_aware=args.contact_aware,
-            velocity_margin=args.velocity_margin,
-            contact_aware_async=args.contact_aware_async,
-        )
+
+def _distances(args: argparse.Namespace) -> list[float]:
+    """The wall distances of the trials (m), from ``--wall-distance(-range)``."""
+    from impact_balance.exceptions import SimulationError
+
+    if args.wall_distance_range is None:
+        return [0.15 if args.wall_distance is None else args.wall_distance]
+    lo, hi = args.wall_distance_range
+    if lo > hi:
+        raise SimulationError("--wall-distance-range", [lo, hi], "must be 0 < LO <= HI <= 1 m")
+    return [lo, 0.5 * (lo + hi), hi] if hi > lo else [lo]
+
+
+def _governor(args: argparse.Namespace, governed: Scenario) -> Governor | None:
+    """The trials' governor (None with ``--governor none``), margins from ``governed``."""
+    if args.governor == "none":
+        return None
+    from impact_balance.governor import ContactAwareOptions, Governor
+
+    aware = ContactAwareOptions(asynchronous=args.contact_aware_async)
+    return Governor(governed, args.governor, contact_aware=aware if args.contact_aware else None)
+
+
+def _trials(
+    args: argparse.Namespace,
+    setup: BalanceSetup,
+    options: BalanceTrialOptions,
+    governor: Governor | None,
+    distances: list[float],
+    margin: float,
+) -> tuple[list[WallTrial], list[Path]]:
+    """Run one trial per wall distance; the trials and the files written (figures, video)."""
+    from impact_balance.sim.studies.wall import WallOptions, run_wall_trial, write_wall_video
+
     trials, written = [], []
     for distance in distances:
         wall = WallOptions(
@@ -169,31 +239,17 @@ def run(args: argparse.Namespace) -> int:
         if args.plots:
             written.append(_plot(trial, setup, Path(args.plots), margin))
         if args.video:
-            written.append(
-                write_wall_video(
-                    setup, trial, args.video, title=f"{scenario.name}: {args.governor} governor"
-                )
-            )
-    if governor is not None:
-        governor.close()  # its worker process, if any
-    docs = [t.to_dict() for t in trials]
-    for d in docs:
-        d["controller"] = args.controller
-        d["rigid_impact"] = args.rigid_impact
-        d["zmp_margin"] = margin
-        d["contact_aware"] = bool(args.contact_aware and governor is not None)
-        d["velocity_margin"] = args.velocity_margin if governor is not None else None
-        d["contact_aware_async"] = bool(args.contact_aware_async and governor is not None)
-    out = (
-        docs[0]
-        if len(docs) == 1
-        else {"governor": args.governor, "reference": args.reference, "trials": docs}
-    )
-    if args.json:
-        print_json(out)
-        return 0
+            title = f"{setup.scenario.name}: {args.governor} governor"
+            written.append(write_wall_video(setup, trial, args.video, title=title))
+    return trials, written
+
+
+def _print_text(
+    name: str | None, args: argparse.Namespace, docs: list[dict[str, Any]], written: list[Path]
+) -> None:
+    """Print the trials as text: one line per wall, then the files written."""
     print(
-        f"{scenario.name}: approach at {args.reference:g} m/s reference, {args.governor} governor, "
+        f"{name}: approach at {args.reference:g} m/s reference, {args.governor} governor, "
         f"{args.controller} controller{', rigid impact' if args.rigid_impact else ''}"
     )
     for d in docs:
@@ -203,25 +259,25 @@ def run(args: argparse.Namespace) -> int:
             if tick["median"] is None
             else f"; governor {tick['median']:.0f} us per tick (p99 {tick['p99']:.0f})"
         )
+        reason = "" if d["reason"] is None else f" ({d['reason']})"
         print(
-            f"  wall {100 * d['wall_distance']:g} cm: speed at contact {_f(d['speed_at_contact'])}, cap at contact "
-            f"{_f(d['cap_at_contact'])}, time to contact {_s(d['time_to_contact'])}: {d['outcome']}"
-            f"{'' if d['reason'] is None else ' (' + str(d['reason']) + ')'}{ticks}"
+            f"  wall {100 * d['wall_distance']:g} cm: speed at contact "
+            f"{_f(d['speed_at_contact'])}, cap at contact {_f(d['cap_at_contact'])}, "
+            f"time to contact {_s(d['time_to_contact'])}: {d['outcome']}{reason}{ticks}"
         )
     for path in written:
         print(f"  wrote {path}")
-    return 0
 
 
-def _f(x) -> str:
+def _f(x: float | None) -> str:
     return "-" if x is None else f"{x:.3f} m/s"
 
 
-def _s(x) -> str:
+def _s(x: float | None) -> str:
     return "never (gave up)" if x is None else f"{x:.2f} s"
 
 
-def _plot(trial, setup, out: Path, zmp_margin: float) -> Path:
+def _plot(trial: WallTrial, setup: BalanceSetup, out: Path, zmp_margin: float) -> Path:
     from impact_balance.plots.approach import plot_approach
     from impact_balance.plots.save import figure_prefix
 
@@ -229,8 +285,8 @@ def _plot(trial, setup, out: Path, zmp_margin: float) -> Path:
     margin = setup.analysis.areas.com_velocity_area_inset(zmp_margin) if zmp_margin > 0 else None
     o = trial.options
     path = (
-        out
-        / f"{figure_prefix(setup.analysis)}_approach_{o.governor}_{o.reference:g}_{100 * o.wall_distance:g}cm.png"
+        out / f"{figure_prefix(setup.analysis)}_approach_{o.governor}_{o.reference:g}_"
+        f"{100 * o.wall_distance:g}cm.png"
     )
     plot_approach(trial, setup.analysis, margin).savefig(path)
     return path

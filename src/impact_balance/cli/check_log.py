@@ -4,15 +4,29 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from impact_balance.cli._options import output_folder
+
+if TYPE_CHECKING:
+    from impact_balance.analysis.result import Diagnostic
+    from impact_balance.cli._options import Subcommands
+    from impact_balance.logs.check import LogCheck
 
 __all__ = ["USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
+    """Add the ``check-log`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     a = sub.add_parser(
         "check-log", help="check a recorded time series (.parquet or .csv) against both criteria"
     )
@@ -31,10 +45,18 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``check-log`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     from impact_balance.cli.output import print_json
     from impact_balance.logs import check_log, read_log
 
-    notes: list = []
+    notes: list[Diagnostic] = []
     frame = read_log(args.log, warnings=notes)
     check = check_log(frame, args.scenario, source=str(args.log)[:80])
     out = check.to_dict(samples=args.samples)
@@ -45,7 +67,8 @@ def run(args: argparse.Namespace) -> int:
         print_json(out)
         return 0
     print(
-        f"{args.log}: {out['samples']} samples over {out['duration']:.3f} s, scenario {check.scenario},"
+        f"{args.log}: {out['samples']} samples over {out['duration']:.3f} s, scenario "
+        f"{check.scenario},"
         f" {len(check.segments)} stance(s)"
     )
     if check.floating:
@@ -69,7 +92,8 @@ def run(args: argparse.Namespace) -> int:
         for v in check.violations:
             unit = "m/s" if v.kind == "com_velocity" else "m"
             print(
-                f"    {v.kind:12s} {v.start:8.3f} s to {v.end:8.3f} s ({v.samples} samples), worst {v.worst_margin:.4g} {unit}"
+                f"    {v.kind:12s} {v.start:8.3f} s to {v.end:8.3f} s ({v.samples} samples), worst "
+                f"{v.worst_margin:.4g} {unit}"
                 f" at {v.worst_time:.3f} s"
             )
     for note in notes:
@@ -79,7 +103,7 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _plots(check, out: Path) -> list[Path]:
+def _plots(check: LogCheck, out: Path) -> list[Path]:
     from impact_balance.plots.balance import plot_log_margins
 
     out.mkdir(parents=True, exist_ok=True)

@@ -4,6 +4,10 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from impact_balance.cli._options import Subcommands
 
 __all__ = ["DEMO_SCENARIOS", "FRICTION_SWEEP", "USES_KERNEL", "add_parser", "run"]
 
@@ -15,7 +19,15 @@ DEMO_SCENARIOS = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot")
 FRICTION_SWEEP = ("palm_push_mu010", "palm_push_mu024", "palm_push_mu040")
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
+    """Add the ``demo`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     d = sub.add_parser(
         "demo", help="run the bundled studies on the default robot, print a report, write figures"
     )
@@ -27,6 +39,14 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``demo`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     from impact_balance.analysis.analyze import analyze
     from impact_balance.analysis.report import format_analysis, format_speed
 
@@ -49,6 +69,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"  {'mu':>5}  {'CoM criterion':>14}  {'ZMP criterion':>14}")
     for a in sweep:
         im = a.impact
+        assert im is not None  # the friction sweep's scenarios have an impact
         print(
             f"  {im.model.spec.friction:>5.2f}  {format_speed(im.max_contact_velocity):>14}  "
             f"{format_speed(im.zmp_max_contact_velocity):>14}"
@@ -69,6 +90,7 @@ def run(args: argparse.Namespace) -> int:
 
     bounds = [round(float(b), 4) for b in com_velocity_bounds(0.78, (-0.13, 0.13))]
     print(
-        f"LIPM check (paper sec. III-B): c_z 0.78 m, ZMP in [-0.13, 0.13] m -> CoM velocity in [{bounds[0]}, {bounds[1]}] m/s"
+        "LIPM check (paper sec. III-B): c_z 0.78 m, ZMP in [-0.13, 0.13] m -> CoM velocity in "
+        f"[{bounds[0]}, {bounds[1]}] m/s"
     )
     return 0

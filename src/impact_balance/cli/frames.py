@@ -1,4 +1,4 @@
-"""``impact-balance frames ROBOT|SCENARIO``: every frame's pose and axes, and every joint of a robot.
+"""``impact-balance frames ROBOT|SCENARIO``: every frame's pose and axes, every joint.
 
 For a scenario, the poses are at its stance (and its contacts are listed, resolved); for a
 robot, at its standing configuration (the free-flyer as the configuration gives it).
@@ -7,12 +7,30 @@ robot, at its standing configuration (the free-flyer as the configuration gives 
 from __future__ import annotations
 
 import argparse
+from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import numpy as np
+    import numpy.typing as npt
+
+    from impact_balance.cli._options import Subcommands
+    from impact_balance.contacts.stance import Stance
+    from impact_balance.robot.robot import Robot
 
 __all__ = ["add_parser", "robot_listing", "run"]
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
+    """Add the ``frames`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     f = sub.add_parser("frames", help="list a robot's frames (world position and axes) and joints")
     f.add_argument(
         "robot", help="a bundled robot (see `impact-balance robots`), a URDF file, or a scenario"
@@ -22,7 +40,7 @@ def add_parser(sub) -> list[str]:
     return ["frames"]
 
 
-def _robot_and_stance(name: str):
+def _robot_and_stance(name: str) -> tuple[Robot, npt.NDArray[np.float64], str, Stance | None]:
     """(robot, configuration, configuration label, stance or None)."""
     from impact_balance.exceptions import UnknownRobotError, UnknownScenarioError
     from impact_balance.robot.robot import BUNDLED_ROBOTS, load_robot
@@ -39,12 +57,17 @@ def _robot_and_stance(name: str):
     return stance.robot, stance.q, f"stance of scenario {scenario.name or name}", stance
 
 
-def robot_listing(robot, q=None, frames: list[str] | None = None) -> dict:
-    """Frames (name, type, parent joint, world pose at ``q``) and actuated joints (limits) of a robot."""
+def robot_listing(
+    robot: Robot, q: npt.NDArray[np.float64] | None = None, frames: list[str] | None = None
+) -> dict[str, Any]:
+    """A robot's frames and actuated joints.
+
+    Frames: name, type, parent joint, world pose at ``q``; joints: their limits.
+    """
     from impact_balance.authoring import frame_poses
 
     q = robot.configuration() if q is None else q
-    effort = dict(zip(*(list(x) for x in robot.effort_limits)))
+    effort = dict(zip(*(list(x) for x in robot.effort_limits), strict=True))
     joints = []
     for name in robot.joint_names:
         slot = robot.joint_slot(name)
@@ -67,11 +90,19 @@ def robot_listing(robot, q=None, frames: list[str] | None = None) -> dict:
     }
 
 
-def _vec(v) -> str:
+def _vec(v: Sequence[float]) -> str:
     return "[" + " ".join(f"{x:+.3f}" for x in v) + "]"
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``frames`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     robot, q, label, stance = _robot_and_stance(args.robot)
     listing = robot_listing(robot, q, args.frame)
     listing["configuration"] = label
@@ -85,7 +116,8 @@ def run(args: argparse.Namespace) -> int:
         print_json(listing)
         return 0
     print(
-        f"{listing['robot']}: {len(listing['frames'])} frames, {len(listing['joints'])} joints ({listing['urdf']})"
+        f"{listing['robot']}: {len(listing['frames'])} frames, {len(listing['joints'])} joints "
+        f"({listing['urdf']})"
     )
     print(f"poses at the {label}; world axes, m; each axis is a unit vector in world coordinates")
     rows = listing["frames"]
@@ -96,7 +128,8 @@ def run(args: argparse.Namespace) -> int:
     )
     for f in rows:
         print(
-            f"  {f['name']:<{width}}  {f['type']:<12} {_vec(f['position']):<22}  {_vec(f['axes']['x']):<22}  "
+            f"  {f['name']:<{width}}  {f['type']:<12} {_vec(f['position']):<22}  "
+            f"{_vec(f['axes']['x']):<22}  "
             f"{_vec(f['axes']['z']):<22}  {f['z_tilt_deg']:5.1f}°  {f['parent_joint']}"
         )
     for i, c in enumerate(listing.get("contacts", [])):

@@ -4,13 +4,26 @@ from __future__ import annotations
 
 import argparse
 import sys
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from impact_balance.cli._options import Subcommands
+    from impact_balance.gui.app import GuiApp
 
 __all__ = ["USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
+    """Add the ``gui`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     g = sub.add_parser(
         "gui", help="interactive web GUI: edit a stance, see its areas and limits live"
     )
@@ -42,13 +55,22 @@ def add_parser(sub) -> list[str]:
         action="append",
         default=[],
         metavar="ORIGIN",
-        help="also accept pages from ORIGIN (scheme://host[:port], e.g. a reverse proxy); repeatable. "
+        help="also accept pages from ORIGIN (scheme://host[:port], e.g. a reverse proxy); "
+        "repeatable. "
         "By default only the GUI's own page may connect",
     )
     return ["gui"]
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``gui`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     try:
         from impact_balance.gui.app import run as run_app
         from impact_balance.gui.state import DEFAULT_SCENARIO
@@ -63,9 +85,10 @@ def run(args: argparse.Namespace) -> int:
     workspace = Workspace(args.workspace)
     origins = tuple(normalize_origin(o) for o in args.allow_origin)
 
-    def ready(app) -> None:
+    def ready(app: GuiApp) -> None:
         print(
-            f"impact-balance gui: {app.session.state.scenario.name or 'scenario'} at {app.url}  (Ctrl-C to stop)\n"
+            f"impact-balance gui: {app.session.state.scenario.name or 'scenario'} at {app.url}  "
+            "(Ctrl-C to stop)\n"
             f"  workspace: {app.workspace.root}  (the GUI loads and saves .yaml files here only)",
             flush=True,
         )

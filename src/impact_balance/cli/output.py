@@ -10,16 +10,20 @@ from __future__ import annotations
 import json
 import math
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from impact_balance.exceptions import ImpactBalanceError
+
+if TYPE_CHECKING:
+    from tqdm import tqdm
 
 __all__ = ["NonFiniteOutputError", "print_json", "progress_bar"]
 
 
 class NonFiniteOutputError(ImpactBalanceError):
-    """A result to print holds NaN or an infinity where a number is expected (a bug, reported
-    as one line naming the field rather than printed as invalid JSON).
+    """A result to print holds NaN or an infinity where a number is expected.
+
+    A bug, reported as one line naming the field rather than printed as invalid JSON.
 
     Attributes:
         field: Dotted path of the value in the document.
@@ -65,7 +69,7 @@ def print_json(document: Any) -> None:
     print(text)
 
 
-def progress_bar(desc: str, total: int | None = None, unit: str = "trial"):
+def progress_bar(desc: str, total: int | None = None, unit: str = "trial") -> tqdm[Any]:
     """A tqdm progress bar on stderr (stdout stays for the answer)."""
     from tqdm import tqdm
 

@@ -37,7 +37,8 @@ def _text(field: str, path: str | os.PathLike[str]) -> Path:
         raise OptionError(
             field,
             text,
-            f"a file or folder name has at most {MAX_NAME_CHARS} characters (this one has {longest})",
+            f"a file or folder name has at most {MAX_NAME_CHARS} characters (this one has "
+            f"{longest})",
         )
     return Path(text).expanduser()
 
@@ -52,8 +53,10 @@ def _probe(field: str, shown: str, folder: Path) -> None:
 
 
 def _existing_ancestor(field: str, shown: str, path: Path, is_target: bool = True) -> Path:
-    """The nearest folder of ``path`` (itself included) that exists; refuses a file on the way
-    (``is_target``: ``path`` is the output folder itself, not the folder of an output file).
+    """The nearest folder of ``path`` (itself included) that exists.
+
+    Refuses a file on the way (``is_target``: ``path`` is the output folder itself, not the
+    folder of an output file).
     """
     here = path
     while True:
@@ -91,8 +94,10 @@ def check_output_folder(path: str | os.PathLike[str], field: str) -> Path:
 def check_output_file(
     path: str | os.PathLike[str], field: str, suffixes: Sequence[str] = ()
 ) -> Path:
-    """Check that ``path`` names a file this process can write (its folder checked as by
-    :func:`check_output_folder`, ``suffixes`` if given); return it. Nothing is created.
+    """Check that ``path`` names a file this process can write; return it.
+
+    Its folder is checked as by :func:`check_output_folder`, its suffix against ``suffixes``
+    if given. Nothing is created.
     """
     shown = os.fspath(path)
     file = _text(field, path)

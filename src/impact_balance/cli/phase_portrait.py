@@ -1,16 +1,31 @@
-"""``impact-balance phase-portrait``: the LIPM phase portrait and CoM velocity bounds (paper sec. III-B)."""
+"""``impact-balance phase-portrait``: the LIPM phase portrait and CoM velocity bounds.
+
+The paper's sec. III-B.
+"""
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from impact_balance.cli._options import output_file
+
+if TYPE_CHECKING:
+    from impact_balance.cli._options import Subcommands
 
 __all__ = ["add_parser", "run"]
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
+    """Add the ``phase-portrait`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     pp = sub.add_parser(
         "phase-portrait", help="LIPM phase portrait and CoM velocity bounds (paper sec. III-B)"
     )
@@ -41,6 +56,14 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``phase-portrait`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     from impact_balance.balance.lipm import phase_portrait
 
     portrait = phase_portrait(args.com_height, tuple(args.zmp_range), args.gravity)
@@ -65,7 +88,8 @@ def run(args: argparse.Namespace) -> int:
     else:
         lo, hi = portrait.com_velocity_bounds
         print(
-            f"omega = {portrait.omega:.4f} 1/s; CoM velocity bounds at c = 0: [{lo:.4f}, {hi:.4f}] m/s"
+            f"omega = {portrait.omega:.4f} 1/s; CoM velocity bounds at c = 0: [{lo:.4f}, {hi:.4f}] "
+            "m/s"
         )
         if args.plot:
             print(f"figure: {args.plot}")

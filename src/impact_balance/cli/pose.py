@@ -1,12 +1,18 @@
 """``impact-balance pose SCENARIO --place FRAME X Y Z [--normal NX NY NZ] [--com X Y] --out FILE``.
 
-Whole-body IK (contacts kept) that writes a new scenario file; see :mod:`impact_balance.authoring.pose`.
+Whole-body IK (contacts kept) that writes a new scenario file; see
+:mod:`impact_balance.authoring.pose`.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from impact_balance.cli._options import Subcommands
 
 __all__ = ["add_parser", "run"]
 
@@ -14,10 +20,20 @@ __all__ = ["add_parser", "run"]
 class _Place(argparse.Action):
     """``--place FRAME X Y Z`` starts a placement; ``--normal NX NY NZ`` completes the last one."""
 
-    def __call__(self, parser, namespace, values, option_string=None):
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: str | Sequence[Any] | None,
+        option_string: str | None = None,
+    ) -> None:
+        """Record ``--place`` or complete the last placement with ``--normal``."""
+        items: Sequence[Any] = (
+            [] if values is None else [values] if isinstance(values, str) else values
+        )
         places = list(getattr(namespace, "places", None) or [])
         if option_string == "--place":
-            frame, *xyz = values
+            frame, *xyz = items
             places.append(
                 {"frame": frame, "position": _numbers(parser, "--place", xyz), "normal": None}
             )
@@ -26,11 +42,14 @@ class _Place(argparse.Action):
                 parser.error("--normal comes after the --place it turns")
             if places[-1]["normal"] is not None:
                 parser.error(f"--normal given twice for --place {places[-1]['frame']}")
-            places[-1]["normal"] = _numbers(parser, "--normal", values)
+            places[-1]["normal"] = _numbers(parser, "--normal", items)
         namespace.places = places
 
 
-def _numbers(parser, option: str, texts) -> tuple[float, ...]:
+def _numbers(
+    parser: argparse.ArgumentParser, option: str, texts: Sequence[Any]
+) -> tuple[float, ...]:
+    """``texts`` as finite numbers within +-1e4 (a usage error otherwise)."""
     try:
         values = tuple(float(t) for t in texts)
     except ValueError:
@@ -40,7 +59,15 @@ def _numbers(parser, option: str, texts) -> tuple[float, ...]:
     return values
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
+    """Add the ``pose`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     p = sub.add_parser(
         "pose", help="place frames by whole-body IK (contacts kept) and write the scenario"
     )
@@ -59,7 +86,8 @@ def add_parser(sub) -> list[str]:
         action=_Place,
         dest="places",
         metavar=("NX", "NY", "NZ"),
-        help="after --place: turn that contact's normal (or the frame's z axis) to this world direction",
+        help="after --place: turn that contact's normal (or the frame's z axis) to this world "
+        "direction",
     )
     p.add_argument(
         "--com", nargs=2, type=float, metavar=("X", "Y"), help="horizontal CoM target, world, m"
@@ -71,6 +99,14 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``pose`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     from pathlib import Path
 
     from impact_balance.authoring import Placement, pose_scenario, posed_mapping, scenario_yaml

@@ -1,25 +1,42 @@
-"""``impact-balance push-test SCENARIO``: impulsive pushes, predicted before the trial and scored after."""
+"""``impact-balance push-test SCENARIO``: impulsive pushes, predicted, then scored.
+
+Each push is predicted before its trial and scored after it.
+"""
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from impact_balance.cli._options import (
     add_controller_option,
     add_output_options,
     add_trial_options,
     open_journal,
-    with_zmp_margin,
+    scoring_margin,
+    with_margins,
 )
+
+if TYPE_CHECKING:
+    from impact_balance.cli._options import Subcommands
+    from impact_balance.sim.studies.push import PushOutcome, PushTestResult
 
 __all__ = ["USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
     # No import of the simulation here: mujoco is imported only when a simulation command runs.
+    """Add the ``push-test`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     a = sub.add_parser(
         "push-test", help="push the simulated robot in every direction; score both criteria"
     )
@@ -55,23 +72,30 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``push-test`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     from impact_balance.cli.output import print_json, progress_bar
     from impact_balance.logs import check_log_path
     from impact_balance.scenario import load_scenario
     from impact_balance.sim.studies.push import check_push_arguments, push_test
     from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, write_trial_log
 
-    scenario = load_scenario(args.scenario)
+    scenario = with_margins(load_scenario(args.scenario), args.zmp_margin)
     if args.log:
         check_log_path(args.log)
     check_push_arguments(args.directions, args.magnitudes, args.duration, args.relative)
-    with_zmp_margin(scenario, args.zmp_margin)  # checks the value before any trial
     options = BalanceTrialOptions(controller=args.controller)
     journal = open_journal(args, "push-test", scenario, "servo", options, {"body": args.body})
     levels = len(args.relative or args.magnitudes or [0] * 6)
     bar = progress_bar(f"push-test {scenario.name}", args.directions * levels)
 
-    def progress(outcome):
+    def progress(outcome: PushOutcome) -> None:
         bar.update(1)
         bar.set_postfix_str(f"{outcome.push.magnitude:.1f} N s {outcome.outcome}")
 
@@ -85,7 +109,7 @@ def run(args: argparse.Namespace) -> int:
             progress=progress,
             options=options,
             relative=args.relative,
-            zmp_margin=args.zmp_margin,
+            zmp_margin=scoring_margin(scenario),
             journal=journal,
         )
     finally:
@@ -120,33 +144,37 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _pct(x) -> str:
+def _pct(x: float | None) -> str:
     return "-" if x is None else f"{100 * x:.1f} %"
 
 
-def _ci(c: list | None) -> str:
+def _ci(c: list[float] | None) -> str:
     return "" if c is None else f" [{100 * c[0]:.0f}, {100 * c[1]:.0f}]"
 
 
-def _text(result, out: dict, args: argparse.Namespace) -> str:
+def _text(result: PushTestResult, out: dict[str, Any], args: argparse.Namespace) -> str:
     counts = out["counts"]
     o = counts["outcomes"]
     controller = out["controller"].get("name", args.controller)
     lines = [
-        f"{result.scenario}: {len(result.outcomes)} pushes ({args.directions} directions, {args.duration * 1e3:.0f} ms) "
+        f"{result.scenario}: {len(result.outcomes)} pushes ({args.directions} directions, "
+        f"{args.duration * 1e3:.0f} ms) "
         f"with the {args.controller} controller ({controller})",
-        f"  outcomes: {o['balanced']} balanced, {o['contact_broken']} contact broken (came to rest), "
+        f"  outcomes: {o['balanced']} balanced, {o['contact_broken']} contact broken (came to "
+        "rest), "
         f"{o['fell']} fell, {o['aborted']} aborted",
     ]
     if counts["reasons"]:
         lines.append("  " + ", ".join(f"{k}: {v}" for k, v in sorted(counts["reasons"].items())))
     margin = 1000 * out["zmp_margin"]
     lines.append(
-        f"  {'magnitude':>14s} {'balanced':>8s} {'broken':>6s} {'fell':>5s} {'CoM safe':>8s} {'ZMP safe':>8s}"
+        f"  {'magnitude':>14s} {'balanced':>8s} {'broken':>6s} {'fell':>5s} {'CoM safe':>8s} "
+        f"{'ZMP safe':>8s}"
     )
     for row in _by_level(result):
         lines.append(
-            f"  {row['label']:>14s} {row['balanced']:8d} {row['contact_broken']:6d} {row['fell']:5d} "
+            f"  {row['label']:>14s} {row['balanced']:8d} {row['contact_broken']:6d} "
+            f"{row['fell']:5d} "
             f"{row['com']:8d} {row['zmp']:8d}"
         )
     lines.append(
@@ -166,16 +194,16 @@ def _text(result, out: dict, args: argparse.Namespace) -> str:
         )
     smallest = out["margin_study"]["smallest_margin"]["com"]
     lines.append(
-        "  smallest ZMP margin that brings the CoM criterion's 'predicted safe, fell' to 5 % or less: "
-        + ("none up to 6 cm" if smallest is None else f"{1000 * smallest:g} mm")
+        "  smallest ZMP margin that brings the CoM criterion's 'predicted safe, fell' to 5 % or "
+        "less: " + ("none up to 6 cm" if smallest is None else f"{1000 * smallest:g} mm")
     )
     if out["journal"]:
         lines.append(f"  trials journal: {out['journal']} ({out['reused_trials']} reused)")
     return "\n".join(lines)
 
 
-def _by_level(result) -> list[dict]:
-    rows: dict[float, dict] = {}
+def _by_level(result: PushTestResult) -> list[dict[str, Any]]:
+    rows: dict[float, dict[str, Any]] = {}
     for o in result.outcomes:
         level = o.relative if o.relative is not None else o.push.magnitude
         label = (
@@ -192,9 +220,11 @@ def _by_level(result) -> list[dict]:
     return [rows[k] for k in sorted(rows)]
 
 
-def _telling(result):
-    """The push of the paper's Exp. 2 if there is one (ZMP outside in the trial, no fall), else the largest
-    that did not fall, else the first.
+def _telling(result: PushTestResult) -> PushOutcome:
+    """The push of the paper's Exp.
+
+    2 if there is one (ZMP outside in the trial, no fall), else the largest that did not fall,
+    else the first.
     """
     stood = [o for o in result.scored if not o.fell]
     exp2 = [o for o in stood if not o.safe("zmp_in_trial", 0.0, result.omega)]
@@ -203,7 +233,7 @@ def _telling(result):
     return max(stood, key=lambda o: o.push.magnitude) if stood else result.outcomes[0]
 
 
-def _plots(result, out: Path) -> list[Path]:
+def _plots(result: PushTestResult, out: Path) -> list[Path]:
     from impact_balance.plots.balance import PushView, plot_push_trajectories
     from impact_balance.plots.save import figure_prefix
 
@@ -211,6 +241,6 @@ def _plots(result, out: Path) -> list[Path]:
     prefix = figure_prefix(result.setup.analysis)
     paths = [out / f"{prefix}_push_zmp.png", out / f"{prefix}_push_com_velocity.png"]
     views: tuple[PushView, ...] = ("zmp", "com_velocity")
-    for path, kind in zip(paths, views):
+    for path, kind in zip(paths, views, strict=True):
         plot_push_trajectories(result, kind).savefig(path)
     return paths

@@ -1,10 +1,14 @@
-"""``impact-balance simulate SCENARIO``: the scenario's impact in MuJoCo, measured against the impact model."""
+"""``impact-balance simulate SCENARIO``: the scenario's impact in MuJoCo.
+
+The simulated impact is measured against the impact model.
+"""
 
 from __future__ import annotations
 
 import argparse
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from impact_balance.cli._options import (
     LOG_SUFFIXES,
@@ -15,6 +19,10 @@ from impact_balance.cli._options import (
 )
 from impact_balance.cli.output import print_json
 
+if TYPE_CHECKING:
+    from impact_balance.cli._options import Subcommands
+    from impact_balance.sim.trials.measure import TrialResult
+
 __all__ = ["MAX_SPEEDS", "add_parser", "parse_speeds", "run"]
 
 #: Most approach speeds in one ``simulate`` run (each is one trial, and one file per output).
@@ -23,7 +31,15 @@ MAX_SPEEDS = 100
 USES_KERNEL = False
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
+    """Add the ``simulate`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     a = sub.add_parser(
         "simulate",
         help="simulate the scenario's impact in MuJoCo and compare with the impact model",
@@ -39,20 +55,23 @@ def add_parser(sub) -> list[str]:
         "--joints",
         default="rigid",
         metavar="rigid|servo",
-        help="joint model: rigid (welded at the stance, the paper's model) or servo (position servos)",
+        help="joint model: rigid (welded at the stance, the paper's model) or servo (position "
+        "servos)",
     )
     a.add_argument(
         "--armature",
         type=number("--armature", 0.0, 100.0, "kg m^2"),
         default=None,
         metavar="KG_M2",
-        help="servo only: rotor inertia of every joint, kg m^2 (default: what the robot files declare, "
+        help="servo only: rotor inertia of every joint, kg m^2 (default: what the robot files "
+        "declare, "
         "the SRDF's rotor_params; 0 where they declare none)",
     )
     a.add_argument(
         "--rigid-impact",
         action="store_true",
-        help="servo only: hold every joint's velocity from the contact to the end of the compression "
+        help="servo only: hold every joint's velocity from the contact to the end of the "
+        "compression "
         "(the paper's rigid robot at the impact)",
     )
     a.add_argument(
@@ -84,8 +103,9 @@ def add_parser(sub) -> list[str]:
 
 
 def parse_speeds(text: str) -> list[float]:
-    """Approach speeds from ``"0.1,0.3"``; :class:`SimulationError` on a bad one (see
-    :mod:`impact_balance.ranges` for the range).
+    """Approach speeds from ``"0.1,0.3"``.
+
+    :class:`SimulationError` on a bad one (see :mod:`impact_balance.ranges` for the range).
     """
     from impact_balance.exceptions import SimulationError
     from impact_balance.ranges import check_approach_speed
@@ -108,12 +128,13 @@ def _per_speed(path: str, speed: float, several: bool) -> Path:
     return p.with_name(f"{p.stem}_{speed:g}{p.suffix}") if several else p
 
 
-def _table(name: str, r) -> str:
+def _table(name: str, r: TrialResult) -> str:
     jump = r.com_velocity_jump_measured
     size = float(math.hypot(*jump))
     lines = [
         f"{name}: {r.joints} joints, approach speed {r.approach_speed:.3f} m/s "
-        f"(measured {r.approach_speed_measured:.3f}), restitution measured {r.restitution_measured:.3f}, "
+        f"(measured {r.approach_speed_measured:.3f}), restitution measured "
+        f"{r.restitution_measured:.3f}, "
         f"slip {r.slip_speed:.3f} m/s",
         f"  {'':<26}{'CoM velocity jump x, y (m/s)':<34}{'distance to set (m/s)':>22}",
         f"  {'measured':<26}{jump[0]:+10.5f} {jump[1]:+10.5f}",
@@ -135,11 +156,13 @@ def _table(name: str, r) -> str:
             for name, v in r.sustained_impulses.items()
         ]
         lines.append(
-            f"  impulse at the sustained contacts (force before the impact subtracted), N s: {'; '.join(parts)}"
+            "  impulse at the sustained contacts (force before the impact subtracted), N s: "
+            f"{'; '.join(parts)}"
         )
     if r.hold is not None and r.hold["duration"] is not None:
         lines.append(
-            f"  joints held through the impact for {1e3 * r.hold['duration']:.1f} ms (largest joint velocity "
+            f"  joints held through the impact for {1e3 * r.hold['duration']:.1f} ms (largest "
+            "joint velocity "
             f"change {r.hold['max_joint_velocity_change']:.2g} rad/s)"
         )
     if r.joints == "servo":
@@ -150,6 +173,14 @@ def _table(name: str, r) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``simulate`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     from impact_balance.exceptions import SimulationError
 
     speeds = parse_speeds(args.speed)  # before MuJoCo loads: a bad speed is refused at once
@@ -192,7 +223,7 @@ def run(args: argparse.Namespace) -> int:
                 write_log(
                     log_frame(sim, record),
                     _per_speed(args.log, speed, several),
-                    {"scenario": name, "joints": args.joints, "approach_speed": speed},
+                    {"scenario": name, "joints": args.joints, "approach_speed": str(speed)},
                 )
             )
         if args.video:
@@ -203,7 +234,10 @@ def run(args: argparse.Namespace) -> int:
             from impact_balance.plots.simulation import plot_jump_on_sets, plot_time_series
             from impact_balance.plots.style import DPI
 
-            title = f"{name}: {args.joints} joints, approach {speed:g} m/s, restitution {result.restitution_measured:.2f}"
+            title = (
+                f"{name}: {args.joints} joints, approach {speed:g} m/s, "
+                f"restitution {result.restitution_measured:.2f}"
+            )
             out = Path(args.plots)
             out.mkdir(parents=True, exist_ok=True)
             for kind, fig in (

@@ -15,9 +15,13 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from impact_balance.cli._options import CommandLineError, output_folder
 from impact_balance.cli.output import print_json
+
+if TYPE_CHECKING:
+    from impact_balance.cli._options import Subcommands
 
 __all__ = ["USES_KERNEL", "add_parser", "run"]
 
@@ -44,11 +48,20 @@ def _scheduler(text: str) -> str:
         raise CommandLineError(exc.field, exc.value, exc.reason) from None
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
+    """Add the ``sweep`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     s = sub.add_parser(
         "sweep",
         help="evaluate a sweep file (grid or quasi-random points) on all cores or a Dask cluster",
-        description="Evaluate every point of a sweep file and write one Parquet row per point. Finished chunks "
+        description="Evaluate every point of a sweep file and write one Parquet row per point. "
+        "Finished chunks "
         "are written at once: after Ctrl-C or a crash, the same command resumes.",
     )
     s.add_argument(
@@ -103,7 +116,7 @@ def add_parser(sub) -> list[str]:
     return ["sweep"]
 
 
-def _print(summary: dict, as_json: bool) -> None:
+def _print(summary: dict[str, Any], as_json: bool) -> None:
     from impact_balance.sweep.summary import format_summary
 
     if as_json:
@@ -132,13 +145,22 @@ def _verify(args: argparse.Namespace) -> int:
         )
         verdict = "ok" if check.ok else f"{len(check.problems)} bad part(s)"
         print(
-            f"{args.verify}: {verdict}; {len(check.good)} good parts, {check.rows} of {check.manifest['n_points']} "
+            f"{args.verify}: {verdict}; {len(check.good)} good parts, {check.rows} of "
+            f"{check.manifest['n_points']} "
             f"points; {state}"
         )
     return 0 if check.ok else 2
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``sweep`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     from impact_balance.exceptions import SweepError
     from impact_balance.sweep import bundled_sweeps, load_sweep_spec, make_plan, run_sweep
     from impact_balance.sweep.figures import save_sweep_figures
@@ -178,7 +200,8 @@ def run(args: argparse.Namespace) -> int:
     else:
         from impact_balance.cli.output_paths import check_output_folder
 
-        out = check_output_folder(f"sweep-{Path(spec.source).stem}", "--out")
+        stem = Path(spec.source).stem if spec.source else "sweep"
+        out = check_output_folder(f"sweep-{stem}", "--out")
     report = run_sweep(
         plan,
         out,
@@ -189,13 +212,16 @@ def run(args: argparse.Namespace) -> int:
     )
     where = args.scheduler or f"{report.workers} worker{'s' if report.workers != 1 else ''}"
     print(
-        f"impact-balance sweep: {report.points_computed} points in {report.elapsed_s:.1f} s on {where} "
-        f"({report.rate:.0f} points/s; {report.chunks_before} of {report.n_chunks} chunks were already done) -> {out}",
+        f"impact-balance sweep: {report.points_computed} points in {report.elapsed_s:.1f} s on "
+        f"{where} "
+        f"({report.rate:.0f} points/s; {report.chunks_before} of {report.n_chunks} chunks were "
+        f"already done) -> {out}",
         file=sys.stderr,
     )
     if report.interrupted:
         print(
-            f"impact-balance sweep: interrupted; {report.chunks_before + report.chunks_computed} of {report.n_chunks} "
+            f"impact-balance sweep: interrupted; {report.chunks_before + report.chunks_computed} "
+            f"of {report.n_chunks} "
             "chunks are written: run the same command to resume",
             file=sys.stderr,
         )

@@ -1,24 +1,41 @@
-"""``impact-balance validate SCENARIO``: the empirical fall threshold of the impact beside the predictions."""
+"""``impact-balance validate SCENARIO``: the impact's empirical fall threshold, and predictions.
+
+The threshold is bracketed in MuJoCo and shown beside the criteria's predictions.
+"""
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from impact_balance.cli._options import (
     add_controller_option,
     add_output_options,
     add_trial_options,
     open_journal,
-    with_zmp_margin,
+    scoring_margin,
+    with_margins,
 )
+
+if TYPE_CHECKING:
+    from impact_balance.cli._options import Subcommands
+    from impact_balance.sim.studies.validate import ValidationResult, ValidationTrial
 
 __all__ = ["USES_KERNEL", "add_parser", "run"]
 
 USES_KERNEL = True
 
 
-def add_parser(sub) -> list[str]:
+def add_parser(sub: Subcommands) -> list[str]:
+    """Add the ``validate`` command to the subcommands ``sub``.
+
+    Args:
+        sub: The subcommands of the ``impact-balance`` parser.
+
+    Returns:
+        The names of the commands added (their runner is :func:`run`).
+    """
     a = sub.add_parser(
         "validate", help="bisect the approach speed at which the simulated robot falls (MuJoCo)"
     )
@@ -44,6 +61,14 @@ def add_parser(sub) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``validate`` with the parsed command line.
+
+    Args:
+        args: The parsed command line.
+
+    Returns:
+        The exit status (0; a failure is raised, for the command line's error rule).
+    """
     from impact_balance.cli.output import print_json, progress_bar
     from impact_balance.exceptions import SimulationError
     from impact_balance.logs import check_log_path
@@ -52,7 +77,7 @@ def run(args: argparse.Namespace) -> int:
     from impact_balance.sim.studies.validate import validate
     from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, write_trial_log
 
-    scenario = load_scenario(args.scenario)
+    scenario = with_margins(load_scenario(args.scenario), args.zmp_margin)
     if scenario.impact is None:
         raise SimulationError(
             "impact", None, f"scenario {scenario.name!r} has no impact: validate needs one"
@@ -60,7 +85,6 @@ def run(args: argparse.Namespace) -> int:
     if not (0 < args.max_speed <= 5.0):
         raise SimulationError("--max-speed", args.max_speed, "must be in (0, 5] m/s")
     check_tolerance(args.tolerance)
-    with_zmp_margin(scenario, args.zmp_margin)  # checks the value before any trial
     if args.log:
         check_log_path(args.log)
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
@@ -74,7 +98,7 @@ def run(args: argparse.Namespace) -> int:
     )
     bar = progress_bar(f"validate {scenario.name}")
 
-    def progress(trial, stood, fell):
+    def progress(trial: ValidationTrial, stood: float | None, fell: float | None) -> None:
         bar.update(1)
         lo = "?" if stood is None else f"{stood:.3f}"
         hi = "?" if fell is None else f"{fell:.3f}"
@@ -90,7 +114,7 @@ def run(args: argparse.Namespace) -> int:
             max_speed=args.max_speed,
             progress=progress,
             options=options,
-            zmp_margin=args.zmp_margin,
+            zmp_margin=scoring_margin(scenario),
             journal=journal,
         )
     finally:
@@ -126,17 +150,18 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _f(x) -> str:
+def _f(x: float | None) -> str:
     return "-" if x is None else f"{x:.3f} m/s"
 
 
-def _text(out: dict, args: argparse.Namespace, n: int) -> str:
+def _text(out: dict[str, Any], args: argparse.Namespace, n: int) -> str:
     e, p, pm = out["empirical"], out["predicted"], out["predicted_with_margin"]
     impact = (
         "rigid impact (joints held through the impact)" if out["rigid_impact"] else "free impact"
     )
     lines = [
-        f"{out['scenario']}: fall threshold of the impact ({args.joints} joints, {args.controller} controller, "
+        f"{out['scenario']}: fall threshold of the impact ({args.joints} joints, {args.controller} "
+        "controller, "
         f"{impact}, {n} trials)",
         f"  measured approach speed: stood at {_f(e['survived'])}, fell at {_f(e['fell'])}"
         f" (commanded {_f(e['survived_commanded'])} / {_f(e['fell_commanded'])})"
@@ -145,7 +170,8 @@ def _text(out: dict, args: argparse.Namespace, n: int) -> str:
     brk = out["contact_break"]
     if brk is not None:
         lines.append(
-            f"  first contact break: {brk['contact']} {brk['kind']} at {_f(brk['measured'])} measured "
+            f"  first contact break: {brk['contact']} {brk['kind']} at {_f(brk['measured'])} "
+            "measured "
             f"({brk['outcome']})"
         )
     else:
@@ -165,7 +191,8 @@ def _text(out: dict, args: argparse.Namespace, n: int) -> str:
             t["com_criterion_safe"]
         ]
         lines.append(
-            f"    {t['speed']:.3f} -> {_f(t['approach_speed_measured'])}: {t['outcome']}{why}   {call}"
+            f"    {t['speed']:.3f} -> {_f(t['approach_speed_measured'])}: {t['outcome']}{why}   "
+            f"{call}"
         )
     lines.append(
         f"  controller: {out['controller'].get('name', args.controller)}; joint armature: "
@@ -176,7 +203,7 @@ def _text(out: dict, args: argparse.Namespace, n: int) -> str:
     return "\n".join(lines)
 
 
-def _plots(result, out: Path) -> list[Path]:
+def _plots(result: ValidationResult, out: Path) -> list[Path]:
     from impact_balance.plots.balance import plot_impact_trajectories, plot_validation
     from impact_balance.plots.save import figure_prefix
 

@@ -10,22 +10,34 @@ A :class:`Governor` gives that maximum every control tick, from the measured sta
     u = governor.cap(u_ref)                        # the reference velocity (world, m/s), capped
 
 - :mod:`.governor`: :class:`Governor` (construction, per-tick calls, reuse, the lock).
+- :mod:`.options`: its criterion and the contact-aware options (:class:`ContactAwareOptions`).
 - :mod:`.posture`: what is computed once per posture (:class:`Posture`).
 - :mod:`.limit`: the per-tick answer (:class:`SpeedLimit`) and the cap (:func:`cap_approach`).
 
 See docs/governor.md for the conventions and how pink, mink or any QP controller uses it.
 """
 
-from impact_balance.governor.governor import CRITERIA, Governor
+from impact_balance.governor.governor import Governor
 from impact_balance.governor.limit import SpeedLimit, cap_approach
+from impact_balance.governor.options import (
+    CRITERIA,
+    STARTS,
+    ContactAwareOptions,
+    Criterion,
+    Starts,
+)
 from impact_balance.governor.posture import Posture, PostureEvaluator, PostureSettings
 
 __all__ = [
     "CRITERIA",
+    "STARTS",
+    "ContactAwareOptions",
+    "Criterion",
     "Governor",
     "Posture",
     "PostureEvaluator",
     "PostureSettings",
     "SpeedLimit",
+    "Starts",
     "cap_approach",
 ]

@@ -5,16 +5,20 @@ from __future__ import annotations
 import math
 import os
 import threading
-from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from impact_balance.balance.areas import warm_up as warm_up_maps
 from impact_balance.contacts.stance import has_free_flyer
 from impact_balance.criteria.com import VelocityLimit
 from impact_balance.exceptions import GovernorError, ScenarioError
 from impact_balance.governor.limit import SpeedLimit, cap_approach
+from impact_balance.governor.options import CRITERIA, ContactAwareOptions, Criterion
 from impact_balance.governor.posture import Posture, PostureEvaluator, PostureSettings
 from impact_balance.governor.support import ContactAwareLimit, combine
 from impact_balance.governor.worker import ContactAwareWorker
@@ -29,11 +33,7 @@ from impact_balance.scenario import (
     with_source,
 )
 
-__all__ = ["CRITERIA", "Governor"]
-
-#: The governor's criteria: "com", the CoM velocity area (the paper's); "zmp", the predicted
-#: ZMP stays in the ZMP support area (the paper's Experiment 1 comparison).
-CRITERIA = ("com", "zmp")
+__all__ = ["Governor"]
 
 #: Largest |norm - 1| of the base quaternion in q (pinocchio's order x, y, z, w).
 QUATERNION_TOLERANCE = 1e-6
@@ -64,7 +64,7 @@ class Governor:
     exactly); otherwise only the CoM velocity is new and a tick costs a few microseconds.
     With a tolerance, the answer is that of the posture last computed. The robot model,
     the contact specifications and the impact's friction cone are built once; the governor
-    has its own pinocchio Data (made once, ~2 ms) and allocates no model per tick.
+    has its own pinocchio Data (made once) and allocates no model per tick.
 
     Thread safety. One lock per instance serialises :meth:`limit`, :meth:`limit_com` and
     :meth:`cap` (they share the Data and the cached posture): several threads may call one
@@ -73,85 +73,57 @@ class Governor:
     :meth:`cap` without a ``limit`` caps with the last answer of any thread; pass the
     :class:`SpeedLimit` you got (or call :meth:`SpeedLimit.cap`) to cap with your own.
 
+    Margins. The scenario's ``zmp_margin`` (m) shrinks the ZMP support area; its
+    ``velocity_margin`` (m/s) keeps every post-impact CoM velocity that far inside the CoM
+    velocity area ("com" criterion, both impact models; the "zmp" criterion has none): a margin
+    for the impact model's error, as ``zmp_margin`` is one for the controller's. Both are read
+    as :func:`~impact_balance.analyze` reads them, so ``analyze`` of the same scenario answers
+    the same maximum at the scenario's posture and CoM velocity (see :meth:`scenario_at`).
+
     Args:
         scenario: A :class:`~impact_balance.scenario.Scenario`, a scenario file or a bundled
             name; it must have an ``impact``.
-        criterion: "com" (default) or "zmp" (see :data:`CRITERIA`).
-        posture_tolerance: See "Reuse" above (>= 0).
+        criterion: "com" (default) or "zmp" (:data:`~impact_balance.governor.options.Criterion`).
+        posture_tolerance: See "Reuse" above (>= 0, in the units of q's entries).
         contact_aware: Also bound the speed by the contact-aware impact model's CoM velocity
             jump (:mod:`.support`: the robot standing on its supports; the answer is then the
             criterion for the union of both models' post-impact CoM velocities, the smaller
-            maximum). "com" criterion, composite inertia only. Its jump rates are recomputed
-            every ``contact_aware_every`` posture evaluations (default 5), not every posture;
-            with ``contact_aware_async``, by a worker process off the tick instead (:mod:`.worker`:
-            the tick never waits for them; rates one recomputation old; :meth:`close` stops it).
-            ``contact_aware_starts``: "union" (default: the criterion holds for every solution
-            of the frictional impact LCP reached from the kept solutions and the cold start),
-            "warm" (the option as frozen in commit 5e477e6: one fixed point, warm-started from
-            the previous answer) or "cold" (one, from gauges 0); see :mod:`.support`.
-        contact_aware_async: With ``contact_aware``, recompute its rates in a worker process
-            (:mod:`.worker`, POSIX) instead of in the tick: each posture tick polls for a
-            finished answer (~1 us) and hands the worker the current posture when it is idle;
-            it never waits. Call :meth:`close` (or use ``with``) to stop the worker.
-        velocity_margin: Every post-impact CoM velocity must lie this far (m/s) inside the
-            CoM velocity area ("com" criterion, both models): a margin for the impact model's
-            error, as ``zmp_margin`` is one for the controller's. Default 0, the paper's
-            criterion (and ``analyze()``'s answer, which has no such margin). See
-            docs/governor.md, "A margin for the impact model's error".
+            maximum). "com" criterion, composite inertia only. None or False: off; True: on
+            with the default :class:`~impact_balance.governor.options.ContactAwareOptions`
+            (rates recomputed every 5 posture evaluations, in the tick); or the options.
+        velocity_margin: Overrides the scenario's ``velocity_margin`` (m/s; through
+            :meth:`~impact_balance.scenario.Scenario.replace`, so checked by the schema).
+            None (default): the scenario's.
 
     Raises:
         ScenarioError: no impact, an unknown frame, an impact model that cannot be built at
             the scenario's posture (the scenario is evaluated once, as a check).
-        GovernorError: an unknown criterion or a bad tolerance.
+        GovernorError: an unknown criterion, a bad tolerance, a bad ``velocity_margin``
+            (or one with the "zmp" criterion), contact-aware options with the "zmp" criterion.
     """
 
     def __init__(
         self,
-        scenario: Scenario | str | os.PathLike,
-        criterion: str = "com",
+        scenario: Scenario | str | os.PathLike[str],
+        criterion: Criterion = "com",
+        *,
         posture_tolerance: float = 0.0,
-        contact_aware: bool = False,
-        contact_aware_every: int = 5,
-        contact_aware_starts: str = "union",
-        velocity_margin: float = 0.0,
-        contact_aware_async: bool = False,
-    ):
+        contact_aware: ContactAwareOptions | bool | None = None,
+        velocity_margin: float | None = None,
+    ) -> None:
         if criterion not in CRITERIA:
             raise GovernorError("criterion", criterion, f"must be one of {', '.join(CRITERIA)}")
-        try:
-            velocity_margin = float(velocity_margin)
-        except (TypeError, ValueError):
-            velocity_margin = math.nan
-        if not (math.isfinite(velocity_margin) and 0.0 <= velocity_margin <= 10.0):
-            raise GovernorError(
-                "velocity_margin", velocity_margin, "must be a number in [0, 10] m/s"
-            )
-        if velocity_margin and criterion != "com":
-            raise GovernorError(
-                "velocity_margin", velocity_margin, "applies to the com criterion only"
-            )
-        try:
-            tolerance = float(posture_tolerance)
-        except (TypeError, ValueError):
-            tolerance = math.nan
-        if not (math.isfinite(tolerance) and tolerance >= 0.0):
-            raise GovernorError(
-                "posture_tolerance", posture_tolerance, "must be a finite number >= 0"
-            )
-        if not isinstance(scenario, Scenario):
-            scenario = load_scenario(scenario)
-        if scenario.impact is None:
-            raise with_source(
-                ScenarioError("impact", None, "the governor needs an impact (frame, normal...)"),
-                scenario.source,
-            )
-        self.scenario = scenario
-        self.criterion = criterion
-        self.posture_tolerance = tolerance
+        self.criterion: Criterion = criterion
+        self.posture_tolerance = _tolerance(posture_tolerance)
+        aware = _contact_aware(contact_aware, criterion)
+        self.scenario = scenario = _governed(scenario, criterion, velocity_margin)
+        #: The velocity margin in use, m/s (the scenario's; 0 with the "zmp" criterion).
+        self.velocity_margin = scenario.velocity_margin if criterion == "com" else 0.0
         self.robot: Robot = scenario.load_robot()
         model = self.robot.model
         self.nq, self.nv = model.nq, model.nv
         self._free_flyer = has_free_flyer(model)
+        assert scenario.impact is not None  # _governed refuses a scenario without one
         settings = PostureSettings(
             tuple(c.spec() for c in scenario.contacts),
             scenario.impact.spec(),
@@ -160,50 +132,48 @@ class Governor:
             bool(scenario.torque_limits),
             float(scenario.zmp_margin),
             criterion,
-            velocity_margin,
+            self.velocity_margin,
         )
-        self.velocity_margin = velocity_margin
         #: The scenario's own configuration (lifted onto the ground as ``analyze`` does): a
         #: posture to start from.
         self.configuration: np.ndarray = scenario.build_stance(self.robot).q.copy()
         self._evaluator = PostureEvaluator(self.robot, settings)
         self._lock = threading.Lock()
         self._support: ContactAwareLimit | None = None
-        if contact_aware:
-            if criterion != "com":
-                raise GovernorError("contact_aware", criterion, "bounds the CoM criterion only")
-            self._support = ContactAwareLimit(
-                settings.impact, contact_aware_every, contact_aware_starts
-            )
-        elif contact_aware_async:
-            raise GovernorError(
-                "contact_aware_async", contact_aware_async, "needs contact_aware=True"
-            )
+        if aware is not None:
+            self._support = ContactAwareLimit(settings.impact, aware.every, aware.starts)
         self._worker: ContactAwareWorker | None = None
-        self._posture: Posture | None = None
         self._last: SpeedLimit | None = None
-        warm_up()  # the projection kernel's one-time load, not in the first tick
-        warm_up_bretl()  # the fallback's (HiGHS), so that a tick that falls back pays 5 ms, not 71
-        warm_up_maps()  # and the fallback's compiled map (12 ms on its first call)
-        try:  # a check of the frames, the normal and the friction, at the scenario's posture
-            self._posture = self._evaluator.evaluate(self.configuration)
-        except ScenarioError as exc:
-            raise with_source(exc, scenario.source) from None
-        if (
-            self._posture.com_criterion is not None
-        ):  # load the criterion's compiled code (1-3 ms) here too
-            self._posture.com_criterion.limit(np.zeros(3))
-            self._posture.com_criterion.limits(np.zeros(3), np.zeros((1, 2)))
+        self._posture: Posture | None = self._first_posture()
         self._support_posture: bytes | None = None
-        if self._support is not None and contact_aware_async:
+        if self._support is not None and aware is not None and aware.asynchronous:
             # The worker's first answer (the scenario's posture, which loads its compiled code)
             # gives the first rates; then it keeps them fresh.
-            self._worker = ContactAwareWorker(scenario, contact_aware_starts)
+            self._worker = ContactAwareWorker(scenario, aware.starts)
             self._support.adopt(self._worker.warm_up(self._posture.q))
 
+    def _first_posture(self) -> Posture:
+        """Load the compiled code and evaluate the scenario's posture.
+
+        The posture is a check of the scenario's frames, normal and friction; the first tick
+        then pays for neither.
+        """
+        warm_up()  # the projection kernel's one-time load
+        warm_up_bretl()  # the fallback's (HiGHS), so that a tick that falls back is not slow
+        warm_up_maps()  # and the fallback's compiled map
+        try:
+            posture = self._evaluator.evaluate(self.configuration)
+        except ScenarioError as exc:
+            raise with_source(exc, self.scenario.source) from None
+        if posture.com_criterion is not None:  # the criterion's compiled code, here too
+            posture.com_criterion.limit(np.zeros(3))
+            posture.com_criterion.limits(np.zeros(3), np.zeros((1, 2)))
+        return posture
+
     def close(self) -> None:
-        """Stop the contact-aware worker process, if any (``contact_aware_async``); the
-        governor then recomputes the rates in the tick, as without it. Idempotent.
+        """Stop the contact-aware worker process, if any (``contact_aware_async``).
+
+        The governor then recomputes the rates in the tick, as without it. Idempotent.
         """
         with self._lock:
             if self._worker is not None:
@@ -213,13 +183,19 @@ class Governor:
     def __enter__(self) -> Governor:
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
     # -- per tick ---------------------------------------------------------------------------
-    def limit(self, q: Sequence[float], v: Sequence[float]) -> SpeedLimit:
-        """The speed limit at configuration ``q`` (nq) and generalized velocity ``v`` (nv),
-        pinocchio's order and conventions (see the class docstring).
+    def limit(self, q: ArrayLike, v: ArrayLike) -> SpeedLimit:
+        """The speed limit at configuration ``q`` and generalized velocity ``v``.
+
+        Args:
+            q: The configuration (nq), pinocchio's order and conventions (class docstring).
+            v: The generalized velocity (nv), pinocchio's order and conventions.
+
+        Returns:
+            The speed limit (m/s), its limiting vertex and edge, the safe interval.
 
         Raises:
             GovernorError: ``q`` or ``v`` of the wrong size, not finite, or a base
@@ -228,17 +204,26 @@ class Governor:
             ScenarioError, ImpactModelError, SolverError: a posture the pipeline cannot
                 evaluate (see :meth:`~impact_balance.governor.posture.PostureEvaluator.evaluate`).
         """
-        q = self._configuration(q)
-        v = _vector(v, self.nv, "v")
+        configuration = self._configuration(q)
+        velocity = _vector(v, self.nv, "v")
         with self._lock:
-            posture, reused = self._posture_at(q)
-            return self._answer(posture, posture.com_jacobian @ v, reused)
+            posture, reused = self._posture_at(configuration)
+            return self._answer(posture, posture.com_jacobian @ velocity, reused)
 
-    def limit_com(self, q: Sequence[float], com_velocity: Sequence[float]) -> SpeedLimit:
-        """:meth:`limit` with the CoM velocity given (world, m/s; 2 or 3 numbers, only x and y
-        matter), for a controller with its own CoM velocity estimate.
+    def limit_com(self, q: ArrayLike, com_velocity: ArrayLike) -> SpeedLimit:
+        """:meth:`limit` with the CoM velocity given, for a controller with its own estimate.
+
+        Args:
+            q: The configuration (nq), pinocchio's order and conventions.
+            com_velocity: The CoM velocity (world, m/s; 2 or 3 numbers, only x and y matter).
+
+        Returns:
+            The speed limit, as :meth:`limit`'s.
+
+        Raises:
+            GovernorError: A bad ``q`` (as :meth:`limit`) or ``com_velocity``.
         """
-        q = self._configuration(q)
+        configuration = self._configuration(q)
         c = np.asarray(com_velocity, dtype=float).ravel() if _is_numeric(com_velocity) else None
         if c is None or c.size not in (2, 3) or not math.isfinite(float(c @ c)):
             raise GovernorError(
@@ -246,21 +231,29 @@ class Governor:
             )
         c = np.append(c, 0.0) if c.size == 2 else c.copy()
         with self._lock:
-            posture, reused = self._posture_at(q)
+            posture, reused = self._posture_at(configuration)
             return self._answer(posture, c, reused)
 
     def cap(
-        self, reference_velocity: Sequence[float] | None = None, limit: SpeedLimit | None = None
-    ) -> np.ndarray:
-        """The reference end-effector velocity (world, m/s) with its approach speed brought
-        into the safe interval of ``limit`` (default: this governor's last answer); see
-        :func:`~impact_balance.governor.limit.cap_approach`. Without ``reference_velocity``,
-        the scenario's ``impact.reference_velocity``.
+        self, reference_velocity: ArrayLike | None = None, limit: SpeedLimit | None = None
+    ) -> npt.NDArray[np.float64]:
+        """The reference velocity with its approach speed brought into the safe interval.
+
+        See :func:`~impact_balance.governor.limit.cap_approach`.
+
+        Args:
+            reference_velocity: The reference end-effector velocity (world, m/s); None: the
+                scenario's ``impact.reference_velocity``.
+            limit: The answer whose safe interval caps it (default: this governor's last).
+
+        Returns:
+            The capped velocity (world, m/s).
 
         Raises:
             GovernorError: no limit yet (call :meth:`limit` first), no reference, or a bad one.
         """
         if reference_velocity is None:
+            assert self.scenario.impact is not None  # the constructor refuses a scenario without
             reference_velocity = self.scenario.impact.reference_velocity
             if reference_velocity is None:
                 raise GovernorError(
@@ -275,29 +268,32 @@ class Governor:
                 raise GovernorError("limit", None, "no speed limit yet: call limit(q, v) first")
         return cap_approach(reference_velocity, limit.normal, limit.safe_interval)
 
-    def scenario_at(self, q: Sequence[float], com_velocity: Sequence[float]) -> Scenario:
-        """The scenario :func:`~impact_balance.analyze` answers the same for (without a
-        ``velocity_margin``, which scenarios do not have): this governor's,
-        at configuration ``q`` (every joint by name, an explicit ``base`` pose) with
-        ``com_velocity`` (world, m/s; e.g. a :class:`SpeedLimit`'s). To replay or save a tick.
+    def scenario_at(self, q: ArrayLike, com_velocity: ArrayLike) -> Scenario:
+        """The scenario :func:`~impact_balance.analyze` answers the same for (its margins included).
+
+        This governor's, at configuration ``q`` (every joint by name, an explicit ``base``
+        pose) with ``com_velocity`` (world, m/s; e.g. a :class:`SpeedLimit`'s). To replay or
+        save a tick.
 
         Raises:
             ScenarioError: a joint outside its position limits (scenarios refuse those).
         """
-        q = self._configuration(q)
+        configuration = self._configuration(q)
         c = np.asarray(com_velocity, dtype=float).ravel()
         robot, joints = self.robot, {}
         for name in robot.joint_names:
             slot = robot.joint_slot(name)
             if slot.nq == 1:
-                joints[name] = float(q[slot.idx_q])
+                joints[name] = float(configuration[slot.idx_q])
             elif slot.nq == 2 and slot.nv == 1:  # continuous: (cos, sin)
-                joints[name] = math.atan2(float(q[slot.idx_q + 1]), float(q[slot.idx_q]))
-        update: dict = {"joints": joints, "com_velocity": (float(c[0]), float(c[1]))}
+                cos, sin = configuration[slot.idx_q], configuration[slot.idx_q + 1]
+                joints[name] = math.atan2(float(sin), float(cos))
+        update: dict[str, Any] = {"joints": joints, "com_velocity": (float(c[0]), float(c[1]))}
         if self._free_flyer:
-            rotation = pin.Quaternion(q[3:7]).normalized().matrix()
-            rpy = pin.rpy.matrixToRpy(rotation)
-            update["base"] = BasePose(position=tuple(map(float, q[:3])), rpy=tuple(map(float, rpy)))
+            rotation = pin.Quaternion(configuration[3:7]).normalized().matrix()
+            x, y, z = (float(a) for a in configuration[:3])
+            roll, pitch, yaw = (float(a) for a in pin.rpy.matrixToRpy(rotation))
+            update["base"] = BasePose(position=(x, y, z), rpy=(roll, pitch, yaw))
         raw = self.scenario.model_dump(exclude_none=True)
         raw.update(update)
         raw["base"] = update.get("base", BasePose()).model_dump(exclude_none=True)
@@ -312,27 +308,30 @@ class Governor:
 
     @property
     def posture(self) -> Posture:
-        """The last posture evaluated (the scenario's until the first call): its stance,
-        areas and impact model, for display.
+        """The last posture evaluated (the scenario's until the first call).
+
+        Its stance, areas and impact model, for display.
         """
         with self._lock:
             assert self._posture is not None
             return self._posture
 
     # -- internals ---------------------------------------------------------------------------
-    def _configuration(self, q: Sequence[float]) -> np.ndarray:
-        q = _vector(q, self.nq, "q")
+    def _configuration(self, q: ArrayLike) -> npt.NDArray[np.float64]:
+        """``q`` as a checked configuration vector (see :meth:`limit`)."""
+        configuration = _vector(q, self.nq, "q")
         if self._free_flyer:
-            norm = float(q[3:7] @ q[3:7])
+            quaternion = configuration[3:7]
+            norm = float(quaternion @ quaternion)
             if abs(norm - 1.0) > 2.0 * QUATERNION_TOLERANCE:
                 raise GovernorError(
                     "q",
-                    q[3:7].tolist(),
+                    quaternion.tolist(),
                     "the base quaternion (x, y, z, w) must be unit; normalise it",
                 )
-        return q
+        return configuration
 
-    def _posture_at(self, q: np.ndarray) -> tuple[Posture, bool]:
+    def _posture_at(self, q: npt.NDArray[np.float64]) -> tuple[Posture, bool]:
         """The posture of ``q``, reused when it is the cached one (under the lock)."""
         cached = self._posture
         if cached is not None:
@@ -348,32 +347,44 @@ class Governor:
         self._posture = posture
         return posture, False
 
-    def _answer(self, posture: Posture, com_velocity: np.ndarray, reused: bool) -> SpeedLimit:
+    def _refresh_support(self, support: ContactAwareLimit, posture: Posture) -> None:
+        """Tell the contact-aware limit a posture was evaluated (under the lock).
+
+        In the tick, it recomputes its rates when due; with a worker, a finished answer is
+        collected and the worker handed this posture when idle (never waiting).
+        """
+        if self._worker is None:
+            support.new_posture(lambda: posture.stance)
+        else:
+            done = self._worker.poll()
+            if done is None:
+                support.aged()
+            else:
+                support.adopt(done)
+            if self._worker.idle:
+                self._worker.submit(posture.key, posture.q)
+        self._support_posture = posture.key
+
+    def _answer(
+        self, posture: Posture, com_velocity: npt.NDArray[np.float64], reused: bool
+    ) -> SpeedLimit:
+        """The answer for ``posture`` and the CoM velocity (world, m/s); kept as the last."""
         binding = "floating"
         criterion = posture.com_criterion
-        if criterion is not None and self._support is None:
+        support = self._support
+        limit: VelocityLimit
+        if criterion is not None and support is None:
             limit = criterion.limit(com_velocity)
             interval = criterion.interval(com_velocity, limit)
-        elif criterion is not None:
-            if (
-                self._support_posture != posture.key
-            ):  # a posture evaluated since: the rates may be due
-                if self._worker is None:
-                    self._support.new_posture(lambda: posture.stance)
-                else:  # collect a finished answer, hand the worker this posture; never wait
-                    done = self._worker.poll()
-                    if done is None:
-                        self._support.aged()
-                    else:
-                        self._support.adopt(done)
-                    if self._worker.idle:
-                        self._worker.submit(posture.key, posture.q)
-                self._support_posture = posture.key
-            limit, aware = self._support.answers(criterion, com_velocity)
+        elif criterion is not None and support is not None:
+            if self._support_posture != posture.key:  # a posture since: the rates may be due
+                self._refresh_support(support, posture)
+            limit, aware = support.answers(criterion, com_velocity)
             interval = combine(criterion.interval(com_velocity, limit), aware.interval)
             if aware.limit.max_approach_speed < limit.max_approach_speed:
                 limit, binding = aware.limit, "contact_aware"
         else:
+            assert posture.zmp_limit is not None  # the "zmp" criterion's posture has it
             limit = posture.zmp_limit
             interval = _zmp_interval(limit)
         model = posture.impact
@@ -394,16 +405,77 @@ class Governor:
         return answer
 
 
+def _tolerance(posture_tolerance: float) -> float:
+    """``posture_tolerance`` as a float; :class:`GovernorError` unless finite and >= 0."""
+    try:
+        tolerance = float(posture_tolerance)
+    except (TypeError, ValueError):
+        tolerance = math.nan
+    if not (math.isfinite(tolerance) and tolerance >= 0.0):
+        raise GovernorError("posture_tolerance", posture_tolerance, "must be a finite number >= 0")
+    return tolerance
+
+
+def _contact_aware(
+    option: ContactAwareOptions | bool | None, criterion: Criterion
+) -> ContactAwareOptions | None:
+    """The contact-aware options of ``option`` (None: off).
+
+    :class:`GovernorError` when it is not one of None, a bool or :class:`ContactAwareOptions`,
+    or with the "zmp" criterion.
+    """
+    if option is None or option is False:
+        return None
+    aware = ContactAwareOptions() if option is True else option
+    if not isinstance(aware, ContactAwareOptions):
+        raise GovernorError(
+            "contact_aware", option, "must be True, False, None or a ContactAwareOptions"
+        )
+    if criterion != "com":
+        raise GovernorError("contact_aware", criterion, "bounds the CoM criterion only")
+    return aware
+
+
+def _governed(
+    scenario: Scenario | str | os.PathLike[str], criterion: Criterion, margin: float | None
+) -> Scenario:
+    """The scenario a governor answers for.
+
+    Loaded, with an impact, its ``velocity_margin`` replaced by ``margin`` when given
+    (:class:`GovernorError` naming ``velocity_margin`` when the schema refuses it, or when it is
+    not 0 with the "zmp" criterion).
+    """
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario if isinstance(scenario, str) else Path(scenario))
+    if scenario.impact is None:
+        raise with_source(
+            ScenarioError("impact", None, "the governor needs an impact (frame, normal...)"),
+            scenario.source,
+        )
+    if margin is None:
+        return scenario
+    try:
+        scenario = scenario.replace(velocity_margin=margin)
+    except ScenarioError as exc:
+        raise GovernorError("velocity_margin", margin, exc.reason) from None
+    if scenario.velocity_margin and criterion != "com":
+        raise GovernorError("velocity_margin", margin, "applies to the com criterion only")
+    return scenario
+
+
 def _zmp_interval(limit: VelocityLimit) -> tuple[float, float] | None:
-    """The ZMP criterion's safe speeds: from 0 to its maximum, or none when it is already
-    violated (the CoM's vertical outside the ZMP area) or the area is empty.
+    """The ZMP criterion's safe speeds.
+
+    From 0 to its maximum, or none when it is already violated (the CoM's vertical outside the
+    ZMP area) or the area is empty.
     """
     if limit.status in ("ok", "unbounded"):
         return 0.0, limit.max_approach_speed
     return None
 
 
-def _is_numeric(x) -> bool:
+def _is_numeric(x: object) -> bool:
+    """Whether ``x`` converts to a float array."""
     try:
         np.asarray(x, dtype=float)
     except (TypeError, ValueError):
@@ -411,7 +483,7 @@ def _is_numeric(x) -> bool:
     return True
 
 
-def _vector(x: Sequence[float], size: int, field: str) -> np.ndarray:
+def _vector(x: ArrayLike, size: int, field: str) -> npt.NDArray[np.float64]:
     """``x`` as a contiguous float vector of ``size`` finite entries (a copy when converted)."""
     try:
         a = np.ascontiguousarray(x, dtype=float)

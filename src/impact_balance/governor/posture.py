@@ -6,8 +6,10 @@ polytope and its projection (the ZMP support area and the CoM velocity area), th
 model at the impacting frame, and the criterion's data that do not depend on the CoM velocity.
 
 The steps are the pipeline's own functions at the array level
-(:func:`~impact_balance.contacts.stance.frame_point`, :func:`~impact_balance.contacts.wrench_polytope.assemble_polytope`,
-:func:`~impact_balance.balance.areas.areas_from_polytope`, :func:`~impact_balance.impact.model.model_from_inertia_map`,
+(:func:`~impact_balance.contacts.stance.frame_point`,
+:func:`~impact_balance.contacts.wrench_polytope.assemble_polytope`,
+:func:`~impact_balance.balance.areas.areas_from_polytope`,
+:func:`~impact_balance.impact.model.model_from_inertia_map`,
 :class:`~impact_balance.criteria.com.ComCriterion`), so a governor answers what
 :func:`~impact_balance.analyze` answers for the same posture (the tests check it to 1e-9);
 what a control loop does not read is skipped: the :class:`~impact_balance.contacts.stance.Stance`
@@ -22,6 +24,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 
 from impact_balance.balance.areas import (
@@ -35,6 +38,7 @@ from impact_balance.contacts.stance import ContactSpec, Stance, frame_point, has
 from impact_balance.contacts.wrench_polytope import assemble_polytope, friction_scaling
 from impact_balance.criteria.com import ComCriterion, VelocityLimit, zmp_max_contact_velocity
 from impact_balance.exceptions import SolverError
+from impact_balance.governor.options import Criterion
 from impact_balance.impact.model import (
     ImpactModel,
     ImpactSpec,
@@ -64,7 +68,8 @@ class PostureSettings:
         zmp_margin: The ZMP support area is shrunk by this margin, m.
         criterion: "com" or "zmp".
         velocity_margin: The post-impact CoM velocities must lie this far inside the CoM
-            velocity area, m/s ("com" criterion; :class:`~impact_balance.criteria.com.ComCriterion`).
+            velocity area, m/s ("com" criterion;
+            :class:`~impact_balance.criteria.com.ComCriterion`).
     """
 
     contacts: Sequence[ContactSpec]
@@ -73,7 +78,7 @@ class PostureSettings:
     gravity: float
     torque_limits: bool
     zmp_margin: float
-    criterion: str
+    criterion: Criterion
     velocity_margin: float = 0.0
 
 
@@ -120,16 +125,18 @@ class Posture:
 
     @functools.cached_property
     def stance(self) -> Stance:
-        """The :class:`~impact_balance.contacts.stance.Stance` at ``q`` (built on first access, in the
-        robot's per-thread Data, ~50 us): for plots and displays.
+        """The :class:`~impact_balance.contacts.stance.Stance` at ``q``, for plots and displays.
+
+        Built on first access, in the robot's per-thread Data.
         """
         return Stance(self.robot, self.q, self.settings.contacts)
 
 
 class PostureEvaluator:
-    """Evaluates postures of one robot with one set of contacts and one impact, in a Data
-    of its own (not thread-safe: its owner, a :class:`~impact_balance.governor.Governor`,
-    holds a lock around :meth:`evaluate`).
+    """Evaluates postures of one robot with one set of contacts and one impact.
+
+    It has a pinocchio Data of its own and is not thread-safe: its owner, a
+    :class:`~impact_balance.governor.Governor`, holds a lock around :meth:`evaluate`.
 
     What does not depend on q is made once here: frame indices, the contact-frame CWC faces,
     the torque-limited joints, the impact's friction cone, the buffers.
@@ -147,7 +154,7 @@ class PostureEvaluator:
         self.model = model = pin.Model(robot.model)
         self._frames = [
             _point_frame(model, fid, c.offset, f"impact_balance_contact_{i}")
-            for i, (fid, c) in enumerate(zip(frames, contacts))
+            for i, (fid, c) in enumerate(zip(frames, contacts, strict=True))
         ]
         self._impact_frame = _point_frame(
             model, impact_frame, impact.offset, "impact_balance_impact"
@@ -165,9 +172,8 @@ class PostureEvaluator:
         self._scaled = any(mu > 1.0 for mu in self._frictions)  # else friction_scaling is None
         idx, limit = robot.effort_limits
         self._torques = bool(settings.torque_limits and m and idx.size)
-        self._idx, self._limit = (
-            (idx, limit) if self._torques else (np.zeros(0, dtype=np.int64), np.zeros(0))
-        )
+        self._idx: npt.NDArray[np.int64] = idx if self._torques else np.zeros(0, dtype=np.int64)
+        self._limit: npt.NDArray[np.float64] = limit if self._torques else np.zeros(0)
         self._normal, self._cone = impact_cone(impact)
         # Buffers, overwritten every posture (the answers keep copies).
         self._q_local = np.zeros(model.nq)
@@ -218,42 +224,9 @@ class PostureEvaluator:
         # computeGeneralizedGravity to rounding (1e-14 N m of 327 on G1), without its pass.
         gravity_torques = -(self._gravity @ data.Ag[:3]) if self._torques else self._zero_velocity
         com = com_local + origin
-        try:
-            if self._scaled:  # a friction above 1: the polytope in friction-normalised variables
-                polytope = assemble_polytope(
-                    self._faces,
-                    rotations,
-                    local + origin,
-                    local - com_local,
-                    mass,
-                    com,
-                    settings.gravity,
-                    jacobians,
-                    self._idx,
-                    self._limit,
-                    gravity_torques,
-                    friction_scaling(self._frictions, rotations),
-                )
-                areas = areas_from_polytope(polytope, settings.plane_height, settings.zmp_margin)
-            else:  # the same numbers, assembled and projected in one compiled call
-                areas = projected_from_arrays(
-                    self._faces,
-                    rotations,
-                    local + origin,
-                    local - com_local,
-                    mass,
-                    com,
-                    settings.gravity,
-                    jacobians,
-                    self._idx,
-                    self._limit,
-                    gravity_torques,
-                    settings.plane_height,
-                    settings.zmp_margin,
-                    self._hint,
-                )
-        except SolverError as exc:
-            raise exc.within("contacts (projection of the contact wrench polytope)") from None
+        areas = self._areas(
+            rotations, local, origin, com_local, mass, com, jacobians, gravity_torques
+        )
         impact = self._impact(
             q, q_local, origin, com_local, mass, np.array(Ig.inertia, dtype=float)
         )
@@ -287,6 +260,65 @@ class PostureEvaluator:
             zmp,
         )
 
+    def _areas(
+        self,
+        rotations: npt.NDArray[np.float64],
+        local: npt.NDArray[np.float64],
+        origin: npt.NDArray[np.float64],
+        com_local: npt.NDArray[np.float64],
+        mass: float,
+        com: npt.NDArray[np.float64],
+        jacobians: npt.NDArray[np.float64],
+        gravity_torques: npt.NDArray[np.float64],
+    ) -> BalanceAreas | Projected:
+        """The contact wrench polytope of the contacts' poses, projected.
+
+        The ZMP support area and the CoM velocity area (positions in m, world axes;
+        ``local``: the contact points in the stance frame, origin at ``origin``).
+
+        Raises:
+            SolverError: The projection failed (naming the contacts).
+        """
+        settings = self.settings
+        areas: BalanceAreas | Projected
+        try:
+            if self._scaled:  # a friction above 1: the polytope in friction-normalised variables
+                polytope = assemble_polytope(
+                    self._faces,
+                    rotations,
+                    local + origin,
+                    local - com_local,
+                    mass,
+                    com,
+                    settings.gravity,
+                    jacobians,
+                    self._idx,
+                    self._limit,
+                    gravity_torques,
+                    friction_scaling(self._frictions, list(rotations)),
+                )
+                areas = areas_from_polytope(polytope, settings.plane_height, settings.zmp_margin)
+            else:  # the same numbers, assembled and projected in one compiled call
+                areas = projected_from_arrays(
+                    self._faces,
+                    rotations,
+                    local + origin,
+                    local - com_local,
+                    mass,
+                    com,
+                    settings.gravity,
+                    jacobians,
+                    self._idx,
+                    self._limit,
+                    gravity_torques,
+                    settings.plane_height,
+                    settings.zmp_margin,
+                    self._hint,
+                )
+        except SolverError as exc:
+            raise exc.within("contacts (projection of the contact wrench polytope)") from None
+        return areas
+
     def _impact(
         self,
         q: np.ndarray,
@@ -296,9 +328,13 @@ class PostureEvaluator:
         mass: float,
         inertia: np.ndarray,
     ) -> ImpactModel:
-        """The impact model at the kinematics held in the Data (as :func:`~impact_balance.impact.model.impact_model`)."""
+        """The impact model at the kinematics held in the Data.
+
+        As :func:`~impact_balance.impact.model.impact_model` computes it.
+        """
         spec, data, model = self.settings.impact, self.scratch.data, self.model
         placement, J6 = frame_point(model, data, self._impact_frame, None)
+        assert J6 is not None  # frame_point gives the Jacobian unless told not to
         point_local = placement.translation.copy()
         arm = point_local - com_local
         J = J6[:3].copy()
@@ -313,12 +349,18 @@ class PostureEvaluator:
 
 
 def _point_frame(model: pin.Model, fid: int, offset: pin.SE3 | None, name: str) -> int:
-    """The id of a frame of ``model`` at frame ``fid`` times ``offset``: ``fid`` itself without
-    an offset, else a new operational frame on the same joint (``model`` is modified).
+    """The id of a frame of ``model`` at frame ``fid`` times ``offset``.
+
+    ``fid`` itself without an offset, else a new operational frame on the same joint (``model``
+    is modified).
     """
     if offset is None or offset == pin.SE3.Identity():  # exact, as frame_point tests it
         return fid
     frame = model.frames[fid]
-    return model.addFrame(
-        pin.Frame(name, frame.parentJoint, fid, frame.placement * offset, pin.FrameType.OP_FRAME)
+    return int(
+        model.addFrame(
+            pin.Frame(
+                name, frame.parentJoint, fid, frame.placement * offset, pin.FrameType.OP_FRAME
+            )
+        )
     )

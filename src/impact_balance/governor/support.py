@@ -2,59 +2,51 @@
 
 The paper's impact model lets the composite robot float through the impact (the post-impact
 CoM velocities form a set, one vertex per friction-cone edge and restitution bound). On some
-stances the supports change the jump: G1's feet keep it from turning about its CoM, so its
-CoM velocity jump is larger than any vertex of the floating set (docs/validation.md, "A
-contact-aware impact model"). :class:`ContactAwareLimit` adds, to the criterion's post-impact
-set, the jumps of :func:`impact_balance.impact.contact_aware.contact_impact` (every support corner a
-unilateral, frictional, plastic point contact; no preload) at both ends of the restitution
-range: the governor then answers for the union of the two models' post-impact CoM velocities,
-i.e. the smaller of the two maximum approach speeds (``Governor(..., contact_aware=True)``).
+stances the supports change the jump (docs/validation.md, "A contact-aware impact model").
+:class:`ContactAwareLimit` adds, to the criterion's post-impact set, the jumps of
+:func:`impact_balance.impact.contact_aware.contact_impact` (every support corner a unilateral,
+frictional, plastic point contact; no preload) at both ends of the restitution range: the
+governor then answers for the union of the two models' post-impact CoM velocities, i.e. the
+smaller of the two maximum approach speeds (``Governor(..., contact_aware=True)``).
 
-Several solutions: the union (default, ``starts="union"``). The frictional impact LCP is not
-convex and may have several solutions (on ``palm_push_ramp`` near the wall, two: lateral jump
-+0.12 and +0.043 per m/s; docs/contact_aware_governor.md, section 4). The De Saxce fixed point
-reaches one of them, depending on its starting gauges. Since the model cannot say which one the
-robot will follow, the criterion must hold for every solution found: at each recomputation and
-each restitution bound, the fixed point is run from a fixed, deterministic set of starts,
+Several solutions. The frictional impact LCP is not convex and may have several solutions;
+the De Saxce fixed point reaches one of them, depending on its starting gauges. With
+``starts="union"`` (the default) the criterion holds for every solution found: at each
+recomputation and each restitution bound, the fixed point is run from a fixed, deterministic
+set of starts,
 
-1. every distinct solution kept from the previous recomputation (the first of them continues the
-   first posture's answer: the frozen warm-started option's branch). A solution of the LCP moves
-   continuously with the posture while it exists, so continuing each one tracks every branch
-   found so far; a branch that ends makes its start converge to another solution (merged);
-2. the cold start (gauges 0, Anitescu's relaxation first): the solution reached from no
-   knowledge of the past, which finds a branch that appears during the approach;
+1. every distinct converged solution kept from the previous recomputation, in order (a
+   solution moves continuously with the posture while it exists, so continuing each one
+   tracks every branch found so far; a branch that ends converges onto another: merged);
+2. the cold start (gauges 0), which finds a branch that appears during the approach;
 
 and every distinct solution reached is kept (rates (k, 2), k >= 2): the limit is the smallest
-over all of them, the safe interval the intersection. Nothing here depends on any trial's
-outcome. ``starts="warm"`` is the option as frozen in commit 5e477e6 (one start, the previous
-answer) and ``starts="cold"`` the post hoc cold start, both kept for the record.
+over all of them, the safe interval the intersection. ``starts="warm"`` runs one fixed point
+per bound from the previous answer, ``starts="cold"`` one from gauges 0
+(:data:`~impact_balance.governor.options.Starts`).
 
-Scored (docs/contact_aware_governor.md, section 5; frozen in commit e0ce502): the union changes
-no outcome on the four stances of the wall study. It lowers the ramp's cap by 2 to 2.5 % where
-the cold start finds a second branch before the contact (trials that stood either way); where the
-ramp falls (walls 12 and 13.5 cm) the LCP has one solution at the contact posture, the cap is
-honoured to 0.1 %, and the model's residual at the inset edge (-0.008 to +0.005 m/s) decides.
-
-Cost. The contact-aware jump is a fixed point of small QPs (2 to 40 ms per start and posture);
-it changes slowly with the posture, so it is recomputed on the first posture and then every
-``every``-th posture evaluation (default 5: every 10 ms at 500 Hz) and, in between, the last jump
-rates are used with the current posture's area and CoM velocity. The jump is linear in the
-approach speed (no preload), so one solve per start and restitution bound at 1 m/s gives the
-rates. The union costs one fixed point per start, the cold start the slowest: median 8 to 67 ms
-per recomputation on the wall study's stances (up to 164 ms on the ramp with two solutions kept),
-2.2 to 2.8 times the warm start's (docs/contact_aware_governor.md, section 5).
+Cost and freshness. The jump is a fixed point of small QPs (milliseconds to a few hundred
+milliseconds per recomputation, more with more starts). It is recomputed on the first posture
+and then every ``every``-th posture evaluation; in between, the last rates are used with the
+current posture's area and CoM velocity (:attr:`ContactAwareAnswer.age` counts the postures
+since). The jump is linear in the approach speed (no preload), so one solve per start and
+restitution bound at 1 m/s gives the rates. Units: rates in m/s of CoM velocity (world xy)
+per m/s of approach speed. Not thread-safe: the governor calls it under its lock.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance.contacts.stance import Stance
 from impact_balance.criteria.com import ComCriterion, VelocityLimit, speed_interval
 from impact_balance.exceptions import GovernorError
+from impact_balance.governor.options import STARTS, ContactAwareOptions, Starts
 from impact_balance.impact.contact_aware import contact_impact
 from impact_balance.impact.model import ImpactSpec
 
@@ -67,11 +59,6 @@ __all__ = [
     "contact_aware_solutions",
 ]
 
-#: The fixed-point starts of :class:`ContactAwareLimit` (module docstring): "union" (default:
-#: every solution reached from the kept solutions and the cold start), "warm" (the previous
-#: answer only, as frozen in commit 5e477e6), "cold" (gauges 0 only, the post hoc variant).
-STARTS = ("union", "warm", "cold")
-
 #: Two fixed points are the same solution when their body velocity changes per m/s of approach
 #: speed differ by at most this (max norm; m/s and rad/s per m/s). The fixed point stops when no
 #: gauge changes by more than 1e-9 m/s per m/s, so runs to one solution agree to ~1e-8; the
@@ -82,10 +69,12 @@ SAME_SOLUTION = 1e-6
 def contact_aware_rates(
     stance: Stance, spec: ImpactSpec, warm: list[np.ndarray] | None = None
 ) -> tuple[np.ndarray, list[np.ndarray], bool]:
-    """One fixed point per restitution bound (the frozen option's ``starts="warm"``): the
-    contact-aware CoM velocity jump per m/s of approach speed, world xy, at the lower and the
-    upper restitution bound: ``(rates (2, 2), body velocity changes (6,) per m/s: (dv_c, dw),
-    world, for a warm start, converged)``. ``warm``: one such change per bound, or None (cold).
+    """One fixed point per restitution bound (``starts="warm"``).
+
+    The contact-aware CoM velocity jump per m/s of approach speed, world xy, at the lower and
+    the upper restitution bound: ``(rates (2, 2), body velocity changes (6,) per m/s: (dv_c,
+    dw), world, for a warm start, converged)``. ``warm``: one such change per bound, or None
+    (cold).
     """
     solutions = _one_per_bound(stance, spec, warm)
     return solutions.rates, list(solutions.states), bool(solutions.converged.all())
@@ -93,7 +82,9 @@ def contact_aware_rates(
 
 @dataclass(frozen=True)
 class ContactAwareSolutions:
-    """Every distinct contact-aware jump found from a set of starts (:func:`contact_aware_solutions`).
+    """Every distinct contact-aware jump found from a set of starts.
+
+    See :func:`contact_aware_solutions`.
 
     Attributes:
         rates: (k, 2) CoM velocity jump per m/s of approach speed, world xy (m/s per m/s), one
@@ -103,7 +94,7 @@ class ContactAwareSolutions:
         states: (k, 6) each row's body velocity change per m/s, (dv_c m/s, dw rad/s) per m/s,
             world: the starts of the next recomputation.
         converged: (k,) whether each row's fixed point was reached (else its last iterate,
-            kept: the criterion answers for it too, as the frozen option did).
+            kept: the criterion answers for it too).
         iterations: QP solves of all the starts (the cost).
         starts: Fixed points run (starts times restitution bounds).
     """
@@ -115,10 +106,11 @@ class ContactAwareSolutions:
     iterations: int
     starts: int
 
-    def of_bound(self, c_r: float) -> np.ndarray:
+    def of_bound(self, c_r: float) -> npt.NDArray[np.float64]:
         """The states (m, 6) of the converged solutions at restitution ``c_r`` (the next starts)."""
         keep = (self.restitution == c_r) & self.converged
-        return self.states[keep]
+        states: npt.NDArray[np.float64] = self.states[keep]
+        return states
 
 
 def contact_aware_solutions(
@@ -128,11 +120,13 @@ def contact_aware_solutions(
     cold: bool = True,
     tolerance: float = SAME_SOLUTION,
 ) -> ContactAwareSolutions:
-    """The union of the contact-aware impact's solutions reached from several starts, per
-    restitution bound (module docstring): starts are every converged solution of ``previous`` at
-    that bound (in its order), then, when ``cold``, gauges 0. Fixed points within ``tolerance``
-    (max norm of the body velocity change per m/s) of a kept one are the same solution; a
-    non-converged fixed point is kept as a row (flagged) but not carried as a start.
+    """The union of the contact-aware impact's solutions reached from several starts.
+
+    Per restitution bound (module docstring), the starts are every converged solution of
+    ``previous`` at that bound (in its order), then, when ``cold``, gauges 0. Fixed points
+    within ``tolerance`` (max norm of the body velocity change per m/s) of a kept one are the
+    same solution; a non-converged fixed point is kept as a row (flagged) but not carried as a
+    start.
 
     Args:
         stance: The posture (its sustained contacts and composite inertia).
@@ -172,10 +166,15 @@ def contact_aware_solutions(
     )
 
 
-def _one_per_bound(stance: Stance, spec: ImpactSpec, guesses) -> ContactAwareSolutions:
-    """One fixed point per restitution bound, from ``guesses[k]`` (a body velocity change (6,)
-    per m/s) or, without guesses, gauges 0: 2 rows even when both bounds give the same jump
-    (the frozen option's ``starts="warm"`` and the post hoc ``"cold"``).
+def _one_per_bound(
+    stance: Stance,
+    spec: ImpactSpec,
+    guesses: Sequence[npt.NDArray[Any]] | npt.NDArray[Any] | None,
+) -> ContactAwareSolutions:
+    """One fixed point per restitution bound (``starts="warm"`` and ``"cold"``).
+
+    From ``guesses[k]`` (a body velocity change (6,) per m/s) or, without guesses, gauges 0:
+    2 rows even when both bounds give the same jump.
     """
     rows, iterations = [], 0
     for k, c_r in enumerate(float(c) for c in spec.restitution):
@@ -191,7 +190,7 @@ def _one_per_bound(stance: Stance, spec: ImpactSpec, guesses) -> ContactAwareSol
             )
         )
         iterations += r.iterations
-    rates, restitution, states, converged = (np.array(x) for x in zip(*rows))
+    rates, restitution, states, converged = (np.array(x) for x in zip(*rows, strict=True))
     return ContactAwareSolutions(
         rates, restitution, states, converged.astype(bool), iterations, len(rows)
     )
@@ -223,36 +222,32 @@ class ContactAwareAnswer:
     age: int
     converged: bool
     restitution: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    starts: str = "warm"
+    starts: Starts = "warm"
     solves: int = 0
 
 
 class ContactAwareLimit:
-    """The contact-aware jump's speed limit for a governor (module docstring); not thread-safe
-    (its governor calls it under its lock).
+    """The contact-aware jump's speed limit for a governor (module docstring).
+
+    Not thread-safe (its governor calls it under its lock).
 
     Args:
         spec: The scenario's impact (composite inertia model).
         every: Recompute the jump rates every this many posture evaluations (>= 1).
         starts: "union" (default: every solution reached from the kept solutions and the cold
-            start), "warm" (the frozen option: the previous answer only) or "cold" (gauges 0
+            start), "warm" (the previous answer only) or "cold" (gauges 0
             only); see :data:`STARTS`.
     """
 
-    def __init__(self, spec: ImpactSpec, every: int = 5, starts: str = "union"):
+    def __init__(self, spec: ImpactSpec, every: int = 5, starts: Starts = "union"):
         if spec.inertia != "composite":
             raise GovernorError(
                 "contact_aware", spec.inertia, "the contact-aware model is the composite one"
             )
-        if not (isinstance(every, (int, np.integer)) and every >= 1):
-            raise GovernorError("contact_aware_every", every, "must be an integer >= 1")
-        if starts not in STARTS:
-            raise GovernorError(
-                "contact_aware_starts", starts, f"must be one of {', '.join(STARTS)}"
-            )
+        options = ContactAwareOptions(every, starts)  # checks both
         self.spec = spec
-        self.every = int(every)
-        self.starts = starts
+        self.every: int = options.every
+        self.starts: Starts = options.starts
         self._solutions: ContactAwareSolutions | None = None
         self._converged = False  # whether every fixed point of _solutions was reached
         self._age = 0
@@ -270,9 +265,17 @@ class ContactAwareLimit:
     def solve(
         self, stance: Stance, kept: ContactAwareSolutions | None = None
     ) -> ContactAwareSolutions:
-        """The rates at ``stance`` from the option's starts, continuing ``kept`` (the solutions
-        to start from; default: this limit's own), without adopting them (:meth:`adopt`): what
-        a worker process computes for its governor (:mod:`.worker`).
+        """The rates at ``stance`` from the option's starts, without adopting them.
+
+        What a worker process computes for its governor (:mod:`.worker`); :meth:`adopt` makes
+        them this limit's.
+
+        Args:
+            stance: The posture.
+            kept: The solutions to start from (default: this limit's own).
+
+        Returns:
+            The solutions found.
         """
         return self._solve(stance, self._solutions if kept is None else kept)
 
@@ -287,8 +290,9 @@ class ContactAwareLimit:
         self._age += 1
 
     def new_posture(self, stance_of: Callable[[], Stance]) -> None:
-        """A posture was evaluated; ``stance_of()`` builds its :class:`Stance` (called only when
-        the rates are due).
+        """A posture was evaluated.
+
+        ``stance_of()`` builds its :class:`Stance` (called only when the rates are due).
         """
         if self._solutions is None or self._count % self.every == 0:
             self.adopt(self._solve(stance_of(), self._solutions))
@@ -297,19 +301,35 @@ class ContactAwareLimit:
         self._count += 1
 
     def answer(self, criterion: ComCriterion, com_velocity: np.ndarray) -> ContactAwareAnswer:
-        """The limit and interval (m/s of approach speed) for the CoM velocity area of
-        ``criterion`` (world xy, m/s; the posture's :class:`~impact_balance.criteria.com.ComCriterion`,
-        its velocity margin included) and the pre-impact CoM velocity (world, m/s): the first
-        exit over every row of the rates (the smallest speed), the intersection of their safe
-        intervals.
+        """The contact-aware limit and safe interval (m/s of approach speed).
+
+        The first exit over every row of the rates (the smallest speed), and the intersection
+        of their safe intervals.
+
+        Args:
+            criterion: The posture's :class:`~impact_balance.criteria.com.ComCriterion` (its
+                CoM velocity area, world xy, m/s, and its velocity margin).
+            com_velocity: The pre-impact CoM velocity (world, m/s).
+
+        Returns:
+            The contact-aware answer.
         """
         return self.answers(criterion, com_velocity)[1]
 
     def answers(
         self, criterion: ComCriterion, com_velocity: np.ndarray
     ) -> tuple[VelocityLimit, ContactAwareAnswer]:
-        """``criterion.limit(com_velocity)`` (the floating model's limit) and :meth:`answer`,
-        in one compiled call: a governor's tick.
+        """The floating model's limit and :meth:`answer`, in one compiled call (a tick).
+
+        Args:
+            criterion: As in :meth:`answer`.
+            com_velocity: As in :meth:`answer`.
+
+        Returns:
+            ``criterion.limit(com_velocity)`` and :meth:`answer`'s answer.
+
+        Raises:
+            GovernorError: No posture evaluated yet.
         """
         s = self._solutions
         if s is None:
@@ -339,8 +359,9 @@ class ContactAwareLimit:
 def combine(
     floating: tuple[float, float] | None, aware: tuple[float, float] | None
 ) -> tuple[float, float] | None:
-    """The approach speeds (m/s) safe for both models: the intersection of two safe intervals
-    (or None).
+    """The approach speeds (m/s) safe for both models.
+
+    The intersection of two safe intervals (or None).
     """
     if floating is None or aware is None:
         return None

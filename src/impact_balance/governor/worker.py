@@ -1,21 +1,24 @@
 """The contact-aware rates in a process of their own, off the control tick.
 
-``Governor(..., contact_aware=True, contact_aware_async=True)``: the contact-aware impact's jump
-rates (:mod:`.support`, 3 to 170 ms per recomputation) are computed by a worker process while
-the governor keeps ticking with the last rates it received. Each tick the governor collects a
-finished answer if there is one (a pipe poll, microseconds) and, when the worker is idle, sends
-it the current posture; the tick itself never waits. The worker continues from its own last
-answer, which is the one the governor uses (it adopts every answer it receives), so a request is
-the posture only: sending the solutions back cost 60 to 150 us on the ticks that sent one. The
-rates in use are therefore those of a posture one recomputation old (tens of ms: the age in
-postures is :attr:`~.support.ContactAwareAnswer.age`), where the synchronous option recomputes
-every 5th posture inside the tick.
+``Governor(..., contact_aware=ContactAwareOptions(asynchronous=True))``: the contact-aware
+impact's jump rates (:mod:`.support`) are computed by a worker process while the governor keeps
+ticking with the last rates it received. Each tick the governor collects a finished answer if
+there is one (a pipe poll that never waits) and, when the worker is idle, sends it the current
+posture. The worker continues from its own last answer, which is the one the governor uses (it
+adopts every answer it receives), so a request is the posture only. The rates in use are
+therefore those of a posture one recomputation old (their age in postures is
+:attr:`~.support.ContactAwareAnswer.age`).
 
-The worker runs at the lowest scheduling priority (nice 19: it computes on a core the control
-loop leaves free, and its wake-up never preempts the loop), builds its own robot from the
+Processes. The worker is a fresh interpreter (``python -m impact_balance.governor.worker``)
+joined by a socket pair; it runs at the lowest scheduling priority (nice 19: it computes on a
+core the control loop leaves free and never preempts it), builds its own robot from the
 scenario once and answers until the governor closes it (:meth:`Governor.close`, the end of a
-``with`` block, or the governor's collection). POSIX only (the worker inherits one end of a
-socket pair).
+``with`` block, or the governor's collection). On a machine whose every core is busy it gets
+little time and its rates age. POSIX only (the worker inherits one end of a socket pair).
+
+Failures are :class:`~impact_balance.exceptions.GovernorError` naming ``contact_aware_async``:
+a worker that cannot start, does not answer in :data:`START_TIMEOUT`, ends, or fails on a
+posture (raised on the governor's next tick).
 """
 
 from __future__ import annotations
@@ -27,12 +30,16 @@ import subprocess
 import sys
 import weakref
 from multiprocessing.connection import Connection
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from impact_balance.exceptions import GovernorError
+from impact_balance.exceptions import GovernorError, ScenarioError
+from impact_balance.governor.options import Starts
 from impact_balance.governor.support import ContactAwareLimit, ContactAwareSolutions
+
+if TYPE_CHECKING:
+    from impact_balance.scenario import Scenario
 
 __all__ = ["ContactAwareWorker"]
 
@@ -41,22 +48,24 @@ START_TIMEOUT = 120.0
 
 
 def _serve(conn: Connection) -> None:
-    """The worker's loop: first ``(scenario dict, source, starts)``, then ``(key, q)`` in and
-    ``(key, solutions, error)`` out, each solve continuing the last answer; None or a closed
-    pipe stops it.
+    """The worker's loop.
+
+    First ``(scenario dict, source, starts)``, then ``(key, q)`` in and ``(key, solutions,
+    error)`` out, each solve continuing the last answer; None or a closed pipe stops it.
     """
     from impact_balance.contacts.stance import Stance
     from impact_balance.scenario import scenario_from_dict
 
     raw, source, starts = conn.recv()
     # The lowest priority: woken by a request, the worker must not take the CPU from the
-    # control loop that sent it (a tick that handed it a posture stalled 1.3 to 4.3 ms in the
-    # write, a few times per score run; none in six runs at nice 19). It runs on a free core.
+    # control loop that sent it (docs/studies/design-history.md). It runs on a free core.
     os.nice(19)
     try:
         scenario = scenario_from_dict(raw, source)
         robot = scenario.load_robot()
         contacts = tuple(c.spec() for c in scenario.contacts)
+        if scenario.impact is None:
+            raise ScenarioError("impact", None, "the contact-aware worker needs an impact")
         limit = ContactAwareLimit(scenario.impact.spec(), 1, starts)
     except Exception as exc:
         conn.send(("ready", None, f"{type(exc).__name__}: {exc}"))
@@ -78,7 +87,8 @@ def _serve(conn: Connection) -> None:
             conn.send((key, None, f"{type(exc).__name__}: {exc}"))
 
 
-def _stop(conn: Connection, process: subprocess.Popen) -> None:
+def _stop(conn: Connection, process: subprocess.Popen[bytes]) -> None:
+    """Ask the worker to stop, then make sure it has (killed after a grace period)."""
     try:
         conn.send(None)
     except (OSError, ValueError):
@@ -92,15 +102,16 @@ def _stop(conn: Connection, process: subprocess.Popen) -> None:
 
 
 class ContactAwareWorker:
-    """One worker process computing contact-aware rates for one governor (module docstring);
-    not thread-safe (its governor calls it under its lock).
+    """One worker process computing contact-aware rates for one governor (module docstring).
+
+    Not thread-safe (its governor calls it under its lock).
 
     The worker is a fresh interpreter (``python -m impact_balance.governor.worker``) joined by a
     socket pair, not a :mod:`multiprocessing` child: a spawned child re-imports the user's main
     script, and a forked one inherits pinocchio's, numba's and BLAS's threads.
     """
 
-    def __init__(self, scenario, starts: str):
+    def __init__(self, scenario: Scenario, starts: Starts):
         parent, child = socket.socketpair()
         env = dict(os.environ)
         env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)  # the same impact_balance
@@ -125,9 +136,9 @@ class ContactAwareWorker:
         finally:
             child.close()
         self._conn = Connection(parent.detach())
-        self._poller = (
-            select.poll()
-        )  # a tick's check for an answer: ~1 us, where Connection.poll takes ~10
+        # A tick's check for an answer: select.poll is several times cheaper than
+        # Connection.poll (docs/studies/design-history.md).
+        self._poller = select.poll()
         self._poller.register(self._conn.fileno(), select.POLLIN)
         self._finalizer = weakref.finalize(self, _stop, self._conn, self._process)
         self._busy = True  # until "ready"
@@ -143,9 +154,19 @@ class ContactAwareWorker:
             raise
 
     def warm_up(self, q: np.ndarray) -> ContactAwareSolutions:
-        """Solve once at ``q`` and wait, returning the answer: the worker's first solve loads
-        its compiled code (~150 ms), which the governor pays at construction (and takes as its
-        first rates) rather than in its first ticks.
+        """Solve once at ``q`` and wait, returning the answer.
+
+        The worker's first solve loads its compiled code: the governor pays it at
+        construction (and takes the answer as its first rates) rather than in its first ticks.
+
+        Args:
+            q: The configuration (nq, pinocchio's order).
+
+        Returns:
+            The contact-aware solutions at ``q``.
+
+        Raises:
+            GovernorError: The worker did not answer within :data:`START_TIMEOUT` s.
         """
         self.submit(b"warm-up", q)
         solutions = self.wait(START_TIMEOUT)
@@ -172,6 +193,7 @@ class ContactAwareWorker:
 
     @property
     def idle(self) -> bool:
+        """Whether the worker waits for a posture (its last answer, if any, collected)."""
         return not self._busy
 
     def submit(self, key: bytes, q: np.ndarray) -> None:
@@ -192,6 +214,7 @@ class ContactAwareWorker:
 
     @property
     def alive(self) -> bool:
+        """Whether the worker process is running."""
         return self._process.poll() is None
 
 

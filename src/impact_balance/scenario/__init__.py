@@ -7,7 +7,8 @@ mappings are merged recursively, everything else is replaced.
 - :mod:`.fields`: value types and bounds (vectors, ranges with units, the strict base model).
 - :mod:`.schema`: the pydantic models (:class:`Scenario` and its parts) and stance building.
 - :mod:`.specs`: library specs built from scenario values, cached by content.
-- :mod:`.validate`: a mapping to a :class:`Scenario`, pydantic's errors to one ``ScenarioError``.
+- :mod:`.errors`: pydantic's errors to one ``ScenarioError`` naming the field.
+- :mod:`.validate`: a mapping to a :class:`Scenario` (:meth:`Scenario.from_mapping`).
 - :mod:`.bundled`: the scenarios shipped in ``impact_balance/scenarios/`` and name lookup.
 - :mod:`.load`: files, ``extends:`` chains and :func:`load_scenario`.
 """
@@ -18,7 +19,8 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 # Also re-exported: the helpers sweep/, gui/, analysis.py and tests import from here
-# (ExtendsResolver, with_source, field_name, merge_mappings, read_mapping). Imported on first use (PEP 562):
+# (ExtendsResolver, with_source, field_name, merge_mappings, read_mapping). Imported on first use
+# (PEP 562):
 # listing the bundled scenarios needs only .bundled, not pydantic and pinocchio.
 _EXPORTS: dict[str, str] = {
     "bundled_scenarios": ".bundled",
@@ -35,7 +37,7 @@ _EXPORTS: dict[str, str] = {
     "RobotFiles": ".schema",
     "Scenario": ".schema",
     "with_source": ".schema",
-    "field_name": ".validate",
+    "field_name": ".errors",
     "scenario_from_dict": ".validate",
 }
 
@@ -51,6 +53,7 @@ def __getattr__(name: str) -> Any:
 
 if TYPE_CHECKING:
     from impact_balance.scenario.bundled import bundled_scenarios, scenario_path
+    from impact_balance.scenario.errors import field_name
     from impact_balance.scenario.load import (
         ExtendsResolver,
         load_scenario,
@@ -67,23 +70,23 @@ if TYPE_CHECKING:
         Scenario,
         with_source,
     )
-    from impact_balance.scenario.validate import field_name, scenario_from_dict
+    from impact_balance.scenario.validate import scenario_from_dict
 
 __all__ = [
     "BasePose",
-    "ExtendsResolver",
-    "field_name",
-    "merge_mappings",
-    "read_mapping",
-    "with_source",
     "ContactConfig",
+    "ExtendsResolver",
     "ImpactConfig",
     "Offset",
     "QPConfig",
     "RobotFiles",
     "Scenario",
     "bundled_scenarios",
+    "field_name",
     "load_scenario",
+    "merge_mappings",
+    "read_mapping",
     "scenario_from_dict",
     "scenario_path",
+    "with_source",
 ]

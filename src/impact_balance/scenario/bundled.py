@@ -21,7 +21,11 @@ def _scenario_dir() -> Path:
 
 
 def bundled_descriptions(folder: str) -> dict[str, str]:
-    """The ``*.yaml`` files of the package data folder ``impact_balance/<folder>``: name -> one-line description."""
+    """The ``*.yaml`` files of the package data folder ``impact_balance/<folder>``.
+
+    Returns:
+        Name -> one-line description.
+    """
     out = {}
     for entry in sorted(
         (resources.files("impact_balance") / folder).iterdir(), key=lambda e: e.name

@@ -75,7 +75,7 @@ def _scalar(
 def _coordinates(limit: float, unit: str) -> AfterValidator:
     """A validator keeping every coordinate of a vector within [-limit, limit]."""
 
-    def check(v: tuple) -> tuple:
+    def check(v: tuple[float, ...]) -> tuple[float, ...]:
         if any(abs(x) > limit for x in v):
             raise ValueError(f"each coordinate must be in [{-limit:g}, {limit:g}] {unit}")
         return v
@@ -83,7 +83,8 @@ def _coordinates(limit: float, unit: str) -> AfterValidator:
     return AfterValidator(check)
 
 
-def _speed(v: tuple) -> tuple:
+def _speed(v: tuple[float, ...]) -> tuple[float, ...]:
+    """``v`` if its norm is at most :data:`~impact_balance.constants.MAX_SPEED` m/s."""
     if math.hypot(*v) > MAX_SPEED:
         raise ValueError(f"the speed must be at most {MAX_SPEED:g} m/s")
     return v

@@ -77,7 +77,7 @@ MAX_LOG_COLUMNS = 2_000
 MAX_LOG_VALUES = 50_000_000
 
 
-class _LimitError(yaml.YAMLError):
+class _LimitError(yaml.YAMLError):  # type: ignore[misc]  # PyYAML ships no type stubs
     def __init__(self, problem: str, mark: yaml.Mark | None = None):
         super().__init__(problem)
         self.problem = problem
@@ -85,8 +85,10 @@ class _LimitError(yaml.YAMLError):
 
 
 def _node_children(node: yaml.Node) -> Iterable[yaml.Node]:
+    """The child nodes of a YAML node (keys and values of a mapping)."""
     if isinstance(node, yaml.SequenceNode):
-        return node.value
+        children: list[yaml.Node] = node.value
+        return children
     if isinstance(node, yaml.MappingNode):
         return [n for pair in node.value for n in pair]
     return ()
@@ -137,14 +139,15 @@ def _count(
     return size[id(root)], depth[id(root)]
 
 
-class _BoundedLoader(yaml.SafeLoader):
+class _BoundedLoader(yaml.SafeLoader):  # type: ignore[misc]  # PyYAML ships no type stubs
     """PyYAML's safe loader with a nesting limit while composing and an expanded-size limit."""
 
     def __init__(self, stream: str):
         super().__init__(stream)
         self._depth = 0
 
-    def compose_node(self, parent, index):
+    def compose_node(self, parent: yaml.Node | None, index: object) -> yaml.Node:
+        """PyYAML's node composition, with the nesting limit."""
         self._depth += 1
         try:
             if self._depth > MAX_DEPTH:
@@ -155,8 +158,9 @@ class _BoundedLoader(yaml.SafeLoader):
         finally:
             self._depth -= 1
 
-    def compose_document(self):
-        node = super().compose_document()
+    def compose_document(self) -> yaml.Node:
+        """PyYAML's document composition, with the expanded-size limit."""
+        node: yaml.Node = super().compose_document()
         try:
             _count(node, _node_children, lambda n: isinstance(n, yaml.ScalarNode))
         except ValueError as exc:
@@ -176,9 +180,9 @@ _BoundedLoader.add_implicit_resolver(
 def parse_yaml(text: str, source: str = "scenario") -> Any:
     """Parse YAML text within the limits; :class:`ScenarioError` on ``scenario`` naming ``source``.
 
-    Cached by content (PyYAML's pure-Python parser is ~95 % of loading a scenario, 5-20 ms for
-    a bundled file). The cached tree is never handed out: callers get a fresh copy of its dicts
-    and lists (scalars are immutable). Refusals are not cached.
+    Cached by content (PyYAML's pure-Python parser is most of the cost of loading a scenario).
+    The cached tree is never handed out: callers get a fresh copy of its dicts and lists
+    (scalars are immutable). Refusals are not cached.
     """
     return _copy_tree(_parse_cached(text, source))
 
@@ -252,8 +256,10 @@ def read_yaml(path: Path) -> Any:
 
 
 def check_structure(raw: Any, source: str | None = None) -> None:
-    """Refuse a mapping nested deeper than :data:`MAX_DEPTH`, larger than :data:`MAX_VALUES`
-    values once shared parts are counted as copies, or containing itself.
+    """Refuse a mapping too deep, too large or containing itself.
+
+    Too deep: nested deeper than :data:`MAX_DEPTH`; too large: more than :data:`MAX_VALUES`
+    values once shared parts are counted as copies.
     """
     try:
         _, depth = _count(raw, _object_children, lambda x: not isinstance(x, (dict, list, tuple)))
@@ -272,5 +278,8 @@ def check_path_text(field: str, text: str, source: str | None = None) -> None:
         raise ScenarioError(field, text, reason, source)
     longest = max((len(part) for part in text.replace("\\", "/").split("/")), default=0)
     if longest > MAX_NAME_CHARS:
-        reason = f"a file or scenario name has at most {MAX_NAME_CHARS} characters (this one has {longest})"
+        reason = (
+            f"a file or scenario name has at most {MAX_NAME_CHARS} characters "
+            f"(this one has {longest})"
+        )
         raise ScenarioError(field, text, reason, source)

@@ -8,11 +8,11 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 import pinocchio as pin
-from pydantic import AfterValidator, Field, ValidationInfo, field_validator
+from pydantic import AfterValidator, Field, ValidationError, ValidationInfo, field_validator
 
 from impact_balance.constants import (
     GRAVITY_RANGE,
@@ -24,12 +24,14 @@ from impact_balance.constants import (
     MAX_PEAK_FACTOR,
     MAX_POSITION,
     MAX_SIZE,
+    MAX_VELOCITY_MARGIN,
 )
 from impact_balance.contacts.stance import ContactSpec, Stance
 from impact_balance.exceptions import ScenarioError
 from impact_balance.geometry.spatial import pose, surface_rotation
 from impact_balance.impact.model import ImpactSpec
 from impact_balance.robot.robot import Robot, load_robot
+from impact_balance.scenario.errors import scenario_error
 from impact_balance.scenario.fields import (
     Angles,
     Flag,
@@ -45,7 +47,7 @@ from impact_balance.scenario.fields import (
     _scalar,
     _speed,
 )
-from impact_balance.scenario.reader import check_path_text
+from impact_balance.scenario.reader import check_path_text, check_structure
 from impact_balance.scenario.specs import _contact_spec, _impact_spec, _quaternion
 
 __all__ = [
@@ -67,6 +69,7 @@ class Offset(_Model):
     rpy: Angles = (0.0, 0.0, 0.0)
 
     def se3(self) -> pin.SE3:
+        """The pose as a pinocchio SE3 (translation m, rotation from roll-pitch-yaw)."""
         return pose(self.position, self.rpy)
 
 
@@ -138,7 +141,8 @@ class ContactConfig(_Model):
         offset = pin.SE3(
             np.asarray(frame_rotation).T @ world, np.asarray(self.offset.position, dtype=float)
         )
-        return ContactSpec(self.frame, self.friction, tuple(self.size), offset)
+        length, width = self.size
+        return ContactSpec(self.frame, self.friction, (length, width), offset)
 
 
 class QPConfig(_Model):
@@ -221,12 +225,15 @@ class Scenario(_Model):
     description: Annotated[str, Field(max_length=MAX_DESCRIPTION)] | None = None
     robot: str | RobotFiles = "talos"
     configuration: str | None = None
-    joints: dict[str, Number] = {}
+    joints: dict[str, Number] = Field(default_factory=dict)
     base: BasePose | None = None
     com_velocity: Annotated[Vec2, AfterValidator(_speed)] = (0.0, 0.0)
     plane_height: Annotated[Number, _scalar(-MAX_POSITION, MAX_POSITION, "m")] = 0.0
     #: The ZMP support area is shrunk by this margin (m), and the CoM velocity area with it.
     zmp_margin: Annotated[Number, _scalar(0.0, MAX_SIZE, "m")] = 0.0
+    #: Every post-impact CoM velocity must lie this far (m/s) inside the CoM velocity area
+    #: (the CoM criterion): a margin for the impact model's error. 0 is the paper's criterion.
+    velocity_margin: Annotated[Number, _scalar(0.0, MAX_VELOCITY_MARGIN, "m/s")] = 0.0
     torque_limits: Flag = True
     gravity: Annotated[Number, _scalar(*GRAVITY_RANGE, "m/s^2")] = 9.81
     contacts: list[ContactConfig] = Field(min_length=1)
@@ -241,8 +248,74 @@ class Scenario(_Model):
             raise ValueError(f"joint values must be finite (not {', '.join(bad)})")
         return joints
 
+    @classmethod
+    def from_mapping(
+        cls, raw: dict[str, Any], source: str | None = None, check_size: bool = True
+    ) -> Scenario:
+        """Validate a scenario mapping; raises :class:`ScenarioError` on the first bad field.
+
+        Args:
+            raw: The mapping (top-level keys of a scenario file, ``extends:`` merged).
+            source: The file it came from, if any (named in errors, and the base of the
+                robot files' relative paths).
+            check_size: ``False`` skips the nesting and expanded-size check of
+                :func:`~impact_balance.scenario.reader.check_structure`.
+
+        Returns:
+            The validated scenario.
+
+        Raises:
+            ScenarioError: The first bad field, naming it, its value and the reason (an
+                :class:`~impact_balance.exceptions.UnknownKeyError` for an unknown key).
+        """
+        if check_size:
+            check_structure(raw, source)
+        try:
+            return cls.model_validate({**raw, "source": source})
+        except ValidationError as exc:
+            raise scenario_error(exc, raw, cls, source) from None
+        except ScenarioError as exc:
+            raise ScenarioError(exc.field, exc.value, exc.reason, source) from None
+
+    def replace(self, **changes: Any) -> Scenario:
+        """A copy with the top-level keys ``changes`` replaced, validated as a file's keys are.
+
+        The one way to override a scenario's value (``zmp_margin``, ``velocity_margin``,
+        ``com_velocity``...): unlike pydantic's ``model_copy``, it refuses what the schema
+        refuses. The keys the scenario set (:attr:`set_keys`) stay set, and the changed ones
+        become set.
+
+        Args:
+            **changes: Top-level keys and their new values, in the file's units.
+
+        Returns:
+            The new scenario (same ``source``); this one when ``changes`` is empty.
+
+        Raises:
+            ScenarioError: A value the schema refuses, or an unknown key, naming the field.
+        """
+        if not changes:
+            return self
+        raw = self.model_dump(exclude_unset=True)
+        raw.pop("source", None)
+        raw.update(changes)
+        return Scenario.from_mapping(raw, self.source)
+
+    @property
+    def set_keys(self) -> frozenset[str]:
+        """The top-level keys the file (with its ``extends:`` chain) or an override set."""
+        return frozenset(self.model_fields_set - {"source"})
+
     # -- resolution against a robot model -------------------------------------------------
     def load_robot(self) -> Robot:
+        """The scenario's robot: a bundled name, or files relative to the scenario file.
+
+        Returns:
+            The robot model (cached after its first load).
+
+        Raises:
+            ScenarioError: A bad robot file path, or an unknown robot name.
+        """
         if isinstance(self.robot, RobotFiles):
             check_path_text("robot.urdf", self.robot.urdf, self.source)
             if self.robot.srdf:
@@ -266,7 +339,10 @@ class Scenario(_Model):
         return q
 
     def contact_specs(self, robot: Robot, q: np.ndarray) -> list[ContactSpec]:
-        """The contacts' specs at configuration ``q`` (which resolves the contacts given by a world normal)."""
+        """The contacts' specs at configuration ``q``.
+
+        The configuration resolves the contacts given by a world normal.
+        """
         if all(c.normal is None for c in self.contacts):
             return [c.spec() for c in self.contacts]
         frames = Stance(robot, q, [])
@@ -279,7 +355,21 @@ class Scenario(_Model):
         return specs
 
     def build_stance(self, robot: Robot | None = None) -> Stance:
-        """Resolve robot, configuration and contacts into a :class:`Stance` (see ``_build_stance``)."""
+        """Resolve robot, configuration and contacts into a :class:`Stance`.
+
+        Without a ``base`` key the robot is translated vertically so that its lowest contact
+        corner touches z = 0.
+
+        Args:
+            robot: The robot (default: the scenario's, loaded).
+
+        Returns:
+            The stance.
+
+        Raises:
+            ScenarioError: An unknown frame or joint, a plane at or above the CoM (with the
+                scenario's file named).
+        """
         try:
             return self._build_stance(robot)
         except ScenarioError as exc:
@@ -314,5 +404,5 @@ def with_source(exc: ScenarioError, source: str | None) -> ScenarioError:
     """Prefix a scenario error found after loading (unknown frame...) with its file name."""
     if source and exc.source is None:
         exc.source = source
-        exc.args = (f"{source}: {exc.args[0]}",) + exc.args[1:]
+        exc.args = (f"{source}: {exc.args[0]}", *exc.args[1:])
     return exc
