@@ -35,7 +35,7 @@ __all__ = [
     "Robot",
     "RobotSpec",
     "Scratch",
-    "Workspace",
+    "ThreadData",
     "example_robot_data_root",
     "load_robot",
 ]
@@ -120,7 +120,7 @@ class JointSlot(NamedTuple):
 class Scratch:
     """One pinocchio ``Data`` for one owner, and the key of the configuration it holds.
 
-    What :class:`Workspace` is per thread, for an owner that serialises its own calls (a
+    What :class:`ThreadData` is per thread, for an owner that serialises its own calls (a
     :class:`~impact_balance.governor.Governor` and its lock): :class:`~impact_balance.contacts.stance.Stance`
     computes in it when given one.
 
@@ -135,7 +135,7 @@ class Scratch:
         self.holder: bytes | None = None
 
 
-class Workspace(threading.local):
+class ThreadData(threading.local):
     """One pinocchio ``Data`` per robot and per thread, reused by every :class:`Stance`.
 
     ``model.createData()`` allocates ~1.6 MB (0.2-1.9 ms) while the kinematics themselves
@@ -359,12 +359,12 @@ class Robot:
         return idx, val
 
     @functools.cached_property
-    def _workspace(self) -> Workspace:
-        return Workspace(self.model)
+    def _thread_data(self) -> ThreadData:
+        return ThreadData(self.model)
 
-    def workspace(self) -> Workspace:
-        """This thread's scratch pinocchio Data for the model (see :class:`Workspace`)."""
-        return self._workspace
+    def thread_data(self) -> ThreadData:
+        """This thread's scratch pinocchio Data for the model (see :class:`ThreadData`)."""
+        return self._thread_data
 
 
 def _is_file(path: Path) -> bool:

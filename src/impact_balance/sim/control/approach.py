@@ -24,7 +24,13 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-__all__ = ["APPROACH_ACCELERATION", "CRUISE_DISTANCE", "MIN_STANDOFF", "ImpactTask"]
+__all__ = [
+    "APPROACH_ACCELERATION",
+    "CRUISE_DISTANCE",
+    "MIN_STANDOFF",
+    "ImpactTask",
+    "approach_profile",
+]
 
 #: Bounded acceleration of the approach and of the withdrawal, m/s^2.
 APPROACH_ACCELERATION = 20.0
@@ -97,11 +103,11 @@ class ImpactTask:
         if self.contact_time is None and normal_force > self.force_threshold:
             self.contact_time = float(t)
         if self.contact_time is not None:
-            s, ds, dds = _profile(
+            s, ds, dds = approach_profile(
                 t - self.contact_time, self.withdraw_speed, self.acceleration, self.retract
             )
             return self.surface_point + s * n, ds * n, dds * n
-        s, ds, dds = _profile(t - self.start_time, self.speed, self.acceleration, np.inf)
+        s, ds, dds = approach_profile(t - self.start_time, self.speed, self.acceleration, np.inf)
         return self.start_point - s * n, -ds * n, -dds * n
 
     def target(self, t: float, normal_force: float = 0.0) -> np.ndarray:
@@ -119,7 +125,7 @@ def standoff(
     return max(minimum, speed * speed / (2.0 * acceleration) + cruise)
 
 
-def _profile(
+def approach_profile(
     tau: float, speed: float, acceleration: float, stop: float
 ) -> tuple[float, float, float]:
     """Distance, speed and acceleration after ``tau`` s of a bounded-acceleration start to ``speed``, held

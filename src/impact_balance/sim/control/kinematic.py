@@ -38,6 +38,7 @@ import pinocchio as pin
 from pink.tasks import ComTask, FrameTask, PostureTask
 
 from impact_balance.analysis.analyze import Analysis
+from impact_balance.balance.lipm import lipm_omega
 from impact_balance.robot.ik import solve_stance
 from impact_balance.sim.control.approach import ImpactTask
 from impact_balance.sim.control.zmp import DcmFeedback, clamp_to_polygon
@@ -159,7 +160,7 @@ class BalanceController:
         self.gravity = areas.gravity
         com0 = np.array(pin.centerOfMass(self.model, self.configuration.data, q0), dtype=float)
         self.com_height = float(com0[2])
-        self.omega = float(np.sqrt(self.gravity / (com0[2] - self.plane_height)))
+        self.omega = lipm_omega(self.com_height, self.plane_height, self.gravity)
         self.feedback = DcmFeedback(
             areas.zmp_area, self.omega, com0[:2].copy(), gains.dcm_gain, gains.zmp_margin
         )

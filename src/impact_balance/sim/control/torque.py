@@ -52,6 +52,7 @@ import numpy as np
 import pinocchio as pin
 
 from impact_balance.analysis.analyze import Analysis
+from impact_balance.balance.lipm import lipm_omega
 from impact_balance.contacts.cwc import cwc_faces_world
 from impact_balance.geometry.spatial import skew
 from impact_balance.sim.control.approach import ImpactTask
@@ -214,7 +215,7 @@ class InverseDynamicsController:
         self.plane_height = analysis.areas.plane_height
         com0 = np.array(pin.centerOfMass(model, self.data, self.q0), dtype=float)
         self.com_height = float(com0[2])
-        self.omega = float(np.sqrt(self.gravity / (com0[2] - self.plane_height)))
+        self.omega = lipm_omega(self.com_height, self.plane_height, self.gravity)
         self.feedback = DcmFeedback(
             analysis.areas.zmp_area, self.omega, com0[:2].copy(), gains.dcm_gain, gains.zmp_margin
         )

@@ -173,6 +173,28 @@ class SimModel:
         mujoco.mj_subtreeVel(self.model, self.data)
         return self.data.subtree_linvel[self.root_body].copy()
 
+    def impact_point_velocity(self, normal: np.ndarray) -> np.ndarray:
+        """World velocity of the impact point (m/s), the impact sphere's surface point along ``-normal``.
+
+        Args:
+            normal: Unit surface normal (world), from the surface into the robot.
+
+        Returns:
+            The point's linear velocity (3,), world axes.
+
+        Raises:
+            SimulationError: The model has no impact sphere.
+        """
+        if self.impact_geom is None:
+            raise SimulationError("impact", None, "the model has no impact point")
+        out = np.zeros(6)
+        mujoco.mj_objectVelocity(
+            self.model, self.data, mujoco.mjtObj.mjOBJ_GEOM, self.impact_geom, out, 0
+        )
+        r = -self.model.geom_size[self.impact_geom][0] * normal
+        (wx, wy, wz), (rx, ry, rz) = out[:3].tolist(), r.tolist()
+        return out[3:] + np.array((wy * rz - wz * ry, wz * rx - wx * rz, wx * ry - wy * rx))
+
     def contact_force(self, geom: int) -> np.ndarray:
         """Total contact force on the robot at ``geom`` (one of its collision geoms), N, world axes."""
         m, d = self.model, self.data

@@ -36,11 +36,11 @@ from impact_balance.sim.trials.balance_trial import (
     BalanceSetup,
     BalanceTrialOptions,
     Push,
-    _push_body,
     controller_margin,
     run_balance_trial,
 )
 from impact_balance.sim.trials.result import TrialEntry, trajectory
+from impact_balance.sim.trials.setup import push_body
 
 __all__ = [
     "CRITERIA",
@@ -338,7 +338,7 @@ def push_test(
     check_push_arguments(directions, magnitudes, duration, relative)
     options = options or BalanceTrialOptions()
     setup = setup or BalanceSetup.create(scenario, "servo", options)
-    body_id = _push_body(setup.sim, body)
+    body_id = push_body(setup.sim, body)
     height = _body_height(setup, body_id)
     a = setup.analysis
     omega = float(a.areas.omega)

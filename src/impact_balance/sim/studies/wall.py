@@ -23,13 +23,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from impact_balance.exceptions import SimulationError
-from impact_balance.sim.control.approach import _profile
+from impact_balance.json_values import json_number
+from impact_balance.sim.control.approach import approach_profile
 from impact_balance.sim.trials.balance_trial import (
     BalanceSetup,
     BalanceTrialOptions,
     run_balance_trial,
 )
-from impact_balance.sim.trials.impact_trial import TrialRecord, _point_velocity
+from impact_balance.sim.trials.impact_trial import TrialRecord
 from impact_balance.sim.trials.result import BalanceTrialResult
 
 __all__ = [
@@ -113,7 +114,7 @@ class GovernedApproach:
 
     def reference_speed(self, t: float) -> float:
         """The reference's own speed at ``t`` (m/s): a bounded-acceleration ramp to ``speed``."""
-        return _profile(t - self.start_time, self.speed, self.acceleration, np.inf)[1]
+        return approach_profile(t - self.start_time, self.speed, self.acceleration, np.inf)[1]
 
     def reference(
         self, t: float, normal_force: float = 0.0
@@ -126,7 +127,7 @@ class GovernedApproach:
             self.contact_time = float(t)
             self._contact_point = self._point.copy()
         if self.contact_time is not None:
-            s, ds, dds = _profile(
+            s, ds, dds = approach_profile(
                 t - self.contact_time, self.withdraw_speed, self.acceleration, self.retract
             )
             return self._contact_point + s * n, ds * n, dds * n
@@ -190,10 +191,6 @@ class WallTrial:
             "tick_us": self.tick_us,
             "trial": s,
         }
-
-
-def _finite(x) -> float | None:
-    return None if x is None or not np.isfinite(x) else float(x)
 
 
 def run_wall_trial(
@@ -267,10 +264,12 @@ def run_wall_trial(
         rows["time"].append(t)
         rows["reference"].append(task.reference_speed(t) if task.contact_time is None else 0.0)
         rows["cap"].append(
-            _finite(task.ceiling) if governor is not None and task.contact_time is None else None
+            json_number(task.ceiling)
+            if governor is not None and task.contact_time is None
+            else None
         )
         rows["commanded"].append(task.commanded if task.contact_time is None else 0.0)
-        rows["measured"].append(float(-n @ _point_velocity(sim, n)))
+        rows["measured"].append(float(-n @ sim.impact_point_velocity(n)))
 
     result = run_balance_trial(
         setup,
@@ -285,7 +284,7 @@ def run_wall_trial(
     cap_at_contact = None
     if impact is not None and caps:
         k = max(0, int(np.searchsorted([c[0] for c in caps], impact.contact_time)) - 1)
-        cap_at_contact = _finite(caps[k][2])
+        cap_at_contact = json_number(caps[k][2])
     us = np.asarray(ticks) * 1e6
     tick_us = (
         {"median": float(np.median(us)), "p99": float(np.percentile(us, 99)), "count": int(us.size)}
@@ -295,7 +294,7 @@ def run_wall_trial(
     return WallTrial(
         options,
         result,
-        None if impact is None else _finite(impact.approach_speed),
+        None if impact is None else json_number(impact.approach_speed),
         cap_at_contact,
         None if impact is None else float(impact.contact_time - task.start_time),
         tick_us,

@@ -24,6 +24,7 @@ speed), the impulses at the impact point and at the sustained contacts, and the 
 
 from __future__ import annotations
 
+import math
 import time
 
 import mujoco
@@ -31,7 +32,9 @@ import numpy as np
 import pinocchio as pin
 
 from impact_balance.analysis.analyze import Analysis
+from impact_balance.balance.lipm import lipm_omega
 from impact_balance.exceptions import SimulationError
+from impact_balance.json_values import json_number
 from impact_balance.logs import write_log
 from impact_balance.sim.control.approach import ImpactTask
 from impact_balance.sim.control.approach import standoff as approach_standoff
@@ -39,7 +42,6 @@ from impact_balance.sim.control.kinematic import BalanceController
 from impact_balance.sim.control.torque import InverseDynamicsController
 from impact_balance.sim.model.build import SimModel
 from impact_balance.sim.trials.impact_tracker import ImpactTracker
-from impact_balance.sim.trials.impact_trial import _point_velocity
 from impact_balance.sim.trials.log import LOG_START, LogRecorder
 from impact_balance.sim.trials.outcomes import OutcomeMonitor
 from impact_balance.sim.trials.result import BalanceTrialResult
@@ -51,6 +53,7 @@ from impact_balance.sim.trials.setup import (
     BalanceTrialOptions,
     Push,
     controller_margin,
+    push_body,
 )
 
 #: Version of the trials' physics and measurements: journals of another version are not reused.
@@ -90,20 +93,19 @@ def measured_zmp(
     return com[:2] + (plane_height - com[2]) * total[:2] / total[2], forces
 
 
-def _push_body(sim: SimModel, name: str | None) -> int:
-    m = sim.model
-    if name is not None:
-        try:
-            return m.body(name).id
-        except KeyError:
-            valid = ", ".join(m.body(i).name for i in range(1, m.nbody))
-            raise SimulationError("--body", name, f"no such body; valid: {valid}") from None
-    torso = [i for i in range(m.nbody) if "torso" in m.body(i).name and m.body_mass[i] > 0]
-    return max(torso) if torso else sim.root_body
-
-
 def _base_rotation(q: np.ndarray) -> np.ndarray:
     return pin.Quaternion(q[6], q[3], q[4], q[5]).toRotationMatrix()
+
+
+def _omega_now(com_height: float, plane_height: float, gravity: float) -> float:
+    """The LIPM's omega (1/s) at the measured CoM height (m), NaN once the CoM is at or below the plane.
+
+    A falling robot's CoM may reach the plane: its CoM velocity margin is then undefined (NaN), not an
+    error.
+    """
+    if com_height <= plane_height:
+        return math.nan
+    return lipm_omega(com_height, plane_height, gravity)
 
 
 def run_balance_trial(
@@ -245,7 +247,7 @@ def _run(
 
     body = None
     if push is not None:
-        body = _push_body(sim, push.body)
+        body = push_body(sim, push.body)
         disturbance, disturbance_end = push.start, push.start + push.duration
         end_time = disturbance_end + options.after
     else:
@@ -294,7 +296,7 @@ def _run(
             # Every step (1 ms): the forces of the last step, the impact point's velocity, the CoM velocity.
             impact_force = sim.contact_force(sim.impact_geom)
             fn = float(impact_force @ n)
-            point_v = _point_velocity(sim, n)
+            point_v = sim.impact_point_velocity(n)
             com_v = sim.com_velocity()
             tracker.update(t, impact_force, sim.contact_forces(sim.contact_geoms), point_v, com_v)
             if hold is not None:
@@ -327,7 +329,7 @@ def _run(
                 v_ff[setup.support_v_index] = 0.0
                 sim.set_servo_targets(out.q, v_ff)
             com, com_velocity = out.com, out.com_velocity
-            omega = np.sqrt(g / (com[2] - h))
+            omega = _omega_now(float(com[2]), h, g)
             zmp_margin = float(zmp_area.margins(zmp)[0]) if np.all(np.isfinite(zmp)) else -np.inf
             dcm_margin = float(zmp_area.margins(out.dcm)[0])
             for key, value in (
@@ -431,7 +433,7 @@ def _margins(result: BalanceTrialResult, analysis: Analysis, arrays: dict[str, n
         during = (tt >= result.disturbance_time) & (tt <= result.disturbance_end + 1e-9)
         if during.any():
             worst = float(np.min(zm[during]))
-            result.min_zmp_margin_during = worst if np.isfinite(worst) else None
+            result.min_zmp_margin_during = json_number(worst)
 
 
 def write_trial_log(

@@ -183,15 +183,6 @@ def approach_joint_velocity(
     return out
 
 
-def _point_velocity(sim: SimModel, normal: np.ndarray) -> np.ndarray:
-    """World velocity of the impact point (the sphere's surface point along -n)."""
-    out = np.zeros(6)
-    mujoco.mj_objectVelocity(sim.model, sim.data, mujoco.mjtObj.mjOBJ_GEOM, sim.impact_geom, out, 0)
-    r = -sim.model.geom_size[sim.impact_geom][0] * normal
-    (wx, wy, wz), (rx, ry, rz) = out[:3].tolist(), r.tolist()
-    return out[3:] + np.array((wy * rz - wz * ry, wz * rx - wx * rz, wx * ry - wy * rx))
-
-
 def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
     """Run one impact trial on ``sim`` (reset to the stance first); see the module docstring."""
     if sim.scenario.impact is None or sim.impact_geom is None:
@@ -265,7 +256,7 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
         for k in range(T):
             if hold is not None and hold.start is None:
                 # Hold from the step in which the point will touch: its gap closes within one step.
-                approach = float(-n @ _point_velocity(sim, n))
+                approach = float(-n @ sim.impact_point_velocity(n))
                 gap = float(n @ (d.geom_xpos[sim.impact_geom] - radius * n)) - surface
                 if gap - max(0.0, approach) * dt <= 0.0:
                     hold.begin(d.time)
@@ -288,7 +279,7 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
             com[k] = d.subtree_com[sim.root_body]
             comd[k] = d.subtree_linvel[sim.root_body]
             forces[k] = sim.contact_forces(geoms)
-            point_v[k] = _point_velocity(sim, n)
+            point_v[k] = sim.impact_point_velocity(n)
             contact_pos[k] = d.geom_xpos[list(sim.contact_geoms)]
             torques[k] = d.actuator_force
             if hold is not None:

@@ -28,6 +28,7 @@ import pinocchio as pin
 from impact_balance.contacts.stance import Stance
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.impact.model import INERTIA_MODELS, impact_model
+from impact_balance.json_values import json_number
 from impact_balance.sim.model.build import SimModel
 from impact_balance.sim.trials.impact_trial import TrialRecord
 
@@ -105,35 +106,33 @@ class TrialResult:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready (strict: no NaN)."""
-
-        def num(x: float) -> float | None:
-            return float(x) if np.isfinite(x) else None
-
         return {
-            "approach_speed": num(self.approach_speed),
+            "approach_speed": json_number(self.approach_speed),
             "joints": self.joints,
-            "approach_speed_measured": num(self.approach_speed_measured),
-            "restitution_measured": num(self.restitution_measured),
-            "impulse_measured": [num(x) for x in self.impulse_measured],
-            "com_velocity_jump_measured": [num(x) for x in self.com_velocity_jump_measured],
-            "slip_speed": num(self.slip_speed),
-            "impact_time": [num(x) for x in self.impact_time],
+            "approach_speed_measured": json_number(self.approach_speed_measured),
+            "restitution_measured": json_number(self.restitution_measured),
+            "impulse_measured": [json_number(x) for x in self.impulse_measured],
+            "com_velocity_jump_measured": [json_number(x) for x in self.com_velocity_jump_measured],
+            "slip_speed": json_number(self.slip_speed),
+            "impact_time": [json_number(x) for x in self.impact_time],
             "predicted": {
                 name: {
-                    "com_velocity_jumps": [[num(x) for x in row] for row in p.com_velocity_jumps],
-                    "distance": num(p.distance),
-                    "relative_distance": num(p.relative_distance),
+                    "com_velocity_jumps": [
+                        [json_number(x) for x in row] for row in p.com_velocity_jumps
+                    ],
+                    "distance": json_number(p.distance),
+                    "relative_distance": json_number(p.relative_distance),
                 }
                 for name, p in self.predicted.items()
             },
             "contacts_kept": self.contacts_kept,
             "saturated_joints": list(self.saturated_joints),
             "sustained_impulses": {
-                k: [num(x) for x in v] for k, v in self.sustained_impulses.items()
+                k: [json_number(x) for x in v] for k, v in self.sustained_impulses.items()
             },
             "armature": self.armature,
             "rigid_hold": self.hold,
-            "sim_time_ratio": num(self.sim_time_ratio),
+            "sim_time_ratio": json_number(self.sim_time_ratio),
         }
 
 

@@ -42,6 +42,7 @@ __all__ = [
     "BalanceTrialOptions",
     "Push",
     "controller_margin",
+    "push_body",
 ]
 
 
@@ -67,6 +68,31 @@ class Push:
     def force(self) -> np.ndarray:
         f = self.magnitude / self.duration
         return np.array([f * np.cos(self.direction), f * np.sin(self.direction), 0.0])
+
+
+def push_body(sim: SimModel, name: str | None) -> int:
+    """The MuJoCo body a :class:`Push` acts on.
+
+    Args:
+        sim: The trial's model.
+        name: MuJoCo body name, or None for the deepest body named like "torso" with a mass
+            (the root body when there is none).
+
+    Returns:
+        The body's id in ``sim.model``.
+
+    Raises:
+        SimulationError: No body of the model has that name.
+    """
+    m = sim.model
+    if name is not None:
+        try:
+            return int(m.body(name).id)
+        except KeyError:
+            valid = ", ".join(m.body(i).name for i in range(1, m.nbody))
+            raise SimulationError("--body", name, f"no such body; valid: {valid}") from None
+    torso = [i for i in range(m.nbody) if "torso" in m.body(i).name and m.body_mass[i] > 0]
+    return max(torso) if torso else sim.root_body
 
 
 @dataclass(frozen=True)
