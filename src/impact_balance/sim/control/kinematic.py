@@ -39,7 +39,7 @@ from pink.tasks import ComTask, FrameTask, PostureTask
 
 from impact_balance.analysis.analyze import Analysis
 from impact_balance.balance.lipm import lipm_omega
-from impact_balance.robot.ik import solve_stance
+from impact_balance.robot.ik import IKOptions, solve_stance
 from impact_balance.sim.control.approach import ImpactTask
 from impact_balance.sim.control.zmp import DcmFeedback, clamp_to_polygon
 
@@ -122,8 +122,7 @@ def retracted_stance(analysis: Analysis, standoff: float) -> np.ndarray:
         {spec.frame: target},
         stance.com[:2],
         fixed_frames=[c.spec.frame for c in stance.contacts],
-        tolerance=1e-5,
-        max_iterations=300,
+        options=IKOptions(tolerance=1e-5, max_iterations=300),
     )
 
 
