@@ -30,9 +30,11 @@ the impact force passed to :meth:`BalanceController.step`.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 import pink
 import pinocchio as pin
 from pink.tasks import ComTask, FrameTask, PostureTask
@@ -40,46 +42,16 @@ from pink.tasks import ComTask, FrameTask, PostureTask
 from impact_balance.analysis.analyze import Analysis
 from impact_balance.balance.lipm import lipm_omega
 from impact_balance.robot.ik import IKOptions, solve_stance
+from impact_balance.sim.control.actuation import stiffen_support_limbs
 from impact_balance.sim.control.approach import ImpactTask
+from impact_balance.sim.control.controller import Controller
+from impact_balance.sim.control.gains import BalanceGains, TrialGains
 from impact_balance.sim.control.zmp import DcmFeedback, clamp_to_polygon
+from impact_balance.sim.model.build import SimModel
 
-__all__ = ["BalanceController", "BalanceGains", "ControlOutput", "ImpactTask", "retracted_stance"]
+__all__ = ["BalanceController", "ControlOutput", "retracted_stance"]
 
-
-@dataclass(frozen=True)
-class BalanceGains:
-    """Gains and rates of :class:`BalanceController` (units in brackets).
-
-    Attributes:
-        rate: Control rate [Hz].
-        dcm_gain: DCM error decay rate k [1/s] (p = xi + k/omega (xi - xi_ref)).
-        zmp_margin: Desired ZMP kept this far inside the ZMP support area [m].
-        zmp_admittance: K_zmp, CoM command velocity per metre of ZMP error [1/s].
-        zmp_filter: Time constant of the first-order filter on the measured ZMP [s].
-        max_com_speed: Bound on the CoM command's speed [m/s].
-        com_cost: Weight of the CoM task [1/m].
-        contact_cost: Weight of each contact frame task (position [1/m] and orientation [1/rad]).
-        impact_cost: Weight of the impact point task [1/m] (its orientation: a tenth).
-        posture_cost: Weight of the posture task [1/rad].
-        damping: Levenberg-Marquardt regularisation of the IK step's QP.
-        solver: QP solver of pink (qpsolvers name).
-    """
-
-    rate: float = 500.0
-    dcm_gain: float = 1.0
-    zmp_margin: float = 0.01
-    zmp_admittance: float = 1.0
-    zmp_filter: float = 0.01
-    max_com_speed: float = 0.3
-    com_cost: float = 10.0
-    contact_cost: float = 10.0
-    impact_cost: float = 1.0
-    posture_cost: float = 1e-2
-    damping: float = 1e-6
-    solver: str = "daqp"
-
-    def to_dict(self) -> dict:
-        return asdict(self)
+_FloatArray = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -126,14 +98,18 @@ def retracted_stance(analysis: Analysis, standoff: float) -> np.ndarray:
     )
 
 
-class BalanceController:
+class BalanceController(Controller["ControlOutput"]):
     """DCM-feedback balance with whole-body IK (see the module docstring).
 
     Args:
         analysis: The scenario's analysis (stance, areas; the impact if any).
         q0: Initial reference configuration (nq); default the stance's.
-        gains: Gains and rates.
+        gains: Gains and rates (default :class:`BalanceGains`).
         impact: The impact task, if any.
+
+    Attributes:
+        support_v_index: Velocity indices (pinocchio) of the support limbs' joints, which get no
+            velocity feed-forward (:meth:`actuate`); none unless built by :meth:`for_trial`.
     """
 
     name = "dcm-zmp-clamp + pink IK -> joint position servos"
@@ -142,9 +118,10 @@ class BalanceController:
         self,
         analysis: Analysis,
         q0: np.ndarray | None = None,
-        gains: BalanceGains = BalanceGains(),
+        gains: BalanceGains | None = None,
         impact: ImpactTask | None = None,
     ):
+        gains = gains or BalanceGains()
         self.analysis = analysis
         self.gains = gains
         self.impact = impact
@@ -153,7 +130,9 @@ class BalanceController:
         self.data = self.model.createData()  # measured state
         q0 = stance.q.copy() if q0 is None else np.asarray(q0, dtype=float).copy()
         self.configuration = pink.Configuration(self.model, self.model.createData(), q0)
+        self.rate = gains.rate
         self.dt = 1.0 / gains.rate
+        self.support_v_index: npt.NDArray[np.int_] = np.zeros(0, dtype=int)
         areas = analysis.areas
         self.plane_height = areas.plane_height
         self.gravity = areas.gravity
@@ -184,8 +163,77 @@ class BalanceController:
         self._lower = self.model.lowerPositionLimit[7:].copy()
         self._upper = self.model.upperPositionLimit[7:].copy()
 
+    @classmethod
+    def prepare_model(cls, sim: SimModel, analysis: Analysis) -> None:
+        """Position servos, the support limbs' stiffened (see :meth:`Controller.prepare_model`)."""
+        stiffen_support_limbs(sim, analysis)
+
+    @classmethod
+    def zmp_margin(cls, options: TrialGains) -> float:
+        """The margin of ``options.gains`` (m; see :meth:`Controller.zmp_margin`)."""
+        return options.gains.zmp_margin
+
+    @classmethod
+    def for_trial(
+        cls,
+        analysis: Analysis,
+        q_start: _FloatArray,
+        options: TrialGains,
+        task: ImpactTask | None,
+        sim: SimModel,
+        support_v_index: npt.NDArray[np.int_],
+    ) -> BalanceController:
+        """The controller of one trial, with ``options.gains`` (see :meth:`Controller.for_trial`)."""
+        controller = cls(analysis, q_start, options.gains, task)
+        controller.support_v_index = support_v_index
+        return controller
+
+    def hold(self, sim: SimModel, q_start: _FloatArray) -> None:
+        """The servos hold ``q_start`` (see :meth:`Controller.hold`)."""
+        sim.set_servo_targets(q_start)
+
+    def actuate(self, sim: SimModel, out: ControlOutput) -> None:
+        """Servo targets ``out.q``, with velocity feed-forward on the free limbs only.
+
+        On the stiffened support limbs the feed-forward would turn the dead-beat IK's velocity
+        noise into large torques.
+
+        Args:
+            sim: The trial's MuJoCo model.
+            out: What :meth:`step` returned.
+        """
+        v_ff = out.v.copy()
+        v_ff[self.support_v_index] = 0.0
+        sim.set_servo_targets(out.q, v_ff)
+
+    @classmethod
+    def trial_description(
+        cls, options: TrialGains, sim: SimModel, effort_limits: bool
+    ) -> dict[str, Any]:
+        """Name, gains, rates and servo gains (see :meth:`Controller.trial_description`)."""
+        gains = options.gains
+        return {
+            "name": cls.name,
+            "gains": gains.to_dict(),
+            "control_rate_hz": gains.rate,
+            "sim_timestep": float(sim.model.opt.timestep),
+            "servo": {
+                "kp": sim.kp.tolist(),
+                "kd": sim.kd.tolist(),
+                "joints": list(sim.joint_names),
+            },
+        }
+
+    @classmethod
+    def trial_summary(
+        cls, options: TrialGains, sim: SimModel, effort_limits: bool
+    ) -> dict[str, Any]:
+        """Name and gains only (see :meth:`Controller.trial_summary`)."""
+        return {"name": cls.name, "gains": options.gains.to_dict()}
+
     @property
-    def q_ref(self) -> np.ndarray:
+    def q_ref(self) -> _FloatArray:
+        """The reference configuration (nq, pinocchio order)."""
         return self.configuration.q
 
     def measure(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -241,6 +289,6 @@ class BalanceController:
             self.configuration.q.copy(), velocity, zmp, xi, clamped, com, com_velocity
         )
 
-    def describe(self) -> dict:
+    def describe(self) -> dict[str, Any]:
         """Name and gains (the ``controller`` object of ``validate --json``)."""
         return {"name": self.name, "gains": self.gains.to_dict(), "omega": self.omega}

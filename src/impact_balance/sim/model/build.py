@@ -30,16 +30,18 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance.contacts.stance import Stance
 from impact_balance.exceptions import ModelRepairWarning, SimulationError
-from impact_balance.robot.robot import Robot
+from impact_balance.robot.robot import JointSlot, Robot
 from impact_balance.scenario import Scenario, load_scenario
 from impact_balance.sim.model.environment import ContactParameters, add_geometry
 from impact_balance.sim.model.inertia import InertiaRepair, repair_message
 from impact_balance.sim.model.joints import (
-    JOINT_MODELS,
+    JointModel,
     ServoOptions,
+    check_joint_model,
     holding_torques,
     servo_gains,
     weld_joints,
@@ -47,6 +49,8 @@ from impact_balance.sim.model.joints import (
 from impact_balance.sim.model.urdf import ROOT_JOINT, robot_spec
 
 __all__ = ["SimModel", "SimOptions", "build_model"]
+
+_FloatArray = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -82,7 +86,7 @@ class SimModel:
 
     scenario: Scenario
     stance: Stance
-    joints: str
+    joints: JointModel
     options: SimOptions
     model: mujoco.MjModel
     data: mujoco.MjData
@@ -303,11 +307,20 @@ def _armature(robot: Robot, override: float | None, v_index: list[int]) -> tuple
 def build_model(
     scenario: Scenario | str | Path, joints: str = "servo", options: SimOptions | None = None
 ) -> SimModel:
-    """The scenario's MuJoCo model with ``rigid`` or ``servo`` joints, set to the stance at rest."""
-    if joints not in JOINT_MODELS:
-        raise SimulationError(
-            "--joints", joints, f"unknown joint model; valid: {', '.join(JOINT_MODELS)}"
-        )
+    """The scenario's MuJoCo model with ``rigid`` or ``servo`` joints, set to the stance at rest.
+
+    Args:
+        scenario: The scenario, or its name or file.
+        joints: Joint model, ``rigid`` (welded at the stance) or ``servo`` (position servos).
+        options: The model's options (default :class:`SimOptions`).
+
+    Returns:
+        The model, at the stance, at rest, the servos holding it.
+
+    Raises:
+        SimulationError: An unknown joint model, or a robot MuJoCo reads differently.
+    """
+    joint_model = check_joint_model(joints)
     options = options or SimOptions()
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
@@ -315,19 +328,7 @@ def build_model(
     robot = stance.robot
     impact = scenario.impact.spec() if scenario.impact is not None else None
 
-    spec, repair = robot_spec(robot, meshes=options.meshes)
-    if repair is not None:
-        # Once per robot and process: the default filter shows a message once per place it is issued from.
-        warnings.warn(
-            ModelRepairWarning(robot.name, repair.bodies, repair_message(robot.name, repair)),
-            stacklevel=1,
-        )
-    spec.option.timestep = options.timestep
-    spec.option.gravity = [0.0, 0.0, -scenario.gravity]
-    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-    if options.elliptic_cone:
-        spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
-    spec.option.impratio = options.impratio
+    spec, repair = _robot_spec(robot, scenario.gravity, options)
     names = add_geometry(spec, stance, _joint_bodies(spec, stance), impact, options.contact)
 
     # Joints simulated as joints (1-dof ones; pinocchio's continuous joints have nq = 2).
@@ -338,67 +339,33 @@ def build_model(
     unfused = spec.copy()
     unfused.compiler.fusestatic = False
     first = unfused.compile()
-    stance_qpos = np.zeros(first.nq)
-    stance_qpos[0:3] = stance.q[0:3]
-    stance_qpos[3:7] = (stance.q[6], *stance.q[3:6])
-    for name, slot in slots.items():
-        value = (
-            stance.q[slot.idx_q]
-            if slot.nq == 1
-            else np.arctan2(stance.q[slot.idx_q + 1], stance.q[slot.idx_q])
-        )
-        stance_qpos[first.joint(name).qposadr[0]] = value
+    stance_qpos = _stance_qpos(first, stance, slots)
 
     v_of = {name: robot.model.joints[slots[name].id].idx_v for name in sim_joints}
     armature, armature_source = _armature(
         robot, options.servo.armature, [v_of[n] for n in sim_joints]
     )
-    if joints == "rigid":
+    if joint_model == "rigid":
         weld_joints(spec, first, stance_qpos)
         sim_joints = []
         armature, armature_source = np.zeros(0), "none (rigid joints)"
     else:
-        data = mujoco.MjData(first)
-        data.qpos[:] = stance_qpos
-        mujoco.mj_forward(first, data)
-        full = np.zeros((first.nv, first.nv))
-        mujoco.mj_fullM(first, data, full)
-        inertia = (
-            np.array([full[first.joint(n).dofadr[0], first.joint(n).dofadr[0]] for n in sim_joints])
-            + armature
-        )
-        kp, kd = servo_gains(inertia, options.servo)
-        efforts = dict(zip(*(a.tolist() for a in robot.effort_limits)))  # velocity index -> N m
-        for name, p, d, a in zip(sim_joints, kp, kd, armature):
-            joint = spec.joint(name)
-            joint.armature = float(a)
-            effort = efforts.get(robot.model.joints[slots[name].id].idx_v, 0.0)
-            limited = options.servo.effort_limits and effort > 0.0
-            spec.add_actuator(
-                name=name,
-                target=name,
-                trntype=mujoco.mjtTrn.mjTRN_JOINT,
-                gaintype=mujoco.mjtGain.mjGAIN_FIXED,
-                gainprm=[p] + [0.0] * 9,
-                biastype=mujoco.mjtBias.mjBIAS_AFFINE,
-                biasprm=[0.0, -p, -d] + [0.0] * 7,
-                forcelimited=bool(limited),
-                forcerange=[-effort, effort] if limited else [0.0, 0.0],
-            )
-            if not options.servo.effort_limits:
-                joint.actfrclimited = mujoco.mjtLimited.mjLIMITED_FALSE
+        _add_servos(spec, first, stance_qpos, sim_joints, armature, robot, options.servo)
     model = spec.compile()
     data = mujoco.MjData(model)
 
-    def geom_id(name: str | None) -> int | None:
-        return None if name is None else model.geom(name).id
+    def geom_id(name: str) -> int:
+        return int(model.geom(name).id)
+
+    def optional_geom_id(name: str | None) -> int | None:
+        return None if name is None else geom_id(name)
 
     qpos_adr = np.array([model.joint(n).qposadr[0] for n in sim_joints], dtype=int)
     dof_adr = np.array([model.joint(n).dofadr[0] for n in sim_joints], dtype=int)
     actuator_ids = np.array([model.actuator(n).id for n in sim_joints], dtype=int)
     q_index = np.array([slots[n].idx_q for n in sim_joints], dtype=int)
     v_index = np.array([robot.model.joints[slots[n].id].idx_v for n in sim_joints], dtype=int)
-    if joints == "servo":
+    if joint_model == "servo":
         kp = model.actuator_gainprm[actuator_ids, 0].copy()
         kd = -model.actuator_biasprm[actuator_ids, 2].copy()
         tau_hold = holding_torques(stance, scenario.gravity)[v_index - 6]
@@ -407,7 +374,7 @@ def build_model(
     sim = SimModel(
         scenario=scenario,
         stance=stance,
-        joints=joints,
+        joints=joint_model,
         options=options,
         model=model,
         data=data,
@@ -421,8 +388,8 @@ def build_model(
         contact_geoms=tuple(geom_id(n) for n in names.contacts),
         support_geoms=tuple(geom_id(n) for n in names.supports),
         ground_geom=geom_id(names.ground),
-        impact_geom=geom_id(names.impact),
-        surface_geom=geom_id(names.surface),
+        impact_geom=optional_geom_id(names.impact),
+        surface_geom=optional_geom_id(names.surface),
         kp=kp,
         kd=kd,
         tau_hold=tau_hold,
@@ -433,3 +400,81 @@ def build_model(
     sim.set_state(stance.q)
     sim.set_servo_targets(stance.q)
     return sim
+
+
+def _robot_spec(
+    robot: Robot, gravity: float, options: SimOptions
+) -> tuple[mujoco.MjSpec, InertiaRepair | None]:
+    """The robot's MuJoCo spec with the simulation options (a repaired inertial is warned of)."""
+    spec, repair = robot_spec(robot, meshes=options.meshes)
+    if repair is not None:
+        # Once per robot and process: the default filter shows a message once per place it is
+        # issued from.
+        warnings.warn(
+            ModelRepairWarning(robot.name, repair.bodies, repair_message(robot.name, repair)),
+            stacklevel=1,
+        )
+    spec.option.timestep = options.timestep
+    spec.option.gravity = [0.0, 0.0, -gravity]
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    if options.elliptic_cone:
+        spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+    spec.option.impratio = options.impratio
+    return spec, repair
+
+
+def _stance_qpos(first: mujoco.MjModel, stance: Stance, slots: dict[str, JointSlot]) -> _FloatArray:
+    """MuJoCo's ``qpos`` of the stance in the model ``first`` (free joint quaternion w first)."""
+    stance_qpos = np.zeros(first.nq)
+    stance_qpos[0:3] = stance.q[0:3]
+    stance_qpos[3:7] = (stance.q[6], *stance.q[3:6])
+    for name, slot in slots.items():
+        value = (
+            stance.q[slot.idx_q]
+            if slot.nq == 1
+            else np.arctan2(stance.q[slot.idx_q + 1], stance.q[slot.idx_q])
+        )
+        stance_qpos[first.joint(name).qposadr[0]] = value
+    return stance_qpos
+
+
+def _add_servos(
+    spec: mujoco.MjSpec,
+    first: mujoco.MjModel,
+    stance_qpos: _FloatArray,
+    sim_joints: list[str],
+    armature: _FloatArray,
+    robot: Robot,
+    servo: ServoOptions,
+) -> None:
+    """One position servo per simulated joint, its gains from the joint's inertia at the stance."""
+    data = mujoco.MjData(first)
+    data.qpos[:] = stance_qpos
+    mujoco.mj_forward(first, data)
+    full = np.zeros((first.nv, first.nv))
+    mujoco.mj_fullM(first, data, full)
+    inertia = (
+        np.array([full[first.joint(n).dofadr[0], first.joint(n).dofadr[0]] for n in sim_joints])
+        + armature
+    )
+    kp, kd = servo_gains(inertia, servo)
+    # velocity index -> N m
+    efforts = dict(zip(*(a.tolist() for a in robot.effort_limits), strict=False))
+    for name, p, d, a in zip(sim_joints, kp, kd, armature, strict=False):
+        joint = spec.joint(name)
+        joint.armature = float(a)
+        effort = efforts.get(robot.model.joints[robot.joint_slot(name).id].idx_v, 0.0)
+        limited = servo.effort_limits and effort > 0.0
+        spec.add_actuator(
+            name=name,
+            target=name,
+            trntype=mujoco.mjtTrn.mjTRN_JOINT,
+            gaintype=mujoco.mjtGain.mjGAIN_FIXED,
+            gainprm=[p] + [0.0] * 9,
+            biastype=mujoco.mjtBias.mjBIAS_AFFINE,
+            biasprm=[0.0, -p, -d] + [0.0] * 7,
+            forcelimited=bool(limited),
+            forcerange=[-effort, effort] if limited else [0.0, 0.0],
+        )
+        if not servo.effort_limits:
+            joint.actfrclimited = mujoco.mjtLimited.mjLIMITED_FALSE

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 import mujoco
 import numpy as np
@@ -38,11 +39,43 @@ import qpsolvers
 from impact_balance.constants import GRAVITY
 from impact_balance.contacts.cwc import cwc_faces_world
 from impact_balance.contacts.stance import Stance
+from impact_balance.exceptions import SimulationError
 
-__all__ = ["JOINT_MODELS", "ServoOptions", "holding_torques", "servo_gains", "weld_joints"]
+__all__ = [
+    "JOINT_MODELS",
+    "JointModel",
+    "ServoOptions",
+    "check_joint_model",
+    "holding_torques",
+    "servo_gains",
+    "weld_joints",
+]
+
+#: A joint model: ``rigid`` (welded joints) or ``servo`` (position servos).
+JointModel = Literal["rigid", "servo"]
 
 #: Joint models, in the order of ``--help``.
-JOINT_MODELS = ("rigid", "servo")
+JOINT_MODELS: tuple[JointModel, ...] = ("rigid", "servo")
+
+
+def check_joint_model(name: str) -> JointModel:
+    """``name`` as a joint model.
+
+    Args:
+        name: ``rigid`` or ``servo``.
+
+    Returns:
+        The joint model.
+
+    Raises:
+        SimulationError: ``name`` is not a joint model's.
+    """
+    for model in JOINT_MODELS:
+        if model == name:
+            return model
+    raise SimulationError(
+        "--joints", name, f"unknown joint model; valid: {', '.join(JOINT_MODELS)}"
+    )
 
 
 @dataclass(frozen=True)

@@ -30,6 +30,7 @@ import numpy as np
 from impact_balance.exceptions import SimulationError
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.scenario import Scenario, load_scenario
+from impact_balance.sim.control.registry import controller_class
 from impact_balance.sim.studies.journal import TrialJournal
 from impact_balance.sim.studies.scores import MARGIN_GRID, confusion
 from impact_balance.sim.trials.balance_trial import (
@@ -391,17 +392,9 @@ def push_test(
             outcomes.append(outcome)
             if progress:
                 progress(outcome)
-    if setup.controller == "id":
-        from impact_balance.sim.control.torque import describe
-
-        controller = describe(
-            options.id_gains, float(setup.sim.model.opt.timestep), setup.joints == "servo"
-        )
-    else:
-        controller = {
-            "name": "dcm-zmp-clamp + pink IK -> joint position servos",
-            "gains": options.gains.to_dict(),
-        }
+    controller = controller_class(setup.controller).trial_summary(
+        options, setup.sim, setup.joints == "servo"
+    )
     controller["armature"] = setup.sim.armature_source
     repair = setup.sim.inertia_repair
     controller["inertia_repair"] = None if repair is None else repair.to_dict()

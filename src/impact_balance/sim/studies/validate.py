@@ -22,14 +22,17 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from impact_balance.analysis.analyze import analyze
 from impact_balance.exceptions import SimulationError
+from impact_balance.impact.model import INERTIA_MODELS
 from impact_balance.json_values import json_number
 from impact_balance.ranges import check_tolerance
 from impact_balance.scenario import Scenario, load_scenario
+from impact_balance.sim.control.registry import controller_class
 from impact_balance.sim.studies.journal import TrialJournal
 from impact_balance.sim.trials.balance_trial import (
     BalanceSetup,
@@ -37,11 +40,17 @@ from impact_balance.sim.trials.balance_trial import (
     controller_margin,
     run_balance_trial,
 )
+from impact_balance.sim.trials.outcomes import OutcomeName
 from impact_balance.sim.trials.result import TrialEntry, trajectory
 
-__all__ = ["INERTIA_MODELS", "ValidationResult", "ValidationTrial", "predictions", "validate"]
-
-INERTIA_MODELS = ("composite", "joint_space")
+__all__ = [
+    "INERTIA_MODELS",
+    "ValidationProgress",
+    "ValidationResult",
+    "ValidationTrial",
+    "predictions",
+    "validate",
+]
 
 
 def predictions(scenario: Scenario, zmp_margin: float = 0.0) -> dict[str, dict[str, float | None]]:
@@ -197,6 +206,128 @@ class ValidationResult:
         }
 
 
+class _TrialRunner:
+    """Runs the search's trials (or reads them from the journal) and keeps them in order."""
+
+    def __init__(self, setup: BalanceSetup, options: BalanceTrialOptions, journal: TrialJournal):
+        self.setup, self.options, self.journal = setup, options, journal
+        self.trials: list[ValidationTrial] = []
+        self.reused = 0
+
+    def __call__(self, speed: float) -> OutcomeName:
+        """The outcome of the trial at the commanded ``speed`` (m/s)."""
+        key = {"speed": round(speed, 9)}
+        entry = self.journal.get(key)
+        if entry is None:
+            result = run_balance_trial(self.setup, impact_speed=speed, options=self.options)
+            start = (
+                result.disturbance_time
+                if result.disturbance_time is not None
+                else self.options.settle
+            )
+            entry = {
+                "summary": result.summary(),
+                "trajectory": trajectory(result, start - 0.05, start + 1.5),
+            }
+            self.journal.add(key, entry)
+        else:
+            self.reused += 1
+        self.trials.append(
+            ValidationTrial(speed=speed, summary=entry["summary"], trajectory=entry["trajectory"])
+        )
+        return self.trials[-1].outcome
+
+
+ValidationProgress = Callable[[ValidationTrial, float | None, float | None], None]
+
+
+class _Search:
+    """The search of the fall threshold: bracket, then bisect (see :func:`validate`)."""
+
+    def __init__(
+        self,
+        trial: _TrialRunner,
+        tolerance: float,
+        min_speed: float,
+        max_speed: float,
+        progress: ValidationProgress | None,
+    ):
+        self.trial, self.tolerance = trial, tolerance
+        self.min_speed, self.max_speed = min_speed, max_speed
+        self.progress = progress
+
+    def _report(self, stood: float | None, fell: float | None) -> None:
+        if self.progress:
+            self.progress(self.trial.trials[-1], stood, fell)
+
+    def bracket(self, speed: float) -> tuple[float | None, float | None]:
+        """Double (or halve) the commanded ``speed`` (m/s) until the outcome changes.
+
+        Returns:
+            The fastest speed that stood and the slowest that fell (None: not found).
+        """
+        tolerance, min_speed, max_speed = self.tolerance, self.min_speed, self.max_speed
+        stood: float | None = None
+        fell: float | None = None
+        ceiling = max_speed  # aborted trials lower it: nothing faster can be tested
+        while True:
+            outcome = self.trial(speed)
+            if outcome == "aborted":  # nothing this fast can be tested: look below
+                ceiling = speed
+                if fell is not None or speed <= min_speed:
+                    break
+                speed = max(min_speed, speed / 2) if stood is None else 0.5 * (stood + speed)
+                if stood is not None and speed - stood <= tolerance * speed:
+                    break
+            elif outcome == "fell":
+                fell = speed
+                if stood is not None or speed <= min_speed:
+                    break
+                speed = max(min_speed, speed / 2)
+            else:
+                stood = speed
+                if fell is not None or speed >= ceiling * (1 - 1e-9):
+                    break
+                speed = min(ceiling, speed * 2)
+                if speed >= ceiling * (1 - 1e-9) and ceiling < max_speed:
+                    break
+            self._report(stood, fell)
+        return stood, fell
+
+    def bisect(self, stood: float, fell: float) -> None:
+        """Bisect ``[stood, fell]`` (m/s) until ``fell - stood <= tolerance * fell``."""
+        while fell - stood > self.tolerance * fell:
+            mid = 0.5 * (stood + fell)
+            outcome = self.trial(mid)
+            if outcome == "aborted":
+                break
+            if outcome == "fell":
+                fell = mid
+            else:
+                stood = mid
+            self._report(stood, fell)
+
+
+def _controller_description(
+    setup: BalanceSetup, options: BalanceTrialOptions, joints: str
+) -> dict[str, Any]:
+    """The ``controller`` object of ``validate --json``."""
+    controller = controller_class(setup.controller).trial_description(
+        options, setup.sim, joints == "servo"
+    )
+    controller["impact_task"] = {
+        "approach": "bounded acceleration, then cruise",
+        "acceleration": 20.0,
+        "cruise": 0.03,
+        "force_threshold": 15.0,
+        "retract": 0.05,
+    }
+    controller["armature"] = setup.sim.armature_source
+    repair = setup.sim.inertia_repair
+    controller["inertia_repair"] = None if repair is None else repair.to_dict()
+    return controller
+
+
 def validate(
     scenario: Scenario | str,
     joints: str = "servo",
@@ -205,7 +336,7 @@ def validate(
     max_speed: float = 4.0,
     min_speed: float = 0.02,
     options: BalanceTrialOptions | None = None,
-    progress: Callable[[ValidationTrial, float | None, float | None], None] | None = None,
+    progress: ValidationProgress | None = None,
     setup: BalanceSetup | None = None,
     zmp_margin: float | None = None,
     journal: TrialJournal | None = None,
@@ -230,101 +361,16 @@ def validate(
     predicted = predictions(scenario)
     with_margin = predictions(scenario, margin)
     setup = setup or BalanceSetup.create(scenario, joints, options)
-    journal = journal or TrialJournal(None, "")
-    trials: list[ValidationTrial] = []
-    reused = 0
-
-    def trial(speed: float) -> str:
-        nonlocal reused
-        key = {"speed": round(speed, 9)}
-        entry = journal.get(key)
-        if entry is None:
-            result = run_balance_trial(setup, impact_speed=speed, options=options)
-            start = (
-                result.disturbance_time if result.disturbance_time is not None else options.settle
-            )
-            entry = {
-                "summary": result.summary(),
-                "trajectory": trajectory(result, start - 0.05, start + 1.5),
-            }
-            journal.add(key, entry)
-        else:
-            reused += 1
-        trials.append(
-            ValidationTrial(speed=speed, summary=entry["summary"], trajectory=entry["trajectory"])
-        )
-        return trials[-1].outcome
-
-    stood: float | None = None
-    fell: float | None = None
-    ceiling = max_speed  # aborted trials lower it: nothing faster can be tested
+    runner = _TrialRunner(setup, options, journal or TrialJournal(None, ""))
     start = predicted["com_criterion"]["composite"] or 0.5
-    speed = float(np.clip(start, min_speed, max_speed))
-    while True:
-        outcome = trial(speed)
-        if outcome == "aborted":  # nothing this fast can be tested: look below
-            ceiling = speed
-            if fell is not None or speed <= min_speed:
-                break
-            speed = max(min_speed, speed / 2) if stood is None else 0.5 * (stood + speed)
-            if stood is not None and speed - stood <= tolerance * speed:
-                break
-        elif outcome == "fell":
-            fell = speed
-            if stood is not None or speed <= min_speed:
-                break
-            speed = max(min_speed, speed / 2)
-        else:
-            stood = speed
-            if fell is not None or speed >= ceiling * (1 - 1e-9):
-                break
-            speed = min(ceiling, speed * 2)
-            if speed >= ceiling * (1 - 1e-9) and ceiling < max_speed:
-                break
-        if progress:
-            progress(trials[-1], stood, fell)
-    if progress and trials:
-        progress(trials[-1], stood, fell)
+    search = _Search(runner, tolerance, min_speed, max_speed, progress)
+    stood, fell = search.bracket(float(np.clip(start, min_speed, max_speed)))
+    if progress and runner.trials:
+        progress(runner.trials[-1], stood, fell)
     if stood is not None and fell is not None:
-        while fell - stood > tolerance * fell:
-            mid = 0.5 * (stood + fell)
-            outcome = trial(mid)
-            if outcome == "aborted":
-                break
-            if outcome == "fell":
-                fell = mid
-            else:
-                stood = mid
-            if progress:
-                progress(trials[-1], stood, fell)
-    if setup.controller == "id":
-        from impact_balance.sim.control.torque import describe
-
-        controller = describe(
-            options.id_gains, float(setup.sim.model.opt.timestep), joints == "servo"
-        )
-    else:
-        controller = {
-            "name": "dcm-zmp-clamp + pink IK -> joint position servos",
-            "gains": options.gains.to_dict(),
-            "control_rate_hz": options.gains.rate,
-            "sim_timestep": float(setup.sim.model.opt.timestep),
-            "servo": {
-                "kp": setup.sim.kp.tolist(),
-                "kd": setup.sim.kd.tolist(),
-                "joints": list(setup.sim.joint_names),
-            },
-        }
-    controller["impact_task"] = {
-        "approach": "bounded acceleration, then cruise",
-        "acceleration": 20.0,
-        "cruise": 0.03,
-        "force_threshold": 15.0,
-        "retract": 0.05,
-    }
-    controller["armature"] = setup.sim.armature_source
-    repair = setup.sim.inertia_repair
-    controller["inertia_repair"] = None if repair is None else repair.to_dict()
+        search.bisect(stood, fell)
+    trials, reused, journal = runner.trials, runner.reused, runner.journal
+    controller = _controller_description(setup, options, joints)
     return ValidationResult(
         scenario.name,
         joints,

@@ -19,12 +19,16 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance.exceptions import SimulationError
+from impact_balance.governor import Governor
 from impact_balance.json_values import json_number
 from impact_balance.sim.control.approach import approach_profile
+from impact_balance.sim.model.build import SimModel
 from impact_balance.sim.trials.balance_trial import (
     BalanceSetup,
     BalanceTrialOptions,
@@ -46,6 +50,8 @@ __all__ = [
 #: Version of the approach trial, for journals (with the balance trial's): 2 = the ``id``
 #: controller bounds the point's speed by the cap (``WallOptions.cap_constraint``).
 APPROACH_VERSION = 2
+
+_FloatArray = npt.NDArray[np.float64]
 
 #: Governors of the approach: the CoM criterion's, the ZMP criterion's, or none (the reference alone).
 GOVERNORS = ("com", "zmp", "none")
@@ -197,28 +203,31 @@ def run_wall_trial(
     setup: BalanceSetup,
     options: WallOptions,
     trial_options: BalanceTrialOptions | None = None,
-    governor=None,
+    governor: Governor | None = None,
     frames: bool = False,
 ) -> WallTrial:
-    """Run one approach (see the module docstring). ``governor``: a
-    :class:`~impact_balance.governor.Governor` of the setup's scenario and ``options.governor``'s criterion
-    (built here when None and the options ask for one); ``frames``: keep what a video needs.
+    """Run one approach (see the module docstring).
+
+    Args:
+        setup: The scenario prepared for balance trials.
+        options: The approach's options.
+        trial_options: The balance trial's options (default: the setup's controller's).
+        governor: A :class:`~impact_balance.governor.Governor` of the setup's scenario and
+            ``options.governor``'s criterion (built here when None and the options ask for one).
+        frames: Keep what a video needs.
+
+    Returns:
+        What the approach measured.
+
+    Raises:
+        SimulationError: Options out of range, or a scenario without an impact.
     """
-    if options.governor not in GOVERNORS:
-        raise SimulationError(
-            "--governor", options.governor, f"must be one of {', '.join(GOVERNORS)}"
-        )
-    if not (np.isfinite(options.reference) and 0.0 < options.reference <= 5.0):
-        raise SimulationError("--reference", options.reference, "must be in (0, 5] m/s")
-    if not (np.isfinite(options.wall_distance) and 0.0 < options.wall_distance <= 1.0):
-        raise SimulationError("--wall-distance", options.wall_distance, "must be in (0, 1] m")
+    _check(options)
     analysis = setup.analysis
     if analysis.impact is None:
         raise SimulationError("impact", None, "the scenario has no impact")
     trial_options = trial_options or BalanceTrialOptions(controller=setup.controller)
     if governor is None and options.governor != "none":
-        from impact_balance.governor import Governor
-
         governor = Governor(setup.scenario, criterion=options.governor)
     im = analysis.impact.model
     n = np.asarray(im.normal, dtype=float)
@@ -234,33 +243,83 @@ def run_wall_trial(
         bound_speed=options.cap_constraint,
     )
     wall = start - options.wall_distance * n
-    ticks: list[float] = []
-    caps: list[tuple[float, float, float]] = []
-    rows: dict[str, list] = {
-        "time": [],
-        "reference": [],
-        "cap": [],
-        "commanded": [],
-        "measured": [],
-    }
-    kept: dict[str, list] = {"time": [], "qpos": [], "com": [], "impact": []}
-    sim = setup.sim
+    recorder = _ApproachRecorder(setup.sim, task, governor, frames)
+    result = run_balance_trial(
+        setup,
+        impact_task=task,
+        surface_point=wall,
+        standoff=options.standoff,
+        options=trial_options,
+        before_control=recorder,
+        max_approach_time=options.max_time,
+    )
+    impact = result.impact
+    cap_at_contact = None
+    caps = recorder.caps
+    if impact is not None and caps:
+        k = max(0, int(np.searchsorted([c[0] for c in caps], impact.contact_time)) - 1)
+        cap_at_contact = json_number(caps[k][2])
+    return WallTrial(
+        options,
+        result,
+        None if impact is None else json_number(impact.approach_speed),
+        cap_at_contact,
+        None if impact is None else float(impact.contact_time - task.start_time),
+        _tick_statistics(recorder.ticks),
+        recorder.rows,
+        wall,
+        {k: np.array(x) for k, x in recorder.kept.items()} if frames else None,
+    )
 
-    def before_control(t: float, q: np.ndarray, v: np.ndarray) -> None:
-        if frames:
-            kept["time"].append(t)
-            kept["qpos"].append(sim.data.qpos.copy())
-            kept["com"].append(sim.com())
-            kept["impact"].append(sim.contact_force(sim.impact_geom))
+
+def _check(options: WallOptions) -> None:
+    """Refuse a governor, reference speed or wall distance out of range."""
+    if options.governor not in GOVERNORS:
+        raise SimulationError(
+            "--governor", options.governor, f"must be one of {', '.join(GOVERNORS)}"
+        )
+    if not (np.isfinite(options.reference) and 0.0 < options.reference <= 5.0):
+        raise SimulationError("--reference", options.reference, "must be in (0, 5] m/s")
+    if not (np.isfinite(options.wall_distance) and 0.0 < options.wall_distance <= 1.0):
+        raise SimulationError("--wall-distance", options.wall_distance, "must be in (0, 1] m")
+
+
+class _ApproachRecorder:
+    """Before every control step: the governor's cap given to the task, and the series recorded."""
+
+    def __init__(
+        self, sim: SimModel, task: GovernedApproach, governor: Governor | None, frames: bool
+    ):
+        self.sim, self.task, self.governor, self.frames = sim, task, governor, frames
+        self.n = np.asarray(task.normal, dtype=float)
+        self.ticks: list[float] = []
+        self.caps: list[tuple[float, float, float]] = []
+        self.rows: dict[str, list[float | None]] = {
+            "time": [],
+            "reference": [],
+            "cap": [],
+            "commanded": [],
+            "measured": [],
+        }
+        self.kept: dict[str, list[Any]] = {"time": [], "qpos": [], "com": [], "impact": []}
+
+    def __call__(self, t: float, q: _FloatArray, v: _FloatArray) -> None:
+        sim, task, governor, rows = self.sim, self.task, self.governor, self.rows
+        if self.frames:
+            assert sim.impact_geom is not None
+            self.kept["time"].append(t)
+            self.kept["qpos"].append(sim.data.qpos.copy())
+            self.kept["com"].append(sim.com())
+            self.kept["impact"].append(sim.contact_force(sim.impact_geom))
         if t < task.start_time:
             return
         if task.contact_time is None and governor is not None:
             t0 = time.perf_counter()
             limit = governor.limit(q, v)
-            ticks.append(time.perf_counter() - t0)
+            self.ticks.append(time.perf_counter() - t0)
             task.ceiling = limit.ceiling
         if task.contact_time is None:
-            caps.append((t, task.reference_speed(t), task.ceiling))
+            self.caps.append((t, task.reference_speed(t), task.ceiling))
         rows["time"].append(t)
         rows["reference"].append(task.reference_speed(t) if task.contact_time is None else 0.0)
         rows["cap"].append(
@@ -269,39 +328,19 @@ def run_wall_trial(
             else None
         )
         rows["commanded"].append(task.commanded if task.contact_time is None else 0.0)
-        rows["measured"].append(float(-n @ sim.impact_point_velocity(n)))
+        rows["measured"].append(float(-self.n @ sim.impact_point_velocity(self.n)))
 
-    result = run_balance_trial(
-        setup,
-        impact_task=task,
-        surface_point=wall,
-        standoff=options.standoff,
-        options=trial_options,
-        before_control=before_control,
-        max_approach_time=options.max_time,
-    )
-    impact = result.impact
-    cap_at_contact = None
-    if impact is not None and caps:
-        k = max(0, int(np.searchsorted([c[0] for c in caps], impact.contact_time)) - 1)
-        cap_at_contact = json_number(caps[k][2])
+
+def _tick_statistics(ticks: list[float]) -> dict[str, float | int | None]:
+    """Median and 99th percentile (us) of the governor's ticks, and their count."""
     us = np.asarray(ticks) * 1e6
-    tick_us = (
-        {"median": float(np.median(us)), "p99": float(np.percentile(us, 99)), "count": int(us.size)}
-        if us.size
-        else {"median": None, "p99": None, "count": 0}
-    )
-    return WallTrial(
-        options,
-        result,
-        None if impact is None else json_number(impact.approach_speed),
-        cap_at_contact,
-        None if impact is None else float(impact.contact_time - task.start_time),
-        tick_us,
-        rows,
-        wall,
-        {k: np.array(x) for k, x in kept.items()} if frames else None,
-    )
+    if not us.size:
+        return {"median": None, "p99": None, "count": 0}
+    return {
+        "median": float(np.median(us)),
+        "p99": float(np.percentile(us, 99)),
+        "count": int(us.size),
+    }
 
 
 def write_wall_video(setup: BalanceSetup, trial: WallTrial, path, title: str | None = None):

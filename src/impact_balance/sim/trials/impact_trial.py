@@ -27,11 +27,14 @@ from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 
 from impact_balance.exceptions import SimulationError
+from impact_balance.impact.model import ImpactSpec
 from impact_balance.ranges import MAX_APPROACH_SPEED, check_approach_speed
 from impact_balance.sim.model.build import SimModel
+from impact_balance.sim.trials.rigid_impact import RigidImpactHold
 
 __all__ = [
     "MAX_APPROACH_SPEED",
@@ -41,6 +44,8 @@ __all__ = [
     "impact_limb",
     "run_trial",
 ]
+
+_FloatArray = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -168,7 +173,7 @@ def approach_joint_velocity(
         if solution is None or not np.allclose(J @ solution, -normal, atol=1e-6):
             names = ", ".join(
                 f"{j} ({q_j:+.3f} rad, range [{lo:+.3f}, {hi:+.3f}])"
-                for j, q_j, lo, hi, bad in zip(limb, q, low, high, outside)
+                for j, q_j, lo, hi, bad in zip(limb, q, low, high, outside, strict=False)
                 if bad
             )
             raise SimulationError(
@@ -184,7 +189,19 @@ def approach_joint_velocity(
 
 
 def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
-    """Run one impact trial on ``sim`` (reset to the stance first); see the module docstring."""
+    """Run one impact trial on ``sim`` (reset to the stance first); see the module docstring.
+
+    Args:
+        sim: The scenario's model (``rigid`` or ``servo`` joints).
+        options: Approach speed, gap, settling and after times.
+
+    Returns:
+        The trial's time series.
+
+    Raises:
+        SimulationError: The scenario has no impact, the approach speed is out of range, or no
+            joint path brings the impact point to the surface.
+    """
     if sim.scenario.impact is None or sim.impact_geom is None:
         raise SimulationError("impact", None, "the scenario has no impact to simulate")
     v_n = options.approach_speed
@@ -194,113 +211,166 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
     n = np.asarray(spec.normal, dtype=float) / np.linalg.norm(spec.normal)
     gap = options.resolved_gap()
     travel = gap / v_n
-    q0 = sim.stance.q.copy()
     gravity = m.opt.gravity.copy()
-    dt = m.opt.timestep
+    start = _start(sim, options, spec, n, gap)
+    total = start.settle + 1.5 * travel + options.after
+    steps = int(round(total / m.opt.timestep))
+    frames = [c.spec.frame for c in sim.stance.contacts]
+    # Log names: the contact's frame, made unique with its index when two contacts share a frame.
+    names = [f if frames.count(f) == 1 else f"{f}_{i}" for i, f in enumerate(frames)] + ["impact"]
+    rec = _Samples.empty(sim, steps)
+    # mj_step computes the kinematics, contacts and forces of the state it starts from, then
+    # integrates: sample k is the state before step k, with what mj_step computed from it
+    # (its contact forces act from sample k to sample k + 1).
+    d.time = 0.0
+    wall0 = time.perf_counter()
+    hold = None
+    if options.rigid_impact and sim.joints == "servo":
+        hold = RigidImpactHold(sim)
+    surface = float(n @ np.asarray(sim.stance.point(spec.frame, spec.offset)[0].translation))
+    try:
+        _simulate(sim, rec, start, n, v_n, surface, hold)
+    finally:
+        wall = time.perf_counter() - wall0
+        m.opt.gravity[:] = gravity
+        sim.enable_supports(True)
+        if hold is not None:
+            hold.release(d.time)
+    return TrialRecord(
+        time=rec.time,
+        qpos=rec.qpos,
+        qvel=rec.qvel,
+        com=rec.com,
+        com_velocity=rec.com_velocity,
+        forces={name: rec.forces[:, i] for i, name in enumerate(names)},
+        impact_velocity=rec.point_velocity,
+        approach_start=start.settle,
+        wall_time=wall,
+        contact_positions=rec.contact_positions,
+        actuator_force=rec.torques[:, sim.actuator_ids] if m.nu else rec.torques,
+        hold=None if hold is None else hold.to_dict(),
+    )
 
+
+@dataclass(frozen=True)
+class _Start:
+    """How a trial starts: settling time (s), the limb's joint velocity per unit approach speed
+    (None with rigid joints: the whole robot flies at the surface) and the start configuration.
+    """
+
+    settle: float
+    limb_dq: _FloatArray | None
+    q_start: _FloatArray
+
+
+def _start(
+    sim: SimModel, options: TrialOptions, spec: ImpactSpec, n: _FloatArray, gap: float
+) -> _Start:
+    """Set ``sim`` to the trial's start: with ``rigid`` joints the robot ``gap`` back from the
+    surface, flying at it without gravity nor supports; with ``servo`` joints the limb backed off.
+    """
+    v_n = options.approach_speed
     if sim.joints == "rigid":
-        m.opt.gravity[:] = 0.0
+        q0 = sim.stance.q.copy()
+        sim.model.opt.gravity[:] = 0.0
         sim.enable_supports(False)
         q0[:3] += gap * n
         R = pin.Quaternion(q0[6], q0[3], q0[4], q0[5]).toRotationMatrix()
         v0 = np.zeros(sim.stance.model.nv)
         v0[:3] = R.T @ (-v_n * n)
         sim.set_state(q0, v0)
-        settle = 0.0
-        limb_dq = None
-    else:
-        sim.enable_supports(True)
-        limb = impact_limb(sim)
-        if not limb:
-            raise SimulationError(
-                "impact.frame",
-                spec.frame,
-                "no joint moves the impact point without moving a contact",
-            )
-        limb_dq = approach_joint_velocity(
-            sim, limb, n, gap
-        )  # joint velocity per unit approach speed
-        q_start = pin.integrate(sim.stance.model, sim.stance.q, -gap * limb_dq)
-        sim.set_state(q_start)
-        sim.set_servo_targets(q_start)
-        settle = options.settle
-    total = settle + 1.5 * travel + options.after
-    steps = int(round(total / dt))
-    frames = [c.spec.frame for c in sim.stance.contacts]
-    # Log names: the contact's frame, made unique with its index when two contacts share a frame.
-    names = [f if frames.count(f) == 1 else f"{f}_{i}" for i, f in enumerate(frames)] + ["impact"]
+        return _Start(0.0, None, q0)
+    sim.enable_supports(True)
+    limb = impact_limb(sim)
+    if not limb:
+        raise SimulationError(
+            "impact.frame",
+            spec.frame,
+            "no joint moves the impact point without moving a contact",
+        )
+    limb_dq = approach_joint_velocity(sim, limb, n, gap)  # joint velocity per unit approach speed
+    q_start = pin.integrate(sim.stance.model, sim.stance.q, -gap * limb_dq)
+    sim.set_state(q_start)
+    sim.set_servo_targets(q_start)
+    return _Start(options.settle, limb_dq, q_start)
+
+
+@dataclass(frozen=True)
+class _Samples:
+    """The trial's samples, one row per integration step (see :class:`TrialRecord`)."""
+
+    time: _FloatArray
+    qpos: _FloatArray
+    qvel: _FloatArray
+    com: _FloatArray
+    com_velocity: _FloatArray
+    forces: _FloatArray
+    point_velocity: _FloatArray
+    contact_positions: _FloatArray
+    torques: _FloatArray
+
+    @classmethod
+    def empty(cls, sim: SimModel, steps: int) -> _Samples:
+        m, k = sim.model, len(sim.contact_geoms)
+        return cls(
+            time=np.empty(steps),
+            qpos=np.empty((steps, m.nq)),
+            qvel=np.empty((steps, m.nv)),
+            com=np.empty((steps, 3)),
+            com_velocity=np.empty((steps, 3)),
+            forces=np.empty((steps, k + 1, 3)),
+            point_velocity=np.empty((steps, 3)),
+            contact_positions=np.empty((steps, k, 3)),
+            torques=np.empty((steps, m.nu)),
+        )
+
+
+def _simulate(
+    sim: SimModel,
+    rec: _Samples,
+    start: _Start,
+    n: _FloatArray,
+    v_n: float,
+    surface: float,
+    hold: RigidImpactHold | None,
+) -> None:
+    """Step MuJoCo, driving the limb at ``v_n`` (m/s) until the contact, and fill ``rec``."""
+    m, d = sim.model, sim.data
+    dt = m.opt.timestep
+    assert sim.impact_geom is not None
     geoms = [*sim.contact_geoms, sim.impact_geom]
-    T = steps
-    rec_t = np.empty(T)
-    qpos, qvel = np.empty((T, m.nq)), np.empty((T, m.nv))
-    com, comd = np.empty((T, 3)), np.empty((T, 3))
-    forces = np.empty((T, len(geoms), 3))
-    point_v = np.empty((T, 3))
-    contact_pos = np.empty((T, len(sim.contact_geoms), 3))
-    torques = np.empty((T, m.nu))
-
-    # mj_step computes the kinematics, contacts and forces of the state it starts from, then
-    # integrates: sample k is the state before step k, with what mj_step computed from it
-    # (its contact forces act from sample k to sample k + 1).
-    d.time = 0.0
-    start = time.perf_counter()
-    frozen = None  # servo targets once the impact begins
-    hold = None
-    if options.rigid_impact and sim.joints == "servo":
-        from impact_balance.sim.trials.rigid_impact import RigidImpactHold
-
-        hold = RigidImpactHold(sim)
-    surface = float(n @ np.asarray(sim.stance.point(spec.frame, spec.offset)[0].translation))
     radius = float(m.geom_size[sim.impact_geom][0])
-    try:
-        for k in range(T):
-            if hold is not None and hold.start is None:
-                # Hold from the step in which the point will touch: its gap closes within one step.
-                approach = float(-n @ sim.impact_point_velocity(n))
-                gap = float(n @ (d.geom_xpos[sim.impact_geom] - radius * n)) - surface
-                if gap - max(0.0, approach) * dt <= 0.0:
-                    hold.begin(d.time)
-            if limb_dq is not None:
-                s = d.time - settle  # time into the approach
-                if frozen is None and s > 0.0 and k > 0 and forces[k - 1, -1].any():
-                    # A kinematic controller stops the limb at contact: hold the targets there.
-                    frozen = pin.integrate(sim.stance.model, q_start, s * v_n * limb_dq)
-                if frozen is not None:
-                    sim.set_servo_targets(frozen)
-                elif s > 0.0:
-                    # Past the stance if need be: the servos lag, the surface is where the stance touches it.
-                    sim.set_servo_targets(
-                        pin.integrate(sim.stance.model, q_start, s * v_n * limb_dq), v_n * limb_dq
-                    )
-            rec_t[k] = d.time
-            qpos[k], qvel[k] = d.qpos, d.qvel
-            mujoco.mj_step(m, d)
-            mujoco.mj_subtreeVel(m, d)
-            com[k] = d.subtree_com[sim.root_body]
-            comd[k] = d.subtree_linvel[sim.root_body]
-            forces[k] = sim.contact_forces(geoms)
-            point_v[k] = sim.impact_point_velocity(n)
-            contact_pos[k] = d.geom_xpos[list(sim.contact_geoms)]
-            torques[k] = d.actuator_force
-            if hold is not None:
-                hold.update(d.time, float(-n @ point_v[k]))
-    finally:
-        wall = time.perf_counter() - start
-        m.opt.gravity[:] = gravity
-        sim.enable_supports(True)
+    limb_dq, q_start, settle = start.limb_dq, start.q_start, start.settle
+    frozen = None  # servo targets once the impact begins
+    for k in range(len(rec.time)):
+        if hold is not None and hold.start is None:
+            # Hold from the step in which the point will touch: its gap closes within one step.
+            approach = float(-n @ sim.impact_point_velocity(n))
+            gap = float(n @ (d.geom_xpos[sim.impact_geom] - radius * n)) - surface
+            if gap - max(0.0, approach) * dt <= 0.0:
+                hold.begin(d.time)
+        if limb_dq is not None:
+            s = d.time - settle  # time into the approach
+            if frozen is None and s > 0.0 and k > 0 and rec.forces[k - 1, -1].any():
+                # A kinematic controller stops the limb at contact: hold the targets there.
+                frozen = pin.integrate(sim.stance.model, q_start, s * v_n * limb_dq)
+            if frozen is not None:
+                sim.set_servo_targets(frozen)
+            elif s > 0.0:
+                # Past the stance if need be: the servos lag, the surface is where the stance
+                # touches it.
+                sim.set_servo_targets(
+                    pin.integrate(sim.stance.model, q_start, s * v_n * limb_dq), v_n * limb_dq
+                )
+        rec.time[k] = d.time
+        rec.qpos[k], rec.qvel[k] = d.qpos, d.qvel
+        mujoco.mj_step(m, d)
+        mujoco.mj_subtreeVel(m, d)
+        rec.com[k] = d.subtree_com[sim.root_body]
+        rec.com_velocity[k] = d.subtree_linvel[sim.root_body]
+        rec.forces[k] = sim.contact_forces(geoms)
+        rec.point_velocity[k] = sim.impact_point_velocity(n)
+        rec.contact_positions[k] = d.geom_xpos[list(sim.contact_geoms)]
+        rec.torques[k] = d.actuator_force
         if hold is not None:
-            hold.release(d.time)
-    return TrialRecord(
-        time=rec_t,
-        qpos=qpos,
-        qvel=qvel,
-        com=com,
-        com_velocity=comd,
-        forces={name: forces[:, i] for i, name in enumerate(names)},
-        impact_velocity=point_v,
-        approach_start=settle,
-        wall_time=wall,
-        contact_positions=contact_pos,
-        actuator_force=torques[:, sim.actuator_ids] if m.nu else torques,
-        hold=None if hold is None else hold.to_dict(),
-    )
+            hold.update(d.time, float(-n @ rec.point_velocity[k]))

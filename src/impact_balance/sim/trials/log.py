@@ -49,7 +49,7 @@ def log_frame(sim: SimModel, record: TrialRecord, start: float = LOG_START) -> p
     data: dict[str, np.ndarray] = {cols.time: record.time}
     for k, name in enumerate(cols.base_position):
         data[name] = record.qpos[:, k]
-    for name, k in zip(cols.base_quaternion, (1, 2, 3, 0)):
+    for name, k in zip(cols.base_quaternion, (1, 2, 3, 0), strict=False):
         data[name] = quat[:, k]
     for k, name in enumerate(cols.base_linear_velocity):
         data[name] = record.qvel[:, k]
@@ -71,7 +71,7 @@ def log_frame(sim: SimModel, record: TrialRecord, start: float = LOG_START) -> p
         data[joint_position_column(name)] = q
         data[joint_velocity_column(name)] = v
     for name, force in record.forces.items():
-        for column, values in zip(force_columns(name), force.T):
+        for column, values in zip(force_columns(name), force.T, strict=False):
             data[column] = values
     for k, name in enumerate(cols.com):
         data[name] = record.com[:, k]

@@ -148,7 +148,7 @@ def distance_to_hull(point: np.ndarray, vertices: np.ndarray) -> float:
     if len(v) == 1:
         return float(np.linalg.norm(point - v[0]))
     best = np.inf
-    for a, b in zip(v, np.roll(v, -1, axis=0)):
+    for a, b in zip(v, np.roll(v, -1, axis=0), strict=False):
         ab = b - a
         t = np.clip((point - a) @ ab / max(ab @ ab, 1e-300), 0.0, 1.0)
         best = min(best, float(np.linalg.norm(point - (a + t * ab))))
@@ -238,7 +238,10 @@ def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialR
             f for name, f in record.forces.items() if name != "impact"
         ]  # in contact order
         normal_forces = np.array(
-            [f[start:] @ c.normal for f, c in zip(contact_forces, sim.stance.contacts)]
+            [
+                f[start:] @ c.normal
+                for f, c in zip(contact_forces, sim.stance.contacts, strict=False)
+            ]
         )
         moved = np.linalg.norm(
             record.contact_positions[start:] - record.contact_positions[start], axis=2
@@ -251,7 +254,7 @@ def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialR
         limited = sim.model.actuator_forcelimited[sim.actuator_ids].astype(bool)
         saturated = [
             name
-            for name, p, lim, on in zip(sim.joint_names, peak, limits, limited)
+            for name, p, lim, on in zip(sim.joint_names, peak, limits, limited, strict=False)
             if on and p >= lim * (1 - 1e-6)
         ]
     ratio = record.simulated_time / record.wall_time if record.wall_time > 0 else float("nan")

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
+from typing import Any, Literal
 
 import numpy as np
 
@@ -48,17 +49,32 @@ __all__ = [
     "FALL_REASONS",
     "OUTCOMES",
     "ContactEvent",
+    "EventKind",
+    "FallReason",
     "Outcome",
+    "OutcomeName",
     "OutcomeCriteria",
     "OutcomeMonitor",
 ]
 
+#: A trial's outcome.
+OutcomeName = Literal["balanced", "contact_broken", "fell", "aborted"]
+#: Why a trial ``fell``.
+FallReason = Literal["base_dropped", "trunk_tipped", "dcm_escaped", "not_at_rest"]
+#: How a sustained contact broke.
+EventKind = Literal["lifted", "slipped", "tilted"]
+
 #: Trial outcomes.
-OUTCOMES = ("balanced", "contact_broken", "fell", "aborted")
+OUTCOMES: tuple[OutcomeName, ...] = ("balanced", "contact_broken", "fell", "aborted")
 #: Reasons of ``fell``.
-FALL_REASONS = ("base_dropped", "trunk_tipped", "dcm_escaped", "not_at_rest")
+FALL_REASONS: tuple[FallReason, ...] = (
+    "base_dropped",
+    "trunk_tipped",
+    "dcm_escaped",
+    "not_at_rest",
+)
 #: Kinds of contact events.
-EVENT_KINDS = ("lifted", "slipped", "tilted")
+EVENT_KINDS: tuple[EventKind, ...] = ("lifted", "slipped", "tilted")
 
 
 @dataclass(frozen=True)
@@ -87,7 +103,7 @@ class ContactEvent:
     """
 
     contact: str
-    kind: str
+    kind: EventKind
     time: float
     value: float
 
@@ -102,7 +118,7 @@ class Outcome:
     contact ``event``.
     """
 
-    outcome: str
+    outcome: OutcomeName
     reason: str | None
     time: float | None
     detail: str = ""

@@ -69,7 +69,7 @@ class ImpactMeasurement:
             "impulse": finite_or_null(nulls, "impulse", self.impulse, "not finite"),
             "sustained_impulses": {
                 name: finite_or_null(nulls, f"sustained_impulses.{name}", imp, "not finite")
-                for name, imp in zip(contact_names, self.sustained_impulses)
+                for name, imp in zip(contact_names, self.sustained_impulses, strict=False)
             },
             "com_velocity_before": finite_or_null(
                 nulls, "com_velocity_before", self.com_velocity_before, "not finite"

@@ -15,24 +15,17 @@ import numpy as np
 from impact_balance.analysis.analyze import Analysis, analyze
 from impact_balance.exceptions import SimulationError
 from impact_balance.scenario import Scenario, load_scenario
-from impact_balance.sim.control.actuation import (
-    STIFF_SERVOS,
-    stiffen_support_limbs,
-    support_joints,
-    use_torque_motors,
-)
-from impact_balance.sim.control.kinematic import BalanceGains, retracted_stance
-from impact_balance.sim.control.torque import InverseDynamicsGains
+from impact_balance.sim.control.actuation import STIFF_SERVOS, support_joints
+from impact_balance.sim.control.controller import ControllerName
+from impact_balance.sim.control.gains import BalanceGains, InverseDynamicsGains
+from impact_balance.sim.control.kinematic import retracted_stance
+from impact_balance.sim.control.registry import CONTROLLERS, controller_class
 from impact_balance.sim.model.build import SimModel, SimOptions, build_model
-from impact_balance.sim.model.joints import JOINT_MODELS, ServoOptions
+from impact_balance.sim.model.joints import JointModel, ServoOptions, check_joint_model
 from impact_balance.sim.trials.outcomes import OutcomeCriteria
 
 #: Iterations of MuJoCo's no-slip solver in balance trials.
 NOSLIP_ITERATIONS = 10
-
-#: Balance controllers: ``ik`` (pink IK -> position servos, :mod:`.balance`) and ``id`` (inverse-dynamics QP ->
-#: torque motors, :mod:`.inverse_dynamics`).
-CONTROLLERS = ("ik", "id")
 
 __all__ = [
     "CONTROLLERS",
@@ -120,14 +113,14 @@ class BalanceTrialOptions:
     gains: BalanceGains = field(default_factory=BalanceGains)
     criteria: OutcomeCriteria = field(default_factory=OutcomeCriteria)
     record: bool = False
-    controller: str = "ik"
+    controller: ControllerName = "ik"
     id_gains: InverseDynamicsGains = field(default_factory=InverseDynamicsGains)
     rigid_impact: bool = False
 
 
 def controller_margin(options: BalanceTrialOptions) -> float:
     """The ZMP margin the trials' controller keeps inside the ZMP support area (m): the scores' default."""
-    return options.id_gains.zmp_margin if options.controller == "id" else options.gains.zmp_margin
+    return controller_class(options.controller).zmp_margin(options)
 
 
 @dataclass
@@ -137,11 +130,11 @@ class BalanceSetup:
     """
 
     scenario: Scenario
-    joints: str
+    joints: JointModel
     analysis: Analysis
     sim: SimModel
     support_v_index: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
-    controller: str = "ik"
+    controller: ControllerName = "ik"
     _starts: dict[float, np.ndarray] = field(default_factory=dict)
 
     @classmethod
@@ -160,16 +153,8 @@ class BalanceSetup:
         options = options or BalanceTrialOptions()
         if not isinstance(scenario, Scenario):
             scenario = load_scenario(scenario)
-        if joints not in JOINT_MODELS:
-            raise SimulationError(
-                "--joints", joints, f"unknown joint model; valid: {', '.join(JOINT_MODELS)}"
-            )
-        if options.controller not in CONTROLLERS:
-            raise SimulationError(
-                "--controller",
-                options.controller,
-                f"unknown controller; valid: {', '.join(CONTROLLERS)}",
-            )
+        joint_model = check_joint_model(joints)
+        controller = controller_class(options.controller)
         # The controller works on the areas themselves: a scoring margin is applied afterwards.
         analysis = analyze(scenario.model_copy(update={"zmp_margin": 0.0}))
         if not analysis.areas.can_balance:
@@ -188,13 +173,10 @@ class BalanceSetup:
         # 3 mm/s within its friction cone); the no-slip pass removes that drift, which would otherwise
         # count as a slip after a few seconds.
         sim.model.opt.noslip_iterations = NOSLIP_ITERATIONS
-        if options.controller == "id":
-            use_torque_motors(sim)
-        else:
-            stiffen_support_limbs(sim, analysis)
+        controller.prepare_model(sim, analysis)
         support = [analysis.stance.robot.joint_slot(n) for n in support_joints(sim, analysis)]
         support_v = np.array([analysis.stance.model.joints[j.id].idx_v for j in support], dtype=int)
-        return cls(scenario, joints, analysis, sim, support_v, options.controller)
+        return cls(scenario, joint_model, analysis, sim, support_v, options.controller)
 
     def start_configuration(self, standoff: float = 0.0) -> np.ndarray:
         """The stance with the impact point backed off ``standoff`` (m) along the normal (whole-body IK, cached)."""
