@@ -12,12 +12,13 @@ import os
 import sys
 import tempfile
 import threading
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field, fields
 from pathlib import Path
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 
 from impact_balance.exceptions import (
@@ -39,6 +40,8 @@ __all__ = [
     "example_robot_data_root",
     "load_robot",
 ]
+
+_FloatArray = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -181,7 +184,7 @@ class Robot:
     package_dirs: list[str] = field(default_factory=list)
     armature_source: str | None = None
 
-    def __getstate__(self) -> dict:
+    def __getstate__(self) -> dict[str, Any]:
         # The caches (thread-local Data, look-up tables) are rebuilt on demand, never copied.
         return {f.name: self.__dict__[f.name] for f in fields(self)}
 
@@ -299,7 +302,7 @@ class Robot:
         return result
 
     @functools.cached_property
-    def _assignments(self) -> dict[tuple, tuple[np.ndarray, np.ndarray]]:
+    def _assignments(self) -> dict[tuple[Any, ...], tuple[np.ndarray, np.ndarray]]:
         return {}
 
     def joint_values(self, q: np.ndarray) -> dict[str, float]:
@@ -319,7 +322,8 @@ class Robot:
         key = self.standing if name is None else name
         if key not in self.reference_configurations:
             raise UnknownConfigurationError(field, key, self.reference_configurations)
-        return self.reference_configurations[key].copy()
+        answer: _FloatArray = self.reference_configurations[key].copy()
+        return answer
 
     def actuated_effort_limits(self) -> tuple[np.ndarray, np.ndarray]:
         """Velocity indices of the torque-limited actuated joints and their effort limits (N m).
@@ -378,7 +382,7 @@ _FD_LOCK = threading.Lock()
 
 
 @contextlib.contextmanager
-def _native_stderr(lines: list[str]):
+def _native_stderr(lines: list[str]) -> Iterator[None]:
     """Collect what C++ code writes to file descriptor 2 (urdfdom's "Error: ..." lines) into
     ``lines`` instead of the terminal: a failure is reported once, as one line naming the file.
 
@@ -512,7 +516,7 @@ def load_robot(
 
 
 #: Robots loaded from files, by :func:`_file_key` of their URDF and SRDF.
-_FILE_ROBOTS: dict[tuple, Robot] = {}
+_FILE_ROBOTS: dict[tuple[Any, ...], Robot] = {}
 
 
 def _file_key(path: Path) -> tuple[str, int, int]:

@@ -20,14 +20,17 @@ The standoff follows from the speed: ``max(min_standoff, v^2 / (2 a) + cruise)``
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 
 __all__ = [
     "APPROACH_ACCELERATION",
     "CRUISE_DISTANCE",
     "MIN_STANDOFF",
+    "ImpactReference",
     "ImpactTask",
     "approach_profile",
 ]
@@ -38,6 +41,57 @@ APPROACH_ACCELERATION = 20.0
 CRUISE_DISTANCE = 0.03
 #: Smallest standoff, m.
 MIN_STANDOFF = 0.05
+
+
+_FloatArray = npt.NDArray[np.float64]
+
+
+class ImpactReference(Protocol):
+    """What the balance controllers and trials need of an impacting point's reference.
+
+    :class:`ImpactTask` is one; :class:`~impact_balance.sim.studies.wall.GovernedApproach`
+    another. A reference may also bound the point's approach speed with a method
+    ``speed_bound() -> float`` (m/s; ``inf``: unbounded), which the torque controller enforces.
+
+    Attributes:
+        frame: Robot frame of the impacting end-effector.
+        offset: Pose of the impact point in ``frame``.
+        normal: Unit surface normal, from the surface into the robot (world).
+        start_time: When the approach starts (s).
+        contact_time: When the contact was felt (s), None before.
+    """
+
+    frame: str
+    offset: pin.SE3
+    normal: _FloatArray
+    start_time: float
+    contact_time: float | None
+
+    def reference(
+        self, t: float, normal_force: float = 0.0
+    ) -> tuple[_FloatArray, _FloatArray, _FloatArray]:
+        """World position (m), velocity (m/s) and acceleration (m/s^2) of the reference at ``t``.
+
+        Args:
+            t: Time (s).
+            normal_force: Measured normal force at the impact point (N).
+
+        Returns:
+            The position, velocity and acceleration (3 each).
+        """
+        ...
+
+    def target(self, t: float, normal_force: float = 0.0) -> _FloatArray:
+        """The reference position alone (m, world) at ``t``.
+
+        Args:
+            t: Time (s).
+            normal_force: Measured normal force at the impact point (N).
+
+        Returns:
+            The position (3,).
+        """
+        ...
 
 
 @dataclass

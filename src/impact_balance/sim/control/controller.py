@@ -21,7 +21,7 @@ import numpy as np
 import numpy.typing as npt
 
 from impact_balance.analysis.analyze import Analysis
-from impact_balance.sim.control.approach import ImpactTask
+from impact_balance.sim.control.approach import ImpactReference
 from impact_balance.sim.control.gains import TrialGains
 from impact_balance.sim.model.build import SimModel
 
@@ -44,11 +44,20 @@ class ControlStep(Protocol):
         com_velocity: Measured CoM velocity (m/s).
     """
 
-    zmp: _FloatArray
-    dcm: _FloatArray
-    clamped: bool
-    com: _FloatArray
-    com_velocity: _FloatArray
+    @property
+    def zmp(self) -> _FloatArray: ...
+
+    @property
+    def dcm(self) -> _FloatArray: ...
+
+    @property
+    def clamped(self) -> bool: ...
+
+    @property
+    def com(self) -> _FloatArray: ...
+
+    @property
+    def com_velocity(self) -> _FloatArray: ...
 
 
 StepT = TypeVar("StepT", bound=ControlStep)
@@ -96,7 +105,7 @@ class Controller(ABC, Generic[StepT]):
         analysis: Analysis,
         q_start: _FloatArray,
         options: TrialGains,
-        task: ImpactTask | None,
+        task: ImpactReference | None,
         sim: SimModel,
         support_v_index: npt.NDArray[np.int_],
     ) -> Controller[StepT]:

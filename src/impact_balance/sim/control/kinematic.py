@@ -43,7 +43,7 @@ from impact_balance.analysis.analyze import Analysis
 from impact_balance.balance.lipm import lipm_omega
 from impact_balance.robot.ik import IKOptions, solve_stance
 from impact_balance.sim.control.actuation import stiffen_support_limbs
-from impact_balance.sim.control.approach import ImpactTask
+from impact_balance.sim.control.approach import ImpactReference
 from impact_balance.sim.control.controller import Controller
 from impact_balance.sim.control.gains import BalanceGains, TrialGains
 from impact_balance.sim.control.zmp import DcmFeedback, clamp_to_polygon
@@ -84,7 +84,8 @@ def retracted_stance(analysis: Analysis, standoff: float) -> np.ndarray:
     """
     stance, impact = analysis.stance, analysis.impact
     if impact is None or standoff <= 0:
-        return stance.q.copy()
+        answer: _FloatArray = stance.q.copy()
+        return answer
     spec = impact.model.spec
     frame_pose = stance.frame_pose(spec.frame)
     target = pin.SE3(frame_pose.rotation, frame_pose.translation + standoff * impact.model.normal)
@@ -119,7 +120,7 @@ class BalanceController(Controller["ControlOutput"]):
         analysis: Analysis,
         q0: np.ndarray | None = None,
         gains: BalanceGains | None = None,
-        impact: ImpactTask | None = None,
+        impact: ImpactReference | None = None,
     ):
         gains = gains or BalanceGains()
         self.analysis = analysis
@@ -153,7 +154,7 @@ class BalanceController(Controller["ControlOutput"]):
         self.com_task.set_target(com0)
         self.posture_task = PostureTask(cost=gains.posture_cost)
         self.posture_task.set_target(q0)
-        self.impact_task = None
+        self.impact_task: FrameTask | None = None
         if impact is not None:
             self.impact_task = FrameTask(impact.frame, gains.impact_cost, 0.1 * gains.impact_cost)
             self._impact_rotation = self.configuration.get_transform_frame_to_world(
@@ -179,7 +180,7 @@ class BalanceController(Controller["ControlOutput"]):
         analysis: Analysis,
         q_start: _FloatArray,
         options: TrialGains,
-        task: ImpactTask | None,
+        task: ImpactReference | None,
         sim: SimModel,
         support_v_index: npt.NDArray[np.int_],
     ) -> BalanceController:
@@ -234,7 +235,8 @@ class BalanceController(Controller["ControlOutput"]):
     @property
     def q_ref(self) -> _FloatArray:
         """The reference configuration (nq, pinocchio order)."""
-        return self.configuration.q
+        answer: _FloatArray = self.configuration.q
+        return answer
 
     def measure(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Measured CoM and CoM velocity (m, m/s, world) from pinocchio's ``(q, v)``."""
@@ -272,7 +274,7 @@ class BalanceController(Controller["ControlOutput"]):
             )
         self.com_task.set_target(np.array([*self.com_command, self.com_height]))
         tasks = [self.com_task, *self.contact_tasks, self.posture_task]
-        if self.impact is not None:
+        if self.impact is not None and self.impact_task is not None:
             point = self.impact.target(t, impact_force)
             frame_origin = point - self._impact_rotation @ self.impact.offset.translation
             self.impact_task.set_target(pin.SE3(self._impact_rotation, frame_origin))

@@ -59,7 +59,7 @@ from impact_balance.balance.lipm import lipm_omega
 from impact_balance.contacts.cwc import cwc_faces_world
 from impact_balance.geometry.spatial import skew
 from impact_balance.sim.control.actuation import use_torque_motors
-from impact_balance.sim.control.approach import ImpactTask
+from impact_balance.sim.control.approach import ImpactReference
 from impact_balance.sim.control.controller import Controller
 from impact_balance.sim.control.gains import InverseDynamicsGains, TrialGains
 from impact_balance.sim.control.zmp import DcmFeedback
@@ -185,7 +185,7 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         analysis: Analysis,
         q0: np.ndarray | None = None,
         gains: InverseDynamicsGains | None = None,
-        impact: ImpactTask | None = None,
+        impact: ImpactReference | None = None,
         effort_limits: bool = True,
     ):
         gains = gains or InverseDynamicsGains()
@@ -295,7 +295,7 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         analysis: Analysis,
         q_start: _FloatArray,
         options: TrialGains,
-        task: ImpactTask | None,
+        task: ImpactReference | None,
         sim: SimModel,
         support_v_index: npt.NDArray[np.int_],
     ) -> InverseDynamicsController:
@@ -458,7 +458,7 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         return tasks, speed_row
 
     def _impact_tasks(
-        self, tasks: _Tasks, impact: ImpactTask, t: float, v: _FloatArray, impact_force: float
+        self, tasks: _Tasks, impact: ImpactReference, t: float, v: _FloatArray, impact_force: float
     ) -> tuple[_FloatArray, float] | None:
         """Impact point: PD to the impact task's target and its velocity; the approach speed's row."""
         g = self.gains

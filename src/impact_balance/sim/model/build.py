@@ -143,7 +143,7 @@ class SimModel:
     def configuration(self) -> np.ndarray:
         """The pinocchio configuration of the current MuJoCo state (welded joints at the stance)."""
         d = self.data
-        q = self.stance.q.copy()
+        q: _FloatArray = self.stance.q.copy()
         q[0:3] = d.qpos[0:3]
         w, x, y, z = d.qpos[3:7]
         q[3:7] = (x, y, z, w)
@@ -170,12 +170,14 @@ class SimModel:
 
     def com(self) -> np.ndarray:
         """Centre of mass, world, m (valid after a forward or a step)."""
-        return self.data.subtree_com[self.root_body].copy()
+        answer: _FloatArray = self.data.subtree_com[self.root_body].copy()
+        return answer
 
     def com_velocity(self) -> np.ndarray:
         """CoM velocity, world, m/s (computes MuJoCo's subtree velocities)."""
         mujoco.mj_subtreeVel(self.model, self.data)
-        return self.data.subtree_linvel[self.root_body].copy()
+        answer: _FloatArray = self.data.subtree_linvel[self.root_body].copy()
+        return answer
 
     def impact_point_velocity(self, normal: np.ndarray) -> np.ndarray:
         """World velocity of the impact point (m/s), the impact sphere's surface point along ``-normal``.
@@ -197,7 +199,10 @@ class SimModel:
         )
         r = -self.model.geom_size[self.impact_geom][0] * normal
         (wx, wy, wz), (rx, ry, rz) = out[:3].tolist(), r.tolist()
-        return out[3:] + np.array((wy * rz - wz * ry, wz * rx - wx * rz, wx * ry - wy * rx))
+        answer: _FloatArray = out[3:] + np.array(
+            (wy * rz - wz * ry, wz * rx - wx * rz, wx * ry - wy * rx)
+        )
+        return answer
 
     def contact_force(self, geom: int) -> np.ndarray:
         """Total contact force on the robot at ``geom`` (one of its collision geoms), N, world axes."""
@@ -240,7 +245,8 @@ class SimModel:
         wanted = np.asarray(geoms)[:, None]
         sign = (contacts.geom2[active][None, :] == wanted).astype(float)
         sign -= contacts.geom1[active][None, :] == wanted
-        return sign @ world
+        answer: _FloatArray = sign @ world
+        return answer
 
     def enable_supports(self, enabled: bool = True) -> None:
         """Let the sustained contacts touch their supports (default), or not (a floating robot).

@@ -100,7 +100,7 @@ def _pair(
     robot_geom: str,
     world_geom: str,
     mu: float,
-    solref,
+    solref: tuple[float, float],
     params: ContactParameters,
 ) -> None:
     spec.add_pair(

@@ -34,6 +34,7 @@ from typing import Literal
 
 import mujoco
 import numpy as np
+import numpy.typing as npt
 import qpsolvers
 
 from impact_balance.constants import GRAVITY
@@ -50,6 +51,8 @@ __all__ = [
     "servo_gains",
     "weld_joints",
 ]
+
+_FloatArray = npt.NDArray[np.float64]
 
 #: A joint model: ``rigid`` (welded joints) or ``servo`` (position servos).
 JointModel = Literal["rigid", "servo"]
@@ -114,9 +117,9 @@ def holding_torques(stance: Stance, gravity: float = GRAVITY) -> np.ndarray:
     the unconstrained least-squares wrenches are used (the stance cannot hold; the servos
     do their best).
     """
-    g = stance.gravity_torques * (gravity / GRAVITY)
+    g: _FloatArray = stance.gravity_torques * (gravity / GRAVITY)
     if not stance.contacts:
-        return g[6:].copy()
+        return np.array(g[6:])
     J = np.vstack([c.jacobian for c in stance.contacts])  # (6k, nv)
     A = J[:, :6].T
     b = g[:6]
@@ -136,7 +139,8 @@ def holding_torques(stance: Stance, gravity: float = GRAVITY) -> np.ndarray:
     )
     if w is None:
         w = np.linalg.lstsq(A, b, rcond=None)[0]
-    return (g - J.T @ w)[6:]
+    torques: _FloatArray = (g - J.T @ w)[6:]
+    return torques
 
 
 def weld_joints(spec: mujoco.MjSpec, model: mujoco.MjModel, qpos: np.ndarray) -> None:

@@ -23,9 +23,11 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import mujoco
 import numpy as np
+from numpy.typing import ArrayLike
 
 from impact_balance.exceptions import SimulationError
 from impact_balance.geometry.polygon import Polygon
@@ -97,7 +99,7 @@ def check_push_arguments(
 
 
 def boundary_impulse(
-    area: Polygon, mass: float, direction: float, com_velocity=(0.0, 0.0)
+    area: Polygon, mass: float, direction: float, com_velocity: ArrayLike = (0.0, 0.0)
 ) -> float:
     """The impulse (N s) along ``direction`` (rad) that puts ``com_velocity + J u / m`` on the boundary of
     ``area`` (m/s); 0 when ``com_velocity`` is outside, inf when the area is unbounded that way.
@@ -151,7 +153,7 @@ class PushOutcome(TrialEntry):
         m = s.get("min_zmp_margin_during")  # null: a foot carried nothing, no ZMP: not safe
         return m is not None and m >= margin
 
-    def to_dict(self, margin: float, omega: float) -> dict:
+    def to_dict(self, margin: float, omega: float) -> dict[str, Any]:
         s = self.summary
         return {
             "direction": float(self.push.direction),
@@ -181,10 +183,10 @@ class PushOutcome(TrialEntry):
 class PushTestResult:
     """Every push of a push test and how each criterion scores (at ``zmp_margin``, and against the margin)."""
 
-    scenario: str
+    scenario: str | None
     outcomes: list[PushOutcome]
-    controller: dict
-    criteria: dict
+    controller: dict[str, Any]
+    criteria: dict[str, Any]
     setup: BalanceSetup
     zmp_margin: float
     controller_margin: float
@@ -197,7 +199,7 @@ class PushTestResult:
     def scored(self) -> list[PushOutcome]:
         return [o for o in self.outcomes if o.scored]
 
-    def scores(self, margin: float | None = None) -> dict:
+    def scores(self, margin: float | None = None) -> dict[str, Any]:
         """Confusion of every criterion (:data:`CRITERIA`) at ZMP margin ``margin`` (default: the result's)."""
         margin = self.zmp_margin if margin is None else margin
         scored = self.scored
@@ -206,16 +208,17 @@ class PushTestResult:
             c: confusion([o.safe(c, margin, self.omega) for o in scored], fell) for c in CRITERIA
         }
 
-    def margin_study(self) -> dict:
+    def margin_study(self) -> dict[str, Any]:
         """Scores at 0, the controller's margin and twice it, and the smallest margin (of :data:`MARGIN_GRID`)
         that brings each criterion's "predicted safe, fell" to :data:`SAFE_FELL_TARGET` or less.
         """
         own = self.controller_margin
         margins = sorted({0.0, own, 2 * own})
+        smallest: dict[str, float | None] = {}
         out = {
             "margins": margins,
             "scores": {f"{m:g}": self.scores(m) for m in margins},
-            "smallest_margin": {},
+            "smallest_margin": smallest,
         }
         for c in CRITERIA:
             found = None
@@ -224,12 +227,12 @@ class PushTestResult:
                 if rate is not None and rate <= SAFE_FELL_TARGET:
                     found = m
                     break
-            out["smallest_margin"][c] = found
+            smallest[c] = found
         return out
 
-    def contact_breaks(self) -> dict:
+    def contact_breaks(self) -> dict[str, Any]:
         """Pushes that broke a contact without a fall, and which contact broke first, by magnitude."""
-        rows: dict[str, dict] = {}
+        rows: dict[str, dict[str, Any]] = {}
         for o in self.scored:
             key = f"{o.push.magnitude:g}"
             row = rows.setdefault(
@@ -256,7 +259,7 @@ class PushTestResult:
             "by_magnitude": list(rows.values()),
         }
 
-    def counts(self) -> dict:
+    def counts(self) -> dict[str, Any]:
         """Outcomes counted, and the falls by reason."""
         outcomes = {
             k: sum(o.outcome == k for o in self.outcomes)
@@ -269,7 +272,7 @@ class PushTestResult:
                 reasons[key] = reasons.get(key, 0) + 1
         return {"outcomes": outcomes, "reasons": reasons}
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         return {
             "scenario": self.scenario,
             "zmp_margin": self.zmp_margin,
@@ -346,7 +349,7 @@ def push_test(
     own = controller_margin(options)
     journal = journal or TrialJournal(None, "")
     outcomes, reused = [], 0
-    levels = list(relative if relative is not None else magnitudes)
+    levels = list(relative if relative is not None else magnitudes or ())
     for level in levels:
         for k in range(directions):
             angle = 2 * np.pi * k / directions

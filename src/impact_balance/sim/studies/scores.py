@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -33,7 +34,7 @@ def wilson(successes: int, total: int, z: float = 1.959963984540054) -> list[flo
     return [max(0.0, centre - half), min(1.0, centre + half)]
 
 
-def confusion(predicted_safe: Sequence[bool], fell: Sequence[bool]) -> dict:
+def confusion(predicted_safe: Sequence[bool], fell: Sequence[bool]) -> dict[str, Any]:
     """Counts of a criterion's predictions against the falls, and its rates with Wilson intervals.
 
     ``accuracy``: share of trials whose outcome it predicted; ``safe_fell_rate``: share of all trials it

@@ -58,14 +58,19 @@ def predictions(scenario: Scenario, zmp_margin: float = 0.0) -> dict[str, dict[s
     support area shrunk by ``zmp_margin`` (m).
     """
     out: dict[str, dict[str, float | None]] = {"com_criterion": {}, "zmp_criterion": {}}
+    impact = scenario.impact
+    if impact is None:
+        raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact")
     for inertia in INERTIA_MODELS:
         variant = scenario.model_copy(
             update={
-                "impact": scenario.impact.model_copy(update={"inertia": inertia}),
+                "impact": impact.model_copy(update={"inertia": inertia}),
                 "zmp_margin": float(zmp_margin),
             }
         )
         answer = analyze(variant).impact
+        if answer is None:
+            raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact")
         out["com_criterion"][inertia] = json_number(answer.max_contact_velocity)
         out["zmp_criterion"][inertia] = json_number(answer.zmp_max_contact_velocity)
     return out
@@ -79,43 +84,56 @@ class ValidationTrial(TrialEntry):
 
     @property
     def measured(self) -> float | None:
-        return self.summary.get("approach_speed_measured")
+        """The approach speed measured at the contact (m/s), None without one."""
+        measured: float | None = self.summary.get("approach_speed_measured")
+        return measured
+
+
+def _measured(trial: ValidationTrial) -> float:
+    """The measured approach speed (m/s) of a scored trial (scored trials have one)."""
+    measured = trial.measured
+    assert measured is not None
+    return measured
 
 
 @dataclass
 class ValidationResult:
     """Predictions beside the empirical bracket; ``to_dict()`` is ``validate --json``."""
 
-    scenario: str
+    scenario: str | None
     joints: str
     rigid_impact: bool
-    predicted: dict
-    predicted_with_margin: dict
+    predicted: dict[str, Any]
+    predicted_with_margin: dict[str, Any]
     zmp_margin: float
     omega: float
     trials: list[ValidationTrial]
-    controller: dict
-    outcome_criteria: dict
+    controller: dict[str, Any]
+    outcome_criteria: dict[str, Any]
     tolerance: float
     max_speed: float
     wall_time: float = 0.0
     journal: str | None = None
     reused: int = 0
-    extra: dict = field(default_factory=dict)
+    extra: dict[str, Any] = field(default_factory=dict)
 
     @property
     def scored(self) -> list[ValidationTrial]:
         return [t for t in self.trials if t.scored and t.measured is not None]
 
-    def bracket(self) -> dict:
+    def bracket(self) -> dict[str, Any]:
         """The bracket in measured and commanded approach speed (see the module docstring)."""
         scored = self.scored
         fell = [t for t in scored if t.fell]
         stood = [t for t in scored if not t.fell]
-        lowest_fall = min(fell, key=lambda t: t.measured) if fell else None
-        below = [t for t in stood if lowest_fall is None or t.measured < lowest_fall.measured]
-        survived = max(below, key=lambda t: t.measured) if below else None
-        monotonic = not (fell and stood and max(t.measured for t in stood) > lowest_fall.measured)
+        lowest_fall = min(fell, key=_measured) if fell else None
+        below = [t for t in stood if lowest_fall is None or _measured(t) < _measured(lowest_fall)]
+        survived = max(below, key=_measured) if below else None
+        monotonic = not (
+            lowest_fall is not None
+            and stood
+            and max(_measured(t) for t in stood) > _measured(lowest_fall)
+        )
         fell_c = min((t.speed for t in fell), default=None)
         stood_c = max((t.speed for t in stood if fell_c is None or t.speed < fell_c), default=None)
         return {
@@ -124,15 +142,15 @@ class ValidationResult:
             "survived_commanded": stood_c,
             "fell_commanded": fell_c,
             "monotonic": monotonic,
-            "fastest_measured": max((t.measured for t in scored), default=None),
+            "fastest_measured": max((_measured(t) for t in scored), default=None),
         }
 
-    def contact_break(self) -> dict | None:
+    def contact_break(self) -> dict[str, Any] | None:
         """The slowest trial (measured speed) that broke a contact (fell or not) and its first event."""
         broken = [t for t in self.scored if t.summary["events"]]
         if not broken:
             return None
-        first = min(broken, key=lambda t: t.measured)
+        first = min(broken, key=_measured)
         event = min(first.summary["events"], key=lambda e: e["time"])
         return {
             "measured": first.measured,
@@ -141,7 +159,7 @@ class ValidationResult:
             **event,
         }
 
-    def post_impact(self, trial: ValidationTrial) -> dict | None:
+    def post_impact(self, trial: ValidationTrial) -> dict[str, Any] | None:
         """The measured post-impact CoM velocity against the predicted set (composite, the scenario's friction and
         restitution range) at the measured speed from the measured pre-impact CoM velocity: the set's vertices and
         the distance from the measurement to it (m/s, 0 inside).
@@ -162,7 +180,7 @@ class ValidationResult:
         after = np.asarray(impact["com_velocity_after"], dtype=float)
         return {"vertices": vertices.tolist(), "distance": float(distance_to_hull(after, vertices))}
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         com_max = self.predicted_with_margin["com_criterion"]["composite"]
         trials = []
         for t in self.trials:

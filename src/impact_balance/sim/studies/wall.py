@@ -19,10 +19,12 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
+import pinocchio as pin
 
 from impact_balance.exceptions import SimulationError
 from impact_balance.governor import Governor
@@ -97,7 +99,7 @@ class GovernedApproach:
     """
 
     frame: str
-    offset: object
+    offset: pin.SE3
     start: np.ndarray
     normal: np.ndarray
     speed: float
@@ -132,7 +134,7 @@ class GovernedApproach:
         if self.contact_time is None and normal_force > self.force_threshold:
             self.contact_time = float(t)
             self._contact_point = self._point.copy()
-        if self.contact_time is not None:
+        if self.contact_time is not None and self._contact_point is not None:
             s, ds, dds = approach_profile(
                 t - self.contact_time, self.withdraw_speed, self.acceleration, self.retract
             )
@@ -174,12 +176,12 @@ class WallTrial:
     speed_at_contact: float | None
     cap_at_contact: float | None
     time_to_contact: float | None
-    tick_us: dict
-    series: dict
+    tick_us: dict[str, Any]
+    series: dict[str, Any]
     wall: np.ndarray | None = None
-    frames: dict | None = None
+    frames: dict[str, Any] | None = None
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         s = self.result.summary()
         o = self.options
         return {
@@ -343,11 +345,26 @@ def _tick_statistics(ticks: list[float]) -> dict[str, float | int | None]:
     }
 
 
-def write_wall_video(setup: BalanceSetup, trial: WallTrial, path, title: str | None = None):
-    """The approach as an MP4 (:func:`~.video.write_video`), the wall where it stood (``frames=True`` trials)."""
+def write_wall_video(
+    setup: BalanceSetup, trial: WallTrial, path: str | Path, title: str | None = None
+) -> Path:
+    """The approach as an MP4 (:func:`~.video.write_video`), the wall where it stood.
+
+    Args:
+        setup: The setup the trial ran on.
+        trial: A trial run with ``frames=True``.
+        path: The ``.mp4`` file.
+        title: The video's title (default: the scenario's name).
+
+    Returns:
+        The path written.
+
+    Raises:
+        SimulationError: The trial kept no frames, or the video cannot be made here.
+    """
     from impact_balance.sim.trials.video import write_video
 
-    if not trial.frames or not len(trial.frames["time"]):
+    if not trial.frames or not len(trial.frames["time"]) or trial.wall is None:
         raise SimulationError("--video", str(path)[:80], "the trial kept no frames")
     sim, f = setup.sim, trial.frames
     k = len(f["time"])
@@ -362,8 +379,11 @@ def write_wall_video(setup: BalanceSetup, trial: WallTrial, path, title: str | N
         approach_start=float(f["time"][0]),
         wall_time=0.0,
     )
+    impact = setup.analysis.impact
+    if impact is None or sim.surface_geom is None:
+        raise SimulationError("impact", None, "the scenario has no impact")
     home = sim.model.geom_pos[sim.surface_geom].copy()
-    sim.model.geom_pos[sim.surface_geom] = home + (trial.wall - setup.analysis.impact.model.point)
+    sim.model.geom_pos[sim.surface_geom] = home + (trial.wall - impact.model.point)
     try:
         return write_video(sim, record, path, title=title)
     finally:

@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import mujoco
@@ -41,9 +42,9 @@ from impact_balance.exceptions import SimulationError
 from impact_balance.impact.model import ImpactModel
 from impact_balance.json_values import json_number
 from impact_balance.logs import write_log
-from impact_balance.sim.control.approach import ImpactTask
+from impact_balance.sim.control.approach import ImpactReference, ImpactTask
 from impact_balance.sim.control.approach import standoff as approach_standoff
-from impact_balance.sim.control.controller import ControlStep
+from impact_balance.sim.control.controller import ControllerName, ControlStep
 from impact_balance.sim.control.registry import controller_class
 from impact_balance.sim.model.build import SimModel
 from impact_balance.sim.trials.impact_tracker import ImpactTracker
@@ -103,7 +104,8 @@ def measured_zmp(
 
 
 def _base_rotation(q: np.ndarray) -> np.ndarray:
-    return pin.Quaternion(q[6], q[3], q[4], q[5]).toRotationMatrix()
+    answer: _FloatArray = pin.Quaternion(q[6], q[3], q[4], q[5]).toRotationMatrix()
+    return answer
 
 
 def _omega_now(com_height: float, plane_height: float, gravity: float) -> float:
@@ -123,10 +125,10 @@ def run_balance_trial(
     push: Push | None = None,
     options: BalanceTrialOptions | None = None,
     *,
-    impact_task=None,
-    surface_point=None,
+    impact_task: ImpactReference | None = None,
+    surface_point: ArrayLike | None = None,
     standoff: float | None = None,
-    before_control=None,
+    before_control: BeforeControl | None = None,
     max_approach_time: float | None = None,
 ) -> BalanceTrialResult:
     """Run one trial (an impact at the commanded ``impact_speed``, or a ``push``) from rest; see the module docstring.
@@ -141,8 +143,8 @@ def run_balance_trial(
     options = options or BalanceTrialOptions()
     sim, analysis = setup.sim, setup.analysis
     impact = impact_speed is not None or impact_task is not None
-    if impact and analysis.impact is None:
-        raise SimulationError("impact", None, "the scenario has no impact")
+    if impact:
+        _impact_model(analysis)  # refuses a scenario without an impact
     if impact_speed is not None and not (np.isfinite(impact_speed) and 0 < impact_speed <= 20):
         raise SimulationError("speed", impact_speed, "must be in (0, 20] m/s")
     hold = RigidImpactHold(sim) if (options.rigid_impact and impact) else None
@@ -150,7 +152,7 @@ def run_balance_trial(
     if moved:
         home = sim.model.geom_pos[sim.surface_geom].copy()
         sim.model.geom_pos[sim.surface_geom] = home + (
-            np.asarray(surface_point, dtype=float) - analysis.impact.model.point
+            np.asarray(surface_point, dtype=float) - _impact_model(analysis).point
         )
     try:
         return _run(
@@ -192,7 +194,7 @@ def _run(
     push: Push | None,
     options: BalanceTrialOptions,
     hold: RigidImpactHold | None,
-    task: ImpactTask | None,
+    task: ImpactReference | None,
     surface_point: ArrayLike | None,
     standoff: float | None,
     before_control: BeforeControl | None,
@@ -240,7 +242,7 @@ class _TrialRun:
         push: Push | None,
         options: BalanceTrialOptions,
         hold: RigidImpactHold | None,
-        task: ImpactTask | None,
+        task: ImpactReference | None,
         surface_point: ArrayLike | None,
         standoff: float | None,
     ):
@@ -312,8 +314,12 @@ class _TrialRun:
             self.end_time = options.settle + options.after
         elif max_approach_time is not None:
             self.end_time = task.start_time + max_approach_time + options.after
-        else:
+        elif isinstance(task, ImpactTask):
             self.end_time = task.arrival_time + options.max_approach_time + options.after
+        else:
+            raise SimulationError(
+                "max_approach_time", None, "an impact task other than ImpactTask needs one"
+            )
 
     def loop(self, before_control: BeforeControl | None) -> None:
         """Step MuJoCo until the trial ends (a fall, or the end time, extended once if still moving)."""
@@ -362,7 +368,7 @@ class _TrialRun:
             gap = float(n @ (sim.data.geom_xpos[sim.impact_geom] - self.radius * n)) - self.surface
             if hold.start is None and gap - max(0.0, float(-point_v @ n)) * self.dt <= 0.0:
                 hold.begin(t)
-        if self.disturbance is None and tracker.touched:
+        if self.disturbance is None and tracker.start is not None:
             self.disturbance = tracker.start
             self.monitor.start_disturbance(tracker.start)
             self.end_time = tracker.start + self.options.after
@@ -500,16 +506,26 @@ def _margins(result: BalanceTrialResult, analysis: Analysis, arrays: dict[str, n
 
 def write_trial_log(
     setup: BalanceSetup,
-    path,
-    controller: str,
-    metadata: dict,
+    path: str | Path,
+    controller: ControllerName,
+    metadata: dict[str, object],
     impact_speed: float | None = None,
     push: Push | None = None,
     rigid_impact: bool = False,
-):
+) -> Path:
     """Run one trial again with recording on and write its log (searches run their trials unrecorded).
 
-    Returns the path written; ``metadata`` goes into the Parquet metadata with the scenario's name.
+    Args:
+        setup: The scenario prepared for trials.
+        path: The log file (Parquet or CSV).
+        controller: The controller's name.
+        metadata: Parquet metadata (as text), written with the scenario's name.
+        impact_speed: Commanded approach speed of an impact trial (m/s).
+        push: The push of a push trial.
+        rigid_impact: Hold every joint's velocity through the impact.
+
+    Returns:
+        The path written.
     """
     trial = run_balance_trial(
         setup,
@@ -517,4 +533,6 @@ def write_trial_log(
         push=push,
         options=BalanceTrialOptions(record=True, controller=controller, rigid_impact=rigid_impact),
     )
-    return write_log(trial.log, path, {"scenario": setup.scenario.name, **metadata})
+    assert trial.log is not None  # recorded
+    values = {"scenario": setup.scenario.name, **metadata}
+    return write_log(trial.log, path, {k: str(v) for k, v in values.items()})

@@ -13,6 +13,7 @@ keeps the planar CoM velocity at both ends.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -39,11 +40,11 @@ class ImpactTracker:
     max_duration: float = MAX_IMPACT_DURATION
     start: float | None = field(default=None, init=False)
     end: float | None = field(default=None, init=False)
-    _prev: tuple | None = field(default=None, init=False)
+    _prev: tuple[Any, ...] | None = field(default=None, init=False)
     _baseline: np.ndarray | None = field(default=None, init=False)
     _impulse: np.ndarray = field(default_factory=lambda: np.zeros(3), init=False)
     _sustained: np.ndarray | None = field(default=None, init=False)
-    _before: tuple | None = field(default=None, init=False)
+    _before: tuple[Any, ...] | None = field(default=None, init=False)
     _after: np.ndarray | None = field(default=None, init=False)
 
     @property
@@ -90,7 +91,7 @@ class ImpactTracker:
         )
 
     def measurement(
-        self, t: float, com_velocity: np.ndarray, hold: dict | None = None
+        self, t: float, com_velocity: np.ndarray, hold: dict[str, Any] | None = None
     ) -> ImpactMeasurement | None:
         """The impact measured so far (None before the contact); an unfinished window ends at ``t``."""
         if self.start is None:
@@ -99,6 +100,8 @@ class ImpactTracker:
         after = (
             self._after if self._after is not None else np.asarray(com_velocity[:2], dtype=float)
         )
+        assert self._before is not None and self._impulse is not None
+        assert self._sustained is not None  # set at the contact
         approach, before = self._before
         return ImpactMeasurement(
             self.start,

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -101,7 +102,7 @@ class TrialRecord:
     wall_time: float
     contact_positions: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 3)))
     actuator_force: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
-    hold: dict | None = None
+    hold: dict[str, Any] | None = None
 
     @property
     def simulated_time(self) -> float:
@@ -115,6 +116,8 @@ def impact_limb(sim: SimModel) -> list[str]:
     the impact frame's joint or beyond it.
     """
     spec = sim.scenario.impact
+    if spec is None:
+        raise SimulationError("impact", None, "the scenario has no impact")
     model = sim.stance.model
     joint = model.frames[sim.robot.frame_id(spec.frame, "impact.frame")].parentJoint
     chain = []
@@ -143,6 +146,8 @@ def approach_joint_velocity(
     """
     import qpsolvers
 
+    if sim.scenario.impact is None:
+        raise SimulationError("impact", None, "the scenario has no impact")
     spec = sim.scenario.impact.spec()
     model = sim.stance.model
     _, J6 = sim.stance.point(spec.frame, spec.offset)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import mujoco
 import numpy as np
+import numpy.typing as npt
 import pandas as pd
 
 from impact_balance.logs import (
@@ -16,6 +17,8 @@ from impact_balance.sim.model.build import SimModel
 from impact_balance.sim.trials.impact_trial import TrialRecord
 
 __all__ = ["LOG_START", "LogRecorder", "log_frame"]
+
+_FloatArray = npt.NDArray[np.float64]
 
 #: Logs start here (s): the first steps settle the model's initial contact penetration (the
 #: contacts carry nothing at t = 0, then briefly one foot carries thousands of newtons), a
@@ -108,7 +111,27 @@ class LogRecorder:
             self.columns += list(force_columns("impact"))
         self.rows: list[np.ndarray] = []
 
-    def add(self, t, q, v, sim: SimModel, zmp, forces, impact_force) -> None:
+    def add(
+        self,
+        t: float,
+        q: _FloatArray,
+        v: _FloatArray,
+        sim: SimModel,
+        zmp: _FloatArray,
+        forces: _FloatArray,
+        impact_force: _FloatArray | None,
+    ) -> None:
+        """One row: time, base and joint state, ZMP, CoM, contact forces (and the impact's).
+
+        Args:
+            t: Time (s).
+            q: Configuration (nq, pinocchio order).
+            v: Velocity (nv, pinocchio order).
+            sim: The trial's MuJoCo model, at the state ``(q, v)``.
+            zmp: Measured ZMP (m, world).
+            forces: Each sustained contact's force (k x 3, N, world).
+            impact_force: The impact point's force (3, N, world), None without an impact.
+        """
         # The CoM columns are MuJoCo's own (subtree CoM and velocity): a cross-check for the log checker,
         # which recomputes them with pinocchio from the base and joint columns.
         # After mj_step, MuJoCo's CoM quantities still describe the state before the step: refresh them

@@ -101,7 +101,7 @@ class TrialResult:
     sim_time_ratio: float
     sustained_impulses: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
     armature: str = ""
-    hold: dict | None = None
+    hold: dict[str, Any] | None = None
     record: TrialRecord | None = None
 
     def to_dict(self) -> dict[str, Any]:
@@ -141,7 +141,7 @@ def distance_to_hull(point: np.ndarray, vertices: np.ndarray) -> float:
     point = np.asarray(point, dtype=float)
     hull = Polygon.from_points(np.asarray(vertices, dtype=float), tol=1e-12)
     v = hull.vertices
-    if len(v) >= 3 and hull.contains(point[None, :], tol=0.0).all():
+    if len(v) >= 3 and np.all(hull.contains(point[None, :], tol=0.0)):
         return 0.0
     if len(v) == 0:
         return float("nan")
@@ -197,6 +197,8 @@ def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialR
     """Measurement and predictions of one trial (see the module docstring)."""
     from impact_balance.exceptions import SimulationError
 
+    if sim.scenario.impact is None:
+        raise SimulationError("impact", None, "the scenario has no impact")
     spec = sim.scenario.impact.spec()
     n = np.asarray(spec.normal, dtype=float) / np.linalg.norm(spec.normal)
     try:

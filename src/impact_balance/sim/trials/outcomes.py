@@ -92,7 +92,7 @@ class OutcomeCriteria:
     rest_speed: float = 0.05
     extra_time: float = 2.5
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         return asdict(self)
 
 
@@ -107,7 +107,7 @@ class ContactEvent:
     time: float
     value: float
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         return {"contact": self.contact, "kind": self.kind, "time": self.time, "value": self.value}
 
 
@@ -159,7 +159,7 @@ class OutcomeMonitor:
     _abort: tuple[str, float, str] | None = field(default=None, init=False)
     _low_since: np.ndarray = field(init=False)
     _loaded: np.ndarray = field(init=False)
-    _seen: set = field(default_factory=set, init=False)
+    _seen: set[tuple[int, EventKind]] = field(default_factory=set, init=False)
 
     def __post_init__(self) -> None:
         self.positions = np.asarray(self.positions, dtype=float).reshape(-1, 3)
@@ -201,7 +201,7 @@ class OutcomeMonitor:
         if self._abort is None:
             self._abort = (reason, float(t), detail)
 
-    def _event(self, i: int, kind: str, t: float, value: float) -> None:
+    def _event(self, i: int, kind: EventKind, t: float, value: float) -> None:
         if (i, kind) not in self._seen:
             self._seen.add((i, kind))
             self.events.append(ContactEvent(self.names[i], kind, float(t), float(value)))

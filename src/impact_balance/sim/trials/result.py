@@ -8,16 +8,29 @@ contacts carry no vertical force, say) never ends a run.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 import pandas as pd
+from numpy.typing import ArrayLike
 
-from impact_balance.sim.trials.outcomes import ContactEvent
+from impact_balance.sim.trials.outcomes import ContactEvent, OutcomeName
 
-__all__ = ["BalanceTrialResult", "ImpactMeasurement", "TrialEntry", "finite_or_null", "trajectory"]
+__all__ = [
+    "BalanceTrialResult",
+    "ImpactMeasurement",
+    "TrialEntry",
+    "finite_or_null",
+    "trajectory",
+]
+
+_FloatArray = npt.NDArray[np.float64]
 
 
-def finite_or_null(nulls: dict[str, str], name: str, value, reason: str):
+def finite_or_null(
+    nulls: dict[str, str], name: str, value: ArrayLike | None, reason: str
+) -> float | list[Any] | None:
     """``value`` as a float (or a list of floats) when finite, else None with ``reason`` recorded in ``nulls``."""
     if value is None:
         nulls[name] = reason
@@ -52,13 +65,15 @@ class ImpactMeasurement:
     sustained_impulses: np.ndarray
     com_velocity_before: np.ndarray
     com_velocity_after: np.ndarray
-    hold: dict | None = None
+    hold: dict[str, Any] | None = None
 
     @property
-    def com_velocity_jump(self) -> np.ndarray:
-        return self.com_velocity_after - self.com_velocity_before
+    def com_velocity_jump(self) -> _FloatArray:
+        """Planar CoM velocity change across the window (m/s)."""
+        jump: _FloatArray = self.com_velocity_after - self.com_velocity_before
+        return jump
 
-    def to_dict(self, contact_names: list[str]) -> dict:
+    def to_dict(self, contact_names: list[str]) -> dict[str, Any]:
         nulls: dict[str, str] = {}
         out = {
             "contact_time": self.contact_time,
@@ -150,7 +165,7 @@ class BalanceTrialResult:
     def approach_speed_measured(self) -> float | None:
         return None if self.impact is None else self.impact.approach_speed
 
-    def summary(self) -> dict:
+    def summary(self) -> dict[str, Any]:
         """JSON-ready summary (no series, no log): finite numbers or null, with ``nulls`` giving the reasons."""
         nulls: dict[str, str] = {}
         out = {
@@ -214,7 +229,9 @@ class BalanceTrialResult:
         return out
 
 
-def trajectory(result: BalanceTrialResult, start: float, stop: float, every: int = 2) -> dict:
+def trajectory(
+    result: BalanceTrialResult, start: float, stop: float, every: int = 2
+) -> dict[str, Any]:
     """The trial's CoM velocity, ZMP and DCM between ``start`` and ``stop`` (s), every ``every``-th control
     step, as plain lists (a ZMP that is undefined is null): what the figures draw.
     """
@@ -224,7 +241,7 @@ def trajectory(result: BalanceTrialResult, start: float, stop: float, every: int
     t = s["time"]
     keep = np.flatnonzero((t >= start - 1e-9) & (t <= stop + 1e-9))[::every]
 
-    def rows(values: np.ndarray) -> list:
+    def rows(values: _FloatArray) -> list[list[float] | None]:
         return [[float(x) for x in row] if np.all(np.isfinite(row)) else None for row in values]
 
     return {
@@ -241,12 +258,14 @@ class TrialEntry:
     (:meth:`BalanceTrialResult.summary`) and a short ``trajectory`` (:func:`trajectory`) for the figures.
     """
 
-    summary: dict
-    trajectory: dict = field(default_factory=dict)
+    summary: dict[str, Any]
+    trajectory: dict[str, Any] = field(default_factory=dict)
 
     @property
-    def outcome(self) -> str:
-        return self.summary["outcome"]
+    def outcome(self) -> OutcomeName:
+        """The trial's outcome."""
+        outcome: OutcomeName = self.summary["outcome"]
+        return outcome
 
     @property
     def fell(self) -> bool:

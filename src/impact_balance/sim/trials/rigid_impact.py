@@ -24,6 +24,7 @@ back afterwards acts on the robot with its joints free.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -86,7 +87,7 @@ class RigidImpactHold:
         self.velocity_change = max(
             self.velocity_change, float(change.max()) if change.size else 0.0
         )
-        if approach_speed <= 0.0 or t - self.start >= self.max_duration:
+        if self.start is None or approach_speed <= 0.0 or t - self.start >= self.max_duration:
             self.release(t)
 
     def release(self, t: float) -> None:
@@ -95,7 +96,7 @@ class RigidImpactHold:
             self.sim.model.dof_armature[self.sim.dof_adr] = self._saved
             self.end = float(t)
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         return {
             "start": self.start,
             "end": self.end,
