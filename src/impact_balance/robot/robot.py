@@ -141,8 +141,8 @@ class Scratch:
 class ThreadData(threading.local):
     """One pinocchio ``Data`` per robot and per thread, reused by every :class:`Stance`.
 
-    ``model.createData()`` allocates ~1.6 MB (0.2-1.9 ms) while the kinematics themselves
-    take ~15 us, so stances compute in this scratch Data and copy out what they keep.
+    ``model.createData()`` allocates a large Data and costs far more than the kinematics
+    themselves, so stances compute in this scratch Data and copy out what they keep.
     Thread-local so that concurrent analyses never overwrite each other's kinematics.
 
     Attributes:

@@ -52,10 +52,14 @@ def stiffen_support_limbs(
     is 88 N m/rad (ankle roll) to 230 N m/rad (ankle pitch) at 15 Hz, against a gravity stiffness
     ``m g h`` of about 820 N m/rad for Talos standing on that ankle. Every joint of a support limb
     gets at least ``kp = factor m g h`` and ``kd = 2 sqrt(kp m h^2)`` (critical damping of the whole
-    robot swinging about that joint at the CoM height ``h``); effort limits are kept. The factor,
-    0.4, was chosen by measurement: at 1 the stiff legs made the robot rock and lift a foot after
-    pushes (half the 15-20 N s pushes survived); at 0.25-0.4 the most survived; the DCM/ZMP feedback
-    holds the rest of the pendulum (Talos stands on one foot at 0.4).
+    robot swinging about that joint at the CoM height ``h``); effort limits are kept. The
+    DCM/ZMP feedback holds the rest of the pendulum. The default factor,
+    :data:`SUPPORT_STIFFNESS_FACTOR`, comes from push trials (``docs/studies/design-history.md``).
+
+    Args:
+        sim: The trials' MuJoCo model (servos).
+        analysis: The scenario's analysis (stance, gravity).
+        factor: Stiffness floor in units of the gravity stiffness ``m g h``.
     """
     m = analysis.stance.mass
     h = float(analysis.stance.com[2] - analysis.stance.lowest_contact_height())

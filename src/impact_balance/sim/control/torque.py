@@ -1,6 +1,7 @@
 """Torque-controlled balance: DCM feedback + a whole-body inverse-dynamics QP, for MuJoCo motors.
 
-The alternative to :mod:`.balance` (pink IK and position servos) that issue 10 allows. Where the
+The alternative to :mod:`~impact_balance.sim.control.kinematic` (pink IK and position servos): the
+``id`` member of the :class:`~impact_balance.sim.control.controller.Controller` family. Where the
 kinematic controller moves the ZMP only through a slow CoM admittance, this one chooses the
 contact wrenches themselves, so the ZMP can reach the edge of the ZMP support area within one
 control step: the zero-step capture that the CoM criterion assumes.
@@ -23,7 +24,7 @@ free-flyer velocity in the base frame):
      (friction and rectangle shrunk by margins, see :class:`InverseDynamicsGains`) with a
      minimum normal force, the joint position limits (as acceleration bounds), and
      ``|tau| <= effort`` with ``tau`` the actuated rows of ``M a + h - sum J_i^T w_i``;
-     with a governed approach (a task whose ``speed_bound()`` is finite, :class:`~.wall.GovernedApproach`),
+     with a governed approach (a task whose ``speed_bound()`` is finite, :class:`~impact_balance.sim.studies.wall.GovernedApproach`),
      the impact point's approach speed one control period ahead, ``-n . (J_p (v + a dt) + J_p_dot v dt)``,
      at most the governor's cap: the paper's "track the maximum contact velocity with a whole-body QP"
      as a hard bound, so that the torque controller's tracking lag cannot carry the point past a

@@ -65,8 +65,8 @@ class SimOptions:
         elliptic_cone: Elliptic friction cones (exact Coulomb); MuJoCo's default pyramid has
             4 edges, inscribed, and would under-estimate friction between its edges.
         impratio: MuJoCo's ratio of frictional to normal constraint impedance. MuJoCo's soft
-            friction lets a loaded contact creep; 10 (instead of 1) stiffens friction so that a
-            foot on the 30 degree ramp stays put (CoM drift 7 mm in 2 s instead of 8 cm).
+            friction lets a loaded contact creep; 10 (MuJoCo's default: 1) stiffens friction so
+            that a foot on the 30 degree ramp stays put.
     """
 
     timestep: float = 0.001

@@ -1,20 +1,18 @@
 """One balance trial in MuJoCo: the controller holds the stance through an impact or a push.
 
-:class:`~.trial_setup.BalanceSetup` prepares a scenario once (analysis, MuJoCo model, the start
+:class:`~impact_balance.sim.trials.setup.BalanceSetup` prepares a scenario once (analysis, MuJoCo model, the start
 configurations with the impacting point backed off); :func:`run_balance_trial` resets the model and
 runs one trial:
 
 - ``impact_speed``: the impact task drives the impact point into the surface at that commanded
   speed (m/s), reached before the surface with a bounded acceleration, then withdraws on contact
-  (:class:`~.approach.ImpactTask`); with ``rigid_impact`` the joints keep their velocities through
+  (:class:`~impact_balance.sim.control.approach.ImpactTask`); with ``rigid_impact`` the joints keep their velocities through
   the impact (:class:`~.rigid_impact.RigidImpactHold`);
 - ``push``: a force on a body (the torso) for a short time (see :class:`Push`).
 
-At every control step (500 Hz) the loop reads MuJoCo's state as pinocchio's ``(q, v)``, runs
-:class:`~.balance.BalanceController` and writes the servo targets (``controller="ik"``), or runs
-:class:`~.inverse_dynamics.InverseDynamicsController` and writes the motor torques
-(``controller="id"``, the actuators then being torque motors), and feeds the
-:class:`~.outcomes.OutcomeMonitor`. It records the measured ZMP (from the sustained contacts' forces,
+At every control step (500 Hz) the loop reads MuJoCo's state as pinocchio's ``(q, v)``, runs the
+setup's :class:`~impact_balance.sim.control.controller.Controller` (``ik``: servo targets; ``id``:
+motor torques) and feeds the :class:`~.outcomes.OutcomeMonitor`. It records the measured ZMP (from the sustained contacts' forces,
 on the plane ``z = h``), the CoM, the CoM velocity and the DCM, and their margins in the scenario's
 ZMP support area and CoM velocity area (without margin: scores apply theirs), and optionally a log
 (:mod:`impact_balance.logs`). The impact itself is measured at every step (1 ms) by an
