@@ -124,8 +124,8 @@ class Scratch:
     """One pinocchio ``Data`` for one owner, and the key of the configuration it holds.
 
     What :class:`ThreadData` is per thread, for an owner that serialises its own calls (a
-    :class:`~impact_balance.governor.Governor` and its lock): :class:`~impact_balance.contacts.stance.Stance`
-    computes in it when given one.
+    :class:`~impact_balance.governor.Governor` and its lock):
+    :class:`~impact_balance.contacts.stance.Stance` computes in it when given one.
 
     Attributes:
         data: The Data.
@@ -247,7 +247,10 @@ class Robot:
         return self.joint_slot(name, field).id
 
     def joint_slot(self, name: str, field: str = "joint") -> JointSlot:
-        """Configuration slot and position limits of a non-root joint; :class:`UnknownJointError` if absent."""
+        """Configuration slot and position limits of a non-root joint.
+
+        Raises :class:`UnknownJointError` when the model has no such joint.
+        """
         slot = self._joint_slots.get(name) if isinstance(name, str) else None
         if slot is None:
             raise UnknownJointError(field, name, self.joint_names, listing=self.listing_command)
@@ -306,7 +309,10 @@ class Robot:
         return {}
 
     def joint_values(self, q: np.ndarray) -> dict[str, float]:
-        """Values of the 1-dof joints at configuration ``q``, rad or m (continuous joints by their angle)."""
+        """Values of the 1-dof joints at configuration ``q`` (rad or m).
+
+        Continuous joints are given by their angle.
+        """
         model = self.model
         out = {}
         for jid in range(2, model.njoints):
@@ -340,7 +346,7 @@ class Robot:
 
     @functools.cached_property
     def effort_limits(self) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`actuated_effort_limits`, computed once (read-only arrays: do not copy per call)."""
+        """:meth:`actuated_effort_limits`, computed once (read-only arrays: never copied)."""
         return self._limited(self.model.effortLimit)
 
     @functools.cached_property
@@ -383,8 +389,10 @@ _FD_LOCK = threading.Lock()
 
 @contextlib.contextmanager
 def _native_stderr(lines: list[str]) -> Iterator[None]:
-    """Collect what C++ code writes to file descriptor 2 (urdfdom's "Error: ..." lines) into
-    ``lines`` instead of the terminal: a failure is reported once, as one line naming the file.
+    """Collect what C++ code writes to file descriptor 2 into ``lines``.
+
+    urdfdom writes its "Error: ..." lines there; they are kept out of the terminal so that a failure
+    is reported once, as one line naming the file.
 
     Redirecting a descriptor is process-wide, so loads are serialised; another thread's
     writes to stderr during a load (a few ms) are collected too, and dropped.
@@ -445,9 +453,11 @@ def _load(urdf: Path, srdf: Path | None, name: str, standing: str | None) -> Rob
 
 
 def _load_rotor_parameters(model: pin.Model, srdf: Path, native: list[str]) -> str | None:
-    """Read the SRDF's ``rotor_params`` into the model (rotor inertia and gear ratio per joint) and set
-    ``model.armature`` = gear ratio^2 x rotor inertia, the rotor inertia reflected at the joint. Returns
-    where it came from, or None when the SRDF declares none.
+    """Read the SRDF's ``rotor_params`` into ``model.armature``.
+
+    Each joint's rotor inertia and gear ratio give ``model.armature`` = gear ratio^2 x rotor
+    inertia, the rotor inertia reflected at the joint. Returns where it came from, or None when the
+    SRDF declares none.
     """
     try:
         declared = "rotor_params" in srdf.read_text(errors="replace")

@@ -22,16 +22,18 @@ __all__ = [
     "use_torque_motors",
 ]
 
-#: Support-limb servo stiffness floor, in units of the robot's gravity stiffness m g h (see stiffen_support_limbs).
+#: Support-limb servo stiffness floor, in units of the robot's gravity stiffness m g h (see
+#: stiffen_support_limbs).
 SUPPORT_STIFFNESS_FACTOR = 0.4
 
-#: Servos of the ``rigid`` joint model in balance trials: 30 Hz bandwidth, no effort limits. A welded
-#: robot cannot be controlled; this is the closest a controlled robot gets to the paper's rigid body.
+#: Servos of the ``rigid`` joint model in balance trials: 30 Hz bandwidth, no effort limits. A
+#: welded robot cannot be controlled; this is the closest a controlled robot gets to the paper's
+#: rigid body.
 STIFF_SERVOS = ServoOptions(bandwidth=2.0 * np.pi * 30.0, effort_limits=False)
 
 
 def support_joints(sim: SimModel, analysis: Analysis) -> list[str]:
-    """Simulated joints on the chain from the root to any sustained contact's frame (the support limbs)."""
+    """Simulated joints on the chain from the root to a sustained contact (the support limbs)."""
     model = analysis.stance.model
     names: set[str] = set()
     for contact in analysis.stance.contacts:

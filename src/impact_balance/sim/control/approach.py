@@ -96,7 +96,9 @@ class ImpactReference(Protocol):
 
 @dataclass
 class ImpactTask:
-    """Drive an end-effector point into a surface at a commanded speed, then pull back (module docstring).
+    """Drive an end-effector point into a surface at a commanded speed, then pull back.
+
+    See the module docstring.
 
     Attributes:
         frame: Robot frame of the impacting end-effector.
@@ -138,6 +140,7 @@ class ImpactTask:
 
     @property
     def start_point(self) -> np.ndarray:
+        """The point's start (m, world): ``standoff`` from the surface along the normal."""
         return self.surface_point + self.standoff * self.normal
 
     @property
@@ -150,8 +153,11 @@ class ImpactTask:
     def reference(
         self, t: float, normal_force: float = 0.0
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """World position (m), velocity (m/s) and acceleration (m/s^2) of the impact point's reference at
-        ``t`` given the measured normal force (N); the first force above the threshold starts the withdrawal.
+        """World position, velocity and acceleration of the impact point's reference at ``t``.
+
+        World position (m), velocity (m/s) and acceleration (m/s^2) of the impact point's reference
+        at ``t`` given the measured normal force (N); the first force above the threshold starts the
+        withdrawal.
         """
         n = self.normal
         if self.contact_time is None and normal_force > self.force_threshold:
@@ -175,15 +181,17 @@ def standoff(
     cruise: float = CRUISE_DISTANCE,
     minimum: float = MIN_STANDOFF,
 ) -> float:
-    """Start distance from the surface (m) that leaves ``cruise`` at full ``speed`` after the ramp."""
+    """Start distance from the surface (m) leaving ``cruise`` at full ``speed`` after the ramp."""
     return max(minimum, speed * speed / (2.0 * acceleration) + cruise)
 
 
 def approach_profile(
     tau: float, speed: float, acceleration: float, stop: float
 ) -> tuple[float, float, float]:
-    """Distance, speed and acceleration after ``tau`` s of a bounded-acceleration start to ``speed``, held
-    at ``stop`` (m) once reached (a trapezoid without its braking: the point stops where it arrives).
+    """Distance, speed and acceleration after ``tau`` s of a bounded-acceleration start.
+
+    The start ramps up to ``speed`` and holds at ``stop`` (m) once reached (a trapezoid without its
+    braking: the point stops where it arrives).
     """
     if tau <= 0.0:
         return 0.0, 0.0, 0.0

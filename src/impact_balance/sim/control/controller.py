@@ -34,30 +34,27 @@ _FloatArray = npt.NDArray[np.float64]
 
 
 class ControlStep(Protocol):
-    """What every control step reports besides its command (world frame).
-
-    Attributes:
-        zmp: Clamped desired ZMP (m).
-        dcm: Measured DCM (m).
-        clamped: Whether the desired ZMP was clamped to the area.
-        com: Measured CoM (m).
-        com_velocity: Measured CoM velocity (m/s).
-    """
+    """What every control step reports besides its command (world frame)."""
 
     @property
-    def zmp(self) -> _FloatArray: ...
+    def zmp(self) -> _FloatArray:
+        """Clamped desired ZMP (m, world)."""
 
     @property
-    def dcm(self) -> _FloatArray: ...
+    def dcm(self) -> _FloatArray:
+        """Measured DCM (m, world)."""
 
     @property
-    def clamped(self) -> bool: ...
+    def clamped(self) -> bool:
+        """Whether the desired ZMP was clamped to the area."""
 
     @property
-    def com(self) -> _FloatArray: ...
+    def com(self) -> _FloatArray:
+        """Measured CoM (m, world)."""
 
     @property
-    def com_velocity(self) -> _FloatArray: ...
+    def com_velocity(self) -> _FloatArray:
+        """Measured CoM velocity (m/s, world)."""
 
 
 StepT = TypeVar("StepT", bound=ControlStep)

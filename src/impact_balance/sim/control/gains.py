@@ -17,7 +17,9 @@ __all__ = ["BalanceGains", "InverseDynamicsGains", "TrialGains"]
 
 @dataclass(frozen=True)
 class BalanceGains:
-    """Gains and rates of :class:`~impact_balance.sim.control.kinematic.BalanceController` (units in brackets).
+    """Gains and rates of the kinematic controller (units in brackets).
+
+    The gains of :class:`~impact_balance.sim.control.kinematic.BalanceController`.
 
     Attributes:
         rate: Control rate [Hz].
@@ -54,7 +56,9 @@ class BalanceGains:
 
 @dataclass(frozen=True)
 class InverseDynamicsGains:
-    """Gains, weights and rate of :class:`~impact_balance.sim.control.torque.InverseDynamicsController` (units in brackets).
+    """Gains, weights and rate of the torque controller (units in brackets).
+
+    The gains of :class:`~impact_balance.sim.control.torque.InverseDynamicsController`.
 
     Task weights multiply squared accelerations (m/s^2, rad/s^2; the angular momentum rate per
     unit mass, m^2/s^2); the wrench regularisation multiplies squared newtons and newton-metres.
@@ -67,12 +71,13 @@ class InverseDynamicsGains:
         angular_momentum_damping: K_L in L_dot = -K_L L [1/s].
         contact_damping: K_c in the contact acceleration J a + J_dot v = -K_c J v [1/s].
         posture_stiffness, posture_damping: PD to the start configuration [1/s^2], [1/s].
-        base_orientation_stiffness, base_orientation_damping: PD on the base orientation [1/s^2], [1/s].
+        base_orientation_stiffness, base_orientation_damping: PD on the base orientation [1/s^2],
+            [1/s].
         impact_stiffness, impact_damping: PD of the impact point to its target [1/s^2], [1/s].
         com_weight, angular_momentum_weight, posture_weight, base_orientation_weight, impact_weight,
         impact_orientation_weight: task weights.
-        acceleration_regularization, wrench_regularization: regularisation weights (the latter on the
-            contact forces).
+        acceleration_regularization, wrench_regularization: regularisation weights (the latter on
+            the contact forces).
         torque_regularization: regularisation weight of the contact torques (N m): keeps the centres
             of pressure central and the yaw torques small.
         friction_scale: The QP's friction coefficient is this fraction of the contact's: a margin

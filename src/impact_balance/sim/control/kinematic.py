@@ -78,9 +78,12 @@ class ControlOutput:
 
 
 def retracted_stance(analysis: Analysis, standoff: float) -> np.ndarray:
-    """The stance's configuration with the impact point backed off ``standoff`` (m) along the normal.
+    """The stance's configuration with the impact point backed off along the normal.
 
-    Whole-body IK (pink, :func:`impact_balance.robot.ik.solve_stance`): contacts fixed, CoM xy fixed.
+    The point backs off by ``standoff`` (m).
+
+    Whole-body IK (pink, :func:`impact_balance.robot.ik.solve_stance`): contacts fixed, CoM xy
+    fixed.
     """
     stance, impact = analysis.stance, analysis.impact
     if impact is None or standoff <= 0:
@@ -184,7 +187,7 @@ class BalanceController(Controller["ControlOutput"]):
         sim: SimModel,
         support_v_index: npt.NDArray[np.int_],
     ) -> BalanceController:
-        """The controller of one trial, with ``options.gains`` (see :meth:`Controller.for_trial`)."""
+        """The controller of one trial, with ``options.gains``; see :meth:`Controller.for_trial`."""
         controller = cls(analysis, q_start, options.gains, task)
         controller.support_v_index = support_v_index
         return controller
@@ -251,10 +254,12 @@ class BalanceController(Controller["ControlOutput"]):
         zmp_measured: np.ndarray | None = None,
         impact_force: float = 0.0,
     ) -> ControlOutput:
-        """One control step from the measured state (pinocchio ``q``, ``v``; free-flyer velocity local).
+        """One control step from the measured state.
 
-        ``zmp_measured`` is the ZMP of the measured contact forces on the plane (m, world; None or NaN
-        when unknown); ``impact_force`` the measured normal force at the impact point (N).
+        ``q`` and ``v`` are pinocchio's, the free-flyer velocity in the base frame.
+
+        ``zmp_measured`` is the ZMP of the measured contact forces on the plane (m, world; None or
+        NaN when unknown); ``impact_force`` the measured normal force at the impact point (N).
         """
         g, dt = self.gains, self.dt
         com, com_velocity = self.measure(q, v)

@@ -20,19 +20,19 @@ free-flyer velocity in the base frame):
 
    - equalities: the 6 unactuated rows of ``M a + h = S^T tau + sum J_i^T w_i`` (the floating
      base), and ``J_i a + J_i_dot v = -K_c J_i v`` for each contact (the contacts stay);
-   - inequalities: each ``w_i`` in its contact wrench cone (:func:`impact_balance.contacts.cwc.cwc_faces_world`)
-     (friction and rectangle shrunk by margins, see :class:`InverseDynamicsGains`) with a
-     minimum normal force, the joint position limits (as acceleration bounds), and
-     ``|tau| <= effort`` with ``tau`` the actuated rows of ``M a + h - sum J_i^T w_i``;
-     with a governed approach (a task whose ``speed_bound()`` is finite, :class:`~impact_balance.sim.studies.wall.GovernedApproach`),
-     the impact point's approach speed one control period ahead, ``-n . (J_p (v + a dt) + J_p_dot v dt)``,
-     at most the governor's cap: the paper's "track the maximum contact velocity with a whole-body QP"
-     as a hard bound, so that the torque controller's tracking lag cannot carry the point past a
-     falling cap;
-   - cost (weighted least squares): the CoM acceleration of the LIPM, ``c_dd_xy = omega^2 (c_xy - p)``,
-     with a PD on the CoM height; angular momentum damping ``L_dot = -K_L L``; the impact point's
-     acceleration (the :class:`~.approach.ImpactTask` reference's acceleration, plus a PD to its
-     position and velocity); a posture
+   - inequalities: each ``w_i`` in its contact wrench cone
+     (:func:`impact_balance.contacts.cwc.cwc_faces_world`) (friction and rectangle shrunk by
+     margins, see :class:`InverseDynamicsGains`) with a minimum normal force, the joint position
+     limits (as acceleration bounds), and ``|tau| <= effort`` with ``tau`` the actuated rows of
+     ``M a + h - sum J_i^T w_i``; with a governed approach (a task whose ``speed_bound()`` is
+     finite, :class:`~impact_balance.sim.studies.wall.GovernedApproach`), the impact point's
+     approach speed one control period ahead, ``-n . (J_p (v + a dt) + J_p_dot v dt)``, at most the
+     governor's cap: the paper's "track the maximum contact velocity with a whole-body QP" as a hard
+     bound, so that the torque controller's tracking lag cannot carry the point past a falling cap;
+   - cost (weighted least squares): the CoM acceleration of the LIPM,
+     ``c_dd_xy = omega^2 (c_xy - p)``, with a PD on the CoM height; angular momentum damping
+     ``L_dot = -K_L L``; the impact point's acceleration (the :class:`~.approach.ImpactTask`
+     reference's acceleration, plus a PD to its position and velocity); a posture
      PD to the start configuration (joints) and one on the base orientation; a small regularisation.
 
    If the torque limits make the QP infeasible, it is solved without them and the torques are
@@ -80,13 +80,15 @@ class TorqueOutput:
     Attributes:
         tau: Joint torques of the actuated joints (nv - 6, pinocchio velocity order) [N m].
         a: Joint accelerations of the QP (nv) [m/s^2, rad/s^2].
-        wrenches: Contact wrenches of the QP (nc x 6, ``[f; tau]`` at each contact point, world axes).
+        wrenches: Contact wrenches of the QP (nc x 6, ``[f; tau]`` at each contact point, world
+            axes).
         zmp: Clamped desired ZMP (m, world).
         dcm: Measured DCM (m, world).
         clamped: Whether the desired ZMP was clamped to the area.
         com: Measured CoM (m, world).
         com_velocity: Measured CoM velocity (m/s, world).
-        torque_limited: Whether the torque limits had to be dropped (infeasible) and the torques clipped.
+        torque_limited: Whether the torque limits had to be dropped (infeasible) and the torques
+            clipped.
     """
 
     tau: np.ndarray
@@ -144,9 +146,13 @@ class _Rows:
 def _point_jacobian(
     model: pin.Model, data: pin.Data, fid: int, offset: pin.SE3
 ) -> tuple[pin.SE3, np.ndarray, np.ndarray]:
-    """Pose, 6 x nv Jacobian (world axes, linear first) and acceleration drift ``J_dot v`` of ``frame * offset``.
+    """Pose, Jacobian and acceleration drift of the point ``frame * offset``.
 
-    Needs ``data`` from a forward kinematics with zero acceleration (so the frame acceleration is the drift).
+    Pose, 6 x nv Jacobian (world axes, linear first) and acceleration drift ``J_dot v`` of ``frame *
+    offset``.
+
+    Needs ``data`` from a forward kinematics with zero acceleration (so the frame acceleration is
+    the drift).
     The drift is the classical one: the linear acceleration of the point itself.
     """
     frame_pose = data.oMf[fid]
@@ -158,7 +164,8 @@ def _point_jacobian(
     r = placement.translation - frame_pose.translation
     velocity = pin.getFrameVelocity(model, data, fid, _LWA)
     w = velocity.angular
-    # Rigid point at r from the frame origin: v_p = v_o + w x r, a_p = a_o + w_dot x r + w x (w x r).
+    # Rigid point at r from the frame origin:
+    # v_p = v_o + w x r, a_p = a_o + w_dot x r + w x (w x r).
     J[:3] -= skew(r) @ J[3:]
     drift[:3] += np.cross(drift[3:], r) + np.cross(w, np.cross(w, r))
     return placement, J, drift
@@ -300,7 +307,9 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         sim: SimModel,
         support_v_index: npt.NDArray[np.int_],
     ) -> InverseDynamicsController:
-        """The controller of one trial, with ``options.id_gains`` (see :meth:`Controller.for_trial`).
+        """The controller of one trial, with ``options.id_gains``.
+
+        See :meth:`Controller.for_trial`.
 
         The torques are bounded when ``sim``'s motors are force-limited; MuJoCo's viscous joint
         damping (the URDF's) is compensated: the motors add ``damping * qdot``.
@@ -394,7 +403,7 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         return out
 
     def _dynamics(self, q: _FloatArray, v: _FloatArray) -> _Dynamics:
-        """Dynamics and kinematics at ``(q, v)`` with zero acceleration: frame accelerations are drifts."""
+        """Dynamics and kinematics at ``(q, v)`` and zero acceleration (so drifts)."""
         model, data = self.model, self.data
         pin.crba(model, data, q)
         M = data.M.copy()
@@ -404,7 +413,7 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         pin.computeJointJacobians(model, data, q)
         pin.updateFramePlacements(model, data)
         Ag = pin.computeCentroidalMap(model, data, q)
-        # With a = 0, dhg is the centroidal momentum drift A_g_dot v; it also sets data.com[0], data.hg.
+        # With a = 0, dhg is the centroidal momentum drift A_g_dot v (also sets data.com, data.hg).
         pin.computeCentroidalMomentumTimeVariation(model, data, q, v, self._zero)
         drift_hg = data.dhg.vector.copy()
         hg = data.hg.vector.copy()
@@ -461,7 +470,7 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
     def _impact_tasks(
         self, tasks: _Tasks, impact: ImpactReference, t: float, v: _FloatArray, impact_force: float
     ) -> tuple[_FloatArray, float] | None:
-        """Impact point: PD to the impact task's target and its velocity; the approach speed's row."""
+        """Impact point tasks: PD to the task's target and velocity; the approach speed's row."""
         g = self.gains
         assert self._impact_frame is not None
         placement, Ji, drift = _point_jacobian(
@@ -521,7 +530,9 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         state: _Dynamics,
         speed_row: tuple[_FloatArray, float] | None,
     ) -> tuple[_FloatArray, _FloatArray, _Rows]:
-        """Fill the QP's constraints; the torques' map ``tau = T x + t0`` and where each block starts.
+        """Fill the QP's constraints; return the torques' map and where each block starts.
+
+        The torques are ``tau = T x + t0``.
 
         Stacked for daqp: [floating base (6); contacts (6 nc)] equalities, the contact wrench cones
         (16 nc), the minimum normal forces (nc), the governed approach speed (0 or 1), the joint
@@ -580,7 +591,9 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         return T, t0, _Rows(ms, m0, m1)
 
     def _solve(self, P: _FloatArray, c: _FloatArray, rows: _Rows) -> tuple[_FloatArray, bool]:
-        """Solve the QP (daqp); infeasible: drop the torque limits, then the joint limits, then the
+        """Solve the QP (daqp), dropping constraints while it is infeasible.
+
+        Solve the QP (daqp); infeasible: drop the torque limits, then the joint limits, then the
         approach speed's bound; still infeasible: hold the last solution.
 
         Returns:

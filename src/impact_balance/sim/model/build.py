@@ -18,7 +18,8 @@ convert state both ways: ``set_state(q, v)`` takes a pinocchio configuration and
 ``com_velocity()`` (m, m/s, world); ``contact_force(geom)`` (N, world, on the robot);
 ``set_servo_targets(q_ref, v_ref)`` writes the servo commands (the holding torques
 included). ``inertia_repair`` says which inertials were changed for MuJoCo (see
-:mod:`.inertia`; a :class:`~impact_balance.exceptions.ModelRepairWarning` names them once). MuJoCo's free joint stores the base orientation as (w, x, y, z) and its angular
+:mod:`.inertia`; a :class:`~impact_balance.exceptions.ModelRepairWarning` names them once). MuJoCo's
+free joint stores the base orientation as (w, x, y, z) and its angular
 velocity in the base frame, but its linear velocity in world axes: the helpers convert.
 """
 
@@ -111,6 +112,7 @@ class SimModel:
 
     @property
     def robot(self) -> Robot:
+        """The scenario's robot (pinocchio)."""
         return self.stance.robot
 
     @property
@@ -120,7 +122,9 @@ class SimModel:
 
     # -- state --------------------------------------------------------------------------
     def set_state(self, q: np.ndarray, v: np.ndarray | None = None) -> None:
-        """Set MuJoCo's state from a pinocchio configuration ``q`` and velocity ``v`` (zero if None), then forward.
+        """Set MuJoCo's state from a pinocchio configuration and velocity, then forward.
+
+        ``q`` and ``v`` are pinocchio's; ``v`` is zero when None.
 
         With ``rigid`` joints, only the free-flyer part of ``q`` and ``v`` is used (the
         joints stay at the stance).
@@ -151,7 +155,7 @@ class SimModel:
         return q
 
     def velocity(self) -> np.ndarray:
-        """The pinocchio velocity (base linear and angular velocity in the base frame) of the current state."""
+        """The pinocchio velocity of the current state (base velocities in the base frame)."""
         d = self.data
         v = np.zeros(self.stance.model.nv)
         rotation = np.empty(9)
@@ -162,7 +166,7 @@ class SimModel:
         return v
 
     def base_velocity_world(self) -> tuple[np.ndarray, np.ndarray]:
-        """Linear velocity of the base origin and angular velocity of the base, both in world axes."""
+        """Linear velocity of the base origin and angular velocity of the base (world axes)."""
         d = self.data
         rotation = np.empty(9)
         mujoco.mju_quat2Mat(rotation, d.qpos[3:7])
@@ -180,7 +184,9 @@ class SimModel:
         return answer
 
     def impact_point_velocity(self, normal: np.ndarray) -> np.ndarray:
-        """World velocity of the impact point (m/s), the impact sphere's surface point along ``-normal``.
+        """World velocity of the impact point (m/s).
+
+        The impact point is the impact sphere's surface point along ``-normal``.
 
         Args:
             normal: Unit surface normal (world), from the surface into the robot.
@@ -205,7 +211,7 @@ class SimModel:
         return answer
 
     def contact_force(self, geom: int) -> np.ndarray:
-        """Total contact force on the robot at ``geom`` (one of its collision geoms), N, world axes."""
+        """Total contact force on the robot at ``geom`` (a collision geom of it), N, world axes."""
         m, d = self.model, self.data
         total = np.zeros(3)
         local = np.zeros(6)
@@ -214,7 +220,8 @@ class SimModel:
             if contact.geom1 != geom and contact.geom2 != geom:
                 continue
             mujoco.mj_contactForce(m, d, i, local)
-            # The force acts on geom2, along the contact frame whose first row (normal) points from geom1 to geom2.
+            # The force acts on geom2, along the contact frame whose first row (normal) points from
+            # geom1 to geom2.
             world = contact.frame.reshape(3, 3).T @ local[:3]
             total += world if contact.geom2 == geom else -world
         return total
@@ -259,8 +266,10 @@ class SimModel:
                 self.model.pair_margin[i] = 0.0 if enabled else -1.0
 
     def enable_impact_surface(self, enabled: bool = True) -> None:
-        """Let the impact point touch the impacted surface (default), or not (a push trial: the surface is
-        not there, so a falling robot cannot lean on it). Disabling sets the pair's margin to -1 m.
+        """Let the impact point touch the impacted surface (default), or not.
+
+        A push trial has no impacted surface, so that a falling robot cannot lean on it. Disabling
+        sets the pair's margin to -1 m.
         """
         if self.surface_geom is None:
             return
@@ -269,7 +278,7 @@ class SimModel:
                 self.model.pair_margin[i] = 0.0 if enabled else -1.0
 
     def set_servo_targets(self, q_ref: np.ndarray, v_ref: np.ndarray | None = None) -> None:
-        """Servo commands from target joint positions (pinocchio ``q``) and velocities (pinocchio ``v``).
+        """Servo commands from target joint positions and velocities (pinocchio order).
 
         The holding torques (:attr:`tau_hold`) are added as a feed-forward.
         """
@@ -297,8 +306,10 @@ def _joint_bodies(spec: mujoco.MjSpec, stance: Stance) -> dict[int, mujoco.MjsBo
 
 
 def _armature(robot: Robot, override: float | None, v_index: list[int]) -> tuple[np.ndarray, str]:
-    """Rotor inertia of each simulated joint (kg m^2) and its source: ``override`` for every joint, or
-    what the robot files declare (pinocchio's ``model.armature``, read from the SRDF's rotor_params).
+    """Rotor inertia of each simulated joint (kg m^2) and its source.
+
+    The source is ``override`` for every joint, or what the robot files declare (pinocchio's
+    ``model.armature``, read from the SRDF's rotor_params).
     """
     if override is not None:
         return np.full(

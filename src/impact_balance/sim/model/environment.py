@@ -146,8 +146,10 @@ def add_geometry(
 
 
 def _add_ground(spec: mujoco.MjSpec, stance: Stance) -> tuple[str, float]:
-    """The ground plane, through the lowest horizontal contact (or the lowest contact corner if
-    none is); its name and height (m).
+    """The ground plane: its name and height (m).
+
+    The ground plane, through the lowest horizontal contact (or the lowest contact corner if none
+    is); its name and height (m).
     """
     horizontal = [c for c in stance.contacts if c.normal[2] > _HORIZONTAL]
     heights = [c.position[2] for c in horizontal] or [stance.lowest_contact_height()]
@@ -176,8 +178,9 @@ def _add_contact(
     ground_z: float,
     params: ContactParameters,
 ) -> tuple[str, str]:
-    """The robot box of contact ``i`` and what supports it (the ground, or a block of its own);
-    their names.
+    """The robot box of contact ``i`` and what supports it: their names.
+
+    The support is the ground, or a block of its own.
     """
     t = params.box_half_thickness
     spec_i = contact.spec

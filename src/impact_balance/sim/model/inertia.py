@@ -79,7 +79,7 @@ class InertiaRepair:
         return tuple(dict.fromkeys([name for name, _ in self.merged] + list(self.floored)))
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready: the bodies merged (with their links) and floored, the floors and the mass added."""
+        """JSON-ready: bodies merged and floored, the floors and the mass added."""
         return {
             "merged": {name: list(links) for name, links in self.merged},
             "floored": list(self.floored),
@@ -136,7 +136,7 @@ def _pose(body: mujoco.MjsBody) -> tuple[_FloatArray, _FloatArray]:
 
 
 def _group(body: mujoco.MjsBody) -> list[tuple[mujoco.MjsBody, _FloatArray, _FloatArray]]:
-    """The jointless links fused into ``body``, with their pose in its frame (rotation, position)."""
+    """The jointless links fused into ``body``, with their pose in its frame."""
     out = []
     stack = [(child, *_pose(child)) for child in body.bodies]
     while stack:

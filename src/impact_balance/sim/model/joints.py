@@ -20,9 +20,10 @@
     limit (the actuator's force range; MuJoCo also keeps it as the joint's actuator force
     range), and the URDF damping and friction loss stay. ``armature`` (rotor inertia
     reflected through the gearbox, kg m^2) is added to every joint: by default what the robot
-    files declare (the SRDF's ``rotor_params``, see :attr:`impact_balance.robot.robot.Robot.armature_source`;
-    0 where they declare none), or one value for every joint. The torque feed-forward holds the stance against gravity: the joint torques of
-    the smallest contact wrenches (least squares) that balance gravity within the contact
+    files declare (the SRDF's ``rotor_params``, see
+    :attr:`impact_balance.robot.robot.Robot.armature_source`; 0 where they declare none), or one
+    value for every joint. The torque feed-forward holds the stance against gravity: the joint
+    torques of the smallest contact wrenches (least squares) that balance gravity within the contact
     wrench cones, solved once at the stance.
 """
 
@@ -102,7 +103,10 @@ class ServoOptions:
 def servo_gains(
     reflected_inertia: np.ndarray, options: ServoOptions
 ) -> tuple[np.ndarray, np.ndarray]:
-    """``(kp, kd)`` of each joint (N m/rad, N m s/rad) from its reflected inertia (kg m^2, armature included)."""
+    """``(kp, kd)`` of each joint from its reflected inertia.
+
+    Gains in N m/rad and N m s/rad, inertias in kg m^2 (armature included).
+    """
     inertia = np.asarray(reflected_inertia, dtype=float)
     w = options.bandwidth
     return inertia * w * w, 2.0 * options.damping_ratio * inertia * w
@@ -144,8 +148,10 @@ def holding_torques(stance: Stance, gravity: float = GRAVITY) -> np.ndarray:
 
 
 def weld_joints(spec: mujoco.MjSpec, model: mujoco.MjModel, qpos: np.ndarray) -> None:
-    """Weld every non-free joint of ``spec`` at ``qpos`` (a configuration of ``model``, compiled from ``spec``
-    without fusing static bodies, so that every body of ``spec`` is in ``model``).
+    """Weld every non-free joint of ``spec`` at ``qpos``.
+
+    ``qpos`` is a configuration of ``model``, compiled from ``spec`` without fusing static bodies,
+    so that every body of ``spec`` is in ``model``.
 
     Each body takes its pose relative to its parent at ``qpos``, then its joints are deleted.
     """

@@ -31,7 +31,10 @@ def journal_digest(parts: dict[str, Any]) -> str:
 
 
 def default_journal_path(command: str, scenario: str, digest: str) -> Path:
-    """``impact-balance-trials/<command>_<scenario>_<digest[:12]>.jsonl`` in the current directory."""
+    """The journal's default path, in ``impact-balance-trials/`` of the current directory.
+
+    ``impact-balance-trials/<command>_<scenario>_<digest[:12]>.jsonl`` in the current directory.
+    """
     safe = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in (scenario or "scenario"))[
         :80
     ]
@@ -133,6 +136,7 @@ class TrialJournal:
         self._write({"key": key, "entry": entry})
 
     def close(self) -> None:
+        """Close the journal's file (idempotent)."""
         if self._handle is not None:
             self._handle.close()
             self._handle = None

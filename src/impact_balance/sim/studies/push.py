@@ -1,4 +1,6 @@
-"""Push recovery (paper Exp. 2): impulsive pushes in every direction, predicted before, scored after.
+"""Push recovery (paper Exp. 2): impulsive pushes in every direction.
+
+Both criteria predict each push's outcome before the trial; the trials then score them.
 
 For every push both criteria predict the outcome **before the trial**, from the scenario alone:
 
@@ -9,9 +11,10 @@ For every push both criteria predict the outcome **before the trial**, from the 
   support area.
 
 They are also read from the trial, as a second column (``*_in_trial``): the measured CoM velocity
-at the end of the push in the area, and the measured ZMP in the ZMP support area throughout the push.
-Each prediction is made against the areas shrunk by a ZMP margin (:mod:`impact_balance.balance.areas`);
-the trials themselves do not depend on it, so one set of trials is scored at any margin.
+at the end of the push in the area, and the measured ZMP in the ZMP support area throughout the
+push. Each prediction is made against the areas shrunk by a ZMP margin
+(:mod:`impact_balance.balance.areas`); the trials themselves do not depend on it, so one set of
+trials is scored at any margin.
 
 Magnitudes are impulses in N s, or fractions of each direction's *boundary impulse* ``m r(u)`` (the
 impulse that puts the predicted CoM velocity on the boundary of the CoM velocity area without
@@ -60,7 +63,8 @@ __all__ = [
 DEFAULT_MAGNITUDES = (5.0, 10.0, 15.0, 20.0, 25.0, 30.0)
 #: The predictions scored: each criterion before the trial, and read in the trial.
 CRITERIA = ("com", "com_in_trial", "zmp", "zmp_in_trial")
-#: Target share of all pushes predicted safe that fell (the margin study reports the smallest margin reaching it).
+#: Target share of all pushes predicted safe that fell (the margin study reports the smallest margin
+#: reaching it).
 SAFE_FELL_TARGET = 0.05
 
 
@@ -101,8 +105,10 @@ def check_push_arguments(
 def boundary_impulse(
     area: Polygon, mass: float, direction: float, com_velocity: ArrayLike = (0.0, 0.0)
 ) -> float:
-    """The impulse (N s) along ``direction`` (rad) that puts ``com_velocity + J u / m`` on the boundary of
-    ``area`` (m/s); 0 when ``com_velocity`` is outside, inf when the area is unbounded that way.
+    """The impulse (N s) along ``direction`` that brings the CoM velocity to the area's boundary.
+
+    The impulse puts ``com_velocity + J u / m`` (m/s) on the boundary of ``area``; it is 0 when
+    ``com_velocity`` is outside, inf when the area is unbounded that way. ``direction`` is in rad.
     """
     G, h = area.halfplanes
     u = np.array([np.cos(direction), np.sin(direction)])
@@ -116,8 +122,10 @@ def boundary_impulse(
 
 @dataclass(frozen=True)
 class PushPrediction:
-    """A push's before-trial predictions, as margins in the areas without margin (safe at a ZMP margin ``M``
-    when ``com_velocity_margin >= omega M``, resp. ``zmp_margin >= M``).
+    """A push's before-trial predictions, as margins in the areas without margin.
+
+    The push is safe at a ZMP margin ``M`` when ``com_velocity_margin >= omega M``, resp.
+    ``zmp_margin >= M``.
 
     Attributes:
         com_velocity: Predicted post-push planar CoM velocity (m/s, world).
@@ -134,14 +142,18 @@ class PushPrediction:
 
 @dataclass(kw_only=True)
 class PushOutcome(TrialEntry):
-    """One push: what was tried, what was predicted before, and the trial's summary and trajectory."""
+    """One push: what was tried and predicted, and the trial's summary and trajectory."""
 
     push: Push
     relative: float | None
     prediction: PushPrediction
 
     def safe(self, criterion: str, margin: float, omega: float) -> bool:
-        """Whether ``criterion`` (one of :data:`CRITERIA`) calls the push safe at ZMP margin ``margin`` (m)."""
+        """Whether ``criterion`` calls the push safe at ZMP margin ``margin`` (m).
+
+        Whether ``criterion`` (one of :data:`CRITERIA`) calls the push safe at ZMP margin ``margin``
+        (m).
+        """
         s, p = self.summary, self.prediction
         if criterion == "com":
             return p.com_velocity_margin >= omega * margin
@@ -154,6 +166,7 @@ class PushOutcome(TrialEntry):
         return m is not None and m >= margin
 
     def to_dict(self, margin: float, omega: float) -> dict[str, Any]:
+        """JSON-ready, the criteria's calls at ZMP margin ``margin`` (m) with ``omega`` (1/s)."""
         s = self.summary
         return {
             "direction": float(self.push.direction),
@@ -181,7 +194,10 @@ class PushOutcome(TrialEntry):
 
 @dataclass
 class PushTestResult:
-    """Every push of a push test and how each criterion scores (at ``zmp_margin``, and against the margin)."""
+    """Every push of a push test and how each criterion scores.
+
+    The scores are at ``zmp_margin``, and against the margin.
+    """
 
     scenario: str | None
     outcomes: list[PushOutcome]
@@ -197,10 +213,14 @@ class PushTestResult:
 
     @property
     def scored(self) -> list[PushOutcome]:
+        """The pushes that count in the scores (their trial was not aborted)."""
         return [o for o in self.outcomes if o.scored]
 
     def scores(self, margin: float | None = None) -> dict[str, Any]:
-        """Confusion of every criterion (:data:`CRITERIA`) at ZMP margin ``margin`` (default: the result's)."""
+        """Confusion of every criterion (:data:`CRITERIA`) at ZMP margin ``margin``.
+
+        ``margin`` defaults to the result's.
+        """
         margin = self.zmp_margin if margin is None else margin
         scored = self.scored
         fell = [o.fell for o in scored]
@@ -209,8 +229,11 @@ class PushTestResult:
         }
 
     def margin_study(self) -> dict[str, Any]:
-        """Scores at 0, the controller's margin and twice it, and the smallest margin (of :data:`MARGIN_GRID`)
-        that brings each criterion's "predicted safe, fell" to :data:`SAFE_FELL_TARGET` or less.
+        """Scores at several margins, and the smallest margin that makes each criterion safe.
+
+        Scores at 0, the controller's margin and twice it, and the smallest margin (of
+        :data:`MARGIN_GRID`) that brings each criterion's "predicted safe, fell" to
+        :data:`SAFE_FELL_TARGET` or less.
         """
         own = self.controller_margin
         margins = sorted({0.0, own, 2 * own})
@@ -231,7 +254,7 @@ class PushTestResult:
         return out
 
     def contact_breaks(self) -> dict[str, Any]:
-        """Pushes that broke a contact without a fall, and which contact broke first, by magnitude."""
+        """Pushes that broke a contact without a fall, and which contact first, by magnitude."""
         rows: dict[str, dict[str, Any]] = {}
         for o in self.scored:
             key = f"{o.push.magnitude:g}"
@@ -273,6 +296,7 @@ class PushTestResult:
         return {"outcomes": outcomes, "reasons": reasons}
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: ``push-test --json``."""
         return {
             "scenario": self.scenario,
             "zmp_margin": self.zmp_margin,
@@ -329,10 +353,12 @@ def push_test(
     zmp_margin: float | None = None,
     journal: TrialJournal | None = None,
 ) -> PushTestResult:
-    """Push the robot in ``directions`` evenly spaced directions at every magnitude (N s, or fractions
-    ``relative`` of each direction's boundary impulse) for ``duration`` s, and score both criteria at
-    ``zmp_margin`` (m; default: the controller's own margin). Finished trials go to ``journal`` as they
-    end, and trials it already holds are not run again.
+    """Push the robot in evenly spaced directions and score both criteria.
+
+    Pushes in ``directions`` directions at every magnitude (N s, or fractions ``relative`` of each
+    direction's boundary impulse) for ``duration`` s; both criteria are scored at ``zmp_margin`` (m;
+    default: the controller's own margin). Finished trials go to ``journal`` as they end, and trials
+    it already holds are not run again.
     """
     wall0 = time.perf_counter()
     if not isinstance(scenario, Scenario):

@@ -54,8 +54,10 @@ __all__ = [
 
 
 def predictions(scenario: Scenario, zmp_margin: float = 0.0) -> dict[str, dict[str, float | None]]:
-    """Maximum contact velocity (m/s; None if unbounded) by each criterion and inertia model, with the ZMP
-    support area shrunk by ``zmp_margin`` (m).
+    """Maximum contact velocity by each criterion and inertia model.
+
+    Maximum contact velocity (m/s; None if unbounded) by each criterion and inertia model, with the
+    ZMP support area shrunk by ``zmp_margin`` (m).
     """
     out: dict[str, dict[str, float | None]] = {"com_criterion": {}, "zmp_criterion": {}}
     impact = scenario.impact
@@ -78,7 +80,7 @@ def predictions(scenario: Scenario, zmp_margin: float = 0.0) -> dict[str, dict[s
 
 @dataclass(kw_only=True)
 class ValidationTrial(TrialEntry):
-    """One trial of the search: the commanded speed, the trial's summary and its CoM velocity trajectory."""
+    """One trial of the search: commanded speed, summary and CoM velocity trajectory."""
 
     speed: float
 
@@ -119,6 +121,7 @@ class ValidationResult:
 
     @property
     def scored(self) -> list[ValidationTrial]:
+        """The trials that count in the bracket (not aborted, approach speed measured)."""
         return [t for t in self.trials if t.scored and t.measured is not None]
 
     def bracket(self) -> dict[str, Any]:
@@ -146,7 +149,10 @@ class ValidationResult:
         }
 
     def contact_break(self) -> dict[str, Any] | None:
-        """The slowest trial (measured speed) that broke a contact (fell or not) and its first event."""
+        """The slowest trial that broke a contact (fell or not) and its first event.
+
+        The slowest trial (measured speed) that broke a contact (fell or not) and its first event.
+        """
         broken = [t for t in self.scored if t.summary["events"]]
         if not broken:
             return None
@@ -160,9 +166,11 @@ class ValidationResult:
         }
 
     def post_impact(self, trial: ValidationTrial) -> dict[str, Any] | None:
-        """The measured post-impact CoM velocity against the predicted set (composite, the scenario's friction and
-        restitution range) at the measured speed from the measured pre-impact CoM velocity: the set's vertices and
-        the distance from the measurement to it (m/s, 0 inside).
+        """The measured post-impact CoM velocity against the predicted set.
+
+        The predicted set is the composite model's, over the scenario's friction and restitution
+        range, at the measured speed from the measured pre-impact CoM velocity. Returns the set's
+        vertices and the distance from the measurement to it (m/s, 0 inside).
         """
         impact = trial.summary.get("impact")
         setup = self.extra.get("setup")
@@ -181,6 +189,7 @@ class ValidationResult:
         return {"vertices": vertices.tolist(), "distance": float(distance_to_hull(after, vertices))}
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: ``validate --json``."""
         com_max = self.predicted_with_margin["com_criterion"]["composite"]
         trials = []
         for t in self.trials:
@@ -361,10 +370,11 @@ def validate(
 ) -> ValidationResult:
     """Bracket the approach speed at which the robot starts to fall (m/s); see the module docstring.
 
-    Starts at the CoM criterion's prediction (composite, no margin), doubles (or halves) the commanded
-    speed until the outcome changes, then bisects until ``fell - stood <= tolerance * fell`` (commanded).
-    If the robot stands at ``max_speed`` (or falls at ``min_speed``), or a trial is aborted, the bracket
-    stays open on that side. ``progress(trial, stood, fell)`` is called after every trial.
+    Starts at the CoM criterion's prediction (composite, no margin), doubles (or halves) the
+    commanded speed until the outcome changes, then bisects until
+    ``fell - stood <= tolerance * fell`` (commanded). If the robot stands at ``max_speed`` (or falls
+    at ``min_speed``), or a trial is aborted, the bracket stays open on that side.
+    ``progress(trial, stood, fell)`` is called after every trial.
     """
     wall0 = time.perf_counter()
     if not isinstance(scenario, Scenario):

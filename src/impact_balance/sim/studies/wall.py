@@ -1,5 +1,7 @@
-"""The paper's Experiment 1 in simulation: the impacting point sent at a wall it does not know,
-its speed capped every control tick by an impact-speed governor.
+"""The paper's Experiment 1 in simulation: a governed approach to an unknown wall.
+
+The impacting point is sent at a wall it does not know, its speed capped every control tick by an
+impact-speed governor.
 
 The robot stands on the scenario's contacts, its impacting point backed off ``standoff`` (15 cm)
 along the surface normal ``n``; the balance controller of ``validate`` holds it (``ik`` or ``id``).
@@ -55,7 +57,8 @@ APPROACH_VERSION = 2
 
 _FloatArray = npt.NDArray[np.float64]
 
-#: Governors of the approach: the CoM criterion's, the ZMP criterion's, or none (the reference alone).
+#: Governors of the approach: the CoM criterion's, the ZMP criterion's, or none (the reference
+#: alone).
 GOVERNORS = ("com", "zmp", "none")
 
 
@@ -88,8 +91,10 @@ class WallOptions:
 
 @dataclass
 class GovernedApproach:
-    """The impacting point's reference when a governor caps its speed every tick (duck-types
-    :class:`~.approach.ImpactTask` for the balance controllers: ``reference``, ``target``, ``start_point``).
+    """The impacting point's reference when a governor caps its speed every tick.
+
+    It duck-types :class:`~impact_balance.sim.control.approach.ImpactTask` for the balance
+    controllers (an :class:`~impact_balance.sim.control.approach.ImpactReference`).
 
     ``speed_limit(t)`` is called by the trial loop before each control step with the governor's
     ceiling (m/s, ``inf`` without a governor); the reference's own speed follows a
@@ -118,6 +123,7 @@ class GovernedApproach:
 
     @property
     def start_point(self) -> np.ndarray:
+        """The point's start (m, world)."""
         return self.start
 
     def reference_speed(self, t: float) -> float:
@@ -127,7 +133,10 @@ class GovernedApproach:
     def reference(
         self, t: float, normal_force: float = 0.0
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """World position, velocity and acceleration of the point's reference at ``t`` (see the class docstring)."""
+        """World position, velocity and acceleration of the point's reference at ``t``.
+
+        See the class docstring.
+        """
         n = np.asarray(self.normal, dtype=float)
         if self._point is None:
             self._point = np.asarray(self.start, dtype=float).copy()
@@ -148,11 +157,13 @@ class GovernedApproach:
         return self._point.copy(), -self.commanded * n, -acceleration * n
 
     def target(self, t: float, normal_force: float = 0.0) -> np.ndarray:
+        """The reference position alone (m, world) at ``t``."""
         return self.reference(t, normal_force)[0]
 
     def speed_bound(self) -> float:
-        """The largest approach speed (m/s, along ``-normal``) a controller should allow the point
-        now: the governor's cap until the contact, ``inf`` after it, without a governor or when
+        """The largest approach speed (m/s, along ``-normal``) a controller should allow now.
+
+        The governor's cap until the contact; ``inf`` after it, without a governor, or when
         ``bound_speed`` is off.
         """
         if not self.bound_speed or self.contact_time is not None:
@@ -182,6 +193,7 @@ class WallTrial:
     frames: dict[str, Any] | None = None
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: one approach of ``approach --json``."""
         s = self.result.summary()
         o = self.options
         return {

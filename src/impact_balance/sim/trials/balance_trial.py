@@ -1,23 +1,24 @@
 """One balance trial in MuJoCo: the controller holds the stance through an impact or a push.
 
-:class:`~impact_balance.sim.trials.setup.BalanceSetup` prepares a scenario once (analysis, MuJoCo model, the start
-configurations with the impacting point backed off); :func:`run_balance_trial` resets the model and
-runs one trial:
+:class:`~impact_balance.sim.trials.setup.BalanceSetup` prepares a scenario once (analysis, MuJoCo
+model, the start configurations with the impacting point backed off); :func:`run_balance_trial`
+resets the model and runs one trial:
 
 - ``impact_speed``: the impact task drives the impact point into the surface at that commanded
   speed (m/s), reached before the surface with a bounded acceleration, then withdraws on contact
-  (:class:`~impact_balance.sim.control.approach.ImpactTask`); with ``rigid_impact`` the joints keep their velocities through
-  the impact (:class:`~.rigid_impact.RigidImpactHold`);
+  (:class:`~impact_balance.sim.control.approach.ImpactTask`); with ``rigid_impact`` the joints keep
+  their velocities through the impact (:class:`~.rigid_impact.RigidImpactHold`);
 - ``push``: a force on a body (the torso) for a short time (see :class:`Push`).
 
 At every control step (500 Hz) the loop reads MuJoCo's state as pinocchio's ``(q, v)``, runs the
 setup's :class:`~impact_balance.sim.control.controller.Controller` (``ik``: servo targets; ``id``:
-motor torques) and feeds the :class:`~.outcomes.OutcomeMonitor`. It records the measured ZMP (from the sustained contacts' forces,
-on the plane ``z = h``), the CoM, the CoM velocity and the DCM, and their margins in the scenario's
-ZMP support area and CoM velocity area (without margin: scores apply theirs), and optionally a log
-(:mod:`impact_balance.logs`). The impact itself is measured at every step (1 ms) by an
-:class:`~.impact_tracker.ImpactTracker`: the approach speed just before the contact (the measured
-speed), the impulses at the impact point and at the sustained contacts, and the CoM velocity across.
+motor torques) and feeds the :class:`~.outcomes.OutcomeMonitor`. It records the measured ZMP (from
+the sustained contacts' forces, on the plane ``z = h``), the CoM, the CoM velocity and the DCM, and
+their margins in the scenario's ZMP support area and CoM velocity area (without margin: scores apply
+theirs), and optionally a log (:mod:`impact_balance.logs`). The impact itself is measured at every
+step (1 ms) by an :class:`~.impact_tracker.ImpactTracker`: the approach speed just before the
+contact (the measured speed), the impulses at the impact point and at the sustained contacts, and
+the CoM velocity across.
 """
 
 from __future__ import annotations
@@ -107,10 +108,12 @@ def _base_rotation(q: np.ndarray) -> np.ndarray:
 
 
 def _omega_now(com_height: float, plane_height: float, gravity: float) -> float:
-    """The LIPM's omega (1/s) at the measured CoM height (m), NaN once the CoM is at or below the plane.
+    """The LIPM's omega (1/s) at the measured CoM height (m).
 
-    A falling robot's CoM may reach the plane: its CoM velocity margin is then undefined (NaN), not an
-    error.
+    NaN once the CoM is at or below the plane.
+
+    A falling robot's CoM may reach the plane: its CoM velocity margin is then undefined (NaN), not
+    an error.
     """
     if com_height <= plane_height:
         return math.nan
@@ -129,7 +132,9 @@ def run_balance_trial(
     before_control: BeforeControl | None = None,
     max_approach_time: float | None = None,
 ) -> BalanceTrialResult:
-    """Run one trial (an impact at the commanded ``impact_speed``, or a ``push``) from rest; see the module docstring.
+    """Run one trial (an impact or a push) from rest; see the module docstring.
+
+    An impact at the commanded ``impact_speed``, or a ``push``.
 
     An impact may instead follow ``impact_task`` (an object with ``reference(t, normal_force)``,
     ``target``, ``start_time``, ``contact_time``, like :class:`~.approach.ImpactTask`), from a start
@@ -209,8 +214,9 @@ def _run(
 def _commanded_task(
     analysis: Analysis, impact_speed: float, settle: float
 ) -> tuple[ImpactTask, float]:
-    """The impact task at the commanded ``impact_speed`` (m/s), starting after ``settle`` (s), and
-    its standoff (m).
+    """The impact task at the commanded ``impact_speed`` (m/s), and its standoff (m).
+
+    The task starts after ``settle`` (s).
     """
     im = _impact_model(analysis)
     task = ImpactTask(
@@ -288,7 +294,7 @@ class _TrialRun:
             LogRecorder(sim, self.contact_names, task is not None) if options.record else None
         )
         self.body = None if push is None else push_body(sim, push.body)
-        self.steps_per_control = max(1, int(round(1.0 / (self.controller.rate * dt))))
+        self.steps_per_control = max(1, round(1.0 / (self.controller.rate * dt)))
         self.series: dict[str, list[Any]] = {k: [] for k in _SERIES}
         self.surface = (
             0.0 if surface_point is None else float(self.n @ np.asarray(surface_point, dtype=float))
@@ -320,7 +326,7 @@ class _TrialRun:
             )
 
     def loop(self, before_control: BeforeControl | None) -> None:
-        """Step MuJoCo until the trial ends (a fall, or the end time, extended once if still moving)."""
+        """Step MuJoCo until the trial ends (a fall, or the end time, extended once if moving)."""
         sim, push, criteria = self.sim, self.push, self.options.criteria
         m, d = sim.model, sim.data
         wall0 = time.perf_counter()
@@ -350,7 +356,9 @@ class _TrialRun:
         self.wall = time.perf_counter() - wall0
 
     def _track_impact(self, t: float) -> None:
-        """Every step (1 ms): the forces of the last step, the impact point's velocity, the CoM
+        """Every MuJoCo step: the impact's measurements, hold and disturbance times.
+
+        Every step (1 ms): the forces of the last step, the impact point's velocity, the CoM
         velocity; the rigid-impact hold; the disturbance's start and end.
         """
         sim, n, hold, tracker = self.sim, self.n, self.hold, self.tracker
@@ -422,7 +430,7 @@ class _TrialRun:
         return False
 
     def _record(self, t: float, zmp: _FloatArray, out: ControlStep) -> float:
-        """Append one control step to the series; returns the DCM's margin in the ZMP support area."""
+        """Append one control step to the series; return the DCM's margin in the ZMP area (m)."""
         areas = self.analysis.areas
         zmp_area = areas.zmp_area
         com, com_velocity = out.com, out.com_velocity
@@ -479,8 +487,10 @@ class _TrialRun:
 
 
 def _margins(result: BalanceTrialResult, analysis: Analysis, arrays: dict[str, np.ndarray]) -> None:
-    """The CoM velocity when the disturbance ended, its margin, the worst margin after it, and the worst ZMP
-    margin during a push (all in the areas without margin).
+    """The CoM velocity margins of a trial after its disturbance.
+
+    The CoM velocity when the disturbance ended, its margin, the worst margin after it, and the
+    worst ZMP margin during a push (all in the areas without margin).
     """
     if result.disturbance_time is None or not len(arrays["time"]):
         return
@@ -511,7 +521,9 @@ def write_trial_log(
     push: Push | None = None,
     rigid_impact: bool = False,
 ) -> Path:
-    """Run one trial again with recording on and write its log (searches run their trials unrecorded).
+    """Run one trial again with recording on and write its log.
+
+    Searches run their trials unrecorded: this reruns one to log it.
 
     Args:
         setup: The scenario prepared for trials.

@@ -49,10 +49,12 @@ class ImpactTracker:
 
     @property
     def touched(self) -> bool:
+        """Whether the impact point has touched the surface."""
         return self.start is not None
 
     @property
     def done(self) -> bool:
+        """Whether the impact's window has ended."""
         return self.end is not None
 
     def update(
@@ -63,7 +65,9 @@ class ImpactTracker:
         point_velocity: np.ndarray,
         com_velocity: np.ndarray,
     ) -> None:
-        """One step: forces that acted over the last step (N, world, on the robot), the impact point's
+        """One step: the forces of the last step, the impact point's and the CoM's velocity now.
+
+        One step: forces that acted over the last step (N, world, on the robot), the impact point's
         velocity and the CoM velocity now (m/s, world).
         """
         touching = bool(np.any(impact_force != 0.0))
@@ -93,7 +97,10 @@ class ImpactTracker:
     def measurement(
         self, t: float, com_velocity: np.ndarray, hold: dict[str, Any] | None = None
     ) -> ImpactMeasurement | None:
-        """The impact measured so far (None before the contact); an unfinished window ends at ``t``."""
+        """The impact measured so far (None before the contact).
+
+        An unfinished window ends at ``t``.
+        """
         if self.start is None:
             return None
         end = self.end if self.end is not None else float(t)

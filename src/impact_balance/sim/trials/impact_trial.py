@@ -70,6 +70,7 @@ class TrialOptions:
     rigid_impact: bool = False
 
     def resolved_gap(self) -> float:
+        """The start gap (m): ``gap``, else 0.1 s of travel at the approach speed, at least 2 cm."""
         return self.gap if self.gap is not None else max(0.02, 0.1 * self.approach_speed)
 
 
@@ -106,6 +107,7 @@ class TrialRecord:
 
     @property
     def simulated_time(self) -> float:
+        """Simulated time (s) from the first sample to the last."""
         return float(self.time[-1] - self.time[0]) if self.time.size else 0.0
 
 
@@ -134,15 +136,23 @@ def impact_limb(sim: SimModel) -> list[str]:
 def approach_joint_velocity(
     sim: SimModel, limb: list[str], normal: np.ndarray, gap: float
 ) -> np.ndarray:
-    """Joint velocity (pinocchio ``nv``) of the ``limb`` that moves the impact point at unit speed along
-    ``-normal`` at the stance, such that the retracted start pose ``q - gap dq`` is within the joints' limits.
+    """Joint velocity of the ``limb`` that moves the impact point at unit speed along ``-normal``.
 
-    The smallest such ``dq``: the Jacobian's pseudo-inverse solution when its start pose is within the
-    limits (MuJoCo's joint ranges), else the least-norm solution with the start pose bounded by them (a QP).
-    A start pose beyond a limit is not a pose the servos can hold: MuJoCo's limit constraint snaps the
-    joint back while the robot settles, and the limb may hit the surface before the approach begins
-    (iCub's right shoulder pitch, at 0.085 rad from its limit in ``icub_two_feet``). When no such ``dq``
-    exists the approach cannot be commanded along a straight joint path from this stance: SimulationError.
+    Joint velocity (pinocchio ``nv``) of the ``limb`` that moves the impact point at unit speed
+    along ``-normal`` at the stance, such that the retracted start pose ``q - gap dq`` is within the
+    joints' limits.
+
+    The smallest such ``dq``: the Jacobian's pseudo-inverse solution when its start pose is within
+    the limits (MuJoCo's joint ranges), else the least-norm solution with the start pose bounded by
+    them (a QP).
+    A start pose beyond a limit is not a pose the servos can hold: MuJoCo's limit constraint
+    snaps the joint back while the robot settles, and the limb may hit the surface before the
+    approach begins (iCub's right shoulder pitch, at 0.085 rad from its limit in
+    ``icub_two_feet``).
+
+    Raises:
+        SimulationError: No such ``dq`` exists: the approach cannot be commanded along a straight
+            joint path from this stance.
     """
     import qpsolvers
 
@@ -160,7 +170,8 @@ def approach_joint_velocity(
     low, high = sim.model.jnt_range[mj_joints].T
     q = sim.stance.q[[model.joints[s.id].idx_q for s in slots]]
     start = q - gap * dq
-    # A start pose within the limits (or a joint already beyond its limit at the stance, kept as it is).
+    # A start pose within the limits (or a joint already beyond its limit at the stance, kept
+    # as it is).
     outside = limited & (((start < low) & (dq > 0)) | ((start > high) & (dq < 0)))
     if outside.any():
         big = 1e6  # rad/m: no bound
@@ -184,8 +195,9 @@ def approach_joint_velocity(
             raise SimulationError(
                 "impact",
                 spec.frame,
-                f"the limb cannot start {gap:.3f} m back from the surface within its joint limits: a straight "
-                f"joint path that moves the impact point along the normal would take {names} beyond its limit",
+                f"the limb cannot start {gap:.3f} m back from the surface within its joint "
+                "limits: a straight joint path that moves the impact point along the normal "
+                f"would take {names} beyond its limit",
             )
         dq = solution
     out = np.zeros(model.nv)
@@ -219,7 +231,7 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
     gravity = m.opt.gravity.copy()
     start = _start(sim, options, spec, n, gap)
     total = start.settle + 1.5 * travel + options.after
-    steps = int(round(total / m.opt.timestep))
+    steps = round(total / m.opt.timestep)
     frames = [c.spec.frame for c in sim.stance.contacts]
     # Log names: the contact's frame, made unique with its index when two contacts share a frame.
     names = [f if frames.count(f) == 1 else f"{f}_{i}" for i, f in enumerate(frames)] + ["impact"]
@@ -259,8 +271,10 @@ def run_trial(sim: SimModel, options: TrialOptions) -> TrialRecord:
 
 @dataclass(frozen=True)
 class _Start:
-    """How a trial starts: settling time (s), the limb's joint velocity per unit approach speed
-    (None with rigid joints: the whole robot flies at the surface) and the start configuration.
+    """How a trial starts: settling time, the limb's joint velocity and the start configuration.
+
+    Settling time in s; the joint velocity is per unit approach speed (None with rigid joints: the
+    whole robot flies at the surface).
     """
 
     settle: float
@@ -271,8 +285,10 @@ class _Start:
 def _start(
     sim: SimModel, options: TrialOptions, spec: ImpactSpec, n: _FloatArray, gap: float
 ) -> _Start:
-    """Set ``sim`` to the trial's start: with ``rigid`` joints the robot ``gap`` back from the
-    surface, flying at it without gravity nor supports; with ``servo`` joints the limb backed off.
+    """Set ``sim`` to the trial's start.
+
+    With ``rigid`` joints the robot ``gap`` back from the surface, flying at it without gravity nor
+    supports; with ``servo`` joints the limb backed off.
     """
     v_n = options.approach_speed
     if sim.joints == "rigid":

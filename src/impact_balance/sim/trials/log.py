@@ -40,9 +40,11 @@ def _rotations(quaternions_wxyz: np.ndarray) -> np.ndarray:
 
 
 def log_frame(sim: SimModel, record: TrialRecord, start: float = LOG_START) -> pd.DataFrame:
-    """One row per step from ``start`` (s) on: time, base pose (quaternion x, y, z, w) and world-axes velocities, every
-    actuated joint's position and velocity (welded ones at the stance, velocity 0), the contact
-    forces on the robot and MuJoCo's CoM and CoM velocity.
+    """The log of an impact trial, one row per step from ``start`` (s) on.
+
+    One row per step from ``start`` (s) on: time, base pose (quaternion x, y, z, w) and world-axes
+    velocities, every actuated joint's position and velocity (welded ones at the stance, velocity
+    0), the contact forces on the robot and MuJoCo's CoM and CoM velocity.
 
     MuJoCo's free joint stores the angular velocity in the base frame: it is rotated to world axes.
     """
@@ -85,8 +87,10 @@ def log_frame(sim: SimModel, record: TrialRecord, start: float = LOG_START) -> p
 
 
 class LogRecorder:
-    """A log built step by step (the balance trials' loop), from pinocchio's ``(q, v)`` and MuJoCo's
-    state; :func:`log_frame` builds the same columns from an impact trial's recorded arrays.
+    """A log built step by step (the balance trials' loop).
+
+    It reads pinocchio's ``(q, v)`` and MuJoCo's state; :func:`log_frame` builds the same columns
+    from an impact trial's recorded arrays.
     """
 
     def __init__(self, sim: SimModel, contact_names: list[str], impact: bool):
@@ -132,10 +136,11 @@ class LogRecorder:
             forces: Each sustained contact's force (k x 3, N, world).
             impact_force: The impact point's force (3, N, world), None without an impact.
         """
-        # The CoM columns are MuJoCo's own (subtree CoM and velocity): a cross-check for the log checker,
-        # which recomputes them with pinocchio from the base and joint columns.
-        # After mj_step, MuJoCo's CoM quantities still describe the state before the step: refresh them
-        # for the current state (position-dependent stages only; the next step recomputes them anyway).
+        # The CoM columns are MuJoCo's own (subtree CoM and velocity): a cross-check for the log
+        # checker, which recomputes them with pinocchio from the base and joint columns.
+        # After mj_step, MuJoCo's CoM quantities still describe the state before the step: refresh
+        # them for the current state (position-dependent stages only; the next step recomputes
+        # them anyway).
         mujoco.mj_kinematics(sim.model, sim.data)
         mujoco.mj_comPos(sim.model, sim.data)
         mujoco.mj_comVel(sim.model, sim.data)
@@ -148,4 +153,5 @@ class LogRecorder:
         self.rows.append(np.concatenate([np.asarray(p, dtype=float).ravel() for p in parts]))
 
     def frame(self) -> pd.DataFrame:
+        """The rows so far as a log frame (:mod:`impact_balance.logs` columns)."""
         return pd.DataFrame(np.array(self.rows), columns=self.columns)

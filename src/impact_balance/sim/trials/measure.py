@@ -80,8 +80,9 @@ class TrialResult:
         saturated_joints: ``servo``: joints whose torque reached its effort limit during the
             impact (empty for ``rigid``).
         sim_time_ratio: Simulated time over wall-clock time.
-        sustained_impulses: Impulse on the robot at each sustained contact over the impact, its force
-            before the impact subtracted, N s, world (by contact name): what the paper neglects.
+        sustained_impulses: Impulse on the robot at each sustained contact over the impact, its
+            force before the impact subtracted, N s, world (by contact name): what the paper
+            neglects.
         armature: Where the joints' rotor inertia came from (``servo``).
         hold: The rigid-impact hold (``--rigid-impact``), or None.
         record: The time series.
@@ -179,8 +180,9 @@ def impact_window(
 
 
 def _stance_with_armature(sim: SimModel) -> Stance:
-    """The stance, on a copy of the robot model carrying the simulated joints' armature
-    (pinocchio's ``crba`` adds ``model.armature`` to the mass matrix), so that ``joint_space``
+    """The stance, on a copy of the robot model carrying the simulated joints' armature.
+
+    pinocchio's ``crba`` adds ``model.armature`` to the mass matrix, so that ``joint_space``
     predicts for the simulated robot. The shared robot model is never modified.
     """
     if sim.joints != "servo" or np.array_equal(
@@ -210,12 +212,14 @@ def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialR
             "the impact point never reached the surface in that time",
         ) from None
     if record.time[before] < record.approach_start:
-        # Not the commanded approach's impact (e.g. a joint snapped back into its range while settling).
+        # Not the commanded approach's impact (e.g. a joint snapped back into its range during
+        # the settling).
         raise SimulationError(
             "impact",
             spec.frame,
             f"the impact point touched the surface at {record.time[before]:.3f} s, before "
-            f"the approach began ({record.approach_start:.3f} s): the limb was not held at its start pose",
+            f"the approach began ({record.approach_start:.3f} s): the limb was not held at its "
+            "start pose",
         )
     dt = sim.model.opt.timestep
     impulse = record.forces["impact"][before:end].sum(axis=0) * dt

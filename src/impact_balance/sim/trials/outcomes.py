@@ -52,9 +52,9 @@ __all__ = [
     "EventKind",
     "FallReason",
     "Outcome",
-    "OutcomeName",
     "OutcomeCriteria",
     "OutcomeMonitor",
+    "OutcomeName",
 ]
 
 #: A trial's outcome.
@@ -79,7 +79,10 @@ EVENT_KINDS: tuple[EventKind, ...] = ("lifted", "slipped", "tilted")
 
 @dataclass(frozen=True)
 class OutcomeCriteria:
-    """Thresholds of :class:`OutcomeMonitor` (SI units, angles in radians); see the module docstring."""
+    """Thresholds of :class:`OutcomeMonitor` (SI units, angles in radians).
+
+    See the module docstring.
+    """
 
     min_force: float = 1.0
     load_force: float = 20.0
@@ -93,13 +96,16 @@ class OutcomeCriteria:
     extra_time: float = 2.5
 
     def to_dict(self) -> dict[str, Any]:
+        """The thresholds by name (JSON-ready)."""
         return asdict(self)
 
 
 @dataclass(frozen=True)
 class ContactEvent:
-    """A sustained contact broke: ``contact`` (its frame), ``kind`` (lifted, slipped, tilted), ``time`` (s)
-    and ``value`` (the slip in m, the tilt in rad, the unloaded time in s).
+    """A sustained contact broke.
+
+    A sustained contact broke: ``contact`` (its frame), ``kind`` (lifted, slipped, tilted), ``time``
+    (s) and ``value`` (the slip in m, the tilt in rad, the unloaded time in s).
     """
 
     contact: str
@@ -108,14 +114,16 @@ class ContactEvent:
     value: float
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
         return {"contact": self.contact, "kind": self.kind, "time": self.time, "value": self.value}
 
 
 @dataclass(frozen=True)
 class Outcome:
-    """A trial's outcome: one of :data:`OUTCOMES`, its ``reason`` (a fall reason, the first contact
-    event, or why it was aborted; None when balanced), when (s), a ``detail`` line, and every
-    contact ``event``.
+    """A trial's outcome: one of :data:`OUTCOMES`, why, when and every contact event.
+
+    ``reason`` is a fall reason, the first contact event, or why it was aborted (None when
+    balanced); ``time`` is when (s); ``detail`` a line.
     """
 
     outcome: OutcomeName
@@ -126,6 +134,7 @@ class Outcome:
 
     @property
     def fell(self) -> bool:
+        """Whether the outcome is ``fell``."""
         return self.outcome == "fell"
 
 
@@ -217,9 +226,11 @@ class OutcomeMonitor:
         dcm_margin: float | None = None,
         impulsive: bool = False,
     ) -> bool:
-        """One sample: contact frame poses, their normal forces (N, None if unknown), the base height (m)
-        and rotation, the DCM's margin in the ZMP support area (m, >= 0 inside; None if unknown);
-        ``impulsive``: a push acts now (unloading does not count). Returns :attr:`fell`.
+        """One sample of the trial.
+
+        One sample: contact frame poses, their normal forces (N, None if unknown), the base height
+        (m) and rotation, the DCM's margin in the ZMP support area (m, >= 0 inside; None if
+        unknown); ``impulsive``: a push acts now (unloading does not count). Returns :attr:`fell`.
         """
         c = self.criteria
         positions = np.asarray(positions, dtype=float).reshape(-1, 3)

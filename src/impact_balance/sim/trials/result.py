@@ -31,7 +31,7 @@ _FloatArray = npt.NDArray[np.float64]
 def finite_or_null(
     nulls: dict[str, str], name: str, value: ArrayLike | None, reason: str
 ) -> float | list[Any] | None:
-    """``value`` as a float (or a list of floats) when finite, else None with ``reason`` recorded in ``nulls``."""
+    """``value`` as a float (or a list of floats) when finite, else None (reason in ``nulls``)."""
     if value is None:
         nulls[name] = reason
         return None
@@ -48,12 +48,13 @@ class ImpactMeasurement:
 
     Attributes:
         contact_time: First contact of the impact point with the surface (s).
-        approach_speed: Normal approach speed of the impact point just before it (m/s): the measured speed.
-        window: (start, end) of the impact (s): from the step before the contact to the separation, or
-            ``max_duration`` later if the point stays.
+        approach_speed: Normal approach speed of the impact point just before it (m/s): the measured
+            speed.
+        window: (start, end) of the impact (s): from the step before the contact to the separation,
+            or ``max_duration`` later if the point stays.
         impulse: Impulse on the robot at the impact point over the window (N s, 3).
-        sustained_impulses: Impulse on the robot at each sustained contact over the window, its force
-            before the contact subtracted (N s, k x 3): what the paper neglects.
+        sustained_impulses: Impulse on the robot at each sustained contact over the window, its
+            force before the contact subtracted (N s, k x 3): what the paper neglects.
         com_velocity_before, com_velocity_after: Planar CoM velocity at the window's ends (m/s).
         hold: The rigid-impact hold (:meth:`RigidImpactHold.to_dict`), or None.
     """
@@ -74,6 +75,7 @@ class ImpactMeasurement:
         return jump
 
     def to_dict(self, contact_names: list[str]) -> dict[str, Any]:
+        """JSON-ready (strict: null for what is not finite, ``nulls`` giving why)."""
         nulls: dict[str, str] = {}
         out = {
             "contact_time": self.contact_time,
@@ -113,19 +115,21 @@ class BalanceTrialResult:
 
     Attributes:
         outcome, reason, outcome_time, detail, events: see :mod:`.outcomes`.
-        disturbance_time, disturbance_end: When the impact began (first contact) or the push began and
-            ended (s).
+        disturbance_time, disturbance_end: When the impact began (first contact) or the push began
+            and ended (s).
         approach_speed: Commanded approach speed (m/s), impacts only.
         impact: What the impact measured (:class:`ImpactMeasurement`), impacts that touched only.
         com_velocity_at_end: Planar CoM velocity when the disturbance ended (m/s): after the impact
             window, or at the end of the push.
-        com_velocity_margin_at_end: Its margin in the CoM velocity area without margin (m/s, >= 0 inside).
+        com_velocity_margin_at_end: Its margin in the CoM velocity area without margin (m/s, >= 0
+            inside).
         min_com_velocity_margin: The worst margin of the CoM velocity after the disturbance (m/s).
-        min_zmp_margin_during: The worst margin of the measured ZMP during the push (m), None if undefined.
-        max_tilt, max_slip, max_trunk_tilt, max_drop: Largest contact tilt (rad) and slip (m), base tilt
-            (rad) and drop (m) seen.
-        angular_momentum_at_end: Angular momentum about the CoM when the disturbance ended (N m s, world):
-            what the LIPM leaves out (a push above the CoM leaves some).
+        min_zmp_margin_during: The worst margin of the measured ZMP during the push (m), None if
+            undefined.
+        max_tilt, max_slip, max_trunk_tilt, max_drop: Largest contact tilt (rad) and slip (m), base
+            tilt (rad) and drop (m) seen.
+        angular_momentum_at_end: Angular momentum about the CoM when the disturbance ended (N m s,
+            world): what the LIPM leaves out (a push above the CoM leaves some).
         sim_time, wall_time: Simulated and wall-clock time (s).
     """
 
@@ -155,18 +159,21 @@ class BalanceTrialResult:
 
     @property
     def fell(self) -> bool:
+        """Whether the outcome is ``fell``."""
         return self.outcome == "fell"
 
     @property
     def aborted(self) -> bool:
+        """Whether the outcome is ``aborted``."""
         return self.outcome == "aborted"
 
     @property
     def approach_speed_measured(self) -> float | None:
+        """The impact point's approach speed just before the contact (m/s), None without one."""
         return None if self.impact is None else self.impact.approach_speed
 
     def summary(self) -> dict[str, Any]:
-        """JSON-ready summary (no series, no log): finite numbers or null, with ``nulls`` giving the reasons."""
+        """JSON-ready summary (no series, no log): finite numbers or null, ``nulls`` giving why."""
         nulls: dict[str, str] = {}
         out = {
             "outcome": self.outcome,
@@ -232,8 +239,9 @@ class BalanceTrialResult:
 def trajectory(
     result: BalanceTrialResult, start: float, stop: float, every: int = 2
 ) -> dict[str, Any]:
-    """The trial's CoM velocity, ZMP and DCM between ``start`` and ``stop`` (s), every ``every``-th control
-    step, as plain lists (a ZMP that is undefined is null): what the figures draw.
+    """The trial's CoM velocity, ZMP and DCM between ``start`` and ``stop`` (s), as plain lists.
+
+    Every ``every``-th control step; a ZMP that is undefined is null. What the figures draw.
     """
     s = result.series
     if not len(s.get("time", ())):
@@ -254,8 +262,10 @@ def trajectory(
 
 @dataclass
 class TrialEntry:
-    """A finished trial as the commands keep it (and as the journal stores it): its JSON ``summary``
-    (:meth:`BalanceTrialResult.summary`) and a short ``trajectory`` (:func:`trajectory`) for the figures.
+    """A finished trial as the commands (and the journal) keep it.
+
+    Its JSON ``summary`` (:meth:`BalanceTrialResult.summary`) and a short ``trajectory``
+    (:func:`trajectory`) for the figures.
     """
 
     summary: dict[str, Any]
@@ -269,6 +279,7 @@ class TrialEntry:
 
     @property
     def fell(self) -> bool:
+        """Whether the outcome is ``fell``."""
         return self.outcome == "fell"
 
     @property

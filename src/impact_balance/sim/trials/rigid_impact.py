@@ -60,10 +60,12 @@ class RigidImpactHold:
 
     @property
     def active(self) -> bool:
+        """Whether the joints are held now."""
         return self.start is not None and self.end is None
 
     @property
     def duration(self) -> float | None:
+        """How long the hold lasted (s), None until it ended."""
         return None if self.start is None or self.end is None else self.end - self.start
 
     def begin(self, t: float) -> None:
@@ -77,8 +79,10 @@ class RigidImpactHold:
         self.start = float(t)
 
     def update(self, t: float, approach_speed: float) -> None:
-        """After a step: end the hold once the impact point no longer approaches the surface
-        (``approach_speed`` = ``-n . v`` <= 0, m/s) or after ``max_duration``.
+        """After a step: end the hold once the point no longer approaches, or after the longest.
+
+        The point approaches while ``approach_speed`` = ``-n . v`` > 0 (m/s); the hold lasts at most
+        ``max_duration``.
         """
         if not self.active:
             return
@@ -97,6 +101,7 @@ class RigidImpactHold:
             self.end = float(t)
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
         return {
             "start": self.start,
             "end": self.end,

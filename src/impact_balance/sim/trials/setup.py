@@ -59,6 +59,7 @@ class Push:
 
     @property
     def force(self) -> np.ndarray:
+        """The force (N, world): ``magnitude / duration`` along ``direction``, horizontal."""
         f = self.magnitude / self.duration
         return np.array([f * np.cos(self.direction), f * np.sin(self.direction), 0.0])
 
@@ -93,16 +94,17 @@ class BalanceTrialOptions:
     """Options of a trial.
 
     Attributes:
-        after: Simulated time after the disturbance (contact or end of push) (s); a robot still moving then
-            gets ``criteria.extra_time`` more (see :mod:`.outcomes`).
+        after: Simulated time after the disturbance (contact or end of push) (s); a robot still
+            moving then gets ``criteria.extra_time`` more (see :mod:`.outcomes`).
         settle: Time standing still before the disturbance (s).
-        max_approach_time: Longest time after the reference reached the surface before the trial gives
-            up waiting for the contact (s).
+        max_approach_time: Longest time after the reference reached the surface before the trial
+            gives up waiting for the contact (s).
         gains: Gains of the ``ik`` controller.
         criteria: Outcome thresholds (:mod:`.outcomes`).
         record: Keep a log (:mod:`impact_balance.logs` columns) in the result.
-        controller: ``ik`` (pink IK, position servos) or ``id`` (inverse-dynamics QP, torque motors); it
-            decides the actuators, so it is read when the :class:`BalanceSetup` is created.
+        controller: ``ik`` (pink IK, position servos) or ``id`` (inverse-dynamics QP, torque
+            motors); it decides the actuators, so it is read when the :class:`BalanceSetup` is
+            created.
         id_gains: Gains of the ``id`` controller.
         rigid_impact: Hold every joint's velocity through the impact (:mod:`.rigid_impact`).
     """
@@ -119,14 +121,20 @@ class BalanceTrialOptions:
 
 
 def controller_margin(options: BalanceTrialOptions) -> float:
-    """The ZMP margin the trials' controller keeps inside the ZMP support area (m): the scores' default."""
+    """The ZMP margin (m) the trials' controller keeps inside the ZMP support area.
+
+    The ZMP margin the trials' controller keeps inside the ZMP support area (m): the scores'
+    default.
+    """
     return controller_class(options.controller).zmp_margin(options)
 
 
 @dataclass
 class BalanceSetup:
-    """A scenario prepared for trials: analysis (without ZMP margin: the controller is configured on its
-    own), MuJoCo model, start configurations (one per standoff of the impacting point).
+    """A scenario prepared for trials: analysis, MuJoCo model, start configurations.
+
+    The analysis is without ZMP margin (the controller is configured on its own); one start
+    configuration per standoff of the impacting point.
     """
 
     scenario: Scenario
@@ -146,9 +154,10 @@ class BalanceSetup:
         sim_options: SimOptions | None = None,
         meshes: bool = False,
     ) -> BalanceSetup:
-        """Analyse ``scenario`` and build its MuJoCo model for trials with ``joints`` and ``options``
-        (``sim_options``: the model's own, default 1 ms steps; ``meshes``: load the robot's meshes,
-        visual only, for a video).
+        """Analyse ``scenario`` and build its MuJoCo model for trials.
+
+        ``joints`` and ``options`` are the trials'; ``sim_options`` the model's own (default 1 ms
+        steps); ``meshes``: load the robot's meshes, visual only, for a video.
         """
         options = options or BalanceTrialOptions()
         if not isinstance(scenario, Scenario):
@@ -167,11 +176,12 @@ class BalanceSetup:
             # 1 ms steps: the stiffest contact (impact, time constant 4 ms) still spans 4 steps.
             servo = ServoOptions() if joints == "servo" else STIFF_SERVOS
             sim_options = SimOptions(timestep=0.001, meshes=meshes, servo=servo)
-        # Welded joints admit no controller: "rigid" balance trials use stiff servos without effort limits.
+        # Welded joints admit no controller: "rigid" balance trials use stiff servos without
+        # effort limits.
         sim = build_model(scenario, "servo", sim_options)
-        # MuJoCo's soft friction lets a loaded contact creep (a sole on the 30 degree ramp slides about
-        # 3 mm/s within its friction cone); the no-slip pass removes that drift, which would otherwise
-        # count as a slip after a few seconds.
+        # MuJoCo's soft friction lets a loaded contact creep (a sole on the 30 degree ramp slides
+        # about 3 mm/s within its friction cone); the no-slip pass removes that drift, which would
+        # otherwise count as a slip after a few seconds.
         sim.model.opt.noslip_iterations = NOSLIP_ITERATIONS
         controller.prepare_model(sim, analysis)
         support = [analysis.stance.robot.joint_slot(n) for n in support_joints(sim, analysis)]
@@ -179,7 +189,10 @@ class BalanceSetup:
         return cls(scenario, joint_model, analysis, sim, support_v, options.controller)
 
     def start_configuration(self, standoff: float = 0.0) -> np.ndarray:
-        """The stance with the impact point backed off ``standoff`` (m) along the normal (whole-body IK, cached)."""
+        """The stance with the impact point backed off ``standoff`` (m) along the normal (cached).
+
+        Whole-body IK, cached by standoff.
+        """
         key = round(float(standoff), 6)
         if key not in self._starts:
             self._starts[key] = retracted_stance(self.analysis, key)

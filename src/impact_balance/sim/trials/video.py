@@ -147,7 +147,7 @@ def _caption(
     if marks:
         _markers(draw, *marks, size=size)
     pad, step = size // 2, int(1.35 * size)
-    for rows, bottom in (([title] + lines, False), ([LEGEND], True)):
+    for rows, bottom in (([title, *lines], False), ([LEGEND], True)):
         width = max(draw.textlength(r, font=font) for r in rows)
         top = height - pad - step * len(rows) - pad if bottom else pad
         draw.rectangle(
