@@ -138,22 +138,22 @@ class Scratch:
         self.holder: bytes | None = None
 
 
-class ThreadData(threading.local):
+class ThreadData(threading.local, Scratch):
     """One pinocchio ``Data`` per robot and per thread, reused by every :class:`Stance`.
 
-    ``model.createData()`` allocates a large Data and costs far more than the kinematics
-    themselves, so stances compute in this scratch Data and copy out what they keep.
-    Thread-local so that concurrent analyses never overwrite each other's kinematics.
+    A :class:`Scratch` of its own in every thread: ``model.createData()`` allocates a large
+    Data and costs far more than the kinematics themselves, so stances compute in this scratch
+    Data and copy out what they keep. Thread-local so that concurrent analyses never overwrite
+    each other's kinematics.
 
     Attributes:
-        data: The scratch Data.
+        data: The scratch Data (this thread's).
         holder: Key of the configuration whose joint placements (``oMi``) and joint
             Jacobians (``J``) ``data`` holds, or None when unknown.
     """
 
     def __init__(self, model: pin.Model):
-        self.data = model.createData()
-        self.holder: bytes | None = None
+        Scratch.__init__(self, model)
 
 
 @dataclass
