@@ -21,7 +21,7 @@ import os
 import sys
 import time
 
-from impact_balance.sim.control.torque import InverseDynamicsGains
+from impact_balance.sim.control.gains import InverseDynamicsGains
 from impact_balance.sim.studies.push import push_test
 from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions
 

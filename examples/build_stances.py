@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from impact_balance.robot.ik import solve_stance, stance_residuals
+from impact_balance.robot.ik import IKOptions, solve_stance, stance_residuals
 from impact_balance.robot.robot import Robot, load_robot
 from impact_balance.scenario import scenario_from_dict
 
@@ -279,9 +279,7 @@ def build(problem: StanceProblem) -> str:
         problem.com_target_xy,
         locked_joints=LOCKED[problem.robot],
         posture_target=q0,
-        max_iterations=2000,
-        tolerance=1e-7,
-        **problem.options,
+        options=IKOptions(max_iterations=2000, tolerance=1e-7, **problem.options),
     )
     text, data = _snippet(problem, robot, q)
     # Check the rounded values, loaded the way a scenario file is.

@@ -17,7 +17,8 @@ from impact_balance.analysis.analyze import analyze
 from impact_balance.cli import main
 from impact_balance.contacts.cwc import cwc_faces_world
 from impact_balance.scenario import load_scenario
-from impact_balance.sim.control.torque import InverseDynamicsController, InverseDynamicsGains
+from impact_balance.sim.control.gains import InverseDynamicsGains
+from impact_balance.sim.control.torque import InverseDynamicsController
 from impact_balance.sim.trials.balance_trial import (
     BalanceSetup,
     BalanceTrialOptions,

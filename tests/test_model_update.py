@@ -118,7 +118,7 @@ def test_stance_data_is_a_data_of_its_own(robot):
     q1, q2 = configurations(robot)
     a = Stance(robot, q1, FEET)
     data = a.data
-    assert data is not robot.workspace().data
+    assert data is not robot.thread_data().data
     Stance(robot, q2, FEET)
     np.testing.assert_allclose(
         np.array([data.oMi[j].homogeneous for j in range(robot.model.njoints)]),
@@ -174,7 +174,7 @@ def test_robot_copies_rebuild_their_caches(robot):
     Stance(robot, q, FEET)  # populates the caches and the scratch Data
     expected = reference(robot, q, "gripper_right_base_link", PALM)
     for other in (pickle.loads(pickle.dumps(robot)), copy.deepcopy(robot)):
-        assert other.workspace() is not robot.workspace()
+        assert other.thread_data() is not robot.thread_data()
         assert_matches(held(Stance(other, q, FEET), "gripper_right_base_link", PALM), expected)
 
 

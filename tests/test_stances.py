@@ -11,7 +11,7 @@ import pytest
 import impact_balance as ib
 from impact_balance.exceptions import ImpactBalanceError
 from impact_balance.geometry.polygon import Polygon
-from impact_balance.robot.ik import IKError, solve_stance, stance_residuals
+from impact_balance.robot.ik import IKError, IKOptions, solve_stance, stance_residuals
 from impact_balance.robot.robot import load_robot
 from impact_balance.scenario import load_scenario
 
@@ -140,7 +140,9 @@ def test_solve_stance_moves_the_com() -> None:
     com0 = pin.centerOfMass(robot.model, data, q0)
     target = com0[:2] + np.array([0.02, 0.0])
     feet = ["left_sole_link", "right_sole_link"]
-    q = solve_stance(robot, q0, com_target_xy=target, fixed_frames=feet, tolerance=1e-6)
+    q = solve_stance(
+        robot, q0, com_target_xy=target, fixed_frames=feet, options=IKOptions(tolerance=1e-6)
+    )
     com = pin.centerOfMass(robot.model, data, q)
     np.testing.assert_allclose(com[:2], target, atol=1e-6)
     pin.framesForwardKinematics(robot.model, data, q0)
@@ -160,7 +162,7 @@ def test_solve_stance_reports_unreachable_targets() -> None:
             q0,
             {"gripper_right_base_link": far},
             fixed_frames=["left_sole_link", "right_sole_link"],
-            max_iterations=30,
+            options=IKOptions(max_iterations=30),
         )
     err = info.value
     assert isinstance(err, ImpactBalanceError)

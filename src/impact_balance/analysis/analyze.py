@@ -61,7 +61,7 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
         robot = scenario.load_robot()  # cached after the first use of a robot
     except ScenarioError as exc:
         raise with_source(exc, scenario.source) from None
-    robot.workspace()  # its scratch pinocchio Data (~2-7 ms, first use per thread): loading too
+    robot.thread_data()  # its scratch pinocchio Data (~2-7 ms, first use per thread): loading too
     timings["robot_loading"] = time.perf_counter() - t
     kernel = warm_up()  # the compiled projection kernel's one-time load, timed apart
     if kernel:

@@ -32,7 +32,7 @@ import yaml
 
 from impact_balance.exceptions import ScenarioError
 from impact_balance.geometry.spatial import aligning_rotation, unit
-from impact_balance.robot.ik import chain_dofs, solve_stance, stance_residuals
+from impact_balance.robot.ik import IKOptions, chain_dofs, solve_stance, stance_residuals
 from impact_balance.scenario import Scenario
 
 __all__ = ["DIGITS", "Placement", "PoseResult", "pose_scenario", "posed_mapping", "scenario_yaml"]
@@ -147,8 +147,7 @@ def pose_scenario(
         com_xy,
         position_only=free,
         posture_target=stance.q,
-        tolerance=tolerance,
-        max_iterations=max_iterations,
+        options=IKOptions(tolerance=tolerance, max_iterations=max_iterations),
     )
     residuals = stance_residuals(robot, q, all_targets, com_xy, free)
     com = pin.centerOfMass(robot.model, robot.model.createData(), q)

@@ -113,7 +113,7 @@ class Stance:
     """Robot configuration + contacts, with everything the criteria need from the model.
 
     The kinematics are computed in the robot's per-thread scratch Data (see
-    :class:`impact_balance.robot.robot.Workspace`), or in ``workspace`` when given (a
+    :class:`impact_balance.robot.robot.ThreadData`), or in ``workspace`` when given (a
     :class:`impact_balance.robot.robot.Scratch` of the caller's, e.g. a governor's own Data), and
     every attribute is a copy, so stances of the same robot never alias. :meth:`point`
     recomputes the joint placements and Jacobians (~4 us) when another stance has used the
@@ -207,9 +207,9 @@ class Stance:
 
     def workspace(self) -> Scratch:
         """The scratch Data this stance computes in: the one it was given, else the robot's
-        (per thread, :meth:`impact_balance.robot.robot.Robot.workspace`).
+        (per thread, :meth:`impact_balance.robot.robot.Robot.thread_data`).
         """
-        return self._scratch if self._scratch is not None else self.robot.workspace()
+        return self._scratch if self._scratch is not None else self.robot.thread_data()
 
     def _kinematics(self) -> pin.Data:
         """The scratch Data holding this stance's joint placements and joint Jacobians."""

@@ -19,7 +19,7 @@ from impact_balance.contacts.stance import Stance
 from impact_balance.exceptions import ScenarioError
 from impact_balance.gui.limbs import joint_values
 from impact_balance.gui.state import FieldPath, GuiState
-from impact_balance.robot.ik import IKError, solve_stance
+from impact_balance.robot.ik import IKError, IKOptions, solve_stance
 
 __all__ = ["FIXED_TOLERANCE", "DragResult", "DragTarget", "drag_changes", "handle_pose"]
 
@@ -156,8 +156,7 @@ def _solve(
             stance.q,
             {frame: target},
             fixed_frames=fixed_frames,
-            max_iterations=DRAG_ITERATIONS,
-            tolerance=DRAG_TOLERANCE,
+            options=IKOptions(max_iterations=DRAG_ITERATIONS, tolerance=DRAG_TOLERANCE),
         )
     except IKError as exc:
         drift = max(

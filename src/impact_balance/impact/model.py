@@ -242,7 +242,7 @@ def joint_space_inertia_map(
 ) -> np.ndarray:
     """W = J M(q)^-1 J^T (1/kg) of the translational Jacobian ``jacobian`` (3 x nv), with M
     computed in ``workspace``'s Data (a :class:`~impact_balance.robot.robot.Scratch` or
-    :class:`~impact_balance.robot.robot.Workspace`; its held kinematics are marked stale).
+    :class:`~impact_balance.robot.robot.ThreadData`; its held kinematics are marked stale).
     """
     M = pin.crba(model, workspace.data, q)  # scratch Data: createData costs up to ~2 ms
     M = np.triu(M) + np.triu(M, 1).T

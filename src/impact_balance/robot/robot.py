@@ -12,12 +12,13 @@ import os
 import sys
 import tempfile
 import threading
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field, fields
 from pathlib import Path
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 
 from impact_balance.exceptions import (
@@ -35,10 +36,12 @@ __all__ = [
     "Robot",
     "RobotSpec",
     "Scratch",
-    "Workspace",
+    "ThreadData",
     "example_robot_data_root",
     "load_robot",
 ]
+
+_FloatArray = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -120,9 +123,9 @@ class JointSlot(NamedTuple):
 class Scratch:
     """One pinocchio ``Data`` for one owner, and the key of the configuration it holds.
 
-    What :class:`Workspace` is per thread, for an owner that serialises its own calls (a
-    :class:`~impact_balance.governor.Governor` and its lock): :class:`~impact_balance.contacts.stance.Stance`
-    computes in it when given one.
+    What :class:`ThreadData` is per thread, for an owner that serialises its own calls (a
+    :class:`~impact_balance.governor.Governor` and its lock):
+    :class:`~impact_balance.contacts.stance.Stance` computes in it when given one.
 
     Attributes:
         data: The Data.
@@ -135,22 +138,22 @@ class Scratch:
         self.holder: bytes | None = None
 
 
-class Workspace(threading.local):
+class ThreadData(threading.local, Scratch):
     """One pinocchio ``Data`` per robot and per thread, reused by every :class:`Stance`.
 
-    ``model.createData()`` allocates ~1.6 MB (0.2-1.9 ms) while the kinematics themselves
-    take ~15 us, so stances compute in this scratch Data and copy out what they keep.
-    Thread-local so that concurrent analyses never overwrite each other's kinematics.
+    A :class:`Scratch` of its own in every thread: ``model.createData()`` allocates a large
+    Data and costs far more than the kinematics themselves, so stances compute in this scratch
+    Data and copy out what they keep. Thread-local so that concurrent analyses never overwrite
+    each other's kinematics.
 
     Attributes:
-        data: The scratch Data.
+        data: The scratch Data (this thread's).
         holder: Key of the configuration whose joint placements (``oMi``) and joint
             Jacobians (``J``) ``data`` holds, or None when unknown.
     """
 
     def __init__(self, model: pin.Model):
-        self.data = model.createData()
-        self.holder: bytes | None = None
+        Scratch.__init__(self, model)
 
 
 @dataclass
@@ -181,7 +184,7 @@ class Robot:
     package_dirs: list[str] = field(default_factory=list)
     armature_source: str | None = None
 
-    def __getstate__(self) -> dict:
+    def __getstate__(self) -> dict[str, Any]:
         # The caches (thread-local Data, look-up tables) are rebuilt on demand, never copied.
         return {f.name: self.__dict__[f.name] for f in fields(self)}
 
@@ -244,7 +247,10 @@ class Robot:
         return self.joint_slot(name, field).id
 
     def joint_slot(self, name: str, field: str = "joint") -> JointSlot:
-        """Configuration slot and position limits of a non-root joint; :class:`UnknownJointError` if absent."""
+        """Configuration slot and position limits of a non-root joint.
+
+        Raises :class:`UnknownJointError` when the model has no such joint.
+        """
         slot = self._joint_slots.get(name) if isinstance(name, str) else None
         if slot is None:
             raise UnknownJointError(field, name, self.joint_names, listing=self.listing_command)
@@ -299,11 +305,14 @@ class Robot:
         return result
 
     @functools.cached_property
-    def _assignments(self) -> dict[tuple, tuple[np.ndarray, np.ndarray]]:
+    def _assignments(self) -> dict[tuple[Any, ...], tuple[np.ndarray, np.ndarray]]:
         return {}
 
     def joint_values(self, q: np.ndarray) -> dict[str, float]:
-        """Values of the 1-dof joints at configuration ``q``, rad or m (continuous joints by their angle)."""
+        """Values of the 1-dof joints at configuration ``q`` (rad or m).
+
+        Continuous joints are given by their angle.
+        """
         model = self.model
         out = {}
         for jid in range(2, model.njoints):
@@ -319,7 +328,8 @@ class Robot:
         key = self.standing if name is None else name
         if key not in self.reference_configurations:
             raise UnknownConfigurationError(field, key, self.reference_configurations)
-        return self.reference_configurations[key].copy()
+        answer: _FloatArray = self.reference_configurations[key].copy()
+        return answer
 
     def actuated_effort_limits(self) -> tuple[np.ndarray, np.ndarray]:
         """Velocity indices of the torque-limited actuated joints and their effort limits (N m).
@@ -336,7 +346,7 @@ class Robot:
 
     @functools.cached_property
     def effort_limits(self) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`actuated_effort_limits`, computed once (read-only arrays: do not copy per call)."""
+        """:meth:`actuated_effort_limits`, computed once (read-only arrays: never copied)."""
         return self._limited(self.model.effortLimit)
 
     @functools.cached_property
@@ -359,12 +369,12 @@ class Robot:
         return idx, val
 
     @functools.cached_property
-    def _workspace(self) -> Workspace:
-        return Workspace(self.model)
+    def _thread_data(self) -> ThreadData:
+        return ThreadData(self.model)
 
-    def workspace(self) -> Workspace:
-        """This thread's scratch pinocchio Data for the model (see :class:`Workspace`)."""
-        return self._workspace
+    def thread_data(self) -> ThreadData:
+        """This thread's scratch pinocchio Data for the model (see :class:`ThreadData`)."""
+        return self._thread_data
 
 
 def _is_file(path: Path) -> bool:
@@ -378,9 +388,11 @@ _FD_LOCK = threading.Lock()
 
 
 @contextlib.contextmanager
-def _native_stderr(lines: list[str]):
-    """Collect what C++ code writes to file descriptor 2 (urdfdom's "Error: ..." lines) into
-    ``lines`` instead of the terminal: a failure is reported once, as one line naming the file.
+def _native_stderr(lines: list[str]) -> Iterator[None]:
+    """Collect what C++ code writes to file descriptor 2 into ``lines``.
+
+    urdfdom writes its "Error: ..." lines there; they are kept out of the terminal so that a failure
+    is reported once, as one line naming the file.
 
     Redirecting a descriptor is process-wide, so loads are serialised; another thread's
     writes to stderr during a load (a few ms) are collected too, and dropped.
@@ -441,9 +453,11 @@ def _load(urdf: Path, srdf: Path | None, name: str, standing: str | None) -> Rob
 
 
 def _load_rotor_parameters(model: pin.Model, srdf: Path, native: list[str]) -> str | None:
-    """Read the SRDF's ``rotor_params`` into the model (rotor inertia and gear ratio per joint) and set
-    ``model.armature`` = gear ratio^2 x rotor inertia, the rotor inertia reflected at the joint. Returns
-    where it came from, or None when the SRDF declares none.
+    """Read the SRDF's ``rotor_params`` into ``model.armature``.
+
+    Each joint's rotor inertia and gear ratio give ``model.armature`` = gear ratio^2 x rotor
+    inertia, the rotor inertia reflected at the joint. Returns where it came from, or None when the
+    SRDF declares none.
     """
     try:
         declared = "rotor_params" in srdf.read_text(errors="replace")
@@ -512,7 +526,7 @@ def load_robot(
 
 
 #: Robots loaded from files, by :func:`_file_key` of their URDF and SRDF.
-_FILE_ROBOTS: dict[tuple, Robot] = {}
+_FILE_ROBOTS: dict[tuple[Any, ...], Robot] = {}
 
 
 def _file_key(path: Path) -> tuple[str, int, int]:

@@ -30,7 +30,7 @@ from impact_balance.contacts.wrench_polytope import wrench_polytope
 from impact_balance.criteria.com import max_contact_velocity, zmp_max_contact_velocity
 from impact_balance.exceptions import ImpactBalanceError, ScenarioError
 from impact_balance.impact.model import impact_model
-from impact_balance.robot.ik import IKError, solve_stance
+from impact_balance.robot.ik import IKError, IKOptions, solve_stance
 from impact_balance.robot.robot import Robot
 from impact_balance.scenario import Scenario, scenario_from_dict
 from impact_balance.sweep.columns import RESULT_COLUMNS, STATUSES, Status, Verdict
@@ -309,8 +309,7 @@ class Evaluator:
             q0,
             targets,
             posture_target=stance.q,
-            tolerance=posture.tolerance,
-            max_iterations=posture.max_iterations,
+            options=IKOptions(tolerance=posture.tolerance, max_iterations=posture.max_iterations),
         )
         warm[base_key] = q
         placed = Stance(self.robot, q, [c.spec for c in stance.contacts])

@@ -22,16 +22,18 @@ __all__ = [
     "use_torque_motors",
 ]
 
-#: Support-limb servo stiffness floor, in units of the robot's gravity stiffness m g h (see stiffen_support_limbs).
+#: Support-limb servo stiffness floor, in units of the robot's gravity stiffness m g h (see
+#: stiffen_support_limbs).
 SUPPORT_STIFFNESS_FACTOR = 0.4
 
-#: Servos of the ``rigid`` joint model in balance trials: 30 Hz bandwidth, no effort limits. A welded
-#: robot cannot be controlled; this is the closest a controlled robot gets to the paper's rigid body.
+#: Servos of the ``rigid`` joint model in balance trials: 30 Hz bandwidth, no effort limits. A
+#: welded robot cannot be controlled; this is the closest a controlled robot gets to the paper's
+#: rigid body.
 STIFF_SERVOS = ServoOptions(bandwidth=2.0 * np.pi * 30.0, effort_limits=False)
 
 
 def support_joints(sim: SimModel, analysis: Analysis) -> list[str]:
-    """Simulated joints on the chain from the root to any sustained contact's frame (the support limbs)."""
+    """Simulated joints on the chain from the root to a sustained contact (the support limbs)."""
     model = analysis.stance.model
     names: set[str] = set()
     for contact in analysis.stance.contacts:
@@ -52,10 +54,14 @@ def stiffen_support_limbs(
     is 88 N m/rad (ankle roll) to 230 N m/rad (ankle pitch) at 15 Hz, against a gravity stiffness
     ``m g h`` of about 820 N m/rad for Talos standing on that ankle. Every joint of a support limb
     gets at least ``kp = factor m g h`` and ``kd = 2 sqrt(kp m h^2)`` (critical damping of the whole
-    robot swinging about that joint at the CoM height ``h``); effort limits are kept. The factor,
-    0.4, was chosen by measurement: at 1 the stiff legs made the robot rock and lift a foot after
-    pushes (half the 15-20 N s pushes survived); at 0.25-0.4 the most survived; the DCM/ZMP feedback
-    holds the rest of the pendulum (Talos stands on one foot at 0.4).
+    robot swinging about that joint at the CoM height ``h``); effort limits are kept. The
+    DCM/ZMP feedback holds the rest of the pendulum. The default factor,
+    :data:`SUPPORT_STIFFNESS_FACTOR`, comes from push trials (``docs/studies/design-history.md``).
+
+    Args:
+        sim: The trials' MuJoCo model (servos).
+        analysis: The scenario's analysis (stance, gravity).
+        factor: Stiffness floor in units of the gravity stiffness ``m g h``.
     """
     m = analysis.stance.mass
     h = float(analysis.stance.com[2] - analysis.stance.lowest_contact_height())

@@ -20,11 +20,20 @@ The standoff follows from the speed: ``max(min_standoff, v^2 / (2 a) + cruise)``
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 
-__all__ = ["APPROACH_ACCELERATION", "CRUISE_DISTANCE", "MIN_STANDOFF", "ImpactTask"]
+__all__ = [
+    "APPROACH_ACCELERATION",
+    "CRUISE_DISTANCE",
+    "MIN_STANDOFF",
+    "ImpactReference",
+    "ImpactTask",
+    "approach_profile",
+]
 
 #: Bounded acceleration of the approach and of the withdrawal, m/s^2.
 APPROACH_ACCELERATION = 20.0
@@ -34,9 +43,62 @@ CRUISE_DISTANCE = 0.03
 MIN_STANDOFF = 0.05
 
 
+_FloatArray = npt.NDArray[np.float64]
+
+
+class ImpactReference(Protocol):
+    """What the balance controllers and trials need of an impacting point's reference.
+
+    :class:`ImpactTask` is one; :class:`~impact_balance.sim.studies.wall.GovernedApproach`
+    another. A reference may also bound the point's approach speed with a method
+    ``speed_bound() -> float`` (m/s; ``inf``: unbounded), which the torque controller enforces.
+
+    Attributes:
+        frame: Robot frame of the impacting end-effector.
+        offset: Pose of the impact point in ``frame``.
+        normal: Unit surface normal, from the surface into the robot (world).
+        start_time: When the approach starts (s).
+        contact_time: When the contact was felt (s), None before.
+    """
+
+    frame: str
+    offset: pin.SE3
+    normal: _FloatArray
+    start_time: float
+    contact_time: float | None
+
+    def reference(
+        self, t: float, normal_force: float = 0.0
+    ) -> tuple[_FloatArray, _FloatArray, _FloatArray]:
+        """World position (m), velocity (m/s) and acceleration (m/s^2) of the reference at ``t``.
+
+        Args:
+            t: Time (s).
+            normal_force: Measured normal force at the impact point (N).
+
+        Returns:
+            The position, velocity and acceleration (3 each).
+        """
+        ...
+
+    def target(self, t: float, normal_force: float = 0.0) -> _FloatArray:
+        """The reference position alone (m, world) at ``t``.
+
+        Args:
+            t: Time (s).
+            normal_force: Measured normal force at the impact point (N).
+
+        Returns:
+            The position (3,).
+        """
+        ...
+
+
 @dataclass
 class ImpactTask:
-    """Drive an end-effector point into a surface at a commanded speed, then pull back (module docstring).
+    """Drive an end-effector point into a surface at a commanded speed, then pull back.
+
+    See the module docstring.
 
     Attributes:
         frame: Robot frame of the impacting end-effector.
@@ -78,6 +140,7 @@ class ImpactTask:
 
     @property
     def start_point(self) -> np.ndarray:
+        """The point's start (m, world): ``standoff`` from the surface along the normal."""
         return self.surface_point + self.standoff * self.normal
 
     @property
@@ -90,18 +153,21 @@ class ImpactTask:
     def reference(
         self, t: float, normal_force: float = 0.0
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """World position (m), velocity (m/s) and acceleration (m/s^2) of the impact point's reference at
-        ``t`` given the measured normal force (N); the first force above the threshold starts the withdrawal.
+        """World position, velocity and acceleration of the impact point's reference at ``t``.
+
+        World position (m), velocity (m/s) and acceleration (m/s^2) of the impact point's reference
+        at ``t`` given the measured normal force (N); the first force above the threshold starts the
+        withdrawal.
         """
         n = self.normal
         if self.contact_time is None and normal_force > self.force_threshold:
             self.contact_time = float(t)
         if self.contact_time is not None:
-            s, ds, dds = _profile(
+            s, ds, dds = approach_profile(
                 t - self.contact_time, self.withdraw_speed, self.acceleration, self.retract
             )
             return self.surface_point + s * n, ds * n, dds * n
-        s, ds, dds = _profile(t - self.start_time, self.speed, self.acceleration, np.inf)
+        s, ds, dds = approach_profile(t - self.start_time, self.speed, self.acceleration, np.inf)
         return self.start_point - s * n, -ds * n, -dds * n
 
     def target(self, t: float, normal_force: float = 0.0) -> np.ndarray:
@@ -115,15 +181,17 @@ def standoff(
     cruise: float = CRUISE_DISTANCE,
     minimum: float = MIN_STANDOFF,
 ) -> float:
-    """Start distance from the surface (m) that leaves ``cruise`` at full ``speed`` after the ramp."""
+    """Start distance from the surface (m) leaving ``cruise`` at full ``speed`` after the ramp."""
     return max(minimum, speed * speed / (2.0 * acceleration) + cruise)
 
 
-def _profile(
+def approach_profile(
     tau: float, speed: float, acceleration: float, stop: float
 ) -> tuple[float, float, float]:
-    """Distance, speed and acceleration after ``tau`` s of a bounded-acceleration start to ``speed``, held
-    at ``stop`` (m) once reached (a trapezoid without its braking: the point stops where it arrives).
+    """Distance, speed and acceleration after ``tau`` s of a bounded-acceleration start.
+
+    The start ramps up to ``speed`` and holds at ``stop`` (m) once reached (a trapezoid without its
+    braking: the point stops where it arrives).
     """
     if tau <= 0.0:
         return 0.0, 0.0, 0.0

@@ -30,55 +30,28 @@ the impact force passed to :meth:`BalanceController.step`.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 import pink
 import pinocchio as pin
 from pink.tasks import ComTask, FrameTask, PostureTask
 
 from impact_balance.analysis.analyze import Analysis
-from impact_balance.robot.ik import solve_stance
-from impact_balance.sim.control.approach import ImpactTask
+from impact_balance.balance.lipm import lipm_omega
+from impact_balance.robot.ik import IKOptions, solve_stance
+from impact_balance.sim.control.actuation import stiffen_support_limbs
+from impact_balance.sim.control.approach import ImpactReference
+from impact_balance.sim.control.controller import Controller
+from impact_balance.sim.control.gains import BalanceGains, TrialGains
 from impact_balance.sim.control.zmp import DcmFeedback, clamp_to_polygon
+from impact_balance.sim.model.build import SimModel
 
-__all__ = ["BalanceController", "BalanceGains", "ControlOutput", "ImpactTask", "retracted_stance"]
+__all__ = ["BalanceController", "ControlOutput", "retracted_stance"]
 
-
-@dataclass(frozen=True)
-class BalanceGains:
-    """Gains and rates of :class:`BalanceController` (units in brackets).
-
-    Attributes:
-        rate: Control rate [Hz].
-        dcm_gain: DCM error decay rate k [1/s] (p = xi + k/omega (xi - xi_ref)).
-        zmp_margin: Desired ZMP kept this far inside the ZMP support area [m].
-        zmp_admittance: K_zmp, CoM command velocity per metre of ZMP error [1/s].
-        zmp_filter: Time constant of the first-order filter on the measured ZMP [s].
-        max_com_speed: Bound on the CoM command's speed [m/s].
-        com_cost: Weight of the CoM task [1/m].
-        contact_cost: Weight of each contact frame task (position [1/m] and orientation [1/rad]).
-        impact_cost: Weight of the impact point task [1/m] (its orientation: a tenth).
-        posture_cost: Weight of the posture task [1/rad].
-        damping: Levenberg-Marquardt regularisation of the IK step's QP.
-        solver: QP solver of pink (qpsolvers name).
-    """
-
-    rate: float = 500.0
-    dcm_gain: float = 1.0
-    zmp_margin: float = 0.01
-    zmp_admittance: float = 1.0
-    zmp_filter: float = 0.01
-    max_com_speed: float = 0.3
-    com_cost: float = 10.0
-    contact_cost: float = 10.0
-    impact_cost: float = 1.0
-    posture_cost: float = 1e-2
-    damping: float = 1e-6
-    solver: str = "daqp"
-
-    def to_dict(self) -> dict:
-        return asdict(self)
+_FloatArray = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -105,13 +78,17 @@ class ControlOutput:
 
 
 def retracted_stance(analysis: Analysis, standoff: float) -> np.ndarray:
-    """The stance's configuration with the impact point backed off ``standoff`` (m) along the normal.
+    """The stance's configuration with the impact point backed off along the normal.
 
-    Whole-body IK (pink, :func:`impact_balance.robot.ik.solve_stance`): contacts fixed, CoM xy fixed.
+    The point backs off by ``standoff`` (m).
+
+    Whole-body IK (pink, :func:`impact_balance.robot.ik.solve_stance`): contacts fixed, CoM xy
+    fixed.
     """
     stance, impact = analysis.stance, analysis.impact
     if impact is None or standoff <= 0:
-        return stance.q.copy()
+        answer: _FloatArray = stance.q.copy()
+        return answer
     spec = impact.model.spec
     frame_pose = stance.frame_pose(spec.frame)
     target = pin.SE3(frame_pose.rotation, frame_pose.translation + standoff * impact.model.normal)
@@ -121,19 +98,22 @@ def retracted_stance(analysis: Analysis, standoff: float) -> np.ndarray:
         {spec.frame: target},
         stance.com[:2],
         fixed_frames=[c.spec.frame for c in stance.contacts],
-        tolerance=1e-5,
-        max_iterations=300,
+        options=IKOptions(tolerance=1e-5, max_iterations=300),
     )
 
 
-class BalanceController:
+class BalanceController(Controller["ControlOutput"]):
     """DCM-feedback balance with whole-body IK (see the module docstring).
 
     Args:
         analysis: The scenario's analysis (stance, areas; the impact if any).
         q0: Initial reference configuration (nq); default the stance's.
-        gains: Gains and rates.
+        gains: Gains and rates (default :class:`BalanceGains`).
         impact: The impact task, if any.
+
+    Attributes:
+        support_v_index: Velocity indices (pinocchio) of the support limbs' joints, which get no
+            velocity feed-forward (:meth:`actuate`); none unless built by :meth:`for_trial`.
     """
 
     name = "dcm-zmp-clamp + pink IK -> joint position servos"
@@ -142,9 +122,10 @@ class BalanceController:
         self,
         analysis: Analysis,
         q0: np.ndarray | None = None,
-        gains: BalanceGains = BalanceGains(),
-        impact: ImpactTask | None = None,
+        gains: BalanceGains | None = None,
+        impact: ImpactReference | None = None,
     ):
+        gains = gains or BalanceGains()
         self.analysis = analysis
         self.gains = gains
         self.impact = impact
@@ -153,13 +134,15 @@ class BalanceController:
         self.data = self.model.createData()  # measured state
         q0 = stance.q.copy() if q0 is None else np.asarray(q0, dtype=float).copy()
         self.configuration = pink.Configuration(self.model, self.model.createData(), q0)
+        self.rate = gains.rate
         self.dt = 1.0 / gains.rate
+        self.support_v_index: npt.NDArray[np.int_] = np.zeros(0, dtype=int)
         areas = analysis.areas
         self.plane_height = areas.plane_height
         self.gravity = areas.gravity
         com0 = np.array(pin.centerOfMass(self.model, self.configuration.data, q0), dtype=float)
         self.com_height = float(com0[2])
-        self.omega = float(np.sqrt(self.gravity / (com0[2] - self.plane_height)))
+        self.omega = lipm_omega(self.com_height, self.plane_height, self.gravity)
         self.feedback = DcmFeedback(
             areas.zmp_area, self.omega, com0[:2].copy(), gains.dcm_gain, gains.zmp_margin
         )
@@ -174,7 +157,7 @@ class BalanceController:
         self.com_task.set_target(com0)
         self.posture_task = PostureTask(cost=gains.posture_cost)
         self.posture_task.set_target(q0)
-        self.impact_task = None
+        self.impact_task: FrameTask | None = None
         if impact is not None:
             self.impact_task = FrameTask(impact.frame, gains.impact_cost, 0.1 * gains.impact_cost)
             self._impact_rotation = self.configuration.get_transform_frame_to_world(
@@ -184,9 +167,79 @@ class BalanceController:
         self._lower = self.model.lowerPositionLimit[7:].copy()
         self._upper = self.model.upperPositionLimit[7:].copy()
 
+    @classmethod
+    def prepare_model(cls, sim: SimModel, analysis: Analysis) -> None:
+        """Position servos, the support limbs' stiffened (see :meth:`Controller.prepare_model`)."""
+        stiffen_support_limbs(sim, analysis)
+
+    @classmethod
+    def zmp_margin(cls, options: TrialGains) -> float:
+        """The margin of ``options.gains`` (m; see :meth:`Controller.zmp_margin`)."""
+        return options.gains.zmp_margin
+
+    @classmethod
+    def for_trial(
+        cls,
+        analysis: Analysis,
+        q_start: _FloatArray,
+        options: TrialGains,
+        task: ImpactReference | None,
+        sim: SimModel,
+        support_v_index: npt.NDArray[np.int_],
+    ) -> BalanceController:
+        """The controller of one trial, with ``options.gains``; see :meth:`Controller.for_trial`."""
+        controller = cls(analysis, q_start, options.gains, task)
+        controller.support_v_index = support_v_index
+        return controller
+
+    def hold(self, sim: SimModel, q_start: _FloatArray) -> None:
+        """The servos hold ``q_start`` (see :meth:`Controller.hold`)."""
+        sim.set_servo_targets(q_start)
+
+    def actuate(self, sim: SimModel, out: ControlOutput) -> None:
+        """Servo targets ``out.q``, with velocity feed-forward on the free limbs only.
+
+        On the stiffened support limbs the feed-forward would turn the dead-beat IK's velocity
+        noise into large torques.
+
+        Args:
+            sim: The trial's MuJoCo model.
+            out: What :meth:`step` returned.
+        """
+        v_ff = out.v.copy()
+        v_ff[self.support_v_index] = 0.0
+        sim.set_servo_targets(out.q, v_ff)
+
+    @classmethod
+    def trial_description(
+        cls, options: TrialGains, sim: SimModel, effort_limits: bool
+    ) -> dict[str, Any]:
+        """Name, gains, rates and servo gains (see :meth:`Controller.trial_description`)."""
+        gains = options.gains
+        return {
+            "name": cls.name,
+            "gains": gains.to_dict(),
+            "control_rate_hz": gains.rate,
+            "sim_timestep": float(sim.model.opt.timestep),
+            "servo": {
+                "kp": sim.kp.tolist(),
+                "kd": sim.kd.tolist(),
+                "joints": list(sim.joint_names),
+            },
+        }
+
+    @classmethod
+    def trial_summary(
+        cls, options: TrialGains, sim: SimModel, effort_limits: bool
+    ) -> dict[str, Any]:
+        """Name and gains only (see :meth:`Controller.trial_summary`)."""
+        return {"name": cls.name, "gains": options.gains.to_dict()}
+
     @property
-    def q_ref(self) -> np.ndarray:
-        return self.configuration.q
+    def q_ref(self) -> _FloatArray:
+        """The reference configuration (nq, pinocchio order)."""
+        answer: _FloatArray = self.configuration.q
+        return answer
 
     def measure(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Measured CoM and CoM velocity (m, m/s, world) from pinocchio's ``(q, v)``."""
@@ -201,10 +254,12 @@ class BalanceController:
         zmp_measured: np.ndarray | None = None,
         impact_force: float = 0.0,
     ) -> ControlOutput:
-        """One control step from the measured state (pinocchio ``q``, ``v``; free-flyer velocity local).
+        """One control step from the measured state.
 
-        ``zmp_measured`` is the ZMP of the measured contact forces on the plane (m, world; None or NaN
-        when unknown); ``impact_force`` the measured normal force at the impact point (N).
+        ``q`` and ``v`` are pinocchio's, the free-flyer velocity in the base frame.
+
+        ``zmp_measured`` is the ZMP of the measured contact forces on the plane (m, world; None or
+        NaN when unknown); ``impact_force`` the measured normal force at the impact point (N).
         """
         g, dt = self.gains, self.dt
         com, com_velocity = self.measure(q, v)
@@ -224,7 +279,7 @@ class BalanceController:
             )
         self.com_task.set_target(np.array([*self.com_command, self.com_height]))
         tasks = [self.com_task, *self.contact_tasks, self.posture_task]
-        if self.impact is not None:
+        if self.impact is not None and self.impact_task is not None:
             point = self.impact.target(t, impact_force)
             frame_origin = point - self._impact_rotation @ self.impact.offset.translation
             self.impact_task.set_target(pin.SE3(self._impact_rotation, frame_origin))
@@ -241,6 +296,6 @@ class BalanceController:
             self.configuration.q.copy(), velocity, zmp, xi, clamped, com, com_velocity
         )
 
-    def describe(self) -> dict:
+    def describe(self) -> dict[str, Any]:
         """Name and gains (the ``controller`` object of ``validate --json``)."""
         return {"name": self.name, "gains": self.gains.to_dict(), "omega": self.omega}

@@ -1,6 +1,7 @@
 """Torque-controlled balance: DCM feedback + a whole-body inverse-dynamics QP, for MuJoCo motors.
 
-The alternative to :mod:`.balance` (pink IK and position servos) that issue 10 allows. Where the
+The alternative to :mod:`~impact_balance.sim.control.kinematic` (pink IK and position servos): the
+``id`` member of the :class:`~impact_balance.sim.control.controller.Controller` family. Where the
 kinematic controller moves the ZMP only through a slow CoM admittance, this one chooses the
 contact wrenches themselves, so the ZMP can reach the edge of the ZMP support area within one
 control step: the zero-step capture that the CoM criterion assumes.
@@ -19,19 +20,19 @@ free-flyer velocity in the base frame):
 
    - equalities: the 6 unactuated rows of ``M a + h = S^T tau + sum J_i^T w_i`` (the floating
      base), and ``J_i a + J_i_dot v = -K_c J_i v`` for each contact (the contacts stay);
-   - inequalities: each ``w_i`` in its contact wrench cone (:func:`impact_balance.contacts.cwc.cwc_faces_world`)
-     (friction and rectangle shrunk by margins, see :class:`InverseDynamicsGains`) with a
-     minimum normal force, the joint position limits (as acceleration bounds), and
-     ``|tau| <= effort`` with ``tau`` the actuated rows of ``M a + h - sum J_i^T w_i``;
-     with a governed approach (a task whose ``speed_bound()`` is finite, :class:`~.wall.GovernedApproach`),
-     the impact point's approach speed one control period ahead, ``-n . (J_p (v + a dt) + J_p_dot v dt)``,
-     at most the governor's cap: the paper's "track the maximum contact velocity with a whole-body QP"
-     as a hard bound, so that the torque controller's tracking lag cannot carry the point past a
-     falling cap;
-   - cost (weighted least squares): the CoM acceleration of the LIPM, ``c_dd_xy = omega^2 (c_xy - p)``,
-     with a PD on the CoM height; angular momentum damping ``L_dot = -K_L L``; the impact point's
-     acceleration (the :class:`~.approach.ImpactTask` reference's acceleration, plus a PD to its
-     position and velocity); a posture
+   - inequalities: each ``w_i`` in its contact wrench cone
+     (:func:`impact_balance.contacts.cwc.cwc_faces_world`) (friction and rectangle shrunk by
+     margins, see :class:`InverseDynamicsGains`) with a minimum normal force, the joint position
+     limits (as acceleration bounds), and ``|tau| <= effort`` with ``tau`` the actuated rows of
+     ``M a + h - sum J_i^T w_i``; with a governed approach (a task whose ``speed_bound()`` is
+     finite, :class:`~impact_balance.sim.studies.wall.GovernedApproach`), the impact point's
+     approach speed one control period ahead, ``-n . (J_p (v + a dt) + J_p_dot v dt)``, at most the
+     governor's cap: the paper's "track the maximum contact velocity with a whole-body QP" as a hard
+     bound, so that the torque controller's tracking lag cannot carry the point past a falling cap;
+   - cost (weighted least squares): the CoM acceleration of the LIPM,
+     ``c_dd_xy = omega^2 (c_xy - p)``, with a PD on the CoM height; angular momentum damping
+     ``L_dot = -K_L L``; the impact point's acceleration (the :class:`~.approach.ImpactTask`
+     reference's acceleration, plus a PD to its position and velocity); a posture
      PD to the start configuration (joints) and one on the base orientation; a small regularisation.
 
    If the torque limits make the QP infeasible, it is solved without them and the torques are
@@ -45,86 +46,31 @@ that both controllers share :meth:`step`'s signature.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
 
 import daqp
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 
 from impact_balance.analysis.analyze import Analysis
+from impact_balance.balance.lipm import lipm_omega
 from impact_balance.contacts.cwc import cwc_faces_world
 from impact_balance.geometry.spatial import skew
-from impact_balance.sim.control.approach import ImpactTask
+from impact_balance.sim.control.actuation import use_torque_motors
+from impact_balance.sim.control.approach import ImpactReference
+from impact_balance.sim.control.controller import Controller
+from impact_balance.sim.control.gains import InverseDynamicsGains, TrialGains
 from impact_balance.sim.control.zmp import DcmFeedback
+from impact_balance.sim.model.build import SimModel
 
-__all__ = ["InverseDynamicsController", "InverseDynamicsGains", "TorqueOutput", "describe"]
+__all__ = ["InverseDynamicsController", "TorqueOutput"]
+
+_FloatArray = npt.NDArray[np.float64]
 
 _LWA = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-
-
-@dataclass(frozen=True)
-class InverseDynamicsGains:
-    """Gains, weights and rate of :class:`InverseDynamicsController` (units in brackets).
-
-    Task weights multiply squared accelerations (m/s^2, rad/s^2; the angular momentum rate per
-    unit mass, m^2/s^2); the wrench regularisation multiplies squared newtons and newton-metres.
-
-    Attributes:
-        rate: Control rate [Hz].
-        dcm_gain: DCM error decay rate k [1/s].
-        zmp_margin: Desired ZMP kept this far inside the ZMP support area [m].
-        com_height_stiffness, com_height_damping: PD on the CoM height [1/s^2], [1/s].
-        angular_momentum_damping: K_L in L_dot = -K_L L [1/s].
-        contact_damping: K_c in the contact acceleration J a + J_dot v = -K_c J v [1/s].
-        posture_stiffness, posture_damping: PD to the start configuration [1/s^2], [1/s].
-        base_orientation_stiffness, base_orientation_damping: PD on the base orientation [1/s^2], [1/s].
-        impact_stiffness, impact_damping: PD of the impact point to its target [1/s^2], [1/s].
-        com_weight, angular_momentum_weight, posture_weight, base_orientation_weight, impact_weight,
-        impact_orientation_weight: task weights.
-        acceleration_regularization, wrench_regularization: regularisation weights (the latter on the
-            contact forces).
-        torque_regularization: regularisation weight of the contact torques (N m): keeps the centres
-            of pressure central and the yaw torques small.
-        friction_scale: The QP's friction coefficient is this fraction of the contact's: a margin
-            against slipping, as MuJoCo's contact, like a real one, is not exactly the ideal cone.
-        cop_margin: The QP's contact rectangles are shrunk by this much on every side [m].
-        min_normal_force: Every contact carries at least this normal force [N]. The ZMP support area
-            includes ZMPs reached only by unloading a contact (its cone contains zero); the fall
-            detector counts an unloaded contact as lost, so the QP keeps each one loaded.
-        joint_limit_horizon: T [s] of the joint position limits on the accelerations: braking at
-            ``a`` from ``(q, v)`` stays within the limits for T, ``q + v T + a T^2 / 2`` in
-            ``[lower, upper]``. MuJoCo enforces the limits with forces the QP would not know.
-    """
-
-    rate: float = 500.0
-    dcm_gain: float = 2.0
-    zmp_margin: float = 0.01
-    com_height_stiffness: float = 100.0
-    com_height_damping: float = 20.0
-    angular_momentum_damping: float = 10.0
-    contact_damping: float = 20.0
-    posture_stiffness: float = 100.0
-    posture_damping: float = 20.0
-    base_orientation_stiffness: float = 100.0
-    base_orientation_damping: float = 20.0
-    impact_stiffness: float = 400.0
-    impact_damping: float = 40.0
-    com_weight: float = 1000.0
-    angular_momentum_weight: float = 0.1
-    posture_weight: float = 1e-2
-    base_orientation_weight: float = 0.1
-    impact_weight: float = 10.0
-    impact_orientation_weight: float = 1.0
-    acceleration_regularization: float = 1e-6
-    wrench_regularization: float = 1e-7
-    torque_regularization: float = 1e-5
-    friction_scale: float = 0.65
-    cop_margin: float = 0.0
-    min_normal_force: float = 20.0
-    joint_limit_horizon: float = 0.1
-
-    def to_dict(self) -> dict:
-        return asdict(self)
 
 
 @dataclass(frozen=True)
@@ -134,13 +80,15 @@ class TorqueOutput:
     Attributes:
         tau: Joint torques of the actuated joints (nv - 6, pinocchio velocity order) [N m].
         a: Joint accelerations of the QP (nv) [m/s^2, rad/s^2].
-        wrenches: Contact wrenches of the QP (nc x 6, ``[f; tau]`` at each contact point, world axes).
+        wrenches: Contact wrenches of the QP (nc x 6, ``[f; tau]`` at each contact point, world
+            axes).
         zmp: Clamped desired ZMP (m, world).
         dcm: Measured DCM (m, world).
         clamped: Whether the desired ZMP was clamped to the area.
         com: Measured CoM (m, world).
         com_velocity: Measured CoM velocity (m/s, world).
-        torque_limited: Whether the torque limits had to be dropped (infeasible) and the torques clipped.
+        torque_limited: Whether the torque limits had to be dropped (infeasible) and the torques
+            clipped.
     """
 
     tau: np.ndarray
@@ -154,12 +102,57 @@ class TorqueOutput:
     torque_limited: bool = False
 
 
+@dataclass(frozen=True)
+class _Dynamics:
+    """What one control step computes at the measured state (pinocchio; world frame)."""
+
+    M: _FloatArray  # mass matrix (nv x nv), both triangles
+    h: _FloatArray  # nonlinear effects (nv)
+    Ag: _FloatArray  # centroidal momentum matrix (6 x nv)
+    drift_hg: _FloatArray  # centroidal momentum drift A_g_dot v (6)
+    hg: _FloatArray  # centroidal momentum (6)
+    com: _FloatArray  # CoM (3), m
+    com_velocity: _FloatArray  # CoM velocity (3), m/s
+
+
+class _Tasks:
+    """The weighted least-squares tasks ``A a = b`` (weight per row) of one control step."""
+
+    def __init__(self) -> None:
+        self.rows: list[_FloatArray] = []
+        self.targets: list[_FloatArray] = []
+        self.weights: list[_FloatArray] = []
+
+    def add(self, A: _FloatArray, b: _FloatArray, weight: float) -> None:
+        """One task: ``A a = b`` with ``weight`` on every row."""
+        self.rows.append(A)
+        self.targets.append(b)
+        self.weights.append(np.full(len(b), weight))
+
+    def stacked(self) -> tuple[_FloatArray, _FloatArray, _FloatArray]:
+        """``A``, ``b`` and the row weights of all the tasks."""
+        return np.vstack(self.rows), np.concatenate(self.targets), np.concatenate(self.weights)
+
+
+@dataclass(frozen=True)
+class _Rows:
+    """Where the optional constraint blocks start: approach speed, joint limits, torque limits."""
+
+    ms: int
+    m0: int
+    m1: int
+
+
 def _point_jacobian(
     model: pin.Model, data: pin.Data, fid: int, offset: pin.SE3
 ) -> tuple[pin.SE3, np.ndarray, np.ndarray]:
-    """Pose, 6 x nv Jacobian (world axes, linear first) and acceleration drift ``J_dot v`` of ``frame * offset``.
+    """Pose, Jacobian and acceleration drift of the point ``frame * offset``.
 
-    Needs ``data`` from a forward kinematics with zero acceleration (so the frame acceleration is the drift).
+    Pose, 6 x nv Jacobian (world axes, linear first) and acceleration drift ``J_dot v`` of ``frame *
+    offset``.
+
+    Needs ``data`` from a forward kinematics with zero acceleration (so the frame acceleration is
+    the drift).
     The drift is the classical one: the linear acceleration of the point itself.
     """
     frame_pose = data.oMf[fid]
@@ -171,21 +164,26 @@ def _point_jacobian(
     r = placement.translation - frame_pose.translation
     velocity = pin.getFrameVelocity(model, data, fid, _LWA)
     w = velocity.angular
-    # Rigid point at r from the frame origin: v_p = v_o + w x r, a_p = a_o + w_dot x r + w x (w x r).
+    # Rigid point at r from the frame origin:
+    # v_p = v_o + w x r, a_p = a_o + w_dot x r + w x (w x r).
     J[:3] -= skew(r) @ J[3:]
     drift[:3] += np.cross(drift[3:], r) + np.cross(w, np.cross(w, r))
     return placement, J, drift
 
 
-class InverseDynamicsController:
+class InverseDynamicsController(Controller["TorqueOutput"]):
     """DCM-feedback balance through a whole-body inverse-dynamics QP (see the module docstring).
 
     Args:
         analysis: The scenario's analysis (stance, areas; the impact if any).
         q0: Start configuration (nq), the posture target; default the stance's.
-        gains: Gains, weights and rate.
+        gains: Gains, weights and rate (default :class:`InverseDynamicsGains`).
         impact: The impact task, if any.
         effort_limits: Bound the joint torques by the URDF effort limits.
+
+    Attributes:
+        joint_damping: MuJoCo's viscous joint damping (N m s/rad, by simulated joint) that
+            :meth:`actuate` compensates; none unless built by :meth:`for_trial`.
     """
 
     name = "dcm-zmp-clamp + inverse-dynamics QP -> joint torques"
@@ -194,10 +192,11 @@ class InverseDynamicsController:
         self,
         analysis: Analysis,
         q0: np.ndarray | None = None,
-        gains: InverseDynamicsGains = InverseDynamicsGains(),
-        impact: ImpactTask | None = None,
+        gains: InverseDynamicsGains | None = None,
+        impact: ImpactReference | None = None,
         effort_limits: bool = True,
     ):
+        gains = gains or InverseDynamicsGains()
         self.analysis = analysis
         self.gains = gains
         self.impact = impact
@@ -205,7 +204,9 @@ class InverseDynamicsController:
         self.model = model = stance.robot.model
         self.data = model.createData()
         self.q0 = stance.q.copy() if q0 is None else np.asarray(q0, dtype=float).copy()
+        self.rate = gains.rate
         self.dt = 1.0 / gains.rate
+        self.joint_damping: _FloatArray = np.zeros(0)
         self.nv = nv = model.nv
         self.nc = len(stance.contacts)
         self.n = nv + 6 * self.nc
@@ -214,7 +215,7 @@ class InverseDynamicsController:
         self.plane_height = analysis.areas.plane_height
         com0 = np.array(pin.centerOfMass(model, self.data, self.q0), dtype=float)
         self.com_height = float(com0[2])
-        self.omega = float(np.sqrt(self.gravity / (com0[2] - self.plane_height)))
+        self.omega = lipm_omega(self.com_height, self.plane_height, self.gravity)
         self.feedback = DcmFeedback(
             analysis.areas.zmp_area, self.omega, com0[:2].copy(), gains.dcm_gain, gains.zmp_margin
         )
@@ -232,7 +233,7 @@ class InverseDynamicsController:
         # Torque limits on the actuated rows (velocity index >= 6); 0 or missing effort: unbounded.
         effort = np.full(nv - 6, np.inf)
         idx, values = stance.robot.effort_limits
-        for i, e in zip(idx, values):
+        for i, e in zip(idx, values, strict=False):
             if i >= 6 and e > 0:
                 effort[i - 6] = e
         self.effort = effort
@@ -267,9 +268,9 @@ class InverseDynamicsController:
         self._q_lower = model.lowerPositionLimit[self._limit_q].copy()
         self._q_upper = model.upperPositionLimit[self._limit_q].copy()
         # One row bounds the impact point's approach speed when the task is governed (see step()).
-        self._speed_rows = int(
-            impact is not None and callable(getattr(impact, "speed_bound", None))
-        )
+        bound = getattr(impact, "speed_bound", None)
+        self._speed_bound: Callable[[], float] | None = bound if callable(bound) else None
+        self._speed_rows = int(impact is not None and self._speed_bound is not None)
         m = 6 + 6 * nc + 17 * nc + self._speed_rows + self._limit_q.size + self._limited.size
         self._C = np.zeros((m, n))
         self._upper = np.zeros(m)
@@ -285,22 +286,125 @@ class InverseDynamicsController:
         pin.centerOfMass(self.model, self.data, q, v, False)
         return self.data.com[0].copy(), self.data.vcom[0].copy()
 
+    # -- the family's hooks ---------------------------------------------------------------
+    @classmethod
+    def prepare_model(cls, sim: SimModel, analysis: Analysis) -> None:
+        """Torque motors instead of servos (see :meth:`Controller.prepare_model`)."""
+        use_torque_motors(sim)
+
+    @classmethod
+    def zmp_margin(cls, options: TrialGains) -> float:
+        """The margin of ``options.id_gains`` (m; see :meth:`Controller.zmp_margin`)."""
+        return options.id_gains.zmp_margin
+
+    @classmethod
+    def for_trial(
+        cls,
+        analysis: Analysis,
+        q_start: _FloatArray,
+        options: TrialGains,
+        task: ImpactReference | None,
+        sim: SimModel,
+        support_v_index: npt.NDArray[np.int_],
+    ) -> InverseDynamicsController:
+        """The controller of one trial, with ``options.id_gains``.
+
+        See :meth:`Controller.for_trial`.
+
+        The torques are bounded when ``sim``'s motors are force-limited; MuJoCo's viscous joint
+        damping (the URDF's) is compensated: the motors add ``damping * qdot``.
+        """
+        controller = cls(
+            analysis,
+            q_start,
+            options.id_gains,
+            task,
+            effort_limits=bool(sim.model.actuator_forcelimited[sim.actuator_ids].any()),
+        )
+        controller.joint_damping = sim.model.dof_damping[sim.dof_adr].copy()
+        return controller
+
+    def hold(self, sim: SimModel, q_start: _FloatArray) -> None:
+        """The motors apply the holding torques (see :meth:`Controller.hold`)."""
+        sim.data.ctrl[sim.actuator_ids] = sim.tau_hold
+
+    def actuate(self, sim: SimModel, out: TorqueOutput) -> None:
+        """The motors apply ``out.tau`` plus the compensation of the joint damping.
+
+        Args:
+            sim: The trial's MuJoCo model.
+            out: What :meth:`step` returned.
+        """
+        d = sim.data
+        d.ctrl[sim.actuator_ids] = (
+            out.tau[sim.v_index - 6] + self.joint_damping * d.qvel[sim.dof_adr]
+        )
+
+    @classmethod
+    def trial_description(
+        cls, options: TrialGains, sim: SimModel, effort_limits: bool
+    ) -> dict[str, Any]:
+        """Name, gains, rates and actuators (see :meth:`Controller.trial_description`)."""
+        gains = options.id_gains
+        return {
+            "name": cls.name,
+            "gains": gains.to_dict(),
+            "control_rate_hz": gains.rate,
+            "sim_timestep": float(sim.model.opt.timestep),
+            "actuators": "torque motors (MuJoCo), viscous joint damping compensated",
+            "effort_limits": effort_limits,
+            "impact_task": {"force_threshold": 15.0, "retract": 0.05},
+        }
+
     # -- control ------------------------------------------------------------------------
     def step(
         self,
         t: float,
-        q: np.ndarray,
-        v: np.ndarray,
-        zmp_measured: np.ndarray | None = None,
+        q: _FloatArray,
+        v: _FloatArray,
+        zmp_measured: _FloatArray | None = None,
         impact_force: float = 0.0,
     ) -> TorqueOutput:
-        """One control step from the measured state; returns the joint torques (see :class:`TorqueOutput`).
+        """One control step from the measured state; returns the joint torques.
 
-        ``impact_force`` is the measured normal force at the impact point (N); ``zmp_measured`` is unused.
+        Args:
+            t: Time (s).
+            q: Measured configuration (nq, pinocchio order).
+            v: Measured velocity (nv, free-flyer velocity in the base frame).
+            zmp_measured: Unused (the wrenches are chosen, not admitted).
+            impact_force: Measured normal force at the impact point (N).
+
+        Returns:
+            The torques and the QP's accelerations and wrenches (see :class:`TorqueOutput`).
         """
-        g = self.gains
-        model, data, nv, nc = self.model, self.data, self.nv, self.nc
-        # Dynamics and kinematics at (q, v) with zero acceleration: frame accelerations are drifts.
+        state = self._dynamics(q, v)
+        zmp, xi, clamped = self.feedback.desired_zmp(state.com[:2], state.com_velocity[:2])
+        tasks, speed_row = self._tasks(t, v, impact_force, state, zmp)
+        P, c = self._cost(tasks, q, v)
+        T, t0, rows = self._constraints(q, v, state, speed_row)
+        x, torque_limited = self._solve(P, c, rows)
+        nv, nc = self.nv, self.nc
+        a, w = x[:nv], x[nv:]
+        tau = T @ x + t0
+        if self.effort_limits:
+            tau = np.clip(tau, -self.effort, self.effort)
+        out = TorqueOutput(
+            tau,
+            a,
+            w.reshape(nc, 6),
+            zmp,
+            xi,
+            clamped,
+            state.com,
+            state.com_velocity,
+            torque_limited,
+        )
+        self.last = out
+        return out
+
+    def _dynamics(self, q: _FloatArray, v: _FloatArray) -> _Dynamics:
+        """Dynamics and kinematics at ``(q, v)`` and zero acceleration (so drifts)."""
+        model, data = self.model, self.data
         pin.crba(model, data, q)
         M = data.M.copy()
         M[self._lower_triangle] = M.T[self._lower_triangle]  # crba fills the upper triangle only
@@ -309,24 +413,29 @@ class InverseDynamicsController:
         pin.computeJointJacobians(model, data, q)
         pin.updateFramePlacements(model, data)
         Ag = pin.computeCentroidalMap(model, data, q)
-        # With a = 0, dhg is the centroidal momentum drift A_g_dot v; it also sets data.com[0], data.hg.
+        # With a = 0, dhg is the centroidal momentum drift A_g_dot v (also sets data.com, data.hg).
         pin.computeCentroidalMomentumTimeVariation(model, data, q, v, self._zero)
         drift_hg = data.dhg.vector.copy()
         hg = data.hg.vector.copy()
         com = data.com[0].copy()
-        com_velocity = hg[:3] / self.mass
-        zmp, xi, clamped = self.feedback.desired_zmp(com[:2], com_velocity[:2])
+        return _Dynamics(M, h, Ag, drift_hg, hg, com, hg[:3] / self.mass)
 
-        n = self.n
-        rows: list[np.ndarray] = []  # (A, b, weight) of the weighted least-squares tasks on a
-        targets: list[np.ndarray] = []
-        weights: list[np.ndarray] = []
+    def _tasks(
+        self,
+        t: float,
+        v: _FloatArray,
+        impact_force: float,
+        state: _Dynamics,
+        zmp: _FloatArray,
+    ) -> tuple[_Tasks, tuple[_FloatArray, float] | None]:
+        """The weighted least-squares tasks on the accelerations, and the approach speed's row.
 
-        def task(A: np.ndarray, b: np.ndarray, weight: float) -> None:
-            rows.append(A)
-            targets.append(b)
-            weights.append(np.full(len(b), weight))
-
+        Returns:
+            The tasks, and ``(row, bound)`` of the governed approach speed (None when unbounded).
+        """
+        g, model, data = self.gains, self.model, self.data
+        com, com_velocity, hg, drift_hg = state.com, state.com_velocity, state.hg, state.drift_hg
+        tasks = _Tasks()
         # CoM: m c_dd = A_g[:3] a + drift; LIPM horizontally, PD on the height.
         com_dd = np.empty(3)
         com_dd[:2] = self.omega**2 * (com[:2] - zmp)
@@ -334,10 +443,10 @@ class InverseDynamicsController:
             g.com_height_stiffness * (self.com_height - com[2])
             - g.com_height_damping * com_velocity[2]
         )
-        task(Ag[:3] / self.mass, com_dd - drift_hg[:3] / self.mass, g.com_weight)
+        tasks.add(state.Ag[:3] / self.mass, com_dd - drift_hg[:3] / self.mass, g.com_weight)
         # Angular momentum about the CoM (per unit mass): L_dot = -K_L L.
-        task(
-            Ag[3:] / self.mass,
+        tasks.add(
+            state.Ag[3:] / self.mass,
             (-g.angular_momentum_damping * hg[3:] - drift_hg[3:]) / self.mass,
             g.angular_momentum_weight,
         )
@@ -346,62 +455,97 @@ class InverseDynamicsController:
         base_drift = pin.getClassicalAcceleration(model, data, 1, _LWA).angular
         R = data.oMi[1].rotation
         rot_error = R @ pin.log3(R.T @ self._base_rotation)
-        task(
+        tasks.add(
             J_base[3:],
             g.base_orientation_stiffness * rot_error
             - g.base_orientation_damping * (J_base[3:] @ v)
             - base_drift,
             g.base_orientation_weight,
         )
-        # Impact point: PD to the impact task's target and its velocity.
         speed_row = None
         if self.impact is not None:
-            placement, Ji, drift = _point_jacobian(
-                model, data, self._impact_frame, self.impact.offset
-            )
-            target, target_velocity, target_acceleration = self.impact.reference(t, impact_force)
-            vel = Ji @ v
-            lin = (
-                target_acceleration
-                + g.impact_stiffness * (target - placement.translation)
-                + g.impact_damping * (target_velocity - vel[:3])
-            )
-            ang = (
-                g.impact_stiffness
-                * (placement.rotation @ pin.log3(placement.rotation.T @ self._impact_rotation))
-                - g.impact_damping * vel[3:]
-            )
-            task(Ji[:3], lin - drift[:3], g.impact_weight)
-            task(Ji[3:], ang - drift[3:], g.impact_orientation_weight)
-            if self._speed_rows:
-                # Approach speed one control period ahead (torques are held for dt):
-                # -n . (vel + (Ji a + drift) dt) <= cap. Linear in a; inactive when unbounded.
-                cap = float(self.impact.speed_bound())
-                n_dir = np.asarray(self.impact.normal, dtype=float)
-                if np.isfinite(cap):
-                    speed_row = (
-                        -self.dt * (n_dir @ Ji[:3]),
-                        cap + n_dir @ vel[:3] + self.dt * (n_dir @ drift[:3]),
-                    )
-        A_t, b_t, w_t = np.vstack(rows), np.concatenate(targets), np.concatenate(weights)
+            speed_row = self._impact_tasks(tasks, self.impact, t, v, impact_force)
+        return tasks, speed_row
+
+    def _impact_tasks(
+        self, tasks: _Tasks, impact: ImpactReference, t: float, v: _FloatArray, impact_force: float
+    ) -> tuple[_FloatArray, float] | None:
+        """Impact point tasks: PD to the task's target and velocity; the approach speed's row."""
+        g = self.gains
+        assert self._impact_frame is not None
+        placement, Ji, drift = _point_jacobian(
+            self.model, self.data, self._impact_frame, impact.offset
+        )
+        target, target_velocity, target_acceleration = impact.reference(t, impact_force)
+        vel = Ji @ v
+        lin = (
+            target_acceleration
+            + g.impact_stiffness * (target - placement.translation)
+            + g.impact_damping * (target_velocity - vel[:3])
+        )
+        ang = (
+            g.impact_stiffness
+            * (placement.rotation @ pin.log3(placement.rotation.T @ self._impact_rotation))
+            - g.impact_damping * vel[3:]
+        )
+        tasks.add(Ji[:3], lin - drift[:3], g.impact_weight)
+        tasks.add(Ji[3:], ang - drift[3:], g.impact_orientation_weight)
+        if not self._speed_rows:
+            return None
+        # Approach speed one control period ahead (torques are held for dt):
+        # -n . (vel + (Ji a + drift) dt) <= cap. Linear in a; inactive when unbounded.
+        assert self._speed_bound is not None
+        cap = float(self._speed_bound())
+        n_dir = np.asarray(impact.normal, dtype=float)
+        if not np.isfinite(cap):
+            return None
+        return (
+            -self.dt * (n_dir @ Ji[:3]),
+            cap + n_dir @ vel[:3] + self.dt * (n_dir @ drift[:3]),
+        )
+
+    def _cost(
+        self, tasks: _Tasks, q: _FloatArray, v: _FloatArray
+    ) -> tuple[_FloatArray, _FloatArray]:
+        """The QP's cost ``x^T P x / 2 + c^T x``: the tasks, the posture PD, the regularisation."""
+        g, nv = self.gains, self.nv
+        A_t, b_t, w_t = tasks.stacked()
         P = self._P
         P[:] = self._P_diag
         Aw = A_t.T * w_t
         P[:nv, :nv] += Aw @ A_t
-        c = np.zeros(n)
+        c = np.zeros(self.n)
         c[:nv] = -(Aw @ b_t)
         # Posture: PD to the start configuration on the joints.
-        posture = g.posture_stiffness * pin.difference(model, q, self.q0) - g.posture_damping * v
+        posture = (
+            g.posture_stiffness * pin.difference(self.model, q, self.q0) - g.posture_damping * v
+        )
         c[:nv] -= self._posture_w * posture
+        return P, c
 
-        # Constraints, stacked for daqp: [floating base (6); contacts (6 nc)] equalities, then the
-        # contact wrench cones (16 nc), then the torque limits (double-sided rows).
+    def _constraints(
+        self,
+        q: _FloatArray,
+        v: _FloatArray,
+        state: _Dynamics,
+        speed_row: tuple[_FloatArray, float] | None,
+    ) -> tuple[_FloatArray, _FloatArray, _Rows]:
+        """Fill the QP's constraints; return the torques' map and where each block starts.
+
+        The torques are ``tau = T x + t0``.
+
+        Stacked for daqp: [floating base (6); contacts (6 nc)] equalities, the contact wrench cones
+        (16 nc), the minimum normal forces (nc), the governed approach speed (0 or 1), the joint
+        position limits, then the torque limits (double-sided rows).
+        """
+        g, model, data, nv, nc = self.gains, self.model, self.data, self.nv, self.nc
+        M, h = state.M, state.h
         C, upper, lower = self._C, self._upper, self._lower
         ne = 6 + 6 * nc
         C[:6, :nv] = M[:6]
         upper[:6] = -h[:6]
         for i, (fid, offset, spec) in enumerate(
-            zip(self.contact_frames, self.contact_offsets, self.contact_specs)
+            zip(self.contact_frames, self.contact_offsets, self.contact_specs, strict=True)
         ):
             placement, J, drift = _point_jacobian(model, data, fid, offset)
             r = 6 + 6 * i
@@ -433,7 +577,7 @@ class InverseDynamicsController:
         t0 = h[6:]
         limited = self._limited
         m0 = ms + self._speed_rows
-        # Joint position limits (rows after the minimum normal forces), then the torque limits.
+        # Joint position limits (rows after the approach speed), then the torque limits.
         T2 = g.joint_limit_horizon
         qj, vj = q[self._limit_q], v[self._limit_v]
         m1 = m0 + self._limit_q.size
@@ -444,32 +588,40 @@ class InverseDynamicsController:
             C[m1:, :] = T[limited]
             upper[m1:] = self.effort[limited] - t0[limited]
             lower[m1:] = -self.effort[limited] - t0[limited]
+        return T, t0, _Rows(ms, m0, m1)
+
+    def _solve(self, P: _FloatArray, c: _FloatArray, rows: _Rows) -> tuple[_FloatArray, bool]:
+        """Solve the QP (daqp), dropping constraints while it is infeasible.
+
+        Solve the QP (daqp); infeasible: drop the torque limits, then the joint limits, then the
+        approach speed's bound; still infeasible: hold the last solution.
+
+        Returns:
+            The solution ``x`` and whether a constraint had to be dropped.
+        """
+        C, upper, lower = self._C, self._upper, self._lower
         x, _, exitflag, _ = daqp.solve(P, c, C, upper, lower, self._sense)
         torque_limited = False
-        # Infeasible: drop the torque limits (the torques are clipped below), then the joint limits.
-        for rows in ((m1,) if limited.size else ()) + (m0,) + ((ms,) if self._speed_rows else ()):
+        # Infeasible: drop the torque limits (the torques are clipped after), then the joint limits.
+        for last in (
+            ((rows.m1,) if self._limited.size else ())
+            + (rows.m0,)
+            + ((rows.ms,) if self._speed_rows else ())
+        ):
             if exitflag >= 1:
                 break
             torque_limited = True
             x, _, exitflag, _ = daqp.solve(
-                P, c, C[:rows], upper[:rows], lower[:rows], self._sense[:rows]
+                P, c, C[:last], upper[:last], lower[:last], self._sense[:last]
             )
         if exitflag < 1:
             # Not even the cones and the contacts together: hold the last command.
             torque_limited = True
-            x = np.zeros(n) if self._x is None else self._x
+            x = np.zeros(self.n) if self._x is None else self._x
         self._x = x
-        a, w = x[:nv], x[nv:]
-        tau = T @ x + t0
-        if self.effort_limits:
-            tau = np.clip(tau, -self.effort, self.effort)
-        out = TorqueOutput(
-            tau, a, w.reshape(nc, 6), zmp, xi, clamped, com, com_velocity, torque_limited
-        )
-        self.last = out
-        return out
+        return x, torque_limited
 
-    def describe(self) -> dict:
+    def describe(self) -> dict[str, Any]:
         """Name and gains (the ``controller`` object of ``validate --json``)."""
         return {
             "name": self.name,
@@ -477,16 +629,3 @@ class InverseDynamicsController:
             "omega": self.omega,
             "effort_limits": self.effort_limits,
         }
-
-
-def describe(gains: InverseDynamicsGains, sim_timestep: float, effort_limits: bool) -> dict:
-    """The ``controller`` object of ``validate --json`` and ``push-test --json`` for the ``id`` controller."""
-    return {
-        "name": InverseDynamicsController.name,
-        "gains": gains.to_dict(),
-        "control_rate_hz": gains.rate,
-        "sim_timestep": sim_timestep,
-        "actuators": "torque motors (MuJoCo), viscous joint damping compensated",
-        "effort_limits": effort_limits,
-        "impact_task": {"force_threshold": 15.0, "retract": 0.05},
-    }

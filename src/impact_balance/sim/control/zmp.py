@@ -18,11 +18,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 import qpsolvers
 
 from impact_balance.geometry.polygon import Polygon
 
 __all__ = ["DcmFeedback", "clamp_to_polygon", "dcm"]
+
+_FloatArray = npt.NDArray[np.float64]
 
 
 def dcm(com_xy: np.ndarray, com_velocity_xy: np.ndarray, omega: float) -> np.ndarray:
@@ -41,19 +44,19 @@ def clamp_to_polygon(
     than the polygon), the margin is dropped. An empty polygon returns the point unchanged: there is
     nothing to clamp to (the caller's fall detector will see the fall).
     """
-    p = np.asarray(point, dtype=float)[:2]
+    p: _FloatArray = np.asarray(point, dtype=float)[:2]
     if polygon.is_empty:
-        return p.copy()
+        return np.array(p)
     G, h = (np.array(a) for a in polygon.halfplanes)  # the polygon's arrays are read-only
     for m in (margin, 0.0):
         if np.all(G @ p <= h - m):
-            return p.copy()
+            return np.array(p)
         x = qpsolvers.solve_qp(np.eye(2), -p, G, h - m, solver=solver)
         if x is not None:
             return np.asarray(x, dtype=float)
     # Degenerate polygon that the QP solver rejects: nearest vertex.
-    v = polygon.vertices
-    return v[int(np.argmin(np.linalg.norm(v - p, axis=1)))].copy()
+    v: _FloatArray = polygon.vertices
+    return np.array(v[int(np.argmin(np.linalg.norm(v - p, axis=1)))])
 
 
 @dataclass

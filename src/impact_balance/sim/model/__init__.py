@@ -1,1 +1,10 @@
-"""The MuJoCo model of a scenario: URDF to MJCF (:mod:`.urdf`), inertia repair (:mod:`.inertia`), collision geometry and environment (:mod:`.environment`), joint models (:mod:`.joints`), and the build (:mod:`.build`)."""
+"""The MuJoCo model of a scenario.
+
+- :mod:`.urdf`: the robot's URDF as a MuJoCo spec;
+- :mod:`.inertia`: inertials repaired for MuJoCo;
+- :mod:`.environment`: collision geometry of the contacts, the impact and the environment;
+- :mod:`.joints`: the joint models (``rigid``, ``servo``);
+- :mod:`.build`: the build, :func:`~impact_balance.sim.model.build.build_model`.
+"""
+
+__all__: list[str] = []

@@ -18,7 +18,8 @@ convert state both ways: ``set_state(q, v)`` takes a pinocchio configuration and
 ``com_velocity()`` (m, m/s, world); ``contact_force(geom)`` (N, world, on the robot);
 ``set_servo_targets(q_ref, v_ref)`` writes the servo commands (the holding torques
 included). ``inertia_repair`` says which inertials were changed for MuJoCo (see
-:mod:`.inertia`; a :class:`~impact_balance.exceptions.ModelRepairWarning` names them once). MuJoCo's free joint stores the base orientation as (w, x, y, z) and its angular
+:mod:`.inertia`; a :class:`~impact_balance.exceptions.ModelRepairWarning` names them once). MuJoCo's
+free joint stores the base orientation as (w, x, y, z) and its angular
 velocity in the base frame, but its linear velocity in world axes: the helpers convert.
 """
 
@@ -30,16 +31,18 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance.contacts.stance import Stance
 from impact_balance.exceptions import ModelRepairWarning, SimulationError
-from impact_balance.robot.robot import Robot
+from impact_balance.robot.robot import JointSlot, Robot
 from impact_balance.scenario import Scenario, load_scenario
 from impact_balance.sim.model.environment import ContactParameters, add_geometry
 from impact_balance.sim.model.inertia import InertiaRepair, repair_message
 from impact_balance.sim.model.joints import (
-    JOINT_MODELS,
+    JointModel,
     ServoOptions,
+    check_joint_model,
     holding_torques,
     servo_gains,
     weld_joints,
@@ -47,6 +50,8 @@ from impact_balance.sim.model.joints import (
 from impact_balance.sim.model.urdf import ROOT_JOINT, robot_spec
 
 __all__ = ["SimModel", "SimOptions", "build_model"]
+
+_FloatArray = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -61,8 +66,8 @@ class SimOptions:
         elliptic_cone: Elliptic friction cones (exact Coulomb); MuJoCo's default pyramid has
             4 edges, inscribed, and would under-estimate friction between its edges.
         impratio: MuJoCo's ratio of frictional to normal constraint impedance. MuJoCo's soft
-            friction lets a loaded contact creep; 10 (instead of 1) stiffens friction so that a
-            foot on the 30 degree ramp stays put (CoM drift 7 mm in 2 s instead of 8 cm).
+            friction lets a loaded contact creep; 10 (MuJoCo's default: 1) stiffens friction so
+            that a foot on the 30 degree ramp stays put.
     """
 
     timestep: float = 0.001
@@ -82,7 +87,7 @@ class SimModel:
 
     scenario: Scenario
     stance: Stance
-    joints: str
+    joints: JointModel
     options: SimOptions
     model: mujoco.MjModel
     data: mujoco.MjData
@@ -107,6 +112,7 @@ class SimModel:
 
     @property
     def robot(self) -> Robot:
+        """The scenario's robot (pinocchio)."""
         return self.stance.robot
 
     @property
@@ -116,7 +122,9 @@ class SimModel:
 
     # -- state --------------------------------------------------------------------------
     def set_state(self, q: np.ndarray, v: np.ndarray | None = None) -> None:
-        """Set MuJoCo's state from a pinocchio configuration ``q`` and velocity ``v`` (zero if None), then forward.
+        """Set MuJoCo's state from a pinocchio configuration and velocity, then forward.
+
+        ``q`` and ``v`` are pinocchio's; ``v`` is zero when None.
 
         With ``rigid`` joints, only the free-flyer part of ``q`` and ``v`` is used (the
         joints stay at the stance).
@@ -139,7 +147,7 @@ class SimModel:
     def configuration(self) -> np.ndarray:
         """The pinocchio configuration of the current MuJoCo state (welded joints at the stance)."""
         d = self.data
-        q = self.stance.q.copy()
+        q: _FloatArray = self.stance.q.copy()
         q[0:3] = d.qpos[0:3]
         w, x, y, z = d.qpos[3:7]
         q[3:7] = (x, y, z, w)
@@ -147,7 +155,7 @@ class SimModel:
         return q
 
     def velocity(self) -> np.ndarray:
-        """The pinocchio velocity (base linear and angular velocity in the base frame) of the current state."""
+        """The pinocchio velocity of the current state (base velocities in the base frame)."""
         d = self.data
         v = np.zeros(self.stance.model.nv)
         rotation = np.empty(9)
@@ -158,7 +166,7 @@ class SimModel:
         return v
 
     def base_velocity_world(self) -> tuple[np.ndarray, np.ndarray]:
-        """Linear velocity of the base origin and angular velocity of the base, both in world axes."""
+        """Linear velocity of the base origin and angular velocity of the base (world axes)."""
         d = self.data
         rotation = np.empty(9)
         mujoco.mju_quat2Mat(rotation, d.qpos[3:7])
@@ -166,15 +174,44 @@ class SimModel:
 
     def com(self) -> np.ndarray:
         """Centre of mass, world, m (valid after a forward or a step)."""
-        return self.data.subtree_com[self.root_body].copy()
+        answer: _FloatArray = self.data.subtree_com[self.root_body].copy()
+        return answer
 
     def com_velocity(self) -> np.ndarray:
         """CoM velocity, world, m/s (computes MuJoCo's subtree velocities)."""
         mujoco.mj_subtreeVel(self.model, self.data)
-        return self.data.subtree_linvel[self.root_body].copy()
+        answer: _FloatArray = self.data.subtree_linvel[self.root_body].copy()
+        return answer
+
+    def impact_point_velocity(self, normal: np.ndarray) -> np.ndarray:
+        """World velocity of the impact point (m/s).
+
+        The impact point is the impact sphere's surface point along ``-normal``.
+
+        Args:
+            normal: Unit surface normal (world), from the surface into the robot.
+
+        Returns:
+            The point's linear velocity (3,), world axes.
+
+        Raises:
+            SimulationError: The model has no impact sphere.
+        """
+        if self.impact_geom is None:
+            raise SimulationError("impact", None, "the model has no impact point")
+        out = np.zeros(6)
+        mujoco.mj_objectVelocity(
+            self.model, self.data, mujoco.mjtObj.mjOBJ_GEOM, self.impact_geom, out, 0
+        )
+        r = -self.model.geom_size[self.impact_geom][0] * normal
+        (wx, wy, wz), (rx, ry, rz) = out[:3].tolist(), r.tolist()
+        answer: _FloatArray = out[3:] + np.array(
+            (wy * rz - wz * ry, wz * rx - wx * rz, wx * ry - wy * rx)
+        )
+        return answer
 
     def contact_force(self, geom: int) -> np.ndarray:
-        """Total contact force on the robot at ``geom`` (one of its collision geoms), N, world axes."""
+        """Total contact force on the robot at ``geom`` (a collision geom of it), N, world axes."""
         m, d = self.model, self.data
         total = np.zeros(3)
         local = np.zeros(6)
@@ -183,7 +220,8 @@ class SimModel:
             if contact.geom1 != geom and contact.geom2 != geom:
                 continue
             mujoco.mj_contactForce(m, d, i, local)
-            # The force acts on geom2, along the contact frame whose first row (normal) points from geom1 to geom2.
+            # The force acts on geom2, along the contact frame whose first row (normal) points from
+            # geom1 to geom2.
             world = contact.frame.reshape(3, 3).T @ local[:3]
             total += world if contact.geom2 == geom else -world
         return total
@@ -214,7 +252,8 @@ class SimModel:
         wanted = np.asarray(geoms)[:, None]
         sign = (contacts.geom2[active][None, :] == wanted).astype(float)
         sign -= contacts.geom1[active][None, :] == wanted
-        return sign @ world
+        answer: _FloatArray = sign @ world
+        return answer
 
     def enable_supports(self, enabled: bool = True) -> None:
         """Let the sustained contacts touch their supports (default), or not (a floating robot).
@@ -227,8 +266,10 @@ class SimModel:
                 self.model.pair_margin[i] = 0.0 if enabled else -1.0
 
     def enable_impact_surface(self, enabled: bool = True) -> None:
-        """Let the impact point touch the impacted surface (default), or not (a push trial: the surface is
-        not there, so a falling robot cannot lean on it). Disabling sets the pair's margin to -1 m.
+        """Let the impact point touch the impacted surface (default), or not.
+
+        A push trial has no impacted surface, so that a falling robot cannot lean on it. Disabling
+        sets the pair's margin to -1 m.
         """
         if self.surface_geom is None:
             return
@@ -237,7 +278,7 @@ class SimModel:
                 self.model.pair_margin[i] = 0.0 if enabled else -1.0
 
     def set_servo_targets(self, q_ref: np.ndarray, v_ref: np.ndarray | None = None) -> None:
-        """Servo commands from target joint positions (pinocchio ``q``) and velocities (pinocchio ``v``).
+        """Servo commands from target joint positions and velocities (pinocchio order).
 
         The holding torques (:attr:`tau_hold`) are added as a feed-forward.
         """
@@ -265,8 +306,10 @@ def _joint_bodies(spec: mujoco.MjSpec, stance: Stance) -> dict[int, mujoco.MjsBo
 
 
 def _armature(robot: Robot, override: float | None, v_index: list[int]) -> tuple[np.ndarray, str]:
-    """Rotor inertia of each simulated joint (kg m^2) and its source: ``override`` for every joint, or
-    what the robot files declare (pinocchio's ``model.armature``, read from the SRDF's rotor_params).
+    """Rotor inertia of each simulated joint (kg m^2) and its source.
+
+    The source is ``override`` for every joint, or what the robot files declare (pinocchio's
+    ``model.armature``, read from the SRDF's rotor_params).
     """
     if override is not None:
         return np.full(
@@ -281,11 +324,20 @@ def _armature(robot: Robot, override: float | None, v_index: list[int]) -> tuple
 def build_model(
     scenario: Scenario | str | Path, joints: str = "servo", options: SimOptions | None = None
 ) -> SimModel:
-    """The scenario's MuJoCo model with ``rigid`` or ``servo`` joints, set to the stance at rest."""
-    if joints not in JOINT_MODELS:
-        raise SimulationError(
-            "--joints", joints, f"unknown joint model; valid: {', '.join(JOINT_MODELS)}"
-        )
+    """The scenario's MuJoCo model with ``rigid`` or ``servo`` joints, set to the stance at rest.
+
+    Args:
+        scenario: The scenario, or its name or file.
+        joints: Joint model, ``rigid`` (welded at the stance) or ``servo`` (position servos).
+        options: The model's options (default :class:`SimOptions`).
+
+    Returns:
+        The model, at the stance, at rest, the servos holding it.
+
+    Raises:
+        SimulationError: An unknown joint model, or a robot MuJoCo reads differently.
+    """
+    joint_model = check_joint_model(joints)
     options = options or SimOptions()
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
@@ -293,19 +345,7 @@ def build_model(
     robot = stance.robot
     impact = scenario.impact.spec() if scenario.impact is not None else None
 
-    spec, repair = robot_spec(robot, meshes=options.meshes)
-    if repair is not None:
-        # Once per robot and process: the default filter shows a message once per place it is issued from.
-        warnings.warn(
-            ModelRepairWarning(robot.name, repair.bodies, repair_message(robot.name, repair)),
-            stacklevel=1,
-        )
-    spec.option.timestep = options.timestep
-    spec.option.gravity = [0.0, 0.0, -scenario.gravity]
-    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-    if options.elliptic_cone:
-        spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
-    spec.option.impratio = options.impratio
+    spec, repair = _robot_spec(robot, scenario.gravity, options)
     names = add_geometry(spec, stance, _joint_bodies(spec, stance), impact, options.contact)
 
     # Joints simulated as joints (1-dof ones; pinocchio's continuous joints have nq = 2).
@@ -316,67 +356,33 @@ def build_model(
     unfused = spec.copy()
     unfused.compiler.fusestatic = False
     first = unfused.compile()
-    stance_qpos = np.zeros(first.nq)
-    stance_qpos[0:3] = stance.q[0:3]
-    stance_qpos[3:7] = (stance.q[6], *stance.q[3:6])
-    for name, slot in slots.items():
-        value = (
-            stance.q[slot.idx_q]
-            if slot.nq == 1
-            else np.arctan2(stance.q[slot.idx_q + 1], stance.q[slot.idx_q])
-        )
-        stance_qpos[first.joint(name).qposadr[0]] = value
+    stance_qpos = _stance_qpos(first, stance, slots)
 
     v_of = {name: robot.model.joints[slots[name].id].idx_v for name in sim_joints}
     armature, armature_source = _armature(
         robot, options.servo.armature, [v_of[n] for n in sim_joints]
     )
-    if joints == "rigid":
+    if joint_model == "rigid":
         weld_joints(spec, first, stance_qpos)
         sim_joints = []
         armature, armature_source = np.zeros(0), "none (rigid joints)"
     else:
-        data = mujoco.MjData(first)
-        data.qpos[:] = stance_qpos
-        mujoco.mj_forward(first, data)
-        full = np.zeros((first.nv, first.nv))
-        mujoco.mj_fullM(first, data, full)
-        inertia = (
-            np.array([full[first.joint(n).dofadr[0], first.joint(n).dofadr[0]] for n in sim_joints])
-            + armature
-        )
-        kp, kd = servo_gains(inertia, options.servo)
-        efforts = dict(zip(*(a.tolist() for a in robot.effort_limits)))  # velocity index -> N m
-        for name, p, d, a in zip(sim_joints, kp, kd, armature):
-            joint = spec.joint(name)
-            joint.armature = float(a)
-            effort = efforts.get(robot.model.joints[slots[name].id].idx_v, 0.0)
-            limited = options.servo.effort_limits and effort > 0.0
-            spec.add_actuator(
-                name=name,
-                target=name,
-                trntype=mujoco.mjtTrn.mjTRN_JOINT,
-                gaintype=mujoco.mjtGain.mjGAIN_FIXED,
-                gainprm=[p] + [0.0] * 9,
-                biastype=mujoco.mjtBias.mjBIAS_AFFINE,
-                biasprm=[0.0, -p, -d] + [0.0] * 7,
-                forcelimited=bool(limited),
-                forcerange=[-effort, effort] if limited else [0.0, 0.0],
-            )
-            if not options.servo.effort_limits:
-                joint.actfrclimited = mujoco.mjtLimited.mjLIMITED_FALSE
+        _add_servos(spec, first, stance_qpos, sim_joints, armature, robot, options.servo)
     model = spec.compile()
     data = mujoco.MjData(model)
 
-    def geom_id(name: str | None) -> int | None:
-        return None if name is None else model.geom(name).id
+    def geom_id(name: str) -> int:
+        return int(model.geom(name).id)
+
+    def optional_geom_id(name: str | None) -> int | None:
+        return None if name is None else geom_id(name)
 
     qpos_adr = np.array([model.joint(n).qposadr[0] for n in sim_joints], dtype=int)
     dof_adr = np.array([model.joint(n).dofadr[0] for n in sim_joints], dtype=int)
     actuator_ids = np.array([model.actuator(n).id for n in sim_joints], dtype=int)
     q_index = np.array([slots[n].idx_q for n in sim_joints], dtype=int)
     v_index = np.array([robot.model.joints[slots[n].id].idx_v for n in sim_joints], dtype=int)
-    if joints == "servo":
+    if joint_model == "servo":
         kp = model.actuator_gainprm[actuator_ids, 0].copy()
         kd = -model.actuator_biasprm[actuator_ids, 2].copy()
         tau_hold = holding_torques(stance, scenario.gravity)[v_index - 6]
@@ -385,7 +391,7 @@ def build_model(
     sim = SimModel(
         scenario=scenario,
         stance=stance,
-        joints=joints,
+        joints=joint_model,
         options=options,
         model=model,
         data=data,
@@ -399,8 +405,8 @@ def build_model(
         contact_geoms=tuple(geom_id(n) for n in names.contacts),
         support_geoms=tuple(geom_id(n) for n in names.supports),
         ground_geom=geom_id(names.ground),
-        impact_geom=geom_id(names.impact),
-        surface_geom=geom_id(names.surface),
+        impact_geom=optional_geom_id(names.impact),
+        surface_geom=optional_geom_id(names.surface),
         kp=kp,
         kd=kd,
         tau_hold=tau_hold,
@@ -411,3 +417,81 @@ def build_model(
     sim.set_state(stance.q)
     sim.set_servo_targets(stance.q)
     return sim
+
+
+def _robot_spec(
+    robot: Robot, gravity: float, options: SimOptions
+) -> tuple[mujoco.MjSpec, InertiaRepair | None]:
+    """The robot's MuJoCo spec with the simulation options (a repaired inertial is warned of)."""
+    spec, repair = robot_spec(robot, meshes=options.meshes)
+    if repair is not None:
+        # Once per robot and process: the default filter shows a message once per place it is
+        # issued from.
+        warnings.warn(
+            ModelRepairWarning(robot.name, repair.bodies, repair_message(robot.name, repair)),
+            stacklevel=1,
+        )
+    spec.option.timestep = options.timestep
+    spec.option.gravity = [0.0, 0.0, -gravity]
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    if options.elliptic_cone:
+        spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+    spec.option.impratio = options.impratio
+    return spec, repair
+
+
+def _stance_qpos(first: mujoco.MjModel, stance: Stance, slots: dict[str, JointSlot]) -> _FloatArray:
+    """MuJoCo's ``qpos`` of the stance in the model ``first`` (free joint quaternion w first)."""
+    stance_qpos = np.zeros(first.nq)
+    stance_qpos[0:3] = stance.q[0:3]
+    stance_qpos[3:7] = (stance.q[6], *stance.q[3:6])
+    for name, slot in slots.items():
+        value = (
+            stance.q[slot.idx_q]
+            if slot.nq == 1
+            else np.arctan2(stance.q[slot.idx_q + 1], stance.q[slot.idx_q])
+        )
+        stance_qpos[first.joint(name).qposadr[0]] = value
+    return stance_qpos
+
+
+def _add_servos(
+    spec: mujoco.MjSpec,
+    first: mujoco.MjModel,
+    stance_qpos: _FloatArray,
+    sim_joints: list[str],
+    armature: _FloatArray,
+    robot: Robot,
+    servo: ServoOptions,
+) -> None:
+    """One position servo per simulated joint, its gains from the joint's inertia at the stance."""
+    data = mujoco.MjData(first)
+    data.qpos[:] = stance_qpos
+    mujoco.mj_forward(first, data)
+    full = np.zeros((first.nv, first.nv))
+    mujoco.mj_fullM(first, data, full)
+    inertia = (
+        np.array([full[first.joint(n).dofadr[0], first.joint(n).dofadr[0]] for n in sim_joints])
+        + armature
+    )
+    kp, kd = servo_gains(inertia, servo)
+    # velocity index -> N m
+    efforts = dict(zip(*(a.tolist() for a in robot.effort_limits), strict=False))
+    for name, p, d, a in zip(sim_joints, kp, kd, armature, strict=False):
+        joint = spec.joint(name)
+        joint.armature = float(a)
+        effort = efforts.get(robot.model.joints[robot.joint_slot(name).id].idx_v, 0.0)
+        limited = servo.effort_limits and effort > 0.0
+        spec.add_actuator(
+            name=name,
+            target=name,
+            trntype=mujoco.mjtTrn.mjTRN_JOINT,
+            gaintype=mujoco.mjtGain.mjGAIN_FIXED,
+            gainprm=[p] + [0.0] * 9,
+            biastype=mujoco.mjtBias.mjBIAS_AFFINE,
+            biasprm=[0.0, -p, -d] + [0.0] * 7,
+            forcelimited=bool(limited),
+            forcerange=[-effort, effort] if limited else [0.0, 0.0],
+        )
+        if not servo.effort_limits:
+            joint.actfrclimited = mujoco.mjtLimited.mjLIMITED_FALSE

@@ -28,8 +28,8 @@ import mujoco
 import numpy as np
 import pinocchio as pin
 
-from impact_balance.contacts.stance import Stance
-from impact_balance.impact.model import cone_tangents
+from impact_balance.contacts.stance import Contact, Stance
+from impact_balance.impact.model import ImpactSpec, cone_tangents
 
 __all__ = ["CONTACT_GROUP", "ENVIRONMENT_GROUP", "ContactParameters", "Geometry", "add_geometry"]
 
@@ -100,7 +100,7 @@ def _pair(
     robot_geom: str,
     world_geom: str,
     mu: float,
-    solref,
+    solref: tuple[float, float],
     params: ContactParameters,
 ) -> None:
     spec.add_pair(
@@ -118,7 +118,7 @@ def add_geometry(
     spec: mujoco.MjSpec,
     stance: Stance,
     bodies: dict[int, mujoco.MjsBody],
-    impact,
+    impact: ImpactSpec | None,
     params: ContactParameters,
 ) -> Geometry:
     """Add the contact boxes, the impact sphere and the environment to ``spec``.
@@ -129,10 +129,28 @@ def add_geometry(
         bodies: MuJoCo body of each pinocchio joint id (1 = the root).
         impact: The scenario's :class:`impact_balance.impact.model.ImpactSpec`, or None.
         params: Sizes and contact parameters.
+
+    Returns:
+        The names of the geoms added.
     """
-    model = stance.model
-    t = params.box_half_thickness
-    # Ground: through the lowest horizontal contact (or the lowest contact corner if none is).
+    ground, ground_z = _add_ground(spec, stance)
+    contacts, supports = [], []
+    for i, contact in enumerate(stance.contacts):
+        name, support = _add_contact(spec, stance, bodies, i, contact, ground, ground_z, params)
+        contacts.append(name)
+        supports.append(support)
+    impact_name = surface_name = None
+    if impact is not None:
+        impact_name, surface_name = _add_impact(spec, stance, bodies, impact, params)
+    return Geometry(tuple(contacts), tuple(supports), ground, impact_name, surface_name)
+
+
+def _add_ground(spec: mujoco.MjSpec, stance: Stance) -> tuple[str, float]:
+    """The ground plane: its name and height (m).
+
+    The ground plane, through the lowest horizontal contact (or the lowest contact corner if none
+    is); its name and height (m).
+    """
     horizontal = [c for c in stance.contacts if c.normal[2] > _HORIZONTAL]
     heights = [c.position[2] for c in horizontal] or [stance.lowest_contact_height()]
     ground_z = float(min(heights)) if heights and np.isfinite(min(heights)) else 0.0
@@ -147,90 +165,112 @@ def add_geometry(
         group=ENVIRONMENT_GROUP,
         rgba=[0.6, 0.6, 0.6, 1.0],
     )
-    contacts, supports = [], []
-    for i, contact in enumerate(stance.contacts):
-        spec_i = contact.spec
-        frame = model.frames[stance.robot.frame_id(spec_i.frame)]
-        joint_pose = frame.placement * spec_i.offset  # contact in its parent joint's frame
-        box = pin.SE3(joint_pose.rotation, joint_pose.act(np.array([0.0, 0.0, t])))
-        name = f"contact_{i}"
-        bodies[frame.parentJoint].add_geom(
-            name=name,
-            type=mujoco.mjtGeom.mjGEOM_BOX,
-            size=[contact.half_length, contact.half_width, t],
-            pos=box.translation,
-            quat=_quat(box.rotation),
-            contype=0,
-            conaffinity=0,
-            condim=3,
-            friction=[spec_i.friction, 0.0, 0.0],
-            solref=list(params.contact_solref),
-            solimp=list(params.solimp),
-            group=CONTACT_GROUP,
-            rgba=[0.1, 0.6, 0.1, 0.8],
-        )
-        contacts.append(name)
-        _pair(spec, name, ground, spec_i.friction, params.contact_solref, params)
-        on_ground = contact.normal[2] > _HORIZONTAL and abs(contact.position[2] - ground_z) < 1e-3
-        if on_ground:
-            supports.append(ground)
-            continue
-        # A block whose face is the contact plane: centred half a thickness behind it.
-        depth = 0.05
-        centre = contact.position - depth * contact.normal
-        support = f"support_{i}"
-        spec.worldbody.add_geom(
-            name=support,
-            type=mujoco.mjtGeom.mjGEOM_BOX,
-            size=[
-                contact.half_length + params.support_margin,
-                contact.half_width + params.support_margin,
-                depth,
-            ],
-            pos=centre,
-            quat=_quat(contact.rotation),
-            contype=0,
-            conaffinity=0,
-            group=ENVIRONMENT_GROUP,
-            rgba=[0.55, 0.5, 0.45, 1.0],
-        )
-        supports.append(support)
-        _pair(spec, name, support, spec_i.friction, params.contact_solref, params)
-    impact_name = surface_name = None
-    if impact is not None:
-        frame = model.frames[stance.robot.frame_id(impact.frame, "impact.frame")]
-        point = stance.point(impact.frame, impact.offset, field="impact.frame")[0].translation
-        n = np.asarray(impact.normal, dtype=float) / np.linalg.norm(impact.normal)
-        r = params.impact_radius
-        centre = _in_joint(stance, frame.parentJoint, pin.SE3(np.eye(3), point + r * n)).translation
-        impact_name = "impact"
-        bodies[frame.parentJoint].add_geom(
-            name=impact_name,
-            type=mujoco.mjtGeom.mjGEOM_SPHERE,
-            size=[r, 0.0, 0.0],
-            pos=centre,
-            contype=0,
-            conaffinity=0,
-            condim=3,
-            friction=[impact.friction, 0.0, 0.0],
-            solref=list(params.impact_solref),
-            solimp=list(params.solimp),
-            group=CONTACT_GROUP,
-            rgba=[0.9, 0.1, 0.1, 1.0],
-        )
-        t1, t2 = cone_tangents(n)
-        depth = 0.05
-        surface_name = "impact_surface"
-        spec.worldbody.add_geom(
-            name=surface_name,
-            type=mujoco.mjtGeom.mjGEOM_BOX,
-            size=[0.25, 0.25, depth],
-            pos=point - depth * n,
-            quat=_quat(np.column_stack([t1, t2, n])),
-            contype=0,
-            conaffinity=0,
-            group=ENVIRONMENT_GROUP,
-            rgba=[0.7, 0.45, 0.3, 0.6],
-        )
-        _pair(spec, impact_name, surface_name, impact.friction, params.impact_solref, params)
-    return Geometry(tuple(contacts), tuple(supports), ground, impact_name, surface_name)
+    return ground, ground_z
+
+
+def _add_contact(
+    spec: mujoco.MjSpec,
+    stance: Stance,
+    bodies: dict[int, mujoco.MjsBody],
+    i: int,
+    contact: Contact,
+    ground: str,
+    ground_z: float,
+    params: ContactParameters,
+) -> tuple[str, str]:
+    """The robot box of contact ``i`` and what supports it: their names.
+
+    The support is the ground, or a block of its own.
+    """
+    t = params.box_half_thickness
+    spec_i = contact.spec
+    frame = stance.model.frames[stance.robot.frame_id(spec_i.frame)]
+    joint_pose = frame.placement * spec_i.offset  # contact in its parent joint's frame
+    box = pin.SE3(joint_pose.rotation, joint_pose.act(np.array([0.0, 0.0, t])))
+    name = f"contact_{i}"
+    bodies[frame.parentJoint].add_geom(
+        name=name,
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        size=[contact.half_length, contact.half_width, t],
+        pos=box.translation,
+        quat=_quat(box.rotation),
+        contype=0,
+        conaffinity=0,
+        condim=3,
+        friction=[spec_i.friction, 0.0, 0.0],
+        solref=list(params.contact_solref),
+        solimp=list(params.solimp),
+        group=CONTACT_GROUP,
+        rgba=[0.1, 0.6, 0.1, 0.8],
+    )
+    _pair(spec, name, ground, spec_i.friction, params.contact_solref, params)
+    on_ground = contact.normal[2] > _HORIZONTAL and abs(contact.position[2] - ground_z) < 1e-3
+    if on_ground:
+        return name, ground
+    # A block whose face is the contact plane: centred half a thickness behind it.
+    depth = 0.05
+    centre = contact.position - depth * contact.normal
+    support = f"support_{i}"
+    spec.worldbody.add_geom(
+        name=support,
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        size=[
+            contact.half_length + params.support_margin,
+            contact.half_width + params.support_margin,
+            depth,
+        ],
+        pos=centre,
+        quat=_quat(contact.rotation),
+        contype=0,
+        conaffinity=0,
+        group=ENVIRONMENT_GROUP,
+        rgba=[0.55, 0.5, 0.45, 1.0],
+    )
+    _pair(spec, name, support, spec_i.friction, params.contact_solref, params)
+    return name, support
+
+
+def _add_impact(
+    spec: mujoco.MjSpec,
+    stance: Stance,
+    bodies: dict[int, mujoco.MjsBody],
+    impact: ImpactSpec,
+    params: ContactParameters,
+) -> tuple[str, str]:
+    """The impact sphere on the robot and the impacted surface; their names."""
+    frame = stance.model.frames[stance.robot.frame_id(impact.frame, "impact.frame")]
+    point = stance.point(impact.frame, impact.offset, field="impact.frame")[0].translation
+    n = np.asarray(impact.normal, dtype=float) / np.linalg.norm(impact.normal)
+    r = params.impact_radius
+    centre = _in_joint(stance, frame.parentJoint, pin.SE3(np.eye(3), point + r * n)).translation
+    impact_name = "impact"
+    bodies[frame.parentJoint].add_geom(
+        name=impact_name,
+        type=mujoco.mjtGeom.mjGEOM_SPHERE,
+        size=[r, 0.0, 0.0],
+        pos=centre,
+        contype=0,
+        conaffinity=0,
+        condim=3,
+        friction=[impact.friction, 0.0, 0.0],
+        solref=list(params.impact_solref),
+        solimp=list(params.solimp),
+        group=CONTACT_GROUP,
+        rgba=[0.9, 0.1, 0.1, 1.0],
+    )
+    t1, t2 = cone_tangents(n)
+    depth = 0.05
+    surface_name = "impact_surface"
+    spec.worldbody.add_geom(
+        name=surface_name,
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        size=[0.25, 0.25, depth],
+        pos=point - depth * n,
+        quat=_quat(np.column_stack([t1, t2, n])),
+        contype=0,
+        conaffinity=0,
+        group=ENVIRONMENT_GROUP,
+        rgba=[0.7, 0.45, 0.3, 0.6],
+    )
+    _pair(spec, impact_name, surface_name, impact.friction, params.impact_solref, params)
+    return impact_name, surface_name

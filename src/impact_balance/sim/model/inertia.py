@@ -35,14 +35,19 @@ The repairs are reported once (:func:`repair_message`), naming the bodies.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import mujoco
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from impact_balance.robot.robot import Robot
 
 __all__ = ["FLOOR_FRACTION", "InertiaRepair", "repair_inertias", "repair_message"]
+
+_FloatArray = npt.NDArray[np.float64]
 
 #: Share of the total mass and of the smallest composite moment that all floors together may add.
 FLOOR_FRACTION = 1e-7
@@ -73,8 +78,8 @@ class InertiaRepair:
         """Every moving body whose inertial changed, merged first."""
         return tuple(dict.fromkeys([name for name, _ in self.merged] + list(self.floored)))
 
-    def to_dict(self) -> dict:
-        """JSON-ready: the bodies merged (with their links) and floored, the floors and the mass added."""
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: bodies merged and floored, the floors and the mass added."""
         return {
             "merged": {name: list(links) for name, links in self.merged},
             "floored": list(self.floored),
@@ -84,7 +89,7 @@ class InertiaRepair:
         }
 
 
-def _quat_matrix(quat) -> np.ndarray:
+def _quat_matrix(quat: ArrayLike) -> _FloatArray:
     out = np.empty(9)
     mujoco.mju_quat2Mat(out, np.asarray(quat, dtype=float))
     return out.reshape(3, 3)
@@ -96,7 +101,7 @@ def _matrix_quat(matrix: np.ndarray) -> np.ndarray:
     return out
 
 
-def _inertial(body) -> tuple[float, np.ndarray, np.ndarray]:
+def _inertial(body: mujoco.MjsBody) -> tuple[float, _FloatArray, _FloatArray]:
     """Mass (kg), CoM (m) and inertia about it (kg m^2), both in the body's frame."""
     mass = float(body.mass)
     com = np.array(body.ipos, dtype=float)
@@ -123,15 +128,15 @@ def _refused(mass: float, inertia: np.ndarray, moving: bool) -> bool:
         return False  # a link without inertial
     if moments[0] <= _MINVAL and np.any(inertia):
         return True  # a singular inertia tensor given explicitly
-    return moments[0] + moments[1] < moments[2] * (1.0 - _TRIANGLE_SLACK)
+    return bool(moments[0] + moments[1] < moments[2] * (1.0 - _TRIANGLE_SLACK))
 
 
-def _pose(body) -> tuple[np.ndarray, np.ndarray]:
+def _pose(body: mujoco.MjsBody) -> tuple[_FloatArray, _FloatArray]:
     return _quat_matrix(body.quat), np.array(body.pos, dtype=float)
 
 
-def _group(body) -> list[tuple[object, np.ndarray, np.ndarray]]:
-    """The jointless links fused into ``body``, with their pose in its frame (rotation, position)."""
+def _group(body: mujoco.MjsBody) -> list[tuple[mujoco.MjsBody, _FloatArray, _FloatArray]]:
+    """The jointless links fused into ``body``, with their pose in its frame."""
     out = []
     stack = [(child, *_pose(child)) for child in body.bodies]
     while stack:
@@ -149,10 +154,14 @@ def _combined(
     parts: list[tuple[float, np.ndarray, np.ndarray]],
 ) -> tuple[float, np.ndarray, np.ndarray]:
     """Sum of inertials (mass, CoM, inertia about the CoM) given in one frame."""
-    mass = sum(m for m, _, _ in parts)
+    mass = float(sum(m for m, _, _ in parts))
     if mass <= 0.0:
-        return 0.0, np.zeros(3), sum((i for _, _, i in parts), np.zeros((3, 3)))
-    com = sum(m * c for m, c, _ in parts) / mass
+        zero: _FloatArray = np.zeros((3, 3))
+        return 0.0, np.zeros(3), sum((i for _, _, i in parts), zero)
+    weighted: _FloatArray = np.zeros(3)
+    for m, c, _ in parts:
+        weighted = weighted + m * c
+    com = weighted / mass
     inertia = np.zeros((3, 3))
     for m, c, i in parts:
         r = c - com
@@ -160,7 +169,9 @@ def _combined(
     return mass, com, inertia
 
 
-def _set_inertial(body, mass: float, com: np.ndarray, inertia: np.ndarray) -> None:
+def _set_inertial(
+    body: mujoco.MjsBody, mass: float, com: _FloatArray, inertia: _FloatArray
+) -> None:
     moments, axes = np.linalg.eigh(0.5 * (inertia + inertia.T))
     if np.linalg.det(axes) < 0:
         axes[:, 0] = -axes[:, 0]
@@ -172,7 +183,7 @@ def _set_inertial(body, mass: float, com: np.ndarray, inertia: np.ndarray) -> No
     body.explicitinertial = True
 
 
-def _clear_inertial(body) -> None:
+def _clear_inertial(body: mujoco.MjsBody) -> None:
     body.mass = 0.0
     body.ipos = [0.0, 0.0, 0.0]
     body.iquat = [1.0, 0.0, 0.0, 0.0]

@@ -20,9 +20,10 @@
     limit (the actuator's force range; MuJoCo also keeps it as the joint's actuator force
     range), and the URDF damping and friction loss stay. ``armature`` (rotor inertia
     reflected through the gearbox, kg m^2) is added to every joint: by default what the robot
-    files declare (the SRDF's ``rotor_params``, see :attr:`impact_balance.robot.robot.Robot.armature_source`;
-    0 where they declare none), or one value for every joint. The torque feed-forward holds the stance against gravity: the joint torques of
-    the smallest contact wrenches (least squares) that balance gravity within the contact
+    files declare (the SRDF's ``rotor_params``, see
+    :attr:`impact_balance.robot.robot.Robot.armature_source`; 0 where they declare none), or one
+    value for every joint. The torque feed-forward holds the stance against gravity: the joint
+    torques of the smallest contact wrenches (least squares) that balance gravity within the contact
     wrench cones, solved once at the stance.
 """
 
@@ -30,19 +31,55 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 import mujoco
 import numpy as np
+import numpy.typing as npt
 import qpsolvers
 
 from impact_balance.constants import GRAVITY
 from impact_balance.contacts.cwc import cwc_faces_world
 from impact_balance.contacts.stance import Stance
+from impact_balance.exceptions import SimulationError
 
-__all__ = ["JOINT_MODELS", "ServoOptions", "holding_torques", "servo_gains", "weld_joints"]
+__all__ = [
+    "JOINT_MODELS",
+    "JointModel",
+    "ServoOptions",
+    "check_joint_model",
+    "holding_torques",
+    "servo_gains",
+    "weld_joints",
+]
+
+_FloatArray = npt.NDArray[np.float64]
+
+#: A joint model: ``rigid`` (welded joints) or ``servo`` (position servos).
+JointModel = Literal["rigid", "servo"]
 
 #: Joint models, in the order of ``--help``.
-JOINT_MODELS = ("rigid", "servo")
+JOINT_MODELS: tuple[JointModel, ...] = ("rigid", "servo")
+
+
+def check_joint_model(name: str) -> JointModel:
+    """``name`` as a joint model.
+
+    Args:
+        name: ``rigid`` or ``servo``.
+
+    Returns:
+        The joint model.
+
+    Raises:
+        SimulationError: ``name`` is not a joint model's.
+    """
+    for model in JOINT_MODELS:
+        if model == name:
+            return model
+    raise SimulationError(
+        "--joints", name, f"unknown joint model; valid: {', '.join(JOINT_MODELS)}"
+    )
 
 
 @dataclass(frozen=True)
@@ -66,7 +103,10 @@ class ServoOptions:
 def servo_gains(
     reflected_inertia: np.ndarray, options: ServoOptions
 ) -> tuple[np.ndarray, np.ndarray]:
-    """``(kp, kd)`` of each joint (N m/rad, N m s/rad) from its reflected inertia (kg m^2, armature included)."""
+    """``(kp, kd)`` of each joint from its reflected inertia.
+
+    Gains in N m/rad and N m s/rad, inertias in kg m^2 (armature included).
+    """
     inertia = np.asarray(reflected_inertia, dtype=float)
     w = options.bandwidth
     return inertia * w * w, 2.0 * options.damping_ratio * inertia * w
@@ -81,9 +121,9 @@ def holding_torques(stance: Stance, gravity: float = GRAVITY) -> np.ndarray:
     the unconstrained least-squares wrenches are used (the stance cannot hold; the servos
     do their best).
     """
-    g = stance.gravity_torques * (gravity / GRAVITY)
+    g: _FloatArray = stance.gravity_torques * (gravity / GRAVITY)
     if not stance.contacts:
-        return g[6:].copy()
+        return np.array(g[6:])
     J = np.vstack([c.jacobian for c in stance.contacts])  # (6k, nv)
     A = J[:, :6].T
     b = g[:6]
@@ -103,12 +143,15 @@ def holding_torques(stance: Stance, gravity: float = GRAVITY) -> np.ndarray:
     )
     if w is None:
         w = np.linalg.lstsq(A, b, rcond=None)[0]
-    return (g - J.T @ w)[6:]
+    torques: _FloatArray = (g - J.T @ w)[6:]
+    return torques
 
 
 def weld_joints(spec: mujoco.MjSpec, model: mujoco.MjModel, qpos: np.ndarray) -> None:
-    """Weld every non-free joint of ``spec`` at ``qpos`` (a configuration of ``model``, compiled from ``spec``
-    without fusing static bodies, so that every body of ``spec`` is in ``model``).
+    """Weld every non-free joint of ``spec`` at ``qpos``.
+
+    ``qpos`` is a configuration of ``model``, compiled from ``spec`` without fusing static bodies,
+    so that every body of ``spec`` is in ``model``.
 
     Each body takes its pose relative to its parent at ``qpos``, then its joints are deleted.
     """

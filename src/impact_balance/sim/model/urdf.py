@@ -74,7 +74,7 @@ def _resolved_urdf(robot: Robot) -> str:
     search = [*robot.package_dirs, str(robot.urdf_path.parent)]
     search += [p for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
 
-    def replace(match: re.Match) -> str:
+    def replace(match: re.Match[str]) -> str:
         found = resolve_package_uri(match.group(1), match.group(2), search)
         return str(found) if found is not None else match.group(0)
 

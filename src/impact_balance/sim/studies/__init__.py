@@ -1,1 +1,9 @@
-"""Studies built on trials: the fall threshold (:mod:`.validate`), push grids (:mod:`.push`), the wall approach (:mod:`.wall`), trial journals (:mod:`.journal`) and scores (:mod:`.scores`)."""
+"""Studies built on balance trials.
+
+- :mod:`.validate`: the fall threshold of an impact, against the criteria's predictions;
+- :mod:`.push`: push grids, against the criteria's predictions;
+- :mod:`.wall`: the governed approach to a wall;
+- :mod:`.journal`: journals of finished trials; :mod:`.scores`: how predictions are scored.
+"""
+
+__all__: list[str] = []

@@ -31,7 +31,10 @@ def journal_digest(parts: dict[str, Any]) -> str:
 
 
 def default_journal_path(command: str, scenario: str, digest: str) -> Path:
-    """``impact-balance-trials/<command>_<scenario>_<digest[:12]>.jsonl`` in the current directory."""
+    """The journal's default path, in ``impact-balance-trials/`` of the current directory.
+
+    ``impact-balance-trials/<command>_<scenario>_<digest[:12]>.jsonl`` in the current directory.
+    """
     safe = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in (scenario or "scenario"))[
         :80
     ]
@@ -56,13 +59,15 @@ class TrialJournal:
 
     path: Path | None
     digest: str
-    header: dict = field(default_factory=dict)
-    entries: dict[str, dict] = field(default_factory=dict)
+    header: dict[str, Any] = field(default_factory=dict)
+    entries: dict[str, dict[str, Any]] = field(default_factory=dict)
     skipped_lines: int = 0
     _handle: Any = field(default=None, init=False, repr=False)
 
     @classmethod
-    def open(cls, path: str | Path | None, digest: str, header: dict | None = None) -> TrialJournal:
+    def open(
+        cls, path: str | Path | None, digest: str, header: dict[str, Any] | None = None
+    ) -> TrialJournal:
         """Open (or create) the journal at ``path``; a file of another digest is refused."""
         from impact_balance.exceptions import SimulationError
 
@@ -86,6 +91,7 @@ class TrialJournal:
     def _read(self) -> None:
         from impact_balance.exceptions import SimulationError
 
+        assert self.path is not None
         with open(self.path, encoding="utf-8", errors="replace") as fh:
             text = fh.read()
         lines = text.splitlines()
@@ -113,23 +119,24 @@ class TrialJournal:
             with open(self.path, "a", encoding="utf-8") as fh:
                 fh.write("\n")
 
-    def _write(self, record: dict) -> None:
+    def _write(self, record: dict[str, Any]) -> None:
         if self._handle is None:
             return
         self._handle.write(json.dumps(record, allow_nan=False) + "\n")
         self._handle.flush()
         os.fsync(self._handle.fileno())
 
-    def get(self, key: Any) -> dict | None:
+    def get(self, key: Any) -> dict[str, Any] | None:
         """The stored entry of a trial, or None."""
         return self.entries.get(_key(key))
 
-    def add(self, key: Any, entry: dict) -> None:
+    def add(self, key: Any, entry: dict[str, Any]) -> None:
         """Record a finished trial (written and flushed at once)."""
         self.entries[_key(key)] = entry
         self._write({"key": key, "entry": entry})
 
     def close(self) -> None:
+        """Close the journal's file (idempotent)."""
         if self._handle is not None:
             self._handle.close()
             self._handle = None

@@ -1,4 +1,6 @@
-"""Push recovery (paper Exp. 2): impulsive pushes in every direction, predicted before, scored after.
+"""Push recovery (paper Exp. 2): impulsive pushes in every direction.
+
+Both criteria predict each push's outcome before the trial; the trials then score them.
 
 For every push both criteria predict the outcome **before the trial**, from the scenario alone:
 
@@ -9,9 +11,10 @@ For every push both criteria predict the outcome **before the trial**, from the 
   support area.
 
 They are also read from the trial, as a second column (``*_in_trial``): the measured CoM velocity
-at the end of the push in the area, and the measured ZMP in the ZMP support area throughout the push.
-Each prediction is made against the areas shrunk by a ZMP margin (:mod:`impact_balance.balance.areas`);
-the trials themselves do not depend on it, so one set of trials is scored at any margin.
+at the end of the push in the area, and the measured ZMP in the ZMP support area throughout the
+push. Each prediction is made against the areas shrunk by a ZMP margin
+(:mod:`impact_balance.balance.areas`); the trials themselves do not depend on it, so one set of
+trials is scored at any margin.
 
 Magnitudes are impulses in N s, or fractions of each direction's *boundary impulse* ``m r(u)`` (the
 impulse that puts the predicted CoM velocity on the boundary of the CoM velocity area without
@@ -23,24 +26,27 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import mujoco
 import numpy as np
+from numpy.typing import ArrayLike
 
 from impact_balance.exceptions import SimulationError
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.scenario import Scenario, load_scenario
+from impact_balance.sim.control.registry import controller_class
 from impact_balance.sim.studies.journal import TrialJournal
 from impact_balance.sim.studies.scores import MARGIN_GRID, confusion
 from impact_balance.sim.trials.balance_trial import (
     BalanceSetup,
     BalanceTrialOptions,
     Push,
-    _push_body,
     controller_margin,
     run_balance_trial,
 )
 from impact_balance.sim.trials.result import TrialEntry, trajectory
+from impact_balance.sim.trials.setup import push_body
 
 __all__ = [
     "CRITERIA",
@@ -57,7 +63,8 @@ __all__ = [
 DEFAULT_MAGNITUDES = (5.0, 10.0, 15.0, 20.0, 25.0, 30.0)
 #: The predictions scored: each criterion before the trial, and read in the trial.
 CRITERIA = ("com", "com_in_trial", "zmp", "zmp_in_trial")
-#: Target share of all pushes predicted safe that fell (the margin study reports the smallest margin reaching it).
+#: Target share of all pushes predicted safe that fell (the margin study reports the smallest margin
+#: reaching it).
 SAFE_FELL_TARGET = 0.05
 
 
@@ -96,10 +103,12 @@ def check_push_arguments(
 
 
 def boundary_impulse(
-    area: Polygon, mass: float, direction: float, com_velocity=(0.0, 0.0)
+    area: Polygon, mass: float, direction: float, com_velocity: ArrayLike = (0.0, 0.0)
 ) -> float:
-    """The impulse (N s) along ``direction`` (rad) that puts ``com_velocity + J u / m`` on the boundary of
-    ``area`` (m/s); 0 when ``com_velocity`` is outside, inf when the area is unbounded that way.
+    """The impulse (N s) along ``direction`` that brings the CoM velocity to the area's boundary.
+
+    The impulse puts ``com_velocity + J u / m`` (m/s) on the boundary of ``area``; it is 0 when
+    ``com_velocity`` is outside, inf when the area is unbounded that way. ``direction`` is in rad.
     """
     G, h = area.halfplanes
     u = np.array([np.cos(direction), np.sin(direction)])
@@ -113,8 +122,10 @@ def boundary_impulse(
 
 @dataclass(frozen=True)
 class PushPrediction:
-    """A push's before-trial predictions, as margins in the areas without margin (safe at a ZMP margin ``M``
-    when ``com_velocity_margin >= omega M``, resp. ``zmp_margin >= M``).
+    """A push's before-trial predictions, as margins in the areas without margin.
+
+    The push is safe at a ZMP margin ``M`` when ``com_velocity_margin >= omega M``, resp.
+    ``zmp_margin >= M``.
 
     Attributes:
         com_velocity: Predicted post-push planar CoM velocity (m/s, world).
@@ -131,14 +142,18 @@ class PushPrediction:
 
 @dataclass(kw_only=True)
 class PushOutcome(TrialEntry):
-    """One push: what was tried, what was predicted before, and the trial's summary and trajectory."""
+    """One push: what was tried and predicted, and the trial's summary and trajectory."""
 
     push: Push
     relative: float | None
     prediction: PushPrediction
 
     def safe(self, criterion: str, margin: float, omega: float) -> bool:
-        """Whether ``criterion`` (one of :data:`CRITERIA`) calls the push safe at ZMP margin ``margin`` (m)."""
+        """Whether ``criterion`` calls the push safe at ZMP margin ``margin`` (m).
+
+        Whether ``criterion`` (one of :data:`CRITERIA`) calls the push safe at ZMP margin ``margin``
+        (m).
+        """
         s, p = self.summary, self.prediction
         if criterion == "com":
             return p.com_velocity_margin >= omega * margin
@@ -150,7 +165,8 @@ class PushOutcome(TrialEntry):
         m = s.get("min_zmp_margin_during")  # null: a foot carried nothing, no ZMP: not safe
         return m is not None and m >= margin
 
-    def to_dict(self, margin: float, omega: float) -> dict:
+    def to_dict(self, margin: float, omega: float) -> dict[str, Any]:
+        """JSON-ready, the criteria's calls at ZMP margin ``margin`` (m) with ``omega`` (1/s)."""
         s = self.summary
         return {
             "direction": float(self.push.direction),
@@ -178,12 +194,15 @@ class PushOutcome(TrialEntry):
 
 @dataclass
 class PushTestResult:
-    """Every push of a push test and how each criterion scores (at ``zmp_margin``, and against the margin)."""
+    """Every push of a push test and how each criterion scores.
 
-    scenario: str
+    The scores are at ``zmp_margin``, and against the margin.
+    """
+
+    scenario: str | None
     outcomes: list[PushOutcome]
-    controller: dict
-    criteria: dict
+    controller: dict[str, Any]
+    criteria: dict[str, Any]
     setup: BalanceSetup
     zmp_margin: float
     controller_margin: float
@@ -194,10 +213,14 @@ class PushTestResult:
 
     @property
     def scored(self) -> list[PushOutcome]:
+        """The pushes that count in the scores (their trial was not aborted)."""
         return [o for o in self.outcomes if o.scored]
 
-    def scores(self, margin: float | None = None) -> dict:
-        """Confusion of every criterion (:data:`CRITERIA`) at ZMP margin ``margin`` (default: the result's)."""
+    def scores(self, margin: float | None = None) -> dict[str, Any]:
+        """Confusion of every criterion (:data:`CRITERIA`) at ZMP margin ``margin``.
+
+        ``margin`` defaults to the result's.
+        """
         margin = self.zmp_margin if margin is None else margin
         scored = self.scored
         fell = [o.fell for o in scored]
@@ -205,16 +228,20 @@ class PushTestResult:
             c: confusion([o.safe(c, margin, self.omega) for o in scored], fell) for c in CRITERIA
         }
 
-    def margin_study(self) -> dict:
-        """Scores at 0, the controller's margin and twice it, and the smallest margin (of :data:`MARGIN_GRID`)
-        that brings each criterion's "predicted safe, fell" to :data:`SAFE_FELL_TARGET` or less.
+    def margin_study(self) -> dict[str, Any]:
+        """Scores at several margins, and the smallest margin that makes each criterion safe.
+
+        Scores at 0, the controller's margin and twice it, and the smallest margin (of
+        :data:`MARGIN_GRID`) that brings each criterion's "predicted safe, fell" to
+        :data:`SAFE_FELL_TARGET` or less.
         """
         own = self.controller_margin
         margins = sorted({0.0, own, 2 * own})
+        smallest: dict[str, float | None] = {}
         out = {
             "margins": margins,
             "scores": {f"{m:g}": self.scores(m) for m in margins},
-            "smallest_margin": {},
+            "smallest_margin": smallest,
         }
         for c in CRITERIA:
             found = None
@@ -223,12 +250,12 @@ class PushTestResult:
                 if rate is not None and rate <= SAFE_FELL_TARGET:
                     found = m
                     break
-            out["smallest_margin"][c] = found
+            smallest[c] = found
         return out
 
-    def contact_breaks(self) -> dict:
-        """Pushes that broke a contact without a fall, and which contact broke first, by magnitude."""
-        rows: dict[str, dict] = {}
+    def contact_breaks(self) -> dict[str, Any]:
+        """Pushes that broke a contact without a fall, and which contact first, by magnitude."""
+        rows: dict[str, dict[str, Any]] = {}
         for o in self.scored:
             key = f"{o.push.magnitude:g}"
             row = rows.setdefault(
@@ -255,7 +282,7 @@ class PushTestResult:
             "by_magnitude": list(rows.values()),
         }
 
-    def counts(self) -> dict:
+    def counts(self) -> dict[str, Any]:
         """Outcomes counted, and the falls by reason."""
         outcomes = {
             k: sum(o.outcome == k for o in self.outcomes)
@@ -268,7 +295,8 @@ class PushTestResult:
                 reasons[key] = reasons.get(key, 0) + 1
         return {"outcomes": outcomes, "reasons": reasons}
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: ``push-test --json``."""
         return {
             "scenario": self.scenario,
             "zmp_margin": self.zmp_margin,
@@ -325,10 +353,12 @@ def push_test(
     zmp_margin: float | None = None,
     journal: TrialJournal | None = None,
 ) -> PushTestResult:
-    """Push the robot in ``directions`` evenly spaced directions at every magnitude (N s, or fractions
-    ``relative`` of each direction's boundary impulse) for ``duration`` s, and score both criteria at
-    ``zmp_margin`` (m; default: the controller's own margin). Finished trials go to ``journal`` as they
-    end, and trials it already holds are not run again.
+    """Push the robot in evenly spaced directions and score both criteria.
+
+    Pushes in ``directions`` directions at every magnitude (N s, or fractions ``relative`` of each
+    direction's boundary impulse) for ``duration`` s; both criteria are scored at ``zmp_margin`` (m;
+    default: the controller's own margin). Finished trials go to ``journal`` as they end, and trials
+    it already holds are not run again.
     """
     wall0 = time.perf_counter()
     if not isinstance(scenario, Scenario):
@@ -338,14 +368,14 @@ def push_test(
     check_push_arguments(directions, magnitudes, duration, relative)
     options = options or BalanceTrialOptions()
     setup = setup or BalanceSetup.create(scenario, "servo", options)
-    body_id = _push_body(setup.sim, body)
+    body_id = push_body(setup.sim, body)
     height = _body_height(setup, body_id)
     a = setup.analysis
     omega = float(a.areas.omega)
     own = controller_margin(options)
     journal = journal or TrialJournal(None, "")
     outcomes, reused = [], 0
-    levels = list(relative if relative is not None else magnitudes)
+    levels = list(relative if relative is not None else magnitudes or ())
     for level in levels:
         for k in range(directions):
             angle = 2 * np.pi * k / directions
@@ -391,17 +421,9 @@ def push_test(
             outcomes.append(outcome)
             if progress:
                 progress(outcome)
-    if setup.controller == "id":
-        from impact_balance.sim.control.torque import describe
-
-        controller = describe(
-            options.id_gains, float(setup.sim.model.opt.timestep), setup.joints == "servo"
-        )
-    else:
-        controller = {
-            "name": "dcm-zmp-clamp + pink IK -> joint position servos",
-            "gains": options.gains.to_dict(),
-        }
+    controller = controller_class(setup.controller).trial_summary(
+        options, setup.sim, setup.joints == "servo"
+    )
     controller["armature"] = setup.sim.armature_source
     repair = setup.sim.inertia_repair
     controller["inertia_repair"] = None if repair is None else repair.to_dict()

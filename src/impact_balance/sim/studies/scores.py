@@ -13,12 +13,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
 __all__ = ["MARGIN_GRID", "confusion", "wilson"]
 
-#: ZMP margins (m) searched for the smallest one that brings "predicted safe, fell" to a target rate.
+#: ZMP margins (m) searched for the smallest one that brings "predicted safe, fell" to a target
+#: rate.
 MARGIN_GRID = tuple(round(0.001 * k, 3) for k in range(61))
 
 
@@ -33,11 +35,11 @@ def wilson(successes: int, total: int, z: float = 1.959963984540054) -> list[flo
     return [max(0.0, centre - half), min(1.0, centre + half)]
 
 
-def confusion(predicted_safe: Sequence[bool], fell: Sequence[bool]) -> dict:
+def confusion(predicted_safe: Sequence[bool], fell: Sequence[bool]) -> dict[str, Any]:
     """Counts of a criterion's predictions against the falls, and its rates with Wilson intervals.
 
-    ``accuracy``: share of trials whose outcome it predicted; ``safe_fell_rate``: share of all trials it
-    called safe that fell; ``fell_given_safe``: share of those it called safe that fell;
+    ``accuracy``: share of trials whose outcome it predicted; ``safe_fell_rate``: share of all
+    trials it called safe that fell; ``fell_given_safe``: share of those it called safe that fell;
     ``survived_given_unsafe``: share of those it called unsafe that did not fall.
     """
     p = np.asarray(predicted_safe, dtype=bool)

@@ -22,13 +22,17 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from impact_balance.analysis.analyze import analyze
 from impact_balance.exceptions import SimulationError
+from impact_balance.impact.model import INERTIA_MODELS
+from impact_balance.json_values import json_number
 from impact_balance.ranges import check_tolerance
 from impact_balance.scenario import Scenario, load_scenario
+from impact_balance.sim.control.registry import controller_class
 from impact_balance.sim.studies.journal import TrialJournal
 from impact_balance.sim.trials.balance_trial import (
     BalanceSetup,
@@ -36,80 +40,103 @@ from impact_balance.sim.trials.balance_trial import (
     controller_margin,
     run_balance_trial,
 )
+from impact_balance.sim.trials.outcomes import OutcomeName
 from impact_balance.sim.trials.result import TrialEntry, trajectory
 
-__all__ = ["INERTIA_MODELS", "ValidationResult", "ValidationTrial", "predictions", "validate"]
-
-INERTIA_MODELS = ("composite", "joint_space")
-
-
-def _num(x: float | None) -> float | None:
-    return None if x is None or not np.isfinite(x) else float(x)
+__all__ = [
+    "INERTIA_MODELS",
+    "ValidationProgress",
+    "ValidationResult",
+    "ValidationTrial",
+    "predictions",
+    "validate",
+]
 
 
 def predictions(scenario: Scenario, zmp_margin: float = 0.0) -> dict[str, dict[str, float | None]]:
-    """Maximum contact velocity (m/s; None if unbounded) by each criterion and inertia model, with the ZMP
-    support area shrunk by ``zmp_margin`` (m).
+    """Maximum contact velocity by each criterion and inertia model.
+
+    Maximum contact velocity (m/s; None if unbounded) by each criterion and inertia model, with the
+    ZMP support area shrunk by ``zmp_margin`` (m).
     """
     out: dict[str, dict[str, float | None]] = {"com_criterion": {}, "zmp_criterion": {}}
+    impact = scenario.impact
+    if impact is None:
+        raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact")
     for inertia in INERTIA_MODELS:
         variant = scenario.model_copy(
             update={
-                "impact": scenario.impact.model_copy(update={"inertia": inertia}),
+                "impact": impact.model_copy(update={"inertia": inertia}),
                 "zmp_margin": float(zmp_margin),
             }
         )
         answer = analyze(variant).impact
-        out["com_criterion"][inertia] = _num(answer.max_contact_velocity)
-        out["zmp_criterion"][inertia] = _num(answer.zmp_max_contact_velocity)
+        if answer is None:
+            raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact")
+        out["com_criterion"][inertia] = json_number(answer.max_contact_velocity)
+        out["zmp_criterion"][inertia] = json_number(answer.zmp_max_contact_velocity)
     return out
 
 
 @dataclass(kw_only=True)
 class ValidationTrial(TrialEntry):
-    """One trial of the search: the commanded speed, the trial's summary and its CoM velocity trajectory."""
+    """One trial of the search: commanded speed, summary and CoM velocity trajectory."""
 
     speed: float
 
     @property
     def measured(self) -> float | None:
-        return self.summary.get("approach_speed_measured")
+        """The approach speed measured at the contact (m/s), None without one."""
+        measured: float | None = self.summary.get("approach_speed_measured")
+        return measured
+
+
+def _measured(trial: ValidationTrial) -> float:
+    """The measured approach speed (m/s) of a scored trial (scored trials have one)."""
+    measured = trial.measured
+    assert measured is not None
+    return measured
 
 
 @dataclass
 class ValidationResult:
     """Predictions beside the empirical bracket; ``to_dict()`` is ``validate --json``."""
 
-    scenario: str
+    scenario: str | None
     joints: str
     rigid_impact: bool
-    predicted: dict
-    predicted_with_margin: dict
+    predicted: dict[str, Any]
+    predicted_with_margin: dict[str, Any]
     zmp_margin: float
     omega: float
     trials: list[ValidationTrial]
-    controller: dict
-    outcome_criteria: dict
+    controller: dict[str, Any]
+    outcome_criteria: dict[str, Any]
     tolerance: float
     max_speed: float
     wall_time: float = 0.0
     journal: str | None = None
     reused: int = 0
-    extra: dict = field(default_factory=dict)
+    extra: dict[str, Any] = field(default_factory=dict)
 
     @property
     def scored(self) -> list[ValidationTrial]:
+        """The trials that count in the bracket (not aborted, approach speed measured)."""
         return [t for t in self.trials if t.scored and t.measured is not None]
 
-    def bracket(self) -> dict:
+    def bracket(self) -> dict[str, Any]:
         """The bracket in measured and commanded approach speed (see the module docstring)."""
         scored = self.scored
         fell = [t for t in scored if t.fell]
         stood = [t for t in scored if not t.fell]
-        lowest_fall = min(fell, key=lambda t: t.measured) if fell else None
-        below = [t for t in stood if lowest_fall is None or t.measured < lowest_fall.measured]
-        survived = max(below, key=lambda t: t.measured) if below else None
-        monotonic = not (fell and stood and max(t.measured for t in stood) > lowest_fall.measured)
+        lowest_fall = min(fell, key=_measured) if fell else None
+        below = [t for t in stood if lowest_fall is None or _measured(t) < _measured(lowest_fall)]
+        survived = max(below, key=_measured) if below else None
+        monotonic = not (
+            lowest_fall is not None
+            and stood
+            and max(_measured(t) for t in stood) > _measured(lowest_fall)
+        )
         fell_c = min((t.speed for t in fell), default=None)
         stood_c = max((t.speed for t in stood if fell_c is None or t.speed < fell_c), default=None)
         return {
@@ -118,15 +145,18 @@ class ValidationResult:
             "survived_commanded": stood_c,
             "fell_commanded": fell_c,
             "monotonic": monotonic,
-            "fastest_measured": max((t.measured for t in scored), default=None),
+            "fastest_measured": max((_measured(t) for t in scored), default=None),
         }
 
-    def contact_break(self) -> dict | None:
-        """The slowest trial (measured speed) that broke a contact (fell or not) and its first event."""
+    def contact_break(self) -> dict[str, Any] | None:
+        """The slowest trial that broke a contact (fell or not) and its first event.
+
+        The slowest trial (measured speed) that broke a contact (fell or not) and its first event.
+        """
         broken = [t for t in self.scored if t.summary["events"]]
         if not broken:
             return None
-        first = min(broken, key=lambda t: t.measured)
+        first = min(broken, key=_measured)
         event = min(first.summary["events"], key=lambda e: e["time"])
         return {
             "measured": first.measured,
@@ -135,10 +165,12 @@ class ValidationResult:
             **event,
         }
 
-    def post_impact(self, trial: ValidationTrial) -> dict | None:
-        """The measured post-impact CoM velocity against the predicted set (composite, the scenario's friction and
-        restitution range) at the measured speed from the measured pre-impact CoM velocity: the set's vertices and
-        the distance from the measurement to it (m/s, 0 inside).
+    def post_impact(self, trial: ValidationTrial) -> dict[str, Any] | None:
+        """The measured post-impact CoM velocity against the predicted set.
+
+        The predicted set is the composite model's, over the scenario's friction and restitution
+        range, at the measured speed from the measured pre-impact CoM velocity. Returns the set's
+        vertices and the distance from the measurement to it (m/s, 0 inside).
         """
         impact = trial.summary.get("impact")
         setup = self.extra.get("setup")
@@ -156,7 +188,8 @@ class ValidationResult:
         after = np.asarray(impact["com_velocity_after"], dtype=float)
         return {"vertices": vertices.tolist(), "distance": float(distance_to_hull(after, vertices))}
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: ``validate --json``."""
         com_max = self.predicted_with_margin["com_criterion"]["composite"]
         trials = []
         for t in self.trials:
@@ -200,6 +233,128 @@ class ValidationResult:
         }
 
 
+class _TrialRunner:
+    """Runs the search's trials (or reads them from the journal) and keeps them in order."""
+
+    def __init__(self, setup: BalanceSetup, options: BalanceTrialOptions, journal: TrialJournal):
+        self.setup, self.options, self.journal = setup, options, journal
+        self.trials: list[ValidationTrial] = []
+        self.reused = 0
+
+    def __call__(self, speed: float) -> OutcomeName:
+        """The outcome of the trial at the commanded ``speed`` (m/s)."""
+        key = {"speed": round(speed, 9)}
+        entry = self.journal.get(key)
+        if entry is None:
+            result = run_balance_trial(self.setup, impact_speed=speed, options=self.options)
+            start = (
+                result.disturbance_time
+                if result.disturbance_time is not None
+                else self.options.settle
+            )
+            entry = {
+                "summary": result.summary(),
+                "trajectory": trajectory(result, start - 0.05, start + 1.5),
+            }
+            self.journal.add(key, entry)
+        else:
+            self.reused += 1
+        self.trials.append(
+            ValidationTrial(speed=speed, summary=entry["summary"], trajectory=entry["trajectory"])
+        )
+        return self.trials[-1].outcome
+
+
+ValidationProgress = Callable[[ValidationTrial, float | None, float | None], None]
+
+
+class _Search:
+    """The search of the fall threshold: bracket, then bisect (see :func:`validate`)."""
+
+    def __init__(
+        self,
+        trial: _TrialRunner,
+        tolerance: float,
+        min_speed: float,
+        max_speed: float,
+        progress: ValidationProgress | None,
+    ):
+        self.trial, self.tolerance = trial, tolerance
+        self.min_speed, self.max_speed = min_speed, max_speed
+        self.progress = progress
+
+    def _report(self, stood: float | None, fell: float | None) -> None:
+        if self.progress:
+            self.progress(self.trial.trials[-1], stood, fell)
+
+    def bracket(self, speed: float) -> tuple[float | None, float | None]:
+        """Double (or halve) the commanded ``speed`` (m/s) until the outcome changes.
+
+        Returns:
+            The fastest speed that stood and the slowest that fell (None: not found).
+        """
+        tolerance, min_speed, max_speed = self.tolerance, self.min_speed, self.max_speed
+        stood: float | None = None
+        fell: float | None = None
+        ceiling = max_speed  # aborted trials lower it: nothing faster can be tested
+        while True:
+            outcome = self.trial(speed)
+            if outcome == "aborted":  # nothing this fast can be tested: look below
+                ceiling = speed
+                if fell is not None or speed <= min_speed:
+                    break
+                speed = max(min_speed, speed / 2) if stood is None else 0.5 * (stood + speed)
+                if stood is not None and speed - stood <= tolerance * speed:
+                    break
+            elif outcome == "fell":
+                fell = speed
+                if stood is not None or speed <= min_speed:
+                    break
+                speed = max(min_speed, speed / 2)
+            else:
+                stood = speed
+                if fell is not None or speed >= ceiling * (1 - 1e-9):
+                    break
+                speed = min(ceiling, speed * 2)
+                if speed >= ceiling * (1 - 1e-9) and ceiling < max_speed:
+                    break
+            self._report(stood, fell)
+        return stood, fell
+
+    def bisect(self, stood: float, fell: float) -> None:
+        """Bisect ``[stood, fell]`` (m/s) until ``fell - stood <= tolerance * fell``."""
+        while fell - stood > self.tolerance * fell:
+            mid = 0.5 * (stood + fell)
+            outcome = self.trial(mid)
+            if outcome == "aborted":
+                break
+            if outcome == "fell":
+                fell = mid
+            else:
+                stood = mid
+            self._report(stood, fell)
+
+
+def _controller_description(
+    setup: BalanceSetup, options: BalanceTrialOptions, joints: str
+) -> dict[str, Any]:
+    """The ``controller`` object of ``validate --json``."""
+    controller = controller_class(setup.controller).trial_description(
+        options, setup.sim, joints == "servo"
+    )
+    controller["impact_task"] = {
+        "approach": "bounded acceleration, then cruise",
+        "acceleration": 20.0,
+        "cruise": 0.03,
+        "force_threshold": 15.0,
+        "retract": 0.05,
+    }
+    controller["armature"] = setup.sim.armature_source
+    repair = setup.sim.inertia_repair
+    controller["inertia_repair"] = None if repair is None else repair.to_dict()
+    return controller
+
+
 def validate(
     scenario: Scenario | str,
     joints: str = "servo",
@@ -208,17 +363,18 @@ def validate(
     max_speed: float = 4.0,
     min_speed: float = 0.02,
     options: BalanceTrialOptions | None = None,
-    progress: Callable[[ValidationTrial, float | None, float | None], None] | None = None,
+    progress: ValidationProgress | None = None,
     setup: BalanceSetup | None = None,
     zmp_margin: float | None = None,
     journal: TrialJournal | None = None,
 ) -> ValidationResult:
     """Bracket the approach speed at which the robot starts to fall (m/s); see the module docstring.
 
-    Starts at the CoM criterion's prediction (composite, no margin), doubles (or halves) the commanded
-    speed until the outcome changes, then bisects until ``fell - stood <= tolerance * fell`` (commanded).
-    If the robot stands at ``max_speed`` (or falls at ``min_speed``), or a trial is aborted, the bracket
-    stays open on that side. ``progress(trial, stood, fell)`` is called after every trial.
+    Starts at the CoM criterion's prediction (composite, no margin), doubles (or halves) the
+    commanded speed until the outcome changes, then bisects until
+    ``fell - stood <= tolerance * fell`` (commanded). If the robot stands at ``max_speed`` (or falls
+    at ``min_speed``), or a trial is aborted, the bracket stays open on that side.
+    ``progress(trial, stood, fell)`` is called after every trial.
     """
     wall0 = time.perf_counter()
     if not isinstance(scenario, Scenario):
@@ -233,101 +389,16 @@ def validate(
     predicted = predictions(scenario)
     with_margin = predictions(scenario, margin)
     setup = setup or BalanceSetup.create(scenario, joints, options)
-    journal = journal or TrialJournal(None, "")
-    trials: list[ValidationTrial] = []
-    reused = 0
-
-    def trial(speed: float) -> str:
-        nonlocal reused
-        key = {"speed": round(speed, 9)}
-        entry = journal.get(key)
-        if entry is None:
-            result = run_balance_trial(setup, impact_speed=speed, options=options)
-            start = (
-                result.disturbance_time if result.disturbance_time is not None else options.settle
-            )
-            entry = {
-                "summary": result.summary(),
-                "trajectory": trajectory(result, start - 0.05, start + 1.5),
-            }
-            journal.add(key, entry)
-        else:
-            reused += 1
-        trials.append(
-            ValidationTrial(speed=speed, summary=entry["summary"], trajectory=entry["trajectory"])
-        )
-        return trials[-1].outcome
-
-    stood: float | None = None
-    fell: float | None = None
-    ceiling = max_speed  # aborted trials lower it: nothing faster can be tested
+    runner = _TrialRunner(setup, options, journal or TrialJournal(None, ""))
     start = predicted["com_criterion"]["composite"] or 0.5
-    speed = float(np.clip(start, min_speed, max_speed))
-    while True:
-        outcome = trial(speed)
-        if outcome == "aborted":  # nothing this fast can be tested: look below
-            ceiling = speed
-            if fell is not None or speed <= min_speed:
-                break
-            speed = max(min_speed, speed / 2) if stood is None else 0.5 * (stood + speed)
-            if stood is not None and speed - stood <= tolerance * speed:
-                break
-        elif outcome == "fell":
-            fell = speed
-            if stood is not None or speed <= min_speed:
-                break
-            speed = max(min_speed, speed / 2)
-        else:
-            stood = speed
-            if fell is not None or speed >= ceiling * (1 - 1e-9):
-                break
-            speed = min(ceiling, speed * 2)
-            if speed >= ceiling * (1 - 1e-9) and ceiling < max_speed:
-                break
-        if progress:
-            progress(trials[-1], stood, fell)
-    if progress and trials:
-        progress(trials[-1], stood, fell)
+    search = _Search(runner, tolerance, min_speed, max_speed, progress)
+    stood, fell = search.bracket(float(np.clip(start, min_speed, max_speed)))
+    if progress and runner.trials:
+        progress(runner.trials[-1], stood, fell)
     if stood is not None and fell is not None:
-        while fell - stood > tolerance * fell:
-            mid = 0.5 * (stood + fell)
-            outcome = trial(mid)
-            if outcome == "aborted":
-                break
-            if outcome == "fell":
-                fell = mid
-            else:
-                stood = mid
-            if progress:
-                progress(trials[-1], stood, fell)
-    if setup.controller == "id":
-        from impact_balance.sim.control.torque import describe
-
-        controller = describe(
-            options.id_gains, float(setup.sim.model.opt.timestep), joints == "servo"
-        )
-    else:
-        controller = {
-            "name": "dcm-zmp-clamp + pink IK -> joint position servos",
-            "gains": options.gains.to_dict(),
-            "control_rate_hz": options.gains.rate,
-            "sim_timestep": float(setup.sim.model.opt.timestep),
-            "servo": {
-                "kp": setup.sim.kp.tolist(),
-                "kd": setup.sim.kd.tolist(),
-                "joints": list(setup.sim.joint_names),
-            },
-        }
-    controller["impact_task"] = {
-        "approach": "bounded acceleration, then cruise",
-        "acceleration": 20.0,
-        "cruise": 0.03,
-        "force_threshold": 15.0,
-        "retract": 0.05,
-    }
-    controller["armature"] = setup.sim.armature_source
-    repair = setup.sim.inertia_repair
-    controller["inertia_repair"] = None if repair is None else repair.to_dict()
+        search.bisect(stood, fell)
+    trials, reused, journal = runner.trials, runner.reused, runner.journal
+    controller = _controller_description(setup, options, joints)
     return ValidationResult(
         scenario.name,
         joints,

@@ -1,5 +1,7 @@
-"""The paper's Experiment 1 in simulation: the impacting point sent at a wall it does not know,
-its speed capped every control tick by an impact-speed governor.
+"""The paper's Experiment 1 in simulation: a governed approach to an unknown wall.
+
+The impacting point is sent at a wall it does not know, its speed capped every control tick by an
+impact-speed governor.
 
 The robot stands on the scenario's contacts, its impacting point backed off ``standoff`` (15 cm)
 along the surface normal ``n``; the balance controller of ``validate`` holds it (``ik`` or ``id``).
@@ -19,17 +21,24 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
+import pinocchio as pin
 
 from impact_balance.exceptions import SimulationError
-from impact_balance.sim.control.approach import _profile
+from impact_balance.governor import Governor
+from impact_balance.json_values import json_number
+from impact_balance.sim.control.approach import approach_profile
+from impact_balance.sim.model.build import SimModel
 from impact_balance.sim.trials.balance_trial import (
     BalanceSetup,
     BalanceTrialOptions,
     run_balance_trial,
 )
-from impact_balance.sim.trials.impact_trial import TrialRecord, _point_velocity
+from impact_balance.sim.trials.impact_trial import TrialRecord
 from impact_balance.sim.trials.result import BalanceTrialResult
 
 __all__ = [
@@ -46,7 +55,10 @@ __all__ = [
 #: controller bounds the point's speed by the cap (``WallOptions.cap_constraint``).
 APPROACH_VERSION = 2
 
-#: Governors of the approach: the CoM criterion's, the ZMP criterion's, or none (the reference alone).
+_FloatArray = npt.NDArray[np.float64]
+
+#: Governors of the approach: the CoM criterion's, the ZMP criterion's, or none (the reference
+#: alone).
 GOVERNORS = ("com", "zmp", "none")
 
 
@@ -79,8 +91,10 @@ class WallOptions:
 
 @dataclass
 class GovernedApproach:
-    """The impacting point's reference when a governor caps its speed every tick (duck-types
-    :class:`~.approach.ImpactTask` for the balance controllers: ``reference``, ``target``, ``start_point``).
+    """The impacting point's reference when a governor caps its speed every tick.
+
+    It duck-types :class:`~impact_balance.sim.control.approach.ImpactTask` for the balance
+    controllers (an :class:`~impact_balance.sim.control.approach.ImpactReference`).
 
     ``speed_limit(t)`` is called by the trial loop before each control step with the governor's
     ceiling (m/s, ``inf`` without a governor); the reference's own speed follows a
@@ -90,7 +104,7 @@ class GovernedApproach:
     """
 
     frame: str
-    offset: object
+    offset: pin.SE3
     start: np.ndarray
     normal: np.ndarray
     speed: float
@@ -109,24 +123,28 @@ class GovernedApproach:
 
     @property
     def start_point(self) -> np.ndarray:
+        """The point's start (m, world)."""
         return self.start
 
     def reference_speed(self, t: float) -> float:
         """The reference's own speed at ``t`` (m/s): a bounded-acceleration ramp to ``speed``."""
-        return _profile(t - self.start_time, self.speed, self.acceleration, np.inf)[1]
+        return approach_profile(t - self.start_time, self.speed, self.acceleration, np.inf)[1]
 
     def reference(
         self, t: float, normal_force: float = 0.0
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """World position, velocity and acceleration of the point's reference at ``t`` (see the class docstring)."""
+        """World position, velocity and acceleration of the point's reference at ``t``.
+
+        See the class docstring.
+        """
         n = np.asarray(self.normal, dtype=float)
         if self._point is None:
             self._point = np.asarray(self.start, dtype=float).copy()
         if self.contact_time is None and normal_force > self.force_threshold:
             self.contact_time = float(t)
             self._contact_point = self._point.copy()
-        if self.contact_time is not None:
-            s, ds, dds = _profile(
+        if self.contact_time is not None and self._contact_point is not None:
+            s, ds, dds = approach_profile(
                 t - self.contact_time, self.withdraw_speed, self.acceleration, self.retract
             )
             return self._contact_point + s * n, ds * n, dds * n
@@ -139,11 +157,13 @@ class GovernedApproach:
         return self._point.copy(), -self.commanded * n, -acceleration * n
 
     def target(self, t: float, normal_force: float = 0.0) -> np.ndarray:
+        """The reference position alone (m, world) at ``t``."""
         return self.reference(t, normal_force)[0]
 
     def speed_bound(self) -> float:
-        """The largest approach speed (m/s, along ``-normal``) a controller should allow the point
-        now: the governor's cap until the contact, ``inf`` after it, without a governor or when
+        """The largest approach speed (m/s, along ``-normal``) a controller should allow now.
+
+        The governor's cap until the contact; ``inf`` after it, without a governor, or when
         ``bound_speed`` is off.
         """
         if not self.bound_speed or self.contact_time is not None:
@@ -167,12 +187,13 @@ class WallTrial:
     speed_at_contact: float | None
     cap_at_contact: float | None
     time_to_contact: float | None
-    tick_us: dict
-    series: dict
+    tick_us: dict[str, Any]
+    series: dict[str, Any]
     wall: np.ndarray | None = None
-    frames: dict | None = None
+    frames: dict[str, Any] | None = None
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: one approach of ``approach --json``."""
         s = self.result.summary()
         o = self.options
         return {
@@ -192,36 +213,35 @@ class WallTrial:
         }
 
 
-def _finite(x) -> float | None:
-    return None if x is None or not np.isfinite(x) else float(x)
-
-
 def run_wall_trial(
     setup: BalanceSetup,
     options: WallOptions,
     trial_options: BalanceTrialOptions | None = None,
-    governor=None,
+    governor: Governor | None = None,
     frames: bool = False,
 ) -> WallTrial:
-    """Run one approach (see the module docstring). ``governor``: a
-    :class:`~impact_balance.governor.Governor` of the setup's scenario and ``options.governor``'s criterion
-    (built here when None and the options ask for one); ``frames``: keep what a video needs.
+    """Run one approach (see the module docstring).
+
+    Args:
+        setup: The scenario prepared for balance trials.
+        options: The approach's options.
+        trial_options: The balance trial's options (default: the setup's controller's).
+        governor: A :class:`~impact_balance.governor.Governor` of the setup's scenario and
+            ``options.governor``'s criterion (built here when None and the options ask for one).
+        frames: Keep what a video needs.
+
+    Returns:
+        What the approach measured.
+
+    Raises:
+        SimulationError: Options out of range, or a scenario without an impact.
     """
-    if options.governor not in GOVERNORS:
-        raise SimulationError(
-            "--governor", options.governor, f"must be one of {', '.join(GOVERNORS)}"
-        )
-    if not (np.isfinite(options.reference) and 0.0 < options.reference <= 5.0):
-        raise SimulationError("--reference", options.reference, "must be in (0, 5] m/s")
-    if not (np.isfinite(options.wall_distance) and 0.0 < options.wall_distance <= 1.0):
-        raise SimulationError("--wall-distance", options.wall_distance, "must be in (0, 1] m")
+    _check(options)
     analysis = setup.analysis
     if analysis.impact is None:
         raise SimulationError("impact", None, "the scenario has no impact")
     trial_options = trial_options or BalanceTrialOptions(controller=setup.controller)
     if governor is None and options.governor != "none":
-        from impact_balance.governor import Governor
-
         governor = Governor(setup.scenario, criterion=options.governor)
     im = analysis.impact.model
     n = np.asarray(im.normal, dtype=float)
@@ -237,79 +257,126 @@ def run_wall_trial(
         bound_speed=options.cap_constraint,
     )
     wall = start - options.wall_distance * n
-    ticks: list[float] = []
-    caps: list[tuple[float, float, float]] = []
-    rows: dict[str, list] = {
-        "time": [],
-        "reference": [],
-        "cap": [],
-        "commanded": [],
-        "measured": [],
-    }
-    kept: dict[str, list] = {"time": [], "qpos": [], "com": [], "impact": []}
-    sim = setup.sim
-
-    def before_control(t: float, q: np.ndarray, v: np.ndarray) -> None:
-        if frames:
-            kept["time"].append(t)
-            kept["qpos"].append(sim.data.qpos.copy())
-            kept["com"].append(sim.com())
-            kept["impact"].append(sim.contact_force(sim.impact_geom))
-        if t < task.start_time:
-            return
-        if task.contact_time is None and governor is not None:
-            t0 = time.perf_counter()
-            limit = governor.limit(q, v)
-            ticks.append(time.perf_counter() - t0)
-            task.ceiling = limit.ceiling
-        if task.contact_time is None:
-            caps.append((t, task.reference_speed(t), task.ceiling))
-        rows["time"].append(t)
-        rows["reference"].append(task.reference_speed(t) if task.contact_time is None else 0.0)
-        rows["cap"].append(
-            _finite(task.ceiling) if governor is not None and task.contact_time is None else None
-        )
-        rows["commanded"].append(task.commanded if task.contact_time is None else 0.0)
-        rows["measured"].append(float(-n @ _point_velocity(sim, n)))
-
+    recorder = _ApproachRecorder(setup.sim, task, governor, frames)
     result = run_balance_trial(
         setup,
         impact_task=task,
         surface_point=wall,
         standoff=options.standoff,
         options=trial_options,
-        before_control=before_control,
+        before_control=recorder,
         max_approach_time=options.max_time,
     )
     impact = result.impact
     cap_at_contact = None
+    caps = recorder.caps
     if impact is not None and caps:
         k = max(0, int(np.searchsorted([c[0] for c in caps], impact.contact_time)) - 1)
-        cap_at_contact = _finite(caps[k][2])
-    us = np.asarray(ticks) * 1e6
-    tick_us = (
-        {"median": float(np.median(us)), "p99": float(np.percentile(us, 99)), "count": int(us.size)}
-        if us.size
-        else {"median": None, "p99": None, "count": 0}
-    )
+        cap_at_contact = json_number(caps[k][2])
     return WallTrial(
         options,
         result,
-        None if impact is None else _finite(impact.approach_speed),
+        None if impact is None else json_number(impact.approach_speed),
         cap_at_contact,
         None if impact is None else float(impact.contact_time - task.start_time),
-        tick_us,
-        rows,
+        _tick_statistics(recorder.ticks),
+        recorder.rows,
         wall,
-        {k: np.array(x) for k, x in kept.items()} if frames else None,
+        {k: np.array(x) for k, x in recorder.kept.items()} if frames else None,
     )
 
 
-def write_wall_video(setup: BalanceSetup, trial: WallTrial, path, title: str | None = None):
-    """The approach as an MP4 (:func:`~.video.write_video`), the wall where it stood (``frames=True`` trials)."""
+def _check(options: WallOptions) -> None:
+    """Refuse a governor, reference speed or wall distance out of range."""
+    if options.governor not in GOVERNORS:
+        raise SimulationError(
+            "--governor", options.governor, f"must be one of {', '.join(GOVERNORS)}"
+        )
+    if not (np.isfinite(options.reference) and 0.0 < options.reference <= 5.0):
+        raise SimulationError("--reference", options.reference, "must be in (0, 5] m/s")
+    if not (np.isfinite(options.wall_distance) and 0.0 < options.wall_distance <= 1.0):
+        raise SimulationError("--wall-distance", options.wall_distance, "must be in (0, 1] m")
+
+
+class _ApproachRecorder:
+    """Before every control step: the governor's cap given to the task, and the series recorded."""
+
+    def __init__(
+        self, sim: SimModel, task: GovernedApproach, governor: Governor | None, frames: bool
+    ):
+        self.sim, self.task, self.governor, self.frames = sim, task, governor, frames
+        self.n = np.asarray(task.normal, dtype=float)
+        self.ticks: list[float] = []
+        self.caps: list[tuple[float, float, float]] = []
+        self.rows: dict[str, list[float | None]] = {
+            "time": [],
+            "reference": [],
+            "cap": [],
+            "commanded": [],
+            "measured": [],
+        }
+        self.kept: dict[str, list[Any]] = {"time": [], "qpos": [], "com": [], "impact": []}
+
+    def __call__(self, t: float, q: _FloatArray, v: _FloatArray) -> None:
+        sim, task, governor, rows = self.sim, self.task, self.governor, self.rows
+        if self.frames:
+            assert sim.impact_geom is not None
+            self.kept["time"].append(t)
+            self.kept["qpos"].append(sim.data.qpos.copy())
+            self.kept["com"].append(sim.com())
+            self.kept["impact"].append(sim.contact_force(sim.impact_geom))
+        if t < task.start_time:
+            return
+        if task.contact_time is None and governor is not None:
+            t0 = time.perf_counter()
+            limit = governor.limit(q, v)
+            self.ticks.append(time.perf_counter() - t0)
+            task.ceiling = limit.ceiling
+        if task.contact_time is None:
+            self.caps.append((t, task.reference_speed(t), task.ceiling))
+        rows["time"].append(t)
+        rows["reference"].append(task.reference_speed(t) if task.contact_time is None else 0.0)
+        rows["cap"].append(
+            json_number(task.ceiling)
+            if governor is not None and task.contact_time is None
+            else None
+        )
+        rows["commanded"].append(task.commanded if task.contact_time is None else 0.0)
+        rows["measured"].append(float(-self.n @ sim.impact_point_velocity(self.n)))
+
+
+def _tick_statistics(ticks: list[float]) -> dict[str, float | int | None]:
+    """Median and 99th percentile (us) of the governor's ticks, and their count."""
+    us = np.asarray(ticks) * 1e6
+    if not us.size:
+        return {"median": None, "p99": None, "count": 0}
+    return {
+        "median": float(np.median(us)),
+        "p99": float(np.percentile(us, 99)),
+        "count": int(us.size),
+    }
+
+
+def write_wall_video(
+    setup: BalanceSetup, trial: WallTrial, path: str | Path, title: str | None = None
+) -> Path:
+    """The approach as an MP4 (:func:`~.video.write_video`), the wall where it stood.
+
+    Args:
+        setup: The setup the trial ran on.
+        trial: A trial run with ``frames=True``.
+        path: The ``.mp4`` file.
+        title: The video's title (default: the scenario's name).
+
+    Returns:
+        The path written.
+
+    Raises:
+        SimulationError: The trial kept no frames, or the video cannot be made here.
+    """
     from impact_balance.sim.trials.video import write_video
 
-    if not trial.frames or not len(trial.frames["time"]):
+    if not trial.frames or not len(trial.frames["time"]) or trial.wall is None:
         raise SimulationError("--video", str(path)[:80], "the trial kept no frames")
     sim, f = setup.sim, trial.frames
     k = len(f["time"])
@@ -324,8 +391,11 @@ def write_wall_video(setup: BalanceSetup, trial: WallTrial, path, title: str | N
         approach_start=float(f["time"][0]),
         wall_time=0.0,
     )
+    impact = setup.analysis.impact
+    if impact is None or sim.surface_geom is None:
+        raise SimulationError("impact", None, "the scenario has no impact")
     home = sim.model.geom_pos[sim.surface_geom].copy()
-    sim.model.geom_pos[sim.surface_geom] = home + (trial.wall - setup.analysis.impact.model.point)
+    sim.model.geom_pos[sim.surface_geom] = home + (trial.wall - impact.model.point)
     try:
         return write_video(sim, record, path, title=title)
     finally:

@@ -1,45 +1,52 @@
 """One balance trial in MuJoCo: the controller holds the stance through an impact or a push.
 
-:class:`~.trial_setup.BalanceSetup` prepares a scenario once (analysis, MuJoCo model, the start
-configurations with the impacting point backed off); :func:`run_balance_trial` resets the model and
-runs one trial:
+:class:`~impact_balance.sim.trials.setup.BalanceSetup` prepares a scenario once (analysis, MuJoCo
+model, the start configurations with the impacting point backed off); :func:`run_balance_trial`
+resets the model and runs one trial:
 
 - ``impact_speed``: the impact task drives the impact point into the surface at that commanded
   speed (m/s), reached before the surface with a bounded acceleration, then withdraws on contact
-  (:class:`~.approach.ImpactTask`); with ``rigid_impact`` the joints keep their velocities through
-  the impact (:class:`~.rigid_impact.RigidImpactHold`);
+  (:class:`~impact_balance.sim.control.approach.ImpactTask`); with ``rigid_impact`` the joints keep
+  their velocities through the impact (:class:`~.rigid_impact.RigidImpactHold`);
 - ``push``: a force on a body (the torso) for a short time (see :class:`Push`).
 
-At every control step (500 Hz) the loop reads MuJoCo's state as pinocchio's ``(q, v)``, runs
-:class:`~.balance.BalanceController` and writes the servo targets (``controller="ik"``), or runs
-:class:`~.inverse_dynamics.InverseDynamicsController` and writes the motor torques
-(``controller="id"``, the actuators then being torque motors), and feeds the
-:class:`~.outcomes.OutcomeMonitor`. It records the measured ZMP (from the sustained contacts' forces,
-on the plane ``z = h``), the CoM, the CoM velocity and the DCM, and their margins in the scenario's
-ZMP support area and CoM velocity area (without margin: scores apply theirs), and optionally a log
-(:mod:`impact_balance.logs`). The impact itself is measured at every step (1 ms) by an
-:class:`~.impact_tracker.ImpactTracker`: the approach speed just before the contact (the measured
-speed), the impulses at the impact point and at the sustained contacts, and the CoM velocity across.
+At every control step (500 Hz) the loop reads MuJoCo's state as pinocchio's ``(q, v)``, runs the
+setup's :class:`~impact_balance.sim.control.controller.Controller` (``ik``: servo targets; ``id``:
+motor torques) and feeds the :class:`~.outcomes.OutcomeMonitor`. It records the measured ZMP (from
+the sustained contacts' forces, on the plane ``z = h``), the CoM, the CoM velocity and the DCM, and
+their margins in the scenario's ZMP support area and CoM velocity area (without margin: scores apply
+theirs), and optionally a log (:mod:`impact_balance.logs`). The impact itself is measured at every
+step (1 ms) by an :class:`~.impact_tracker.ImpactTracker`: the approach speed just before the
+contact (the measured speed), the impulses at the impact point and at the sustained contacts, and
+the CoM velocity across.
 """
 
 from __future__ import annotations
 
+import math
 import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
 
 import mujoco
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from impact_balance.analysis.analyze import Analysis
+from impact_balance.balance.lipm import lipm_omega
 from impact_balance.exceptions import SimulationError
+from impact_balance.impact.model import ImpactModel
+from impact_balance.json_values import json_number
 from impact_balance.logs import write_log
-from impact_balance.sim.control.approach import ImpactTask
+from impact_balance.sim.control.approach import ImpactReference, ImpactTask
 from impact_balance.sim.control.approach import standoff as approach_standoff
-from impact_balance.sim.control.kinematic import BalanceController
-from impact_balance.sim.control.torque import InverseDynamicsController
+from impact_balance.sim.control.controller import ControllerName, ControlStep
+from impact_balance.sim.control.registry import controller_class
 from impact_balance.sim.model.build import SimModel
 from impact_balance.sim.trials.impact_tracker import ImpactTracker
-from impact_balance.sim.trials.impact_trial import _point_velocity
 from impact_balance.sim.trials.log import LOG_START, LogRecorder
 from impact_balance.sim.trials.outcomes import OutcomeMonitor
 from impact_balance.sim.trials.result import BalanceTrialResult
@@ -51,7 +58,12 @@ from impact_balance.sim.trials.setup import (
     BalanceTrialOptions,
     Push,
     controller_margin,
+    push_body,
 )
+
+_FloatArray = npt.NDArray[np.float64]
+#: ``before_control(t, q, v)``: called before every control step with the measured state.
+BeforeControl = Callable[[float, _FloatArray, _FloatArray], None]
 
 #: Version of the trials' physics and measurements: journals of another version are not reused.
 TRIAL_VERSION = 3
@@ -90,20 +102,22 @@ def measured_zmp(
     return com[:2] + (plane_height - com[2]) * total[:2] / total[2], forces
 
 
-def _push_body(sim: SimModel, name: str | None) -> int:
-    m = sim.model
-    if name is not None:
-        try:
-            return m.body(name).id
-        except KeyError:
-            valid = ", ".join(m.body(i).name for i in range(1, m.nbody))
-            raise SimulationError("--body", name, f"no such body; valid: {valid}") from None
-    torso = [i for i in range(m.nbody) if "torso" in m.body(i).name and m.body_mass[i] > 0]
-    return max(torso) if torso else sim.root_body
-
-
 def _base_rotation(q: np.ndarray) -> np.ndarray:
-    return pin.Quaternion(q[6], q[3], q[4], q[5]).toRotationMatrix()
+    answer: _FloatArray = pin.Quaternion(q[6], q[3], q[4], q[5]).toRotationMatrix()
+    return answer
+
+
+def _omega_now(com_height: float, plane_height: float, gravity: float) -> float:
+    """The LIPM's omega (1/s) at the measured CoM height (m).
+
+    NaN once the CoM is at or below the plane.
+
+    A falling robot's CoM may reach the plane: its CoM velocity margin is then undefined (NaN), not
+    an error.
+    """
+    if com_height <= plane_height:
+        return math.nan
+    return lipm_omega(com_height, plane_height, gravity)
 
 
 def run_balance_trial(
@@ -112,13 +126,15 @@ def run_balance_trial(
     push: Push | None = None,
     options: BalanceTrialOptions | None = None,
     *,
-    impact_task=None,
-    surface_point=None,
+    impact_task: ImpactReference | None = None,
+    surface_point: ArrayLike | None = None,
     standoff: float | None = None,
-    before_control=None,
+    before_control: BeforeControl | None = None,
     max_approach_time: float | None = None,
 ) -> BalanceTrialResult:
-    """Run one trial (an impact at the commanded ``impact_speed``, or a ``push``) from rest; see the module docstring.
+    """Run one trial (an impact or a push) from rest; see the module docstring.
+
+    An impact at the commanded ``impact_speed``, or a ``push``.
 
     An impact may instead follow ``impact_task`` (an object with ``reference(t, normal_force)``,
     ``target``, ``start_time``, ``contact_time``, like :class:`~.approach.ImpactTask`), from a start
@@ -130,8 +146,8 @@ def run_balance_trial(
     options = options or BalanceTrialOptions()
     sim, analysis = setup.sim, setup.analysis
     impact = impact_speed is not None or impact_task is not None
-    if impact and analysis.impact is None:
-        raise SimulationError("impact", None, "the scenario has no impact")
+    if impact:
+        _impact_model(analysis)  # refuses a scenario without an impact
     if impact_speed is not None and not (np.isfinite(impact_speed) and 0 < impact_speed <= 20):
         raise SimulationError("speed", impact_speed, "must be in (0, 20] m/s")
     hold = RigidImpactHold(sim) if (options.rigid_impact and impact) else None
@@ -139,7 +155,7 @@ def run_balance_trial(
     if moved:
         home = sim.model.geom_pos[sim.surface_geom].copy()
         sim.model.geom_pos[sim.surface_geom] = home + (
-            np.asarray(surface_point, dtype=float) - analysis.impact.model.point
+            np.asarray(surface_point, dtype=float) - _impact_model(analysis).point
         )
     try:
         return _run(
@@ -163,256 +179,318 @@ def run_balance_trial(
             sim.model.geom_pos[sim.surface_geom] = home
 
 
+_SERIES = (
+    "time",
+    "zmp",
+    "zmp_desired",
+    "com",
+    "com_velocity",
+    "dcm",
+    "zmp_margin",
+    "com_velocity_margin",
+)
+
+
 def _run(
     setup: BalanceSetup,
     impact_speed: float | None,
     push: Push | None,
     options: BalanceTrialOptions,
     hold: RigidImpactHold | None,
-    task,
-    surface_point,
-    standoff,
-    before_control,
-    max_approach_time,
+    task: ImpactReference | None,
+    surface_point: ArrayLike | None,
+    standoff: float | None,
+    before_control: BeforeControl | None,
+    max_approach_time: float | None,
 ) -> BalanceTrialResult:
-    sim, analysis = setup.sim, setup.analysis
-    m, d = sim.model, sim.data
-    stance = analysis.stance
-    model = stance.robot.model
-    pdata = model.createData()
-    dt = float(m.opt.timestep)
-
-    tracker = None
-    n = None
     if impact_speed is not None and task is None:
-        im = analysis.impact.model
-        standoff = approach_standoff(impact_speed)
-        task = ImpactTask(
-            im.spec.frame,
-            im.spec.offset,
-            im.point,
-            im.normal,
-            impact_speed,
-            start_time=options.settle,
-        )
-    if task is not None:
-        n = np.asarray(analysis.impact.model.normal, dtype=float)
-        tracker = ImpactTracker(n, dt)
-        if surface_point is None:
-            surface_point = analysis.impact.model.point
-    q_start = setup.start_configuration(standoff or 0.0)
-    # A push trial has no impacted surface: a robot falling forward must not lean on the wall of the impact.
-    sim.enable_impact_surface(task is not None)
-    mujoco.mj_resetData(m, d)
-    sim.set_state(q_start)
-    if setup.controller == "id":
-        d.ctrl[sim.actuator_ids] = (
-            sim.tau_hold
-        )  # motors: the holding torques until the first control step
-    else:
-        sim.set_servo_targets(q_start)
+        task, standoff = _commanded_task(setup.analysis, impact_speed, options.settle)
+    trial = _TrialRun(setup, impact_speed, push, options, hold, task, surface_point, standoff)
+    trial.set_end_time(max_approach_time)
+    trial.loop(before_control)
+    return trial.result()
 
-    torque = setup.controller == "id"
-    if torque:
-        controller = InverseDynamicsController(
-            analysis,
-            q_start,
-            options.id_gains,
-            task,
-            effort_limits=bool(sim.model.actuator_forcelimited[sim.actuator_ids].any()),
-        )
-        # MuJoCo's viscous joint damping (the URDF's) is compensated: the motors add damping * qdot.
-        joint_damping = m.dof_damping[sim.dof_adr].copy()
-        rate = options.id_gains.rate
-    else:
-        controller = BalanceController(analysis, q_start, options.gains, task)
-        rate = options.gains.rate
-    contact_names = [c.spec.frame for c in stance.contacts]
-    contact_frames = [model.getFrameId(name) for name in contact_names]
-    pin.framesForwardKinematics(model, pdata, q_start)
-    monitor = OutcomeMonitor(
-        contact_names,
-        np.array([pdata.oMf[f].translation for f in contact_frames]),
-        np.array([pdata.oMf[f].rotation for f in contact_frames]),
-        float(q_start[2]),
-        _base_rotation(q_start),
-        options.criteria,
+
+def _commanded_task(
+    analysis: Analysis, impact_speed: float, settle: float
+) -> tuple[ImpactTask, float]:
+    """The impact task at the commanded ``impact_speed`` (m/s), and its standoff (m).
+
+    The task starts after ``settle`` (s).
+    """
+    im = _impact_model(analysis)
+    task = ImpactTask(
+        im.spec.frame,
+        im.spec.offset,
+        im.point,
+        im.normal,
+        impact_speed,
+        start_time=settle,
     )
-    normals = np.array([c.normal for c in stance.contacts])
-    zmp_area = analysis.areas.zmp_area
-    h, g = analysis.areas.plane_height, analysis.areas.gravity
-    recorder = LogRecorder(sim, contact_names, task is not None) if options.record else None
+    return task, approach_standoff(impact_speed)
 
-    body = None
-    if push is not None:
-        body = _push_body(sim, push.body)
-        disturbance, disturbance_end = push.start, push.start + push.duration
-        end_time = disturbance_end + options.after
-    else:
-        disturbance = disturbance_end = None
-        if task is None:
-            end_time = options.settle + options.after
-        elif max_approach_time is not None:
-            end_time = task.start_time + max_approach_time + options.after
-        else:
-            end_time = task.arrival_time + options.max_approach_time + options.after
-    steps_per_control = max(1, int(round(1.0 / (rate * dt))))
-    series: dict[str, list] = {
-        k: []
-        for k in (
-            "time",
-            "zmp",
-            "zmp_desired",
-            "com",
-            "com_velocity",
-            "dcm",
-            "zmp_margin",
-            "com_velocity_margin",
-        )
-    }
-    surface = None if task is None else float(n @ np.asarray(surface_point, dtype=float))
-    radius = 0.0 if task is None else float(m.geom_size[sim.impact_geom][0])
-    wall0 = time.perf_counter()
-    step = 0
-    impact_force = np.zeros(3)
-    fn = 0.0
-    extended = False
-    angular_momentum = None
-    while True:
-        if d.time >= end_time:
-            # Still moving at the end: the robot gets extra_time more to come to rest (a slow recovery is no fall).
-            moving = (
-                len(series["com_velocity"])
-                and np.linalg.norm(series["com_velocity"][-1]) > options.criteria.rest_speed
-            )
-            if extended or disturbance is None or not moving:
-                break
-            extended = True
-            end_time += options.criteria.extra_time
-        t = float(d.time)
+
+def _impact_model(analysis: Analysis) -> ImpactModel:
+    if analysis.impact is None:
+        raise SimulationError("impact", None, "the scenario has no impact")
+    return analysis.impact.model
+
+
+class _TrialRun:
+    """One trial's state between its steps: the model, the controller, the monitors, the series."""
+
+    def __init__(
+        self,
+        setup: BalanceSetup,
+        impact_speed: float | None,
+        push: Push | None,
+        options: BalanceTrialOptions,
+        hold: RigidImpactHold | None,
+        task: ImpactReference | None,
+        surface_point: ArrayLike | None,
+        standoff: float | None,
+    ):
+        self.setup, self.impact_speed, self.push, self.options = setup, impact_speed, push, options
+        self.hold, self.task = hold, task
+        sim, analysis = setup.sim, setup.analysis
+        self.sim, self.analysis = sim, analysis
+        m, d = sim.model, sim.data
+        stance = analysis.stance
+        self.model = model = stance.robot.model
+        self.pdata = model.createData()
+        self.dt = dt = float(m.opt.timestep)
+        self.tracker: ImpactTracker | None = None
+        self.n = np.zeros(3)
         if task is not None:
-            # Every step (1 ms): the forces of the last step, the impact point's velocity, the CoM velocity.
-            impact_force = sim.contact_force(sim.impact_geom)
-            fn = float(impact_force @ n)
-            point_v = _point_velocity(sim, n)
-            com_v = sim.com_velocity()
-            tracker.update(t, impact_force, sim.contact_forces(sim.contact_geoms), point_v, com_v)
-            if hold is not None:
-                hold.update(t, float(-point_v @ n))
-                # Hold from the step in which the point will touch: its gap closes within one step.
-                gap = float(n @ (sim.data.geom_xpos[sim.impact_geom] - radius * n)) - surface
-                if hold.start is None and gap - max(0.0, float(-point_v @ n)) * dt <= 0.0:
-                    hold.begin(t)
-            if disturbance is None and tracker.touched:
-                disturbance = tracker.start
-                monitor.start_disturbance(disturbance)
-                end_time = disturbance + options.after
-            if disturbance_end is None and tracker.done:
-                disturbance_end = tracker.end
-        if step % steps_per_control == 0:
-            q, v = sim.configuration(), sim.velocity()
-            if before_control is not None:
-                before_control(t, q, v)
-            com_now, _ = controller.measure(q, v)
-            zmp, forces = measured_zmp(sim, com_now, h)
-            out = controller.step(t, q, v, zmp, fn)
-            if torque:
-                d.ctrl[sim.actuator_ids] = (
-                    out.tau[sim.v_index - 6] + joint_damping * d.qvel[sim.dof_adr]
-                )
-            else:
-                # Velocity feed-forward (kd v_ref) for the free limbs only: on the stiffened support limbs
-                # it would turn the dead-beat IK's velocity noise into large torques.
-                v_ff = out.v.copy()
-                v_ff[setup.support_v_index] = 0.0
-                sim.set_servo_targets(out.q, v_ff)
-            com, com_velocity = out.com, out.com_velocity
-            omega = np.sqrt(g / (com[2] - h))
-            zmp_margin = float(zmp_area.margins(zmp)[0]) if np.all(np.isfinite(zmp)) else -np.inf
-            dcm_margin = float(zmp_area.margins(out.dcm)[0])
-            for key, value in (
-                ("time", t),
-                ("zmp", zmp),
-                ("zmp_desired", out.zmp),
-                ("com", com),
-                ("com_velocity", com_velocity),
-                ("dcm", out.dcm),
-                ("zmp_margin", zmp_margin),
-                ("com_velocity_margin", omega * dcm_margin),
-            ):
-                series[key].append(value)
-            pin.framesForwardKinematics(model, pdata, q)
-            if angular_momentum is None and disturbance_end is not None and t >= disturbance_end:
-                # What the LIPM leaves out: the angular momentum about the CoM the disturbance left.
-                angular_momentum = np.array(
-                    pin.computeCentroidalMomentum(model, pdata, q, v).angular
-                )
-            if push is not None and t >= push.start:
-                monitor.start_disturbance(push.start)
-            pushing = push is not None and push.start <= t < push.start + push.duration
-            monitor.update(
-                t,
-                np.array([pdata.oMf[f].translation for f in contact_frames]),
-                np.array([pdata.oMf[f].rotation for f in contact_frames]),
-                np.einsum("ij,ij->i", forces, normals),
-                float(q[2]),
-                _base_rotation(q),
-                dcm_margin if disturbance is not None and t >= disturbance else None,
-                impulsive=pushing,
-            )
-            if recorder is not None and t >= LOG_START:
-                recorder.add(t, q, v, sim, zmp, forces, impact_force if task is not None else None)
-            if monitor.fell:
-                if monitor.disturbance is None:
-                    monitor.abort(
-                        "fell_before_disturbance", t, "the robot fell before the disturbance"
-                    )
-                break
-        if body is not None:
-            d.xfrc_applied[body, :3] = (
-                push.force if push.start <= t < push.start + push.duration else 0.0
-            )
-        mujoco.mj_step(m, d)
-        step += 1
-    wall = time.perf_counter() - wall0
-    arrays = {k: np.array(v) for k, v in series.items()}
-    t = float(d.time)
-    if task is not None and disturbance is None:
-        monitor.abort("no_contact", t, "the impact point never reached the surface")
-    outcome = monitor.finish(
-        t, arrays["com_velocity"][-1] if len(arrays["com_velocity"]) else np.zeros(3)
-    )
-    result = BalanceTrialResult(
-        outcome=outcome.outcome,
-        reason=outcome.reason,
-        outcome_time=outcome.time,
-        detail=outcome.detail,
-        events=outcome.events,
-        disturbance_time=disturbance,
-        disturbance_end=disturbance_end,
-        approach_speed=impact_speed,
-        max_tilt=monitor.max_tilt,
-        max_slip=monitor.max_slip,
-        max_trunk_tilt=monitor.max_trunk_tilt,
-        max_drop=monitor.max_drop,
-        sim_time=t,
-        wall_time=wall,
-        contact_names=tuple(contact_names),
-        series=arrays,
-        log=recorder.frame() if recorder is not None else None,
-        angular_momentum_at_end=angular_momentum,
-    )
-    if tracker is not None and tracker.touched:
-        result.impact = tracker.measurement(
-            t, sim.com_velocity(), None if hold is None else hold.to_dict()
+            im = _impact_model(analysis)
+            self.n = np.asarray(im.normal, dtype=float)
+            self.tracker = ImpactTracker(self.n, dt)
+            if surface_point is None:
+                surface_point = im.point
+        q_start = setup.start_configuration(standoff or 0.0)
+        # A push trial has no impacted surface: a robot falling forward must not lean on the wall of
+        # the impact.
+        sim.enable_impact_surface(task is not None)
+        mujoco.mj_resetData(m, d)
+        sim.set_state(q_start)
+        cls = controller_class(setup.controller)
+        self.controller = cls.for_trial(
+            analysis, q_start, options, task, sim, setup.support_v_index
         )
-    _margins(result, analysis, arrays)
-    return result
+        self.controller.hold(sim, q_start)
+        self.contact_names = [c.spec.frame for c in stance.contacts]
+        self.contact_frames = [model.getFrameId(name) for name in self.contact_names]
+        pin.framesForwardKinematics(model, self.pdata, q_start)
+        self.monitor = OutcomeMonitor(
+            self.contact_names,
+            np.array([self.pdata.oMf[f].translation for f in self.contact_frames]),
+            np.array([self.pdata.oMf[f].rotation for f in self.contact_frames]),
+            float(q_start[2]),
+            _base_rotation(q_start),
+            options.criteria,
+        )
+        self.normals = np.array([c.normal for c in stance.contacts])
+        self.recorder = (
+            LogRecorder(sim, self.contact_names, task is not None) if options.record else None
+        )
+        self.body = None if push is None else push_body(sim, push.body)
+        self.steps_per_control = max(1, round(1.0 / (self.controller.rate * dt)))
+        self.series: dict[str, list[Any]] = {k: [] for k in _SERIES}
+        self.surface = (
+            0.0 if surface_point is None else float(self.n @ np.asarray(surface_point, dtype=float))
+        )
+        self.radius = 0.0 if task is None else float(m.geom_size[sim.impact_geom][0])
+        self.impact_force = np.zeros(3)
+        self.fn = 0.0
+        self.angular_momentum: _FloatArray | None = None
+        self.disturbance: float | None = None
+        self.disturbance_end: float | None = None
+        self.end_time = 0.0
+        self.wall = 0.0
+
+    def set_end_time(self, max_approach_time: float | None) -> None:
+        """The disturbance's times when known (a push) and when the trial ends (s)."""
+        push, task, options = self.push, self.task, self.options
+        if push is not None:
+            self.disturbance, self.disturbance_end = push.start, push.start + push.duration
+            self.end_time = self.disturbance_end + options.after
+        elif task is None:
+            self.end_time = options.settle + options.after
+        elif max_approach_time is not None:
+            self.end_time = task.start_time + max_approach_time + options.after
+        elif isinstance(task, ImpactTask):
+            self.end_time = task.arrival_time + options.max_approach_time + options.after
+        else:
+            raise SimulationError(
+                "max_approach_time", None, "an impact task other than ImpactTask needs one"
+            )
+
+    def loop(self, before_control: BeforeControl | None) -> None:
+        """Step MuJoCo until the trial ends (a fall, or the end time, extended once if moving)."""
+        sim, push, criteria = self.sim, self.push, self.options.criteria
+        m, d = sim.model, sim.data
+        wall0 = time.perf_counter()
+        step = 0
+        extended = False
+        while True:
+            if d.time >= self.end_time:
+                # Still moving at the end: the robot gets extra_time more to come to rest (a slow
+                # recovery is no fall).
+                velocities = self.series["com_velocity"]
+                moving = len(velocities) and np.linalg.norm(velocities[-1]) > criteria.rest_speed
+                if extended or self.disturbance is None or not moving:
+                    break
+                extended = True
+                self.end_time += criteria.extra_time
+            t = float(d.time)
+            if self.task is not None:
+                self._track_impact(t)
+            if step % self.steps_per_control == 0 and self._control(t, before_control):
+                break
+            if self.body is not None and push is not None:
+                d.xfrc_applied[self.body, :3] = (
+                    push.force if push.start <= t < push.start + push.duration else 0.0
+                )
+            mujoco.mj_step(m, d)
+            step += 1
+        self.wall = time.perf_counter() - wall0
+
+    def _track_impact(self, t: float) -> None:
+        """Every MuJoCo step: the impact's measurements, hold and disturbance times.
+
+        Every step (1 ms): the forces of the last step, the impact point's velocity, the CoM
+        velocity; the rigid-impact hold; the disturbance's start and end.
+        """
+        sim, n, hold, tracker = self.sim, self.n, self.hold, self.tracker
+        assert tracker is not None and sim.impact_geom is not None
+        self.impact_force = sim.contact_force(sim.impact_geom)
+        self.fn = float(self.impact_force @ n)
+        point_v = sim.impact_point_velocity(n)
+        com_v = sim.com_velocity()
+        tracker.update(t, self.impact_force, sim.contact_forces(sim.contact_geoms), point_v, com_v)
+        if hold is not None:
+            hold.update(t, float(-point_v @ n))
+            # Hold from the step in which the point will touch: its gap closes within one step.
+            gap = float(n @ (sim.data.geom_xpos[sim.impact_geom] - self.radius * n)) - self.surface
+            if hold.start is None and gap - max(0.0, float(-point_v @ n)) * self.dt <= 0.0:
+                hold.begin(t)
+        if self.disturbance is None and tracker.start is not None:
+            self.disturbance = tracker.start
+            self.monitor.start_disturbance(tracker.start)
+            self.end_time = tracker.start + self.options.after
+        if self.disturbance_end is None and tracker.done:
+            self.disturbance_end = tracker.end
+
+    def _control(self, t: float, before_control: BeforeControl | None) -> bool:
+        """One control step: command, record, monitor. Returns whether the robot fell."""
+        sim, controller = self.sim, self.controller
+        q, v = sim.configuration(), sim.velocity()
+        if before_control is not None:
+            before_control(t, q, v)
+        com_now, _ = controller.measure(q, v)
+        areas = self.analysis.areas
+        zmp, forces = measured_zmp(sim, com_now, areas.plane_height)
+        out = controller.step(t, q, v, zmp, self.fn)
+        controller.actuate(sim, out)
+        dcm_margin = self._record(t, zmp, out)
+        pin.framesForwardKinematics(self.model, self.pdata, q)
+        if (
+            self.angular_momentum is None
+            and self.disturbance_end is not None
+            and t >= self.disturbance_end
+        ):
+            # What the LIPM leaves out: the angular momentum about the CoM the disturbance left.
+            self.angular_momentum = np.array(
+                pin.computeCentroidalMomentum(self.model, self.pdata, q, v).angular
+            )
+        push = self.push
+        if push is not None and t >= push.start:
+            self.monitor.start_disturbance(push.start)
+        pushing = push is not None and push.start <= t < push.start + push.duration
+        disturbed = self.disturbance is not None and t >= self.disturbance
+        self.monitor.update(
+            t,
+            np.array([self.pdata.oMf[f].translation for f in self.contact_frames]),
+            np.array([self.pdata.oMf[f].rotation for f in self.contact_frames]),
+            np.einsum("ij,ij->i", forces, self.normals),
+            float(q[2]),
+            _base_rotation(q),
+            dcm_margin if disturbed else None,
+            impulsive=pushing,
+        )
+        if self.recorder is not None and t >= LOG_START:
+            impact_force = self.impact_force if self.task is not None else None
+            self.recorder.add(t, q, v, sim, zmp, forces, impact_force)
+        if self.monitor.fell:
+            if self.monitor.disturbance is None:
+                self.monitor.abort(
+                    "fell_before_disturbance", t, "the robot fell before the disturbance"
+                )
+            return True
+        return False
+
+    def _record(self, t: float, zmp: _FloatArray, out: ControlStep) -> float:
+        """Append one control step to the series; return the DCM's margin in the ZMP area (m)."""
+        areas = self.analysis.areas
+        zmp_area = areas.zmp_area
+        com, com_velocity = out.com, out.com_velocity
+        omega = _omega_now(float(com[2]), areas.plane_height, areas.gravity)
+        zmp_margin = float(zmp_area.margins(zmp)[0]) if np.all(np.isfinite(zmp)) else -np.inf
+        dcm_margin = float(zmp_area.margins(out.dcm)[0])
+        for key, value in (
+            ("time", t),
+            ("zmp", zmp),
+            ("zmp_desired", out.zmp),
+            ("com", com),
+            ("com_velocity", com_velocity),
+            ("dcm", out.dcm),
+            ("zmp_margin", zmp_margin),
+            ("com_velocity_margin", omega * dcm_margin),
+        ):
+            self.series[key].append(value)
+        return dcm_margin
+
+    def result(self) -> BalanceTrialResult:
+        """The trial's outcome, measurements and series."""
+        sim, monitor, tracker = self.sim, self.monitor, self.tracker
+        arrays = {k: np.array(v) for k, v in self.series.items()}
+        t = float(sim.data.time)
+        if self.task is not None and self.disturbance is None:
+            monitor.abort("no_contact", t, "the impact point never reached the surface")
+        velocities = arrays["com_velocity"]
+        outcome = monitor.finish(t, velocities[-1] if len(velocities) else np.zeros(3))
+        result = BalanceTrialResult(
+            outcome=outcome.outcome,
+            reason=outcome.reason,
+            outcome_time=outcome.time,
+            detail=outcome.detail,
+            events=outcome.events,
+            disturbance_time=self.disturbance,
+            disturbance_end=self.disturbance_end,
+            approach_speed=self.impact_speed,
+            max_tilt=monitor.max_tilt,
+            max_slip=monitor.max_slip,
+            max_trunk_tilt=monitor.max_trunk_tilt,
+            max_drop=monitor.max_drop,
+            sim_time=t,
+            wall_time=self.wall,
+            contact_names=tuple(self.contact_names),
+            series=arrays,
+            log=self.recorder.frame() if self.recorder is not None else None,
+            angular_momentum_at_end=self.angular_momentum,
+        )
+        if tracker is not None and tracker.touched:
+            hold = None if self.hold is None else self.hold.to_dict()
+            result.impact = tracker.measurement(t, sim.com_velocity(), hold)
+        _margins(result, self.analysis, arrays)
+        return result
 
 
 def _margins(result: BalanceTrialResult, analysis: Analysis, arrays: dict[str, np.ndarray]) -> None:
-    """The CoM velocity when the disturbance ended, its margin, the worst margin after it, and the worst ZMP
-    margin during a push (all in the areas without margin).
+    """The CoM velocity margins of a trial after its disturbance.
+
+    The CoM velocity when the disturbance ended, its margin, the worst margin after it, and the
+    worst ZMP margin during a push (all in the areas without margin).
     """
     if result.disturbance_time is None or not len(arrays["time"]):
         return
@@ -431,21 +509,33 @@ def _margins(result: BalanceTrialResult, analysis: Analysis, arrays: dict[str, n
         during = (tt >= result.disturbance_time) & (tt <= result.disturbance_end + 1e-9)
         if during.any():
             worst = float(np.min(zm[during]))
-            result.min_zmp_margin_during = worst if np.isfinite(worst) else None
+            result.min_zmp_margin_during = json_number(worst)
 
 
 def write_trial_log(
     setup: BalanceSetup,
-    path,
-    controller: str,
-    metadata: dict,
+    path: str | Path,
+    controller: ControllerName,
+    metadata: dict[str, object],
     impact_speed: float | None = None,
     push: Push | None = None,
     rigid_impact: bool = False,
-):
-    """Run one trial again with recording on and write its log (searches run their trials unrecorded).
+) -> Path:
+    """Run one trial again with recording on and write its log.
 
-    Returns the path written; ``metadata`` goes into the Parquet metadata with the scenario's name.
+    Searches run their trials unrecorded: this reruns one to log it.
+
+    Args:
+        setup: The scenario prepared for trials.
+        path: The log file (Parquet or CSV).
+        controller: The controller's name.
+        metadata: Parquet metadata (as text), written with the scenario's name.
+        impact_speed: Commanded approach speed of an impact trial (m/s).
+        push: The push of a push trial.
+        rigid_impact: Hold every joint's velocity through the impact.
+
+    Returns:
+        The path written.
     """
     trial = run_balance_trial(
         setup,
@@ -453,4 +543,6 @@ def write_trial_log(
         push=push,
         options=BalanceTrialOptions(record=True, controller=controller, rigid_impact=rigid_impact),
     )
-    return write_log(trial.log, path, {"scenario": setup.scenario.name, **metadata})
+    assert trial.log is not None  # recorded
+    values = {"scenario": setup.scenario.name, **metadata}
+    return write_log(trial.log, path, {k: str(v) for k, v in values.items()})

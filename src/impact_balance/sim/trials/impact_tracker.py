@@ -13,6 +13,7 @@ keeps the planar CoM velocity at both ends.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -39,19 +40,21 @@ class ImpactTracker:
     max_duration: float = MAX_IMPACT_DURATION
     start: float | None = field(default=None, init=False)
     end: float | None = field(default=None, init=False)
-    _prev: tuple | None = field(default=None, init=False)
+    _prev: tuple[Any, ...] | None = field(default=None, init=False)
     _baseline: np.ndarray | None = field(default=None, init=False)
     _impulse: np.ndarray = field(default_factory=lambda: np.zeros(3), init=False)
     _sustained: np.ndarray | None = field(default=None, init=False)
-    _before: tuple | None = field(default=None, init=False)
+    _before: tuple[Any, ...] | None = field(default=None, init=False)
     _after: np.ndarray | None = field(default=None, init=False)
 
     @property
     def touched(self) -> bool:
+        """Whether the impact point has touched the surface."""
         return self.start is not None
 
     @property
     def done(self) -> bool:
+        """Whether the impact's window has ended."""
         return self.end is not None
 
     def update(
@@ -62,7 +65,9 @@ class ImpactTracker:
         point_velocity: np.ndarray,
         com_velocity: np.ndarray,
     ) -> None:
-        """One step: forces that acted over the last step (N, world, on the robot), the impact point's
+        """One step: the forces of the last step, the impact point's and the CoM's velocity now.
+
+        One step: forces that acted over the last step (N, world, on the robot), the impact point's
         velocity and the CoM velocity now (m/s, world).
         """
         touching = bool(np.any(impact_force != 0.0))
@@ -90,15 +95,20 @@ class ImpactTracker:
         )
 
     def measurement(
-        self, t: float, com_velocity: np.ndarray, hold: dict | None = None
+        self, t: float, com_velocity: np.ndarray, hold: dict[str, Any] | None = None
     ) -> ImpactMeasurement | None:
-        """The impact measured so far (None before the contact); an unfinished window ends at ``t``."""
+        """The impact measured so far (None before the contact).
+
+        An unfinished window ends at ``t``.
+        """
         if self.start is None:
             return None
         end = self.end if self.end is not None else float(t)
         after = (
             self._after if self._after is not None else np.asarray(com_velocity[:2], dtype=float)
         )
+        assert self._before is not None and self._impulse is not None
+        assert self._sustained is not None  # set at the contact
         approach, before = self._before
         return ImpactMeasurement(
             self.start,

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import mujoco
 import numpy as np
+import numpy.typing as npt
 import pandas as pd
 
 from impact_balance.logs import (
@@ -16,6 +17,8 @@ from impact_balance.sim.model.build import SimModel
 from impact_balance.sim.trials.impact_trial import TrialRecord
 
 __all__ = ["LOG_START", "LogRecorder", "log_frame"]
+
+_FloatArray = npt.NDArray[np.float64]
 
 #: Logs start here (s): the first steps settle the model's initial contact penetration (the
 #: contacts carry nothing at t = 0, then briefly one foot carries thousands of newtons), a
@@ -37,9 +40,11 @@ def _rotations(quaternions_wxyz: np.ndarray) -> np.ndarray:
 
 
 def log_frame(sim: SimModel, record: TrialRecord, start: float = LOG_START) -> pd.DataFrame:
-    """One row per step from ``start`` (s) on: time, base pose (quaternion x, y, z, w) and world-axes velocities, every
-    actuated joint's position and velocity (welded ones at the stance, velocity 0), the contact
-    forces on the robot and MuJoCo's CoM and CoM velocity.
+    """The log of an impact trial, one row per step from ``start`` (s) on.
+
+    One row per step from ``start`` (s) on: time, base pose (quaternion x, y, z, w) and world-axes
+    velocities, every actuated joint's position and velocity (welded ones at the stance, velocity
+    0), the contact forces on the robot and MuJoCo's CoM and CoM velocity.
 
     MuJoCo's free joint stores the angular velocity in the base frame: it is rotated to world axes.
     """
@@ -49,7 +54,7 @@ def log_frame(sim: SimModel, record: TrialRecord, start: float = LOG_START) -> p
     data: dict[str, np.ndarray] = {cols.time: record.time}
     for k, name in enumerate(cols.base_position):
         data[name] = record.qpos[:, k]
-    for name, k in zip(cols.base_quaternion, (1, 2, 3, 0)):
+    for name, k in zip(cols.base_quaternion, (1, 2, 3, 0), strict=False):
         data[name] = quat[:, k]
     for k, name in enumerate(cols.base_linear_velocity):
         data[name] = record.qvel[:, k]
@@ -71,7 +76,7 @@ def log_frame(sim: SimModel, record: TrialRecord, start: float = LOG_START) -> p
         data[joint_position_column(name)] = q
         data[joint_velocity_column(name)] = v
     for name, force in record.forces.items():
-        for column, values in zip(force_columns(name), force.T):
+        for column, values in zip(force_columns(name), force.T, strict=False):
             data[column] = values
     for k, name in enumerate(cols.com):
         data[name] = record.com[:, k]
@@ -82,8 +87,10 @@ def log_frame(sim: SimModel, record: TrialRecord, start: float = LOG_START) -> p
 
 
 class LogRecorder:
-    """A log built step by step (the balance trials' loop), from pinocchio's ``(q, v)`` and MuJoCo's
-    state; :func:`log_frame` builds the same columns from an impact trial's recorded arrays.
+    """A log built step by step (the balance trials' loop).
+
+    It reads pinocchio's ``(q, v)`` and MuJoCo's state; :func:`log_frame` builds the same columns
+    from an impact trial's recorded arrays.
     """
 
     def __init__(self, sim: SimModel, contact_names: list[str], impact: bool):
@@ -108,11 +115,32 @@ class LogRecorder:
             self.columns += list(force_columns("impact"))
         self.rows: list[np.ndarray] = []
 
-    def add(self, t, q, v, sim: SimModel, zmp, forces, impact_force) -> None:
-        # The CoM columns are MuJoCo's own (subtree CoM and velocity): a cross-check for the log checker,
-        # which recomputes them with pinocchio from the base and joint columns.
-        # After mj_step, MuJoCo's CoM quantities still describe the state before the step: refresh them
-        # for the current state (position-dependent stages only; the next step recomputes them anyway).
+    def add(
+        self,
+        t: float,
+        q: _FloatArray,
+        v: _FloatArray,
+        sim: SimModel,
+        zmp: _FloatArray,
+        forces: _FloatArray,
+        impact_force: _FloatArray | None,
+    ) -> None:
+        """One row: time, base and joint state, ZMP, CoM, contact forces (and the impact's).
+
+        Args:
+            t: Time (s).
+            q: Configuration (nq, pinocchio order).
+            v: Velocity (nv, pinocchio order).
+            sim: The trial's MuJoCo model, at the state ``(q, v)``.
+            zmp: Measured ZMP (m, world).
+            forces: Each sustained contact's force (k x 3, N, world).
+            impact_force: The impact point's force (3, N, world), None without an impact.
+        """
+        # The CoM columns are MuJoCo's own (subtree CoM and velocity): a cross-check for the log
+        # checker, which recomputes them with pinocchio from the base and joint columns.
+        # After mj_step, MuJoCo's CoM quantities still describe the state before the step: refresh
+        # them for the current state (position-dependent stages only; the next step recomputes
+        # them anyway).
         mujoco.mj_kinematics(sim.model, sim.data)
         mujoco.mj_comPos(sim.model, sim.data)
         mujoco.mj_comVel(sim.model, sim.data)
@@ -125,4 +153,5 @@ class LogRecorder:
         self.rows.append(np.concatenate([np.asarray(p, dtype=float).ravel() for p in parts]))
 
     def frame(self) -> pd.DataFrame:
+        """The rows so far as a log frame (:mod:`impact_balance.logs` columns)."""
         return pd.DataFrame(np.array(self.rows), columns=self.columns)

@@ -28,6 +28,7 @@ import pinocchio as pin
 from impact_balance.contacts.stance import Stance
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.impact.model import INERTIA_MODELS, impact_model
+from impact_balance.json_values import json_number
 from impact_balance.sim.model.build import SimModel
 from impact_balance.sim.trials.impact_trial import TrialRecord
 
@@ -79,8 +80,9 @@ class TrialResult:
         saturated_joints: ``servo``: joints whose torque reached its effort limit during the
             impact (empty for ``rigid``).
         sim_time_ratio: Simulated time over wall-clock time.
-        sustained_impulses: Impulse on the robot at each sustained contact over the impact, its force
-            before the impact subtracted, N s, world (by contact name): what the paper neglects.
+        sustained_impulses: Impulse on the robot at each sustained contact over the impact, its
+            force before the impact subtracted, N s, world (by contact name): what the paper
+            neglects.
         armature: Where the joints' rotor inertia came from (``servo``).
         hold: The rigid-impact hold (``--rigid-impact``), or None.
         record: The time series.
@@ -100,40 +102,38 @@ class TrialResult:
     sim_time_ratio: float
     sustained_impulses: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
     armature: str = ""
-    hold: dict | None = None
+    hold: dict[str, Any] | None = None
     record: TrialRecord | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready (strict: no NaN)."""
-
-        def num(x: float) -> float | None:
-            return float(x) if np.isfinite(x) else None
-
         return {
-            "approach_speed": num(self.approach_speed),
+            "approach_speed": json_number(self.approach_speed),
             "joints": self.joints,
-            "approach_speed_measured": num(self.approach_speed_measured),
-            "restitution_measured": num(self.restitution_measured),
-            "impulse_measured": [num(x) for x in self.impulse_measured],
-            "com_velocity_jump_measured": [num(x) for x in self.com_velocity_jump_measured],
-            "slip_speed": num(self.slip_speed),
-            "impact_time": [num(x) for x in self.impact_time],
+            "approach_speed_measured": json_number(self.approach_speed_measured),
+            "restitution_measured": json_number(self.restitution_measured),
+            "impulse_measured": [json_number(x) for x in self.impulse_measured],
+            "com_velocity_jump_measured": [json_number(x) for x in self.com_velocity_jump_measured],
+            "slip_speed": json_number(self.slip_speed),
+            "impact_time": [json_number(x) for x in self.impact_time],
             "predicted": {
                 name: {
-                    "com_velocity_jumps": [[num(x) for x in row] for row in p.com_velocity_jumps],
-                    "distance": num(p.distance),
-                    "relative_distance": num(p.relative_distance),
+                    "com_velocity_jumps": [
+                        [json_number(x) for x in row] for row in p.com_velocity_jumps
+                    ],
+                    "distance": json_number(p.distance),
+                    "relative_distance": json_number(p.relative_distance),
                 }
                 for name, p in self.predicted.items()
             },
             "contacts_kept": self.contacts_kept,
             "saturated_joints": list(self.saturated_joints),
             "sustained_impulses": {
-                k: [num(x) for x in v] for k, v in self.sustained_impulses.items()
+                k: [json_number(x) for x in v] for k, v in self.sustained_impulses.items()
             },
             "armature": self.armature,
             "rigid_hold": self.hold,
-            "sim_time_ratio": num(self.sim_time_ratio),
+            "sim_time_ratio": json_number(self.sim_time_ratio),
         }
 
 
@@ -142,14 +142,14 @@ def distance_to_hull(point: np.ndarray, vertices: np.ndarray) -> float:
     point = np.asarray(point, dtype=float)
     hull = Polygon.from_points(np.asarray(vertices, dtype=float), tol=1e-12)
     v = hull.vertices
-    if len(v) >= 3 and hull.contains(point[None, :], tol=0.0).all():
+    if len(v) >= 3 and np.all(hull.contains(point[None, :], tol=0.0)):
         return 0.0
     if len(v) == 0:
         return float("nan")
     if len(v) == 1:
         return float(np.linalg.norm(point - v[0]))
     best = np.inf
-    for a, b in zip(v, np.roll(v, -1, axis=0)):
+    for a, b in zip(v, np.roll(v, -1, axis=0), strict=False):
         ab = b - a
         t = np.clip((point - a) @ ab / max(ab @ ab, 1e-300), 0.0, 1.0)
         best = min(best, float(np.linalg.norm(point - (a + t * ab))))
@@ -180,8 +180,9 @@ def impact_window(
 
 
 def _stance_with_armature(sim: SimModel) -> Stance:
-    """The stance, on a copy of the robot model carrying the simulated joints' armature
-    (pinocchio's ``crba`` adds ``model.armature`` to the mass matrix), so that ``joint_space``
+    """The stance, on a copy of the robot model carrying the simulated joints' armature.
+
+    pinocchio's ``crba`` adds ``model.armature`` to the mass matrix, so that ``joint_space``
     predicts for the simulated robot. The shared robot model is never modified.
     """
     if sim.joints != "servo" or np.array_equal(
@@ -198,6 +199,8 @@ def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialR
     """Measurement and predictions of one trial (see the module docstring)."""
     from impact_balance.exceptions import SimulationError
 
+    if sim.scenario.impact is None:
+        raise SimulationError("impact", None, "the scenario has no impact")
     spec = sim.scenario.impact.spec()
     n = np.asarray(spec.normal, dtype=float) / np.linalg.norm(spec.normal)
     try:
@@ -209,12 +212,14 @@ def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialR
             "the impact point never reached the surface in that time",
         ) from None
     if record.time[before] < record.approach_start:
-        # Not the commanded approach's impact (e.g. a joint snapped back into its range while settling).
+        # Not the commanded approach's impact (e.g. a joint snapped back into its range during
+        # the settling).
         raise SimulationError(
             "impact",
             spec.frame,
             f"the impact point touched the surface at {record.time[before]:.3f} s, before "
-            f"the approach began ({record.approach_start:.3f} s): the limb was not held at its start pose",
+            f"the approach began ({record.approach_start:.3f} s): the limb was not held at its "
+            "start pose",
         )
     dt = sim.model.opt.timestep
     impulse = record.forces["impact"][before:end].sum(axis=0) * dt
@@ -239,7 +244,10 @@ def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialR
             f for name, f in record.forces.items() if name != "impact"
         ]  # in contact order
         normal_forces = np.array(
-            [f[start:] @ c.normal for f, c in zip(contact_forces, sim.stance.contacts)]
+            [
+                f[start:] @ c.normal
+                for f, c in zip(contact_forces, sim.stance.contacts, strict=False)
+            ]
         )
         moved = np.linalg.norm(
             record.contact_positions[start:] - record.contact_positions[start], axis=2
@@ -252,7 +260,7 @@ def measure(sim: SimModel, record: TrialRecord, approach_speed: float) -> TrialR
         limited = sim.model.actuator_forcelimited[sim.actuator_ids].astype(bool)
         saturated = [
             name
-            for name, p, lim, on in zip(sim.joint_names, peak, limits, limited)
+            for name, p, lim, on in zip(sim.joint_names, peak, limits, limited, strict=False)
             if on and p >= lim * (1 - 1e-6)
         ]
     ratio = record.simulated_time / record.wall_time if record.wall_time > 0 else float("nan")

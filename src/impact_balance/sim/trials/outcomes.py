@@ -40,6 +40,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
+from typing import Any, Literal
 
 import numpy as np
 
@@ -48,22 +49,40 @@ __all__ = [
     "FALL_REASONS",
     "OUTCOMES",
     "ContactEvent",
+    "EventKind",
+    "FallReason",
     "Outcome",
     "OutcomeCriteria",
     "OutcomeMonitor",
+    "OutcomeName",
 ]
 
+#: A trial's outcome.
+OutcomeName = Literal["balanced", "contact_broken", "fell", "aborted"]
+#: Why a trial ``fell``.
+FallReason = Literal["base_dropped", "trunk_tipped", "dcm_escaped", "not_at_rest"]
+#: How a sustained contact broke.
+EventKind = Literal["lifted", "slipped", "tilted"]
+
 #: Trial outcomes.
-OUTCOMES = ("balanced", "contact_broken", "fell", "aborted")
+OUTCOMES: tuple[OutcomeName, ...] = ("balanced", "contact_broken", "fell", "aborted")
 #: Reasons of ``fell``.
-FALL_REASONS = ("base_dropped", "trunk_tipped", "dcm_escaped", "not_at_rest")
+FALL_REASONS: tuple[FallReason, ...] = (
+    "base_dropped",
+    "trunk_tipped",
+    "dcm_escaped",
+    "not_at_rest",
+)
 #: Kinds of contact events.
-EVENT_KINDS = ("lifted", "slipped", "tilted")
+EVENT_KINDS: tuple[EventKind, ...] = ("lifted", "slipped", "tilted")
 
 
 @dataclass(frozen=True)
 class OutcomeCriteria:
-    """Thresholds of :class:`OutcomeMonitor` (SI units, angles in radians); see the module docstring."""
+    """Thresholds of :class:`OutcomeMonitor` (SI units, angles in radians).
+
+    See the module docstring.
+    """
 
     min_force: float = 1.0
     load_force: float = 20.0
@@ -76,33 +95,38 @@ class OutcomeCriteria:
     rest_speed: float = 0.05
     extra_time: float = 2.5
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
+        """The thresholds by name (JSON-ready)."""
         return asdict(self)
 
 
 @dataclass(frozen=True)
 class ContactEvent:
-    """A sustained contact broke: ``contact`` (its frame), ``kind`` (lifted, slipped, tilted), ``time`` (s)
-    and ``value`` (the slip in m, the tilt in rad, the unloaded time in s).
+    """A sustained contact broke.
+
+    A sustained contact broke: ``contact`` (its frame), ``kind`` (lifted, slipped, tilted), ``time``
+    (s) and ``value`` (the slip in m, the tilt in rad, the unloaded time in s).
     """
 
     contact: str
-    kind: str
+    kind: EventKind
     time: float
     value: float
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
         return {"contact": self.contact, "kind": self.kind, "time": self.time, "value": self.value}
 
 
 @dataclass(frozen=True)
 class Outcome:
-    """A trial's outcome: one of :data:`OUTCOMES`, its ``reason`` (a fall reason, the first contact
-    event, or why it was aborted; None when balanced), when (s), a ``detail`` line, and every
-    contact ``event``.
+    """A trial's outcome: one of :data:`OUTCOMES`, why, when and every contact event.
+
+    ``reason`` is a fall reason, the first contact event, or why it was aborted (None when
+    balanced); ``time`` is when (s); ``detail`` a line.
     """
 
-    outcome: str
+    outcome: OutcomeName
     reason: str | None
     time: float | None
     detail: str = ""
@@ -110,6 +134,7 @@ class Outcome:
 
     @property
     def fell(self) -> bool:
+        """Whether the outcome is ``fell``."""
         return self.outcome == "fell"
 
 
@@ -143,7 +168,7 @@ class OutcomeMonitor:
     _abort: tuple[str, float, str] | None = field(default=None, init=False)
     _low_since: np.ndarray = field(init=False)
     _loaded: np.ndarray = field(init=False)
-    _seen: set = field(default_factory=set, init=False)
+    _seen: set[tuple[int, EventKind]] = field(default_factory=set, init=False)
 
     def __post_init__(self) -> None:
         self.positions = np.asarray(self.positions, dtype=float).reshape(-1, 3)
@@ -185,7 +210,7 @@ class OutcomeMonitor:
         if self._abort is None:
             self._abort = (reason, float(t), detail)
 
-    def _event(self, i: int, kind: str, t: float, value: float) -> None:
+    def _event(self, i: int, kind: EventKind, t: float, value: float) -> None:
         if (i, kind) not in self._seen:
             self._seen.add((i, kind))
             self.events.append(ContactEvent(self.names[i], kind, float(t), float(value)))
@@ -201,9 +226,11 @@ class OutcomeMonitor:
         dcm_margin: float | None = None,
         impulsive: bool = False,
     ) -> bool:
-        """One sample: contact frame poses, their normal forces (N, None if unknown), the base height (m)
-        and rotation, the DCM's margin in the ZMP support area (m, >= 0 inside; None if unknown);
-        ``impulsive``: a push acts now (unloading does not count). Returns :attr:`fell`.
+        """One sample of the trial.
+
+        One sample: contact frame poses, their normal forces (N, None if unknown), the base height
+        (m) and rotation, the DCM's margin in the ZMP support area (m, >= 0 inside; None if
+        unknown); ``impulsive``: a push acts now (unloading does not count). Returns :attr:`fell`.
         """
         c = self.criteria
         positions = np.asarray(positions, dtype=float).reshape(-1, 3)

@@ -8,17 +8,30 @@ contacts carry no vertical force, say) never ends a run.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 import pandas as pd
+from numpy.typing import ArrayLike
 
-from impact_balance.sim.trials.outcomes import ContactEvent
+from impact_balance.sim.trials.outcomes import ContactEvent, OutcomeName
 
-__all__ = ["BalanceTrialResult", "ImpactMeasurement", "TrialEntry", "finite_or_null", "trajectory"]
+__all__ = [
+    "BalanceTrialResult",
+    "ImpactMeasurement",
+    "TrialEntry",
+    "finite_or_null",
+    "trajectory",
+]
+
+_FloatArray = npt.NDArray[np.float64]
 
 
-def finite_or_null(nulls: dict[str, str], name: str, value, reason: str):
-    """``value`` as a float (or a list of floats) when finite, else None with ``reason`` recorded in ``nulls``."""
+def finite_or_null(
+    nulls: dict[str, str], name: str, value: ArrayLike | None, reason: str
+) -> float | list[Any] | None:
+    """``value`` as a float (or a list of floats) when finite, else None (reason in ``nulls``)."""
     if value is None:
         nulls[name] = reason
         return None
@@ -35,12 +48,13 @@ class ImpactMeasurement:
 
     Attributes:
         contact_time: First contact of the impact point with the surface (s).
-        approach_speed: Normal approach speed of the impact point just before it (m/s): the measured speed.
-        window: (start, end) of the impact (s): from the step before the contact to the separation, or
-            ``max_duration`` later if the point stays.
+        approach_speed: Normal approach speed of the impact point just before it (m/s): the measured
+            speed.
+        window: (start, end) of the impact (s): from the step before the contact to the separation,
+            or ``max_duration`` later if the point stays.
         impulse: Impulse on the robot at the impact point over the window (N s, 3).
-        sustained_impulses: Impulse on the robot at each sustained contact over the window, its force
-            before the contact subtracted (N s, k x 3): what the paper neglects.
+        sustained_impulses: Impulse on the robot at each sustained contact over the window, its
+            force before the contact subtracted (N s, k x 3): what the paper neglects.
         com_velocity_before, com_velocity_after: Planar CoM velocity at the window's ends (m/s).
         hold: The rigid-impact hold (:meth:`RigidImpactHold.to_dict`), or None.
     """
@@ -52,13 +66,16 @@ class ImpactMeasurement:
     sustained_impulses: np.ndarray
     com_velocity_before: np.ndarray
     com_velocity_after: np.ndarray
-    hold: dict | None = None
+    hold: dict[str, Any] | None = None
 
     @property
-    def com_velocity_jump(self) -> np.ndarray:
-        return self.com_velocity_after - self.com_velocity_before
+    def com_velocity_jump(self) -> _FloatArray:
+        """Planar CoM velocity change across the window (m/s)."""
+        jump: _FloatArray = self.com_velocity_after - self.com_velocity_before
+        return jump
 
-    def to_dict(self, contact_names: list[str]) -> dict:
+    def to_dict(self, contact_names: list[str]) -> dict[str, Any]:
+        """JSON-ready (strict: null for what is not finite, ``nulls`` giving why)."""
         nulls: dict[str, str] = {}
         out = {
             "contact_time": self.contact_time,
@@ -69,7 +86,7 @@ class ImpactMeasurement:
             "impulse": finite_or_null(nulls, "impulse", self.impulse, "not finite"),
             "sustained_impulses": {
                 name: finite_or_null(nulls, f"sustained_impulses.{name}", imp, "not finite")
-                for name, imp in zip(contact_names, self.sustained_impulses)
+                for name, imp in zip(contact_names, self.sustained_impulses, strict=False)
             },
             "com_velocity_before": finite_or_null(
                 nulls, "com_velocity_before", self.com_velocity_before, "not finite"
@@ -98,19 +115,21 @@ class BalanceTrialResult:
 
     Attributes:
         outcome, reason, outcome_time, detail, events: see :mod:`.outcomes`.
-        disturbance_time, disturbance_end: When the impact began (first contact) or the push began and
-            ended (s).
+        disturbance_time, disturbance_end: When the impact began (first contact) or the push began
+            and ended (s).
         approach_speed: Commanded approach speed (m/s), impacts only.
         impact: What the impact measured (:class:`ImpactMeasurement`), impacts that touched only.
         com_velocity_at_end: Planar CoM velocity when the disturbance ended (m/s): after the impact
             window, or at the end of the push.
-        com_velocity_margin_at_end: Its margin in the CoM velocity area without margin (m/s, >= 0 inside).
+        com_velocity_margin_at_end: Its margin in the CoM velocity area without margin (m/s, >= 0
+            inside).
         min_com_velocity_margin: The worst margin of the CoM velocity after the disturbance (m/s).
-        min_zmp_margin_during: The worst margin of the measured ZMP during the push (m), None if undefined.
-        max_tilt, max_slip, max_trunk_tilt, max_drop: Largest contact tilt (rad) and slip (m), base tilt
-            (rad) and drop (m) seen.
-        angular_momentum_at_end: Angular momentum about the CoM when the disturbance ended (N m s, world):
-            what the LIPM leaves out (a push above the CoM leaves some).
+        min_zmp_margin_during: The worst margin of the measured ZMP during the push (m), None if
+            undefined.
+        max_tilt, max_slip, max_trunk_tilt, max_drop: Largest contact tilt (rad) and slip (m), base
+            tilt (rad) and drop (m) seen.
+        angular_momentum_at_end: Angular momentum about the CoM when the disturbance ended (N m s,
+            world): what the LIPM leaves out (a push above the CoM leaves some).
         sim_time, wall_time: Simulated and wall-clock time (s).
     """
 
@@ -140,18 +159,21 @@ class BalanceTrialResult:
 
     @property
     def fell(self) -> bool:
+        """Whether the outcome is ``fell``."""
         return self.outcome == "fell"
 
     @property
     def aborted(self) -> bool:
+        """Whether the outcome is ``aborted``."""
         return self.outcome == "aborted"
 
     @property
     def approach_speed_measured(self) -> float | None:
+        """The impact point's approach speed just before the contact (m/s), None without one."""
         return None if self.impact is None else self.impact.approach_speed
 
-    def summary(self) -> dict:
-        """JSON-ready summary (no series, no log): finite numbers or null, with ``nulls`` giving the reasons."""
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready summary (no series, no log): finite numbers or null, ``nulls`` giving why."""
         nulls: dict[str, str] = {}
         out = {
             "outcome": self.outcome,
@@ -214,9 +236,12 @@ class BalanceTrialResult:
         return out
 
 
-def trajectory(result: BalanceTrialResult, start: float, stop: float, every: int = 2) -> dict:
-    """The trial's CoM velocity, ZMP and DCM between ``start`` and ``stop`` (s), every ``every``-th control
-    step, as plain lists (a ZMP that is undefined is null): what the figures draw.
+def trajectory(
+    result: BalanceTrialResult, start: float, stop: float, every: int = 2
+) -> dict[str, Any]:
+    """The trial's CoM velocity, ZMP and DCM between ``start`` and ``stop`` (s), as plain lists.
+
+    Every ``every``-th control step; a ZMP that is undefined is null. What the figures draw.
     """
     s = result.series
     if not len(s.get("time", ())):
@@ -224,7 +249,7 @@ def trajectory(result: BalanceTrialResult, start: float, stop: float, every: int
     t = s["time"]
     keep = np.flatnonzero((t >= start - 1e-9) & (t <= stop + 1e-9))[::every]
 
-    def rows(values: np.ndarray) -> list:
+    def rows(values: _FloatArray) -> list[list[float] | None]:
         return [[float(x) for x in row] if np.all(np.isfinite(row)) else None for row in values]
 
     return {
@@ -237,19 +262,24 @@ def trajectory(result: BalanceTrialResult, start: float, stop: float, every: int
 
 @dataclass
 class TrialEntry:
-    """A finished trial as the commands keep it (and as the journal stores it): its JSON ``summary``
-    (:meth:`BalanceTrialResult.summary`) and a short ``trajectory`` (:func:`trajectory`) for the figures.
+    """A finished trial as the commands (and the journal) keep it.
+
+    Its JSON ``summary`` (:meth:`BalanceTrialResult.summary`) and a short ``trajectory``
+    (:func:`trajectory`) for the figures.
     """
 
-    summary: dict
-    trajectory: dict = field(default_factory=dict)
+    summary: dict[str, Any]
+    trajectory: dict[str, Any] = field(default_factory=dict)
 
     @property
-    def outcome(self) -> str:
-        return self.summary["outcome"]
+    def outcome(self) -> OutcomeName:
+        """The trial's outcome."""
+        outcome: OutcomeName = self.summary["outcome"]
+        return outcome
 
     @property
     def fell(self) -> bool:
+        """Whether the outcome is ``fell``."""
         return self.outcome == "fell"
 
     @property

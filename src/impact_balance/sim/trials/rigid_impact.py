@@ -24,6 +24,7 @@ back afterwards acts on the robot with its joints free.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -59,10 +60,12 @@ class RigidImpactHold:
 
     @property
     def active(self) -> bool:
+        """Whether the joints are held now."""
         return self.start is not None and self.end is None
 
     @property
     def duration(self) -> float | None:
+        """How long the hold lasted (s), None until it ended."""
         return None if self.start is None or self.end is None else self.end - self.start
 
     def begin(self, t: float) -> None:
@@ -76,8 +79,10 @@ class RigidImpactHold:
         self.start = float(t)
 
     def update(self, t: float, approach_speed: float) -> None:
-        """After a step: end the hold once the impact point no longer approaches the surface
-        (``approach_speed`` = ``-n . v`` <= 0, m/s) or after ``max_duration``.
+        """After a step: end the hold once the point no longer approaches, or after the longest.
+
+        The point approaches while ``approach_speed`` = ``-n . v`` > 0 (m/s); the hold lasts at most
+        ``max_duration``.
         """
         if not self.active:
             return
@@ -86,7 +91,7 @@ class RigidImpactHold:
         self.velocity_change = max(
             self.velocity_change, float(change.max()) if change.size else 0.0
         )
-        if approach_speed <= 0.0 or t - self.start >= self.max_duration:
+        if self.start is None or approach_speed <= 0.0 or t - self.start >= self.max_duration:
             self.release(t)
 
     def release(self, t: float) -> None:
@@ -95,7 +100,8 @@ class RigidImpactHold:
             self.sim.model.dof_armature[self.sim.dof_adr] = self._saved
             self.end = float(t)
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
         return {
             "start": self.start,
             "end": self.end,

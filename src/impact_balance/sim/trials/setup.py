@@ -15,24 +15,17 @@ import numpy as np
 from impact_balance.analysis.analyze import Analysis, analyze
 from impact_balance.exceptions import SimulationError
 from impact_balance.scenario import Scenario, load_scenario
-from impact_balance.sim.control.actuation import (
-    STIFF_SERVOS,
-    stiffen_support_limbs,
-    support_joints,
-    use_torque_motors,
-)
-from impact_balance.sim.control.kinematic import BalanceGains, retracted_stance
-from impact_balance.sim.control.torque import InverseDynamicsGains
+from impact_balance.sim.control.actuation import STIFF_SERVOS, support_joints
+from impact_balance.sim.control.controller import ControllerName
+from impact_balance.sim.control.gains import BalanceGains, InverseDynamicsGains
+from impact_balance.sim.control.kinematic import retracted_stance
+from impact_balance.sim.control.registry import CONTROLLERS, controller_class
 from impact_balance.sim.model.build import SimModel, SimOptions, build_model
-from impact_balance.sim.model.joints import JOINT_MODELS, ServoOptions
+from impact_balance.sim.model.joints import JointModel, ServoOptions, check_joint_model
 from impact_balance.sim.trials.outcomes import OutcomeCriteria
 
 #: Iterations of MuJoCo's no-slip solver in balance trials.
 NOSLIP_ITERATIONS = 10
-
-#: Balance controllers: ``ik`` (pink IK -> position servos, :mod:`.balance`) and ``id`` (inverse-dynamics QP ->
-#: torque motors, :mod:`.inverse_dynamics`).
-CONTROLLERS = ("ik", "id")
 
 __all__ = [
     "CONTROLLERS",
@@ -42,6 +35,7 @@ __all__ = [
     "BalanceTrialOptions",
     "Push",
     "controller_margin",
+    "push_body",
 ]
 
 
@@ -65,8 +59,34 @@ class Push:
 
     @property
     def force(self) -> np.ndarray:
+        """The force (N, world): ``magnitude / duration`` along ``direction``, horizontal."""
         f = self.magnitude / self.duration
         return np.array([f * np.cos(self.direction), f * np.sin(self.direction), 0.0])
+
+
+def push_body(sim: SimModel, name: str | None) -> int:
+    """The MuJoCo body a :class:`Push` acts on.
+
+    Args:
+        sim: The trial's model.
+        name: MuJoCo body name, or None for the deepest body named like "torso" with a mass
+            (the root body when there is none).
+
+    Returns:
+        The body's id in ``sim.model``.
+
+    Raises:
+        SimulationError: No body of the model has that name.
+    """
+    m = sim.model
+    if name is not None:
+        try:
+            return int(m.body(name).id)
+        except KeyError:
+            valid = ", ".join(m.body(i).name for i in range(1, m.nbody))
+            raise SimulationError("--body", name, f"no such body; valid: {valid}") from None
+    torso = [i for i in range(m.nbody) if "torso" in m.body(i).name and m.body_mass[i] > 0]
+    return max(torso) if torso else sim.root_body
 
 
 @dataclass(frozen=True)
@@ -74,16 +94,17 @@ class BalanceTrialOptions:
     """Options of a trial.
 
     Attributes:
-        after: Simulated time after the disturbance (contact or end of push) (s); a robot still moving then
-            gets ``criteria.extra_time`` more (see :mod:`.outcomes`).
+        after: Simulated time after the disturbance (contact or end of push) (s); a robot still
+            moving then gets ``criteria.extra_time`` more (see :mod:`.outcomes`).
         settle: Time standing still before the disturbance (s).
-        max_approach_time: Longest time after the reference reached the surface before the trial gives
-            up waiting for the contact (s).
+        max_approach_time: Longest time after the reference reached the surface before the trial
+            gives up waiting for the contact (s).
         gains: Gains of the ``ik`` controller.
         criteria: Outcome thresholds (:mod:`.outcomes`).
         record: Keep a log (:mod:`impact_balance.logs` columns) in the result.
-        controller: ``ik`` (pink IK, position servos) or ``id`` (inverse-dynamics QP, torque motors); it
-            decides the actuators, so it is read when the :class:`BalanceSetup` is created.
+        controller: ``ik`` (pink IK, position servos) or ``id`` (inverse-dynamics QP, torque
+            motors); it decides the actuators, so it is read when the :class:`BalanceSetup` is
+            created.
         id_gains: Gains of the ``id`` controller.
         rigid_impact: Hold every joint's velocity through the impact (:mod:`.rigid_impact`).
     """
@@ -94,28 +115,34 @@ class BalanceTrialOptions:
     gains: BalanceGains = field(default_factory=BalanceGains)
     criteria: OutcomeCriteria = field(default_factory=OutcomeCriteria)
     record: bool = False
-    controller: str = "ik"
+    controller: ControllerName = "ik"
     id_gains: InverseDynamicsGains = field(default_factory=InverseDynamicsGains)
     rigid_impact: bool = False
 
 
 def controller_margin(options: BalanceTrialOptions) -> float:
-    """The ZMP margin the trials' controller keeps inside the ZMP support area (m): the scores' default."""
-    return options.id_gains.zmp_margin if options.controller == "id" else options.gains.zmp_margin
+    """The ZMP margin (m) the trials' controller keeps inside the ZMP support area.
+
+    The ZMP margin the trials' controller keeps inside the ZMP support area (m): the scores'
+    default.
+    """
+    return controller_class(options.controller).zmp_margin(options)
 
 
 @dataclass
 class BalanceSetup:
-    """A scenario prepared for trials: analysis (without ZMP margin: the controller is configured on its
-    own), MuJoCo model, start configurations (one per standoff of the impacting point).
+    """A scenario prepared for trials: analysis, MuJoCo model, start configurations.
+
+    The analysis is without ZMP margin (the controller is configured on its own); one start
+    configuration per standoff of the impacting point.
     """
 
     scenario: Scenario
-    joints: str
+    joints: JointModel
     analysis: Analysis
     sim: SimModel
     support_v_index: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
-    controller: str = "ik"
+    controller: ControllerName = "ik"
     _starts: dict[float, np.ndarray] = field(default_factory=dict)
 
     @classmethod
@@ -127,23 +154,16 @@ class BalanceSetup:
         sim_options: SimOptions | None = None,
         meshes: bool = False,
     ) -> BalanceSetup:
-        """Analyse ``scenario`` and build its MuJoCo model for trials with ``joints`` and ``options``
-        (``sim_options``: the model's own, default 1 ms steps; ``meshes``: load the robot's meshes,
-        visual only, for a video).
+        """Analyse ``scenario`` and build its MuJoCo model for trials.
+
+        ``joints`` and ``options`` are the trials'; ``sim_options`` the model's own (default 1 ms
+        steps); ``meshes``: load the robot's meshes, visual only, for a video.
         """
         options = options or BalanceTrialOptions()
         if not isinstance(scenario, Scenario):
             scenario = load_scenario(scenario)
-        if joints not in JOINT_MODELS:
-            raise SimulationError(
-                "--joints", joints, f"unknown joint model; valid: {', '.join(JOINT_MODELS)}"
-            )
-        if options.controller not in CONTROLLERS:
-            raise SimulationError(
-                "--controller",
-                options.controller,
-                f"unknown controller; valid: {', '.join(CONTROLLERS)}",
-            )
+        joint_model = check_joint_model(joints)
+        controller = controller_class(options.controller)
         # The controller works on the areas themselves: a scoring margin is applied afterwards.
         analysis = analyze(scenario.model_copy(update={"zmp_margin": 0.0}))
         if not analysis.areas.can_balance:
@@ -156,22 +176,23 @@ class BalanceSetup:
             # 1 ms steps: the stiffest contact (impact, time constant 4 ms) still spans 4 steps.
             servo = ServoOptions() if joints == "servo" else STIFF_SERVOS
             sim_options = SimOptions(timestep=0.001, meshes=meshes, servo=servo)
-        # Welded joints admit no controller: "rigid" balance trials use stiff servos without effort limits.
+        # Welded joints admit no controller: "rigid" balance trials use stiff servos without
+        # effort limits.
         sim = build_model(scenario, "servo", sim_options)
-        # MuJoCo's soft friction lets a loaded contact creep (a sole on the 30 degree ramp slides about
-        # 3 mm/s within its friction cone); the no-slip pass removes that drift, which would otherwise
-        # count as a slip after a few seconds.
+        # MuJoCo's soft friction lets a loaded contact creep (a sole on the 30 degree ramp slides
+        # about 3 mm/s within its friction cone); the no-slip pass removes that drift, which would
+        # otherwise count as a slip after a few seconds.
         sim.model.opt.noslip_iterations = NOSLIP_ITERATIONS
-        if options.controller == "id":
-            use_torque_motors(sim)
-        else:
-            stiffen_support_limbs(sim, analysis)
+        controller.prepare_model(sim, analysis)
         support = [analysis.stance.robot.joint_slot(n) for n in support_joints(sim, analysis)]
         support_v = np.array([analysis.stance.model.joints[j.id].idx_v for j in support], dtype=int)
-        return cls(scenario, joints, analysis, sim, support_v, options.controller)
+        return cls(scenario, joint_model, analysis, sim, support_v, options.controller)
 
     def start_configuration(self, standoff: float = 0.0) -> np.ndarray:
-        """The stance with the impact point backed off ``standoff`` (m) along the normal (whole-body IK, cached)."""
+        """The stance with the impact point backed off ``standoff`` (m) along the normal (cached).
+
+        Whole-body IK, cached by standoff.
+        """
         key = round(float(standoff), 6)
         if key not in self._starts:
             self._starts[key] = retracted_stance(self.analysis, key)

@@ -15,15 +15,22 @@ from __future__ import annotations
 
 import warnings
 from pathlib import Path
+from typing import Any
 
 import mujoco
 import numpy as np
+from numpy.typing import ArrayLike
 
 from impact_balance.exceptions import SimulationError
 from impact_balance.sim.model.build import SimModel
 from impact_balance.sim.trials.impact_trial import TrialRecord
 
 __all__ = ["VIDEO_SIZE", "frame_caption", "project", "write_video"]
+
+#: A pixel (column, row).
+_Pixel = tuple[float, float]
+#: The markers of a frame: CoM, its ground projection and impact point pixels, and contact.
+_Marks = tuple[_Pixel | None, _Pixel | None, _Pixel | None, bool]
 
 #: Default frame size, pixels (width, height).
 VIDEO_SIZE = (1280, 720)
@@ -48,7 +55,9 @@ def frame_caption(t: float, impact_start: float, slowdown: float, in_contact: bo
     return lines
 
 
-def project(scene, point, width: int, height: int) -> tuple[float, float] | None:
+def project(
+    scene: mujoco.MjvScene, point: ArrayLike, width: int, height: int
+) -> tuple[float, float] | None:
     """Pixel (column, row) of a world point in the last rendered view, None behind the camera.
 
     Uses the scene's OpenGL camera (position, forward and up axes, frustum at the near plane).
@@ -69,7 +78,7 @@ def project(scene, point, width: int, height: int) -> tuple[float, float] | None
     return u, v
 
 
-def _font(size: int):
+def _font(size: int) -> Any:
     from PIL import ImageFont
 
     try:
@@ -78,7 +87,14 @@ def _font(size: int):
         return ImageFont.load_default()
 
 
-def _markers(draw, com_px, ground_px, impact_px, contact: bool, size: int) -> None:
+def _markers(
+    draw: Any,
+    com_px: _Pixel | None,
+    ground_px: _Pixel | None,
+    impact_px: _Pixel | None,
+    contact: bool,
+    size: int,
+) -> None:
     """CoM and impact markers drawn over the picture (never hidden inside the robot), labelled."""
     font = _font(size)
     r = max(6, size // 2)
@@ -117,7 +133,9 @@ def _markers(draw, com_px, ground_px, impact_px, contact: bool, size: int) -> No
         )
 
 
-def _caption(image: np.ndarray, lines: list[str], title: str, marks: tuple = ()) -> np.ndarray:
+def _caption(
+    image: np.ndarray, lines: list[str], title: str, marks: _Marks | None = None
+) -> np.ndarray:
     """Write the caption and the markers on a copy of ``image`` (Pillow, which imageio brings)."""
     from PIL import Image, ImageDraw
 
@@ -129,7 +147,7 @@ def _caption(image: np.ndarray, lines: list[str], title: str, marks: tuple = ())
     if marks:
         _markers(draw, *marks, size=size)
     pad, step = size // 2, int(1.35 * size)
-    for rows, bottom in (([title] + lines, False), ([LEGEND], True)):
+    for rows, bottom in (([title, *lines], False), ([LEGEND], True)):
         width = max(draw.textlength(r, font=font) for r in rows)
         top = height - pad - step * len(rows) - pad if bottom else pad
         draw.rectangle(
@@ -188,7 +206,10 @@ def write_video(
     camera.lookat[:] = sim.stance.com
     camera.distance = 3.0
     camera.elevation = -12.0
-    normal = np.asarray(sim.scenario.impact.normal, dtype=float)
+    impact = sim.scenario.impact
+    if impact is None:
+        raise SimulationError("--video", str(path)[:80], "the scenario has no impact to film")
+    normal = np.asarray(impact.normal, dtype=float)
     # Side view: look along the horizontal direction orthogonal to the impact normal.
     side = np.cross([0.0, 0.0, 1.0], normal)
     side = side if np.linalg.norm(side) > 1e-6 else np.array([0.0, 1.0, 0.0])
@@ -234,7 +255,7 @@ def write_video(
                     name,
                     marks,
                 )
-                writer.append_data(frame)
+                writer.append_data(frame)  # type: ignore[attr-defined]  # imageio's v2 writer
     finally:
         renderer.close()
         light.ambient[:], light.diffuse[:], light.specular[:] = saved
