@@ -299,6 +299,6 @@ def test_a_cycling_walk_gives_up_early_and_the_answer_is_bretls():
     assert pivots <= 5 * (n + m) < MAX_PIVOTS
     # The fallback's answer is analyze()'s for the same state (which falls back the same way).
     reference = analyze(governor.scenario_at(q, answer.com_velocity))
-    assert answer.max_approach_speed == pytest.approx(
+    assert answer.max_contact_velocity == pytest.approx(
         reference.impact.max_contact_velocity, abs=1e-9
     )

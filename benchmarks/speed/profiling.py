@@ -68,7 +68,7 @@ def profile_report(args) -> dict[str, Any]:
     """
     import pinocchio as pin
 
-    from impact_balance.criteria.com import first_exit
+    from impact_balance.criteria.linear_exit import first_exit
     from impact_balance.projection import _kernel, project_walk
 
     out: dict[str, Any] = {}

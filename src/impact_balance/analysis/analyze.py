@@ -12,13 +12,10 @@ from impact_balance.analysis.result import Analysis, ImpactAnswer
 from impact_balance.balance.areas import BalanceAreas, areas_from_polytope, with_reason
 from impact_balance.contacts.stance import Stance
 from impact_balance.contacts.wrench_polytope import wrench_polytope
-from impact_balance.criteria.com import (
-    max_contact_velocity,
-    safe_contact_velocity,
-    safe_interval,
-    zmp_max_contact_velocity,
-)
+from impact_balance.criteria.cap import safe_contact_velocity
+from impact_balance.criteria.com import max_contact_velocity, safe_interval
 from impact_balance.criteria.qp import QPOptions, solve_contact_velocity_qp, static_torques
+from impact_balance.criteria.zmp import zmp_max_contact_velocity
 from impact_balance.exceptions import NonFiniteResultError, ScenarioError, SolverError
 from impact_balance.impact.model import ImpactModel, impact_model
 from impact_balance.projection.walk import warm_up

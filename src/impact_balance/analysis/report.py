@@ -81,7 +81,7 @@ def format_analysis(analysis: Analysis) -> str:
             f"mu {spec.friction:g}, restitution [{spec.restitution[0]:g}, {spec.restitution[1]:g}], N = {spec.cone_edges}"
         )
         com_v, zmp_v = im.max_contact_velocity, im.zmp_max_contact_velocity
-        if im.com_limit.status == "already_falling":
+        if im.com.status == "already_falling":
             # The ZMP criterion ignores the CoM velocity: its number is not comparable here.
             lines.append(
                 f"  max contact velocity: none, the robot is already falling (CoM criterion 0); "

@@ -11,7 +11,7 @@
 
 J is the impact point's 3 x nv translational Jacobian, so the approach speed is -n^T J qd.
 Without the optional bounds, its solution equals :func:`criteria.max_contact_velocity` with
-:func:`criteria.capped_velocity` (tested). The QP also forces -n^T J qd >= 0 (lambda >= 0).
+:func:`~impact_balance.criteria.cap.capped_velocity` (tested). The QP also forces -n^T J qd >= 0 (lambda >= 0).
 """
 
 from __future__ import annotations

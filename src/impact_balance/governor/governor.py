@@ -12,9 +12,10 @@ import pinocchio as pin
 
 from impact_balance.balance.areas import warm_up as warm_up_maps
 from impact_balance.contacts.stance import has_free_flyer
-from impact_balance.criteria.com import VelocityLimit
+from impact_balance.criteria.cap import cap_approach
+from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.exceptions import GovernorError, ScenarioError
-from impact_balance.governor.limit import SpeedLimit, cap_approach
+from impact_balance.governor.limit import SpeedLimit
 from impact_balance.governor.posture import Posture, PostureEvaluator, PostureSettings
 from impact_balance.governor.support import ContactAwareLimit, combine
 from impact_balance.governor.worker import ContactAwareWorker
@@ -254,7 +255,7 @@ class Governor:
     ) -> np.ndarray:
         """The reference end-effector velocity (world, m/s) with its approach speed brought
         into the safe interval of ``limit`` (default: this governor's last answer); see
-        :func:`~impact_balance.governor.limit.cap_approach`. Without ``reference_velocity``,
+        :func:`~impact_balance.criteria.cap.cap_approach`. Without ``reference_velocity``,
         the scenario's ``impact.reference_velocity``.
 
         Raises:
@@ -371,7 +372,7 @@ class Governor:
                 self._support_posture = posture.key
             limit, aware = self._support.answers(criterion, com_velocity)
             interval = combine(criterion.interval(com_velocity, limit), aware.interval)
-            if aware.limit.max_approach_speed < limit.max_approach_speed:
+            if aware.limit.max_contact_velocity < limit.max_contact_velocity:
                 limit, binding = aware.limit, "contact_aware"
         else:
             limit = posture.zmp_limit
@@ -379,7 +380,7 @@ class Governor:
         model = posture.impact
         answer = SpeedLimit(
             self.criterion,
-            limit.max_approach_speed,
+            limit.max_contact_velocity,
             limit.status,
             limit.limiting_vertex,
             limit.limiting_edge,
@@ -394,13 +395,11 @@ class Governor:
         return answer
 
 
-def _zmp_interval(limit: VelocityLimit) -> tuple[float, float] | None:
+def _zmp_interval(limit: ContactVelocityLimit) -> tuple[float, float] | None:
     """The ZMP criterion's safe speeds: from 0 to its maximum, or none when it is already
     violated (the CoM's vertical outside the ZMP area) or the area is empty.
     """
-    if limit.status in ("ok", "unbounded"):
-        return 0.0, limit.max_approach_speed
-    return None
+    return limit.interval_from_inside()
 
 
 def _is_numeric(x) -> bool:

@@ -53,7 +53,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from impact_balance.contacts.stance import Stance
-from impact_balance.criteria.com import ComCriterion, VelocityLimit, speed_interval
+from impact_balance.criteria.com import ComCriterion
+from impact_balance.criteria.linear_exit import speed_interval
+from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.exceptions import GovernorError
 from impact_balance.impact.contact_aware import contact_impact
 from impact_balance.impact.model import ImpactSpec
@@ -203,7 +205,7 @@ class ContactAwareAnswer:
 
     Attributes:
         limit: Largest approach speed (m/s) keeping every contact-aware post-impact CoM velocity
-            in the area, as :class:`~impact_balance.criteria.com.VelocityLimit` (its vertex j: row j
+            in the area, as :class:`~impact_balance.criteria.velocity_limit.ContactVelocityLimit` (its vertex j: row j
             of ``rates``).
         interval: The approach speeds ``(lo, hi)`` (m/s) that keep them all in (the
             intersection over the rows), or None.
@@ -217,7 +219,7 @@ class ContactAwareAnswer:
         solves: QP solves of the last recomputation (all its fixed points; the cost).
     """
 
-    limit: VelocityLimit
+    limit: ContactVelocityLimit
     interval: tuple[float, float] | None
     rates: np.ndarray
     age: int
@@ -307,7 +309,7 @@ class ContactAwareLimit:
 
     def answers(
         self, criterion: ComCriterion, com_velocity: np.ndarray
-    ) -> tuple[VelocityLimit, ContactAwareAnswer]:
+    ) -> tuple[ContactVelocityLimit, ContactAwareAnswer]:
         """``criterion.limit(com_velocity)`` (the floating model's limit) and :meth:`answer`,
         in one compiled call: a governor's tick.
         """
@@ -317,11 +319,8 @@ class ContactAwareLimit:
         floating, limit = criterion.limits(com_velocity, s.rates)
         if criterion.G is None:
             interval = None
-        elif limit.status in (
-            "ok",
-            "unbounded",
-        ):  # from inside: [0, limit] (as ComCriterion.interval)
-            interval = (0.0, limit.max_approach_speed)
+        elif limit.from_inside:
+            interval = limit.interval_from_inside()
         else:
             interval = speed_interval(criterion.margins(com_velocity), s.rates @ criterion.G.T)
         return floating, ContactAwareAnswer(

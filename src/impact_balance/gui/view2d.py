@@ -293,7 +293,7 @@ def svg_view(analysis: Analysis, width: int = 420) -> str:
         )
     im = analysis.impact
     if im is not None:
-        model, limit = im.model, im.com_limit
+        model, limit = im.model, im.com
         s = im.evaluation_speed()
         at_max = model.post_impact_com_velocities(c0, s)
         if s > 0:

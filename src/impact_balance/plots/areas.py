@@ -145,8 +145,8 @@ def draw_com_velocity_area(
     im = analysis.impact
     if im is not None:
         model = im.model
-        limit = im.com_limit
-        vmax = limit.max_approach_speed
+        limit = im.com
+        vmax = limit.max_contact_velocity
         ref = model.spec.reference_velocity
         v_ref = max(0.0, model.approach_speed(ref)) if ref is not None else None
         # The series k / n * v_max (or of the reference speed when there is no limit).

@@ -26,7 +26,8 @@ import pyarrow as pa
 from impact_balance.balance.areas import BalanceAreas, areas_from_polytope
 from impact_balance.contacts.stance import Stance
 from impact_balance.contacts.wrench_polytope import wrench_polytope
-from impact_balance.criteria.com import max_contact_velocity, zmp_max_contact_velocity
+from impact_balance.criteria.com import max_contact_velocity
+from impact_balance.criteria.zmp import zmp_max_contact_velocity
 from impact_balance.exceptions import ImpactBalanceError, ScenarioError
 from impact_balance.impact.model import impact_model
 from impact_balance.robot.ik import IKError, solve_stance
@@ -200,8 +201,8 @@ class Evaluator:
         out.update(
             status=com.status,
             verdict=verdict,
-            max_contact_velocity=com.max_approach_speed,
-            zmp_max_contact_velocity=zmp.max_approach_speed,
+            max_contact_velocity=com.max_contact_velocity,
+            zmp_max_contact_velocity=zmp.max_contact_velocity,
             zmp_status=zmp.status,
             com_velocity_area=entry.com_velocity_area,
             zmp_area=entry.zmp_area,
