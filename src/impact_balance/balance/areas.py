@@ -18,7 +18,6 @@ from the edges does; the CoM velocity area follows (it is the same set, scaled b
 from __future__ import annotations
 
 import dataclasses
-import math
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -26,6 +25,7 @@ import numpy as np
 
 from impact_balance._jit import cache_depends_on, njit
 from impact_balance.balance.infeasibility import CannotBalanceReason, explain_cannot_balance
+from impact_balance.balance.lipm import lipm_omega
 from impact_balance.constants import GRAVITY
 from impact_balance.contacts import wrench_polytope as constraints
 from impact_balance.contacts.stance import Stance
@@ -35,7 +35,7 @@ from impact_balance.contacts.wrench_polytope import (
     face_blocks,
     wrench_polytope,
 )
-from impact_balance.exceptions import ScenarioError, SolverError
+from impact_balance.exceptions import SolverError
 from impact_balance.geometry import polygon
 from impact_balance.geometry.polygon import (
     MERGE_AREA_TOLERANCE,
@@ -53,7 +53,6 @@ __all__ = [
     "areas_from_arrays",
     "areas_from_polytope",
     "balance_areas",
-    "omega",
     "projected_from_arrays",
     "with_reason",
 ]
@@ -66,15 +65,6 @@ FORCE_TOLERANCE = 1e-8
 MERGE_TOLERANCE = 1e-6
 #: Clipping box on the resultant horizontal force for unbounded directions, in units of m g.
 FORCE_BOX = 1e3
-
-
-def omega(com_height: float, plane_height: float = 0.0, gravity: float = GRAVITY) -> float:
-    """LIPM natural frequency sqrt(g / (c_z - h)), 1/s; the plane must be below the CoM."""
-    if not com_height > plane_height:
-        raise ScenarioError(
-            "plane_height", plane_height, f"must be below the CoM height {com_height:.4g} m"
-        )
-    return math.sqrt(gravity / (com_height - plane_height))
 
 
 @dataclass(frozen=True)
@@ -138,7 +128,7 @@ def areas_from_polytope(
     support area shrunk by ``zmp_margin`` (m).
     """
     com = polytope.com
-    w = omega(float(com[2]), plane_height, polytope.gravity)
+    w = lipm_omega(float(com[2]), plane_height, polytope.gravity, field="plane_height")
     depth = plane_height - float(com[2])  # < 0
     # Work in units of m g so that tolerances mean the same for every robot, and in
     # friction-normalised variables so that a large or small friction keeps full precision.
@@ -236,7 +226,7 @@ def projected_from_arrays(
             f"hint must be a writable 1-D int64 numpy array, not {type(hint).__name__} "
             f"{getattr(hint, 'dtype', '')}".rstrip()
         )
-    w = omega(float(com[2]), plane_height, gravity)
+    w = lipm_omega(float(com[2]), plane_height, gravity, field="plane_height")
     depth = plane_height - float(com[2])
     positions, arms, jacobians, torque_limits, gravity_torques = (
         np.ascontiguousarray(x, dtype=np.float64)
@@ -468,7 +458,8 @@ def balance_areas(
     zmp_margin: float = 0.0,
 ) -> BalanceAreas:
     """ZMP support area (shrunk by ``zmp_margin``, m) and CoM velocity area of ``stance``."""
-    omega(float(stance.com[2]), plane_height, gravity)  # validate the plane before any work
+    # validate the plane before any work
+    lipm_omega(float(stance.com[2]), plane_height, gravity, field="plane_height")
     areas = areas_from_polytope(
         wrench_polytope(stance, torque_limits, gravity), plane_height, zmp_margin
     )
