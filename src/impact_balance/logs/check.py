@@ -39,6 +39,7 @@ from impact_balance.balance.areas import balance_areas
 from impact_balance.contacts.stance import Stance
 from impact_balance.exceptions import ScenarioError
 from impact_balance.geometry.polygon import Polygon
+from impact_balance.json_values import json_number
 from impact_balance.logs.io import check_log_columns
 from impact_balance.logs.schema import (
     LogColumns,
@@ -141,9 +142,7 @@ class LogCheck:
         return not self.violations
 
     def to_dict(self, samples: bool = False) -> dict:
-        def num(x):
-            return None if x is None or not np.isfinite(x) else float(x)
-
+        num = json_number
         s = self.samples
         out = {
             "scenario": self.scenario,

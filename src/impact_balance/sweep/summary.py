@@ -10,13 +10,13 @@ are read; a bad part is named in ``problems`` (and the summary is not ``complete
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
+from impact_balance.json_values import json_number
 from impact_balance.sweep.evaluate import STATUSES
 from impact_balance.sweep.store import FolderCheck, load_results
 
@@ -57,7 +57,7 @@ def _clean(value: Any) -> Any:
     if isinstance(value, (np.integer,)):
         return int(value)
     if isinstance(value, (float, np.floating)):
-        return float(value) if math.isfinite(value) else None
+        return json_number(value)
     if value is pd.NA:
         return None
     return value

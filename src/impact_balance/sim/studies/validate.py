@@ -27,6 +27,7 @@ import numpy as np
 
 from impact_balance.analysis.analyze import analyze
 from impact_balance.exceptions import SimulationError
+from impact_balance.json_values import json_number
 from impact_balance.ranges import check_tolerance
 from impact_balance.scenario import Scenario, load_scenario
 from impact_balance.sim.studies.journal import TrialJournal
@@ -43,10 +44,6 @@ __all__ = ["INERTIA_MODELS", "ValidationResult", "ValidationTrial", "predictions
 INERTIA_MODELS = ("composite", "joint_space")
 
 
-def _num(x: float | None) -> float | None:
-    return None if x is None or not np.isfinite(x) else float(x)
-
-
 def predictions(scenario: Scenario, zmp_margin: float = 0.0) -> dict[str, dict[str, float | None]]:
     """Maximum contact velocity (m/s; None if unbounded) by each criterion and inertia model, with the ZMP
     support area shrunk by ``zmp_margin`` (m).
@@ -60,8 +57,8 @@ def predictions(scenario: Scenario, zmp_margin: float = 0.0) -> dict[str, dict[s
             }
         )
         answer = analyze(variant).impact
-        out["com_criterion"][inertia] = _num(answer.max_contact_velocity)
-        out["zmp_criterion"][inertia] = _num(answer.zmp_max_contact_velocity)
+        out["com_criterion"][inertia] = json_number(answer.max_contact_velocity)
+        out["zmp_criterion"][inertia] = json_number(answer.zmp_max_contact_velocity)
     return out
 
 

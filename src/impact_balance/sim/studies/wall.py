@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from impact_balance.exceptions import SimulationError
+from impact_balance.json_values import json_number
 from impact_balance.sim.control.approach import _profile
 from impact_balance.sim.trials.balance_trial import (
     BalanceSetup,
@@ -192,10 +193,6 @@ class WallTrial:
         }
 
 
-def _finite(x) -> float | None:
-    return None if x is None or not np.isfinite(x) else float(x)
-
-
 def run_wall_trial(
     setup: BalanceSetup,
     options: WallOptions,
@@ -267,7 +264,7 @@ def run_wall_trial(
         rows["time"].append(t)
         rows["reference"].append(task.reference_speed(t) if task.contact_time is None else 0.0)
         rows["cap"].append(
-            _finite(task.ceiling) if governor is not None and task.contact_time is None else None
+            json_number(task.ceiling) if governor is not None and task.contact_time is None else None
         )
         rows["commanded"].append(task.commanded if task.contact_time is None else 0.0)
         rows["measured"].append(float(-n @ _point_velocity(sim, n)))
@@ -285,7 +282,7 @@ def run_wall_trial(
     cap_at_contact = None
     if impact is not None and caps:
         k = max(0, int(np.searchsorted([c[0] for c in caps], impact.contact_time)) - 1)
-        cap_at_contact = _finite(caps[k][2])
+        cap_at_contact = json_number(caps[k][2])
     us = np.asarray(ticks) * 1e6
     tick_us = (
         {"median": float(np.median(us)), "p99": float(np.percentile(us, 99)), "count": int(us.size)}
@@ -295,7 +292,7 @@ def run_wall_trial(
     return WallTrial(
         options,
         result,
-        None if impact is None else _finite(impact.approach_speed),
+        None if impact is None else json_number(impact.approach_speed),
         cap_at_contact,
         None if impact is None else float(impact.contact_time - task.start_time),
         tick_us,

@@ -28,6 +28,7 @@ import pinocchio as pin
 from impact_balance.contacts.stance import Stance
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.impact.model import INERTIA_MODELS, impact_model
+from impact_balance.json_values import json_number
 from impact_balance.sim.model.build import SimModel
 from impact_balance.sim.trials.impact_trial import TrialRecord
 
@@ -106,9 +107,7 @@ class TrialResult:
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready (strict: no NaN)."""
 
-        def num(x: float) -> float | None:
-            return float(x) if np.isfinite(x) else None
-
+        num = json_number
         return {
             "approach_speed": num(self.approach_speed),
             "joints": self.joints,
