@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 from impact_balance.balance.areas import projected_from_arrays
 from impact_balance.governor import Governor
 from impact_balance.governor.posture import PostureEvaluator
-from impact_balance.projection import _kernel as K
+from impact_balance.projection import kernel as K
 from impact_balance.projection.walk import NO_HINT
 
 

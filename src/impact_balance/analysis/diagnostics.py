@@ -43,6 +43,7 @@ __all__ = [
     "Diagnostic",
     "contact_diagnostics",
     "diagnose",
+    "diagnostics_to_json",
     "impact_diagnostics",
 ]
 

@@ -43,17 +43,21 @@ from impact_balance.geometry.polygon import (
     edge_halfplanes,
     inset_polygon,
 )
-from impact_balance.projection import _kernel, project_polytope, walk
-from impact_balance.projection._kernel import LINE, OK
+from impact_balance.projection import kernel, project_polytope, walk
+from impact_balance.projection.kernel import LINE, OK
 from impact_balance.projection.walk import MAX_PIVOTS, NO_HINT, certified_walk
 
 __all__ = [
+    "FORCE_BOX",
+    "FORCE_TOLERANCE",
+    "MERGE_TOLERANCE",
     "BalanceAreas",
     "Projected",
     "areas_from_arrays",
     "areas_from_polytope",
     "balance_areas",
     "projected_from_arrays",
+    "warm_up",
     "with_reason",
 ]
 
@@ -446,8 +450,8 @@ def _assembled_areas(
 
 # The compiled functions above embed the polygon module's, the walk's and the assembly's.
 cache_depends_on(_maps, polygon)
-cache_depends_on(_walk_areas, polygon, walk, _kernel)
-cache_depends_on(_assembled_areas, polygon, walk, _kernel, constraints)
+cache_depends_on(_walk_areas, polygon, walk, kernel)
+cache_depends_on(_assembled_areas, polygon, walk, kernel, constraints)
 
 
 def balance_areas(

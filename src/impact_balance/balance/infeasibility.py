@@ -33,7 +33,13 @@ from impact_balance.contacts.stance import Stance
 from impact_balance.contacts.wrench_polytope import contact_polytope, wrench_polytope
 from impact_balance.solvers import HighsLP, LinearProgram
 
-__all__ = ["HIGH_FRICTION", "BindingJoint", "CannotBalanceReason", "explain_cannot_balance"]
+__all__ = [
+    "FRICTION_RTOL",
+    "HIGH_FRICTION",
+    "BindingJoint",
+    "CannotBalanceReason",
+    "explain_cannot_balance",
+]
 
 #: Friction coefficient taken as "as much friction as one wants" (the polytope is then
 #: already the limit one up to 1e-6 of the weight for any practical geometry).

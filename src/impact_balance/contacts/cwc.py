@@ -11,7 +11,13 @@ import functools
 
 import numpy as np
 
-__all__ = ["cwc_faces", "cwc_faces_world", "cwc_span", "rotate_wrench_matrix"]
+__all__ = [
+    "cwc_faces",
+    "cwc_faces_world",
+    "cwc_span",
+    "local_faces",
+    "rotate_wrench_matrix",
+]
 
 
 def cwc_faces(mu: float, half_length: float, half_width: float) -> np.ndarray:

@@ -17,7 +17,13 @@ import pinocchio as pin
 from impact_balance.geometry.spatial import skew
 from impact_balance.robot.robot import Robot, Scratch
 
-__all__ = ["Contact", "ContactSpec", "Stance", "frame_point"]
+__all__ = [
+    "Contact",
+    "ContactSpec",
+    "Stance",
+    "frame_point",
+    "has_free_flyer",
+]
 
 _IDENTITY = pin.SE3.Identity()
 

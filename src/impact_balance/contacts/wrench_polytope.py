@@ -29,8 +29,10 @@ from impact_balance.contacts.stance import Contact, Stance
 
 __all__ = [
     "WrenchPolytope",
+    "assemble_arrays",
     "assemble_polytope",
     "contact_polytope",
+    "face_blocks",
     "friction_scaling",
     "grasp_matrix",
     "torque_limit_rows",

@@ -10,7 +10,15 @@ import numpy as np
 
 from impact_balance._jit import njit
 
-__all__ = ["MERGE_AREA_TOLERANCE", "Polygon"]
+__all__ = [
+    "MERGE_AREA_TOLERANCE",
+    "Polygon",
+    "edge_halfplanes",
+    "inset_polygon",
+    "simplify",
+    "simplify_convex",
+    "simplify_convex_kernel",
+]
 
 #: Largest fraction of a polygon's area that merging its near-duplicate and near-collinear
 #: vertices may remove. Bounded so that a larger set never gets a smaller merged area by
@@ -143,8 +151,12 @@ def _convex_ccw(v):
 
 
 @njit(cache=True)
-def _simplify_convex(v, check_tol, tol, area_tol, box):
-    """Compiled body of :func:`simplify_convex`."""
+def simplify_convex_kernel(v, check_tol, tol, area_tol, box):
+    """:func:`simplify_convex` compiled, on a contiguous (k, 2) float array.
+
+    Returns ``(ok, vertices, bounded)``: ``ok`` False when the check fails. A compiled
+    caller (the projection walk) calls it directly.
+    """
     first = _simplify(v, check_tol, area_tol)
     if not _convex_ccw(first):
         return False, first, False
@@ -172,7 +184,7 @@ def simplify_convex(
     under ``box`` (the clipping box), or None when the check fails.
     """
     v = np.ascontiguousarray(np.asarray(vertices, dtype=float).reshape(-1, 2))
-    ok, out, bounded = _simplify_convex(
+    ok, out, bounded = simplify_convex_kernel(
         v, float(check_tol), float(tol), float(area_tol), float(box)
     )
     return (out, bool(bounded)) if ok else None

@@ -32,9 +32,11 @@ __all__ = [
     "ImpactModel",
     "ImpactSpec",
     "composite_inertia_map",
+    "cone_tangents",
     "friction_cone",
     "impact_cone",
     "impact_model",
+    "impulse_to_velocity",
     "joint_space_inertia_map",
     "model_from_inertia_map",
 ]

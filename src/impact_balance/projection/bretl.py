@@ -26,7 +26,11 @@ from impact_balance.geometry.polygon import Polygon, simplify
 from impact_balance.projection.result import ProjectionResult
 from impact_balance.solvers import HighsLP, LinearProgram
 
-__all__ = ["project_bretl", "warm_up"]
+__all__ = [
+    "INITIAL_ANGLES",
+    "project_bretl",
+    "warm_up",
+]
 
 #: First ray directions (rad).
 INITIAL_ANGLES = (0.0, 2.0 * np.pi / 3.0, 4.0 * np.pi / 3.0)
