@@ -30,6 +30,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance.analysis.result import Diagnostic, ImpactAnswer
 
@@ -90,10 +91,10 @@ def contact_diagnostics(stance: Stance) -> list[Diagnostic]:
 
 
 def impact_diagnostics(
-    answer: ImpactAnswer, reference_velocity: Sequence[float] | None
+    answer: ImpactAnswer, reference_velocity: npt.ArrayLike | None
 ) -> list[Diagnostic]:
     """An impact that does not approach its surface, a QP capped by its reference."""
-    out = []
+    out: list[Diagnostic] = []
     if reference_velocity is None:
         return out
     approach = answer.model.approach_speed(reference_velocity)

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import numpy as np
 
-from impact_balance.analysis.analyze import Analysis
+from impact_balance.analysis.result import Analysis
 
 __all__ = ["format_analysis", "format_safe_interval", "format_speed", "format_timings"]
 
@@ -43,7 +45,7 @@ def format_safe_interval(interval: tuple[float, float] | None, inside: bool) -> 
     return text
 
 
-def _vec(v, digits: int = 3) -> str:
+def _vec(v: Iterable[float], digits: int = 3) -> str:
     return "(" + ", ".join(f"{x:.{digits}f}" for x in v) + ")"
 
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -136,10 +136,14 @@ def areas_from_polytope(
     depth = plane_height - float(com[2])  # < 0
     # Work in units of m g so that tolerances mean the same for every robot, and in
     # friction-normalised variables so that a large or small friction keeps full precision.
-    data = tuple(np.ascontiguousarray(x, dtype=np.float64) for x in polytope.projection_data())
+    A, b, C, d, E = (np.ascontiguousarray(x, dtype=np.float64) for x in polytope.projection_data())
     # The walk, its certificate and both maps in one compiled call (a governor's every tick).
     walked = _walk_areas(
-        *data,
+        A,
+        b,
+        C,
+        d,
+        E,
         FORCE_BOX,
         MAX_PIVOTS,
         MERGE_TOLERANCE,
@@ -152,7 +156,14 @@ def areas_from_polytope(
         NO_HINT,
     )
     return _projected(
-        walked, data, com, w, plane_height, polytope.mass, polytope.gravity, float(zmp_margin)
+        walked,
+        (A, b, C, d, E),
+        com,
+        w,
+        plane_height,
+        polytope.mass,
+        polytope.gravity,
+        float(zmp_margin),
     ).areas()
 
 
@@ -298,8 +309,8 @@ class Projected(NamedTuple):
 
 
 def _projected(
-    walked: tuple,
-    data: tuple,
+    walked: tuple[Any, ...],
+    data: tuple[Any, ...],
     com: np.ndarray,
     w: float,
     plane_height: float,
@@ -314,8 +325,13 @@ def _projected(
     status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h = walked
     n_lp = 1
     if status != OK or force.shape[0] == 0:
+        A, b, C, d, E = data
         result = project_polytope(
-            *data,
+            A,
+            b,
+            C,
+            d,
+            E,
             tol=FORCE_TOLERANCE,
             box=FORCE_BOX,
             merge_tol=MERGE_TOLERANCE,

@@ -12,10 +12,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 
 from impact_balance.geometry.spatial import skew
-from impact_balance.robot.robot import Robot, Scratch
+from impact_balance.robot.robot import Robot, Scratch, Workspace
 
 __all__ = [
     "Contact",
@@ -30,7 +31,7 @@ _IDENTITY = pin.SE3.Identity()
 
 def has_free_flyer(model: pin.Model) -> bool:
     """Whether the model's first joint is a free flyer (then q[:3] is the base position)."""
-    return model.njoints > 1 and model.joints[1].shortname() == "JointModelFreeFlyer"
+    return bool(model.njoints > 1 and model.joints[1].shortname() == "JointModelFreeFlyer")
 
 
 def frame_point(
@@ -112,7 +113,8 @@ class Contact:
         """The 4 rectangle corners in world (4 x 3), counter-clockwise in the contact plane."""
         X, Y = self.half_length, self.half_width
         local = np.array([[X, Y, 0], [-X, Y, 0], [-X, -Y, 0], [X, -Y, 0]], dtype=float)
-        return self.position + local @ self.rotation.T
+        out: npt.NDArray[np.float64] = self.position + local @ self.rotation.T
+        return out
 
 
 class Stance:
@@ -165,12 +167,12 @@ class Stance:
             self.origin = self.q[:3].copy()
             self._q_local = self.q.copy()
             self._q_local[:3] = 0.0
-        workspace = self.workspace()
-        data = workspace.data
+        scratch = self.workspace()
+        data = scratch.data
         # ccrba runs the forward kinematics and also fills the joint Jacobians data.J (as
         # computeJointJacobians does) and data.Ig, the centroidal composite inertia in world axes.
         pin.ccrba(model, data, self._q_local, np.zeros(model.nv))
-        workspace.holder = self._q_local.tobytes()
+        scratch.holder = self._q_local.tobytes()
         self.com_local = np.array(
             pin.centerOfMass(model, data, pin.KinematicLevel.POSITION, False), dtype=float
         )
@@ -211,7 +213,7 @@ class Stance:
         pin.computeGeneralizedGravity(model, data, self.q)
         return data
 
-    def workspace(self) -> Scratch:
+    def workspace(self) -> Scratch | Workspace:
         """The scratch Data this stance computes in: the one it was given, else the robot's
         (per thread, :meth:`impact_balance.robot.robot.Robot.workspace`).
         """
@@ -244,7 +246,9 @@ class Stance:
         self, data: pin.Data, fid: int, offset: pin.SE3 | None
     ) -> tuple[pin.SE3, np.ndarray]:
         """:meth:`point` of frame ``fid`` from ``data`` holding this stance's kinematics (copies)."""
-        return frame_point(self.model, data, fid, offset)
+        placement, J = frame_point(self.model, data, fid, offset)
+        assert J is not None  # asked for (jacobian=True)
+        return placement, J
 
     def frame_pose(self, frame: str, field: str = "frame") -> pin.SE3:
         """World pose of a frame (a copy); ``field`` names it in an unknown-frame error."""

@@ -21,6 +21,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance._jit import njit
 from impact_balance.constants import GRAVITY
@@ -53,7 +54,7 @@ def grasp_matrix(positions: np.ndarray) -> np.ndarray:
     """
     positions = np.atleast_2d(np.asarray(positions, dtype=float))
     identity, rows, cols = _grasp_pattern(len(positions))
-    G = identity.copy()
+    G: npt.NDArray[np.float64] = identity.copy()
     # [p]x = [[0, -z, y], [z, 0, -x], [-y, x, 0]]: its 6 off-diagonal entries, contact by contact.
     G[rows, cols] = (positions[:, _SKEW_COMPONENTS] * _SKEW_SIGNS).ravel()
     return G
@@ -104,7 +105,7 @@ class WrenchPolytope:
 
     @property
     def dim(self) -> int:
-        return self.A.shape[1]
+        return int(self.A.shape[1])
 
     def projection_data(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(A', b', C', d', F')``: the same polytope and map in friction-normalised variables
@@ -273,10 +274,11 @@ def face_blocks(faces: np.ndarray, rotations: np.ndarray) -> np.ndarray:
     the two-feet-and-two-walls stance and returned a polygon 72 % off.
     """
     m = len(faces)
-    return np.matmul(
+    out: npt.NDArray[np.float64] = np.matmul(
         np.asarray(faces, dtype=float).reshape(m, 32, 3),
         np.asarray(rotations, dtype=float).transpose(0, 2, 1),
     )
+    return out
 
 
 @njit(cache=True)

@@ -5,8 +5,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance._jit import njit
 
@@ -206,7 +208,8 @@ def simplify(
     """
     v = np.ascontiguousarray(np.asarray(vertices, dtype=float).reshape(-1, 2))
     if len(v) == 0:
-        return v.copy()
+        out: npt.NDArray[np.float64] = v.copy()
+        return out
     return _simplify(v, float(tol), float(area_tol))
 
 
@@ -427,7 +430,10 @@ class Polygon:
         xs, ys = np.roll(x, -1), np.roll(y, -1)
         cross = x * ys - xs * y
         a = cross.sum() / 2
-        return np.array([((x + xs) * cross).sum(), ((y + ys) * cross).sum()]) / (6 * a)
+        out: npt.NDArray[np.float64] = np.array(
+            [((x + xs) * cross).sum(), ((y + ys) * cross).sum()]
+        ) / (6 * a)
+        return out
 
     @cached_property
     def halfplanes(self) -> tuple[np.ndarray, np.ndarray]:
@@ -454,7 +460,8 @@ class Polygon:
         """Signed distance-like margin of each point: ``min_k (h_k - G_k p)`` (>= 0 inside)."""
         G, h = self.halfplanes
         points = np.atleast_2d(points)
-        return np.min(h[None, :] - points @ G.T, axis=1)
+        out: npt.NDArray[np.float64] = np.min(h[None, :] - points @ G.T, axis=1)
+        return out
 
     def contains(self, points: np.ndarray, tol: float = 1e-9) -> np.ndarray | bool:
         """Whether each point lies in the polygon (within ``tol``)."""
@@ -483,7 +490,8 @@ class Polygon:
             return Polygon.empty()
         return Polygon(inset_polygon(np.ascontiguousarray(self.vertices), distance), self.bounded)
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
+        """The polygon as JSON: ``vertices``, ``halfplanes`` (``G``, ``h``), ``area``, ``bounded``."""
         G, h = self.halfplanes
         return {
             "vertices": self.vertices.tolist(),

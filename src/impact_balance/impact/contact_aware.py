@@ -52,6 +52,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance.contacts.cwc import cwc_span
 from impact_balance.contacts.stance import Stance
@@ -273,14 +274,15 @@ def _least_norm_multipliers(
         1.0, float(np.abs(resultant).max())
     ):
         return z
-    return np.maximum(least, 0.0)
+    out: npt.NDArray[np.float64] = np.maximum(least, 0.0)
+    return out
 
 
 def contact_impact(
     stance: Stance,
     spec: ImpactSpec,
     approach_speed: float,
-    com_velocity: Sequence[float] | None = None,
+    com_velocity: npt.ArrayLike | None = None,
     restitution: float | None = None,
     solver: str = "daqp",
     tolerance: float = 1e-9,

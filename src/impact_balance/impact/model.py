@@ -16,16 +16,17 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 
 from impact_balance._jit import njit
 from impact_balance.contacts.stance import Stance
 from impact_balance.exceptions import ImpactModelError
 from impact_balance.geometry.spatial import skew, unit
+from impact_balance.robot.robot import Scratch, Workspace
 
 __all__ = [
     "INERTIA_MODELS",
@@ -88,8 +89,20 @@ def cone_tangents(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     raise AssertionError("unreachable")  # pragma: no cover
 
 
-def friction_cone(normal: Sequence[float], mu: float, edges: int) -> np.ndarray:
-    """Generators K (3 x N): K_i = n + mu (cos a_i t1 + sin a_i t2), a_i = 2 pi i / N."""
+def friction_cone(normal: npt.ArrayLike, mu: float, edges: int) -> npt.NDArray[np.float64]:
+    """Generators K (3 x N): K_i = n + mu (cos a_i t1 + sin a_i t2), a_i = 2 pi i / N.
+
+    Args:
+        normal: (3,) surface normal, world (normalised here).
+        mu: Friction coefficient.
+        edges: N, the number of generators.
+
+    Returns:
+        (3, N) generators, world.
+
+    Raises:
+        ValueError: ``normal`` is zero.
+    """
     n = unit(normal)
     t1, t2 = cone_tangents(n)
     a = 2.0 * np.pi * np.arange(edges) / edges
@@ -149,15 +162,31 @@ class ImpactModel:
         return approach_speed * self.impulse_rates / self.mass
 
     def post_impact_com_velocities(
-        self, com_velocity: Sequence[float], approach_speed: float
-    ) -> np.ndarray:
-        """(2N, 2) vertices of the post-impact planar CoM velocity set, m/s."""
-        return (
+        self, com_velocity: npt.ArrayLike, approach_speed: float
+    ) -> npt.NDArray[np.float64]:
+        """The vertices of the post-impact planar CoM velocity set.
+
+        Args:
+            com_velocity: Pre-impact CoM velocity, world, m/s (x and y are read).
+            approach_speed: v_n, m/s.
+
+        Returns:
+            (2N, 2) post-impact CoM velocities, world xy, m/s.
+        """
+        out: npt.NDArray[np.float64] = (
             np.asarray(com_velocity, dtype=float)[None, :2] + approach_speed * self.com_jump_rates
         )
+        return out
 
-    def approach_speed(self, velocity: Sequence[float]) -> float:
-        """Approach speed -n . v of an end-effector velocity (m/s)."""
+    def approach_speed(self, velocity: npt.ArrayLike) -> float:
+        """Approach speed -n . v of an end-effector velocity.
+
+        Args:
+            velocity: (3,) end-effector velocity, world, m/s.
+
+        Returns:
+            m/s, positive towards the surface.
+        """
         return float(-self.normal @ np.asarray(velocity, dtype=float))
 
 
@@ -194,7 +223,8 @@ def composite_inertia_map(arm: np.ndarray, mass: float, com_inertia: np.ndarray)
     if _composite_map(arm, float(mass), com_inertia, W):
         return W
     r = skew(arm)  # Ic not positive definite (not a rigid body's): LAPACK's LU says what it can
-    return np.eye(3) / mass - r @ np.linalg.solve(com_inertia, r)
+    out: npt.NDArray[np.float64] = np.eye(3) / mass - r @ np.linalg.solve(com_inertia, r)
+    return out
 
 
 @njit(cache=True)
@@ -240,7 +270,7 @@ def _composite_map(arm, mass, Ic, W):
 
 
 def joint_space_inertia_map(
-    workspace, model: pin.Model, q: np.ndarray, jacobian: np.ndarray
+    workspace: Scratch | Workspace, model: pin.Model, q: np.ndarray, jacobian: np.ndarray
 ) -> np.ndarray:
     """W = J M(q)^-1 J^T (1/kg) of the translational Jacobian ``jacobian`` (3 x nv), with M
     computed in ``workspace``'s Data (a :class:`~impact_balance.robot.robot.Scratch` or

@@ -20,6 +20,7 @@ the empty polygon.
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance.exceptions import SolverError
 from impact_balance.geometry.polygon import Polygon, simplify
@@ -85,7 +86,8 @@ def project_bretl(
             return None
         if not sol.optimal:  # the box makes it bounded, so this would be a solver fault
             raise SolverError("HiGHS", sol.status, "support LP of the projection")
-        return E @ sol.x
+        out: npt.NDArray[np.float64] | None = E @ sol.x
+        return out
 
     first = []
     for angle in INITIAL_ANGLES:

@@ -21,6 +21,7 @@ from __future__ import annotations
 import os
 
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance._jit import HAVE_NUMBA, cache_depends_on, njit
 from impact_balance.geometry import polygon
@@ -164,7 +165,7 @@ cache_depends_on(_certify, polygon)
 cache_depends_on(certified_walk, polygon, kernel)
 
 
-def _array(x, ndim: int, columns: int | None = None) -> np.ndarray:
+def _array(x: npt.ArrayLike, ndim: int, columns: int | None = None) -> np.ndarray:
     """``x`` as a C-contiguous float64 array of ``ndim`` dimensions (``columns`` columns):
     itself when it already is one (a polytope's own arrays, every governor tick).
     """
@@ -188,7 +189,7 @@ def kernel_is_compiled() -> bool:
     if not HAVE_NUMBA:
         return True
     try:  # numba's cache index of the entry point; private API, hence the guard
-        return os.path.exists(project._cache._cache_file._index_path)
+        return os.path.exists(project._cache._cache_file._index_path)  # type: ignore[attr-defined]
     except AttributeError:
         return True
 

@@ -27,7 +27,7 @@ try:
     # output flag is switched off before that.
     from highspy._core import _Highs as _Solver
 except ImportError:  # pragma: no cover - a highspy without the private core name
-    _Solver = highspy.Highs
+    _Solver = highspy.Highs  # type: ignore[misc]
 
 
 class HighsLP:
@@ -99,7 +99,7 @@ class HighsLP:
 
     @property
     def dim(self) -> int:
-        return self._n
+        return int(self._n)
 
     def maximize(self, c: np.ndarray) -> LPSolution:
         """Solve ``max c^T x`` over the fixed constraints."""
@@ -124,7 +124,7 @@ class HighsLP:
             return LPSolution("unbounded", None, float("inf"))
         raise SolverError("HiGHS", h.modelStatusToString(status))
 
-    def _rerun_cold(self):
+    def _rerun_cold(self) -> highspy.HighsModelStatus:
         """The same LP from scratch with HiGHS's default strategy (presolve on, no basis): the
         warm-started primal simplex stopped undecided ("Unknown") on a ramp foot at friction
         2.5e4 (the unnormalised polytope), where a cold solve answers.
