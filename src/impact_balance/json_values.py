@@ -1,4 +1,4 @@
-"""Numbers as JSON values: a finite float, or ``null`` for a result that is undefined or infinite."""
+"""Numbers as JSON values: a finite float, or ``null`` for an undefined or infinite result."""
 
 from __future__ import annotations
 

@@ -73,8 +73,9 @@ def contact_diagnostics(stance: Stance) -> list[Diagnostic]:
                 Diagnostic(
                     "contact_normal_down",
                     field,
-                    f"the normal of {frame} points down ({tilt:.0f}° from vertical): the surface would be above "
-                    "the contact; the frame's z axis (after offset) must point from the surface into the robot",
+                    f"the normal of {frame} points down ({tilt:.0f}° from vertical): "
+                    "the surface would be above the contact; the frame's z axis (after offset) "
+                    "must point from the surface into the robot",
                 )
             )
         elif FLOOR_TILT < tilt < WALL_TILT:
@@ -83,7 +84,8 @@ def contact_diagnostics(stance: Stance) -> list[Diagnostic]:
                     "contact_normal_tilted",
                     field,
                     f"the normal of {frame} is {tilt:.0f}° from vertical, neither a floor or ramp "
-                    f"(<= {FLOOR_TILT:.0f}°) nor a wall (>= {WALL_TILT:.0f}°): is its z axis the surface normal? "
+                    f"(<= {FLOOR_TILT:.0f}°) nor a wall (>= {WALL_TILT:.0f}°): "
+                    "is its z axis the surface normal? "
                     "(set offset.rpy to align it)",
                 )
             )
@@ -103,9 +105,10 @@ def impact_diagnostics(
             Diagnostic(
                 "impact_moving_away",
                 "impact.reference_velocity",
-                f"the reference velocity does not move towards the impacted surface (approach speed -n.v = "
-                f"{approach:.3g} m/s <= 0), so there is no impact and nothing to cap; impact.normal must point from "
-                "the surface into the robot (is its sign flipped?)",
+                "the reference velocity does not move towards the impacted surface "
+                f"(approach speed -n.v = {approach:.3g} m/s <= 0), so there is no impact and "
+                "nothing to cap; impact.normal must point from the surface into the robot "
+                "(is its sign flipped?)",
             )
         )
     qp = answer.qp
@@ -122,8 +125,9 @@ def impact_diagnostics(
             Diagnostic(
                 "qp_capped_by_reference",
                 "impact.qp",
-                f"the paper's QP gives the reference approach speed {approach:.3f} m/s, not the maximum "
-                f"{limit:.3f} m/s: it tracks the reference velocity and never exceeds it",
+                f"the paper's QP gives the reference approach speed {approach:.3f} m/s, "
+                f"not the maximum {limit:.3f} m/s: it tracks the reference velocity and never "
+                "exceeds it",
             )
         )
     return out

@@ -1,4 +1,4 @@
-"""What an analysis answers: :class:`Analysis` (the areas and the impact) and :class:`ImpactAnswer`."""
+"""What an analysis answers: :class:`Analysis` (areas and impact) and :class:`ImpactAnswer`."""
 
 from __future__ import annotations
 
@@ -25,7 +25,8 @@ class Diagnostic:
     """One warning.
 
     Attributes:
-        code: Stable identifier (see the module docstring of :mod:`impact_balance.analysis.diagnostics`).
+        code: Stable identifier (see the module docstring of
+            :mod:`impact_balance.analysis.diagnostics`).
         field: The scenario field it is about (``contacts[1].frame``, ``impact.normal``, ...).
         message: One sentence, in the user's terms.
     """
@@ -38,6 +39,7 @@ class Diagnostic:
         return f"{self.field}: {self.message} [{self.code}]"
 
     def to_dict(self) -> dict[str, str]:
+        """The JSON object of one entry of ``warnings``."""
         return {"code": self.code, "field": self.field, "message": self.message}
 
 
@@ -121,6 +123,7 @@ class Analysis:
 
     @property
     def com_velocity(self) -> np.ndarray:
+        """The pre-impact CoM velocity (3,), world, m/s."""
         return np.asarray(self.scenario.com_velocity, dtype=float)
 
     @property
@@ -133,11 +136,15 @@ class Analysis:
 
     @property
     def cannot_balance_reason(self) -> CannotBalanceReason | None:
-        """Why the robot cannot balance (None when it can); see :mod:`impact_balance.balance.infeasibility`."""
+        """Why the robot cannot balance (None when it can).
+
+        See :mod:`impact_balance.balance.infeasibility`.
+        """
         return self.areas.reason
 
     @property
     def verdict(self) -> str:
+        """One line: "balanced", "falling: ..." or "cannot balance: ..."."""
         if not self.areas.can_balance:
             return "cannot balance: the contacts cannot hold the robot at rest (empty areas)"
         if not self.com_velocity_inside:
@@ -145,6 +152,7 @@ class Analysis:
         return "balanced"
 
     def to_dict(self) -> dict[str, Any]:
+        """The JSON document of ``impact-balance analyze --json`` (strict JSON: no NaN, inf)."""
         a = self.areas
         out: dict[str, Any] = {
             "scenario": self.scenario.name,

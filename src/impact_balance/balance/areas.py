@@ -11,8 +11,9 @@ images of ONE projection: the set of feasible resultant horizontal forces, obtai
 projecting the contact-wrench polytope (:mod:`impact_balance.contacts.wrench_polytope`).
 
 A ZMP margin ``M`` (m) shrinks the ZMP support area to the points at least ``M`` inside its
-edges (:meth:`~impact_balance.geometry.polygon.Polygon.inset`), as a controller that keeps its ZMP away
-from the edges does; the CoM velocity area follows (it is the same set, scaled by omega).
+edges (:meth:`~impact_balance.geometry.polygon.Polygon.inset`), as a controller that keeps
+its ZMP away from the edges does; the CoM velocity area follows (it is the same set, scaled
+by omega).
 """
 
 from __future__ import annotations
@@ -107,8 +108,9 @@ class BalanceAreas:
         return not self.com_velocity_area.is_empty
 
     def com_velocity_area_inset(self, margin: float) -> Polygon:
-        """The CoM velocity area of ``zmp_area`` shrunk by ``margin`` more metres (what a
-        controller that keeps its ZMP that far inside can use); empty when nothing is left.
+        """The CoM velocity area of ``zmp_area`` shrunk by ``margin`` more metres.
+
+        What a controller that keeps its ZMP that far inside can use; empty when nothing is left.
         """
         return _velocity_area(self.zmp_area.inset(margin), self.omega, self.com)
 
@@ -128,8 +130,9 @@ def _velocity_area(zmp: Polygon, w: float, com: np.ndarray) -> Polygon:
 def areas_from_polytope(
     polytope: WrenchPolytope, plane_height: float = 0.0, zmp_margin: float = 0.0
 ) -> BalanceAreas:
-    """Project a contact-wrench polytope and map it to the ZMP and CoM velocity areas, the ZMP
-    support area shrunk by ``zmp_margin`` (m).
+    """Project a contact-wrench polytope and map it to the ZMP and CoM velocity areas.
+
+    The ZMP support area is shrunk by ``zmp_margin`` (m).
     """
     com = polytope.com
     w = lipm_omega(float(com[2]), plane_height, polytope.gravity, field="plane_height")
@@ -182,11 +185,14 @@ def areas_from_arrays(
     plane_height: float = 0.0,
     zmp_margin: float = 0.0,
 ) -> BalanceAreas:
-    """``areas_from_polytope(assemble_polytope(...))`` for contacts whose frictions are all at
-    most 1 (no friction scaling), in one compiled call: a governor's every tick.
+    """``areas_from_polytope(assemble_polytope(...))`` in one compiled call.
 
-    The arguments are :func:`~impact_balance.contacts.wrench_polytope.assemble_polytope`'s (``faces`` (m,
-    16, 6); ``com`` (3,) world, m), then the plane height (m) and the ZMP margin (m).
+    For contacts whose frictions are all at most 1 (no friction scaling): a governor's every
+    tick.
+
+    The arguments are :func:`~impact_balance.contacts.wrench_polytope.assemble_polytope`'s
+    (``faces`` (m, 16, 6); ``com`` (3,) world, m), then the plane height (m) and the ZMP
+    margin (m).
     """
     return projected_from_arrays(
         faces,
@@ -221,8 +227,10 @@ def projected_from_arrays(
     zmp_margin: float = 0.0,
     hint: np.ndarray | None = None,
 ) -> Projected:
-    """:func:`areas_from_arrays` before its :class:`BalanceAreas` is built (a governor's tick
-    reads only the CoM velocity area; :meth:`Projected.areas` builds the rest on demand).
+    """:func:`areas_from_arrays` before its :class:`BalanceAreas` is built.
+
+    A governor's tick reads only the CoM velocity area; :meth:`Projected.areas` builds the rest
+    on demand.
 
     ``hint``: an int64 array (2 + the number of wrench variables, e.g. 2 + 6 per contact) the
     walk reads its start from and writes its optimal basis to: one caller that projects
@@ -271,8 +279,10 @@ def projected_from_arrays(
 
 
 class Projected(NamedTuple):
-    """One projection's areas as arrays, the CoM velocity area (with its half-planes) as a
-    :class:`Polygon`, and what :meth:`areas` needs to build the :class:`BalanceAreas`.
+    """One projection's areas as arrays.
+
+    The CoM velocity area (with its half-planes) is a :class:`Polygon`; the rest is what
+    :meth:`areas` needs to build the :class:`BalanceAreas`.
 
     ``force``, ``zmp`` (k, 2): the force area (units of m g) and the ZMP support area (world,
     m) vertices; ``w`` omega (1/s); ``com`` (3,) m; ``plane_height`` m; ``mass`` kg;
@@ -318,9 +328,10 @@ def _projected(
     gravity: float,
     margin: float,
 ) -> Projected:
-    """The areas from :func:`_walk_areas`' answer ``walked`` on the projection data ``data``
-    ``(A, b, C, d, E)``: where the walk cannot answer, project_polytope chooses as it always
-    does, and the same compiled maps make the ZMP and CoM velocity areas.
+    """The areas from :func:`_walk_areas`' answer ``walked`` on the projection data ``data``.
+
+    ``data`` is ``(A, b, C, d, E)``: where the walk cannot answer, project_polytope chooses as it
+    always does, and the same compiled maps make the ZMP and CoM velocity areas.
     """
     status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h = walked
     n_lp = 1
@@ -371,9 +382,10 @@ def _projected(
 
 
 def warm_up() -> None:
-    """Load the compiled map that the fallback path (a walk refused, Bretl's polygon mapped in
-    :func:`_projected`) calls from Python: numba loads a cached function on its first call
-    (12 ms in a G1 tick). A governor calls this when it is built.
+    """Load the compiled map that the fallback path calls from Python.
+
+    The fallback path (a walk refused, Bretl's polygon mapped in :func:`_projected`) calls it;
+    numba loads a cached function on its first call. A governor calls this when it is built.
     """
     _maps(np.zeros((0, 2)), True, -1.0, 0.0, 0.0, 1.0, 0.0)
 
@@ -390,9 +402,11 @@ def _affine(v, scale, ox, oy):
 
 @njit(cache=True)
 def _maps(force, bounded, depth, cx, cy, w, margin):
-    """The ZMP support area (shrunk by ``margin``) and the CoM velocity area of the force area
-    ``force`` (vertices, units of m g): ``(zmp, zmp_bounded, vel, vel_bounded)``, the numbers
-    :class:`Polygon`'s ``affine`` and ``inset`` give (``depth`` = h - c_z, CoM ``(cx, cy)``).
+    """The ZMP support area (shrunk by ``margin``) and the CoM velocity area of a force area.
+
+    ``force``: vertices, units of m g. Returns ``(zmp, zmp_bounded, vel, vel_bounded)``, the
+    numbers :class:`Polygon`'s ``affine`` and ``inset`` give (``depth`` = h - c_z, CoM
+    ``(cx, cy)``).
     """
     empty = np.empty((0, 2))
     if force.shape[0] == 0:
@@ -411,9 +425,10 @@ def _maps(force, bounded, depth, cx, cy, w, margin):
 def _walk_areas(
     A, b, C, d, E, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, margin, hint
 ):
-    """:func:`~impact_balance.projection.walk.certified_walk` and :func:`_maps` in one call:
-    ``(status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h)``, ``G, h`` the CoM
-    velocity area's half-planes when it has 3 vertices or more (else none).
+    """:func:`~impact_balance.projection.walk.certified_walk` and :func:`_maps` in one call.
+
+    Returns ``(status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h)``, ``G, h`` the
+    CoM velocity area's half-planes when it has 3 vertices or more (else none).
     """
     status, force, bounded, _, _, _ = certified_walk(
         A, b, C, d, E, box, max_pivots, merge_tol, area_tol, hint
@@ -447,9 +462,11 @@ def _assembled_areas(
     margin,
     hint,
 ):
-    """The polytope's arrays (as :func:`~impact_balance.contacts.wrench_polytope.assemble_polytope`) in
-    units of m g (as ``WrenchPolytope.projection_data`` without scaling) and
-    :func:`_walk_areas` on them: ``(A, b, C, d, E) + _walk_areas(...)``.
+    """The polytope's arrays in units of m g, and :func:`_walk_areas` on them.
+
+    The arrays are those of :func:`~impact_balance.contacts.wrench_polytope.assemble_polytope`,
+    as ``WrenchPolytope.projection_data`` without scaling. Returns
+    ``(A, b, C, d, E) + _walk_areas(...)``.
     """
     A, b, C, G = assemble_arrays(
         blocks, positions, arms, jacobians, torque_indices, torque_limits, gravity_torques
@@ -497,7 +514,8 @@ def with_reason(
             areas,
             reason=CannotBalanceReason(
                 "zmp_margin",
-                f"no point of the ZMP support area is {areas.zmp_margin:g} m (the ZMP margin) inside its edges",
+                f"no point of the ZMP support area is {areas.zmp_margin:g} m "
+                "(the ZMP margin) inside its edges",
             ),
         )
     try:

@@ -78,7 +78,8 @@ class CannotBalanceReason:
     Attributes:
         kind: "torque_limits", "friction" or "com_outside" (see the module docstring),
             "zmp_margin" when the stance balances but its ZMP support area is too small for the
-            margin asked (:mod:`impact_balance.balance.areas`), or "unknown" when an LP of the diagnosis failed.
+            margin asked (:mod:`impact_balance.balance.areas`), or "unknown" when an LP of the
+            diagnosis failed.
         message: One line for people.
         binding_joints: For "torque_limits": the joints whose limit alone, raised by
             ``min_scale``, restores balance (smallest first), then those that bind at the
@@ -198,8 +199,9 @@ def _contacts_feasible(stance: Stance, contacts: Sequence[Contact], gravity: flo
 
 
 def _min_friction(stance: Stance, gravity: float) -> float:
-    """Smallest common friction coefficient that makes CWC + LIPM feasible (bisection in
-    log scale between the largest current friction and :data:`HIGH_FRICTION`).
+    """Smallest common friction coefficient that makes CWC + LIPM feasible.
+
+    A bisection in log scale between the largest current friction and :data:`HIGH_FRICTION`.
     """
 
     def ok(mu: float) -> bool:
@@ -265,7 +267,8 @@ def _torque_reason(
     common = f"; or every limit x{uniform:.3g}" if uniform is not None else ""
     return CannotBalanceReason(
         "torque_limits",
-        f"the joint torque limits: the contacts could hold the robot without them; {detail}{common}",
+        "the joint torque limits: the contacts could hold the robot without them; "
+        f"{detail}{common}",
         tuple(joints),
         uniform,
     )

@@ -69,8 +69,9 @@ def lipm_omega(
 
 
 def _check_com_height(com_height: float) -> None:
-    """Refuse a CoM height (above a plane at 0) that is not finite, not above the plane, or
-    more than twice the largest position above it: the inputs of the one-axis LIPM.
+    """Refuse a CoM height (above a plane at 0) that the one-axis LIPM does not take.
+
+    Refused: not finite, not above the plane, or more than twice the largest position above it.
     """
     if not (math.isfinite(com_height) and 0 < com_height <= 2 * MAX_POSITION):
         raise ScenarioError(

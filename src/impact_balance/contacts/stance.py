@@ -37,10 +37,11 @@ def has_free_flyer(model: pin.Model) -> bool:
 def frame_point(
     model: pin.Model, data: pin.Data, fid: int, offset: pin.SE3 | None, jacobian: bool = True
 ) -> tuple[pin.SE3, np.ndarray | None]:
-    """Pose of frame ``fid`` times ``offset`` and its 6 x nv Jacobian in world-aligned axes
-    (linear rows first, at the offset point), from ``data`` holding the joint placements and
-    joint Jacobians (in the frame of those placements); the Jacobian is skipped (None)
-    without ``jacobian``. The pose may be ``data``'s own: copy what you keep.
+    """Pose of frame ``fid`` times ``offset`` and its 6 x nv Jacobian in world-aligned axes.
+
+    The Jacobian has its linear rows first, at the offset point; ``data`` holds the joint
+    placements and joint Jacobians (in the frame of those placements); the Jacobian is skipped
+    (None) without ``jacobian``. The pose may be ``data``'s own: copy what you keep.
     """
     frame_pose = pin.updateFramePlacement(model, data, fid)
     J = (
@@ -98,10 +99,12 @@ class Contact:
 
     @property
     def half_length(self) -> float:
+        """Half the rectangle's length (contact x axis), m."""
         return 0.5 * float(self.spec.size[0])
 
     @property
     def half_width(self) -> float:
+        """Half the rectangle's width (contact y axis), m."""
         return 0.5 * float(self.spec.size[1])
 
     @property
@@ -124,7 +127,7 @@ class Stance:
     :class:`impact_balance.robot.robot.Workspace`), or in ``workspace`` when given (a
     :class:`impact_balance.robot.robot.Scratch` of the caller's, e.g. a governor's own Data), and
     every attribute is a copy, so stances of the same robot never alias. :meth:`point`
-    recomputes the joint placements and Jacobians (~4 us) when another stance has used the
+    recomputes the joint placements and Jacobians when another stance has used the
     scratch Data since.
 
     Precision far from the origin: the kinematics are computed with the free-flyer's
@@ -195,11 +198,12 @@ class Stance:
 
     @property
     def model(self) -> pin.Model:
+        """The robot's pinocchio model."""
         return self.robot.model
 
     @functools.cached_property
     def data(self) -> pin.Data:
-        """A pinocchio Data of this stance's own, made on first access (~1 ms).
+        """A pinocchio Data of this stance's own, made on first access.
 
         It holds the joint and frame placements, Jacobians, composite inertia, CoM and
         gravity at ``q``, for callers that read the model directly (plots, GUI meshes);
@@ -214,8 +218,10 @@ class Stance:
         return data
 
     def workspace(self) -> Scratch | Workspace:
-        """The scratch Data this stance computes in: the one it was given, else the robot's
-        (per thread, :meth:`impact_balance.robot.robot.Robot.workspace`).
+        """The scratch Data this stance computes in.
+
+        The one it was given, else the robot's (per thread,
+        :meth:`impact_balance.robot.robot.Robot.workspace`).
         """
         return self._scratch if self._scratch is not None else self.robot.workspace()
 
@@ -245,7 +251,10 @@ class Stance:
     def _point(
         self, data: pin.Data, fid: int, offset: pin.SE3 | None
     ) -> tuple[pin.SE3, np.ndarray]:
-        """:meth:`point` of frame ``fid`` from ``data`` holding this stance's kinematics (copies)."""
+        """:meth:`point` of frame ``fid`` from ``data`` holding this stance's kinematics.
+
+        Returns copies.
+        """
         placement, J = frame_point(self.model, data, fid, offset)
         assert J is not None  # asked for (jacobian=True)
         return placement, J

@@ -10,8 +10,10 @@
           -tau_max <= tau0 + (a / dt) (J^T K_i lambda_j)_act <= tau_max   (impulsive torques)
 
 J is the impact point's 3 x nv translational Jacobian, so the approach speed is -n^T J qd.
-Without the optional bounds, its solution equals :func:`criteria.max_contact_velocity` with
-:func:`~impact_balance.criteria.cap.capped_velocity` (tested). The QP also forces -n^T J qd >= 0 (lambda >= 0).
+Without the optional bounds, its solution equals
+:func:`~impact_balance.criteria.com.max_contact_velocity` with
+:func:`~impact_balance.criteria.cap.capped_velocity` (tested). The QP also forces
+-n^T J qd >= 0 (lambda >= 0).
 """
 
 from __future__ import annotations

@@ -214,8 +214,10 @@ def impulse_to_velocity(
 
 
 def composite_inertia_map(arm: np.ndarray, mass: float, com_inertia: np.ndarray) -> np.ndarray:
-    """W = I / m - [r]x Ic^-1 [r]x (1/kg) of the robot as one rigid body: ``arm`` r = point - CoM
-    (m), ``mass`` (kg), ``com_inertia`` Ic about the CoM in world axes (kg m^2).
+    """W = I / m - [r]x Ic^-1 [r]x (1/kg) of the robot as one rigid body.
+
+    ``arm`` r = point - CoM (m), ``mass`` (kg), ``com_inertia`` Ic about the CoM in world axes
+    (kg m^2).
     """
     arm = np.ascontiguousarray(arm, dtype=float)
     com_inertia = np.ascontiguousarray(com_inertia, dtype=float)
@@ -229,10 +231,11 @@ def composite_inertia_map(arm: np.ndarray, mass: float, com_inertia: np.ndarray)
 
 @njit(cache=True)
 def _composite_map(arm, mass, Ic, W):
-    """``W`` = I / m - [r]x Ic^-1 [r]x by a 3 x 3 Cholesky of ``Ic``, in floats; False (W
-    untouched) when ``Ic`` is not positive definite. Compiled: numpy's and LAPACK's set-up
-    cost ~15 us per call for these few flops, and a governor builds W every tick. Python
-    floats when interpreted: an overflow gives inf (reported by the caller), not a warning.
+    """``W`` = I / m - [r]x Ic^-1 [r]x by a 3 x 3 Cholesky of ``Ic``, in floats.
+
+    False (W untouched) when ``Ic`` is not positive definite. Compiled (a governor builds W every
+    tick). Python floats when interpreted: an overflow gives inf (reported by the caller), not a
+    warning.
     """
     a, b, c = float(Ic[0, 0]), float(Ic[0, 1]), float(Ic[0, 2])
     d, e, f = float(Ic[1, 1]), float(Ic[1, 2]), float(Ic[2, 2])
@@ -272,8 +275,9 @@ def _composite_map(arm, mass, Ic, W):
 def joint_space_inertia_map(
     workspace: Scratch | Workspace, model: pin.Model, q: np.ndarray, jacobian: np.ndarray
 ) -> np.ndarray:
-    """W = J M(q)^-1 J^T (1/kg) of the translational Jacobian ``jacobian`` (3 x nv), with M
-    computed in ``workspace``'s Data (a :class:`~impact_balance.robot.robot.Scratch` or
+    """W = J M(q)^-1 J^T (1/kg) of the translational Jacobian ``jacobian`` (3 x nv).
+
+    M is computed in ``workspace``'s Data (a :class:`~impact_balance.robot.robot.Scratch` or
     :class:`~impact_balance.robot.robot.Workspace`; its held kinematics are marked stale).
     """
     M = pin.crba(model, workspace.data, q)  # scratch Data: createData costs up to ~2 ms
@@ -334,8 +338,13 @@ def model_from_inertia_map(
     """The impact model from its map W (what :func:`impact_model` computes from a stance).
 
     Args:
-        point: Impact point, world, m. arm: point - CoM, m (for messages).
-        normal, cone: From :func:`impact_cone`. W: 3 x 3, 1/kg. mass: kg.
+        spec: The impact specification.
+        point: Impact point, world, m.
+        arm: point - CoM, m (for messages).
+        normal: Unit normal, from :func:`impact_cone`.
+        cone: Friction-cone generators (3 x N), from :func:`impact_cone`.
+        W: Impulse-to-velocity map at the point, 3 x 3, 1/kg.
+        mass: kg.
         jacobian: 3 x nv translational Jacobian of the point (world axes).
 
     Raises:
@@ -367,10 +376,11 @@ def model_from_inertia_map(
 
 @njit(cache=True)
 def _impulse_rates(normal, W, K, lo, hi):
-    """``(W finite, min_i n^T W K_i, rates)``: rows 2i and 2i+1 of ``rates`` (2N, 3) are
-    ``(1 + c) / (n^T W K_i) K_i`` for c = hi and lo (the impulse vertices per unit approach
-    speed); n^T W K_i > 0 for an impulse that pushes the point back. Compiled: numpy spent
-    ~15 us of call overhead on these few multiplications.
+    """``(W finite, min_i n^T W K_i, rates)``, compiled.
+
+    Rows 2i and 2i+1 of ``rates`` (2N, 3) are ``(1 + c) / (n^T W K_i) K_i`` for c = hi and lo
+    (the impulse vertices per unit approach speed); n^T W K_i > 0 for an impulse that pushes the
+    point back.
     """
     N = K.shape[1]
     rates = np.empty((2 * N, 3))

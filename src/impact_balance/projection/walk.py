@@ -110,8 +110,9 @@ def project_walk(
 
 @njit(cache=True)
 def _certify(status, vertices, worst, b, merge_tol, area_tol, box):
-    """A walk's raw vertices certified and merged: ``(status, vertices, bounded)``, status
-    FAILED when the walk cannot answer (see :func:`project_walk`).
+    """A walk's raw vertices certified and merged: ``(status, vertices, bounded)``.
+
+    The status is FAILED when the walk cannot answer (see :func:`project_walk`).
     """
     none = np.empty((0, 2))
     if status == FAILED or status == LINE:
@@ -144,8 +145,9 @@ def _certify(status, vertices, worst, b, merge_tol, area_tol, box):
 
 @njit(cache=True)
 def certified_walk(A, b, C, d, E, box, max_pivots, merge_tol, area_tol, hint):
-    """The walk of :func:`project_walk` in one compiled call, its certificate and merge
-    included (a governor pays each call's dispatch every tick).
+    """The walk of :func:`project_walk` in one compiled call, certificate and merge included.
+
+    A governor pays each call's dispatch every tick.
 
     Returns ``(status, vertices, bounded, pivots, x0, N)`` with a kernel status: OK (the
     certified polygon), INFEASIBLE or INCONSISTENT (empty), FAILED (the walk cannot answer),
@@ -166,8 +168,9 @@ cache_depends_on(certified_walk, polygon, kernel)
 
 
 def _array(x: npt.ArrayLike, ndim: int, columns: int | None = None) -> np.ndarray:
-    """``x`` as a C-contiguous float64 array of ``ndim`` dimensions (``columns`` columns):
-    itself when it already is one (a polytope's own arrays, every governor tick).
+    """``x`` as a C-contiguous float64 array of ``ndim`` dimensions (``columns`` columns).
+
+    Itself when it already is one (a polytope's own arrays, every governor tick).
     """
     if (
         type(x) is np.ndarray
@@ -183,8 +186,10 @@ def _array(x: npt.ArrayLike, ndim: int, columns: int | None = None) -> np.ndarra
 
 
 def kernel_is_compiled() -> bool:
-    """Whether numba's on-disk cache holds the kernel; if not, the first projection compiles
-    it (0.5 to 1.5 min, once per installation). True without numba (nothing to compile).
+    """Whether numba's on-disk cache holds the kernel.
+
+    If not, the first projection compiles it (once per installation). True without numba
+    (nothing to compile).
     """
     if not HAVE_NUMBA:
         return True
@@ -198,10 +203,11 @@ _warm = False
 
 
 def warm_up() -> float:
-    """Load (or compile) the kernel now, by projecting a square; returns the seconds spent
-    (0.0 once done). numba loads a cached kernel on its first call (0.3-1.5 s, 0.5 to 1.5 min to
-    compile after an installation): callers that time a projection call this first, so
-    that the load is not mistaken for the projection.
+    """Load (or compile) the kernel now, by projecting a square; returns the seconds spent.
+
+    0.0 once done. numba loads a cached kernel on its first call (and compiles it after an
+    installation): callers that time a projection call this first, so that the load is not
+    mistaken for the projection.
     """
     global _warm
     if _warm:
