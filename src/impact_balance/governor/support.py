@@ -205,8 +205,8 @@ class ContactAwareAnswer:
 
     Attributes:
         limit: Largest approach speed (m/s) keeping every contact-aware post-impact CoM velocity
-            in the area, as :class:`~impact_balance.criteria.velocity_limit.ContactVelocityLimit` (its vertex j: row j
-            of ``rates``).
+            in the area, as :class:`~impact_balance.criteria.velocity_limit.ContactVelocityLimit`
+            (its vertex j: row j of ``rates``).
         interval: The approach speeds ``(lo, hi)`` (m/s) that keep them all in (the
             intersection over the rows), or None.
         rates: (k, 2) the jumps per m/s used (world xy, m/s per m/s): with ``starts`` "warm" or
