@@ -74,7 +74,9 @@ def test_union_limit_is_at_most_each_single_start(answers):
     for row in answers:
         union = row["union"]
         for single in (row["warm"], row["cold"]):
-            assert union.limit.max_contact_velocity <= single.limit.max_contact_velocity + FIXED_POINT
+            assert (
+                union.limit.max_contact_velocity <= single.limit.max_contact_velocity + FIXED_POINT
+            )
             for k, c_r in enumerate(single.restitution):
                 assert _contains(union.rates[union.restitution == c_r], single.rates[k])
             lo, hi = union.interval

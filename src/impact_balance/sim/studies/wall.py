@@ -264,7 +264,9 @@ def run_wall_trial(
         rows["time"].append(t)
         rows["reference"].append(task.reference_speed(t) if task.contact_time is None else 0.0)
         rows["cap"].append(
-            json_number(task.ceiling) if governor is not None and task.contact_time is None else None
+            json_number(task.ceiling)
+            if governor is not None and task.contact_time is None
+            else None
         )
         rows["commanded"].append(task.commanded if task.contact_time is None else 0.0)
         rows["measured"].append(float(-n @ _point_velocity(sim, n)))
