@@ -151,7 +151,7 @@ def criterion_table(names: list[str], margin: float) -> str:
         floating = [a.impact.max_contact_velocity]
         inset = a.areas.com_velocity_area_inset(margin)
 
-        floating.append(max_contact_velocity(inset, a.impact.model, c0).max_approach_speed)
+        floating.append(max_contact_velocity(inset, a.impact.model, c0).max_contact_velocity)
         rates = [
             contact_impact(a.stance, spec, 1.0, restitution=c).com_velocity_jump
             for c in spec.restitution

@@ -95,7 +95,7 @@ def bench_scenario(name: str, ticks: int, criterion: str) -> dict[str, Any]:
         "posture": Case(
             lambda: governor.limit(qs[k["i"]], vs[k["i"]]),
             setup=at,
-            keep=lambda r: (r.max_approach_speed, r.posture_reused),
+            keep=lambda r: (r.max_contact_velocity, r.posture_reused),
         ),
         "velocity": Case(
             lambda: steady.limit(q_fixed, vs[k["i"]]), setup=at, keep=lambda r: r.posture_reused

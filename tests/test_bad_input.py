@@ -502,7 +502,7 @@ def test_already_falling_is_an_answer(tmp_path, capsys):
     assert a.verdict.startswith("falling")
     assert a.areas.can_balance
     assert a.impact.max_contact_velocity == 0
-    assert a.impact.com_limit.status == "already_falling"
+    assert a.impact.com.status == "already_falling"
 
     rc, out, err = run_cli(capsys, "analyze", str(path), "--json")
     assert rc == 0 and err == ""
@@ -525,7 +525,7 @@ def test_frictionless_vertical_impact_is_unbounded(tmp_path, capsys, normal):
     a = analyze(path)
     assert a.verdict == "balanced"
     assert a.impact.max_contact_velocity == math.inf
-    assert a.impact.com_limit.status == "unbounded"
+    assert a.impact.com.status == "unbounded"
     np.testing.assert_allclose(a.impact.model.com_jump_rates, 0.0, atol=1e-12)
 
     rc, out, err = run_cli(capsys, "analyze", str(path), "--json")

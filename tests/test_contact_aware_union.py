@@ -74,13 +74,15 @@ def test_union_limit_is_at_most_each_single_start(answers):
     for row in answers:
         union = row["union"]
         for single in (row["warm"], row["cold"]):
-            assert union.limit.max_approach_speed <= single.limit.max_approach_speed + FIXED_POINT
+            assert (
+                union.limit.max_contact_velocity <= single.limit.max_contact_velocity + FIXED_POINT
+            )
             for k, c_r in enumerate(single.restitution):
                 assert _contains(union.rates[union.restitution == c_r], single.rates[k])
             lo, hi = union.interval
             assert single.interval[0] <= lo + FIXED_POINT and hi <= single.interval[1] + FIXED_POINT
-        assert union.limit.max_approach_speed == pytest.approx(
-            min(row["warm"].limit.max_approach_speed, row["cold"].limit.max_approach_speed),
+        assert union.limit.max_contact_velocity == pytest.approx(
+            min(row["warm"].limit.max_contact_velocity, row["cold"].limit.max_contact_velocity),
             abs=FIXED_POINT,
         )
 
@@ -156,7 +158,7 @@ def test_the_governor_defaults_to_the_union(path):
     assert union._support.starts == "union" and warm._support.starts == "warm"
     for posture in postures:
         a, b = union.limit_com(posture.q, np.zeros(3)), warm.limit_com(posture.q, np.zeros(3))
-        assert a.max_approach_speed <= b.max_approach_speed + FIXED_POINT
+        assert a.max_contact_velocity <= b.max_contact_velocity + FIXED_POINT
     with pytest.raises(GovernorError) as info:
         Governor(NAME, contact_aware=ContactAwareOptions(starts="several"))  # type: ignore[arg-type]
     assert info.value.field == "contact_aware.starts"

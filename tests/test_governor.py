@@ -78,9 +78,9 @@ def test_each_tick_is_analyze_of_the_same_state(name, inertia, margin, friction)
         limit = governor.limit(q, v)
         a = analyze_at(governor, q, v)
         assert limit.posture_reused is False
-        assert limit.status == a.impact.com_limit.status
-        assert limit.max_approach_speed == pytest.approx(a.impact.max_contact_velocity, abs=1e-9)
-        assert limit.limiting_vertex == a.impact.com_limit.limiting_vertex
+        assert limit.status == a.impact.com.status
+        assert limit.max_contact_velocity == pytest.approx(a.impact.max_contact_velocity, abs=1e-9)
+        assert limit.limiting_vertex == a.impact.com.limiting_vertex
         expected = a.impact.safe_interval
         assert (limit.safe_interval is None) == (expected is None)
         if expected is not None:
@@ -94,7 +94,7 @@ def test_zmp_governor_is_analyzes_zmp_criterion():
         limit = governor.limit(q, v)
         a = analyze_at(governor, q, v)
         assert limit.criterion == "zmp"
-        assert limit.max_approach_speed == pytest.approx(
+        assert limit.max_contact_velocity == pytest.approx(
             a.impact.zmp_max_contact_velocity, abs=1e-9
         )
 
@@ -106,7 +106,7 @@ def test_velocity_only_ticks_reuse_the_posture_and_agree_with_a_fresh_governor()
     again = governor.limit(q, v1)
     assert not first.posture_reused and again.posture_reused
     fresh = Governor("palm_push_two_feet").limit(q, v1)
-    assert again.max_approach_speed == pytest.approx(fresh.max_approach_speed, abs=1e-12)
+    assert again.max_contact_velocity == pytest.approx(fresh.max_contact_velocity, abs=1e-12)
     assert again.safe_interval == pytest.approx(fresh.safe_interval, abs=1e-12)
     # A tolerance reuses a posture that moved less than it; any change is new without one.
     tolerant = Governor("palm_push_two_feet", posture_tolerance=1e-3)
@@ -147,7 +147,7 @@ def test_cap_follows_the_safe_interval():
 def test_one_instance_from_several_threads_gives_the_serial_answers():
     governor = Governor("palm_push_ramp")
     inputs = states(governor, 12, seed=3)
-    serial = [Governor("palm_push_ramp").limit(q, v).max_approach_speed for q, v in inputs]
+    serial = [Governor("palm_push_ramp").limit(q, v).max_contact_velocity for q, v in inputs]
     results: dict[int, float] = {}
     errors = []
 
@@ -155,7 +155,7 @@ def test_one_instance_from_several_threads_gives_the_serial_answers():
         try:
             for i in indices:
                 q, v = inputs[i]
-                results[i] = governor.limit(q, v).max_approach_speed
+                results[i] = governor.limit(q, v).max_contact_velocity
         except Exception as exc:
             errors.append(exc)
 

@@ -42,12 +42,12 @@ def test_g1_is_bounded_by_its_feet():
     q, v = aware.configuration, np.zeros(aware.nv)
     floating, limit = plain.limit(q, v), aware.limit(q, v)
     assert limit.binding == "contact_aware"
-    assert limit.max_approach_speed == pytest.approx(
+    assert limit.max_contact_velocity == pytest.approx(
         contact_aware_maximum("g1_two_feet", 0.01), abs=1e-6
     )
-    assert 0.38 < limit.max_approach_speed < 0.43 < 0.6 < floating.max_approach_speed
-    assert limit.safe_interval == pytest.approx((0.0, limit.max_approach_speed))
-    assert limit.ceiling == pytest.approx(limit.max_approach_speed)
+    assert 0.38 < limit.max_contact_velocity < 0.43 < 0.6 < floating.max_contact_velocity
+    assert limit.safe_interval == pytest.approx((0.0, limit.max_contact_velocity))
+    assert limit.ceiling == pytest.approx(limit.max_contact_velocity)
 
 
 def test_two_flat_feet_keep_the_floating_answer():
@@ -57,9 +57,9 @@ def test_two_flat_feet_keep_the_floating_answer():
     q, v = aware.configuration, np.zeros(aware.nv)
     a, b = plain.limit(q, v), aware.limit(q, v)
     assert b.binding == "floating"
-    assert b.max_approach_speed == a.max_approach_speed
+    assert b.max_contact_velocity == a.max_contact_velocity
     assert b.safe_interval == a.safe_interval
-    assert contact_aware_maximum("palm_push_two_feet", 0.0) > a.max_approach_speed
+    assert contact_aware_maximum("palm_push_two_feet", 0.0) > a.max_contact_velocity
 
 
 def test_rates_are_reused_between_recomputations():

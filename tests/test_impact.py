@@ -10,7 +10,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import impact_balance as ib
-from impact_balance.criteria.com import capped_velocity, max_contact_velocity
+from impact_balance.criteria.cap import capped_velocity
+from impact_balance.criteria.com import max_contact_velocity
 from impact_balance.criteria.qp import QPOptions, solve_contact_velocity_qp
 from impact_balance.impact.model import cone_tangents, friction_cone, impact_model
 
@@ -134,7 +135,7 @@ def _check_overlap(area, model, c0, v_max):
 def test_overlap_condition_at_the_maximum(analyses, name):
     a = analyses[name]
     im = a.impact
-    assert im.com_limit.status == "ok"
+    assert im.com.status == "ok"
     _check_overlap(a.areas.com_velocity_area, im.model, a.com_velocity, im.max_contact_velocity)
 
 
@@ -162,15 +163,15 @@ def test_overlap_condition_random_impacts(analyses, frac, theta, mu):
     if limit.status == "unbounded":
         assert np.all(model.com_jump_rates @ area.halfplanes[0].T <= 1e-9)
         return
-    assert limit.status == "ok" and limit.max_approach_speed > 0
-    _check_overlap(area, model, c0, limit.max_approach_speed)
+    assert limit.status == "ok" and limit.max_contact_velocity > 0
+    _check_overlap(area, model, c0, limit.max_contact_velocity)
     # independent bisection with Polygon.contains
-    lo_s, hi_s = 0.0, 10 * limit.max_approach_speed
+    lo_s, hi_s = 0.0, 10 * limit.max_contact_velocity
     for _ in range(60):
         mid = 0.5 * (lo_s + hi_s)
         inside = np.all(area.contains(model.post_impact_com_velocities(c0, mid), tol=0.0))
         lo_s, hi_s = (mid, hi_s) if inside else (lo_s, mid)
-    assert lo_s == pytest.approx(limit.max_approach_speed, rel=1e-7)
+    assert lo_s == pytest.approx(limit.max_contact_velocity, rel=1e-7)
 
 
 def test_already_falling_and_cannot_balance(analyses):
@@ -178,10 +179,10 @@ def test_already_falling_and_cannot_balance(analyses):
     model, area = a.impact.model, a.areas.com_velocity_area
     outside = area.vertices.max(0) + 0.1
     assert max_contact_velocity(area, model, outside).status == "already_falling"
-    assert max_contact_velocity(area, model, outside).max_approach_speed == 0.0
+    assert max_contact_velocity(area, model, outside).max_contact_velocity == 0.0
     empty = ib.Polygon.empty()
     limit = max_contact_velocity(empty, model, (0, 0))
-    assert limit.status == "cannot_balance" and limit.max_approach_speed == 0.0
+    assert limit.status == "cannot_balance" and limit.max_contact_velocity == 0.0
 
 
 def test_frictionless_vertical_impact_is_unbounded(analyses):
@@ -190,7 +191,7 @@ def test_frictionless_vertical_impact_is_unbounded(analyses):
     model = impact_model(a.stance, spec)
     np.testing.assert_allclose(model.com_jump_rates, 0, atol=1e-12)
     limit = max_contact_velocity(a.areas.com_velocity_area, model, (0, 0))
-    assert limit.status == "unbounded" and np.isinf(limit.max_approach_speed)
+    assert limit.status == "unbounded" and np.isinf(limit.max_contact_velocity)
 
 
 def test_inconsistent_impact_is_a_clear_error(analyses):
@@ -240,7 +241,7 @@ def test_zmp_criterion_against_direct_zmp(analyses, name):
 def test_qp_matches_the_exact_answer(analyses, reference):
     a = analyses["palm_push_two_feet"]
     model, area = a.impact.model, a.areas.com_velocity_area
-    exact = max_contact_velocity(area, model, a.com_velocity).max_approach_speed
+    exact = max_contact_velocity(area, model, a.com_velocity).max_contact_velocity
     expected = capped_velocity(reference, model.normal, exact)
     result = solve_contact_velocity_qp(model, area, a.com_velocity, reference)
     assert result.status == "optimal"

@@ -96,7 +96,7 @@ def test_plot_areas(analysis: ib.Analysis) -> None:
         line for line in vel_ax.get_lines() if line.get_label().startswith("limiting vertex")
     )
     point = np.array([star.get_xdata()[0], star.get_ydata()[0]])
-    lim = analysis.impact.com_limit
+    lim = analysis.impact.com
     expected = analysis.impact.model.post_impact_com_velocities(analysis.com_velocity, vmax)[
         lim.limiting_vertex
     ]

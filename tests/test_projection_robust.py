@@ -236,7 +236,7 @@ def test_carried_inverse_check_accepts_a_fresh_inverse_and_refuses_a_drifted_one
     or vertex off by 1e-9 of its size (the drift of rank-one updates on an ill-conditioned
     basis) does not. (A fresh inverse of an ill-conditioned basis may fail it too: the walk
     then makes a fresh one, as it did at every breakpoint before.)"""
-    from impact_balance.projection._kernel import _accurate
+    from impact_balance.projection.kernel import _accurate
 
     rng = np.random.default_rng(seed)
     m = n + 5

@@ -64,7 +64,7 @@ def test_square(c0, jumps, expected):
     assert got == pytest.approx(expected, abs=1e-12)
     limit = max_contact_velocity(SQUARE, model, c0)
     if expected[0] == 0.0:  # c0 inside: the interval's top is the maximum contact velocity
-        assert limit.max_approach_speed == pytest.approx(expected[1])
+        assert limit.max_contact_velocity == pytest.approx(expected[1])
     else:
         assert limit.status == "already_falling"
     # Spot check by brute force: the vertices are inside exactly at the speeds in between.

@@ -230,7 +230,7 @@ def test_rows_match_analyze():
         assert r["zmp_max_contact_velocity"] == pytest.approx(
             a.impact.zmp_max_contact_velocity, rel=1e-12
         )
-        assert r["limiting_edge"] == a.impact.com_limit.limiting_edge
+        assert r["limiting_edge"] == a.impact.com.limiting_edge
         assert r["com_velocity_area"] == pytest.approx(a.areas.com_velocity_area.area, rel=1e-12)
         assert r["verdict"] == "balanced"
 

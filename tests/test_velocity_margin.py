@@ -44,7 +44,7 @@ def test_the_limit_puts_the_worst_vertex_d_inside(name, d, cx, cy):
         return  # already within d of the edge: no speed is safe with that margin
     limit = ComCriterion(area, model, d).limit(c0)
     assert limit.status == "ok"
-    s = limit.max_approach_speed
+    s = limit.max_contact_velocity
     worst = min(inside_distance(area.vertices, p) for p in model.post_impact_com_velocities(c0, s))
     assert worst == pytest.approx(d, abs=1e-9)
     beyond = min(
@@ -52,7 +52,7 @@ def test_the_limit_puts_the_worst_vertex_d_inside(name, d, cx, cy):
         for p in model.post_impact_com_velocities(c0, s * 1.001 + 1e-6)
     )
     assert beyond < d
-    assert s <= ComCriterion(area, model).limit(c0).max_approach_speed + 1e-12
+    assert s <= ComCriterion(area, model).limit(c0).max_contact_velocity + 1e-12
 
 
 def test_the_governor_applies_it_to_both_models():
@@ -61,18 +61,18 @@ def test_the_governor_applies_it_to_both_models():
     margin = Governor("palm_push_two_feet", contact_aware=warm, velocity_margin=0.02)
     q, v = plain.configuration, np.zeros(plain.nv)
     a, b = plain.limit(q, v), margin.limit(q, v)
-    assert b.max_approach_speed < a.max_approach_speed
+    assert b.max_contact_velocity < a.max_contact_velocity
     posture = margin.posture
     floating = ComCriterion(posture.com_criterion.area, posture.impact, 0.02).limit(b.com_velocity)
-    assert b.max_approach_speed <= floating.max_approach_speed + 1e-12
+    assert b.max_contact_velocity <= floating.max_contact_velocity + 1e-12
     # The contact-aware jump with the margin: the point it predicts at the limit is 0.02 inside (or the floating set binds).
     aware = margin._support.answer(posture.com_criterion, b.com_velocity)
-    assert b.max_approach_speed == pytest.approx(
-        min(floating.max_approach_speed, aware.limit.max_approach_speed)
+    assert b.max_contact_velocity == pytest.approx(
+        min(floating.max_contact_velocity, aware.limit.max_contact_velocity)
     )
     rates = aware.rates
     vertices = posture.com_criterion.area.vertices
-    s = aware.limit.max_approach_speed
+    s = aware.limit.max_contact_velocity
     worst = min(inside_distance(vertices, b.com_velocity[:2] + s * r) for r in rates)
     assert worst == pytest.approx(0.02, abs=1e-9)
 
@@ -121,8 +121,8 @@ def test_async_rates_are_the_workers_answer_for_the_posture_it_was_sent():
         second = governor.limit(q2, v)
         aware = governor._support.answer(governor.posture.com_criterion, second.com_velocity)
         floating = governor.posture.com_criterion.limit(second.com_velocity)
-        assert second.max_approach_speed == pytest.approx(
-            min(aware.limit.max_approach_speed, floating.max_approach_speed)
+        assert second.max_contact_velocity == pytest.approx(
+            min(aware.limit.max_contact_velocity, floating.max_contact_velocity)
         )
         assert first.binding == "contact_aware"
     assert governor._worker is None and not worker.alive  # closed by the with block

@@ -205,8 +205,8 @@ def bounds(args: argparse.Namespace) -> list[dict]:
                 governed, criterion="com", contact_aware=True, velocity_margin=args.velocity_margin
             ).limit(q, v)
             row[f"{1e3 * margin:g} mm"] = {
-                "floating": floating.limit(q, v).max_approach_speed,
-                "union": union.max_approach_speed,
+                "floating": floating.limit(q, v).max_contact_velocity,
+                "union": union.max_contact_velocity,
                 "binding": union.binding,
             }
         analysis = ib.analyze(name)

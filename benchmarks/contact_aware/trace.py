@@ -147,9 +147,9 @@ def branches_table(
             f"{x:+.3f}, {y:+.3f}" for (x, y), c in zip(u.rates, u.restitution) if c == upper
         )
         rows.append(
-            f"| {dt:+.3f} | {answer.max_approach_speed:.3f} | {a.rates[-1][0]:+.3f}, {a.rates[-1][1]:+.3f} "
-            f"| {a.limit.max_approach_speed:.3f} | {b.rates[-1][0]:+.3f}, {b.rates[-1][1]:+.3f} "
-            f"| {b.limit.max_approach_speed:.3f} | {jumps} | {u.limit.max_approach_speed:.3f} "
+            f"| {dt:+.3f} | {answer.max_contact_velocity:.3f} | {a.rates[-1][0]:+.3f}, {a.rates[-1][1]:+.3f} "
+            f"| {a.limit.max_contact_velocity:.3f} | {b.rates[-1][0]:+.3f}, {b.rates[-1][1]:+.3f} "
+            f"| {b.limit.max_contact_velocity:.3f} | {jumps} | {u.limit.max_contact_velocity:.3f} "
             f"| {costs[-1]:.1f} |"
         )
     tail = (

@@ -64,7 +64,7 @@ def bench_pipeline(sc: ib.Scenario, args) -> dict[str, Any]:
     if model is not None:
         staged = ib.max_contact_velocity(
             areas.com_velocity_area, model, sc.com_velocity
-        ).max_approach_speed
+        ).max_contact_velocity
         out["consistent"] &= bool(
             a.impact.max_contact_velocity == staged
             or (math.isinf(staged) and math.isinf(a.impact.max_contact_velocity))

@@ -68,8 +68,8 @@ def profile_report(args) -> dict[str, Any]:
     """
     import pinocchio as pin
 
-    from impact_balance.criteria.com import first_exit
-    from impact_balance.projection import _kernel, project_walk
+    from impact_balance.criteria.linear_exit import first_exit
+    from impact_balance.projection import kernel, project_walk
 
     out: dict[str, Any] = {}
     sc = ib.load_scenario(TARGET_PIPELINE_SCENARIO)
@@ -116,7 +116,7 @@ def profile_report(args) -> dict[str, Any]:
             lambda: np.linalg.svd(C), n
         ),
         "compiled kernel project() alone": _median_us(
-            lambda: _kernel.project(A, b, F, x0, N, FORCE_BOX, 5000, NO_HINT), n
+            lambda: kernel.project(A, b, F, x0, N, FORCE_BOX, 5000, NO_HINT), n
         ),
         "project_walk": _median_us(
             lambda: project_walk(A, b, C, d, F, box=FORCE_BOX, merge_tol=1e-6), n

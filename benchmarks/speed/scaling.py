@@ -102,7 +102,7 @@ def bench_cone_edges(
             times, _ = measure(cases, args.repeat_cheap, max(args.warmup, 10))
             v = ib.max_contact_velocity(
                 areas.com_velocity_area, model, sc.com_velocity
-            ).max_approach_speed
+            ).max_contact_velocity
             rows.append(
                 {
                     "scenario": name,

@@ -26,10 +26,10 @@ _EXPORTS: dict[str, str] = {
     "WrenchPolytope": ".contacts.wrench_polytope",
     "contact_polytope": ".contacts.wrench_polytope",
     "wrench_polytope": ".contacts.wrench_polytope",
-    "VelocityLimit": ".criteria.com",
-    "capped_velocity": ".criteria.com",
+    "ContactVelocityLimit": ".criteria.velocity_limit",
+    "capped_velocity": ".criteria.cap",
     "max_contact_velocity": ".criteria.com",
-    "zmp_max_contact_velocity": ".criteria.com",
+    "zmp_max_contact_velocity": ".criteria.zmp",
     "cwc_faces": ".contacts.cwc",
     "cwc_faces_world": ".contacts.cwc",
     "cwc_span": ".contacts.cwc",
@@ -83,6 +83,7 @@ __all__ = [
     "Contact",
     "ContactAwareOptions",
     "ContactSpec",
+    "ContactVelocityLimit",
     "Diagnostic",
     "Governor",
     "ImpactAnswer",
@@ -108,7 +109,6 @@ __all__ = [
     "UnknownKeyError",
     "UnknownRobotError",
     "UnknownScenarioError",
-    "VelocityLimit",
     "WrenchPolytope",
     "analyze",
     "areas_from_polytope",
@@ -170,12 +170,10 @@ if TYPE_CHECKING:  # static analysers and IDEs see the plain imports
         contact_polytope,
         wrench_polytope,
     )
-    from impact_balance.criteria.com import (
-        VelocityLimit,
-        capped_velocity,
-        max_contact_velocity,
-        zmp_max_contact_velocity,
-    )
+    from impact_balance.criteria.cap import capped_velocity
+    from impact_balance.criteria.com import max_contact_velocity
+    from impact_balance.criteria.velocity_limit import ContactVelocityLimit
+    from impact_balance.criteria.zmp import zmp_max_contact_velocity
     from impact_balance.criteria.qp import QPOptions, QPResult, solve_contact_velocity_qp
     from impact_balance.exceptions import (
         ImpactBalanceError,

@@ -12,12 +12,10 @@ from impact_balance.analysis.result import Analysis, ImpactAnswer
 from impact_balance.balance.areas import BalanceAreas, areas_from_polytope, with_reason
 from impact_balance.contacts.stance import Stance
 from impact_balance.contacts.wrench_polytope import wrench_polytope
-from impact_balance.criteria.com import (
-    ComCriterion,
-    safe_contact_velocity,
-    zmp_max_contact_velocity,
-)
+from impact_balance.criteria.cap import safe_contact_velocity
+from impact_balance.criteria.com import ComCriterion
 from impact_balance.criteria.qp import QPOptions, solve_contact_velocity_qp, static_torques
+from impact_balance.criteria.zmp import zmp_max_contact_velocity
 from impact_balance.exceptions import NonFiniteResultError, ScenarioError, SolverError
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.impact.model import ImpactModel, impact_model
@@ -91,11 +89,11 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
             raise with_source(exc, scenario.source) from None
         _check_finite(_impact_checks(model))
         criterion = ComCriterion(areas.com_velocity_area, model, scenario.velocity_margin)
-        com_limit = criterion.limit(scenario.com_velocity)
-        zmp_limit = zmp_max_contact_velocity(
+        com = criterion.limit(scenario.com_velocity)
+        zmp = zmp_max_contact_velocity(
             areas.zmp_area, model, stance.com, scenario.plane_height, scenario.gravity, cfg.duration
         )
-        interval = criterion.interval(scenario.com_velocity, com_limit)
+        interval = criterion.interval(scenario.com_velocity, com)
         contact_velocity = None
         if cfg.reference_velocity is not None:
             contact_velocity = safe_contact_velocity(cfg.reference_velocity, model.normal, interval)
@@ -121,7 +119,7 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
                 )
             except SolverError as exc:
                 raise exc.within("impact.qp") from None
-        answer = ImpactAnswer(model, com_limit, zmp_limit, contact_velocity, qp, interval)
+        answer = ImpactAnswer(model, com, zmp, contact_velocity, qp, interval)
         timings["impact"] = time.perf_counter() - t3
     timings["total"] = time.perf_counter() - t0
     return Analysis(scenario, stance, areas, answer, timings, diagnose(scenario, stance, answer))

@@ -30,6 +30,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance.analysis.result import Diagnostic, ImpactAnswer
 
@@ -43,6 +44,7 @@ __all__ = [
     "Diagnostic",
     "contact_diagnostics",
     "diagnose",
+    "diagnostics_to_json",
     "impact_diagnostics",
 ]
 
@@ -71,8 +73,9 @@ def contact_diagnostics(stance: Stance) -> list[Diagnostic]:
                 Diagnostic(
                     "contact_normal_down",
                     field,
-                    f"the normal of {frame} points down ({tilt:.0f}° from vertical): the surface would be above "
-                    "the contact; the frame's z axis (after offset) must point from the surface into the robot",
+                    f"the normal of {frame} points down ({tilt:.0f}° from vertical): "
+                    "the surface would be above the contact; the frame's z axis (after offset) "
+                    "must point from the surface into the robot",
                 )
             )
         elif FLOOR_TILT < tilt < WALL_TILT:
@@ -81,7 +84,8 @@ def contact_diagnostics(stance: Stance) -> list[Diagnostic]:
                     "contact_normal_tilted",
                     field,
                     f"the normal of {frame} is {tilt:.0f}° from vertical, neither a floor or ramp "
-                    f"(<= {FLOOR_TILT:.0f}°) nor a wall (>= {WALL_TILT:.0f}°): is its z axis the surface normal? "
+                    f"(<= {FLOOR_TILT:.0f}°) nor a wall (>= {WALL_TILT:.0f}°): "
+                    "is its z axis the surface normal? "
                     "(set offset.rpy to align it)",
                 )
             )
@@ -89,10 +93,10 @@ def contact_diagnostics(stance: Stance) -> list[Diagnostic]:
 
 
 def impact_diagnostics(
-    answer: ImpactAnswer, reference_velocity: Sequence[float] | None
+    answer: ImpactAnswer, reference_velocity: npt.ArrayLike | None
 ) -> list[Diagnostic]:
     """An impact that does not approach its surface, a QP capped by its reference."""
-    out = []
+    out: list[Diagnostic] = []
     if reference_velocity is None:
         return out
     approach = answer.model.approach_speed(reference_velocity)
@@ -101,9 +105,10 @@ def impact_diagnostics(
             Diagnostic(
                 "impact_moving_away",
                 "impact.reference_velocity",
-                f"the reference velocity does not move towards the impacted surface (approach speed -n.v = "
-                f"{approach:.3g} m/s <= 0), so there is no impact and nothing to cap; impact.normal must point from "
-                "the surface into the robot (is its sign flipped?)",
+                "the reference velocity does not move towards the impacted surface "
+                f"(approach speed -n.v = {approach:.3g} m/s <= 0), so there is no impact and "
+                "nothing to cap; impact.normal must point from the surface into the robot "
+                "(is its sign flipped?)",
             )
         )
     qp = answer.qp
@@ -120,8 +125,9 @@ def impact_diagnostics(
             Diagnostic(
                 "qp_capped_by_reference",
                 "impact.qp",
-                f"the paper's QP gives the reference approach speed {approach:.3f} m/s, not the maximum "
-                f"{limit:.3f} m/s: it tracks the reference velocity and never exceeds it",
+                f"the paper's QP gives the reference approach speed {approach:.3f} m/s, "
+                f"not the maximum {limit:.3f} m/s: it tracks the reference velocity and never "
+                "exceeds it",
             )
         )
     return out

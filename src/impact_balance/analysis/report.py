@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import numpy as np
 
-from impact_balance.analysis.analyze import Analysis
+from impact_balance.analysis.result import Analysis
 
 __all__ = ["format_analysis", "format_safe_interval", "format_speed", "format_timings"]
 
@@ -39,11 +41,15 @@ def format_safe_interval(interval: tuple[float, float] | None, inside: bool) -> 
         f"safe approach speeds: [{lo:.3f}, {f'{hi:.3f}' if np.isfinite(hi) else 'unbounded'}] m/s"
     )
     if not inside:
-        text += " (the CoM velocity is outside the area: an impact in this range would bring it back inside)"
+        text += (
+            " (the CoM velocity is outside the area: "
+            "an impact in this range would bring it back inside)"
+        )
     return text
 
 
-def _vec(v, digits: int = 3) -> str:
+def _vec(v: Iterable[float], digits: int = 3) -> str:
+    """``(x, y, z)`` with ``digits`` decimals."""
     return "(" + ", ".join(f"{x:.{digits}f}" for x in v) + ")"
 
 
@@ -52,7 +58,8 @@ def format_analysis(analysis: Analysis) -> str:
     a, st, sc = analysis.areas, analysis.stance, analysis.scenario
     lines = [f"{sc.name or 'scenario'}: {sc.description or ''}".rstrip(": ")]
     lines.append(
-        f"  robot {st.robot.name}, mass {st.mass:.2f} kg, CoM {_vec(st.com)} m, omega {a.omega:.4f} 1/s, "
+        f"  robot {st.robot.name}, mass {st.mass:.2f} kg, CoM {_vec(st.com)} m, "
+        f"omega {a.omega:.4f} 1/s, "
         f"{len(st.contacts)} contact(s), torque limits {'on' if sc.torque_limits else 'off'}"
     )
     warnings = [f"  warning: {w}" for w in analysis.warnings]
@@ -77,11 +84,13 @@ def format_analysis(analysis: Analysis) -> str:
     if im is not None:
         spec = im.model.spec
         lines.append(
-            f"  impact at {spec.frame}, point {_vec(im.model.point)} m, normal {_vec(im.model.normal, 2)}, "
-            f"mu {spec.friction:g}, restitution [{spec.restitution[0]:g}, {spec.restitution[1]:g}], N = {spec.cone_edges}"
+            f"  impact at {spec.frame}, point {_vec(im.model.point)} m, "
+            f"normal {_vec(im.model.normal, 2)}, mu {spec.friction:g}, "
+            f"restitution [{spec.restitution[0]:g}, {spec.restitution[1]:g}], "
+            f"N = {spec.cone_edges}"
         )
         com_v, zmp_v = im.max_contact_velocity, im.zmp_max_contact_velocity
-        if im.com_limit.status == "already_falling":
+        if im.com.status == "already_falling":
             # The ZMP criterion ignores the CoM velocity: its number is not comparable here.
             lines.append(
                 f"  max contact velocity: none, the robot is already falling (CoM criterion 0); "
@@ -92,7 +101,8 @@ def format_analysis(analysis: Analysis) -> str:
                 f" (x{com_v / zmp_v:.1f})" if np.isfinite(com_v) and com_v > 0 and zmp_v > 0 else ""
             )
             lines.append(
-                f"  max contact velocity: CoM criterion {format_speed(com_v)}, ZMP criterion {format_speed(zmp_v)}{ratio}"
+                f"  max contact velocity: CoM criterion {format_speed(com_v)}, "
+                f"ZMP criterion {format_speed(zmp_v)}{ratio}"
             )
         lines.append("  " + format_safe_interval(im.safe_interval, analysis.com_velocity_inside))
         if spec.reference_velocity is not None:
@@ -105,7 +115,8 @@ def format_analysis(analysis: Analysis) -> str:
             lines.append(f"  reference velocity {_vec(spec.reference_velocity)} m/s -> {target}")
         if im.qp is not None:
             lines.append(
-                f"  paper's QP ({im.qp.status}): approach speed {format_speed(im.qp.approach_speed)}"
+                f"  paper's QP ({im.qp.status}): "
+                f"approach speed {format_speed(im.qp.approach_speed)}"
             )
     lines.append(f"  {format_timings(analysis.timings)}")
     return "\n".join(lines + warnings)

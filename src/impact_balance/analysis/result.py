@@ -1,4 +1,4 @@
-"""What an analysis answers: :class:`Analysis` (the areas and the impact) and :class:`ImpactAnswer`."""
+"""What an analysis answers: :class:`Analysis` (areas and impact) and :class:`ImpactAnswer`."""
 
 from __future__ import annotations
 
@@ -6,13 +6,15 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance.balance.areas import BalanceAreas
 from impact_balance.balance.infeasibility import CannotBalanceReason
 from impact_balance.contacts.stance import Stance
-from impact_balance.criteria.com import VelocityLimit
 from impact_balance.criteria.qp import QPResult
+from impact_balance.criteria.velocity_limit import ContactVelocityLimit, LimitStatus
 from impact_balance.impact.model import ImpactModel
+from impact_balance.json_values import json_number
 from impact_balance.scenario import Scenario
 
 __all__ = ["Analysis", "Diagnostic", "ImpactAnswer"]
@@ -23,7 +25,8 @@ class Diagnostic:
     """One warning.
 
     Attributes:
-        code: Stable identifier (see the module docstring of :mod:`impact_balance.analysis.diagnostics`).
+        code: Stable identifier (see the module docstring of
+            :mod:`impact_balance.analysis.diagnostics`).
         field: The scenario field it is about (``contacts[1].frame``, ``impact.normal``, ...).
         message: One sentence, in the user's terms.
     """
@@ -36,12 +39,8 @@ class Diagnostic:
         return f"{self.field}: {self.message} [{self.code}]"
 
     def to_dict(self) -> dict[str, str]:
+        """The JSON object of one entry of ``warnings``."""
         return {"code": self.code, "field": self.field, "message": self.message}
-
-
-def _num(x: float) -> float | None:
-    """JSON-safe float (inf -> None)."""
-    return float(x) if np.isfinite(x) else None
 
 
 @dataclass(frozen=True)
@@ -50,12 +49,13 @@ class ImpactAnswer:
 
     Attributes:
         model: Impact model (impulse rates, W, cone).
-        com_limit: Maximum approach speed by the CoM velocity criterion (m/s).
-        zmp_limit: Maximum approach speed by the ZMP criterion (m/s).
+        com: The CoM velocity criterion's answer: the maximum contact velocity (m/s) and
+            its status.
+        zmp: The ZMP criterion's answer.
         contact_velocity: Reference velocity with its approach speed moved into the safe
             interval (capped at the maximum when the CoM velocity is inside the area; see
-            :func:`~impact_balance.criteria.com.safe_contact_velocity`), m/s, world; None without a
-            reference velocity or when no approach speed is safe.
+            :func:`~impact_balance.criteria.cap.safe_contact_velocity`), m/s, world; None
+            without a reference velocity or when no approach speed is safe.
         qp: The paper's QP solution when requested.
         safe_interval: The approach speeds (lo, hi) m/s whose post-impact CoM velocities all
             stay in the area (hi may be inf), or None when there are none; see
@@ -63,24 +63,41 @@ class ImpactAnswer:
     """
 
     model: ImpactModel
-    com_limit: VelocityLimit
-    zmp_limit: VelocityLimit
-    contact_velocity: np.ndarray | None
+    com: ContactVelocityLimit
+    zmp: ContactVelocityLimit
+    contact_velocity: npt.NDArray[np.float64] | None
     qp: QPResult | None = None
     safe_interval: tuple[float, float] | None = None
 
     @property
     def max_contact_velocity(self) -> float:
-        return self.com_limit.max_approach_speed
+        """The CoM velocity criterion's maximum contact velocity, m/s (inf: unbounded)."""
+        return self.com.max_contact_velocity
+
+    @property
+    def status(self) -> LimitStatus:
+        """The CoM velocity criterion's status."""
+        return self.com.status
 
     @property
     def zmp_max_contact_velocity(self) -> float:
-        return self.zmp_limit.max_approach_speed
+        """The ZMP criterion's maximum contact velocity, m/s (inf: unbounded)."""
+        return self.zmp.max_contact_velocity
+
+    @property
+    def zmp_status(self) -> LimitStatus:
+        """The ZMP criterion's status."""
+        return self.zmp.status
 
     def evaluation_speed(self) -> float:
-        """Approach speed at which sets are reported: the maximum, or the reference's if unbounded."""
-        if self.com_limit.is_finite:
-            return self.com_limit.max_approach_speed
+        """Approach speed at which sets are reported, m/s.
+
+        Returns:
+            The maximum contact velocity, or the reference's approach speed (at least 0)
+            when the maximum is unbounded (0 without a reference).
+        """
+        if self.com.is_finite:
+            return self.com.max_contact_velocity
         ref = self.model.spec.reference_velocity
         return max(0.0, self.model.approach_speed(ref)) if ref is not None else 0.0
 
@@ -106,6 +123,7 @@ class Analysis:
 
     @property
     def com_velocity(self) -> np.ndarray:
+        """The pre-impact CoM velocity (3,), world, m/s."""
         return np.asarray(self.scenario.com_velocity, dtype=float)
 
     @property
@@ -118,11 +136,15 @@ class Analysis:
 
     @property
     def cannot_balance_reason(self) -> CannotBalanceReason | None:
-        """Why the robot cannot balance (None when it can); see :mod:`impact_balance.balance.infeasibility`."""
+        """Why the robot cannot balance (None when it can).
+
+        See :mod:`impact_balance.balance.infeasibility`.
+        """
         return self.areas.reason
 
     @property
     def verdict(self) -> str:
+        """One line: "balanced", "falling: ..." or "cannot balance: ..."."""
         if not self.areas.can_balance:
             return "cannot balance: the contacts cannot hold the robot at rest (empty areas)"
         if not self.com_velocity_inside:
@@ -130,6 +152,7 @@ class Analysis:
         return "balanced"
 
     def to_dict(self) -> dict[str, Any]:
+        """The JSON document of ``impact-balance analyze --json`` (strict JSON: no NaN, inf)."""
         a = self.areas
         out: dict[str, Any] = {
             "scenario": self.scenario.name,
@@ -171,8 +194,8 @@ class Analysis:
                 "friction": im.model.spec.friction,
                 "restitution": list(im.model.spec.restitution),
                 "cone_edges": im.model.spec.cone_edges,
-                "max_contact_velocity": _num(im.max_contact_velocity),
-                "status": im.com_limit.status,
+                "max_contact_velocity": json_number(im.max_contact_velocity),
+                "status": im.status,
                 "reference_velocity": None
                 if im.model.spec.reference_velocity is None
                 else list(im.model.spec.reference_velocity),
@@ -186,15 +209,15 @@ class Analysis:
                 ).tolist(),
                 "safe_interval": None
                 if im.safe_interval is None
-                else [_num(x) for x in im.safe_interval],
-                "zmp_max_contact_velocity": _num(im.zmp_max_contact_velocity),
-                "zmp_status": im.zmp_limit.status,
+                else [json_number(x) for x in im.safe_interval],
+                "zmp_max_contact_velocity": json_number(im.zmp_max_contact_velocity),
+                "zmp_status": im.zmp_status,
                 "W": im.model.W.tolist(),
             }
             if im.qp is not None:
                 out["impact"]["qp"] = {
                     "status": im.qp.status,
-                    "approach_speed": _num(im.qp.approach_speed),
+                    "approach_speed": json_number(im.qp.approach_speed),
                     "contact_velocity": None
                     if im.qp.contact_velocity is None
                     else im.qp.contact_velocity.tolist(),

@@ -11,21 +11,22 @@ images of ONE projection: the set of feasible resultant horizontal forces, obtai
 projecting the contact-wrench polytope (:mod:`impact_balance.contacts.wrench_polytope`).
 
 A ZMP margin ``M`` (m) shrinks the ZMP support area to the points at least ``M`` inside its
-edges (:meth:`~impact_balance.geometry.polygon.Polygon.inset`), as a controller that keeps its ZMP away
-from the edges does; the CoM velocity area follows (it is the same set, scaled by omega).
+edges (:meth:`~impact_balance.geometry.polygon.Polygon.inset`), as a controller that keeps
+its ZMP away from the edges does; the CoM velocity area follows (it is the same set, scaled
+by omega).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import math
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from impact_balance._jit import cache_depends_on, njit
 from impact_balance.balance.infeasibility import CannotBalanceReason, explain_cannot_balance
+from impact_balance.balance.lipm import lipm_omega
 from impact_balance.constants import GRAVITY
 from impact_balance.contacts import wrench_polytope as constraints
 from impact_balance.contacts.stance import Stance
@@ -35,7 +36,7 @@ from impact_balance.contacts.wrench_polytope import (
     face_blocks,
     wrench_polytope,
 )
-from impact_balance.exceptions import ScenarioError, SolverError
+from impact_balance.exceptions import SolverError
 from impact_balance.geometry import polygon
 from impact_balance.geometry.polygon import (
     MERGE_AREA_TOLERANCE,
@@ -43,18 +44,21 @@ from impact_balance.geometry.polygon import (
     edge_halfplanes,
     inset_polygon,
 )
-from impact_balance.projection import _kernel, project_polytope, walk
-from impact_balance.projection._kernel import LINE, OK
+from impact_balance.projection import kernel, project_polytope, walk
+from impact_balance.projection.kernel import LINE, OK
 from impact_balance.projection.walk import MAX_PIVOTS, NO_HINT, certified_walk
 
 __all__ = [
+    "FORCE_BOX",
+    "FORCE_TOLERANCE",
+    "MERGE_TOLERANCE",
     "BalanceAreas",
     "Projected",
     "areas_from_arrays",
     "areas_from_polytope",
     "balance_areas",
-    "omega",
     "projected_from_arrays",
+    "warm_up",
     "with_reason",
 ]
 
@@ -66,15 +70,6 @@ FORCE_TOLERANCE = 1e-8
 MERGE_TOLERANCE = 1e-6
 #: Clipping box on the resultant horizontal force for unbounded directions, in units of m g.
 FORCE_BOX = 1e3
-
-
-def omega(com_height: float, plane_height: float = 0.0, gravity: float = GRAVITY) -> float:
-    """LIPM natural frequency sqrt(g / (c_z - h)), 1/s; the plane must be below the CoM."""
-    if not com_height > plane_height:
-        raise ScenarioError(
-            "plane_height", plane_height, f"must be below the CoM height {com_height:.4g} m"
-        )
-    return math.sqrt(gravity / (com_height - plane_height))
 
 
 @dataclass(frozen=True)
@@ -113,8 +108,9 @@ class BalanceAreas:
         return not self.com_velocity_area.is_empty
 
     def com_velocity_area_inset(self, margin: float) -> Polygon:
-        """The CoM velocity area of ``zmp_area`` shrunk by ``margin`` more metres (what a
-        controller that keeps its ZMP that far inside can use); empty when nothing is left.
+        """The CoM velocity area of ``zmp_area`` shrunk by ``margin`` more metres.
+
+        What a controller that keeps its ZMP that far inside can use; empty when nothing is left.
         """
         return _velocity_area(self.zmp_area.inset(margin), self.omega, self.com)
 
@@ -134,18 +130,23 @@ def _velocity_area(zmp: Polygon, w: float, com: np.ndarray) -> Polygon:
 def areas_from_polytope(
     polytope: WrenchPolytope, plane_height: float = 0.0, zmp_margin: float = 0.0
 ) -> BalanceAreas:
-    """Project a contact-wrench polytope and map it to the ZMP and CoM velocity areas, the ZMP
-    support area shrunk by ``zmp_margin`` (m).
+    """Project a contact-wrench polytope and map it to the ZMP and CoM velocity areas.
+
+    The ZMP support area is shrunk by ``zmp_margin`` (m).
     """
     com = polytope.com
-    w = omega(float(com[2]), plane_height, polytope.gravity)
+    w = lipm_omega(float(com[2]), plane_height, polytope.gravity, field="plane_height")
     depth = plane_height - float(com[2])  # < 0
     # Work in units of m g so that tolerances mean the same for every robot, and in
     # friction-normalised variables so that a large or small friction keeps full precision.
-    data = tuple(np.ascontiguousarray(x, dtype=np.float64) for x in polytope.projection_data())
+    A, b, C, d, E = (np.ascontiguousarray(x, dtype=np.float64) for x in polytope.projection_data())
     # The walk, its certificate and both maps in one compiled call (a governor's every tick).
     walked = _walk_areas(
-        *data,
+        A,
+        b,
+        C,
+        d,
+        E,
         FORCE_BOX,
         MAX_PIVOTS,
         MERGE_TOLERANCE,
@@ -158,7 +159,14 @@ def areas_from_polytope(
         NO_HINT,
     )
     return _projected(
-        walked, data, com, w, plane_height, polytope.mass, polytope.gravity, float(zmp_margin)
+        walked,
+        (A, b, C, d, E),
+        com,
+        w,
+        plane_height,
+        polytope.mass,
+        polytope.gravity,
+        float(zmp_margin),
     ).areas()
 
 
@@ -177,11 +185,14 @@ def areas_from_arrays(
     plane_height: float = 0.0,
     zmp_margin: float = 0.0,
 ) -> BalanceAreas:
-    """``areas_from_polytope(assemble_polytope(...))`` for contacts whose frictions are all at
-    most 1 (no friction scaling), in one compiled call: a governor's every tick.
+    """``areas_from_polytope(assemble_polytope(...))`` in one compiled call.
 
-    The arguments are :func:`~impact_balance.contacts.wrench_polytope.assemble_polytope`'s (``faces`` (m,
-    16, 6); ``com`` (3,) world, m), then the plane height (m) and the ZMP margin (m).
+    For contacts whose frictions are all at most 1 (no friction scaling): a governor's every
+    tick.
+
+    The arguments are :func:`~impact_balance.contacts.wrench_polytope.assemble_polytope`'s
+    (``faces`` (m, 16, 6); ``com`` (3,) world, m), then the plane height (m) and the ZMP
+    margin (m).
     """
     return projected_from_arrays(
         faces,
@@ -216,8 +227,10 @@ def projected_from_arrays(
     zmp_margin: float = 0.0,
     hint: np.ndarray | None = None,
 ) -> Projected:
-    """:func:`areas_from_arrays` before its :class:`BalanceAreas` is built (a governor's tick
-    reads only the CoM velocity area; :meth:`Projected.areas` builds the rest on demand).
+    """:func:`areas_from_arrays` before its :class:`BalanceAreas` is built.
+
+    A governor's tick reads only the CoM velocity area; :meth:`Projected.areas` builds the rest
+    on demand.
 
     ``hint``: an int64 array (2 + the number of wrench variables, e.g. 2 + 6 per contact) the
     walk reads its start from and writes its optimal basis to: one caller that projects
@@ -236,7 +249,7 @@ def projected_from_arrays(
             f"hint must be a writable 1-D int64 numpy array, not {type(hint).__name__} "
             f"{getattr(hint, 'dtype', '')}".rstrip()
         )
-    w = omega(float(com[2]), plane_height, gravity)
+    w = lipm_omega(float(com[2]), plane_height, gravity, field="plane_height")
     depth = plane_height - float(com[2])
     positions, arms, jacobians, torque_limits, gravity_torques = (
         np.ascontiguousarray(x, dtype=np.float64)
@@ -266,8 +279,10 @@ def projected_from_arrays(
 
 
 class Projected(NamedTuple):
-    """One projection's areas as arrays, the CoM velocity area (with its half-planes) as a
-    :class:`Polygon`, and what :meth:`areas` needs to build the :class:`BalanceAreas`.
+    """One projection's areas as arrays.
+
+    The CoM velocity area (with its half-planes) is a :class:`Polygon`; the rest is what
+    :meth:`areas` needs to build the :class:`BalanceAreas`.
 
     ``force``, ``zmp`` (k, 2): the force area (units of m g) and the ZMP support area (world,
     m) vertices; ``w`` omega (1/s); ``com`` (3,) m; ``plane_height`` m; ``mass`` kg;
@@ -304,8 +319,8 @@ class Projected(NamedTuple):
 
 
 def _projected(
-    walked: tuple,
-    data: tuple,
+    walked: tuple[Any, ...],
+    data: tuple[Any, ...],
     com: np.ndarray,
     w: float,
     plane_height: float,
@@ -313,15 +328,21 @@ def _projected(
     gravity: float,
     margin: float,
 ) -> Projected:
-    """The areas from :func:`_walk_areas`' answer ``walked`` on the projection data ``data``
-    ``(A, b, C, d, E)``: where the walk cannot answer, project_polytope chooses as it always
-    does, and the same compiled maps make the ZMP and CoM velocity areas.
+    """The areas from :func:`_walk_areas`' answer ``walked`` on the projection data ``data``.
+
+    ``data`` is ``(A, b, C, d, E)``: where the walk cannot answer, project_polytope chooses as it
+    always does, and the same compiled maps make the ZMP and CoM velocity areas.
     """
     status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h = walked
     n_lp = 1
     if status != OK or force.shape[0] == 0:
+        A, b, C, d, E = data
         result = project_polytope(
-            *data,
+            A,
+            b,
+            C,
+            d,
+            E,
             tol=FORCE_TOLERANCE,
             box=FORCE_BOX,
             merge_tol=MERGE_TOLERANCE,
@@ -361,9 +382,10 @@ def _projected(
 
 
 def warm_up() -> None:
-    """Load the compiled map that the fallback path (a walk refused, Bretl's polygon mapped in
-    :func:`_projected`) calls from Python: numba loads a cached function on its first call
-    (12 ms in a G1 tick). A governor calls this when it is built.
+    """Load the compiled map that the fallback path calls from Python.
+
+    The fallback path (a walk refused, Bretl's polygon mapped in :func:`_projected`) calls it;
+    numba loads a cached function on its first call. A governor calls this when it is built.
     """
     _maps(np.zeros((0, 2)), True, -1.0, 0.0, 0.0, 1.0, 0.0)
 
@@ -380,9 +402,11 @@ def _affine(v, scale, ox, oy):
 
 @njit(cache=True)
 def _maps(force, bounded, depth, cx, cy, w, margin):
-    """The ZMP support area (shrunk by ``margin``) and the CoM velocity area of the force area
-    ``force`` (vertices, units of m g): ``(zmp, zmp_bounded, vel, vel_bounded)``, the numbers
-    :class:`Polygon`'s ``affine`` and ``inset`` give (``depth`` = h - c_z, CoM ``(cx, cy)``).
+    """The ZMP support area (shrunk by ``margin``) and the CoM velocity area of a force area.
+
+    ``force``: vertices, units of m g. Returns ``(zmp, zmp_bounded, vel, vel_bounded)``, the
+    numbers :class:`Polygon`'s ``affine`` and ``inset`` give (``depth`` = h - c_z, CoM
+    ``(cx, cy)``).
     """
     empty = np.empty((0, 2))
     if force.shape[0] == 0:
@@ -401,9 +425,10 @@ def _maps(force, bounded, depth, cx, cy, w, margin):
 def _walk_areas(
     A, b, C, d, E, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, margin, hint
 ):
-    """:func:`~impact_balance.projection.walk.certified_walk` and :func:`_maps` in one call:
-    ``(status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h)``, ``G, h`` the CoM
-    velocity area's half-planes when it has 3 vertices or more (else none).
+    """:func:`~impact_balance.projection.walk.certified_walk` and :func:`_maps` in one call.
+
+    Returns ``(status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h)``, ``G, h`` the
+    CoM velocity area's half-planes when it has 3 vertices or more (else none).
     """
     status, force, bounded, _, _, _ = certified_walk(
         A, b, C, d, E, box, max_pivots, merge_tol, area_tol, hint
@@ -437,9 +462,11 @@ def _assembled_areas(
     margin,
     hint,
 ):
-    """The polytope's arrays (as :func:`~impact_balance.contacts.wrench_polytope.assemble_polytope`) in
-    units of m g (as ``WrenchPolytope.projection_data`` without scaling) and
-    :func:`_walk_areas` on them: ``(A, b, C, d, E) + _walk_areas(...)``.
+    """The polytope's arrays in units of m g, and :func:`_walk_areas` on them.
+
+    The arrays are those of :func:`~impact_balance.contacts.wrench_polytope.assemble_polytope`,
+    as ``WrenchPolytope.projection_data`` without scaling. Returns
+    ``(A, b, C, d, E) + _walk_areas(...)``.
     """
     A, b, C, G = assemble_arrays(
         blocks, positions, arms, jacobians, torque_indices, torque_limits, gravity_torques
@@ -456,8 +483,8 @@ def _assembled_areas(
 
 # The compiled functions above embed the polygon module's, the walk's and the assembly's.
 cache_depends_on(_maps, polygon)
-cache_depends_on(_walk_areas, polygon, walk, _kernel)
-cache_depends_on(_assembled_areas, polygon, walk, _kernel, constraints)
+cache_depends_on(_walk_areas, polygon, walk, kernel)
+cache_depends_on(_assembled_areas, polygon, walk, kernel, constraints)
 
 
 def balance_areas(
@@ -468,7 +495,8 @@ def balance_areas(
     zmp_margin: float = 0.0,
 ) -> BalanceAreas:
     """ZMP support area (shrunk by ``zmp_margin``, m) and CoM velocity area of ``stance``."""
-    omega(float(stance.com[2]), plane_height, gravity)  # validate the plane before any work
+    # validate the plane before any work
+    lipm_omega(float(stance.com[2]), plane_height, gravity, field="plane_height")
     areas = areas_from_polytope(
         wrench_polytope(stance, torque_limits, gravity), plane_height, zmp_margin
     )
@@ -486,7 +514,8 @@ def with_reason(
             areas,
             reason=CannotBalanceReason(
                 "zmp_margin",
-                f"no point of the ZMP support area is {areas.zmp_margin:g} m (the ZMP margin) inside its edges",
+                f"no point of the ZMP support area is {areas.zmp_margin:g} m "
+                "(the ZMP margin) inside its edges",
             ),
         )
     try:

@@ -24,16 +24,25 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance.constants import GRAVITY
-from impact_balance.contacts.stance import Stance
+from impact_balance.contacts.stance import Contact, Stance
 from impact_balance.contacts.wrench_polytope import contact_polytope, wrench_polytope
 from impact_balance.solvers import HighsLP, LinearProgram
 
-__all__ = ["HIGH_FRICTION", "BindingJoint", "CannotBalanceReason", "explain_cannot_balance"]
+__all__ = [
+    "FRICTION_RTOL",
+    "HIGH_FRICTION",
+    "BindingJoint",
+    "CannotBalanceReason",
+    "explain_cannot_balance",
+]
 
 #: Friction coefficient taken as "as much friction as one wants" (the polytope is then
 #: already the limit one up to 1e-6 of the weight for any practical geometry).
@@ -57,7 +66,8 @@ class BindingJoint:
     effort: float
     min_scale: float | None
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON object of ``cannot_balance_reason.binding_joints[i]``."""
         return {"joint": self.joint, "effort": self.effort, "min_scale": self.min_scale}
 
 
@@ -68,7 +78,8 @@ class CannotBalanceReason:
     Attributes:
         kind: "torque_limits", "friction" or "com_outside" (see the module docstring),
             "zmp_margin" when the stance balances but its ZMP support area is too small for the
-            margin asked (:mod:`impact_balance.balance.areas`), or "unknown" when an LP of the diagnosis failed.
+            margin asked (:mod:`impact_balance.balance.areas`), or "unknown" when an LP of the
+            diagnosis failed.
         message: One line for people.
         binding_joints: For "torque_limits": the joints whose limit alone, raised by
             ``min_scale``, restores balance (smallest first), then those that bind at the
@@ -86,7 +97,8 @@ class CannotBalanceReason:
     def __str__(self) -> str:
         return self.message
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON object ``cannot_balance_reason`` of ``impact-balance analyze --json``."""
         return {
             "kind": self.kind,
             "message": self.message,
@@ -101,7 +113,14 @@ def _feasible(A: np.ndarray, b: np.ndarray, C: np.ndarray, d: np.ndarray) -> boo
     return lp.maximize(np.zeros(A.shape[1])).status != "infeasible"
 
 
-def _min_scale(A, b, C, d, rows: np.ndarray, limits: np.ndarray) -> float | None:
+def _min_scale(
+    A: npt.NDArray[np.float64],
+    b: npt.NDArray[np.float64],
+    C: npt.NDArray[np.float64],
+    d: npt.NDArray[np.float64],
+    rows: npt.NDArray[np.int_],
+    limits: npt.NDArray[np.float64],
+) -> float | None:
     """``min s`` over ``{A w - s L <= b, C w = d}`` where L is ``limits`` on ``rows`` (else 0).
 
     None when infeasible for every s (or unbounded below: then any s >= 0 works, 0).
@@ -118,7 +137,7 @@ def _min_scale(A, b, C, d, rows: np.ndarray, limits: np.ndarray) -> float | None
     sol = HighsLP(LinearProgram(A_s, b_s, C_s, d), warm=False).maximize(c)
     if sol.status == "infeasible":
         return None
-    if sol.status == "unbounded":  # cannot happen with s >= 0 and a bounded objective
+    if sol.status == "unbounded" or sol.x is None:  # cannot happen: s >= 0, bounded objective
         return 0.0
     return float(sol.x[-1])
 
@@ -168,7 +187,7 @@ def explain_cannot_balance(
     )
 
 
-def _contacts_feasible(stance: Stance, contacts, gravity: float) -> bool:
+def _contacts_feasible(stance: Stance, contacts: Sequence[Contact], gravity: float) -> bool:
     """Whether CWC + LIPM (no torque limits) is feasible for ``contacts`` at this stance.
 
     Uses the stance-frame lever arms (contact positions relative to the CoM).
@@ -180,8 +199,9 @@ def _contacts_feasible(stance: Stance, contacts, gravity: float) -> bool:
 
 
 def _min_friction(stance: Stance, gravity: float) -> float:
-    """Smallest common friction coefficient that makes CWC + LIPM feasible (bisection in
-    log scale between the largest current friction and :data:`HIGH_FRICTION`).
+    """Smallest common friction coefficient that makes CWC + LIPM feasible.
+
+    A bisection in log scale between the largest current friction and :data:`HIGH_FRICTION`.
     """
 
     def ok(mu: float) -> bool:
@@ -201,7 +221,15 @@ def _min_friction(stance: Stance, gravity: float) -> float:
     return hi
 
 
-def _torque_reason(stance, A, b, C, d, n_cwc, weight) -> CannotBalanceReason:
+def _torque_reason(
+    stance: Stance,
+    A: npt.NDArray[np.float64],
+    b: npt.NDArray[np.float64],
+    C: npt.NDArray[np.float64],
+    d: npt.NDArray[np.float64],
+    n_cwc: int,
+    weight: float,
+) -> CannotBalanceReason:
     idx, limits = stance.robot.effort_limits
     k = idx.size
     names = _joint_names(stance, idx)
@@ -219,7 +247,7 @@ def _torque_reason(stance, A, b, C, d, n_cwc, weight) -> CannotBalanceReason:
         s = _min_scale(A, bj, C, d, rows, np.array([scaled[j], scaled[j]]))
         if s is not None and s > 1.0 + 1e-9:
             joints.append(BindingJoint(names[j], float(limits[j]), s))
-    joints.sort(key=lambda jt: jt.min_scale)
+    joints.sort(key=lambda jt: math.inf if jt.min_scale is None else jt.min_scale)
     if not joints and uniform is not None:
         # No joint alone: list those at their (scaled) limit at the common optimum.
         joints = [
@@ -239,20 +267,31 @@ def _torque_reason(stance, A, b, C, d, n_cwc, weight) -> CannotBalanceReason:
     common = f"; or every limit x{uniform:.3g}" if uniform is not None else ""
     return CannotBalanceReason(
         "torque_limits",
-        f"the joint torque limits: the contacts could hold the robot without them; {detail}{common}",
+        "the joint torque limits: the contacts could hold the robot without them; "
+        f"{detail}{common}",
         tuple(joints),
         uniform,
     )
 
 
-def _active_at_uniform(A, b0, C, d, rows, L, t, names, limits):
+def _active_at_uniform(
+    A: npt.NDArray[np.float64],
+    b0: npt.NDArray[np.float64],
+    C: npt.NDArray[np.float64],
+    d: npt.NDArray[np.float64],
+    rows: npt.NDArray[np.int_],
+    L: npt.NDArray[np.float64],
+    t: float,
+    names: list[str],
+    limits: npt.NDArray[np.float64],
+) -> list[tuple[str, float]]:
     """Joints whose torque is at t times its limit at a solution with the common factor t."""
     Lfull = np.zeros(A.shape[0])
     Lfull[rows] = L
     sol = HighsLP(LinearProgram(A, b0 + t * (1 + 1e-9) * Lfull, C, d), warm=False).maximize(
         np.zeros(A.shape[1])
     )
-    if not sol.optimal:
+    if not sol.optimal or sol.x is None:
         return []
     slack = (b0 + t * Lfull - A @ sol.x)[rows]
     k = len(names)

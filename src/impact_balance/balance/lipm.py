@@ -10,28 +10,75 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
 from impact_balance.constants import GRAVITY, GRAVITY_RANGE, MAX_POSITION
 from impact_balance.exceptions import ScenarioError
 
-__all__ = ["PhasePortrait", "com_velocity_bounds", "lipm_omega", "phase_portrait"]
+__all__ = ["HeightField", "PhasePortrait", "com_velocity_bounds", "lipm_omega", "phase_portrait"]
+
+#: The input a caller of :func:`lipm_omega` took from its user: the CoM height or the plane's.
+HeightField = Literal["com_height", "plane_height"]
 
 
-def lipm_omega(com_height: float, plane_height: float = 0.0, gravity: float = GRAVITY) -> float:
-    """Omega = sqrt(g / (c_z - h)), 1/s."""
-    if not (math.isfinite(com_height) and 0 < com_height - plane_height <= 2 * MAX_POSITION):
+def lipm_omega(
+    com_height: float,
+    plane_height: float = 0.0,
+    gravity: float = GRAVITY,
+    *,
+    field: HeightField = "com_height",
+) -> float:
+    """The LIPM natural frequency omega = sqrt(g / (c_z - h)), 1/s.
+
+    Args:
+        com_height: c_z, the CoM height, world, m.
+        plane_height: h, the height of the ZMP plane, world, m.
+        gravity: g, m/s^2.
+        field: The input the caller took from its user, named by the error when the CoM is
+            not above the plane: "com_height" (a CoM height given for a plane, as in
+            :func:`phase_portrait`) or "plane_height" (a plane given for a robot's CoM, as in
+            a scenario).
+
+    Returns:
+        omega, 1/s.
+
+    Raises:
+        ScenarioError: The CoM is not strictly above the plane, or a height is not finite
+            (the error names ``field``: "com_height ... must be above the plane height" or
+            "plane_height ... must be below the CoM height"); ``gravity`` is not a finite
+            number in :data:`~impact_balance.constants.GRAVITY_RANGE` (the error names
+            "gravity").
+    """
+    if not (
+        math.isfinite(com_height) and math.isfinite(plane_height) and com_height > plane_height
+    ):
+        if field == "plane_height":
+            raise ScenarioError(
+                "plane_height", plane_height, f"must be below the CoM height {com_height:.4g} m"
+            )
         raise ScenarioError(
-            "com_height",
-            com_height,
-            f"must be above the plane height {plane_height} m (at most {2 * MAX_POSITION:g} m above)",
+            "com_height", com_height, f"must be above the plane height {plane_height} m"
         )
     if not GRAVITY_RANGE[0] <= gravity <= GRAVITY_RANGE[1]:
         raise ScenarioError(
             "gravity", gravity, f"must be in [{GRAVITY_RANGE[0]:g}, {GRAVITY_RANGE[1]:g}] m/s^2"
         )
     return math.sqrt(gravity / (com_height - plane_height))
+
+
+def _check_com_height(com_height: float) -> None:
+    """Refuse a CoM height (above a plane at 0) that the one-axis LIPM does not take.
+
+    Refused: not finite, not above the plane, or more than twice the largest position above it.
+    """
+    if not (math.isfinite(com_height) and 0 < com_height <= 2 * MAX_POSITION):
+        raise ScenarioError(
+            "com_height",
+            com_height,
+            f"must be above the plane height 0.0 m (at most {2 * MAX_POSITION:g} m above)",
+        )
 
 
 def com_velocity_bounds(
@@ -48,6 +95,7 @@ def com_velocity_bounds(
             [lo, hi],
             f"must be [lo, hi] with lo <= hi, within [{-MAX_POSITION:g}, {MAX_POSITION:g}] m",
         )
+    _check_com_height(com_height)
     w = lipm_omega(com_height, 0.0, gravity)
     return w * (lo - com_position), w * (hi - com_position)
 
@@ -88,6 +136,7 @@ def phase_portrait(
     DCM xi = c + cd / omega: inside the stable standing region they converge to rest at the
     origin, outside it they diverge whatever the (bounded) ZMP does.
     """
+    _check_com_height(com_height)
     w = lipm_omega(com_height, 0.0, gravity)
     bounds = com_velocity_bounds(com_height, zmp_range, 0.0, gravity)
     lo, hi = zmp_range

@@ -10,8 +10,15 @@ from __future__ import annotations
 import functools
 
 import numpy as np
+import numpy.typing as npt
 
-__all__ = ["cwc_faces", "cwc_faces_world", "cwc_span", "rotate_wrench_matrix"]
+__all__ = [
+    "cwc_faces",
+    "cwc_faces_world",
+    "cwc_span",
+    "local_faces",
+    "rotate_wrench_matrix",
+]
 
 
 def cwc_faces(mu: float, half_length: float, half_width: float) -> np.ndarray:
@@ -21,7 +28,10 @@ def cwc_faces(mu: float, half_length: float, half_width: float) -> np.ndarray:
     |tau_y| <= X fz (4), then the yaw-torque bounds tau_min <= tau_z <= tau_max (8), as in
     the paper's appendix with its ``[tau; f]`` columns reordered to ``[f; tau]``.
     """
-    return local_faces(float(mu), float(half_length), float(half_width)).copy()
+    out: npt.NDArray[np.float64] = local_faces(
+        float(mu), float(half_length), float(half_width)
+    ).copy()
+    return out
 
 
 @functools.lru_cache(maxsize=256)
@@ -73,7 +83,10 @@ def cwc_faces_world(
     each row's force and torque halves are rotated by one (32 x 3) @ (3 x 3) product.
     """
     faces = local_faces(float(mu), float(half_length), float(half_width))
-    return (faces.reshape(32, 3) @ np.asarray(rotation, dtype=float).T).reshape(16, 6)
+    out: npt.NDArray[np.float64] = (
+        faces.reshape(32, 3) @ np.asarray(rotation, dtype=float).T
+    ).reshape(16, 6)
+    return out
 
 
 def cwc_span(mu: float, half_length: float, half_width: float) -> np.ndarray:
@@ -89,4 +102,5 @@ def cwc_span(mu: float, half_length: float, half_width: float) -> np.ndarray:
         for ex, ey in ((mu, mu), (mu, -mu), (-mu, mu), (-mu, -mu)):
             edge = np.array([ex, ey, 1.0])
             columns.append(np.concatenate([edge, np.cross(corner, edge)]))
-    return np.array(columns).T
+    out: npt.NDArray[np.float64] = np.array(columns).T
+    return out

@@ -12,28 +12,36 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 
 from impact_balance.geometry.spatial import skew
 from impact_balance.robot.robot import Robot, Scratch
 
-__all__ = ["Contact", "ContactSpec", "Stance", "frame_point"]
+__all__ = [
+    "Contact",
+    "ContactSpec",
+    "Stance",
+    "frame_point",
+    "has_free_flyer",
+]
 
 _IDENTITY = pin.SE3.Identity()
 
 
 def has_free_flyer(model: pin.Model) -> bool:
     """Whether the model's first joint is a free flyer (then q[:3] is the base position)."""
-    return model.njoints > 1 and model.joints[1].shortname() == "JointModelFreeFlyer"
+    return bool(model.njoints > 1 and model.joints[1].shortname() == "JointModelFreeFlyer")
 
 
 def frame_point(
     model: pin.Model, data: pin.Data, fid: int, offset: pin.SE3 | None, jacobian: bool = True
 ) -> tuple[pin.SE3, np.ndarray | None]:
-    """Pose of frame ``fid`` times ``offset`` and its 6 x nv Jacobian in world-aligned axes
-    (linear rows first, at the offset point), from ``data`` holding the joint placements and
-    joint Jacobians (in the frame of those placements); the Jacobian is skipped (None)
-    without ``jacobian``. The pose may be ``data``'s own: copy what you keep.
+    """Pose of frame ``fid`` times ``offset`` and its 6 x nv Jacobian in world-aligned axes.
+
+    The Jacobian has its linear rows first, at the offset point; ``data`` holds the joint
+    placements and joint Jacobians (in the frame of those placements); the Jacobian is skipped
+    (None) without ``jacobian``. The pose may be ``data``'s own: copy what you keep.
     """
     frame_pose = pin.updateFramePlacement(model, data, fid)
     J = (
@@ -91,10 +99,12 @@ class Contact:
 
     @property
     def half_length(self) -> float:
+        """Half the rectangle's length (contact x axis), m."""
         return 0.5 * float(self.spec.size[0])
 
     @property
     def half_width(self) -> float:
+        """Half the rectangle's width (contact y axis), m."""
         return 0.5 * float(self.spec.size[1])
 
     @property
@@ -106,7 +116,8 @@ class Contact:
         """The 4 rectangle corners in world (4 x 3), counter-clockwise in the contact plane."""
         X, Y = self.half_length, self.half_width
         local = np.array([[X, Y, 0], [-X, Y, 0], [-X, -Y, 0], [X, -Y, 0]], dtype=float)
-        return self.position + local @ self.rotation.T
+        out: npt.NDArray[np.float64] = self.position + local @ self.rotation.T
+        return out
 
 
 class Stance:
@@ -116,7 +127,7 @@ class Stance:
     :class:`impact_balance.robot.robot.ThreadData`), or in ``workspace`` when given (a
     :class:`impact_balance.robot.robot.Scratch` of the caller's, e.g. a governor's own Data), and
     every attribute is a copy, so stances of the same robot never alias. :meth:`point`
-    recomputes the joint placements and Jacobians (~4 us) when another stance has used the
+    recomputes the joint placements and Jacobians when another stance has used the
     scratch Data since.
 
     Precision far from the origin: the kinematics are computed with the free-flyer's
@@ -159,12 +170,12 @@ class Stance:
             self.origin = self.q[:3].copy()
             self._q_local = self.q.copy()
             self._q_local[:3] = 0.0
-        workspace = self.workspace()
-        data = workspace.data
+        scratch = self.workspace()
+        data = scratch.data
         # ccrba runs the forward kinematics and also fills the joint Jacobians data.J (as
         # computeJointJacobians does) and data.Ig, the centroidal composite inertia in world axes.
         pin.ccrba(model, data, self._q_local, np.zeros(model.nv))
-        workspace.holder = self._q_local.tobytes()
+        scratch.holder = self._q_local.tobytes()
         self.com_local = np.array(
             pin.centerOfMass(model, data, pin.KinematicLevel.POSITION, False), dtype=float
         )
@@ -187,11 +198,12 @@ class Stance:
 
     @property
     def model(self) -> pin.Model:
+        """The robot's pinocchio model."""
         return self.robot.model
 
     @functools.cached_property
     def data(self) -> pin.Data:
-        """A pinocchio Data of this stance's own, made on first access (~1 ms).
+        """A pinocchio Data of this stance's own, made on first access.
 
         It holds the joint and frame placements, Jacobians, composite inertia, CoM and
         gravity at ``q``, for callers that read the model directly (plots, GUI meshes);
@@ -206,8 +218,10 @@ class Stance:
         return data
 
     def workspace(self) -> Scratch:
-        """The scratch Data this stance computes in: the one it was given, else the robot's
-        (per thread, :meth:`impact_balance.robot.robot.Robot.thread_data`).
+        """The scratch Data this stance computes in.
+
+        The one it was given, else the robot's (per thread,
+        :meth:`impact_balance.robot.robot.Robot.thread_data`).
         """
         return self._scratch if self._scratch is not None else self.robot.thread_data()
 
@@ -237,8 +251,13 @@ class Stance:
     def _point(
         self, data: pin.Data, fid: int, offset: pin.SE3 | None
     ) -> tuple[pin.SE3, np.ndarray]:
-        """:meth:`point` of frame ``fid`` from ``data`` holding this stance's kinematics (copies)."""
-        return frame_point(self.model, data, fid, offset)
+        """:meth:`point` of frame ``fid`` from ``data`` holding this stance's kinematics.
+
+        Returns copies.
+        """
+        placement, J = frame_point(self.model, data, fid, offset)
+        assert J is not None  # asked for (jacobian=True)
+        return placement, J
 
     def frame_pose(self, frame: str, field: str = "frame") -> pin.SE3:
         """World pose of a frame (a copy); ``field`` names it in an unknown-frame error."""

@@ -21,6 +21,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance._jit import njit
 from impact_balance.constants import GRAVITY
@@ -29,8 +30,10 @@ from impact_balance.contacts.stance import Contact, Stance
 
 __all__ = [
     "WrenchPolytope",
+    "assemble_arrays",
     "assemble_polytope",
     "contact_polytope",
+    "face_blocks",
     "friction_scaling",
     "grasp_matrix",
     "torque_limit_rows",
@@ -51,7 +54,7 @@ def grasp_matrix(positions: np.ndarray) -> np.ndarray:
     """
     positions = np.atleast_2d(np.asarray(positions, dtype=float))
     identity, rows, cols = _grasp_pattern(len(positions))
-    G = identity.copy()
+    G: npt.NDArray[np.float64] = identity.copy()
     # [p]x = [[0, -z, y], [z, 0, -x], [-y, x, 0]]: its 6 off-diagonal entries, contact by contact.
     G[rows, cols] = (positions[:, _SKEW_COMPONENTS] * _SKEW_SIGNS).ravel()
     return G
@@ -59,8 +62,10 @@ def grasp_matrix(positions: np.ndarray) -> np.ndarray:
 
 @functools.lru_cache(maxsize=16)
 def _grasp_pattern(m: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The grasp matrix's constant part for m contacts (identity blocks, read-only) and the
-    (row, column) indices of its skew entries, in the order of ``_SKEW_COMPONENTS``.
+    """The grasp matrix's constant part for m contacts, and the indices of its skew entries.
+
+    The constant part is the identity blocks (read-only); the (row, column) indices are in the
+    order of ``_SKEW_COMPONENTS``.
     """
     identity = np.zeros((6, 6 * m))
     for r in range(6):
@@ -102,13 +107,15 @@ class WrenchPolytope:
 
     @property
     def dim(self) -> int:
-        return self.A.shape[1]
+        """The number of variables (6 per contact)."""
+        return int(self.A.shape[1])
 
     def projection_data(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """``(A', b', C', d', F')``: the same polytope and map in friction-normalised variables
-        ``v`` (``w = scaling @ v``), forces in units of m g: ``A' = A S``, ``b' = b / (m g)``,
-        ``C' = C S``, ``d' = d / (m g)``, ``F' = F S`` with ``S = scaling``. ``F' v`` is the
-        resultant horizontal force over m g, so both describe the same force area.
+        """``(A', b', C', d', F')``: the same polytope and map in friction-normalised variables.
+
+        The variables are ``v`` (``w = scaling @ v``), forces in units of m g: ``A' = A S``,
+        ``b' = b / (m g)``, ``C' = C S``, ``d' = d / (m g)``, ``F' = F S`` with ``S = scaling``.
+        ``F' v`` is the resultant horizontal force over m g, so both describe the same force area.
 
         Why: in ``w`` the rows of a cone with a large mu (|f_x| <= mu f_z, tau_z bounds with mu
         times tau_x, tau_y and f_z) are nearly parallel to each other and to the centre-of-
@@ -236,15 +243,19 @@ def assemble_polytope(
     """The polytope from arrays (what :func:`wrench_polytope` builds from a stance).
 
     Args:
-        faces: (m, 16, 6) contact-frame CWC face matrices (:func:`~impact_balance.contacts.cwc.cwc_faces`).
+        faces: (m, 16, 6) contact-frame CWC face matrices
+            (:func:`~impact_balance.contacts.cwc.cwc_faces`).
         rotations: (m, 3, 3) contact-to-world rotations.
         positions: (m, 3) contact centres in world, m (for :attr:`WrenchPolytope.grasp`).
         arms: (m, 3) contact centres minus the CoM, m (for the LIPM rows).
-        mass: kg. com: (3,) CoM in world, m. gravity: m/s^2.
+        mass: kg.
+        com: (3,) CoM in world, m.
+        gravity: m/s^2.
         jacobians: (6m, nv) contact Jacobians stacked (world-aligned, linear rows first), or
             (0, 0) without torque limits.
         torque_indices: (k,) velocity indices of the torque-limited joints (int64).
-        torque_limits: (k,) their effort limits, N m. gravity_torques: (nv,) g(q).
+        torque_limits: (k,) their effort limits, N m.
+        gravity_torques: (nv,) g(q).
         scaling: See :attr:`WrenchPolytope.scaling`.
     """
     m = len(faces)
@@ -263,26 +274,29 @@ def assemble_polytope(
 
 
 def face_blocks(faces: np.ndarray, rotations: np.ndarray) -> np.ndarray:
-    """Every contact's CWC faces acting on world-axes forces and torques: (m, 32, 3), row 2r
-    (2r + 1) the force (torque) half of face r (the numbers of cwc_faces_world).
+    """Every contact's CWC faces acting on world-axes forces and torques, (m, 32, 3).
 
-    One batched numpy product, on purpose: computed in a compiled loop, the same faces differed
-    by rounding, and pypoman's GLPK (the benchmark's peer) then took 190 ms instead of 4 ms on
-    the two-feet-and-two-walls stance and returned a polygon 72 % off.
+    Row 2r (2r + 1) is the force (torque) half of face r (the numbers of cwc_faces_world).
+
+    One batched numpy product, on purpose: these are exactly the numbers of
+    :func:`~impact_balance.contacts.cwc.cwc_faces_world` (a compiled loop differs by rounding,
+    which an external LP solver given the same faces can be sensitive to).
     """
     m = len(faces)
-    return np.matmul(
+    out: npt.NDArray[np.float64] = np.matmul(
         np.asarray(faces, dtype=float).reshape(m, 32, 3),
         np.asarray(rotations, dtype=float).transpose(0, 2, 1),
     )
+    return out
 
 
 @njit(cache=True)
 def assemble_arrays(
     blocks, positions, arms, jacobians, torque_indices, torque_limits, gravity_torques
 ):
-    """The arrays ``(A, b, C, G)`` of :func:`assemble_polytope` in one compiled call (a
-    governor's every tick), from the contacts' :func:`face_blocks`.
+    """The arrays ``(A, b, C, G)`` of :func:`assemble_polytope` in one compiled call.
+
+    From the contacts' :func:`face_blocks` (a governor's every tick).
     """
     m = blocks.shape[0]
     k = torque_indices.size if jacobians.size else 0
@@ -300,11 +314,12 @@ def assemble_arrays(
 
 @njit(cache=True)
 def _fill(blocks, positions, arms, A, C, G):
-    """The CWC blocks of ``A`` from ``blocks`` (m, 32, 3), each contact's face rows acting on
-    world-axes wrenches as (force, torque) halves (:func:`~impact_balance.contacts.cwc.cwc_faces_world`
-    reshaped), the LIPM rows ``C`` (rows 2-5 of the grasp matrix at the arms) and the grasp
-    matrix ``G`` at the world positions (:func:`grasp_matrix`). Compiled: numpy spent ~40 us
-    of call overhead per stance on these copies.
+    """The CWC blocks of ``A``, the LIPM rows ``C`` and the grasp matrix ``G``.
+
+    ``blocks`` (m, 32, 3) are each contact's face rows acting on world-axes wrenches as (force,
+    torque) halves (:func:`~impact_balance.contacts.cwc.cwc_faces_world` reshaped); ``C`` is rows
+    2-5 of the grasp matrix at the arms, ``G`` the grasp matrix at the world positions
+    (:func:`grasp_matrix`).
     """
     m = blocks.shape[0]
     for i in range(m):
@@ -339,8 +354,10 @@ def _grasp_block(G, row0, i, p):
 
 @njit(cache=True)
 def _torque_rows(J, idx, limit, g, A, b):
-    """:func:`torque_limit_rows` into ``A`` (2k x 6m) and ``b`` (2k): row r is the limited
-    joint idx[r]'s column of every contact Jacobian, ``(J_a^T)[r]``, then its negative.
+    """:func:`torque_limit_rows` into ``A`` (2k x 6m) and ``b`` (2k).
+
+    Row r is the limited joint idx[r]'s column of every contact Jacobian, ``(J_a^T)[r]``, then
+    its negative.
     """
     k = idx.size
     for r in range(k):
@@ -364,17 +381,17 @@ def _scaling(contacts: Sequence[Contact]) -> np.ndarray | None:
 def friction_scaling(
     frictions: Sequence[float], rotations: Sequence[np.ndarray]
 ) -> np.ndarray | None:
-    """Block-diagonal ``S`` (6m x 6m), block i = ``diag(R_i, R_i) diag(s_i)``: ``s_i`` is mu_i
-    on f_x, f_y, tau_z and 1 elsewhere, or 1 everywhere when mu_i <= 1 (None when every
-    mu_i is; :meth:`WrenchPolytope.projection_data` then skips the products): a small mu needs
-    no help (HiGHS, in Bretl's path, was less precise with it divided out: 1e-5 relative on a
-    2 mu-wide area). See :meth:`WrenchPolytope.projection_data`.
+    """Block-diagonal ``S`` (6m x 6m), block i = ``diag(R_i, R_i) diag(s_i)``.
+
+    ``s_i`` is mu_i on f_x, f_y, tau_z and 1 elsewhere, or 1 everywhere when mu_i <= 1 (None when
+    every mu_i is; :meth:`WrenchPolytope.projection_data` then skips the products): a small mu
+    needs no help. See :meth:`WrenchPolytope.projection_data`.
     """
     if all(float(mu) <= 1.0 for mu in frictions):
         return None  # the identity: no work on the hot path of common stances
     m = len(frictions)
     S = np.zeros((6 * m, 6 * m))
-    for i, (mu, rotation) in enumerate(zip(frictions, rotations)):
+    for i, (mu, rotation) in enumerate(zip(frictions, rotations, strict=True)):
         scale = np.where(_TANGENTIAL, max(float(mu), 1.0), 1.0)
         R = np.asarray(rotation, dtype=float)
         block = S[6 * i : 6 * i + 6, 6 * i : 6 * i + 6]

@@ -10,16 +10,19 @@
           -tau_max <= tau0 + (a / dt) (J^T K_i lambda_j)_act <= tau_max   (impulsive torques)
 
 J is the impact point's 3 x nv translational Jacobian, so the approach speed is -n^T J qd.
-Without the optional bounds, its solution equals :func:`criteria.max_contact_velocity` with
-:func:`criteria.capped_velocity` (tested). The QP also forces -n^T J qd >= 0 (lambda >= 0).
+Without the optional bounds, its solution equals
+:func:`~impact_balance.criteria.com.max_contact_velocity` with
+:func:`~impact_balance.criteria.cap.capped_velocity` (tested). The QP also forces
+-n^T J qd >= 0 (lambda >= 0).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance.contacts.stance import Stance
 from impact_balance.contacts.wrench_polytope import WrenchPolytope
@@ -74,8 +77,8 @@ class QPResult:
 def solve_contact_velocity_qp(
     impact: ImpactModel,
     area: Polygon,
-    com_velocity: Sequence[float],
-    reference_velocity: Sequence[float],
+    com_velocity: npt.ArrayLike,
+    reference_velocity: npt.ArrayLike,
     robot: Robot | None = None,
     pre_impact_torques: np.ndarray | None = None,
     options: QPOptions = QPOptions(),
@@ -120,7 +123,7 @@ def solve_contact_velocity_qp(
     if options.joint_velocity_limits or options.impulsive_torque_limits:
         if robot is None:
             raise ValueError("robot is needed for the joint velocity / torque bounds")
-    if options.joint_velocity_limits:
+    if options.joint_velocity_limits and robot is not None:
         idx, vmax = robot.actuated_velocity_limits()
         pinv = J.T @ np.linalg.inv(J @ J.T)  # J^+ = J^T (J J^T)^-1
         for j in range(2 * N):
@@ -129,7 +132,7 @@ def solve_contact_velocity_qp(
             block[:, nv + j] = (pinv @ impact.W @ gen[j])[idx]
             rows += [block, -block]
             rhs += [vmax, vmax]
-    if options.impulsive_torque_limits:
+    if options.impulsive_torque_limits and robot is not None:
         idx, tmax = robot.actuated_effort_limits()
         tau0 = (
             np.zeros(nv)
@@ -146,7 +149,9 @@ def solve_contact_velocity_qp(
     lb = np.full(nx, -np.inf)
     lb[nv:] = 0.0
     ub = np.full(nx, np.inf)
-    tolerances = {"eps_abs": 1e-10, "eps_rel": 0.0} if options.solver == "proxqp" else {}
+    tolerances: dict[str, Any] = (
+        {"eps_abs": 1e-10, "eps_rel": 0.0} if options.solver == "proxqp" else {}
+    )
     import qpsolvers  # here: its import takes ~0.4 s, and a plain analysis does not solve this QP
 
     try:
@@ -162,7 +167,7 @@ def solve_contact_velocity_qp(
     return QPResult("optimal", qd, v, float(-(n @ v)), x[nv:].copy())
 
 
-def static_torques(stance: Stance, polytope: WrenchPolytope) -> np.ndarray:
+def static_torques(stance: Stance, polytope: WrenchPolytope) -> npt.NDArray[np.float64]:
     """Pre-impact joint torques tau0 (nv) of a static stance, for the impulsive-torque bound.
 
     The contact wrenches are the least-norm ones that hold the robot at rest (resultant = the
@@ -170,8 +175,9 @@ def static_torques(stance: Stance, polytope: WrenchPolytope) -> np.ndarray:
     stance cannot hold the robot at rest, tau0 = g(q).
     """
     n = polytope.dim
+    tau0: npt.NDArray[np.float64] = stance.gravity_torques.copy()
     if n == 0:
-        return stance.gravity_torques.copy()
+        return tau0
     weight = polytope.weight
     target = np.concatenate([[0.0, 0.0, weight], np.cross(stance.com, [0.0, 0.0, weight])])
     cwc = slice(0, polytope.n_cwc_rows)
@@ -190,6 +196,7 @@ def static_torques(stance: Stance, polytope: WrenchPolytope) -> np.ndarray:
     except (qpsolvers.SolverError, ValueError):
         w = None
     if w is None:
-        return stance.gravity_torques.copy()
+        return tau0
     JT = np.hstack([c.jacobian.T for c in stance.contacts])
-    return stance.gravity_torques - JT @ w
+    tau0 = stance.gravity_torques - JT @ w
+    return tau0

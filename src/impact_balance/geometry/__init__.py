@@ -1,1 +1,3 @@
-"""Plane and space geometry: convex polygons (:mod:`.polygon`) and spatial helpers (:mod:`.spatial`)."""
+"""Plane geometry: convex polygons (:mod:`.polygon`) and spatial helpers (:mod:`.spatial`)."""
+
+__all__: list[str] = []

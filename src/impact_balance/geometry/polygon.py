@@ -5,12 +5,22 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance._jit import njit
 
-__all__ = ["MERGE_AREA_TOLERANCE", "Polygon"]
+__all__ = [
+    "MERGE_AREA_TOLERANCE",
+    "Polygon",
+    "edge_halfplanes",
+    "inset_polygon",
+    "simplify",
+    "simplify_convex",
+    "simplify_convex_kernel",
+]
 
 #: Largest fraction of a polygon's area that merging its near-duplicate and near-collinear
 #: vertices may remove. Bounded so that a larger set never gets a smaller merged area by
@@ -21,8 +31,9 @@ MERGE_AREA_TOLERANCE = 1e-6
 
 @njit(cache=True)
 def _chord_distance(v, p, c, n):
-    """Distance from vertex c to the segment from p to n (the chord that replaces it): the
-    line distance, or the distance to the nearer end when c projects outside the segment
+    """Distance from vertex c to the segment from p to n (the chord that replaces it).
+
+    The line distance, or the distance to the nearer end when c projects outside the segment
     (of three collinear points, only the middle one is on its chord).
     """
     ex, ey = v[n, 0] - v[p, 0], v[n, 1] - v[p, 1]
@@ -34,9 +45,11 @@ def _chord_distance(v, p, c, n):
 
 @njit(cache=True)
 def _merge_cost(v, idx, k, i, total):
-    """(distance, area) of dropping the vertex in position i of ``idx[:k]``: the largest
-    distance from the chord between its neighbours of the original vertices it replaces
-    (dropped ones included, so that drops cannot drift), and the area of the triangle lost.
+    """(distance, area) of dropping the vertex in position i of ``idx[:k]``.
+
+    The largest distance from the chord between its neighbours of the original vertices it
+    replaces (dropped ones included, so that drops cannot drift), and the area of the triangle
+    lost.
     """
     p, c, n = idx[(i - 1) % k], idx[i], idx[(i + 1) % k]  # idx[k:] is stale
     dist = 0.0
@@ -143,8 +156,12 @@ def _convex_ccw(v):
 
 
 @njit(cache=True)
-def _simplify_convex(v, check_tol, tol, area_tol, box):
-    """Compiled body of :func:`simplify_convex`."""
+def simplify_convex_kernel(v, check_tol, tol, area_tol, box):
+    """:func:`simplify_convex` compiled, on a contiguous (k, 2) float array.
+
+    Returns ``(ok, vertices, bounded)``: ``ok`` False when the check fails. A compiled
+    caller (the projection walk) calls it directly.
+    """
     first = _simplify(v, check_tol, area_tol)
     if not _convex_ccw(first):
         return False, first, False
@@ -165,14 +182,15 @@ def simplify_convex(
     box: float,
     area_tol: float = MERGE_AREA_TOLERANCE,
 ) -> tuple[np.ndarray, bool] | None:
-    """A projection's raw vertices (k >= 1, counter-clockwise), certified and merged in one
-    compiled call: merged within ``check_tol`` (rounding-level duplicates), checked convex,
-    counter-clockwise and winding once (see :func:`_convex_ccw`), then merged within ``tol``
-    (see :func:`simplify`). Returns ``(vertices, bounded)``, bounded when every coordinate is
-    under ``box`` (the clipping box), or None when the check fails.
+    """A projection's raw vertices (k >= 1, counter-clockwise), certified and merged.
+
+    In one compiled call: merged within ``check_tol`` (rounding-level duplicates), checked
+    convex, counter-clockwise and winding once (see :func:`_convex_ccw`), then merged within
+    ``tol`` (see :func:`simplify`). Returns ``(vertices, bounded)``, bounded when every
+    coordinate is under ``box`` (the clipping box), or None when the check fails.
     """
     v = np.ascontiguousarray(np.asarray(vertices, dtype=float).reshape(-1, 2))
-    ok, out, bounded = _simplify_convex(
+    ok, out, bounded = simplify_convex_kernel(
         v, float(check_tol), float(tol), float(area_tol), float(box)
     )
     return (out, bool(bounded)) if ok else None
@@ -194,7 +212,8 @@ def simplify(
     """
     v = np.ascontiguousarray(np.asarray(vertices, dtype=float).reshape(-1, 2))
     if len(v) == 0:
-        return v.copy()
+        out: npt.NDArray[np.float64] = v.copy()
+        return out
     return _simplify(v, float(tol), float(area_tol))
 
 
@@ -217,8 +236,10 @@ def _corner(n: np.ndarray, h: np.ndarray, a: int, b: int) -> tuple[float, float,
 
 @njit(cache=True)
 def _collapse_time(n: np.ndarray, h: np.ndarray, a: int, i: int, b: int) -> float:
-    """When edge ``i`` (between lines ``a`` and ``b``) shrinks to nothing as every line moves
-    inwards at unit speed (inf if it never does; -inf if its neighbours are parallel).
+    """When edge ``i`` (between lines ``a`` and ``b``) shrinks to nothing.
+
+    Every line moves inwards at unit speed; inf if it never does, -inf if its neighbours are
+    parallel.
     """
     p = _corner(n, h, a, i)
     q = _corner(n, h, i, b)
@@ -234,8 +255,9 @@ def _collapse_time(n: np.ndarray, h: np.ndarray, a: int, i: int, b: int) -> floa
 
 @njit(cache=True)
 def _inset(n: np.ndarray, h: np.ndarray, d: float) -> np.ndarray:
-    """Vertices of ``{x : n_k . x <= h_k - d}`` for the edges (unit outward normals ``n``, CCW)
-    of a convex polygon; (0, 2) when empty.
+    """Vertices of ``{x : n_k . x <= h_k - d}``, (0, 2) when empty.
+
+    For the edges (unit outward normals ``n``, CCW) of a convex polygon.
 
     The lines move inwards together; an edge whose length reaches zero before ``d`` leaves
     (earliest first, as in the straight skeleton of a convex polygon) and its neighbours meet.
@@ -288,9 +310,10 @@ def _inset(n: np.ndarray, h: np.ndarray, d: float) -> np.ndarray:
 
 @njit(cache=True)
 def edge_halfplanes(v):
-    """Unit outward normals ``G`` (k, 2) and offsets ``h`` (k,) of the edges of the CCW
-    polygon ``v`` (k >= 3): edge i goes from vertex i to i+1, its normal is the edge turned
-    clockwise. Compiled: numpy spent ~30 us of call overhead on these few flops.
+    """Unit outward normals ``G`` (k, 2) and offsets ``h`` (k,) of a CCW polygon's edges.
+
+    The polygon ``v`` has k >= 3 vertices: edge i goes from vertex i to i+1, its normal is the
+    edge turned clockwise. Compiled.
     """
     k = v.shape[0]
     G = np.empty((k, 2))
@@ -307,8 +330,9 @@ def edge_halfplanes(v):
 
 @njit(cache=True)
 def inset_polygon(v, distance):
-    """Vertices of the CCW polygon ``v`` (k >= 3) shrunk by ``distance`` > 0; (0, 2) when
-    empty. One compiled call: a governor shrinks an area every tick.
+    """Vertices of the CCW polygon ``v`` (k >= 3) shrunk by ``distance`` > 0; (0, 2) when empty.
+
+    One compiled call: a governor shrinks an area every tick.
     """
     G, h = edge_halfplanes(v)
     # Relative to a point inside (the vertices' mean): corners stay well conditioned far
@@ -360,14 +384,17 @@ class Polygon:
 
     @classmethod
     def empty(cls) -> Polygon:
+        """The empty polygon (no vertex)."""
         return cls(np.zeros((0, 2)))
 
     @classmethod
     def with_halfplanes(
         cls, vertices: np.ndarray, bounded: bool, G: np.ndarray, h: np.ndarray
     ) -> Polygon:
-        """The polygon of ``vertices`` (k >= 3) whose :attr:`halfplanes` ``(G, h)`` were
-        computed with it (by ``edge_halfplanes``, in a compiled pipeline): not computed again.
+        """The polygon of ``vertices`` (k >= 3) with its :attr:`halfplanes` ``(G, h)``.
+
+        They were computed with it (by ``edge_halfplanes``, in a compiled pipeline): not computed
+        again.
         """
         polygon = cls(vertices, bounded)
         polygon.__dict__["halfplanes"] = _frozen(G, h)  # the cached_property's own slot
@@ -397,6 +424,7 @@ class Polygon:
 
     @property
     def is_empty(self) -> bool:
+        """Whether the polygon has no vertex."""
         return len(self.vertices) == 0
 
     @property
@@ -409,13 +437,17 @@ class Polygon:
 
     @property
     def centroid(self) -> np.ndarray:
+        """The centroid (2,); the vertices' mean under 3 vertices, NaN when empty."""
         if len(self.vertices) < 3:
             return self.vertices.mean(axis=0) if len(self.vertices) else np.full(2, np.nan)
         x, y = self.vertices.T
         xs, ys = np.roll(x, -1), np.roll(y, -1)
         cross = x * ys - xs * y
         a = cross.sum() / 2
-        return np.array([((x + xs) * cross).sum(), ((y + ys) * cross).sum()]) / (6 * a)
+        out: npt.NDArray[np.float64] = np.array(
+            [((x + xs) * cross).sum(), ((y + ys) * cross).sum()]
+        ) / (6 * a)
+        return out
 
     @cached_property
     def halfplanes(self) -> tuple[np.ndarray, np.ndarray]:
@@ -442,7 +474,8 @@ class Polygon:
         """Signed distance-like margin of each point: ``min_k (h_k - G_k p)`` (>= 0 inside)."""
         G, h = self.halfplanes
         points = np.atleast_2d(points)
-        return np.min(h[None, :] - points @ G.T, axis=1)
+        out: npt.NDArray[np.float64] = np.min(h[None, :] - points @ G.T, axis=1)
+        return out
 
     def contains(self, points: np.ndarray, tol: float = 1e-9) -> np.ndarray | bool:
         """Whether each point lies in the polygon (within ``tol``)."""
@@ -456,8 +489,9 @@ class Polygon:
         return Polygon(self.vertices * scale + np.asarray(offset, dtype=float), self.bounded)
 
     def inset(self, distance: float) -> Polygon:
-        """The points at least ``distance`` inside the polygon (its erosion by a disc): the
-        intersection of its half-planes moved inwards by ``distance`` (same units).
+        """The points at least ``distance`` inside the polygon (its erosion by a disc).
+
+        The intersection of its half-planes moved inwards by ``distance`` (same units).
 
         Empty from the inradius on (what is left there has no interior); a point or a segment
         has nothing left for any positive distance. ``distance`` 0 returns the polygon itself.
@@ -471,7 +505,12 @@ class Polygon:
             return Polygon.empty()
         return Polygon(inset_polygon(np.ascontiguousarray(self.vertices), distance), self.bounded)
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
+        """The polygon as JSON: ``vertices``, ``halfplanes`` (``G``, ``h``), ``area``, ``bounded``.
+
+        Returns:
+            A JSON-ready dict (lists of floats).
+        """
         G, h = self.halfplanes
         return {
             "vertices": self.vertices.tolist(),

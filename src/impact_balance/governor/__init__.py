@@ -12,13 +12,15 @@ A :class:`Governor` gives that maximum every control tick, from the measured sta
 - :mod:`.governor`: :class:`Governor` (construction, per-tick calls, reuse, the lock).
 - :mod:`.options`: its criterion and the contact-aware options (:class:`ContactAwareOptions`).
 - :mod:`.posture`: what is computed once per posture (:class:`Posture`).
-- :mod:`.limit`: the per-tick answer (:class:`SpeedLimit`) and the cap (:func:`cap_approach`).
+- :mod:`.limit`: the per-tick answer (:class:`SpeedLimit`); the cap is
+  :func:`~impact_balance.criteria.cap.cap_approach`.
 
 See docs/governor.md for the conventions and how pink, mink or any QP controller uses it.
 """
 
+from impact_balance.criteria.cap import cap_approach
 from impact_balance.governor.governor import Governor
-from impact_balance.governor.limit import SpeedLimit, cap_approach
+from impact_balance.governor.limit import SpeedLimit
 from impact_balance.governor.options import (
     CRITERIA,
     STARTS,

@@ -15,9 +15,11 @@ from numpy.typing import ArrayLike
 
 from impact_balance.balance.areas import warm_up as warm_up_maps
 from impact_balance.contacts.stance import has_free_flyer
-from impact_balance.criteria.com import VelocityLimit
+from impact_balance.criteria.cap import cap_approach
+from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.exceptions import GovernorError, ScenarioError
-from impact_balance.governor.limit import SpeedLimit, cap_approach
+from impact_balance.criteria.cap import cap_approach
+from impact_balance.governor.limit import SpeedLimit
 from impact_balance.governor.options import CRITERIA, ContactAwareOptions, Criterion
 from impact_balance.governor.posture import Posture, PostureEvaluator, PostureSettings
 from impact_balance.governor.support import ContactAwareLimit, combine
@@ -239,7 +241,7 @@ class Governor:
     ) -> npt.NDArray[np.float64]:
         """The reference velocity with its approach speed brought into the safe interval.
 
-        See :func:`~impact_balance.governor.limit.cap_approach`.
+        See :func:`~impact_balance.criteria.cap.cap_approach`.
 
         Args:
             reference_velocity: The reference end-effector velocity (world, m/s); None: the
@@ -372,7 +374,7 @@ class Governor:
         binding = "floating"
         criterion = posture.com_criterion
         support = self._support
-        limit: VelocityLimit
+        limit: ContactVelocityLimit
         if criterion is not None and support is None:
             limit = criterion.limit(com_velocity)
             interval = criterion.interval(com_velocity, limit)
@@ -381,7 +383,7 @@ class Governor:
                 self._refresh_support(support, posture)
             limit, aware = support.answers(criterion, com_velocity)
             interval = combine(criterion.interval(com_velocity, limit), aware.interval)
-            if aware.limit.max_approach_speed < limit.max_approach_speed:
+            if aware.limit.max_contact_velocity < limit.max_contact_velocity:
                 limit, binding = aware.limit, "contact_aware"
         else:
             assert posture.zmp_limit is not None  # the "zmp" criterion's posture has it
@@ -390,7 +392,7 @@ class Governor:
         model = posture.impact
         answer = SpeedLimit(
             self.criterion,
-            limit.max_approach_speed,
+            limit.max_contact_velocity,
             limit.status,
             limit.limiting_vertex,
             limit.limiting_edge,
@@ -463,15 +465,13 @@ def _governed(
     return scenario
 
 
-def _zmp_interval(limit: VelocityLimit) -> tuple[float, float] | None:
+def _zmp_interval(limit: ContactVelocityLimit) -> tuple[float, float] | None:
     """The ZMP criterion's safe speeds.
 
     From 0 to its maximum, or none when it is already violated (the CoM's vertical outside the
     ZMP area) or the area is empty.
     """
-    if limit.status in ("ok", "unbounded"):
-        return 0.0, limit.max_approach_speed
-    return None
+    return limit.interval_from_inside()
 
 
 def _is_numeric(x: object) -> bool:

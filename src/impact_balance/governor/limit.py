@@ -1,16 +1,25 @@
-"""What a governor answers at one control tick: the speed limit, and the capped reference."""
+"""What a governor answers at one control tick: :class:`SpeedLimit`.
+
+The clamp of a reference velocity into the safe speeds is
+:func:`~impact_balance.criteria.cap.cap_approach`.
+"""
 
 from __future__ import annotations
 
-import math
-from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
+import numpy.typing as npt
 
-from impact_balance.exceptions import GovernorError
+from impact_balance.criteria.cap import cap_approach
+from impact_balance.criteria.criterion import CriterionName
+from impact_balance.criteria.velocity_limit import LimitStatus
 
-__all__ = ["SpeedLimit", "cap_approach"]
+__all__ = ["Binding", "SpeedLimit"]
+
+#: Which impact model gave a governor's maximum: "floating" (the paper's) or "contact_aware".
+Binding = Literal["floating", "contact_aware"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -23,19 +32,20 @@ class SpeedLimit:
     Attributes:
         criterion: "com" (the CoM velocity area, paper sec. V-C) or "zmp" (the predicted ZMP
             stays in the ZMP support area, the paper's Experiment 1 comparison).
-        max_approach_speed: The criterion's maximum approach speed, m/s (``inf``: no speed
-            is unsafe; 0 when the robot is already falling or cannot balance), the number
-            ``impact-balance analyze`` reports as ``max_contact_velocity``.
+        max_contact_velocity: The criterion's maximum approach speed, m/s (``inf``: no speed
+            is unsafe; 0 when the robot is already falling or cannot balance), as
+            ``impact-balance analyze`` reports it.
         status: "ok", "unbounded", "already_falling" or "cannot_balance"
-            (see :class:`~impact_balance.criteria.com.VelocityLimit`).
+            (see :data:`~impact_balance.criteria.velocity_limit.LimitStatus`).
         limiting_vertex: Index of the post-impact vertex (CoM) or impulse vertex (ZMP) that
             reaches the area's boundary first (None unless "ok").
         limiting_edge: Index of the area's edge it reaches (None unless "ok"; None also for
             the ZMP criterion's lift-off bound).
         safe_interval: The approach speeds ``(lo, hi)`` (m/s) that keep the robot balanced,
             or None when there are none. With the CoM velocity inside its area it is
-            ``(0, max_approach_speed)``; outside (a falling start) it is the range of impacts
-            that bring it back inside (``lo > 0``), as :func:`~impact_balance.criteria.com.safe_interval`.
+            ``(0, max_contact_velocity)``; outside (a falling start) it is the range of
+            impacts that bring it back inside (``lo > 0``), as
+            :func:`~impact_balance.criteria.com.safe_interval`.
             The ZMP criterion has no falling start: ``(0, max)`` or None.
         com_velocity: The CoM velocity the answer is for (3,), world, m/s.
         normal: The impact surface's unit normal (3,), world, pointing into the robot.
@@ -49,67 +59,33 @@ class SpeedLimit:
             solution found, ``ContactAwareAnswer.restitution`` giving each row's bound).
     """
 
-    criterion: str
-    max_approach_speed: float
-    status: str
+    criterion: CriterionName
+    max_contact_velocity: float
+    status: LimitStatus
     limiting_vertex: int | None
     limiting_edge: int | None
     safe_interval: tuple[float, float] | None
-    com_velocity: np.ndarray
-    normal: np.ndarray
-    point: np.ndarray
+    com_velocity: npt.NDArray[np.float64]
+    normal: npt.NDArray[np.float64]
+    point: npt.NDArray[np.float64]
     posture_reused: bool
-    binding: str = "floating"
+    binding: Binding = "floating"
 
     @property
     def ceiling(self) -> float:
-        """Largest approach speed :meth:`cap` lets through, m/s: the safe interval's top,
-        0 when there is no safe speed.
+        """Largest approach speed :meth:`cap` lets through, m/s.
+
+        The safe interval's top, 0 when there is no safe speed.
         """
         return 0.0 if self.safe_interval is None else self.safe_interval[1]
 
-    def cap(self, reference_velocity: Sequence[float]) -> np.ndarray:
-        """``reference_velocity`` (world, m/s) with its approach speed brought into the safe
-        interval; see :func:`cap_approach`.
+    def cap(self, reference_velocity: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """The reference velocity with its approach speed brought into the safe interval.
+
+        Args:
+            reference_velocity: (3,) world, m/s.
+
+        Returns:
+            See :func:`~impact_balance.criteria.cap.cap_approach`.
         """
         return cap_approach(reference_velocity, self.normal, self.safe_interval)
-
-
-def cap_approach(
-    reference_velocity: Sequence[float], normal: np.ndarray, interval: tuple[float, float] | None
-) -> np.ndarray:
-    """The end-effector velocity nearest ``reference_velocity`` whose approach speed is safe.
-
-    Only the component along ``normal`` changes (the tangential part is kept): this is the
-    minimiser of ``||u - u_ref||`` under the speed bounds, the paper's QP objective, and
-    :func:`~impact_balance.criteria.com.capped_velocity` when the robot is balanced. With
-    ``s = -normal . u_ref``:
-
-    - ``s <= 0`` (moving away or along the surface: no impact): unchanged;
-    - ``interval`` None (no approach speed is safe): the approach component is removed
-      (``s`` becomes 0: do not hit);
-    - otherwise ``s`` is clamped into ``[lo, hi]``: capped at ``hi``, and, for a falling start
-      (``lo > 0``), raised to ``lo``, the slowest impact that catches the fall. A caller that
-      must never speed up takes ``min(s_ref, s_capped)`` itself.
-
-    Args:
-        reference_velocity: (3,) world, m/s.
-        normal: (3,) unit normal of the surface, world, pointing into the robot.
-        interval: The safe approach speeds ``(lo, hi)``, m/s (``hi`` may be inf), or None.
-    """
-    try:
-        u = np.array(reference_velocity, dtype=float).reshape(3)
-    except (TypeError, ValueError):
-        raise GovernorError(
-            "reference_velocity", reference_velocity, "must be 3 numbers (world, m/s)"
-        ) from None
-    if not math.isfinite(float(u @ u)):
-        raise GovernorError("reference_velocity", reference_velocity, "must be finite")
-    s = -float(normal @ u)
-    if s <= 0.0:
-        return u
-    lo, hi = (0.0, 0.0) if interval is None else interval
-    target = min(max(s, lo), hi)
-    if target != s:
-        u += (s - target) * normal
-    return u

@@ -36,7 +36,9 @@ from impact_balance.balance.areas import (
 from impact_balance.contacts.cwc import local_faces
 from impact_balance.contacts.stance import ContactSpec, Stance, frame_point, has_free_flyer
 from impact_balance.contacts.wrench_polytope import assemble_polytope, friction_scaling
-from impact_balance.criteria.com import ComCriterion, VelocityLimit, zmp_max_contact_velocity
+from impact_balance.criteria.com import ComCriterion
+from impact_balance.criteria.velocity_limit import ContactVelocityLimit
+from impact_balance.criteria.zmp import zmp_max_contact_velocity
 from impact_balance.exceptions import SolverError
 from impact_balance.governor.options import Criterion
 from impact_balance.impact.model import (
@@ -115,7 +117,7 @@ class Posture:
     impact: ImpactModel
     com_jacobian: np.ndarray
     com_criterion: ComCriterion | None
-    zmp_limit: VelocityLimit | None
+    zmp_limit: ContactVelocityLimit | None
 
     @functools.cached_property
     def areas(self) -> BalanceAreas:

@@ -44,7 +44,9 @@ import numpy as np
 import numpy.typing as npt
 
 from impact_balance.contacts.stance import Stance
-from impact_balance.criteria.com import ComCriterion, VelocityLimit, speed_interval
+from impact_balance.criteria.com import ComCriterion
+from impact_balance.criteria.linear_exit import speed_interval
+from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.exceptions import GovernorError
 from impact_balance.governor.options import STARTS, ContactAwareOptions, Starts
 from impact_balance.impact.contact_aware import contact_impact
@@ -202,8 +204,8 @@ class ContactAwareAnswer:
 
     Attributes:
         limit: Largest approach speed (m/s) keeping every contact-aware post-impact CoM velocity
-            in the area, as :class:`~impact_balance.criteria.com.VelocityLimit` (its vertex j: row j
-            of ``rates``).
+            in the area, as :class:`~impact_balance.criteria.velocity_limit.ContactVelocityLimit`
+            (its vertex j: row j of ``rates``).
         interval: The approach speeds ``(lo, hi)`` (m/s) that keep them all in (the
             intersection over the rows), or None.
         rates: (k, 2) the jumps per m/s used (world xy, m/s per m/s): with ``starts`` "warm" or
@@ -216,7 +218,7 @@ class ContactAwareAnswer:
         solves: QP solves of the last recomputation (all its fixed points; the cost).
     """
 
-    limit: VelocityLimit
+    limit: ContactVelocityLimit
     interval: tuple[float, float] | None
     rates: np.ndarray
     age: int
@@ -318,7 +320,7 @@ class ContactAwareLimit:
 
     def answers(
         self, criterion: ComCriterion, com_velocity: np.ndarray
-    ) -> tuple[VelocityLimit, ContactAwareAnswer]:
+    ) -> tuple[ContactVelocityLimit, ContactAwareAnswer]:
         """The floating model's limit and :meth:`answer`, in one compiled call (a tick).
 
         Args:
@@ -337,11 +339,8 @@ class ContactAwareLimit:
         floating, limit = criterion.limits(com_velocity, s.rates)
         if criterion.G is None:
             interval = None
-        elif limit.status in (
-            "ok",
-            "unbounded",
-        ):  # from inside: [0, limit] (as ComCriterion.interval)
-            interval = (0.0, limit.max_approach_speed)
+        elif limit.from_inside:
+            interval = limit.interval_from_inside()
         else:
             interval = speed_interval(criterion.margins(com_velocity), s.rates @ criterion.G.T)
         return floating, ContactAwareAnswer(

@@ -348,7 +348,7 @@ def _post_impact_sets(
     and the limiting vertex. Returns their legend rows.
     """
     legend: list[_LegendRow] = []
-    model, limit = impact.model, impact.com_limit
+    model, limit = impact.model, impact.com
     s = impact.evaluation_speed()
     at_max = model.post_impact_com_velocities(c0, s)
     if s > 0:

@@ -36,7 +36,7 @@ returned are those of least norm.
 
 Why this formulation: the criterion reads the CoM velocity jump, and Gauss's principle gives
 one (the floating model's impulse set becomes one point: maximal dissipation picks the friction
-direction); each step is a dense QP in 6 unknowns (daqp, ~0.1 ms); and the fixed point is the
+direction); each step is a dense QP in 6 unknowns (daqp); and the fixed point is the
 LCP's Coulomb answer, not the relaxation's, whose drift would add mu |u_t| of separation at a
 palm that slides (0.1 to 0.9 m/s in the simulated impacts). The fixed point is not guaranteed
 to exist or be reached in general: ``converged`` says whether it was.
@@ -52,6 +52,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance.contacts.cwc import cwc_span
 from impact_balance.contacts.stance import Stance
@@ -119,16 +120,20 @@ class ContactImpact:
 
 
 def _unique_columns(D: np.ndarray) -> np.ndarray:
-    """Generators without repeats (mu = 0 makes every edge the normal): an active-set QP
-    solver dislikes identical constraint rows.
+    """Generators without repeats.
+
+    mu = 0 makes every edge the normal, and an active-set QP solver dislikes identical
+    constraint rows.
     """
     _, index = np.unique(np.round(D.T, 12), axis=0, return_index=True)
     return D[:, np.sort(index)]
 
 
 def corner_contacts(stance: Stance) -> list[list[PointContact]]:
-    """The 4 corners of each sustained contact of ``stance`` as plastic point contacts at rest,
-    each with the friction-pyramid edges (+-mu, +-mu, 1) of :func:`~impact_balance.contacts.cwc.cwc_span`.
+    """The 4 corners of each sustained contact of ``stance`` as plastic point contacts at rest.
+
+    Each has the friction-pyramid edges (+-mu, +-mu, 1) of
+    :func:`~impact_balance.contacts.cwc.cwc_span`.
     """
     out = []
     for c in stance.contacts:
@@ -158,7 +163,8 @@ def rigid_body_impact(
     """Solve the frictional impact of one rigid body on ``points`` (see the module docstring).
 
     Args:
-        mass: kg. com_inertia: rotational inertia about the CoM, world axes, kg m^2.
+        mass: kg.
+        com_inertia: Rotational inertia about the CoM, world axes, kg m^2.
         points: The contact points, pre-impact velocities included.
         solver: qpsolvers backend (returning the multipliers: "daqp", "highs").
         tolerance: Fixed point reached when no gauge s_p changes by more than this (m/s).
@@ -181,9 +187,9 @@ def rigid_body_impact(
     jacobians = [np.hstack([np.eye(3), -skew(p.arm)]) for p in points]
     # Velocity targets: the pre-impact velocity, shifted along n by the restitution term.
     targets = [p.velocity + p.restitution * float(p.normal @ p.velocity) * p.normal for p in points]
-    rows = [-(p.generators.T @ J) for p, J in zip(points, jacobians)]
+    rows = [-(p.generators.T @ J) for p, J in zip(points, jacobians, strict=True)]
     G = np.vstack(rows)
-    base = np.concatenate([p.generators.T @ t for p, t in zip(points, targets)])
+    base = np.concatenate([p.generators.T @ t for p, t in zip(points, targets, strict=True)])
     sizes = [p.generators.shape[1] for p in points]
     owner = np.repeat(np.arange(len(points)), sizes)
     gauges = np.zeros(len(points))
@@ -192,14 +198,14 @@ def rigid_body_impact(
         gauges = np.array(
             [
                 max(0.0, float(np.max(-(p.generators - p.normal[:, None]).T @ (t + J @ guess))))
-                for p, t, J in zip(points, targets, jacobians)
+                for p, t, J in zip(points, targets, jacobians, strict=True)
             ]
         )
     dxi = np.zeros(6)
     z = np.zeros(len(base))
     converged = False
     iterations = 0
-    for iterations in range(1, max_iterations + 1):
+    for iterations in range(1, max_iterations + 1):  # noqa: B007 (returned: the count)
         problem = qpsolvers.Problem(M, np.zeros(6), G, base + gauges[owner])
         try:
             solution = qpsolvers.solve_problem(problem, solver=solver)
@@ -223,7 +229,7 @@ def rigid_body_impact(
         new = np.array(
             [
                 max(0.0, float(np.max(-(p.generators - p.normal[:, None]).T @ (t + J @ dxi))))
-                for p, t, J in zip(points, targets, jacobians)
+                for p, t, J in zip(points, targets, jacobians, strict=True)
             ]
         )
         change = float(np.max(np.abs(new - gauges))) if len(new) else 0.0
@@ -234,7 +240,7 @@ def rigid_body_impact(
     z = _least_norm_multipliers(G, base + gauges[owner], M @ dxi, dxi, z, solver)
     impulses = []
     start = 0
-    for p, size in zip(points, sizes):
+    for p, size in zip(points, sizes, strict=True):
         impulses.append(p.generators @ z[start : start + size])
         start += size
     return dxi, impulses, iterations, converged
@@ -243,10 +249,12 @@ def rigid_body_impact(
 def _least_norm_multipliers(
     G: np.ndarray, h: np.ndarray, resultant: np.ndarray, dxi: np.ndarray, z: np.ndarray, solver: str
 ) -> np.ndarray:
-    """The multipliers of least norm with the same resultant ``M dxi = -G^T z`` and the same
-    active rows: with more support corners than the body has freedoms (two flat feet) the
-    active-set solver returns one vertex of many (one foot taking everything); this spreads
-    the impulses as evenly as the constraints allow. The solver's own multipliers if it fails.
+    """The multipliers of least norm with the same resultant and the same active rows.
+
+    The resultant is ``M dxi = -G^T z``: with more support corners than the body has freedoms
+    (two flat feet) the active-set solver returns one vertex of many (one foot taking
+    everything); this spreads the impulses as evenly as the constraints allow. The solver's own
+    multipliers if it fails.
     """
     import qpsolvers
 
@@ -273,14 +281,15 @@ def _least_norm_multipliers(
         1.0, float(np.abs(resultant).max())
     ):
         return z
-    return np.maximum(least, 0.0)
+    out: npt.NDArray[np.float64] = np.maximum(least, 0.0)
+    return out
 
 
 def contact_impact(
     stance: Stance,
     spec: ImpactSpec,
     approach_speed: float,
-    com_velocity: Sequence[float] | None = None,
+    com_velocity: npt.ArrayLike | None = None,
     restitution: float | None = None,
     solver: str = "daqp",
     tolerance: float = 1e-9,
@@ -297,11 +306,12 @@ def contact_impact(
         com_velocity: Pre-impact planar CoM velocity, world xy, m/s (default 0). The jump does
             not depend on it (the contacts' pre-impact velocities do not): it is only added.
         restitution: c_r at the impact point (default: the upper end of ``spec.restitution``).
-        solver, max_iterations: See :func:`rigid_body_impact`.
+        solver: See :func:`rigid_body_impact`.
         tolerance: Fixed-point tolerance relative to ``approach_speed``.
         initial_dxi: Warm start, see :func:`rigid_body_impact` (the body's velocity change
             (6,) expected at this ``approach_speed``, e.g. a previous answer's
             ``concatenate([com_velocity_jump_3d, angular_velocity_jump])``).
+        max_iterations: See :func:`rigid_body_impact`.
 
     The jump is linear in ``approach_speed``.
     """

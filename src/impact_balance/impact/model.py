@@ -16,25 +16,28 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+import numpy.typing as npt
 import pinocchio as pin
 
 from impact_balance._jit import njit
 from impact_balance.contacts.stance import Stance
 from impact_balance.exceptions import ImpactModelError
 from impact_balance.geometry.spatial import skew, unit
+from impact_balance.robot.robot import Scratch
 
 __all__ = [
     "INERTIA_MODELS",
     "ImpactModel",
     "ImpactSpec",
     "composite_inertia_map",
+    "cone_tangents",
     "friction_cone",
     "impact_cone",
     "impact_model",
+    "impulse_to_velocity",
     "joint_space_inertia_map",
     "model_from_inertia_map",
 ]
@@ -86,8 +89,20 @@ def cone_tangents(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     raise AssertionError("unreachable")  # pragma: no cover
 
 
-def friction_cone(normal: Sequence[float], mu: float, edges: int) -> np.ndarray:
-    """Generators K (3 x N): K_i = n + mu (cos a_i t1 + sin a_i t2), a_i = 2 pi i / N."""
+def friction_cone(normal: npt.ArrayLike, mu: float, edges: int) -> npt.NDArray[np.float64]:
+    """Generators K (3 x N): K_i = n + mu (cos a_i t1 + sin a_i t2), a_i = 2 pi i / N.
+
+    Args:
+        normal: (3,) surface normal, world (normalised here).
+        mu: Friction coefficient.
+        edges: N, the number of generators.
+
+    Returns:
+        (3, N) generators, world.
+
+    Raises:
+        ValueError: ``normal`` is zero.
+    """
     n = unit(normal)
     t1, t2 = cone_tangents(n)
     a = 2.0 * np.pi * np.arange(edges) / edges
@@ -147,15 +162,31 @@ class ImpactModel:
         return approach_speed * self.impulse_rates / self.mass
 
     def post_impact_com_velocities(
-        self, com_velocity: Sequence[float], approach_speed: float
-    ) -> np.ndarray:
-        """(2N, 2) vertices of the post-impact planar CoM velocity set, m/s."""
-        return (
+        self, com_velocity: npt.ArrayLike, approach_speed: float
+    ) -> npt.NDArray[np.float64]:
+        """The vertices of the post-impact planar CoM velocity set.
+
+        Args:
+            com_velocity: Pre-impact CoM velocity, world, m/s (x and y are read).
+            approach_speed: v_n, m/s.
+
+        Returns:
+            (2N, 2) post-impact CoM velocities, world xy, m/s.
+        """
+        out: npt.NDArray[np.float64] = (
             np.asarray(com_velocity, dtype=float)[None, :2] + approach_speed * self.com_jump_rates
         )
+        return out
 
-    def approach_speed(self, velocity: Sequence[float]) -> float:
-        """Approach speed -n . v of an end-effector velocity (m/s)."""
+    def approach_speed(self, velocity: npt.ArrayLike) -> float:
+        """Approach speed -n . v of an end-effector velocity.
+
+        Args:
+            velocity: (3,) end-effector velocity, world, m/s.
+
+        Returns:
+            m/s, positive towards the surface.
+        """
         return float(-self.normal @ np.asarray(velocity, dtype=float))
 
 
@@ -183,8 +214,10 @@ def impulse_to_velocity(
 
 
 def composite_inertia_map(arm: np.ndarray, mass: float, com_inertia: np.ndarray) -> np.ndarray:
-    """W = I / m - [r]x Ic^-1 [r]x (1/kg) of the robot as one rigid body: ``arm`` r = point - CoM
-    (m), ``mass`` (kg), ``com_inertia`` Ic about the CoM in world axes (kg m^2).
+    """W = I / m - [r]x Ic^-1 [r]x (1/kg) of the robot as one rigid body.
+
+    ``arm`` r = point - CoM (m), ``mass`` (kg), ``com_inertia`` Ic about the CoM in world axes
+    (kg m^2).
     """
     arm = np.ascontiguousarray(arm, dtype=float)
     com_inertia = np.ascontiguousarray(com_inertia, dtype=float)
@@ -192,15 +225,17 @@ def composite_inertia_map(arm: np.ndarray, mass: float, com_inertia: np.ndarray)
     if _composite_map(arm, float(mass), com_inertia, W):
         return W
     r = skew(arm)  # Ic not positive definite (not a rigid body's): LAPACK's LU says what it can
-    return np.eye(3) / mass - r @ np.linalg.solve(com_inertia, r)
+    out: npt.NDArray[np.float64] = np.eye(3) / mass - r @ np.linalg.solve(com_inertia, r)
+    return out
 
 
 @njit(cache=True)
 def _composite_map(arm, mass, Ic, W):
-    """``W`` = I / m - [r]x Ic^-1 [r]x by a 3 x 3 Cholesky of ``Ic``, in floats; False (W
-    untouched) when ``Ic`` is not positive definite. Compiled: numpy's and LAPACK's set-up
-    cost ~15 us per call for these few flops, and a governor builds W every tick. Python
-    floats when interpreted: an overflow gives inf (reported by the caller), not a warning.
+    """``W`` = I / m - [r]x Ic^-1 [r]x by a 3 x 3 Cholesky of ``Ic``, in floats.
+
+    False (W untouched) when ``Ic`` is not positive definite. Compiled (a governor builds W every
+    tick). Python floats when interpreted: an overflow gives inf (reported by the caller), not a
+    warning.
     """
     a, b, c = float(Ic[0, 0]), float(Ic[0, 1]), float(Ic[0, 2])
     d, e, f = float(Ic[1, 1]), float(Ic[1, 2]), float(Ic[2, 2])
@@ -238,10 +273,11 @@ def _composite_map(arm, mass, Ic, W):
 
 
 def joint_space_inertia_map(
-    workspace, model: pin.Model, q: np.ndarray, jacobian: np.ndarray
+    workspace: Scratch, model: pin.Model, q: np.ndarray, jacobian: np.ndarray
 ) -> np.ndarray:
-    """W = J M(q)^-1 J^T (1/kg) of the translational Jacobian ``jacobian`` (3 x nv), with M
-    computed in ``workspace``'s Data (a :class:`~impact_balance.robot.robot.Scratch` or
+    """W = J M(q)^-1 J^T (1/kg) of the translational Jacobian ``jacobian`` (3 x nv).
+
+    M is computed in ``workspace``'s Data (a :class:`~impact_balance.robot.robot.Scratch` or
     :class:`~impact_balance.robot.robot.ThreadData`; its held kinematics are marked stale).
     """
     M = pin.crba(model, workspace.data, q)  # scratch Data: createData costs up to ~2 ms
@@ -302,8 +338,13 @@ def model_from_inertia_map(
     """The impact model from its map W (what :func:`impact_model` computes from a stance).
 
     Args:
-        point: Impact point, world, m. arm: point - CoM, m (for messages).
-        normal, cone: From :func:`impact_cone`. W: 3 x 3, 1/kg. mass: kg.
+        spec: The impact specification.
+        point: Impact point, world, m.
+        arm: point - CoM, m (for messages).
+        normal: Unit normal, from :func:`impact_cone`.
+        cone: Friction-cone generators (3 x N), from :func:`impact_cone`.
+        W: Impulse-to-velocity map at the point, 3 x 3, 1/kg.
+        mass: kg.
         jacobian: 3 x nv translational Jacobian of the point (world axes).
 
     Raises:
@@ -335,10 +376,11 @@ def model_from_inertia_map(
 
 @njit(cache=True)
 def _impulse_rates(normal, W, K, lo, hi):
-    """``(W finite, min_i n^T W K_i, rates)``: rows 2i and 2i+1 of ``rates`` (2N, 3) are
-    ``(1 + c) / (n^T W K_i) K_i`` for c = hi and lo (the impulse vertices per unit approach
-    speed); n^T W K_i > 0 for an impulse that pushes the point back. Compiled: numpy spent
-    ~15 us of call overhead on these few multiplications.
+    """``(W finite, min_i n^T W K_i, rates)``, compiled.
+
+    Rows 2i and 2i+1 of ``rates`` (2N, 3) are ``(1 + c) / (n^T W K_i) K_i`` for c = hi and lo
+    (the impulse vertices per unit approach speed); n^T W K_i > 0 for an impulse that pushes the
+    point back.
     """
     N = K.shape[1]
     rates = np.empty((2 * N, 3))

@@ -207,8 +207,8 @@ def _draw_post_impact_sets(
         The reference approach speed (m/s, at least 0), None without a reference velocity.
     """
     model = im.model
-    limit = im.com_limit
-    vmax = limit.max_approach_speed
+    limit = im.com
+    vmax = limit.max_contact_velocity
     ref = model.spec.reference_velocity
     v_ref = max(0.0, model.approach_speed(ref)) if ref is not None else None
     # The series k / n * v_max (or of the reference speed when there is no limit).
@@ -249,7 +249,7 @@ def _draw_speed_series(
     view: list[FloatArray],
 ) -> None:
     """The post-impact sets at ``k / n_steps * top`` (m/s), k = 1..n_steps, the last one bold."""
-    model, limit = im.model, im.com_limit
+    model, limit = im.model, im.com
     cmap = colormaps["Blues"]
     for k in range(1, n_steps + 1):
         s = top * k / n_steps
@@ -275,10 +275,10 @@ def _draw_speed_series(
 
 def _draw_limiting(ax: Axes, im: ImpactAnswer, area: Polygon, c0: FloatArray) -> None:
     """The vertex of the post-impact set at v_max on the boundary, and the edge it reaches."""
-    limit = im.com_limit
+    limit = im.com
     if limit.limiting_vertex is None:
         return
-    p = im.model.post_impact_com_velocities(c0, limit.max_approach_speed)[limit.limiting_vertex]
+    p = im.model.post_impact_com_velocities(c0, limit.max_contact_velocity)[limit.limiting_vertex]
     ax.plot(
         *p,
         marker="*",
@@ -305,9 +305,9 @@ def _draw_limiting(ax: Axes, im: ImpactAnswer, area: Polygon, c0: FloatArray) ->
 
 def _impact_note(im: ImpactAnswer, v_ref: float | None) -> list[str]:
     """The lines of the note about the impact: the maxima and the impact's parameters."""
-    model, limit = im.model, im.com_limit
+    model, limit = im.model, im.com
     lines = ["maximum approach speed:"]
-    lines.append(f"  CoM criterion: {fmt_speed(limit.max_approach_speed)}")
+    lines.append(f"  CoM criterion: {fmt_speed(limit.max_contact_velocity)}")
     lines.append(f"  ZMP criterion: {fmt_speed(im.zmp_max_contact_velocity)}")
     if v_ref is not None:
         lines.append(f"  reference: {v_ref:.3g} m/s")

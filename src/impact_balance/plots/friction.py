@@ -116,7 +116,7 @@ def _draw_sets(ax: Axes, runs: list[_Run]) -> None:
         draw_polygon(
             ax, hull(pts), color=color, alpha=0.35, edge=color, lw=2, label=label, zorder=3
         )
-        lim = im.com_limit
+        lim = im.com
         if lim.is_finite and lim.limiting_vertex is not None:
             ax.plot(*pts[lim.limiting_vertex], "*", color=color, mec="black", ms=13, zorder=5)
         view.append(c0)

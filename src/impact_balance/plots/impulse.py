@@ -49,7 +49,7 @@ def impulse_set_speed(analysis: Analysis) -> tuple[float, SetSpeed]:
     im = analysis.impact
     if im is None:
         return 0.0, "no impact"
-    if im.com_limit.is_finite and im.max_contact_velocity > 0:
+    if im.com.is_finite and im.max_contact_velocity > 0:
         return im.max_contact_velocity, "v_max"
     ref = im.model.spec.reference_velocity
     if ref is not None and im.model.approach_speed(ref) > 0:

@@ -42,7 +42,10 @@ def project_polytope(
     """Project ``{x : A x <= b, C x = d}`` onto ``y = E x``.
 
     Args:
-        A, b, C, d: The polytope (C, d may have zero rows).
+        A: (m, n) inequality matrix of the polytope.
+        b: (m,) its right-hand side.
+        C: (p, n) equality matrix (may have zero rows).
+        d: (p,) its right-hand side.
         E: 2 x n projection map.
         tol: Bretl: distance (in y units) under which a new support point is on the edge.
         box: Clipping box ``|y_k| <= box`` for unbounded directions; the polygon is then

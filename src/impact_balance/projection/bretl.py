@@ -1,5 +1,6 @@
-"""Projection of a polytope onto a plane: Bretl & Lall's incremental algorithm (2008), one
-HiGHS LP per support direction. The reference path (and the fallback of the walk).
+"""Projection of a polytope onto a plane: Bretl & Lall's incremental algorithm (2008).
+
+One HiGHS LP per support direction. The reference path (and the fallback of the walk).
 
 Given ``P = {x : A x <= b, C x = d}`` and a 2 x n map ``E``, computes the convex polygon
 ``E P`` exactly (up to a documented tolerance) by solving one LP per support direction:
@@ -20,13 +21,18 @@ the empty polygon.
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance.exceptions import SolverError
 from impact_balance.geometry.polygon import Polygon, simplify
 from impact_balance.projection.result import ProjectionResult
 from impact_balance.solvers import HighsLP, LinearProgram
 
-__all__ = ["project_bretl", "warm_up"]
+__all__ = [
+    "INITIAL_ANGLES",
+    "project_bretl",
+    "warm_up",
+]
 
 #: First ray directions (rad).
 INITIAL_ANGLES = (0.0, 2.0 * np.pi / 3.0, 4.0 * np.pi / 3.0)
@@ -46,7 +52,10 @@ def project_bretl(
     """Project ``{x : A x <= b, C x = d}`` onto ``y = E x``.
 
     Args:
-        A, b, C, d: The polytope (C, d may have zero rows).
+        A: (m, n) inequality matrix of the polytope.
+        b: (m,) its right-hand side.
+        C: (p, n) equality matrix (may have zero rows).
+        d: (p,) its right-hand side.
         E: 2 x n projection map.
         tol: Distance (in y units) under which a new support point is considered on the edge.
         box: Clipping box ``|y_k| <= box`` for unbounded directions.
@@ -81,7 +90,8 @@ def project_bretl(
             return None
         if not sol.optimal:  # the box makes it bounded, so this would be a solver fault
             raise SolverError("HiGHS", sol.status, "support LP of the projection")
-        return E @ sol.x
+        out: npt.NDArray[np.float64] | None = E @ sol.x
+        return out
 
     first = []
     for angle in INITIAL_ANGLES:
@@ -89,7 +99,7 @@ def project_bretl(
         if y is None:
             return ProjectionResult(Polygon.empty(), "bretl", n_lp=count)
         first.append(y)
-    vertices = [v for v in simplify(np.array(first), tol)]
+    vertices = list(simplify(np.array(first), tol))
     if len(vertices) == 1:
         return ProjectionResult(Polygon(np.array(vertices)), "bretl", n_lp=count)
     confirmed = [False] * len(vertices)  # confirmed[i]: edge from vertex i to vertex i+1
@@ -130,9 +140,10 @@ _warm = False
 
 
 def warm_up() -> None:
-    """One projection of a square, once per process: the first Bretl projection costs ~0.3 s
-    (loading and setting up HiGHS). A governor calls this when it is built, so that a tick
-    whose walk falls back to Bretl (about 1 in 300 on G1's approach) pays ~5 ms, not 71.
+    """One projection of a square, once per process.
+
+    The first Bretl projection of a process loads and sets up HiGHS. A governor calls this when
+    it is built, so that a tick whose walk falls back to Bretl does not pay it.
     """
     global _warm
     if _warm:

@@ -7,7 +7,7 @@ basis stays optimal over an arc of theta that has a closed form; at its end one 
 visits every vertex of the projected polygon in counter-clockwise order. This is what
 Bretl & Lall's algorithm computes with one LP per edge, but each step here is a pivot on a
 dense n x n basis instead of a solver call, in a compiled kernel
-(:mod:`impact_balance.projection._kernel`).
+(:mod:`impact_balance.projection.kernel`).
 
 Before walking, the equalities are eliminated (``x = x0 + N z``), zero rows are checked and
 dropped, rows are scaled to unit norm, and the clipping box ``|y_k| <= box`` is added as four
@@ -21,12 +21,13 @@ from __future__ import annotations
 import os
 
 import numpy as np
+import numpy.typing as npt
 
 from impact_balance._jit import HAVE_NUMBA, cache_depends_on, njit
 from impact_balance.geometry import polygon
-from impact_balance.geometry.polygon import MERGE_AREA_TOLERANCE, Polygon, _simplify_convex
-from impact_balance.projection import _kernel
-from impact_balance.projection._kernel import (
+from impact_balance.geometry.polygon import MERGE_AREA_TOLERANCE, Polygon, simplify_convex_kernel
+from impact_balance.projection import kernel
+from impact_balance.projection.kernel import (
     FAILED,
     INCONSISTENT,
     INFEASIBLE,
@@ -37,7 +38,17 @@ from impact_balance.projection._kernel import (
 )
 from impact_balance.projection.result import ProjectionResult
 
-__all__ = ["MAX_PIVOTS", "certified_walk", "kernel_is_compiled", "project_walk", "warm_up"]
+__all__ = [
+    "CHECK_MERGE",
+    "MAX_PIVOTS",
+    "NO_HINT",
+    "RANK_TOLERANCE",
+    "SLACK_TOLERANCE",
+    "certified_walk",
+    "kernel_is_compiled",
+    "project_walk",
+    "warm_up",
+]
 
 #: Relative singular-value threshold for the rank of the lines of the polytope.
 RANK_TOLERANCE = 1e-12
@@ -99,8 +110,9 @@ def project_walk(
 
 @njit(cache=True)
 def _certify(status, vertices, worst, b, merge_tol, area_tol, box):
-    """A walk's raw vertices certified and merged: ``(status, vertices, bounded)``, status
-    FAILED when the walk cannot answer (see :func:`project_walk`).
+    """A walk's raw vertices certified and merged: ``(status, vertices, bounded)``.
+
+    The status is FAILED when the walk cannot answer (see :func:`project_walk`).
     """
     none = np.empty((0, 2))
     if status == FAILED or status == LINE:
@@ -123,7 +135,7 @@ def _certify(status, vertices, worst, b, merge_tol, area_tol, box):
     # first pass only drops rounding-level duplicates, which would fail the strict check:
     # within 1e-9, or 10 times the worst slack (a vertex's rounding shows in its slacks; 1e-8
     # with a friction of 2.5e4 on Talos's foot).
-    ok, merged, bounded = _simplify_convex(
+    ok, merged, bounded = simplify_convex_kernel(
         vertices, min(merge_tol, max(CHECK_MERGE, -10.0 * worst)), merge_tol, area_tol, box
     )
     if not ok:
@@ -133,14 +145,15 @@ def _certify(status, vertices, worst, b, merge_tol, area_tol, box):
 
 @njit(cache=True)
 def certified_walk(A, b, C, d, E, box, max_pivots, merge_tol, area_tol, hint):
-    """The walk of :func:`project_walk` in one compiled call, its certificate and merge
-    included (a governor pays each call's dispatch every tick).
+    """The walk of :func:`project_walk` in one compiled call, certificate and merge included.
+
+    A governor pays each call's dispatch every tick.
 
     Returns ``(status, vertices, bounded, pivots, x0, N)`` with a kernel status: OK (the
     certified polygon), INFEASIBLE or INCONSISTENT (empty), FAILED (the walk cannot answer),
     LINE (the polytope holds a line: :func:`project_walk` quotients it out; ``x0 + N z``
     spans the equalities). ``hint``: the kernel's warm start, kept by a caller that projects
-    postures in a row (:func:`~impact_balance.projection._kernel.walk`); :data:`NO_HINT` for none.
+    postures in a row (:func:`~impact_balance.projection.kernel.walk`); :data:`NO_HINT` for none.
     """
     status, raw, pivots, worst, x0, N = project_equalities(A, b, C, d, E, box, max_pivots, hint)
     if status == LINE or status == INCONSISTENT:
@@ -151,12 +164,13 @@ def certified_walk(A, b, C, d, E, box, max_pivots, merge_tol, area_tol, hint):
 
 # The compiled functions above embed the kernel's and the polygon module's.
 cache_depends_on(_certify, polygon)
-cache_depends_on(certified_walk, polygon, _kernel)
+cache_depends_on(certified_walk, polygon, kernel)
 
 
-def _array(x, ndim: int, columns: int | None = None) -> np.ndarray:
-    """``x`` as a C-contiguous float64 array of ``ndim`` dimensions (``columns`` columns):
-    itself when it already is one (a polytope's own arrays, every governor tick).
+def _array(x: npt.ArrayLike, ndim: int, columns: int | None = None) -> np.ndarray:
+    """``x`` as a C-contiguous float64 array of ``ndim`` dimensions (``columns`` columns).
+
+    Itself when it already is one (a polytope's own arrays, every governor tick).
     """
     if (
         type(x) is np.ndarray
@@ -172,13 +186,15 @@ def _array(x, ndim: int, columns: int | None = None) -> np.ndarray:
 
 
 def kernel_is_compiled() -> bool:
-    """Whether numba's on-disk cache holds the kernel; if not, the first projection compiles
-    it (0.5 to 1.5 min, once per installation). True without numba (nothing to compile).
+    """Whether numba's on-disk cache holds the kernel.
+
+    If not, the first projection compiles it (once per installation). True without numba
+    (nothing to compile).
     """
     if not HAVE_NUMBA:
         return True
     try:  # numba's cache index of the entry point; private API, hence the guard
-        return os.path.exists(project._cache._cache_file._index_path)
+        return os.path.exists(project._cache._cache_file._index_path)  # type: ignore[attr-defined]
     except AttributeError:
         return True
 
@@ -187,10 +203,11 @@ _warm = False
 
 
 def warm_up() -> float:
-    """Load (or compile) the kernel now, by projecting a square; returns the seconds spent
-    (0.0 once done). numba loads a cached kernel on its first call (0.3-1.5 s, 0.5 to 1.5 min to
-    compile after an installation): callers that time a projection call this first, so
-    that the load is not mistaken for the projection.
+    """Load (or compile) the kernel now, by projecting a square; returns the seconds spent.
+
+    0.0 once done. numba loads a cached kernel on its first call (and compiles it after an
+    installation): callers that time a projection call this first, so that the load is not
+    mistaken for the projection.
     """
     global _warm
     if _warm:

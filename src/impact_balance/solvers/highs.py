@@ -27,7 +27,7 @@ try:
     # output flag is switched off before that.
     from highspy._core import _Highs as _Solver
 except ImportError:  # pragma: no cover - a highspy without the private core name
-    _Solver = highspy.Highs
+    _Solver = highspy.Highs  # type: ignore[misc]
 
 
 class HighsLP:
@@ -60,7 +60,8 @@ class HighsLP:
             blocks.append(np.atleast_2d(problem.R))
             lower.append(np.asarray(problem.lo, dtype=float))
             upper.append(np.asarray(problem.hi, dtype=float))
-        import scipy.sparse as sp  # here: scipy.sparse costs ~0.1 s to import, and most analyses never build an LP
+        # here: scipy.sparse is slow to import, and most analyses never build an LP
+        import scipy.sparse as sp
 
         M = sp.csc_matrix(np.vstack(blocks)) if blocks else sp.csc_matrix((0, n))
         M.eliminate_zeros()
@@ -99,7 +100,8 @@ class HighsLP:
 
     @property
     def dim(self) -> int:
-        return self._n
+        """The number of variables."""
+        return int(self._n)
 
     def maximize(self, c: np.ndarray) -> LPSolution:
         """Solve ``max c^T x`` over the fixed constraints."""
@@ -124,10 +126,11 @@ class HighsLP:
             return LPSolution("unbounded", None, float("inf"))
         raise SolverError("HiGHS", h.modelStatusToString(status))
 
-    def _rerun_cold(self):
-        """The same LP from scratch with HiGHS's default strategy (presolve on, no basis): the
-        warm-started primal simplex stopped undecided ("Unknown") on a ramp foot at friction
-        2.5e4 (the unnormalised polytope), where a cold solve answers.
+    def _rerun_cold(self) -> highspy.HighsModelStatus:
+        """The same LP from scratch with HiGHS's default strategy (presolve on, no basis).
+
+        The warm-started primal simplex can stop undecided ("Unknown") on a badly scaled LP (a ramp
+        foot at friction 2.5e4, the unnormalised polytope), where a cold solve answers.
         """
         h = self._h
         h.clearSolver()

@@ -42,4 +42,5 @@ class LPSolution:
 
     @property
     def optimal(self) -> bool:
+        """Whether the status is "optimal"."""
         return self.status == "optimal"

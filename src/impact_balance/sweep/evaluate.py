@@ -27,7 +27,8 @@ import pyarrow as pa
 from impact_balance.balance.areas import BalanceAreas, areas_from_polytope
 from impact_balance.contacts.stance import Stance
 from impact_balance.contacts.wrench_polytope import wrench_polytope
-from impact_balance.criteria.com import max_contact_velocity, zmp_max_contact_velocity
+from impact_balance.criteria.com import max_contact_velocity
+from impact_balance.criteria.zmp import zmp_max_contact_velocity
 from impact_balance.exceptions import ImpactBalanceError, ScenarioError
 from impact_balance.impact.model import impact_model
 from impact_balance.robot.ik import IKError, IKOptions, solve_stance
@@ -233,8 +234,8 @@ class Evaluator:
         out.update(
             status=com.status,
             verdict=verdict,
-            max_contact_velocity=com.max_approach_speed,
-            zmp_max_contact_velocity=zmp.max_approach_speed,
+            max_contact_velocity=com.max_contact_velocity,
+            zmp_max_contact_velocity=zmp.max_contact_velocity,
             zmp_status=zmp.status,
             com_velocity_area=ready.com_velocity_area,
             zmp_area=ready.zmp_area,

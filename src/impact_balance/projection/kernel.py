@@ -19,7 +19,8 @@ error grows with it), which keeps Bland's rule from chasing rounding noise.
 
 The basis inverse is kept explicitly, updated by the rank-one formula at each pivot and
 recomputed every ``_REFACTOR`` pivots, and in the walk around the polygon whenever it no
-longer solves its system to near rounding or has carried ``_CARRY`` pivots. Without numba the same code runs as plain Python.
+longer solves its system to near rounding or has carried ``_CARRY`` pivots. Without numba
+the same code runs as plain Python.
 """
 
 from __future__ import annotations
@@ -121,9 +122,10 @@ def _point(g0, GT, z, out, i):
 
 @njit(cache=True, inline="always")
 def _step(H, h, z, p, j, hp, slack):
-    """Row j's step along ``p`` in the ratio test (inf if it does not block); its ``H_j p`` and
-    slack go to ``hp[j]`` and ``slack[j]``. Inlined by numba: called per row, as a function of
-    its own it made the walk 20 % slower.
+    """Row j's step along ``p`` in the ratio test (inf if it does not block).
+
+    Its ``H_j p`` and slack go to ``hp[j]`` and ``slack[j]``. Inlined by numba (called per
+    row).
     """
     a = 0.0
     b = h[j]
@@ -176,8 +178,10 @@ def _near(z, zd):
 
 @njit(cache=True)
 def _ratio_test_near(H, h, z, p, active, hp, slack, zd, dset):
-    """:func:`_ratio_test`, over the rows listed near z (``dset``, at ``zd``) when that gives
-    its answer exactly: z still within _D_MOVE of ``zd`` and a step up to _D_STEP.
+    """:func:`_ratio_test` over the rows listed near z (``dset``, at ``zd``).
+
+    Used when that gives its answer exactly: z still within _D_MOVE of ``zd`` and a step up to
+    _D_STEP.
     """
     count = dset[0]
     if count >= 0 and _near(z, zd):
@@ -198,8 +202,9 @@ def _ratio_test_near(H, h, z, p, active, hp, slack, zd, dset):
 
 @njit(cache=True)
 def _min_slack_near(H, h, z, worst, zd, dset):
-    """``worst[0]`` = min(worst[0], min_j h_j - H_j z) (``worst[0]`` <= 0): a vertex's
-    feasibility check. Over the rows listed near z (``dset``) when z is within _D_MOVE of where
+    """A vertex's feasibility check: ``worst[0]`` = min(worst[0], min_j h_j - H_j z).
+
+    ``worst[0]`` <= 0. Over the rows listed near z (``dset``) when z is within _D_MOVE of where
     they were listed (``zd``: the others' slacks are positive there); else over every row,
     listing them again at z.
     """
@@ -248,8 +253,10 @@ def _project_out(Q, k, v, out):
 
 @njit(cache=True)
 def _longest_axis(Q, k, out):
-    """``out`` = the coordinate axis that keeps most of its length once the k orthonormal rows
-    of Q are projected out (pivoted, hence well conditioned), projected; returns |out|.
+    """``out`` = the coordinate axis that keeps most of its length, projected; returns |out|.
+
+    The axis keeps most of its length once the k orthonormal rows of Q are projected out
+    (pivoted, hence well conditioned).
     """
     n = Q.shape[1]
     best, axis = -1.0, 0
@@ -266,8 +273,9 @@ def _longest_axis(Q, k, out):
 
 @njit(cache=True)
 def _null_direction(Q, k, c, dc, p):
-    """Unit direction ``p`` orthogonal to the k working rows (orthonormal basis ``Q[:k]``),
-    lexicographically ascending for (c, dc): the projection of c, else of dc, else of the
+    """Unit direction ``p`` orthogonal to the k working rows (orthonormal basis ``Q[:k]``).
+
+    Lexicographically ascending for (c, dc): the projection of c, else of dc, else of the
     coordinate axis that keeps most of its length.
 
     Returns kind: 0 = ascending for c, 1 = ascending for dc only, 2 = neutral.
@@ -360,9 +368,10 @@ def _invert(B, out):
 
 @njit(cache=True)
 def _workspace(m, n):
-    """The walk's work buffers, made once per walk (an allocation per pivot would cost as much
-    as the pivot): (p, col, alpha) of n, (hp, slack) of m, an n x n basis copy and a 3 x n
-    buffer for the breakpoints.
+    """The walk's work buffers, made once per walk.
+
+    (p, col, alpha) of n, (hp, slack) of m, an n x n basis copy and a 3 x n buffer for the
+    breakpoints.
     """
     dset = np.empty(m + 1, dtype=np.int64)  # [0]: count (-1: none yet), then the rows
     dset[0] = -1
@@ -423,9 +432,10 @@ def _pivot(H, h, W, Binv, z, leave, j, since, work):
 
 @njit(cache=True)
 def _accurate(H, h, W, Binv, z, ones):
-    """Whether a carried basis inverse still solves its system to near rounding: the vertex
-    ``H_W z = h_W`` within 1e-14 of max(1, |h_W|), and ``H_W (Binv 1) = 1`` within 1e-14 n
-    (3 n^2 products, where a fresh inverse costs 2 n^3). ``ones`` (n): a work buffer.
+    """Whether a carried basis inverse still solves its system to near rounding.
+
+    The vertex ``H_W z = h_W`` within 1e-14 of max(1, |h_W|), and ``H_W (Binv 1) = 1`` within
+    1e-14 n (3 n^2 products, where a fresh inverse costs 2 n^3). ``ones`` (n): a work buffer.
     """
     n = Binv.shape[0]
     size = 1.0
@@ -460,8 +470,9 @@ def _vertex(h, W, Binv, z):
 
 @njit(cache=True)
 def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work):
-    """Simplex pivots from the vertex basis (W, Binv, z) until it is optimal for the
-    lexicographic objective (c, dc); ``scale`` scales the multiplier tolerance.
+    """Simplex pivots from the vertex basis (W, Binv, z) until it is lexicographically optimal.
+
+    The objective is (c, dc); ``scale`` scales the multiplier tolerance.
 
     Returns (status, pivots).
     """
@@ -575,13 +586,14 @@ def _breakpoint(Binv, GT, theta, cos_t, sin_t, scale, ab):
 
 @njit(cache=True)
 def _warm_start(H, h, W, Binv, z, active, work, hint):
-    """Start from the basis in ``hint`` when it is a feasible vertex basis here: ``hint`` =
-    (m, n, the n rows), written by the previous walk of the same caller (a governor's last
-    posture, whose optimal basis at theta0 is one or two pivots from this one's). Replaces
-    the crash, which costs n ratio tests over every row (~10 % of a walk on the governor's
-    postures). Any feasible vertex basis is a valid simplex start, so the walk's answer is
-    the same polygon (its vertices to rounding). Returns False otherwise, z back at 0 (the
-    crash's start: the caller tries only where 0 is feasible).
+    """Start from the basis in ``hint`` when it is a feasible vertex basis here.
+
+    ``hint`` = (m, n, the n rows), written by the previous walk of the same caller (a governor's
+    last posture, whose optimal basis at theta0 is one or two pivots from this one's). Replaces
+    the crash, which costs n ratio tests over every row. Any feasible vertex basis is a valid
+    simplex start, so the walk's answer is the same polygon (its vertices to rounding). Returns
+    False otherwise, z back at 0 (the crash's start: the caller tries only where 0 is
+    feasible).
     """
     m, n = H.shape
     if hint.shape[0] < n + 2 or hint[0] != m or hint[1] != n:
@@ -609,8 +621,10 @@ def _warm_start(H, h, W, Binv, z, active, work, hint):
 
 @njit(cache=True)
 def _phase_one(H, h, z, W, active, max_pivots):
-    """A feasible point of ``{H z <= h}`` into ``z`` (and, when the phase-1 optimum is a vertex
-    basis of it, its rows into ``W[:k]``, flagged in ``active``). Returns (status, pivots, k).
+    """A feasible point of ``{H z <= h}`` into ``z``; returns (status, pivots, k).
+
+    When the phase-1 optimum is a vertex basis of it, its rows go into ``W[:k]``, flagged in
+    ``active``.
 
     Phase 1: max -s over {H z - s <= h, s >= 0} from (0, s0), s0 feasible.
     """
@@ -711,12 +725,8 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
         _times_into(GT, du, dc)
         # The inverse is carried across breakpoints by rank-one updates only while it still
         # solves its system to 1e-14 (checked after the pivots that changed it, below) and for
-        # at most _CARRY pivots; then a fresh one (15 % less time on the governor's postures
-        # than one per breakpoint at _CARRY = 4, 6 % less again at 8 on G1's walks; the check,
-        # not the count, is what guards the precision). Carried unchecked (a fresh one every 16 pivots), the walk
-        # lost a vertex on an ill-conditioned stance (a hand at friction 1e8: area -0.3 %,
-        # every vertex certified feasible and convex); checked to 1e-12 only, its area at foot
-        # friction 1e6 was 1.2e-9 off Bretl's.
+        # at most _CARRY pivots; then a fresh one. The check, not the count, guards the
+        # precision (docs/studies/design-history.md, "Core floors").
         if since >= _CARRY:
             if not _refactor(H, h, W, Binv, z, work):
                 return FAILED, vertices, count, pivots
@@ -870,8 +880,9 @@ def equality_basis(C, d):
 
 @njit(cache=True)
 def project_equalities(A, b, C, d, E, box, max_pivots, hint):
-    """:func:`project` of ``{x : A x <= b, C x = d}``, the equalities eliminated by
-    :func:`equality_basis` in the same compiled call (a governor pays each call's dispatch
+    """:func:`project` of ``{x : A x <= b, C x = d}``, the equalities eliminated.
+
+    By :func:`equality_basis`, in the same compiled call (a governor pays each call's dispatch
     every tick). Returns (status, vertices, pivots, worst, x0, N); status INCONSISTENT for
     inconsistent equalities.
     """
