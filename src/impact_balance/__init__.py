@@ -172,9 +172,9 @@ if TYPE_CHECKING:  # static analysers and IDEs see the plain imports
     )
     from impact_balance.criteria.cap import capped_velocity
     from impact_balance.criteria.com import max_contact_velocity
+    from impact_balance.criteria.qp import QPOptions, QPResult, solve_contact_velocity_qp
     from impact_balance.criteria.velocity_limit import ContactVelocityLimit
     from impact_balance.criteria.zmp import zmp_max_contact_velocity
-    from impact_balance.criteria.qp import QPOptions, QPResult, solve_contact_velocity_qp
     from impact_balance.exceptions import (
         ImpactBalanceError,
         ImpactModelError,

@@ -38,7 +38,8 @@ def test_a_margin_lowers_the_answer_and_an_argument_overrides_the_scenario():
     zeroed = Governor(scenario.replace(velocity_margin=0.02), velocity_margin=0.0)
     q, c = plain.configuration, np.zeros(3)
     a, b, d, z = (
-        g.limit_com(q, c).max_contact_velocity for g in (plain, from_scenario, from_argument, zeroed)
+        g.limit_com(q, c).max_contact_velocity
+        for g in (plain, from_scenario, from_argument, zeroed)
     )
     assert b < a and b == d and z == a
     assert from_argument.scenario.velocity_margin == 0.02

@@ -18,8 +18,7 @@ from impact_balance.contacts.stance import has_free_flyer
 from impact_balance.criteria.cap import cap_approach
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.exceptions import GovernorError, ScenarioError
-from impact_balance.criteria.cap import cap_approach
-from impact_balance.governor.limit import SpeedLimit
+from impact_balance.governor.limit import Binding, SpeedLimit
 from impact_balance.governor.options import CRITERIA, ContactAwareOptions, Criterion
 from impact_balance.governor.posture import Posture, PostureEvaluator, PostureSettings
 from impact_balance.governor.support import ContactAwareLimit, combine
@@ -371,7 +370,7 @@ class Governor:
         self, posture: Posture, com_velocity: npt.NDArray[np.float64], reused: bool
     ) -> SpeedLimit:
         """The answer for ``posture`` and the CoM velocity (world, m/s); kept as the last."""
-        binding = "floating"
+        binding: Binding = "floating"
         criterion = posture.com_criterion
         support = self._support
         limit: ContactVelocityLimit

@@ -29,7 +29,7 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from impact_balance.exceptions import SimulationError
-from impact_balance.governor import Governor
+from impact_balance.governor import Criterion, Governor
 from impact_balance.json_values import json_number
 from impact_balance.sim.control.approach import approach_profile
 from impact_balance.sim.model.build import SimModel
@@ -242,7 +242,8 @@ def run_wall_trial(
         raise SimulationError("impact", None, "the scenario has no impact")
     trial_options = trial_options or BalanceTrialOptions(controller=setup.controller)
     if governor is None and options.governor != "none":
-        governor = Governor(setup.scenario, criterion=options.governor)
+        criterion: Criterion = "zmp" if options.governor == "zmp" else "com"
+        governor = Governor(setup.scenario, criterion=criterion)
     im = analysis.impact.model
     n = np.asarray(im.normal, dtype=float)
     start = im.point + options.standoff * n
