@@ -64,11 +64,28 @@ import json
 import sys
 from pathlib import Path
 
-# The benchmark's modules live in contact_aware/, beside this file (on sys.path as the script's folder).
-from contact_aware.preload import TRAINING, bounds, bounds_table, preload, preload_table, ramp_jumps
-from contact_aware.trace import trace
-from contact_aware.trials import SWEEP_REFERENCES, VARIANTS, score, score_table, sweep, sweep_table
-from governor_study import SCENARIOS, _load
+# Run as a file, only the script's folder is on sys.path: put the repository root first,
+# for the ``benchmarks`` package.
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.contact_aware.preload import (
+    TRAINING,
+    bounds,
+    bounds_table,
+    preload,
+    preload_table,
+    ramp_jumps,
+)
+from benchmarks.contact_aware.trace import trace
+from benchmarks.contact_aware.trials import (
+    SWEEP_REFERENCES,
+    VARIANTS,
+    score,
+    score_table,
+    sweep,
+    sweep_table,
+)
+from benchmarks.governor_study import SCENARIOS, _load
 
 
 def main(argv: list[str] | None = None) -> int:

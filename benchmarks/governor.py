@@ -30,16 +30,19 @@ import argparse
 import json
 import sys
 import time
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
-# The benchmark's modules live in speed/, beside this file (on sys.path as the script's folder).
-from speed.machine import machine_info
-from speed.timing import Case, measure, progress
+# Run as a file, only the script's folder is on sys.path: put the repository root first,
+# for the ``benchmarks`` package.
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import impact_balance as ib
+from benchmarks.speed.machine import machine_info
+from benchmarks.speed.timing import Case, measure, progress
 from impact_balance.governor import Governor
 
 #: The wall study's scenarios (issue 15, item 3).
@@ -199,13 +202,13 @@ def evaluate_targets(rows: list[dict[str, Any]]) -> list[str]:
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv[:1] == ["--study"]:  # the wall study (issue 15, item 3): benchmarks/governor_study.py
-        import governor_study
+        from benchmarks import governor_study
 
         return governor_study.main(argv[1:])
     if argv[:1] == [
         "--tolerance"
     ]:  # posture_tolerance in the wall experiment: benchmarks/governor_tolerance.py
-        import governor_tolerance
+        from benchmarks import governor_tolerance
 
         return governor_tolerance.main(argv[1:])
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])

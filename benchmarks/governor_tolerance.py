@@ -18,10 +18,15 @@ import json
 import os
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
-from governor_study import SCENARIOS, governed_setup
 
+# Run as a file, only the script's folder is on sys.path: put the repository root first,
+# for the ``benchmarks`` package.
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.governor_study import SCENARIOS, governed_setup
 from impact_balance.governor import Governor
 from impact_balance.sim.studies.wall import WallOptions, run_wall_trial
 

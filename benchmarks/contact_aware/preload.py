@@ -12,9 +12,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from contact_impact import one_row
 
 import impact_balance as ib
+from benchmarks.contact_aware.journal import journalled, open_journal
+from benchmarks.contact_impact import one_row
 from impact_balance.contacts.stance import Stance
 from impact_balance.governor import Governor
 from impact_balance.impact.contact_aware import (
@@ -26,8 +27,6 @@ from impact_balance.impact.contact_aware import (
 from impact_balance.impact.model import ImpactSpec, impact_cone
 from impact_balance.scenario import load_scenario
 from impact_balance.sim import SimOptions, build_model
-
-from .journal import journalled, open_journal
 
 __all__ = [
     "GRAVITY",

@@ -10,8 +10,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from governor_study import _f, governed_setup
 
+from benchmarks.governor_study import _f, governed_setup
 from impact_balance.governor import Governor
 from impact_balance.sim.studies.wall import WallOptions, run_wall_trial
 

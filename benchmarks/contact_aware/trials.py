@@ -9,13 +9,12 @@ import time
 from pathlib import Path
 
 import numpy as np
-from governor_study import _f, governed_setup
 
+from benchmarks.contact_aware.journal import journalled, open_journal, slim
+from benchmarks.governor_study import _f, governed_setup
 from impact_balance.contacts.stance import Stance
 from impact_balance.governor import ContactAwareOptions, Governor
 from impact_balance.sim.studies.wall import WallOptions, run_wall_trial
-
-from .journal import journalled, open_journal, slim
 
 __all__ = [
     "OUTCOMES",

@@ -10,15 +10,14 @@ from typing import Any
 import numpy as np
 
 import impact_balance as ib
+from benchmarks.speed.projection import projection_cases
+from benchmarks.speed.targets import TARGET_PIPELINE_SCENARIO
+from benchmarks.speed.timing import Case, measure, stats
 from impact_balance.balance.areas import FORCE_BOX
 from impact_balance.contacts.stance import Stance
 from impact_balance.contacts.wrench_polytope import wrench_polytope
 from impact_balance.projection import project_polytope
 from impact_balance.projection.walk import NO_HINT
-
-from .projection import projection_cases
-from .targets import TARGET_PIPELINE_SCENARIO
-from .timing import Case, measure, stats
 
 __all__ = ["profile_report", "profile_text"]
 

@@ -10,11 +10,10 @@ from typing import Any
 import numpy as np
 
 import impact_balance as ib
+from benchmarks.speed.polygons import compare
+from benchmarks.speed.timing import Case, measure, stats
 from impact_balance.balance.areas import FORCE_BOX, FORCE_TOLERANCE
 from impact_balance.projection import project_polytope
-
-from .polygons import compare
-from .timing import Case, measure, stats
 
 try:  # pypoman is a test extra of the project
     import pypoman

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from .pipeline import PIPELINE_STAGES
+from benchmarks.speed.pipeline import PIPELINE_STAGES
 
 __all__ = ["fmt_us", "table", "text_report"]
 

@@ -10,11 +10,10 @@ from typing import Any
 import numpy as np
 
 import impact_balance as ib
+from benchmarks.speed.projection import bench_projection
+from benchmarks.speed.timing import Case, measure, progress, stats
 from impact_balance.contacts.stance import ContactSpec, Stance
 from impact_balance.contacts.wrench_polytope import wrench_polytope
-
-from .projection import bench_projection
-from .timing import Case, measure, progress, stats
 
 __all__ = ["bench_cone_edges", "bench_contacts", "talos_contact_sets"]
 
