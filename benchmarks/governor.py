@@ -83,8 +83,8 @@ def bench_scenario(name: str, ticks: int, criterion: str) -> dict[str, Any]:
     governor = Governor(name, criterion=criterion)
     qs, vs = trajectory(governor, ticks)
     # The equivalent scenarios, built before timing (analyze() is timed, not pydantic).
-    answers = [governor.limit(q, v) for q, v in zip(qs, vs)]
-    scenarios = [governor.scenario_at(q, a.com_velocity) for q, a in zip(qs, answers)]
+    answers = [governor.limit(q, v) for q, v in zip(qs, vs, strict=True)]
+    scenarios = [governor.scenario_at(q, a.com_velocity) for q, a in zip(qs, answers, strict=True)]
     k = {"i": 0}
 
     def at(i: int) -> None:

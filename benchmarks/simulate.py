@@ -96,7 +96,7 @@ def accuracy(
 def speed(seconds: float = 2.0) -> dict:
     sim = build_model("palm_push_two_feet", "servo", SimOptions(meshes=False))
     m, d = sim.model, sim.data
-    steps = int(round(seconds / m.opt.timestep))
+    steps = round(seconds / m.opt.timestep)
     start = time.perf_counter()
     for _ in range(steps):
         mujoco.mj_step(m, d)

@@ -90,8 +90,10 @@ def speedup(tmp: Path, quick: bool, rounds: int = 3) -> dict[str, Any]:
     """1 worker against 2, alternated ``rounds`` times; the best rate of each (the machine is
     shared: the best round is the one least slowed down by other processes)."""
     plan = _plan(
-        IMPACT_AXES[:2]
-        + [{"direction": "impact.normal", "azimuth": {"range": [150.0, 210.0], "count": 10}}]
+        [
+            *IMPACT_AXES[:2],
+            {"direction": "impact.normal", "azimuth": {"range": [150.0, 210.0], "count": 10}},
+        ]
     )
     rates: dict[int, list[float]] = {1: [], 2: []}
     startup = []

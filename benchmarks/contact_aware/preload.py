@@ -74,7 +74,7 @@ def preload_jump(
     dxi, impulses, _, converged = rigid_body_impact(
         stance.mass,
         stance.com_inertia,
-        [impact] + corners,
+        [impact, *corners],
         tolerance=1e-9 * max(approach_speed, 1e-3),
     )
     return dxi[:2], impulses, converged
@@ -111,7 +111,7 @@ def preload(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
         pairs, failed = journalled(
             journal,
             [{"speed": s} for s in args.speeds],
-            lambda key: one_row(sim, name, key["speed"]),
+            lambda key, sim=sim, name=name: one_row(sim, name, key["speed"]),
             f"preload {name}",
         )
         journal.close()
@@ -144,6 +144,11 @@ def preload(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
     return rows, failures
 
 
+def _joined(group: list[dict], key: str) -> str:
+    """``group``'s values of ``key``, 3 decimals, joined by " / "."""
+    return " / ".join(f"{r[key]:.3f}" for r in group)
+
+
 def preload_table(rows: list[dict]) -> str:
     """|predicted - measured| of the CoM velocity jump per stance at each speed, then the ramp's jumps."""
     lines = [
@@ -152,11 +157,10 @@ def preload_table(rows: list[dict]) -> str:
     ]
     for name in dict.fromkeys(r["scenario"] for r in rows):
         group = [r for r in rows if r["scenario"] == name]
-        join = lambda k: " / ".join(f"{r[k]:.3f}" for r in group)  # noqa: E731
         speeds = " / ".join(f"{r['speed']:g}" for r in group)
         lines.append(
-            f"| {name} | {speeds} | {join('error_no_preload')} "
-            f"| {join('error_preload')} (T = {1e3 * group[0]['duration']:g} ms) |"
+            f"| {name} | {speeds} | {_joined(group, 'error_no_preload')} "
+            f"| {_joined(group, 'error_preload')} (T = {1e3 * group[0]['duration']:g} ms) |"
         )
     return "\n".join(lines)
 

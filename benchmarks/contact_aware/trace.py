@@ -132,19 +132,21 @@ def branches_table(
         )
         posture = floating.posture
         t0 = time.perf_counter()
-        warm.new_posture(lambda: posture.stance)
+        warm.new_posture(lambda posture=posture: posture.stance)
         t1 = time.perf_counter()
-        union.new_posture(lambda: posture.stance)
+        union.new_posture(lambda posture=posture: posture.stance)
         warm_costs.append(1e3 * (t1 - t0))
         costs.append(1e3 * (time.perf_counter() - t1))
         if dt < -window:
             continue
-        cold.new_posture(lambda: posture.stance)
+        cold.new_posture(lambda posture=posture: posture.stance)
         a, b, u = (
             s.answer(posture.com_criterion, answer.com_velocity) for s in (cold, warm, union)
         )
         jumps = "; ".join(
-            f"{x:+.3f}, {y:+.3f}" for (x, y), c in zip(u.rates, u.restitution) if c == upper
+            f"{x:+.3f}, {y:+.3f}"
+            for (x, y), c in zip(u.rates, u.restitution, strict=True)
+            if c == upper
         )
         rows.append(
             f"| {dt:+.3f} | {answer.max_approach_speed:.3f} | {a.rates[-1][0]:+.3f}, {a.rates[-1][1]:+.3f} "

@@ -79,82 +79,7 @@ def score(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
     """The governed trials of ``args.variant`` (module docstring); rows and failures."""
     rows, failures = [], 0
     for name in args.scenarios:
-        options, margin, governed, setup = governed_setup(name, rigid=True)
-        parts = {"variant": args.variant, "margin": margin}
-        if args.velocity_margin:  # keeps the journals of the runs without one
-            parts["velocity_margin"] = args.velocity_margin
-        journal = open_journal(out, "score", name, parts)
-
-        def new_governor() -> Governor:
-            if args.variant == "off":
-                return Governor(governed, criterion="com", velocity_margin=args.velocity_margin)
-            if (
-                args.variant == "async"
-            ):  # the union's starts, recomputed by a worker process off the tick
-                return Governor(
-                    governed,
-                    criterion="com",
-                    contact_aware=ContactAwareOptions(asynchronous=True),
-                    velocity_margin=args.velocity_margin,
-                )
-            return Governor(
-                governed,
-                criterion="com",
-                contact_aware=ContactAwareOptions(starts=args.variant),
-                velocity_margin=args.velocity_margin,
-            )
-
-        def run(key: dict) -> dict:
-            governor, trials = (
-                new_governor(),
-                [],
-            )  # one governor for the walls of a reference, as the command
-            record = [] if governor._support is None else _timed(governor)
-            ages = [] if governor._worker is None else _adoptions(governor)
-            for distance in key["distances"]:
-                if args.variant == "cold":
-                    governor = new_governor()  # as the post hoc cold variant of section 4 was run
-                    record = _timed(governor)
-                del record[:]  # this trial's recomputations only
-                del ages[:]
-                wall = WallOptions(
-                    reference=key["reference"], governor="com", wall_distance=distance
-                )
-                trials.append(
-                    slim(run_wall_trial(setup, wall, options, governor=governor).to_dict())
-                )
-                d = trials[-1]
-                ms = np.array([r[0] for r in record]) if record else np.zeros(0)
-                d["recompute"] = (
-                    None
-                    if not record
-                    else {
-                        "count": len(record),
-                        "ms_median": float(np.median(ms)),
-                        "ms_max": float(ms.max()),
-                        "ms_p90": float(np.percentile(ms, 90)),
-                        "rows_max": max(r[1] for r in record),
-                        "solves_median": float(np.median([r[2] for r in record])),
-                    }
-                )
-                if ages:  # async: postures between two answers of the worker (the rates' age when replaced)
-                    d["rates_age"] = {
-                        "median": float(np.median(ages)),
-                        "max": int(max(ages)),
-                        "answers": len(ages),
-                    }
-                print(
-                    f"  {name} {key['reference']:g} m/s {100 * distance:g} cm: {d['outcome']} speed "
-                    f"{_f(d['speed_at_contact'])} cap {_f(d['cap_at_contact'])}",
-                    file=sys.stderr,
-                    flush=True,
-                )
-            governor.close()  # a worker process, with "async"
-            return {"trials": trials}
-
-        keys = [{"reference": r, "distances": list(args.distances)} for r in args.references]
-        pairs, failed = journalled(journal, keys, run, f"score {name}")
-        journal.close()
+        pairs, failed = _score_scenario(args, out, name)
         failures += failed
         rows += [
             {
@@ -167,6 +92,81 @@ def score(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
             for t in e["trials"]
         ]
     return rows, failures
+
+
+def _score_scenario(args: argparse.Namespace, out: Path, name: str) -> tuple[list, int]:
+    """The journalled governed trials of ``name``: ``(key, entry)`` pairs and failures."""
+    options, margin, governed, setup = governed_setup(name, rigid=True)
+    parts = {"variant": args.variant, "margin": margin}
+    if args.velocity_margin:  # keeps the journals of the runs without one
+        parts["velocity_margin"] = args.velocity_margin
+    journal = open_journal(out, "score", name, parts)
+
+    def new_governor() -> Governor:
+        if args.variant == "off":
+            return Governor(governed, criterion="com", velocity_margin=args.velocity_margin)
+        if args.variant == "async":
+            # the union's starts, recomputed by a worker process off the tick
+            return Governor(
+                governed,
+                criterion="com",
+                contact_aware=ContactAwareOptions(asynchronous=True),
+                velocity_margin=args.velocity_margin,
+            )
+        return Governor(
+            governed,
+            criterion="com",
+            contact_aware=ContactAwareOptions(starts=args.variant),
+            velocity_margin=args.velocity_margin,
+        )
+
+    def run(key: dict) -> dict:
+        # one governor for the walls of a reference, as the command
+        governor, trials = new_governor(), []
+        record = [] if governor._support is None else _timed(governor)
+        ages = [] if governor._worker is None else _adoptions(governor)
+        for distance in key["distances"]:
+            if args.variant == "cold":
+                governor = new_governor()  # as the post hoc cold variant of section 4 was run
+                record = _timed(governor)
+            del record[:]  # this trial's recomputations only
+            del ages[:]
+            wall = WallOptions(reference=key["reference"], governor="com", wall_distance=distance)
+            trials.append(slim(run_wall_trial(setup, wall, options, governor=governor).to_dict()))
+            d = trials[-1]
+            ms = np.array([r[0] for r in record]) if record else np.zeros(0)
+            d["recompute"] = (
+                None
+                if not record
+                else {
+                    "count": len(record),
+                    "ms_median": float(np.median(ms)),
+                    "ms_max": float(ms.max()),
+                    "ms_p90": float(np.percentile(ms, 90)),
+                    "rows_max": max(r[1] for r in record),
+                    "solves_median": float(np.median([r[2] for r in record])),
+                }
+            )
+            if ages:
+                # async: postures between two answers of the worker (the rates' age when replaced)
+                d["rates_age"] = {
+                    "median": float(np.median(ages)),
+                    "max": int(max(ages)),
+                    "answers": len(ages),
+                }
+            print(
+                f"  {name} {key['reference']:g} m/s {100 * distance:g} cm: {d['outcome']} speed "
+                f"{_f(d['speed_at_contact'])} cap {_f(d['cap_at_contact'])}",
+                file=sys.stderr,
+                flush=True,
+            )
+        governor.close()  # a worker process, with "async"
+        return {"trials": trials}
+
+    keys = [{"reference": r, "distances": list(args.distances)} for r in args.references]
+    pairs, failed = journalled(journal, keys, run, f"score {name}")
+    journal.close()
+    return pairs, failed
 
 
 def _signed(x: float | None, digits: int = 4) -> str:
@@ -238,35 +238,44 @@ def sweep(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
     """Ungoverned approaches at wall 15 cm with the inset margin at the end of the impact."""
     rows, failures = [], 0
     for name in args.scenarios:
-        options, margin, _, setup = governed_setup(name, rigid=True)
-        inset = setup.analysis.areas.com_velocity_area_inset(margin)
-        journal = open_journal(out, "sweep", name, {"wall": SWEEP_WALL, "margin": margin})
-
-        def run(key: dict) -> dict:
-            wall = WallOptions(
-                reference=key["reference"], governor="none", wall_distance=SWEEP_WALL
-            )
-            d = slim(run_wall_trial(setup, wall, options).to_dict())
-            after = np.asarray(
-                d["com_velocity_after"] if d["com_velocity_after"] is not None else [np.nan] * 2
-            )
-            d["margin_inset"] = float(inset.margins(after)[0]) if np.isfinite(after).all() else None
-            print(
-                f"  {name} {key['reference']:g} m/s: {d['outcome']} speed {_f(d['speed_at_contact'])} "
-                f"inset margin {_signed(d['margin_inset'])}",
-                file=sys.stderr,
-                flush=True,
-            )
-            return d
-
-        references = args.references or SWEEP_REFERENCES[name]
-        pairs, failed = journalled(
-            journal, [{"reference": r} for r in references], run, f"sweep {name}"
-        )
-        journal.close()
+        pairs, failed = _sweep_scenario(args, out, name)
         failures += failed
         rows += [{"scenario": name, **e} for _, e in pairs]
     return rows, failures
+
+
+def _sweep_scenario(args: argparse.Namespace, out: Path, name: str) -> tuple[list, int]:
+    """The journalled ungoverned trials of ``name``: ``(key, entry)`` pairs and failures."""
+    options, margin, _, setup = governed_setup(name, rigid=True)
+    inset = setup.analysis.areas.com_velocity_area_inset(margin)
+    journal = open_journal(out, "sweep", name, {"wall": SWEEP_WALL, "margin": margin})
+
+    def run(key: dict) -> dict:
+        wall = WallOptions(reference=key["reference"], governor="none", wall_distance=SWEEP_WALL)
+        d = slim(run_wall_trial(setup, wall, options).to_dict())
+        after = np.asarray(
+            d["com_velocity_after"] if d["com_velocity_after"] is not None else [np.nan] * 2
+        )
+        d["margin_inset"] = float(inset.margins(after)[0]) if np.isfinite(after).all() else None
+        print(
+            f"  {name} {key['reference']:g} m/s: {d['outcome']} speed {_f(d['speed_at_contact'])} "
+            f"inset margin {_signed(d['margin_inset'])}",
+            file=sys.stderr,
+            flush=True,
+        )
+        return d
+
+    references = args.references or SWEEP_REFERENCES[name]
+    pairs, failed = journalled(
+        journal, [{"reference": r} for r in references], run, f"sweep {name}"
+    )
+    journal.close()
+    return pairs, failed
+
+
+def _trial_cell(r: dict | None) -> str:
+    """A trial's speed at contact (m/s) and inset margin (m/s), or "-" without a trial."""
+    return "-" if r is None else f"{r['speed_at_contact']:.3f} ({_signed(r['margin_inset'])})"
 
 
 def sweep_table(rows: list[dict]) -> str:
@@ -295,10 +304,7 @@ def sweep_table(rows: list[dict]) -> str:
         fell = [r for r in group if r["outcome"] == "fell"]
         best = max(stood, key=lambda r: r["speed_at_contact"], default=None)
         worst = min(fell, key=lambda r: r["speed_at_contact"], default=None)
-        cell = lambda r: (
-            "-" if r is None else f"{r['speed_at_contact']:.3f} ({_signed(r['margin_inset'])})"
-        )
-        lines.append(f"| {name} | {len(group)} | {cell(best)} | {cell(worst)} |")
+        lines.append(f"| {name} | {len(group)} | {_trial_cell(best)} | {_trial_cell(worst)} |")
     stood = [
         r["margin_inset"] for r in rows if r["outcome"] != "fell" and r["margin_inset"] is not None
     ]

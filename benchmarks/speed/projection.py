@@ -59,7 +59,7 @@ def projection_cases(poly: ib.WrenchPolytope, scale: float, seed: int) -> dict[s
             return exc
 
     def reseed(i: int) -> None:  # pypoman's first ray is random (numpy's global RNG)
-        np.random.seed((seed + i) % 2**32)
+        np.random.seed((seed + i) % 2**32)  # noqa: NPY002 (pypoman draws from the global RNG)
 
     cases = {"ours": Case(ours, keep=lambda r: r)}  # a ProjectionResult holds only the polygon
     cases["bretl_highs"] = Case(ours_bretl, keep=lambda r: r)
