@@ -145,7 +145,8 @@ def main(argv: list[str] | None = None) -> int:
         m = result["machine"]
         print(
             f"\n(wall time {result['wall_time_s']:.0f} s; load average before "
-            f"{' '.join(map(str, m['load_average_before']))}, after {' '.join(map(str, m['load_average_after']))})"
+            f"{' '.join(map(str, m['load_average_before']))}, after "
+            f"{' '.join(map(str, m['load_average_after']))})"
         )
     return 0 if result["checks"]["ok"] else 1
 

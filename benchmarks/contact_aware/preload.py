@@ -84,7 +84,8 @@ def preload_bound(
     stance: Stance, spec: ImpactSpec, area, com_velocity: np.ndarray, duration: float
 ) -> float:
     """The largest approach speed (m/s, to 2e-6) keeping the preload jump at both restitution
-    bounds inside ``area``: bisection on [0, 2] m/s (the jump is affine, not linear, in the speed)."""
+    bounds inside ``area``: bisection on [0, 2] m/s (the jump is affine, not linear, in the
+    speed)."""
 
     def inside(speed: float) -> bool:
         return all(
@@ -150,7 +151,8 @@ def _joined(group: list[dict], key: str) -> str:
 
 
 def preload_table(rows: list[dict]) -> str:
-    """|predicted - measured| of the CoM velocity jump per stance at each speed, then the ramp's jumps."""
+    """|predicted - measured| of the CoM velocity jump per stance at each speed, then the ramp's
+    jumps."""
     lines = [
         "| stance | commanded speeds (m/s) | no preload | preload T = impact.duration |",
         "|---|---|---|---|",
@@ -238,6 +240,7 @@ def bounds_table(rows: list[dict], margins: list[float]) -> str:
         floating = " / ".join(f"{r[t]['floating']:.3f}" for t in tags)
         union = " / ".join(f"{r[t]['union']:.3f}" for t in tags)
         lines.append(
-            f"| {r['scenario']} | {floating} | {union}, {r[tags[-1]]['binding']} | {r['preload']:.3f} |"
+            f"| {r['scenario']} | {floating} | {union}, {r[tags[-1]]['binding']} | "
+            f"{r['preload']:.3f} |"
         )
     return "\n".join(lines)

@@ -1,5 +1,5 @@
-"""The simulated trials of ``score`` (governed, with or without the option: union, warm or cold starts)
-and ``sweep`` (ungoverned, wall 15 cm, the inset rule), and their tables."""
+"""The simulated trials of ``score`` (governed, with or without the option: union, warm or cold
+starts) and ``sweep`` (ungoverned, wall 15 cm, the inset rule), and their tables."""
 
 from __future__ import annotations
 
@@ -180,9 +180,9 @@ def _span(values: list[float], digits: int = 3) -> str:
 def score_table(rows: list[dict]) -> str:
     """Outcome counts and ranges per scenario (the table of docs/contact_aware_governor.md)."""
     lines = [
-        "| scenario | variant | trials | balanced / contact broken / fell | measured speed at contact (m/s) "
-        "| cap at contact (m/s) | speed / min(ref, cap) | tick median (us) | tick p99 (us) "
-        "| recomputation median / max (ms) | rows of the rates (most) |",
+        "| scenario | variant | trials | balanced / contact broken / fell | measured speed at "
+        "contact (m/s) | cap at contact (m/s) | speed / min(ref, cap) | tick median (us) | tick "
+        "p99 (us) | recomputation median / max (ms) | rows of the rates (most) |",
         "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for name in dict.fromkeys(r["scenario"] for r in rows):
@@ -207,14 +207,15 @@ def score_table(rows: list[dict]) -> str:
         )
         most = "-" if not recomputes else str(max(c["rows_max"] for c in recomputes))
         lines.append(
-            f"| {name} | {group[0]['variant']} | {len(group)} | {counts} | {_span(speeds)} | {_span(caps)} "
-            f"| {_span(ratios, 2)} | {_span([t['median'] for t in ticks], 0)} "
-            f"| {_span([t['p99'] for t in ticks], 0)} | {costs} | {most} |"
+            f"| {name} | {group[0]['variant']} | {len(group)} | {counts} | {_span(speeds)} | "
+            f"{_span(caps)} | {_span(ratios, 2)} | {_span([t['median'] for t in ticks], 0)} | "
+            f"{_span([t['p99'] for t in ticks], 0)} | {costs} | {most} |"
         )
     lines += [
         "",
-        "| scenario | reference (m/s) | wall (cm) | outcome | speed at contact (m/s) | cap at contact (m/s) "
-        "| speed / cap | raw margin at end (m/s) | slip (cm) | tick median / p99 (us) |",
+        "| scenario | reference (m/s) | wall (cm) | outcome | speed at contact (m/s) | cap at "
+        "contact (m/s) | speed / cap | raw margin at end (m/s) | slip (cm) | tick median / p99 "
+        "(us) |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
@@ -226,9 +227,9 @@ def score_table(rows: list[dict]) -> str:
         tick = r["tick_us"]
         ticks = "-" if tick["median"] is None else f"{tick['median']:.0f} / {tick['p99']:.0f}"
         lines.append(
-            f"| {r['scenario']} | {r['reference']:g} | {100 * r['wall_distance']:g} | {r['outcome']} "
-            f"| {_f(r['speed_at_contact'])} | {_f(r['cap_at_contact'])} | {ratio} | {r['margin_raw']:+.3f} "
-            f"| {100 * r['max_slip']:.1f} | {ticks} |"
+            f"| {r['scenario']} | {r['reference']:g} | {100 * r['wall_distance']:g} | "
+            f"{r['outcome']} | {_f(r['speed_at_contact'])} | {_f(r['cap_at_contact'])} | {ratio} | "
+            f"{r['margin_raw']:+.3f} | {100 * r['max_slip']:.1f} | {ticks} |"
         )
     return "\n".join(lines)
 
@@ -281,8 +282,8 @@ def _trial_cell(r: dict | None) -> str:
 def sweep_table(rows: list[dict]) -> str:
     """Every trial, then per stance the fastest that did not fall and the slowest that fell."""
     lines = [
-        "| scenario | reference (m/s) | measured v_n (m/s) | outcome | raw margin | inset margin | slip (cm) "
-        "| sustained impulse z per contact (N s) |",
+        "| scenario | reference (m/s) | measured v_n (m/s) | outcome | raw margin | inset margin "
+        "| slip (cm) | sustained impulse z per contact (N s) |",
         "|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
@@ -290,12 +291,14 @@ def sweep_table(rows: list[dict]) -> str:
             f"{k} {v[2]:+.2f}" for k, v in (r["sustained_impulses"] or {}).items()
         )
         lines.append(
-            f"| {r['scenario']} | {r['reference']:g} | {_f(r['speed_at_contact'])} | {r['outcome']} "
-            f"| {r['margin_raw']:+.3f} | {_signed(r['margin_inset'])} | {100 * r['max_slip']:.2f} | {sustained} |"
+            f"| {r['scenario']} | {r['reference']:g} | {_f(r['speed_at_contact'])} | "
+            f"{r['outcome']} | {r['margin_raw']:+.3f} | {_signed(r['margin_inset'])} | "
+            f"{100 * r['max_slip']:.2f} | {sustained} |"
         )
     lines += [
         "",
-        "| scenario | trials | stood: largest v_n (inset margin) | fell: smallest v_n (inset margin) |",
+        "| scenario | trials | stood: largest v_n (inset margin) | fell: smallest v_n (inset "
+        "margin) |",
         "|---|---|---|---|",
     ]
     for name in dict.fromkeys(r["scenario"] for r in rows):
@@ -312,7 +315,8 @@ def sweep_table(rows: list[dict]) -> str:
         r["margin_inset"] for r in rows if r["outcome"] == "fell" and r["margin_inset"] is not None
     ]
     lines.append(
-        f"\nThe inset rule over {len(rows)} trials: the trials that did not fall end with inset margins "
-        f">= {_signed(min(stood, default=None))} m/s; those that fell <= {_signed(max(fell, default=None))} m/s."
+        f"\nThe inset rule over {len(rows)} trials: the trials that did not fall end with inset "
+        f"margins >= {_signed(min(stood, default=None))} m/s; those that fell <= "
+        f"{_signed(max(fell, default=None))} m/s."
     )
     return "\n".join(lines)

@@ -155,18 +155,21 @@ def profile_text(p: dict[str, Any]) -> str:
     for key in ("analyze", "projection_talos_three_contacts"):
         e = p[key]
         out.append(
-            f"  {key}: {e['total_us_per_run']:.0f} us per run under cProfile ({e['runs']} runs); top by own time:"
+            f"  {key}: {e['total_us_per_run']:.0f} us per run under cProfile ({e['runs']} runs); "
+            "top by own time:"
         )
         for r in e["top"]:
             out.append(
-                f"    {r['tottime_pct']:5.1f}%  {r['tottime_us_per_run']:8.0f} us  {r['calls_per_run']:6.1f} calls  {r['function']}"
+                f"    {r['tottime_pct']:5.1f}%  {r['tottime_us_per_run']:8.0f} us  "
+                f"{r['calls_per_run']:6.1f} calls  {r['function']}"
             )
     out.append("  micro-breakdown, median us (palm_push_two_feet):")
     for k, v in p["micro_us"].items():
         out.append(f"    {v:9.1f}  {k}")
     w = p["walk"]
     out.append(
-        f"  walk on {w['scenario']}: {w['pivots']} pivots for {w['vertices']} vertices"
-        f" ({w['reduced_variables']} variables after the equalities, {w['rows']} rows before dropping zero rows)"
+        f"  walk on {w['scenario']}: {w['pivots']} pivots for {w['vertices']} vertices "
+        f"({w['reduced_variables']} variables after the equalities, {w['rows']} rows before "
+        "dropping zero rows)"
     )
     return "\n".join(out)

@@ -51,13 +51,14 @@ def text_report(result: dict[str, Any], args) -> str:
     )
     s = result["settings"]
     out.append(
-        f"Repeats: {s['repeat']} (cheap calls {s['repeat_cheap']}), warm-up {s['warmup']}; times in us, median (p10-p90)"
+        f"Repeats: {s['repeat']} (cheap calls {s['repeat_cheap']}), warm-up {s['warmup']}; times "
+        "in us, median (p10-p90)"
     )
     out.append("")
     out.append(
-        "1. Projection (resultant horizontal force polygon, units of m g): ours (compiled walk) vs pypoman bretl"
-        f" (onto {s['pypoman_scale']:g} F) and vs our own Bretl/HiGHS path;"
-        f" agreement = relative area of the symmetric difference, tol {s['tol']:g}, with both"
+        "1. Projection (resultant horizontal force polygon, units of m g): ours (compiled walk) "
+        f"vs pypoman bretl (onto {s['pypoman_scale']:g} F) and vs our own Bretl/HiGHS path; "
+        f"agreement = relative area of the symmetric difference, tol {s['tol']:g}, with both"
     )
     rows = []
     for name, e in result["stances"].items():
@@ -219,8 +220,8 @@ def text_report(result: dict[str, Any], args) -> str:
     out.append("")
     if c["ok"]:
         out.append(
-            f"Answers: OK, every pypoman and Bretl/HiGHS polygon matches ours within {s['tol']:g} relative area "
-            f"(worst symmetric difference {c['worst_symdiff_rel']:.1e})."
+            f"Answers: OK, every pypoman and Bretl/HiGHS polygon matches ours within {s['tol']:g} "
+            f"relative area (worst symmetric difference {c['worst_symdiff_rel']:.1e})."
         )
     else:
         out.append("Answers: MISMATCH")

@@ -68,7 +68,8 @@ def bench_contacts(args) -> list[dict[str, Any]]:
             entry.update(bench_projection(poly, args))
             rows.append(entry)
             progress(
-                f"  scaling {label}, torque limits {tl}: {entry['project_us']['median']:.0f} us, {entry['pivots']} pivots"
+                f"  scaling {label}, torque limits {tl}: {entry['project_us']['median']:.0f} us, "
+                f"{entry['pivots']} pivots"
             )
     return rows
 
