@@ -1,14 +1,16 @@
 """Physics evidence: every table of README's and docs/validation.md's balance sections.
 
     python benchmarks/balance.py [--parts speed impacts pushes] [--out DIR] [--directions 8]
-                                 [--relative 0.5 0.7 0.85 1.0 1.15 1.3 1.5] [--scenarios ...] [--push-scenarios ...]
+                                 [--relative 0.5 0.7 0.85 1.0 1.15 1.3 1.5]
+                                 [--scenarios ...] [--push-scenarios ...]
 
-Held-out protocol (docs/validation.md): the controllers' gains are frozen (benchmarks/tune_id.py tuned
-the ``id`` controller's margins on ``talos_tuning_stagger``, which is never scored); every push is
-predicted before its trial and scored after, on grids that straddle the boundary (fractions of each
-direction's boundary impulse); rates come with 95 % Wilson intervals. Trials are written to journals
-under ``--out`` as they finish: a second run resumes and recomputes only the scores. It takes tens of
-minutes on 2 cores; it prints markdown tables and writes every number to ``DIR/balance.json``.
+Held-out protocol (docs/validation.md): the controllers' gains are frozen (benchmarks/tune_id.py
+tuned the ``id`` controller's margins on ``talos_tuning_stagger``, which is never scored); every
+push is predicted before its trial and scored after, on grids that straddle the boundary
+(fractions of each direction's boundary impulse); rates come with 95 % Wilson intervals. Trials
+are written to journals under ``--out`` as they finish: a second run resumes and recomputes only
+the scores. It takes tens of minutes on 2 cores; it prints markdown tables and writes every
+number to ``DIR/balance.json``.
 """
 
 from __future__ import annotations
@@ -101,8 +103,9 @@ def impacts(names, out: Path) -> list[dict]:
     rows = []
     print("\n## Impacts: fall threshold in measured approach speed (m/s)\n")
     print(
-        "| scenario | controller, joints | impact | CoM crit. (0 / margin) | stood / fell, measured | commanded | "
-        "fell / predicted | first contact break | palm impulse at 'fell' (N s) | sustained contacts' impulse | trials |"
+        "| scenario | controller, joints | impact | CoM crit. (0 / margin) | stood / fell, "
+        "measured | commanded | fell / predicted | first contact break | palm impulse at 'fell' "
+        "(N s) | sustained contacts' impulse | trials |"
     )
     print("|---|---|---|---|---|---|---|---|---|---|---|", flush=True)
     for name in names:
@@ -149,9 +152,10 @@ def impacts(names, out: Path) -> list[dict]:
             )
             stood = _f(e["survived"]) + ("" if e["monotonic"] else " (non-monotonic)")
             print(
-                f"| {name} | {controller}, {joints} | {'rigid' if rigid else 'free'} | {_f(p['composite'])} / "
-                f"{_f(pm['composite'])} | {stood} / {_f(e['fell'])} | {_f(e['survived_commanded'])} / "
-                f"{_f(e['fell_commanded'])} | {_f(ratio, 2)} | {brk_text} | {palm} | {sustained} | {len(d['trials'])} |",
+                f"| {name} | {controller}, {joints} | {'rigid' if rigid else 'free'} | "
+                f"{_f(p['composite'])} / {_f(pm['composite'])} | {stood} / {_f(e['fell'])} | "
+                f"{_f(e['survived_commanded'])} / {_f(e['fell_commanded'])} | {_f(ratio, 2)} | "
+                f"{brk_text} | {palm} | {sustained} | {len(d['trials'])} |",
                 flush=True,
             )
     return rows
@@ -164,16 +168,19 @@ def pushes(
     options = BalanceTrialOptions(controller="id")
     own = controller_margin(options)
     print(
-        f"\n## Pushes (id controller, {directions} directions x {relative} of the boundary impulse, 50 ms)\n"
+        f"\n## Pushes (id controller, {directions} directions x {relative} of the boundary "
+        "impulse, 50 ms)\n"
     )
     print(
-        "| scenario | body | pushes | balanced / contact broken / fell / aborted | margin (mm) | CoM criterion before: "
-        "right / safe & fell (%) | CoM in trial | ZMP before | ZMP in trial | smallest margin (CoM, <= 5 %) |"
+        "| scenario | body | pushes | balanced / contact broken / fell / aborted | margin (mm) | "
+        "CoM criterion before: right / safe & fell (%) | CoM in trial | ZMP before | ZMP in trial "
+        "| smallest margin (CoM, <= 5 %) |"
     )
     print("|---|---|---|---|---|---|---|---|---|---|", flush=True)
     for name, which in ((n, b) for n in names for b in bodies):
         setup = BalanceSetup.create(name, "servo", options)
-        # "torso": the push-test default; "base": the root body (Talos' base_link, G1's pelvis), near the CoM.
+        # "torso": the push-test default; "base": the root body (Talos' base_link, G1's pelvis),
+        # near the CoM.
         body = None if which == "torso" else setup.sim.model.body(setup.sim.root_body).name
         journal = _journal(
             out,
@@ -198,19 +205,21 @@ def pushes(
         d["margin_study"] = study
         rows.append(d)
         o = d["counts"]["outcomes"]
+        counts = " / ".join(str(o[k]) for k in ("balanced", "contact_broken", "fell", "aborted"))
         smallest = study["smallest_margin"]["com"]
         for m in study["margins"]:
             s = study["scores"][f"{m:g}"]
             cells = [
-                f"{_pct(s[k]['accuracy'])}{_ci(s[k]['accuracy_ci95'])} / {_pct(s[k]['safe_fell_rate'])}"
-                f"{_ci(s[k]['safe_fell_rate_ci95'])}"
+                f"{_pct(s[k]['accuracy'])}{_ci(s[k]['accuracy_ci95'])} / "
+                f"{_pct(s[k]['safe_fell_rate'])}{_ci(s[k]['safe_fell_rate_ci95'])}"
                 for k in ("com", "com_in_trial", "zmp", "zmp_in_trial")
             ]
             first = m == study["margins"][0]
             print(
-                f"| {name if first else ''} | {d['body'] if first else ''} | {len(r.outcomes) if first else ''} | "
-                f"{(str(o['balanced']) + ' / ' + str(o['contact_broken']) + ' / ' + str(o['fell']) + ' / ' + str(o['aborted'])) if first else ''} | "
-                f"{1e3 * m:g}{' (own)' if m == own else ''} | {' | '.join(cells)} | "
+                f"| {name if first else ''} | {d['body'] if first else ''} | "
+                f"{len(r.outcomes) if first else ''} | "
+                f"{counts if first else ''} "
+                f"| {1e3 * m:g}{' (own)' if m == own else ''} | {' | '.join(cells)} | "
                 f"{('-' if smallest is None else f'{1e3 * smallest:g} mm') if first else ''} |",
                 flush=True,
             )
@@ -237,7 +246,8 @@ def pushes(
                 or "-"
             )
             print(
-                f"| {d['scenario']} | {d['body']} | {frac:g} | {row['n']} | {row['broken']} | {row['fell']} | {first} |"
+                f"| {d['scenario']} | {d['body']} | {frac:g} | {row['n']} | {row['broken']} | "
+                f"{row['fell']} | {first} |"
             )
     return rows
 

@@ -1,12 +1,14 @@
 #!/usr/bin/env python
 """The contact-aware governor option (experimental): every table of docs/contact_aware_governor.md.
 
-    python benchmarks/contact_aware_governor.py score --out DIR [--variant union|warm|cold|off|async]
+    python benchmarks/contact_aware_governor.py score --out DIR
+            [--variant union|warm|cold|off|async]
             [--scenarios ...] [--references 0.5 1 2] [--distances 0.12 0.15 0.18]
     python benchmarks/contact_aware_governor.py sweep --out DIR [--scenarios ...] [--references ...]
     python benchmarks/contact_aware_governor.py bounds [--scenarios ...] [--margins 0 0.01]
     python benchmarks/contact_aware_governor.py preload --out DIR [--scenarios ...] [--speeds ...]
-    python benchmarks/contact_aware_governor.py trace --out DIR [--scenario S] [--governor com|none] [--contact-aware]
+    python benchmarks/contact_aware_governor.py trace --out DIR [--scenario S]
+            [--governor com|none] [--contact-aware]
             [--reference R] [--wall D] [--every MS] [--branches]
 
 Every simulated trial is the ``approach`` command's (``id`` controller, ``servo`` joints held
@@ -64,11 +66,28 @@ import json
 import sys
 from pathlib import Path
 
-# The benchmark's modules live in contact_aware/, beside this file (on sys.path as the script's folder).
-from contact_aware.preload import TRAINING, bounds, bounds_table, preload, preload_table, ramp_jumps
-from contact_aware.trace import trace
-from contact_aware.trials import SWEEP_REFERENCES, VARIANTS, score, score_table, sweep, sweep_table
-from governor_study import SCENARIOS, _load
+# Run as a file, only the script's folder is on sys.path: put the repository root first,
+# for the ``benchmarks`` package.
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.contact_aware.preload import (
+    TRAINING,
+    bounds,
+    bounds_table,
+    preload,
+    preload_table,
+    ramp_jumps,
+)
+from benchmarks.contact_aware.trace import trace
+from benchmarks.contact_aware.trials import (
+    SWEEP_REFERENCES,
+    VARIANTS,
+    score,
+    score_table,
+    sweep,
+    sweep_table,
+)
+from benchmarks.governor_study import SCENARIOS, _load
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -82,9 +101,9 @@ def main(argv: list[str] | None = None) -> int:
         "--variant",
         choices=VARIANTS,
         default="union",
-        help="union: --contact-aware, the union of the LCP's solutions (default, section 5); async: the same "
-        "computed off the tick (--contact-aware-async); warm: as "
-        "frozen in 5e477e6 (section 4's 'aware'); cold: post hoc cold start; off: without it",
+        help="union: --contact-aware, the union of the LCP's solutions (default, section 5); "
+        "async: the same computed off the tick (--contact-aware-async); warm: as frozen in "
+        "5e477e6 (section 4's 'aware'); cold: post hoc cold start; off: without it",
     )
     s.add_argument("--scenarios", nargs="+", default=list(SCENARIOS))
     s.add_argument("--references", type=float, nargs="+", default=[0.5, 1.0, 2.0], help="m/s")

@@ -58,7 +58,8 @@ def one_row(sim, name: str, speed: float) -> dict:
     floating = result.predicted["composite"]
     model = contact_impact(sim.stance, sim.scenario.impact.spec(), v_n, restitution=e)
     error = float(np.linalg.norm(model.com_velocity_jump - measured))
-    # The same Coulomb impact without the sustained contacts: what the contacts change, at equal friction law.
+    # The same Coulomb impact without the sustained contacts: what the contacts change, at equal
+    # friction law.
     free = contact_impact(
         Stance(sim.stance.robot, sim.stance.q, []), sim.scenario.impact.spec(), v_n, restitution=e
     )
@@ -105,9 +106,9 @@ def one_row(sim, name: str, speed: float) -> dict:
 
 def table(rows: list[dict]) -> str:
     head = (
-        "| scenario | v cmd | v_n meas. | e meas. | jump measured x, y | floating: distance (x range) "
-        "| same law, no sustained contacts: jump x, y (error) | contact-aware: jump x, y | error (rel.) "
-        "| sustained impulse x, z: measured / predicted (N s) |"
+        "| scenario | v cmd | v_n meas. | e meas. | jump measured x, y | floating: distance (x "
+        "range) | same law, no sustained contacts: jump x, y (error) | contact-aware: jump x, y | "
+        "error (rel.) | sustained impulse x, z: measured / predicted (N s) |"
     )
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
@@ -116,12 +117,13 @@ def table(rows: list[dict]) -> str:
         rel = r["contact_relative_error"]
         sm, sp = r["sustained_impulse_measured"], r["contact_sustained_impulse"]
         lines.append(
-            f"| {r['scenario']} | {r['speed']:g} | {r['approach_measured']:.3f} | {r['restitution_measured']:.2f} "
-            f"| {jm[0]:+.3f}, {jm[1]:+.3f} | {r['floating_distance']:.3f} ({lo:+.3f} to {hi:+.3f}) "
-            f"| {r['free_jump'][0]:+.3f}, {r['free_jump'][1]:+.3f} ({r['free_error']:.3f}) "
-            f"| {jc[0]:+.3f}, {jc[1]:+.3f}{'' if r['contact_converged'] else ' (not converged)'} "
-            f"| {r['contact_error']:.3f} ({100 * rel:.0f} %) "
-            f"| {sm[0]:+.2f}, {sm[2]:+.2f} / {sp[0]:+.2f}, {sp[2]:+.2f} |"
+            f"| {r['scenario']} | {r['speed']:g} | {r['approach_measured']:.3f} | "
+            f"{r['restitution_measured']:.2f} | {jm[0]:+.3f}, {jm[1]:+.3f} | "
+            f"{r['floating_distance']:.3f} ({lo:+.3f} to {hi:+.3f}) | {r['free_jump'][0]:+.3f}, "
+            f"{r['free_jump'][1]:+.3f} ({r['free_error']:.3f}) | {jc[0]:+.3f}, "
+            f"{jc[1]:+.3f}{'' if r['contact_converged'] else ' (not converged)'} | "
+            f"{r['contact_error']:.3f} ({100 * rel:.0f} %) | {sm[0]:+.2f}, {sm[2]:+.2f} / "
+            f"{sp[0]:+.2f}, {sp[2]:+.2f} |"
         )
     return "\n".join(lines)
 
@@ -142,7 +144,8 @@ def criterion_table(names: list[str], margin: float) -> str:
     import impact_balance as ib
 
     lines = [
-        f"| scenario | floating: max v_n, m/s (no margin / {1e3 * margin:g} mm) | contact-aware (no margin / {1e3 * margin:g} mm) |",
+        f"| scenario | floating: max v_n, m/s (no margin / {1e3 * margin:g} mm) | contact-aware "
+        f"(no margin / {1e3 * margin:g} mm) |",
         "|---|---|---|",
     ]
     for name in names:

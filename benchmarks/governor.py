@@ -2,8 +2,8 @@
 """Issue 15 targets: the governor's time per control tick, beside a full ``analyze()`` per tick.
 
     python benchmarks/governor.py [--json] [--ticks N] [--scenarios NAME ...] [--criterion com|zmp]
-    python benchmarks/governor.py --study [--out DIR] ...     # the wall study: see governor_study.py
-    python benchmarks/governor.py --tolerance ...             # posture_tolerance: see governor_tolerance.py
+    python benchmarks/governor.py --study [--out DIR] ...  # wall study: governor_study.py
+    python benchmarks/governor.py --tolerance ...          # tolerance: governor_tolerance.py
 
 For each scenario of the wall study (palm_push_two_feet, palm_push_ramp, kick_one_foot,
 g1_two_feet), a 500 Hz trajectory of N ticks (default 2000, 4 s): every actuated joint follows
@@ -30,16 +30,19 @@ import argparse
 import json
 import sys
 import time
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
-# The benchmark's modules live in speed/, beside this file (on sys.path as the script's folder).
-from speed.machine import machine_info
-from speed.timing import Case, measure, progress
+# Run as a file, only the script's folder is on sys.path: put the repository root first,
+# for the ``benchmarks`` package.
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import impact_balance as ib
+from benchmarks.speed.machine import machine_info
+from benchmarks.speed.timing import Case, measure, progress
 from impact_balance.governor import Governor
 
 #: The wall study's scenarios (issue 15, item 3).
@@ -80,8 +83,8 @@ def bench_scenario(name: str, ticks: int, criterion: str) -> dict[str, Any]:
     governor = Governor(name, criterion=criterion)
     qs, vs = trajectory(governor, ticks)
     # The equivalent scenarios, built before timing (analyze() is timed, not pydantic).
-    answers = [governor.limit(q, v) for q, v in zip(qs, vs)]
-    scenarios = [governor.scenario_at(q, a.com_velocity) for q, a in zip(qs, answers)]
+    answers = [governor.limit(q, v) for q, v in zip(qs, vs, strict=True)]
+    scenarios = [governor.scenario_at(q, a.com_velocity) for q, a in zip(qs, answers, strict=True)]
     k = {"i": 0}
 
     def at(i: int) -> None:
@@ -161,15 +164,17 @@ def text_report(result: dict[str, Any]) -> str:
     ]
     head = (
         f"{'scenario':20s}  {'posture med':>11s}  {'p99':>7s}  {'velocity med':>12s}  {'p99':>6s}  "
-        f"{'analyze med':>11s}  {'p99':>7s}  {'analyze/posture':>15s}  {'check':>5s}  load avg (before; after)"
+        f"{'analyze med':>11s}  {'p99':>7s}  {'analyze/posture':>15s}  {'check':>5s}  load avg "
+        "(before; after)"
     )
     lines += [head, "-" * len(head)]
     for r in result["scenarios"]:
         lines.append(
             f"{r['scenario']:20s}  {r['posture']['median']:11.1f}  {r['posture']['p99']:7.0f}  "
-            f"{r['velocity']['median']:12.1f}  {r['velocity']['p99']:6.0f}  {r['analyze']['median']:11.1f}  "
-            f"{r['analyze']['p99']:7.0f}  {r['ratio_analyze_over_posture']:15.2f}  "
-            f"{'ok' if r['agree'] else 'FAIL':>5s}  {r['loadavg_before']}; {r['loadavg_after']}"
+            f"{r['velocity']['median']:12.1f}  {r['velocity']['p99']:6.0f}  "
+            f"{r['analyze']['median']:11.1f}  {r['analyze']['p99']:7.0f}  "
+            f"{r['ratio_analyze_over_posture']:15.2f}  {'ok' if r['agree'] else 'FAIL':>5s}  "
+            f"{r['loadavg_before']}; {r['loadavg_after']}"
         )
     lines.append("")
     lines.append("Targets (informative; they do not change the exit status)")
@@ -190,8 +195,8 @@ def evaluate_targets(rows: list[dict[str, Any]]) -> list[str]:
         worst = max(rows, key=lambda r: r[case][stat])
         value = worst[case][stat]
         out.append(
-            f"[{'PASS' if value <= bound else 'FAIL'}] {label} <= {bound:g} us: worst {value:.1f} us "
-            f"({worst['scenario']})"
+            f"[{'PASS' if value <= bound else 'FAIL'}] {label} <= {bound:g} us: worst {value:.1f} "
+            f"us ({worst['scenario']})"
         )
     return out
 
@@ -199,13 +204,13 @@ def evaluate_targets(rows: list[dict[str, Any]]) -> list[str]:
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv[:1] == ["--study"]:  # the wall study (issue 15, item 3): benchmarks/governor_study.py
-        import governor_study
+        from benchmarks import governor_study
 
         return governor_study.main(argv[1:])
     if argv[:1] == [
         "--tolerance"
     ]:  # posture_tolerance in the wall experiment: benchmarks/governor_tolerance.py
-        import governor_tolerance
+        from benchmarks import governor_tolerance
 
         return governor_tolerance.main(argv[1:])
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])

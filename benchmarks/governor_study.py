@@ -1,15 +1,17 @@
 """Issue 15's study: the governed approach to an unknown wall, on four stances.
 
-    python benchmarks/governor.py --study [--out DIR] [--scenarios ...] [--references 0.2 0.5 1.0 2.0]
-                                        [--distances 0.12 0.15 0.18] [--governors com zmp none] [--impacts rigid free]
+    python benchmarks/governor.py --study [--out DIR] [--scenarios ...]
+                                        [--references 0.2 0.5 1.0 2.0] [--distances 0.12 0.15 0.18]
+                                        [--governors com zmp none] [--impacts rigid free]
 
-For every scenario, reference speed, wall distance, governor and impact model (``rigid``: every joint
-held through the impact, the paper's robot; ``free``: the torque-controlled robot as it is), one
-``approach`` trial with the ``id`` controller; the governor uses the scenario's areas shrunk by the
-controller's 10 mm ZMP margin. Trials go to journals under ``--out`` as they finish (a rerun
-resumes). Prints the outcome counts per governor, the measured contact speed against
+For every scenario, reference speed, wall distance, governor and impact model (``rigid``: every
+joint held through the impact, the paper's robot; ``free``: the torque-controlled robot as it
+is), one ``approach`` trial with the ``id`` controller; the governor uses the scenario's areas
+shrunk by the controller's 10 mm ZMP margin. Trials go to journals under ``--out`` as they finish
+(a rerun resumes). Prints the outcome counts per governor, the measured contact speed against
 min(reference, the cap at contact), the time to contact, the governor's time per tick, and writes
-``DIR/governor_study.json`` and the figure of the paper's case (0.8 m/s reference, 15 cm) per governor.
+``DIR/governor_study.json`` and the figure of the paper's case (0.8 m/s reference, 15 cm) per
+governor.
 """
 
 from __future__ import annotations
@@ -99,9 +101,9 @@ def study(args, out: Path) -> list[dict]:
                         rows.append({"scenario": name, "impact": impact, **entry})
                         d = rows[-1]
                         print(
-                            f"  {name} {impact} {g} {reference:g} m/s {100 * distance:g} cm: {d['outcome']} "
-                            f"speed {_f(d['speed_at_contact'])} cap {_f(d['cap_at_contact'])} "
-                            f"t {_f(d['time_to_contact'], 2)}",
+                            f"  {name} {impact} {g} {reference:g} m/s {100 * distance:g} cm: "
+                            f"{d['outcome']} speed {_f(d['speed_at_contact'])} cap "
+                            f"{_f(d['cap_at_contact'])} t {_f(d['time_to_contact'], 2)}",
                             file=sys.stderr,
                             flush=True,
                         )
@@ -112,8 +114,9 @@ def study(args, out: Path) -> list[dict]:
 def tables(rows: list[dict]) -> None:
     print("\n## Outcomes per governor (all references and wall distances)\n")
     print(
-        "| scenario | impact | governor | trials | balanced / contact broken / fell / aborted | measured speed at contact (m/s) "
-        "| cap at contact (m/s) | time to contact (s) | speed / min(reference, cap): worst | governor tick median / p99 (us) |"
+        "| scenario | impact | governor | trials | balanced / contact broken / fell / aborted | "
+        "measured speed at contact (m/s) | cap at contact (m/s) | time to contact (s) | speed / "
+        "min(reference, cap): worst | governor tick median / p99 (us) |"
     )
     print("|---|---|---|---|---|---|---|---|---|---|")
     keys = sorted(
@@ -147,9 +150,10 @@ def tables(rows: list[dict]) -> None:
         )
         span = lambda v, d=3: "-" if not v else f"{min(v):.{d}f} to {max(v):.{d}f}"  # noqa: E731
         print(
-            f"| {scenario} | {impact} | {g} | {len(group)} | {counts['balanced']} / {counts['contact_broken']} / "
-            f"{counts['fell']} / {counts['aborted']} | {span(speeds)} | {span(caps)} | {span(times, 2)} | "
-            f"{_f(min(ratios) if ratios else None, 2)} | {tick} |"
+            f"| {scenario} | {impact} | {g} | {len(group)} | {counts['balanced']} / "
+            f"{counts['contact_broken']} / {counts['fell']} / {counts['aborted']} | {span(speeds)} "
+            f"| {span(caps)} | {span(times, 2)} | {_f(min(ratios) if ratios else None, 2)} | "
+            f"{tick} |"
         )
 
 

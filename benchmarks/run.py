@@ -33,20 +33,23 @@ import json
 import sys
 import time
 import warnings
+from pathlib import Path
 from typing import Any
 
-# The benchmark's modules live in speed/, beside this file (on sys.path as the script's folder).
-from speed.checks import answer_checks
-from speed.machine import load_average, machine_info
-from speed.profiling import profile_report, profile_text
-from speed.projection import pypoman
-from speed.report import text_report
-from speed.scaling import bench_cone_edges, bench_contacts
-from speed.stances import bench_stance
-from speed.targets import evaluate_targets
-from speed.timing import progress
+# Run as a file, only the script's folder is on sys.path: put the repository root first,
+# for the ``benchmarks`` package.
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import impact_balance as ib
+from benchmarks.speed.checks import answer_checks
+from benchmarks.speed.machine import load_average, machine_info
+from benchmarks.speed.profiling import profile_report, profile_text
+from benchmarks.speed.projection import pypoman
+from benchmarks.speed.report import text_report
+from benchmarks.speed.scaling import bench_cone_edges, bench_contacts
+from benchmarks.speed.stances import bench_stance
+from benchmarks.speed.targets import evaluate_targets
+from benchmarks.speed.timing import progress
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -142,7 +145,8 @@ def main(argv: list[str] | None = None) -> int:
         m = result["machine"]
         print(
             f"\n(wall time {result['wall_time_s']:.0f} s; load average before "
-            f"{' '.join(map(str, m['load_average_before']))}, after {' '.join(map(str, m['load_average_after']))})"
+            f"{' '.join(map(str, m['load_average_before']))}, after "
+            f"{' '.join(map(str, m['load_average_after']))})"
         )
     return 0 if result["checks"]["ok"] else 1
 

@@ -9,9 +9,9 @@ the jump's magnitude, and where the jump falls between the two models (its magni
 each set's size, the largest norm of its vertices). ``servo`` joints carry the rotor
 inertia the robot files declare (the SRDF's rotor_params; ``--armature`` sets one value for every
 joint instead); ``held`` is ``servo`` with ``--rigid-impact`` (every joint keeps its velocity
-through the impact). The impulse the sustained contacts take is reported too. Then the speed: standing Talos (``servo``, holding
-``palm_push_two_feet``) stepped for 2 s of simulated time, bare ``mj_step`` and with the
-trial's recording.
+through the impact). The impulse the sustained contacts take is reported too. Then the speed:
+standing Talos (``servo``, holding ``palm_push_two_feet``) stepped for 2 s of simulated time,
+bare ``mj_step`` and with the trial's recording.
 
 Targets: ``rigid``: distance to ``composite`` <= 2 % of the jump everywhere; standing Talos
 >= 5x faster than real time.
@@ -96,7 +96,7 @@ def accuracy(
 def speed(seconds: float = 2.0) -> dict:
     sim = build_model("palm_push_two_feet", "servo", SimOptions(meshes=False))
     m, d = sim.model, sim.data
-    steps = int(round(seconds / m.opt.timestep))
+    steps = round(seconds / m.opt.timestep)
     start = time.perf_counter()
     for _ in range(steps):
         mujoco.mj_step(m, d)
@@ -115,17 +115,19 @@ def speed(seconds: float = 2.0) -> dict:
 
 def markdown(rows: list[dict], perf: dict) -> str:
     out = [
-        "| scenario (robot) | joints | v (m/s) | e | |jump| (m/s) | to composite | to joint_space | |jump| / composite size "
-        "| |jump| / joint_space size | impulse: impact / sustained (N s) | contacts kept |",
+        "| scenario (robot) | joints | v (m/s) | e | |jump| (m/s) | to composite | to "
+        "joint_space | |jump| / composite size | |jump| / joint_space size | impulse: impact / "
+        "sustained (N s) | contacts kept |",
         "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         kept = "n/a" if r["contacts_kept"] is None else ("yes" if r["contacts_kept"] else "no")
         out.append(
-            f"| {r['scenario']} ({r['robot']}) | {r['joints']} | {r['speed']:g} | {r['restitution']:.2f} | "
-            f"{r['jump_norm']:.4f} | {r['composite_relative']:.2%} | {r['joint_space_relative']:.0%} | "
-            f"{r['jump_over_composite']:.3f} | {r['jump_over_joint_space']:.2f} | "
-            f"{r['palm_impulse']:.2f} / {r['sustained_impulse']:.2f} | {kept} |"
+            f"| {r['scenario']} ({r['robot']}) | {r['joints']} | {r['speed']:g} | "
+            f"{r['restitution']:.2f} | {r['jump_norm']:.4f} | {r['composite_relative']:.2%} | "
+            f"{r['joint_space_relative']:.0%} | {r['jump_over_composite']:.3f} | "
+            f"{r['jump_over_joint_space']:.2f} | {r['palm_impulse']:.2f} / "
+            f"{r['sustained_impulse']:.2f} | {kept} |"
         )
     sources = sorted({(r["robot"], r["armature"]) for r in rows if r["joints"] != "rigid"})
     out += [f"\narmature of {robot}: {source}" for robot, source in sources]
@@ -133,16 +135,17 @@ def markdown(rows: list[dict], perf: dict) -> str:
     if rigid:
         worst = max(r["composite_relative"] for r in rigid)
         out.append(
-            f"\nrigid: worst distance to the composite set {worst:.2%} of the jump (target <= 2 %): "
-            f"{'pass' if worst <= 0.02 else 'FAIL'}"
+            f"\nrigid: worst distance to the composite set {worst:.2%} of the jump (target <= 2 "
+            f"%): {'pass' if worst <= 0.02 else 'FAIL'}"
         )
     if perf is None:
         return "\n".join(out)
     out.append(
-        f"standing Talos (servo, step {perf['timestep'] * 1e3:g} ms): bare mj_step {perf['bare_ratio']:.1f}x "
-        f"real time, trial loop with recording {perf['trial_ratio']:.1f}x (target >= 5x): "
-        f"{'pass' if perf['bare_ratio'] >= 5 else 'FAIL'}; CoM drift over {perf['simulated_s']:g} s "
-        f"{perf['standing_com_drift_m'] * 1e3:.2f} mm"
+        f"standing Talos (servo, step {perf['timestep'] * 1e3:g} ms): bare mj_step "
+        f"{perf['bare_ratio']:.1f}x real time, trial loop with recording "
+        f"{perf['trial_ratio']:.1f}x (target >= 5x): "
+        f"{'pass' if perf['bare_ratio'] >= 5 else 'FAIL'}; CoM drift over {perf['simulated_s']:g} "
+        f"s {perf['standing_com_drift_m'] * 1e3:.2f} mm"
     )
     return "\n".join(out)
 
@@ -190,7 +193,8 @@ def main() -> int:
     else:
         print(markdown(rows, perf))
         print(
-            f"\nload average before {' '.join(map(str, load_before))}, after {' '.join(map(str, load_after))}"
+            f"\nload average before {' '.join(map(str, load_before))}, after "
+            f"{' '.join(map(str, load_after))}"
         )
     return 0
 

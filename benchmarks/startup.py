@@ -1,7 +1,7 @@
 """What a user waits for: command start-up, the scenario cache, and the kernel's first compile.
 
 ```bash
-python benchmarks/startup.py            # ~2 min on the 2-core machine (most of it: one kernel compile)
+python benchmarks/startup.py            # ~2 min on the 2-core machine (mostly one kernel compile)
 python benchmarks/startup.py --runs 20  # more runs per command (default 10)
 python benchmarks/startup.py --no-compile   # skip the from-scratch kernel compile
 python benchmarks/startup.py --json
@@ -167,7 +167,8 @@ def main(argv: list[str] | None = None) -> int:
     print(f"\ncommand wall time, a new process each ({args.runs} runs, round-robin):")
     for name, t in result["commands"].items():
         print(
-            f"  impact-balance {name:<16} median {t['median_s']:.3f} s   min {t['min_s']:.3f} s   max {t['max_s']:.3f} s"
+            f"  impact-balance {name:<16} median {t['median_s']:.3f} s   min {t['min_s']:.3f} s   "
+            f"max {t['max_s']:.3f} s"
         )
     c = result["scenario_cache"]
     print(
@@ -178,7 +179,8 @@ def main(argv: list[str] | None = None) -> int:
     if "kernel" in result:
         k = result["kernel"]
         print(
-            f"\nprojection kernel: first compile {k['compile_s']:.1f} s, load from numba's cache {k['cached_load_s']:.2f} s"
+            f"\nprojection kernel: first compile {k['compile_s']:.1f} s, load from numba's cache "
+            f"{k['cached_load_s']:.2f} s"
         )
     print(f"\nload average after: {' '.join(map(str, result['load_average_after']))}")
     return 0

@@ -90,8 +90,10 @@ def speedup(tmp: Path, quick: bool, rounds: int = 3) -> dict[str, Any]:
     """1 worker against 2, alternated ``rounds`` times; the best rate of each (the machine is
     shared: the best round is the one least slowed down by other processes)."""
     plan = _plan(
-        IMPACT_AXES[:2]
-        + [{"direction": "impact.normal", "azimuth": {"range": [150.0, 210.0], "count": 10}}]
+        [
+            *IMPACT_AXES[:2],
+            {"direction": "impact.normal", "azimuth": {"range": [150.0, 210.0], "count": 10}},
+        ]
     )
     rates: dict[int, list[float]] = {1: [], 2: []}
     startup = []
@@ -286,28 +288,31 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     d = result["details"]
     print(
-        f"load average before {result['load_average_before'][0]:.2f}, after {result['load_average_after'][0]:.2f} "
-        f"({result['cores']} cores)"
+        f"load average before {result['load_average_before'][0]:.2f}, after "
+        f"{result['load_average_after'][0]:.2f} ({result['cores']} cores)"
     )
     for key, t in result["targets"].items():
         print(
-            f"{key:28s} {t['measured']:10.1f}   target >= {t['target']:g}   {'PASS' if t['pass'] else 'FAIL'}"
+            f"{key:28s} {t['measured']:10.1f}   target >= {t['target']:g}   "
+            f"{'PASS' if t['pass'] else 'FAIL'}"
         )
     print(
-        f"{'rows_identical':28s} {result['rows_identical']}  (1 worker, 2 workers, Dask LocalCluster)"
+        f"{'rows_identical':28s} {result['rows_identical']}  (1 worker, 2 workers, Dask "
+        "LocalCluster)"
     )
     sp = d["speedup"]
     print(
-        f"speed-up on {sp['points']} points (best of {len(sp['rates_1'])}): {sp['rate_1']:.0f} -> {sp['rate_2']:.0f} points/s "
-        f"(2 workers start in {sp['startup_2_s']:.1f} s, not counted)"
+        f"speed-up on {sp['points']} points (best of {len(sp['rates_1'])}): {sp['rate_1']:.0f} -> "
+        f"{sp['rate_2']:.0f} points/s (2 workers start in {sp['startup_2_s']:.1f} s, not counted)"
     )
     big = d["sweep_100k"]
     if big:
         print(
             f"100 000 points via the CLI: {big['wall_s']:.1f} s in all"
             + (
-                f" (killed after {big['killed_after_s']:.1f} s with {big['chunks_done_at_kill']} of 100 chunks written; "
-                f"resumed in {big['resume_s']:.1f} s; finished chunks computed again: {big['finished_chunks_recomputed']})"
+                f" (killed after {big['killed_after_s']:.1f} s with {big['chunks_done_at_kill']} "
+                f"of 100 chunks written; resumed in {big['resume_s']:.1f} s; finished chunks "
+                f"computed again: {big['finished_chunks_recomputed']})"
                 if "killed_after_s" in big
                 else ""
             )

@@ -1,6 +1,7 @@
 """How the ``id`` controller's margins were chosen: on the tuning stance only, before any score.
 
-    python benchmarks/tune_id.py [--scenario talos_tuning_stagger] [--directions 8] [--relative 0.7 0.85 1.0]
+    python benchmarks/tune_id.py [--scenario talos_tuning_stagger] [--directions 8]
+                                 [--relative 0.7 0.85 1.0]
 
 The held-out protocol (docs/validation.md): the balance controller's gains are frozen before any
 scenario is scored, and nothing is tuned on a scenario whose score is reported. This script is the
@@ -62,7 +63,8 @@ def main() -> int:
             )
         rows.append((fell, broken, cop + zmp, cop, zmp))
         print(
-            f"| {1e3 * cop:g} | {1e3 * zmp:g} | {n} | {fell} | {broken} | {time.perf_counter() - t0:.0f} |",
+            f"| {1e3 * cop:g} | {1e3 * zmp:g} | {n} | {fell} | {broken} | "
+            f"{time.perf_counter() - t0:.0f} |",
             flush=True,
         )
     best = min(rows)

@@ -134,7 +134,8 @@ PROBLEMS = [
             "gripper_right_base_link": TALOS_PUSH_GRIPPER,
         },
         _mid(TALOS_LEFT_SOLE, TALOS_RIGHT_SOLE),
-        "feet flat; right gripper at (0.40, -0.25, 1.00), fingers down, +x face forward; CoM between the soles",
+        "feet flat; right gripper at (0.40, -0.25, 1.00), fingers down, +x face forward; CoM "
+        "between the soles",
         _talos_arm_forward,
         {"joint_costs": TALOS_JOINT_COSTS},
     ),
@@ -163,7 +164,8 @@ PROBLEMS = [
             "left_sole_link": se3((0.20, 0.085, 0.12)),
         },
         TALOS_RIGHT_SOLE[:2],
-        "right sole flat; left sole lifted 0.12 m and 0.21 m forward; CoM over the right sole centre",
+        "right sole flat; left sole lifted 0.12 m and 0.21 m forward; CoM over the right sole "
+        "centre",
         None,
         {"joint_costs": TALOS_JOINT_COSTS},
     ),
@@ -178,8 +180,8 @@ PROBLEMS = [
             "gripper_right_base_link": TALOS_PUSH_GRIPPER,
         },
         _mid(TALOS_LEFT_SOLE, TALOS_RIGHT_SOLE),
-        f"feet flat; left gripper's -x face on a wall at y = {WALL_Y} (contact centre (0.05, {WALL_Y}, 1.00)); "
-        "right gripper as in palm_push_two_feet; CoM between the soles",
+        f"feet flat; left gripper's -x face on a wall at y = {WALL_Y} (contact centre (0.05, "
+        f"{WALL_Y}, 1.00)); right gripper as in palm_push_two_feet; CoM between the soles",
         _talos_both_arms,
         {"joint_costs": TALOS_JOINT_COSTS},
     ),
@@ -193,8 +195,9 @@ PROBLEMS = [
             "gripper_right_base_link": TALOS_PUSH_GRIPPER,
         },
         _mid(TALOS_STAGGER_LEFT, TALOS_STAGGER_RIGHT),
-        "feet flat, staggered: left sole 8 cm forward, right 8 cm back, 20 cm apart; right gripper as in "
-        "palm_push_two_feet; CoM between the soles. The balance controllers' gains are tuned here only.",
+        "feet flat, staggered: left sole 8 cm forward, right 8 cm back, 20 cm apart; right "
+        "gripper as in palm_push_two_feet; CoM between the soles. The balance controllers' gains "
+        "are tuned here only.",
         _talos_arm_forward,
         {"joint_costs": TALOS_JOINT_COSTS},
     ),
@@ -204,14 +207,15 @@ PROBLEMS = [
         "half_sitting",
         {
             "left_sole_link": se3(TALOS_LEFT_SOLE),
-            # Rolled 15 degrees about world x: the sole normal tilts inwards (+y), the slope rises outwards.
+            # Rolled 15 degrees about world x: the sole normal tilts inwards (+y), the slope rises
+            # outwards.
             "right_sole_link": se3(SIDE_SLOPE_SOLE, (-SIDE_SLOPE_ANGLE, 0.0, 0.0)),
             "gripper_right_base_link": TALOS_PUSH_GRIPPER,
         },
         _mid(TALOS_LEFT_SOLE, SIDE_SLOPE_SOLE),
-        "left sole flat; right sole on a 15 deg side slope (rolled, normal tilted inwards), centre at "
-        "(-0.009, -0.12, 0.04); right gripper as in palm_push_two_feet; CoM at the midpoint of the sole centres. "
-        "Written for the held-out scores: nothing is tuned on it.",
+        "left sole flat; right sole on a 15 deg side slope (rolled, normal tilted inwards), "
+        "centre at (-0.009, -0.12, 0.04); right gripper as in palm_push_two_feet; CoM at the "
+        "midpoint of the sole centres. Written for the held-out scores: nothing is tuned on it.",
         _talos_arm_forward,
         {"joint_costs": TALOS_JOINT_COSTS},
     ),
@@ -225,7 +229,8 @@ PROBLEMS = [
             "right_rubber_hand": G1_HAND,
         },
         _mid(G1_LEFT_SOLE, G1_RIGHT_SOLE),
-        "soles flat at y = +-0.119; knees bent; right hand at (0.25, -0.15, 0.95), palm forward; CoM between the soles",
+        "soles flat at y = +-0.119; knees bent; right hand at (0.25, -0.15, 0.95), palm forward; "
+        "CoM between the soles",
         _g1_knees,
         {
             "joint_costs": {
@@ -298,9 +303,9 @@ def build(problem: StanceProblem) -> str:
     worst = max(residuals.values())
     com = pin.centerOfMass(robot.model, robot.model.createData(), q_rounded)
     header = (
-        f"# --- {problem.name} ({problem.robot}, from {problem.configuration}) ---\n"
-        f"# {problem.notes}\n"
-        f"# CoM = [{', '.join(f'{v:.4f}' for v in com)}] m; largest residual after rounding = {worst:.1e} (m / rad)"
+        f"# --- {problem.name} ({problem.robot}, from {problem.configuration}) ---\n# "
+        f"{problem.notes}\n# CoM = [{', '.join(f'{v:.4f}' for v in com)}] m; largest residual "
+        f"after rounding = {worst:.1e} (m / rad)"
     )
     return f"{header}\n{text}\n"
 

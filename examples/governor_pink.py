@@ -36,8 +36,9 @@ def run(
 ) -> dict:
     """Drive the impact frame at ``reference`` m/s towards the scenario's wall for ``ticks`` ticks.
 
-    Returns the per-tick arrays: ``commanded`` and ``cap`` (approach speeds, m/s), ``measured`` (the
-    impact point's approach speed from the IK's velocity, m/s) and ``tick_us`` (the governor's time)."""
+    Returns the per-tick arrays: ``commanded`` and ``cap`` (approach speeds, m/s), ``measured``
+    (the impact point's approach speed from the IK's velocity, m/s) and ``tick_us`` (the
+    governor's time)."""
     scenario = load_scenario(scenario_name)
     governor = Governor(scenario, criterion=criterion)  # once: robot, contacts, impact, margin
     robot = governor.robot
@@ -111,7 +112,8 @@ def main(argv: list[str] | None = None) -> int:
         f"the IK's approach speed {np.median(r['measured'][late]):.3f} m/s (median, second half)"
     )
     print(
-        f"  governor: {np.median(r['tick_us']):.0f} us per tick (median), {np.percentile(r['tick_us'], 99):.0f} (p99)"
+        f"  governor: {np.median(r['tick_us']):.0f} us per tick (median), "
+        f"{np.percentile(r['tick_us'], 99):.0f} (p99)"
     )
     return 0
 

@@ -1,10 +1,11 @@
-"""Check a robot's recorded motion against the balance criteria (what ``impact-balance check-log`` does).
+"""Check a robot's recorded motion against the balance criteria (as ``impact-balance check-log``).
 
 A real robot records its base pose and velocity (from its state estimator) and its joint
 encoders. This example turns such arrays into a log with the column names of
 ``impact_balance.logs.schema``, writes it as Parquet, and checks it against the areas of the
 stance. The motion here is synthetic, so that the answer is known: Talos, standing on two feet,
-is given a growing forward speed until its CoM velocity leaves the CoM velocity area. Replace :func:`record` with your robot's arrays.
+is given a growing forward speed until its CoM velocity leaves the CoM velocity area. Replace
+:func:`record` with your robot's arrays.
 
     python examples/robot_log.py [--out sway.parquet] [--scenario palm_push_two_feet]
 """
@@ -77,8 +78,8 @@ def main(argv: list[str] | None = None) -> int:
     for violation in check.violations:
         unit = "m/s" if violation.kind == "com_velocity" else "m"
         print(
-            f"  {violation.kind} outside its area from {violation.start:.3f} s to {violation.end:.3f} s, "
-            f"worst margin {violation.worst_margin:.3f} {unit}"
+            f"  {violation.kind} outside its area from {violation.start:.3f} s to "
+            f"{violation.end:.3f} s, worst margin {violation.worst_margin:.3f} {unit}"
         )
     if not check.violations:
         print("  the CoM velocity stayed inside the CoM velocity area")

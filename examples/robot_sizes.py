@@ -96,8 +96,9 @@ def main() -> None:
         if "hand_box" in s:
             lo, hi = map(np.asarray, s["hand_box"])
             hand = (
-                f"; hand box {' x '.join(f'{x:.3f}' for x in hi - lo)} m, x [{lo[0]:+.3f}, {hi[0]:+.3f}] "
-                f"y [{lo[1]:+.3f}, {hi[1]:+.3f}] z [{lo[2]:+.3f}, {hi[2]:+.3f}] in {s['hand_frame']}"
+                f"; hand box {' x '.join(f'{x:.3f}' for x in hi - lo)} m, x [{lo[0]:+.3f}, "
+                f"{hi[0]:+.3f}] y [{lo[1]:+.3f}, {hi[1]:+.3f}] z [{lo[2]:+.3f}, {hi[2]:+.3f}] in "
+                f"{s['hand_frame']}"
             )
         print(f"{name} ({s['mass']:.2f} kg): {sole}{hand}")
 

@@ -20,7 +20,8 @@ __all__ = ["journalled", "open_journal", "slim"]
 def journalled(
     journal: TrialJournal, keys: Iterable[dict], run: Callable[[dict], dict], label: str
 ) -> tuple[list, int]:
-    """``[(key, entry)]`` for every key: the journal's entry, else ``run(key)``'s, journalled at once.
+    """``[(key, entry)]`` for every key: the journal's entry, else ``run(key)``'s, journalled at
+    once.
 
     A key whose run raises is printed and left out (a rerun tries it again). Returns the pairs
     and the number of failures."""

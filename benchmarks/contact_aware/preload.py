@@ -12,9 +12,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from contact_impact import one_row
 
 import impact_balance as ib
+from benchmarks.contact_aware.journal import journalled, open_journal
+from benchmarks.contact_impact import one_row
 from impact_balance.contacts.stance import Stance
 from impact_balance.governor import Governor
 from impact_balance.impact.contact_aware import (
@@ -26,8 +27,6 @@ from impact_balance.impact.contact_aware import (
 from impact_balance.impact.model import ImpactSpec, impact_cone
 from impact_balance.scenario import load_scenario
 from impact_balance.sim import SimOptions, build_model
-
-from .journal import journalled, open_journal
 
 __all__ = [
     "GRAVITY",
@@ -75,7 +74,7 @@ def preload_jump(
     dxi, impulses, _, converged = rigid_body_impact(
         stance.mass,
         stance.com_inertia,
-        [impact] + corners,
+        [impact, *corners],
         tolerance=1e-9 * max(approach_speed, 1e-3),
     )
     return dxi[:2], impulses, converged
@@ -85,7 +84,8 @@ def preload_bound(
     stance: Stance, spec: ImpactSpec, area, com_velocity: np.ndarray, duration: float
 ) -> float:
     """The largest approach speed (m/s, to 2e-6) keeping the preload jump at both restitution
-    bounds inside ``area``: bisection on [0, 2] m/s (the jump is affine, not linear, in the speed)."""
+    bounds inside ``area``: bisection on [0, 2] m/s (the jump is affine, not linear, in the
+    speed)."""
 
     def inside(speed: float) -> bool:
         return all(
@@ -112,7 +112,7 @@ def preload(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
         pairs, failed = journalled(
             journal,
             [{"speed": s} for s in args.speeds],
-            lambda key: one_row(sim, name, key["speed"]),
+            lambda key, sim=sim, name=name: one_row(sim, name, key["speed"]),
             f"preload {name}",
         )
         journal.close()
@@ -145,19 +145,24 @@ def preload(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
     return rows, failures
 
 
+def _joined(group: list[dict], key: str) -> str:
+    """``group``'s values of ``key``, 3 decimals, joined by " / "."""
+    return " / ".join(f"{r[key]:.3f}" for r in group)
+
+
 def preload_table(rows: list[dict]) -> str:
-    """|predicted - measured| of the CoM velocity jump per stance at each speed, then the ramp's jumps."""
+    """|predicted - measured| of the CoM velocity jump per stance at each speed, then the ramp's
+    jumps."""
     lines = [
         "| stance | commanded speeds (m/s) | no preload | preload T = impact.duration |",
         "|---|---|---|---|",
     ]
     for name in dict.fromkeys(r["scenario"] for r in rows):
         group = [r for r in rows if r["scenario"] == name]
-        join = lambda k: " / ".join(f"{r[k]:.3f}" for r in group)  # noqa: E731
         speeds = " / ".join(f"{r['speed']:g}" for r in group)
         lines.append(
-            f"| {name} | {speeds} | {join('error_no_preload')} "
-            f"| {join('error_preload')} (T = {1e3 * group[0]['duration']:g} ms) |"
+            f"| {name} | {speeds} | {_joined(group, 'error_no_preload')} "
+            f"| {_joined(group, 'error_preload')} (T = {1e3 * group[0]['duration']:g} ms) |"
         )
     return "\n".join(lines)
 
@@ -235,6 +240,7 @@ def bounds_table(rows: list[dict], margins: list[float]) -> str:
         floating = " / ".join(f"{r[t]['floating']:.3f}" for t in tags)
         union = " / ".join(f"{r[t]['union']:.3f}" for t in tags)
         lines.append(
-            f"| {r['scenario']} | {floating} | {union}, {r[tags[-1]]['binding']} | {r['preload']:.3f} |"
+            f"| {r['scenario']} | {floating} | {union}, {r[tags[-1]]['binding']} | "
+            f"{r['preload']:.3f} |"
         )
     return "\n".join(lines)

@@ -10,8 +10,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from governor_study import _f, governed_setup
 
+from benchmarks.governor_study import _f, governed_setup
 from impact_balance.governor import Governor
 from impact_balance.sim.studies.wall import WallOptions, run_wall_trial
 
@@ -43,7 +43,8 @@ def logged_trial(args: argparse.Namespace, out: Path) -> tuple[dict, Any, dict]:
 
     import pandas as pd
 
-    tag = f"{args.scenario}_{args.governor}{'_aware' if args.contact_aware else ''}_{args.reference:g}_{args.wall:g}"
+    aware = "_aware" if args.contact_aware else ""
+    tag = f"{args.scenario}_{args.governor}{aware}_{args.reference:g}_{args.wall:g}"
     summary_path, log_path = out / f"trace_{tag}.json", out / f"trace_{tag}.parquet"
     if summary_path.exists() and log_path.exists():
         saved = json.loads(summary_path.read_text())
@@ -74,8 +75,8 @@ def after_impact_table(summary: dict, log, series: dict, step_ms: float, span: f
         {c[len("force_") : -2] for c in log.columns if c.startswith("force_")} - {"impact"}
     )
     lines = [
-        f"| t - contact (s) | {' | '.join(f'{n} force x, y, z (N)' for n in supports)} | CoM velocity x, y "
-        "| ZMP desired x, y | ZMP measured x, y | DCM margin (m/s) |",
+        f"| t - contact (s) | {' | '.join(f'{n} force x, y, z (N)' for n in supports)} | CoM "
+        "velocity x, y | ZMP desired x, y | ZMP measured x, y | DCM margin (m/s) |",
         "|---" * (5 + len(supports)) + "|",
     ]
     records = [r for r in log.to_dict("records") if 0.0 <= r["time"] - contact <= span]
@@ -88,8 +89,8 @@ def after_impact_table(summary: dict, log, series: dict, step_ms: float, span: f
         )
         zd, zm = series["zmp_desired"][k], series["zmp"][k]
         lines.append(
-            f"| {dt:+.3f} | {forces} | {row['comd_x']:+.3f}, {row['comd_y']:+.3f} "
-            f"| {zd[0]:+.3f}, {zd[1]:+.3f} | {zm[0]:+.3f}, {zm[1]:+.3f} | {series['com_velocity_margin'][k]:+.3f} |"
+            f"| {dt:+.3f} | {forces} | {row['comd_x']:+.3f}, {row['comd_y']:+.3f} | {zd[0]:+.3f}, "
+            f"{zd[1]:+.3f} | {zm[0]:+.3f}, {zm[1]:+.3f} | {series['com_velocity_margin'][k]:+.3f} |"
         )
     return "\n".join(lines)
 
@@ -116,8 +117,9 @@ def branches_table(
     )
     contact = summary["trial"]["impact"]["contact_time"]
     lines = [
-        "| t - contact (s) | floating cap (m/s) | cold: jump per m/s x, y | cold cap | warm: jump per m/s x, y "
-        "| warm cap | union: jumps per m/s x, y (upper c_r) | union cap | union ms |",
+        "| t - contact (s) | floating cap (m/s) | cold: jump per m/s x, y | cold cap | warm: "
+        "jump per m/s x, y | warm cap | union: jumps per m/s x, y (upper c_r) | union cap | "
+        "union ms |",
         "|---|---|---|---|---|---|---|---|---|",
     ]
     rows: list[str] = []
@@ -132,30 +134,33 @@ def branches_table(
         )
         posture = floating.posture
         t0 = time.perf_counter()
-        warm.new_posture(lambda: posture.stance)
+        warm.new_posture(lambda posture=posture: posture.stance)
         t1 = time.perf_counter()
-        union.new_posture(lambda: posture.stance)
+        union.new_posture(lambda posture=posture: posture.stance)
         warm_costs.append(1e3 * (t1 - t0))
         costs.append(1e3 * (time.perf_counter() - t1))
         if dt < -window:
             continue
-        cold.new_posture(lambda: posture.stance)
+        cold.new_posture(lambda posture=posture: posture.stance)
         a, b, u = (
             s.answer(posture.com_criterion, answer.com_velocity) for s in (cold, warm, union)
         )
         jumps = "; ".join(
-            f"{x:+.3f}, {y:+.3f}" for (x, y), c in zip(u.rates, u.restitution) if c == upper
+            f"{x:+.3f}, {y:+.3f}"
+            for (x, y), c in zip(u.rates, u.restitution, strict=True)
+            if c == upper
         )
         rows.append(
-            f"| {dt:+.3f} | {answer.max_contact_velocity:.3f} | {a.rates[-1][0]:+.3f}, {a.rates[-1][1]:+.3f} "
-            f"| {a.limit.max_contact_velocity:.3f} | {b.rates[-1][0]:+.3f}, {b.rates[-1][1]:+.3f} "
-            f"| {b.limit.max_contact_velocity:.3f} | {jumps} | {u.limit.max_contact_velocity:.3f} "
-            f"| {costs[-1]:.1f} |"
+            f"| {dt:+.3f} | {answer.max_contact_velocity:.3f} | {a.rates[-1][0]:+.3f}, "
+            f"{a.rates[-1][1]:+.3f} | {a.limit.max_contact_velocity:.3f} | {b.rates[-1][0]:+.3f}, "
+            f"{b.rates[-1][1]:+.3f} | {b.limit.max_contact_velocity:.3f} | {jumps} | "
+            f"{u.limit.max_contact_velocity:.3f} | {costs[-1]:.1f} |"
         )
     tail = (
-        f"\nThe union's recomputation over the {len(costs)} logged postures of the approach: median "
-        f"{np.median(costs):.1f} ms, p99 {np.percentile(costs, 99):.1f} ms, max {max(costs):.1f} ms (the warm "
-        f"start's: median {np.median(warm_costs):.1f} ms, p99 {np.percentile(warm_costs, 99):.1f} ms)."
+        f"\nThe union's recomputation over the {len(costs)} logged postures of the approach: "
+        f"median {np.median(costs):.1f} ms, p99 {np.percentile(costs, 99):.1f} ms, max "
+        f"{max(costs):.1f} ms (the warm start's: median {np.median(warm_costs):.1f} ms, p99 "
+        f"{np.percentile(warm_costs, 99):.1f} ms)."
     )
     return "\n".join(lines + rows[::-every][::-1]) + "\n" + tail
 
@@ -192,7 +197,8 @@ def contact_posture_table(args: argparse.Namespace, summary: dict, log) -> str:
         for c in spec.restitution
     ]
     lines = [
-        f"At the contact posture (t = {row['time']:.3f} s), v_n {speed:.3f} m/s, area inset by the controller's margin:",
+        f"At the contact posture (t = {row['time']:.3f} s), v_n {speed:.3f} m/s, area inset by "
+        "the controller's margin:",
         "",
         "| post-impact CoM velocity | x, y (m/s) | inset margin (m/s) |",
         "|---|---|---|",
@@ -210,9 +216,10 @@ def trace(args: argparse.Namespace, out: Path) -> None:
     summary, log, series = logged_trial(args, out)
     trial = summary["trial"]
     print(
-        f"{args.scenario} {args.governor} {args.reference:g} m/s, wall {100 * args.wall:g} cm: {summary['outcome']} "
-        f"({summary['reason']}), speed at contact {_f(summary['speed_at_contact'])}, cap at contact "
-        f"{_f(summary['cap_at_contact'])}, raw margin at the end {trial['com_velocity_margin_at_end']:+.3f} m/s\n"
+        f"{args.scenario} {args.governor} {args.reference:g} m/s, wall {100 * args.wall:g} cm: "
+        f"{summary['outcome']} ({summary['reason']}), speed at contact "
+        f"{_f(summary['speed_at_contact'])}, cap at contact {_f(summary['cap_at_contact'])}, raw "
+        f"margin at the end {trial['com_velocity_margin_at_end']:+.3f} m/s\n"
     )
     print(after_impact_table(summary, log, series, args.every))
     if summary["speed_at_contact"] is not None:

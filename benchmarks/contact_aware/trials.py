@@ -1,5 +1,5 @@
-"""The simulated trials of ``score`` (governed, with or without the option: union, warm or cold starts)
-and ``sweep`` (ungoverned, wall 15 cm, the inset rule), and their tables."""
+"""The simulated trials of ``score`` (governed, with or without the option: union, warm or cold
+starts) and ``sweep`` (ungoverned, wall 15 cm, the inset rule), and their tables."""
 
 from __future__ import annotations
 
@@ -9,13 +9,12 @@ import time
 from pathlib import Path
 
 import numpy as np
-from governor_study import _f, governed_setup
 
+from benchmarks.contact_aware.journal import journalled, open_journal, slim
+from benchmarks.governor_study import _f, governed_setup
 from impact_balance.contacts.stance import Stance
 from impact_balance.governor import ContactAwareOptions, Governor
 from impact_balance.sim.studies.wall import WallOptions, run_wall_trial
-
-from .journal import journalled, open_journal, slim
 
 __all__ = [
     "OUTCOMES",
@@ -80,82 +79,7 @@ def score(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
     """The governed trials of ``args.variant`` (module docstring); rows and failures."""
     rows, failures = [], 0
     for name in args.scenarios:
-        options, margin, governed, setup = governed_setup(name, rigid=True)
-        parts = {"variant": args.variant, "margin": margin}
-        if args.velocity_margin:  # keeps the journals of the runs without one
-            parts["velocity_margin"] = args.velocity_margin
-        journal = open_journal(out, "score", name, parts)
-
-        def new_governor() -> Governor:
-            if args.variant == "off":
-                return Governor(governed, criterion="com", velocity_margin=args.velocity_margin)
-            if (
-                args.variant == "async"
-            ):  # the union's starts, recomputed by a worker process off the tick
-                return Governor(
-                    governed,
-                    criterion="com",
-                    contact_aware=ContactAwareOptions(asynchronous=True),
-                    velocity_margin=args.velocity_margin,
-                )
-            return Governor(
-                governed,
-                criterion="com",
-                contact_aware=ContactAwareOptions(starts=args.variant),
-                velocity_margin=args.velocity_margin,
-            )
-
-        def run(key: dict) -> dict:
-            governor, trials = (
-                new_governor(),
-                [],
-            )  # one governor for the walls of a reference, as the command
-            record = [] if governor._support is None else _timed(governor)
-            ages = [] if governor._worker is None else _adoptions(governor)
-            for distance in key["distances"]:
-                if args.variant == "cold":
-                    governor = new_governor()  # as the post hoc cold variant of section 4 was run
-                    record = _timed(governor)
-                del record[:]  # this trial's recomputations only
-                del ages[:]
-                wall = WallOptions(
-                    reference=key["reference"], governor="com", wall_distance=distance
-                )
-                trials.append(
-                    slim(run_wall_trial(setup, wall, options, governor=governor).to_dict())
-                )
-                d = trials[-1]
-                ms = np.array([r[0] for r in record]) if record else np.zeros(0)
-                d["recompute"] = (
-                    None
-                    if not record
-                    else {
-                        "count": len(record),
-                        "ms_median": float(np.median(ms)),
-                        "ms_max": float(ms.max()),
-                        "ms_p90": float(np.percentile(ms, 90)),
-                        "rows_max": max(r[1] for r in record),
-                        "solves_median": float(np.median([r[2] for r in record])),
-                    }
-                )
-                if ages:  # async: postures between two answers of the worker (the rates' age when replaced)
-                    d["rates_age"] = {
-                        "median": float(np.median(ages)),
-                        "max": int(max(ages)),
-                        "answers": len(ages),
-                    }
-                print(
-                    f"  {name} {key['reference']:g} m/s {100 * distance:g} cm: {d['outcome']} speed "
-                    f"{_f(d['speed_at_contact'])} cap {_f(d['cap_at_contact'])}",
-                    file=sys.stderr,
-                    flush=True,
-                )
-            governor.close()  # a worker process, with "async"
-            return {"trials": trials}
-
-        keys = [{"reference": r, "distances": list(args.distances)} for r in args.references]
-        pairs, failed = journalled(journal, keys, run, f"score {name}")
-        journal.close()
+        pairs, failed = _score_scenario(args, out, name)
         failures += failed
         rows += [
             {
@@ -170,6 +94,81 @@ def score(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
     return rows, failures
 
 
+def _score_scenario(args: argparse.Namespace, out: Path, name: str) -> tuple[list, int]:
+    """The journalled governed trials of ``name``: ``(key, entry)`` pairs and failures."""
+    options, margin, governed, setup = governed_setup(name, rigid=True)
+    parts = {"variant": args.variant, "margin": margin}
+    if args.velocity_margin:  # keeps the journals of the runs without one
+        parts["velocity_margin"] = args.velocity_margin
+    journal = open_journal(out, "score", name, parts)
+
+    def new_governor() -> Governor:
+        if args.variant == "off":
+            return Governor(governed, criterion="com", velocity_margin=args.velocity_margin)
+        if args.variant == "async":
+            # the union's starts, recomputed by a worker process off the tick
+            return Governor(
+                governed,
+                criterion="com",
+                contact_aware=ContactAwareOptions(asynchronous=True),
+                velocity_margin=args.velocity_margin,
+            )
+        return Governor(
+            governed,
+            criterion="com",
+            contact_aware=ContactAwareOptions(starts=args.variant),
+            velocity_margin=args.velocity_margin,
+        )
+
+    def run(key: dict) -> dict:
+        # one governor for the walls of a reference, as the command
+        governor, trials = new_governor(), []
+        record = [] if governor._support is None else _timed(governor)
+        ages = [] if governor._worker is None else _adoptions(governor)
+        for distance in key["distances"]:
+            if args.variant == "cold":
+                governor = new_governor()  # as the post hoc cold variant of section 4 was run
+                record = _timed(governor)
+            del record[:]  # this trial's recomputations only
+            del ages[:]
+            wall = WallOptions(reference=key["reference"], governor="com", wall_distance=distance)
+            trials.append(slim(run_wall_trial(setup, wall, options, governor=governor).to_dict()))
+            d = trials[-1]
+            ms = np.array([r[0] for r in record]) if record else np.zeros(0)
+            d["recompute"] = (
+                None
+                if not record
+                else {
+                    "count": len(record),
+                    "ms_median": float(np.median(ms)),
+                    "ms_max": float(ms.max()),
+                    "ms_p90": float(np.percentile(ms, 90)),
+                    "rows_max": max(r[1] for r in record),
+                    "solves_median": float(np.median([r[2] for r in record])),
+                }
+            )
+            if ages:
+                # async: postures between two answers of the worker (the rates' age when replaced)
+                d["rates_age"] = {
+                    "median": float(np.median(ages)),
+                    "max": int(max(ages)),
+                    "answers": len(ages),
+                }
+            print(
+                f"  {name} {key['reference']:g} m/s {100 * distance:g} cm: {d['outcome']} speed "
+                f"{_f(d['speed_at_contact'])} cap {_f(d['cap_at_contact'])}",
+                file=sys.stderr,
+                flush=True,
+            )
+        governor.close()  # a worker process, with "async"
+        return {"trials": trials}
+
+    keys = [{"reference": r, "distances": list(args.distances)} for r in args.references]
+    pairs, failed = journalled(journal, keys, run, f"score {name}")
+    journal.close()
+    return pairs, failed
+
+
 def _signed(x: float | None, digits: int = 4) -> str:
     return "-" if x is None else f"{x:+.{digits}f}"
 
@@ -181,9 +180,9 @@ def _span(values: list[float], digits: int = 3) -> str:
 def score_table(rows: list[dict]) -> str:
     """Outcome counts and ranges per scenario (the table of docs/contact_aware_governor.md)."""
     lines = [
-        "| scenario | variant | trials | balanced / contact broken / fell | measured speed at contact (m/s) "
-        "| cap at contact (m/s) | speed / min(ref, cap) | tick median (us) | tick p99 (us) "
-        "| recomputation median / max (ms) | rows of the rates (most) |",
+        "| scenario | variant | trials | balanced / contact broken / fell | measured speed at "
+        "contact (m/s) | cap at contact (m/s) | speed / min(ref, cap) | tick median (us) | tick "
+        "p99 (us) | recomputation median / max (ms) | rows of the rates (most) |",
         "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for name in dict.fromkeys(r["scenario"] for r in rows):
@@ -208,14 +207,15 @@ def score_table(rows: list[dict]) -> str:
         )
         most = "-" if not recomputes else str(max(c["rows_max"] for c in recomputes))
         lines.append(
-            f"| {name} | {group[0]['variant']} | {len(group)} | {counts} | {_span(speeds)} | {_span(caps)} "
-            f"| {_span(ratios, 2)} | {_span([t['median'] for t in ticks], 0)} "
-            f"| {_span([t['p99'] for t in ticks], 0)} | {costs} | {most} |"
+            f"| {name} | {group[0]['variant']} | {len(group)} | {counts} | {_span(speeds)} | "
+            f"{_span(caps)} | {_span(ratios, 2)} | {_span([t['median'] for t in ticks], 0)} | "
+            f"{_span([t['p99'] for t in ticks], 0)} | {costs} | {most} |"
         )
     lines += [
         "",
-        "| scenario | reference (m/s) | wall (cm) | outcome | speed at contact (m/s) | cap at contact (m/s) "
-        "| speed / cap | raw margin at end (m/s) | slip (cm) | tick median / p99 (us) |",
+        "| scenario | reference (m/s) | wall (cm) | outcome | speed at contact (m/s) | cap at "
+        "contact (m/s) | speed / cap | raw margin at end (m/s) | slip (cm) | tick median / p99 "
+        "(us) |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
@@ -227,9 +227,9 @@ def score_table(rows: list[dict]) -> str:
         tick = r["tick_us"]
         ticks = "-" if tick["median"] is None else f"{tick['median']:.0f} / {tick['p99']:.0f}"
         lines.append(
-            f"| {r['scenario']} | {r['reference']:g} | {100 * r['wall_distance']:g} | {r['outcome']} "
-            f"| {_f(r['speed_at_contact'])} | {_f(r['cap_at_contact'])} | {ratio} | {r['margin_raw']:+.3f} "
-            f"| {100 * r['max_slip']:.1f} | {ticks} |"
+            f"| {r['scenario']} | {r['reference']:g} | {100 * r['wall_distance']:g} | "
+            f"{r['outcome']} | {_f(r['speed_at_contact'])} | {_f(r['cap_at_contact'])} | {ratio} | "
+            f"{r['margin_raw']:+.3f} | {100 * r['max_slip']:.1f} | {ticks} |"
         )
     return "\n".join(lines)
 
@@ -239,42 +239,51 @@ def sweep(args: argparse.Namespace, out: Path) -> tuple[list[dict], int]:
     """Ungoverned approaches at wall 15 cm with the inset margin at the end of the impact."""
     rows, failures = [], 0
     for name in args.scenarios:
-        options, margin, _, setup = governed_setup(name, rigid=True)
-        inset = setup.analysis.areas.com_velocity_area_inset(margin)
-        journal = open_journal(out, "sweep", name, {"wall": SWEEP_WALL, "margin": margin})
-
-        def run(key: dict) -> dict:
-            wall = WallOptions(
-                reference=key["reference"], governor="none", wall_distance=SWEEP_WALL
-            )
-            d = slim(run_wall_trial(setup, wall, options).to_dict())
-            after = np.asarray(
-                d["com_velocity_after"] if d["com_velocity_after"] is not None else [np.nan] * 2
-            )
-            d["margin_inset"] = float(inset.margins(after)[0]) if np.isfinite(after).all() else None
-            print(
-                f"  {name} {key['reference']:g} m/s: {d['outcome']} speed {_f(d['speed_at_contact'])} "
-                f"inset margin {_signed(d['margin_inset'])}",
-                file=sys.stderr,
-                flush=True,
-            )
-            return d
-
-        references = args.references or SWEEP_REFERENCES[name]
-        pairs, failed = journalled(
-            journal, [{"reference": r} for r in references], run, f"sweep {name}"
-        )
-        journal.close()
+        pairs, failed = _sweep_scenario(args, out, name)
         failures += failed
         rows += [{"scenario": name, **e} for _, e in pairs]
     return rows, failures
 
 
+def _sweep_scenario(args: argparse.Namespace, out: Path, name: str) -> tuple[list, int]:
+    """The journalled ungoverned trials of ``name``: ``(key, entry)`` pairs and failures."""
+    options, margin, _, setup = governed_setup(name, rigid=True)
+    inset = setup.analysis.areas.com_velocity_area_inset(margin)
+    journal = open_journal(out, "sweep", name, {"wall": SWEEP_WALL, "margin": margin})
+
+    def run(key: dict) -> dict:
+        wall = WallOptions(reference=key["reference"], governor="none", wall_distance=SWEEP_WALL)
+        d = slim(run_wall_trial(setup, wall, options).to_dict())
+        after = np.asarray(
+            d["com_velocity_after"] if d["com_velocity_after"] is not None else [np.nan] * 2
+        )
+        d["margin_inset"] = float(inset.margins(after)[0]) if np.isfinite(after).all() else None
+        print(
+            f"  {name} {key['reference']:g} m/s: {d['outcome']} speed {_f(d['speed_at_contact'])} "
+            f"inset margin {_signed(d['margin_inset'])}",
+            file=sys.stderr,
+            flush=True,
+        )
+        return d
+
+    references = args.references or SWEEP_REFERENCES[name]
+    pairs, failed = journalled(
+        journal, [{"reference": r} for r in references], run, f"sweep {name}"
+    )
+    journal.close()
+    return pairs, failed
+
+
+def _trial_cell(r: dict | None) -> str:
+    """A trial's speed at contact (m/s) and inset margin (m/s), or "-" without a trial."""
+    return "-" if r is None else f"{r['speed_at_contact']:.3f} ({_signed(r['margin_inset'])})"
+
+
 def sweep_table(rows: list[dict]) -> str:
     """Every trial, then per stance the fastest that did not fall and the slowest that fell."""
     lines = [
-        "| scenario | reference (m/s) | measured v_n (m/s) | outcome | raw margin | inset margin | slip (cm) "
-        "| sustained impulse z per contact (N s) |",
+        "| scenario | reference (m/s) | measured v_n (m/s) | outcome | raw margin | inset margin "
+        "| slip (cm) | sustained impulse z per contact (N s) |",
         "|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
@@ -282,12 +291,14 @@ def sweep_table(rows: list[dict]) -> str:
             f"{k} {v[2]:+.2f}" for k, v in (r["sustained_impulses"] or {}).items()
         )
         lines.append(
-            f"| {r['scenario']} | {r['reference']:g} | {_f(r['speed_at_contact'])} | {r['outcome']} "
-            f"| {r['margin_raw']:+.3f} | {_signed(r['margin_inset'])} | {100 * r['max_slip']:.2f} | {sustained} |"
+            f"| {r['scenario']} | {r['reference']:g} | {_f(r['speed_at_contact'])} | "
+            f"{r['outcome']} | {r['margin_raw']:+.3f} | {_signed(r['margin_inset'])} | "
+            f"{100 * r['max_slip']:.2f} | {sustained} |"
         )
     lines += [
         "",
-        "| scenario | trials | stood: largest v_n (inset margin) | fell: smallest v_n (inset margin) |",
+        "| scenario | trials | stood: largest v_n (inset margin) | fell: smallest v_n (inset "
+        "margin) |",
         "|---|---|---|---|",
     ]
     for name in dict.fromkeys(r["scenario"] for r in rows):
@@ -296,10 +307,7 @@ def sweep_table(rows: list[dict]) -> str:
         fell = [r for r in group if r["outcome"] == "fell"]
         best = max(stood, key=lambda r: r["speed_at_contact"], default=None)
         worst = min(fell, key=lambda r: r["speed_at_contact"], default=None)
-        cell = lambda r: (
-            "-" if r is None else f"{r['speed_at_contact']:.3f} ({_signed(r['margin_inset'])})"
-        )
-        lines.append(f"| {name} | {len(group)} | {cell(best)} | {cell(worst)} |")
+        lines.append(f"| {name} | {len(group)} | {_trial_cell(best)} | {_trial_cell(worst)} |")
     stood = [
         r["margin_inset"] for r in rows if r["outcome"] != "fell" and r["margin_inset"] is not None
     ]
@@ -307,7 +315,8 @@ def sweep_table(rows: list[dict]) -> str:
         r["margin_inset"] for r in rows if r["outcome"] == "fell" and r["margin_inset"] is not None
     ]
     lines.append(
-        f"\nThe inset rule over {len(rows)} trials: the trials that did not fall end with inset margins "
-        f">= {_signed(min(stood, default=None))} m/s; those that fell <= {_signed(max(fell, default=None))} m/s."
+        f"\nThe inset rule over {len(rows)} trials: the trials that did not fall end with inset "
+        f"margins >= {_signed(min(stood, default=None))} m/s; those that fell <= "
+        f"{_signed(max(fell, default=None))} m/s."
     )
     return "\n".join(lines)

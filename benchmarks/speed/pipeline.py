@@ -9,9 +9,8 @@ from typing import Any
 import numpy as np
 
 import impact_balance as ib
+from benchmarks.speed.timing import Case, measure, stats
 from impact_balance.contacts.wrench_polytope import wrench_polytope
-
-from .timing import Case, measure, stats
 
 __all__ = ["PIPELINE_STAGES", "bench_max_velocity", "bench_pipeline"]
 

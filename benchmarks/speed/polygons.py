@@ -38,6 +38,11 @@ def area(v: np.ndarray) -> float:
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
 
 
+def _side(a, b, v) -> float:
+    """Twice the signed area of the triangle (a, b, v): > 0 when v is left of the line a -> b."""
+    return (b[0] - a[0]) * (v[1] - a[1]) - (b[1] - a[1]) * (v[0] - a[0])
+
+
 def intersection(p: np.ndarray, q: np.ndarray) -> np.ndarray:
     """Intersection of two CCW convex polygons (Sutherland-Hodgman)."""
     out = [tuple(v) for v in p]
@@ -46,13 +51,9 @@ def intersection(p: np.ndarray, q: np.ndarray) -> np.ndarray:
         if not out:
             break
         inp, out = out, []
-
-        def side(v):
-            return (b[0] - a[0]) * (v[1] - a[1]) - (b[1] - a[1]) * (v[0] - a[0])
-
         for j in range(len(inp)):
             cur, prev = inp[j], inp[j - 1]
-            sc, sp = side(cur), side(prev)
+            sc, sp = _side(a, b, cur), _side(a, b, prev)
             if sc >= 0:
                 if sp < 0:
                     t = sp / (sp - sc)

@@ -10,15 +10,14 @@ from typing import Any
 import numpy as np
 
 import impact_balance as ib
+from benchmarks.speed.projection import projection_cases
+from benchmarks.speed.targets import TARGET_PIPELINE_SCENARIO
+from benchmarks.speed.timing import Case, measure, stats
 from impact_balance.balance.areas import FORCE_BOX
 from impact_balance.contacts.stance import Stance
 from impact_balance.contacts.wrench_polytope import wrench_polytope
 from impact_balance.projection import project_polytope
 from impact_balance.projection.walk import NO_HINT
-
-from .projection import projection_cases
-from .targets import TARGET_PIPELINE_SCENARIO
-from .timing import Case, measure, stats
 
 __all__ = ["profile_report", "profile_text"]
 
@@ -156,18 +155,21 @@ def profile_text(p: dict[str, Any]) -> str:
     for key in ("analyze", "projection_talos_three_contacts"):
         e = p[key]
         out.append(
-            f"  {key}: {e['total_us_per_run']:.0f} us per run under cProfile ({e['runs']} runs); top by own time:"
+            f"  {key}: {e['total_us_per_run']:.0f} us per run under cProfile ({e['runs']} runs); "
+            "top by own time:"
         )
         for r in e["top"]:
             out.append(
-                f"    {r['tottime_pct']:5.1f}%  {r['tottime_us_per_run']:8.0f} us  {r['calls_per_run']:6.1f} calls  {r['function']}"
+                f"    {r['tottime_pct']:5.1f}%  {r['tottime_us_per_run']:8.0f} us  "
+                f"{r['calls_per_run']:6.1f} calls  {r['function']}"
             )
     out.append("  micro-breakdown, median us (palm_push_two_feet):")
     for k, v in p["micro_us"].items():
         out.append(f"    {v:9.1f}  {k}")
     w = p["walk"]
     out.append(
-        f"  walk on {w['scenario']}: {w['pivots']} pivots for {w['vertices']} vertices"
-        f" ({w['reduced_variables']} variables after the equalities, {w['rows']} rows before dropping zero rows)"
+        f"  walk on {w['scenario']}: {w['pivots']} pivots for {w['vertices']} vertices "
+        f"({w['reduced_variables']} variables after the equalities, {w['rows']} rows before "
+        "dropping zero rows)"
     )
     return "\n".join(out)

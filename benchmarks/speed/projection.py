@@ -10,11 +10,10 @@ from typing import Any
 import numpy as np
 
 import impact_balance as ib
+from benchmarks.speed.polygons import compare
+from benchmarks.speed.timing import Case, measure, stats
 from impact_balance.balance.areas import FORCE_BOX, FORCE_TOLERANCE
 from impact_balance.projection import project_polytope
-
-from .polygons import compare
-from .timing import Case, measure, stats
 
 try:  # pypoman is a test extra of the project
     import pypoman
@@ -60,7 +59,7 @@ def projection_cases(poly: ib.WrenchPolytope, scale: float, seed: int) -> dict[s
             return exc
 
     def reseed(i: int) -> None:  # pypoman's first ray is random (numpy's global RNG)
-        np.random.seed((seed + i) % 2**32)
+        np.random.seed((seed + i) % 2**32)  # noqa: NPY002 (pypoman draws from the global RNG)
 
     cases = {"ours": Case(ours, keep=lambda r: r)}  # a ProjectionResult holds only the polygon
     cases["bretl_highs"] = Case(ours_bretl, keep=lambda r: r)

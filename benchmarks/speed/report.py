@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from .pipeline import PIPELINE_STAGES
+from benchmarks.speed.pipeline import PIPELINE_STAGES
 
 __all__ = ["fmt_us", "table", "text_report"]
 
@@ -27,9 +27,13 @@ def table(headers: list[str], rows: list[list[str]]) -> str:
     widths = [
         max(len(h), *(len(r[i]) for r in rows)) if rows else len(h) for i, h in enumerate(headers)
     ]
-    line = lambda cells: "  ".join(
-        c.rjust(w) if i else c.ljust(w) for i, (c, w) in enumerate(zip(cells, widths))
-    )
+
+    def line(cells: list[str]) -> str:
+        return "  ".join(
+            c.rjust(w) if i else c.ljust(w)
+            for i, (c, w) in enumerate(zip(cells, widths, strict=True))
+        )
+
     return "\n".join([line(headers), line(["-" * w for w in widths])] + [line(r) for r in rows])
 
 
@@ -47,13 +51,14 @@ def text_report(result: dict[str, Any], args) -> str:
     )
     s = result["settings"]
     out.append(
-        f"Repeats: {s['repeat']} (cheap calls {s['repeat_cheap']}), warm-up {s['warmup']}; times in us, median (p10-p90)"
+        f"Repeats: {s['repeat']} (cheap calls {s['repeat_cheap']}), warm-up {s['warmup']}; times "
+        "in us, median (p10-p90)"
     )
     out.append("")
     out.append(
-        "1. Projection (resultant horizontal force polygon, units of m g): ours (compiled walk) vs pypoman bretl"
-        f" (onto {s['pypoman_scale']:g} F) and vs our own Bretl/HiGHS path;"
-        f" agreement = relative area of the symmetric difference, tol {s['tol']:g}, with both"
+        "1. Projection (resultant horizontal force polygon, units of m g): ours (compiled walk) "
+        f"vs pypoman bretl (onto {s['pypoman_scale']:g} F) and vs our own Bretl/HiGHS path; "
+        f"agreement = relative area of the symmetric difference, tol {s['tol']:g}, with both"
     )
     rows = []
     for name, e in result["stances"].items():
@@ -215,8 +220,8 @@ def text_report(result: dict[str, Any], args) -> str:
     out.append("")
     if c["ok"]:
         out.append(
-            f"Answers: OK, every pypoman and Bretl/HiGHS polygon matches ours within {s['tol']:g} relative area "
-            f"(worst symmetric difference {c['worst_symdiff_rel']:.1e})."
+            f"Answers: OK, every pypoman and Bretl/HiGHS polygon matches ours within {s['tol']:g} "
+            f"relative area (worst symmetric difference {c['worst_symdiff_rel']:.1e})."
         )
     else:
         out.append("Answers: MISMATCH")

@@ -10,11 +10,10 @@ from typing import Any
 import numpy as np
 
 import impact_balance as ib
+from benchmarks.speed.projection import bench_projection
+from benchmarks.speed.timing import Case, measure, progress, stats
 from impact_balance.contacts.stance import ContactSpec, Stance
 from impact_balance.contacts.wrench_polytope import wrench_polytope
-
-from .projection import bench_projection
-from .timing import Case, measure, progress, stats
 
 __all__ = ["bench_cone_edges", "bench_contacts", "talos_contact_sets"]
 
@@ -49,12 +48,14 @@ def bench_contacts(args) -> list[dict[str, Any]]:
     for label, specs in sets:
         stance = Stance(robot, q, specs)
         t_stance, _ = measure(
-            {"stance": Case(lambda: Stance(robot, q, specs))}, args.repeat, args.warmup
+            {"stance": Case(lambda specs=specs: Stance(robot, q, specs))}, args.repeat, args.warmup
         )
         for tl in (True, False):
             poly = wrench_polytope(stance, tl)
             t_poly, _ = measure(
-                {"constraints": Case(lambda: wrench_polytope(stance, tl))}, args.repeat, args.warmup
+                {"constraints": Case(lambda stance=stance, tl=tl: wrench_polytope(stance, tl))},
+                args.repeat,
+                args.warmup,
             )
             entry = {
                 "contacts": label,
@@ -67,9 +68,30 @@ def bench_contacts(args) -> list[dict[str, Any]]:
             entry.update(bench_projection(poly, args))
             rows.append(entry)
             progress(
-                f"  scaling {label}, torque limits {tl}: {entry['project_us']['median']:.0f} us, {entry['pivots']} pivots"
+                f"  scaling {label}, torque limits {tl}: {entry['project_us']['median']:.0f} us, "
+                f"{entry['pivots']} pivots"
             )
     return rows
+
+
+def _cone_edge_cases(sc, stance: Stance, areas, spec, model) -> dict[str, Case]:
+    """The timed calls of the impact part at one impact ``spec`` (its friction-cone edges)."""
+    return {
+        "impact_model": Case(lambda: ib.impact_model(stance, spec)),
+        "max_velocity": Case(
+            lambda: ib.max_contact_velocity(areas.com_velocity_area, model, sc.com_velocity)
+        ),
+        "zmp_max_velocity": Case(
+            lambda: ib.zmp_max_contact_velocity(
+                areas.zmp_area,
+                model,
+                stance.com,
+                sc.plane_height,
+                sc.gravity,
+                spec.duration,
+            )
+        ),
+    }
 
 
 def bench_cone_edges(
@@ -83,22 +105,7 @@ def bench_cone_edges(
         for n in (8, 16, 32, 64):
             spec = dataclasses.replace(sc.impact.spec(), cone_edges=n)
             model = ib.impact_model(stance, spec)
-            cases = {
-                "impact_model": Case(lambda: ib.impact_model(stance, spec)),
-                "max_velocity": Case(
-                    lambda: ib.max_contact_velocity(areas.com_velocity_area, model, sc.com_velocity)
-                ),
-                "zmp_max_velocity": Case(
-                    lambda: ib.zmp_max_contact_velocity(
-                        areas.zmp_area,
-                        model,
-                        stance.com,
-                        sc.plane_height,
-                        sc.gravity,
-                        spec.duration,
-                    )
-                ),
-            }
+            cases = _cone_edge_cases(sc, stance, areas, spec, model)
             times, _ = measure(cases, args.repeat_cheap, max(args.warmup, 10))
             v = ib.max_contact_velocity(
                 areas.com_velocity_area, model, sc.com_velocity

@@ -6,11 +6,10 @@ from __future__ import annotations
 from typing import Any
 
 import impact_balance as ib
+from benchmarks.speed.pipeline import bench_max_velocity, bench_pipeline
+from benchmarks.speed.projection import bench_projection
+from benchmarks.speed.timing import progress
 from impact_balance.contacts.wrench_polytope import wrench_polytope
-
-from .pipeline import bench_max_velocity, bench_pipeline
-from .projection import bench_projection
-from .timing import progress
 
 __all__ = ["bench_stance"]
 

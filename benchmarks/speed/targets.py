@@ -29,8 +29,13 @@ def evaluate_targets(result: dict[str, Any]) -> list[dict[str, Any]]:
         worst = min(ratios, key=ratios.get)
         targets.append(
             {
-                "target": f"area projection >= {TARGET_RATIO:g}x faster than pypoman (median ratio) on every stance",
-                "measured": f"worst {ratios[worst]:.2f}x ({worst}); best {max(ratios.values()):.2f}x",
+                "target": (
+                    f"area projection >= {TARGET_RATIO:g}x faster than pypoman (median "
+                    "ratio) on every stance"
+                ),
+                "measured": (
+                    f"worst {ratios[worst]:.2f}x ({worst}); best {max(ratios.values()):.2f}x"
+                ),
                 "pass": all(r >= TARGET_RATIO for r in ratios.values()),
             }
         )
@@ -38,8 +43,14 @@ def evaluate_targets(result: dict[str, Any]) -> list[dict[str, Any]]:
         p = stances[TARGET_PIPELINE_SCENARIO]["pipeline"]
         targets.append(
             {
-                "target": f"whole pipeline, Talos two feet with torque limits ({TARGET_PIPELINE_SCENARIO}) < {TARGET_PIPELINE_US:g} us",
-                "measured": f"analyze() median {p['analyze']['median']:.0f} us (sum of stage medians {p['sum_of_stages']['median']:.0f} us)",
+                "target": (
+                    "whole pipeline, Talos two feet with torque limits "
+                    f"({TARGET_PIPELINE_SCENARIO}) < {TARGET_PIPELINE_US:g} us"
+                ),
+                "measured": (
+                    f"analyze() median {p['analyze']['median']:.0f} us (sum of stage "
+                    f"medians {p['sum_of_stages']['median']:.0f} us)"
+                ),
                 "pass": p["analyze"]["median"] < TARGET_PIPELINE_US,
             }
         )
@@ -53,7 +64,9 @@ def evaluate_targets(result: dict[str, Any]) -> list[dict[str, Any]]:
         targets.append(
             {
                 "target": f"max contact velocity given the area < {TARGET_MAXVEL_US:g} us",
-                "measured": f"worst median {mv[worst]:.1f} us ({worst}); best {min(mv.values()):.1f} us",
+                "measured": (
+                    f"worst median {mv[worst]:.1f} us ({worst}); best {min(mv.values()):.1f} us"
+                ),
                 "pass": all(t < TARGET_MAXVEL_US for t in mv.values()),
             }
         )
