@@ -71,7 +71,11 @@ def _imports(name: str) -> list[tuple[str, str, int]]:
                     else:
                         out.append((target, alias.name, node.lineno))
         elif isinstance(node, ast.Import):
-            out += [(a.name, "", node.lineno) for a in node.names if a.name.split(".")[0] == "impact_balance"]
+            out += [
+                (a.name, "", node.lineno)
+                for a in node.names
+                if a.name.split(".")[0] == "impact_balance"
+            ]
     return out
 
 
@@ -164,7 +168,11 @@ def test_private_names_stay_in_their_package():
             private = imported.startswith("_") or any(
                 p.startswith("_") for p in target.split(".")[1:] if p != "_jit"
             )
-            target_package = target if MODULES.get(target, Path()).name == "__init__.py" else target.rsplit(".", 1)[0]
+            target_package = (
+                target
+                if MODULES.get(target, Path()).name == "__init__.py"
+                else target.rsplit(".", 1)[0]
+            )
             if private and imported != "__version__" and target_package != own_package:
                 wrong.append(f"{name}:{line} imports {target}.{imported}".rstrip("."))
     assert not wrong, "\n".join(wrong)
@@ -188,7 +196,10 @@ def test_every_module_declares_its_public_names():
         if path.name != "__main__.py"
         and not any(
             isinstance(n, (ast.Assign, ast.AnnAssign))
-            and any(getattr(t, "id", None) == "__all__" for t in (n.targets if isinstance(n, ast.Assign) else [n.target]))
+            and any(
+                getattr(t, "id", None) == "__all__"
+                for t in (n.targets if isinstance(n, ast.Assign) else [n.target])
+            )
             for n in ast.parse(path.read_text(encoding="utf-8")).body
         )
     ]
