@@ -1,7 +1,7 @@
 """Stance authoring from the command line: `frames` (poses and axes), contacts given by their
 world normal, and `pose` (whole-body IK that writes a scenario).
 
-The two stances of issue 16 are written with `frames` and `pose` alone: a hand flat on a table
+Two stances are written with `frames` and `pose` alone: a hand flat on a table
 beside two feet, and a one-foot kick. Each result is checked independently: frame poses with
 pinocchio's forward kinematics of the written configuration, the analysis of the written file.
 """

@@ -1,4 +1,4 @@
-"""Why a stance cannot balance (issue 8, section 5).
+"""Why a stance cannot balance: the torque limit or the friction that empties its area.
 
 Checked independently: the torque case by editing the model's effort limit around the
 reported factor and recomputing the areas; the friction case against the closed-form

@@ -1,8 +1,8 @@
-"""Issue 17 (and issue 16 item 4): every error is one line whatever raised it, with the right exit
+"""Every error of a command is one line whatever raised it, with the right exit
 status (2 bad input, 1 machine failure), no traceback, and no output folder created before the
 inputs are known good; numbers limited to what the code can do; logs bounded and strict.
 
-Each hostile input of the issues is driven through the command line (in process where that
+Each hostile input is driven through the command line (in process where that
 sees the same thing, in a real process for streams, signals and ``--debug``), beside a control
 that is accepted.
 """

@@ -1,4 +1,4 @@
-"""Optional parts (issue 16, item 6): the core works without them, a command that needs a
+"""Optional parts (pip extras): the core works without them, a command that needs a
 missing one says which extra to install in one line, and light commands import no heavy part.
 
 Absence is simulated the way Python marks a blocked import: ``sys.modules[name] = None``

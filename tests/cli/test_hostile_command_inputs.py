@@ -1,4 +1,4 @@
-"""Fuzz (issue 17, item 6): hostile sweep files, logs and simulation options.
+"""The commands under hostile sweep files, logs and simulation options (hypothesis).
 
 The contract is the command line's: for any input, either the command's answer (exit status 0)
 or one line ``...: error: ...`` with exit status 2 (1 for a failure of the machine), never a

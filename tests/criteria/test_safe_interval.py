@@ -1,4 +1,4 @@
-"""The safe interval of approach speeds (issue 8, section 5): analytic cases.
+"""The safe interval of approach speeds: analytic cases.
 
 The post-impact CoM velocities are ``c0 + s d_j``; in the square ``[-1, 1]^2`` the safe
 speeds are found by hand below, independently of the half-plane code.

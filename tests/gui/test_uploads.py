@@ -1,4 +1,4 @@
-"""Issue 17: GUI uploads are counted as they arrive and cut at the 1 MiB limit; the server's
+"""GUI uploads are counted as they arrive and cut at the 1 MiB limit; the server's
 memory stays bounded during a 200 MB upload.
 
 The server runs in its own process (its resident memory is measured alone, sampled every 5 ms);

@@ -1,5 +1,5 @@
-"""Figures a reader can trust (issue 16, item 5): each figure is rendered and checked by
-:mod:`layout` (no text or legend outside the canvas, no overlapping texts, no legend or note
+"""Every figure is readable: each is rendered and checked by
+:mod:`tests.helpers.figure_layout` (no text or legend outside the canvas, no overlapping texts, no legend or note
 over data, axis labels with units), plus what each figure must say.
 
 The simulation, sweep and video figures run short trials (a few hundredths of a second).

@@ -1,4 +1,4 @@
-"""Figure layout (issue 8, section 6): legends and notes never cover the areas, no quarter
+"""Figure layout of the areas figure: legends and notes never cover the areas, no quarter
 of a figure left blank. Checked on the rendered figures' bounding boxes."""
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """The walk projection under badly scaled rows: it must detect trouble and fall back to
-Bretl, never return a wrong polygon (issue 8, section 3), and keep its precision at
+Bretl, never return a wrong polygon, and keep its precision at
 extreme frictions (docs/numerics.md, "Precision at extreme friction").
 
 Independent references: Bretl's projection (one HiGHS LP per edge, HiGHS scales the rows
@@ -91,8 +91,8 @@ def _same_polygon(p, q, rel=1e-6):
     [(0.7, 0.7, 1e8), (0.7, 0.7, 1e9), (1e-9, 1e-9, 0.7), (0.7, 1e9, 0.7), (1e-6, 0.7, 1e6)],
 )
 def test_extreme_friction_matches_bretl(frictions):
-    """The cases of the issue: the walk gave a non-convex polygon (wall friction 1e9) and a
-    negative area of vertices outside the clipping box (feet at 1e-9). The answer is now
+    """Extreme frictions where an unchecked walk gives a non-convex polygon (wall friction 1e9)
+    or a negative area of vertices outside the clipping box (feet at 1e-9): the answer is
     Bretl's, or the walk's when it is verified to agree."""
     auto = _project("talos_three_contacts", frictions)
     bretl = _project("talos_three_contacts", frictions, method="bretl")
@@ -156,8 +156,8 @@ def test_area_is_monotone_in_friction(name, which, exponents):
 @pytest.mark.parametrize("name", sorted(bundled_scenarios()))
 def test_area_is_monotone_on_a_friction_grid(name):
     """The same on a deterministic grid, 1e-6 to 1e6 in steps of 10^0.2, every contact:
-    the property does not hold by luck of the draw (the cases of the issue: feet at 10^4.625
-    and 10^5.5 shrank the area by 1.1e-6; a hand at 1.6e-6 doubled it)."""
+    the property does not hold by luck of the draw (feet at 10^4.625 and 10^5.5, a hand at
+    1.6e-6 are on the grid)."""
     _, _, specs = _base(name)
     for which in range(len(specs)):
         _check_monotone(name, which, 10.0 ** np.linspace(-6.0, 6.0, 61))
@@ -165,8 +165,8 @@ def test_area_is_monotone_on_a_friction_grid(name):
 
 @pytest.mark.parametrize("mu", [1.0, 10**4.625, 10**5.5, 1e6])
 def test_walk_answers_and_equals_bretl_at_large_foot_friction(mu):
-    """The issue's case: the walk itself (no fallback) gives Bretl's polygon. Before, it
-    refused at 10^5.5 and lost the corner (area -1.1e-6 relative) at 10^4.625."""
+    """At large foot frictions the walk itself (no fallback) answers and gives Bretl's polygon
+    to 1e-9 relative, the corner included."""
     walk = _project("palm_push_two_feet", [mu, 0.7], method="walk")
     bretl = _project("palm_push_two_feet", [mu, 0.7], method="bretl")
     _same_polygon(walk.polygon, bretl.polygon, rel=1e-9)

@@ -1,8 +1,8 @@
-"""Hostile and mistaken input (issue 8): bounded reading, bounded messages, quiet pipes, strict
+"""Hostile and mistaken scenario input: bounded reading, bounded messages, quiet pipes, strict
 JSON on a clean stdout, physical ranges, warnings and ``--strict``, nearest-key suggestions,
 ``impact-balance frames`` and ``--version``.
 
-Each test would have caught one observed failure; each refusal is checked beside a control
+Each refusal is checked beside a control
 that is accepted.
 """
 
@@ -346,17 +346,6 @@ def test_nan_is_refused_everywhere(path):
 
 
 # -- stdout: one strict JSON document, quiet pipes, no native chatter ---------------------------
-def test_highs_prints_nothing():
-    code = (
-        "import numpy as np\nfrom impact_balance.solvers import HighsLP, LinearProgram\n"
-        "lp = HighsLP(LinearProgram(np.eye(2), np.ones(2), np.zeros((0, 2)), np.zeros(0)))\n"
-        "assert lp.maximize(np.ones(2)).objective == 2.0\n"
-    )
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
-    assert proc.returncode == 0, proc.stderr
-    assert proc.stdout == "" and proc.stderr == ""  # the "Running HiGHS ..." banner went to stdout
-
-
 def test_analyze_json_stdout_is_one_strict_document():
     proc = run_process("analyze", "talos_three_contacts", "--json", "--qp")
     assert proc.returncode == 0, proc.stderr

@@ -1,4 +1,4 @@
-"""Loading caches (issue 8, section 6): fast repeated loads that never serve stale or shared
+"""Loading caches of scenarios and robots: fast repeated loads that never serve stale or shared
 mutable data, and printed timings that say what they measure."""
 
 from __future__ import annotations

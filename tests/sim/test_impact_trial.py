@@ -83,7 +83,7 @@ def test_rigid_jump_is_impulse_over_mass_and_inside_composite_set(rigid_push):
     i_n = result.impulse_measured @ n
     assert i_n > 0
     assert np.linalg.norm(result.impulse_measured - i_n * n) <= spec.friction * i_n * (1 + 1e-6)
-    # Target of issue 9: within 2 % of the jump's magnitude of the composite set.
+    # The contract (README): within 2 % of the jump's magnitude of the composite set.
     assert result.predicted["composite"].distance <= 0.02 * np.linalg.norm(jump)
     # The joint-space model (every joint free) predicts a far smaller jump for a welded robot.
     assert result.predicted["joint_space"].distance > 0.5 * np.linalg.norm(jump)

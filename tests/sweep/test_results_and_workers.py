@@ -1,7 +1,7 @@
-"""Issue 17: a sweep's results folder is checked like a database, every axis does what it says,
+"""A sweep's results folder is checked like a database, every axis does what it says,
 nothing is created for bad input, and workers die with their sweep.
 
-Folders are damaged in each way the issue lists (a part cut in half, emptied, copied from
+Folders are damaged in every way a folder can be (a part cut in half, emptied, copied from
 another sweep, extra, renamed, edited, deleted): ``--verify`` names each in one line, the
 summary leaves them out without crashing, and a resume recomputes exactly what is missing or
 damaged, ending with the same rows as an uninterrupted run.
