@@ -35,8 +35,8 @@ def test_robot_log_example_finds_the_exit_of_the_area(tmp_path, capsys):
 
 
 def test_governor_in_a_pink_loop_caps_the_speed_at_the_criterion(capsys):
-    """The commanded approach speed is min(reference, the cap), the cap is the analysis' maximum at the
-    start, and pink's IK tracks the commanded speed."""
+    """The commanded approach speed is min(reference, the cap), the cap is the analysis' maximum at
+    the start, and pink's IK tracks the commanded speed."""
     example = _load("governor_pink")
     fast = example.run("palm_push_two_feet", reference=0.8, ticks=80)
     start = ib.analyze("palm_push_two_feet").impact.max_contact_velocity

@@ -82,7 +82,7 @@ def test_overflow_is_an_error_not_nan():
     impact = scenario.impact.model_copy(
         update={"offset": scenario.impact.offset.model_copy(update={"position": (1e160, 0.0, 0.0)})}
     )
-    with pytest.raises(ib.ImpactBalanceError, match="impact.offset") as info:
+    with pytest.raises(ib.ImpactBalanceError, match=r"impact\.offset") as info:
         ib.analyze(scenario.model_copy(update={"impact": impact}))
     assert "nan" not in str(info.value).lower()
 

@@ -30,7 +30,7 @@ def frames_json(capsys, target: str, *names: str) -> dict:
 
 
 def fk(scenario_path: str, frame: str) -> pin.SE3:
-    """Independent: the frame's pose by pinocchio's forward kinematics of the scenario's stance q."""
+    """Independent: the frame's pose by pinocchio's forward kinematics at the scenario's q."""
     scenario = load_scenario(scenario_path)
     stance = scenario.build_stance()
     model = stance.robot.model
@@ -140,7 +140,7 @@ def test_hand_on_table_with_frames_and_pose(tmp_path, capsys):
     hand = analysis.stance.contacts[2]
     np.testing.assert_allclose(hand.normal, [0, 0, 1], atol=1e-5)  # not 127 degrees off
     np.testing.assert_allclose(hand.position, [0.3, -0.4, 1.0], atol=1e-5)
-    for before, contact in zip(feet, analysis.stance.contacts[:2]):
+    for before, contact in zip(feet, analysis.stance.contacts[:2], strict=True):
         np.testing.assert_allclose(
             contact.position, before["position"], atol=1e-5
         )  # the feet stayed
@@ -166,8 +166,10 @@ def test_kick_one_foot_with_frames_and_pose(tmp_path, capsys):
     right, left = soles["right_sole_link"]["position"], soles["left_sole_link"]["position"]
     draft = tmp_path / "kick_draft.yaml"
     draft.write_text(
-        "extends: palm_push_two_feet\ncontacts:\n  - {frame: right_sole_link, friction: 0.7, size: [0.2, 0.1]}\n"
-        "impact:\n  frame: left_sole_link\n  offset: {position: [0.105, 0.0, 0.0]}\n  normal: [-1.0, 0.0, 0.0]\n"
+        "extends: palm_push_two_feet\n"
+        "contacts:\n  - {frame: right_sole_link, friction: 0.7, size: [0.2, 0.1]}\n"
+        "impact:\n  frame: left_sole_link\n  offset: {position: [0.105, 0.0, 0.0]}\n"
+        "  normal: [-1.0, 0.0, 0.0]\n"
         "  reference_velocity: [1.0, 0.0, 0.0]\n"
     )
     out = tmp_path / "kick.yaml"

@@ -9,6 +9,7 @@ feasibility with scipy.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import replace
 
@@ -184,14 +185,14 @@ def test_talos_zmp_area_is_close_to_sole_hull(geo, talos_stance):
 def test_more_friction_never_shrinks(geo, make_contact, name):
     areas = [areas_of(make_contact, name, mu_scale=s).force_area for s in (0.7, 1.0, 1.5, 3.0)]
     assert not areas[-1].is_empty
-    for small, big in zip(areas, areas[1:]):  # (clipping to the same box keeps inclusions)
+    for small, big in itertools.pairwise(areas):  # (clipping to the same box keeps inclusions)
         assert_nested(geo, small, big)
 
 
 @pytest.mark.parametrize("name", ["two_level", "one_foot", "ramp", "wall", "far_com"])
 def test_bigger_soles_never_shrink(geo, make_contact, name):
     areas = [areas_of(make_contact, name, size_scale=s).force_area for s in (0.5, 1.0, 1.3, 2.0)]
-    for small, big in zip(areas, areas[1:]):
+    for small, big in itertools.pairwise(areas):
         assert_nested(geo, small, big)
     assert areas[-1].area > areas[0].area  # the CoP rows matter in every one of these
 
@@ -242,9 +243,9 @@ def test_tighter_torque_limits_are_nested_and_empty_iff_infeasible(geo, talos_st
 
 
 def _independent_talos_polytope(stance, scale):
-    """Talos wrench polytope rebuilt without impact_balance.contacts.wrench_polytope: joint torques from
-    pinocchio's RNEA with the contact wrenches as external forces, LIPM rows by hand.
-    Returns (A, b, C, d, F) in units of m g."""
+    """Talos wrench polytope rebuilt without impact_balance.contacts.wrench_polytope: joint torques
+    from pinocchio's RNEA with the contact wrenches as external forces, LIPM rows by hand. Returns
+    (A, b, C, d, F) in units of m g."""
     import pinocchio as pin
 
     from impact_balance.contacts.cwc import cwc_faces_world
@@ -264,7 +265,7 @@ def _independent_talos_polytope(stance, scale):
         fext = pin.StdVec_Force()
         for _ in range(model.njoints):
             fext.append(pin.Force.Zero())
-        for k, (f, pose) in enumerate(zip(frames, poses)):
+        for k, (f, pose) in enumerate(zip(frames, poses, strict=True)):
             force, moment = w[6 * k : 6 * k + 3] * mg, w[6 * k + 3 : 6 * k + 6] * mg
             world = pin.Force(force, moment + np.cross(pose.translation, force))  # about the origin
             joint = model.frames[f].parentJoint
@@ -366,7 +367,7 @@ def pypoman_force_area(P, scale=1e3):
     """pypoman's Bretl projection of (A, b/mg, C, d/mg) onto F. Its stopping rule is an
     absolute 1e-4 and it drops vertices closer than 1e-2, so project onto scale * F."""
     pypoman = pytest.importorskip("pypoman", reason="needs pypoman (the test extra, --no-deps)")
-    np.random.seed(12345)  # pypoman draws its first ray with numpy's global generator
+    np.random.seed(12345)  # noqa: NPY002 (pypoman draws its first ray from numpy's global generator)
     w = P.weight
     V = pypoman.project_polytope(
         proj=(scale * P.F, np.zeros(2)),

@@ -68,7 +68,8 @@ def test_simple_humanoid_torque_limits():
 def test_simple_humanoid_through_analyze(tmp_path):
     path = tmp_path / "simple.yaml"
     path.write_text(
-        f"robot: {{urdf: {SIMPLE / 'urdf' / 'simple_humanoid.urdf'}, srdf: {SIMPLE / 'srdf' / 'simple_humanoid.srdf'},"
+        f"robot: {{urdf: {SIMPLE / 'urdf' / 'simple_humanoid.urdf'},"
+        f" srdf: {SIMPLE / 'srdf' / 'simple_humanoid.srdf'},"
         " standing: half_sitting}\n"
         "contacts:\n"
         "  - {frame: l_ankle, friction: 0.7, size: [0.2, 0.1]}\n"

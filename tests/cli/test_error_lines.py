@@ -165,7 +165,7 @@ def test_output_folder_that_is_a_file_is_bad_input(capsys, in_tmp):
             "taken/p.png",
         ],
     ):
-        rc, out, err = run_cli(capsys, *argv)
+        rc, _out, err = run_cli(capsys, *argv)
         assert rc == 2 and "taken" in error_line(err)
     assert in_tmp() == ["taken"]
 
@@ -197,7 +197,8 @@ def test_full_and_closed_stdout_are_one_line_exit_1(tmp_path):
     assert proc.returncode == 1
     assert (
         error_line(proc.stderr)
-        == "impact-balance: error: standard output: cannot write the output: No space left on device"
+        == "impact-balance: error: standard output: cannot write the output: "
+        "No space left on device"
     )
     proc = subprocess.run(
         f"{sys.executable} -m impact_balance scenarios >&-",
@@ -300,7 +301,7 @@ def test_an_unexpected_exception_in_a_command_is_one_line_exit_1(capsys, monkeyp
         raise KeyError("surprise")
 
     monkeypatch.setattr(listing, "run", broken)
-    rc, out, err = run_cli(capsys, "scenarios")
+    rc, _out, err = run_cli(capsys, "scenarios")
     assert rc == 1 and "internal error (KeyError: 'surprise')" in error_line(err)
 
 
@@ -324,13 +325,13 @@ def test_numbers_outside_what_the_simulation_can_do_are_refused(capsys, monkeypa
         balance_trial, "run_balance_trial", lambda *a, **k: pytest.fail("simulated")
     )
     start = time.perf_counter()
-    rc, out, err = run_cli(capsys, *argv)
+    rc, _out, err = run_cli(capsys, *argv)
     assert rc == 2 and needle in error_line(err)
     assert time.perf_counter() - start < 60  # refused, not run for ever (a hang guard)
 
 
 def test_a_push_that_throws_the_robot_is_an_answer(capsys):
-    """1000 N s is inside the documented (0, 1000]: the robot leaves the ground (no ZMP), an answer."""
+    """1000 N s is inside the documented (0, 1000]: the robot leaves the ground, an answer."""
     rc, out, err = run_cli(
         capsys,
         "push-test",
@@ -408,7 +409,7 @@ def test_a_log_over_the_row_limit_is_refused_from_its_metadata(tmp_path, capsys)
     assert time.perf_counter() - start < 30
 
 
-# -- sweeps: bounded plans, the robot axis, files that are not sweep files -----------------------------
+# -- sweeps: bounded plans, the robot axis, files that are not sweep files -------------------------
 BASE = "palm_push_two_feet"
 
 
@@ -452,7 +453,7 @@ def test_point_count_is_exact_beyond_64_bits():
 
 @needs_extra("sweep")
 def test_quasi_random_samples_are_bounded():
-    with pytest.raises(SweepError, match="sampling.samples"):
+    with pytest.raises(SweepError, match=r"sampling\.samples"):
         sweep_spec_from_dict(
             {
                 "base": BASE,
@@ -485,7 +486,8 @@ def test_sweep_file_linked_to_a_system_file_is_not_quoted(tmp_path, capsys, in_t
     rc, _, err = run_cli(capsys, "sweep", "s.yaml", "--out", "o")
     assert rc == 2 and "SECRET" not in err and "must be a YAML mapping" in error_line(err)
     (tmp_path / "t.yaml").write_text(
-        "base: palm_push_two_feet\nSECRET-KEY: SECRET-CONTENT\naxes: [{path: impact.friction, values: [0.1]}]\n"
+        "base: palm_push_two_feet\nSECRET-KEY: SECRET-CONTENT\n"
+        "axes: [{path: impact.friction, values: [0.1]}]\n"
     )
     rc, _, err = run_cli(capsys, "sweep", "t.yaml", "--out", "o")
     assert rc == 2 and "unknown key" in error_line(err) and "SECRET-CONTENT" not in err

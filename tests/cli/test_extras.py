@@ -163,9 +163,9 @@ def test_core_runs_without_any_extra():
 @pytest.mark.parametrize(
     "argv, absent",
     [
-        (["robots"], HEAVY + ("numba", "scipy", "pydantic")),
-        (["scenarios"], HEAVY + ("numba", "scipy", "pinocchio", "pydantic", "numpy")),
-        (["analyze", "palm_push_two_feet", "--json"], HEAVY + ("qpsolvers", "numba")),
+        (["robots"], (*HEAVY, "numba", "scipy", "pydantic")),
+        (["scenarios"], (*HEAVY, "numba", "scipy", "pinocchio", "pydantic", "numpy")),
+        (["analyze", "palm_push_two_feet", "--json"], (*HEAVY, "qpsolvers", "numba")),
     ],
 )
 def test_light_commands_import_no_heavy_part(argv, absent):

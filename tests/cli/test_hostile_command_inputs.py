@@ -89,7 +89,7 @@ def mutated_specs(draw):
         if op == "number" and numbers:
             path = draw(st.sampled_from(numbers))
             data = apply_mutation(
-                data, path, "set", draw(st.sampled_from(HOSTILE_NUMBERS + [0.3, 1, 2, -1]))
+                data, path, "set", draw(st.sampled_from([*HOSTILE_NUMBERS, 0.3, 1, 2, -1]))
             )
             continue
         paths = [p for p, _ in mapping_paths(data)]

@@ -117,7 +117,7 @@ def test_random_wrenches_in_faces_iff_in_span(mu, X, Y, seed):
     assert inside.sum() >= 5 and outside.sum() >= 5  # the sampler hits both sides
     for w in W[:, inside].T:
         assert _nnls_residual(S, w) <= 1e-8 * np.linalg.norm(w)
-    for w, v in zip(W[:, outside].T, viol[outside]):
+    for w, v in zip(W[:, outside].T, viol[outside], strict=True):
         assert _nnls_residual(S, w) >= v * (1 - 1e-6) - 1e-12
 
 
@@ -226,8 +226,8 @@ def test_world_faces_for_a_wall_contact():
     Cw = cwc_faces_world(mu, X, Y, R)
     push = np.array([-1.0, 0, 0, 0, 0, 0])
     assert np.all(Cw @ push < 0)
-    assert np.max(Cw @ (push + [0, 0, 0.49, 0, 0, 0])) <= 0
-    assert np.max(Cw @ (push + [0, 0, 0.51, 0, 0, 0])) > 0
+    assert np.max(Cw @ ([*push, 0, 0, 0.49, 0, 0, 0])) <= 0
+    assert np.max(Cw @ ([*push, 0, 0, 0.51, 0, 0, 0])) > 0
     # force at local point (x, 0, 0): local x axis is world R[:,0] = (0, 0, 1) (up)
     for x, ok in [(0.099, True), (0.101, False)]:
         p = R @ np.array([x, 0.0, 0.0])

@@ -26,7 +26,8 @@ def test_reference_inside_the_interval_is_kept(falling, capsys):
     lo, hi = im.safe_interval
     assert 0 < lo < 0.8 < hi  # the 0.8 m/s reference would catch the fall
     np.testing.assert_allclose(im.contact_velocity, im.model.spec.reference_velocity)
-    # Independent check: at the contact velocity's approach speed every post-impact vertex is inside.
+    # Independent check: at the contact velocity's approach speed every post-impact vertex is
+    # inside.
     speed = im.model.approach_speed(im.contact_velocity)
     post = im.model.post_impact_com_velocities(analysis.com_velocity, speed)
     G, h = analysis.areas.com_velocity_area.halfplanes

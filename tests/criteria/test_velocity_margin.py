@@ -1,4 +1,5 @@
-"""The velocity margin: every post-impact CoM velocity at least d (m/s) inside the CoM velocity area."""
+"""The velocity margin: every post-impact CoM velocity at least d (m/s) inside the CoM velocity
+area."""
 
 from __future__ import annotations
 
@@ -21,7 +22,7 @@ def inside_distance(vertices: np.ndarray, x: np.ndarray) -> float:
     """Signed distance from ``x`` to the boundary of the convex CCW polygon ``vertices``
     (positive inside), from the vertices alone: the smallest distance to an edge's line."""
     best = math.inf
-    for a, b in zip(vertices, np.roll(vertices, -1, axis=0)):
+    for a, b in zip(vertices, np.roll(vertices, -1, axis=0), strict=True):
         edge = b - a
         best = min(
             best, float(edge[0] * (x[1] - a[1]) - edge[1] * (x[0] - a[0])) / float(np.hypot(*edge))
@@ -66,7 +67,8 @@ def test_the_governor_applies_it_to_both_models():
     posture = margin.posture
     floating = ComCriterion(posture.com_criterion.area, posture.impact, 0.02).limit(b.com_velocity)
     assert b.max_approach_speed <= floating.max_approach_speed + 1e-12
-    # The contact-aware jump with the margin: the point it predicts at the limit is 0.02 inside (or the floating set binds).
+    # The contact-aware jump with the margin: the point it predicts at the limit is 0.02 inside (or
+    # the floating set binds).
     aware = margin._support.answer(posture.com_criterion, b.com_velocity)
     assert b.max_approach_speed == pytest.approx(
         min(floating.max_approach_speed, aware.limit.max_approach_speed)

@@ -1,7 +1,9 @@
-"""The ZMP margin: the ZMP support area shrunk by M, and the CoM velocity area and both criteria with it."""
+"""The ZMP margin: the ZMP support area shrunk by M, and the CoM velocity area and both criteria
+with it."""
 
 from __future__ import annotations
 
+import itertools
 import json
 
 import numpy as np
@@ -25,7 +27,8 @@ def test_areas_are_the_inset_of_the_unshrunk_ones(name):
     expected = a.zmp_area.inset(0.01)
     assert np.allclose(b.zmp_area.vertices, expected.vertices, atol=1e-12)
     assert np.allclose(b.zmp_area_without_margin.vertices, a.zmp_area.vertices, atol=1e-12)
-    # Every ZMP of the shrunk area is 1 cm inside the full one, and the CoM velocity area is omega (Z - c).
+    # Every ZMP of the shrunk area is 1 cm inside the full one, and the CoM velocity area is omega
+    # (Z - c).
     assert np.all(a.zmp_area.margins(b.zmp_area.vertices) >= 0.01 - 1e-12)
     c = b.com[:2]
     assert np.allclose(
@@ -39,8 +42,8 @@ def test_both_criteria_fall_as_the_margin_grows():
         im = analyze(with_margin("palm_push_two_feet", margin)).impact
         com.append(im.max_contact_velocity)
         zmp.append(im.zmp_max_contact_velocity)
-    assert all(x > y for x, y in zip(com, com[1:]))
-    assert all(x > y for x, y in zip(zmp, zmp[1:]))
+    assert all(x > y for x, y in itertools.pairwise(com))
+    assert all(x > y for x, y in itertools.pairwise(zmp))
 
 
 def test_a_margin_larger_than_the_area_is_an_answer():

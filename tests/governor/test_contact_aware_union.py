@@ -62,7 +62,7 @@ def answers(path):
     for posture in postures:
         row = {}
         for name, limit in limits.items():
-            limit.new_posture(lambda: posture.stance)
+            limit.new_posture(lambda posture=posture: posture.stance)
             row[name] = limit.answer(posture.com_criterion, np.zeros(3))
         out.append(row)
     return out
@@ -124,7 +124,9 @@ def test_each_kept_row_is_a_fixed_point(path):
     for posture in postures:
         previous = contact_aware_solutions(posture.stance, spec, previous)
         if len(previous.rates) > len(spec.restitution):
-            for rate, c_r, state in zip(previous.rates, previous.restitution, previous.states):
+            for rate, c_r, state in zip(
+                previous.rates, previous.restitution, previous.states, strict=True
+            ):
                 again = contact_impact(
                     posture.stance, spec, 1.0, restitution=float(c_r), initial_dxi=state
                 )
@@ -154,7 +156,7 @@ def test_the_governor_defaults_to_the_union(path):
     """``Governor(contact_aware=True)`` uses the union; ``contact_aware_starts="warm"`` is the
     frozen option; along the path (every posture a recomputation) the union's cap is never above
     the warm one's."""
-    governor, postures = path
+    _governor, postures = path
     union = Governor(NAME, contact_aware=True, contact_aware_every=1)
     warm = Governor(NAME, contact_aware=True, contact_aware_every=1, contact_aware_starts="warm")
     assert union._support.starts == "union" and warm._support.starts == "warm"

@@ -16,8 +16,8 @@ from impact_balance.scenario import load_scenario
 
 
 def states(governor: Governor, count: int, seed: int = 0):
-    """``count`` (q, v) pairs near the scenario's posture: joints moved by up to 0.05 rad, the base by
-    a few cm, joint and base velocities of a moving robot (pinocchio's base-frame convention)."""
+    """``count`` (q, v) pairs near the scenario's posture: joints moved by up to 0.05 rad, the base
+    by a few cm, joint and base velocities of a moving robot (pinocchio's base-frame convention)."""
     rng = np.random.default_rng(seed)
     model = governor.robot.model
     out = []

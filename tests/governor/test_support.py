@@ -15,8 +15,8 @@ from impact_balance.scenario import load_scenario
 
 
 def contact_aware_maximum(name: str, margin: float) -> float:
-    """The contact-aware criterion computed independently: analyze(), contact_impact at 1 m/s at both
-    restitution bounds, the first exit of the scenario's CoM velocity from the inset area."""
+    """The contact-aware criterion computed independently: analyze(), contact_impact at 1 m/s at
+    both restitution bounds, the first exit of the scenario's CoM velocity from the inset area."""
     a = ib.analyze(name)
     spec = a.scenario.impact.spec()
     area = a.areas.com_velocity_area_inset(margin) if margin > 0 else a.areas.com_velocity_area

@@ -320,8 +320,10 @@ def test_scene_objects_follow_the_state(session):
     np.testing.assert_allclose(vel.ends[0] - vel.starts[0], [0.1, 0.0, 0.0], atol=TOL)
     assert session.apply(
         {
-            ("contacts",): session.state.get(("contacts",))
-            + [{"frame": "gripper_left_base_link", "friction": 0.5, "size": [0.1, 0.08]}]
+            ("contacts",): [
+                *session.state.get(("contacts",)),
+                {"frame": "gripper_left_base_link", "friction": 0.5, "size": [0.1, 0.08]},
+            ]
         }
     )
     assert "contacts/2/outline" in by_name(scene_objects(session.analysis))

@@ -303,9 +303,12 @@ def test_upload_rename_does_not_leak_the_temporary_path(session):
 # -- Host and Origin -----------------------------------------------------------------------------
 def test_policy_for_a_localhost_bind():
     policy = AccessPolicy.for_bind("127.0.0.1")
-    ok = dict(
-        bound_port=8080, host=["127.0.0.1:8080"], origin=["http://127.0.0.1:8080"], websocket=True
-    )
+    ok = {
+        "bound_port": 8080,
+        "host": ["127.0.0.1:8080"],
+        "origin": ["http://127.0.0.1:8080"],
+        "websocket": True,
+    }
     assert policy.refusal(**ok) is None
     for origin in ("http://localhost:8080", "http://[::1]:8080"):
         assert policy.refusal(**{**ok, "origin": [origin]}) is None

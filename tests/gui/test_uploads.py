@@ -18,12 +18,11 @@ from pathlib import Path
 import pytest
 
 pytest.importorskip("viser", reason="needs the gui extra (viser)")
-msgspec = pytest.importorskip(
-    "msgspec", reason="needs msgspec (installed with the gui extra's viser)"
-)
-psutil = pytest.importorskip(
-    "psutil", reason="needs psutil (installed with the sweep extra's Dask)"
-)
+pytest.importorskip("msgspec", reason="needs msgspec (installed with the gui extra's viser)")
+pytest.importorskip("psutil", reason="needs psutil (installed with the sweep extra's Dask)")
+
+import msgspec
+import psutil
 
 SRC = str(Path(__file__).parents[2] / "src")
 PART = 512 << 10  # what viser's page sends
@@ -34,13 +33,15 @@ SERVER = r"""
 import sys
 from impact_balance.gui.app import GuiApp
 app = GuiApp(port=0, workspace=sys.argv[1])
-uuid = next(u for u, h in app.server.gui._gui_input_handle_from_uuid.items() if "Upload" in type(h).__name__)
+handles = app.server.gui._gui_input_handle_from_uuid.items()
+uuid = next(u for u, h in handles if "Upload" in type(h).__name__)
 print("READY", app.server.get_port(), uuid, flush=True)
 while True:
     line = sys.stdin.readline()
     if not line.strip():
         break
-    print("STATE", app.uploads.refused, app.uploads.peak_bytes, app.session.revision, repr(app.session.message), flush=True)
+    state = (app.uploads.refused, app.uploads.peak_bytes, app.session.revision)
+    print("STATE", *state, repr(app.session.message), flush=True)
 app.stop()
 """
 
@@ -64,7 +65,7 @@ class Server:
         self.process = psutil.Process(self.proc.pid)
 
     def state(self) -> tuple[int, int, str, int]:
-        """Uploads refused, most bytes held for one, the GUI's message, its count of accepted edits."""
+        """Uploads refused, most bytes held for one, the GUI's message, its accepted edits."""
         self.proc.stdin.write("state\n")
         self.proc.stdin.flush()
         _, refused, peak, revision, message = self.proc.stdout.readline().rstrip("\n").split(" ", 4)
@@ -153,9 +154,10 @@ def test_a_200_mb_upload_is_refused_before_a_byte_is_kept(server):
     grew, base = _send(
         server, _upload(server, "t1", "big.yaml", total, total // PART, [PART] * (total // PART))
     )
-    refused, peak, message, _ = server.state()
+    _refused, peak, message, _ = server.state()
     print(
-        f"\n200 MB declared: server RSS {base:.0f} MB, +{grew:.1f} MB at its peak; load {open('/proc/loadavg').read().split()[0]}"
+        f"\n200 MB declared: server RSS {base:.0f} MB, +{grew:.1f} MB at its peak;"
+        f" load {open('/proc/loadavg').read().split()[0]}"
     )
     assert "larger than 1024 KiB" in message and "big.yaml" in message
     assert peak == 0 and grew < BOUND_MB

@@ -27,7 +27,8 @@ SLACK = 1.0
 #: Spacing of the points sampled along a path, pixels.
 STEP = 3.0
 UNIT = re.compile(r"\(.*\S.*\)|\[.*\S.*\]")
-#: An artist with this gid is background (a full-height band, a reference line): legends may cover it.
+# : An artist with this gid is background (a full-height band, a reference line): legends may cover
+# it.
 BACKGROUND = "background"
 
 
@@ -118,7 +119,7 @@ def _samples(path, transform) -> np.ndarray:
         out.append(poly)
         seg = np.diff(poly, axis=0)
         length = np.hypot(seg[:, 0], seg[:, 1])
-        for p, d, n in zip(poly[:-1], seg, np.ceil(length / STEP).astype(int)):
+        for p, d, n in zip(poly[:-1], seg, np.ceil(length / STEP).astype(int), strict=True):
             if n > 1:
                 t = np.linspace(0.0, 1.0, min(n, 2000))[1:-1, None]
                 out.append(p + t * d)
@@ -192,7 +193,7 @@ def layout_problems(fig: Figure, units: bool = True, dpi: float = 120) -> list[s
             b.x0 < -SLACK or b.y0 < -SLACK or b.x1 > W + SLACK or b.y1 > H + SLACK
         ):
             problems.append(f"axes {ax.get_title()[:30]!r} is outside the canvas")
-    for (k1, o1, a1, b1), (k2, o2, a2, b2) in itertools.combinations(boxes, 2):
+    for (k1, _o1, a1, b1), (k2, _o2, a2, b2) in itertools.combinations(boxes, 2):
         if _overlap(b1, b2):  # tick labels of one axis too: a narrow panel crowds them
             problems.append(f"{_name(k1, a1)} overlaps {_name(k2, a2)}")
     # Legends over data.
@@ -200,7 +201,7 @@ def layout_problems(fig: Figure, units: bool = True, dpi: float = 120) -> list[s
         if not ax.get_visible() or hasattr(ax, "zaxis"):
             continue  # a 3D axes' projected data has no fixed place to check against
         legends = [ax.get_legend()] if ax.get_legend() is not None else []
-        legends += [leg for leg in fig.legends]
+        legends += list(fig.legends)
         notes = [t for t in ax.texts if _visible_text(t)]  # boxed notes, labels, annotations
         for box_artist in legends + notes:
             lb = _box(box_artist, renderer)

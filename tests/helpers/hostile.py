@@ -78,14 +78,14 @@ def mapping_paths(node: Any, prefix: tuple[Any, ...] = ()) -> Iterator[tuple[tup
     yield prefix, node
     if isinstance(node, dict):
         for k, v in node.items():
-            yield from mapping_paths(v, prefix + (k,))
+            yield from mapping_paths(v, (*prefix, k))
     elif isinstance(node, list):
         for i, v in enumerate(node):
-            yield from mapping_paths(v, prefix + (i,))
+            yield from mapping_paths(v, (*prefix, i))
 
 
 def apply_mutation(data: Any, path: tuple[Any, ...], op: str, value: Any) -> Any:
-    """``data`` with the item at ``path`` set, deleted, wrapped in a list or given an unknown key."""
+    """``data`` with the item at ``path`` set, deleted, wrapped in a list or given a new key."""
     if not path:
         return value if op == "set" else data
     parent = data

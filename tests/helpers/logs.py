@@ -52,10 +52,10 @@ def synthetic_log(
             q[s.idx_q] += wiggle * np.sin(2 * np.pi * t)
             v[model.joints[s.id].idx_v] = wiggle * 2 * np.pi * np.cos(2 * np.pi * t)
         row = {cols.time: t}
-        row.update(zip(cols.base_position, q[0:3]))
-        row.update(zip(cols.base_quaternion, q[3:7]))
-        row.update(zip(cols.base_linear_velocity, com_velocity_of_base))
-        row.update(zip(cols.base_angular_velocity, np.zeros(3)))
+        row.update(zip(cols.base_position, q[0:3], strict=True))
+        row.update(zip(cols.base_quaternion, q[3:7], strict=True))
+        row.update(zip(cols.base_linear_velocity, com_velocity_of_base, strict=True))
+        row.update(zip(cols.base_angular_velocity, np.zeros(3), strict=True))
         for name in robot.joint_names:
             s = robot.joint_slot(name)
             row[joint_position_column(name)] = q[s.idx_q]

@@ -1,4 +1,4 @@
-"""Quantities read from a MuJoCo model on its own terms (the simulator's bodies, not pinocchio's)."""
+"""Quantities read from a MuJoCo model on its own terms (its bodies, not pinocchio's)."""
 
 from __future__ import annotations
 

@@ -175,9 +175,9 @@ def _complementarity(stance: Stance, spec: ImpactSpec, v_n: float, e: float) -> 
     arm = model.point - stance.com
     moment = np.cross(arm, result.impact_impulse)
     for contact, corners, impulses in zip(
-        stance.contacts, corner_contacts(stance), result.corner_impulses
+        stance.contacts, corner_contacts(stance), result.corner_impulses, strict=True
     ):
-        for corner, impulse in zip(corners, impulses):
+        for corner, impulse in zip(corners, impulses, strict=True):
             moment += np.cross(corner.arm, impulse)
             local = contact.rotation.T @ impulse  # in the contact frame: z normal
             mu = contact.spec.friction

@@ -35,13 +35,15 @@ def test_com_velocity_matches_finite_differences_and_pinocchio():
 
 @pytest.mark.parametrize("speed, inside", [(0.05, True), (1.5, False)])
 def test_inside_agrees_with_the_analysis(speed, inside):
-    """A rigid translation at `speed` along x: the checker's verdict is the analysis' at that CoM velocity."""
+    """A rigid translation at `speed` along x: the checker's verdict is the analysis' at that CoM
+    velocity."""
     frame, _, scenario = synthetic_log(np.array([speed, 0.0, 0.0]), T=0.05, wiggle=0.0)
     check = check_log(frame, scenario)
     reference = ib.analyze(scenario.model_copy(update={"com_velocity": (speed, 0.0)}))
     assert reference.com_velocity_inside is inside
     assert bool(check.samples["com_velocity_inside"].iloc[0]) is inside
-    # The margin is the distance of the CoM velocity to the area's boundary (the area is a polygon in m/s).
+    # The margin is the distance of the CoM velocity to the area's boundary (the area is a polygon
+    # in m/s).
     area = reference.areas.com_velocity_area
     assert check.samples["com_velocity_margin"].iloc[0] == pytest.approx(
         area.margins(np.array([speed, 0.0]))[0], abs=1e-6

@@ -7,14 +7,15 @@ import json
 import numpy as np
 import pytest
 
-#: The log comes from a simulation (simulate --joints rigid).
-pytestmark = pytest.mark.sim
 pytest.importorskip("mujoco", reason="needs the sim extra (MuJoCo)")
 pytest.importorskip("pandas", reason="needs the logs extra (pandas)")
 pytest.importorskip("pyarrow", reason="needs the logs or sweep extra (pyarrow)")
 
 from impact_balance.cli import main
 from impact_balance.logs import check_log, read_log
+
+#: The log comes from a simulation (simulate --joints rigid).
+pytestmark = pytest.mark.sim
 
 
 @pytest.fixture(scope="module")

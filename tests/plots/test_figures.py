@@ -1,6 +1,6 @@
-"""Every figure is readable: each is rendered and checked by
-:mod:`tests.helpers.figure_layout` (no text or legend outside the canvas, no overlapping texts, no legend or note
-over data, axis labels with units), plus what each figure must say.
+"""Every figure is readable: each is rendered and checked by :mod:`tests.helpers.figure_layout` (no
+text or legend outside the canvas, no overlapping texts, no legend or note over data, axis labels
+with units), plus what each figure must say.
 
 The simulation, sweep and video figures run short trials (a few hundredths of a second).
 """
@@ -280,7 +280,8 @@ for geom in range(sim.model.ngeom):  # every drawn geom whose centre is on scree
         continue
     u, v = int(uv[0]), int(uv[1])
     hits += int(geom in seg[v - 2:v + 3, u - 2:u + 3, 0])
-    mirrored += int(geom in seg[v - 2:v + 3, 317 - u:322 - u, 0])  # a wrong projection, for contrast
+    # a wrong projection, for contrast
+    mirrored += int(geom in seg[v - 2:v + 3, 317 - u:322 - u, 0])
 print(hits, mirrored)
 """
 
@@ -344,7 +345,7 @@ def test_sweep_heatmap_marks_falling_points(tmp_path):
         )
     )
     run_sweep(plan, tmp_path / "res", workers=1, progress=False)
-    [(name, fig)] = sweep_figures(tmp_path / "res")
+    [(_name, fig)] = sweep_figures(tmp_path / "res")
     assert_layout(fig)
     ax = fig.axes[0]
     falling = [

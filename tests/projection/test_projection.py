@@ -1,9 +1,10 @@
-"""Projection of polytopes onto the plane (both methods: the parametric walk and Bretl's
-LP-per-edge algorithm), and the Polygon it returns.
+"""Projection of polytopes onto the plane (both methods: the parametric walk and Bretl's LP-per-edge
+algorithm), and the Polygon it returns.
 
-Every projection test runs for both methods (the ``method`` fixture). Expected polygons come from geometry (boxes, simplices, zonotopes as hulls of projected
-vertices) or from independent LPs (scipy.optimize.linprog): support values in many
-directions, the distance of each returned vertex to the true projection, and membership.
+Every projection test runs for both methods (the ``method`` fixture). Expected polygons come from
+geometry (boxes, simplices, zonotopes as hulls of projected vertices) or from independent LPs
+(scipy.optimize.linprog): support values in many directions, the distance of each returned vertex to
+the true projection, and membership.
 """
 
 from __future__ import annotations
@@ -116,7 +117,7 @@ def assert_is_projection(A, b, C, d, E, poly, tol=1e-7, n_dirs=64):
         assert lp_distance(A, b, C, d, E, y) <= tol
     # projection within poly: no feasible point beyond any of poly's own edges
     G, h = own_halfplanes(v)
-    for g, hk in zip(G, h):
+    for g, hk in zip(G, h, strict=True):
         assert lp_support(A, b, C, d, E, g) <= hk + tol
     # and the brief's support-function comparison in evenly spread directions
     for a in np.linspace(0, 2 * np.pi, n_dirs, endpoint=False):
@@ -152,7 +153,7 @@ def test_box_under_random_map_is_the_zonotope_hull(geo, n, seed, method):
     E = rng.normal(size=(2, n))
     A, b = box_rows(lo, hi)
     poly = project(A, b, E, method=method).polygon
-    corners = np.array(list(itertools.product(*zip(lo, hi))))
+    corners = np.array(list(itertools.product(*zip(lo, hi, strict=True))))
     expected = geo.hull(corners @ E.T)
     assert_ccw_convex(poly.vertices)
     assert geo.hausdorff(poly.vertices, expected) <= 1e-7

@@ -42,7 +42,10 @@ def _base(name: str):
 
 def _project(name: str, frictions, method: str = "auto"):
     robot, q, specs = _base(name)
-    specs = [ContactSpec(s.frame, float(mu), s.size, s.offset) for s, mu in zip(specs, frictions)]
+    specs = [
+        ContactSpec(s.frame, float(mu), s.size, s.offset)
+        for s, mu in zip(specs, frictions, strict=True)
+    ]
     polytope = wrench_polytope(Stance(robot, q, specs))
     return project_polytope(
         *polytope.projection_data(),

@@ -118,7 +118,7 @@ def assert_clean(rc: int, out: str, err: str) -> None:
 def warm_up():
     """Compile the kernel and load the robots once, outside the examples' timing."""
     for name in ("palm_push_two_feet", "g1_two_feet"):
-        rc, out, err = _run(["analyze", name, "--json"])
+        rc, _out, err = _run(["analyze", name, "--json"])
         assert rc == 0, err
 
 

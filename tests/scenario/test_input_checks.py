@@ -428,11 +428,11 @@ def test_impact_moving_away_warns(tmp_path, capsys):
     analysis = analyze(path)
     assert codes(analysis) == ["impact_moving_away"]
     assert analysis.impact.model.approach_speed([0.8, 0.0, 0.0]) < 0  # independent: -n.v = -0.8
-    rc, out, err = run_cli(capsys, "analyze", str(path))
+    rc, out, _err = run_cli(capsys, "analyze", str(path))
     assert (
         rc == 0 and "warning: impact.reference_velocity:" in out and "[impact_moving_away]" in out
     )
-    rc, out, err = run_cli(capsys, "analyze", str(path), "--json")
+    rc, out, _err = run_cli(capsys, "analyze", str(path), "--json")
     assert rc == 0 and strict_json(out)["warnings"][0]["code"] == "impact_moving_away"
     # control: the same reference towards the surface is capped, no warning
     control = write(
@@ -478,7 +478,9 @@ def test_strict_turns_warnings_into_one_error_line(tmp_path, capsys):
     assert "(--strict)" in line and "impact_moving_away" in line
     exc = StrictWarningsError(analyze(path).warnings)
     assert exc.warnings[0].code == "impact_moving_away" and str(exc) in line
-    rc, out, err = run_cli(capsys, "analyze", "palm_push_two_feet", "--json", "--strict")  # control
+    rc, out, _err = run_cli(
+        capsys, "analyze", "palm_push_two_feet", "--json", "--strict"
+    )  # control
     assert rc == 0 and strict_json(out)["warnings"] == []
 
 

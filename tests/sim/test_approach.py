@@ -48,7 +48,8 @@ def test_com_governor_caps_the_speed_at_contact(capsys, tmp_path):
         update={"zmp_margin": out["zmp_margin"]}
     )
     at_stance = ib.analyze(margin).impact.max_contact_velocity
-    # The cap in force at contact is the criterion's maximum at the posture of the contact (close to the stance's).
+    # The cap in force at contact is the criterion's maximum at the posture of the contact (close to
+    # the stance's).
     assert out["cap_at_contact"] == pytest.approx(at_stance, rel=0.05)
     assert out["speed_at_contact"] == pytest.approx(
         out["cap_at_contact"], rel=0.1

@@ -1,4 +1,5 @@
-"""Balance controller pieces on pinocchio alone: ZMP clamp, DCM feedback, IK tasks, impact task, fall detector."""
+"""Balance controller pieces on pinocchio alone: ZMP clamp, DCM feedback, IK tasks, impact task,
+fall detector."""
 
 from __future__ import annotations
 
@@ -46,7 +47,8 @@ def test_clamp_drops_a_margin_larger_than_the_polygon():
 
 
 def test_dcm_feedback_makes_the_dcm_error_decay_at_its_gain():
-    """LIPM integrated finely with the feedback's ZMP: xi - xi_ref decays as exp(-k t) while unclamped."""
+    """LIPM integrated finely with the feedback's ZMP: xi - xi_ref decays as exp(-k t) while
+    unclamped."""
     omega, k = 3.3, 2.0
     big = Polygon(np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]))
     fb = DcmFeedback(big, omega, np.zeros(2), gain=k, margin=0.0)
@@ -64,7 +66,7 @@ def test_dcm_feedback_makes_the_dcm_error_decay_at_its_gain():
 def test_clamped_zmp_stays_in_the_area_for_a_falling_dcm():
     omega = 3.3
     fb = DcmFeedback(SQUARE, omega, np.zeros(2), gain=3.0, margin=0.01)
-    p, xi, clamped = fb.desired_zmp(np.array([0.0, 0.0]), np.array([1.0, 0.0]))
+    p, _xi, clamped = fb.desired_zmp(np.array([0.0, 0.0]), np.array([1.0, 0.0]))
     assert clamped and SQUARE.margins(p)[0] >= 0.01 - 1e-7 and p[0] == pytest.approx(0.09, abs=1e-6)
 
 
@@ -74,7 +76,8 @@ def analysis():
 
 
 def test_ik_keeps_contacts_and_drives_the_impact_point_at_the_commanded_speed(analysis):
-    """Kinematic loop (measured state = reference): contacts stay put, the palm follows the approach profile."""
+    """Kinematic loop (measured state = reference): contacts stay put, the palm follows the approach
+    profile."""
     im = analysis.impact.model
     speed = 0.2
     task = ImpactTask(im.spec.frame, im.spec.offset, im.point, im.normal, speed, start_time=0.0)
@@ -114,7 +117,7 @@ def test_approach_reaches_the_speed_before_the_surface_with_bounded_acceleration
         max(0.05, speed**2 / (2 * task.acceleration) + task.cruise)
     )
     times = np.arange(0.0, task.arrival_time + 0.05, 1e-4)
-    p, v, a = (np.array(x) for x in zip(*(task.reference(t) for t in times)))
+    p, v, a = (np.array(x) for x in zip(*(task.reference(t) for t in times), strict=True))
     assert np.all(np.abs(a @ n) <= task.acceleration + 1e-9)
     # Finite differences agree with the reference's velocity and acceleration.
     assert np.allclose(np.gradient(p[:, 0], times), v[:, 0], atol=2e-3 * task.acceleration)
@@ -135,7 +138,7 @@ def test_impact_task_stops_pushing_and_withdraws_on_contact():
     task = ImpactTask("f", pin.SE3.Identity(), np.zeros(3), n, speed=0.5, start_time=0.0)
     t_touch = task.arrival_time + 0.004
     assert task.reference(t_touch, 10.0)[0] @ n < 0  # below the 15 N threshold: still pushing
-    p, v, a = task.reference(t_touch + 0.001, 20.0)
+    p, v, _a = task.reference(t_touch + 0.001, 20.0)
     assert np.allclose(p, 0.0) and np.allclose(v, 0.0)  # at the surface, at rest: no more pushing
     later, v_later, _ = task.reference(t_touch + 0.02, 0.0)
     assert later @ n > 0 and v_later @ n > 0  # withdrawing along the normal

@@ -1,4 +1,4 @@
-"""Balance trials in MuJoCo (a few simulated seconds each): pushes, an impact bisection, logs, CLI."""
+"""Balance trials in MuJoCo (a few simulated seconds each): pushes, impact bisection, logs, CLI."""
 
 from __future__ import annotations
 
@@ -41,7 +41,8 @@ def test_small_push_is_recovered_and_logged(setup, tmp_path):
     path = write_log(result.log, tmp_path / "push.parquet")
     frame = read_log(path)
     check = check_log(frame, SCENARIO)
-    # The checker's CoM velocity (pinocchio, from base and joint columns) against MuJoCo's own (logged).
+    # The checker's CoM velocity (pinocchio, from base and joint columns) against MuJoCo's own
+    # (logged).
     ours = check.samples[["comd_x", "comd_y", "comd_z"]].to_numpy()
     mujoco_com = frame[["comd_x", "comd_y", "comd_z"]].to_numpy()
     assert np.abs(ours - mujoco_com).max() < 1e-6
@@ -66,7 +67,8 @@ def test_large_push_falls_and_the_com_criterion_saw_it(setup):
 
 
 def test_validate_brackets_the_threshold_in_measured_speed(tmp_path):
-    """The paper's robot at the impact (joints held) with the torque controller: a bracket near the prediction."""
+    """The paper's robot at the impact (joints held) with the torque controller: a bracket near the
+    prediction."""
     from impact_balance.sim.studies.journal import TrialJournal
 
     options = BalanceTrialOptions(after=1.0, controller="id", rigid_impact=True)
@@ -154,13 +156,14 @@ def test_push_test_json(capsys, tmp_path):
     assert out["zmp_margin"] == pytest.approx(0.01)  # the ik controller's own margin, by default
     c = out["scores"]["com"]
     assert c["total"] == 1 and c["safe_survived"] == 1 and c["accuracy_ci95"][1] == 1.0
-    assert main(argv[:-2] + ["--journal", str(tmp_path / "j.jsonl"), "--zmp-margin", "0"]) == 0
+    assert main([*argv[:-2], "--journal", str(tmp_path / "j.jsonl"), "--zmp-margin", "0"]) == 0
     again = json.loads(capsys.readouterr().out)
     assert again["reused_trials"] == 1 and again["zmp_margin"] == 0.0
 
 
 def test_checker_reads_simulate_logs(tmp_path, capsys):
-    """`simulate --log` (servo joints, a palm impact) writes a log the checker reads; its CoM is MuJoCo's."""
+    """`simulate --log` (servo joints, a palm impact) writes a log the checker reads; its CoM is
+    MuJoCo's."""
     path = tmp_path / "simulate.csv"
     assert (
         main(["simulate", SCENARIO, "--speed", "0.2", "--joints", "servo", "--log", str(path)]) == 0
@@ -187,7 +190,7 @@ def test_validate_cli_json_keys_and_text(capsys, tmp_path):
         "--journal",
         str(tmp_path / "v.jsonl"),
     ]
-    assert main(argv + ["--json"]) == 0
+    assert main([*argv, "--json"]) == 0
     cap = capsys.readouterr()
     out = json.loads(cap.out, parse_constant=lambda c: pytest.fail(c))
     assert "trials journal" in cap.err

@@ -16,9 +16,12 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-mujoco = pytest.importorskip("mujoco", reason="needs the sim extra (MuJoCo)")
-pd = pytest.importorskip("pandas", reason="needs the logs extra (pandas)")
+pytest.importorskip("mujoco", reason="needs the sim extra (MuJoCo)")
+pytest.importorskip("pandas", reason="needs the logs extra (pandas)")
 pytest.importorskip("pyarrow", reason="needs the logs or sweep extra (pyarrow)")
+
+import mujoco
+import pandas as pd
 
 from impact_balance.exceptions import ModelRepairWarning, SimulationError
 from impact_balance.logs import read_log, write_log
@@ -70,7 +73,7 @@ def test_distance_to_hull():
 
 
 def test_rigid_jump_is_impulse_over_mass_and_inside_composite_set(rigid_push):
-    sim, record, result = rigid_push
+    sim, _record, result = rigid_push
     jump = result.com_velocity_jump_measured
     # Floating, gravity off: the only external force is the impact's (to the contact solver's
     # tolerance: MuJoCo's reported contact forces and the ones it integrated differ by ~1e-5).
@@ -117,9 +120,10 @@ def test_servo_trial_falls_near_the_joint_space_model(models):
     "name,speed", [("g1_two_feet", 0.75), ("romeo_two_feet", 0.75), ("palm_push_two_feet", 0.5)]
 )
 def test_servo_approach_starts_within_joint_limits_and_hits_after_it_begins(models, name, speed):
-    """The retracted start pose is within the joints' ranges (G1's right wrist yaw and Romeo's right elbow yaw
-    left them with the Jacobian's pseudo-inverse alone), and the impact is the commanded approach's: after the
-    settling, near the commanded speed. A start pose beyond a limit is snapped back while the robot settles."""
+    """The retracted start pose is within the joints' ranges (G1's right wrist yaw and Romeo's right
+    elbow yaw left them with the Jacobian's pseudo-inverse alone), and the impact is the commanded
+    approach's: after the settling, near the commanded speed. A start pose beyond a limit is snapped
+    back while the robot settles."""
     sim = models(name, "servo")
     spec = sim.scenario.impact.spec()
     n = np.asarray(spec.normal, dtype=float) / np.linalg.norm(spec.normal)
@@ -142,11 +146,11 @@ def test_servo_approach_starts_within_joint_limits_and_hits_after_it_begins(mode
 
 
 def test_servo_approach_beyond_joint_limits_is_refused(models):
-    """iCub's right hand hangs at a near-singular pose (the point Jacobian's smallest singular value 0.017
-    m/rad) with the shoulder pitch 0.085 rad from its limit: no straight joint path retracts the hand 5 cm
-    along the wall's normal within the limits. The trial used to start the shoulder 0.42 rad beyond its
-    limit; MuJoCo snapped it back and the hand hit the wall at 1.09 m/s during the settling, 0.15 s
-    before the commanded 0.5 m/s approach began."""
+    """iCub's right hand hangs at a near-singular pose (the point Jacobian's smallest singular value
+    0.017 m/rad) with the shoulder pitch 0.085 rad from its limit: no straight joint path retracts
+    the hand 5 cm along the wall's normal within the limits. The trial used to start the shoulder
+    0.42 rad beyond its limit; MuJoCo snapped it back and the hand hit the wall at 1.09 m/s during
+    the settling, 0.15 s before the commanded 0.5 m/s approach began."""
     sim = models("icub_two_feet", "servo")
     with pytest.raises(SimulationError, match="r_shoulder_pitch"):
         run_trial(sim, TrialOptions(0.5, after=0.02, rigid_impact=True))
@@ -163,7 +167,8 @@ def test_log_frame_matches_finite_differences(rigid_push, tmp_path):
     ):
         p, v = frame[list(pos)].to_numpy(), frame[list(vel)].to_numpy()
         np.testing.assert_allclose(np.diff(p, axis=0) / dt, v[1:], atol=2e-3)
-    # Base angular velocity (world axes): R_{k+1} = exp([w dt]) R_k after the impact (the robot spins).
+    # Base angular velocity (world axes): R_{k+1} = exp([w dt]) R_k after the impact (the robot
+    # spins).
     q = frame[["base_qw", "base_qx", "base_qy", "base_qz"]].to_numpy()
     w = frame[["base_wx", "base_wy", "base_wz"]].to_numpy()
     k = len(frame) - 2
@@ -235,7 +240,7 @@ def test_cli_text_plots_and_log(capsys, tmp_path):
     ],
 )
 def test_cli_bad_input_is_one_line(capsys, argv, needles):
-    rc, out, err = run(capsys, "simulate", "palm_push_two_feet", *argv)
+    rc, _out, err = run(capsys, "simulate", "palm_push_two_feet", *argv)
     assert rc == 2 and "Traceback" not in err and len(err.strip().splitlines()) == 1
     for needle in needles:
         assert needle in err
@@ -310,7 +315,8 @@ def test_armature_enters_gains_and_joint_space_prediction():
 
 
 def test_declared_rotor_inertia_is_the_default_armature():
-    """Talos's SRDF declares rotor_params (rotor inertia 1e-5 kg m^2, gear ratio 100): 0.1 kg m^2 per joint."""
+    """Talos's SRDF declares rotor_params (rotor inertia 1e-5 kg m^2, gear ratio 100): 0.1 kg m^2
+    per joint."""
     import xml.etree.ElementTree as ET
 
     sim = build_model("palm_push_two_feet", "servo", SimOptions(meshes=False))

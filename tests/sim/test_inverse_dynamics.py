@@ -1,4 +1,5 @@
-"""The torque-controlled balance controller (inverse-dynamics QP): the QP's answer, and trials in MuJoCo.
+"""The torque-controlled balance controller (inverse-dynamics QP): the QP's answer, and trials in
+MuJoCo.
 
 The QP's output is checked against independent computations: pinocchio's RNEA for the dynamics,
 pinocchio's forward kinematics with the QP's accelerations for the contacts, and the contact wrench
@@ -44,7 +45,7 @@ def test_qp_solution_obeys_dynamics_contacts_and_cones(name):
     model, data = analysis.stance.model, analysis.stance.model.createData()
     rng = np.random.default_rng(3)
     q = analysis.stance.q.copy()
-    for trial in range(5):
+    for _trial in range(5):
         v = 0.3 * rng.standard_normal(model.nv)  # a moving robot: drifts and Coriolis terms matter
         out = controller.step(0.0, q, v)
         a, w = out.a, out.wrenches
@@ -57,13 +58,15 @@ def test_qp_solution_obeys_dynamics_contacts_and_cones(name):
             )
             tau_contacts += J.T @ w[i]
             rotation = data.oMf[fid].rotation
-            # Inside the QP's cone (friction scaled, rectangle shrunk), hence inside the contact's own.
+            # Inside the QP's cone (friction scaled, rectangle shrunk), hence inside the contact's
+            # own.
             faces = cwc_faces_world(
                 contact.spec.friction, contact.half_length, contact.half_width, rotation
             )
             assert (faces @ w[i]).max() <= 1e-6 * np.abs(w[i]).max()
             assert w[i][:3] @ rotation[:, 2] >= gains.min_normal_force - 1e-6
-        # Floating base: RNEA's unactuated rows are balanced by the contact wrenches; the actuated rows are tau.
+        # Floating base: RNEA's unactuated rows are balanced by the contact wrenches; the actuated
+        # rows are tau.
         rnea = pin.rnea(model, data, q, v, a)
         np.testing.assert_allclose(rnea[:6], tau_contacts[:6], atol=1e-6 * np.abs(rnea).max())
         np.testing.assert_allclose(
@@ -112,7 +115,8 @@ def test_dcm_converges_after_a_small_push(setup):
     end = int(np.searchsorted(s["time"], push.start + push.duration))
     later = int(np.searchsorted(s["time"], push.start + push.duration + 1.0))
     assert error[end] > 0.01  # the push moved the DCM (5 N s on 90 kg: about 0.06 m/s)
-    # Unclamped, the DCM error decays as exp(-k t): after 1 s, exp(-2) = 0.14; allow for model error.
+    # Unclamped, the DCM error decays as exp(-k t): after 1 s, exp(-2) = 0.14; allow for model
+    # error.
     assert error[later] < 0.35 * error[end]
     assert not np.any(np.isnan(s["zmp_desired"]))
 

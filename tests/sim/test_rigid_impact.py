@@ -1,4 +1,5 @@
-"""--rigid-impact: the joints keep their velocities through the impact, the impulse becomes the rigid body's."""
+"""--rigid-impact: the joints keep their velocities through the impact, the impulse becomes the
+rigid body's."""
 
 from __future__ import annotations
 
@@ -47,14 +48,16 @@ def test_hold_keeps_every_joint_velocity_and_ends_at_the_end_of_compression(sim,
 
 def test_held_impact_is_the_composite_one_up_to_the_sustained_contacts(sim, trials):
     free, held = trials[False][1], trials[True][1]
-    # A servo-held arm gives way (joint_space); held joints transmit the rigid body's impulse (composite).
+    # A servo-held arm gives way (joint_space); held joints transmit the rigid body's impulse
+    # (composite).
     assert np.linalg.norm(held.impulse_measured) > 10 * np.linalg.norm(free.impulse_measured)
     assert held.predicted["composite"].relative_distance < 0.1
     assert (
         free.predicted["joint_space"].relative_distance
         < held.predicted["joint_space"].relative_distance
     )
-    # Momentum: the CoM velocity jump is the impact's impulse plus the sustained contacts' (gravity and the
+    # Momentum: the CoM velocity jump is the impact's impulse plus the sustained contacts' (gravity
+    # and the
     # contacts' forces before the impact subtracted), over the mass.
     total = held.impulse_measured + sum(held.sustained_impulses.values())
     mass = sim.stance.mass

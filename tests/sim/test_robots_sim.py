@@ -60,9 +60,11 @@ def extra_scenarios(tmp_path_factory):
     simple = ROOT / "simple_humanoid_description"
     _draft(
         folder / "simple_draft.yaml",
-        f"{{urdf: {simple / 'urdf' / 'simple_humanoid.urdf'}, srdf: {simple / 'srdf' / 'simple_humanoid.srdf'}, "
+        f"{{urdf: {simple / 'urdf' / 'simple_humanoid.urdf'},"
+        f" srdf: {simple / 'srdf' / 'simple_humanoid.srdf'}, "
         "standing: neutral}",  # its SRDF half_sitting is outside its own joint limits
-        "  - {frame: l_ankle, friction: 0.7, size: [0.2, 0.1]}\n  - {frame: r_ankle, friction: 0.7, size: [0.2, 0.1]}\n",
+        "  - {frame: l_ankle, friction: 0.7, size: [0.2, 0.1]}\n"
+        "  - {frame: r_ankle, friction: 0.7, size: [0.2, 0.1]}\n",
         "  {frame: r_wrist, normal: [-1, 0, 0], reference_velocity: [0.5, 0, 0]}\n",
     )
     solo = ROOT / "solo_description"
@@ -72,7 +74,8 @@ def extra_scenarios(tmp_path_factory):
     )  # the *_FOOT frames are tilted 45 degrees: give the normal
     _draft(
         folder / "solo_draft.yaml",
-        f"{{urdf: {solo / 'robots' / 'solo12.urdf'}, srdf: {solo / 'srdf' / 'solo.srdf'}, standing: straight_standing}}",
+        f"{{urdf: {solo / 'robots' / 'solo12.urdf'}, srdf: {solo / 'srdf' / 'solo.srdf'},"
+        " standing: straight_standing}",
         feet,
         "  {frame: FL_FOOT, normal: [-1, 0, 0], reference_velocity: [0.5, 0, 0]}\n",
     )
@@ -179,7 +182,8 @@ def test_simulate_rigid_impact_matches_the_composite_model(extra_scenarios, robo
     result = json.loads(out)
     jump = np.asarray(result["com_velocity_jump_measured"])
     assert np.all(np.isfinite(jump)) and np.linalg.norm(jump) > 1e-3
-    # A rigid robot obeys the paper's model: the jump lies on the composite set (README: within 2 %).
+    # A rigid robot obeys the paper's model: the jump lies on the composite set (README: within 2
+    # %).
     assert result["predicted"]["composite"]["distance"] < 0.02 * np.linalg.norm(jump)
 
 

@@ -11,7 +11,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-mujoco = pytest.importorskip("mujoco", reason="needs the sim extra (MuJoCo)")
+pytest.importorskip("mujoco", reason="needs the sim extra (MuJoCo)")
+
+import mujoco
 
 from impact_balance.exceptions import SimulationError
 from impact_balance.sim import SimOptions, build_model
@@ -70,7 +72,7 @@ def test_contact_boxes_and_impact_sphere_at_the_stance(models, name, joints):
     sim = models(name, joints)
     d = sim.data
     t = sim.options.contact.box_half_thickness
-    for contact, geom in zip(sim.stance.contacts, sim.contact_geoms):
+    for contact, geom in zip(sim.stance.contacts, sim.contact_geoms, strict=True):
         R = d.geom_xmat[geom].reshape(3, 3)
         face_centre = d.geom_xpos[geom] - t * R[:, 2]
         np.testing.assert_allclose(face_centre, contact.position, atol=1e-12)
@@ -83,15 +85,17 @@ def test_contact_boxes_and_impact_sphere_at_the_stance(models, name, joints):
     m = sim.model
     pairs = {
         (int(a), int(b)): float(mu)
-        for a, b, mu in zip(m.pair_geom1, m.pair_geom2, m.pair_friction[:, 0])
+        for a, b, mu in zip(m.pair_geom1, m.pair_geom2, m.pair_friction[:, 0], strict=True)
     }
-    for contact, geom, support in zip(sim.stance.contacts, sim.contact_geoms, sim.support_geoms):
+    for contact, geom, support in zip(
+        sim.stance.contacts, sim.contact_geoms, sim.support_geoms, strict=True
+    ):
         assert pairs[(support, geom)] == contact.spec.friction
         assert pairs[(sim.ground_geom, geom)] == contact.spec.friction
     assert pairs[(sim.surface_geom, sim.impact_geom)] == sim.scenario.impact.friction
     assert not m.geom_contype.any() and not m.geom_conaffinity.any()
     # Each contact's support touches it: its face is the contact plane, normals opposed.
-    for contact, geom in zip(sim.stance.contacts, sim.support_geoms):
+    for contact, geom in zip(sim.stance.contacts, sim.support_geoms, strict=True):
         R = d.geom_xmat[geom].reshape(3, 3)
         if sim.model.geom_type[geom] == mujoco.mjtGeom.mjGEOM_PLANE:
             assert contact.position[2] == pytest.approx(d.geom_xpos[geom][2], abs=1e-3)
@@ -121,7 +125,8 @@ def test_mesh_geoms_do_not_collide():
 
 @pytest.mark.parametrize("name", ["palm_push_two_feet", "g1_two_feet"])
 def test_state_round_trip_and_com_velocity_against_pinocchio(models, name):
-    """Random q, v: MuJoCo's CoM and CoM velocity equal pinocchio's (checks the free-joint conventions)."""
+    """Random q, v: MuJoCo's CoM and CoM velocity equal pinocchio's (checks the free-joint
+    conventions)."""
     sim = models(name, "servo")
     pmodel = sim.stance.model
     pdata = pmodel.createData()
@@ -163,7 +168,8 @@ def test_servo_holds_the_stance_under_gravity(name):
 
 
 def test_servo_gain_rule(models):
-    """kp = I omega^2, kd = 2 zeta I omega on the joint's diagonal mass-matrix entry (pinocchio's crba)."""
+    """kp = I omega^2, kd = 2 zeta I omega on the joint's diagonal mass-matrix entry (pinocchio's
+    crba)."""
     sim = models("palm_push_two_feet", "servo")
     M = pin.crba(sim.stance.model, sim.stance.model.createData(), sim.stance.q)
     inertia = M[sim.v_index, sim.v_index]
@@ -172,7 +178,7 @@ def test_servo_gain_rule(models):
     np.testing.assert_allclose(sim.kd, 2 * inertia * w, rtol=1e-9)
     # Effort limits: the actuator force range is the URDF effort.
     idx, lim = sim.robot.effort_limits
-    limits = dict(zip(idx.tolist(), lim.tolist()))
+    limits = dict(zip(idx.tolist(), lim.tolist(), strict=True))
     for k, a in enumerate(sim.actuator_ids):
         assert sim.model.actuator_forcerange[a][1] == pytest.approx(limits[sim.v_index[k]])
 

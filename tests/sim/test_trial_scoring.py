@@ -1,5 +1,5 @@
-"""Scoring of the balance trials: Wilson intervals, confusion, margins, the boundary impulse, the journal,
-and resuming an interrupted push test."""
+"""Scoring of the balance trials: Wilson intervals, confusion, margins, the boundary impulse, the
+journal, and resuming an interrupted push test."""
 
 from __future__ import annotations
 
@@ -67,7 +67,8 @@ def test_boundary_impulse_puts_the_predicted_velocity_on_the_boundary():
 
 
 def test_push_calls_at_a_margin_are_the_inset_area():
-    """Safe at margin M exactly when the prediction lies in the area shrunk by M (omega M in CoM velocity)."""
+    """Safe at margin M exactly when the prediction lies in the area shrunk by M (omega M in CoM
+    velocity)."""
     omega = 3.3
     summary = {
         "outcome": "balanced",

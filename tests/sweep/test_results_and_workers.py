@@ -24,12 +24,13 @@ import pytest
 pytest.importorskip("dask", reason="needs the sweep extra (Dask)")
 pytest.importorskip("distributed", reason="needs the sweep extra (Dask distributed)")
 pytest.importorskip("pandas", reason="needs the logs extra (pandas)")
-pa = pytest.importorskip("pyarrow", reason="needs the logs or sweep extra (pyarrow)")
-pq = pytest.importorskip("pyarrow.parquet", reason="needs the logs or sweep extra (pyarrow)")
-psutil = pytest.importorskip(
-    "psutil", reason="needs psutil (installed with the sweep extra's Dask)"
-)
+pytest.importorskip("pyarrow", reason="needs the logs or sweep extra (pyarrow)")
+pytest.importorskip("pyarrow.parquet", reason="needs the logs or sweep extra (pyarrow)")
+pytest.importorskip("psutil", reason="needs psutil (installed with the sweep extra's Dask)")
 
+import psutil
+import pyarrow as pa
+import pyarrow.parquet as pq
 import yaml
 
 from impact_balance import analyze, cli
@@ -240,7 +241,8 @@ def test_rows_say_what_was_evaluated_and_match_analyze():
 
 
 def test_a_robot_axis_varies_the_robot(tmp_path):
-    """Talos and a Talos with a heavier torso: rows differ, and each matches analyze() of that robot."""
+    """Talos and a Talos with a heavier torso: rows differ, and each matches analyze() of that
+    robot."""
     talos = load_robot("talos")
     text = Path(talos.urdf_path).read_text()
     start = text.index('<link name="torso_2_link">')
@@ -260,7 +262,7 @@ def test_a_robot_axis_varies_the_robot(tmp_path):
     rows = Evaluator(plan).evaluate_chunk(0).to_pylist()
     assert [r["robot_name"] for r in rows] == ["talos", str(heavy)]
     assert rows[0]["stance_digest"] != rows[1]["stance_digest"]
-    for row, robot in zip(rows, ("talos", files)):
+    for row, robot in zip(rows, ("talos", files), strict=True):
         raw = read_mapping(scenario_path(BASE))
         raw["robot"], raw["impact"]["friction"] = robot, 0.1
         expected = analyze(scenario_from_dict(raw)).impact.max_contact_velocity
@@ -405,7 +407,9 @@ def test_no_process_is_left_five_seconds_after_a_killed_sweep(tmp_path, how):
             os.killpg(proc.pid, signal.SIGINT)  # what a terminal sends to the foreground group
         killed = time.time()
         proc.wait(timeout=30)
-        gone, alive = psutil.wait_procs(descendants, timeout=max(0.0, 5.0 - (time.time() - killed)))
+        _gone, alive = psutil.wait_procs(
+            descendants, timeout=max(0.0, 5.0 - (time.time() - killed))
+        )
         assert not [p for p in alive if p.status() != psutil.STATUS_ZOMBIE], (how, alive)
         assert time.time() - killed <= 5.0 + 0.5
         if how != "SIGKILL":

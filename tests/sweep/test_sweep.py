@@ -12,9 +12,11 @@ import pytest
 pytest.importorskip("dask", reason="needs the sweep extra (Dask)")
 pytest.importorskip("distributed", reason="needs the sweep extra (Dask distributed)")
 pytest.importorskip("pandas", reason="needs the logs extra (pandas)")
-pa = pytest.importorskip("pyarrow", reason="needs the logs or sweep extra (pyarrow)")
-pq = pytest.importorskip("pyarrow.parquet", reason="needs the logs or sweep extra (pyarrow)")
+pytest.importorskip("pyarrow", reason="needs the logs or sweep extra (pyarrow)")
+pytest.importorskip("pyarrow.parquet", reason="needs the logs or sweep extra (pyarrow)")
 
+import pyarrow as pa
+import pyarrow.parquet as pq
 import yaml
 from scipy.stats import qmc
 
@@ -132,7 +134,7 @@ def test_hostile_sweep_file_is_refused_quickly(tmp_path):
 
     bomb = "a: &a [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
         f"{c}: &{c} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n"
-        for p, c in zip("abcdefgh", "bcdefghi")
+        for p, c in zip("abcdefgh", "bcdefghi", strict=True)
     )
     path = tmp_path / "bomb.yaml"
     path.write_text(bomb + "base: palm_push_two_feet\naxes: []\n")
@@ -388,7 +390,8 @@ def test_summary_ranks_and_is_strict_json(tmp_path):
     run_sweep(plan, tmp_path / "s", workers=1, progress=False)
     s = summarize(tmp_path / "s", top=2)
     df = read_results(tmp_path / "s").to_pandas()
-    # A vertical impact without friction moves the CoM vertically only: unbounded, ranked best, null in JSON.
+    # A vertical impact without friction moves the CoM vertically only: unbounded, ranked best, null
+    # in JSON.
     assert s["status_counts"]["unbounded"] == 1 and s["status_counts"]["invalid"] == 2
     assert (
         s["best"][0]["max_contact_velocity"] is None
