@@ -1,9 +1,9 @@
 """`analyze --json --qp` of every bundled scenario, number for number, against the recorded outputs.
 
-The files in ``tests/data/analyze_golden/`` were written by the command before the package's
-redesign; a change that moves a number, a key or a status shows here. ``timings_ms`` is left
-out (it measures the machine). To record a deliberate change, rerun the command and review the
-diff of the data files.
+The files in ``tests/analysis/data/analyze_golden/`` were written by the command before the
+package's redesign; a change that moves a number, a key or a status shows here. ``timings_ms``
+is left out (it measures the machine). To record a deliberate change, rerun the command and
+review the diff of the data files.
 """
 
 from __future__ import annotations

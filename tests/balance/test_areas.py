@@ -15,7 +15,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from hypothesis import assume, given, settings
+from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 from scipy.optimize import linprog
 
@@ -422,16 +422,21 @@ def test_walk_and_bretl_agree_on_every_bundled_stance(geo, name, torque_limits):
 
 # (e) CoM far outside the support: single level contact ------------------------------------
 def clip(poly, normal, offset):
-    """Sutherland-Hodgman: keep {x : normal . x <= offset} of a convex CCW polygon."""
+    """Sutherland-Hodgman: keep {x : normal . x <= offset} of a convex CCW polygon.
+
+    The crossing point is computed from the two signed distances (of opposite signs, so their
+    difference is not zero and the point lies on the edge), also for an edge that lies on the
+    line up to rounding.
+    """
     out = []
     for i in range(len(poly)):
         P, Q = poly[i], poly[(i + 1) % len(poly)]
-        inP, inQ = normal @ P <= offset, normal @ Q <= offset
+        dP, dQ = normal @ P - offset, normal @ Q - offset
+        inP, inQ = dP <= 0, dQ <= 0
         if inP:
             out.append(P)
         if inP != inQ:
-            t = (offset - normal @ P) / (normal @ (Q - P))
-            out.append(P + t * (Q - P))
+            out.append(P + dP / (dP - dQ) * (Q - P))
     return np.array(out).reshape(-1, 2)
 
 
@@ -489,6 +494,9 @@ def test_far_com_with_limited_friction_clips_the_sole(geo, make_contact):
     length=st.floats(0.05, 0.3),
     width=st.floats(0.05, 0.3),
 )
+# Sole edges on the friction square's lines (mu * cz = half the width): the reference's clip.
+@example(u=0.0, v=0.0, cz=0.5, mu=0.125, yaw=2.0, length=0.05, width=0.125)
+@example(u=0.0, v=0.0, cz=0.5, mu=0.125, yaw=2.0, length=0.25, width=0.125)
 def test_single_level_contact_matches_statics(geo, make_contact, u, v, cz, mu, yaw, length, width):
     """CoM at (u, v) half-sizes from the sole centre in sole axes: inside, near or far."""
     position = np.array([0.1, -0.2, 0.05])
