@@ -241,6 +241,7 @@ def test_analyze_writes_plots(tmp_path, capsys):
         assert f"figure: {p}" in out
 
 
+@pytest.mark.slow
 def test_analyze_json_with_plots_keeps_stdout_json(tmp_path, capsys):
     rc, out, _ = run(capsys, "analyze", "palm_push_two_feet", "--json", "--plots", str(tmp_path))
     assert rc == 0
@@ -348,6 +349,7 @@ def test_phase_portrait_plot(tmp_path, capsys):
 
 
 # -- demo -------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_demo(tmp_path, capsys):
     rc, out, err = run(capsys, "demo", "--out", str(tmp_path))
     assert rc == 0, err

@@ -245,6 +245,7 @@ def test_every_command_reports_a_failing_stdout_in_one_line(capsys, monkeypatch)
         assert "standard output: cannot write the output" in error_line(err), name
 
 
+@pytest.mark.slow
 def test_debug_flag_and_environment_variable_show_the_traceback(tmp_path):
     for argv, env in (
         (["analyze", "nope.yaml", "--debug"], {}),

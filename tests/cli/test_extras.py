@@ -144,6 +144,7 @@ def _run(code: str, blocked=OPTIONAL) -> subprocess.CompletedProcess:
     )
 
 
+@pytest.mark.slow
 def test_core_runs_without_any_extra():
     r = _run("""
         import impact_balance as ib

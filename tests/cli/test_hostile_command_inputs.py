@@ -108,6 +108,7 @@ def warm_up():
     assert rc == 0, err
 
 
+@pytest.mark.slow
 @needs_extra("sweep")
 @settings(
     max_examples=int(80 * SCALE),

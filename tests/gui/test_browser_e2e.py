@@ -39,7 +39,8 @@ FLAGS = [
 ]
 TIMEOUT_MS = 120_000
 
-pytestmark = pytest.mark.e2e
+#: A browser start and page loads: seconds each.
+pytestmark = [pytest.mark.e2e, pytest.mark.slow]
 
 if not REQUIRED:  # CI (IMPACT_BALANCE_E2E=1): a missing browser, playwright or viser fails
     if not CHROMIUM.exists():

@@ -497,6 +497,7 @@ def test_app_refused_value_reverts_the_widget(app):
     assert app.w_impact_edges.value == 16
 
 
+@pytest.mark.slow
 def test_app_contacts_impact_and_load(app, tmp_path):
     reset(app)
     app.w_new_frame.value = "gripper_left_base_link"
@@ -592,6 +593,7 @@ def test_cli_gui_bad_host_exit_2(capsys):
     assert "0..65535" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_cli_gui_serves_and_stops_on_ctrl_c():
     proc = subprocess.Popen(
         [sys.executable, "-m", "impact_balance", "gui", "--port", "0"],

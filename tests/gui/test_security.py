@@ -482,6 +482,7 @@ def test_cli_refuses_bad_flags(capsys, tmp_path):
     assert err.count("\n") == 1 and "--allow-origin" in err
 
 
+@pytest.mark.slow
 def test_cli_prints_the_workspace_and_stops_on_sigterm(tmp_path):
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[2] / "src")}
     proc = subprocess.Popen(

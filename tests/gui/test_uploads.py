@@ -24,6 +24,9 @@ pytest.importorskip("psutil", reason="needs psutil (installed with the sweep ext
 import msgspec
 import psutil
 
+#: A server process and 200 MB through a WebSocket: seconds each.
+pytestmark = pytest.mark.slow
+
 SRC = str(Path(__file__).parents[2] / "src")
 PART = 512 << 10  # what viser's page sends
 #: Allowed growth of the server's resident memory while 200 MB arrive.

@@ -149,6 +149,7 @@ def test_phase_portrait_paper_gravity():
     assert "+0.4608" in " ".join(t.get_text() for t in fig.legends[0].get_texts())
 
 
+@pytest.mark.slow
 def test_saved_figures_titles_give_gravity(analyses, tmp_path):
     save_figures(analyses["kick_one_foot"], tmp_path)
     assert sorted(p.name for p in tmp_path.iterdir()) == [
@@ -214,6 +215,7 @@ def test_flat_set_test():
     assert not _flat(np.column_stack([np.cos(6 * t), 0.5 * np.sin(6 * t)]))
 
 
+@pytest.mark.slow
 def test_video_frame(trials, tmp_path):
     """1280 x 720 frames, light background, caption with time and slow motion, CoM marker."""
     import subprocess

@@ -258,6 +258,7 @@ def test_determinism(method):
     assert (r1.n_lp, r1.pivots) == (r2.n_lp, r2.pivots) and r1.polygon.bounded == r2.polygon.bounded
 
 
+@pytest.mark.slow
 @settings(max_examples=30, deadline=None)
 @given(
     n=st.integers(2, 5), m=st.integers(3, 12), with_eq=st.booleans(), seed=st.integers(0, 2**32 - 1)

@@ -253,6 +253,7 @@ def test_cli_scenario_without_impact(capsys, tmp_path):
     assert rc == 2 and "no impact" in err and len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.slow
 def test_cli_video(tmp_path):
     """Offscreen MP4 in a fresh process (MUJOCO_GL must be set before MuJoCo is imported)."""
     import subprocess

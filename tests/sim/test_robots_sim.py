@@ -221,6 +221,7 @@ def assert_real_outcome(summary: dict, criteria: OutcomeCriteria = DEFAULT_CRITE
             assert summary["max_trunk_tilt_deg"] > math.degrees(criteria.max_trunk_tilt)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("robot", ROBOTS)
 def test_push_and_validate_run(extra_scenarios, robot):
     with warnings.catch_warnings():

@@ -352,6 +352,7 @@ def test_a_scheduler_given_by_address_runs_the_sweep(tmp_path, clean):
 
 
 # -- workers die with their sweep -----------------------------------------------------------------
+@pytest.mark.slow
 @pytest.mark.parametrize("how", ["SIGKILL", "SIGTERM", "Ctrl-C"])
 def test_no_process_is_left_five_seconds_after_a_killed_sweep(tmp_path, how):
     spec = {

@@ -349,6 +349,7 @@ def test_resume_computes_only_missing_chunks(tmp_path):
         run_sweep(plan_of(SMALL, chunk_size=5), tmp_path / "out", workers=1, progress=False)
 
 
+@pytest.mark.slow
 def test_same_rows_on_one_two_workers_and_dask(tmp_path):
     from distributed import Client, LocalCluster
 
