@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 import impact_balance as ib
+from tests.helpers.extras import needs_extra
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -19,6 +20,7 @@ def _load(name: str):
     return module
 
 
+@needs_extra("logs")
 def test_robot_log_example_finds_the_exit_of_the_area(tmp_path, capsys):
     """The synthetic log's forward speed grows linearly: it leaves the CoM velocity area at the
     first sample beyond the area's extent along x (from analyze, not from the log checker)."""

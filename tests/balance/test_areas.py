@@ -366,6 +366,8 @@ def test_horizontal_translation_moves_only_the_zmp_area(geo, make_contact, name)
 def pypoman_force_area(P, scale=1e3):
     """pypoman's Bretl projection of (A, b/mg, C, d/mg) onto F. Its stopping rule is an
     absolute 1e-4 and it drops vertices closer than 1e-2, so project onto scale * F."""
+    pytest.importorskip("cdd", reason="needs pycddlib-standalone (the test extra)")
+    pytest.importorskip("cvxopt", reason="needs cvxopt (the test extra)")
     pypoman = pytest.importorskip("pypoman", reason="needs pypoman (the test extra, --no-deps)")
     np.random.seed(12345)  # noqa: NPY002 (pypoman draws its first ray from numpy's global generator)
     w = P.weight

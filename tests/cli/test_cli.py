@@ -21,6 +21,7 @@ import impact_balance
 from impact_balance import cli
 from tests.helpers.cli import assert_one_line_error, run_process, strict_json
 from tests.helpers.cli import run_cli as run
+from tests.helpers.extras import needs_extra
 
 PNG = b"\x89PNG\r\n\x1a\n"
 BUNDLED_DIR = Path(impact_balance.__file__).parent / "scenarios"
@@ -230,6 +231,7 @@ def test_analyze_file_path(capsys):
     assert strict_json(out)["scenario"] == "palm_push_two_feet"
 
 
+@needs_extra("plots")
 def test_analyze_writes_plots(tmp_path, capsys):
     out_dir = tmp_path / "figs" / "nested"
     rc, out, err = run(capsys, "analyze", "palm_push_two_feet", "--plots", str(out_dir))
@@ -241,6 +243,7 @@ def test_analyze_writes_plots(tmp_path, capsys):
         assert f"figure: {p}" in out
 
 
+@needs_extra("plots")
 @pytest.mark.slow
 def test_analyze_json_with_plots_keeps_stdout_json(tmp_path, capsys):
     rc, out, _ = run(capsys, "analyze", "palm_push_two_feet", "--json", "--plots", str(tmp_path))
@@ -330,6 +333,7 @@ def test_phase_portrait_bad_value_subprocess():
     assert_one_line_error(proc.returncode, proc.stderr, "com_height")
 
 
+@needs_extra("plots")
 def test_phase_portrait_plot(tmp_path, capsys):
     target = tmp_path / "sub" / "pp.png"
     rc, out, _ = run(
@@ -349,6 +353,7 @@ def test_phase_portrait_plot(tmp_path, capsys):
 
 
 # -- demo -------------------------------------------------------------------------------------
+@needs_extra("plots")
 @pytest.mark.slow
 def test_demo(tmp_path, capsys):
     rc, out, err = run(capsys, "demo", "--out", str(tmp_path))

@@ -78,6 +78,7 @@ def test_control_characters_and_nul_bytes_are_one_line(tmp_path, capsys, bad, wh
     assert run_cli(capsys, "analyze", str(path), "--json")[0] == 0
 
 
+@needs_extra("sweep", "sim")
 def test_control_character_in_a_sweep_file_and_simulate(tmp_path, capsys, in_tmp):
     sweep = tmp_path / "s.yaml"
     sweep.write_text(
@@ -215,6 +216,7 @@ def test_full_and_closed_stdout_are_one_line_exit_1(tmp_path):
     )
 
 
+@needs_extra("plots", "logs", "sim", "sweep", "gui")
 def test_every_command_reports_a_failing_stdout_in_one_line(capsys, monkeypatch):
     """The rule is in ``main``, not in the commands: a command added later gets it too."""
 
@@ -307,6 +309,7 @@ def test_an_unexpected_exception_in_a_command_is_one_line_exit_1(capsys, monkeyp
 
 
 # -- numbers the code cannot use ------------------------------------------------------------------
+@needs_extra("sim")
 @pytest.mark.parametrize(
     "argv, needle",
     [
@@ -331,6 +334,7 @@ def test_numbers_outside_what_the_simulation_can_do_are_refused(capsys, monkeypa
     assert time.perf_counter() - start < 60  # refused, not run for ever (a hang guard)
 
 
+@needs_extra("sim")
 def test_a_push_that_throws_the_robot_is_an_answer(capsys):
     """1000 N s is inside the documented (0, 1000]: the robot leaves the ground, an answer."""
     rc, out, err = run_cli(

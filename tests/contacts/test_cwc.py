@@ -226,8 +226,8 @@ def test_world_faces_for_a_wall_contact():
     Cw = cwc_faces_world(mu, X, Y, R)
     push = np.array([-1.0, 0, 0, 0, 0, 0])
     assert np.all(Cw @ push < 0)
-    assert np.max(Cw @ ([*push, 0, 0, 0.49, 0, 0, 0])) <= 0
-    assert np.max(Cw @ ([*push, 0, 0, 0.51, 0, 0, 0])) > 0
+    assert np.max(Cw @ (push + np.array([0, 0, 0.49, 0, 0, 0]))) <= 0
+    assert np.max(Cw @ (push + np.array([0, 0, 0.51, 0, 0, 0]))) > 0
     # force at local point (x, 0, 0): local x axis is world R[:,0] = (0, 0, 1) (up)
     for x, ok in [(0.099, True), (0.101, False)]:
         p = R @ np.array([x, 0.0, 0.0])

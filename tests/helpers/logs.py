@@ -8,6 +8,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+pytest.importorskip("pandas", reason="needs the logs extra (pandas)")
+
 import impact_balance as ib
 from impact_balance.logs.schema import LogColumns, joint_position_column, joint_velocity_column
 
@@ -32,7 +34,8 @@ def synthetic_log(
         The log (a pandas DataFrame), its pinocchio states ``(q, v)`` row by row, and the
         scenario ``palm_push_two_feet`` it moves.
     """
-    pd = pytest.importorskip("pandas")
+    import pandas as pd
+
     scenario = ib.load_scenario(SCENARIO)
     stance = scenario.build_stance()
     robot = stance.robot

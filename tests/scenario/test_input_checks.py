@@ -36,6 +36,7 @@ from impact_balance.robot.robot import load_robot
 from impact_balance.scenario import load_scenario, scenario_from_dict
 from impact_balance.scenario.reader import MAX_BYTES, MAX_DEPTH, MAX_VALUES, parse_yaml
 from tests.helpers.cli import assert_one_line_error, run_cli, run_process, strict_json
+from tests.helpers.extras import needs_extra
 
 TWO_FEET = {
     "robot": "talos",
@@ -453,6 +454,7 @@ def test_qp_capped_by_the_reference_warns():
     assert codes(analyze("kick_one_foot")) == []  # without the QP, nothing to say
 
 
+@needs_extra("plots")
 def test_skipped_figure_warns(tmp_path, capsys):
     path = write(
         tmp_path, {"robot": "talos", "contacts": [TWO_FEET["contacts"][0]]}
@@ -523,6 +525,7 @@ def test_pinocchio_frame_count_is_independent():
     assert model.nframes == len(load_robot("talos").frame_names)
 
 
+@needs_extra("gui")
 def test_gui_shows_the_warnings(tmp_path):
     from impact_balance.gui.app import GuiApp
 
