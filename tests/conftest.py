@@ -1,13 +1,21 @@
-"""Shared fixtures for the CWC, projection and area tests.
+"""Shared fixtures for the CWC, projection and area tests, and the folder markers.
 
 Plain helper functions are handed out through session-scoped fixtures so that hypothesis
-tests can use them without the function-scoped-fixture health check.
+tests can use them without the function-scoped-fixture health check. Every test under
+``tests/sim``, ``tests/gui`` and ``tests/sweep`` gets that folder's marker (``-m "not sim"``
+leaves the folder out); helpers shared by test files live in :mod:`tests.helpers`.
 """
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
+
+#: Folders whose every test needs an extra, and the marker each gets.
+FOLDER_MARKERS = {"sim": "sim", "gui": "gui", "sweep": "sweep"}
+HERE = Path(__file__).parent
 
 GRAVITY = 9.81  # CONVENTIONS.md: g = 9.81 m/s^2 along -z
 
@@ -143,3 +151,15 @@ def _trial_journals_in_tmp(tmp_path, monkeypatch):
     except ImportError:  # no sim extra: nothing writes journals
         return
     monkeypatch.setattr(journal, "JOURNAL_FOLDER", str(tmp_path / "impact-balance-trials"))
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Add the folder's marker to every test under ``tests/sim``, ``tests/gui``, ``tests/sweep``."""
+    for item in items:
+        try:
+            folder = item.path.relative_to(HERE).parts[0]
+        except ValueError:  # a test outside tests/
+            continue
+        marker = FOLDER_MARKERS.get(folder)
+        if marker is not None:
+            item.add_marker(getattr(pytest.mark, marker))

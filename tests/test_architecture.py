@@ -1,9 +1,10 @@
-"""The package's shape: pipeline-order layers, no import circle, few top-level modules, short functions.
+"""The package's shape: pipeline-order layers, no import circle, few top-level modules, short
+functions.
 
-These are the rules of the house (CONTRIBUTING.md): a module imports only from its own layer
-or the ones below it, a private name (``_x``) is imported only inside its own package, the top
-level keeps the public API, exceptions and a few shared constants, and no function outside the
-compiled kernels is over 100 lines.
+These are the rules of the house (CONTRIBUTING.md): a module imports only from its own layer or the
+ones below it, a private name (``_x``) is imported only inside its own package, the top level keeps
+the public API, exceptions and a few shared constants, and no function outside the compiled kernels
+is over 100 lines.
 """
 
 from __future__ import annotations

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 import impact_balance as ib
+from tests.helpers.extras import needs_extra
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -19,6 +20,7 @@ def _load(name: str):
     return module
 
 
+@needs_extra("logs")
 def test_robot_log_example_finds_the_exit_of_the_area(tmp_path, capsys):
     """The synthetic log's forward speed grows linearly: it leaves the CoM velocity area at the
     first sample beyond the area's extent along x (from analyze, not from the log checker)."""
@@ -35,8 +37,8 @@ def test_robot_log_example_finds_the_exit_of_the_area(tmp_path, capsys):
 
 
 def test_governor_in_a_pink_loop_caps_the_speed_at_the_criterion(capsys):
-    """The commanded approach speed is min(reference, the cap), the cap is the analysis' maximum at the
-    start, and pink's IK tracks the commanded speed."""
+    """The commanded approach speed is min(reference, the cap), the cap is the analysis' maximum at
+    the start, and pink's IK tracks the commanded speed."""
     example = _load("governor_pink")
     fast = example.run("palm_push_two_feet", reference=0.8, ticks=80)
     start = ib.analyze("palm_push_two_feet").impact.max_contact_velocity

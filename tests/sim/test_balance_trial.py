@@ -1,0 +1,219 @@
+"""Balance trials in MuJoCo (a few simulated seconds each): pushes, impact bisection, logs, CLI."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+pytest.importorskip("mujoco", reason="needs the sim extra (MuJoCo)")
+pytest.importorskip("pandas", reason="needs the logs extra (pandas)")
+pytest.importorskip("pyarrow", reason="needs the logs or sweep extra (pyarrow)")
+
+from impact_balance.cli import main
+from impact_balance.logs import check_log, read_log, write_log
+from impact_balance.sim.studies.validate import validate
+from impact_balance.sim.trials.balance_trial import (
+    BalanceSetup,
+    BalanceTrialOptions,
+    Push,
+    run_balance_trial,
+)
+
+SCENARIO = "palm_push_two_feet"
+
+
+@pytest.fixture(scope="module")
+def setup():
+    return BalanceSetup.create(SCENARIO)
+
+
+def test_small_push_is_recovered_and_logged(setup, tmp_path):
+    result = run_balance_trial(
+        setup, push=Push(0.0, 5.0, 0.05), options=BalanceTrialOptions(after=1.0, record=True)
+    )
+    assert result.outcome == "balanced", result.detail
+    assert result.com_velocity_margin_at_end > 0 and result.min_com_velocity_margin > 0
+    # A 5 N s push changes the CoM velocity by about 5 / 90 m/s; the controller brings it back.
+    peak = np.abs(result.series["com_velocity"][:, 0]).max()
+    assert 0.03 < peak < 0.12
+    path = write_log(result.log, tmp_path / "push.parquet")
+    frame = read_log(path)
+    check = check_log(frame, SCENARIO)
+    # The checker's CoM velocity (pinocchio, from base and joint columns) against MuJoCo's own
+    # (logged).
+    ours = check.samples[["comd_x", "comd_y", "comd_z"]].to_numpy()
+    mujoco_com = frame[["comd_x", "comd_y", "comd_z"]].to_numpy()
+    assert np.abs(ours - mujoco_com).max() < 1e-6
+    assert (
+        np.abs(
+            check.samples[["com_x", "com_y", "com_z"]].to_numpy()
+            - frame[["com_x", "com_y", "com_z"]].to_numpy()
+        ).max()
+        < 1e-6
+    )
+    late = check.samples["time"] > 0.2
+    assert check.samples.loc[late, "com_velocity_inside"].all()
+
+
+def test_large_push_falls_and_the_com_criterion_saw_it(setup):
+    result = run_balance_trial(
+        setup, push=Push(0.0, 100.0, 0.05), options=BalanceTrialOptions(after=1.5)
+    )
+    assert result.fell and result.reason in ("base_dropped", "trunk_tipped")
+    assert result.com_velocity_margin_at_end < 0  # ~1.1 m/s is far outside the CoM velocity area
+    json.dumps(result.summary(), allow_nan=False)
+
+
+def test_validate_brackets_the_threshold_in_measured_speed(tmp_path):
+    """The paper's robot at the impact (joints held) with the torque controller: a bracket near the
+    prediction."""
+    from impact_balance.sim.studies.journal import TrialJournal
+
+    options = BalanceTrialOptions(after=1.0, controller="id", rigid_impact=True)
+    setup = BalanceSetup.create(SCENARIO, options=options)
+    journal = TrialJournal.open(tmp_path / "v.jsonl", "digest")
+    result = validate(SCENARIO, tolerance=0.5, options=options, setup=setup, journal=journal)
+    journal.close()
+    out = json.loads(json.dumps(result.to_dict(), allow_nan=False))
+    assert set(out["predicted"]) == {"com_criterion", "zmp_criterion"}
+    assert set(out["predicted"]["com_criterion"]) == {"composite", "joint_space"}
+    e = out["empirical"]
+    s, f = e["survived"], e["fell"]
+    assert s is not None and f is not None and s < f
+    assert (
+        e["survived_commanded"] < e["fell_commanded"]
+        and e["fell_commanded"] - e["survived_commanded"] <= 0.5 * e["fell_commanded"]
+    )
+    measured = {t["speed"]: t["approach_speed_measured"] for t in out["trials"]}
+    assert s in measured.values() and f in measured.values()  # the bracket is in measured speed
+    for t in out["trials"]:
+        assert t["outcome"] in ("balanced", "contact_broken", "fell", "aborted")
+        assert t["fell"] == (t["outcome"] == "fell")
+        assert t["approach_speed_measured"] == pytest.approx(
+            t["speed"], rel=0.35
+        )  # reached before the surface
+    assert any(t["fell"] for t in out["trials"]) and any(not t["fell"] for t in out["trials"])
+    assert out["controller"]["name"] and out["rigid_impact"] is True
+    predicted = out["predicted"]["com_criterion"]["composite"]
+    assert 0.5 * predicted < f < 2.0 * predicted  # loose here; benchmarks/balance.py measures it
+    for t in out["trials"]:
+        hold = t["trial"]["impact"]["rigid_hold"]
+        assert hold["duration"] is not None and hold["max_joint_velocity_change"] < 0.01
+    # The same search again reuses every trial from the journal and gives the same answer.
+    again = validate(
+        SCENARIO,
+        tolerance=0.5,
+        options=options,
+        setup=setup,
+        journal=TrialJournal.open(tmp_path / "v.jsonl", "digest"),
+    )
+    assert again.reused == len(result.trials) and again.bracket() == result.bracket()
+
+
+def test_cli_errors_are_one_line(capsys, tmp_path):
+    no_impact = tmp_path / "no_impact.yaml"
+    no_impact.write_text("extends: palm_push_two_feet\nimpact: null\n")
+    assert main(["validate", str(no_impact)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "has no impact" in err[0]
+    assert main(["push-test", SCENARIO, "--magnitudes", "-3"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--magnitudes" in err[0]
+
+
+def test_push_test_json(capsys, tmp_path):
+    argv = [
+        "push-test",
+        SCENARIO,
+        "--controller",
+        "ik",
+        "--directions",
+        "1",
+        "--magnitudes",
+        "5",
+        "--json",
+        "--journal",
+        str(tmp_path / "j.jsonl"),
+    ]
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out, parse_constant=lambda c: pytest.fail(c))
+    (push,) = out["pushes"]
+    assert set(push) >= {
+        "direction",
+        "magnitude",
+        "outcome",
+        "fell",
+        "reason",
+        "com_criterion_safe",
+        "com_criterion_safe_in_trial",
+        "zmp_criterion_safe",
+        "com_velocity_margin",
+    }
+    assert push["magnitude"] == 5.0 and push["fell"] is False and push["outcome"] == "balanced"
+    assert push["com_criterion_safe"] is True and push["com_velocity_margin"] > 0
+    assert out["zmp_margin"] == pytest.approx(0.01)  # the ik controller's own margin, by default
+    c = out["scores"]["com"]
+    assert c["total"] == 1 and c["safe_survived"] == 1 and c["accuracy_ci95"][1] == 1.0
+    assert main([*argv[:-2], "--journal", str(tmp_path / "j.jsonl"), "--zmp-margin", "0"]) == 0
+    again = json.loads(capsys.readouterr().out)
+    assert again["reused_trials"] == 1 and again["zmp_margin"] == 0.0
+
+
+def test_checker_reads_simulate_logs(tmp_path, capsys):
+    """`simulate --log` (servo joints, a palm impact) writes a log the checker reads; its CoM is
+    MuJoCo's."""
+    path = tmp_path / "simulate.csv"
+    assert (
+        main(["simulate", SCENARIO, "--speed", "0.2", "--joints", "servo", "--log", str(path)]) == 0
+    )
+    capsys.readouterr()
+    frame = read_log(path)
+    check = check_log(frame, SCENARIO)
+    ours = check.samples[["comd_x", "comd_y", "comd_z"]].to_numpy()
+    assert np.abs(ours - frame[["comd_x", "comd_y", "comd_z"]].to_numpy()).max() < 1e-9
+    assert main(["check-log", str(path), "--scenario", SCENARIO, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["samples"] == len(frame) and "violations" in out
+
+
+def test_validate_cli_json_keys_and_text(capsys, tmp_path):
+    argv = [
+        "validate",
+        SCENARIO,
+        "--controller",
+        "id",
+        "--rigid-impact",
+        "--max-speed",
+        "0.3",
+        "--journal",
+        str(tmp_path / "v.jsonl"),
+    ]
+    assert main([*argv, "--json"]) == 0
+    cap = capsys.readouterr()
+    out = json.loads(cap.out, parse_constant=lambda c: pytest.fail(c))
+    assert "trials journal" in cap.err
+    e = out["empirical"]
+    assert set(e) >= {"survived", "fell", "survived_commanded", "fell_commanded", "monotonic"}
+    assert (
+        e["survived_commanded"] == 0.3
+        and e["fell"] is None
+        and e["survived"] == pytest.approx(0.3, rel=0.1)
+    )
+    assert (
+        out["predicted"]["com_criterion"]["composite"]
+        > out["predicted_with_margin"]["com_criterion"]["composite"]
+    )
+    assert out["zmp_margin"] == pytest.approx(0.01) and out["rigid_impact"] is True
+    (trial,) = out["trials"]
+    assert trial["outcome"] == "balanced" and trial["com_criterion_safe"] is True
+    impact = trial["trial"]["impact"]
+    assert set(impact["sustained_impulses"]) == {"left_sole_link", "right_sole_link"}
+    assert main(argv) == 0  # text, from the journal
+    text = capsys.readouterr().out
+    assert (
+        "measured approach speed: stood at" in text
+        and "CoM criterion" in text
+        and "(1 reused)" in text
+    )

@@ -1,0 +1,423 @@
+"""A sweep's results folder is checked like a database, every axis does what it says,
+nothing is created for bad input, and workers die with their sweep.
+
+Folders are damaged in every way a folder can be (a part cut in half, emptied, copied from
+another sweep, extra, renamed, edited, deleted): ``--verify`` names each in one line, the
+summary leaves them out without crashing, and a resume recomputes exactly what is missing or
+damaged, ending with the same rows as an uninterrupted run.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("dask", reason="needs the sweep extra (Dask)")
+pytest.importorskip("distributed", reason="needs the sweep extra (Dask distributed)")
+pytest.importorskip("pandas", reason="needs the logs extra (pandas)")
+pytest.importorskip("pyarrow", reason="needs the logs or sweep extra (pyarrow)")
+pytest.importorskip("pyarrow.parquet", reason="needs the logs or sweep extra (pyarrow)")
+pytest.importorskip("psutil", reason="needs psutil (installed with the sweep extra's Dask)")
+
+import psutil
+import pyarrow as pa
+import pyarrow.parquet as pq
+import yaml
+
+from impact_balance import analyze, cli
+from impact_balance.exceptions import EnvironmentFailure, OptionError
+from impact_balance.robot.robot import load_robot
+from impact_balance.scenario import read_mapping, scenario_from_dict, scenario_path
+from impact_balance.sweep import Evaluator, make_plan, read_results, run_sweep, sweep_spec_from_dict
+from impact_balance.sweep.cluster import check_scheduler_address, connect
+from impact_balance.sweep.store import LEDGER, check_folder, table_checksum
+
+SRC = str(Path(__file__).parents[2] / "src")
+BASE = "palm_push_two_feet"
+SPEC = {
+    "base": BASE,
+    "chunk_size": 4,
+    "axes": [
+        {"path": "impact.friction", "range": [0.0, 0.6], "count": 5},
+        {"path": "impact.restitution[1]", "values": [0.0, 0.5, 1.0]},
+    ],
+}  # 15 points, 4 chunks
+
+
+def main(argv: list[str]) -> int:
+    """``cli.main``, with argparse's usage errors (SystemExit) as their status."""
+    try:
+        return cli.main(argv)
+    except SystemExit as exc:
+        return int(exc.code)
+
+
+def plan_of(spec=SPEC):
+    return make_plan(sweep_spec_from_dict(spec))
+
+
+@pytest.fixture(scope="module")
+def clean(tmp_path_factory):
+    """An uninterrupted run (the reference) and another sweep's folder (for foreign parts)."""
+    root = tmp_path_factory.mktemp("clean")
+    run_sweep(plan_of(), root / "whole", workers=1, progress=False)
+    other = {
+        **SPEC,
+        "axes": [SPEC["axes"][0], {"path": "impact.restitution[1]", "values": [0.1, 0.2, 0.3]}],
+    }
+    run_sweep(plan_of(other), root / "other", workers=1, progress=False)
+    return root
+
+
+def _cut(path: Path) -> None:
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 2])
+
+
+def _edit(path: Path) -> None:
+    """Change one value, keep the part's metadata (what an edit in place would do)."""
+    table = pq.read_table(path)
+    values = table["max_contact_velocity"].to_pylist()
+    values[1] += 0.1
+    column = table.schema.get_field_index("max_contact_velocity")
+    pq.write_table(table.set_column(column, "max_contact_velocity", pa.array(values)), path)
+
+
+def _without_metadata(path: Path) -> None:
+    pq.write_table(pq.read_table(path).replace_schema_metadata(None), path)
+
+
+DAMAGE = {
+    "cut in half": (
+        lambda p, o: _cut(p / "parts/part-000001.parquet"),
+        "part-000001",
+        "damaged",
+        {1},
+    ),
+    "emptied": (
+        lambda p, o: (p / "parts/part-000002.parquet").write_bytes(b""),
+        "part-000002",
+        "damaged",
+        {2},
+    ),
+    "foreign": (
+        lambda p, o: shutil.copy(o / "parts/part-000000.parquet", p / "parts/part-000000.parquet"),
+        "part-000000",
+        "foreign",
+        {0},
+    ),
+    "extra": (
+        lambda p, o: shutil.copy(p / "parts/part-000001.parquet", p / "parts/part-000009.parquet"),
+        "part-000009",
+        "extra",
+        set(),
+    ),
+    "renamed": (
+        lambda p, o: os.replace(p / "parts/part-000003.parquet", p / "parts/part-000002.parquet"),
+        "part-000002",
+        "renamed",
+        {2, 3},
+    ),
+    "edited": (lambda p, o: _edit(p / "parts/part-000003.parquet"), "part-000003", "damaged", {3}),
+    "metadata stripped": (
+        lambda p, o: _without_metadata(p / "parts/part-000000.parquet"),
+        "part-000000",
+        "foreign",
+        {0},
+    ),
+    "deleted": (
+        lambda p, o: (p / "parts/part-000001.parquet").unlink(),
+        "part-000001",
+        "missing",
+        {1},
+    ),
+}
+
+
+@pytest.mark.parametrize("case", list(DAMAGE))
+def test_a_damaged_folder_is_named_left_out_and_recomputed(tmp_path, capsys, clean, case):
+    damage, file, kind, recomputed = DAMAGE[case]
+    out = tmp_path / "out"
+    shutil.copytree(clean / "whole", out)
+    damage(out, clean / "other")
+    # verify: one line naming the part and what is wrong, exit 2
+    assert main(["sweep", "--verify", str(out)]) == 2
+    lines = capsys.readouterr().out.splitlines()
+    bad = [ln for ln in lines if file in ln]
+    assert bad and all(f": {kind}: " in ln or ": missing: " in ln for ln in bad), lines
+    # the summary leaves the part out and says so; it never crashes nor mixes
+    assert main(["sweep", "--summary", str(out), "--json"]) == 0
+    captured = capsys.readouterr()
+    assert file in captured.err and "left out" in captured.err
+    good = check_folder(out)
+    assert good.rows == 15 - sum(4 if c < 3 else 3 for c in recomputed)
+    # a resume recomputes exactly the bad chunks: same rows as an uninterrupted run, no duplicate
+    computed = []
+    report = run_sweep(
+        plan_of(),
+        out,
+        workers=1,
+        progress=False,
+        on_chunk=computed.append,
+        notify=lambda line: computed.append(line),
+    )
+    assert {c for c in computed if isinstance(c, int)} == recomputed
+    assert any(file in str(c) for c in computed if isinstance(c, str))
+    resumed, whole = read_results(out), read_results(clean / "whole")
+    assert resumed.num_rows == 15 and resumed.equals(whole)
+    assert check_folder(out).ok and report.complete
+    assert main(["sweep", "--verify", str(out)]) == 0
+    capsys.readouterr()
+
+
+def test_a_part_of_the_same_chunk_with_edited_metadata_is_caught_by_the_manifest(tmp_path, clean):
+    """Values edited and the part's own checksum recomputed: the manifest of parts still differs."""
+    out = tmp_path / "out"
+    shutil.copytree(clean / "whole", out)
+    path = out / "parts/part-000002.parquet"
+    table = pq.read_table(path)
+    meta = dict(table.schema.metadata)
+    values = table["max_contact_velocity"].to_pylist()
+    values[0] *= 2
+    edited = table.set_column(
+        table.schema.get_field_index("max_contact_velocity"),
+        "max_contact_velocity",
+        pa.array(values),
+    ).replace_schema_metadata(None)
+    meta[b"impact_balance.checksum"] = table_checksum(edited).encode()
+    pq.write_table(edited.replace_schema_metadata(meta), path)
+    problems = check_folder(out).problems
+    assert len(problems) == 1 and "recorded in the manifest" in problems[0].reason
+
+
+def test_the_checksum_survives_parquet_and_sees_one_bit(tmp_path, clean):
+    table = read_results(clean / "whole")
+    pq.write_table(table, tmp_path / "t.parquet")
+    back = pq.read_table(tmp_path / "t.parquet")
+    assert table_checksum(back.replace_schema_metadata(None)) == table_checksum(
+        table.replace_schema_metadata(None)
+    )
+    values = table["zmp_max_contact_velocity"].to_pylist()
+    values[7] = float.fromhex(
+        values[7].hex()[:-1] + ("0" if values[7].hex()[-1] != "0" else "1")
+    )  # flip the last bit
+    other = table.set_column(
+        table.schema.get_field_index("zmp_max_contact_velocity"),
+        "zmp_max_contact_velocity",
+        pa.array(values),
+    )
+    assert table_checksum(other) != table_checksum(table)
+
+
+def test_a_torn_manifest_line_is_skipped_and_repaired(tmp_path, clean):
+    out = tmp_path / "out"
+    shutil.copytree(clean / "whole", out)
+    ledger = out / LEDGER
+    ledger.write_text(ledger.read_text()[:-20])  # killed while appending
+    assert check_folder(out).ok  # the unrecorded part is checked by its own metadata
+    run_sweep(plan_of(), out, workers=1, progress=False)
+    assert len(ledger.read_text().splitlines()) == 4
+
+
+def test_rows_say_what_was_evaluated_and_match_analyze():
+    plan = plan_of({"base": BASE, "axes": [{"path": "impact.friction", "values": [0.2]}]})
+    row = Evaluator(plan).evaluate_chunk(0).to_pylist()[0]
+    stance = analyze(BASE).stance
+    assert row["robot_name"] == "talos" and row["contact_frames"] == ",".join(
+        c.spec.frame for c in stance.contacts
+    )
+    assert (
+        row["q"] == pytest.approx(stance.q.tolist(), abs=1e-12) and len(row["stance_digest"]) == 12
+    )
+
+
+def test_a_robot_axis_varies_the_robot(tmp_path):
+    """Talos and a Talos with a heavier torso: rows differ, and each matches analyze() of that
+    robot."""
+    talos = load_robot("talos")
+    text = Path(talos.urdf_path).read_text()
+    start = text.index('<link name="torso_2_link">')
+    mass = text.index("<mass value=", start)
+    heavy = tmp_path / "talos_heavy.urdf"
+    heavy.write_text(text[:mass] + '<mass value="40.0"/>' + text[text.index("/>", mass) + 2 :])
+    files = {"urdf": str(heavy), "srdf": str(talos.srdf_path)}
+    plan = plan_of(
+        {
+            "base": BASE,
+            "axes": [
+                {"path": "robot", "values": ["talos", files]},
+                {"path": "impact.friction", "values": [0.1]},
+            ],
+        }
+    )
+    rows = Evaluator(plan).evaluate_chunk(0).to_pylist()
+    assert [r["robot_name"] for r in rows] == ["talos", str(heavy)]
+    assert rows[0]["stance_digest"] != rows[1]["stance_digest"]
+    for row, robot in zip(rows, ("talos", files), strict=True):
+        raw = read_mapping(scenario_path(BASE))
+        raw["robot"], raw["impact"]["friction"] = robot, 0.1
+        expected = analyze(scenario_from_dict(raw)).impact.max_contact_velocity
+        assert row["status"] == "ok" and row["max_contact_velocity"] == pytest.approx(
+            expected, rel=1e-9
+        )
+    assert rows[0]["max_contact_velocity"] != pytest.approx(
+        rows[1]["max_contact_velocity"], rel=1e-3
+    )
+
+
+# -- nothing created for bad input ----------------------------------------------------------------
+def _closed_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.mark.parametrize(
+    "out, scheduler, status, needle",
+    [
+        ("/proc/nope/out", None, 1, "--out"),
+        ("AFILE", None, 2, "--out"),
+        ("o", "tcp://", 2, "no host"),
+        ("o", "not-an-address", 2, "no port"),
+        ("o", "http://127.0.0.1:8787", 2, "not Dask's protocol"),
+        ("o", "tcp://127.0.0.1:{port}", 1, "cannot connect"),
+        ("o", "tcp://no-such-host.invalid:8786", 1, "unknown host"),
+    ],
+)
+def test_bad_out_or_scheduler_is_one_line_and_creates_nothing(
+    tmp_path, capsys, monkeypatch, out, scheduler, status, needle
+):
+    monkeypatch.chdir(tmp_path)
+    Path("AFILE").write_text("x")
+    Path("s.yaml").write_text(yaml.safe_dump(SPEC))
+    argv = ["sweep", "s.yaml", "--out", out, "--no-progress"]
+    if scheduler:
+        argv += ["--scheduler", scheduler.format(port=_closed_port())]
+    start = time.perf_counter()
+    rc = main(argv)
+    err = capsys.readouterr().err
+    assert rc == status and len(err.splitlines()) == 1 and needle in err and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["AFILE", "s.yaml"]
+    assert (
+        time.perf_counter() - start < 30
+    )  # the closed port answers at once, not after Dask's 30 s
+
+
+def test_scheduler_addresses():
+    assert check_scheduler_address("tcp://10.0.0.5:8786") == "tcp://10.0.0.5:8786"
+    assert check_scheduler_address("localhost:8786") == "tcp://localhost:8786"
+    assert check_scheduler_address("tls://[::1]:8786") == "tls://[::1]:8786"
+    for bad in (
+        "",
+        "tcp://",
+        "tcp://host",
+        "host:0",
+        "host:99999",
+        "ucx://h:1",
+        "tcp://h:1/path",
+        "a b:1",
+    ):
+        with pytest.raises(OptionError):
+            check_scheduler_address(bad)
+    with pytest.raises(EnvironmentFailure, match="cannot connect"):
+        connect(f"tcp://127.0.0.1:{_closed_port()}")
+
+
+def test_a_scheduler_given_by_address_runs_the_sweep(tmp_path, clean):
+    from distributed import LocalCluster
+
+    with LocalCluster(
+        n_workers=1,
+        threads_per_worker=1,
+        processes=False,
+        protocol="tcp://",
+        host="127.0.0.1",
+        dashboard_address=None,
+    ) as cluster:
+        report = run_sweep(
+            plan_of(), tmp_path / "d", scheduler=cluster.scheduler_address, progress=False
+        )
+    assert report.backend == "dask" and read_results(tmp_path / "d").equals(
+        read_results(clean / "whole")
+    )
+
+
+# -- workers die with their sweep -----------------------------------------------------------------
+@pytest.mark.slow
+@pytest.mark.parametrize("how", ["SIGKILL", "SIGTERM", "Ctrl-C"])
+def test_no_process_is_left_five_seconds_after_a_killed_sweep(tmp_path, how):
+    spec = {
+        "base": BASE,
+        "chunk_size": 8,
+        "axes": [
+            {
+                "posture": {
+                    "y": {"range": [-0.5, 0.0], "count": 12},
+                    "z": {"range": [0.8, 1.2], "count": 12},
+                }
+            }
+        ],
+    }
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(spec))
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "impact_balance",
+            "sweep",
+            "s.yaml",
+            "--out",
+            "out",
+            "--workers",
+            "2",
+            "--no-progress",
+            "--no-plots",
+        ],
+        cwd=tmp_path,
+        env={**os.environ, "PYTHONPATH": SRC},
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        start_new_session=True,
+    )
+    descendants: list[psutil.Process] = []
+    try:
+        command = psutil.Process(proc.pid)
+        deadline = time.time() + 240
+        while time.time() < deadline:  # running: the workers exist and a first part is written
+            parts = tmp_path / "out" / "parts"
+            if parts.is_dir() and any(p.name.startswith("part-") for p in parts.iterdir()):
+                break
+            assert proc.poll() is None, proc.stderr.read().decode()[-2000:]
+            time.sleep(0.1)
+        descendants = command.children(recursive=True)
+        assert len(descendants) >= 2, descendants  # the two workers (and multiprocessing's helpers)
+        if how == "SIGKILL":
+            proc.send_signal(signal.SIGKILL)  # the workers must notice by themselves
+        elif how == "SIGTERM":
+            proc.send_signal(signal.SIGTERM)
+        else:
+            os.killpg(proc.pid, signal.SIGINT)  # what a terminal sends to the foreground group
+        killed = time.time()
+        proc.wait(timeout=30)
+        _gone, alive = psutil.wait_procs(
+            descendants, timeout=max(0.0, 5.0 - (time.time() - killed))
+        )
+        assert not [p for p in alive if p.status() != psutil.STATUS_ZOMBIE], (how, alive)
+        assert time.time() - killed <= 5.0 + 0.5
+        if how != "SIGKILL":
+            assert proc.returncode == 130 and "interrupted" in proc.stderr.read().decode()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        for p in descendants:
+            with contextlib.suppress(psutil.Error):
+                p.kill()
