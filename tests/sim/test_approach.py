@@ -3,9 +3,8 @@ its speed capped every tick by a governor fed the simulated state."""
 
 from __future__ import annotations
 
-import os
-
 import json
+import os
 
 import numpy as np
 import pytest
