@@ -458,7 +458,7 @@ def test_list_values_and_unexpected_errors_are_rows(monkeypatch):
     import impact_balance.sweep.evaluate as evaluate
 
     calls = {"n": 0}
-    real = evaluate.max_contact_velocity
+    real = evaluate.impact_answer
 
     def flaky(*args):
         calls["n"] += 1
@@ -466,7 +466,7 @@ def test_list_values_and_unexpected_errors_are_rows(monkeypatch):
             raise FloatingPointError("simulated")
         return real(*args)
 
-    monkeypatch.setattr(evaluate, "max_contact_velocity", flaky)
+    monkeypatch.setattr(evaluate, "impact_answer", flaky)
     df = rows(plan_of([{"path": "impact.friction", "values": [0.1, 0.2, 0.3]}]))
     assert (
         list(df["status"]) == ["ok", "error", "ok"]
@@ -522,3 +522,13 @@ def test_impact_offset_axis_moves_the_impact_point():
         )
         assert r["max_contact_velocity"] == pytest.approx(a.impact.max_contact_velocity, rel=1e-12)
     assert abs(df["impact_y"][1] - df["impact_y"][0]) > 0.04  # the point moved
+
+
+def test_rows_honour_the_velocity_margin_as_analyze_does():
+    """A sweep of velocity_margin gives analyze()'s maximum at each margin (and it decreases)."""
+    margins = [0.0, 0.01, 0.03]
+    df = rows(plan_of([{"path": "velocity_margin", "values": margins}]))
+    assert list(df["status"]) == ["ok"] * len(margins)
+    expected = [_analyze_with(velocity_margin=d).impact.max_contact_velocity for d in margins]
+    assert list(df["max_contact_velocity"]) == pytest.approx(expected, rel=1e-12)
+    assert expected[0] > expected[1] > expected[2]

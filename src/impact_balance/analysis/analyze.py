@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from typing import Any
 
@@ -11,7 +12,7 @@ from impact_balance.analysis.diagnostics import diagnose
 from impact_balance.analysis.result import Analysis, ImpactAnswer
 from impact_balance.balance.areas import BalanceAreas, areas_from_polytope, with_reason
 from impact_balance.contacts.stance import Stance
-from impact_balance.contacts.wrench_polytope import wrench_polytope
+from impact_balance.contacts.wrench_polytope import WrenchPolytope, wrench_polytope
 from impact_balance.criteria.cap import safe_contact_velocity
 from impact_balance.criteria.com import ComCriterion
 from impact_balance.criteria.qp import QPOptions, solve_contact_velocity_qp, static_torques
@@ -22,7 +23,7 @@ from impact_balance.impact.model import ImpactModel, impact_model
 from impact_balance.projection.walk import warm_up
 from impact_balance.scenario import Scenario, load_scenario, with_source
 
-__all__ = ["Analysis", "ImpactAnswer", "analyze"]
+__all__ = ["Analysis", "ImpactAnswer", "analyze", "impact_answer", "stance_areas"]
 
 
 def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
@@ -67,12 +68,7 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
     t0 = time.perf_counter()
     stance = scenario.build_stance(robot)
     t1 = time.perf_counter()
-    polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
-    t2 = time.perf_counter()
-    try:
-        areas = areas_from_polytope(polytope, scenario.plane_height, scenario.zmp_margin)
-    except SolverError as exc:
-        raise exc.within("contacts (projection of the contact wrench polytope)") from None
+    polytope, areas, t2 = _stance_areas(scenario, stance)
     t3 = time.perf_counter()
     timings.update(stance=t1 - t0, constraints=t2 - t1, areas=t3 - t2)
     if not areas.can_balance:  # explain why (LPs; only for a stance that cannot balance)
@@ -88,15 +84,7 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
         except ScenarioError as exc:
             raise with_source(exc, scenario.source) from None
         _check_finite(_impact_checks(model))
-        criterion = ComCriterion(areas.com_velocity_area, model, scenario.velocity_margin)
-        com = criterion.limit(scenario.com_velocity)
-        zmp = zmp_max_contact_velocity(
-            areas.zmp_area, model, stance.com, scenario.plane_height, scenario.gravity, cfg.duration
-        )
-        interval = criterion.interval(scenario.com_velocity, com)
-        contact_velocity = None
-        if cfg.reference_velocity is not None:
-            contact_velocity = safe_contact_velocity(cfg.reference_velocity, model.normal, interval)
+        answer = impact_answer(scenario, stance, areas, model)
         qp = None
         if (cfg.qp.solve if solve_qp is None else solve_qp) and cfg.reference_velocity is not None:
             tau0 = static_torques(stance, polytope) if cfg.qp.impulsive_torque_limits else None
@@ -119,10 +107,81 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
                 )
             except SolverError as exc:
                 raise exc.within("impact.qp") from None
-        answer = ImpactAnswer(model, com, zmp, contact_velocity, qp, interval)
+        answer = dataclasses.replace(answer, qp=qp)
         timings["impact"] = time.perf_counter() - t3
     timings["total"] = time.perf_counter() - t0
     return Analysis(scenario, stance, areas, answer, timings, diagnose(scenario, stance, answer))
+
+
+def stance_areas(scenario: Scenario, stance: Stance) -> tuple[WrenchPolytope, BalanceAreas]:
+    """The scenario's contact wrench polytope and balance areas at a stance.
+
+    The one composition of the first half of the pipeline (stance -> constraints -> areas),
+    with the scenario's torque limits, gravity, ZMP plane and ZMP margin; :func:`analyze` and
+    the sweep evaluator both use it.
+
+    Args:
+        scenario: Its ``torque_limits``, ``gravity``, ``plane_height`` (m) and ``zmp_margin``
+            (m) are used.
+        stance: The robot at a configuration with its contacts (world frame).
+
+    Returns:
+        The polytope of the stacked contact wrenches and the ZMP support and CoM velocity areas.
+
+    Raises:
+        SolverError: The projection failed (named as the projection of the contacts' polytope).
+    """
+    polytope, areas, _ = _stance_areas(scenario, stance)
+    return polytope, areas
+
+
+def _stance_areas(scenario: Scenario, stance: Stance) -> tuple[WrenchPolytope, BalanceAreas, float]:
+    """:func:`stance_areas`, and the time (``time.perf_counter``) between its two steps."""
+    polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
+    t = time.perf_counter()
+    try:
+        areas = areas_from_polytope(polytope, scenario.plane_height, scenario.zmp_margin)
+    except SolverError as exc:
+        raise exc.within("contacts (projection of the contact wrench polytope)") from None
+    return polytope, areas, t
+
+
+def impact_answer(
+    scenario: Scenario, stance: Stance, areas: BalanceAreas, model: ImpactModel
+) -> ImpactAnswer:
+    """What the criteria answer for an impact: the second half of the pipeline, composed once.
+
+    The CoM velocity criterion with the scenario's ``velocity_margin`` (m/s), its safe interval
+    of approach speeds, the ZMP criterion (impulse duration ``impact.duration``), and the
+    reference velocity brought into the safe interval. :func:`analyze` and the sweep evaluator
+    both use it; the paper's QP is :func:`analyze`'s alone.
+
+    Args:
+        scenario: The scenario (its ``impact`` must be set); ``com_velocity`` (m/s, world xy),
+            ``plane_height`` (m) and ``gravity`` (m/s^2) are used.
+        stance: The stance the areas were computed at.
+        areas: Its ZMP support area and CoM velocity area.
+        model: The impact model at that stance.
+
+    Returns:
+        The answer, without the QP (``qp`` is None).
+
+    Raises:
+        ScenarioError: The scenario has no impact.
+    """
+    cfg = scenario.impact
+    if cfg is None:
+        raise ScenarioError("impact", None, "the scenario has no impact to answer for")
+    criterion = ComCriterion(areas.com_velocity_area, model, scenario.velocity_margin)
+    com = criterion.limit(scenario.com_velocity)
+    zmp = zmp_max_contact_velocity(
+        areas.zmp_area, model, stance.com, scenario.plane_height, scenario.gravity, cfg.duration
+    )
+    interval = criterion.interval(scenario.com_velocity, com)
+    contact_velocity = None
+    if cfg.reference_velocity is not None:
+        contact_velocity = safe_contact_velocity(cfg.reference_velocity, model.normal, interval)
+    return ImpactAnswer(model, com, zmp, contact_velocity, None, interval)
 
 
 def _area_checks(stance: Stance, areas: BalanceAreas) -> list[tuple[str, Any, tuple[str, ...]]]:

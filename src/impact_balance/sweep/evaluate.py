@@ -24,11 +24,9 @@ import numpy.typing as npt
 import pinocchio as pin
 import pyarrow as pa
 
-from impact_balance.balance.areas import BalanceAreas, areas_from_polytope
+from impact_balance.analysis.analyze import impact_answer, stance_areas
+from impact_balance.balance.areas import BalanceAreas
 from impact_balance.contacts.stance import Stance
-from impact_balance.contacts.wrench_polytope import wrench_polytope
-from impact_balance.criteria.com import max_contact_velocity
-from impact_balance.criteria.zmp import zmp_max_contact_velocity
 from impact_balance.exceptions import ImpactBalanceError, ScenarioError
 from impact_balance.impact.model import impact_model
 from impact_balance.robot.ik import IKError, IKOptions, solve_stance
@@ -224,10 +222,8 @@ class Evaluator:
             model = impact_model(stance, cfg.spec())
         except ImpactBalanceError as exc:
             return {**out, "status": "invalid", "message": str(exc)}
-        com = max_contact_velocity(areas.com_velocity_area, model, scenario.com_velocity)
-        zmp = zmp_max_contact_velocity(
-            areas.zmp_area, model, stance.com, scenario.plane_height, scenario.gravity, cfg.duration
-        )
+        answer = impact_answer(scenario, stance, areas, model)
+        com, zmp = answer.com, answer.zmp
         verdict = ready.verdicts.get(scenario.com_velocity)
         if verdict is None:
             verdict = ready.verdicts[scenario.com_velocity] = _verdict(areas, scenario.com_velocity)
@@ -269,8 +265,7 @@ class Evaluator:
             stance = scenario.build_stance(self._robot(scenario))
             if self._posture is not None:
                 stance, residual = self._place(self._posture, stance, values, warm)
-            polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
-            areas = areas_from_polytope(polytope, scenario.plane_height, scenario.zmp_margin)
+            _, areas = stance_areas(scenario, stance)
         except IKError as exc:
             return _StanceEntry(None, "unreachable", str(exc), _worst(exc.residuals))
         except ScenarioError as exc:
