@@ -6,6 +6,10 @@ import json
 import math
 
 import numpy as np
+import pytest
+
+pytest.importorskip("pandas", reason="needs the logs extra (pandas)")
+
 import pandas as pd
 
 from impact_balance.logs.check import Violation, json_records

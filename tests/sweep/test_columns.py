@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import pytest
+
+pytest.importorskip("pyarrow", reason="needs the sweep extra (pyarrow)")
+
 import pyarrow as pa
 
 from impact_balance.sweep.columns import EVALUATED, RESULT_COLUMNS, STATUSES, VERDICTS

@@ -8,6 +8,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+pytest.importorskip("pyarrow", reason="needs the sweep extra (pyarrow)")
+
 from impact_balance.sweep.paths import format_path, get_path, parse_path, set_path
 
 BASE = {

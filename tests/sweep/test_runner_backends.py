@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import pytest
 
+pytest.importorskip("pyarrow", reason="needs the sweep extra (pyarrow)")
+
 from impact_balance.sweep import make_plan, read_results, run_sweep, sweep_spec_from_dict
 
 

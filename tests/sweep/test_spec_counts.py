@@ -8,6 +8,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+pytest.importorskip("pyarrow", reason="needs the sweep extra (pyarrow)")
+
 from impact_balance.sweep.spec import (
     QMC_METHODS,
     SAMPLING_METHODS,
