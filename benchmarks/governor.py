@@ -2,6 +2,7 @@
 """Issue 15 targets: the governor's time per control tick, beside a full ``analyze()`` per tick.
 
     python benchmarks/governor.py [--json] [--ticks N] [--scenarios NAME ...] [--criterion com|zmp]
+    python benchmarks/governor.py --baseline DIR [--blocks B] ...  # ratios to another tree
     python benchmarks/governor.py --study [--out DIR] ...  # wall study: governor_study.py
     python benchmarks/governor.py --tolerance ...          # tolerance: governor_tolerance.py
 
@@ -20,8 +21,15 @@ frame). Timed per tick, round-robin in one run (the garbage collector paused):
 Every tick's governor answer is checked against ``analyze()`` (maximum within 1e-9 m/s). The
 load average is printed beside the times: the machine is shared, absolute times move with it.
 
+With ``--baseline DIR`` (another checkout or installed tree of the project), the current code
+and DIR's are timed in the same run, each in its own worker process, in B alternating blocks of
+N/B ticks per scenario (``benchmarks/speed/interleave.py``), and every quantity is reported as
+the ratio current / baseline (median of the per-block ratios, with an interval over blocks)
+beside both sides' absolute times and the load average.
+
 Targets (informative; issue 15): posture-changing ticks median <= 250 us and p99 <= 1 ms;
-velocity-only ticks median <= 20 us. Exit status 1 if an answer disagrees, else 0.
+velocity-only ticks median <= 20 us. Exit status 1 if an answer disagrees, 2 for a bad
+``--baseline`` or ``--blocks``, 1 if a worker fails, else 0.
 """
 
 from __future__ import annotations
@@ -34,116 +42,91 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pinocchio as pin
 
 # Run as a file, only the script's folder is on sys.path: put the repository root first,
 # for the ``benchmarks`` package.
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import impact_balance as ib
+from benchmarks.speed.interleave import (
+    BaselineError,
+    WorkerError,
+    compare,
+    current_tree,
+    resolve_tree,
+    run_interleaved,
+)
 from benchmarks.speed.machine import machine_info
-from benchmarks.speed.timing import Case, measure, progress
-from impact_balance.governor import Governor
+from benchmarks.speed.ticks import RATE, TickBench, trajectory
+from benchmarks.speed.timing import progress
 
 #: The wall study's scenarios (issue 15, item 3).
 SCENARIOS = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot", "g1_two_feet")
-RATE = 500.0  # Hz
-AMPLITUDE = 0.05  # rad
-FREQUENCY = 0.5  # Hz
 TARGETS = {"posture_median": 250.0, "posture_p99": 1000.0, "velocity_median": 20.0}
+CASES = ("posture", "velocity", "analyze")
 
-
-def trajectory(governor: Governor, ticks: int) -> tuple[np.ndarray, np.ndarray]:
-    """``(q (ticks, nq), v (ticks, nv))`` of the moving posture described in the docstring."""
-    robot, q0 = governor.robot, governor.configuration
-    model = robot.model
-    t = np.arange(ticks) / RATE
-    qs = np.tile(q0, (ticks, 1))
-    vs = np.zeros((ticks, model.nv))
-    rng = np.random.default_rng(0)
-    for name in robot.joint_names:
-        slot = robot.joint_slot(name)
-        if slot.nq != 1:
-            continue
-        phase = rng.uniform(0.0, 2.0 * np.pi)
-        w = 2.0 * np.pi * FREQUENCY
-        raw = q0[slot.idx_q] + AMPLITUDE * (np.sin(w * t + phase) - np.sin(phase))
-        lo, hi = slot.lower, slot.upper
-        qs[:, slot.idx_q] = np.clip(raw, lo + 1e-6, hi - 1e-6) if lo < hi else raw
-        dq = AMPLITUDE * w * np.cos(w * t + phase)
-        vs[:, model.joints[slot.id].idx_v] = np.where(qs[:, slot.idx_q] == raw, dq, 0.0)
-    forward = 0.1 * np.sin(np.pi * t / t[-1] if ticks > 1 else t)  # m/s, world x
-    qs[:, 0] += np.concatenate([[0.0], np.cumsum(forward[:-1]) / RATE])
-    rotation = pin.Quaternion(q0[3:7]).normalized().matrix()
-    vs[:, :3] = (rotation.T @ np.vstack([forward, np.zeros((2, ticks))])).T  # base frame
-    return qs, vs
+__all__ = ["SCENARIOS", "bench_baseline", "bench_scenario", "main", "trajectory"]
 
 
 def bench_scenario(name: str, ticks: int, criterion: str) -> dict[str, Any]:
-    governor = Governor(name, criterion=criterion)
-    qs, vs = trajectory(governor, ticks)
-    # The equivalent scenarios, built before timing (analyze() is timed, not pydantic).
-    answers = [governor.limit(q, v) for q, v in zip(qs, vs, strict=True)]
-    scenarios = [governor.scenario_at(q, a.com_velocity) for q, a in zip(qs, answers, strict=True)]
-    k = {"i": 0}
-
-    def at(i: int) -> None:
-        k["i"] = i % ticks
-
-    q_fixed = qs[0]
-    # A second governor for the velocity-only ticks: the first one's posture changes every tick.
-    steady = Governor(name, criterion=criterion)
-    steady.limit(q_fixed, vs[0])
-    cases = {
-        "posture": Case(
-            lambda: governor.limit(qs[k["i"]], vs[k["i"]]),
-            setup=at,
-            keep=lambda r: (r.max_contact_velocity, r.posture_reused),
-        ),
-        "velocity": Case(
-            lambda: steady.limit(q_fixed, vs[k["i"]]), setup=at, keep=lambda r: r.posture_reused
-        ),
-        "analyze": Case(
-            lambda: ib.analyze(scenarios[k["i"]]),
-            setup=at,
-            keep=lambda a: (
-                a.impact.max_contact_velocity
-                if criterion == "com"
-                else a.impact.zmp_max_contact_velocity
-            ),
-        ),
-    }
+    bench = TickBench(name, ticks, criterion)
     load_before = _loadavg()
-    times, results = measure(cases, ticks, warmup=3)
+    out = bench.run(0, ticks)
     load_after = _loadavg()
-    got = np.array([r[0] for r in results["posture"]])
-    want = np.array(results["analyze"])
-    finite = np.isfinite(want)
-    worst = float(np.max(np.abs(got[finite] - want[finite]), initial=0.0))
-    agree = bool(np.array_equal(np.isfinite(got), finite) and worst <= 1e-9)
-    reused_posture = sum(r[1] for r in results["posture"])
-    reused_velocity = sum(results["velocity"])
-    out: dict[str, Any] = {
+    times = out.pop("times")
+    result: dict[str, Any] = {
         "scenario": name,
         "criterion": criterion,
         "ticks": ticks,
         "loadavg_before": load_before,
         "loadavg_after": load_after,
-        "agree": agree,
-        "worst_difference": worst,
-        "posture_reused": int(reused_posture),
-        "velocity_reused": int(reused_velocity),
+        **out,
     }
     for case, samples in times.items():
         a = np.asarray(samples)
-        out[case] = {
+        result[case] = {
             "median": float(np.median(a)),
             "p99": float(np.percentile(a, 99)),
             "p90": float(np.percentile(a, 90)),
             "min": float(a.min()),
         }
-    out["ratio_analyze_over_posture"] = out["analyze"]["median"] / out["posture"]["median"]
-    return out
+    result["ratio_analyze_over_posture"] = result["analyze"]["median"] / result["posture"]["median"]
+    return result
+
+
+def bench_baseline(
+    baseline: str, names: list[str], ticks: int, criterion: str, blocks: int
+) -> dict[str, Any]:
+    """The current code and the ``baseline`` tree, interleaved in ``blocks`` blocks of ticks."""
+    trees = {"current": current_tree(), "baseline": resolve_tree(baseline)}
+    if not 1 <= blocks <= ticks:
+        raise BaselineError("--blocks", blocks, f"must be an integer in [1, --ticks = {ticks}]")
+    params = {"scenarios": names, "ticks": ticks, "criterion": criterion}
+    run = run_interleaved("benchmarks.speed.ticks:governor_job", params, trees, blocks, progress)
+    ratios = compare(run)
+    rows = []
+    for name in names:
+        checks = {side: [b["checks"][name] for b in run.blocks[side]] for side in trees}
+        rows.append(
+            {
+                "scenario": name,
+                "agree": {side: all(c["agree"] for c in checks[side]) for side in trees},
+                "worst_difference": {
+                    side: max(c["worst_difference"] for c in checks[side]) for side in trees
+                },
+                **{case: ratios[f"{name}/{case}"] for case in CASES},
+            }
+        )
+    loads = [row[0] for row in run.load_average]
+    return {
+        "trees": run.trees,
+        "blocks": blocks,
+        "ticks_per_block": ticks // blocks,
+        "order": run.order,
+        "load_average_per_block": run.load_average,
+        "load_average_1min_range": [min(loads), max(loads)],
+        "scenarios": rows,
+        "interleaved_wall_time_s": run.wall_time_s,
+    }
 
 
 def _loadavg() -> str:
@@ -181,6 +164,46 @@ def text_report(result: dict[str, Any]) -> str:
     for line in result["targets"]:
         lines.append("  " + line)
     lines.append(f"\n(wall time {result['wall_time_s']:.0f} s)")
+    return "\n".join(lines)
+
+
+def _ratio(r: dict[str, Any]) -> str:
+    return f"{r['median']:.2f} [{r['low']:.2f}-{r['high']:.2f}]"
+
+
+def baseline_report(result: dict[str, Any]) -> str:
+    """The side-by-side table of ``--baseline``."""
+    b = result["baseline"]
+    coverage = min(
+        row[case]["ratio"]["median"]["coverage"] for row in b["scenarios"] for case in CASES
+    )
+    lines = [
+        f"Side by side, interleaved: current {b['trees']['current']} / baseline "
+        f"{b['trees']['baseline']}",
+        f"{b['blocks']} blocks of {b['ticks_per_block']} ticks per scenario and side, "
+        f"alternating; load average (1 min) {b['load_average_1min_range'][0]:.2f} to "
+        f"{b['load_average_1min_range'][1]:.2f} over the blocks",
+        "times in us per tick over all blocks (median / p99); ratio = current / baseline, "
+        f"median of the per-block ratios [interval over blocks, coverage >= {coverage:.0%}]",
+        "",
+    ]
+    head = (
+        f"{'scenario':20s}  {'case':8s}  {'current':>7s}  {'p99':>6s}  {'baseline':>8s}  "
+        f"{'p99':>6s}  {'ratio median':>18s}  {'ratio p99':>18s}  {'check':>5s}"
+    )
+    lines += [head, "-" * len(head)]
+    for row in b["scenarios"]:
+        ok = "ok" if all(row["agree"].values()) else "FAIL"
+        for case in CASES:
+            q = row[case]
+            lines.append(
+                f"{row['scenario'] if case == CASES[0] else '':20s}  {case:8s}  "
+                f"{q['current']['median']:7.1f}  {q['current']['p99']:6.0f}  "
+                f"{q['baseline']['median']:8.1f}  {q['baseline']['p99']:6.0f}  "
+                f"{_ratio(q['ratio']['median']):>18s}  {_ratio(q['ratio']['p99']):>18s}  "
+                f"{ok if case == CASES[0] else '':>5s}"
+            )
+    lines.append(f"\n(interleaved wall time {b['interleaved_wall_time_s']:.0f} s)")
     return "\n".join(lines)
 
 
@@ -226,7 +249,21 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument(
         "--criterion", choices=("com", "zmp"), default="com", help="the governor's criterion"
     )
+    ap.add_argument(
+        "--baseline",
+        metavar="DIR",
+        help="also time DIR (a checkout or installed tree of the project) interleaved with the "
+        "current code, and report ratios current / baseline",
+    )
+    ap.add_argument(
+        "--blocks",
+        type=int,
+        default=10,
+        help="with --baseline: alternating blocks per side (default 10; --ticks split among them)",
+    )
     args = ap.parse_args(argv)
+    if args.baseline is not None:
+        return _main_baseline(args)
     t0 = time.perf_counter()
     rows = []
     for name in args.scenarios:
@@ -248,6 +285,41 @@ def main(argv: list[str] | None = None) -> int:
     else:
         print(text_report(result))
     return 0 if all(r["agree"] for r in rows) else 1
+
+
+def _main_baseline(args: argparse.Namespace) -> int:
+    """``--baseline``: the interleaved run only (both sides in worker processes)."""
+    t0 = time.perf_counter()
+    ticks = max(2, args.ticks)
+    try:
+        side_by_side = bench_baseline(
+            args.baseline, list(args.scenarios), ticks, args.criterion, args.blocks
+        )
+    except BaselineError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except WorkerError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("error: interrupted", file=sys.stderr)
+        return 130
+    result = {
+        "benchmark": "impact_balance benchmarks/governor.py --baseline",
+        "machine": machine_info(),
+        "ticks": ticks,
+        "criterion": args.criterion,
+        "rate_hz": RATE,
+        "unit": "us",
+        "baseline": side_by_side,
+        "wall_time_s": time.perf_counter() - t0,
+    }
+    if args.json:
+        print(json.dumps(result, allow_nan=False))
+    else:
+        print(baseline_report(result))
+    agree = all(all(r["agree"].values()) for r in side_by_side["scenarios"])
+    return 0 if agree else 1
 
 
 if __name__ == "__main__":

@@ -9,10 +9,10 @@ from typing import Any
 import numpy as np
 
 import impact_balance as ib
+from benchmarks.speed.compat import wrench_polytope
 from benchmarks.speed.timing import Case, measure, stats
-from impact_balance.contacts.wrench_polytope import wrench_polytope
 
-__all__ = ["PIPELINE_STAGES", "bench_max_velocity", "bench_pipeline"]
+__all__ = ["PIPELINE_STAGES", "bench_max_velocity", "bench_pipeline", "pipeline_cases"]
 
 PIPELINE_STAGES = (
     "stance",
@@ -24,7 +24,8 @@ PIPELINE_STAGES = (
 )
 
 
-def bench_pipeline(sc: ib.Scenario, args) -> dict[str, Any]:
+def pipeline_cases(sc: ib.Scenario) -> tuple[dict[str, Case], Any, Any, Any]:
+    """The stages and ``analyze`` of ``sc`` as timed cases, with ``(stance, areas, model)``."""
     sc.build_stance()  # loads (and caches) the robot model: not part of the timings
     stance = sc.build_stance()
     poly = wrench_polytope(stance, sc.torque_limits, sc.gravity)
@@ -48,6 +49,11 @@ def bench_pipeline(sc: ib.Scenario, args) -> dict[str, Any]:
             )
         )
     cases["analyze"] = Case(lambda: ib.analyze(sc))
+    return cases, stance, areas, model
+
+
+def bench_pipeline(sc: ib.Scenario, args) -> dict[str, Any]:
+    cases, _stance, areas, model = pipeline_cases(sc)
     times, _ = measure(cases, args.repeat, args.warmup)
     out: dict[str, Any] = {k: stats(v) for k, v in times.items()}
     out["sum_of_stages"] = {

@@ -10,9 +10,9 @@ from typing import Any
 import numpy as np
 
 import impact_balance as ib
+from benchmarks.speed.compat import force_box_and_tolerance
 from benchmarks.speed.polygons import compare
 from benchmarks.speed.timing import Case, measure, stats
-from impact_balance.balance.areas import FORCE_BOX, FORCE_TOLERANCE
 from impact_balance.projection import project_polytope
 
 try:  # pypoman is a test extra of the project
@@ -21,6 +21,8 @@ except ImportError:  # pragma: no cover
     pypoman = None
 
 __all__ = ["bench_projection", "check_projection", "projection_cases", "pypoman"]
+
+FORCE_BOX, FORCE_TOLERANCE = force_box_and_tolerance()
 
 
 def projection_cases(poly: ib.WrenchPolytope, scale: float, seed: int) -> dict[str, Case]:

@@ -6,7 +6,7 @@ from typing import Any
 
 from benchmarks.speed.pipeline import PIPELINE_STAGES
 
-__all__ = ["fmt_us", "table", "text_report"]
+__all__ = ["baseline_text", "fmt_us", "table", "text_report"]
 
 
 def fmt_us(s: dict[str, float] | None, spread: bool = True) -> str:
@@ -228,3 +228,39 @@ def text_report(result: dict[str, Any], args) -> str:
         for f in c["failures"]:
             out.append(f"  {f}")
     return "\n".join(out)
+
+
+def baseline_text(side: dict[str, Any]) -> str:
+    """Part 5 (``--baseline``): current and baseline interleaved, ratios current / baseline."""
+    rows = []
+    for name, entry in side["stances"].items():
+        for i, (case, q) in enumerate(entry["cases"].items()):
+            r = q["ratio"]["median"]
+            rows.append(
+                [
+                    name if i == 0 else "",
+                    case,
+                    fmt_us(q["current"], spread=False),
+                    fmt_us(q["baseline"], spread=False),
+                    f"{r['median']:.2f} [{r['low']:.2f}-{r['high']:.2f}]",
+                    ("yes" if entry["same_answer"] else "NO") if i == 0 else "",
+                ]
+            )
+    coverage = min(
+        (
+            q["ratio"]["median"]["coverage"]
+            for e in side["stances"].values()
+            for q in e["cases"].values()
+        ),
+        default=0.0,
+    )
+    low, high = side["load_average_1min_range"]
+    head = (
+        f"5. Side by side, interleaved: current {side['trees']['current']} / baseline "
+        f"{side['trees']['baseline']}\n"
+        f"{side['blocks']} alternating blocks per side; load average (1 min) {low:.2f} to "
+        f"{high:.2f} over the blocks; median us over all blocks; ratio = current / baseline, "
+        f"median of the per-block ratios [interval over blocks, coverage >= {coverage:.0%}]"
+    )
+    headers = ["stance", "case", "current us", "baseline us", "ratio [interval]", "same answer"]
+    return head + "\n" + table(headers, rows)

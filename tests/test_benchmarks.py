@@ -1,0 +1,81 @@
+"""The interleaved side-by-side driver of the benchmarks (``--baseline``), with a stand-in for
+both sides: fake ``impact_balance`` trees whose one call waits a known time."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from benchmarks.speed.interleave import (
+    BaselineError,
+    WorkerError,
+    compare,
+    median_interval,
+    resolve_tree,
+    run_interleaved,
+)
+
+JOB = "tests.helpers.bench_standin:sleep_job"
+
+
+def fake_tree(root: Path, delay: float, fail: bool = False, layout: str = "checkout") -> Path:
+    package = (root / "src" if layout == "checkout" else root) / "impact_balance"
+    package.mkdir(parents=True)
+    (package / "__init__.py").write_text(f"DELAY = {delay!r}\nFAIL = {fail!r}\n")
+    return root
+
+
+def test_a_side_twice_as_slow_gives_a_ratio_of_two(tmp_path: Path) -> None:
+    slow = resolve_tree(fake_tree(tmp_path / "slow", 0.002))
+    fast = resolve_tree(fake_tree(tmp_path / "fast", 0.001, layout="installed"))
+    run = run_interleaved(JOB, {"calls": 10}, {"current": slow, "baseline": fast}, blocks=6)
+    assert run.info["current"]["info"]["delay"] == 0.002  # each side imported its own tree
+    assert run.info["baseline"]["info"]["delay"] == 0.001
+    assert run.info["current"]["impact_balance"].startswith(str(slow))
+    assert [b["k"] for b in run.blocks["baseline"]] == list(range(6))
+    assert run.order[0] == ["current", "baseline"] and run.order[1] == ["baseline", "current"]
+    result = compare(run)["sleep"]
+    ratio = result["ratio"]["median"]
+    assert 1.8 < ratio["median"] < 2.2
+    assert ratio["low"] <= ratio["median"] <= ratio["high"]
+    assert ratio["blocks"] == 6 and ratio["coverage"] >= 0.95
+    assert result["current"]["n"] == result["baseline"]["n"] == 60
+    assert result["current"]["median"] >= 2000.0 and result["baseline"]["median"] >= 1000.0
+
+
+def test_a_failing_side_is_named(tmp_path: Path) -> None:
+    good = resolve_tree(fake_tree(tmp_path / "good", 0.0))
+    bad = resolve_tree(fake_tree(tmp_path / "bad", 0.0, fail=True))
+    with pytest.raises(WorkerError, match=r"baseline worker .*bad.*told to fail"):
+        run_interleaved(JOB, {"calls": 1}, {"current": good, "baseline": bad}, blocks=2)
+
+
+def test_bad_baseline_and_blocks_are_refused(tmp_path: Path) -> None:
+    with pytest.raises(BaselineError, match=r"--baseline .*missing: is not a folder"):
+        resolve_tree(tmp_path / "missing")
+    with pytest.raises(BaselineError, match=r"--baseline .*: holds neither"):
+        resolve_tree(tmp_path)
+    tree = resolve_tree(fake_tree(tmp_path / "t", 0.0))
+    with pytest.raises(BaselineError, match=r"--blocks 0: must be"):
+        run_interleaved(JOB, {"calls": 1}, {"current": tree, "baseline": tree}, blocks=0)
+
+
+@given(st.lists(st.floats(0.01, 100.0), min_size=1, max_size=40))
+def test_median_interval_holds_the_median(values: list[float]) -> None:
+    low, high, coverage = median_interval(values)
+    values.sort()
+    n = len(values)
+    median = (values[(n - 1) // 2] + values[n // 2]) / 2
+    assert low <= median <= high
+    assert low in values and high in values
+    expected = 1 - 2 ** (1 - n) if n < 6 else 0.95
+    assert coverage >= expected - 1e-12
+    if n >= 6:  # the narrowest such interval: one order statistic further in falls short
+        k = values.index(low) + 1 if values.count(low) == 1 else None
+        if k is not None and k + 1 <= n - k:
+            below = sum(math.comb(n, j) for j in range(k + 1)) / 2**n
+            assert 1 - 2 * below < 0.95
