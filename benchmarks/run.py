@@ -161,6 +161,9 @@ def main(argv: list[str] | None = None) -> int:
         except WorkerError as exc:
             print(f"error: {exc}", file=sys.stderr)
             return 1
+        except KeyboardInterrupt:
+            print("error: interrupted", file=sys.stderr)
+            return 130
     result["checks"] = answer_checks(result, args.tol)
     result["targets"] = evaluate_targets(result)
     if args.profile:

@@ -11,4 +11,7 @@
 - :mod:`.checks`: the answer checks (they set the exit status).
 - :mod:`.targets`: the performance targets (informative).
 - :mod:`.report`: the text tables.
+- :mod:`.interleave`, :mod:`.worker`: ``--baseline``, two trees timed in one run, interleaved.
+- :mod:`.stage_job`, :mod:`.ticks`: what one side times (``run.py``, ``governor.py``).
+- :mod:`.compat`: the differences between the project's versions (feature detection).
 """
