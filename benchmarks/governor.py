@@ -168,6 +168,8 @@ def text_report(result: dict[str, Any]) -> str:
 
 
 def _ratio(r: dict[str, Any]) -> str:
+    if r["median"] is None:
+        return "-"
     return f"{r['median']:.2f} [{r['low']:.2f}-{r['high']:.2f}]"
 
 

@@ -249,10 +249,10 @@ def compare(run: InterleavedRun, subject: str = "current", reference: str = "bas
             ]
             ratios = [r for r in ratios if math.isfinite(r)]
             low, high, coverage = median_interval(ratios)
-            entry["ratio"][stat] = {
-                "median": float(np.median(ratios)) if ratios else math.nan,
-                "low": low,
-                "high": high,
+            entry["ratio"][stat] = {  # None, not NaN, without a finite ratio (strict JSON)
+                "median": float(np.median(ratios)) if ratios else None,
+                "low": low if ratios else None,
+                "high": high if ratios else None,
                 "coverage": coverage,
                 "blocks": len(ratios),
             }

@@ -242,7 +242,9 @@ def baseline_text(side: dict[str, Any]) -> str:
                     case,
                     fmt_us(q["current"], spread=False),
                     fmt_us(q["baseline"], spread=False),
-                    f"{r['median']:.2f} [{r['low']:.2f}-{r['high']:.2f}]",
+                    "-"
+                    if r["median"] is None
+                    else f"{r['median']:.2f} [{r['low']:.2f}-{r['high']:.2f}]",
                     ("yes" if entry["same_answer"] else "NO") if i == 0 else "",
                 ]
             )
