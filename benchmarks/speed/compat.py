@@ -14,7 +14,7 @@ def force_box_and_tolerance() -> tuple[float, float]:
     try:
         from impact_balance.balance.areas import FORCE_BOX, FORCE_TOLERANCE
     except ImportError:  # before the reorganisation: impact_balance.areas
-        from impact_balance.areas import (  # type: ignore[import-not-found,no-redef]
+        from impact_balance.areas import (  # type: ignore[no-redef]
             FORCE_BOX,
             FORCE_TOLERANCE,
         )

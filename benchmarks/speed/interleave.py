@@ -228,7 +228,9 @@ def _stat(samples: list[float], stat: str) -> float:
     return float(np.median(a) if stat == "median" else np.percentile(a, 99))
 
 
-def compare(run: InterleavedRun, subject: str = "current", reference: str = "baseline") -> dict:
+def compare(
+    run: InterleavedRun, subject: str = "current", reference: str = "baseline"
+) -> dict[str, Any]:
     """Per sample key: both sides' absolute times over all blocks and the per-block ratios.
 
     Returns ``{key: {"current": {"median", "p99", "n"}, "baseline": {...}, "ratio": {stat:

@@ -7,7 +7,7 @@ through :mod:`benchmarks.speed.compat`.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import pinocchio as pin
@@ -19,6 +19,7 @@ from impact_balance.governor import Governor
 
 __all__ = ["AMPLITUDE", "FREQUENCY", "RATE", "TickBench", "governor_job", "trajectory"]
 
+Criterion = Literal["com", "zmp"]
 RATE = 500.0  # Hz
 AMPLITUDE = 0.05  # rad
 FREQUENCY = 0.5  # Hz
@@ -54,7 +55,7 @@ class TickBench:
     """One scenario's ticks: ``posture`` (a new posture every tick), ``velocity`` (the same
     posture, a new velocity) and ``analyze`` (the equivalent scenario), warmed up once."""
 
-    def __init__(self, name: str, ticks: int, criterion: str, warmup: int = 3) -> None:
+    def __init__(self, name: str, ticks: int, criterion: Criterion, warmup: int = 3) -> None:
         self.name, self.ticks, self.criterion = name, ticks, criterion
         governor = Governor(name, criterion=criterion)
         qs, vs = trajectory(governor, ticks)
