@@ -533,7 +533,7 @@ def load_robot(
         return _load_bundled(name)
     urdf = Path(urdf)
     if not _is_file(urdf):
-        raise RobotLoadError(str(urdf), "no such file")
+        read_robot_file(urdf)  # names what it is: missing, not a regular file, unreadable
     srdf_path = Path(srdf) if srdf else None
     # Cached by the files' identity and modification: an edited URDF or SRDF is reloaded.
     key = (

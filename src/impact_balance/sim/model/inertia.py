@@ -235,7 +235,8 @@ def _check_finite(spec: mujoco.MjSpec, robot: Robot) -> None:
     for body in spec.bodies:
         if body.name == "world":
             continue
-        mass, com, inertia = _inertial(body)
+        with np.errstate(all="ignore"):
+            mass, com, inertia = _inertial(body)
         if not (np.isfinite(mass) and np.all(np.isfinite(com)) and np.all(np.isfinite(inertia))):
             raise RobotLoadError(
                 str(robot.urdf_path), f"link {body.name!r}: a mass or inertia is not finite"
