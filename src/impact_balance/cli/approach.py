@@ -237,7 +237,10 @@ def _trials(
         trial = run_wall_trial(setup, wall, options, governor=governor, frames=bool(args.video))
         trials.append(trial)
         if args.plots:
-            written.append(_plot(trial, setup, Path(args.plots), margin))
+            from impact_balance.cli.output_paths import writing
+
+            with writing("--plots", args.plots):
+                written.append(_plot(trial, setup, Path(args.plots), margin))
         if args.video:
             title = f"{setup.scenario.name}: {args.governor} governor"
             written.append(write_wall_video(setup, trial, args.video, title=title))
