@@ -231,7 +231,8 @@ def run(args: argparse.Namespace) -> int:
         if args.video:
             from impact_balance.sim.trials.video import write_video
 
-            written.append(write_video(sim, record, _per_speed(args.video, speed, several)))
+            with writing("--video", args.video):
+                written.append(write_video(sim, record, _per_speed(args.video, speed, several)))
         if args.plots:
             from impact_balance.plots.simulation import plot_jump_on_sets, plot_time_series
             from impact_balance.plots.style import DPI
