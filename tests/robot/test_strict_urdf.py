@@ -199,3 +199,32 @@ def test_any_non_finite_or_absurd_number_in_any_link_is_refused(field, bad, inde
     values[index][field] = "0.5"  # control: a good number there is accepted
     text = "<robot name='r'>" + "".join(LINK.format(**v) for v in values) + joints + "</robot>"
     assert check_urdf(text.encode(), "r.urdf").masses[f"l{index}"] > 0.0
+
+
+TALOS = BUNDLED_ROBOTS["talos"]
+TALOS_SRDF = (example_robot_data_root() / str(TALOS.srdf)).read_text()
+KNEE = r'<group_state name="half_sitting".*?<joint name="leg_left_4_joint" value="([^"]+)"'
+ROTOR = r'<rotor_params>.*?gear_ratio="([^"]+)"'
+
+
+@pytest.mark.parametrize(
+    "pattern, value, needle",
+    [
+        (KNEE, "nan", "group_state 'half_sitting' joint 'leg_left_4_joint'"),
+        (KNEE, "abc", "not a decimal number"),  # pinocchio read it as 0: the knee straight
+        (ROTOR, "-100", "negative"),
+        (ROTOR, "inf", "not a finite number"),
+    ],
+)
+def test_a_corrupted_srdf_value_is_refused(tmp_path, pattern, value, needle):
+    urdf = example_robot_data_root() / TALOS.urdf
+    srdf = write(tmp_path, corrupt(pattern, value, TALOS_SRDF), "talos.srdf")
+    with pytest.raises(RobotLoadError) as caught:
+        load_robot(urdf=urdf, srdf=srdf)
+    assert str(srdf) in str(caught.value) and needle in str(caught.value), str(caught.value)
+    # control: the unmodified copy gives the knee its half-sitting angle
+    good = write(tmp_path, TALOS_SRDF, "good.srdf")
+    knee = load_robot(urdf=urdf, srdf=good).configuration()[
+        load_robot("talos").joint_slot("leg_left_4_joint").idx_q
+    ]
+    assert knee > 0.5

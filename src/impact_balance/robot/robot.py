@@ -29,7 +29,7 @@ from impact_balance.exceptions import (
     UnknownJointError,
     UnknownRobotError,
 )
-from impact_balance.robot.urdf_check import check_urdf, read_robot_file
+from impact_balance.robot.urdf_check import check_srdf, check_urdf, read_robot_file
 
 __all__ = [
     "BUNDLED_ROBOTS",
@@ -464,7 +464,7 @@ def _load(urdf: Path, srdf: Path | None, name: str, standing: str | None) -> Rob
     configurations = {"neutral": pin.neutral(model)}
     armature_source = None
     if srdf is not None:
-        srdf_text = read_robot_file(srdf).decode("utf-8", "replace")
+        srdf_text = check_srdf(read_robot_file(srdf), str(srdf))
         try:
             with _native_stderr(native):
                 pin.loadReferenceConfigurationsFromXML(model, srdf_text, False)

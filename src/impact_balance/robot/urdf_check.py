@@ -22,7 +22,9 @@ Refused:
 - an origin (``xyz``) beyond :data:`MAX_LENGTH` from its parent, or an ``rpy`` not finite;
 - a joint axis that is not finite, or (on a revolute, continuous, prismatic or planar joint)
   shorter than :data:`MIN_AXIS_NORM`;
-- a joint damping or friction that is negative or not finite.
+- a joint damping or friction that is negative or not finite;
+- in an SRDF (:func:`check_srdf`): a ``<group_state>`` joint value or a ``<rotor_params>``
+  number that is not a finite decimal number, a negative rotor parameter.
 
 Accepted as they are, because the model is still well defined and the simulation repairs
 them by the documented rule of :mod:`impact_balance.sim.model.inertia`: a massless link (mass
@@ -56,6 +58,7 @@ __all__ = [
     "TRIANGLE_FACTOR",
     "TRIANGLE_TOLERANCE",
     "CheckedUrdf",
+    "check_srdf",
     "check_urdf",
     "read_robot_file",
 ]
@@ -121,7 +124,7 @@ def read_robot_file(path: Path, max_bytes: int = MAX_ROBOT_FILE_BYTES) -> bytes:
     return b"".join(chunks)
 
 
-def _parse_xml(data: bytes, source: str) -> Element:
+def _parse_xml(data: bytes, source: str, root_tag: str = "robot") -> Element:
     """The XML tree of ``data``; entity declarations refused, nothing external fetched."""
     builder = TreeBuilder()
     parser = expat.ParserCreate()
@@ -140,8 +143,8 @@ def _parse_xml(data: bytes, source: str) -> Element:
             source, f"not valid XML: {expat.ErrorString(exc.code)} at line {exc.lineno}"
         ) from None
     root = builder.close()
-    if root.tag != "robot":
-        raise RobotLoadError(source, f"the root element is <{root.tag}>, not <robot>")
+    if root.tag != root_tag:
+        raise RobotLoadError(source, f"the root element is <{root.tag}>, not <{root_tag}>")
     return root
 
 
@@ -321,3 +324,37 @@ def check_urdf(data: bytes, source: str) -> CheckedUrdf:
     for joint in root.findall("joint"):
         _check_joint(reader, joint)
     return CheckedUrdf(text, masses)
+
+
+def check_srdf(data: bytes, source: str) -> str:
+    """Check an SRDF's bytes; returns them as text.
+
+    pinocchio reads a joint value it cannot parse (``nan``, ``abc``) in a ``<group_state>`` as
+    0, silently; here every ``<group_state>`` joint value and every number of ``<rotor_params>``
+    must be a finite decimal number (rotor parameters not negative).
+
+    Raises:
+        RobotLoadError: Naming ``source``, the group state or joint and the field refused.
+    """
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise RobotLoadError(source, "not UTF-8 text") from None
+    root = _parse_xml(data, source)
+    reader = _Reader(source)
+    for state in root.findall("group_state"):
+        where = f"group_state {state.get('name')!r}"
+        for joint in state.findall("joint"):
+            value = joint.get("value")
+            count = len(value.split()) if value is not None else 0
+            reader.numbers(f"{where} joint {joint.get('name')!r}", "value", value, max(count, 1))
+    for params in root.findall("rotor_params"):
+        for joint in params.findall("joint"):
+            where = f"rotor_params joint {joint.get('name')!r}"
+            for key, value in joint.attrib.items():
+                if key == "name":
+                    continue
+                got = reader.numbers(where, key, value, 1)
+                if got is not None and got[0] < 0.0:
+                    raise reader.fail(where, key, value, "negative")
+    return text
