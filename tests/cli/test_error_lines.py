@@ -34,10 +34,9 @@ from impact_balance.exit_status import describe_error
 from impact_balance.ranges import MAX_SWEEP_POINTS
 from impact_balance.scenario import scenario_from_dict
 from impact_balance.scenario.reader import MAX_LOG_ROWS, parse_yaml
-from tests.helpers.cli import run_cli, run_process
+from tests.helpers.cli import SRC, run_cli, run_process
 from tests.helpers.extras import needs_extra
 
-SRC = str(Path(__file__).parents[1] / "src")
 UNWRITABLE = "/proc/forbidden"  # no folder can be made there, even by root
 
 
@@ -520,3 +519,189 @@ def test_robot_axis_of_robots_without_the_base_frames_is_refused():
         and "/etc/passwd" in str(info.value)
         and "root:" not in str(info.value)
     )
+
+
+# -- writing fails after the check: the option and the file are named, exit 1 ---------------------
+def full_link(folder: Path, name: str) -> Path:
+    """``folder/name``, a link to /dev/full: every write there fails with ENOSPC."""
+    if not Path("/dev/full").exists():
+        pytest.skip("no /dev/full on this system")
+    folder.mkdir(parents=True, exist_ok=True)
+    link = folder / name
+    link.symlink_to("/dev/full")
+    return link
+
+
+def test_a_full_disk_under_plots_names_the_option_and_the_figure(tmp_path, capsys):
+    figure = full_link(tmp_path / "figs", "palm_push_two_feet_areas.png")
+    rc, out, err = run_cli(capsys, "analyze", "palm_push_two_feet", "--plots", str(figure.parent))
+    line = error_line(err)
+    assert rc == 1 and out == ""
+    assert f"--plots = '{figure.parent}'" in line and str(figure) in line, line
+    assert "No space left on device" in line
+
+
+def test_a_full_disk_under_plot_names_the_option(tmp_path, capsys):
+    figure = full_link(tmp_path, "p.png")
+    rc, _, err = run_cli(
+        capsys, "phase-portrait", "--com-height", "0.8", "--zmp-range", "-0.1", "0.1",
+        "--plot", str(figure),
+    )  # fmt: skip
+    line = error_line(err)
+    assert rc == 1 and f"--plot = '{figure}'" in line and "No space left on device" in line
+
+
+@needs_extra("sim", "logs")
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_a_full_disk_under_log_names_the_option(tmp_path, capsys, suffix):
+    log = full_link(tmp_path, f"log{suffix}")
+    rc, _, err = run_cli(
+        capsys, "simulate", "palm_push_two_feet", "--speed", "0.3", "--log", str(log)
+    )
+    line = error_line(err)
+    assert rc == 1 and f"--log = '{log}'" in line and "No space left on device" in line
+
+
+def test_writing_keeps_a_broken_pipe_and_names_other_failures():
+    from impact_balance.cli.output_paths import writing
+    from impact_balance.exceptions import OutputError
+
+    with pytest.raises(BrokenPipeError), writing("--log", "x.csv"):
+        raise BrokenPipeError(errno.EPIPE, "Broken pipe")
+    with pytest.raises(OutputError) as caught, writing("--plots", "d"):
+        raise OSError(errno.EROFS, "Read-only file system", "d/a.png")
+    assert str(caught.value) == "--plots = 'd': cannot write d/a.png: Read-only file system"
+    assert caught.value.exit_status == 1
+
+
+# -- pose --out: checked before the IK ------------------------------------------------------------
+@pytest.fixture
+def no_scenario_load(monkeypatch):
+    """Record any scenario load (the IK starts with one); yields the list of calls."""
+    import impact_balance.scenario as scenario
+
+    calls: list[object] = []
+    monkeypatch.setattr(scenario, "load_scenario", lambda *a, **k: calls.append(a))
+    return calls
+
+
+@pytest.mark.parametrize("out", ["/proc/posed.yaml", "/sys/posed.yaml", "/proc/self/posed.yaml"])
+def test_pose_into_a_virtual_file_system_is_exit_1_before_the_ik(capsys, no_scenario_load, out):
+    if not Path(out).parent.is_dir():
+        pytest.skip(f"no {Path(out).parent} here")
+    try:
+        os.rmdir(__import__("tempfile").mkdtemp(dir=Path(out).parent))
+        pytest.skip(f"{Path(out).parent} is writable here")
+    except OSError:
+        pass
+    rc, stdout, err = run_cli(capsys, "pose", "palm_push_two_feet", "--com", "0", "0", "--out", out)
+    line = error_line(err)
+    assert rc == 1 and stdout == "" and f"--out = '{out}'" in line, line
+    assert no_scenario_load == []
+
+
+def test_pose_that_cannot_write_its_file_is_exit_1_naming_out(tmp_path, capsys, monkeypatch):
+    import impact_balance.gui.workspace as workspace
+
+    real = os.fdopen
+
+    class Full(io.StringIO):
+        def write(self, text):
+            raise OSError(errno.ENOSPC, "No space left on device")
+
+    def fdopen(fd, mode="r", *args, **kwargs):
+        if "w" in mode:
+            os.close(fd)
+            return Full()
+        return real(fd, mode, *args, **kwargs)
+
+    monkeypatch.setattr(workspace.os, "fdopen", fdopen)
+    out = tmp_path / "posed.yaml"
+    rc, _, err = run_cli(capsys, "pose", "palm_push_two_feet", "--com", "0", "0", "--out", str(out))
+    line = error_line(err)
+    assert rc == 1 and "--out" in line and "No space left on device" in line, line
+    assert not out.exists()
+
+
+# -- failures of the machine raised as something else ---------------------------------------------
+def test_a_governor_error_or_a_foreign_broken_pipe_is_one_line_exit_1(capsys, monkeypatch):
+    from impact_balance.cli import listing
+    from impact_balance.exceptions import GovernorError
+
+    def dead_worker(args):
+        raise GovernorError("worker", None, "the contact-aware worker process ended")
+
+    monkeypatch.setattr(listing, "run", dead_worker)
+    rc, _, err = run_cli(capsys, "scenarios")
+    assert rc == 1 and "worker" in error_line(err)
+
+    def broken(args):
+        raise BrokenPipeError(errno.EPIPE, "Broken pipe")
+
+    monkeypatch.setattr(listing, "run", broken)
+    rc, _, err = run_cli(capsys, "scenarios")
+    assert rc == 1 and "Broken pipe" in error_line(err) and "worker" in err
+
+
+CHILD = """
+import pathlib, sys, time
+from impact_balance import cli
+from impact_balance.cli import listing
+
+def slow(args):
+    pathlib.Path(sys.argv[1]).write_text("ready")
+    time.sleep(60)
+    return 0
+
+listing.run = slow
+sys.exit(cli.main(["scenarios"]))
+"""
+
+
+@pytest.mark.parametrize(
+    "sig, message",
+    [("SIGINT", "impact-balance: error: interrupted"), ("SIGTERM", "terminated (SIGTERM)")],
+)
+def test_sigint_and_sigterm_exit_130_with_one_line(tmp_path, sig, message):
+    import signal
+
+    marker = tmp_path / "ready"
+    proc = subprocess.Popen(
+        [sys.executable, "-c", CHILD, str(marker)],
+        env={**os.environ, "PYTHONPATH": SRC},
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        deadline = time.monotonic() + 60
+        while not marker.exists() and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.05)
+        assert marker.exists(), proc.communicate(timeout=10)
+        proc.send_signal(getattr(signal, sig))
+        _, err = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 130, err
+    assert message in error_line(err)
+
+
+def test_the_exit_status_table_of_the_readme(tmp_path):
+    """0 an answer, 2 bad input, 1 the machine, 141 stdout closed early (130: the test above)."""
+    assert run_process("scenarios", cwd=tmp_path).returncode == 0
+    bad = run_process("analyze", "nope.yaml", cwd=tmp_path)
+    assert bad.returncode == 2 and "nope.yaml" in error_line(bad.stderr)
+    machine = run_process("analyze", "palm_push_two_feet", "--plots", UNWRITABLE, cwd=tmp_path)
+    assert machine.returncode == 1 and "--plots" in error_line(machine.stderr)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "impact_balance", "frames", "talos", "--json"],
+        env={**os.environ, "PYTHONPATH": SRC},
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    assert proc.stdout is not None
+    proc.stdout.close()  # closed before the command writes
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 141 and err == b"", err

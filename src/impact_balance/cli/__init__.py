@@ -6,7 +6,13 @@ One module per command (``demo``, ``analyze``, ...), each with ``add_parser(sub)
 PyYAML, pyarrow, Dask, numpy): one line on stderr, exit status 2 for bad input and 1 for a
 failure of the machine, no traceback unless ``--debug`` (anywhere on the line) or
 ``IMPACT_BALANCE_DEBUG=1``. A closed stdout (``analyze --json | head -c 10``) ends quietly
-with status 141, what a shell reports for a command stopped by SIGPIPE; Ctrl-C ends with 130.
+with status 141, what a shell reports for a command stopped by SIGPIPE; Ctrl-C and SIGTERM end
+with one line (``interrupted``, ``terminated (SIGTERM)``) and status 130 (``gui`` keeps the
+system's default action for SIGTERM: it ends at once). Two failures of the machine that a
+library raises as something else are status 1 here: a
+:class:`~impact_balance.exceptions.GovernorError` (the command's governor is fed by the command
+itself, not by the user: a worker that died, a posture it refused) and a broken pipe that is
+not stdout's (a worker process that ended).
 """
 
 from __future__ import annotations
@@ -14,7 +20,9 @@ from __future__ import annotations
 import argparse
 import errno
 import os
+import signal
 import sys
+import threading
 import traceback
 import warnings
 from collections.abc import Sequence
@@ -37,8 +45,19 @@ from impact_balance.cli import (
     validate,
 )
 from impact_balance.cli.demo import DEMO_SCENARIOS, FRICTION_SWEEP
-from impact_balance.exceptions import EnvironmentFailure, ImpactBalanceWarning, one_line
-from impact_balance.exit_status import EXIT_BROKEN_PIPE, debug_requested, describe_error
+from impact_balance.exceptions import (
+    EnvironmentFailure,
+    GovernorError,
+    ImpactBalanceWarning,
+    one_line,
+)
+from impact_balance.exit_status import (
+    EXIT_BROKEN_PIPE,
+    EXIT_ENVIRONMENT,
+    EXIT_INTERRUPTED,
+    debug_requested,
+    describe_error,
+)
 from impact_balance.extras import require_for
 
 __all__ = ["COMMANDS", "DEMO_SCENARIOS", "EXIT_BROKEN_PIPE", "FRICTION_SWEEP", "main"]
@@ -117,6 +136,8 @@ class _Stdout:
 
     def __init__(self, stream: TextIO | None):
         self._stream = stream
+        #: A write or flush of this stream met a closed pipe.
+        self.broken = False
 
     def _failed(self, exc: OSError) -> EnvironmentFailure:
         reason = (
@@ -132,6 +153,7 @@ class _Stdout:
         try:
             return self._stream.write(text)
         except BrokenPipeError:
+            self.broken = True
             raise
         except OSError as exc:
             raise self._failed(exc) from None
@@ -142,6 +164,7 @@ class _Stdout:
         try:
             self._stream.flush()
         except BrokenPipeError:
+            self.broken = True
             raise
         except OSError as exc:
             raise self._failed(exc) from None
@@ -153,15 +176,58 @@ class _Stdout:
         return getattr(self._stream, name)
 
 
-def _report(exc: BaseException, debug: bool) -> int:
+def _stdout_pipe_closed() -> bool:
+    """Is file descriptor 1 a pipe whose reader has gone (poll says POLLERR)?"""
+    try:
+        import select
+
+        poller = select.poll()
+        poller.register(1, select.POLLOUT)
+        return any(event & select.POLLERR for _, event in poller.poll(0))
+    except (OSError, ValueError, AttributeError):  # no poll (Windows), fd 1 closed
+        return False
+
+
+def _broken_pipe(exc: BaseException) -> bool:
+    return isinstance(exc, BrokenPipeError) or (
+        isinstance(exc, OSError) and exc.errno == errno.EPIPE
+    )
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, raised in the main thread: handled as Ctrl-C is, reported as SIGTERM."""
+
+
+def _on_sigterm(signum: int, frame: Any) -> None:
+    raise _Terminated("SIGTERM")
+
+
+def _describe(exc: BaseException) -> tuple[str, int]:
+    """:func:`describe_error`, with the command line's own classes (see the module docstring)."""
+    if isinstance(exc, _Terminated):
+        return "terminated (SIGTERM)", EXIT_INTERRUPTED
+    if _broken_pipe(exc):
+        return (
+            "a pipe to another process closed (Broken pipe): a worker process or a connection "
+            "ended unexpectedly",
+            EXIT_ENVIRONMENT,
+        )
+    line, status = describe_error(exc)
+    if isinstance(exc, GovernorError):
+        status = EXIT_ENVIRONMENT
+    return line, status
+
+
+def _report(exc: BaseException, debug: bool, stdout: _Stdout | None = None) -> int:
     """The one error rule: one line on stderr and the exit status.
 
-    With ``--debug``, the traceback first.
+    With ``--debug``, the traceback first. A closed stdout (``stdout.broken``, or a pipe whose
+    reader has gone) ends quietly with 141; any other broken pipe is a failure, status 1.
     """
-    if isinstance(exc, BrokenPipeError) or (isinstance(exc, OSError) and exc.errno == errno.EPIPE):
+    if _broken_pipe(exc) and ((stdout is not None and stdout.broken) or _stdout_pipe_closed()):
         _silence_stdout()
         return EXIT_BROKEN_PIPE
-    line, status = describe_error(exc)
+    line, status = _describe(exc)
     if isinstance(exc, EnvironmentFailure) and exc.field == "standard output":
         _silence_stdout()  # what is left in its buffer must not fail again at exit
     try:
@@ -262,8 +328,9 @@ def main(argv: list[str] | None = None) -> int:
     debug = debug_requested(argv)
     argv = [a for a in argv if a != "--debug"]  # accepted anywhere on the line
     stdout = sys.stdout
-    sys.stdout = _Stdout(stdout)
+    wrapped = sys.stdout = _Stdout(stdout)
     warnings.showwarning = _warning_line
+    previous = _catch_sigterm()
     try:
         parser, owners = _parser()
         args = parser.parse_args(argv)  # option types check values and outputs (exit 2 or 1)
@@ -284,7 +351,26 @@ def main(argv: list[str] | None = None) -> int:
     except SystemExit:  # argparse's --help, --version and usage errors: already one line
         raise
     except BaseException as exc:
-        return _report(exc, debug)
+        return _report(exc, debug, wrapped)
     finally:
         sys.stdout = stdout
         warnings.showwarning = _show_warning
+        if previous is not _NOT_INSTALLED:
+            signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)
+
+
+def _catch_sigterm() -> Any:
+    """SIGTERM stops the command as Ctrl-C does (main thread only); returns the previous handler.
+
+    :data:`_NOT_INSTALLED` when nothing was installed (another thread, or no SIGTERM here).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        return _NOT_INSTALLED
+    try:
+        return signal.signal(signal.SIGTERM, _on_sigterm)
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - no SIGTERM here
+        return _NOT_INSTALLED
+
+
+#: What :func:`_catch_sigterm` returns when it installed nothing.
+_NOT_INSTALLED = object()

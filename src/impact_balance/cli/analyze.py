@@ -80,10 +80,12 @@ def run(args: argparse.Namespace) -> int:
         raise StrictWarningsError(analysis.warnings)
     written = []
     if args.plots:
+        from impact_balance.cli.output_paths import writing
         from impact_balance.plots import save_figures
 
         skipped: list[Diagnostic] = []
-        written = save_figures(analysis, Path(args.plots), skipped=skipped)
+        with writing("--plots", args.plots):
+            written = save_figures(analysis, Path(args.plots), skipped=skipped)
         analysis = dataclasses.replace(analysis, warnings=analysis.warnings + tuple(skipped))
         if args.strict and skipped:
             raise StrictWarningsError(skipped)

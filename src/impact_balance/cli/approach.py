@@ -224,6 +224,7 @@ def _trials(
     margin: float,
 ) -> tuple[list[WallTrial], list[Path]]:
     """Run one trial per wall distance; the trials and the files written (figures, video)."""
+    from impact_balance.cli.output_paths import writing
     from impact_balance.sim.studies.wall import WallOptions, run_wall_trial, write_wall_video
 
     trials, written = [], []
@@ -237,10 +238,12 @@ def _trials(
         trial = run_wall_trial(setup, wall, options, governor=governor, frames=bool(args.video))
         trials.append(trial)
         if args.plots:
-            written.append(_plot(trial, setup, Path(args.plots), margin))
+            with writing("--plots", args.plots):
+                written.append(_plot(trial, setup, Path(args.plots), margin))
         if args.video:
             title = f"{setup.scenario.name}: {args.governor} governor"
-            written.append(write_wall_video(setup, trial, args.video, title=title))
+            with writing("--video", args.video):
+                written.append(write_wall_video(setup, trial, args.video, title=title))
     return trials, written
 
 

@@ -62,7 +62,12 @@ def run(args: argparse.Namespace) -> int:
     out = check.to_dict(samples=args.samples)
     out["log"] = str(args.log)
     out["warnings"] = [n.to_dict() for n in notes]
-    written = _plots(check, Path(args.plots)) if args.plots and not check.floating else []
+    written = []
+    if args.plots and not check.floating:
+        from impact_balance.cli.output_paths import writing
+
+        with writing("--plots", args.plots):
+            written = _plots(check, Path(args.plots))
     if args.json:
         print_json(out)
         return 0

@@ -55,6 +55,8 @@ def run(args: argparse.Namespace) -> int:
         from impact_balance.cli.output_paths import check_output_folder
 
         check_output_folder(out, "--out")  # before the studies run, not after
+    from impact_balance.cli.output_paths import writing
+
     print("impact-balance demo: the paper's studies on Talos (bundled scenarios)\n")
     written: list[Path] = []
     for name in DEMO_SCENARIOS:
@@ -63,7 +65,8 @@ def run(args: argparse.Namespace) -> int:
         if not args.no_plots:
             from impact_balance.plots import save_figures
 
-            written += save_figures(analysis, out)
+            with writing("--out", out):
+                written += save_figures(analysis, out)
     sweep = [analyze(name) for name in FRICTION_SWEEP]
     print("impact-friction sweep (palm push, two coplanar feet):")
     print(f"  {'mu':>5}  {'CoM criterion':>14}  {'ZMP criterion':>14}")
@@ -78,13 +81,14 @@ def run(args: argparse.Namespace) -> int:
         from impact_balance.balance.lipm import phase_portrait
         from impact_balance.plots import plot_friction_comparison, plot_phase_portrait
 
-        out.mkdir(parents=True, exist_ok=True)
-        for fig, fname in (
-            (plot_friction_comparison(sweep), "friction_comparison.png"),
-            (plot_phase_portrait(phase_portrait(0.78, (-0.13, 0.13))), "phase_portrait.png"),
-        ):
-            fig.savefig(out / fname, dpi=120)
-            written.append(out / fname)
+        with writing("--out", out):
+            out.mkdir(parents=True, exist_ok=True)
+            for fig, fname in (
+                (plot_friction_comparison(sweep), "friction_comparison.png"),
+                (plot_phase_portrait(phase_portrait(0.78, (-0.13, 0.13))), "phase_portrait.png"),
+            ):
+                fig.savefig(out / fname, dpi=120)
+                written.append(out / fname)
         print(f"\n{len(written)} figures written to {out}/")
     from impact_balance.balance.lipm import com_velocity_bounds
 

@@ -7,19 +7,24 @@ where nothing can be created (a read-only or virtual file system, no permission:
 1), so that a long run never ends in an error about where to put its result. The check creates
 nothing that stays: it makes and removes one empty temporary folder in the nearest existing
 folder, which is what writing there needs.
+
+What fails later, while the command writes (a disk that fills up, a file swapped for
+``/dev/full``), is reported by :func:`writing` naming the option and the file:
+``--plots = 'DIR': cannot write DIR/x_areas.png: No space left on device`` (exit status 1).
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 from impact_balance.exceptions import OptionError, OutputError
 from impact_balance.scenario.reader import MAX_NAME_CHARS, MAX_PATH_CHARS
 
-__all__ = ["check_output_file", "check_output_folder"]
+__all__ = ["check_output_file", "check_output_folder", "writing"]
 
 
 def _text(field: str, path: str | os.PathLike[str]) -> Path:
@@ -118,3 +123,29 @@ def check_output_file(
     parent = file.parent if str(file.parent) else Path(".")
     _probe(field, shown, _existing_ancestor(field, shown, parent, is_target=False))
     return file
+
+
+@contextlib.contextmanager
+def writing(field: str, path: str | os.PathLike[str] | None) -> Iterator[None]:
+    """Within the block, a failure to write is an error naming the option and the file.
+
+    An ``OSError`` (a full disk, a read-only file system, a file that became a device) becomes
+    :class:`~impact_balance.exceptions.OutputError` (exit status 1) on ``field = path``, with the
+    file that failed when the system names one and the system's reason. A closed pipe stays a
+    ``BrokenPipeError``.
+
+    Args:
+        field: The option (``--plots``, ``--plot``, ``--log``...).
+        path: Its value, the folder or file written.
+    """
+    try:
+        yield
+    except BrokenPipeError:
+        raise
+    except OSError as exc:
+        reason = exc.strerror or (os.strerror(exc.errno) if exc.errno else "") or str(exc)
+        reason = reason or type(exc).__name__
+        named = os.fsdecode(exc.filename) if exc.filename is not None else None
+        shown = None if path is None else os.fspath(path)
+        where = f"cannot write {named}" if named and named != shown else "cannot write"
+        raise OutputError(field, shown, f"{where}: {reason}") from None

@@ -68,11 +68,13 @@ def run(args: argparse.Namespace) -> int:
 
     portrait = phase_portrait(args.com_height, tuple(args.zmp_range), args.gravity)
     if args.plot:
+        from impact_balance.cli.output_paths import writing
         from impact_balance.plots import plot_phase_portrait
 
         fig = plot_phase_portrait(portrait)
-        Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(args.plot, dpi=120)
+        with writing("--plot", args.plot):
+            Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
+            fig.savefig(args.plot, dpi=120)
     if args.json:
         from impact_balance.cli.output import print_json
 

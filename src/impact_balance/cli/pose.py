@@ -110,6 +110,7 @@ def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from impact_balance.authoring import Placement, pose_scenario, posed_mapping, scenario_yaml
+    from impact_balance.cli.output_paths import check_output_file
     from impact_balance.exceptions import ScenarioError, WorkspaceError
     from impact_balance.gui.workspace import Workspace
     from impact_balance.scenario import (
@@ -131,6 +132,8 @@ def run(args: argparse.Namespace) -> int:
     workspace.resolve(
         out.name, for_write=True, overwrite=True, field="--out"
     )  # a bad name fails before the IK
+    # ... and a folder nothing can be written in (/proc, /sys, a read-only file system): exit 1
+    check_output_file(args.out, "--out")
     if not args.force and (out.exists() or out.is_symlink()):
         raise WorkspaceError("--out", str(out), "the file exists (--force replaces it)")
     scenario = load_scenario(args.scenario)
@@ -152,7 +155,7 @@ def run(args: argparse.Namespace) -> int:
         f"Posed by `impact-balance pose {scenario.name or args.scenario} {argv.strip()}`\n"
         "(whole-body IK, the other contacts kept).",
     )
-    written = workspace.write_text(out.name, text, overwrite=args.force, field="--out")
+    written = _write(workspace, out, text, args.force)
     worst = max(result.residuals.values(), default=0.0)
     if args.json:
         from impact_balance.cli.output import print_json
@@ -193,3 +196,17 @@ def run(args: argparse.Namespace) -> int:
     )
     print(f"wrote: {written}")
     return 0
+
+
+def _write(workspace: Any, out: Any, text: str, force: bool) -> Any:
+    """Write the scenario; a refusal of the system (a full disk) is exit status 1, naming --out."""
+    from impact_balance.exceptions import OutputError, WorkspaceError
+
+    try:
+        return workspace.write_text(out.name, text, overwrite=force, field="--out")
+    except WorkspaceError as exc:
+        cause = exc.__context__
+        if isinstance(cause, OSError) and not isinstance(cause, FileExistsError):
+            reason = cause.strerror or type(cause).__name__
+            raise OutputError("--out", str(out), f"cannot write: {reason}") from None
+        raise

@@ -81,6 +81,7 @@ def run(args: argparse.Namespace) -> int:
         The exit status (0; a failure is raised, for the command line's error rule).
     """
     from impact_balance.cli.output import print_json, progress_bar
+    from impact_balance.cli.output_paths import writing
     from impact_balance.logs import check_log_path
     from impact_balance.scenario import load_scenario
     from impact_balance.sim.studies.push import check_push_arguments, push_test
@@ -119,22 +120,27 @@ def run(args: argparse.Namespace) -> int:
     written = []
     if args.log:
         chosen = _telling(result)
-        written.append(
-            write_trial_log(
-                result.setup,
-                args.log,
-                args.controller,
-                {"push_direction": chosen.push.direction, "push_magnitude": chosen.push.magnitude},
-                push=chosen.push,
+        with writing("--log", args.log):
+            written.append(
+                write_trial_log(
+                    result.setup,
+                    args.log,
+                    args.controller,
+                    {
+                        "push_direction": chosen.push.direction,
+                        "push_magnitude": chosen.push.magnitude,
+                    },
+                    push=chosen.push,
+                )
             )
-        )
         out["log"] = {
             "file": str(args.log),
             "direction": chosen.push.direction,
             "magnitude": chosen.push.magnitude,
         }
     if args.plots:
-        written += _plots(result, Path(args.plots))
+        with writing("--plots", args.plots):
+            written += _plots(result, Path(args.plots))
     if args.json:
         print_json(out)
         return 0

@@ -18,6 +18,7 @@ from impact_balance.cli._options import (
     output_folder,
 )
 from impact_balance.cli.output import print_json
+from impact_balance.cli.output_paths import writing
 
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
@@ -219,17 +220,19 @@ def run(args: argparse.Namespace) -> int:
             from impact_balance.logs import write_log
             from impact_balance.sim.trials.log import log_frame
 
-            written.append(
-                write_log(
-                    log_frame(sim, record),
-                    _per_speed(args.log, speed, several),
-                    {"scenario": name, "joints": args.joints, "approach_speed": str(speed)},
+            with writing("--log", args.log):
+                written.append(
+                    write_log(
+                        log_frame(sim, record),
+                        _per_speed(args.log, speed, several),
+                        {"scenario": name, "joints": args.joints, "approach_speed": str(speed)},
+                    )
                 )
-            )
         if args.video:
             from impact_balance.sim.trials.video import write_video
 
-            written.append(write_video(sim, record, _per_speed(args.video, speed, several)))
+            with writing("--video", args.video):
+                written.append(write_video(sim, record, _per_speed(args.video, speed, several)))
         if args.plots:
             from impact_balance.plots.simulation import plot_jump_on_sets, plot_time_series
             from impact_balance.plots.style import DPI
@@ -239,14 +242,15 @@ def run(args: argparse.Namespace) -> int:
                 f"restitution {result.restitution_measured:.2f}"
             )
             out = Path(args.plots)
-            out.mkdir(parents=True, exist_ok=True)
-            for kind, fig in (
-                ("jump", plot_jump_on_sets(result, title)),
-                ("time", plot_time_series(result, title)),
-            ):
-                path = out / f"{name}_simulate_{args.joints}_{speed:g}_{kind}.png"
-                fig.savefig(path, dpi=DPI)
-                written.append(path)
+            with writing("--plots", args.plots):
+                out.mkdir(parents=True, exist_ok=True)
+                for kind, fig in (
+                    ("jump", plot_jump_on_sets(result, title)),
+                    ("time", plot_time_series(result, title)),
+                ):
+                    path = out / f"{name}_simulate_{args.joints}_{speed:g}_{kind}.png"
+                    fig.savefig(path, dpi=DPI)
+                    written.append(path)
     if args.json:
         docs = [r.to_dict() for r in results]
         print_json(docs if several else docs[0])

@@ -183,7 +183,11 @@ def run(args: argparse.Namespace) -> int:
         for line in summary["problems"]:
             _warn(f"{args.summary}/{line} (left out of the summary)")
         if args.plots_dir:
-            summary["figures"] = [str(p) for p in save_sweep_figures(args.summary, args.plots_dir)]
+            from impact_balance.cli.output_paths import writing
+
+            with writing("--plots", args.plots_dir):
+                figures = save_sweep_figures(args.summary, args.plots_dir)
+            summary["figures"] = [str(p) for p in figures]
         _print(summary, args.json)
         if not args.json:
             for path in summary.get("figures", []):

@@ -70,6 +70,7 @@ def run(args: argparse.Namespace) -> int:
         The exit status (0; a failure is raised, for the command line's error rule).
     """
     from impact_balance.cli.output import print_json, progress_bar
+    from impact_balance.cli.output_paths import writing
     from impact_balance.exceptions import SimulationError
     from impact_balance.logs import check_log_path
     from impact_balance.ranges import check_tolerance
@@ -128,19 +129,21 @@ def run(args: argparse.Namespace) -> int:
             e["survived_commanded"] if e["survived_commanded"] is not None else e["fell_commanded"]
         )
         if speed is not None:
-            written.append(
-                write_trial_log(
-                    result.extra["setup"],
-                    args.log,
-                    args.controller,
-                    {"approach_speed": speed, "joints": args.joints},
-                    impact_speed=speed,
-                    rigid_impact=args.rigid_impact,
+            with writing("--log", args.log):
+                written.append(
+                    write_trial_log(
+                        result.extra["setup"],
+                        args.log,
+                        args.controller,
+                        {"approach_speed": speed, "joints": args.joints},
+                        impact_speed=speed,
+                        rigid_impact=args.rigid_impact,
+                    )
                 )
-            )
             out["log"] = {"file": str(args.log), "approach_speed": speed}
     if args.plots:
-        written += _plots(result, Path(args.plots))
+        with writing("--plots", args.plots):
+            written += _plots(result, Path(args.plots))
     if args.json:
         print_json(out)
         return 0

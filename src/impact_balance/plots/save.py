@@ -74,6 +74,11 @@ def save_figures(
     written = []
     for name, fig in figures:
         path = out / f"{prefix}_{name}.png"
-        fig.savefig(path, dpi=dpi)
+        try:
+            fig.savefig(path, dpi=dpi)
+        except OSError as exc:  # the image writer names no file: say which one failed
+            if exc.filename is None:
+                exc.filename = str(path)
+            raise
         written.append(path)
     return written

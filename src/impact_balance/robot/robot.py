@@ -29,6 +29,7 @@ from impact_balance.exceptions import (
     UnknownJointError,
     UnknownRobotError,
 )
+from impact_balance.robot.urdf_check import check_srdf, check_urdf, read_robot_file
 
 __all__ = [
     "BUNDLED_ROBOTS",
@@ -419,32 +420,63 @@ def _native_reason(lines: list[str], fallback: str) -> str:
     return fallback
 
 
+def _build_model(urdf: Path, native: list[str]) -> pin.Model:
+    """The pinocchio model of the URDF, from the bytes that :func:`check_urdf` accepted.
+
+    What urdfdom refuses while pinocchio still builds a model (an ``<inertial>`` it skips, so
+    the link loads massless) is an error, as is a total mass other than the file's.
+    """
+    source = str(urdf)
+    data = read_robot_file(urdf)
+    text, masses = check_urdf(data, source)
+    try:
+        with _native_stderr(native):
+            model = pin.buildModelFromXML(text, pin.JointModelFreeFlyer())
+    except (RuntimeError, ValueError, OSError) as exc:
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else "invalid URDF"
+        if source in first:  # pinocchio repeats the path
+            first = "not a valid URDF model"
+        raise RobotLoadError(source, _native_reason(native, first)) from None
+    refused = [ln.removeprefix("Error:").strip() for ln in native if ln.startswith("Error:")]
+    if refused:
+        raise RobotLoadError(source, "urdfdom refused part of it: " + "; ".join(refused[:3]))
+    declared, built = sum(masses.values()), float(sum(i.mass for i in model.inertias))
+    if not math.isclose(declared, built, rel_tol=1e-9, abs_tol=1e-12):
+        raise RobotLoadError(
+            source, f"the links' masses add up to {declared:.6g} kg, the model to {built:.6g} kg"
+        )
+    return model
+
+
+def _check_srdf_values(model: pin.Model, srdf: Path, configurations: Mapping[str, Any]) -> None:
+    for name, q in configurations.items():
+        if not np.all(np.isfinite(q)):
+            raise RobotLoadError(str(srdf), f"group_state {name!r}: a joint value is not finite")
+    armature = np.asarray(model.armature, dtype=float)
+    if armature.size and not (np.all(np.isfinite(armature)) and np.all(armature >= 0.0)):
+        raise RobotLoadError(str(srdf), "rotor_params: an armature is negative or not finite")
+
+
 def _load(urdf: Path, srdf: Path | None, name: str, standing: str | None) -> Robot:
     package_dirs = [str(urdf.parent.parent.parent), str(urdf.parent.parent)]
     native: list[str] = []
-    try:
-        with _native_stderr(native):
-            model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
-    except (RuntimeError, ValueError, OSError) as exc:
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else "invalid URDF"
-        if str(urdf) in first:  # pinocchio repeats the path
-            first = "not a valid URDF model"
-        raise RobotLoadError(str(urdf), _native_reason(native, first)) from None
+    model = _build_model(urdf, native)
     configurations = {"neutral": pin.neutral(model)}
     armature_source = None
     if srdf is not None:
-        if not _is_file(srdf):
-            raise RobotLoadError(str(srdf), "no such file")
+        srdf_text = check_srdf(read_robot_file(srdf), str(srdf))
         try:
             with _native_stderr(native):
-                pin.loadReferenceConfigurations(model, str(srdf), False)
+                pin.loadReferenceConfigurationsFromXML(model, srdf_text, False)
         except (RuntimeError, ValueError, OSError) as exc:
             raise RobotLoadError(
                 str(srdf), _native_reason(native, str(exc).strip() or "invalid SRDF")
             ) from None
         for entry in model.referenceConfigurations:
             configurations[entry.key()] = np.array(entry.data(), dtype=float)
-        armature_source = _load_rotor_parameters(model, srdf, native)
+        if "rotor_params" in srdf_text:
+            armature_source = _load_rotor_parameters(model, srdf, native)
+        _check_srdf_values(model, srdf, configurations)
     if standing is None:
         standing = "half_sitting" if "half_sitting" in configurations else "neutral"
     if standing not in configurations:
@@ -452,19 +484,13 @@ def _load(urdf: Path, srdf: Path | None, name: str, standing: str | None) -> Rob
     return Robot(name, model, configurations, standing, urdf, srdf, package_dirs, armature_source)
 
 
-def _load_rotor_parameters(model: pin.Model, srdf: Path, native: list[str]) -> str | None:
+def _load_rotor_parameters(model: pin.Model, srdf: Path, native: list[str]) -> str:
     """Read the SRDF's ``rotor_params`` into ``model.armature``.
 
     Each joint's rotor inertia and gear ratio give ``model.armature`` = gear ratio^2 x rotor
-    inertia, the rotor inertia reflected at the joint. Returns where it came from, or None when the
-    SRDF declares none.
+    inertia, the rotor inertia reflected at the joint (called when the SRDF declares
+    ``rotor_params``). Returns where it came from.
     """
-    try:
-        declared = "rotor_params" in srdf.read_text(errors="replace")
-    except OSError:
-        return None
-    if not declared:
-        return None
     try:
         with _native_stderr(native):
             pin.loadRotorParameters(model, str(srdf), False)
@@ -507,7 +533,7 @@ def load_robot(
         return _load_bundled(name)
     urdf = Path(urdf)
     if not _is_file(urdf):
-        raise RobotLoadError(str(urdf), "no such file")
+        read_robot_file(urdf)  # names what it is: missing, not a regular file, unreadable
     srdf_path = Path(srdf) if srdf else None
     # Cached by the files' identity and modification: an edited URDF or SRDF is reloaded.
     key = (

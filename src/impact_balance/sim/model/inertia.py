@@ -29,6 +29,11 @@ The rule, applied to each moving body and the jointless links MuJoCo fuses into 
    distance of a joint from the CoM and ``n`` the number of floored bodies. The tests
    check the total mass and the composite inertia against pinocchio's to 1e-6 relative.
 
+Only zero and tiny inertials are repaired: a URDF with a non-finite or absurd mass or inertia
+(negative principal moments, the triangle inequality badly broken, magnitudes beyond the bounds
+of :mod:`impact_balance.robot.urdf_check`) is refused before, by the check pinocchio's load
+applies too.
+
 The repairs are reported once (:func:`repair_message`), naming the bodies.
 """
 
@@ -43,6 +48,7 @@ import numpy.typing as npt
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from impact_balance.exceptions import RobotLoadError
 from impact_balance.robot.robot import Robot
 
 __all__ = ["FLOOR_FRACTION", "InertiaRepair", "repair_inertias", "repair_message"]
@@ -220,11 +226,29 @@ def _floors(robot: Robot, count: int) -> tuple[float, float]:
     return share * min(robot.mass, i_min / reach**2), share * i_min
 
 
+def _check_finite(spec: mujoco.MjSpec, robot: Robot) -> None:
+    """Refuse a body whose mass or inertia is not finite (never repaired: not a tiny inertia).
+
+    :func:`impact_balance.robot.urdf_check.check_urdf` refuses such a URDF first; this guards a
+    specification built another way.
+    """
+    for body in spec.bodies:
+        if body.name == "world":
+            continue
+        with np.errstate(all="ignore"):
+            mass, com, inertia = _inertial(body)
+        if not (np.isfinite(mass) and np.all(np.isfinite(com)) and np.all(np.isfinite(inertia))):
+            raise RobotLoadError(
+                str(robot.urdf_path), f"link {body.name!r}: a mass or inertia is not finite"
+            )
+
+
 def repair_inertias(spec: mujoco.MjSpec, robot: Robot) -> InertiaRepair | None:
     """Apply the module's rule to ``spec`` (in place; the root must already have its free joint).
 
     Returns what changed, or None when MuJoCo accepts every inertial as it is.
     """
+    _check_finite(spec, robot)
     moving = [b for b in spec.bodies if b.name != "world" and len(b.joints)]
     todo = []
     for body in moving:

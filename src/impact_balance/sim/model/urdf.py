@@ -10,6 +10,9 @@ MuJoCo reads URDF itself; three things make its model the same robot as pinocchi
 - Inertias come from the URDF ``<inertial>`` tags only (``inertiafromgeom`` off), so that
   geoms added later for collision or display carry no mass.
 
+- The URDF is read and checked by :func:`impact_balance.robot.urdf_check.check_urdf`, the
+  rule pinocchio's load follows: a file with a non-finite or absurd mass, inertia, origin or
+  axis is refused with the file, link or joint and field named.
 - Inertials MuJoCo refuses (massless moving links, singular inertia tensors) are repaired by
   the rule of :mod:`.inertia` (merged into the moving body they are fused with, else raised
   to a floor below 1e-7 of the robot's mass and inertia); :func:`robot_spec` returns what
@@ -37,6 +40,7 @@ import mujoco
 from impact_balance.exceptions import RobotLoadError
 from impact_balance.robot.meshes import mujoco_reads, read_mesh
 from impact_balance.robot.robot import Robot
+from impact_balance.robot.urdf_check import check_urdf, read_robot_file
 from impact_balance.sim.model.inertia import InertiaRepair, repair_inertias
 
 __all__ = ["ROOT_JOINT", "VISUAL_GROUP", "resolve_package_uri", "robot_spec"]
@@ -70,7 +74,8 @@ def resolve_package_uri(package: str, relative: str, search: list[str]) -> Path 
 
 
 def _resolved_urdf(robot: Robot) -> str:
-    text = robot.urdf_path.read_text()
+    # The rule of the robot layer: the bytes checked are the bytes MuJoCo reads.
+    text = check_urdf(read_robot_file(robot.urdf_path), str(robot.urdf_path)).text
     search = [*robot.package_dirs, str(robot.urdf_path.parent)]
     search += [p for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
 
