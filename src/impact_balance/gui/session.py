@@ -230,13 +230,34 @@ class Session:
         """Switch to another (already parsed) state."""
         return self._commit(lambda: state)
 
+    def _commit_read(self, read: Callable[[], GuiState]) -> bool:
+        """Read and parse a state *outside* the lock (other pages keep working), then commit it."""
+        try:
+            state = read()
+        except ImpactBalanceError as exc:
+            with self.lock:
+                self.message, self.refused = describe(exc, self.files.workspace), True
+            return False
+        except Exception as exc:
+            log.exception("unexpected error while reading a scenario")
+            with self.lock:
+                self.message, self.refused = describe(exc), True
+            return False
+        return self._commit(lambda: state)
+
     def load(self, name: str) -> bool:
-        """Load a bundled scenario by name, or a workspace ``.yaml`` file by its relative name."""
-        return self._commit(lambda: self.files.load(name))
+        """Load a bundled scenario by name, or a workspace ``.yaml`` file by its relative name.
+
+        The file is read and parsed outside the session lock; only the analysis holds it.
+        """
+        return self._commit_read(lambda: self.files.load(name))
 
     def upload(self, filename: str, content: bytes) -> bool:
-        """Load an uploaded scenario file (its bytes; size-limited, parsed like a file)."""
-        return self._commit(lambda: self.files.upload(filename, content))
+        """Load an uploaded scenario file (its bytes; size-limited, parsed like a file).
+
+        The YAML is parsed outside the session lock; only the analysis holds it.
+        """
+        return self._commit_read(lambda: self.files.upload(filename, content))
 
     def load_yaml(self, text: str, source: str | None = None) -> bool:
         """Load scenario YAML text, as an upload named ``source``."""
