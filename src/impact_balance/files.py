@@ -1,7 +1,8 @@
 """The one rule for reading an input file: open once, check the open file, read a bounded count.
 
 Every file the package reads from a user (scenarios and their ``extends``, logs, journals,
-manifests, sweep files, GUI loads) goes through :func:`read_bounded`:
+manifests, sweep files, GUI loads) goes through :func:`read_bounded` (or, for a parser that
+streams, :func:`open_regular`, which applies the same checks and hands over the open file):
 
 - the file is opened once, without blocking (``O_NONBLOCK``: a FIFO never makes the reader
   wait) and, where the caller asks it, without following a link at its last component
@@ -22,10 +23,11 @@ from __future__ import annotations
 import errno
 import os
 import stat
+from typing import BinaryIO
 
 from impact_balance.exceptions import ScenarioError
 
-__all__ = ["describe_mode", "read_bounded"]
+__all__ = ["describe_mode", "open_regular", "read_bounded"]
 
 _KINDS = (
     (stat.S_ISDIR, "a folder"),
@@ -61,6 +63,60 @@ def _open(path: str | os.PathLike[str], what: str, no_follow: bool, dir_fd: int 
         raise ScenarioError(what, os.fspath(path), reason) from None
 
 
+def open_regular(
+    path: str | os.PathLike[str],
+    *,
+    limit: int,
+    what: str,
+    no_follow: bool = False,
+    dir_fd: int | None = None,
+) -> BinaryIO:
+    """The regular file ``path`` opened once for reading, its size checked on the descriptor.
+
+    For a reader that streams (a Parquet or CSV parser given the file object): the same rule
+    as :func:`read_bounded` but nothing is read yet; the caller reads through this object
+    only, and bounds what it reads.
+
+    Args:
+        path: The file (relative to ``dir_fd`` when given).
+        limit: Largest size accepted, bytes.
+        what: The field or option named in errors.
+        no_follow: Refuse a symbolic link at the last component (``O_NOFOLLOW``).
+        dir_fd: Open ``path`` relative to this folder descriptor (``openat``).
+
+    Returns:
+        A binary file object (close it; a ``with`` block does).
+
+    Raises:
+        ScenarioError: Missing, unreadable, a link (with ``no_follow``), not a regular file,
+            or larger than ``limit``.
+    """
+    fd = _checked(path, limit, what, no_follow, dir_fd)
+    return os.fdopen(fd, "rb")
+
+
+def _checked(
+    path: str | os.PathLike[str], limit: int, what: str, no_follow: bool, dir_fd: int | None
+) -> int:
+    """An open descriptor of the regular file ``path`` of at most ``limit`` bytes."""
+    shown = os.fspath(path)
+    fd = _open(path, what, no_follow, dir_fd)
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            raise ScenarioError(
+                what, shown, f"{describe_mode(st.st_mode)}, not a regular file: refused"
+            )
+        if st.st_size > limit:
+            raise ScenarioError(
+                what, shown, f"{st.st_size:,} bytes: larger than the limit of {limit:,} bytes"
+            )
+    except BaseException:
+        os.close(fd)
+        raise
+    return fd
+
+
 def read_bounded(
     path: str | os.PathLike[str],
     *,
@@ -86,17 +142,8 @@ def read_bounded(
             (FIFO, device, folder, socket), or larger than ``limit``.
     """
     shown = os.fspath(path)
-    fd = _open(path, what, no_follow, dir_fd)
+    fd = _checked(path, limit, what, no_follow, dir_fd)
     try:
-        st = os.fstat(fd)
-        if not stat.S_ISREG(st.st_mode):
-            raise ScenarioError(
-                what, shown, f"{describe_mode(st.st_mode)}, not a regular file: refused"
-            )
-        if st.st_size > limit:
-            raise ScenarioError(
-                what, shown, f"{st.st_size:,} bytes: larger than the limit of {limit:,} bytes"
-            )
         chunks: list[bytes] = []
         count = 0
         while count <= limit:
