@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from impact_balance.exceptions import ScenarioError, UnknownScenarioError
-from impact_balance.scenario.bundled import _is_file, scenario_path
+from impact_balance.scenario.bundled import _exists, _is_file, scenario_path
 from impact_balance.scenario.reader import (
     MAX_EXTENDS,
     _copy_tree,
@@ -58,7 +58,9 @@ def _parent(path: Path, parent: typing.Any, resolve_path: ExtendsResolver | None
     try:
         if resolve_path is not None:
             return resolve_path(parent, path)
-        return candidate if _is_file(candidate) else scenario_path(parent)
+        if _is_file(candidate) or (candidate.suffix in (".yaml", ".yml") and _exists(candidate)):
+            return candidate  # a FIFO or a device is refused by the reader, naming what it is
+        return scenario_path(parent)
     except UnknownScenarioError as exc:
         raise UnknownScenarioError("extends", parent, exc.valid, str(path)) from None
     except ScenarioError as exc:
