@@ -638,3 +638,43 @@ def test_an_upload_of_too_many_keys_is_refused_quickly(session):
     assert not session.upload("many.yaml", content)
     assert time.perf_counter() - t0 < 5.0
     assert f"more than {MAX_KEYS} keys" in session.message and session.state is state
+
+
+def test_the_apps_upload_and_load_parse_before_taking_the_lock(app, monkeypatch):
+    """The upload button's callback: the YAML is parsed while another page holds the lock."""
+    import threading
+    from types import SimpleNamespace
+
+    session = app.session
+    parsed = threading.Event()
+    original = session.files.upload
+
+    def upload(filename, content):
+        state = original(filename, content)
+        parsed.set()
+        return state
+
+    monkeypatch.setattr(session.files, "upload", upload)
+    release = threading.Event()
+    holding = threading.Event()
+
+    def hold():
+        with session.lock:
+            holding.set()
+            release.wait(30)
+
+    threading.Thread(target=hold, daemon=True).start()
+    assert holding.wait(5)
+    event = SimpleNamespace(
+        target=SimpleNamespace(
+            value=SimpleNamespace(name="up.yaml", content=b"extends: kick_one_foot\n")
+        )
+    )
+    done = threading.Event()
+    threading.Thread(target=lambda: (app._on_upload(event), done.set()), daemon=True).start()
+    try:
+        assert parsed.wait(30), "the upload waited for the lock before it was parsed"
+        assert not done.is_set()
+    finally:
+        release.set()
+    assert done.wait(30) and session.state.source == "up.yaml"
