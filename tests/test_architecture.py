@@ -18,7 +18,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "src" / "impact_balance"
 
 #: Layers from the bottom up: a module may import from its own layer and the ones below.
 LAYERS: tuple[tuple[str, ...], ...] = (
-    ("exceptions", "constants", "ranges", "_jit", "extras", "exit_status", "json_values"),
+    ("exceptions", "constants", "ranges", "_jit", "extras", "exit_status", "json_values", "files"),
     ("geometry", "solvers"),
     ("robot",),
     ("contacts",),

@@ -342,3 +342,38 @@ def test_simulation_options_are_refused_in_one_line_or_within_the_limits(command
     else:
         assert_one_line(rc, err)
         assert rc == 2
+
+
+# -- inputs that are not regular files: refused at once, in one line ---------------------------
+def _not_a_file(tmp_path: Path, kind: str, name: str) -> Path:
+    path = tmp_path / name
+    if kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "folder":
+        path.mkdir()
+    else:  # a link to an endless device
+        path.symlink_to("/dev/zero")
+    return path
+
+
+@pytest.mark.parametrize("kind", ["fifo", "folder", "dev-zero"])
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["analyze", "{path}", "--json"],
+        ["check-log", "{log}", "--scenario", "palm_push_two_feet", "--json"],
+    ],
+    ids=["analyze", "check-log"],
+)
+def test_a_fifo_device_or_folder_input_is_refused_in_one_line(tmp_path, kind, command):
+    from tests.helpers.cli import assert_one_line_error, run_process
+
+    if command[0] == "check-log":
+        pytest.importorskip("pandas", reason="needs the logs extra (pandas)")
+    path = _not_a_file(tmp_path, kind, "input.yaml")
+    log = _not_a_file(tmp_path, kind, "input.csv")
+    argv = [a.format(path=path, log=log) for a in command]
+    proc = run_process(*argv, timeout=60)  # a FIFO read would block: the timeout fails the test
+    what = {"fifo": "FIFO", "folder": "a folder", "dev-zero": "a character device"}[kind]
+    assert_one_line_error(proc.returncode, proc.stderr, what)
+    assert proc.stdout == ""

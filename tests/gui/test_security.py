@@ -527,3 +527,154 @@ def test_state_of_a_file_in_the_workspace_names_it_relatively(ws):
     assert (
         Path(state.source) == ws / "a.yaml" and files.workspace.relative(state.source) == "a.yaml"
     )
+
+
+# -- the GUI reads only what it checked --------------------------------------------------------
+def _swap_after_check(monkeypatch, ws, name: str, swap) -> None:
+    """Swap ``ws/name`` right after the workspace checked it, before it is opened (the race)."""
+    original = Workspace._open_folder
+
+    def open_folder(self, parts, field, shown):
+        target = ws / name
+        if target.exists() and not target.is_symlink() and target.is_file():
+            target.unlink()
+            swap(target)
+        return original(self, parts, field, shown)
+
+    monkeypatch.setattr(Workspace, "_open_folder", open_folder)
+
+
+def test_a_link_swapped_in_after_the_check_is_refused(session, ws, monkeypatch):
+    state = session.state
+    (ws / "race.yaml").write_text((ws / "a.yaml").read_text())
+    outside = ws.parent / "outside.yaml"
+    _swap_after_check(monkeypatch, ws, "race.yaml", lambda p: p.symlink_to(outside))
+    assert not session.load("race.yaml")
+    assert "symbolic links" in session.message and SECRET not in session.message
+    assert session.state is state
+    # The same through an extends: the extended file is read through the checked folder too.
+    monkeypatch.undo()
+    (ws / "base.yaml").write_text((ws / "a.yaml").read_text())
+    (ws / "child.yaml").write_text("extends: base.yaml\nplane_height: 0.01\n")
+    _swap_after_check(monkeypatch, ws, "base.yaml", lambda p: p.symlink_to(outside))
+    assert not session.load("child.yaml")
+    assert "symbolic links" in session.message and SECRET not in session.message
+    assert session.state is state
+
+
+def test_an_inside_file_never_serves_content_read_elsewhere(session, ws):
+    """The cache poisoning of issue 30: after a refused race, the inside file loads its own."""
+    (ws / "race.yaml").write_text("extends: palm_push_two_feet\nimpact: {friction: 0.3}\n")
+    assert session.load("race.yaml") and session.state.scenario.impact.friction == 0.3
+    (ws / "race.yaml").write_text("extends: palm_push_two_feet\nimpact: {friction: 0.2}\n")
+    assert session.load("race.yaml") and session.state.scenario.impact.friction == 0.2
+
+
+def test_a_fifo_swapped_in_during_a_load_neither_blocks_nor_holds_the_lock(
+    session, ws, monkeypatch
+):
+    import threading
+
+    (ws / "race.yaml").write_text((ws / "a.yaml").read_text())
+    _swap_after_check(monkeypatch, ws, "race.yaml", lambda p: os.mkfifo(p))
+    done = threading.Event()
+
+    def load():
+        session.load("race.yaml")
+        done.set()
+
+    threading.Thread(target=load, daemon=True).start()
+    assert done.wait(10), "the load waits on the FIFO"
+    assert session.refused and "FIFO" in session.message
+    assert session.lock.acquire(timeout=1)  # nobody holds it
+    session.lock.release()
+
+
+def test_uploads_are_parsed_outside_the_session_lock(session, monkeypatch):
+    import threading
+
+    parsed = threading.Event()
+    original = session.files.upload
+
+    def upload(filename, content):
+        state = original(filename, content)
+        parsed.set()
+        return state
+
+    monkeypatch.setattr(session.files, "upload", upload)
+    holding, release = threading.Event(), threading.Event()
+
+    def hold():  # another page redrawing, for as long as the test says
+        with session.lock:
+            holding.set()
+            release.wait(30)
+
+    threading.Thread(target=hold, daemon=True).start()
+    assert holding.wait(5)
+    finished = threading.Event()
+
+    def do_upload():
+        session.upload("up.yaml", b"extends: kick_one_foot\n")
+        finished.set()
+
+    threading.Thread(target=do_upload, daemon=True).start()
+    try:
+        assert parsed.wait(30), "the upload was not parsed while another page held the lock"
+        assert not finished.is_set()  # its commit waits for the lock, as it must
+    finally:
+        release.set()
+    assert finished.wait(30) and session.state.source == "up.yaml"
+
+
+def test_an_upload_of_too_many_keys_is_refused_quickly(session):
+    import time
+
+    from impact_balance.scenario.reader import MAX_KEYS
+
+    content = "".join(f"k{i}: 1\n" for i in range(60_000)).encode()
+    assert len(content) <= MAX_FILE_BYTES
+    state = session.state
+    t0 = time.perf_counter()
+    assert not session.upload("many.yaml", content)
+    assert time.perf_counter() - t0 < 5.0
+    assert f"more than {MAX_KEYS} keys" in session.message and session.state is state
+
+
+def test_the_apps_upload_and_load_parse_before_taking_the_lock(app, monkeypatch):
+    """The upload button's callback: the YAML is parsed while another page holds the lock."""
+    import threading
+    from types import SimpleNamespace
+
+    session = app.session
+    parsed = threading.Event()
+    original = session.files.upload
+
+    def upload(filename, content):
+        state = original(filename, content)
+        parsed.set()
+        return state
+
+    monkeypatch.setattr(session.files, "upload", upload)
+    release = threading.Event()
+    holding = threading.Event()
+
+    def hold():
+        with session.lock:
+            holding.set()
+            release.wait(30)
+
+    threading.Thread(target=hold, daemon=True).start()
+    assert holding.wait(5)
+    event = SimpleNamespace(
+        target=SimpleNamespace(
+            value=SimpleNamespace(name="up.yaml", content=b"extends: kick_one_foot\n")
+        )
+    )
+    done = threading.Event()
+    threading.Thread(target=lambda: (app._on_upload(event), done.set()), daemon=True).start()
+    try:
+        assert parsed.wait(30), "the upload waited for the lock before it was parsed"
+        assert not done.is_set()
+    finally:
+        release.set()
+    assert done.wait(30) and session.state.source == "up.yaml"

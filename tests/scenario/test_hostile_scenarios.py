@@ -158,6 +158,9 @@ def _alias_text(base: str, fan: int, levels: int) -> str:
             "deep_flow",
             "deep_block",
             "merge_key",
+            "duplicate_key",
+            "many_keys",
+            "fifo_extends",
         ]
     ),
     size=st.integers(1, 40),
@@ -198,6 +201,14 @@ def test_text_mutation_gives_clean_error_orstrict_json(name, kind, size):
                 + "".join(f"{'  ' * i}k{i}:\n" for i in range(5 * size))
                 + f"{'  ' * 5 * size}v: 1\n"
             )
+        elif kind == "duplicate_key":  # a top-level key of the file given again
+            key = next(k for k in yaml.safe_load(base) if k != "extends")
+            text = base + f"\n{key}: {yaml.safe_load(base)[key]!r}\n"
+        elif kind == "many_keys":
+            text = base + "".join(f"\nk{i}: {i}" for i in range(200 * size)) + "\n"
+        elif kind == "fifo_extends":
+            os.mkfifo(tmp / "pipe.yaml")
+            text = "extends: pipe.yaml\n"
         else:  # merge keys over an anchored contact
             text = (
                 base
@@ -205,7 +216,13 @@ def test_text_mutation_gives_clean_error_orstrict_json(name, kind, size):
                 + "contacts: [{<<: *d, frame: left_sole_link}, {<<: *d, frame: right_sole_link}]\n"
             )
         path.write_text(text)
-        assert_clean(*_run(["analyze", str(path), "--json"]))
+        rc, out, err = _run(["analyze", str(path), "--json"])
+        assert_clean(rc, out, err)
+        refusal = {"duplicate_key": "duplicate key", "fifo_extends": "FIFO"}.get(kind)
+        if kind == "many_keys" and 200 * size > 1000:
+            refusal = "more than 1000 keys"
+        if refusal is not None:
+            assert rc == 2 and refusal in err, (kind, err)
 
 
 # -- real processes: bounded time and memory -------------------------------------------
@@ -244,3 +261,49 @@ def test_alias_bomb_in_a_real_process_is_refused_quickly(tmp_path, argv):
     assert proc.stdout == ""
     assert len(err) == 1 and err[0].startswith("impact-balance: error: "), proc.stderr[-2000:]
     assert "expands to more than" in err[0]
+
+
+LOAD = r"""
+import resource, sys
+from impact_balance.exceptions import ScenarioError
+from impact_balance.scenario import load_scenario
+before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+try:
+    load_scenario(sys.argv[1])
+    print("LOADED")
+except ScenarioError as exc:
+    print("REFUSED", str(exc).splitlines()[0][:200])
+after = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+print("PEAK_KB", before, after)
+"""
+
+
+@pytest.mark.parametrize(
+    ("kind", "needle"),
+    [("keys", "more than 1000 keys"), ("duplicates", "duplicate key"), ("nodes", "larger than")],
+    ids=["60000-keys", "duplicates", "nodes"],
+)
+def test_hostile_files_of_2_mb_are_refused_within_50_mb(tmp_path, kind, needle):
+    """Files of at most 2 MB are refused, growing the loader's peak by less than 50 MB (the
+    imports alone take ~230 MB: the whole stays under 500 MB). Parsed whole, the 60 000 keys
+    grew it by 98 MB."""
+    if kind == "keys":
+        text = "".join(f"k{i}: 1\n" for i in range(60_000))
+    elif kind == "duplicates":
+        text = "gravity: 9.81\n" * 60_000
+    else:  # a huge flat list: many nodes, one key, over the reader's 1 MB
+        text = "contacts: [" + ", ".join(["0"] * 600_000) + "]\n"
+    path = tmp_path / "hostile.yaml"
+    path.write_text(text if kind == "nodes" else text[:1_000_000].rsplit("\n", 1)[0] + "\n")
+    assert path.stat().st_size <= 2_000_000
+    proc = subprocess.run(
+        [sys.executable, "-c", LOAD, str(path)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "PYTHONPATH": str(Path(__file__).parents[2] / "src")},
+    )
+    assert proc.returncode == 0 and "REFUSED" in proc.stdout, proc.stdout + proc.stderr[-2000:]
+    assert needle in proc.stdout
+    before, after = (int(x) for x in proc.stdout.split("PEAK_KB")[1].split())
+    assert after - before < 50 * 1024, f"loading grew the peak by {(after - before) / 1024:.0f} MB"

@@ -1,6 +1,8 @@
 """Every file the GUI reads or writes, through the workspace rule (:mod:`.workspace`).
 
-- load: a bundled scenario by name, or a ``.yaml`` file of the workspace;
+- load: a bundled scenario by name, or a ``.yaml`` file of the workspace, read through the
+  workspace folder's descriptors (no link followed, a regular file only, bounded) and parsed from
+  the bytes read, never from a second read of the path;
 - ``extends:`` in a loaded or uploaded file: a bundled name or a workspace file;
 - ``robot: {urdf, srdf}`` in a loaded or uploaded file: workspace files (``.urdf``/``.srdf``);
 - upload: at most :data:`~impact_balance.gui.workspace.MAX_FILE_BYTES`, parsed like a file;
@@ -15,7 +17,6 @@ from __future__ import annotations
 
 import functools
 import reprlib
-import tempfile
 from importlib import resources
 from pathlib import Path
 
@@ -29,13 +30,18 @@ from impact_balance.gui.state import GuiState
 from impact_balance.gui.workspace import MAX_FILE_BYTES, Workspace
 from impact_balance.scenario import (
     ExtendsResolver,
+    FileReader,
     RobotFiles,
     Scenario,
     bundled_scenarios,
     load_scenario,
 )
+from impact_balance.scenario.reader import read_text
 
 __all__ = ["MAX_MESSAGE", "GuiFiles", "bundled_path", "describe"]
+
+#: The folder an upload is named in (never created nor opened: the upload is read from memory).
+_UPLOADS = Path("/.impact-balance-upload")
 
 #: Longest message shown in the browser, characters.
 MAX_MESSAGE = 300
@@ -86,10 +92,10 @@ def describe(exc: BaseException, workspace: Workspace | None = None) -> str:
     return text if len(text) <= MAX_MESSAGE else text[: MAX_MESSAGE - 3] + "..."
 
 
-def _load(path: Path, resolve: ExtendsResolver, shown: str) -> Scenario:
+def _load(path: Path, resolve: ExtendsResolver, shown: str, read: FileReader) -> Scenario:
     """:func:`load_scenario` with a last net: a file nested too deeply for Python is refused."""
     try:
-        return load_scenario(path, resolve_path=resolve)
+        return load_scenario(path, resolve_path=resolve, read_file=read)
     except RecursionError:
         raise ScenarioError("scenario", shown, "nested too deeply", shown) from None
 
@@ -106,6 +112,24 @@ class GuiFiles:
 
     def _extends(self, name: str, referrer: Path) -> Path:
         return self.workspace.extends_resolver(bundled_path)(name, referrer)
+
+    def _reader(self, upload: Path | None = None, text: str = "") -> FileReader:
+        """How a load reads each file.
+
+        A workspace file through the workspace's descriptors (:meth:`Workspace.read_text`: no
+        link, a regular file, bounded), a bundled one through
+        :func:`~impact_balance.scenario.reader.read_text`, the upload from its bytes.
+        """
+
+        def read(path: Path) -> str:
+            if upload is not None and path == upload:
+                return text
+            name = self.workspace.relative(path)
+            if name is None:  # the extends resolver gives bundled files or workspace files only
+                return read_text(path)
+            return self.workspace.read_text(name)
+
+        return read
 
     def _robot_files(self, scenario: Scenario, folder: Path) -> Scenario:
         """``scenario`` with its robot files checked against the workspace and made absolute.
@@ -149,7 +173,7 @@ class GuiFiles:
                 )
             return GuiState.from_file(path)
         path = self.workspace.resolve(name)
-        scenario = _load(path, self._extends, name)
+        scenario = _load(path, self._extends, name, self._reader())
         return GuiState.from_scenario(self._robot_files(scenario, path.parent))
 
     def upload(self, filename: str, content: bytes) -> GuiState:
@@ -178,16 +202,14 @@ class GuiFiles:
             "".join(c if c.isalnum() or c in "-_." else "_" for c in Path(shown).stem)[:80]
             or "uploaded"
         )
-        with tempfile.TemporaryDirectory() as tmp:
-            # The scenario loader reads files (it resolves `extends`, reports YAML errors with
-            # their line): give it one, outside the workspace, gone after the parse.
-            path = Path(tmp) / f"{stem}.yaml"
-            path.write_text(text, encoding="utf-8")
-            try:
-                scenario = _load(path, self._extends, shown)
-            except ScenarioError as exc:
-                value = shown if exc.value == str(path) else exc.value
-                raise ScenarioError(exc.field, value, exc.reason, shown) from None
+        # The loader takes a path (it resolves `extends`, names the file in errors): the upload
+        # gets a name outside the workspace that is never opened, its reader serves the bytes.
+        path = _UPLOADS / f"{stem}.yaml"
+        try:
+            scenario = _load(path, self._extends, shown, self._reader(path, text))
+        except ScenarioError as exc:
+            value = shown if exc.value == str(path) else exc.value
+            raise ScenarioError(exc.field, value, exc.reason, shown) from None
         scenario = self._robot_files(scenario, self.workspace.root)
         state = GuiState.from_scenario(scenario)
         return GuiState(state.raw, shown)

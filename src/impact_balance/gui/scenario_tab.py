@@ -89,7 +89,7 @@ class ScenarioTabMixin(GuiHost):
             initial_value=DEFAULT_SCENARIO if DEFAULT_SCENARIO in names else names[0],
         )
         load_bundled = gui.add_button("Load bundled scenario")
-        load_bundled.on_click(lambda _: self.edit(lambda: self.session.load(self.w_bundled.value)))
+        load_bundled.on_click(lambda _: self._load(self.w_bundled.value))
         root = self.workspace.root
         self.w_file = gui.add_text(
             "file",
@@ -97,7 +97,7 @@ class ScenarioTabMixin(GuiHost):
             hint=f"A .yaml file in the workspace {root} (a name relative to it)",
         )
         load = gui.add_button("Load file", hint=f"Read the file from the workspace {root}")
-        load.on_click(lambda _: self.edit(lambda: self.session.load(self.w_file.value)))
+        load.on_click(lambda _: self._load(self.w_file.value))
         self.w_overwrite = gui.add_checkbox(
             "overwrite", False, hint="Allow the next save to replace an existing file"
         )
@@ -142,10 +142,14 @@ class ScenarioTabMixin(GuiHost):
             if self._meshes is not None:
                 self._meshes.set_opacity(float(event.target.value))
 
+    def _load(self, name: str) -> None:
+        read = self.session.read_file(str(name))  # read and parsed before taking the lock
+        self.edit(lambda: self.session.commit(read))
+
     def _on_upload(self, event: Any) -> None:
         file = event.target.value
-
-        self.edit(lambda: self.session.upload(str(file.name), bytes(file.content)))
+        read = self.session.read_upload(str(file.name), bytes(file.content))  # before the lock
+        self.edit(lambda: self.session.commit(read))
 
     def _on_download(self, event: Any) -> None:
         with self.session.lock:

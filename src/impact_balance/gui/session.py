@@ -230,13 +230,53 @@ class Session:
         """Switch to another (already parsed) state."""
         return self._commit(lambda: state)
 
+    @staticmethod
+    def _read(read: Callable[[], GuiState]) -> GuiState | BaseException:
+        """A state read and parsed by ``read``, or what it raised (kept for :meth:`commit`)."""
+        try:
+            return read()
+        except ImpactBalanceError as exc:
+            return exc
+        except Exception as exc:
+            log.exception("unexpected error while reading a scenario")
+            return exc
+
+    def read_file(self, name: str) -> GuiState | BaseException:
+        """Read and parse a load (see :meth:`load`) *without* the session lock.
+
+        Returns the state, or the error to show; :meth:`commit` makes it current. The GUI
+        calls this before taking the lock, so a slow or hostile file never stops other pages.
+        """
+        return self._read(lambda: self.files.load(name))
+
+    def read_upload(self, filename: str, content: bytes) -> GuiState | BaseException:
+        """Parse an upload (see :meth:`upload`) without the session lock, as :meth:`read_file`."""
+        return self._read(lambda: self.files.upload(filename, content))
+
+    def commit(self, read: GuiState | BaseException) -> bool:
+        """Make a state read by :meth:`read_file` or :meth:`read_upload` current, or show its error.
+
+        The state is analysed under the lock. Returns False (and :attr:`message`) when refused.
+        """
+        if isinstance(read, BaseException):
+            with self.lock:
+                self.message, self.refused = describe(read, self.files.workspace), True
+            return False
+        return self._commit(lambda: read)
+
     def load(self, name: str) -> bool:
-        """Load a bundled scenario by name, or a workspace ``.yaml`` file by its relative name."""
-        return self._commit(lambda: self.files.load(name))
+        """Load a bundled scenario by name, or a workspace ``.yaml`` file by its relative name.
+
+        The file is read and parsed outside the session lock; only the analysis holds it.
+        """
+        return self.commit(self.read_file(name))
 
     def upload(self, filename: str, content: bytes) -> bool:
-        """Load an uploaded scenario file (its bytes; size-limited, parsed like a file)."""
-        return self._commit(lambda: self.files.upload(filename, content))
+        """Load an uploaded scenario file (its bytes; size-limited, parsed like a file).
+
+        The YAML is parsed outside the session lock; only the analysis holds it.
+        """
+        return self.commit(self.read_upload(filename, content))
 
     def load_yaml(self, text: str, source: str | None = None) -> bool:
         """Load scenario YAML text, as an upload named ``source``."""

@@ -10,6 +10,10 @@ held. So the server counts an upload while it arrives:
 - each part is counted on arrival; the transfer is dropped (its buffered parts freed) as soon as
   the bytes received pass the declared size or the limit;
 - a client has at most :data:`MAX_TRANSFERS_PER_CLIENT` uploads in flight;
+- all pages together hold at most :data:`MAX_PENDING_BYTES` in unfinished uploads: an upload's
+  declared size is reserved when it starts, and refused if the reservations of the uploads in
+  flight would pass the cap; an upload unfinished after :data:`UPLOAD_TIMEOUT_S` is dropped
+  (its parts freed, its reservation returned), so idle pages cannot hold the cap forever;
 - a WebSocket message is at most :data:`MAX_MESSAGE_BYTES` and at most :data:`MAX_QUEUED_MESSAGES`
   wait to be handled (:mod:`.guard` passes both to websockets), so a huge message or a flood of
   them is not buffered either.
@@ -25,6 +29,7 @@ from __future__ import annotations
 
 import math
 import threading
+import time
 from collections.abc import Callable
 from typing import Any
 
@@ -32,10 +37,12 @@ from impact_balance.gui.workspace import MAX_FILE_BYTES
 
 __all__ = [
     "MAX_MESSAGE_BYTES",
+    "MAX_PENDING_BYTES",
     "MAX_QUEUED_MESSAGES",
     "MAX_TRANSFERS_PER_CLIENT",
     "MAX_UPLOAD_BYTES",
     "MAX_UPLOAD_PARTS",
+    "UPLOAD_TIMEOUT_S",
     "UploadLimit",
     "limit_uploads",
 ]
@@ -46,6 +53,10 @@ MAX_UPLOAD_BYTES = MAX_FILE_BYTES
 MAX_UPLOAD_PARTS = 64
 #: Uploads one client may have in flight.
 MAX_TRANSFERS_PER_CLIENT = 2
+#: Bytes all unfinished uploads together may hold (declared sizes), across every page.
+MAX_PENDING_BYTES = 4 * MAX_UPLOAD_BYTES
+#: An upload still unfinished this long after it started is dropped, seconds.
+UPLOAD_TIMEOUT_S = 60.0
 #: Largest WebSocket message from a browser, bytes (a 512 KiB upload part and its envelope).
 MAX_MESSAGE_BYTES = MAX_UPLOAD_BYTES + (64 << 10)
 #: Messages read ahead of the handlers, per connection.
@@ -58,10 +69,15 @@ class UploadLimit:
     Attributes:
         refused: Number of uploads refused so far.
         peak_bytes: Largest number of bytes held for one upload.
+        pending_cap: Bytes all unfinished uploads may reserve together.
     """
 
     def __init__(
-        self, server: Any, on_refused: Callable[[str, str], None], limit: int = MAX_UPLOAD_BYTES
+        self,
+        server: Any,
+        on_refused: Callable[[str, str], None],
+        limit: int = MAX_UPLOAD_BYTES,
+        pending_cap: int = MAX_PENDING_BYTES,
     ):
         from viser import _messages
 
@@ -76,6 +92,8 @@ class UploadLimit:
         self._on_refused = on_refused
         self._received: dict[str, int] = {}
         self._owner: dict[str, Any] = {}
+        self._reserved: dict[str, tuple[int, float]] = {}  # uuid -> (declared bytes, start)
+        self.pending_cap = int(pending_cap)
         self.refused = 0
         self.peak_bytes = 0
         handlers = self._iface._incoming_handlers
@@ -94,10 +112,24 @@ class UploadLimit:
         # The GUI redraws under its lock: not in viser's event loop, which must keep serving.
         threading.Thread(target=self._on_refused, args=(name, reason), daemon=True).start()
 
+    def _drop(self, uuid: str) -> None:
+        self._received.pop(uuid, None)
+        self._owner.pop(uuid, None)
+        self._reserved.pop(uuid, None)
+
     def _forget_finished(self) -> None:
-        for uuid in [u for u in self._received if u not in self._states]:
-            self._received.pop(uuid, None)
-            self._owner.pop(uuid, None)
+        now = time.monotonic()
+        for uuid in list(self._received):
+            if uuid not in self._states:
+                self._drop(uuid)
+            elif now - self._reserved.get(uuid, (0, now))[1] > UPLOAD_TIMEOUT_S:
+                self._states.pop(uuid, None)  # frees the parts buffered so far
+                self._drop(uuid)
+
+    @property
+    def pending_bytes(self) -> int:
+        """Bytes reserved by the uploads in flight (their declared sizes)."""
+        return sum(size for size, _ in self._reserved.values())
 
     def _start(self, client_id: Any, message: Any) -> None:
         self._forget_finished()
@@ -114,11 +146,17 @@ class UploadLimit:
             reason = f"{parts} parts declared for {size:,} bytes: not a valid upload"
         elif sum(owner == client_id for owner in self._owner.values()) >= MAX_TRANSFERS_PER_CLIENT:
             reason = f"more than {MAX_TRANSFERS_PER_CLIENT} uploads at once"
+        elif self.pending_bytes + size > self.pending_cap:
+            reason = (
+                f"the server already holds {self.pending_bytes:,} bytes of unfinished uploads "
+                f"(at most {self.pending_cap:,} for all pages): try again in a minute"
+            )
         if reason is not None:
             self._refuse(client_id, message.filename, reason)
             return
         self._received[message.transfer_uuid] = 0
         self._owner[message.transfer_uuid] = client_id
+        self._reserved[message.transfer_uuid] = (size, time.monotonic())
         self._start_original(client_id, message)
 
     def _part(self, client_id: Any, message: Any) -> None:
@@ -129,8 +167,7 @@ class UploadLimit:
         count = self._received[uuid] + len(message.content)
         if count > self._limit or count > state["total_bytes"]:
             self._states.pop(uuid, None)  # frees the parts buffered so far
-            self._received.pop(uuid, None)
-            self._owner.pop(uuid, None)
+            self._drop(uuid)
             self._refuse(
                 client_id,
                 state.get("filename"),
@@ -141,12 +178,14 @@ class UploadLimit:
         self.peak_bytes = max(self.peak_bytes, count)
         self._part_original(client_id, message)
         if uuid not in self._states:  # complete
-            self._received.pop(uuid, None)
-            self._owner.pop(uuid, None)
+            self._drop(uuid)
 
 
 def limit_uploads(
-    server: Any, on_refused: Callable[[str, str], None], limit: int = MAX_UPLOAD_BYTES
+    server: Any,
+    on_refused: Callable[[str, str], None],
+    limit: int = MAX_UPLOAD_BYTES,
+    pending_cap: int = MAX_PENDING_BYTES,
 ) -> UploadLimit:
     """Count the uploads of ``server`` as they arrive (see the module docstring).
 
@@ -156,6 +195,7 @@ def limit_uploads(
         server: The :class:`viser.ViserServer`.
         on_refused: Called with (file name, reason) for each refused upload.
         limit: The largest upload, bytes.
+        pending_cap: Bytes all unfinished uploads together may reserve.
 
     Returns:
         The installed counting handlers.
@@ -164,6 +204,7 @@ def limit_uploads(
         ValueError: ``limit`` is not a byte count.
         RuntimeError: viser's upload handlers are not where this viser version should have them.
     """
-    if not math.isfinite(limit) or limit < 0:
-        raise ValueError("limit must be a byte count")
-    return UploadLimit(server, on_refused, int(limit))
+    for value in (limit, pending_cap):
+        if not math.isfinite(value) or value < 0:
+            raise ValueError("limit and pending_cap must be byte counts")
+    return UploadLimit(server, on_refused, int(limit), int(pending_cap))

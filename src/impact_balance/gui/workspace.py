@@ -11,8 +11,12 @@ rest of the machine through them, so every file the GUI touches goes through one
 - writing: into an existing folder of the workspace (none is created), and an existing file is
   replaced only when the caller says so (``overwrite=True``).
 
-:meth:`Workspace.read_text` and :meth:`Workspace.write_text` apply the rule and do the I/O
-without following links (``O_NOFOLLOW``), so a link swapped in after the check is refused too.
+:meth:`Workspace.read_bytes` (and :meth:`Workspace.read_text`) and :meth:`Workspace.write_text`
+apply the rule and do the I/O through descriptors: the folders are opened one by one without
+following links, the file relative to its folder's descriptor with ``O_NOFOLLOW`` and
+``O_NONBLOCK``, checked with ``fstat`` and read within the size limit. A link or a FIFO swapped
+in after the check is refused, never followed or waited on; the bytes returned are the bytes
+checked, and the GUI parses those.
 Refusals raise :class:`~impact_balance.exceptions.WorkspaceError` with the field, the name (cut
 short) and the reason; no message quotes a file's content.
 """
@@ -25,7 +29,8 @@ import stat
 from collections.abc import Callable
 from pathlib import Path, PurePosixPath, PureWindowsPath
 
-from impact_balance.exceptions import WorkspaceError
+from impact_balance.exceptions import ScenarioError, WorkspaceError
+from impact_balance.files import read_bounded
 
 __all__ = ["MAX_FILE_BYTES", "SCENARIO_SUFFIXES", "Workspace"]
 
@@ -244,6 +249,42 @@ class Workspace:
                 field, shown, f"cannot write ({exc.strerror or 'error'})"
             ) from None
 
+    def read_bytes(
+        self,
+        name: str | os.PathLike[str],
+        *,
+        field: str = "file",
+        suffixes: tuple[str, ...] = SCENARIO_SUFFIXES,
+    ) -> bytes:
+        """The bytes of the workspace file ``name`` (at most :data:`MAX_FILE_BYTES`).
+
+        The name is checked by :meth:`resolve`, then read through descriptors only: the
+        workspace folder and each folder on the way are opened without following links, and
+        the file is opened relative to its folder's descriptor (``openat``) with ``O_NOFOLLOW``
+        and ``O_NONBLOCK``, checked with ``fstat`` (a regular file) and read within the limit
+        (:func:`impact_balance.files.read_bounded`). A link or a FIFO swapped in after the
+        check is refused; what is returned is what was checked.
+
+        Raises:
+            WorkspaceError: Refused by :meth:`resolve`, a link, not a regular file, too large,
+                or unreadable.
+        """
+        parts = self.resolve(name, field=field, suffixes=suffixes).relative_to(self.root).parts
+        folder = self._open_folder(parts[:-1], field, str(name))
+        try:
+            return read_bounded(
+                parts[-1], limit=MAX_FILE_BYTES, what=field, no_follow=True, dir_fd=folder
+            )
+        except ScenarioError as exc:
+            reason = exc.reason
+            if "larger than" in reason:
+                reason = f"larger than {MAX_FILE_BYTES >> 10} KiB"
+            elif "symbolic link" in reason:
+                reason = "symbolic links are not followed in the workspace"
+            raise WorkspaceError(field, str(name), reason) from None
+        finally:
+            os.close(folder)
+
     def read_text(
         self,
         name: str | os.PathLike[str],
@@ -251,28 +292,12 @@ class Workspace:
         field: str = "file",
         suffixes: tuple[str, ...] = SCENARIO_SUFFIXES,
     ) -> str:
-        """The UTF-8 text of the workspace file ``name`` (at most :data:`MAX_FILE_BYTES`).
+        """The UTF-8 text of the workspace file ``name``, read by :meth:`read_bytes`.
 
         Raises:
-            WorkspaceError: Refused by :meth:`resolve`, unreadable, or not UTF-8 text.
+            WorkspaceError: Refused by :meth:`read_bytes`, or not UTF-8 text.
         """
-        parts = self.resolve(name, field=field, suffixes=suffixes).relative_to(self.root).parts
-        folder = self._open_folder(parts[:-1], field, str(name))
-        try:
-            try:
-                fd = os.open(parts[-1], os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0), dir_fd=folder)
-            except OSError as exc:
-                raise WorkspaceError(
-                    field, str(name), f"cannot read ({exc.strerror or 'error'})"
-                ) from None
-        finally:
-            os.close(folder)
-        with os.fdopen(fd, "rb") as f:
-            if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
-                raise WorkspaceError(field, str(name), "not a regular file")
-            data = f.read(MAX_FILE_BYTES + 1)
-        if len(data) > MAX_FILE_BYTES:
-            raise WorkspaceError(field, str(name), f"larger than {MAX_FILE_BYTES >> 10} KiB")
+        data = self.read_bytes(name, field=field, suffixes=suffixes)
         try:
             return data.decode("utf-8")
         except UnicodeDecodeError:

@@ -2,8 +2,14 @@
 
 Reading is bounded and strict (see :mod:`impact_balance.scenario.reader` for the limits):
 
+- the file is opened once and must be a regular file (a FIFO or a device is refused at once);
 - the file's size, row count, column count and value count are checked before it is read
   (a Parquet file's from its metadata; a CSV file is read up to the first row past the limit);
+- only the columns the checker reads are read (``time``, the base, ``q_``/``v_``, ``zmp_``,
+  ``force_``, ``com_``, ``comd_``); any other column is skipped unread. A Parquet column the
+  checker reads may hold at most :data:`MAX_LOG_COLUMN_BYTES_PER_ROW` bytes a row once
+  uncompressed (checked from the footer, before reading), so a small file cannot unpack into
+  gigabytes;
 - every column the checker reads (``time``, the base pose and velocity, each ``q_``/``v_``
   joint column) must hold finite numbers: text, a boolean, an empty cell, NaN or infinity is
   named with its column and row (and the line of a CSV file);
@@ -18,12 +24,14 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import BinaryIO
 
 import numpy as np
 import pandas as pd
 
 from impact_balance.analysis.result import Diagnostic
 from impact_balance.exceptions import ScenarioError, short_repr
+from impact_balance.files import open_regular
 from impact_balance.logs.schema import LOG_VERSION, LogColumns
 from impact_balance.scenario.reader import (
     MAX_LOG_BYTES,
@@ -32,10 +40,23 @@ from impact_balance.scenario.reader import (
     MAX_LOG_VALUES,
 )
 
-__all__ = ["SUFFIXES", "check_log_columns", "check_log_path", "read_log", "write_log"]
+__all__ = [
+    "MAX_LOG_COLUMN_BYTES_PER_ROW",
+    "MAX_LOG_COLUMN_SLACK",
+    "SUFFIXES",
+    "check_log_columns",
+    "check_log_path",
+    "read_log",
+    "write_log",
+]
 
 #: Supported file types.
 SUFFIXES = (".parquet", ".csv")
+#: Largest uncompressed size of a column the checker reads, bytes per row (a float64 is 8; a
+#: column of short text, refused later with its row named, fits too).
+MAX_LOG_COLUMN_BYTES_PER_ROW = 64
+#: Uncompressed bytes a read column may hold beyond its rows' share (page headers, a few texts).
+MAX_LOG_COLUMN_SLACK = 1 << 20
 #: Prefixes of the optional numeric columns (an empty cell: not measured at that sample).
 _OPTIONAL = ("zmp_", "force_", "com_", "comd_")
 
@@ -115,40 +136,64 @@ def _size_limits(shown: str, rows: int, columns: int) -> int:
     return allowed
 
 
-def _read_parquet(path: Path, shown: str) -> pd.DataFrame:
+def _used(name: object) -> bool:
+    """Whether the checker reads column ``name`` (the others are never read)."""
+    text = str(name)
+    return text in LogColumns().required or text.startswith(("q_", "v_", *_OPTIONAL))
+
+
+def _read_parquet(f: BinaryIO, shown: str) -> pd.DataFrame:
     import pyarrow.parquet as pq
 
-    meta = pq.ParquetFile(path).metadata  # counts from the footer: nothing is read yet
+    parquet = pq.ParquetFile(f)
+    meta = parquet.metadata  # counts and sizes from the footer: no column is read yet
     _size_limits(shown, meta.num_rows, meta.num_columns)
-    return pd.read_parquet(path)
+    used = [name for name in parquet.schema_arrow.names if _used(name)]
+    sizes: dict[str, int] = {}
+    for group in range(meta.num_row_groups):
+        row_group = meta.row_group(group)
+        for j in range(row_group.num_columns):
+            column = row_group.column(j)
+            name = column.path_in_schema.split(".")[0]
+            sizes[name] = sizes.get(name, 0) + column.total_uncompressed_size
+    allowed = MAX_LOG_COLUMN_BYTES_PER_ROW * meta.num_rows + MAX_LOG_COLUMN_SLACK
+    for name in used:
+        if sizes.get(name, 0) > allowed:
+            raise ScenarioError(
+                "LOG",
+                shown,
+                f"column {name}: {sizes[name]:,} bytes once uncompressed for {meta.num_rows:,} "
+                f"rows (at most {MAX_LOG_COLUMN_BYTES_PER_ROW} a row): not a column of numbers",
+            )
+    f.seek(0)
+    return pd.read_parquet(f, columns=used)
 
 
-def _last_line(path: Path) -> tuple[bool, str]:
+def _last_line(f: BinaryIO) -> tuple[bool, str]:
     """(ends with a line break, the last line's text)."""
-    size = path.stat().st_size
-    with open(path, "rb") as f:
-        f.seek(max(0, size - 65536))
-        tail = f.read()
+    size = os.fstat(f.fileno()).st_size
+    f.seek(max(0, size - 65536))
+    tail = f.read(65536)
     ends = tail.endswith(b"\n")
     last = tail.rstrip(b"\r\n").rsplit(b"\n", 1)[-1]
     return ends, last.decode("utf-8", errors="replace")
 
 
-def _read_csv(path: Path, shown: str, warnings: list[Diagnostic] | None) -> pd.DataFrame:
-    with open(path, "rb") as f:
-        header = f.readline(1 << 20)
+def _read_csv(f: BinaryIO, shown: str, warnings: list[Diagnostic] | None) -> pd.DataFrame:
+    header = f.readline(1 << 20)
     columns = header.count(b",") + 1 if header.strip() else 0
     allowed = _size_limits(shown, 0, columns)
-    frame = pd.read_csv(path, nrows=allowed + 1)
+    f.seek(0)
+    frame = pd.read_csv(f, nrows=allowed + 1, usecols=_used)
     _size_limits(shown, len(frame), columns)
-    ends, last = _last_line(path)
+    ends, last = _last_line(f)
     if not ends and len(frame):
         fields = last.count(",") + 1
         line = len(frame) + 1
-        if fields < len(frame.columns):
+        if fields < columns:
             frame = frame.iloc[:-1]
             note = (
-                f"the last line ({line}) has {fields} of {len(frame.columns)} fields and no "
+                f"the last line ({line}) has {fields} of {columns} fields and no "
                 "line break: the file was cut while written; that line is left out"
             )
         else:
@@ -162,39 +207,44 @@ def _read_csv(path: Path, shown: str, warnings: list[Diagnostic] | None) -> pd.D
 
 
 def read_log(path: str | Path, warnings: list[Diagnostic] | None = None) -> pd.DataFrame:
-    """Read a log within the limits.
+    """Read a log within the limits (only the columns the checker uses).
+
+    The file is opened once (:func:`impact_balance.files.open_regular`: a regular file, never a
+    FIFO or a device, at most :data:`~impact_balance.scenario.reader.MAX_LOG_BYTES`) and
+    parsed through that descriptor. A Parquet file's row, column and uncompressed sizes are
+    checked from its footer before any column is read; unused columns are never read.
 
     Args:
         path: A ``.parquet`` or ``.csv`` file.
         warnings: If given, receives the caveats (a CSV file cut in its last line).
 
     Returns:
-        The log, one row per sample.
+        The log, one row per sample: the columns the checker reads (time, base, joints, ZMP,
+        forces, CoM), in the file's order.
 
     Raises:
-        ScenarioError: The file is too large, lacks a required column (named) or holds a value
-            the checker cannot use (named with its column and row).
+        ScenarioError: The file is missing, not a regular file, too large (in bytes, rows,
+            columns or uncompressed bytes of a column), lacks a required column (named) or
+            holds a value the checker cannot use (named with its column and row).
     """
     path = Path(path)
     suffix = check_log_path(path, "LOG")
     shown = str(path)[:80]
-    if not path.is_file():
-        raise ScenarioError("LOG", shown, "no such file")
-    size = os.path.getsize(path)
-    if size > MAX_LOG_BYTES:
-        raise ScenarioError(
-            "LOG", shown, f"{size:,} bytes: a log file has at most {MAX_LOG_BYTES:,}"
-        )
     try:
-        frame = _read_csv(path, shown, warnings) if suffix == ".csv" else _read_parquet(path, shown)
-    except ScenarioError:
-        raise
-    except MemoryError:
-        raise
-    except Exception as exc:  # pandas/pyarrow raise many types for a malformed file
-        raise ScenarioError(
-            "LOG", shown, f"cannot read as {suffix[1:]}: {type(exc).__name__}"
-        ) from None
+        f = open_regular(path, limit=MAX_LOG_BYTES, what="LOG")
+    except ScenarioError as exc:
+        raise ScenarioError("LOG", shown, exc.reason) from None
+    with f:
+        try:
+            frame = _read_csv(f, shown, warnings) if suffix == ".csv" else _read_parquet(f, shown)
+        except ScenarioError:
+            raise
+        except MemoryError:
+            raise
+        except Exception as exc:  # pandas/pyarrow raise many types for a malformed file
+            raise ScenarioError(
+                "LOG", shown, f"cannot read as {suffix[1:]}: {type(exc).__name__}"
+            ) from None
     missing = [c for c in LogColumns().required if c not in frame.columns]
     if missing:
         raise ScenarioError("LOG", shown, f"missing required columns: {', '.join(missing)}")

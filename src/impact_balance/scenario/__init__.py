@@ -26,6 +26,7 @@ _EXPORTS: dict[str, str] = {
     "bundled_scenarios": ".bundled",
     "scenario_path": ".bundled",
     "ExtendsResolver": ".load",
+    "FileReader": ".load",
     "merge_mappings": ".load",
     "read_mapping": ".load",
     "load_scenario": ".load",
@@ -56,6 +57,7 @@ if TYPE_CHECKING:
     from impact_balance.scenario.errors import field_name
     from impact_balance.scenario.load import (
         ExtendsResolver,
+        FileReader,
         load_scenario,
         merge_mappings,
         read_mapping,
@@ -76,6 +78,7 @@ __all__ = [
     "BasePose",
     "ContactConfig",
     "ExtendsResolver",
+    "FileReader",
     "ImpactConfig",
     "Offset",
     "QPConfig",

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import os
 from importlib import resources
 from pathlib import Path
 
@@ -42,12 +43,18 @@ def bundled_scenarios() -> dict[str, str]:
 
 
 def scenario_path(name_or_path: str | Path) -> Path:
-    """A scenario file's path: an existing file, or the name of a bundled scenario."""
+    """A scenario file's path: an existing file, or the name of a bundled scenario.
+
+    A path that names something else (a FIFO, a device, a folder) is returned as is: reading it
+    refuses it with what it is (:func:`impact_balance.files.read_bounded`).
+    """
     check_path_text("scenario", str(name_or_path))
     path = Path(name_or_path)
     if _is_file(path):
         return path
     if path.suffix in (".yaml", ".yml") or "/" in str(name_or_path) or "\\" in str(name_or_path):
+        if _exists(path):  # a FIFO, a device, a folder: the reader refuses it, naming what it is
+            return path
         raise ScenarioError("scenario", str(name_or_path), "no such file")
     bundled = _scenario_dir() / f"{name_or_path}.yaml"
     if _is_file(bundled):
@@ -59,4 +66,11 @@ def _is_file(path: Path) -> bool:
     try:
         return path.is_file()
     except (OSError, ValueError):  # a name the OS refuses is simply not an existing file
+        return False
+
+
+def _exists(path: Path) -> bool:
+    try:
+        return os.path.lexists(path)
+    except (OSError, ValueError):
         return False

@@ -11,6 +11,10 @@ reading it must finish quickly in bounded memory whatever it contains:
   file can stand for 10^9 values (a "billion laughs" alias bomb). The composed node graph is
   counted as if every alias were expanded, without expanding it, and refused beyond
   :data:`MAX_VALUES`; an alias inside its own anchor (a cycle) is refused;
+- **keys**: a key appears at most once in a mapping (a repeated key is refused with its line,
+  never silently replaced by the last value), and a mapping has at most :data:`MAX_KEYS` keys
+  (more than any scenario or sweep can have); both are checked while composing, so a file of
+  60,000 keys is refused at key :data:`MAX_KEYS`, before the rest is parsed;
 - **names**: a file name or ``extends`` longer than :data:`MAX_NAME_CHARS` characters per path
   component (the usual file-system limit) or :data:`MAX_PATH_CHARS` in all is refused before
   the operating system is asked.
@@ -19,6 +23,9 @@ Logs (``check-log``) are bounded too, before they are read: a file of at most
 :data:`MAX_LOG_BYTES`, at most :data:`MAX_LOG_ROWS` rows, :data:`MAX_LOG_COLUMNS` columns and
 :data:`MAX_LOG_VALUES` values (rows x columns, 400 MB as float64). A Parquet log's counts come
 from its metadata; a CSV log is read up to the first row past the limit.
+
+Files are read through :func:`impact_balance.files.read_bounded` (one open, a regular file
+only, a byte bound), and the bytes read are the bytes parsed.
 
 Every refusal is a :class:`~impact_balance.exceptions.ScenarioError` naming the file and the
 limit. Mappings given directly (the GUI, the library) get the same depth and size checks
@@ -36,11 +43,13 @@ from typing import Any
 import yaml
 
 from impact_balance.exceptions import ScenarioError
+from impact_balance.files import read_bounded
 
 __all__ = [
     "MAX_BYTES",
     "MAX_DEPTH",
     "MAX_EXTENDS",
+    "MAX_KEYS",
     "MAX_LOG_BYTES",
     "MAX_LOG_COLUMNS",
     "MAX_LOG_ROWS",
@@ -50,6 +59,7 @@ __all__ = [
     "MAX_VALUES",
     "check_path_text",
     "check_structure",
+    "decode_text",
     "parse_yaml",
     "read_text",
     "read_yaml",
@@ -61,6 +71,8 @@ MAX_BYTES = 1_000_000
 MAX_DEPTH = 32
 #: Most values (scalars, mappings, lists) after expanding every alias.
 MAX_VALUES = 100_000
+#: Most keys in one mapping (a scenario has about 20 top-level keys, a 100-joint robot 100 joints).
+MAX_KEYS = 1_000
 #: Longest file-name component, characters (the usual file-system limit).
 MAX_NAME_CHARS = 255
 #: Longest path, characters (Linux PATH_MAX is 4096 bytes).
@@ -145,22 +157,49 @@ class _BoundedLoader(yaml.SafeLoader):  # type: ignore[misc]  # PyYAML ships no 
     def __init__(self, stream: str):
         super().__init__(stream)
         self._depth = 0
+        self._nodes = 0
+        #: Keys seen so far in each mapping being composed: id(node) -> {key: line}.
+        self._keys: dict[int, dict[tuple[str, str], int]] = {}
 
     def compose_node(self, parent: yaml.Node | None, index: object) -> yaml.Node:
-        """PyYAML's node composition, with the nesting limit."""
+        """PyYAML's node composition, with the nesting, node-count and key limits."""
         self._depth += 1
+        self._nodes += 1
         try:
             if self._depth > MAX_DEPTH:
                 raise _LimitError(
                     f"nested deeper than {MAX_DEPTH} levels", self.peek_event().start_mark
                 )
-            return super().compose_node(parent, index)
+            if self._nodes > MAX_VALUES:
+                raise _LimitError(f"more than {MAX_VALUES} values", self.peek_event().start_mark)
+            node: yaml.Node = super().compose_node(parent, index)
         finally:
             self._depth -= 1
+        if isinstance(parent, yaml.MappingNode) and index is None:  # ``node`` is a key
+            self._check_key(parent, node)
+        return node
+
+    def _check_key(self, mapping: yaml.MappingNode, key: yaml.Node) -> None:
+        """Refuse a key seen before in ``mapping``, or one key too many."""
+        seen = self._keys.setdefault(id(mapping), {})
+        if len(seen) >= MAX_KEYS:
+            raise _LimitError(f"a mapping with more than {MAX_KEYS} keys", key.start_mark)
+        if not isinstance(key, yaml.ScalarNode) or key.tag == "tag:yaml.org,2002:merge":
+            return
+        line = key.start_mark.line + 1
+        first = seen.get((key.tag, key.value))
+        seen[(key.tag, key.value)] = line if first is None else first
+        if first is not None:
+            raise _LimitError(
+                f"duplicate key {key.value[:80]!r} at line {line} (first at line {first}): "
+                "a key may appear once in a mapping",
+                key.start_mark,
+            )
 
     def compose_document(self) -> yaml.Node:
         """PyYAML's document composition, with the expanded-size limit."""
         node: yaml.Node = super().compose_document()
+        self._keys.clear()
         try:
             _count(node, _node_children, lambda n: isinstance(n, yaml.ScalarNode))
         except ValueError as exc:
@@ -228,26 +267,23 @@ def _parse_cached(text: str, source: str) -> Any:
             loader.dispose()
 
 
-def read_text(path: Path) -> str:
-    """A scenario file's text, within the size limit (:class:`ScenarioError` otherwise)."""
-    check_path_text("scenario", str(path))
-    try:
-        with open(path, "rb") as f:
-            data = f.read(MAX_BYTES + 1)
-    except OSError as exc:
-        raise ScenarioError(
-            "scenario", str(path), f"cannot read: {exc.__class__.__name__}"
-        ) from None
-    if len(data) > MAX_BYTES:
-        raise ScenarioError(
-            "scenario",
-            str(path),
-            f"larger than {MAX_BYTES // 1000} kB, the limit for a scenario file",
-        )
+def decode_text(data: bytes, source: str) -> str:
+    """``data`` as UTF-8 text (:class:`ScenarioError` naming ``source`` otherwise)."""
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError:
-        raise ScenarioError("scenario", str(path), "cannot read: not UTF-8 text") from None
+        raise ScenarioError("scenario", source, "cannot read: not UTF-8 text") from None
+
+
+def read_text(path: Path) -> str:
+    """A scenario file's text, read once within the size limit (:class:`ScenarioError` otherwise).
+
+    Read through :func:`~impact_balance.files.read_bounded`: a FIFO, a device or a folder is
+    refused without waiting, a file over :data:`MAX_BYTES` is refused.
+    """
+    check_path_text("scenario", str(path))
+    data = read_bounded(path, limit=MAX_BYTES, what="scenario")
+    return decode_text(data, str(path))
 
 
 def read_yaml(path: Path) -> Any:
