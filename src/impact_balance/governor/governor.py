@@ -44,7 +44,7 @@ QUATERNION_TOLERANCE = 1e-6
 #: How far a 1-dof joint of q may lie beyond its finite position limits (rad, or m for a
 #: prismatic joint): a measured state may overshoot a limit a little (a soft limit in
 #: simulation, encoder noise), a posture farther out is not the robot's.
-JOINT_LIMIT_TOLERANCE = 0.05
+JOINT_LIMIT_TOLERANCE = 0.1
 
 
 class Governor:
