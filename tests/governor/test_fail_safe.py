@@ -270,6 +270,21 @@ def test_the_joint_rule_is_the_limits_plus_the_tolerance(talos, joint, excess, u
             pass
 
 
+def test_huge_finite_inputs_say_what_is_wrong(talos):
+    v = np.zeros(talos.nv)
+    q = talos.configuration.copy()
+    q[0] = 1e300
+    with pytest.raises(GovernorError, match=r"q\[0\] = 1e\+300: the base position must be within"):
+        talos.limit(q, v)
+    v[6:] = 1e300  # finite, but the CoM velocity overflows
+    with pytest.raises(GovernorError, match="CoM speed above 100 m/s"):
+        talos.limit(talos.configuration, v)
+    v[:] = 0.0
+    v[0] = np.nan
+    with pytest.raises(GovernorError, match=r"must be finite \(entry 0\)"):
+        talos.limit(talos.configuration, v)
+
+
 def test_a_quaternion_off_unit_names_the_tolerance(talos):
     q = talos.configuration.copy()
     q[3:7] *= 1.001

@@ -15,7 +15,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from impact_balance.balance.areas import warm_up as warm_up_maps
-from impact_balance.constants import MAX_SPEED
+from impact_balance.constants import MAX_POSITION, MAX_SPEED
 from impact_balance.contacts.stance import has_free_flyer
 from impact_balance.criteria.cap import cap_approach
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
@@ -210,9 +210,12 @@ class Governor:
             The speed limit (m/s), its limiting vertex and edge, the safe interval.
 
         Raises:
-            GovernorError: ``q`` or ``v`` of the wrong size, not finite, or a base
-                quaternion that is not unit (within 1e-6); with ``contact_aware_async``, a
-                worker that failed on an earlier posture or ended.
+            GovernorError: ``q`` or ``v`` not real numbers, of the wrong size, not finite, a
+                base quaternion that is not unit (within :data:`QUATERNION_TOLERANCE`), a joint
+                beyond its limits by more than :data:`JOINT_LIMIT_TOLERANCE`; with
+                ``contact_aware_async``, rates older than the options allow with
+                ``on_stale="raise"``, and :class:`~.worker.WorkerError` for a worker that
+                failed on an earlier posture or ended.
             ScenarioError, ImpactModelError, SolverError: a posture the pipeline cannot
                 evaluate (see :meth:`~impact_balance.governor.posture.PostureEvaluator.evaluate`).
         """
@@ -220,7 +223,16 @@ class Governor:
         velocity = _vector(v, self.nv, "v")
         with self._lock:
             posture, reused = self._posture_at(configuration)
-            return self._answer(posture, posture.com_jacobian @ velocity, reused)
+            with np.errstate(over="ignore", invalid="ignore"):
+                com_velocity = posture.com_jacobian @ velocity
+            speed = math.hypot(*com_velocity)
+            if not speed <= MAX_SPEED:  # NaN too: an overflow
+                raise GovernorError(
+                    "v",
+                    f"CoM velocity {speed:.3g} m/s",
+                    f"gives a CoM speed above {MAX_SPEED:g} m/s (the scenario's bound)",
+                )
+            return self._answer(posture, com_velocity, reused)
 
     def limit_com(self, q: ArrayLike, com_velocity: ArrayLike) -> SpeedLimit:
         """:meth:`limit` with the CoM velocity given, for a controller with its own estimate.
@@ -341,6 +353,13 @@ class Governor:
         """``q`` as a checked configuration vector (see :meth:`limit`)."""
         configuration = _vector(q, self.nq, "q")
         if self._free_flyer:
+            far = np.flatnonzero(np.abs(configuration[:3]) > MAX_POSITION)
+            if far.size:
+                raise GovernorError(
+                    f"q[{int(far[0])}]",
+                    float(configuration[far[0]]),
+                    f"the base position must be within {MAX_POSITION:g} m per coordinate",
+                )
             quaternion = configuration[3:7]
             norm = float(quaternion @ quaternion)
             if abs(norm - 1.0) > 2.0 * QUATERNION_TOLERANCE:
@@ -649,10 +668,9 @@ def _vector(x: ArrayLike, size: int, field: str) -> npt.NDArray[np.float64]:
         raise GovernorError(
             field, f"shape {a.shape}", f"must have {size} entries (the model's n{field})"
         )
-    if not math.isfinite(float(a @ a)):
+    if not np.isfinite(a).all():
         bad = np.flatnonzero(~np.isfinite(a))
-        which = f"entry {int(bad[0])}" if bad.size else "the entries are too large"
-        raise GovernorError(field, x, f"must be finite ({which})")
+        raise GovernorError(field, x, f"must be finite (entry {int(bad[0])})")
     return a
 
 

@@ -217,8 +217,12 @@ class ContactAwareWorker:
         Raises:
             GovernorError: The worker did not answer within :data:`START_TIMEOUT` s.
         """
-        self.submit(b"warm-up", q)
-        solutions = self.wait(START_TIMEOUT)
+        try:
+            self.submit(b"warm-up", q)
+            solutions = self.wait(START_TIMEOUT)
+        except GovernorError:
+            self.close()
+            raise
         if solutions is None:
             self.close()
             raise WorkerError("contact_aware_async", None, "the worker did not answer")
