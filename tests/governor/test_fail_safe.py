@@ -273,10 +273,16 @@ def test_the_joint_rule_is_the_limits_plus_the_tolerance(talos, joint, excess, u
 def test_huge_finite_inputs_say_what_is_wrong(talos):
     v = np.zeros(talos.nv)
     q = talos.configuration.copy()
-    q[0] = 1e300
-    with pytest.raises(GovernorError, match=r"q\[0\] = 1e\+300: the base position must be within"):
+    q[0] = 1e300  # its square overflows
+    with pytest.raises(GovernorError, match=r"q\[0\] = 1e\+300: is finite but beyond any"):
         talos.limit(q, v)
-    v[6:] = 1e300  # finite, but the CoM velocity overflows
+    q[0] = 1e5
+    with pytest.raises(GovernorError, match=r"q\[0\] = 100000.0: the base position must be within"):
+        talos.limit(q, v)
+    v[6:] = 1e300  # finite, but its square overflows
+    with pytest.raises(GovernorError, match=r"v\[6\] = 1e\+300: is finite but beyond any"):
+        talos.limit(talos.configuration, v)
+    v[6:] = 1e3  # a CoM speed of thousands of m/s
     with pytest.raises(GovernorError, match="CoM speed above 100 m/s"):
         talos.limit(talos.configuration, v)
     v[:] = 0.0
