@@ -224,11 +224,10 @@ class Governor:
         with self._lock:
             posture, reused = self._posture_at(configuration)
             com_velocity = posture.com_jacobian @ velocity  # |v| < 1e154: no overflow
-            speed = math.hypot(*com_velocity)
-            if not speed <= MAX_SPEED:  # NaN too: an overflow
+            if not float(com_velocity @ com_velocity) <= MAX_SPEED * MAX_SPEED:
                 raise GovernorError(
                     "v",
-                    f"CoM velocity {speed:.3g} m/s",
+                    f"CoM velocity {math.hypot(*com_velocity):.3g} m/s",
                     f"gives a CoM speed above {MAX_SPEED:g} m/s (the scenario's bound)",
                 )
             return self._answer(posture, com_velocity, reused)
@@ -310,6 +309,7 @@ class Governor:
             ScenarioError: a joint outside its position limits (scenarios refuse those).
         """
         configuration = self._configuration(q)
+        self._joints.check(configuration)
         c = np.asarray(com_velocity, dtype=float).ravel()
         robot, joints = self.robot, {}
         for name in robot.joint_names:
@@ -352,13 +352,8 @@ class Governor:
         """``q`` as a checked configuration vector (see :meth:`limit`)."""
         configuration = _vector(q, self.nq, "q")
         if self._free_flyer:
-            far = np.flatnonzero(np.abs(configuration[:3]) > MAX_POSITION)
-            if far.size:
-                raise GovernorError(
-                    f"q[{int(far[0])}]",
-                    float(configuration[far[0]]),
-                    f"the base position must be within {MAX_POSITION:g} m per coordinate",
-                )
+            if np.vdot(configuration, configuration) > MAX_POSITION * MAX_POSITION:  # rarely
+                _base_within_bounds(configuration)
             quaternion = configuration[3:7]
             norm = float(quaternion @ quaternion)
             if abs(norm - 1.0) > 2.0 * QUATERNION_TOLERANCE:
@@ -368,7 +363,6 @@ class Governor:
                     "the base quaternion (x, y, z, w) must be unit (within "
                     f"{QUATERNION_TOLERANCE:g}); normalise it",
                 )
-        self._joints.check(configuration)
         return configuration
 
     def _posture_at(self, q: npt.NDArray[np.float64]) -> tuple[Posture, bool]:
@@ -376,10 +370,12 @@ class Governor:
         cached = self._posture
         if cached is not None:
             if self.posture_tolerance == 0.0:
-                if cached.key == q.tobytes():
+                if cached.key == q.tobytes():  # the very q checked when it was evaluated
                     return cached, True
             elif float(np.abs(q - cached.q).max()) <= self.posture_tolerance:
+                self._joints.check(q)
                 return cached, True
+        self._joints.check(q)
         try:
             posture = self._evaluator.evaluate(q)
         except ScenarioError as exc:
@@ -600,6 +596,17 @@ def _governed(
     if scenario.velocity_margin and criterion != "com":
         raise GovernorError("velocity_margin", margin, "applies to the com criterion only")
     return scenario
+
+
+def _base_within_bounds(q: npt.NDArray[np.float64]) -> None:
+    """Raise :class:`GovernorError` naming a base coordinate of ``q`` beyond ``MAX_POSITION``."""
+    far = np.flatnonzero(np.abs(q[:3]) > MAX_POSITION)
+    if far.size:
+        raise GovernorError(
+            f"q[{int(far[0])}]",
+            float(q[far[0]]),
+            f"the base position must be within {MAX_POSITION:g} m per coordinate",
+        )
 
 
 def _zero_answer(
