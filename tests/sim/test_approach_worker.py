@@ -41,11 +41,11 @@ def test_a_killed_worker_ends_approach_with_one_line_and_status_1():
         "approach",
         "palm_push_two_feet",
         "--reference",
-        "0.5",
+        "0.01",  # a slow approach (15 s of simulated ticks): the kill falls inside it
         "--contact-aware",
         "--contact-aware-async",
         "--max-time",
-        "20",
+        "30",
     ]
     process = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
@@ -55,7 +55,7 @@ def test_a_killed_worker_ends_approach_with_one_line_and_status_1():
             time.sleep(0.2)
             found = workers_of(process.pid)
         assert found, "the worker process never started"
-        time.sleep(1.0)  # into the run (its warm-up or the trial: both must fail cleanly)
+        time.sleep(2.0)  # into the approach, the governor ticking
         os.kill(found[0], signal.SIGKILL)
         _, err = process.communicate(timeout=300)
     finally:
