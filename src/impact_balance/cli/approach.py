@@ -135,7 +135,8 @@ def run(args: argparse.Namespace) -> int:
         The exit status, 0.
 
     Raises:
-        SimulationError: Options that do not go together, a scenario without an impact.
+        SimulationError: Options that do not go together, a scenario without an impact, a
+            wall closer than the approach needs.
         ScenarioError: A margin the schema refuses (naming its option).
     """
     from impact_balance.exceptions import SimulationError
@@ -161,6 +162,7 @@ def run(args: argparse.Namespace) -> int:
             "impact", None, f"scenario {scenario.name!r} has no impact: approach needs one"
         )
     distances = _distances(args)
+    _check_distances(args, distances)
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
     own = scoring_margin(scenario)
     margin = controller_margin(options) if own is None else own
@@ -203,6 +205,15 @@ def _distances(args: argparse.Namespace) -> list[float]:
     if lo > hi:
         raise SimulationError("--wall-distance-range", [lo, hi], "must be 0 < LO <= HI <= 1 m")
     return [lo, 0.5 * (lo + hi), hi] if hi > lo else [lo]
+
+
+def _check_distances(args: argparse.Namespace, distances: list[float]) -> None:
+    """Refuse, before any trial, a wall closer than the approach needs (naming the option)."""
+    from impact_balance.sim.studies.wall import check_wall_distance
+
+    field = "--wall-distance" if args.wall_distance_range is None else "--wall-distance-range"
+    for distance in distances:
+        check_wall_distance(distance, args.reference, field=field)
 
 
 def _governor(args: argparse.Namespace, governed: Scenario) -> Governor | None:

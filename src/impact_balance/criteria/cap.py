@@ -31,6 +31,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
+from impact_balance.constants import MAX_SPEED
 from impact_balance.exceptions import GovernorError
 
 __all__ = ["cap_approach", "capped_velocity", "clamp_approach_speed", "safe_contact_velocity"]
@@ -129,16 +130,26 @@ def cap_approach(
         The velocity (3,), world, m/s.
 
     Raises:
-        GovernorError: ``reference_velocity`` is not 3 finite numbers.
+        GovernorError: ``reference_velocity`` is not 3 finite numbers, or its speed (norm) is
+            above :data:`~impact_balance.constants.MAX_SPEED` m/s (the scenario's bound).
     """
     try:
+        if np.asarray(reference_velocity).dtype.kind not in "iuf":  # no complex, text, object
+            raise TypeError(reference_velocity)
         u = np.array(reference_velocity, dtype=float).reshape(3)
     except (TypeError, ValueError):
         raise GovernorError(
-            "reference_velocity", reference_velocity, "must be 3 numbers (world, m/s)"
+            "reference_velocity", reference_velocity, "must be 3 real numbers (world, m/s)"
         ) from None
-    if not math.isfinite(float(u @ u)):
-        raise GovernorError("reference_velocity", reference_velocity, "must be finite")
+    bad = np.flatnonzero(~np.isfinite(u))
+    if bad.size:
+        raise GovernorError(
+            "reference_velocity", reference_velocity, f"must be finite (entry {int(bad[0])})"
+        )
+    if math.hypot(*u) > MAX_SPEED:
+        raise GovernorError(
+            "reference_velocity", reference_velocity, f"the speed must be at most {MAX_SPEED:g} m/s"
+        )
     n = np.asarray(normal, dtype=float)
     if -float(n @ u) <= 0.0:
         return u

@@ -23,23 +23,29 @@ from impact_balance.governor.governor import Governor
 from impact_balance.governor.limit import SpeedLimit
 from impact_balance.governor.options import (
     CRITERIA,
+    ON_STALE,
     STARTS,
     ContactAwareOptions,
     Criterion,
+    OnStale,
     Starts,
 )
 from impact_balance.governor.posture import Posture, PostureEvaluator, PostureSettings
+from impact_balance.governor.worker import WorkerError
 
 __all__ = [
     "CRITERIA",
+    "ON_STALE",
     "STARTS",
     "ContactAwareOptions",
     "Criterion",
     "Governor",
+    "OnStale",
     "Posture",
     "PostureEvaluator",
     "PostureSettings",
     "SpeedLimit",
     "Starts",
+    "WorkerError",
     "cap_approach",
 ]

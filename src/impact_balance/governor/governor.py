@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import os
 import threading
+import time
 from pathlib import Path
 from typing import Any
 
@@ -14,6 +15,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from impact_balance.balance.areas import warm_up as warm_up_maps
+from impact_balance.constants import MAX_POSITION, MAX_SPEED
 from impact_balance.contacts.stance import has_free_flyer
 from impact_balance.criteria.cap import cap_approach
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
@@ -36,8 +38,13 @@ from impact_balance.scenario import (
 
 __all__ = ["Governor"]
 
-#: Largest |norm - 1| of the base quaternion in q (pinocchio's order x, y, z, w).
+#: Largest |norm - 1| of the base quaternion in q (pinocchio's order x, y, z, w), and of a
+#: continuous joint's (cos, sin) pair.
 QUATERNION_TOLERANCE = 1e-6
+#: How far a 1-dof joint of q may lie beyond its finite position limits (rad, or m for a
+#: prismatic joint): a measured state may overshoot a limit a little (a soft limit in
+#: simulation, encoder noise), a posture farther out is not the robot's.
+JOINT_LIMIT_TOLERANCE = 0.1
 
 
 class Governor:
@@ -124,6 +131,7 @@ class Governor:
         model = self.robot.model
         self.nq, self.nv = model.nq, model.nv
         self._free_flyer = has_free_flyer(model)
+        self._joints = _JointBounds(self.robot)
         assert scenario.impact is not None  # _governed refuses a scenario without one
         settings = PostureSettings(
             tuple(c.spec() for c in scenario.contacts),
@@ -147,11 +155,14 @@ class Governor:
         self._last: SpeedLimit | None = None
         self._posture: Posture | None = self._first_posture()
         self._support_posture: bytes | None = None
+        self._aware = aware
+        self._clock = _RatesClock()  # the rates' age
         if self._support is not None and aware is not None and aware.asynchronous:
             # The worker's first answer (the scenario's posture, which loads its compiled code)
             # gives the first rates; then it keeps them fresh.
             self._worker = ContactAwareWorker(scenario, aware.starts)
             self._support.adopt(self._worker.warm_up(self._posture.q))
+            self._support_posture = self._posture.key
 
     def _first_posture(self) -> Posture:
         """Load the compiled code and evaluate the scenario's posture.
@@ -199,9 +210,12 @@ class Governor:
             The speed limit (m/s), its limiting vertex and edge, the safe interval.
 
         Raises:
-            GovernorError: ``q`` or ``v`` of the wrong size, not finite, or a base
-                quaternion that is not unit (within 1e-6); with ``contact_aware_async``, a
-                worker that failed on an earlier posture or ended.
+            GovernorError: ``q`` or ``v`` not real numbers, of the wrong size, not finite, a
+                base quaternion that is not unit (within :data:`QUATERNION_TOLERANCE`), a joint
+                beyond its limits by more than :data:`JOINT_LIMIT_TOLERANCE`; with
+                ``contact_aware_async``, rates older than the options allow with
+                ``on_stale="raise"``, and :class:`~.worker.WorkerError` for a worker that
+                failed on an earlier posture or ended.
             ScenarioError, ImpactModelError, SolverError: a posture the pipeline cannot
                 evaluate (see :meth:`~impact_balance.governor.posture.PostureEvaluator.evaluate`).
         """
@@ -209,7 +223,14 @@ class Governor:
         velocity = _vector(v, self.nv, "v")
         with self._lock:
             posture, reused = self._posture_at(configuration)
-            return self._answer(posture, posture.com_jacobian @ velocity, reused)
+            com_velocity = posture.com_jacobian @ velocity  # |v| < 1e154: no overflow
+            if not float(com_velocity @ com_velocity) <= MAX_SPEED * MAX_SPEED:
+                raise GovernorError(
+                    "v",
+                    f"CoM velocity {math.hypot(*com_velocity):.3g} m/s",
+                    f"gives a CoM speed above {MAX_SPEED:g} m/s (the scenario's bound)",
+                )
+            return self._answer(posture, com_velocity, reused)
 
     def limit_com(self, q: ArrayLike, com_velocity: ArrayLike) -> SpeedLimit:
         """:meth:`limit` with the CoM velocity given, for a controller with its own estimate.
@@ -225,10 +246,14 @@ class Governor:
             GovernorError: A bad ``q`` (as :meth:`limit`) or ``com_velocity``.
         """
         configuration = self._configuration(q)
-        c = np.asarray(com_velocity, dtype=float).ravel() if _is_numeric(com_velocity) else None
-        if c is None or c.size not in (2, 3) or not math.isfinite(float(c @ c)):
+        c = np.asarray(com_velocity, dtype=float).ravel() if _is_real(com_velocity) else None
+        if c is None or c.size not in (2, 3) or not np.isfinite(c).all():
             raise GovernorError(
-                "com_velocity", com_velocity, "must be 2 or 3 finite numbers (world, m/s)"
+                "com_velocity", com_velocity, "must be 2 or 3 finite real numbers (world, m/s)"
+            )
+        if math.hypot(*c) > MAX_SPEED:
+            raise GovernorError(
+                "com_velocity", com_velocity, f"the speed must be at most {MAX_SPEED:g} m/s"
             )
         c = np.append(c, 0.0) if c.size == 2 else c.copy()
         with self._lock:
@@ -267,6 +292,10 @@ class Governor:
                 limit = self._last
             if limit is None:
                 raise GovernorError("limit", None, "no speed limit yet: call limit(q, v) first")
+        elif not isinstance(limit, SpeedLimit):
+            raise GovernorError(
+                "limit", limit, "must be a SpeedLimit (a governor's answer) or None"
+            )
         return cap_approach(reference_velocity, limit.normal, limit.safe_interval)
 
     def scenario_at(self, q: ArrayLike, com_velocity: ArrayLike) -> Scenario:
@@ -280,6 +309,7 @@ class Governor:
             ScenarioError: a joint outside its position limits (scenarios refuse those).
         """
         configuration = self._configuration(q)
+        self._joints.check(configuration)
         c = np.asarray(com_velocity, dtype=float).ravel()
         robot, joints = self.robot, {}
         for name in robot.joint_names:
@@ -322,13 +352,16 @@ class Governor:
         """``q`` as a checked configuration vector (see :meth:`limit`)."""
         configuration = _vector(q, self.nq, "q")
         if self._free_flyer:
+            if np.vdot(configuration, configuration) > MAX_POSITION * MAX_POSITION:  # rarely
+                _base_within_bounds(configuration)
             quaternion = configuration[3:7]
             norm = float(quaternion @ quaternion)
             if abs(norm - 1.0) > 2.0 * QUATERNION_TOLERANCE:
                 raise GovernorError(
                     "q",
                     quaternion.tolist(),
-                    "the base quaternion (x, y, z, w) must be unit; normalise it",
+                    "the base quaternion (x, y, z, w) must be unit (within "
+                    f"{QUATERNION_TOLERANCE:g}); normalise it",
                 )
         return configuration
 
@@ -337,10 +370,12 @@ class Governor:
         cached = self._posture
         if cached is not None:
             if self.posture_tolerance == 0.0:
-                if cached.key == q.tobytes():
+                if cached.key == q.tobytes():  # the very q checked when it was evaluated
                     return cached, True
             elif float(np.abs(q - cached.q).max()) <= self.posture_tolerance:
+                self._joints.check(q)
                 return cached, True
+        self._joints.check(q)
         try:
             posture = self._evaluator.evaluate(q)
         except ScenarioError as exc:
@@ -349,22 +384,55 @@ class Governor:
         return posture, False
 
     def _refresh_support(self, support: ContactAwareLimit, posture: Posture) -> None:
-        """Tell the contact-aware limit a posture was evaluated (under the lock).
+        """Keep the contact-aware rates up to date for ``posture`` (under the lock).
 
-        In the tick, it recomputes its rates when due; with a worker, a finished answer is
-        collected and the worker handed this posture when idle (never waiting).
+        In the tick, the limit recomputes its rates when due (on a new posture); with a
+        worker, every tick checks it (a finished answer is collected, a dead worker raised)
+        and hands it the current posture when it is idle (never waiting).
+
+        Raises:
+            WorkerError: The worker has ended, or failed on the posture it was given.
         """
-        if self._worker is None:
-            support.new_posture(lambda: posture.stance)
-        else:
-            done = self._worker.poll()
-            if done is None:
-                support.aged()
-            else:
-                support.adopt(done)
-            if self._worker.idle:
-                self._worker.submit(posture.key, posture.q)
-        self._support_posture = posture.key
+        clock = self._clock
+        new = self._support_posture != posture.key
+        if new:
+            clock.evaluated()
+            self._support_posture = posture.key
+        worker = self._worker
+        if worker is None:
+            if new:
+                support.new_posture(lambda: posture.stance)
+                if support.age == 0:
+                    clock.computed()
+            return
+        done = worker.poll()
+        if done is not None:
+            support.adopt(done, clock.adopted())
+        elif new:
+            support.aged()
+        if worker.idle and worker.submitted != posture.key:
+            worker.submit(posture.key, posture.q)
+            clock.submitted()
+
+    def _stale(self, postures: int, seconds: float) -> bool:
+        """Whether the asynchronous rates are older than the options allow.
+
+        Raises:
+            GovernorError: They are, and ``on_stale`` is "raise".
+        """
+        aware = self._aware
+        if self._worker is None or aware is None:
+            return False
+        if postures <= aware.max_age and seconds <= aware.max_age_seconds:
+            return False
+        if aware.on_stale == "raise":
+            raise GovernorError(
+                "contact_aware_async",
+                f"{postures} postures, {seconds:.3g} s",
+                f"the contact-aware rates are older than max_age ({aware.max_age} postures) "
+                f"or max_age_seconds ({aware.max_age_seconds:g} s): the worker is stalled",
+            )
+        return True
 
     def _answer(
         self, posture: Posture, com_velocity: npt.NDArray[np.float64], reused: bool
@@ -374,36 +442,96 @@ class Governor:
         criterion = posture.com_criterion
         support = self._support
         limit: ContactVelocityLimit
+        ages: tuple[int, float] | None = None
+        stale = False
         if criterion is not None and support is None:
             limit = criterion.limit(com_velocity)
             interval = criterion.interval(com_velocity, limit)
         elif criterion is not None and support is not None:
-            if self._support_posture != posture.key:  # a posture since: the rates may be due
-                self._refresh_support(support, posture)
+            if self._worker is not None or self._support_posture != posture.key:
+                self._refresh_support(support, posture)  # the rates may be due
+            ages = self._clock.age()
+            stale = self._stale(*ages)
             limit, aware = support.answers(criterion, com_velocity)
-            interval = combine(criterion.interval(com_velocity, limit), aware.interval)
-            if aware.limit.max_contact_velocity < limit.max_contact_velocity:
-                limit, binding = aware.limit, "contact_aware"
+            interval = criterion.interval(com_velocity, limit)
+            if not stale:
+                interval = combine(interval, aware.interval)
+                if aware.limit.max_contact_velocity < limit.max_contact_velocity:
+                    limit, binding = aware.limit, "contact_aware"
+            elif self._aware is not None and self._aware.on_stale == "zero":
+                return self._keep(
+                    _zero_answer(self.criterion, limit, com_velocity, posture, reused, ages)
+                )
         else:
             assert posture.zmp_limit is not None  # the "zmp" criterion's posture has it
             limit = posture.zmp_limit
             interval = _zmp_interval(limit)
         model = posture.impact
-        answer = SpeedLimit(
-            self.criterion,
-            limit.max_contact_velocity,
-            limit.status,
-            limit.limiting_vertex,
-            limit.limiting_edge,
-            interval,
-            com_velocity,
-            model.normal,
-            model.point,
-            reused,
-            binding,
+        return self._keep(
+            SpeedLimit(
+                self.criterion,
+                limit.max_contact_velocity,
+                limit.status,
+                limit.limiting_vertex,
+                limit.limiting_edge,
+                interval,
+                com_velocity,
+                model.normal,
+                model.point,
+                reused,
+                binding,
+                None if ages is None else ages[0],
+                None if ages is None else ages[1],
+                stale,
+            )
         )
+
+    def _keep(self, answer: SpeedLimit) -> SpeedLimit:
+        """``answer``, kept as the last (under the lock)."""
         self._last = answer
         return answer
+
+
+class _RatesClock:
+    """The contact-aware rates' age, in postures and in seconds.
+
+    Postures: evaluations since the one the rates are for. Seconds: since the first posture
+    evaluated after that one (0 while the rates are the current posture's: rates of a posture
+    the robot still holds are exact however old).
+    """
+
+    def __init__(self) -> None:
+        self.evaluations = 0
+        self._rates: tuple[int, float | None] = (0, None)  # (index, first later time)
+        self._submitted: tuple[int, float | None] = (0, None)
+
+    def evaluated(self) -> None:
+        """A new posture was evaluated."""
+        self.evaluations += 1
+        now = time.monotonic()
+        if self._rates[1] is None:
+            self._rates = (self._rates[0], now)
+        if self._submitted[1] is None:
+            self._submitted = (self._submitted[0], now)
+
+    def computed(self) -> None:
+        """The rates were computed for the current posture (in the tick)."""
+        self._rates = self._submitted = (self.evaluations, None)
+
+    def submitted(self) -> None:
+        """The current posture was handed to the worker."""
+        self._submitted = (self.evaluations, None)
+
+    def adopted(self) -> int:
+        """The worker's answer (for the posture last submitted) is in use; its age in postures."""
+        self._rates = self._submitted
+        return self.evaluations - self._rates[0]
+
+    def age(self) -> tuple[int, float]:
+        """The rates' age: (postures, seconds)."""
+        postures = self.evaluations - self._rates[0]
+        later = self._rates[1]
+        return postures, 0.0 if postures == 0 or later is None else time.monotonic() - later
 
 
 def _tolerance(posture_tolerance: float) -> float:
@@ -447,6 +575,12 @@ def _governed(
     not 0 with the "zmp" criterion).
     """
     if not isinstance(scenario, Scenario):
+        if not isinstance(scenario, (str, os.PathLike)):
+            raise GovernorError(
+                "scenario",
+                scenario,
+                "must be a Scenario, a scenario file or a bundled scenario name",
+            )
         scenario = load_scenario(scenario if isinstance(scenario, str) else Path(scenario))
     if scenario.impact is None:
         raise with_source(
@@ -464,6 +598,48 @@ def _governed(
     return scenario
 
 
+def _base_within_bounds(q: npt.NDArray[np.float64]) -> None:
+    """Raise :class:`GovernorError` naming a base coordinate of ``q`` beyond ``MAX_POSITION``."""
+    far = np.flatnonzero(np.abs(q[:3]) > MAX_POSITION)
+    if far.size:
+        raise GovernorError(
+            f"q[{int(far[0])}]",
+            float(q[far[0]]),
+            f"the base position must be within {MAX_POSITION:g} m per coordinate",
+        )
+
+
+def _zero_answer(
+    criterion: Criterion,
+    floating: ContactVelocityLimit,
+    com_velocity: npt.NDArray[np.float64],
+    posture: Posture,
+    reused: bool,
+    ages: tuple[int, float],
+) -> SpeedLimit:
+    """The answer of stale rates with ``on_stale="zero"``: no approach speed is vouched for.
+
+    The floating criterion's status is kept (it says whether the robot is already falling); the
+    maximum is 0 and there is no safe interval, so the cap removes the approach component.
+    """
+    return SpeedLimit(
+        criterion,
+        0.0,
+        floating.status,
+        None,
+        None,
+        None,
+        com_velocity,
+        posture.impact.normal,
+        posture.impact.point,
+        reused,
+        "contact_aware",
+        ages[0],
+        ages[1],
+        True,
+    )
+
+
 def _zmp_interval(limit: ContactVelocityLimit) -> tuple[float, float] | None:
     """The ZMP criterion's safe speeds.
 
@@ -473,27 +649,89 @@ def _zmp_interval(limit: ContactVelocityLimit) -> tuple[float, float] | None:
     return limit.interval_from_inside()
 
 
-def _is_numeric(x: object) -> bool:
-    """Whether ``x`` converts to a float array."""
+def _is_real(x: object) -> bool:
+    """Whether ``x`` is an array of real numbers (integers or floats; no complex, no text)."""
     try:
-        np.asarray(x, dtype=float)
+        return np.asarray(x).dtype.kind in "iuf"
     except (TypeError, ValueError):
         return False
-    return True
 
 
 def _vector(x: ArrayLike, size: int, field: str) -> npt.NDArray[np.float64]:
-    """``x`` as a contiguous float vector of ``size`` finite entries (a copy when converted)."""
+    """``x`` as a contiguous float vector of ``size`` finite entries (a copy when converted).
+
+    Real numbers only: a complex, boolean, text or object entry is refused (numpy would drop
+    an imaginary part with a warning, or parse text).
+    """
     try:
-        a = np.ascontiguousarray(x, dtype=float)
+        raw = np.asarray(x)
+        if raw.dtype.kind not in "iuf":
+            raise TypeError(raw.dtype)
+        a = np.ascontiguousarray(raw, dtype=float)
     except (TypeError, ValueError):
-        raise GovernorError(field, x, f"must be {size} numbers") from None
+        raise GovernorError(field, x, f"must be {size} real numbers") from None
     if a.shape != (size,):
         raise GovernorError(
             field, f"shape {a.shape}", f"must have {size} entries (the model's n{field})"
         )
-    if not math.isfinite(float(a @ a)):
+    if not math.isfinite(np.vdot(a, a)):  # one product per tick (vdot: no overflow warning)
         bad = np.flatnonzero(~np.isfinite(a))
-        which = f"entry {int(bad[0])}" if bad.size else "the entries are too large"
-        raise GovernorError(field, x, f"must be finite ({which})")
+        if bad.size:
+            raise GovernorError(field, x, f"must be finite (entry {int(bad[0])})")
+        k = int(np.argmax(np.abs(a)))
+        raise GovernorError(
+            f"{field}[{k}]", float(a[k]), "is finite but beyond any physical value (m, rad, m/s)"
+        )
     return a
+
+
+class _JointBounds:
+    """The joint part of a configuration check: limits plus :data:`JOINT_LIMIT_TOLERANCE`.
+
+    The rule of a scenario's ``joints`` (:meth:`~impact_balance.robot.robot.Robot.joint_assignment`:
+    a 1-dof joint with finite limits ``lower < upper`` lies within them), with a tolerance for a
+    measured state; a continuous joint's (cos, sin) is a unit pair (within
+    :data:`QUATERNION_TOLERANCE`).
+    """
+
+    def __init__(self, robot: Robot) -> None:
+        names, idx, lower, upper, pairs = [], [], [], [], []
+        for name in robot.joint_names:
+            slot = robot.joint_slot(name)
+            if slot.nq == 1:
+                lo, hi = slot.lower, slot.upper
+                if math.isfinite(lo) and math.isfinite(hi) and lo < hi:
+                    names.append(name)
+                    idx.append(slot.idx_q)
+                    lower.append(lo - JOINT_LIMIT_TOLERANCE)
+                    upper.append(hi + JOINT_LIMIT_TOLERANCE)
+            elif slot.nq == 2 and slot.nv == 1:
+                pairs.append((name, slot.idx_q))
+        self.names = names
+        self.idx = np.asarray(idx, dtype=np.int64)
+        self.lower = np.asarray(lower, dtype=float)
+        self.upper = np.asarray(upper, dtype=float)
+        self.pairs = pairs
+
+    def check(self, q: npt.NDArray[np.float64]) -> None:
+        """Raise :class:`GovernorError` naming the first joint of ``q`` out of bounds."""
+        values = q[self.idx]
+        outside = (values < self.lower) | (values > self.upper)
+        if outside.any():
+            k = int(np.flatnonzero(outside)[0])
+            lo = self.lower[k] + JOINT_LIMIT_TOLERANCE
+            hi = self.upper[k] - JOINT_LIMIT_TOLERANCE
+            raise GovernorError(
+                f"q[{int(self.idx[k])}]",
+                float(values[k]),
+                f"joint {self.names[k]!r} is outside its limits [{lo:.4g}, {hi:.4g}] "
+                f"(tolerance {JOINT_LIMIT_TOLERANCE:g})",
+            )
+        for name, i in self.pairs:
+            norm = float(q[i] * q[i] + q[i + 1] * q[i + 1])
+            if abs(norm - 1.0) > 2.0 * QUATERNION_TOLERANCE:
+                raise GovernorError(
+                    f"q[{i}:{i + 2}]",
+                    [float(q[i]), float(q[i + 1])],
+                    f"continuous joint {name!r}: (cos, sin) must be a unit pair",
+                )

@@ -57,6 +57,15 @@ class SpeedLimit:
             ``limiting_vertex`` is the row of its jump rates, ``ContactAwareAnswer.rates``:
             0 / 1 the lower / upper restitution bound with one start, else one row per
             solution found, ``ContactAwareAnswer.restitution`` giving each row's bound).
+        rates_age: The contact-aware rates' age in postures (posture evaluations since the
+            one they were computed for; 0: this posture's); None without contact-aware rates.
+        rates_age_seconds: Their age in seconds (since the governor was given the posture
+            they are for; 0 while it is the current posture); None without contact-aware rates.
+        stale: True when the rates were older than the options allow
+            (:class:`~impact_balance.governor.options.ContactAwareOptions` ``max_age``,
+            ``max_age_seconds``) and were not used: the answer is then ``on_stale``'s, zero
+            approach speed (binding "contact_aware", ``max_contact_velocity`` 0, no safe
+            interval) or the floating criterion alone (binding "floating").
     """
 
     criterion: CriterionName
@@ -70,6 +79,9 @@ class SpeedLimit:
     point: npt.NDArray[np.float64]
     posture_reused: bool
     binding: Binding = "floating"
+    rates_age: int | None = None
+    rates_age_seconds: float | None = None
+    stale: bool = False
 
     @property
     def ceiling(self) -> float:

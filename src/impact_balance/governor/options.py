@@ -8,13 +8,22 @@ scenario's own keys, as :func:`~impact_balance.analyze` reads them.
 
 from __future__ import annotations
 
+import math
 import numbers
 from dataclasses import dataclass
 from typing import Literal, get_args
 
 from impact_balance.exceptions import GovernorError
 
-__all__ = ["CRITERIA", "STARTS", "ContactAwareOptions", "Criterion", "Starts"]
+__all__ = [
+    "CRITERIA",
+    "ON_STALE",
+    "STARTS",
+    "ContactAwareOptions",
+    "Criterion",
+    "OnStale",
+    "Starts",
+]
 
 #: A governor's criterion: "com", the CoM velocity area (the paper's); "zmp", the predicted
 #: ZMP stays in the ZMP support area (the paper's Experiment 1 comparison).
@@ -28,6 +37,15 @@ CRITERIA: tuple[Criterion, ...] = get_args(Criterion)
 Starts = Literal["union", "warm", "cold"]
 #: Every :data:`Starts`, in order.
 STARTS: tuple[Starts, ...] = get_args(Starts)
+
+#: What an asynchronous governor answers when its contact-aware rates are older than the
+#: options' ages allow: "zero" (no approach speed: ``max_contact_velocity`` 0, the approach
+#: component removed by the cap), "floating" (the floating criterion alone, with the velocity
+#: margin: the paper's governor, which is above the contact-aware cap where that binds) or
+#: "raise" (:class:`~impact_balance.exceptions.GovernorError`).
+OnStale = Literal["zero", "floating", "raise"]
+#: Every :data:`OnStale`, in order.
+ON_STALE: tuple[OnStale, ...] = get_args(OnStale)
 
 
 @dataclass(frozen=True)
@@ -43,15 +61,28 @@ class ContactAwareOptions:
         asynchronous: Recompute the rates in a worker process (:mod:`.worker`, POSIX) instead
             of in the tick: the tick never waits and uses rates one recomputation old; close
             the governor (or use ``with``) to stop the worker.
+        max_age: With ``asynchronous``: the oldest rates the governor answers with, in
+            postures (posture evaluations since the one the rates were computed for;
+            :attr:`~impact_balance.governor.limit.SpeedLimit.rates_age`). Default 250 (0.5 s
+            of postures at 500 Hz; a recomputation takes 12 to 170 ms on the bundled stances).
+        max_age_seconds: With ``asynchronous``: the oldest rates in seconds (since the governor
+            handed the worker the posture they are for; 0 while that is still the current
+            posture). Default 0.5 s.
+        on_stale: What an asynchronous governor answers beyond either age (:data:`OnStale`):
+            "zero" (default), "floating" or "raise". The synchronous governor recomputes the
+            rates in the tick every ``every`` postures: its rates are never stale.
 
     Raises:
-        GovernorError: ``every`` not an integer >= 1, or unknown ``starts``, naming the field
-            (``contact_aware.every``, ``contact_aware.starts``).
+        GovernorError: ``every`` not an integer >= 1, unknown ``starts`` or ``on_stale``, an
+            age that is not a number >= 0, naming the field (``contact_aware.every``...).
     """
 
     every: int = 5
     starts: Starts = "union"
     asynchronous: bool = False
+    max_age: int = 250
+    max_age_seconds: float = 0.5
+    on_stale: OnStale = "zero"
 
     def __post_init__(self) -> None:
         """Check the settings (see the class docstring)."""
@@ -62,4 +93,23 @@ class ContactAwareOptions:
         if self.starts not in STARTS:
             raise GovernorError(
                 "contact_aware.starts", self.starts, f"must be one of {', '.join(STARTS)}"
+            )
+        age = self.max_age
+        if isinstance(age, bool) or not isinstance(age, numbers.Integral) or age < 0:
+            raise GovernorError("contact_aware.max_age", age, "must be an integer >= 0 (postures)")
+        object.__setattr__(self, "max_age", int(age))
+        seconds = self.max_age_seconds
+        if (
+            isinstance(seconds, bool)
+            or not isinstance(seconds, numbers.Real)
+            or not math.isfinite(float(seconds))
+            or seconds < 0
+        ):
+            raise GovernorError(
+                "contact_aware.max_age_seconds", seconds, "must be a finite number >= 0 (s)"
+            )
+        object.__setattr__(self, "max_age_seconds", float(seconds))
+        if self.on_stale not in ON_STALE:
+            raise GovernorError(
+                "contact_aware.on_stale", self.on_stale, f"must be one of {', '.join(ON_STALE)}"
             )

@@ -281,11 +281,19 @@ class ContactAwareLimit:
         """
         return self._solve(stance, self._solutions if kept is None else kept)
 
-    def adopt(self, solutions: ContactAwareSolutions) -> None:
-        """Use ``solutions`` from now on (age 0), e.g. a worker's answer."""
+    def adopt(self, solutions: ContactAwareSolutions, age: int = 0) -> None:
+        """Use ``solutions`` from now on, e.g. a worker's answer.
+
+        ``age``: postures evaluated since the one they were computed for (0: the current).
+        """
         self._solutions = solutions
         self._converged = bool(solutions.converged.all())
-        self._age = 0
+        self._age = age
+
+    @property
+    def age(self) -> int:
+        """Posture evaluations since the one the rates in use were computed for."""
+        return self._age
 
     def aged(self) -> None:
         """A posture was evaluated and the rates were not recomputed for it (age + 1)."""

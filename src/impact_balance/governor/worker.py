@@ -16,16 +16,21 @@ scenario once and answers until the governor closes it (:meth:`Governor.close`, 
 ``with`` block, or the governor's collection). On a machine whose every core is busy it gets
 little time and its rates age. POSIX only (the worker inherits one end of a socket pair).
 
-Failures are :class:`~impact_balance.exceptions.GovernorError` naming ``contact_aware_async``:
-a worker that cannot start, does not answer in :data:`START_TIMEOUT`, ends, or fails on a
-posture (raised on the governor's next tick).
+Failures are :class:`WorkerError` (a :class:`~impact_balance.exceptions.GovernorError`)
+naming ``contact_aware_async``: a worker that cannot start, does not answer in
+:data:`START_TIMEOUT`, fails on a posture (raised on the governor's next tick), or ends (killed,
+crashed: noticed on the next tick, whether the posture changed or not, and raised on every
+tick after). The governor never writes to the worker with SIGPIPE armed: a dead worker is an
+error, not a signal that ends the controller.
 """
 
 from __future__ import annotations
 
 import os
+import pickle
 import select
 import socket
+import struct
 import subprocess
 import sys
 import weakref
@@ -41,10 +46,29 @@ from impact_balance.governor.support import ContactAwareLimit, ContactAwareSolut
 if TYPE_CHECKING:
     from impact_balance.scenario import Scenario
 
-__all__ = ["ContactAwareWorker"]
+__all__ = ["ContactAwareWorker", "WorkerError"]
 
 #: Seconds to wait for the worker's start (a fresh interpreter, its imports and the robot, ~2 s).
 START_TIMEOUT = 120.0
+#: send() without SIGPIPE (Linux); elsewhere 0, and a dead worker raises BrokenPipeError only
+#: where SIGPIPE is ignored (Python's default).
+_NOSIGNAL = getattr(socket, "MSG_NOSIGNAL", 0)
+
+
+class WorkerError(GovernorError):
+    """The contact-aware worker process failed: it did not start, ended, or failed on a posture.
+
+    A :class:`~impact_balance.exceptions.GovernorError` on ``contact_aware_async``; the
+    command line exits 1 (a failure of the machine, not of the input).
+    """
+
+    exit_status = 1
+
+
+def _send(sock: socket.socket, message: object) -> None:
+    """``message`` in :class:`~multiprocessing.connection.Connection`'s framing, without SIGPIPE."""
+    payload = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
+    sock.sendall(struct.pack("!i", len(payload)) + payload, _NOSIGNAL)
 
 
 def _serve(conn: Connection) -> None:
@@ -87,18 +111,19 @@ def _serve(conn: Connection) -> None:
             conn.send((key, None, f"{type(exc).__name__}: {exc}"))
 
 
-def _stop(conn: Connection, process: subprocess.Popen[bytes]) -> None:
+def _stop(sock: socket.socket, conn: Connection, process: subprocess.Popen[bytes]) -> None:
     """Ask the worker to stop, then make sure it has (killed after a grace period)."""
     try:
-        conn.send(None)
+        _send(sock, None)
     except (OSError, ValueError):
         pass
     try:
         process.wait(timeout=2.0)
     except subprocess.TimeoutExpired:
-        process.kill()
+        process.kill()  # also ends a stopped (SIGSTOP) worker
         process.wait(timeout=2.0)
     conn.close()
+    sock.close()
 
 
 class ContactAwareWorker:
@@ -130,28 +155,52 @@ class ContactAwareWorker:
             ValueError,
         ) as exc:  # ValueError: no pass_fds (Windows); the option is POSIX-only
             parent.close()
-            raise GovernorError(
+            raise WorkerError(
                 "contact_aware_async", None, f"could not start the worker ({exc})"
             ) from None
         finally:
             child.close()
-        self._conn = Connection(parent.detach())
+        # Sent through the socket (MSG_NOSIGNAL), received through a Connection on its copy.
+        self._sock = parent
+        self._conn = Connection(os.dup(parent.fileno()))
         # A tick's check for an answer: select.poll is several times cheaper than
-        # Connection.poll (docs/studies/design-history.md).
+        # Connection.poll (docs/studies/design-history.md). A dead worker reports POLLHUP.
         self._poller = select.poll()
         self._poller.register(self._conn.fileno(), select.POLLIN)
-        self._finalizer = weakref.finalize(self, _stop, self._conn, self._process)
+        self._finalizer = weakref.finalize(self, _stop, self._sock, self._conn, self._process)
         self._busy = True  # until "ready"
+        self._failure: WorkerError | None = None  # once the worker has ended: raised every call
         self.submitted: bytes | None = None
-        self._conn.send((scenario.model_dump(exclude_none=True), scenario.source, starts))
+        self._write((scenario.model_dump(exclude_none=True), scenario.source, starts))
         if not self._conn.poll(START_TIMEOUT):
             self.close()
-            raise GovernorError("contact_aware_async", None, "the worker process did not start")
+            raise WorkerError("contact_aware_async", None, "the worker process did not start")
         try:
             self._receive()
         except GovernorError:
             self.close()
             raise
+
+    @property
+    def pid(self) -> int:
+        """The worker's process id."""
+        return self._process.pid
+
+    def _ended(self, how: str) -> WorkerError:
+        """Record that the worker has ended (every later call raises it) and return the error."""
+        code = self._process.poll()
+        detail = f"{how}; exit status {code}" if code is not None else how
+        self._failure = WorkerError(
+            "contact_aware_async", self._process.pid, f"the worker process ended ({detail})"
+        )
+        self._busy = False
+        return self._failure
+
+    def _write(self, message: object) -> None:
+        try:
+            _send(self._sock, message)
+        except OSError as exc:  # BrokenPipeError, ConnectionResetError: the worker is gone
+            raise self._ended(type(exc).__name__) from None
 
     def warm_up(self, q: np.ndarray) -> ContactAwareSolutions:
         """Solve once at ``q`` and wait, returning the answer.
@@ -168,26 +217,44 @@ class ContactAwareWorker:
         Raises:
             GovernorError: The worker did not answer within :data:`START_TIMEOUT` s.
         """
-        self.submit(b"warm-up", q)
-        solutions = self.wait(START_TIMEOUT)
+        try:
+            self.submit(b"warm-up", q)
+            solutions = self.wait(START_TIMEOUT)
+        except GovernorError:
+            self.close()
+            raise
         if solutions is None:
             self.close()
-            raise GovernorError("contact_aware_async", None, "the worker did not answer")
+            raise WorkerError("contact_aware_async", None, "the worker did not answer")
         return solutions
 
     def _receive(self) -> tuple[Any, ContactAwareSolutions | None]:
+        if self._failure is not None:
+            raise self._failure
         try:
-            key, solutions, error = self._conn.recv()
-        except (EOFError, OSError):
-            raise GovernorError("contact_aware_async", None, "the worker process ended") from None
+            message = self._conn.recv()
+        except (EOFError, OSError) as exc:
+            raise self._ended(type(exc).__name__) from None
+        except Exception as exc:  # a damaged message (unpickling): the worker is not trusted
+            raise self._ended(f"unreadable answer, {type(exc).__name__}") from None
+        if not self._busy or not (isinstance(message, tuple) and len(message) == 3):
+            raise self._ended("an answer nobody asked for")
+        key, solutions, error = message
         self._busy = False
         if error is not None:
-            raise GovernorError("contact_aware_async", error[:200], "the worker failed")
+            raise WorkerError("contact_aware_async", str(error)[:200], "the worker failed")
         return key, solutions
 
     def poll(self) -> ContactAwareSolutions | None:
-        """A finished answer, if the worker has one (never waits)."""
-        if self._busy and self._poller.poll(0):
+        """A finished answer, if the worker has one (never waits).
+
+        Raises:
+            WorkerError: The worker has ended (its end of the socket closed: also noticed
+                while it is idle), or failed on the posture it was given.
+        """
+        if self._failure is not None:
+            raise self._failure
+        if self._poller.poll(0):
             return self._receive()[1]
         return None
 
@@ -197,8 +264,14 @@ class ContactAwareWorker:
         return not self._busy
 
     def submit(self, key: bytes, q: np.ndarray) -> None:
-        """Ask for the rates at configuration ``q`` (nq), continuing the worker's last answer."""
-        self._conn.send((key, np.asarray(q)))
+        """Ask for the rates at configuration ``q`` (nq), continuing the worker's last answer.
+
+        Raises:
+            WorkerError: The worker has ended.
+        """
+        if self._failure is not None:
+            raise self._failure
+        self._write((key, np.asarray(q)))
         self._busy = True
         self.submitted = key
 

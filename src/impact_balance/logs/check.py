@@ -38,9 +38,11 @@ import pandas as pd
 import pinocchio as pin
 
 from impact_balance.balance.areas import balance_areas
+from impact_balance.constants import MAX_POSITION
 from impact_balance.contacts.stance import ContactSpec, Stance
 from impact_balance.exceptions import ScenarioError
 from impact_balance.geometry.polygon import Polygon
+from impact_balance.governor.governor import JOINT_LIMIT_TOLERANCE
 from impact_balance.json_values import json_number
 from impact_balance.logs.io import check_log_columns
 from impact_balance.logs.schema import (
@@ -64,6 +66,13 @@ __all__ = [
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int_]
+
+#: Largest |norm - 1| of a logged base quaternion: a quaternion further from unit is refused,
+#: not normalised (its scale says the column is not a rotation; float32 logs are within 1e-6).
+QUATERNION_TOLERANCE = 1e-3
+#: Prefixes of the optional columns whose values must not be infinite (an empty cell, NaN, is a
+#: sample where the value was not measured).
+_OPTIONAL = ("zmp_", "force_", "com_", "comd_")
 
 #: What a violation left: the CoM velocity area (margin in m/s) or the ZMP support area (m).
 ViolationKind = Literal["com_velocity", "zmp"]
@@ -265,7 +274,8 @@ def log_state(frame: pd.DataFrame, robot: Robot) -> tuple[FloatArray, FloatArray
         The configurations and the velocities, one row per sample.
 
     Raises:
-        ScenarioError: A base quaternion is zero or not finite, or a joint has several dofs.
+        ScenarioError: A base quaternion that is not unit (within :data:`QUATERNION_TOLERANCE`;
+            it is then normalised exactly), or a joint has several dofs.
     """
     cols = LogColumns()
     model = robot.model
@@ -274,10 +284,16 @@ def log_state(frame: pd.DataFrame, robot: Robot) -> tuple[FloatArray, FloatArray
     V = np.zeros((T, model.nv))
     Q[:, 0:3] = frame[list(cols.base_position)].to_numpy(float)
     quat = frame[list(cols.base_quaternion)].to_numpy(float)
-    norms = np.linalg.norm(quat, axis=1, keepdims=True)
-    if np.any(~np.isfinite(norms)) or np.any(norms < 1e-9):
+    with np.errstate(over="ignore", invalid="ignore"):
+        norms = np.sqrt(np.sum((quat / 2.0) ** 2, axis=1, keepdims=True)) * 2.0  # no overflow
+    off = ~(np.abs(norms[:, 0] - 1.0) <= QUATERNION_TOLERANCE)
+    if off.any():
+        k = int(np.flatnonzero(off)[0])
         raise ScenarioError(
-            "LOG", "base_qx..base_qw", "the base quaternion must be finite and non-zero"
+            "LOG",
+            "base_qx..base_qw",
+            f"row {k + 1}: the base quaternion has norm {float(norms[k, 0]):.6g}; it must be "
+            f"unit within {QUATERNION_TOLERANCE:g} (x, y, z, w)",
         )
     Q[:, 3:7] = quat / norms
     lin = frame[list(cols.base_linear_velocity)].to_numpy(float)
@@ -371,9 +387,67 @@ def _checked_times(
     robot = scenario.load_robot()
     _joint_columns(frame, robot, source)
     times = frame[cols.time].to_numpy(float)
-    if np.any(~np.isfinite(times)) or np.any(np.diff(times) < 0):
-        raise ScenarioError("LOG", source, "time must be finite and increasing")
+    if np.any(~np.isfinite(times)):
+        raise ScenarioError("LOG", source, "time must be finite")
+    steps = np.flatnonzero(~(np.diff(times) > 0.0))
+    if steps.size:
+        k = int(steps[0]) + 1
+        raise ScenarioError(
+            "LOG",
+            source,
+            f"column {cols.time}, row {k + 1}: {times[k]:.9g} s after {times[k - 1]:.9g} s; "
+            "time must strictly increase",
+        )
+    _infinite_optional(frame, source)
+    _bounded_positions(frame, robot, source)
     return robot, times
+
+
+def _infinite_optional(frame: pd.DataFrame, source: str) -> None:
+    """Refuse an infinite value in an optional column (a force, the ZMP, a reference CoM)."""
+    for name in frame.columns:
+        if not str(name).startswith(_OPTIONAL):
+            continue
+        values = pd.to_numeric(frame[name], errors="coerce").to_numpy(dtype=float)
+        bad = np.flatnonzero(np.isinf(values))
+        if bad.size:
+            raise ScenarioError(
+                "LOG",
+                source,
+                f"column {name}, row {int(bad[0]) + 1}: {values[bad[0]]:g}, not a finite number "
+                "(leave the cell empty where it was not measured)",
+            )
+
+
+def _bounded_positions(frame: pd.DataFrame, robot: Robot, source: str) -> None:
+    """Refuse a base position or a joint beyond what a scenario accepts.
+
+    The base within :data:`~impact_balance.constants.MAX_POSITION` m of the origin per
+    coordinate; a 1-dof joint with finite limits within them plus
+    :data:`~impact_balance.governor.governor.JOINT_LIMIT_TOLERANCE` (the governor's rule).
+    """
+    columns = [(c, -MAX_POSITION, MAX_POSITION, "m") for c in LogColumns().base_position]
+    for name in robot.joint_names:
+        slot = robot.joint_slot(name)
+        lo, hi = slot.lower, slot.upper
+        if slot.nq == 1 and np.isfinite(lo) and np.isfinite(hi) and lo < hi:
+            column = joint_position_column(name)
+            columns.append((column, lo - JOINT_LIMIT_TOLERANCE, hi + JOINT_LIMIT_TOLERANCE, ""))
+    for column, lo, hi, unit in columns:
+        values = frame[column].to_numpy(dtype=float)
+        bad = np.flatnonzero((values < lo) | (values > hi))
+        if bad.size:
+            k = int(bad[0])
+            if unit:
+                bound = f"must be in [{lo:g}, {hi:g}] {unit}"
+            else:
+                bound = (
+                    f"outside the joint limits [{lo + JOINT_LIMIT_TOLERANCE:.4g}, "
+                    f"{hi - JOINT_LIMIT_TOLERANCE:.4g}] (tolerance {JOINT_LIMIT_TOLERANCE:g})"
+                )
+            raise ScenarioError(
+                "LOG", source, f"column {column}, row {k + 1}: {values[k]:.6g} {bound}"
+            )
 
 
 class _StanceTracker:
@@ -571,7 +645,11 @@ def check_log(
 
     Raises:
         ScenarioError: The log lacks a column, has no sample, a value that is not a finite
-            number, joints that are not the robot's, or times that decrease.
+            number (an infinite force or ZMP included), joints that are not the robot's,
+            times that do not strictly increase, a base quaternion that is not unit (within
+            :data:`QUATERNION_TOLERANCE`), a base position beyond
+            :data:`~impact_balance.constants.MAX_POSITION` m or a joint beyond its limits
+            (plus the governor's ``JOINT_LIMIT_TOLERANCE``); each names its column and row.
     """
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)

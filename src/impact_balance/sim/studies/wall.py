@@ -44,9 +44,11 @@ from impact_balance.sim.trials.result import BalanceTrialResult
 __all__ = [
     "APPROACH_VERSION",
     "GOVERNORS",
+    "MIN_WALL_DISTANCE",
     "GovernedApproach",
     "WallOptions",
     "WallTrial",
+    "check_wall_distance",
     "run_wall_trial",
     "write_wall_video",
 ]
@@ -60,6 +62,39 @@ _FloatArray = npt.NDArray[np.float64]
 #: Governors of the approach: the CoM criterion's, the ZMP criterion's, or none (the reference
 #: alone).
 GOVERNORS = ("com", "zmp", "none")
+
+#: Closest wall, m from the point's start: a trial starts the point at least 2 cm from the
+#: surface (:mod:`impact_balance.ranges`); a wall at the start point is touched before the
+#: approach begins, and nothing is tested.
+MIN_WALL_DISTANCE = 0.02
+
+
+def check_wall_distance(
+    distance: float, reference: float, acceleration: float = 20.0, field: str = "--wall-distance"
+) -> float:
+    """``distance`` (m) if the approach can reach its reference speed before the wall.
+
+    The reference speed ramps up at ``acceleration`` (m/s^2) from rest, so it needs
+    ``reference**2 / (2 * acceleration)`` m to reach ``reference`` (m/s); the wall must be at
+    least that far, and at least :data:`MIN_WALL_DISTANCE`, from the point's start (and at most
+    1 m).
+
+    Raises:
+        SimulationError: Otherwise, naming ``field`` and the least distance.
+    """
+    if not (np.isfinite(distance) and 0.0 < distance <= 1.0):
+        raise SimulationError(field, distance, "must be in (0, 1] m")
+    needed = max(MIN_WALL_DISTANCE, reference * reference / (2.0 * acceleration))
+    if distance < needed:
+        raise SimulationError(
+            field,
+            distance,
+            f"the wall must be at least {needed:.3g} m from the point's start: the reference "
+            f"reaches {reference:g} m/s after {reference * reference / (2.0 * acceleration):.3g} m "
+            f"at {acceleration:g} m/s^2, and a trial needs {MIN_WALL_DISTANCE:g} m at least "
+            "(move the wall or lower --reference)",
+        )
+    return float(distance)
 
 
 @dataclass(frozen=True)
@@ -234,7 +269,8 @@ def run_wall_trial(
         What the approach measured.
 
     Raises:
-        SimulationError: Options out of range, or a scenario without an impact.
+        SimulationError: Options out of range (a wall closer than the approach needs:
+            :func:`check_wall_distance`), or a scenario without an impact.
     """
     _check(options)
     analysis = setup.analysis
@@ -295,8 +331,9 @@ def _check(options: WallOptions) -> None:
         )
     if not (np.isfinite(options.reference) and 0.0 < options.reference <= 5.0):
         raise SimulationError("--reference", options.reference, "must be in (0, 5] m/s")
-    if not (np.isfinite(options.wall_distance) and 0.0 < options.wall_distance <= 1.0):
-        raise SimulationError("--wall-distance", options.wall_distance, "must be in (0, 1] m")
+    if not (np.isfinite(options.acceleration) and options.acceleration > 0.0):
+        raise SimulationError("acceleration", options.acceleration, "must be > 0 m/s^2")
+    check_wall_distance(options.wall_distance, options.reference, options.acceleration)
 
 
 class _ApproachRecorder:
