@@ -16,6 +16,7 @@ pytest.importorskip("mujoco", reason="needs the sim extra (MuJoCo)")
 from impact_balance.exceptions import EnvironmentFailure, SimulationError
 from impact_balance.sim.studies import journal as journal_module
 from impact_balance.sim.studies.journal import TrialJournal
+from tests.helpers.cli import assert_one_line_error, run_cli
 
 BALANCED = {"summary": {"outcome": "balanced", "x": 1.5}, "trajectory": {"time": [0.0]}}
 FELL = {"summary": {"outcome": "fell"}, "trajectory": {}}
@@ -186,3 +187,12 @@ def test_a_cut_last_line_is_ended_before_the_next_trial(tmp_path):
     third = TrialJournal.open(path, "d")
     assert len(third.entries) == 3 and third.skipped_lines == 1
     third.close()
+
+
+@pytest.mark.parametrize("command", ["validate", "push-test"])
+def test_the_commands_refuse_a_fifo_journal_in_one_line(tmp_path, capsys, command):
+    fifo = tmp_path / "j.jsonl"
+    os.mkfifo(fifo)
+    rc, _, err = run_cli(capsys, command, "palm_push_two_feet", "--journal", str(fifo))
+    err = "".join(line for line in err.splitlines(True) if "compiling" not in line)
+    assert_one_line_error(rc, err, "--journal", "not a regular file")
