@@ -10,12 +10,14 @@ damaged, ending with the same rows as an uninterrupted run.
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 import shutil
 import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -39,7 +41,7 @@ from impact_balance.robot.robot import load_robot
 from impact_balance.scenario import read_mapping, scenario_from_dict, scenario_path
 from impact_balance.sweep import Evaluator, make_plan, read_results, run_sweep, sweep_spec_from_dict
 from impact_balance.sweep.cluster import check_scheduler_address, connect
-from impact_balance.sweep.store import LEDGER, check_folder, table_checksum
+from impact_balance.sweep.store import LEDGER, MANIFEST, check_folder, table_checksum
 
 SRC = str(Path(__file__).parents[2] / "src")
 BASE = "palm_push_two_feet"
@@ -226,6 +228,138 @@ def test_a_torn_manifest_line_is_skipped_and_repaired(tmp_path, clean):
     assert check_folder(out).ok  # the unrecorded part is checked by its own metadata
     run_sweep(plan_of(), out, workers=1, progress=False)
     assert len(ledger.read_text().splitlines()) == 4
+
+
+def _manifest_edit(out: Path, **changes) -> None:
+    manifest = json.loads((out / MANIFEST).read_text())
+    (out / MANIFEST).write_text(json.dumps({**manifest, **changes}))
+
+
+def _verify_line(capsys, out: Path) -> tuple[int, str]:
+    rc = main(["sweep", "--verify", str(out)])
+    captured = capsys.readouterr()
+    return rc, captured.out + captured.err
+
+
+@pytest.mark.parametrize(
+    "changes, needle",
+    [
+        ({"chunk_size": 7}, "chunk_size is 7, its sweep has 4"),
+        ({"n_chunks": 100000000}, "n_chunks is 100000000, its sweep has 4"),
+        ({"n_points": 16}, "n_points is 16"),
+        ({"dimensions": 3}, "dimensions is not a list"),
+        ({"dimensions": [{"name": "a"}]}, "1 dimensions"),
+        ({"spec": [1]}, "spec"),
+    ],
+)
+def test_a_manifest_is_checked_against_the_sweep_it_records(
+    tmp_path, capsys, clean, changes, needle
+):
+    out = tmp_path / "out"
+    shutil.copytree(clean / "whole", out)
+    _manifest_edit(out, **changes)
+    rc, text = _verify_line(capsys, out)
+    assert rc == 2 and len(text.splitlines()) == 1 and "manifest.json is damaged" in text
+    assert needle in text and "internal error" not in text
+
+
+def test_a_resume_rewrites_an_edited_manifest_and_repairs_once(tmp_path, capsys, clean):
+    out = tmp_path / "out"
+    shutil.copytree(clean / "whole", out)
+    _manifest_edit(out, chunk_size=2, n_chunks=8)
+    lines: list = []
+    report = run_sweep(plan_of(), out, workers=1, progress=False, notify=lines.append)
+    assert any("manifest.json: damaged: chunk_size is 2" in str(line) for line in lines)
+    assert report.chunks_computed == 0 and report.complete
+    assert not (out / "rejected").exists()  # the parts were good: nothing moved aside
+    assert read_results(out).equals(read_results(clean / "whole"))
+    assert _verify_line(capsys, out)[0] == 0
+    again: list = []
+    run_sweep(plan_of(), out, workers=1, progress=False, notify=again.append)
+    assert again == []
+
+
+def test_a_missing_ledger_is_damage_even_with_a_forged_part(tmp_path, capsys, clean):
+    out = tmp_path / "out"
+    shutil.copytree(clean / "whole", out)
+    path = out / "parts/part-000002.parquet"
+    table = pq.read_table(path)
+    meta = dict(table.schema.metadata)
+    values = table["max_contact_velocity"].to_pylist()
+    values[0] *= 2
+    forged = table.set_column(
+        table.schema.get_field_index("max_contact_velocity"),
+        "max_contact_velocity",
+        pa.array(values),
+    ).replace_schema_metadata(None)
+    meta[b"impact_balance.checksum"] = table_checksum(forged).encode()
+    pq.write_table(forged.replace_schema_metadata(meta), path)
+    (out / LEDGER).unlink()
+    rc, text = _verify_line(capsys, out)
+    assert rc == 2 and f"{LEDGER}: missing" in text and "part-000002.parquet: damaged" in text
+    computed: list = []
+    run_sweep(plan_of(), out, workers=1, progress=False, on_chunk=computed.append)
+    assert sorted(computed) == [0, 1, 2, 3]
+    assert read_results(out).equals(read_results(clean / "whole"))
+    assert _verify_line(capsys, out)[0] == 0
+
+
+def _padded(path: Path, how: str) -> None:
+    table = pq.read_table(path)
+    meta = table.schema.metadata
+    if how == "padding column":
+        pad = pa.array(["0" * 4_000_000] * table.num_rows)
+        table = table.append_column("padding", pad)
+    else:  # the message column holds megabytes
+        column = table.schema.get_field_index("message")
+        table = table.set_column(column, "message", pa.array(["0" * 4_000_000] * table.num_rows))
+    pq.write_table(table.replace_schema_metadata(meta), path, compression="zstd")
+
+
+@pytest.mark.parametrize(
+    "how, needle", [("padding column", "not this sweep's"), ("huge values", "uncompressed")]
+)
+def test_verify_checks_a_part_from_its_footer_before_reading_it(
+    tmp_path, capsys, clean, how, needle
+):
+    out = tmp_path / "out"
+    shutil.copytree(clean / "whole", out)
+    path = out / "parts/part-000001.parquet"
+    _padded(path, how)
+    assert path.stat().st_size < 200_000  # small on disk, 16 MB once read
+    read = []
+    real = pq.ParquetFile.read
+    pq.ParquetFile.read = lambda self, *a, **k: read.append(1) or real(self, *a, **k)
+    try:
+        rc, text = _verify_line(capsys, out)
+    finally:
+        pq.ParquetFile.read = real
+    assert rc == 2 and "part-000001.parquet: damaged" in text and needle in text
+    assert len(read) == 3  # the three good parts only
+
+
+def _in_thread(fn, timeout=20.0):
+    result: list = []
+    worker = threading.Thread(target=lambda: result.append(fn()), daemon=True)
+    worker.start()
+    worker.join(timeout)
+    assert not worker.is_alive(), "blocked"
+    return result[0]
+
+
+@pytest.mark.parametrize("name", [MANIFEST, LEDGER])
+@pytest.mark.parametrize("kind", ["fifo", "/dev/zero"])
+def test_a_fifo_or_device_manifest_does_not_block(tmp_path, capsys, clean, name, kind):
+    out = tmp_path / "out"
+    shutil.copytree(clean / "whole", out)
+    (out / name).unlink()
+    if kind == "fifo":
+        os.mkfifo(out / name)
+    else:
+        (out / name).symlink_to("/dev/zero")
+    rc, text = _in_thread(lambda: _verify_line(capsys, out))
+    assert rc == 2 and len(text.splitlines()) == 1 and name in text
+    assert "not a regular file" in text
 
 
 def test_rows_say_what_was_evaluated_and_match_analyze():
