@@ -10,6 +10,7 @@ damaged, ending with the same rows as an uninterrupted run.
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import os
 import shutil
@@ -483,6 +484,147 @@ def test_a_scheduler_given_by_address_runs_the_sweep(tmp_path, clean):
     assert report.backend == "dask" and read_results(tmp_path / "d").equals(
         read_results(clean / "whole")
     )
+
+
+@contextlib.contextmanager
+def _silent_port():
+    """A port that accepts connections (the kernel's backlog) and never says anything."""
+    with socket.socket() as server:
+        server.bind(("127.0.0.1", 0))
+        server.listen(8)
+        yield server.getsockname()[1]
+
+
+def test_a_silent_port_is_refused_within_the_timeout():
+    with _silent_port() as port:
+        start = time.perf_counter()
+        with pytest.raises(EnvironmentFailure, match="says nothing within 1 s"):
+            connect(f"tcp://127.0.0.1:{port}", timeout=1.0)
+        assert time.perf_counter() - start < 3
+
+
+@pytest.mark.slow
+def test_the_command_gives_up_on_a_silent_scheduler_within_ten_seconds(tmp_path, capsys):
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(SPEC))
+    with _silent_port() as port:
+        start = time.perf_counter()
+        argv = ["sweep", str(tmp_path / "s.yaml"), "--out", str(tmp_path / "o")]
+        rc = main([*argv, "--no-progress", "--scheduler", f"tcp://127.0.0.1:{port}"])
+        elapsed = time.perf_counter() - start
+    err = capsys.readouterr().err
+    assert rc == 1 and len(err.splitlines()) == 1 and "--scheduler" in err and "10 s" in err
+    assert elapsed < 15 and not (tmp_path / "o").exists()
+
+
+def _sabotaged(monkeypatch, sig, chunk_timeout=None):
+    """Local worker processes that get ``sig`` as soon as they are up; their pids.
+
+    ``chunk_timeout``: the wait for chunks once the workers are up (their start keeps the
+    run's, longer on a busy machine).
+    """
+    from impact_balance.sweep import runner
+
+    pids: list[int] = []
+    real = runner._Processes.__init__
+
+    def init(self, *args, **kwargs):
+        real(self, *args, **kwargs)
+        if chunk_timeout is not None:
+            self.timeout = chunk_timeout
+        for process in self.processes:
+            pids.append(process.pid)
+            os.kill(process.pid, sig)
+
+    monkeypatch.setattr(runner._Processes, "__init__", init)
+    return pids
+
+
+def _gone(pids, timeout=5.0):
+    procs = []
+    for pid in pids:
+        with contextlib.suppress(psutil.NoSuchProcess):
+            procs.append(psutil.Process(pid))
+    _, alive = psutil.wait_procs(procs, timeout=timeout)
+    return not [p for p in alive if p.status() != psutil.STATUS_ZOMBIE]
+
+
+@pytest.mark.slow
+def test_a_stopped_worker_fails_the_sweep_after_the_chunk_timeout(tmp_path, clean, monkeypatch):
+    pids = _sabotaged(monkeypatch, signal.SIGSTOP, chunk_timeout=2.0)
+    out = tmp_path / "out"
+    start = time.perf_counter()
+    with pytest.raises(EnvironmentFailure, match=r"--chunk-timeout .*within 2 s \(chunks 0, 1"):
+        run_sweep(plan_of(), out, workers=2, progress=False, chunk_timeout=120)
+    assert time.perf_counter() - start < 60 and pids and _gone(pids)
+    monkeypatch.undo()
+    run_sweep(plan_of(), out, workers=1, progress=False)  # the same command resumes
+    assert read_results(out).equals(read_results(clean / "whole"))
+
+
+def test_a_killed_worker_is_one_line_naming_a_chunk(tmp_path, capsys, monkeypatch):
+    pids = _sabotaged(monkeypatch, signal.SIGKILL)
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(SPEC))
+    argv = ["sweep", str(tmp_path / "s.yaml"), "--out", str(tmp_path / "o"), "--no-progress"]
+    rc = main([*argv, "--workers", "2"])
+    err = capsys.readouterr().err
+    assert rc == 1 and len(err.splitlines()) == 1 and "internal error" not in err, err
+    assert "chunk = " in err and "worker process died" in err and pids and _gone(pids)
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "nan", "inf", "soon"])
+def test_a_bad_chunk_timeout_is_a_usage_error(capsys, value):
+    assert main(["sweep", "s.yaml", "--chunk-timeout", value]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and "--chunk-timeout" in err
+
+
+def test_a_full_disk_names_out_and_the_part(tmp_path, capsys, monkeypatch):
+    from impact_balance.sweep import store
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(store.pq, "write_table", full)
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(SPEC))
+    argv = ["sweep", str(tmp_path / "s.yaml"), "--out", str(tmp_path / "o"), "--no-progress"]
+    rc = main([*argv, "--workers", "1"])
+    err = capsys.readouterr().err
+    assert rc == 1 and len(err.splitlines()) == 1, err
+    assert "--out" in err and "part-000000.parquet: No space left on device" in err
+    assert not list((tmp_path / "o" / "parts").iterdir())  # no part cut short left
+
+
+@pytest.mark.slow
+def test_sigterm_while_the_workers_start_exits_130_with_a_message(tmp_path):
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(SPEC))
+    argv = ["sweep", "s.yaml", "--out", "out", "--workers", "2", "--no-progress", "--no-plots"]
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "impact_balance", *argv],
+        cwd=tmp_path,
+        env={**os.environ, "PYTHONPATH": SRC},
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        start_new_session=True,
+    )
+    descendants: list[psutil.Process] = []
+    try:
+        command = psutil.Process(proc.pid)
+        deadline = time.time() + 120
+        while time.time() < deadline and not command.children():  # the fork server: starting
+            assert proc.poll() is None, proc.stderr.read().decode()[-2000:]
+            time.sleep(0.02)
+        descendants = command.children(recursive=True)
+        proc.send_signal(signal.SIGTERM)
+        proc.wait(timeout=60)
+        err = proc.stderr.read().decode()
+        assert proc.returncode == 130 and "interrupted" in err, (proc.returncode, err)
+        assert _gone([p.pid for p in descendants])
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        for p in descendants:
+            with contextlib.suppress(psutil.Error):
+                p.kill()
 
 
 # -- workers die with their sweep -----------------------------------------------------------------

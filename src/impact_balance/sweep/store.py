@@ -43,6 +43,7 @@ names the others; ``impact-balance sweep --verify DIR`` checks a folder.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import hashlib
 import json
@@ -50,7 +51,7 @@ import math
 import os
 import re
 import stat
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -60,7 +61,7 @@ import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
-from impact_balance.exceptions import SweepError, short_repr
+from impact_balance.exceptions import EnvironmentFailure, SweepError, short_repr
 from impact_balance.ranges import MAX_SWEEP_POINTS
 from impact_balance.sweep.columns import RESULT_COLUMNS
 from impact_balance.sweep.plan import PLAN_VERSION, SweepPlan, chunk_size_of
@@ -583,17 +584,20 @@ class ResultStore:
         Args:
             notify: Gets one line per bad part.
         """
-        (self.root / PARTS).mkdir(parents=True, exist_ok=True)
-        for stale in (self.root / PARTS).iterdir():  # writes cut short by a kill
-            if _TMP.match(stale.name):
-                stale.unlink(missing_ok=True)
+        with _writing(self.root, f"{PARTS}/"):
+            (self.root / PARTS).mkdir(parents=True, exist_ok=True)
+            for stale in (self.root / PARTS).iterdir():  # writes cut short by a kill
+                if _TMP.match(stale.name):
+                    stale.unlink(missing_ok=True)
         if self.repair is not None and notify is not None:
             notify(f"{MANIFEST}: damaged: {self.repair}; rewritten from the sweep file")
         if self.repair is not None or not (self.root / MANIFEST).is_file():
-            _atomic_write_text(self.root / MANIFEST, json.dumps(self.manifest(), indent=1))
+            with _writing(self.root, MANIFEST):
+                _atomic_write_text(self.root / MANIFEST, json.dumps(self.manifest(), indent=1))
         good: dict[int, PartRecord] = dict(self.check.good) if self.check is not None else {}
         for problem in self.problems:
-            moved = _reject(self.root, problem)
+            with _writing(self.root, f"{REJECTED}/"):
+                moved = _reject(self.root, problem)
             if notify is not None:
                 again = (
                     f"; chunk {problem.chunk} is computed again"
@@ -604,7 +608,8 @@ class ResultStore:
                 )
                 notify(f"{problem.line()}{f': moved to {moved}' if moved else ''}{again}")
         lines = "".join(json.dumps(good[c].to_dict()) + "\n" for c in sorted(good))
-        _atomic_write_text(self.root / LEDGER, lines)
+        with _writing(self.root, LEDGER):
+            _atomic_write_text(self.root / LEDGER, lines)
         self._good = set(good)
 
     def manifest(self) -> dict[str, Any]:
@@ -643,6 +648,10 @@ class ResultStore:
 
         Returns:
             The part's path.
+
+        Raises:
+            EnvironmentFailure: The part or its record cannot be written (``--out`` and the
+                file named: a full disk).
         """
         path = self.root / PARTS / _part_name(chunk)
         data = table.replace_schema_metadata(None)
@@ -654,12 +663,36 @@ class ResultStore:
             META_CHECKSUM: checksum.encode(),
         }
         tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-        pq.write_table(data.replace_schema_metadata(meta), tmp)
-        os.replace(tmp, path)
+        with _writing(self.root, f"{PARTS}/{path.name}"):
+            try:
+                pq.write_table(data.replace_schema_metadata(meta), tmp)
+            except BaseException:
+                tmp.unlink(missing_ok=True)  # a part cut by a full disk: never left behind
+                raise
+            os.replace(tmp, path)
         record = PartRecord(chunk, f"{PARTS}/{path.name}", table.num_rows, checksum)
-        with open(self.root / LEDGER, "a", encoding="utf-8") as f:
+        with _writing(self.root, LEDGER), open(self.root / LEDGER, "a", encoding="utf-8") as f:
             f.write(json.dumps(record.to_dict()) + "\n")
         return path
+
+
+@contextlib.contextmanager
+def _writing(root: Path, what: str) -> Iterator[None]:
+    """An error of the machine while writing ``what`` in ``root``: ``--out`` and the file named.
+
+    Raises:
+        EnvironmentFailure: For any ``OSError`` (a full disk, a folder made read-only), exit 1.
+    """
+    try:
+        yield
+    except OSError as exc:
+        reason = (
+            exc.strerror
+            or (os.strerror(exc.errno) if exc.errno else None)
+            or " ".join(str(exc).split())[:160]
+            or type(exc).__name__
+        )
+        raise EnvironmentFailure("--out", str(root), f"cannot write {what}: {reason}") from None
 
 
 def _reject(root: Path, problem: PartProblem) -> str | None:
