@@ -409,21 +409,30 @@ def _check_part(
         return PartProblem(rel, "damaged", footer, named)
     if ledger is None:
         return PartProblem(rel, "damaged", f"not vouched for: {LEDGER} is gone", named)
+    table = _checked_values(parquet, chunk, start, stop, checksum)
+    if isinstance(table, str):
+        return PartProblem(rel, "damaged", table, named)
     recorded = ledger.get(chunk)
+    if recorded is not None and recorded.get("checksum") != checksum:
+        return PartProblem(
+            rel, "damaged", "not the part recorded in the manifest (another checksum)", named
+        )
+    if keep is not None:
+        keep[chunk] = table
+    return PartRecord(chunk, rel, rows, checksum)
+
+
+def _checked_values(
+    parquet: pq.ParquetFile, chunk: int, start: int, stop: int, checksum: str
+) -> pa.Table | str:
+    """A part's rows, read once its footer passed; or what is wrong with its values."""
     try:
         table = parquet.read()
     except Exception:
-        return PartProblem(
-            rel, "damaged", "cannot be read to the end (cut short or overwritten)", named
-        )
+        return "cannot be read to the end (cut short or overwritten)"
     table = table.replace_schema_metadata(None)
     if table_checksum(table) != checksum:
-        return PartProblem(
-            rel,
-            "damaged",
-            "its values are not those written (checksum mismatch: edited or corrupted)",
-            named,
-        )
+        return "its values are not those written (checksum mismatch: edited or corrupted)"
     try:
         points_ok = (
             table["point"].to_numpy().tolist() == list(range(start, stop))
@@ -432,19 +441,8 @@ def _check_part(
     except (KeyError, pa.ArrowInvalid):
         points_ok = False
     if not points_ok:
-        return PartProblem(
-            rel,
-            "damaged",
-            f"its rows are not the points {start}..{stop - 1} of chunk {chunk}",
-            named,
-        )
-    if recorded is not None and recorded.get("checksum") != checksum:
-        return PartProblem(
-            rel, "damaged", "not the part recorded in the manifest (another checksum)", named
-        )
-    if keep is not None:
-        keep[chunk] = table
-    return PartRecord(chunk, rel, rows, checksum)
+        return f"its rows are not the points {start}..{stop - 1} of chunk {chunk}"
+    return table
 
 
 def check_folder(
