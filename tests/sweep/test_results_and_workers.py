@@ -23,6 +23,8 @@ import time
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 pytest.importorskip("dask", reason="needs the sweep extra (Dask)")
 pytest.importorskip("distributed", reason="needs the sweep extra (Dask distributed)")
@@ -43,6 +45,7 @@ from impact_balance.scenario import read_mapping, scenario_from_dict, scenario_p
 from impact_balance.sweep import Evaluator, make_plan, read_results, run_sweep, sweep_spec_from_dict
 from impact_balance.sweep.cluster import check_scheduler_address, connect
 from impact_balance.sweep.store import LEDGER, MANIFEST, check_folder, table_checksum
+from tests.helpers.hostile import hostile_values, nested
 
 SRC = str(Path(__file__).parents[2] / "src")
 BASE = "palm_push_two_feet"
@@ -262,6 +265,50 @@ def test_a_manifest_is_checked_against_the_sweep_it_records(
     rc, text = _verify_line(capsys, out)
     assert rc == 2 and len(text.splitlines()) == 1 and "manifest.json is damaged" in text
     assert needle in text and "internal error" not in text
+
+
+@settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    key=st.sampled_from(
+        ["n_points", "chunk_size", "n_chunks", "dimensions", "spec", "digest", "format"]
+    ),
+    value=st.one_of(hostile_values, st.lists(hostile_values, max_size=3), st.just(nested(3000))),
+)
+def test_any_manifest_edit_is_one_line_never_an_internal_error(
+    tmp_path_factory, capsys, clean, key, value
+):
+    out = tmp_path_factory.mktemp("m") / "out"
+    shutil.copytree(clean / "whole", out)
+    manifest = json.loads((out / MANIFEST).read_text())
+    manifest[key] = value
+    try:
+        text = json.dumps(manifest)
+    except (ValueError, RecursionError):
+        return  # not JSON at all: the torn-file cases cover it
+    (out / MANIFEST).write_text(text)
+    rc, shown = _verify_line(capsys, out)
+    assert "internal error" not in shown and "Traceback" not in shown
+    assert rc in (0, 2) and (rc == 0) == (
+        manifest == json.loads((clean / "whole" / MANIFEST).read_text())
+    )
+
+
+@settings(
+    max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    lines=st.lists(
+        st.one_of(st.text(max_size=30), st.builds(json.dumps, hostile_values)), max_size=4
+    )
+)
+def test_a_garbled_ledger_never_is_an_internal_error(tmp_path_factory, capsys, clean, lines):
+    out = tmp_path_factory.mktemp("l") / "out"
+    shutil.copytree(clean / "whole", out)
+    (out / LEDGER).write_text("\n".join(line.replace("\n", " ") for line in lines) + "\n")
+    rc, shown = _verify_line(capsys, out)
+    assert rc in (0, 2) and "internal error" not in shown and "Traceback" not in shown
 
 
 def test_a_resume_rewrites_an_edited_manifest_and_repairs_once(tmp_path, capsys, clean):
