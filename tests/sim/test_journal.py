@@ -196,3 +196,29 @@ def test_the_commands_refuse_a_fifo_journal_in_one_line(tmp_path, capsys, comman
     rc, _, err = run_cli(capsys, command, "palm_push_two_feet", "--journal", str(fifo))
     err = "".join(line for line in err.splitlines(True) if "compiling" not in line)
     assert_one_line_error(rc, err, "--journal", "not a regular file")
+
+
+def _push(capsys, scenario, journal):
+    argv = ["push-test", scenario, "--controller", "ik", "--directions", "2", "--magnitudes", "5"]
+    rc, out, err = run_cli(capsys, *argv, "--json", "--journal", str(journal))
+    assert rc == 0, err
+    return json.loads(out), err
+
+
+@pytest.mark.slow
+def test_push_test_never_reuses_another_scenarios_trials_behind_a_damaged_header(tmp_path, capsys):
+    journal = tmp_path / "j.jsonl"
+    first, _ = _push(capsys, "palm_push_two_feet", journal)
+    assert first["reused_trials"] == 0
+    _rewrite(journal, 1, "xx")  # the header cut by a full disk
+    ramp, err = _push(capsys, "palm_push_ramp", journal)
+    assert ramp["reused_trials"] == 0
+    named = [line for line in err.splitlines() if "--journal" in line]
+    assert any("line 1: not a journal header" in line for line in named)
+    assert sum("another scenario" in line for line in named) == 2
+    # an edited outcome is named and rerun; the untouched trial is reused
+    lines = _lines(journal)
+    _rewrite(journal, len(lines), lines[-1].replace('"balanced"', '"fell"'))
+    again, err = _push(capsys, "palm_push_ramp", journal)
+    assert again["reused_trials"] == 1 and "checksum does not match" in err
+    assert [p["outcome"] for p in again["pushes"]] == [p["outcome"] for p in ramp["pushes"]]

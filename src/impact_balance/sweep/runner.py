@@ -466,7 +466,11 @@ class _Dask(_Backend):
 
     def stop(self) -> list[tuple[int, pa.Table]]:
         """Cancel the tasks left; the chunks that finished meanwhile."""
-        done = [(c, f.result()) for f, c in self.futures.items() if f.status == "finished"]
+        done = []
+        for f, c in self.futures.items():
+            if f.status == "finished":
+                with contextlib.suppress(Exception):  # a worker that does not answer: recomputed
+                    done.append((c, f.result(timeout=STOP_GRACE_S)))
         self.client.cancel(list(self.futures))
         self.futures = {}
         return done
