@@ -101,15 +101,15 @@ def test_non_finite_numbers_are_null_with_a_reason():
 def test_journal_round_trip_cut_line_and_foreign_digest(tmp_path):
     path = tmp_path / "j.jsonl"
     j = TrialJournal.open(path, "abc", {"command": "push-test"})
-    j.add({"speed": 0.5}, {"summary": {"outcome": "fell"}})
-    j.add({"speed": 0.25}, {"summary": {"outcome": "balanced"}})
+    j.add({"speed": 0.5}, {"summary": {"outcome": "fell"}, "trajectory": {}})
+    j.add({"speed": 0.25}, {"summary": {"outcome": "balanced"}, "trajectory": {}})
     j.close()
     with open(path, "a") as fh:
         fh.write('{"key": {"speed": 0.375}, "entry": {"summ')  # a crash in the middle of a line
     again = TrialJournal.open(path, "abc")
     assert again.skipped_lines == 1 and again.get({"speed": 0.5})["summary"]["outcome"] == "fell"
     assert again.get({"speed": 0.375}) is None
-    again.add({"speed": 0.375}, {"summary": {"outcome": "balanced"}})
+    again.add({"speed": 0.375}, {"summary": {"outcome": "balanced"}, "trajectory": {}})
     again.close()
     third = TrialJournal.open(path, "abc")
     assert len(third.entries) == 3 and third.skipped_lines == 1

@@ -372,8 +372,10 @@ def open_journal(
         path.unlink()
     journal = TrialJournal.open(path, digest, {"command": command, "scenario": scenario.name})
     note = f", {len(journal.entries)} finished trials to reuse" if journal.entries else ""
-    cut = f", {journal.skipped_lines} unreadable line(s) skipped" if journal.skipped_lines else ""
+    cut = f", {journal.skipped_lines} line(s) not reused" if journal.skipped_lines else ""
     print(f"impact-balance: trials journal {path}{note}{cut}", file=sys.stderr)
+    for problem in journal.problems:
+        print(f"impact-balance: --journal {path}: {problem}", file=sys.stderr)
     return journal
 
 

@@ -38,6 +38,18 @@ def _positive(text: str) -> int:
     return value
 
 
+def _seconds(text: str) -> float:
+    import math
+
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"{text} must be a positive, finite number of seconds")
+    return value
+
+
 def _scheduler(text: str) -> str:
     from impact_balance.exceptions import OptionError
     from impact_balance.sweep.cluster import check_scheduler_address
@@ -84,6 +96,15 @@ def add_parser(sub: Subcommands) -> list[str]:
         metavar="ADDRESS",
         type=_scheduler,
         help="Dask scheduler address, tcp://HOST:PORT (e.g. tcp://10.0.0.5:8786)",
+    )
+    s.add_argument(
+        "--chunk-timeout",
+        type=_seconds,
+        metavar="S",
+        default=None,
+        help="longest wait for the workers to start and for the next chunk to finish, s; "
+        "then the sweep fails (exit status 1, the finished chunks kept) "
+        "(default 900; worker processes and Dask)",
     )
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
     s.add_argument(
@@ -164,6 +185,7 @@ def run(args: argparse.Namespace) -> int:
     from impact_balance.exceptions import SweepError
     from impact_balance.sweep import bundled_sweeps, load_sweep_spec, make_plan, run_sweep
     from impact_balance.sweep.figures import save_sweep_figures
+    from impact_balance.sweep.runner import CHUNK_TIMEOUT_S
     from impact_balance.sweep.summary import summarize
 
     if args.list:
@@ -213,6 +235,7 @@ def run(args: argparse.Namespace) -> int:
         scheduler=args.scheduler,
         progress=not args.no_progress,
         notify=lambda line: _warn(f"{out}/{line}"),
+        chunk_timeout=args.chunk_timeout or CHUNK_TIMEOUT_S,
     )
     where = args.scheduler or f"{report.workers} worker{'s' if report.workers != 1 else ''}"
     print(

@@ -5,7 +5,9 @@
 port out of range) is bad input, refused when the command line is read (exit status 2). A
 scheduler that does not answer (a closed port, an unknown host, no route) is a failure of the
 machine, refused after at most :data:`CONNECT_TIMEOUT_S` seconds (exit status 1); in both cases
-before the output folder is created.
+before the output folder is created. A port that accepts the connection but says nothing (a
+scheduler greets its client at once) is refused within the same time, as is a scheduler that
+does not answer the client's requests (:func:`bounded`).
 """
 
 from __future__ import annotations
@@ -13,11 +15,16 @@ from __future__ import annotations
 import ipaddress
 import re
 import socket
-from typing import Any
+import threading
+import time
+from collections.abc import Callable
+from typing import Any, TypeVar
 
 from impact_balance.exceptions import EnvironmentFailure, OptionError
 
-__all__ = ["CONNECT_TIMEOUT_S", "SCHEMES", "check_scheduler_address", "connect"]
+__all__ = ["CONNECT_TIMEOUT_S", "SCHEMES", "bounded", "check_scheduler_address", "connect"]
+
+_T = TypeVar("_T")
 
 #: Longest wait for a scheduler to answer, s.
 CONNECT_TIMEOUT_S = 10.0
@@ -82,6 +89,54 @@ def check_scheduler_address(address: str) -> str:
     return f"{scheme}://{shown}:{port}"
 
 
+def bounded(call: Callable[[], _T], timeout: float, field: str, value: Any, what: str) -> _T:
+    """``call()``, waited for at most ``timeout`` seconds (in a daemon thread).
+
+    Raises:
+        EnvironmentFailure: ``call`` did not return in time (``field = value: what ...``).
+        BaseException: What ``call`` raised.
+    """
+    result: list[Any] = []
+
+    def target() -> None:
+        try:
+            result.append((True, call()))
+        except BaseException as exc:
+            result.append((False, exc))
+
+    worker = threading.Thread(target=target, name="impact-balance-bounded", daemon=True)
+    worker.start()
+    worker.join(timeout)
+    if not result:
+        raise EnvironmentFailure(field, value, f"{what}: no answer within {timeout:g} s")
+    ok, value_or_error = result[0]
+    if not ok:
+        raise value_or_error
+    returned: _T = value_or_error
+    return returned
+
+
+def _greeting(sock: socket.socket, canonical: str, deadline: float, timeout: float) -> None:
+    """Wait for a Dask scheduler's first bytes (it writes its handshake at once over tcp)."""
+    sock.settimeout(max(0.01, deadline - time.monotonic()))
+    try:
+        data = sock.recv(1)
+    except TimeoutError:
+        raise EnvironmentFailure(
+            "--scheduler",
+            canonical,
+            f"accepts connections but says nothing within {timeout:g} s (not a Dask scheduler?)",
+        ) from None
+    except OSError as exc:
+        raise EnvironmentFailure(
+            "--scheduler", canonical, f"cannot connect: {exc.strerror or type(exc).__name__}"
+        ) from None
+    if not data:
+        raise EnvironmentFailure(
+            "--scheduler", canonical, "closed the connection at once (not a Dask scheduler?)"
+        )
+
+
 def connect(address: str, timeout: float = CONNECT_TIMEOUT_S) -> Any:
     """A :class:`distributed.Client` of the scheduler at ``address``.
 
@@ -95,10 +150,15 @@ def connect(address: str, timeout: float = CONNECT_TIMEOUT_S) -> Any:
     Raises:
         EnvironmentFailure: (exit status 1) naming ``--scheduler`` and what the network said.
     """
-    _, host, port = _split(address)
+    scheme, host, port = _split(address)
     canonical = check_scheduler_address(address)
+    deadline = time.monotonic() + timeout
     try:  # a closed port answers at once; Dask itself would retry for its whole timeout
-        socket.create_connection((host, port), timeout=timeout).close()
+        with socket.create_connection((host, port), timeout=timeout) as sock:
+            if scheme == "tcp":
+                _greeting(sock, canonical, deadline, timeout)
+    except EnvironmentFailure:
+        raise
     except socket.gaierror as exc:
         raise EnvironmentFailure(
             "--scheduler", canonical, f"unknown host ({exc.strerror or exc})"
@@ -113,8 +173,17 @@ def connect(address: str, timeout: float = CONNECT_TIMEOUT_S) -> Any:
         ) from None
     from distributed import Client
 
+    left = max(1.0, deadline - time.monotonic())
     try:
-        return Client(canonical, timeout=timeout)  # type: ignore[no-untyped-call]
+        return bounded(
+            lambda: Client(canonical, timeout=left),  # type: ignore[no-untyped-call]
+            left,
+            "--scheduler",
+            canonical,
+            "the scheduler did not take the client",
+        )
+    except EnvironmentFailure:
+        raise
     except Exception as exc:
         text = " ".join(str(exc).split())[:160] or type(exc).__name__
         raise EnvironmentFailure(

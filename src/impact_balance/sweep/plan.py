@@ -58,6 +58,7 @@ __all__ = [
     "Dimension",
     "DimensionKind",
     "SweepPlan",
+    "chunk_size_of",
     "make_plan",
     "plan_sweep",
 ]
@@ -192,9 +193,7 @@ class SweepPlan:
 
         IK takes milliseconds per point: small chunks keep every worker busy to the end.
         """
-        if self.spec.chunk_size is not None:
-            return self.spec.chunk_size
-        return DEFAULT_CHUNK_IK if self.posture is not None else DEFAULT_CHUNK
+        return chunk_size_of(self.spec)
 
     @property
     def n_chunks(self) -> int:
@@ -219,6 +218,14 @@ class SweepPlan:
     def posture(self) -> PostureAxis | None:
         """The posture axis, if any (a sweep has at most one)."""
         return next((a for a in self.spec.axes if isinstance(a, PostureAxis)), None)
+
+
+def chunk_size_of(spec: SweepSpec) -> int:
+    """Points per chunk of a sweep file: its ``chunk_size``, else 1000 (25 with a posture axis)."""
+    if spec.chunk_size is not None:
+        return spec.chunk_size
+    posture = any(isinstance(a, PostureAxis) for a in spec.axes)
+    return DEFAULT_CHUNK_IK if posture else DEFAULT_CHUNK
 
 
 def _base_mapping(spec: SweepSpec) -> tuple[dict[str, Any], str | None]:

@@ -21,9 +21,18 @@ Nothing is created before the inputs are known good: the output folder is checke
 workers started or the scheduler reached, and only then is the folder made.
 
 Workers die with their sweep: Ctrl-C or SIGTERM stops the run (finished chunks are written,
-running ones get :data:`STOP_GRACE_S` seconds, then the workers are killed), and each local
+running ones get :data:`STOP_GRACE_S` seconds, then the workers are killed), also while the
+workers start, and each local
 worker watches the command's process and exits when it ends, even by SIGKILL (Linux: a pidfd;
 elsewhere it polls twice a second).
+
+No wait is unbounded: the workers must start, and the next chunk must finish, within
+``chunk_timeout`` seconds (:data:`CHUNK_TIMEOUT_S` by default; ``--chunk-timeout``). A worker
+that is stopped (SIGSTOP) or stuck makes the run fail after that time with an
+:class:`~impact_balance.exceptions.EnvironmentFailure` naming the chunks not finished; a local
+worker killed (by the out-of-memory killer, say) fails the run at once, naming a chunk it left.
+Either way the finished chunks are written, the workers are ended, and the same command
+resumes.
 """
 
 from __future__ import annotations
@@ -37,8 +46,10 @@ import sys
 import threading
 import time
 from collections.abc import Callable, Iterator
-from concurrent.futures import Future, ProcessPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor
+from concurrent.futures import TimeoutError as FutureTimeout
 from concurrent.futures import wait as wait_futures
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from pathlib import Path
 from types import FrameType
@@ -49,12 +60,21 @@ from tqdm import tqdm
 
 from impact_balance.balance.areas import areas_from_polytope
 from impact_balance.contacts.wrench_polytope import wrench_polytope
+from impact_balance.exceptions import EnvironmentFailure, OptionError
 from impact_balance.scenario import scenario_from_dict
 from impact_balance.sweep.evaluate import Evaluator
 from impact_balance.sweep.plan import SweepPlan
 from impact_balance.sweep.store import PartProblem, ResultStore
 
-__all__ = ["STOP_GRACE_S", "BackendName", "RunReport", "dask_chunk", "default_workers", "run_sweep"]
+__all__ = [
+    "CHUNK_TIMEOUT_S",
+    "STOP_GRACE_S",
+    "BackendName",
+    "RunReport",
+    "dask_chunk",
+    "default_workers",
+    "run_sweep",
+]
 
 #: Where the chunks ran: nowhere (nothing was left), this process, local worker processes, or a
 #: Dask cluster.
@@ -62,6 +82,35 @@ BackendName = Literal["none", "inline", "processes", "dask"]
 
 #: After Ctrl-C or SIGTERM, how long running chunks may finish before the workers are killed, s.
 STOP_GRACE_S = 1.0
+#: Default longest wait for the workers to start, and for the next chunk to finish, s.
+CHUNK_TIMEOUT_S = 900.0
+#: Chunks named in a message; the others are counted.
+_NAMED_CHUNKS = 5
+
+
+def _chunk_list(chunks: list[int]) -> str:
+    shown = ", ".join(str(c) for c in chunks[:_NAMED_CHUNKS])
+    more = f" and {len(chunks) - _NAMED_CHUNKS} more" if len(chunks) > _NAMED_CHUNKS else ""
+    return f"chunk{'s' if len(chunks) > 1 else ''} {shown}{more}"
+
+
+def _stalled(timeout: float, chunks: list[int]) -> EnvironmentFailure:
+    return EnvironmentFailure(
+        "--chunk-timeout",
+        timeout,
+        f"no chunk finished within {timeout:g} s ({_chunk_list(sorted(chunks))} not finished: a "
+        "worker is stopped or stuck); the finished chunks are written: run the same command to "
+        "resume, with a longer --chunk-timeout if chunks take longer",
+    )
+
+
+def _worker_died(chunk: int, left: int) -> EnvironmentFailure:
+    return EnvironmentFailure(
+        "chunk",
+        chunk,
+        f"a worker process died while {left} chunk(s) were unfinished (killed: out of memory?); "
+        "the finished chunks are written: run the same command to resume",
+    )
 
 
 def default_workers() -> int:
@@ -254,10 +303,10 @@ class _Processes(_Backend):
 
     name: BackendName = "processes"
 
-    def __init__(self, plan: SweepPlan, workers: int) -> None:
+    def __init__(self, plan: SweepPlan, workers: int, timeout: float) -> None:
         _warm_kernel(plan)
         context = _context()
-        self.workers = workers
+        self.workers, self.timeout = workers, timeout
         self.pool = ProcessPoolExecutor(
             max_workers=workers,
             mp_context=context,
@@ -269,7 +318,21 @@ class _Processes(_Backend):
         # Start every worker (and its robot) before the clock of the computing loop starts.
         try:
             for f in [self.pool.submit(_ready) for _ in range(workers)]:
-                f.result()
+                f.result(timeout=timeout)
+        except FutureTimeout:
+            self.kill()
+            raise EnvironmentFailure(
+                "--chunk-timeout",
+                timeout,
+                f"the workers did not start within {timeout:g} s (a worker is stopped or stuck)",
+            ) from None
+        except BrokenProcessPool:
+            self.kill()
+            raise EnvironmentFailure(
+                "--workers",
+                workers,
+                "a worker process died while starting (killed: out of memory?)",
+            ) from None
         except BaseException:
             self.kill()
             raise
@@ -279,10 +342,24 @@ class _Processes(_Backend):
 
     def run(self, chunks: list[int]) -> Iterator[tuple[int, pa.Table]]:
         """The chunks' tables, as the workers finish them."""
-        self.futures = {self.pool.submit(_process_chunk, c): c for c in chunks}
-        for f in as_completed(self.futures):
-            chunk = self.futures.pop(f)
-            yield chunk, f.result()
+        self.futures = {}
+        for c in chunks:
+            try:
+                self.futures[self.pool.submit(_process_chunk, c)] = c
+            except BrokenProcessPool:
+                raise _worker_died(c, len(chunks) - len(self.futures)) from None
+        pending = set(self.futures)
+        while pending:
+            done, pending = wait_futures(pending, timeout=self.timeout, return_when=FIRST_COMPLETED)
+            if not done:
+                raise _stalled(self.timeout, list(self.futures.values()))
+            for f in sorted(done, key=self.futures.__getitem__):
+                chunk = self.futures.pop(f)
+                try:
+                    table = f.result()
+                except BrokenProcessPool:
+                    raise _worker_died(chunk, len(self.futures) + 1) from None
+                yield chunk, table
 
     def stop(self) -> list[tuple[int, pa.Table]]:
         """Cancel what has not started, give what runs :data:`STOP_GRACE_S` seconds.
@@ -328,19 +405,39 @@ class _Dask(_Backend):
 
     name: BackendName = "dask"
 
-    def __init__(self, plan: SweepPlan, scheduler: Any) -> None:
-        from impact_balance.sweep.cluster import connect
+    def __init__(self, plan: SweepPlan, scheduler: Any, timeout: float) -> None:
+        from impact_balance.sweep.cluster import CONNECT_TIMEOUT_S, bounded, connect
 
         self.own = isinstance(scheduler, str)
         self.client = connect(scheduler) if self.own else scheduler
-        self.workers = sum(self.client.nthreads().values()) or 1
-        self.plan_future = self.client.scatter(plan, broadcast=True)
+        self.timeout = timeout
+        address = getattr(self.client, "scheduler", None)
+        shown = scheduler if self.own else getattr(address, "address", None)
+        try:
+            self.workers = (
+                sum(
+                    bounded(
+                        self.client.nthreads, CONNECT_TIMEOUT_S, "--scheduler", shown, "workers"
+                    ).values()
+                )
+                or 1
+            )
+            self.plan_future = bounded(
+                lambda: self.client.scatter(plan, broadcast=True),
+                timeout,
+                "--scheduler",
+                shown,
+                "sending the plan to the workers",
+            )
+        except BaseException:
+            self.abort()
+            raise
         self.plan = plan
         self.futures: dict[Any, int] = {}
 
     def run(self, chunks: list[int]) -> Iterator[tuple[int, pa.Table]]:
         """The chunks' tables, as the cluster finishes them."""
-        from distributed import as_completed as dask_completed
+        from distributed import wait as dask_wait
 
         self.futures = {
             self.client.submit(
@@ -352,13 +449,28 @@ class _Dask(_Backend):
             ): c
             for c in chunks
         }
-        for f in dask_completed(list(self.futures)):  # type: ignore[no-untyped-call]
-            chunk = self.futures.pop(f)
-            yield chunk, f.result()
+        pending = list(self.futures)
+        while pending:
+            try:
+                done, left = dask_wait(pending, timeout=self.timeout, return_when="FIRST_COMPLETED")  # type: ignore[no-untyped-call]
+            except TimeoutError:
+                raise _stalled(self.timeout, list(self.futures.values())) from None
+            pending = list(left)
+            for f in sorted(done, key=self.futures.__getitem__):
+                chunk = self.futures.pop(f)
+                try:
+                    table = f.result(timeout=self.timeout)
+                except TimeoutError:
+                    raise _stalled(self.timeout, [chunk, *self.futures.values()]) from None
+                yield chunk, table
 
     def stop(self) -> list[tuple[int, pa.Table]]:
         """Cancel the tasks left; the chunks that finished meanwhile."""
-        done = [(c, f.result()) for f, c in self.futures.items() if f.status == "finished"]
+        done = []
+        for f, c in self.futures.items():
+            if f.status == "finished":
+                with contextlib.suppress(Exception):  # a worker that does not answer: recomputed
+                    done.append((c, f.result(timeout=STOP_GRACE_S)))
         self.client.cancel(list(self.futures))
         self.futures = {}
         return done
@@ -374,17 +486,17 @@ class _Dask(_Backend):
 
 
 def _start_backend(
-    plan: SweepPlan, todo: list[int], workers: int | None, scheduler: Any
+    plan: SweepPlan, todo: list[int], workers: int | None, scheduler: Any, timeout: float
 ) -> _Backend:
     """The backend for the chunks ``todo`` (see :func:`run_sweep`), its workers started."""
     n = workers or default_workers()
     if not todo:
         return _Backend()
     if scheduler is not None:
-        return _Dask(plan, scheduler)
+        return _Dask(plan, scheduler, timeout)
     if n <= 1 or len(todo) <= 1:
         return _Inline(plan)
-    return _Processes(plan, min(n, len(todo)))
+    return _Processes(plan, min(n, len(todo)), timeout)
 
 
 class _ChunkWriter:
@@ -473,6 +585,7 @@ def run_sweep(
     stop_after: int | None = None,
     on_chunk: Callable[[int], None] | None = None,
     notify: Callable[[str], None] | None = None,
+    chunk_timeout: float = CHUNK_TIMEOUT_S,
 ) -> RunReport:
     """Compute the chunks of ``plan`` not yet in ``out``, writing each one as it finishes.
 
@@ -491,28 +604,38 @@ def run_sweep(
         on_chunk: Called with each chunk index once its part file is written.
         notify: Called with one line per bad part found in ``out`` (moved to ``rejected/``,
             computed again).
+        chunk_timeout: Longest wait for the workers to start and for the next chunk to finish,
+            s (worker processes and Dask; see the module docstring).
 
     Returns:
         What the run did.
 
     Raises:
+        OptionError: ``chunk_timeout`` is not a positive number.
         SweepError: ``out`` holds another sweep, or is not a sweep folder.
-        EnvironmentFailure: the scheduler cannot be reached (nothing is created then).
+        EnvironmentFailure: the scheduler cannot be reached (nothing is created then); no chunk
+            finished within ``chunk_timeout``; a worker process died.
+        KeyboardInterrupt: Ctrl-C or SIGTERM while the workers start.
     """
+    if isinstance(chunk_timeout, bool) or not (
+        isinstance(chunk_timeout, (int, float)) and 0 < chunk_timeout < float("inf")
+    ):
+        raise OptionError("--chunk-timeout", chunk_timeout, "must be a positive number of seconds")
     store = ResultStore.prepare(out, plan)  # checks only: nothing is created yet
     good = set(store.check.good) if store.check is not None else set()
     todo = [c for c in range(plan.n_chunks) if c not in good]
     t0 = time.perf_counter()
-    backend = _start_backend(plan, todo, workers, scheduler)
-    startup = time.perf_counter() - t0
-    try:
-        store.create(notify)  # the inputs are good and the workers are up: now the folder
-    except BaseException:
-        backend.abort()
-        raise
-    done = store.finished()
-    writer = _ChunkWriter(store, plan, done, progress, on_chunk)
-    interrupted, elapsed = _compute(backend, todo, writer, stop_after)
+    with _sigterm_interrupts():  # SIGTERM while the workers start: stop as Ctrl-C does
+        backend = _start_backend(plan, todo, workers, scheduler, chunk_timeout)
+        startup = time.perf_counter() - t0
+        try:
+            store.create(notify)  # the inputs are good and the workers are up: now the folder
+        except BaseException:
+            backend.abort()
+            raise
+        done = store.finished()
+        writer = _ChunkWriter(store, plan, done, progress, on_chunk)
+        interrupted, elapsed = _compute(backend, todo, writer, stop_after)
     return RunReport(
         Path(out),
         backend.name,

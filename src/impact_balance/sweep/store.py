@@ -12,13 +12,28 @@ parts. A folder is never trusted by its file names: :func:`check_folder` opens e
 checks that it is readable to the end, that it belongs to this sweep (the digest in its
 metadata), that it holds the chunk its name says, the row count of that chunk, the points of
 that chunk, and the checksum of its values (against its metadata and against the manifest).
+Before a part is read, its footer is checked: its columns must be this sweep's and its sizes
+(file, uncompressed values) within :data:`MAX_PART_ROW_BYTES` a row. A part recorded
+in the manifest of parts must have the checksum recorded (a part written just before a kill may
+be unrecorded); a folder whose ``manifest-parts.jsonl`` is gone is damaged: none of its parts
+is vouched for, a resume computes them again. The manifest itself is checked against the sweep
+it records (``spec``): ``n_points``, ``chunk_size``, ``n_chunks`` and the number of
+``dimensions`` are recomputed from it, not trusted; a resume rewrites a damaged manifest from
+the sweep file. The manifest, the manifest of parts and the parts must be regular files, read
+with a bound (:data:`MAX_MANIFEST_BYTES`, :data:`MAX_LEDGER_BYTES`): a FIFO is refused, never
+waited on.
+
+The checksums protect against damage and accidental edits (a cut file, a flipped value, a
+part copied from another folder); they do not protect against a forger, who can recompute
+them.
+
 A part that fails is named in one line with what is wrong:
 
 - ``damaged``: cut short, emptied, edited (checksum), the wrong rows, or not the part recorded;
 - ``foreign``: from another sweep (another digest), or not written by impact-balance;
 - ``renamed``: holds another chunk than its name says;
 - ``extra``: a chunk beyond the sweep, or a file that is not a part;
-- ``missing``: recorded in the manifest, but the file is gone.
+- ``missing``: recorded in the manifest, but the file is gone (or the manifest of parts is gone).
 
 A resume (:func:`~impact_balance.sweep.runner.run_sweep`) moves every bad part to ``rejected/``
 and computes its chunk again: rows are never duplicated, never silently skipped, and a resumed
@@ -28,11 +43,15 @@ names the others; ``impact-balance sweep --verify DIR`` checks a folder.
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import hashlib
 import json
+import math
 import os
 import re
-from collections.abc import Callable
+import stat
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -42,12 +61,18 @@ import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
-from impact_balance.exceptions import SweepError
-from impact_balance.sweep.plan import PLAN_VERSION, SweepPlan
+from impact_balance.exceptions import EnvironmentFailure, SweepError, short_repr
+from impact_balance.ranges import MAX_SWEEP_POINTS
+from impact_balance.sweep.columns import RESULT_COLUMNS
+from impact_balance.sweep.plan import PLAN_VERSION, SweepPlan, chunk_size_of
+from impact_balance.sweep.spec import SweepSpec
 
 __all__ = [
     "LEDGER",
     "MANIFEST",
+    "MAX_LEDGER_BYTES",
+    "MAX_MANIFEST_BYTES",
+    "MAX_PART_ROW_BYTES",
     "PARTS",
     "REJECTED",
     "FolderCheck",
@@ -69,6 +94,12 @@ MANIFEST = "manifest.json"
 LEDGER = "manifest-parts.jsonl"
 PARTS = "parts"
 REJECTED = "rejected"
+#: Largest manifest and manifest of parts read (bytes).
+MAX_MANIFEST_BYTES = 32 * 1024 * 1024
+MAX_LEDGER_BYTES = 64 * 1024 * 1024
+#: Largest size of a part a row (bytes, on disk and uncompressed), from its footer, plus 1 MiB.
+MAX_PART_ROW_BYTES = 64 * 1024
+_PART_ALLOWANCE = 1024 * 1024
 _PART = re.compile(r"^part-(\d{6})\.parquet$")
 _TMP = re.compile(r"^\.part-\d{6}\.parquet\.\d+\.tmp$")
 #: Keys of a part's Parquet metadata.
@@ -232,32 +263,88 @@ def _rows_of(manifest: dict[str, Any], chunk: int) -> tuple[int, int]:
     return start, min(n, start + size)
 
 
-def _read_ledger(root: Path) -> dict[int, dict[str, Any]]:
-    """The manifest of parts: the last record of each chunk (a line cut by a kill is skipped)."""
+def _read_regular(path: Path, limit: int) -> bytes:
+    """The bytes of ``path``: a regular file (non-blocking open, ``fstat``) of at most ``limit``.
+
+    The one place this module reads a whole file (the project's bounded file-reading rule).
+
+    Raises:
+        OSError: Cannot be opened or read, not a regular file, or larger than ``limit``.
+    """
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise OSError(errno.EINVAL, "not a regular file", str(path))
+        chunks, size = [], 0
+        while chunk := os.read(fd, min(1 << 20, limit + 1 - size)):
+            chunks.append(chunk)
+            size += len(chunk)
+            if size > limit:
+                raise OSError(errno.EFBIG, f"larger than {limit} bytes", str(path))
+        return b"".join(chunks)
+    finally:
+        os.close(fd)
+
+
+def _read_ledger(root: Path) -> dict[int, dict[str, Any]] | None:
+    """The manifest of parts: the last record of each chunk (a line cut by a kill is skipped).
+
+    Returns:
+        The records by chunk, or None when the file is gone.
+    """
     records: dict[int, dict[str, Any]] = {}
     try:
-        text = (root / LEDGER).read_text(encoding="utf-8", errors="replace")
+        data = _read_regular(root / LEDGER, MAX_LEDGER_BYTES)
     except FileNotFoundError:
-        return records
+        return None
     except OSError as exc:
         raise SweepError(
             "DIR", str(root), f"cannot read {LEDGER} ({exc.strerror or type(exc).__name__})"
         ) from None
-    for line in text.splitlines():
+    for line in data.decode("utf-8", errors="replace").splitlines():
         try:
             rec = json.loads(line)
             chunk = rec["chunk"]
-            if isinstance(chunk, int) and isinstance(rec.get("checksum"), str):
+            if (
+                isinstance(chunk, int)
+                and not isinstance(chunk, bool)
+                and isinstance(rec.get("checksum"), str)
+            ):
                 records[chunk] = rec
-        except (ValueError, TypeError, KeyError):
+        except (ValueError, TypeError, KeyError, RecursionError):
             continue
     return records
+
+
+def _expected_columns(manifest: dict[str, Any]) -> list[str]:
+    names = [str(d["name"]) for d in manifest["dimensions"]]
+    return ["point", "chunk", *names, *(name for name, _, _ in RESULT_COLUMNS)]
+
+
+def _footer_problem(parquet: pq.ParquetFile, manifest: dict[str, Any], rows: int) -> str | None:
+    """What the footer of a part shows wrong (columns, sizes), before anything is read."""
+    names = parquet.schema_arrow.names
+    expected = _expected_columns(manifest)
+    if names != expected:
+        odd = sorted(set(names) ^ set(expected))
+        which = f" ({', '.join(short_repr(n, 40) for n in odd[:3])})" if odd else " (order)"
+        return f"its columns are not this sweep's{which}"
+    types = {f.name: _type_name(f.type) for f in parquet.schema_arrow}
+    for name, typ, _ in RESULT_COLUMNS:
+        if types[name] != _type_name(typ):
+            return f"its column {name} is {types[name]}, not {_type_name(typ)}"
+    bound = _PART_ALLOWANCE + rows * MAX_PART_ROW_BYTES
+    meta = parquet.metadata
+    size = sum(meta.row_group(i).total_byte_size for i in range(meta.num_row_groups))
+    if size > bound:
+        return f"its values take {size} bytes uncompressed, more than {rows} rows can"
+    return None
 
 
 def _check_part(
     path: Path,
     manifest: dict[str, Any],
-    ledger: dict[int, dict[str, Any]],
+    ledger: dict[int, dict[str, Any]] | None,
     keep: dict[int, pa.Table] | None,
 ) -> PartRecord | PartProblem:
     rel = f"{PARTS}/{path.name}"
@@ -272,10 +359,14 @@ def _check_part(
         return PartProblem(
             rel, "extra", f"chunk {named} is beyond this sweep's {n_chunks} chunks", named
         )
+    start, stop = _rows_of(manifest, named)
+    if path.stat().st_size > _PART_ALLOWANCE + (stop - start) * MAX_PART_ROW_BYTES:
+        return PartProblem(rel, "damaged", f"larger than {stop - start} rows can be", named)
     try:
         parquet = pq.ParquetFile(path)
         meta = parquet.schema_arrow.metadata or {}
         stored_rows = parquet.metadata.num_rows
+        footer = _footer_problem(parquet, manifest, stop - start)
     except Exception:
         return PartProblem(
             rel, "damaged", "not a readable Parquet file (cut short, emptied or overwritten)", named
@@ -310,39 +401,17 @@ def _check_part(
         return PartProblem(
             rel, "renamed", f"holds chunk {chunk}, but its name says chunk {named}", named
         )
-    start, stop = _rows_of(manifest, chunk)
     if rows != stop - start or stored_rows != stop - start:
         return PartProblem(
             rel, "damaged", f"{stored_rows} rows where chunk {chunk} has {stop - start}", named
         )
-    try:
-        table = parquet.read()
-    except Exception:
-        return PartProblem(
-            rel, "damaged", "cannot be read to the end (cut short or overwritten)", named
-        )
-    table = table.replace_schema_metadata(None)
-    if table_checksum(table) != checksum:
-        return PartProblem(
-            rel,
-            "damaged",
-            "its values are not those written (checksum mismatch: edited or corrupted)",
-            named,
-        )
-    try:
-        points_ok = (
-            table["point"].to_numpy().tolist() == list(range(start, stop))
-            and pc.all(pc.equal(table["chunk"], chunk)).as_py() is not False
-        )
-    except (KeyError, pa.ArrowInvalid):
-        points_ok = False
-    if not points_ok:
-        return PartProblem(
-            rel,
-            "damaged",
-            f"its rows are not the points {start}..{stop - 1} of chunk {chunk}",
-            named,
-        )
+    if footer is not None:
+        return PartProblem(rel, "damaged", footer, named)
+    if ledger is None:
+        return PartProblem(rel, "damaged", f"not vouched for: {LEDGER} is gone", named)
+    table = _checked_values(parquet, chunk, start, stop, checksum)
+    if isinstance(table, str):
+        return PartProblem(rel, "damaged", table, named)
     recorded = ledger.get(chunk)
     if recorded is not None and recorded.get("checksum") != checksum:
         return PartProblem(
@@ -353,16 +422,52 @@ def _check_part(
     return PartRecord(chunk, rel, rows, checksum)
 
 
-def check_folder(root: str | Path, keep_tables: bool = False) -> FolderCheck:
+def _checked_values(
+    parquet: pq.ParquetFile, chunk: int, start: int, stop: int, checksum: str
+) -> pa.Table | str:
+    """A part's rows, read once its footer passed; or what is wrong with its values."""
+    try:
+        table = parquet.read()
+    except Exception:
+        return "cannot be read to the end (cut short or overwritten)"
+    table = table.replace_schema_metadata(None)
+    if table_checksum(table) != checksum:
+        return "its values are not those written (checksum mismatch: edited or corrupted)"
+    try:
+        points_ok = (
+            table["point"].to_numpy().tolist() == list(range(start, stop))
+            and pc.all(pc.equal(table["chunk"], chunk)).as_py() is not False
+        )
+    except (KeyError, pa.ArrowInvalid):
+        points_ok = False
+    if not points_ok:
+        return f"its rows are not the points {start}..{stop - 1} of chunk {chunk}"
+    return table
+
+
+def check_folder(
+    root: str | Path, keep_tables: bool = False, manifest: dict[str, Any] | None = None
+) -> FolderCheck:
     """Check every part of a sweep folder (see the module docstring); never raises for a bad part.
 
+    Args:
+        root: The folder.
+        keep_tables: Keep the good parts' rows (:attr:`FolderCheck.tables`).
+        manifest: The manifest to check the parts against (a resume gives its plan's);
+            default: the folder's own, checked by :func:`read_manifest`.
+
     Raises:
-        SweepError: ``root`` is not a sweep folder (no manifest, or an unreadable one).
+        SweepError: ``root`` is not a sweep folder (no manifest, or an unreadable or damaged
+            one), or its manifest of parts cannot be read.
     """
     root = Path(root)
-    manifest = read_manifest(root)
+    manifest = read_manifest(root) if manifest is None else manifest
     check = FolderCheck(root, manifest)
     ledger = _read_ledger(root)
+    if ledger is None:
+        check.problems.append(
+            PartProblem(LEDGER, "missing", "the manifest of parts is gone: no part is vouched for")
+        )
     parts = root / PARTS
     try:
         entries = sorted(parts.iterdir()) if parts.is_dir() else []
@@ -387,7 +492,7 @@ def check_folder(root: str | Path, keep_tables: bool = False) -> FolderCheck:
         else:
             check.problems.append(found)
     named = {p.chunk for p in check.problems if p.chunk is not None}
-    for chunk, rec in sorted(ledger.items()):
+    for chunk, rec in sorted((ledger or {}).items()):
         if chunk not in check.good and chunk not in named and 0 <= chunk < check.n_chunks:
             check.problems.append(
                 PartProblem(
@@ -412,6 +517,7 @@ class ResultStore:
     root: Path
     plan: SweepPlan
     check: FolderCheck | None = None
+    repair: str | None = None
     _good: set[int] = field(default_factory=set)
 
     @classmethod
@@ -425,8 +531,8 @@ class ResultStore:
         if root.exists() and not root.is_dir():
             raise SweepError("--out", str(root), "exists and is not a folder: choose another --out")
         store = cls(root, plan)
-        if (root / MANIFEST).is_file():
-            old = read_manifest(root)
+        if (root / MANIFEST).exists() or (root / MANIFEST).is_symlink():
+            old = _manifest_data(root)
             if old.get("digest") != plan.digest:
                 raise SweepError(
                     "--out",
@@ -435,7 +541,16 @@ class ResultStore:
                     f"this one is {plan.digest}): choose another --out, or delete the folder "
                     "to start again",
                 )
-            store.check = check_folder(root)
+            want = json.loads(json.dumps(store.manifest()))
+            store.repair = _plan_damage(old) or next(
+                (
+                    f"{k} is {short_repr(old[k])}, the sweep file has {short_repr(want[k])}"
+                    for k in ("n_points", "chunk_size", "n_chunks", "dimensions")
+                    if old[k] != want[k]
+                ),
+                None,
+            )
+            store.check = check_folder(root, manifest=want)
         elif root.exists() and any(root.iterdir()):
             raise SweepError(
                 "--out",
@@ -467,15 +582,20 @@ class ResultStore:
         Args:
             notify: Gets one line per bad part.
         """
-        (self.root / PARTS).mkdir(parents=True, exist_ok=True)
-        for stale in (self.root / PARTS).iterdir():  # writes cut short by a kill
-            if _TMP.match(stale.name):
-                stale.unlink(missing_ok=True)
-        if not (self.root / MANIFEST).is_file():
-            _atomic_write_text(self.root / MANIFEST, json.dumps(self.manifest(), indent=1))
+        with _writing(self.root, f"{PARTS}/"):
+            (self.root / PARTS).mkdir(parents=True, exist_ok=True)
+            for stale in (self.root / PARTS).iterdir():  # writes cut short by a kill
+                if _TMP.match(stale.name):
+                    stale.unlink(missing_ok=True)
+        if self.repair is not None and notify is not None:
+            notify(f"{MANIFEST}: damaged: {self.repair}; rewritten from the sweep file")
+        if self.repair is not None or not (self.root / MANIFEST).is_file():
+            with _writing(self.root, MANIFEST):
+                _atomic_write_text(self.root / MANIFEST, json.dumps(self.manifest(), indent=1))
         good: dict[int, PartRecord] = dict(self.check.good) if self.check is not None else {}
         for problem in self.problems:
-            moved = _reject(self.root, problem)
+            with _writing(self.root, f"{REJECTED}/"):
+                moved = _reject(self.root, problem)
             if notify is not None:
                 again = (
                     f"; chunk {problem.chunk} is computed again"
@@ -486,7 +606,8 @@ class ResultStore:
                 )
                 notify(f"{problem.line()}{f': moved to {moved}' if moved else ''}{again}")
         lines = "".join(json.dumps(good[c].to_dict()) + "\n" for c in sorted(good))
-        _atomic_write_text(self.root / LEDGER, lines)
+        with _writing(self.root, LEDGER):
+            _atomic_write_text(self.root / LEDGER, lines)
         self._good = set(good)
 
     def manifest(self) -> dict[str, Any]:
@@ -525,6 +646,10 @@ class ResultStore:
 
         Returns:
             The part's path.
+
+        Raises:
+            EnvironmentFailure: The part or its record cannot be written (``--out`` and the
+                file named: a full disk).
         """
         path = self.root / PARTS / _part_name(chunk)
         data = table.replace_schema_metadata(None)
@@ -536,12 +661,36 @@ class ResultStore:
             META_CHECKSUM: checksum.encode(),
         }
         tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-        pq.write_table(data.replace_schema_metadata(meta), tmp)
-        os.replace(tmp, path)
+        with _writing(self.root, f"{PARTS}/{path.name}"):
+            try:
+                pq.write_table(data.replace_schema_metadata(meta), tmp)
+            except BaseException:
+                tmp.unlink(missing_ok=True)  # a part cut by a full disk: never left behind
+                raise
+            os.replace(tmp, path)
         record = PartRecord(chunk, f"{PARTS}/{path.name}", table.num_rows, checksum)
-        with open(self.root / LEDGER, "a", encoding="utf-8") as f:
+        with _writing(self.root, LEDGER), open(self.root / LEDGER, "a", encoding="utf-8") as f:
             f.write(json.dumps(record.to_dict()) + "\n")
         return path
+
+
+@contextlib.contextmanager
+def _writing(root: Path, what: str) -> Iterator[None]:
+    """An error of the machine while writing ``what`` in ``root``: ``--out`` and the file named.
+
+    Raises:
+        EnvironmentFailure: For any ``OSError`` (a full disk, a folder made read-only), exit 1.
+    """
+    try:
+        yield
+    except OSError as exc:
+        reason = (
+            exc.strerror
+            or (os.strerror(exc.errno) if exc.errno else None)
+            or " ".join(str(exc).split())[:160]
+            or type(exc).__name__
+        )
+        raise EnvironmentFailure("--out", str(root), f"cannot write {what}: {reason}") from None
 
 
 def _reject(root: Path, problem: PartProblem) -> str | None:
@@ -571,38 +720,79 @@ def _atomic_write_text(path: Path, text: str) -> None:
 
 
 # -- reading ---------------------------------------------------------------------------------
-def read_manifest(root: str | Path) -> dict[str, Any]:
-    """The manifest of a sweep folder.
+def _manifest_data(root: str | Path) -> dict[str, Any]:
+    """The manifest's JSON object, read with a bound; its format and keys checked, not its plan.
 
     Raises:
-        SweepError: no manifest, or not readable.
+        SweepError: no manifest, not readable, not a sweep manifest.
     """
     path = Path(root) / MANIFEST
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
+        data = json.loads(_read_regular(path, MAX_MANIFEST_BYTES).decode("utf-8"))
     except FileNotFoundError:
         raise SweepError("DIR", str(root), "is not a sweep folder (no manifest.json)") from None
     except NotADirectoryError:
         raise SweepError("DIR", str(root), "is not a folder") from None
-    except (OSError, ValueError) as exc:
+    except OSError as exc:
+        raise SweepError(
+            "DIR", str(root), f"cannot read manifest.json ({exc.strerror or type(exc).__name__})"
+        ) from None
+    except (ValueError, RecursionError) as exc:
         raise SweepError(
             "DIR", str(root), f"cannot read manifest.json ({exc.__class__.__name__})"
         ) from None
-    keys = ("digest", "n_points", "chunk_size", "n_chunks", "dimensions")
+    keys = ("digest", "n_points", "chunk_size", "n_chunks", "dimensions", "spec")
     if (
         not isinstance(data, dict)
         or data.get("format") != "impact-balance sweep"
         or not all(k in data for k in keys)
     ):
         raise SweepError("DIR", str(root), "manifest.json is not an impact-balance sweep manifest")
+    return data
+
+
+def _plan_damage(data: dict[str, Any]) -> str | None:
+    """What in a manifest disagrees with the sweep it records (``spec``), or None.
+
+    ``n_points``, ``chunk_size``, ``n_chunks`` and the number of ``dimensions`` are recomputed
+    from the recorded sweep file.
+    """
     ints = [data[k] for k in ("n_points", "chunk_size", "n_chunks")]
-    if (
-        not all(isinstance(v, int) and not isinstance(v, bool) and v >= 0 for v in ints)
-        or data["chunk_size"] < 1
+    if not all(isinstance(v, int) and not isinstance(v, bool) and v >= 0 for v in ints):
+        return "its point and chunk counts are not counts"
+    try:
+        spec = SweepSpec.model_validate(data["spec"])
+    except Exception:  # pydantic's ValidationError, or a value its validators refuse
+        return "the sweep it records (spec) is not a sweep file's"
+    n_points = spec.point_count()
+    if n_points is None or n_points > MAX_SWEEP_POINTS:
+        return "the sweep it records (spec) has no bounded point count"
+    chunk = chunk_size_of(spec)
+    expected = {"n_points": n_points, "chunk_size": chunk, "n_chunks": math.ceil(n_points / chunk)}
+    for key, value in expected.items():
+        if data[key] != value:
+            return f"{key} is {short_repr(data[key])}, its sweep has {value}"
+    dims, n_dims = data["dimensions"], len(spec.dimension_sizes())
+    if not isinstance(dims, list) or not all(
+        isinstance(d, dict) and isinstance(d.get("name"), str) for d in dims
     ):
-        raise SweepError(
-            "DIR", str(root), "manifest.json is damaged (its point and chunk counts are not counts)"
-        )
+        return "dimensions is not a list of named dimensions"
+    if len(dims) != n_dims or len({d["name"] for d in dims}) != n_dims:
+        return f"{len(dims)} dimensions (distinct names), its sweep has {n_dims}"
+    return None
+
+
+def read_manifest(root: str | Path) -> dict[str, Any]:
+    """The manifest of a sweep folder, checked against the sweep it records.
+
+    Raises:
+        SweepError: no manifest, not readable (not a regular file, too large), not a sweep
+            manifest, or damaged (its counts or dimensions are not those of its sweep).
+    """
+    data = _manifest_data(root)
+    why = _plan_damage(data)
+    if why is not None:
+        raise SweepError("DIR", str(root), f"manifest.json is damaged: {why}")
     return data
 
 
