@@ -47,6 +47,7 @@ __all__ = [
     "GovernedApproach",
     "WallOptions",
     "WallTrial",
+    "pooled_tick_statistics",
     "run_wall_trial",
     "write_wall_video",
 ]
@@ -179,7 +180,8 @@ class WallTrial:
     (s), ``reference`` (the reference's own speed), ``cap`` (the governor's ceiling, None when
     unbounded or without a governor), ``commanded`` (the speed commanded), ``measured`` (the
     point's approach speed, ``-n . v``), all m/s. ``frames``: MuJoCo ``qpos``, CoM and impact force
-    per tick, for the video (when asked).
+    per tick, for the video (when asked). ``ticks``: the governor's time of every tick (s), for
+    statistics pooled over several trials (:func:`pooled_tick_statistics`).
     """
 
     options: WallOptions
@@ -191,6 +193,7 @@ class WallTrial:
     series: dict[str, Any]
     wall: np.ndarray | None = None
     frames: dict[str, Any] | None = None
+    ticks: list[float] = field(default_factory=list)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready: one approach of ``approach --json``."""
@@ -205,7 +208,9 @@ class WallTrial:
             "cap_at_contact": self.cap_at_contact,
             "time_to_contact": self.time_to_contact,
             "outcome": s["outcome"],
+            "strict_fail": s["strict_fail"],
             "reason": s["reason"],
+            "strict_reason": s["strict_reason"],
             "detail": s["detail"],
             "events": s["events"],
             "tick_us": self.tick_us,
@@ -284,6 +289,7 @@ def run_wall_trial(
         recorder.rows,
         wall,
         {k: np.array(x) for k, x in recorder.kept.items()} if frames else None,
+        list(recorder.ticks),
     )
 
 
@@ -356,6 +362,15 @@ def _tick_statistics(ticks: list[float]) -> dict[str, float | int | None]:
         "p99": float(np.percentile(us, 99)),
         "count": int(us.size),
     }
+
+
+def pooled_tick_statistics(trials: list[WallTrial]) -> dict[str, float | int | None]:
+    """Median and 99th percentile (us) of the governor's ticks of all ``trials`` pooled, and count.
+
+    A percentile of one trial's few ticks (70 to 140) is one of its largest ticks; pooled over the
+    trials it is a percentile.
+    """
+    return _tick_statistics([tick for trial in trials for tick in trial.ticks])
 
 
 def write_wall_video(
