@@ -57,6 +57,8 @@ def test_com_governor_caps_the_speed_at_contact(capsys, tmp_path):
     )  # tracked, not conservative for nothing
     assert out["outcome"] in ("balanced", "contact_broken") and out["time_to_contact"] > 0
     assert out["tick_us"]["median"] > 0 and out["tick_us"]["count"] > 10
+    assert len(out["ticks_us"]) == out["tick_us"]["count"]
+    assert np.median(out["ticks_us"]) == pytest.approx(out["tick_us"]["median"], abs=1e-3)
     assert out["strict_fail"] == (
         out["outcome"] == "fell" or out["trial"]["stance_changed_time"] is not None
     )
@@ -108,6 +110,10 @@ def test_tick_percentiles_are_pooled_over_the_trials():
     assert pooled["p99"] == pytest.approx(np.percentile(everything, 99))
     assert pooled["median"] == pytest.approx(np.median(everything))
     assert pooled_tick_statistics([]) == {"median": None, "p99": None, "count": 0}
+    # From the trials' JSON (what a study's journal keeps): the same statistics.
+    docs = [{"ticks_us": [1e6 * x for x in t]} for t in ticks]
+    again = pooled_tick_statistics(docs)
+    assert again["count"] == 270 and again["p99"] == pytest.approx(pooled["p99"])
 
 
 def test_without_a_governor_the_reference_is_reached(capsys):

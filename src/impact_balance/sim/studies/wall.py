@@ -20,6 +20,7 @@ governor's time per tick.
 from __future__ import annotations
 
 import time
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -214,6 +215,7 @@ class WallTrial:
             "detail": s["detail"],
             "events": s["events"],
             "tick_us": self.tick_us,
+            "ticks_us": [round(1e6 * t, 3) for t in self.ticks],  # for statistics over trials
             "trial": s,
         }
 
@@ -364,13 +366,22 @@ def _tick_statistics(ticks: list[float]) -> dict[str, float | int | None]:
     }
 
 
-def pooled_tick_statistics(trials: list[WallTrial]) -> dict[str, float | int | None]:
+def pooled_tick_statistics(
+    trials: Iterable[WallTrial | Mapping[str, Any]],
+) -> dict[str, float | int | None]:
     """Median and 99th percentile (us) of the governor's ticks of all ``trials`` pooled, and count.
 
+    Each trial is a :class:`WallTrial` or its JSON (:meth:`WallTrial.to_dict`, its ``ticks_us``).
     A percentile of one trial's few ticks (70 to 140) is one of its largest ticks; pooled over the
     trials it is a percentile.
     """
-    return _tick_statistics([tick for trial in trials for tick in trial.ticks])
+    ticks: list[float] = []
+    for trial in trials:
+        if isinstance(trial, Mapping):
+            ticks += [1e-6 * float(us) for us in trial["ticks_us"]]
+        else:
+            ticks += trial.ticks
+    return _tick_statistics(ticks)
 
 
 def write_wall_video(
