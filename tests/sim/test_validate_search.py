@@ -93,3 +93,37 @@ def test_the_result_reports_the_thresholds_in_measured_speed():
     assert brk["commanded"] - brk["no_break_below_commanded"] <= 0.05 * brk["commanded"]
     assert brk["measured"] == pytest.approx(1.02 * brk["commanded"])
     assert brk["contact"] == "palm" and brk["kind"] == "slipped"
+
+
+class _Runner(_Robot):
+    """The search's runner on the synthetic robot, aborting below ``abort`` (commanded m/s), and
+    running each speed once, as :class:`~impact_balance.sim.studies.validate._TrialRunner` does."""
+
+    def __init__(self, brk: float, strict: float, fall: float, abort: float):
+        super().__init__(brk, strict, fall)
+        self.abort, self.runs = abort, 0
+
+    def __call__(self, speed: float) -> str:
+        for done in self.trials:
+            if round(done.speed, 9) == round(speed, 9):
+                return done.outcome
+        self.runs += 1
+        if speed < self.abort:
+            summary = {"outcome": "aborted", "reason": "before_disturbance", "events": []}
+            self.trials.append(ValidationTrial(speed=speed, summary=summary))
+            return "aborted"
+        return super().__call__(speed)
+
+
+def test_searches_stop_above_an_aborted_speed_and_never_run_one_twice():
+    robot = _Runner(0.2, 0.2, 0.4, abort=0.15)
+    search = _Search(robot, 0.05, 0.02, 4.0, None)
+    stood, fell = search.bracket(0.4)  # falls at once: halves to 0.2 (broke, stood), bisects
+    search.bisect(stood, fell)
+    search.threshold(_strict)  # fails at 0.2 already: halves to 0.1, aborted, stops
+    before = robot.runs
+    search.threshold(_broke)  # the same: the aborted 0.1 is not run again
+    assert robot.runs == before
+    speeds = [round(t.speed, 9) for t in robot.trials]
+    assert len(speeds) == len(set(speeds)) and 0.1 in speeds
+    assert min(speeds) == 0.1  # nothing below the aborted speed

@@ -333,7 +333,13 @@ class _TrialRunner:
         self.reused = 0
 
     def __call__(self, speed: float) -> OutcomeName:
-        """The outcome of the trial at the commanded ``speed`` (m/s)."""
+        """The outcome of the trial at the commanded ``speed`` (m/s).
+
+        A speed already run in this search is not run (nor kept) again.
+        """
+        for done in self.trials:
+            if round(done.speed, 9) == round(speed, 9):
+                return done.outcome
         key = {"speed": round(speed, 9)}
         entry = self.journal.get(key)
         if entry is None:
@@ -425,9 +431,13 @@ class _Search:
         hi = min(bad)
         good = [t.speed for t in scored if not failed(t) and t.speed < hi]
         lo = max(good) if good else None
+        # Nothing at or below an aborted speed can be tested (a slower approach lasts longer).
+        floor = max(
+            (t.speed for t in self.trial.trials if not t.scored and t.speed < hi), default=0
+        )
         while lo is None or hi - lo > self.tolerance * hi:
             speed = max(self.min_speed, hi / 2) if lo is None else 0.5 * (lo + hi)
-            if speed >= hi * (1 - 1e-9):
+            if speed >= hi * (1 - 1e-9) or (lo is None and speed <= floor):
                 return
             if self.trial(speed) == "aborted":
                 return
