@@ -215,7 +215,7 @@ def test_push_test_band_scores_the_band_and_all_pushes(capsys, tmp_path):
     assert [p["relative"] for p in out["pushes"]] == [0.3, 0.9, 0.95, 1.0]
     assert out["band"] == [0.9, 1.0] and out["scores_scope"] == "all pushes"
     assert out["scores"]["com"]["total"] == 4 and out["band_scores"]["com"]["total"] == 3
-    assert out["margin_study"]["scope"] == "band"
+    assert out["margin_study"]["scope"] == "all"
     for p in out["pushes"]:
         assert p["strict_fail"] == (p["fell"] or p["trial"]["stance_changed_time"] is not None)
     band = [p for p in out["pushes"] if p["relative"] >= 0.9]

@@ -237,3 +237,53 @@ def test_predictions_start_at_rest_as_the_trials_do():
         default_prediction(scenario, 0.01)
         == predictions(scenario, 0.01)["com_criterion"]["composite"]
     )
+
+
+def _push(margin: float, outcome: str, strict: bool, relative: float) -> PushOutcome:
+    summary = {"outcome": outcome, "fell": outcome == "fell", "strict_fail": strict, "events": []}
+    return PushOutcome(
+        push=Push(0.0, 10.0),
+        relative=relative,
+        prediction=PushPrediction(np.zeros(2), margin, np.zeros(2), 0.05),
+        summary=summary,
+    )
+
+
+@settings(max_examples=50, deadline=None)
+@given(
+    st.lists(
+        st.tuples(st.floats(-0.05, 0.2), st.sampled_from(["balanced", "contact_broken", "fell"])),
+        min_size=1,
+        max_size=25,
+    )
+)
+def test_margin_study_finds_the_smallest_margin_by_the_false_safe_rate(rows):
+    from impact_balance.sim.studies.push import PushTestResult
+    from impact_balance.sim.studies.scores import MARGIN_GRID
+
+    omega = 3.0
+    pushes = [
+        _push(m, outcome, outcome == "fell" or (outcome == "contact_broken" and k % 2 == 0), 1.0)
+        for k, (m, outcome) in enumerate(rows)
+    ]
+    result = PushTestResult("s", pushes, {}, {}, None, 0.01, 0.01, omega, 0.0)
+    study = result.margin_study()
+
+    def brute(failed):
+        for margin in MARGIN_GRID:
+            safe = [p for p in pushes if p.prediction.com_velocity_margin >= omega * margin]
+            if safe and sum(failed(p) for p in safe) / len(safe) <= 0.05:
+                return margin
+        return None
+
+    assert study["smallest_margin"]["com"] == brute(lambda p: p.fell)
+    assert study["smallest_margin_strict"]["com"] == brute(lambda p: p.strict_fail)
+    # Strict failures include the falls: the strict margin is never the smaller one.
+    lenient, strict = study["smallest_margin"]["com"], study["smallest_margin_strict"]["com"]
+    if strict is not None:
+        assert lenient is not None and lenient <= strict
+    scores = result.scores()
+    assert (
+        scores["com"]["strict"]["fell_given_safe"]["count"]
+        >= scores["com"]["fell_given_safe"]["count"]
+    )

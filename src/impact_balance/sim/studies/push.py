@@ -305,11 +305,12 @@ class PushTestResult:
         Scores at 0, the controller's margin and twice it, and the smallest margin (of
         :data:`~.scores.MARGIN_GRID`) that brings each criterion's false-safe rate
         P(fell | predicted safe) to :data:`~.scores.FALSE_SAFE_TARGET` or less, for the lenient
-        outcome (``smallest_margin``) and the strict one (``smallest_margin_strict``). On the band's
-        pushes when there is a band (``scope``).
+        outcome (``smallest_margin``) and the strict one (``smallest_margin_strict``), over every
+        scored push (``scope``): on a band alone, where every push may fall, a margin that calls
+        nothing safe has no false-safe rate, and the far points are what it must still call safe.
         """
         own = self.controller_margin
-        pushes = self.in_band
+        pushes = self.scored
         margins = sorted({0.0, own, 2 * own})
         grid = {m: self.scores(m, pushes) for m in MARGIN_GRID}
         smallest: dict[str, float | None] = {}
@@ -318,7 +319,7 @@ class PushTestResult:
             smallest[c] = _smallest(grid, c, strict=False)
             strict[c] = _smallest(grid, c, strict=True)
         return {
-            "scope": "band" if self.band is not None else "all",
+            "scope": "all",
             "target": FALSE_SAFE_TARGET,
             "margins": margins,
             "scores": {f"{m:g}": self.scores(m, pushes) for m in margins},
