@@ -8,6 +8,9 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
+pytest.importorskip("mujoco", reason="needs the sim extra (MuJoCo)")
+pytest.importorskip("pandas", reason="needs the logs extra (pandas)")
+
 from impact_balance.sim.trials.outcomes import STRICT_BOUNDS, OutcomeCriteria, OutcomeMonitor
 
 

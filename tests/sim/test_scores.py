@@ -7,6 +7,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+pytest.importorskip("mujoco", reason="needs the sim extra (MuJoCo)")
+pytest.importorskip("pandas", reason="needs the logs extra (pandas)")
+
 from impact_balance.sim.studies.scores import confusion, rate, wilson
 
 scipy_stats = pytest.importorskip("scipy.stats")

@@ -7,6 +7,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+pytest.importorskip("mujoco", reason="needs the sim extra (MuJoCo)")
+pytest.importorskip("pandas", reason="needs the logs extra (pandas)")
+
 from impact_balance.sim.studies.validate import (
     ValidationResult,
     ValidationTrial,
