@@ -229,7 +229,16 @@ def test_push_test_band_scores_the_band_and_all_pushes(capsys, tmp_path):
     assert "scores over all 4 pushes" in text and "strict" in text and "P(fell | safe)" in text
     rc = main([*argv[:-2], "--relative", "0.5"])
     err = capsys.readouterr().err.strip().splitlines()
-    assert rc == 2 and len(err) == 1 and "--relative" in err[0]
+    assert rc == 2 and len(err) == 1 and "--relative" in err[0] and "not both" in err[0]
+    for bad, needle in (
+        (["--band-step", "0.05"], "--band-step"),
+        (["--far", "0.5"], "--far"),
+        (["--band", "1.0", "0.9"], "--band"),
+        (["--band", "0.9", "1.0", "--band-step", "0.5"], "--band-step"),
+    ):
+        rc = main(["push-test", SCENARIO, "--directions", "1", *bad])
+        err = capsys.readouterr().err.strip().splitlines()
+        assert rc == 2 and len(err) == 1 and needle in err[0], err
 
 
 def test_checker_reads_simulate_logs(tmp_path, capsys):

@@ -73,7 +73,7 @@ def add_parser(sub: Subcommands) -> list[str]:
     a.add_argument(
         "--band-step",
         type=float,
-        default=0.03,
+        default=None,
         metavar="F",
         help="step of --band, in boundary fractions (default 0.03)",
     )
@@ -119,13 +119,18 @@ def run(args: argparse.Namespace) -> int:
     scenario = with_margins(load_scenario(args.scenario), args.zmp_margin)
     if args.log:
         check_log_path(args.log)
-    check_band_arguments(args.band, args.band_step, args.far)
+    if args.band is None and args.band_step is not None:
+        raise SimulationError("--band-step", args.band_step, "needs --band (the step of the band)")
+    step = 0.03 if args.band_step is None else args.band_step
+    check_band_arguments(args.band, step, args.far)
     relative = args.relative
     if args.band is not None:
         if args.relative is not None or args.magnitudes is not None:
             given = "--relative" if args.relative is not None else "--magnitudes"
-            raise SimulationError(given, args.relative or args.magnitudes, "give it or --band")
-        relative = band_levels(args.band, args.band_step, args.far or ())
+            raise SimulationError(
+                given, args.relative or args.magnitudes, f"give {given} or --band, not both"
+            )
+        relative = band_levels(args.band, step, args.far or ())
     check_push_arguments(args.directions, args.magnitudes, args.duration, relative)
     options = BalanceTrialOptions(controller=args.controller)
     journal = open_journal(args, "push-test", scenario, "servo", options, {"body": args.body})
