@@ -211,7 +211,7 @@ def pushes(
             s = study["scores"][f"{m:g}"]
             cells = [
                 f"{_pct(s[k]['accuracy'])}{_ci(s[k]['accuracy_ci95'])} / "
-                f"{_pct(s[k]['safe_fell_rate'])}{_ci(s[k]['safe_fell_rate_ci95'])}"
+                f"{_pct(s[k]['safe_and_fell_share'])}{_ci(s[k]['safe_and_fell_share_ci95'])}"
                 for k in ("com", "com_in_trial", "zmp", "zmp_in_trial")
             ]
             first = m == study["margins"][0]

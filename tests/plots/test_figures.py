@@ -502,6 +502,33 @@ def test_push_figures_label_directions_and_keep_survivors_on_top(balance_results
     )  # falls drawn first: the pushes that did not fall stay visible on top
 
 
+def test_push_figure_dashes_the_pushes_beyond_the_strict_bounds(balance_results):
+    from dataclasses import replace
+
+    from impact_balance.plots.balance import OUTCOME_COLORS, plot_push_trajectories
+
+    _, _, pushes = balance_results
+    first = pushes.outcomes[0]
+    broken = replace(
+        first,
+        summary={"outcome": "contact_broken", "strict_fail": True, "events": []},
+    )
+    strict = replace(pushes, outcomes=[broken, *pushes.outcomes[1:]])
+    fig = plot_push_trajectories(strict, "com_velocity")
+    broken_lines = [
+        line
+        for line in fig.axes[0].get_lines()
+        if line.get_color() == OUTCOME_COLORS["contact_broken"] and len(line.get_xdata()) > 1
+    ]
+    assert [line.get_linestyle() for line in broken_lines] == ["--"]  # the one push, dashed
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert "a contact beyond the strict bounds" in labels
+    plain = plot_push_trajectories(pushes, "com_velocity")
+    assert "a contact beyond the strict bounds" not in [
+        t.get_text() for t in plain.legends[0].get_texts()
+    ]
+
+
 def test_impact_trajectories_name_each_trial(balance_results):
     from impact_balance.plots.balance import plot_impact_trajectories
 

@@ -57,6 +57,12 @@ def test_com_governor_caps_the_speed_at_contact(capsys, tmp_path):
     )  # tracked, not conservative for nothing
     assert out["outcome"] in ("balanced", "contact_broken") and out["time_to_contact"] > 0
     assert out["tick_us"]["median"] > 0 and out["tick_us"]["count"] > 10
+    assert len(out["ticks_us"]) == out["tick_us"]["count"]
+    assert np.median(out["ticks_us"]) == pytest.approx(out["tick_us"]["median"], abs=1e-3)
+    assert out["strict_fail"] == (
+        out["outcome"] == "fell" or out["trial"]["stance_changed_time"] is not None
+    )
+    assert out["strict_reason"] == out["trial"]["strict_reason"]
     assert any(p.name.endswith("_approach_com_0.8_15cm.png") for p in tmp_path.iterdir())
 
 
@@ -89,6 +95,27 @@ def test_the_id_controller_holds_the_point_under_a_falling_cap():
     assert ratio[False] > ratio[True] + 0.01  # the lag the bound removes
 
 
+def test_tick_percentiles_are_pooled_over_the_trials():
+    from types import SimpleNamespace
+
+    from impact_balance.sim.studies.wall import pooled_tick_statistics
+
+    rng = np.random.default_rng(3)
+    ticks = [list(rng.uniform(1e-4, 2e-4, 90)) for _ in range(3)]
+    ticks[1][5] = 5e-3  # one slow tick in one trial
+    trials = [SimpleNamespace(ticks=t) for t in ticks]
+    pooled = pooled_tick_statistics(trials)
+    everything = 1e6 * np.concatenate(ticks)
+    assert pooled["count"] == 270
+    assert pooled["p99"] == pytest.approx(np.percentile(everything, 99))
+    assert pooled["median"] == pytest.approx(np.median(everything))
+    assert pooled_tick_statistics([]) == {"median": None, "p99": None, "count": 0}
+    # From the trials' JSON (what a study's journal keeps): the same statistics.
+    docs = [{"ticks_us": [1e6 * x for x in t]} for t in ticks]
+    again = pooled_tick_statistics(docs)
+    assert again["count"] == 270 and again["p99"] == pytest.approx(pooled["p99"])
+
+
 def test_without_a_governor_the_reference_is_reached(capsys):
     out = run_json(
         capsys,
@@ -102,6 +129,7 @@ def test_without_a_governor_the_reference_is_reached(capsys):
         "0.18",
     )
     assert out["governor"] == "none" and len(out["trials"]) == 3
+    assert out["tick_us"] == {"median": None, "p99": None, "count": 0}  # pooled: no governor
     for trial in out["trials"]:
         assert trial["cap_at_contact"] is None and trial["tick_us"]["median"] is None
         assert trial["speed_at_contact"] == pytest.approx(0.5, rel=0.1)

@@ -77,7 +77,12 @@ def test_validate_brackets_the_threshold_in_measured_speed(tmp_path):
     result = validate(SCENARIO, tolerance=0.5, options=options, setup=setup, journal=journal)
     journal.close()
     out = json.loads(json.dumps(result.to_dict(), allow_nan=False))
-    assert set(out["predicted"]) == {"com_criterion", "zmp_criterion"}
+    assert set(out["predicted"]) == {"com_criterion", "zmp_criterion", "default"}
+    # The default (the governor's cap): the CoM criterion with the scenario's inertia model and
+    # the scoring margin.
+    assert out["predicted"]["default"] == pytest.approx(
+        out["predicted_with_margin"]["com_criterion"]["composite"]
+    )
     assert set(out["predicted"]["com_criterion"]) == {"composite", "joint_space"}
     e = out["empirical"]
     s, f = e["survived"], e["fell"]
@@ -95,6 +100,21 @@ def test_validate_brackets_the_threshold_in_measured_speed(tmp_path):
             t["speed"], rel=0.35
         )  # reached before the surface
     assert any(t["fell"] for t in out["trials"]) and any(not t["fell"] for t in out["trials"])
+    # The strict threshold: the slowest measured speed that failed strictly, at or below the fall.
+    assert e["strict_failed"] is not None and e["strict_failed"] <= f
+    strict = [t for t in out["trials"] if t["strict_fail"]]
+    assert e["strict_failed"] == min(t["approach_speed_measured"] for t in strict)
+    assert all(t["strict_fail"] for t in out["trials"] if t["fell"])
+    if e["strict_stood"] is not None:
+        assert e["strict_stood"] < e["strict_failed"]
+    # The first contact break, bisected to the same tolerance (commanded), below the fall.
+    brk = e["first_contact_break"]
+    if brk is not None:
+        broke = [t for t in out["trials"] if t["events"]]
+        assert brk["measured"] == min(t["approach_speed_measured"] for t in broke)
+        if brk["no_break_below"] is not None:
+            lo, hi = brk["no_break_below_commanded"], brk["commanded"]
+            assert lo < hi and hi - lo <= 0.5 * hi
     assert out["controller"]["name"] and out["rigid_impact"] is True
     predicted = out["predicted"]["com_criterion"]["composite"]
     assert 0.5 * predicted < f < 2.0 * predicted  # loose here; benchmarks/balance.py measures it
@@ -153,12 +173,72 @@ def test_push_test_json(capsys, tmp_path):
     }
     assert push["magnitude"] == 5.0 and push["fell"] is False and push["outcome"] == "balanced"
     assert push["com_criterion_safe"] is True and push["com_velocity_margin"] > 0
+    assert push["paper_com_criterion_safe"] is push["com_criterion_safe"]  # the same call today
+    assert push["strict_fail"] is False and push["strict_reason"] is None
+    assert out["start_com_velocity"] == [0.0, 0.0] and out["band_scores"] is None
+    strict = out["scores"]["com"]["strict"]["fell_given_safe"]
+    assert strict == {
+        "rate": 0.0,
+        "ci95": [0.0, pytest.approx(0.7935, abs=1e-4)],
+        "count": 0,
+        "of": 1,
+    }
     assert out["zmp_margin"] == pytest.approx(0.01)  # the ik controller's own margin, by default
     c = out["scores"]["com"]
     assert c["total"] == 1 and c["safe_survived"] == 1 and c["accuracy_ci95"][1] == 1.0
     assert main([*argv[:-2], "--journal", str(tmp_path / "j.jsonl"), "--zmp-margin", "0"]) == 0
     again = json.loads(capsys.readouterr().out)
     assert again["reused_trials"] == 1 and again["zmp_margin"] == 0.0
+
+
+def test_push_test_band_scores_the_band_and_all_pushes(capsys, tmp_path):
+    """A band 0.9-1.0 in steps of 0.05 and a far point 0.3: four pushes, three in the band."""
+    argv = [
+        "push-test",
+        SCENARIO,
+        "--controller",
+        "ik",
+        "--directions",
+        "1",
+        "--band",
+        "0.9",
+        "1.0",
+        "--band-step",
+        "0.05",
+        "--far",
+        "0.3",
+        "--journal",
+        str(tmp_path / "b.jsonl"),
+    ]
+    assert main([*argv, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out, parse_constant=lambda c: pytest.fail(c))
+    assert [p["relative"] for p in out["pushes"]] == [0.3, 0.9, 0.95, 1.0]
+    assert out["band"] == [0.9, 1.0] and out["scores_scope"] == "all pushes"
+    assert out["scores"]["com"]["total"] == 4 and out["band_scores"]["com"]["total"] == 3
+    assert out["margin_study"]["scope"] == "all"
+    for p in out["pushes"]:
+        assert p["strict_fail"] == (p["fell"] or p["trial"]["stance_changed_time"] is not None)
+    band = [p for p in out["pushes"] if p["relative"] >= 0.9]
+    k = out["band_scores"]["com"]
+    safe = [p for p in band if p["com_criterion_safe"]]
+    assert k["fell_given_safe"]["of"] == len(safe)
+    assert k["strict"]["fell_given_safe"]["count"] == sum(p["strict_fail"] for p in safe)
+    assert main(argv) == 0  # text, from the journal
+    text = capsys.readouterr().out
+    assert "scores on the band 0.9-1 of the boundary (3 pushes" in text
+    assert "scores over all 4 pushes" in text and "strict" in text and "P(fell | safe)" in text
+    rc = main([*argv[:-2], "--relative", "0.5"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and "--relative" in err[0] and "not both" in err[0]
+    for bad, needle in (
+        (["--band-step", "0.05"], "--band-step"),
+        (["--far", "0.5"], "--far"),
+        (["--band", "1.0", "0.9"], "--band"),
+        (["--band", "0.9", "1.0", "--band-step", "0.5"], "--band-step"),
+    ):
+        rc = main(["push-test", SCENARIO, "--directions", "1", *bad])
+        err = capsys.readouterr().err.strip().splitlines()
+        assert rc == 2 and len(err) == 1 and needle in err[0], err
 
 
 def test_checker_reads_simulate_logs(tmp_path, capsys):
@@ -208,6 +288,7 @@ def test_validate_cli_json_keys_and_text(capsys, tmp_path):
     assert out["zmp_margin"] == pytest.approx(0.01) and out["rigid_impact"] is True
     (trial,) = out["trials"]
     assert trial["outcome"] == "balanced" and trial["com_criterion_safe"] is True
+    assert trial["strict_fail"] is False and e["strict_failed"] is None
     impact = trial["trial"]["impact"]
     assert set(impact["sustained_impulses"]) == {"left_sole_link", "right_sole_link"}
     assert main(argv) == 0  # text, from the journal
@@ -215,5 +296,7 @@ def test_validate_cli_json_keys_and_text(capsys, tmp_path):
     assert (
         "measured approach speed: stood at" in text
         and "CoM criterion" in text
+        and "strict (fell, or a contact beyond the strict bounds)" in text
+        and "default (the governor's cap)" in text
         and "(1 reused)" in text
     )

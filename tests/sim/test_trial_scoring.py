@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 pytest.importorskip("mujoco", reason="needs the sim extra (MuJoCo)")
 pytest.importorskip("pandas", reason="needs the logs extra (pandas)")
@@ -48,11 +50,24 @@ def test_confusion_counts_and_rates():
         1,
         1,
     )
-    assert c["accuracy"] == pytest.approx(4 / 6) and c["safe_fell_rate"] == pytest.approx(1 / 6)
-    assert c["fell_given_safe"] == pytest.approx(1 / 4) and c[
-        "survived_given_unsafe"
-    ] == pytest.approx(1 / 2)
+    assert c["accuracy"] == pytest.approx(4 / 6)
+    assert c["safe_and_fell_share"] == pytest.approx(1 / 6)  # of all trials: not the headline
+    assert c["fell_given_safe"]["rate"] == pytest.approx(1 / 4)
+    assert (c["fell_given_safe"]["count"], c["fell_given_safe"]["of"]) == (1, 4)
+    assert c["stood_given_unsafe"]["rate"] == pytest.approx(1 / 2)
+    assert c["safe_given_stood"]["rate"] == pytest.approx(3 / 4)
+    assert c["fell_given_safe"]["ci95"] == wilson(1, 4)
     assert c["accuracy_ci95"][0] < 4 / 6 < c["accuracy_ci95"][1]
+    # The conditional rates come first in the JSON object.
+    assert list(c)[:3] == ["fell_given_safe", "stood_given_unsafe", "safe_given_stood"]
+
+
+def test_confusion_without_a_safe_call_has_no_false_safe_rate():
+    c = confusion([False, False], [True, False])
+    assert c["fell_given_safe"] == {"rate": None, "ci95": None, "count": 0, "of": 0}
+    assert c["stood_given_unsafe"]["rate"] == 0.5
+    with pytest.raises(ValueError, match="differ in length"):
+        confusion([True], [True, False])
 
 
 def test_boundary_impulse_puts_the_predicted_velocity_on_the_boundary():
@@ -160,4 +175,115 @@ def test_an_interrupted_push_test_resumes_with_the_same_answers(tmp_path):
     ]
     assert [o.summary["com_velocity_margin_at_end"] for o in resumed.outcomes] == pytest.approx(
         [o.summary["com_velocity_margin_at_end"] for o in fresh.outcomes], abs=1e-12
+    )
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    st.floats(0.1, 2.0),
+    st.floats(0.02, 1.0),
+    st.floats(0.005, 0.1),
+    st.lists(st.floats(0.05, 3.0), max_size=3),
+)
+def test_band_levels_cover_the_band_in_steps(lo, width, step, far):
+    from impact_balance.sim.studies.push import band_levels
+
+    hi = lo + width
+    assume(step <= width)
+    levels = band_levels((lo, hi), step, far)
+    inside = [x for x in levels if lo - 1e-6 <= x <= hi + 1e-6]
+    assert inside[0] == pytest.approx(lo, abs=1e-6) and inside[-1] == pytest.approx(hi, abs=1e-6)
+    assert max(np.diff(inside), default=0.0) <= step + 2e-6  # no gap wider than the step
+    assert levels == sorted(set(levels))
+    for x in far:
+        assert any(abs(x - y) <= 1e-6 for y in levels)
+
+
+def test_the_documented_band_has_steps_of_at_most_003():
+    from impact_balance.sim.studies.push import band_levels
+
+    levels = band_levels((0.75, 1.05), 0.03, (0.5, 1.3))
+    assert levels[0] == 0.5 and levels[-1] == 1.3 and len(levels) == 13
+    assert np.allclose(np.diff(levels[1:-1]), 0.03)
+
+
+@pytest.mark.parametrize(
+    "band, step, far, field",
+    [
+        ((1.05, 0.75), 0.03, None, "--band"),
+        ((0.75, 1.05), 0.0, None, "--band-step"),
+        ((0.75, 1.05), 0.5, None, "--band-step"),
+        ((0.75, 1.05), 0.03, (-1.0,), "--far"),
+        (None, 0.03, (0.5,), "--far"),
+    ],
+)
+def test_bad_band_arguments_name_the_option(band, step, far, field):
+    from impact_balance.sim.studies.push import check_band_arguments
+
+    with pytest.raises(SimulationError, match=field):
+        check_band_arguments(band, step, far)
+
+
+def test_predictions_start_at_rest_as_the_trials_do():
+    """A scenario's com_velocity does not move the sim predictions: every trial starts at rest."""
+    from impact_balance.scenario import load_scenario
+    from impact_balance.sim.studies.validate import default_prediction, predictions
+
+    scenario = load_scenario("palm_push_two_feet")
+    moving = scenario.replace(com_velocity=(0.05, 0.02))
+    assert predictions(moving) == predictions(scenario)
+    assert default_prediction(moving, 0.01) == default_prediction(scenario, 0.01)
+    assert (
+        default_prediction(scenario, 0.01)
+        == predictions(scenario, 0.01)["com_criterion"]["composite"]
+    )
+
+
+def _push(margin: float, outcome: str, strict: bool, relative: float) -> PushOutcome:
+    summary = {"outcome": outcome, "fell": outcome == "fell", "strict_fail": strict, "events": []}
+    return PushOutcome(
+        push=Push(0.0, 10.0),
+        relative=relative,
+        prediction=PushPrediction(np.zeros(2), margin, np.zeros(2), 0.05),
+        summary=summary,
+    )
+
+
+@settings(max_examples=50, deadline=None)
+@given(
+    st.lists(
+        st.tuples(st.floats(-0.05, 0.2), st.sampled_from(["balanced", "contact_broken", "fell"])),
+        min_size=1,
+        max_size=25,
+    )
+)
+def test_margin_study_finds_the_smallest_margin_by_the_false_safe_rate(rows):
+    from impact_balance.sim.studies.push import PushTestResult
+    from impact_balance.sim.studies.scores import MARGIN_GRID
+
+    omega = 3.0
+    pushes = [
+        _push(m, outcome, outcome == "fell" or (outcome == "contact_broken" and k % 2 == 0), 1.0)
+        for k, (m, outcome) in enumerate(rows)
+    ]
+    result = PushTestResult("s", pushes, {}, {}, None, 0.01, 0.01, omega, 0.0)
+    study = result.margin_study()
+
+    def brute(failed):
+        for margin in MARGIN_GRID:
+            safe = [p for p in pushes if p.prediction.com_velocity_margin >= omega * margin]
+            if safe and sum(failed(p) for p in safe) / len(safe) <= 0.05:
+                return margin
+        return None
+
+    assert study["smallest_margin"]["com"] == brute(lambda p: p.fell)
+    assert study["smallest_margin_strict"]["com"] == brute(lambda p: p.strict_fail)
+    # Strict failures include the falls: the strict margin is never the smaller one.
+    lenient, strict = study["smallest_margin"]["com"], study["smallest_margin_strict"]["com"]
+    if strict is not None:
+        assert lenient is not None and lenient <= strict
+    scores = result.scores()
+    assert (
+        scores["com"]["strict"]["fell_given_safe"]["count"]
+        >= scores["com"]["fell_given_safe"]["count"]
     )

@@ -183,15 +183,28 @@ def run(args: argparse.Namespace) -> int:
         d["contact_aware"] = bool(args.contact_aware and governor is not None)
         d["velocity_margin"] = governed.velocity_margin if governor is not None else None
         d["contact_aware_async"] = bool(args.contact_aware_async and governor is not None)
+    from impact_balance.sim.studies.wall import pooled_tick_statistics
+
     out = (
         docs[0]
         if len(docs) == 1
-        else {"governor": args.governor, "reference": args.reference, "trials": docs}
+        else {
+            "governor": args.governor,
+            "reference": args.reference,
+            "tick_us": pooled_tick_statistics(trials),  # over the ticks of every trial
+            "trials": docs,
+        }
     )
     if args.json:
         print_json(out)
         return 0
     _print_text(scenario.name, args, docs, written)
+    if len(docs) > 1 and out["tick_us"]["median"] is not None:
+        t = out["tick_us"]
+        print(
+            f"  governor over all {t['count']} ticks: median {t['median']:.0f} us, "
+            f"p99 {t['p99']:.0f} us"
+        )
     return 0
 
 
@@ -274,10 +287,15 @@ def _print_text(
             else f"; governor {tick['median']:.0f} us per tick (p99 {tick['p99']:.0f})"
         )
         reason = "" if d["reason"] is None else f" ({d['reason']})"
+        strict = (
+            f"; strict fail ({d['strict_reason']})"
+            if d["strict_fail"] and d["outcome"] != "fell"
+            else ""
+        )
         print(
             f"  wall {100 * d['wall_distance']:g} cm: speed at contact "
             f"{_f(d['speed_at_contact'])}, cap at contact {_f(d['cap_at_contact'])}, "
-            f"time to contact {_s(d['time_to_contact'])}: {d['outcome']}{reason}{ticks}"
+            f"time to contact {_s(d['time_to_contact'])}: {d['outcome']}{reason}{strict}{ticks}"
         )
     for path in written:
         print(f"  wrote {path}")

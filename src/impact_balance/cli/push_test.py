@@ -61,6 +61,30 @@ def add_parser(sub: Subcommands) -> list[str]:
         help="impulses as fractions of each direction's boundary impulse (the one that puts the "
         "predicted CoM velocity on the CoM velocity area's boundary), e.g. 0.6 0.8 1.0 1.2 1.4",
     )
+    a.add_argument(
+        "--band",
+        type=float,
+        nargs=2,
+        default=None,
+        metavar=("LO", "HI"),
+        help="sample the band LO..HI of each direction's boundary impulse densely, where the "
+        "criterion decides (e.g. 0.75 1.05); scores are given on the band and overall",
+    )
+    a.add_argument(
+        "--band-step",
+        type=float,
+        default=None,
+        metavar="F",
+        help="step of --band, in boundary fractions (default 0.03)",
+    )
+    a.add_argument(
+        "--far",
+        type=float,
+        nargs="+",
+        default=None,
+        metavar="F",
+        help="a few far points beside --band, in boundary fractions (e.g. 0.5 1.3)",
+    )
     a.add_argument("--duration", type=float, default=0.05, help="push duration, s (default 0.05)")
     a.add_argument("--body", help="MuJoCo body pushed (default: the torso)")
     add_controller_option(
@@ -82,18 +106,36 @@ def run(args: argparse.Namespace) -> int:
     """
     from impact_balance.cli.output import print_json, progress_bar
     from impact_balance.cli.output_paths import writing
+    from impact_balance.exceptions import SimulationError
     from impact_balance.logs import check_log_path
     from impact_balance.scenario import load_scenario
-    from impact_balance.sim.studies.push import check_push_arguments, push_test
+    from impact_balance.sim.studies.push import (
+        band_levels,
+        check_band_arguments,
+        check_push_arguments,
+        push_test,
+    )
     from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, write_trial_log
 
     scenario = with_margins(load_scenario(args.scenario), args.zmp_margin)
     if args.log:
         check_log_path(args.log)
-    check_push_arguments(args.directions, args.magnitudes, args.duration, args.relative)
+    if args.band is None and args.band_step is not None:
+        raise SimulationError("--band-step", args.band_step, "needs --band (the step of the band)")
+    step = 0.03 if args.band_step is None else args.band_step
+    check_band_arguments(args.band, step, args.far)
+    relative = args.relative
+    if args.band is not None:
+        if args.relative is not None or args.magnitudes is not None:
+            given = "--relative" if args.relative is not None else "--magnitudes"
+            raise SimulationError(
+                given, args.relative or args.magnitudes, f"give {given} or --band, not both"
+            )
+        relative = band_levels(args.band, step, args.far or ())
+    check_push_arguments(args.directions, args.magnitudes, args.duration, relative)
     options = BalanceTrialOptions(controller=args.controller)
     journal = open_journal(args, "push-test", scenario, "servo", options, {"body": args.body})
-    levels = len(args.relative or args.magnitudes or [0] * 6)
+    levels = len(relative or args.magnitudes or [0] * 6)
     bar = progress_bar(f"push-test {scenario.name}", args.directions * levels)
 
     def progress(outcome: PushOutcome) -> None:
@@ -109,9 +151,10 @@ def run(args: argparse.Namespace) -> int:
             args.body,
             progress=progress,
             options=options,
-            relative=args.relative,
+            relative=relative,
             zmp_margin=scoring_margin(scenario),
             journal=journal,
+            band=args.band,
         )
     finally:
         bar.close()
@@ -158,6 +201,34 @@ def _ci(c: list[float] | None) -> str:
     return "" if c is None else f" [{100 * c[0]:.0f}, {100 * c[1]:.0f}]"
 
 
+def _rate(r: dict[str, Any]) -> str:
+    """A rate of :func:`~impact_balance.sim.studies.scores.rate`: percent, interval, counts."""
+    return f"{_pct(r['rate'])}{_ci(r['ci95'])} ({r['count']}/{r['of']})"
+
+
+_CRITERIA_LABELS = (
+    ("com", "CoM criterion, before the trial"),
+    ("paper_com", "paper's CoM criterion"),
+    ("com_in_trial", "CoM criterion, in the trial"),
+    ("zmp", "ZMP criterion, before the trial"),
+    ("zmp_in_trial", "ZMP criterion, in the trial"),
+)
+
+
+def _score_lines(scores: dict[str, Any], title: str) -> list[str]:
+    """The conditional rates of every criterion, lenient and strict."""
+    lines = [f"  {title}"]
+    for key, label in _CRITERIA_LABELS:
+        k = scores[key]
+        for outcome, c in (("fell", k), ("strict", k["strict"])):
+            lines.append(
+                f"    {label:32s} {outcome:6s} P(fell | safe) {_rate(c['fell_given_safe'])}, "
+                f"P(stood | unsafe) {_rate(c['stood_given_unsafe'])}, "
+                f"stood called safe {_pct(c['safe_given_stood']['rate'])}"
+            )
+    return lines
+
+
 def _text(result: PushTestResult, out: dict[str, Any], args: argparse.Namespace) -> str:
     counts = out["counts"]
     o = counts["outcomes"]
@@ -168,41 +239,38 @@ def _text(result: PushTestResult, out: dict[str, Any], args: argparse.Namespace)
         f"with the {args.controller} controller ({controller})",
         f"  outcomes: {o['balanced']} balanced, {o['contact_broken']} contact broken (came to "
         "rest), "
-        f"{o['fell']} fell, {o['aborted']} aborted",
+        f"{o['fell']} fell, {o['aborted']} aborted; {counts['strict_fail']} failed strictly (fell, "
+        "or a contact beyond the strict bounds)",
     ]
     if counts["reasons"]:
         lines.append("  " + ", ".join(f"{k}: {v}" for k, v in sorted(counts["reasons"].items())))
     margin = 1000 * out["zmp_margin"]
     lines.append(
-        f"  {'magnitude':>14s} {'balanced':>8s} {'broken':>6s} {'fell':>5s} {'CoM safe':>8s} "
-        f"{'ZMP safe':>8s}"
+        f"  {'magnitude':>14s} {'balanced':>8s} {'broken':>6s} {'fell':>5s} {'strict':>6s} "
+        f"{'CoM safe':>8s} {'ZMP safe':>8s}"
     )
     for row in _by_level(result):
         lines.append(
             f"  {row['label']:>14s} {row['balanced']:8d} {row['contact_broken']:6d} "
-            f"{row['fell']:5d} "
+            f"{row['fell']:5d} {row['strict']:6d} "
             f"{row['com']:8d} {row['zmp']:8d}"
         )
-    lines.append(
-        f"  scores (fell against the rest; {len(result.scored)} pushes, ZMP margin {margin:g} mm; "
-        f"95 % Wilson intervals):"
-    )
-    for key, label in (
-        ("com", "CoM criterion, before the trial"),
-        ("com_in_trial", "CoM criterion, in the trial"),
-        ("zmp", "ZMP criterion, before the trial"),
-        ("zmp_in_trial", "ZMP criterion, in the trial"),
-    ):
-        k = out["scores"][key]
-        lines.append(
-            f"    {label:32s} right {_pct(k['accuracy'])}{_ci(k['accuracy_ci95'])}, "
-            f"predicted safe and fell {_pct(k['safe_fell_rate'])}{_ci(k['safe_fell_rate_ci95'])}"
+    head = f"ZMP margin {margin:g} mm; 95 % Wilson intervals"
+    if out["band_scores"] is not None:
+        lo, hi = out["band"]
+        n = len(result.in_band)
+        lines += _score_lines(
+            out["band_scores"],
+            f"scores on the band {lo:g}-{hi:g} of the boundary ({n} pushes, {head}):",
         )
-    smallest = out["margin_study"]["smallest_margin"]["com"]
-    lines.append(
-        "  smallest ZMP margin that brings the CoM criterion's 'predicted safe, fell' to 5 % or "
-        "less: " + ("none up to 6 cm" if smallest is None else f"{1000 * smallest:g} mm")
-    )
+    lines += _score_lines(out["scores"], f"scores over all {len(result.scored)} pushes ({head}):")
+    study = out["margin_study"]
+    for key, outcome in (("smallest_margin", "fell"), ("smallest_margin_strict", "strict")):
+        smallest = study[key]["com"]
+        lines.append(
+            f"  smallest ZMP margin that brings the CoM criterion's P(fell | safe) ({outcome}) to "
+            "5 % or less: " + ("none up to 6 cm" if smallest is None else f"{1000 * smallest:g} mm")
+        )
     if out["journal"]:
         lines.append(f"  trials journal: {out['journal']} ({out['reused_trials']} reused)")
     return "\n".join(lines)
@@ -217,10 +285,19 @@ def _by_level(result: PushTestResult) -> list[dict[str, Any]]:
         )
         row = rows.setdefault(
             level,
-            {"label": label, "balanced": 0, "contact_broken": 0, "fell": 0, "com": 0, "zmp": 0},
+            {
+                "label": label,
+                "balanced": 0,
+                "contact_broken": 0,
+                "fell": 0,
+                "strict": 0,
+                "com": 0,
+                "zmp": 0,
+            },
         )
         if o.outcome in row:
             row[o.outcome] += 1
+        row["strict"] += o.strict_fail
         row["com"] += o.safe("com", result.zmp_margin, result.omega)
         row["zmp"] += o.safe("zmp", result.zmp_margin, result.omega)
     return [rows[k] for k in sorted(rows)]

@@ -170,11 +170,15 @@ def _text(out: dict[str, Any], args: argparse.Namespace, n: int) -> str:
         f" (commanded {_f(e['survived_commanded'])} / {_f(e['fell_commanded'])})"
         + ("" if e["monotonic"] else "; NOT monotonic in measured speed"),
     ]
-    brk = out["contact_break"]
+    lines.append(
+        f"  strict (fell, or a contact beyond the strict bounds): stood at "
+        f"{_f(e['strict_stood'])}, failed at {_f(e['strict_failed'])}"
+    )
+    brk = e["first_contact_break"]
     if brk is not None:
         lines.append(
-            f"  first contact break: {brk['contact']} {brk['kind']} at {_f(brk['measured'])} "
-            "measured "
+            f"  first contact break (bisected): {brk['contact']} {brk['kind']} at "
+            f"{_f(brk['measured'])} measured, none at {_f(brk['no_break_below'])} "
             f"({brk['outcome']})"
         )
     else:
@@ -187,15 +191,17 @@ def _text(out: dict[str, Any], args: argparse.Namespace, n: int) -> str:
             f"    {label:14s} composite {_f(p[crit]['composite'])} / {_f(pm[crit]['composite'])}, "
             f"joint_space {_f(p[crit]['joint_space'])} / {_f(pm[crit]['joint_space'])}"
         )
+    lines.append(f"    default (the governor's cap) {_f(p['default'])}")
     lines.append("  trials (commanded -> measured: outcome):")
     for t in out["trials"]:
         why = f" {t['reason']}" if t["reason"] else ""
         call = {True: "CoM criterion: safe", False: "CoM criterion: unsafe", None: ""}[
             t["com_criterion_safe"]
         ]
+        strict = "; strict fail" if t["strict_fail"] else ""
         lines.append(
-            f"    {t['speed']:.3f} -> {_f(t['approach_speed_measured'])}: {t['outcome']}{why}   "
-            f"{call}"
+            f"    {t['speed']:.3f} -> {_f(t['approach_speed_measured'])}: {t['outcome']}{why}"
+            f"{strict}   {call}"
         )
     lines.append(
         f"  controller: {out['controller'].get('name', args.controller)}; joint armature: "

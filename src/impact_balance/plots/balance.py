@@ -291,7 +291,8 @@ def plot_push_trajectories(result: Any, kind: PushView = "com_velocity") -> Figu
             dtype=float,
         ).reshape(-1, 2)
         if len(path):
-            ax.plot(path[:, 0], path[:, 1], color=c, lw=0.7, alpha=0.75)
+            beyond = o.strict_fail and not o.fell  # came to rest, but not on its stance
+            ax.plot(path[:, 0], path[:, 1], color=c, lw=0.7, alpha=0.75, ls="--" if beyond else "-")
             paths.append(path)
         guess = o.prediction.zmp if kind == "zmp" else o.prediction.com_velocity
         ax.plot([guess[0]], [guess[1]], "x", color=c, ms=4, mew=1.0, alpha=0.9, zorder=4)
@@ -322,6 +323,10 @@ def plot_push_trajectories(result: Any, kind: PushView = "com_velocity") -> Figu
     )
     ax.grid(alpha=0.3)
     handles += _outcome_handles(o.outcome for o in result.outcomes)
+    if any(o.strict_fail and not o.fell for o in result.outcomes):
+        handles.append(
+            Line2D([], [], color="0.3", ls="--", lw=0.7, label="a contact beyond the strict bounds")
+        )
     handles.append(
         Line2D([], [], marker="x", color="0.3", ls="none", label="predicted before the trial")
     )

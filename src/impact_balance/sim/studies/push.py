@@ -4,8 +4,8 @@ Both criteria predict each push's outcome before the trial; the trials then scor
 
 For every push both criteria predict the outcome **before the trial**, from the scenario alone:
 
-- the CoM criterion: the post-push CoM velocity ``c0 + J u / m`` (pre-push velocity plus impulse
-  over mass) lies in the CoM velocity area;
+- the CoM criterion: the post-push CoM velocity ``c0 + J u / m`` (pre-push velocity, zero: the
+  trial starts at rest, plus impulse over mass) lies in the CoM velocity area;
 - the ZMP criterion: the quasi-static ZMP while the push force ``F = J u / duration`` acts at the
   pushed body's centre of mass (height ``z_b``), ``c_xy + (z_b - h) F / (m g)``, lies in the ZMP
   support area.
@@ -18,7 +18,16 @@ trials is scored at any margin.
 
 Magnitudes are impulses in N s, or fractions of each direction's *boundary impulse* ``m r(u)`` (the
 impulse that puts the predicted CoM velocity on the boundary of the CoM velocity area without
-margin), so that a grid straddles the boundary in every direction.
+margin), so that a grid straddles the boundary in every direction. A *band* (:func:`band_levels`)
+samples the fractions where the criterion decides densely (0.75 to 1.05 of the boundary in steps
+of 0.03, say) plus a few far points; the scores are then also given on the band alone.
+
+Every trial starts at rest, so the predictions start from a CoM at rest too (``c0 = 0``), whatever
+the scenario's ``com_velocity``.
+
+``com`` is the project's default prediction; ``paper_com`` is the paper's CoM criterion (the same
+call today). Each criterion is scored against the lenient outcome (fell) and the strict one
+(:mod:`.scores`).
 """
 
 from __future__ import annotations
@@ -37,7 +46,7 @@ from impact_balance.geometry.polygon import Polygon
 from impact_balance.scenario import Scenario, load_scenario
 from impact_balance.sim.control.registry import controller_class
 from impact_balance.sim.studies.journal import TrialJournal
-from impact_balance.sim.studies.scores import MARGIN_GRID, confusion
+from impact_balance.sim.studies.scores import FALSE_SAFE_TARGET, MARGIN_GRID, confusion
 from impact_balance.sim.trials.balance_trial import (
     BalanceSetup,
     BalanceTrialOptions,
@@ -51,21 +60,24 @@ from impact_balance.sim.trials.setup import push_body
 __all__ = [
     "CRITERIA",
     "DEFAULT_MAGNITUDES",
+    "START_COM_VELOCITY",
     "PushOutcome",
     "PushPrediction",
     "PushTestResult",
+    "band_levels",
     "boundary_impulse",
+    "check_band_arguments",
     "check_push_arguments",
     "push_test",
 ]
 
 #: Default impulses (N s): for a 90 kg robot, CoM velocity changes of about 0.06 to 0.33 m/s.
 DEFAULT_MAGNITUDES = (5.0, 10.0, 15.0, 20.0, 25.0, 30.0)
-#: The predictions scored: each criterion before the trial, and read in the trial.
-CRITERIA = ("com", "com_in_trial", "zmp", "zmp_in_trial")
-#: Target share of all pushes predicted safe that fell (the margin study reports the smallest margin
-#: reaching it).
-SAFE_FELL_TARGET = 0.05
+#: The predictions scored: each criterion before the trial, and read in the trial. ``com`` is the
+#: project's default prediction, ``paper_com`` the paper's CoM criterion.
+CRITERIA = ("com", "paper_com", "com_in_trial", "zmp", "zmp_in_trial")
+#: The planar CoM velocity every push trial starts from (m/s): at rest; the predictions use it.
+START_COM_VELOCITY = (0.0, 0.0)
 
 
 def check_push_arguments(
@@ -100,6 +112,42 @@ def check_push_arguments(
         raise SimulationError(
             "--duration", duration, "must be in [0.001, 0.2] s (an impulsive push: 10-50 ms)"
         )
+
+
+def check_band_arguments(
+    band: Sequence[float] | None, step: float, far: Sequence[float] | None
+) -> None:
+    """Refuse a bad ``--band LO HI``, ``--band-step`` or ``--far`` with a clear error."""
+    if band is None:
+        if far is not None:
+            raise SimulationError("--far", list(far), "needs --band (far points beside the band)")
+        return
+    lo, hi = (float(x) for x in band)
+    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi <= 10):
+        raise SimulationError("--band", [lo, hi], "must be 0 < LO < HI <= 10 (boundary fractions)")
+    if not (np.isfinite(step) and 0 < step <= hi - lo + 1e-9):
+        raise SimulationError("--band-step", step, f"must be in (0, {hi - lo:g}] (HI - LO)")
+    if far is not None and any(not (np.isfinite(f) and 0 < f <= 10) for f in far):
+        raise SimulationError("--far", list(far), "each must be in (0, 10] (boundary fractions)")
+
+
+def band_levels(
+    band: Sequence[float], step: float = 0.03, far: Sequence[float] = ()
+) -> list[float]:
+    """The boundary fractions of a band: ``LO, LO + step, ...`` up to ``HI``, then ``far``.
+
+    Fractions are rounded to 1e-6 and kept once, in increasing order.
+
+    Raises:
+        SimulationError: A bad band, step or far point (naming the option).
+    """
+    check_band_arguments(band, step, list(far) or None)
+    lo, hi = float(band[0]), float(band[1])
+    count = int(np.floor((hi - lo) / step + 1e-9))
+    levels = [lo + k * step for k in range(count + 1)]
+    if hi - levels[-1] > 1e-9:
+        levels.append(hi)
+    return sorted({round(x, 6) for x in [*levels, *far]})
 
 
 def boundary_impulse(
@@ -155,7 +203,7 @@ class PushOutcome(TrialEntry):
         (m).
         """
         s, p = self.summary, self.prediction
-        if criterion == "com":
+        if criterion in ("com", "paper_com"):  # the project's default is the paper's criterion
             return p.com_velocity_margin >= omega * margin
         if criterion == "zmp":
             return p.zmp_margin >= margin
@@ -176,11 +224,14 @@ class PushOutcome(TrialEntry):
             "duration": float(self.push.duration),
             "outcome": s["outcome"],
             "fell": self.fell,
+            "strict_fail": self.strict_fail,
             "reason": s["reason"],
+            "strict_reason": s["strict_reason"],
             "detail": s["detail"],
             "events": s["events"],
             "outcome_time": s["outcome_time"],
             "com_criterion_safe": self.safe("com", margin, omega),
+            "paper_com_criterion_safe": self.safe("paper_com", margin, omega),
             "com_criterion_safe_in_trial": self.safe("com_in_trial", margin, omega),
             "zmp_criterion_safe": self.safe("zmp", margin, omega),
             "zmp_criterion_safe_in_trial": self.safe("zmp_in_trial", margin, omega),
@@ -210,48 +261,71 @@ class PushTestResult:
     wall_time: float
     journal: str | None = None
     reused: int = 0
+    band: tuple[float, float] | None = None
 
     @property
     def scored(self) -> list[PushOutcome]:
         """The pushes that count in the scores (their trial was not aborted)."""
         return [o for o in self.outcomes if o.scored]
 
-    def scores(self, margin: float | None = None) -> dict[str, Any]:
+    @property
+    def in_band(self) -> list[PushOutcome]:
+        """The scored pushes whose boundary fraction lies in the band (all of them without one)."""
+        if self.band is None:
+            return self.scored
+        lo, hi = self.band
+        return [
+            o
+            for o in self.scored
+            if o.relative is not None and lo - 1e-9 <= o.relative <= hi + 1e-9
+        ]
+
+    def scores(
+        self, margin: float | None = None, pushes: Sequence[PushOutcome] | None = None
+    ) -> dict[str, Any]:
         """Confusion of every criterion (:data:`CRITERIA`) at ZMP margin ``margin``.
 
-        ``margin`` defaults to the result's.
+        Each criterion's :func:`~.scores.confusion` against the falls (lenient), with the one
+        against the strict failures under ``strict``. ``margin`` defaults to the result's,
+        ``pushes`` to every scored push.
         """
         margin = self.zmp_margin if margin is None else margin
-        scored = self.scored
+        scored = self.scored if pushes is None else list(pushes)
         fell = [o.fell for o in scored]
-        return {
-            c: confusion([o.safe(c, margin, self.omega) for o in scored], fell) for c in CRITERIA
-        }
+        strict = [o.strict_fail for o in scored]
+        out = {}
+        for c in CRITERIA:
+            safe = [o.safe(c, margin, self.omega) for o in scored]
+            out[c] = {**confusion(safe, fell), "strict": confusion(safe, strict)}
+        return out
 
     def margin_study(self) -> dict[str, Any]:
         """Scores at several margins, and the smallest margin that makes each criterion safe.
 
         Scores at 0, the controller's margin and twice it, and the smallest margin (of
-        :data:`MARGIN_GRID`) that brings each criterion's "predicted safe, fell" to
-        :data:`SAFE_FELL_TARGET` or less.
+        :data:`~.scores.MARGIN_GRID`) that brings each criterion's false-safe rate
+        P(fell | predicted safe) to :data:`~.scores.FALSE_SAFE_TARGET` or less, for the lenient
+        outcome (``smallest_margin``) and the strict one (``smallest_margin_strict``), over every
+        scored push (``scope``): on a band alone, where every push may fall, a margin that calls
+        nothing safe has no false-safe rate, and the far points are what it must still call safe.
         """
         own = self.controller_margin
+        pushes = self.scored
         margins = sorted({0.0, own, 2 * own})
+        grid = {m: self.scores(m, pushes) for m in MARGIN_GRID}
         smallest: dict[str, float | None] = {}
-        out = {
-            "margins": margins,
-            "scores": {f"{m:g}": self.scores(m) for m in margins},
-            "smallest_margin": smallest,
-        }
+        strict: dict[str, float | None] = {}
         for c in CRITERIA:
-            found = None
-            for m in MARGIN_GRID:
-                rate = self.scores(m)[c]["safe_fell_rate"]
-                if rate is not None and rate <= SAFE_FELL_TARGET:
-                    found = m
-                    break
-            smallest[c] = found
-        return out
+            smallest[c] = _smallest(grid, c, strict=False)
+            strict[c] = _smallest(grid, c, strict=True)
+        return {
+            "scope": "all",
+            "target": FALSE_SAFE_TARGET,
+            "margins": margins,
+            "scores": {f"{m:g}": self.scores(m, pushes) for m in margins},
+            "smallest_margin": smallest,
+            "smallest_margin_strict": strict,
+        }
 
     def contact_breaks(self) -> dict[str, Any]:
         """Pushes that broke a contact without a fall, and which contact first, by magnitude."""
@@ -266,11 +340,13 @@ class PushTestResult:
                     "pushes": 0,
                     "contact_broken": 0,
                     "fell": 0,
+                    "strict_fail": 0,
                     "first": {},
                 },
             )
             row["pushes"] += 1
             row["fell"] += o.fell
+            row["strict_fail"] += o.strict_fail
             if o.outcome == "contact_broken":
                 row["contact_broken"] += 1
             events = sorted(o.summary["events"], key=lambda e: e["time"])
@@ -293,7 +369,8 @@ class PushTestResult:
             if o.outcome in ("fell", "aborted"):
                 key = f"{o.outcome}: {o.summary['reason']}"
                 reasons[key] = reasons.get(key, 0) + 1
-        return {"outcomes": outcomes, "reasons": reasons}
+        strict = sum(o.strict_fail for o in self.scored)
+        return {"outcomes": outcomes, "strict_fail": strict, "reasons": reasons}
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready: ``push-test --json``."""
@@ -303,8 +380,12 @@ class PushTestResult:
             "controller_margin": self.controller_margin,
             "omega": self.omega,
             "pushes": [o.to_dict(self.zmp_margin, self.omega) for o in self.outcomes],
+            "start_com_velocity": list(START_COM_VELOCITY),
             "counts": self.counts(),
+            "scores_scope": "all pushes",
             "scores": self.scores(),
+            "band": None if self.band is None else list(self.band),
+            "band_scores": None if self.band is None else self.scores(pushes=self.in_band),
             "margin_study": self.margin_study(),
             "contact_breaks": self.contact_breaks(),
             "controller": self.controller,
@@ -315,6 +396,16 @@ class PushTestResult:
         }
 
 
+def _smallest(grid: dict[float, dict[str, Any]], criterion: str, strict: bool) -> float | None:
+    """The smallest margin of ``grid`` whose false-safe rate is at most the target (None: none)."""
+    for m, scores in grid.items():
+        k = scores[criterion]["strict"] if strict else scores[criterion]
+        r = k["fell_given_safe"]["rate"]
+        if r is not None and r <= FALSE_SAFE_TARGET:
+            return m
+    return None
+
+
 def _body_height(setup: BalanceSetup, body: int) -> float:
     """Height of the pushed body's centre of mass at the start (m)."""
     sim = setup.sim
@@ -323,12 +414,30 @@ def _body_height(setup: BalanceSetup, body: int) -> float:
     return float(sim.data.xipos[body][2])
 
 
+def _impulse(setup: BalanceSetup, level: float, angle: float, relative: bool) -> float:
+    """The push's impulse (N s): ``level`` itself, or that fraction of the boundary impulse."""
+    if not relative:
+        return level
+    a = setup.analysis
+    J = level * boundary_impulse(
+        a.areas.com_velocity_area, a.stance.mass, angle, START_COM_VELOCITY
+    )
+    if not (np.isfinite(J) and 0 < J <= 1000):
+        raise SimulationError(
+            "--relative",
+            level,
+            f"gives {J:g} N s at {np.rad2deg(angle):g} deg: "
+            "not in (0, 1000] N s (unbounded or empty area that way)",
+        )
+    return J
+
+
 def predict_push(setup: BalanceSetup, push: Push, body_height: float) -> PushPrediction:
     """The push's before-trial predictions (see the module docstring)."""
     a = setup.analysis
     areas, mass, g = a.areas, a.stance.mass, a.areas.gravity
     u = np.array([np.cos(push.direction), np.sin(push.direction)])
-    c0 = np.asarray(a.scenario.com_velocity, dtype=float)
+    c0 = np.asarray(START_COM_VELOCITY, dtype=float)  # the trial starts at rest
     velocity = c0 + push.magnitude * u / mass
     force = push.magnitude / push.duration * u
     zmp = a.stance.com[:2] + (body_height - areas.plane_height) * force / (mass * g)
@@ -352,13 +461,15 @@ def push_test(
     relative: Sequence[float] | None = None,
     zmp_margin: float | None = None,
     journal: TrialJournal | None = None,
+    band: Sequence[float] | None = None,
 ) -> PushTestResult:
     """Push the robot in evenly spaced directions and score both criteria.
 
     Pushes in ``directions`` directions at every magnitude (N s, or fractions ``relative`` of each
     direction's boundary impulse) for ``duration`` s; both criteria are scored at ``zmp_margin`` (m;
     default: the controller's own margin). Finished trials go to ``journal`` as they end, and trials
-    it already holds are not run again.
+    it already holds are not run again. ``band`` (``(LO, HI)``, fractions of the boundary impulse,
+    with ``relative`` from :func:`band_levels`) adds the scores of the pushes in it.
     """
     wall0 = time.perf_counter()
     if not isinstance(scenario, Scenario):
@@ -379,19 +490,7 @@ def push_test(
     for level in levels:
         for k in range(directions):
             angle = 2 * np.pi * k / directions
-            if relative is not None:
-                J = float(level) * boundary_impulse(
-                    a.areas.com_velocity_area, a.stance.mass, angle, a.scenario.com_velocity
-                )
-                if not (np.isfinite(J) and 0 < J <= 1000):
-                    raise SimulationError(
-                        "--relative",
-                        level,
-                        f"gives {J:g} N s at {np.rad2deg(angle):g} deg: "
-                        "not in (0, 1000] N s (unbounded or empty area that way)",
-                    )
-            else:
-                J = float(level)
+            J = _impulse(setup, float(level), angle, relative is not None)
             push = Push(angle, J, duration, options.settle, body)
             key = {
                 "direction": round(angle, 9),
@@ -439,4 +538,5 @@ def push_test(
         time.perf_counter() - wall0,
         None if journal.path is None else str(journal.path),
         reused,
+        None if band is None else (float(band[0]), float(band[1])),
     )

@@ -5,16 +5,21 @@ commanded approach speeds until the robot falls, then bisects the commanded spee
 bracket ``[stood, fell]`` is within a relative tolerance (5 %). The bracket is reported in the
 **measured** approach speed at first contact (the commanded one beside it): ``survived`` is the
 fastest measured speed that did not fall below the slowest that fell. Only ``fell`` counts as a
-fall; ``contact_broken`` trials (the robot came to rest without a step, but a contact slipped,
-lifted or tilted) are reported apart, with the first speed and contact that broke. Aborted
-trials (the impact point never reached the surface, or something went wrong before the contact)
-close the search on their side and are left out.
+fall (the lenient outcome). Two more thresholds are then bisected to the same tolerance, from the
+trials already run: the **strict** failure (fell, or a contact broke beyond the strict bounds of
+:mod:`~impact_balance.sim.trials.outcomes`; ``strict_failed``) and the **first contact break**
+(any contact event, fell or not). Aborted trials (the impact point never reached the surface, or
+something went wrong before the contact) close a search on their side and are left out.
 
-Beside the bracket: the maximum contact velocity by the CoM criterion and by the ZMP criterion,
+Beside the brackets: the maximum contact velocity by the CoM criterion and by the ZMP criterion,
 each with both inertia models (``composite`` and ``joint_space``), without margin and with the
-scoring ZMP margin; and per trial the CoM criterion's call at the measured speed (safe when the
-measured speed is at most the maximum: a prediction made before the trial, evaluated at the
-speed the trial reached) and in the trial (the measured post-impact CoM velocity in the area).
+scoring ZMP margin; the project's default (``default``: the CoM criterion with the scenario's
+inertia model, the scoring ZMP margin and the scenario's velocity margin, the maximum the governor
+caps at); and per trial the CoM criterion's call at the measured speed (safe when the measured
+speed is at most the maximum: a prediction made before the trial, evaluated at the speed the
+trial reached) and in the trial (the measured post-impact CoM velocity in the area). Every trial
+starts at rest, so every prediction is made from a CoM at rest (the scenario's ``com_velocity``
+is replaced by zero).
 """
 
 from __future__ import annotations
@@ -45,9 +50,11 @@ from impact_balance.sim.trials.result import TrialEntry, trajectory
 
 __all__ = [
     "INERTIA_MODELS",
+    "TrialTest",
     "ValidationProgress",
     "ValidationResult",
     "ValidationTrial",
+    "default_prediction",
     "predictions",
     "validate",
 ]
@@ -68,6 +75,7 @@ def predictions(scenario: Scenario, zmp_margin: float = 0.0) -> dict[str, dict[s
             update={
                 "impact": impact.model_copy(update={"inertia": inertia}),
                 "zmp_margin": float(zmp_margin),
+                "com_velocity": (0.0, 0.0),  # the trials start at rest
             }
         )
         answer = analyze(variant).impact
@@ -76,6 +84,23 @@ def predictions(scenario: Scenario, zmp_margin: float = 0.0) -> dict[str, dict[s
         out["com_criterion"][inertia] = json_number(answer.max_contact_velocity)
         out["zmp_criterion"][inertia] = json_number(answer.zmp_max_contact_velocity)
     return out
+
+
+def default_prediction(scenario: Scenario, zmp_margin: float) -> float | None:
+    """The project's default maximum contact velocity (m/s; None if unbounded): the governor's cap.
+
+    The CoM criterion with the scenario's inertia model and velocity margin, the ZMP support area
+    shrunk by ``zmp_margin`` (m), from a CoM at rest (the trials start at rest).
+    """
+    if scenario.impact is None:
+        raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact")
+    variant = scenario.model_copy(
+        update={"zmp_margin": float(zmp_margin), "com_velocity": (0.0, 0.0)}
+    )
+    answer = analyze(variant).impact
+    if answer is None:
+        raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact")
+    return json_number(answer.max_contact_velocity)
 
 
 @dataclass(kw_only=True)
@@ -98,6 +123,40 @@ def _measured(trial: ValidationTrial) -> float:
     return measured
 
 
+#: Whether a trial failed, for a threshold search (fell, failed strictly, broke a contact).
+TrialTest = Callable[[ValidationTrial], bool]
+
+
+def _fell(trial: ValidationTrial) -> bool:
+    return trial.fell
+
+
+def _strict(trial: ValidationTrial) -> bool:
+    return trial.strict_fail
+
+
+def _broke(trial: ValidationTrial) -> bool:
+    return bool(trial.summary["events"])
+
+
+def _threshold(trials: list[ValidationTrial], failed: TrialTest) -> dict[str, Any]:
+    """The slowest measured speed that ``failed`` and the fastest below it that did not (m/s).
+
+    Both None when not found; the commanded speeds beside them.
+    """
+    bad = [t for t in trials if failed(t)]
+    lowest = min(bad, key=_measured) if bad else None
+    good = [t for t in trials if not failed(t)]
+    below = [t for t in good if lowest is None or _measured(t) < _measured(lowest)]
+    highest = max(below, key=_measured) if below else None
+    return {
+        "failed": None if lowest is None else lowest.measured,
+        "stood": None if highest is None else highest.measured,
+        "failed_commanded": None if lowest is None else lowest.speed,
+        "stood_commanded": None if highest is None else highest.speed,
+    }
+
+
 @dataclass
 class ValidationResult:
     """Predictions beside the empirical bracket; ``to_dict()`` is ``validate --json``."""
@@ -118,6 +177,7 @@ class ValidationResult:
     journal: str | None = None
     reused: int = 0
     extra: dict[str, Any] = field(default_factory=dict)
+    default: float | None = None
 
     @property
     def scored(self) -> list[ValidationTrial]:
@@ -139,6 +199,7 @@ class ValidationResult:
         )
         fell_c = min((t.speed for t in fell), default=None)
         stood_c = max((t.speed for t in stood if fell_c is None or t.speed < fell_c), default=None)
+        strict = _threshold(scored, _strict)
         return {
             "survived": None if survived is None else survived.measured,
             "fell": None if lowest_fall is None else lowest_fall.measured,
@@ -146,6 +207,34 @@ class ValidationResult:
             "fell_commanded": fell_c,
             "monotonic": monotonic,
             "fastest_measured": max((_measured(t) for t in scored), default=None),
+            "strict_failed": strict["failed"],
+            "strict_stood": strict["stood"],
+            "strict_failed_commanded": strict["failed_commanded"],
+            "strict_stood_commanded": strict["stood_commanded"],
+            "first_contact_break": self.first_contact_break(),
+        }
+
+    def first_contact_break(self) -> dict[str, Any] | None:
+        """The contact-break threshold, bisected (see the module docstring); None: no break.
+
+        ``measured``: the slowest measured speed with a contact event; ``no_break_below``: the
+        fastest measured speed below it without one (None if none was found); the commanded
+        speeds, the trial's outcome and its first event (``contact``, ``kind``, ``time``,
+        ``value``) beside them.
+        """
+        scored = self.scored
+        found = _threshold(scored, _broke)
+        if found["failed"] is None:
+            return None
+        first = min((t for t in scored if _broke(t)), key=_measured)
+        event = min(first.summary["events"], key=lambda e: e["time"])
+        return {
+            "measured": found["failed"],
+            "no_break_below": found["stood"],
+            "commanded": found["failed_commanded"],
+            "no_break_below_commanded": found["stood_commanded"],
+            "outcome": first.outcome,
+            **event,
         }
 
     def contact_break(self) -> dict[str, Any] | None:
@@ -201,7 +290,9 @@ class ValidationResult:
                     "approach_speed_measured": t.measured,
                     "outcome": t.outcome,
                     "fell": t.fell,
+                    "strict_fail": t.strict_fail,
                     "reason": s["reason"],
+                    "strict_reason": s["strict_reason"],
                     "detail": s["detail"],
                     "events": s["events"],
                     "com_criterion_safe": None
@@ -220,7 +311,7 @@ class ValidationResult:
             "joints": self.joints,
             "rigid_impact": self.rigid_impact,
             "zmp_margin": self.zmp_margin,
-            "predicted": self.predicted,
+            "predicted": {**self.predicted, "default": self.default},
             "predicted_with_margin": self.predicted_with_margin,
             "empirical": empirical,
             "contact_break": self.contact_break(),
@@ -242,7 +333,13 @@ class _TrialRunner:
         self.reused = 0
 
     def __call__(self, speed: float) -> OutcomeName:
-        """The outcome of the trial at the commanded ``speed`` (m/s)."""
+        """The outcome of the trial at the commanded ``speed`` (m/s).
+
+        A speed already run in this search is not run (nor kept) again.
+        """
+        for done in self.trials:
+            if round(done.speed, 9) == round(speed, 9):
+                return done.outcome
         key = {"speed": round(speed, 9)}
         entry = self.journal.get(key)
         if entry is None:
@@ -321,6 +418,38 @@ class _Search:
             self._report(stood, fell)
         return stood, fell
 
+    def threshold(self, failed: TrialTest) -> None:
+        """Bisect the commanded speed where ``failed`` starts, from the trials already run.
+
+        Between the slowest commanded speed that failed and the fastest below it that did not (or,
+        without one, halving down to the minimum speed) until ``hi - lo <= tolerance * hi``.
+        """
+        scored = [t for t in self.trial.trials if t.scored and t.measured is not None]
+        bad = [t.speed for t in scored if failed(t)]
+        if not bad:
+            return
+        hi = min(bad)
+        good = [t.speed for t in scored if not failed(t) and t.speed < hi]
+        lo = max(good) if good else None
+        # Nothing at or below an aborted speed can be tested (a slower approach lasts longer).
+        floor = max(
+            (t.speed for t in self.trial.trials if not t.scored and t.speed < hi), default=0
+        )
+        while lo is None or hi - lo > self.tolerance * hi:
+            speed = max(self.min_speed, hi / 2) if lo is None else 0.5 * (lo + hi)
+            if speed >= hi * (1 - 1e-9) or (lo is None and speed <= floor):
+                return
+            if self.trial(speed) == "aborted":
+                return
+            last = self.trial.trials[-1]
+            if last.measured is None:
+                return
+            if failed(last):
+                hi = speed
+            else:
+                lo = speed
+            self._report(lo, hi)
+
     def bisect(self, stood: float, fell: float) -> None:
         """Bisect ``[stood, fell]`` (m/s) until ``fell - stood <= tolerance * fell``."""
         while fell - stood > self.tolerance * fell:
@@ -397,6 +526,8 @@ def validate(
         progress(runner.trials[-1], stood, fell)
     if stood is not None and fell is not None:
         search.bisect(stood, fell)
+    search.threshold(_strict)
+    search.threshold(_broke)
     trials, reused, journal = runner.trials, runner.reused, runner.journal
     controller = _controller_description(setup, options, joints)
     return ValidationResult(
@@ -416,4 +547,5 @@ def validate(
         None if journal.path is None else str(journal.path),
         reused,
         {"setup": setup},
+        default_prediction(scenario, margin),
     )

@@ -20,6 +20,7 @@ governor's time per tick.
 from __future__ import annotations
 
 import time
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -49,6 +50,7 @@ __all__ = [
     "WallOptions",
     "WallTrial",
     "check_wall_distance",
+    "pooled_tick_statistics",
     "run_wall_trial",
     "write_wall_video",
 ]
@@ -214,7 +216,8 @@ class WallTrial:
     (s), ``reference`` (the reference's own speed), ``cap`` (the governor's ceiling, None when
     unbounded or without a governor), ``commanded`` (the speed commanded), ``measured`` (the
     point's approach speed, ``-n . v``), all m/s. ``frames``: MuJoCo ``qpos``, CoM and impact force
-    per tick, for the video (when asked).
+    per tick, for the video (when asked). ``ticks``: the governor's time of every tick (s), for
+    statistics pooled over several trials (:func:`pooled_tick_statistics`).
     """
 
     options: WallOptions
@@ -226,6 +229,7 @@ class WallTrial:
     series: dict[str, Any]
     wall: np.ndarray | None = None
     frames: dict[str, Any] | None = None
+    ticks: list[float] = field(default_factory=list)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready: one approach of ``approach --json``."""
@@ -240,10 +244,13 @@ class WallTrial:
             "cap_at_contact": self.cap_at_contact,
             "time_to_contact": self.time_to_contact,
             "outcome": s["outcome"],
+            "strict_fail": s["strict_fail"],
             "reason": s["reason"],
+            "strict_reason": s["strict_reason"],
             "detail": s["detail"],
             "events": s["events"],
             "tick_us": self.tick_us,
+            "ticks_us": [round(1e6 * t, 3) for t in self.ticks],  # for statistics over trials
             "trial": s,
         }
 
@@ -320,6 +327,7 @@ def run_wall_trial(
         recorder.rows,
         wall,
         {k: np.array(x) for k, x in recorder.kept.items()} if frames else None,
+        list(recorder.ticks),
     )
 
 
@@ -393,6 +401,24 @@ def _tick_statistics(ticks: list[float]) -> dict[str, float | int | None]:
         "p99": float(np.percentile(us, 99)),
         "count": int(us.size),
     }
+
+
+def pooled_tick_statistics(
+    trials: Iterable[WallTrial | Mapping[str, Any]],
+) -> dict[str, float | int | None]:
+    """Median and 99th percentile (us) of the governor's ticks of all ``trials`` pooled, and count.
+
+    Each trial is a :class:`WallTrial` or its JSON (:meth:`WallTrial.to_dict`, its ``ticks_us``).
+    A percentile of one trial's few ticks (70 to 140) is one of its largest ticks; pooled over the
+    trials it is a percentile.
+    """
+    ticks: list[float] = []
+    for trial in trials:
+        if isinstance(trial, Mapping):
+            ticks += [1e-6 * float(us) for us in trial["ticks_us"]]
+        else:
+            ticks += trial.ticks
+    return _tick_statistics(ticks)
 
 
 def write_wall_video(

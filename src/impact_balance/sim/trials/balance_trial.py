@@ -66,7 +66,7 @@ _FloatArray = npt.NDArray[np.float64]
 BeforeControl = Callable[[float, _FloatArray, _FloatArray], None]
 
 #: Version of the trials' physics and measurements: journals of another version are not reused.
-TRIAL_VERSION = 3
+TRIAL_VERSION = 4
 
 __all__ = [
     "CONTROLLERS",
@@ -478,6 +478,12 @@ class _TrialRun:
             series=arrays,
             log=self.recorder.frame() if self.recorder is not None else None,
             angular_momentum_at_end=self.angular_momentum,
+            strict_fail=outcome.strict_fail,
+            strict_reason=outcome.strict_reason,
+            stance_changed_time=None
+            if outcome.stance_changed is None
+            else outcome.stance_changed[0],
+            max_unloaded=outcome.max_unloaded,
         )
         if tracker is not None and tracker.touched:
             hold = None if self.hold is None else self.hold.to_dict()

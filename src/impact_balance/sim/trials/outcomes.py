@@ -10,7 +10,9 @@ The criterion makes two promises, and a trial can break either, or both:
   - ``trunk_tipped``: the base turns more than ``max_trunk_tilt`` (25 degrees) from its start
     orientation: no recovery without a step comes back from there;
   - ``dcm_escaped``: the DCM left the ZMP support area and was still outside at the end (the
-    robot cannot be at rest with its DCM outside its support);
+    robot cannot be at rest with its DCM outside its support). The area is the scenario's, so
+    the check stops (is *not applicable*) once the stance changed beyond the strict bounds
+    below: the support in contact is then another one;
   - ``not_at_rest``: the CoM still moves faster than ``rest_speed`` (5 cm/s) at the end: 2.5 s
     after the disturbance (``settle_time``), or, for a robot still moving then, up to
     ``extra_time`` (2.5 s) later (a controller may bring the CoM back to its start slowly: that
@@ -28,6 +30,19 @@ The criterion makes two promises, and a trial can break either, or both:
   A trial with an event after the disturbance and no fall is ``contact_broken``: the robot
   came to rest without a step, but not on the contacts it started with.
 
+**Strict outcome.** The criterion's premise is that the sustained contacts stay where they are.
+A trial **fails strictly** (``strict_fail``) when it fell, or when after the disturbance a
+contact broke beyond the strict bounds (:data:`STRICT_BOUNDS`, fields of :class:`OutcomeCriteria`):
+
+- ``strict_max_tilt``: a contact frame turned more than 10 degrees from its start (a sole
+  rolled over its edge);
+- ``strict_max_slip``: a contact frame moved more than 3 cm from its start (a sole or a hand
+  slid);
+- ``strict_max_unloaded``: a contact that had carried ``load_force`` carried less than
+  ``min_force`` for more than 0.1 s (a foot lifted, a hand contact lost).
+
+A ``contact_broken`` trial within these bounds does not fail strictly; one beyond them does.
+
 A trial is ``aborted`` when it went wrong before the disturbance (a fall or a contact event
 before the impact or the push, or an impact point that never reached the surface): it tests
 nothing and is left out of brackets and scores. Otherwise it is ``balanced``.
@@ -39,7 +54,7 @@ recorded logs.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -48,6 +63,7 @@ __all__ = [
     "EVENT_KINDS",
     "FALL_REASONS",
     "OUTCOMES",
+    "STRICT_BOUNDS",
     "ContactEvent",
     "EventKind",
     "FallReason",
@@ -75,6 +91,13 @@ FALL_REASONS: tuple[FallReason, ...] = (
 )
 #: Kinds of contact events.
 EVENT_KINDS: tuple[EventKind, ...] = ("lifted", "slipped", "tilted")
+#: The strict bounds on the sustained contacts: a sole rolled over 10 degrees (rad), a contact slid
+#: over 3 cm (m), a contact unloaded for over 0.1 s (s). The defaults of :class:`OutcomeCriteria`.
+STRICT_BOUNDS: dict[str, float] = {
+    "strict_max_tilt": float(np.deg2rad(10.0)),
+    "strict_max_slip": 0.03,
+    "strict_max_unloaded": 0.1,
+}
 
 
 @dataclass(frozen=True)
@@ -94,6 +117,9 @@ class OutcomeCriteria:
     settle_time: float = 2.5
     rest_speed: float = 0.05
     extra_time: float = 2.5
+    strict_max_tilt: float = STRICT_BOUNDS["strict_max_tilt"]
+    strict_max_slip: float = STRICT_BOUNDS["strict_max_slip"]
+    strict_max_unloaded: float = STRICT_BOUNDS["strict_max_unloaded"]
 
     def to_dict(self) -> dict[str, Any]:
         """The thresholds by name (JSON-ready)."""
@@ -123,7 +149,10 @@ class Outcome:
     """A trial's outcome: one of :data:`OUTCOMES`, why, when and every contact event.
 
     ``reason`` is a fall reason, the first contact event, or why it was aborted (None when
-    balanced); ``time`` is when (s); ``detail`` a line.
+    balanced); ``time`` is when (s); ``detail`` a line. ``stance_changed``: when the contacts
+    first went beyond the strict bounds after the disturbance, and how (``(time, "contact kind")``,
+    None if never); ``max_unloaded``: the longest time a loaded contact carried (almost) nothing
+    after the disturbance (s).
     """
 
     outcome: OutcomeName
@@ -131,11 +160,28 @@ class Outcome:
     time: float | None
     detail: str = ""
     events: tuple[ContactEvent, ...] = ()
+    stance_changed: tuple[float, str] | None = None
+    max_unloaded: float = 0.0
 
     @property
     def fell(self) -> bool:
         """Whether the outcome is ``fell``."""
         return self.outcome == "fell"
+
+    @property
+    def strict_fail(self) -> bool:
+        """Fell, or broke a contact beyond the strict bounds (False when aborted)."""
+        return self.outcome != "aborted" and (self.fell or self.stance_changed is not None)
+
+    @property
+    def strict_reason(self) -> str | None:
+        """Why the trial failed strictly: the fall's reason, else the contact beyond the bounds."""
+        if not self.strict_fail:
+            return None
+        if self.fell:
+            return self.reason
+        assert self.stance_changed is not None
+        return self.stance_changed[1]
 
 
 @dataclass
@@ -162,6 +208,8 @@ class OutcomeMonitor:
     max_slip: float = field(default=0.0, init=False)
     max_trunk_tilt: float = field(default=0.0, init=False)
     max_drop: float = field(default=0.0, init=False)
+    max_unloaded: float = field(default=0.0, init=False)
+    stance_changed: tuple[float, str] | None = field(default=None, init=False)
     events: list[ContactEvent] = field(default_factory=list, init=False)
     _fall: tuple[str, float, str] | None = field(default=None, init=False)
     _dcm_out_since: float | None = field(default=None, init=False)
@@ -252,6 +300,7 @@ class OutcomeMonitor:
                     self._low_since[i] = t
                 elif t - self._low_since[i] > c.lost_time:
                     self._event(i, "lifted", self._low_since[i], t - self._low_since[i])
+            self._strict(i, t, tilt, slip)
         drop = self.base_height - float(base_height)
         trunk = _angle(self.base_rotation, np.asarray(base_rotation, dtype=float).reshape(3, 3))
         self.max_drop = max(self.max_drop, drop)
@@ -261,7 +310,9 @@ class OutcomeMonitor:
                 self._fall = ("base_dropped", float(t), f"base {100 * drop:.0f} cm below its start")
             elif trunk > c.max_trunk_tilt:
                 self._fall = ("trunk_tipped", float(t), f"trunk turned {np.rad2deg(trunk):.0f} deg")
-        if dcm_margin is not None and np.isfinite(dcm_margin):
+        if self.stance_changed is not None:  # another support: the scenario's area does not apply
+            self._dcm_out_since = None
+        elif dcm_margin is not None and np.isfinite(dcm_margin):
             if dcm_margin < 0.0:
                 if self._dcm_out_since is None:
                     self._dcm_out_since = float(t)
@@ -269,9 +320,31 @@ class OutcomeMonitor:
                 self._dcm_out_since = None
         return self.fell
 
+    def _strict(self, i: int, t: float, tilt: float, slip: float) -> None:
+        """After the disturbance: the longest unloading, the contacts beyond the strict bounds."""
+        if self.disturbance is None or t < self.disturbance:
+            return
+        c = self.criteria
+        unloaded = 0.0 if np.isnan(self._low_since[i]) else t - float(self._low_since[i])
+        self.max_unloaded = max(self.max_unloaded, unloaded)
+        if self.stance_changed is not None:
+            return
+        name = self.names[i]
+        if tilt > c.strict_max_tilt:
+            self.stance_changed = (float(t), f"{name} tilted {np.rad2deg(tilt):.1f} deg")
+        elif slip > c.strict_max_slip:
+            self.stance_changed = (float(t), f"{name} slipped {100 * slip:.1f} cm")
+        elif unloaded > c.strict_max_unloaded:
+            self.stance_changed = (float(t), f"{name} lifted {unloaded:.2f} s")
+
     # -- at the end ---------------------------------------------------------------------
     def finish(self, t: float, com_velocity: np.ndarray) -> Outcome:
         """The outcome at the end of the trial (time ``t``, CoM velocity in m/s, world)."""
+        outcome = self._verdict(t, com_velocity)
+        return replace(outcome, stance_changed=self.stance_changed, max_unloaded=self.max_unloaded)
+
+    def _verdict(self, t: float, com_velocity: np.ndarray) -> Outcome:
+        """The lenient outcome (see :meth:`finish`)."""
         events = tuple(self.events)
         if self._abort is not None:
             reason, when, detail = self._abort

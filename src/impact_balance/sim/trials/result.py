@@ -130,6 +130,12 @@ class BalanceTrialResult:
             tilt (rad) and drop (m) seen.
         angular_momentum_at_end: Angular momentum about the CoM when the disturbance ended (N m s,
             world): what the LIPM leaves out (a push above the CoM leaves some).
+        strict_fail, strict_reason: Whether the trial failed strictly (fell, or a contact broke
+            beyond the strict bounds of :mod:`.outcomes`) and why.
+        stance_changed_time: When the contacts first went beyond the strict bounds (s), None if
+            never: the ``dcm_escaped`` check stops there.
+        max_unloaded: The longest time a loaded contact carried (almost) nothing after the
+            disturbance (s).
         sim_time, wall_time: Simulated and wall-clock time (s).
     """
 
@@ -153,6 +159,10 @@ class BalanceTrialResult:
     sim_time: float = 0.0
     wall_time: float = 0.0
     angular_momentum_at_end: np.ndarray | None = None
+    strict_fail: bool = False
+    strict_reason: str | None = None
+    stance_changed_time: float | None = None
+    max_unloaded: float = 0.0
     contact_names: tuple[str, ...] = ()
     series: dict[str, np.ndarray] = field(default_factory=dict)
     log: pd.DataFrame | None = None
@@ -178,7 +188,9 @@ class BalanceTrialResult:
         out = {
             "outcome": self.outcome,
             "fell": self.fell,
+            "strict_fail": bool(self.strict_fail),
             "reason": self.reason,
+            "strict_reason": self.strict_reason,
             "outcome_time": finite_or_null(nulls, "outcome_time", self.outcome_time, "no event"),
             "detail": self.detail,
             "events": [e.to_dict() for e in self.events],
@@ -226,6 +238,13 @@ class BalanceTrialResult:
             "max_slip": float(self.max_slip),
             "max_trunk_tilt_deg": float(np.rad2deg(self.max_trunk_tilt)),
             "max_drop": float(self.max_drop),
+            "max_unloaded": float(self.max_unloaded),
+            "stance_changed_time": finite_or_null(
+                nulls,
+                "stance_changed_time",
+                self.stance_changed_time,
+                "the contacts stayed within the strict bounds (the DCM was checked throughout)",
+            ),
             "sim_time": float(self.sim_time),
             "wall_time": float(self.wall_time),
         }
@@ -281,6 +300,15 @@ class TrialEntry:
     def fell(self) -> bool:
         """Whether the outcome is ``fell``."""
         return self.outcome == "fell"
+
+    @property
+    def strict_fail(self) -> bool:
+        """Whether the trial fell or broke a contact beyond the strict bounds.
+
+        A summary without ``strict_fail`` (made by hand, without the strict outcome) counts its
+        falls only.
+        """
+        return bool(self.summary.get("strict_fail", self.fell))
 
     @property
     def scored(self) -> bool:
