@@ -117,3 +117,24 @@ def test_describe_mode_names_each_kind():
     assert describe_mode(stat.S_IFIFO) == "a FIFO (named pipe)"
     assert describe_mode(stat.S_IFREG) == "a regular file"
     assert describe_mode(stat.S_IFSOCK) == "a socket"
+
+
+def test_read_regular_raises_the_operating_systems_errors(tmp_path):
+    """The rule behind read_bounded, for readers that word their own errors."""
+    from impact_balance.files import FileTooLargeError, NotRegularFileError, read_regular
+
+    good = tmp_path / "good.txt"
+    good.write_bytes(b"x" * 10)
+    assert read_regular(good, limit=10) == b"x" * 10
+    with pytest.raises(FileTooLargeError) as big:
+        read_regular(good, limit=9)
+    assert (big.value.size, big.value.limit) == (10, 9) and isinstance(big.value, OSError)
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    with pytest.raises(NotRegularFileError) as pipe:
+        read_regular(fifo, limit=10)  # never waits for a writer
+    assert "FIFO" in pipe.value.kind
+    with pytest.raises(NotRegularFileError):
+        read_regular(tmp_path, limit=10)
+    with pytest.raises(FileNotFoundError):
+        read_regular(tmp_path / "missing", limit=10)

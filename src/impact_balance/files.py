@@ -27,7 +27,14 @@ from typing import BinaryIO
 
 from impact_balance.exceptions import ScenarioError
 
-__all__ = ["describe_mode", "open_regular", "read_bounded"]
+__all__ = [
+    "FileTooLargeError",
+    "NotRegularFileError",
+    "describe_mode",
+    "open_regular",
+    "read_bounded",
+    "read_regular",
+]
 
 _KINDS = (
     (stat.S_ISDIR, "a folder"),
@@ -37,6 +44,32 @@ _KINDS = (
     (stat.S_ISSOCK, "a socket"),
     (stat.S_ISLNK, "a symbolic link"),
 )
+
+
+class NotRegularFileError(OSError):
+    """The path names something other than a regular file (a FIFO, a device, a folder...).
+
+    Attributes:
+        kind: What it is, in words (:func:`describe_mode`).
+    """
+
+    def __init__(self, path: str, kind: str) -> None:
+        super().__init__(errno.EINVAL, f"{kind}, not a regular file", path)
+        self.kind = kind
+
+
+class FileTooLargeError(OSError):
+    """The file is larger than the reader's limit.
+
+    Attributes:
+        size: Its size when it was checked, or None when it grew past the limit while read.
+        limit: The limit, bytes.
+    """
+
+    def __init__(self, path: str, size: int | None, limit: int) -> None:
+        super().__init__(errno.EFBIG, f"larger than {limit} bytes", path)
+        self.size = size
+        self.limit = limit
 
 
 def describe_mode(mode: int) -> str:
@@ -54,13 +87,16 @@ def _open(path: str | os.PathLike[str], what: str, no_follow: bool, dir_fd: int 
     try:
         return os.open(path, flags, dir_fd=dir_fd)
     except OSError as exc:
-        if no_follow and exc.errno == errno.ELOOP:
-            reason = "a symbolic link: links are not followed here"
-        elif exc.errno == errno.ENOENT:
-            reason = "no such file"
-        else:
-            reason = f"cannot read: {exc.strerror or exc.__class__.__name__}"
-        raise ScenarioError(what, os.fspath(path), reason) from None
+        raise ScenarioError(what, os.fspath(path), _open_reason(exc, no_follow)) from None
+
+
+def _open_reason(exc: OSError, no_follow: bool) -> str:
+    """Why a file could not be opened or read, in words."""
+    if no_follow and exc.errno == errno.ELOOP:
+        return "a symbolic link: links are not followed here"
+    if exc.errno == errno.ENOENT:
+        return "no such file"
+    return f"cannot read: {exc.strerror or exc.__class__.__name__}"
 
 
 def open_regular(
@@ -142,24 +178,67 @@ def read_bounded(
             (FIFO, device, folder, socket), or larger than ``limit``.
     """
     shown = os.fspath(path)
-    fd = _checked(path, limit, what, no_follow, dir_fd)
     try:
+        return read_regular(path, limit=limit, no_follow=no_follow, dir_fd=dir_fd)
+    except NotRegularFileError as exc:
+        raise ScenarioError(what, shown, f"{exc.kind}, not a regular file: refused") from None
+    except FileTooLargeError as exc:
+        if exc.size is None:
+            reason = f"grew past the limit of {limit:,} bytes while it was read"
+        else:
+            reason = f"{exc.size:,} bytes: larger than the limit of {limit:,} bytes"
+        raise ScenarioError(what, shown, reason) from None
+    except OSError as exc:
+        raise ScenarioError(what, shown, _open_reason(exc, no_follow)) from None
+
+
+def read_regular(
+    path: str | os.PathLike[str],
+    *,
+    limit: int,
+    no_follow: bool = False,
+    dir_fd: int | None = None,
+) -> bytes:
+    """The rule of :func:`read_bounded`, raising the operating system's errors.
+
+    For a reader that words its own errors (a journal, a sweep folder, a robot file): the
+    same open, check and bounded read, with an :class:`OSError` to translate.
+
+    Args:
+        path: The file (relative to ``dir_fd`` when given).
+        limit: Largest size accepted, bytes.
+        no_follow: Refuse a symbolic link at the last component (``O_NOFOLLOW``: ``ELOOP``).
+        dir_fd: Open ``path`` relative to this folder descriptor (``openat``).
+
+    Returns:
+        The file's bytes, as read through the descriptor that was checked.
+
+    Raises:
+        NotRegularFileError: A FIFO, a device, a folder or a socket (never waited on).
+        FileTooLargeError: Larger than ``limit`` (checked before the read, and while reading).
+        OSError: The file cannot be opened or read (``FileNotFoundError``...).
+    """
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
+    if no_follow:
+        flags |= getattr(os, "O_NOFOLLOW", 0)
+    shown = os.fspath(path)
+    fd = os.open(path, flags, dir_fd=dir_fd)
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            raise NotRegularFileError(shown, describe_mode(st.st_mode))
+        if st.st_size > limit:
+            raise FileTooLargeError(shown, st.st_size, limit)
         chunks: list[bytes] = []
         count = 0
         while count <= limit:
-            try:
-                chunk = os.read(fd, min(1 << 20, limit + 1 - count))
-            except OSError as exc:
-                reason = f"cannot read: {exc.strerror or exc.__class__.__name__}"
-                raise ScenarioError(what, shown, reason) from None
+            chunk = os.read(fd, min(1 << 20, limit + 1 - count))
             if not chunk:
                 break
             chunks.append(chunk)
             count += len(chunk)
         if count > limit:
-            raise ScenarioError(
-                what, shown, f"grew past the limit of {limit:,} bytes while it was read"
-            )
+            raise FileTooLargeError(shown, None, limit)
         return b"".join(chunks)
     finally:
         os.close(fd)

@@ -36,9 +36,7 @@ PR2's sensor mount, Allegro's finger links), a zero axis on a fixed joint (unuse
 from __future__ import annotations
 
 import math
-import os
 import re
-import stat
 from pathlib import Path
 from typing import Any, NamedTuple
 from xml.etree.ElementTree import Element, TreeBuilder
@@ -47,6 +45,7 @@ from xml.parsers import expat
 import numpy as np
 
 from impact_balance.exceptions import RobotLoadError
+from impact_balance.files import FileTooLargeError, NotRegularFileError, read_regular
 
 __all__ = [
     "INERTIA_TOLERANCE",
@@ -95,33 +94,18 @@ def read_robot_file(path: Path, max_bytes: int = MAX_ROBOT_FILE_BYTES) -> bytes:
         RobotLoadError: The file is missing, unreadable, not a regular file or too large.
     """
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+        return read_regular(path, limit=max_bytes)
     except FileNotFoundError:
         raise RobotLoadError(str(path), "no such file") from None
+    except NotRegularFileError:
+        raise RobotLoadError(str(path), "not a regular file") from None
+    except FileTooLargeError:
+        raise RobotLoadError(
+            str(path), f"larger than {max_bytes} bytes, the limit for a robot file"
+        ) from None
     except (OSError, ValueError) as exc:
         reason = getattr(exc, "strerror", None) or type(exc).__name__
         raise RobotLoadError(str(path), f"cannot read: {reason}") from None
-    try:
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
-            raise RobotLoadError(str(path), "not a regular file")
-        chunks, size = [], 0
-        while size <= max_bytes:
-            chunk = os.read(fd, min(1 << 20, max_bytes + 1 - size))
-            if not chunk:
-                break
-            chunks.append(chunk)
-            size += len(chunk)
-    except OSError as exc:
-        raise RobotLoadError(
-            str(path), f"cannot read: {exc.strerror or type(exc).__name__}"
-        ) from None
-    finally:
-        os.close(fd)
-    if size > max_bytes:
-        raise RobotLoadError(
-            str(path), f"larger than {max_bytes} bytes, the limit for a robot file"
-        )
-    return b"".join(chunks)
 
 
 def _parse_xml(data: bytes, source: str, root_tag: str = "robot") -> Element:

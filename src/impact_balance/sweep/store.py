@@ -44,13 +44,11 @@ names the others; ``impact-balance sweep --verify DIR`` checks a folder.
 from __future__ import annotations
 
 import contextlib
-import errno
 import hashlib
 import json
 import math
 import os
 import re
-import stat
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -62,6 +60,7 @@ import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
 from impact_balance.exceptions import EnvironmentFailure, SweepError, short_repr
+from impact_balance.files import read_regular
 from impact_balance.ranges import MAX_SWEEP_POINTS
 from impact_balance.sweep.columns import RESULT_COLUMNS
 from impact_balance.sweep.plan import PLAN_VERSION, SweepPlan, chunk_size_of
@@ -264,26 +263,14 @@ def _rows_of(manifest: dict[str, Any], chunk: int) -> tuple[int, int]:
 
 
 def _read_regular(path: Path, limit: int) -> bytes:
-    """The bytes of ``path``: a regular file (non-blocking open, ``fstat``) of at most ``limit``.
+    """The bytes of ``path``, by the package's one file-reading rule.
 
-    The one place this module reads a whole file (the project's bounded file-reading rule).
+    See :func:`impact_balance.files.read_regular`.
 
     Raises:
         OSError: Cannot be opened or read, not a regular file, or larger than ``limit``.
     """
-    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
-    try:
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
-            raise OSError(errno.EINVAL, "not a regular file", str(path))
-        chunks, size = [], 0
-        while chunk := os.read(fd, min(1 << 20, limit + 1 - size)):
-            chunks.append(chunk)
-            size += len(chunk)
-            if size > limit:
-                raise OSError(errno.EFBIG, f"larger than {limit} bytes", str(path))
-        return b"".join(chunks)
-    finally:
-        os.close(fd)
+    return read_regular(path, limit=limit)
 
 
 def _read_ledger(root: Path) -> dict[int, dict[str, Any]] | None:

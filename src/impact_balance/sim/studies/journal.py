@@ -31,6 +31,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from impact_balance.files import FileTooLargeError, NotRegularFileError, read_regular
+
 __all__ = [
     "MAX_JOURNAL_BYTES",
     "TrialJournal",
@@ -82,9 +84,9 @@ def _refuse_constant(constant: str) -> Any:
 
 
 def _read_regular(path: Path, limit: int) -> bytes:
-    """The bytes of ``path``: a regular file (non-blocking open, ``fstat``) of at most ``limit``.
+    """The bytes of ``path``, by the package's one file-reading rule.
 
-    The one place this module reads a file (the project's bounded file-reading rule).
+    See :func:`impact_balance.files.read_regular`.
 
     Raises:
         SimulationError: Not a regular file, or larger than ``limit`` (``--journal`` named).
@@ -92,25 +94,14 @@ def _read_regular(path: Path, limit: int) -> bytes:
     """
     from impact_balance.exceptions import SimulationError
 
-    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
     try:
-        info = os.fstat(fd)
-        if not stat.S_ISREG(info.st_mode):
-            raise SimulationError("--journal", str(path), "not a regular file")
-        chunks, size = [], 0
-        while True:
-            chunk = os.read(fd, min(1 << 20, limit + 1 - size))
-            if not chunk:
-                break
-            chunks.append(chunk)
-            size += len(chunk)
-            if size > limit:
-                raise SimulationError(
-                    "--journal", str(path), f"larger than {limit} bytes; choose another file"
-                )
-        return b"".join(chunks)
-    finally:
-        os.close(fd)
+        return read_regular(path, limit=limit)
+    except NotRegularFileError:
+        raise SimulationError("--journal", str(path), "not a regular file") from None
+    except FileTooLargeError:
+        raise SimulationError(
+            "--journal", str(path), f"larger than {limit} bytes; choose another file"
+        ) from None
 
 
 def check_trial_entry(entry: Any) -> str | None:
