@@ -744,3 +744,18 @@ def test_no_process_is_left_five_seconds_after_a_killed_sweep(tmp_path, how):
         for p in descendants:
             with contextlib.suppress(psutil.Error):
                 p.kill()
+
+
+def test_a_fifo_named_as_sweep_file_or_part_is_named_never_waited_on(tmp_path):
+    """A FIFO given as the sweep file is named for what it is (no open, no wait)."""
+    import os
+
+    from impact_balance.exceptions import SweepError
+    from impact_balance.sweep.spec import sweep_path
+
+    fifo = tmp_path / "sweep.yaml"
+    os.mkfifo(fifo)
+    with pytest.raises(SweepError, match="FIFO"):
+        sweep_path(fifo)
+    with pytest.raises(SweepError, match="a folder, not a regular file"):
+        sweep_path(tmp_path)

@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, Any, Literal, get_args
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from impact_balance.exceptions import ScenarioError, SweepError, UnknownNameError
+from impact_balance.files import describe_mode
 from impact_balance.ranges import MAX_SWEEP_CHUNKS, MAX_SWEEP_POINTS
 from impact_balance.scenario import Offset, field_name
 from impact_balance.scenario.bundled import bundled_descriptions
@@ -393,6 +394,10 @@ def sweep_path(name_or_path: str | Path) -> Path:
     path = Path(name_or_path)
     if path.is_file():
         return path
+    if path.exists():  # a FIFO, a device, a folder: named for what it is, never opened
+        raise SweepError(
+            "sweep", str(name_or_path), f"{describe_mode(path.stat().st_mode)}, not a regular file"
+        )
     if path.suffix in (".yaml", ".yml") or "/" in str(name_or_path):
         raise SweepError("sweep", str(name_or_path), "no such file")
     bundled = _sweep_dir() / f"{name_or_path}.yaml"

@@ -50,6 +50,7 @@ import math
 import os
 import re
 from collections.abc import Callable, Iterator
+from contextlib import ExitStack
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -60,7 +61,7 @@ import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
 from impact_balance.exceptions import EnvironmentFailure, SweepError, short_repr
-from impact_balance.files import read_regular
+from impact_balance.files import open_regular, read_regular
 from impact_balance.ranges import MAX_SWEEP_POINTS
 from impact_balance.sweep.columns import RESULT_COLUMNS
 from impact_balance.sweep.plan import PLAN_VERSION, SweepPlan, chunk_size_of
@@ -334,6 +335,18 @@ def _check_part(
     ledger: dict[int, dict[str, Any]] | None,
     keep: dict[int, pa.Table] | None,
 ) -> PartRecord | PartProblem:
+    """One part checked against the manifest and the ledger (its file closed on return)."""
+    with ExitStack() as stack:
+        return _check_part_in(path, manifest, ledger, keep, stack)
+
+
+def _check_part_in(
+    path: Path,
+    manifest: dict[str, Any],
+    ledger: dict[int, dict[str, Any]] | None,
+    keep: dict[int, pa.Table] | None,
+    stack: ExitStack,
+) -> PartRecord | PartProblem:
     rel = f"{PARTS}/{path.name}"
     match = _PART.match(path.name)
     if match is None:
@@ -350,7 +363,11 @@ def _check_part(
     if path.stat().st_size > _PART_ALLOWANCE + (stop - start) * MAX_PART_ROW_BYTES:
         return PartProblem(rel, "damaged", f"larger than {stop - start} rows can be", named)
     try:
-        parquet = pq.ParquetFile(path)
+        # Read through the descriptor the file-reading rule checked (a regular file, opened
+        # without blocking): a FIFO swapped in after the checks above is never waited on.
+        limit = _PART_ALLOWANCE + (stop - start) * MAX_PART_ROW_BYTES
+        handle = stack.enter_context(open_regular(path, limit=limit, what=rel))
+        parquet = pq.ParquetFile(handle)
         meta = parquet.schema_arrow.metadata or {}
         stored_rows = parquet.metadata.num_rows
         footer = _footer_problem(parquet, manifest, stop - start)
