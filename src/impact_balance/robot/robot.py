@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import hashlib
 import math
 import os
 import sys
@@ -420,14 +421,15 @@ def _native_reason(lines: list[str], fallback: str) -> str:
     return fallback
 
 
-def _build_model(urdf: Path, native: list[str]) -> pin.Model:
+def _build_model(urdf: Path, native: list[str], data: bytes | None = None) -> pin.Model:
     """The pinocchio model of the URDF, from the bytes that :func:`check_urdf` accepted.
 
     What urdfdom refuses while pinocchio still builds a model (an ``<inertial>`` it skips, so
     the link loads massless) is an error, as is a total mass other than the file's.
     """
     source = str(urdf)
-    data = read_robot_file(urdf)
+    if data is None:
+        data = read_robot_file(urdf)
     text, masses = check_urdf(data, source)
     try:
         with _native_stderr(native):
@@ -457,14 +459,23 @@ def _check_srdf_values(model: pin.Model, srdf: Path, configurations: Mapping[str
         raise RobotLoadError(str(srdf), "rotor_params: an armature is negative or not finite")
 
 
-def _load(urdf: Path, srdf: Path | None, name: str, standing: str | None) -> Robot:
+def _load(
+    urdf: Path,
+    srdf: Path | None,
+    name: str,
+    standing: str | None,
+    urdf_data: bytes | None = None,
+    srdf_data: bytes | None = None,
+) -> Robot:
+    """The robot of a URDF (+ SRDF), parsed from the bytes given (read here when None)."""
     package_dirs = [str(urdf.parent.parent.parent), str(urdf.parent.parent)]
     native: list[str] = []
-    model = _build_model(urdf, native)
+    model = _build_model(urdf, native, urdf_data)
     configurations = {"neutral": pin.neutral(model)}
     armature_source = None
     if srdf is not None:
-        srdf_text = check_srdf(read_robot_file(srdf), str(srdf))
+        data = srdf_data if srdf_data is not None else read_robot_file(srdf)
+        srdf_text = check_srdf(data, str(srdf))
         try:
             with _native_stderr(native):
                 pin.loadReferenceConfigurationsFromXML(model, srdf_text, False)
@@ -475,7 +486,7 @@ def _load(urdf: Path, srdf: Path | None, name: str, standing: str | None) -> Rob
         for entry in model.referenceConfigurations:
             configurations[entry.key()] = np.array(entry.data(), dtype=float)
         if "rotor_params" in srdf_text:
-            armature_source = _load_rotor_parameters(model, srdf, native)
+            armature_source = _load_rotor_parameters(model, srdf, srdf_text, native)
         _check_srdf_values(model, srdf, configurations)
     if standing is None:
         standing = "half_sitting" if "half_sitting" in configurations else "neutral"
@@ -484,16 +495,20 @@ def _load(urdf: Path, srdf: Path | None, name: str, standing: str | None) -> Rob
     return Robot(name, model, configurations, standing, urdf, srdf, package_dirs, armature_source)
 
 
-def _load_rotor_parameters(model: pin.Model, srdf: Path, native: list[str]) -> str:
+def _load_rotor_parameters(model: pin.Model, srdf: Path, text: str, native: list[str]) -> str:
     """Read the SRDF's ``rotor_params`` into ``model.armature``.
 
     Each joint's rotor inertia and gear ratio give ``model.armature`` = gear ratio^2 x rotor
     inertia, the rotor inertia reflected at the joint (called when the SRDF declares
     ``rotor_params``). Returns where it came from.
     """
+    # pinocchio reads rotor parameters from a path only: give it a private copy of the text
+    # that was checked, never the user's file again (which may have changed since).
     try:
-        with _native_stderr(native):
-            pin.loadRotorParameters(model, str(srdf), False)
+        with tempfile.TemporaryDirectory() as folder, _native_stderr(native):
+            copy = Path(folder) / srdf.name
+            copy.write_text(text, encoding="utf-8")
+            pin.loadRotorParameters(model, str(copy), False)
     except (RuntimeError, ValueError, OSError) as exc:
         raise RobotLoadError(
             str(srdf), _native_reason(native, str(exc).strip() or "invalid rotor_params")
@@ -535,30 +550,26 @@ def load_robot(
     if not _is_file(urdf):
         read_robot_file(urdf)  # names what it is: missing, not a regular file, unreadable
     srdf_path = Path(srdf) if srdf else None
-    # Cached by the files' identity and modification: an edited URDF or SRDF is reloaded.
+    # Each file is read once, and the model is parsed from those bytes and cached by their
+    # digest: an edited file is reloaded, and a file rewritten while it loads can never leave
+    # one content's model under another content's key.
+    urdf_data = read_robot_file(urdf)
+    srdf_data = read_robot_file(srdf_path) if srdf_path else None
     key = (
-        _file_key(urdf),
-        _file_key(srdf_path) if srdf_path else None,
+        str(urdf.resolve()),
+        hashlib.sha256(urdf_data).hexdigest(),
+        hashlib.sha256(srdf_data).hexdigest() if srdf_data is not None else None,
         robot or urdf.stem,
         standing,
     )
     cached = _FILE_ROBOTS.get(key)
     if cached is None:
-        cached = _load(urdf, srdf_path, robot or urdf.stem, standing)
+        cached = _load(urdf, srdf_path, robot or urdf.stem, standing, urdf_data, srdf_data)
         if len(_FILE_ROBOTS) >= 16:  # bounded
             _FILE_ROBOTS.pop(next(iter(_FILE_ROBOTS)))
         _FILE_ROBOTS[key] = cached
     return cached
 
 
-#: Robots loaded from files, by :func:`_file_key` of their URDF and SRDF.
+#: Robots loaded from files, by the digests of the URDF and SRDF bytes they were parsed from.
 _FILE_ROBOTS: dict[tuple[Any, ...], Robot] = {}
-
-
-def _file_key(path: Path) -> tuple[str, int, int]:
-    """(resolved path, modification time in ns, size) of a file; (path, -1, -1) if absent."""
-    try:
-        st = path.stat()
-    except OSError:
-        return (str(path), -1, -1)
-    return (str(path.resolve()), st.st_mtime_ns, st.st_size)
