@@ -37,7 +37,9 @@ def test_robot_file_cache_follows_the_file(tmp_path):
     first = ib.load_robot(None, urdf)
     assert ib.load_robot(None, urdf) is first  # cached
     stat = urdf.stat()
-    os.utime(urdf, ns=(stat.st_atime_ns, stat.st_mtime_ns + 10**9))  # "edited"
+    os.utime(urdf, ns=(stat.st_atime_ns, stat.st_mtime_ns + 10**9))  # touched, same bytes
+    assert ib.load_robot(None, urdf) is first  # the cache follows the content, not the time
+    urdf.write_text(urdf.read_text() + "\n<!-- edited -->\n")
     assert ib.load_robot(None, urdf) is not first
 
 
