@@ -678,3 +678,24 @@ def test_the_apps_upload_and_load_parse_before_taking_the_lock(app, monkeypatch)
     finally:
         release.set()
     assert done.wait(30) and session.state.source == "up.yaml"
+
+
+def test_a_robot_file_swapped_for_a_link_after_the_load_is_never_read(session, ws, tmp_path):
+    """Every analysis reads the robot files through the workspace (no link followed): a URDF
+    replaced by a link to a file outside the workspace after the load is refused, not loaded."""
+    erd = example_robot_data_root()
+    urdf, srdf = erd / "talos_data/robots/talos_reduced.urdf", erd / "talos_data/srdf/talos.srdf"
+    shutil.copy(urdf, ws / "sub" / "talos.urdf")
+    shutil.copy(srdf, ws / "sub" / "talos.srdf")
+    raw = yaml.safe_load((ws / "a.yaml").read_text())
+    raw["robot"] = {"urdf": "talos.urdf", "srdf": "talos.srdf", "standing": "half_sitting"}
+    (ws / "sub" / "robot.yaml").write_text(yaml.safe_dump(raw))
+    assert session.load("sub/robot.yaml"), session.message
+    # Outside the workspace, a URDF with other content (so that a read of it would show).
+    outside = tmp_path / "outside.urdf"
+    outside.write_text(urdf.read_text() + "\n<!-- outside -->\n")
+    (ws / "sub" / "talos.urdf").unlink()
+    (ws / "sub" / "talos.urdf").symlink_to(outside)
+    assert not session.set(("com_velocity",), [0.01, 0.0])
+    assert "link" in session.message and "robot file" in session.message
+    assert str(outside) not in session.message

@@ -28,6 +28,7 @@ from impact_balance.exceptions import (
 )
 from impact_balance.gui.state import GuiState
 from impact_balance.gui.workspace import MAX_FILE_BYTES, Workspace
+from impact_balance.robot.urdf_check import MAX_ROBOT_FILE_BYTES
 from impact_balance.scenario import (
     ExtendsResolver,
     FileReader,
@@ -151,7 +152,24 @@ class GuiFiles:
             srdf=check(robot.srdf, "robot.srdf", ".srdf") if robot.srdf else None,
             standing=robot.standing,
         )
-        return scenario.model_copy(update={"robot": files})
+        return scenario.model_copy(update={"robot": files}).with_robot_reader(self._read_robot)
+
+    def _read_robot(self, path: Path) -> bytes:
+        """A robot file's bytes, read through the workspace every time it is loaded.
+
+        No link is followed (see :meth:`~impact_balance.gui.workspace.Workspace.read_bytes`).
+
+        Raises:
+            WorkspaceError: Outside the workspace, a link, not a regular file, or too large.
+        """
+        try:  # lexically: the path the load checked, never a link's target
+            name = Path(path).relative_to(self.workspace.root)
+        except ValueError:
+            where = f"outside the workspace {self.workspace.root}"
+            raise WorkspaceError("robot file", str(path), where) from None
+        return self.workspace.read_bytes(
+            name, field="robot file", suffixes=(".urdf", ".srdf"), limit=MAX_ROBOT_FILE_BYTES
+        )
 
     # -- loads ------------------------------------------------------------------------------
     def load(self, name: str) -> GuiState:
@@ -212,7 +230,7 @@ class GuiFiles:
             raise ScenarioError(exc.field, value, exc.reason, shown) from None
         scenario = self._robot_files(scenario, self.workspace.root)
         state = GuiState.from_scenario(scenario)
-        return GuiState(state.raw, shown)
+        return GuiState(state.raw, shown, robot_reader=state.robot_reader)
 
     # -- saves ------------------------------------------------------------------------------
     def save(self, state: GuiState, name: str, overwrite: bool = False) -> Path:

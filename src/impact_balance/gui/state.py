@@ -20,6 +20,7 @@ import numpy as np
 import yaml
 
 from impact_balance.exceptions import ScenarioError
+from impact_balance.robot.robot import RobotFileReader
 from impact_balance.scenario import RobotFiles, Scenario, load_scenario, scenario_from_dict
 
 __all__ = ["DEFAULT_SCENARIO", "FieldPath", "GuiState", "plain"]
@@ -107,13 +108,21 @@ class GuiState:
             state can be saved anywhere).
     """
 
-    __slots__ = ("_raw", "scenario", "source")
+    __slots__ = ("_raw", "robot_reader", "scenario", "source")
 
-    def __init__(self, raw: Mapping[str, Any], source: str | None = None):
+    def __init__(
+        self,
+        raw: Mapping[str, Any],
+        source: str | None = None,
+        robot_reader: RobotFileReader | None = None,
+    ):
         data = plain(copy.deepcopy(dict(raw)))
-        self.scenario: Scenario = scenario_from_dict(data, source)
+        self.scenario: Scenario = scenario_from_dict(data, source).with_robot_reader(robot_reader)
         self._raw: dict[str, Any] = data
         self.source = source
+        #: How the scenario's robot files are read (the workspace's reader for a workspace
+        #: file; kept by every edit), or None.
+        self.robot_reader = robot_reader
 
     # -- construction -------------------------------------------------------------------
     @classmethod
@@ -128,7 +137,7 @@ class GuiState:
             files["urdf"] = str((base / scenario.robot.urdf).resolve())
             if scenario.robot.srdf:
                 files["srdf"] = str((base / scenario.robot.srdf).resolve())
-        return cls(raw, scenario.source)
+        return cls(raw, scenario.source, scenario.robot_reader)
 
     @classmethod
     def from_file(cls, name_or_path: str | Path = DEFAULT_SCENARIO) -> GuiState:
@@ -210,7 +219,7 @@ class GuiState:
             value = plain(value)
             _check_finite(path, value)
             _set(raw, path, value)
-        return GuiState(raw, self.source)
+        return GuiState(raw, self.source, self.robot_reader)
 
     def __eq__(self, other: object) -> bool:
         return isinstance(other, GuiState) and self._raw == other._raw

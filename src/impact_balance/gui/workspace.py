@@ -255,8 +255,9 @@ class Workspace:
         *,
         field: str = "file",
         suffixes: tuple[str, ...] = SCENARIO_SUFFIXES,
+        limit: int = MAX_FILE_BYTES,
     ) -> bytes:
-        """The bytes of the workspace file ``name`` (at most :data:`MAX_FILE_BYTES`).
+        """The bytes of the workspace file ``name`` (at most ``limit``: :data:`MAX_FILE_BYTES`).
 
         The name is checked by :meth:`resolve`, then read through descriptors only: the
         workspace folder and each folder on the way are opened without following links, and
@@ -272,13 +273,11 @@ class Workspace:
         parts = self.resolve(name, field=field, suffixes=suffixes).relative_to(self.root).parts
         folder = self._open_folder(parts[:-1], field, str(name))
         try:
-            return read_bounded(
-                parts[-1], limit=MAX_FILE_BYTES, what=field, no_follow=True, dir_fd=folder
-            )
+            return read_bounded(parts[-1], limit=limit, what=field, no_follow=True, dir_fd=folder)
         except ScenarioError as exc:
             reason = exc.reason
             if "larger than" in reason:
-                reason = f"larger than {MAX_FILE_BYTES >> 10} KiB"
+                reason = f"larger than {limit >> 10} KiB"
             elif "symbolic link" in reason:
                 reason = "symbolic links are not followed in the workspace"
             raise WorkspaceError(field, str(name), reason) from None

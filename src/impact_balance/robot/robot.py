@@ -13,7 +13,7 @@ import os
 import sys
 import tempfile
 import threading
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any, NamedTuple
@@ -36,12 +36,16 @@ __all__ = [
     "BUNDLED_ROBOTS",
     "JointSlot",
     "Robot",
+    "RobotFileReader",
     "RobotSpec",
     "Scratch",
     "ThreadData",
     "example_robot_data_root",
     "load_robot",
 ]
+
+#: Reads a robot file's bytes (path -> bytes), raising an error that names the file.
+RobotFileReader = Callable[[Path], bytes]
 
 _FloatArray = npt.NDArray[np.float64]
 
@@ -534,6 +538,8 @@ def load_robot(
     urdf: str | Path | None = None,
     srdf: str | Path | None = None,
     standing: str | None = None,
+    *,
+    read_file: RobotFileReader | None = None,
 ) -> Robot:
     """Load a bundled robot by name, or any URDF (+ optional SRDF) that pinocchio reads.
 
@@ -547,14 +553,15 @@ def load_robot(
             raise UnknownRobotError("robot", name, BUNDLED_ROBOTS)
         return _load_bundled(name)
     urdf = Path(urdf)
-    if not _is_file(urdf):
+    if read_file is None and not _is_file(urdf):
         read_robot_file(urdf)  # names what it is: missing, not a regular file, unreadable
     srdf_path = Path(srdf) if srdf else None
     # Each file is read once, and the model is parsed from those bytes and cached by their
     # digest: an edited file is reloaded, and a file rewritten while it loads can never leave
     # one content's model under another content's key.
-    urdf_data = read_robot_file(urdf)
-    srdf_data = read_robot_file(srdf_path) if srdf_path else None
+    read = read_file or read_robot_file
+    urdf_data = read(urdf)
+    srdf_data = read(srdf_path) if srdf_path else None
     key = (
         str(urdf.resolve()),
         hashlib.sha256(urdf_data).hexdigest(),

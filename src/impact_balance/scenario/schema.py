@@ -12,7 +12,14 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 import pinocchio as pin
-from pydantic import AfterValidator, Field, ValidationError, ValidationInfo, field_validator
+from pydantic import (
+    AfterValidator,
+    Field,
+    PrivateAttr,
+    ValidationError,
+    ValidationInfo,
+    field_validator,
+)
 
 from impact_balance.constants import (
     GRAVITY_RANGE,
@@ -30,7 +37,7 @@ from impact_balance.contacts.stance import ContactSpec, Stance
 from impact_balance.exceptions import ScenarioError
 from impact_balance.geometry.spatial import pose, surface_rotation
 from impact_balance.impact.model import ImpactSpec
-from impact_balance.robot.robot import Robot, load_robot
+from impact_balance.robot.robot import Robot, RobotFileReader, load_robot
 from impact_balance.scenario.errors import scenario_error
 from impact_balance.scenario.fields import (
     Angles,
@@ -221,6 +228,10 @@ class BasePose(_Model):
 class Scenario(_Model):
     """One situation. See README, "Scenario files", for every key."""
 
+    #: How its robot files are read (None: by path, with the package's file-reading rule); a
+    #: confined reader (the GUI's workspace) travels with the scenario and its replacements.
+    _robot_reader: RobotFileReader | None = PrivateAttr(default=None)
+
     name: Annotated[str, Field(max_length=MAX_NAME)] | None = None
     description: Annotated[str, Field(max_length=MAX_DESCRIPTION)] | None = None
     robot: str | RobotFiles = "talos"
@@ -299,7 +310,32 @@ class Scenario(_Model):
         raw = self.model_dump(exclude_unset=True)
         raw.pop("source", None)
         raw.update(changes)
-        return Scenario.from_mapping(raw, self.source)
+        return Scenario.from_mapping(raw, self.source).with_robot_reader(self._robot_reader)
+
+    @property
+    def robot_reader(self) -> RobotFileReader | None:
+        """How its robot files are read (see :meth:`with_robot_reader`); None: by path."""
+        return self._robot_reader
+
+    def with_robot_reader(self, reader: RobotFileReader | None) -> Scenario:
+        """A copy whose robot files are read by ``reader`` (path -> bytes) instead of by path.
+
+        The GUI gives its workspace's reader (no link followed, relative to the workspace's
+        folder descriptors), so that a robot file swapped for a link after the workspace
+        checked it is refused, never read.
+
+        Args:
+            reader: Reads a robot file's bytes, raising an
+                :class:`~impact_balance.exceptions.ImpactBalanceError` naming it; None: by path.
+
+        Returns:
+            The copy (this scenario when the reader is already the same).
+        """
+        if reader is self._robot_reader:
+            return self
+        copy = self.model_copy()
+        copy._robot_reader = reader
+        return copy
 
     @property
     def set_keys(self) -> frozenset[str]:
@@ -321,9 +357,12 @@ class Scenario(_Model):
             if self.robot.srdf:
                 check_path_text("robot.srdf", self.robot.srdf, self.source)
             base = Path(self.source).parent if self.source else Path.cwd()
-            urdf = (base / self.robot.urdf).resolve()
-            srdf = (base / self.robot.srdf).resolve() if self.robot.srdf else None
-            return load_robot(None, urdf, srdf, self.robot.standing)
+            # With a confined reader, the paths stay as written (made absolute, no link
+            # resolved): the reader decides what a link means.
+            absolute = Path.absolute if self._robot_reader is not None else Path.resolve
+            urdf = absolute(base / self.robot.urdf)
+            srdf = absolute(base / self.robot.srdf) if self.robot.srdf else None
+            return load_robot(None, urdf, srdf, self.robot.standing, read_file=self._robot_reader)
         return load_robot(self.robot)
 
     def configuration_vector(self, robot: Robot) -> np.ndarray:
