@@ -28,6 +28,7 @@ FRAMES = {
     "g1": ("left_ankle_roll_link", "left_rubber_hand"),
     "romeo": ("l_sole", "l_wrist"),
     "icub": ("l_sole", "l_hand"),
+    "jvrc1": ("l_ankle", "l_wrist"),
 }
 SOLE_BAND = 0.005
 

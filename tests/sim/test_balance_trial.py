@@ -289,6 +289,9 @@ def test_validate_cli_json_keys_and_text(capsys, tmp_path):
     (trial,) = out["trials"]
     assert trial["outcome"] == "balanced" and trial["com_criterion_safe"] is True
     assert trial["strict_fail"] is False and e["strict_failed"] is None
+    verdict = out["verdict"]  # no fall up to 0.3 m/s: the bracket is open above
+    assert verdict["verdict"] == "inconclusive" and verdict["fall_over_predicted"]["high"] is None
+    assert verdict["predicted"] == out["predicted"]["default"]
     impact = trial["trial"]["impact"]
     assert set(impact["sustained_impulses"]) == {"left_sole_link", "right_sole_link"}
     assert main(argv) == 0  # text, from the journal
@@ -298,5 +301,6 @@ def test_validate_cli_json_keys_and_text(capsys, tmp_path):
         and "CoM criterion" in text
         and "strict (fell, or a contact beyond the strict bounds)" in text
         and "default (the governor's cap)" in text
+        and "inconclusive: no fall up to" in text
         and "(1 reused)" in text
     )

@@ -123,7 +123,8 @@ def test_sampling_and_top_level_errors():
     assert info.value.field == "chunksize"
     with pytest.raises(ImpactBalanceError) as info:
         plan_of([{"path": "impact.friction", "values": [0.1]}], base="no_such_scenario")
-    assert "palm_push_two_feet" in str(info.value)  # the valid names are listed
+    assert "palm_push_two_feet" in info.value.valid  # the valid names are carried
+    assert "valid scenarios" in str(info.value)
 
 
 # -- paths and points -----------------------------------------------------------------------

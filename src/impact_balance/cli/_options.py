@@ -28,11 +28,14 @@ if TYPE_CHECKING:
     Subcommands: TypeAlias = argparse._SubParsersAction[argparse.ArgumentParser]
 
 __all__ = [
+    "DEFAULT_CONTROLLER",
     "LOG_SUFFIXES",
+    "TRIAL_JOINTS",
     "CommandLineError",
     "a_number",
     "add_controller_option",
     "add_output_options",
+    "add_trial_joints_option",
     "add_trial_options",
     "add_velocity_margin_option",
     "add_zmp_margin_option",
@@ -47,6 +50,16 @@ __all__ = [
 
 #: Suffixes of a log file (``--log``).
 LOG_SUFFIXES = (".parquet", ".csv")
+
+#: The balance controller of every trial command (``validate``, ``push-test``, ``approach``)
+#: unless ``--controller`` says otherwise: the inverse-dynamics QP places the ZMP anywhere in the
+#: support area, as the criteria assume, and holds the commanded approach speed.
+DEFAULT_CONTROLLER = "id"
+
+#: ``--joints`` of the balance-trial commands: the study's joint model of each word. ``stiff``
+#: (stiff servos, no effort limits) is what the study calls ``rigid``; in ``simulate``,
+#: ``rigid`` means welded joints.
+TRIAL_JOINTS = {"servo": "servo", "stiff": "rigid"}
 
 
 class CommandLineError(ImpactBalanceError):
@@ -157,7 +170,7 @@ def add_controller_option(parser: argparse.ArgumentParser, default: str, why: st
 
     Args:
         parser: The command's parser.
-        default: The default controller.
+        default: The default controller (every trial command gives :data:`DEFAULT_CONTROLLER`).
         why: The default's reason, for the help.
     """
     parser.add_argument(
@@ -166,6 +179,37 @@ def add_controller_option(parser: argparse.ArgumentParser, default: str, why: st
         choices=("ik", "id"),
         help=f"ik: pink IK -> position servos; id: inverse-dynamics QP -> torque motors "
         f"(default: {default}, {why})",
+    )
+
+
+def add_trial_joints_option(parser: argparse.ArgumentParser) -> None:
+    """Add ``--joints servo|stiff`` to a balance-trial command (default ``servo``).
+
+    ``rigid``, this option's former word for ``stiff``, is still read, with one deprecation line
+    on stderr: in ``simulate`` ``rigid`` means welded joints, which a balance trial cannot use.
+    The study's own name of the joint model is ``TRIAL_JOINTS[args.joints]``.
+    """
+
+    def check(text: str) -> str:
+        if text == "rigid":
+            import sys
+
+            print(
+                "impact-balance: --joints rigid is deprecated here: it means stiff servos "
+                "(write --joints stiff); rigid means welded joints in simulate",
+                file=sys.stderr,
+            )
+            return "stiff"
+        return text
+
+    check.__name__ = "joint model"
+    parser.add_argument(
+        "--joints",
+        default="servo",
+        type=check,
+        choices=tuple(TRIAL_JOINTS),
+        help="servo: URDF effort limits, 15 Hz servos; stiff: stiff 30 Hz servos, no effort "
+        "limits ('rigid', its former name, is deprecated: in simulate it means welded joints)",
     )
 
 

@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from impact_balance.cli._options import (
+    DEFAULT_CONTROLLER,
     add_controller_option,
     add_velocity_margin_option,
     add_zmp_margin_option,
@@ -100,7 +101,9 @@ def add_parser(sub: Subcommands) -> list[str]:
         action="store_true",
         help="hold every joint's velocity through the impact (the paper's rigid robot)",
     )
-    add_controller_option(a, "id", "it puts the ZMP anywhere in the support area after the impact")
+    add_controller_option(
+        a, DEFAULT_CONTROLLER, "it puts the ZMP anywhere in the support area after the impact"
+    )
     add_zmp_margin_option(a, "the governor's; default: the ZMP margin the trial's controller keeps")
     a.add_argument(
         "--max-time",

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from impact_balance.cli._options import (
+    DEFAULT_CONTROLLER,
     add_controller_option,
     add_output_options,
     add_trial_options,
@@ -88,7 +89,9 @@ def add_parser(sub: Subcommands) -> list[str]:
     a.add_argument("--duration", type=float, default=0.05, help="push duration, s (default 0.05)")
     a.add_argument("--body", help="MuJoCo body pushed (default: the torso)")
     add_controller_option(
-        a, "id", "it places the ZMP anywhere in the support area, as the criterion assumes"
+        a,
+        DEFAULT_CONTROLLER,
+        "it places the ZMP anywhere in the support area, as the criterion assumes",
     )
     add_trial_options(a, impact=False)
     add_output_options(a, "of one telling push")

@@ -10,8 +10,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from impact_balance.cli._options import (
+    DEFAULT_CONTROLLER,
+    TRIAL_JOINTS,
     add_controller_option,
     add_output_options,
+    add_trial_joints_option,
     add_trial_options,
     open_journal,
     scoring_margin,
@@ -40,14 +43,12 @@ def add_parser(sub: Subcommands) -> list[str]:
         "validate", help="bisect the approach speed at which the simulated robot falls (MuJoCo)"
     )
     a.add_argument("scenario", help="YAML file or bundled scenario name (must have an impact)")
-    a.add_argument(
-        "--joints",
-        default="servo",
-        choices=("rigid", "servo"),
-        help="servo: URDF effort limits, 15 Hz servos; rigid: stiff 30 Hz servos, no effort limits",
-    )
+    add_trial_joints_option(a)
     add_controller_option(
-        a, "ik", "a kinematically controlled robot, as the paper's impact model assumes"
+        a,
+        DEFAULT_CONTROLLER,
+        "it places the ZMP anywhere in the support area, as the criterion assumes, and holds the "
+        "commanded approach speed",
     )
     a.add_argument(
         "--tolerance", type=float, default=0.05, help="relative width of the bracket (default 0.05)"
@@ -89,11 +90,12 @@ def run(args: argparse.Namespace) -> int:
     if args.log:
         check_log_path(args.log)
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
+    joints = TRIAL_JOINTS[args.joints]  # the study's name (the journals' digests keep it)
     journal = open_journal(
         args,
         "validate",
         scenario,
-        args.joints,
+        joints,
         options,
         {"tolerance": args.tolerance, "max_speed": args.max_speed},
     )
@@ -110,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         result = validate(
             scenario,
-            args.joints,
+            joints,
             tolerance=args.tolerance,
             max_speed=args.max_speed,
             progress=progress,
@@ -122,6 +124,7 @@ def run(args: argparse.Namespace) -> int:
         bar.close()
         journal.close()
     out = result.to_dict()
+    out["joints"] = args.joints
     written = []
     e = out["empirical"]
     if args.log:
@@ -135,7 +138,7 @@ def run(args: argparse.Namespace) -> int:
                         result.extra["setup"],
                         args.log,
                         args.controller,
-                        {"approach_speed": speed, "joints": args.joints},
+                        {"approach_speed": speed, "joints": joints},
                         impact_speed=speed,
                         rigid_impact=args.rigid_impact,
                     )
@@ -157,6 +160,17 @@ def _f(x: float | None) -> str:
     return "-" if x is None else f"{x:.3f} m/s"
 
 
+def _verdict_line(v: dict[str, Any]) -> str:
+    """``fall bracket / prediction: [low, high] (...): verdict`` (see ``fall_verdict``)."""
+    r = v["fall_over_predicted"]
+    low = "-" if r["low"] is None else f"{r['low']:.2f}"
+    high = "-" if r["high"] is None else f"{r['high']:.2f}"
+    return (
+        f"  fall bracket / prediction ({_f(v['predicted'])}, the governor's cap): "
+        f"[{low}, {high}]: {v['text']}"
+    )
+
+
 def _text(out: dict[str, Any], args: argparse.Namespace, n: int) -> str:
     e, p, pm = out["empirical"], out["predicted"], out["predicted_with_margin"]
     impact = (
@@ -169,6 +183,7 @@ def _text(out: dict[str, Any], args: argparse.Namespace, n: int) -> str:
         f"  measured approach speed: stood at {_f(e['survived'])}, fell at {_f(e['fell'])}"
         f" (commanded {_f(e['survived_commanded'])} / {_f(e['fell_commanded'])})"
         + ("" if e["monotonic"] else "; NOT monotonic in measured speed"),
+        _verdict_line(out["verdict"]),
     ]
     lines.append(
         f"  strict (fell, or a contact beyond the strict bounds): stood at "

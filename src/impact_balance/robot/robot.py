@@ -67,6 +67,16 @@ class RobotSpec:
     description: str
 
 
+def _jvrc_description_file(relative: str) -> str:
+    """Absolute path of a file of the jvrc-description wheel (found without importing it)."""
+    import importlib.util
+
+    spec = importlib.util.find_spec("jvrc_description")
+    if spec is None or spec.origin is None:  # pragma: no cover - install issue
+        return f"jvrc_description/{relative}"  # missing: the load names the file
+    return str(Path(spec.origin).parent / relative)
+
+
 BUNDLED_ROBOTS: dict[str, RobotSpec] = {
     "talos": RobotSpec(
         "talos_data/robots/talos_reduced.urdf",
@@ -91,6 +101,14 @@ BUNDLED_ROBOTS: dict[str, RobotSpec] = {
         "icub_description/srdf/icub.srdf",
         "half_sitting",
         "IIT iCub, 28 kg humanoid (reduced model)",
+    ),
+    # Not in example-robot-data: the jvrc-description wheel's URDF, as an absolute path (a
+    # path joined to an absolute one is that one). No SRDF: the stance is in the scenarios.
+    "jvrc1": RobotSpec(
+        _jvrc_description_file("urdf/jvrc1.urdf"),
+        None,
+        "neutral",
+        "JVRC-1 (jvrc-description), 62 kg HRP-class humanoid; no SRDF: neutral configuration",
     ),
 }
 

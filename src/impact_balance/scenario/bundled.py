@@ -59,7 +59,9 @@ def scenario_path(name_or_path: str | Path) -> Path:
     bundled = _scenario_dir() / f"{name_or_path}.yaml"
     if _is_file(bundled):
         return bundled
-    raise UnknownScenarioError("scenario", str(name_or_path), list(bundled_scenarios()))
+    raise UnknownScenarioError(
+        "scenario", str(name_or_path), list(bundled_scenarios()), listing="impact-balance scenarios"
+    )
 
 
 def _is_file(path: Path) -> bool:

@@ -20,6 +20,15 @@ speed is at most the maximum: a prediction made before the trial, evaluated at t
 trial reached) and in the trial (the measured post-impact CoM velocity in the area). Every trial
 starts at rest, so every prediction is made from a CoM at rest (the scenario's ``com_velocity``
 is replaced by zero).
+
+The **verdict** (:func:`fall_verdict`) compares the fall bracket in measured speed,
+``(survived, fell]``, with the prediction ``default``: ``fall_over_predicted`` is
+``[survived / default, fell / default]`` (the low end 0 when no trial stood below the fall, the
+high end None when none fell), and the verdict is ``within`` when the prediction lies in the
+bracket (``survived <= default <= fell``), ``optimistic`` by ``1 - fell / default`` when the robot
+fell below the prediction, ``conservative`` by ``survived / default - 1`` when it stood above it,
+and ``inconclusive`` when no trial fell (the bracket is open above; the fastest measured speed is
+named) or there is no prediction.
 """
 
 from __future__ import annotations
@@ -55,6 +64,7 @@ __all__ = [
     "ValidationResult",
     "ValidationTrial",
     "default_prediction",
+    "fall_verdict",
     "predictions",
     "validate",
 ]
@@ -155,6 +165,53 @@ def _threshold(trials: list[ValidationTrial], failed: TrialTest) -> dict[str, An
         "failed_commanded": None if lowest is None else lowest.speed,
         "stood_commanded": None if highest is None else highest.speed,
     }
+
+
+def fall_verdict(
+    survived: float | None,
+    fell: float | None,
+    predicted: float | None,
+    fastest: float | None = None,
+) -> dict[str, Any]:
+    """The fall bracket over the prediction, and the verdict (see the module docstring).
+
+    Args:
+        survived: Fastest measured approach speed that stood below the slowest fall, m/s (None:
+            none stood).
+        fell: Slowest measured approach speed that fell, m/s (None: none fell).
+        predicted: The predicted maximum contact velocity, m/s (None: unbounded or unknown).
+        fastest: Fastest measured approach speed of any scored trial, m/s (named when no trial
+            fell).
+
+    Returns:
+        ``predicted``; ``fall_over_predicted`` (``low``, ``high``: the bracket's ends over the
+        prediction, None where undefined); ``verdict`` (``within``, ``optimistic``,
+        ``conservative`` or ``inconclusive``); ``by`` (the relative error, a fraction, for
+        optimistic and conservative, else None); ``text`` (one line).
+    """
+    out: dict[str, Any] = {
+        "predicted": predicted,
+        "fall_over_predicted": {"low": None, "high": None},
+        "verdict": "inconclusive",
+        "by": None,
+    }
+    if predicted is None or not predicted > 0.0:
+        return {**out, "text": "inconclusive: no finite prediction to compare with"}
+    low = 0.0 if survived is None else survived / predicted
+    high = None if fell is None else fell / predicted
+    out["fall_over_predicted"] = {"low": low, "high": high}
+    if high is None:
+        up_to = "-" if fastest is None else f"{fastest:.3f} m/s ({fastest / predicted:.2f} x)"
+        return {**out, "text": f"inconclusive: no fall up to {up_to}"}
+    if high < 1.0:
+        by = 1.0 - high
+        text = f"optimistic by {100 * by:.0f} %: fell at {high:.2f} x the prediction"
+        return {**out, "verdict": "optimistic", "by": by, "text": text}
+    if low > 1.0:
+        by = low - 1.0
+        text = f"conservative by {100 * by:.0f} %: stood at {low:.2f} x the prediction"
+        return {**out, "verdict": "conservative", "by": by, "text": text}
+    return {**out, "verdict": "within", "text": "prediction within the bracket"}
 
 
 @dataclass
@@ -306,6 +363,9 @@ class ValidationResult:
                 }
             )
         empirical = {**self.bracket(), "tolerance": self.tolerance, "max_speed": self.max_speed}
+        verdict = fall_verdict(
+            empirical["survived"], empirical["fell"], self.default, empirical["fastest_measured"]
+        )
         return {
             "scenario": self.scenario,
             "joints": self.joints,
@@ -314,6 +374,7 @@ class ValidationResult:
             "predicted": {**self.predicted, "default": self.default},
             "predicted_with_margin": self.predicted_with_margin,
             "empirical": empirical,
+            "verdict": verdict,
             "contact_break": self.contact_break(),
             "trials": trials,
             "controller": self.controller,
