@@ -96,6 +96,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--wall", type=float, default=0.1, help="the wall's distance ahead, m")
     p.add_argument("--steps", type=int, default=200, help="IK steps at 500 Hz (at most)")
     args = p.parse_args(argv)
+    if args.steps < 1:
+        p.error(f"--steps = {args.steps}: must be at least 1")
+    for name in ("reference", "wall"):
+        value = getattr(args, name)
+        if not (np.isfinite(value) and 0.0 < value <= 100.0):
+            p.error(f"--{name} = {value:g}: must be a number in (0, 100]")
     r = run(args.scenario, args.reference, args.wall, args.steps)
     ratio = r["commanded"] / r["cap"]
     hit = r["distance"][-1] <= 0.0

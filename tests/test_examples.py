@@ -77,6 +77,10 @@ def test_pink_loop_with_the_cap_as_a_limit(capsys):
     assert np.allclose(slow["commanded"], 0.2, atol=0.01)
     assert example.main(["--steps", "10"]) == 0
     assert "pink IK with the cap as a limit" in capsys.readouterr().out
+    for bad in (["--steps", "0"], ["--reference", "nan"], ["--wall", "-1"]):
+        with pytest.raises(SystemExit) as exit_:
+            example.main(bad)
+        assert exit_.value.code == 2 and bad[0] in capsys.readouterr().err
 
 
 @needs_extra("sim")
