@@ -6,6 +6,7 @@ import importlib.util
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import impact_balance as ib
 from tests.helpers.extras import needs_extra
@@ -50,3 +51,49 @@ def test_governor_in_a_pink_loop_caps_the_speed_at_the_criterion(capsys):
     assert np.allclose(slow["commanded"], 0.2)  # below the cap: the reference as it is
     assert example.main(["--ticks", "20"]) == 0
     assert "com governor" in capsys.readouterr().out
+
+
+def _approach_checks(r: dict, reference: float) -> None:
+    """The cap is a constraint of the QP: at every tick the commanded approach speed (the QP's
+    -n . J v) and the speed the point travelled stay within 1 % of the cap, and at the wall they
+    reach at least 95 % of it (the reference is higher)."""
+    assert r["distance"][-1] <= 0.0  # the point reached the wall
+    assert np.all(r["cap"] < reference)  # the cap binds
+    assert np.all(r["commanded"] <= 1.01 * r["cap"])
+    assert np.all(r["measured"] <= 1.01 * r["cap"])
+    assert r["commanded"][-1] >= 0.95 * r["cap"][-1]
+    assert r["measured"][-1] >= 0.95 * r["cap"][-1]
+
+
+def test_pink_loop_with_the_cap_as_a_limit(capsys):
+    example = _load("pink_limit")
+    r = example.run("palm_push_two_feet", reference=1.5, wall=0.05, steps=100)
+    _approach_checks(r, 1.5)
+    start = ib.analyze("palm_push_two_feet").impact.max_contact_velocity
+    assert abs(r["cap"][0] - start) < 1e-9  # the governor's answer at the scenario's state
+    free = example.run("palm_push_two_feet", reference=1.5, wall=0.05, steps=100, limited=False)
+    assert free["commanded"].max() > 1.5 * free["cap"].max()  # without the limit: no cap
+    slow = example.run("palm_push_two_feet", reference=0.2, wall=0.05, steps=20)
+    assert np.allclose(slow["commanded"], 0.2, atol=0.01)
+    assert example.main(["--steps", "10"]) == 0
+    assert "pink IK with the cap as a limit" in capsys.readouterr().out
+    for bad in (["--steps", "0"], ["--reference", "nan"], ["--wall", "-1"]):
+        with pytest.raises(SystemExit) as exit_:
+            example.main(bad)
+        assert exit_.value.code == 2 and bad[0] in capsys.readouterr().err
+
+
+@needs_extra("sim")
+def test_mink_loop_on_mujoco_with_the_cap_as_a_limit(capsys):
+    pytest.importorskip("mink", reason="needs the mink extra (pip install 'impact-balance[mink]')")
+    example = _load("mink_limit")
+    r = example.run("palm_push_two_feet", reference=1.5, wall=0.05, steps=100)
+    _approach_checks(r, 1.5)
+    free = example.run("palm_push_two_feet", reference=1.5, wall=0.05, steps=100, limited=False)
+    assert free["commanded"].max() > 1.5 * free["cap"].max()
+    slow = example.run("palm_push_two_feet", reference=0.2, wall=0.05, steps=20)
+    # Below the cap the limit is inactive: the task's speed (the posture task holds it back 3 %).
+    assert np.allclose(slow["commanded"], 0.2, atol=0.01)
+    assert np.all(slow["commanded"] < 0.9 * slow["cap"])
+    assert example.main(["--steps", "10"]) == 0
+    assert "mink IK (MuJoCo) with the cap as a limit" in capsys.readouterr().out

@@ -10,7 +10,9 @@ of them, so a controller can depend on ``impact-balance`` alone. ``pip install
 - ``sim`` (mujoco, imageio, imageio-ffmpeg, pandas, pyarrow, matplotlib): ``simulate``,
   ``validate``, ``push-test``, ``approach``;
 - ``gui`` (viser, and trimesh, which it brings): ``gui``;
-- ``sweep`` (dask.distributed, pandas, pyarrow, matplotlib): ``sweep`` (figures included).
+- ``sweep`` (dask.distributed, pandas, pyarrow, matplotlib): ``sweep`` (figures included);
+- ``mink`` (mink, which brings MuJoCo): the governor's mink limit
+  (:mod:`impact_balance.governor.mink_limit`), no command.
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ EXTRAS: dict[str, tuple[str, ...]] = {
     "sim": ("mujoco", "imageio", "imageio_ffmpeg", "pandas", "pyarrow", "matplotlib"),
     "gui": ("viser",),
     "sweep": ("distributed", "pandas", "pyarrow", "matplotlib"),
+    "mink": ("mink",),
 }
 
 #: The extra each command needs, whatever its options.

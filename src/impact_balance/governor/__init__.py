@@ -14,6 +14,10 @@ A :class:`Governor` gives that maximum every control tick, from the measured sta
 - :mod:`.posture`: what is computed once per posture (:class:`Posture`).
 - :mod:`.limit`: the per-tick answer (:class:`SpeedLimit`); the cap is
   :func:`~impact_balance.criteria.cap.cap_approach`.
+- :mod:`.approach`: the cap as one inequality on an IK step (``-n^T J Δq <= ceiling dt``);
+  :mod:`.pink_limit` (``PinkApproachLimit``) and :mod:`.mink_limit` (``MinkApproachLimit``, the
+  ``mink`` extra; :mod:`.mujoco_state` maps MuJoCo's state) put it in pink's and mink's QPs.
+  They are imported from their modules (not here: mink is optional).
 
 See docs/governor.md for the conventions and how pink, mink or any QP controller uses it.
 """

@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike
 
 from impact_balance.balance.areas import warm_up as warm_up_maps
 from impact_balance.constants import MAX_POSITION, MAX_SPEED
-from impact_balance.contacts.stance import has_free_flyer
+from impact_balance.contacts.stance import ContactSpec, has_free_flyer
 from impact_balance.criteria.cap import cap_approach
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.exceptions import GovernorError, ScenarioError
@@ -133,8 +133,16 @@ class Governor:
         self._free_flyer = has_free_flyer(model)
         self._joints = _JointBounds(self.robot)
         assert scenario.impact is not None  # _governed refuses a scenario without one
+        # The stance analyze() builds: its contacts are resolved there (a contact given by its
+        # world normal is turned into an offset fixed in its frame at the scenario's posture).
+        stance = scenario.build_stance(self.robot)
+        #: The scenario's own configuration (lifted onto the ground as ``analyze`` does): a
+        #: posture to start from.
+        self.configuration: np.ndarray = stance.q.copy()
+        #: The sustained contacts, resolved (frame, size, friction, offset in the frame).
+        self.contacts: tuple[ContactSpec, ...] = tuple(c.spec for c in stance.contacts)
         settings = PostureSettings(
-            tuple(c.spec() for c in scenario.contacts),
+            self.contacts,
             scenario.impact.spec(),
             float(scenario.plane_height),
             float(scenario.gravity),
@@ -143,9 +151,6 @@ class Governor:
             criterion,
             self.velocity_margin,
         )
-        #: The scenario's own configuration (lifted onto the ground as ``analyze`` does): a
-        #: posture to start from.
-        self.configuration: np.ndarray = scenario.build_stance(self.robot).q.copy()
         self._evaluator = PostureEvaluator(self.robot, settings)
         self._lock = threading.Lock()
         self._support: ContactAwareLimit | None = None
@@ -327,6 +332,9 @@ class Governor:
             update["base"] = BasePose(position=(x, y, z), rpy=(roll, pitch, yaw))
         raw = self.scenario.model_dump(exclude_none=True)
         raw.update(update)
+        raw["contacts"] = [
+            _fixed_in_frame(c, s) for c, s in zip(raw["contacts"], self.contacts, strict=True)
+        ]
         raw["base"] = update.get("base", BasePose()).model_dump(exclude_none=True)
         return scenario_from_dict(raw, self.scenario.source)
 
@@ -596,6 +604,25 @@ def _governed(
     if scenario.velocity_margin and criterion != "com":
         raise GovernorError("velocity_margin", margin, "applies to the com criterion only")
     return scenario
+
+
+def _fixed_in_frame(contact: dict[str, Any], spec: ContactSpec) -> dict[str, Any]:
+    """A scenario's contact (its mapping) with its orientation as the governor holds it.
+
+    A contact given by its world normal is resolved once, at the scenario's stance, into an
+    offset fixed in its frame (:meth:`~impact_balance.scenario.Scenario.build_stance`); at
+    another posture the normal form would be resolved anew. It is written as that offset's
+    ``rpy``; a contact given in its frame is returned as it is.
+    """
+    if contact.get("normal") is None:
+        return contact
+    fixed = {k: v for k, v in contact.items() if k not in ("normal", "angle")}
+    rpy = pin.rpy.matrixToRpy(spec.offset.rotation)
+    fixed["offset"] = {
+        "position": [float(x) for x in spec.offset.translation],
+        "rpy": [float(x) for x in rpy],
+    }
+    return fixed
 
 
 def _base_within_bounds(q: npt.NDArray[np.float64]) -> None:

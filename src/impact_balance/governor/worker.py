@@ -87,7 +87,8 @@ def _serve(conn: Connection) -> None:
     try:
         scenario = scenario_from_dict(raw, source)
         robot = scenario.load_robot()
-        contacts = tuple(c.spec() for c in scenario.contacts)
+        # The governor's contacts: resolved at the scenario's stance, as analyze() does.
+        contacts = tuple(c.spec for c in scenario.build_stance(robot).contacts)
         if scenario.impact is None:
             raise ScenarioError("impact", None, "the contact-aware worker needs an impact")
         limit = ContactAwareLimit(scenario.impact.spec(), 1, starts)
