@@ -86,7 +86,8 @@ def contact_diagnostics(stance: Stance) -> list[Diagnostic]:
                     f"the normal of {frame} is {tilt:.0f}° from vertical, neither a floor or ramp "
                     f"(<= {FLOOR_TILT:.0f}°) nor a wall (>= {WALL_TILT:.0f}°): "
                     "is its z axis the surface normal? "
-                    "(set offset.rpy to align it)",
+                    "(give the contact the surface's normal, normal: [0, 0, 1] for the ground, "
+                    "or turn it with offset.rpy)",
                 )
             )
     return out
