@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+import math
+import re
 import warnings
 
 import numpy as np
+import pinocchio as pin
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from impact_balance.exceptions import ImpactBalanceWarning, UnknownRobotError
 from impact_balance.robot.robot import (
@@ -65,7 +70,7 @@ def test_human_is_named_as_not_z_up_with_the_base_that_stands_it_up():
     assert up is not None and abs(up[1]) > 0.99  # y up
     problem = robot.up_axis_problem(q)
     assert problem is not None
-    assert "'human' is not z-up" in problem and "+y" in problem
+    assert "'human' is not z-up" in problem and "along +y" in problem
     assert "base: {position: [0.0, 0.0, 0.979], rpy: [1.5708, 0.0, 0.0]}" in problem
 
 
@@ -95,3 +100,29 @@ def test_a_scenario_of_a_lying_robot_warns_and_the_suggested_base_stands_it_up()
     feet_z = [c.position[2] for c in stance.contacts]
     assert max(abs(z) for z in feet_z) < 0.05  # standing on its feet, near the ground
     assert result.areas.can_balance and result.areas.com_velocity_area.area > 0
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    rpy=st.tuples(st.floats(-math.pi, math.pi), st.floats(-1.5, 1.5), st.floats(-math.pi, math.pi))
+)
+def test_any_base_tilt_past_45_degrees_is_named_and_the_suggested_base_stands_it_up(rpy):
+    robot = load_robot("go2")
+    q = robot.configuration()
+    q[3:7] = pin.Quaternion(pin.rpy.rpyToMatrix(np.array(rpy))).coeffs()
+    up = robot.up_direction(q)
+    problem = robot.up_axis_problem(q)
+    assert (problem is None) == (up[2] >= math.cos(math.radians(45.0)))
+    if problem is None:
+        return
+    match = re.search(r"base: \{position: \[(.*)\], rpy: \[(.*)\]\}$", problem)
+    assert match, problem
+    position, angles = (np.array([float(x) for x in g.split(",")]) for g in match.groups())
+    q[:3] = position
+    q[3:7] = pin.Quaternion(pin.rpy.rpyToMatrix(angles)).coeffs()
+    assert robot.up_axis_problem(q) is None
+    assert robot.up_direction(q)[2] > math.cos(math.radians(11.0))
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, q)
+    lowest = min(data.oMf[robot.frame_id(f)].translation[2] for f in robot.foot_frames)
+    assert abs(lowest) < 1e-3  # on the ground

@@ -352,8 +352,9 @@ class Robot:
         The feet-to-CoM axis (:meth:`up_direction`) more than 45 degrees from the world's +z
         means a model whose up axis is not z (the y-up ``human`` of example-robot-data lies
         on its side, and every contact looks short of friction). Returns one line naming the
-        axis and the scenario key that stands it up (``base: {rpy: ...}``), or None when it
-        stands (or its feet are unknown).
+        axis and the scenario key that stands it up (``base: {position: ..., rpy: ...}``: the
+        nearest world axis turned to +z, or the axis itself when none is within 10 degrees;
+        the lowest foot frame at z = 0), or None when it stands (or its feet are unknown).
         """
         key = np.asarray(q, dtype=float).tobytes()
         cache = self._up_axis_answers
@@ -375,6 +376,8 @@ class Robot:
         name = ("+" if up[axis] > 0 else "-") + "xyz"[axis]
         axis_vector = np.zeros(3)
         axis_vector[axis] = math.copysign(1.0, up[axis])
+        if abs(up[axis]) < math.cos(math.radians(10.0)):  # not along a world axis: turn it all
+            axis_vector = up
         base = pin.Quaternion(np.asarray(q[3:7])).normalized().matrix()
         upright = aligning_rotation(axis_vector, (0.0, 0.0, 1.0)) @ base
         stood = np.array(q, dtype=float)
@@ -387,7 +390,7 @@ class Robot:
         tilt = math.degrees(math.acos(max(-1.0, min(1.0, float(up[2])))))
         return (
             f"robot {self.name!r} is not z-up: its feet-to-CoM axis points along {name} "
-            f"in the world ({tilt:.0f} deg from +z), so it lies on its side; stand it up "
+            f"in the world ({tilt:.0f} deg from +z), so it does not stand on its feet; stand it up "
             f"with base: {{position: {position}, rpy: {rpy}}}"
         )
 
