@@ -85,3 +85,34 @@ def test_the_suggested_com_move_makes_it_balance(capsys, draft, tmp_path):
     rc, text, _ = _pose(capsys, draft, out, "0.45", "0.15", "0.08", "--com", "-0.06", "-0.06")
     assert rc == 0
     assert text.strip().splitlines()[-1].startswith("verdict: can balance")
+
+
+def test_normal_on_a_point_foot_is_its_surface_normal(capsys, draft, tmp_path):
+    out = tmp_path / "go2_ramp.yaml"
+    rc, _, err = run(
+        capsys,
+        "pose", str(draft),
+        "--place", "FR_foot", "0.19", "-0.17", "0.02", "--normal", "0", "-0.5", "0.866",
+        "--out", str(out),
+    )  # fmt: skip
+    assert rc == 0, err
+    written = yaml.safe_load(out.read_text())
+    normals = {c["frame"]: c.get("normal") for c in written["contacts"]}
+    ramp = np.array([0.0, -0.5, 0.866]) / np.linalg.norm([0.0, -0.5, 0.866])
+    assert normals["FR_foot"] == pytest.approx(ramp, abs=1e-6)
+    assert normals["RL_foot"] == normals["RR_foot"] == [0.0, 0.0, 1.0]
+    stance = load_scenario(str(out)).build_stance()
+    fr = stance.contacts[0]
+    assert np.allclose(fr.normal, ramp, atol=1e-6)
+    assert np.allclose(fr.position, [0.19, -0.17, 0.02], atol=1e-5)
+
+
+def test_normal_on_a_point_frame_without_a_contact_is_refused(capsys, draft, tmp_path):
+    rc, _, err = run(
+        capsys,
+        "pose", str(draft),
+        "--place", "FL_foot", "0.25", "0.15", "0.08", "--normal", "1", "0", "0",
+        "--out", str(tmp_path / "x.yaml"),
+    )  # fmt: skip
+    assert rc == 2
+    assert "FL_foot is on a chain of 3 joints" in err and "--normal" in err

@@ -10,7 +10,9 @@
 - Every other contact stays where it is; ``--com X Y`` moves the CoM's horizontal position
   (kept free otherwise).
 - A frame on a chain of fewer than 6 joints from the base (a quadruped's 3-joint leg) cannot
-  hold an orientation: its position alone is placed or kept (a point foot).
+  hold an orientation: its position alone is placed or kept (a point foot). ``--normal`` on
+  such a frame's contact is the surface's normal, written as the contact's ``normal:``.
+- A point foot on the ground is written flat, ``normal: [0, 0, 1]`` (:func:`flat_feet`).
 
 The IK is :func:`impact_balance.robot.ik.solve_stance` (pink, as the GUI's drags), started from the
 scenario's stance and pulled towards it. The result is the scenario with an explicit ``base``
@@ -137,16 +139,20 @@ def pose_scenario(
                 raise ScenarioError(
                     "--normal", list(p.normal), "must be a non-zero vector"
                 ) from None
-            rotation = aligning_rotation(rotation[:, 2], n) @ rotation
-            if index is not None and scenario.contacts[index].normal is not None:
+            point_foot = index is not None and chain_dofs(robot, p.frame) < 6
+            if not point_foot:
+                rotation = aligning_rotation(rotation[:, 2], n) @ rotation
+            if index is not None and (point_foot or scenario.contacts[index].normal is not None):
+                # a point foot cannot turn: N is its surface's normal, written on its contact
                 normals[index] = (float(n[0]), float(n[1]), float(n[2]))
         targets[p.frame] = pin.SE3(rotation, np.asarray(p.position, dtype=float)) * offset.inverse()
-    kept = sorted({c.spec.frame for c in stance.contacts} - set(targets))
+    contact_frames = {c.spec.frame for c in stance.contacts}
+    kept = sorted(contact_frames - set(targets))
     all_targets = dict(targets)
     all_targets.update({f: stance.frame_pose(f) for f in kept})
     free = tuple(f for f in all_targets if chain_dofs(robot, f) < 6)
     for p in placements:
-        if p.normal is not None and p.frame in free:
+        if p.normal is not None and p.frame in free and p.frame not in contact_frames:
             raise ScenarioError(
                 "--normal",
                 list(p.normal),
