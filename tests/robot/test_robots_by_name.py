@@ -126,3 +126,8 @@ def test_any_base_tilt_past_45_degrees_is_named_and_the_suggested_base_stands_it
     pin.framesForwardKinematics(robot.model, data, q)
     lowest = min(data.oMf[robot.frame_id(f)].translation[2] for f in robot.foot_frames)
     assert abs(lowest) < 1e-3  # on the ground
+
+
+def test_a_robot_by_name_points_at_frames_by_its_name():
+    assert load_robot("go2").listing_command == "impact-balance frames go2"
+    assert load_robot("talos").listing_command == "impact-balance frames talos"
