@@ -42,6 +42,7 @@ def test_an_unknown_name_lists_every_robot_by_name():
         load_robot("go3")
     assert info.value.field == "robot" and info.value.value == "go3"
     assert "go2" in info.value.valid and "talos" in info.value.valid
+    assert "valid robots: a1, alex," in str(info.value) and "go2" in str(info.value)
 
 
 def test_bundled_robots_come_first_and_are_not_shadowed():
