@@ -12,7 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from impact_balance.exceptions import ImpactBalanceWarning, UnknownRobotError
+from impact_balance.exceptions import UnknownRobotError
 from impact_balance.robot.robot import (
     BUNDLED_ROBOTS,
     EXAMPLE_ROBOTS,
@@ -88,16 +88,20 @@ def _human(base=None):
     return Scenario.model_validate(data)
 
 
-def test_a_scenario_of_a_lying_robot_warns_and_the_suggested_base_stands_it_up():
+def test_analyze_of_a_lying_robot_warns_and_the_suggested_base_stands_it_up():
     from impact_balance.analysis.analyze import analyze
 
-    with pytest.warns(ImpactBalanceWarning, match=r"not z-up.*\+y.*base: \{position"):
-        _human().build_stance()
+    lying = analyze(_human())
+    codes = [d.code for d in lying.warnings]
+    assert codes[0] == "robot_not_z_up" and lying.warnings[0].field == "base"
+    assert re.search(r"not z-up.*along \+y.*base: \{position", lying.warnings[0].message)
+    assert not lying.areas.can_balance  # on its side: "not enough friction"
     upright = _human({"position": [0.0, 0.0, 0.979], "rpy": [1.5708, 0.0, 0.0]})
     with warnings.catch_warnings():
-        warnings.simplefilter("error", ImpactBalanceWarning)
+        warnings.simplefilter("error")
         stance = upright.build_stance()
         result = analyze(upright)
+    assert "robot_not_z_up" not in [d.code for d in result.warnings]
     feet_z = [c.position[2] for c in stance.contacts]
     assert max(abs(z) for z in feet_z) < 0.05  # standing on its feet, near the ground
     assert result.areas.can_balance and result.areas.com_velocity_area.area > 0

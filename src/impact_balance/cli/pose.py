@@ -238,6 +238,8 @@ def _report(
     if flat:
         print(f"laid flat (normal: [0, 0, 1]): {', '.join(flat)}")
     print(f"wrote: {written}")
+    for warning in verdict["warnings"]:
+        print(f"warning: {warning}")
     print(f"verdict: {verdict['summary']}")
 
 
@@ -272,6 +274,7 @@ def _verdict(scenario: Any) -> dict[str, Any]:
         speed = float(analysis.impact.max_contact_velocity)
         line += f"; max contact velocity {speed:.3f} m/s (CoM criterion)"
     return {
+        "warnings": [str(d) for d in analysis.warnings],
         "can_balance": bool(analysis.com_velocity_inside),
         "verdict": analysis.verdict,
         "reason": None if reason is None else str(reason),

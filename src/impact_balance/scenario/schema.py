@@ -7,7 +7,6 @@ against a robot model into a :class:`~impact_balance.contacts.stance.Stance`.
 from __future__ import annotations
 
 import math
-import warnings
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -28,7 +27,7 @@ from impact_balance.constants import (
     MAX_VELOCITY_MARGIN,
 )
 from impact_balance.contacts.stance import ContactSpec, Stance
-from impact_balance.exceptions import ImpactBalanceWarning, ScenarioError
+from impact_balance.exceptions import ScenarioError
 from impact_balance.geometry.spatial import pose, surface_rotation
 from impact_balance.impact.model import ImpactSpec
 from impact_balance.robot.robot import Robot, load_robot
@@ -392,8 +391,6 @@ class Scenario(_Model):
                 q = q.copy()
                 q[2] += lift
                 stance = Stance(robot, q, specs)
-        if problem := robot.up_axis_problem(stance.q):
-            warnings.warn(problem, ImpactBalanceWarning, stacklevel=3)
         if not stance.com[2] > self.plane_height:
             raise ScenarioError(
                 "plane_height",
