@@ -167,6 +167,8 @@ class UnknownNameError(ScenarioError, KeyError):
     """
 
     kind = "name"
+    #: Up to how many valid names the message lists (at least ``LISTED_NAMES``).
+    listed = 0
 
     def __init__(
         self,
@@ -180,7 +182,7 @@ class UnknownNameError(ScenarioError, KeyError):
         self.valid: Sequence[str] = sorted(valid)
         close = _closest(value, self.valid)
         hint = f" (did you mean {', '.join(close)}?)" if close else ""
-        if len(self.valid) <= LISTED_NAMES:
+        if len(self.valid) <= max(LISTED_NAMES, self.listed):
             names = f"valid {self.kind}s: {', '.join(self.valid)}"
         else:
             where = f"; `{listing}` lists them" if listing else ""
@@ -192,9 +194,10 @@ class UnknownNameError(ScenarioError, KeyError):
 
 
 class UnknownRobotError(UnknownNameError):
-    """The robot name is not one of the bundled robots."""
+    """The robot name is not one that loads (``impact-balance robots --all``)."""
 
     kind = "robot"
+    listed = 40  # every robot by name, as a scenario's author needs them
 
 
 class UnknownFrameError(UnknownNameError):

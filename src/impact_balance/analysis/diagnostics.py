@@ -6,6 +6,10 @@ JSON's ``warnings`` list, and an error under ``--strict``.
 
 The rules (codes):
 
+- ``robot_not_z_up``: the robot's feet-to-CoM axis is more than 45° from the world's +z
+  (:meth:`impact_balance.robot.robot.Robot.up_axis_problem`): a model whose up axis is not z
+  (example-robot-data's y-up ``human``) lies on its side, and its contacts look short of
+  friction. The message gives the ``base`` that stands it up.
 - ``contact_normal_down``: a contact normal (the frame's z axis after its offset, which must
   point from the surface into the robot) has a negative world z, i.e. the surface would be
   above the contact, like a ceiling. Usually a flipped offset (``rpy: [3.14159, 0, 0]``).
@@ -86,7 +90,8 @@ def contact_diagnostics(stance: Stance) -> list[Diagnostic]:
                     f"the normal of {frame} is {tilt:.0f}° from vertical, neither a floor or ramp "
                     f"(<= {FLOOR_TILT:.0f}°) nor a wall (>= {WALL_TILT:.0f}°): "
                     "is its z axis the surface normal? "
-                    "(set offset.rpy to align it)",
+                    "(give the contact the surface's normal, normal: [0, 0, 1] for the ground, "
+                    "or turn it with offset.rpy)",
                 )
             )
     return out
@@ -137,7 +142,9 @@ def diagnose(
     scenario: Scenario, stance: Stance, impact: ImpactAnswer | None
 ) -> tuple[Diagnostic, ...]:
     """Every warning of one analysis, in scenario order."""
-    out = contact_diagnostics(stance)
+    problem = stance.robot.up_axis_problem(stance.q)
+    out = [Diagnostic("robot_not_z_up", "base", problem)] if problem else []
+    out += contact_diagnostics(stance)
     if impact is not None and scenario.impact is not None:
         out += impact_diagnostics(impact, scenario.impact.reference_velocity)
     return tuple(out)

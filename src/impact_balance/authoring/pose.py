@@ -10,7 +10,9 @@
 - Every other contact stays where it is; ``--com X Y`` moves the CoM's horizontal position
   (kept free otherwise).
 - A frame on a chain of fewer than 6 joints from the base (a quadruped's 3-joint leg) cannot
-  hold an orientation: its position alone is placed or kept (a point foot).
+  hold an orientation: its position alone is placed or kept (a point foot). ``--normal`` on
+  such a frame's contact is the surface's normal, written as the contact's ``normal:``.
+- A point foot on the ground is written flat, ``normal: [0, 0, 1]`` (:func:`flat_feet`).
 
 The IK is :func:`impact_balance.robot.ik.solve_stance` (pink, as the GUI's drags), started from the
 scenario's stance and pulled towards it. The result is the scenario with an explicit ``base``
@@ -35,10 +37,23 @@ from impact_balance.geometry.spatial import aligning_rotation, unit
 from impact_balance.robot.ik import IKOptions, chain_dofs, solve_stance, stance_residuals
 from impact_balance.scenario import Scenario
 
-__all__ = ["DIGITS", "Placement", "PoseResult", "pose_scenario", "posed_mapping", "scenario_yaml"]
+__all__ = [
+    "DIGITS",
+    "GROUND_BAND",
+    "Placement",
+    "PoseResult",
+    "flat_feet",
+    "pose_scenario",
+    "posed_mapping",
+    "scenario_yaml",
+]
 
 #: Decimals kept in the written base pose and joint values (1e-6 m, 1e-6 rad).
 DIGITS = 6
+
+#: A point foot whose contact centre lies within this height (m) of the lowest contact's is
+#: on the ground, and written flat (``normal: [0, 0, 1]``) by :func:`posed_mapping`.
+GROUND_BAND = 0.01
 
 
 @dataclass(frozen=True)
@@ -124,16 +139,20 @@ def pose_scenario(
                 raise ScenarioError(
                     "--normal", list(p.normal), "must be a non-zero vector"
                 ) from None
-            rotation = aligning_rotation(rotation[:, 2], n) @ rotation
-            if index is not None and scenario.contacts[index].normal is not None:
+            point_foot = index is not None and chain_dofs(robot, p.frame) < 6
+            if not point_foot:
+                rotation = aligning_rotation(rotation[:, 2], n) @ rotation
+            if index is not None and (point_foot or scenario.contacts[index].normal is not None):
+                # a point foot cannot turn: N is its surface's normal, written on its contact
                 normals[index] = (float(n[0]), float(n[1]), float(n[2]))
         targets[p.frame] = pin.SE3(rotation, np.asarray(p.position, dtype=float)) * offset.inverse()
-    kept = sorted({c.spec.frame for c in stance.contacts} - set(targets))
+    contact_frames = {c.spec.frame for c in stance.contacts}
+    kept = sorted(contact_frames - set(targets))
     all_targets = dict(targets)
     all_targets.update({f: stance.frame_pose(f) for f in kept})
     free = tuple(f for f in all_targets if chain_dofs(robot, f) < 6)
     for p in placements:
-        if p.normal is not None and p.frame in free:
+        if p.normal is not None and p.frame in free and p.frame not in contact_frames:
             raise ScenarioError(
                 "--normal",
                 list(p.normal),
@@ -159,16 +178,46 @@ def _rounded(x: float) -> float:
     return 0.0 if value == 0 else value
 
 
+def flat_feet(scenario: Scenario, result: PoseResult) -> dict[int, tuple[float, float, float]]:
+    """The contacts to lay flat on the ground: ``{index: (0, 0, 1)}``.
+
+    A contact is laid flat when its frame is on a chain of fewer than 6 joints (a point foot,
+    ``result.position_only``: its frame's orientation is the leg's, not the ground's), its
+    orientation is not given (no ``normal``, no ``offset.rpy``) and its centre lies within
+    :data:`GROUND_BAND` of the lowest contact centre at ``result.q``.
+    """
+    robot = scenario.load_robot()
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, result.q)
+    heights = [
+        float(data.oMf[robot.frame_id(c.frame)].act(np.asarray(c.offset.position))[2])
+        for c in scenario.contacts
+    ]
+    lowest = min(heights, default=0.0)
+    return {
+        i: (0.0, 0.0, 1.0)
+        for i, c in enumerate(scenario.contacts)
+        if c.frame in result.position_only
+        and c.normal is None
+        and not any(c.offset.rpy)
+        and heights[i] <= lowest + GROUND_BAND
+    }
+
+
 def posed_mapping(
     raw: Mapping[str, Any],
     scenario: Scenario,
     result: PoseResult,
     out_dir: str | Path | None = None,
+    *,
+    flat: bool = True,
 ) -> dict[str, Any]:
     """The scenario mapping ``raw`` (as read, ``extends`` merged) with the posed base and joints.
 
     Joint values are rounded to 1e-6 rad and kept within their limits; robot file paths are
-    rewritten relative to ``out_dir`` (the written file's folder).
+    rewritten relative to ``out_dir`` (the written file's folder). With ``flat``, the point
+    feet on the ground are written with ``normal: [0, 0, 1]`` (:func:`flat_feet`): the
+    ground's normal, not their frame's tilted z axis.
     """
     robot = scenario.load_robot()
     out: dict[str, Any] = {}
@@ -200,9 +249,10 @@ def posed_mapping(
                 rounded = value  # rounding would leave the limits
             joints[name] = rounded
     out["joints"] = joints
-    if result.contact_normals:
+    normals = {**(flat_feet(scenario, result) if flat else {}), **result.contact_normals}
+    if normals:
         contacts = [dict(c) for c in out["contacts"]]
-        for i, n in result.contact_normals.items():
+        for i, n in normals.items():
             contacts[i]["normal"] = [_rounded(v) for v in n]
         out["contacts"] = contacts
     robot_entry = out.get("robot")

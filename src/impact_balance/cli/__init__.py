@@ -45,6 +45,7 @@ from impact_balance.cli import (
     validate,
 )
 from impact_balance.cli.demo import DEMO_SCENARIOS, FRICTION_SWEEP
+from impact_balance.cli.help_text import describe
 from impact_balance.exceptions import (
     EnvironmentFailure,
     GovernorError,
@@ -298,6 +299,7 @@ def _parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
     for module in COMMANDS:
         for name in module.add_parser(sub):
             owners[name] = module
+    describe(sub.choices)
     return p, owners
 
 

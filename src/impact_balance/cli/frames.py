@@ -43,16 +43,17 @@ def add_parser(sub: Subcommands) -> list[str]:
 def _robot_and_stance(name: str) -> tuple[Robot, npt.NDArray[np.float64], str, Stance | None]:
     """(robot, configuration, configuration label, stance or None)."""
     from impact_balance.exceptions import UnknownRobotError, UnknownScenarioError
-    from impact_balance.robot.robot import BUNDLED_ROBOTS, load_robot
+    from impact_balance.robot.robot import load_robot, robot_names
     from impact_balance.scenario import load_scenario
 
-    if name in BUNDLED_ROBOTS or name.endswith(".urdf"):
-        robot = load_robot(name) if name in BUNDLED_ROBOTS else load_robot(None, name)
+    names = robot_names()
+    if name in names or name.endswith(".urdf"):
+        robot = load_robot(name) if name in names else load_robot(None, name)
         return robot, robot.configuration(), f"configuration {robot.standing}", None
     try:
         scenario = load_scenario(name)  # a scenario file or a bundled scenario's name
     except UnknownScenarioError:  # neither: say which robots there are
-        raise UnknownRobotError("robot", name, BUNDLED_ROBOTS) from None
+        raise UnknownRobotError("robot", name, names) from None
     stance = scenario.build_stance()
     return stance.robot, stance.q, f"stance of scenario {scenario.name or name}", stance
 

@@ -93,6 +93,13 @@ def add_parser(sub: Subcommands) -> list[str]:
         "--com", nargs=2, type=float, metavar=("X", "Y"), help="horizontal CoM target, world, m"
     )
     p.add_argument("--out", required=True, metavar="FILE", help="scenario file to write (.yaml)")
+    p.add_argument(
+        "--no-flat",
+        dest="flat",
+        action="store_false",
+        help="leave point feet on the ground as their frames are (by default their contacts "
+        "are written flat: normal: [0, 0, 1])",
+    )
     p.add_argument("--force", action="store_true", help="replace FILE if it exists")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     return ["pose"]
@@ -140,9 +147,14 @@ def run(args: argparse.Namespace) -> int:
     placements = [Placement(p["frame"], p["position"], p["normal"]) for p in places]
     result = pose_scenario(scenario, placements, args.com)
     mapping = posed_mapping(
-        read_mapping(scenario_path(args.scenario)), scenario, result, out.parent
+        read_mapping(scenario_path(args.scenario)),
+        scenario,
+        result,
+        out.parent,
+        flat=getattr(args, "flat", True),
     )
-    scenario_from_dict(mapping, str(out)).build_stance()  # what is written loads
+    posed = scenario_from_dict(mapping, str(out))
+    posed.build_stance()  # what is written loads
     argv = " ".join(
         f"--place {p.frame} {' '.join(f'{x:g}' for x in p.position)}"
         + (f" --normal {' '.join(f'{x:g}' for x in p.normal)}" if p.normal else "")
@@ -156,7 +168,25 @@ def run(args: argparse.Namespace) -> int:
         "(whole-body IK, the other contacts kept).",
     )
     written = _write(workspace, out, text, args.force)
+    _report(args, placements, result, mapping, (scenario, posed), written)
+    return 0
+
+
+def _report(
+    args: argparse.Namespace,
+    placements: Sequence[Any],
+    result: Any,
+    mapping: dict[str, Any],
+    scenarios: tuple[Any, Any],
+    written: Any,
+) -> None:
+    """Print what ``pose`` did (text or JSON), ending with the verdict of the written stance.
+
+    ``scenarios``: the scenario posed and the one written.
+    """
+    scenario, posed = scenarios
     worst = max(result.residuals.values(), default=0.0)
+    verdict = _verdict(posed)
     if args.json:
         from impact_balance.cli.output import print_json
 
@@ -168,9 +198,15 @@ def run(args: argparse.Namespace) -> int:
                 "com": result.com.tolist(),
                 "base": mapping["base"],
                 "joints": mapping["joints"],
+                "flat": sorted(
+                    c["frame"]
+                    for i, c in enumerate(mapping["contacts"])
+                    if "normal" in c and not scenario.contacts[i].normal
+                ),
+                **verdict,
             }
         )
-        return 0
+        return
     for p in placements:
         target = result.targets[p.frame]
         print(
@@ -194,8 +230,57 @@ def run(args: argparse.Namespace) -> int:
             else ""
         )
     )
+    flat = [
+        c["frame"]
+        for i, c in enumerate(mapping["contacts"])
+        if "normal" in c and not scenario.contacts[i].normal
+    ]
+    if flat:
+        print(f"laid flat (normal: [0, 0, 1]): {', '.join(flat)}")
     print(f"wrote: {written}")
-    return 0
+    for warning in verdict["warnings"]:
+        print(f"warning: {warning}")
+    print(f"verdict: {verdict['summary']}")
+
+
+def _verdict(scenario: Any) -> dict[str, Any]:
+    """The analysis of the written stance: can it balance, why not, its max contact velocity."""
+    from impact_balance.analysis.analyze import analyze
+
+    analysis = analyze(scenario)
+    reason = analysis.cannot_balance_reason
+    line = analysis.verdict
+    if not analysis.areas.can_balance:
+        line = "CANNOT BALANCE: the contacts cannot hold the robot at rest" + (
+            f"; {reason}" if reason is not None else ""
+        )
+    elif analysis.com_velocity_inside:
+        line = "can balance (" + line + " at rest)"
+    else:
+        com = analysis.stance.com[:2]
+        outside = not analysis.areas.zmp_area.contains(com, 1e-10)
+        line = (
+            "CANNOT BALANCE: "
+            + line
+            + (
+                f"; the CoM ({com[0]:.3f}, {com[1]:.3f}) m is outside the ZMP support area "
+                "(move it with --com)"
+                if outside
+                else ""
+            )
+        )
+    speed = None
+    if analysis.impact is not None and analysis.com_velocity_inside:
+        speed = float(analysis.impact.max_contact_velocity)
+        line += f"; max contact velocity {speed:.3f} m/s (CoM criterion)"
+    return {
+        "warnings": [str(d) for d in analysis.warnings],
+        "can_balance": bool(analysis.com_velocity_inside),
+        "verdict": analysis.verdict,
+        "reason": None if reason is None else str(reason),
+        "max_contact_velocity": speed,
+        "summary": line,
+    }
 
 
 def _write(workspace: Any, out: Any, text: str, force: bool) -> Any:

@@ -10,6 +10,7 @@ import functools
 import hashlib
 import math
 import os
+import re
 import sys
 import tempfile
 import threading
@@ -30,10 +31,12 @@ from impact_balance.exceptions import (
     UnknownJointError,
     UnknownRobotError,
 )
+from impact_balance.geometry.spatial import aligning_rotation
 from impact_balance.robot.urdf_check import check_srdf, check_urdf, read_robot_file
 
 __all__ = [
     "BUNDLED_ROBOTS",
+    "EXAMPLE_ROBOTS",
     "JointSlot",
     "Robot",
     "RobotFileReader",
@@ -42,12 +45,17 @@ __all__ = [
     "ThreadData",
     "example_robot_data_root",
     "load_robot",
+    "robot_names",
 ]
 
 #: Reads a robot file's bytes (path -> bytes), raising an error that names the file.
 RobotFileReader = Callable[[Path], bytes]
 
 _FloatArray = npt.NDArray[np.float64]
+
+#: Words of a link name (split at ``_``, ``-``, digits) that say it is no foot.
+_NOT_FOOT = frozenset({"imu", "sensor", "ft", "virtual", "adapter", "dh", "fixed", "joint"})
+_WORD = re.compile(r"[^a-z]+")
 
 
 @dataclass(frozen=True)
@@ -111,6 +119,100 @@ BUNDLED_ROBOTS: dict[str, RobotSpec] = {
         "JVRC-1 (jvrc-description), 62 kg HRP-class humanoid; no SRDF: neutral configuration",
     ),
 }
+
+
+#: Every other floating-base robot example-robot-data ships, loadable by name
+#: (``robot: go2``): its files as example-robot-data's own loader (``robots_loader.py``)
+#: names them, relative to its ``robots/`` folder, and its SRDF's standing posture.
+EXAMPLE_ROBOTS: dict[str, RobotSpec] = {
+    "a1": RobotSpec(
+        "a1_description/urdf/a1.urdf", "a1_description/srdf/a1.srdf", "standing", "Unitree A1"
+    ),
+    "alex": RobotSpec(
+        "alex_description/urdf/alex_nub_hands.urdf",
+        "alex_description/srdf/alex_nub_hands.srdf",
+        "default",
+        "IHMC Alex humanoid (nub hands)",
+    ),
+    "alexander": RobotSpec(
+        "alexander_description/urdf/alexander_v1.lowerBodyOnly.urdf",
+        "alexander_description/srdf/alexander.srdf",
+        "default",
+        "IHMC Alexander, lower body",
+    ),
+    "anymal_b": RobotSpec(
+        "anymal_b_simple_description/robots/anymal.urdf",
+        "anymal_b_simple_description/srdf/anymal.srdf",
+        "standing",
+        "ANYbotics ANYmal B",
+    ),
+    "anymal_c": RobotSpec(
+        "anymal_c_simple_description/urdf/anymal.urdf",
+        "anymal_c_simple_description/srdf/anymal.srdf",
+        "standing",
+        "ANYbotics ANYmal C",
+    ),
+    "b1": RobotSpec(
+        "b1_description/urdf/b1.urdf", "b1_description/srdf/b1.srdf", "standing", "Unitree B1"
+    ),
+    "bolt": RobotSpec(
+        "bolt_description/robots/bolt.urdf",
+        "bolt_description/srdf/bolt.srdf",
+        "standing",
+        "ODRI Bolt biped",
+    ),
+    "centauro": RobotSpec(
+        "centauro_description/urdf/centauro.urdf",
+        "centauro_description/srdf/centauro.srdf",
+        "homing_nominal",
+        "IIT Centauro, wheeled quadruped with two arms",
+    ),
+    "go1": RobotSpec(
+        "go1_description/urdf/go1.urdf", "go1_description/srdf/go1.srdf", "standing", "Unitree Go1"
+    ),
+    "go2": RobotSpec(
+        "go2_description/urdf/go2.urdf", "go2_description/srdf/go2.srdf", "standing", "Unitree Go2"
+    ),
+    "human": RobotSpec(
+        "human_description/robots/human.urdf", None, "neutral", "Human body model (y up)"
+    ),
+    "hyq": RobotSpec(
+        "hyq_description/robots/hyq_no_sensors.urdf",
+        "hyq_description/srdf/hyq.srdf",
+        "standing",
+        "IIT HyQ",
+    ),
+    "laikago": RobotSpec(
+        "laikago_description/urdf/laikago.urdf", None, "neutral", "Unitree Laikago"
+    ),
+    "quadruped": RobotSpec(
+        "quadruped_description/urdf/quadruped.urdf", None, "neutral", "A generic quadruped"
+    ),
+    "simple_humanoid": RobotSpec(
+        "simple_humanoid_description/urdf/simple_humanoid.urdf",
+        "simple_humanoid_description/srdf/simple_humanoid.srdf",
+        "half_sitting",
+        "A toy humanoid",
+    ),
+    "solo8": RobotSpec(
+        "solo_description/robots/solo.urdf",
+        "solo_description/srdf/solo.srdf",
+        "standing",
+        "ODRI Solo 8",
+    ),
+    "solo12": RobotSpec(
+        "solo_description/robots/solo12.urdf",
+        "solo_description/srdf/solo.srdf",
+        "standing",
+        "ODRI Solo 12",
+    ),
+}
+
+
+def robot_names() -> dict[str, RobotSpec]:
+    """Every robot loadable by name: the bundled ones first, then example-robot-data's others."""
+    others = {name: spec for name, spec in EXAMPLE_ROBOTS.items() if name not in BUNDLED_ROBOTS}
+    return {**BUNDLED_ROBOTS, **others}
 
 
 def example_robot_data_root() -> Path:
@@ -231,7 +333,89 @@ class Robot:
     def listing_command(self) -> str:
         """The command that lists this robot's frames and joints (named in error messages)."""
         bundled = self.name in BUNDLED_ROBOTS and self.urdf_path == _bundled_urdf(self.name)
+        named = self.name in EXAMPLE_ROBOTS and self.urdf_path == (
+            example_robot_data_root() / EXAMPLE_ROBOTS[self.name].urdf
+        )
+        bundled = bundled or named
         return f"impact-balance frames {self.name if bundled else self.urdf_path}"
+
+    @functools.cached_property
+    def foot_frames(self) -> tuple[str, ...]:
+        """The feet, inferred from the link names: ``*sole*`` links, else ``*foot*`` links.
+
+        A link named like ``l_sole``, ``left_sole_link``, ``FL_foot``, ``LF_FOOT`` (``foot`` or
+        ``sole`` as a word of the name, sensors, IMUs and virtual links left out). Empty when
+        no name says it (the feet are then unknown: nothing is guessed).
+        """
+        names = [f.name for f in self.model.frames if f.type == pin.FrameType.BODY]
+        words = [(n, set(_WORD.split(n.lower()))) for n in names]
+        usable = [(n, w) for n, w in words if not w & _NOT_FOOT]
+        soles = tuple(n for n, w in usable if "sole" in w)
+        return soles or tuple(n for n, w in usable if "foot" in w)
+
+    def up_direction(self, q: np.ndarray) -> np.ndarray | None:
+        """The unit vector from the feet's mean position to the CoM at ``q``, world frame.
+
+        The robot's up axis as it stands at ``q`` (+z for a robot upright in the world); None
+        when its feet are unknown (:attr:`foot_frames`).
+        """
+        if not self.foot_frames:
+            return None
+        data = self.model.createData()
+        com = pin.centerOfMass(self.model, data, q)
+        pin.updateFramePlacements(self.model, data)
+        feet = np.mean([data.oMf[self.frame_id(f)].translation for f in self.foot_frames], axis=0)
+        direction = np.asarray(com - feet, dtype=float)
+        length = float(np.linalg.norm(direction))
+        return direction / length if length > 1e-9 else None
+
+    def up_axis_problem(self, q: np.ndarray) -> str | None:
+        """Why the robot does not stand upright at ``q``, with the base rotation that would.
+
+        The feet-to-CoM axis (:meth:`up_direction`) more than 45 degrees from the world's +z
+        means a model whose up axis is not z (the y-up ``human`` of example-robot-data lies
+        on its side, and every contact looks short of friction). Returns one line naming the
+        axis and the scenario key that stands it up (``base: {position: ..., rpy: ...}``: the
+        nearest world axis turned to +z, or the axis itself when none is within 10 degrees;
+        the lowest foot frame at z = 0), or None when it stands (or its feet are unknown).
+        """
+        key = np.asarray(q, dtype=float).tobytes()
+        cache = self._up_axis_answers
+        if key not in cache:
+            if len(cache) >= 64:
+                cache.clear()
+            cache[key] = self._up_axis_line(np.asarray(q, dtype=float))
+        return cache[key]
+
+    @functools.cached_property
+    def _up_axis_answers(self) -> dict[bytes, str | None]:
+        return {}
+
+    def _up_axis_line(self, q: np.ndarray) -> str | None:
+        up = self.up_direction(q)
+        if up is None or up[2] >= math.cos(math.radians(45.0)):
+            return None
+        axis = int(np.argmax(np.abs(up)))
+        name = ("+" if up[axis] > 0 else "-") + "xyz"[axis]
+        axis_vector = np.zeros(3)
+        axis_vector[axis] = math.copysign(1.0, up[axis])
+        if abs(up[axis]) < math.cos(math.radians(10.0)):  # not along a world axis: turn it all
+            axis_vector = up
+        base = pin.Quaternion(np.asarray(q[3:7])).normalized().matrix()
+        upright = aligning_rotation(axis_vector, (0.0, 0.0, 1.0)) @ base
+        stood = np.array(q, dtype=float)
+        stood[3:7] = pin.Quaternion(upright).coeffs()
+        data = self.model.createData()
+        pin.framesForwardKinematics(self.model, data, stood)
+        lowest = min(float(data.oMf[self.frame_id(f)].translation[2]) for f in self.foot_frames)
+        position = [round(float(q[0]), 4), round(float(q[1]), 4), round(float(q[2]) - lowest, 4)]
+        rpy = [round(float(v), 4) + 0.0 for v in pin.rpy.matrixToRpy(upright)]
+        tilt = math.degrees(math.acos(max(-1.0, min(1.0, float(up[2])))))
+        return (
+            f"robot {self.name!r} is not z-up: its feet-to-CoM axis points along {name} "
+            f"in the world ({tilt:.0f} deg from +z), so it does not stand on its feet; stand it up "
+            f"with base: {{position: {position}, rpy: {rpy}}}"
+        )
 
     @functools.cached_property
     def _frame_ids(self) -> dict[str, int]:
@@ -551,6 +735,13 @@ def _load_bundled(name: str) -> Robot:
     return _load(root / spec.urdf, root / spec.srdf if spec.srdf else None, name, spec.standing)
 
 
+@functools.lru_cache(maxsize=16)
+def _load_example(name: str) -> Robot:
+    spec = EXAMPLE_ROBOTS[name]
+    root = example_robot_data_root()
+    return _load(root / spec.urdf, root / spec.srdf if spec.srdf else None, name, spec.standing)
+
+
 def load_robot(
     robot: str | None = None,
     urdf: str | Path | None = None,
@@ -567,8 +758,10 @@ def load_robot(
     """
     if urdf is None:
         name = robot or "talos"
+        if name in EXAMPLE_ROBOTS and name not in BUNDLED_ROBOTS:
+            return _load_example(name)
         if name not in BUNDLED_ROBOTS:
-            raise UnknownRobotError("robot", name, BUNDLED_ROBOTS)
+            raise UnknownRobotError("robot", name, robot_names())
         return _load_bundled(name)
     urdf = Path(urdf)
     if read_file is None and not _is_file(urdf):
