@@ -532,6 +532,7 @@ def full_link(folder: Path, name: str) -> Path:
     return link
 
 
+@needs_extra("plots")
 def test_a_full_disk_under_plots_names_the_option_and_the_figure(tmp_path, capsys):
     figure = full_link(tmp_path / "figs", "palm_push_two_feet_areas.png")
     rc, out, err = run_cli(capsys, "analyze", "palm_push_two_feet", "--plots", str(figure.parent))
@@ -541,6 +542,7 @@ def test_a_full_disk_under_plots_names_the_option_and_the_figure(tmp_path, capsy
     assert "No space left on device" in line
 
 
+@needs_extra("plots")
 def test_a_full_disk_under_plot_names_the_option(tmp_path, capsys):
     figure = full_link(tmp_path, "p.png")
     rc, _, err = run_cli(

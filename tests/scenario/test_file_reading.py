@@ -23,6 +23,7 @@ from impact_balance.exceptions import ScenarioError
 from impact_balance.scenario import load, load_scenario
 from impact_balance.scenario.reader import MAX_KEYS, parse_yaml
 from tests.helpers.cli import assert_one_line_error, run_cli
+from tests.helpers.extras import needs_extra
 
 BASE = "extends: palm_push_two_feet\nimpact:\n  friction: {mu}\n"
 
@@ -120,6 +121,7 @@ def test_a_duplicated_key_is_refused_with_its_line(tmp_path, capsys):
     assert parse_yaml("a: &a {x: 1}\nb:\n  <<: *a\n  x: 2\n")["b"] == {"x": 2}
 
 
+@needs_extra("sweep")
 def test_a_duplicated_key_in_a_sweep_file_is_refused(tmp_path):
     from impact_balance.exceptions import SweepError
     from impact_balance.sweep.spec import load_sweep_spec

@@ -6,6 +6,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+pytest.importorskip("mujoco", reason="needs the sim extra (MuJoCo)")
+
 from impact_balance.sim.studies.validate import fall_verdict
 
 speeds = st.floats(0.01, 5.0, allow_nan=False)
