@@ -196,10 +196,6 @@ def run(args: argparse.Namespace) -> int:
         print_json(out)
         return 0
     print(_text(result, out, args))
-    if calibration is not None:
-        from impact_balance.cli.calibrate import calibration_line
-
-        print(calibration_line(calibration))
     for path in written:
         print(f"  wrote {path}")
     return 0
@@ -285,6 +281,10 @@ def _text(result: PushTestResult, out: dict[str, Any], args: argparse.Namespace)
         )
     if out["journal"]:
         lines.append(f"  trials journal: {out['journal']} ({out['reused_trials']} reused)")
+    if out.get("calibration") is not None:
+        from impact_balance.cli.calibrate import calibration_line
+
+        lines.append(calibration_line(out["calibration"]))
     return "\n".join(lines)
 
 
