@@ -226,9 +226,10 @@ def _check_same(sets: Sequence[TrainingSet]) -> None:
             what = f"{first.robot!r} and {other.robot!r}" if key == "robot" else "different values"
             raise ScenarioError(
                 key,
-                [first.file, other.file],
-                f"the training files mix {key}s ({what}): calibrate one robot and one "
-                "controller with one set of criterion settings at a time",
+                getattr(other, key),
+                f"the training files {first.file} and {other.file} mix {key}s ({what}): "
+                "calibrate one robot and one controller with one set of criterion settings "
+                "at a time",
             )
 
 
