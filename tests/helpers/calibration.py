@@ -7,7 +7,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-__all__ = ["push_test_document", "write_document"]
+__all__ = ["calibration_mapping", "push_test_document", "write_document"]
 
 
 def push_test_document(
@@ -63,3 +63,27 @@ def write_document(path: Path, document: dict[str, Any]) -> Path:
     """Write ``document`` as strict JSON to ``path`` and return the path."""
     path.write_text(json.dumps(document, allow_nan=False))
     return path
+
+
+def calibration_mapping(robot: str = "talos", zmp_margin: float = 0.017) -> dict[str, Any]:
+    """The mapping of a valid calibration file (as ``calibrate --out`` writes it)."""
+    rate = {"rate": 0.04, "ci95": [0.01, 0.13], "count": 2, "of": 50}
+    return {
+        "version": 1,
+        "robot": robot,
+        "controller": {"name": "id"},
+        "criterion": {"start_com_velocity": [0.0, 0.0]},
+        "outcome_criteria": {"strict_max_slip": 0.03},
+        "outcome": "strict",
+        "target": 0.05,
+        "zmp_margin": zmp_margin,
+        "fell_given_safe": rate,
+        "safe_given_stood": {"rate": 0.6, "ci95": [0.45, 0.73], "count": 30, "of": 50},
+        "upper_target": 0.12,
+        "upper_margin": None,
+        "training": [
+            {"file": "a.json", "sha256": "0" * 64, "scenario": "s", "body": "b", "pushes": 100}
+        ],
+        "created": "2026-11-27T05:00:00+00:00",
+        "impact_balance_version": "0.1.0",
+    }
