@@ -161,3 +161,19 @@ def test_calibrate_on_a_real_push_test(tmp_path, capsys, monkeypatch):
         assert rc == 0, err
         again = strict_json(out)
         assert again["zmp_margin"] == expected and again["calibration"]["applied"]
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["validate", "palm_push_two_feet"],
+        ["push-test", "palm_push_two_feet", "--directions", "1"],
+        ["approach", "palm_push_two_feet", "--reference", "0.5"],
+        ["simulate", "palm_push_two_feet"],
+    ],
+)
+def test_every_trial_command_reads_the_calibration_before_any_trial(tmp_path, capsys, argv):
+    path = tmp_path / "g1.yaml"
+    path.write_text(yaml.safe_dump(calibration_mapping(robot="g1")))
+    rc, _, err = run_cli(capsys, *argv, "--calibration", str(path))
+    assert_one_line_error(rc, err, "--calibration", "calibrated for robot 'g1'")
