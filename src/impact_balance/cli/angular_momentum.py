@@ -23,6 +23,7 @@ __all__ = [
     "CONTROLLER",
     "OFF",
     "add_angular_momentum_option",
+    "controller_damping",
     "damping_time_value",
     "with_angular_momentum",
 ]
@@ -129,3 +130,16 @@ def with_angular_momentum(
         return scenario.replace(angular_momentum_damping_time=tau)
     except ScenarioError as exc:
         raise ScenarioError(ANGULAR_MOMENTUM_OPTION, exc.value, exc.reason) from None
+
+
+def controller_damping(controller: str, id_damping: float) -> float | None:
+    """K_L (1/s) of a trial's controller, for ``controller``: the ``id`` controller's gain.
+
+    Args:
+        controller: The trial controller's name (``id`` or ``ik``).
+        id_damping: The ``id`` controller's ``angular_momentum_damping`` gain, 1/s.
+
+    Returns:
+        K_L, or None for a controller that declares none (``ik``).
+    """
+    return float(id_damping) if controller == "id" else None

@@ -22,6 +22,11 @@ from impact_balance.cli._options import (
     scoring_margin,
     with_margins,
 )
+from impact_balance.cli.angular_momentum import (
+    add_angular_momentum_option,
+    controller_damping,
+    with_angular_momentum,
+)
 
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
@@ -125,6 +130,7 @@ def add_parser(sub: Subcommands) -> list[str]:
         type=output_file("--video", (".mp4",)),
         help="render an MP4 of the trial (one trial: give --wall-distance)",
     )
+    add_angular_momentum_option(a, controller=True)
     return ["approach"]
 
 
@@ -167,6 +173,11 @@ def run(args: argparse.Namespace) -> int:
     distances = _distances(args)
     _check_distances(args, distances)
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
+    scenario = with_angular_momentum(
+        scenario,
+        args.angular_momentum_damping_time,
+        controller_damping(options.controller, options.id_gains.angular_momentum_damping),
+    )
     own = scoring_margin(scenario)
     margin = controller_margin(options) if own is None else own
     # The governor's view: the area the controller can use.

@@ -18,6 +18,11 @@ from impact_balance.cli._options import (
     scoring_margin,
     with_margins,
 )
+from impact_balance.cli.angular_momentum import (
+    add_angular_momentum_option,
+    controller_damping,
+    with_angular_momentum,
+)
 
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
@@ -95,6 +100,7 @@ def add_parser(sub: Subcommands) -> list[str]:
     )
     add_trial_options(a, impact=False)
     add_output_options(a, "of one telling push")
+    add_angular_momentum_option(a, controller=True)
     return ["push-test"]
 
 
@@ -137,7 +143,13 @@ def run(args: argparse.Namespace) -> int:
         relative = band_levels(args.band, step, args.far or ())
     check_push_arguments(args.directions, args.magnitudes, args.duration, relative)
     options = BalanceTrialOptions(controller=args.controller)
+    judged = with_angular_momentum(
+        scenario,
+        args.angular_momentum_damping_time,
+        controller_damping(options.controller, options.id_gains.angular_momentum_damping),
+    )
     journal = open_journal(args, "push-test", scenario, "servo", options, {"body": args.body})
+    scenario = judged  # the trials journal keys the scenario without the option
     levels = len(relative or args.magnitudes or [0] * 6)
     bar = progress_bar(f"push-test {scenario.name}", args.directions * levels)
 

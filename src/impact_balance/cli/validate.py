@@ -20,6 +20,11 @@ from impact_balance.cli._options import (
     scoring_margin,
     with_margins,
 )
+from impact_balance.cli.angular_momentum import (
+    add_angular_momentum_option,
+    controller_damping,
+    with_angular_momentum,
+)
 
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
@@ -58,6 +63,7 @@ def add_parser(sub: Subcommands) -> list[str]:
     )
     add_trial_options(a, impact=True)
     add_output_options(a, "of the fastest trial survived")
+    add_angular_momentum_option(a, controller=True)
     return ["validate"]
 
 
@@ -91,6 +97,11 @@ def run(args: argparse.Namespace) -> int:
         check_log_path(args.log)
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
     joints = TRIAL_JOINTS[args.joints]  # the study's name (the journals' digests keep it)
+    judged = with_angular_momentum(
+        scenario,
+        args.angular_momentum_damping_time,
+        controller_damping(options.controller, options.id_gains.angular_momentum_damping),
+    )
     journal = open_journal(
         args,
         "validate",
@@ -99,6 +110,7 @@ def run(args: argparse.Namespace) -> int:
         options,
         {"tolerance": args.tolerance, "max_speed": args.max_speed},
     )
+    scenario = judged  # the trials journal keys the scenario without the option
     bar = progress_bar(f"validate {scenario.name}")
 
     def progress(trial: ValidationTrial, stood: float | None, fell: float | None) -> None:
