@@ -56,7 +56,7 @@ def test_an_impact_above_the_com_lowers_the_maximum_the_more_the_faster_it_is_re
 @pytest.mark.parametrize("name", ["palm_push_two_feet", "kick_one_foot", "g1_two_feet"])
 @pytest.mark.parametrize("tau", [0.0, 0.05])
 def test_the_extended_maximum_puts_the_effective_velocities_on_the_boundary(name, tau):
-    """Independent of the criterion's kernel: v_eff = c0 + s (iota + S((p - c) x iota) / (h (1 + w tau))) / m."""
+    """Independent of the kernel: v_eff = c0 + (iota + S((p - c) x iota) / (h (1 + w tau))) / m."""
     scenario = load_scenario(name).replace(angular_momentum_damping_time=tau, velocity_margin=0.01)
     a = analyze(scenario)
     im = a.impact
