@@ -17,6 +17,7 @@ from impact_balance.cli._options import CommandLineError
 
 if TYPE_CHECKING:
     from impact_balance.scenario import Scenario
+    from impact_balance.sim.trials.setup import BalanceTrialOptions
 
 __all__ = [
     "ANGULAR_MOMENTUM_OPTION",
@@ -25,6 +26,7 @@ __all__ = [
     "add_angular_momentum_option",
     "controller_damping",
     "damping_time_value",
+    "for_trials",
     "with_angular_momentum",
 ]
 
@@ -143,3 +145,20 @@ def controller_damping(controller: str, id_damping: float) -> float | None:
         K_L, or None for a controller that declares none (``ik``).
     """
     return float(id_damping) if controller == "id" else None
+
+
+def for_trials(
+    scenario: Scenario, value: float | str | None, options: BalanceTrialOptions
+) -> Scenario:
+    """:func:`with_angular_momentum` with the trial controller's K_L (for ``controller``).
+
+    Args:
+        scenario: The command's scenario.
+        value: The option's value (None: the scenario's own).
+        options: The trials' options (their controller and its gains).
+
+    Returns:
+        The scenario the predictions use.
+    """
+    damping = controller_damping(options.controller, options.id_gains.angular_momentum_damping)
+    return with_angular_momentum(scenario, value, damping)

@@ -22,11 +22,7 @@ from impact_balance.cli._options import (
     scoring_margin,
     with_margins,
 )
-from impact_balance.cli.angular_momentum import (
-    add_angular_momentum_option,
-    controller_damping,
-    with_angular_momentum,
-)
+from impact_balance.cli.angular_momentum import add_angular_momentum_option, for_trials
 
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
@@ -173,11 +169,7 @@ def run(args: argparse.Namespace) -> int:
     distances = _distances(args)
     _check_distances(args, distances)
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
-    scenario = with_angular_momentum(
-        scenario,
-        args.angular_momentum_damping_time,
-        controller_damping(options.controller, options.id_gains.angular_momentum_damping),
-    )
+    scenario = for_trials(scenario, args.angular_momentum_damping_time, options)
     own = scoring_margin(scenario)
     margin = controller_margin(options) if own is None else own
     # The governor's view: the area the controller can use.

@@ -18,11 +18,7 @@ from impact_balance.cli._options import (
     scoring_margin,
     with_margins,
 )
-from impact_balance.cli.angular_momentum import (
-    add_angular_momentum_option,
-    controller_damping,
-    with_angular_momentum,
-)
+from impact_balance.cli.angular_momentum import add_angular_momentum_option, for_trials
 
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
@@ -143,11 +139,7 @@ def run(args: argparse.Namespace) -> int:
         relative = band_levels(args.band, step, args.far or ())
     check_push_arguments(args.directions, args.magnitudes, args.duration, relative)
     options = BalanceTrialOptions(controller=args.controller)
-    judged = with_angular_momentum(
-        scenario,
-        args.angular_momentum_damping_time,
-        controller_damping(options.controller, options.id_gains.angular_momentum_damping),
-    )
+    judged = for_trials(scenario, args.angular_momentum_damping_time, options)
     journal = open_journal(args, "push-test", scenario, "servo", options, {"body": args.body})
     scenario = judged  # the trials journal keys the scenario without the option
     levels = len(relative or args.magnitudes or [0] * 6)

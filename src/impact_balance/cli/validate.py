@@ -20,11 +20,7 @@ from impact_balance.cli._options import (
     scoring_margin,
     with_margins,
 )
-from impact_balance.cli.angular_momentum import (
-    add_angular_momentum_option,
-    controller_damping,
-    with_angular_momentum,
-)
+from impact_balance.cli.angular_momentum import add_angular_momentum_option, for_trials
 
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
@@ -97,11 +93,7 @@ def run(args: argparse.Namespace) -> int:
         check_log_path(args.log)
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
     joints = TRIAL_JOINTS[args.joints]  # the study's name (the journals' digests keep it)
-    judged = with_angular_momentum(
-        scenario,
-        args.angular_momentum_damping_time,
-        controller_damping(options.controller, options.id_gains.angular_momentum_damping),
-    )
+    judged = for_trials(scenario, args.angular_momentum_damping_time, options)
     journal = open_journal(
         args,
         "validate",
