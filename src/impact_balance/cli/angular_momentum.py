@@ -123,7 +123,8 @@ def with_angular_momentum(
             raise ScenarioError(
                 ANGULAR_MOMENTUM_OPTION,
                 value,
-                "the trial's controller declares no angular momentum damping gain > 0",
+                "the trial's controller declares no angular momentum damping gain K_L > 0 "
+                "(only the id controller does)",
             )
         tau = 1.0 / controller_damping
     else:

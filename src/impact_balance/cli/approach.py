@@ -188,6 +188,9 @@ def run(args: argparse.Namespace) -> int:
         d["zmp_margin"] = margin
         d["contact_aware"] = bool(args.contact_aware and governor is not None)
         d["velocity_margin"] = governed.velocity_margin if governor is not None else None
+        d["angular_momentum_damping_time"] = (
+            governed.angular_momentum_damping_time if governor is not None else None
+        )
         d["contact_aware_async"] = bool(args.contact_aware_async and governor is not None)
     from impact_balance.sim.studies.wall import pooled_tick_statistics
 
