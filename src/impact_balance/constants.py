@@ -3,9 +3,11 @@
 import math
 
 __all__ = [
+    "DEFAULT_ANGULAR_MOMENTUM_DAMPING_TIME",
     "GRAVITY",
     "GRAVITY_RANGE",
     "MAX_ANGLE",
+    "MAX_ANGULAR_MOMENTUM_DAMPING_TIME",
     "MAX_DESCRIPTION",
     "MAX_DURATION",
     "MAX_FRICTION",
@@ -47,3 +49,9 @@ MAX_PEAK_FACTOR = 1e3
 MAX_NAME = 100
 #: Longest description, characters.
 MAX_DESCRIPTION = 2000
+#: Longest angular momentum damping time (``angular_momentum_damping_time``), s: a day.
+MAX_ANGULAR_MOMENTUM_DAMPING_TIME = 86400.0
+#: The angular momentum damping time a scenario has when it sets none, s; None is the paper's
+#: criterion (the angular momentum the impulse leaves is ignored). The one place to change the
+#: project's default (see docs/angular-momentum.md).
+DEFAULT_ANGULAR_MOMENTUM_DAMPING_TIME: float | None = None

@@ -357,6 +357,8 @@ class UnknownPathError(UnknownNameError):
     """A sweep axis path names a scenario key that does not exist; lists the valid paths."""
 
     kind = "key"
+    #: A scenario's top-level keys are listed in full.
+    listed = 20
 
 
 class MissingExtraError(ImpactBalanceError, ImportError):

@@ -497,6 +497,21 @@ def test_app_refused_value_reverts_the_widget(app):
     assert app.w_impact_edges.value == 16
 
 
+def test_app_angular_momentum_field_sets_the_key_and_the_answer(app):
+    reset(app)
+    paper = app.session.summary.max_contact_velocity
+    app.w_angular_momentum.value = 0.0
+    try:
+        assert app.session.state.scenario.angular_momentum_damping_time == 0.0
+        extended = app.session.analysis.impact.extended
+        assert app.session.summary.max_contact_velocity == extended.max_contact_velocity < paper
+        assert f'id="ib-vmax-com">{extended.max_contact_velocity:.3f} m/s' in app.w_results.content
+    finally:
+        app.w_angular_momentum.value = -1.0
+    assert app.session.state.scenario.angular_momentum_damping_time is None
+    assert app.session.summary.max_contact_velocity == paper
+
+
 @pytest.mark.slow
 def test_app_contacts_impact_and_load(app, tmp_path):
     reset(app)

@@ -19,11 +19,19 @@ from impact_balance.criteria.qp import QPOptions, solve_contact_velocity_qp, sta
 from impact_balance.criteria.zmp import zmp_max_contact_velocity
 from impact_balance.exceptions import NonFiniteResultError, ScenarioError, SolverError
 from impact_balance.geometry.polygon import Polygon
+from impact_balance.impact.angular_momentum import AngularMomentumTerm, angular_momentum_gain
 from impact_balance.impact.model import ImpactModel, impact_model
 from impact_balance.projection.walk import warm_up
 from impact_balance.scenario import Scenario, load_scenario, with_source
 
-__all__ = ["Analysis", "ImpactAnswer", "analyze", "impact_answer", "stance_areas"]
+__all__ = [
+    "Analysis",
+    "ImpactAnswer",
+    "analyze",
+    "angular_momentum_term",
+    "impact_answer",
+    "stance_areas",
+]
 
 
 def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
@@ -177,11 +185,38 @@ def impact_answer(
     zmp = zmp_max_contact_velocity(
         areas.zmp_area, model, stance.com, scenario.plane_height, scenario.gravity, cfg.duration
     )
-    interval = criterion.interval(scenario.com_velocity, com)
+    term = angular_momentum_term(scenario, stance, areas, model)
+    extended = None
+    default_limit = com
+    if term is not None:
+        criterion = ComCriterion(areas.com_velocity_area, model, scenario.velocity_margin, term)
+        extended = default_limit = criterion.limit(scenario.com_velocity)
+    interval = criterion.interval(scenario.com_velocity, default_limit)
     contact_velocity = None
     if cfg.reference_velocity is not None:
         contact_velocity = safe_contact_velocity(cfg.reference_velocity, model.normal, interval)
-    return ImpactAnswer(model, com, zmp, contact_velocity, None, interval)
+    return ImpactAnswer(model, com, zmp, contact_velocity, None, interval, term, extended)
+
+
+def angular_momentum_term(
+    scenario: Scenario, stance: Stance, areas: BalanceAreas, model: ImpactModel
+) -> AngularMomentumTerm | None:
+    """The scenario's angular momentum term at a stance, or None (the paper's criterion).
+
+    Args:
+        scenario: Its ``angular_momentum_damping_time`` (s, None: off) and ``gravity`` are used.
+        stance: Its CoM (world, m) is the moment's centre.
+        areas: Their ``omega`` (1/s) is the LIPM's.
+        model: The impact model (its point, world, m).
+
+    Returns:
+        The term, or None when the scenario leaves the option off.
+    """
+    tau = scenario.angular_momentum_damping_time
+    if tau is None:
+        return None
+    gain = angular_momentum_gain(areas.omega, scenario.gravity, tau)
+    return AngularMomentumTerm(np.asarray(model.point - stance.com, dtype=float), gain, float(tau))
 
 
 def _area_checks(stance: Stance, areas: BalanceAreas) -> list[tuple[str, Any, tuple[str, ...]]]:

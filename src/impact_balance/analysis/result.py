@@ -13,6 +13,7 @@ from impact_balance.balance.infeasibility import CannotBalanceReason
 from impact_balance.contacts.stance import Stance
 from impact_balance.criteria.qp import QPResult
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit, LimitStatus
+from impact_balance.impact.angular_momentum import AngularMomentumTerm
 from impact_balance.impact.model import ImpactModel
 from impact_balance.json_values import json_number
 from impact_balance.scenario import Scenario
@@ -59,7 +60,12 @@ class ImpactAnswer:
         qp: The paper's QP solution when requested.
         safe_interval: The approach speeds (lo, hi) m/s whose post-impact CoM velocities all
             stay in the area (hi may be inf), or None when there are none; see
-            :func:`~impact_balance.criteria.com.safe_interval`.
+            :func:`~impact_balance.criteria.com.safe_interval` (of the extended criterion
+            when ``angular_momentum`` is set, as ``contact_velocity`` is).
+        angular_momentum: The term of the angular momentum the impulse leaves (scenario key
+            ``angular_momentum_damping_time``), or None (the paper's criterion).
+        extended: The CoM velocity criterion that counts that angular momentum (None without
+            ``angular_momentum``); ``com`` stays the paper's.
     """
 
     model: ImpactModel
@@ -68,6 +74,13 @@ class ImpactAnswer:
     contact_velocity: npt.NDArray[np.float64] | None
     qp: QPResult | None = None
     safe_interval: tuple[float, float] | None = None
+    angular_momentum: AngularMomentumTerm | None = None
+    extended: ContactVelocityLimit | None = None
+
+    @property
+    def default(self) -> ContactVelocityLimit:
+        """The project's default answer: :attr:`extended` when set, else the paper's :attr:`com`."""
+        return self.com if self.extended is None else self.extended
 
     @property
     def max_contact_velocity(self) -> float:
@@ -166,6 +179,11 @@ class Analysis:
             "plane_height": a.plane_height,
             "zmp_margin": a.zmp_margin,
             "velocity_margin": self.scenario.velocity_margin,
+            **(
+                {}
+                if self.scenario.angular_momentum_damping_time is None
+                else {"angular_momentum_damping_time": self.scenario.angular_momentum_damping_time}
+            ),
             "gravity": a.gravity,
             "com_velocity": self.com_velocity.tolist(),
             "com_velocity_inside": self.com_velocity_inside,
@@ -214,6 +232,16 @@ class Analysis:
                 "zmp_status": im.zmp_status,
                 "W": im.model.W.tolist(),
             }
+            if im.angular_momentum is not None and im.extended is not None:
+                out["impact"]["angular_momentum"] = {
+                    "damping_time": im.angular_momentum.damping_time,
+                    "gain": im.angular_momentum.gain,
+                    "max_contact_velocity": json_number(im.extended.max_contact_velocity),
+                    "status": im.extended.status,
+                }
+                out["impact"]["default_max_contact_velocity"] = json_number(
+                    im.extended.max_contact_velocity
+                )
             if im.qp is not None:
                 out["impact"]["qp"] = {
                     "status": im.qp.status,

@@ -13,6 +13,7 @@ from impact_balance.cli._options import (
     output_folder,
     with_margins,
 )
+from impact_balance.cli.angular_momentum import add_angular_momentum_option, with_angular_momentum
 from impact_balance.cli.calibrate import add_calibration_option, apply_calibration_option
 
 if TYPE_CHECKING:
@@ -55,6 +56,7 @@ def add_parser(sub: Subcommands) -> list[str]:
     add_zmp_margin_option(a, "default: the scenario's zmp_margin, 0 unless set")
     add_velocity_margin_option(a, "CoM criterion")
     add_calibration_option(a)
+    add_angular_momentum_option(a, controller=False)
     return ["analyze"]
 
 
@@ -80,6 +82,13 @@ def run(args: argparse.Namespace) -> int:
 
         scenario = with_margins(load_scenario(scenario), args.zmp_margin, args.velocity_margin)
         scenario, calibration = apply_calibration_option(args, scenario)
+    if args.angular_momentum_damping_time is not None:
+        from impact_balance.scenario import load_scenario
+
+        scenario = with_angular_momentum(
+            load_scenario(scenario) if isinstance(scenario, str) else scenario,
+            args.angular_momentum_damping_time,
+        )
     analysis = analyze(scenario, solve_qp=True if args.qp else None)
     if args.strict and analysis.warnings:
         raise StrictWarningsError(analysis.warnings)

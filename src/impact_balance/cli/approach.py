@@ -22,6 +22,7 @@ from impact_balance.cli._options import (
     scoring_margin,
     with_margins,
 )
+from impact_balance.cli.angular_momentum import add_angular_momentum_option, for_trials
 from impact_balance.cli.calibrate import add_calibration_option, apply_calibration_option
 
 if TYPE_CHECKING:
@@ -127,6 +128,7 @@ def add_parser(sub: Subcommands) -> list[str]:
         type=output_file("--video", (".mp4",)),
         help="render an MP4 of the trial (one trial: give --wall-distance)",
     )
+    add_angular_momentum_option(a, controller=True)
     return ["approach"]
 
 
@@ -170,6 +172,7 @@ def run(args: argparse.Namespace) -> int:
     distances = _distances(args)
     _check_distances(args, distances)
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
+    scenario = for_trials(scenario, args.angular_momentum_damping_time, options)
     own = scoring_margin(scenario)
     margin = controller_margin(options) if own is None else own
     # The governor's view: the area the controller can use.
@@ -188,6 +191,9 @@ def run(args: argparse.Namespace) -> int:
         d["zmp_margin"] = margin
         d["contact_aware"] = bool(args.contact_aware and governor is not None)
         d["velocity_margin"] = governed.velocity_margin if governor is not None else None
+        d["angular_momentum_damping_time"] = (
+            governed.angular_momentum_damping_time if governor is not None else None
+        )
         d["contact_aware_async"] = bool(args.contact_aware_async and governor is not None)
         if calibration is not None:
             d["calibration"] = calibration

@@ -18,6 +18,7 @@ from impact_balance.cli._options import (
     scoring_margin,
     with_margins,
 )
+from impact_balance.cli.angular_momentum import add_angular_momentum_option, for_trials
 from impact_balance.cli.calibrate import add_calibration_option, apply_calibration_option
 
 if TYPE_CHECKING:
@@ -97,6 +98,7 @@ def add_parser(sub: Subcommands) -> list[str]:
     add_trial_options(a, impact=False)
     add_calibration_option(a)
     add_output_options(a, "of one telling push")
+    add_angular_momentum_option(a, controller=True)
     return ["push-test"]
 
 
@@ -140,7 +142,9 @@ def run(args: argparse.Namespace) -> int:
         relative = band_levels(args.band, step, args.far or ())
     check_push_arguments(args.directions, args.magnitudes, args.duration, relative)
     options = BalanceTrialOptions(controller=args.controller)
+    judged = for_trials(scenario, args.angular_momentum_damping_time, options)
     journal = open_journal(args, "push-test", scenario, "servo", options, {"body": args.body})
+    scenario = judged  # the trials journal keys the scenario without the option
     levels = len(relative or args.magnitudes or [0] * 6)
     bar = progress_bar(f"push-test {scenario.name}", args.directions * levels)
 

@@ -20,6 +20,7 @@ from impact_balance.cli._options import (
     scoring_margin,
     with_margins,
 )
+from impact_balance.cli.angular_momentum import add_angular_momentum_option, for_trials
 from impact_balance.cli.calibrate import add_calibration_option, apply_calibration_option
 
 if TYPE_CHECKING:
@@ -60,6 +61,7 @@ def add_parser(sub: Subcommands) -> list[str]:
     add_trial_options(a, impact=True)
     add_calibration_option(a)
     add_output_options(a, "of the fastest trial survived")
+    add_angular_momentum_option(a, controller=True)
     return ["validate"]
 
 
@@ -94,6 +96,7 @@ def run(args: argparse.Namespace) -> int:
         check_log_path(args.log)
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
     joints = TRIAL_JOINTS[args.joints]  # the study's name (the journals' digests keep it)
+    judged = for_trials(scenario, args.angular_momentum_damping_time, options)
     journal = open_journal(
         args,
         "validate",
@@ -102,6 +105,7 @@ def run(args: argparse.Namespace) -> int:
         options,
         {"tolerance": args.tolerance, "max_speed": args.max_speed},
     )
+    scenario = judged  # the trials journal keys the scenario without the option
     bar = progress_bar(f"validate {scenario.name}")
 
     def progress(trial: ValidationTrial, stood: float | None, fell: float | None) -> None:

@@ -25,6 +25,7 @@ from impact_balance.criteria.linear_exit import (
 )
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.geometry.polygon import Polygon
+from impact_balance.impact.angular_momentum import AngularMomentumTerm, effective_impulse_rates
 from impact_balance.impact.model import ImpactModel
 
 __all__ = ["ComCriterion", "max_contact_velocity", "safe_interval"]
@@ -91,6 +92,11 @@ class ComCriterion:
     inside the area (the area eroded by a disc of radius d: each half-plane moved in by d), a
     margin for the impact model's error; 0 is the paper's criterion.
 
+    With an ``angular_momentum`` term, the post-impact vertices are the *effective* CoM
+    velocities ``c0 + s (d_j + gain S((p - c) x iota_j) / m)`` that count the centroidal angular
+    momentum the impulse leaves (:mod:`impact_balance.impact.angular_momentum`); None is the
+    paper's criterion.
+
     Attributes:
         name: "com".
         area: The CoM velocity area (world x, y), m/s.
@@ -99,9 +105,10 @@ class ComCriterion:
         G: (n_c, 2) unit outward normals of the area's half-planes (None for an empty area).
         h: (n_c,) their offsets less the velocity margin, m/s (None for an empty area).
         rates: (n_v, n_c) the rates ``d_j . G_k`` (None for an empty area).
+        angular_momentum: The angular momentum term, or None (the paper's criterion).
     """
 
-    __slots__ = ("G", "area", "h", "impact", "rates", "velocity_margin")
+    __slots__ = ("G", "angular_momentum", "area", "h", "impact", "rates", "velocity_margin")
 
     name: ClassVar[CriterionName] = "com"
 
@@ -109,10 +116,17 @@ class ComCriterion:
     h: npt.NDArray[np.float64] | None
     rates: npt.NDArray[np.float64] | None
 
-    def __init__(self, area: Polygon, impact: ImpactModel, velocity_margin: float = 0.0):
+    def __init__(
+        self,
+        area: Polygon,
+        impact: ImpactModel,
+        velocity_margin: float = 0.0,
+        angular_momentum: AngularMomentumTerm | None = None,
+    ):
         self.area = area
         self.impact = impact
         self.velocity_margin = float(velocity_margin)
+        self.angular_momentum = angular_momentum
         if area.is_empty:
             self.G = self.h = self.rates = None
             return
@@ -120,7 +134,10 @@ class ComCriterion:
         if self.velocity_margin:
             h = h - self.velocity_margin
         self.G, self.h = G, h
-        self.rates = _jump_rates(impact.impulse_rates, float(impact.mass), G)
+        impulse_rates = impact.impulse_rates
+        if angular_momentum is not None and angular_momentum.gain != 0.0:
+            impulse_rates = effective_impulse_rates(impulse_rates, angular_momentum)
+        self.rates = _jump_rates(impulse_rates, float(impact.mass), G)
 
     def margins(self, com_velocity: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """The slack ``h - G c0`` of the pre-impact CoM velocity in each half-plane.
@@ -207,6 +224,7 @@ def safe_interval(
     impact: ImpactModel,
     com_velocity: npt.ArrayLike,
     limit: ContactVelocityLimit | None = None,
+    angular_momentum: AngularMomentumTerm | None = None,
 ) -> tuple[float, float] | None:
     """The approach speeds s >= 0 whose whole post-impact CoM velocity set lies in ``area``.
 
@@ -222,6 +240,7 @@ def safe_interval(
         com_velocity: Pre-impact CoM velocity c0, world, m/s (x and y are read).
         limit: :func:`max_contact_velocity`'s answer for the same data when the caller has
             it: with ``c0`` inside, the interval is ``(0, limit)`` and is not computed again.
+        angular_momentum: The angular momentum term (see :class:`ComCriterion`), or None.
 
     Returns:
         ``(s_lo, s_hi)``, or None.
@@ -230,11 +249,14 @@ def safe_interval(
         return None
     if limit is not None and limit.from_inside:
         return limit.interval_from_inside()
-    return ComCriterion(area, impact).interval(com_velocity)
+    return ComCriterion(area, impact, angular_momentum=angular_momentum).interval(com_velocity)
 
 
 def max_contact_velocity(
-    area: Polygon, impact: ImpactModel, com_velocity: npt.ArrayLike
+    area: Polygon,
+    impact: ImpactModel,
+    com_velocity: npt.ArrayLike,
+    angular_momentum: AngularMomentumTerm | None = None,
 ) -> ContactVelocityLimit:
     """Largest approach speed keeping every post-impact CoM velocity in ``area``.
 
@@ -242,10 +264,11 @@ def max_contact_velocity(
         area: The CoM velocity area (world x, y), m/s.
         impact: The impact model.
         com_velocity: Pre-impact CoM velocity, world, m/s (x and y are read).
+        angular_momentum: The angular momentum term (see :class:`ComCriterion`), or None.
 
     Returns:
         The limit (m/s); "cannot_balance" (0) for an empty area.
     """
     if area.is_empty:
         return ContactVelocityLimit(0.0, "cannot_balance")
-    return ComCriterion(area, impact).limit(com_velocity)
+    return ComCriterion(area, impact, angular_momentum=angular_momentum).limit(com_velocity)

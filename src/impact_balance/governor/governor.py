@@ -92,6 +92,9 @@ class Governor:
     for the impact model's error, as ``zmp_margin`` is one for the controller's. Both are read
     as :func:`~impact_balance.analyze` reads them, so ``analyze`` of the same scenario answers
     the same maximum at the scenario's posture and CoM velocity (see :meth:`scenario_at`).
+    Its ``angular_momentum_damping_time`` (s) likewise makes the "com" criterion count the
+    centroidal angular momentum the impulse leaves, as ``analyze``'s default answer does
+    (:mod:`impact_balance.impact.angular_momentum`; the contact-aware bound does not count it).
 
     Args:
         scenario: A :class:`~impact_balance.scenario.Scenario`, a scenario file or a bundled
@@ -166,6 +169,7 @@ class Governor:
             float(scenario.zmp_margin),
             criterion,
             self.velocity_margin,
+            scenario.angular_momentum_damping_time if criterion == "com" else None,
         )
         self._evaluator = PostureEvaluator(self.robot, settings)
         self._lock = threading.Lock()

@@ -33,6 +33,7 @@ from impact_balance.balance.areas import (
     areas_from_polytope,
     projected_from_arrays,
 )
+from impact_balance.balance.lipm import lipm_omega
 from impact_balance.contacts.cwc import local_faces
 from impact_balance.contacts.stance import ContactSpec, Stance, frame_point, has_free_flyer
 from impact_balance.contacts.wrench_polytope import assemble_polytope, friction_scaling
@@ -41,6 +42,7 @@ from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.criteria.zmp import zmp_max_contact_velocity
 from impact_balance.exceptions import SolverError
 from impact_balance.governor.options import Criterion
+from impact_balance.impact.angular_momentum import AngularMomentumTerm, angular_momentum_gain
 from impact_balance.impact.model import (
     ImpactModel,
     ImpactSpec,
@@ -72,6 +74,9 @@ class PostureSettings:
         velocity_margin: The post-impact CoM velocities must lie this far inside the CoM
             velocity area, m/s ("com" criterion;
             :class:`~impact_balance.criteria.com.ComCriterion`).
+        angular_momentum_damping_time: tau, s: the "com" criterion counts the centroidal
+            angular momentum the impulse leaves (:mod:`impact_balance.impact.angular_momentum`);
+            None: the paper's criterion.
     """
 
     contacts: Sequence[ContactSpec]
@@ -82,6 +87,7 @@ class PostureSettings:
     zmp_margin: float
     criterion: Criterion
     velocity_margin: float = 0.0
+    angular_momentum_damping_time: float | None = None
 
 
 @dataclass(frozen=True)
@@ -245,7 +251,12 @@ class PostureEvaluator:
                 settings.impact.duration,
             )
         else:
-            com_criterion = ComCriterion(areas.com_velocity_area, impact, settings.velocity_margin)
+            com_criterion = ComCriterion(
+                areas.com_velocity_area,
+                impact,
+                settings.velocity_margin,
+                self._angular_momentum(impact, com),
+            )
         q = q.copy()
         q.setflags(write=False)
         return Posture(
@@ -320,6 +331,18 @@ class PostureEvaluator:
         except SolverError as exc:
             raise exc.within("contacts (projection of the contact wrench polytope)") from None
         return areas
+
+    def _angular_momentum(self, impact: ImpactModel, com: np.ndarray) -> AngularMomentumTerm | None:
+        """The angular momentum term at this posture (None: the paper's criterion)."""
+        settings = self.settings
+        tau = settings.angular_momentum_damping_time
+        if tau is None:
+            return None
+        omega = lipm_omega(
+            float(com[2]), settings.plane_height, settings.gravity, field="plane_height"
+        )
+        gain = angular_momentum_gain(omega, settings.gravity, tau)
+        return AngularMomentumTerm(np.asarray(impact.point - com, dtype=float), gain, float(tau))
 
     def _impact(
         self,

@@ -30,6 +30,7 @@ class ScenarioTabMixin(GuiHost):
     w_com_velocity: viser.GuiVector2Handle
     w_plane: viser.GuiNumberHandle[float]
     w_zmp_margin: viser.GuiNumberHandle[float]
+    w_angular_momentum: viser.GuiNumberHandle[float]
     # View options.
     w_gizmos: viser.GuiCheckboxHandle
     w_opacity: viser.GuiSliderHandle[float]
@@ -66,6 +67,17 @@ class ScenarioTabMixin(GuiHost):
             "m",
         )
         self.w_zmp_margin.on_update(self._field(("zmp_margin",), float))
+        self.w_angular_momentum = gui.add_number(
+            "angular momentum tau (s)",
+            -1.0,
+            min=-1.0,
+            step=0.01,
+            hint="CoM criterion: count the angular momentum the impulse leaves, removed with this "
+            "time constant, s (0: at once; 0.1: the id controller); below 0: off, the paper's",
+        )
+        self.w_angular_momentum.on_update(
+            self._field(("angular_momentum_damping_time",), _damping_time)
+        )
         self.w_gizmos = gui.add_checkbox(
             "drag gizmos",
             True,
@@ -122,6 +134,8 @@ class ScenarioTabMixin(GuiHost):
         set_value(self.w_com_velocity, vec2(scenario.com_velocity))
         set_value(self.w_plane, float(scenario.plane_height))
         set_value(self.w_zmp_margin, float(scenario.zmp_margin))
+        tau = scenario.angular_momentum_damping_time
+        set_value(self.w_angular_momentum, -1.0 if tau is None else float(tau))
         source = state.source
         name = (
             self.workspace.relative(os.path.abspath(source))
@@ -157,3 +171,8 @@ class ScenarioTabMixin(GuiHost):
             content = self.session.state.to_yaml().encode()
         target = event.client if event.client is not None else self.server
         target.send_file_download(name, content)
+
+
+def _damping_time(value: float) -> float | None:
+    """The GUI's tau field as the scenario key: a negative value is off (None: key removed)."""
+    return None if float(value) < 0 else float(value)

@@ -70,8 +70,9 @@ class Summary:
         verdict: "balanced", "falling: ..." or "cannot balance: ..." (see
             :attr:`Analysis.verdict`).
         can_balance: Whether the contacts can hold the robot at rest.
-        max_contact_velocity: Maximum approach speed by the CoM velocity criterion, m/s
-            (``inf`` unbounded, None without an impact).
+        max_contact_velocity: Maximum approach speed by the CoM velocity criterion (with the
+            scenario's angular momentum term when set: ``ImpactAnswer.default``), m/s (``inf``
+            unbounded, None without an impact).
         zmp_max_contact_velocity: The same by the ZMP criterion, m/s.
         reference_speed: Approach speed of the reference velocity, m/s (None without one).
         falls_at_reference: Whether the reference approach speed exceeds the maximum.
@@ -97,7 +98,7 @@ class Summary:
         vmax = zmp = ref = None
         falls = False
         if im is not None:
-            vmax, zmp = im.max_contact_velocity, im.zmp_max_contact_velocity
+            vmax, zmp = im.default.max_contact_velocity, im.zmp_max_contact_velocity
             v_ref = im.model.spec.reference_velocity
             if v_ref is not None:
                 ref = max(0.0, im.model.approach_speed(v_ref))

@@ -22,8 +22,10 @@ from pydantic import (
 )
 
 from impact_balance.constants import (
+    DEFAULT_ANGULAR_MOMENTUM_DAMPING_TIME,
     GRAVITY_RANGE,
     MAX_ANGLE,
+    MAX_ANGULAR_MOMENTUM_DAMPING_TIME,
     MAX_DESCRIPTION,
     MAX_DURATION,
     MAX_FRICTION,
@@ -245,6 +247,12 @@ class Scenario(_Model):
     #: Every post-impact CoM velocity must lie this far (m/s) inside the CoM velocity area
     #: (the CoM criterion): a margin for the impact model's error. 0 is the paper's criterion.
     velocity_margin: Annotated[Number, _scalar(0.0, MAX_VELOCITY_MARGIN, "m/s")] = 0.0
+    #: tau (s): the centroidal angular momentum the impulse leaves is removed by the contacts
+    #: with this time constant, and the CoM criterion sees the effective post-impact CoM
+    #: velocity (docs/angular-momentum.md). None: the paper's criterion (it is ignored).
+    angular_momentum_damping_time: (
+        Annotated[Number, _scalar(0.0, MAX_ANGULAR_MOMENTUM_DAMPING_TIME, "s")] | None
+    ) = DEFAULT_ANGULAR_MOMENTUM_DAMPING_TIME
     torque_limits: Flag = True
     gravity: Annotated[Number, _scalar(*GRAVITY_RANGE, "m/s^2")] = 9.81
     contacts: list[ContactConfig] = Field(min_length=1)

@@ -25,9 +25,13 @@ of 0.03, say) plus a few far points; the scores are then also given on the band 
 Every trial starts at rest, so the predictions start from a CoM at rest too (``c0 = 0``), whatever
 the scenario's ``com_velocity``.
 
-``com`` is the project's default prediction; ``paper_com`` is the paper's CoM criterion (the same
-call today). Each criterion is scored against the lenient outcome (fell) and the strict one
-(:mod:`.scores`).
+``com`` is the project's default prediction; ``paper_com`` is the paper's CoM criterion. With the
+scenario's ``angular_momentum_damping_time`` tau set, ``com`` counts the centroidal angular momentum
+the push leaves, ``L = (p - c) x J u`` (p the pushed body's centre of mass, c the CoM): the
+effective post-push CoM velocity ``c0 + (J u + S(L) / (h (1 + omega tau))) / m``,
+``S(L) = (L_y, -L_x)``, must lie in the area (:mod:`impact_balance.impact.angular_momentum`);
+without it the two are the same call. Each criterion is scored against the lenient outcome (fell)
+and the strict one (:mod:`.scores`).
 """
 
 from __future__ import annotations
@@ -43,6 +47,7 @@ from numpy.typing import ArrayLike
 
 from impact_balance.exceptions import SimulationError
 from impact_balance.geometry.polygon import Polygon
+from impact_balance.impact.angular_momentum import angular_momentum_gain
 from impact_balance.scenario import Scenario, load_scenario
 from impact_balance.sim.control.registry import controller_class
 from impact_balance.sim.studies.journal import TrialJournal
@@ -180,12 +185,27 @@ class PushPrediction:
         com_velocity_margin: Its margin in the CoM velocity area (m/s, >= 0 inside).
         zmp: Predicted quasi-static ZMP while the push acts (m, world).
         zmp_margin: Its margin in the ZMP support area (m, >= 0 inside).
+        angular_momentum: Predicted centroidal angular momentum the push leaves,
+            ``(p - c) x J u`` (N m s, world axes, about the CoM).
+        effective_com_velocity: The effective post-push CoM velocity that counts it (m/s,
+            world xy; None when the scenario's ``angular_momentum_damping_time`` is unset).
+        effective_com_velocity_margin: Its margin in the CoM velocity area (m/s; None likewise).
     """
 
     com_velocity: np.ndarray
     com_velocity_margin: float
     zmp: np.ndarray
     zmp_margin: float
+    angular_momentum: np.ndarray | None = None
+    effective_com_velocity: np.ndarray | None = None
+    effective_com_velocity_margin: float | None = None
+
+    @property
+    def default_com_velocity_margin(self) -> float:
+        """The margin of the project's default prediction (the effective one when set), m/s."""
+        if self.effective_com_velocity_margin is None:
+            return self.com_velocity_margin
+        return self.effective_com_velocity_margin
 
 
 @dataclass(kw_only=True)
@@ -203,7 +223,9 @@ class PushOutcome(TrialEntry):
         (m).
         """
         s, p = self.summary, self.prediction
-        if criterion in ("com", "paper_com"):  # the project's default is the paper's criterion
+        if criterion == "com":  # the project's default: with the angular momentum when set
+            return p.default_com_velocity_margin >= omega * margin
+        if criterion == "paper_com":
             return p.com_velocity_margin >= omega * margin
         if criterion == "zmp":
             return p.zmp_margin >= margin
@@ -237,9 +259,11 @@ class PushOutcome(TrialEntry):
             "zmp_criterion_safe_in_trial": self.safe("zmp_in_trial", margin, omega),
             # Before the trial, in the area the score uses (with the margin): m/s, >= 0 inside.
             "com_velocity_margin": float(self.prediction.com_velocity_margin - omega * margin),
-            # The same, without the margin (m/s): what a calibration compares with omega M.
-            "predicted_com_velocity_margin": float(self.prediction.com_velocity_margin),
+            # The default prediction's margin without the margin (m/s; the effective one when the
+            # angular momentum is counted): what a calibration compares with omega M.
+            "predicted_com_velocity_margin": float(self.prediction.default_com_velocity_margin),
             "predicted_com_velocity": self.prediction.com_velocity.tolist(),
+            **_angular_momentum_keys(self.prediction, margin, omega),
             "predicted_zmp": self.prediction.zmp.tolist(),
             "trial": s,
         }
@@ -412,12 +436,12 @@ def _smallest(grid: dict[float, dict[str, Any]], criterion: str, strict: bool) -
     return None
 
 
-def _body_height(setup: BalanceSetup, body: int) -> float:
-    """Height of the pushed body's centre of mass at the start (m)."""
+def _body_position(setup: BalanceSetup, body: int) -> np.ndarray:
+    """The pushed body's centre of mass at the start (m, world)."""
     sim = setup.sim
     sim.set_state(setup.start_configuration())
     mujoco.mj_forward(sim.model, sim.data)
-    return float(sim.data.xipos[body][2])
+    return np.array(sim.data.xipos[body], dtype=float)
 
 
 def _impulse(setup: BalanceSetup, level: float, angle: float, relative: bool) -> float:
@@ -438,8 +462,14 @@ def _impulse(setup: BalanceSetup, level: float, angle: float, relative: bool) ->
     return J
 
 
-def predict_push(setup: BalanceSetup, push: Push, body_height: float) -> PushPrediction:
-    """The push's before-trial predictions (see the module docstring)."""
+def predict_push(
+    setup: BalanceSetup, push: Push, body_height: float, body_position: ArrayLike | None = None
+) -> PushPrediction:
+    """The push's before-trial predictions (see the module docstring).
+
+    ``body_position`` (m, world) is the pushed body's centre of mass at the start, where the push
+    acts; without it, the point above the CoM at ``body_height`` (m).
+    """
     a = setup.analysis
     areas, mass, g = a.areas, a.stance.mass, a.areas.gravity
     u = np.array([np.cos(push.direction), np.sin(push.direction)])
@@ -447,12 +477,43 @@ def predict_push(setup: BalanceSetup, push: Push, body_height: float) -> PushPre
     velocity = c0 + push.magnitude * u / mass
     force = push.magnitude / push.duration * u
     zmp = a.stance.com[:2] + (body_height - areas.plane_height) * force / (mass * g)
+    com = np.asarray(a.stance.com, dtype=float)
+    point = (
+        np.array([com[0], com[1], body_height])
+        if body_position is None
+        else np.asarray(body_position, dtype=float)
+    )
+    L = np.cross(point - com, np.array([*(push.magnitude * u), 0.0]))
+    tau = a.scenario.angular_momentum_damping_time
+    effective = effective_margin = None
+    if tau is not None:
+        gain = angular_momentum_gain(float(areas.omega), g, tau)
+        effective = velocity + gain * np.array([L[1], -L[0]]) / mass
+        effective_margin = float(areas.com_velocity_area.margins(effective)[0])
     return PushPrediction(
         velocity,
         float(areas.com_velocity_area.margins(velocity)[0]),
         zmp,
         float(areas.zmp_area.margins(zmp)[0]),
+        L,
+        effective,
+        effective_margin,
     )
+
+
+def _angular_momentum_keys(p: PushPrediction, margin: float, omega: float) -> dict[str, Any]:
+    """The JSON keys of the angular momentum a push leaves (predicted, and what it costs)."""
+    out: dict[str, Any] = {
+        "predicted_angular_momentum": None
+        if p.angular_momentum is None
+        else p.angular_momentum.tolist()
+    }
+    if p.effective_com_velocity is not None and p.effective_com_velocity_margin is not None:
+        out["predicted_effective_com_velocity"] = p.effective_com_velocity.tolist()
+        out["effective_com_velocity_margin"] = float(
+            p.effective_com_velocity_margin - omega * margin
+        )
+    return out
 
 
 def push_test(
@@ -486,7 +547,8 @@ def push_test(
     options = options or BalanceTrialOptions()
     setup = setup or BalanceSetup.create(scenario, "servo", options)
     body_id = push_body(setup.sim, body)
-    height = _body_height(setup, body_id)
+    position = _body_position(setup, body_id)
+    height = float(position[2])
     a = setup.analysis
     omega = float(a.areas.omega)
     own = controller_margin(options)
@@ -519,7 +581,7 @@ def push_test(
             outcome = PushOutcome(
                 push=push,
                 relative=None if relative is None else float(level),
-                prediction=predict_push(setup, push, height),
+                prediction=predict_push(setup, push, height, position),
                 summary=entry["summary"],
                 trajectory=entry["trajectory"],
             )

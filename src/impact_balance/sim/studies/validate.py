@@ -99,8 +99,9 @@ def predictions(scenario: Scenario, zmp_margin: float = 0.0) -> dict[str, dict[s
 def default_prediction(scenario: Scenario, zmp_margin: float) -> float | None:
     """The project's default maximum contact velocity (m/s; None if unbounded): the governor's cap.
 
-    The CoM criterion with the scenario's inertia model and velocity margin, the ZMP support area
-    shrunk by ``zmp_margin`` (m), from a CoM at rest (the trials start at rest).
+    The CoM criterion with the scenario's inertia model, velocity margin and angular momentum
+    damping time (:attr:`~impact_balance.analysis.result.ImpactAnswer.default`), the ZMP support
+    area shrunk by ``zmp_margin`` (m), from a CoM at rest (the trials start at rest).
     """
     if scenario.impact is None:
         raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact")
@@ -110,7 +111,7 @@ def default_prediction(scenario: Scenario, zmp_margin: float) -> float | None:
     answer = analyze(variant).impact
     if answer is None:
         raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact")
-    return json_number(answer.max_contact_velocity)
+    return json_number(answer.default.max_contact_velocity)  # with the angular momentum when set
 
 
 @dataclass(kw_only=True)
