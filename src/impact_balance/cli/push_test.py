@@ -113,33 +113,16 @@ def run(args: argparse.Namespace) -> int:
     """
     from impact_balance.cli.output import print_json, progress_bar
     from impact_balance.cli.output_paths import writing
-    from impact_balance.exceptions import SimulationError
     from impact_balance.logs import check_log_path
     from impact_balance.scenario import load_scenario
-    from impact_balance.sim.studies.push import (
-        band_levels,
-        check_band_arguments,
-        check_push_arguments,
-        push_test,
-    )
+    from impact_balance.sim.studies.push import check_push_arguments, push_test
     from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, write_trial_log
 
     scenario = with_margins(load_scenario(args.scenario), args.zmp_margin)
     scenario, calibration = apply_calibration_option(args, scenario)
     if args.log:
         check_log_path(args.log)
-    if args.band is None and args.band_step is not None:
-        raise SimulationError("--band-step", args.band_step, "needs --band (the step of the band)")
-    step = 0.03 if args.band_step is None else args.band_step
-    check_band_arguments(args.band, step, args.far)
-    relative = args.relative
-    if args.band is not None:
-        if args.relative is not None or args.magnitudes is not None:
-            given = "--relative" if args.relative is not None else "--magnitudes"
-            raise SimulationError(
-                given, args.relative or args.magnitudes, f"give {given} or --band, not both"
-            )
-        relative = band_levels(args.band, step, args.far or ())
+    relative = _relative_levels(args)
     check_push_arguments(args.directions, args.magnitudes, args.duration, relative)
     options = BalanceTrialOptions(controller=args.controller)
     judged = for_trials(scenario, args.angular_momentum_damping_time, options)
@@ -203,6 +186,25 @@ def run(args: argparse.Namespace) -> int:
     for path in written:
         print(f"  wrote {path}")
     return 0
+
+
+def _relative_levels(args: argparse.Namespace) -> list[float] | None:
+    """The impulses as fractions of the boundary impulse: ``--relative``, or ``--band``'s levels."""
+    from impact_balance.exceptions import SimulationError
+    from impact_balance.sim.studies.push import band_levels, check_band_arguments
+
+    if args.band is None and args.band_step is not None:
+        raise SimulationError("--band-step", args.band_step, "needs --band (the step of the band)")
+    step = 0.03 if args.band_step is None else args.band_step
+    check_band_arguments(args.band, step, args.far)
+    if args.band is None:
+        return args.relative  # type: ignore[no-any-return]
+    if args.relative is not None or args.magnitudes is not None:
+        given = "--relative" if args.relative is not None else "--magnitudes"
+        raise SimulationError(
+            given, args.relative or args.magnitudes, f"give {given} or --band, not both"
+        )
+    return band_levels(args.band, step, args.far or ())
 
 
 def _pct(x: float | None) -> str:
