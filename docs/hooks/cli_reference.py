@@ -169,19 +169,19 @@ def cli_reference() -> str:
 
 
 def on_page_markdown(markdown: str, **kwargs: Any) -> str:
-    """mkdocs event: put the generated references in place of their markers."""
+    """On each page: put the generated references in place of their markers."""
     if MARKER in markdown:
         markdown = markdown.replace(MARKER, cli_reference())
     return API_MARKER.sub(lambda m: api_directives(m.group(1).split()), markdown)
 
 
 def on_pre_build(**kwargs: Any) -> None:
-    """mkdocs event: a new build places every public name anew."""
+    """Before a build: a new build places every public name anew."""
     _placed.clear()
 
 
 def on_post_build(**kwargs: Any) -> None:
-    """mkdocs event: fail unless every public name was placed on exactly one page."""
+    """After a build: fail unless every public name was placed on exactly one page."""
     names = public_names()
     missing = sorted(n for n in names if _placed[n] == 0)
     twice = sorted(n for n in names if _placed[n] > 1)
