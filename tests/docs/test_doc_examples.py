@@ -238,3 +238,14 @@ def test_every_scenario_key_is_in_the_reference():
     page = (ROOT / "docs" / "reference" / "scenario.md").read_text(encoding="utf-8")
     missing = sorted(k for k in keys if not re.search(rf"(^|[\s{{,]){k}:", page, re.MULTILINE))
     assert not missing, f"docs/reference/scenario.md does not show {missing}"
+
+
+def test_readme_links_resolve():
+    """README's relative links (into the site's pages, the project files) point at files."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    links = re.findall(r"\]\(([^)#\s]+)(?:#[^)]*)?\)", text)
+    local = [link for link in links if "://" not in link]
+    assert len(local) >= 20
+    missing = sorted(link for link in local if not (ROOT / link).exists())
+    assert not missing, f"README.md links to missing files: {missing}"
+    assert len(text.splitlines()) <= 250
