@@ -249,3 +249,23 @@ def test_readme_links_resolve():
     missing = sorted(link for link in local if not (ROOT / link).exists())
     assert not missing, f"README.md links to missing files: {missing}"
     assert len(text.splitlines()) <= 250
+
+
+def test_license_and_citation_match_the_project():
+    import tomllib
+    import yaml
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    assert project["license"] == "BSD-3-Clause"
+    license_text = (ROOT / "LICENSE").read_text(encoding="utf-8")
+    assert license_text.startswith("BSD 3-Clause License")
+    assert "the impact-balance developers" in license_text
+    cff = yaml.safe_load((ROOT / "CITATION.cff").read_text(encoding="utf-8"))
+    assert cff["cff-version"] == "1.2.0" and cff["license"] == project["license"]
+    assert cff["version"] == project["version"]
+    paper = cff["preferred-citation"]
+    tex = "\n".join(p.read_text(errors="replace") for p in (ROOT / "docs").glob("*.md"))
+    assert paper["title"] == "Impact-Aware Multi-Contact Balance Criteria" and paper["title"] in tex
+    assert [a["family-names"] for a in paper["authors"]] == ["Wang", "Tanguy", "Kheddar"]
+    assert "Keep a Changelog" in (ROOT / "CHANGELOG.md").read_text(encoding="utf-8")
+    assert any(c.startswith("Programming Language :: Python :: 3") for c in project["classifiers"])
