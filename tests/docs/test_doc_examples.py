@@ -175,6 +175,11 @@ def test_command_line_example_parses_and_cheap_ones_run(block, line, tmp_path, m
     except CommandLineError as exc:  # an option's own check: fine for a placeholder value
         assert PLACEHOLDER.search(str(exc.value)), f"{block.id}: {line}: {exc}"
         return
+    except ImportError as exc:  # an option's check that needs an extra (sweep --scheduler)
+        extra = _missing_extra(exc)
+        if extra is None:
+            raise
+        pytest.skip(f"needs the {extra} extra")
     except SystemExit as exc:  # --help and --version end here, with status 0
         out, err = capsys.readouterr()
         assert exc.code in (0, None), f"{block.id}: {line}: {err.strip()}"
