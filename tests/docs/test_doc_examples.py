@@ -274,3 +274,32 @@ def test_license_and_citation_match_the_project():
     assert [a["family-names"] for a in paper["authors"]] == ["Wang", "Tanguy", "Kheddar"]
     assert "Keep a Changelog" in (ROOT / "CHANGELOG.md").read_text(encoding="utf-8")
     assert any(c.startswith("Programming Language :: Python :: 3") for c in project["classifiers"])
+
+
+def test_the_generated_cli_reference_has_every_command_and_option():
+    import argparse
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "cli_reference", ROOT / "docs" / "hooks" / "cli_reference.py"
+    )
+    assert spec is not None and spec.loader is not None
+    hook = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(hook)
+    page = hook.on_page_markdown(f"# Command line\n\n{hook.MARKER}\n")
+    assert hook.MARKER not in page
+    parser, _ = cli._parser()
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    assert len(sub.choices) >= 14
+    for name, command in sub.choices.items():
+        assert f"## `impact-balance {name}`" in page
+        for action in command._actions:
+            if action.help == argparse.SUPPRESS or isinstance(action, argparse._HelpAction):
+                continue
+            shown = action.option_strings or [action.metavar or action.dest]
+            assert all(f"`{s}" in page for s in shown), (name, shown)
+    # The API markers: every public name of impact_balance lives in some subpackage.
+    names = hook.public_names()
+    import impact_balance
+
+    assert set(names) == set(impact_balance.__all__) - {"__version__"}
