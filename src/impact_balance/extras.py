@@ -40,6 +40,7 @@ COMMAND_EXTRAS: dict[str, str] = {
     "simulate": "sim",
     "validate": "sim",
     "push-test": "sim",
+    "calibrate": "sim",
     "approach": "sim",
     "check-log": "logs",
     "gui": "gui",

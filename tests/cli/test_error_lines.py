@@ -230,6 +230,7 @@ def test_every_command_reports_a_failing_stdout_in_one_line(capsys, monkeypatch)
         "simulate": ["s"],
         "validate": ["s"],
         "push-test": ["s"],
+        "calibrate": ["t.json"],
         "check-log": ["l", "--scenario", "s"],
         "phase-portrait": ["--com-height", "1", "--zmp-range", "0", "1"],
         "pose": ["s", "--place", "f", "0", "0", "1", "--out", "o.yaml"],

@@ -35,6 +35,7 @@ COMMAND_ARGS = {
     "simulate": ["simulate", "palm_push_two_feet"],
     "validate": ["validate", "palm_push_two_feet"],
     "push-test": ["push-test", "palm_push_ramp"],
+    "calibrate": ["calibrate", "trials.json"],
     "approach": ["approach", "palm_push_two_feet", "--reference", "0.5"],
     "check-log": ["check-log", "log.parquet", "--scenario", "palm_push_two_feet"],
     "gui": ["gui", "palm_push_two_feet"],

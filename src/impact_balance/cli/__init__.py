@@ -32,6 +32,7 @@ from typing import Any, NoReturn, TextIO
 from impact_balance.cli import (
     analyze,
     approach,
+    calibrate,
     check_log,
     demo,
     frames,
@@ -75,6 +76,7 @@ COMMANDS: tuple[ModuleType, ...] = (
     simulate,
     validate,
     push_test,
+    calibrate,
     approach,
     check_log,
     sweep,

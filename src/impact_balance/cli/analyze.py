@@ -13,6 +13,7 @@ from impact_balance.cli._options import (
     output_folder,
     with_margins,
 )
+from impact_balance.cli.calibrate import add_calibration_option, apply_calibration_option
 
 if TYPE_CHECKING:
     from impact_balance.analysis.result import Diagnostic
@@ -53,6 +54,7 @@ def add_parser(sub: Subcommands) -> list[str]:
     a.add_argument("--strict", action="store_true", help="treat warnings as errors (exit status 2)")
     add_zmp_margin_option(a, "default: the scenario's zmp_margin, 0 unless set")
     add_velocity_margin_option(a, "CoM criterion")
+    add_calibration_option(a)
     return ["analyze"]
 
 
@@ -67,14 +69,17 @@ def run(args: argparse.Namespace) -> int:
     """
     from impact_balance.analysis.analyze import analyze
     from impact_balance.analysis.report import format_analysis
+    from impact_balance.cli.calibrate import calibration_line
     from impact_balance.cli.output import print_json
     from impact_balance.exceptions import StrictWarningsError
 
     scenario = args.scenario
-    if args.zmp_margin is not None or args.velocity_margin is not None:
+    calibration = None
+    if args.zmp_margin is not None or args.velocity_margin is not None or args.calibration:
         from impact_balance.scenario import load_scenario
 
         scenario = with_margins(load_scenario(scenario), args.zmp_margin, args.velocity_margin)
+        scenario, calibration = apply_calibration_option(args, scenario)
     analysis = analyze(scenario, solve_qp=True if args.qp else None)
     if args.strict and analysis.warnings:
         raise StrictWarningsError(analysis.warnings)
@@ -90,9 +95,14 @@ def run(args: argparse.Namespace) -> int:
         if args.strict and skipped:
             raise StrictWarningsError(skipped)
     if args.json:
-        print_json(analysis.to_dict())
+        out = analysis.to_dict()
+        if calibration is not None:
+            out["calibration"] = calibration
+        print_json(out)
     else:
         print(format_analysis(analysis))
+        if calibration is not None:
+            print(calibration_line(calibration))
         for path in written:
             print(f"  figure: {path}")
     return 0

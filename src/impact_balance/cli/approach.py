@@ -22,6 +22,7 @@ from impact_balance.cli._options import (
     scoring_margin,
     with_margins,
 )
+from impact_balance.cli.calibrate import add_calibration_option, apply_calibration_option
 
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
@@ -105,6 +106,7 @@ def add_parser(sub: Subcommands) -> list[str]:
         a, DEFAULT_CONTROLLER, "it puts the ZMP anywhere in the support area after the impact"
     )
     add_zmp_margin_option(a, "the governor's; default: the ZMP margin the trial's controller keeps")
+    add_calibration_option(a)
     a.add_argument(
         "--max-time",
         type=number("--max-time", 0.0, 120.0, "s", lo_open=True),
@@ -160,6 +162,7 @@ def run(args: argparse.Namespace) -> int:
     )
 
     scenario = with_margins(load_scenario(args.scenario), args.zmp_margin, args.velocity_margin)
+    scenario, calibration = apply_calibration_option(args, scenario)
     if scenario.impact is None:
         raise SimulationError(
             "impact", None, f"scenario {scenario.name!r} has no impact: approach needs one"
@@ -186,6 +189,8 @@ def run(args: argparse.Namespace) -> int:
         d["contact_aware"] = bool(args.contact_aware and governor is not None)
         d["velocity_margin"] = governed.velocity_margin if governor is not None else None
         d["contact_aware_async"] = bool(args.contact_aware_async and governor is not None)
+        if calibration is not None:
+            d["calibration"] = calibration
     from impact_balance.sim.studies.wall import pooled_tick_statistics
 
     out = (

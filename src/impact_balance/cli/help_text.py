@@ -73,6 +73,13 @@ COMMAND_HELP: dict[str, tuple[str, str]] = {
         "criteria's predictions (balanced or fell) against the outcomes.",
         "impact-balance push-test palm_push_two_feet --directions 8 --magnitudes 5 10",
     ),
+    "calibrate": (
+        "From push-test --json outputs of one robot and one controller, the smallest ZMP "
+        "margin that brings the pooled P(fell | predicted safe) to a target (strict outcome by "
+        "default), with its Wilson interval, the share of standing pushes still called safe, "
+        "each file's rates and the whole curve; --out writes the file that --calibration reads.",
+        "impact-balance calibrate train_*.json --target 0.05 --out talos_id.yaml",
+    ),
     "approach": (
         "Send the impact point at a wall the robot does not know, its speed capped every tick "
         "by the governor, and report the speed at contact and whether the robot stayed up.",

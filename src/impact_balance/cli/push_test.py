@@ -18,6 +18,7 @@ from impact_balance.cli._options import (
     scoring_margin,
     with_margins,
 )
+from impact_balance.cli.calibrate import add_calibration_option, apply_calibration_option
 
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
@@ -94,6 +95,7 @@ def add_parser(sub: Subcommands) -> list[str]:
         "it places the ZMP anywhere in the support area, as the criterion assumes",
     )
     add_trial_options(a, impact=False)
+    add_calibration_option(a)
     add_output_options(a, "of one telling push")
     return ["push-test"]
 
@@ -121,6 +123,7 @@ def run(args: argparse.Namespace) -> int:
     from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, write_trial_log
 
     scenario = with_margins(load_scenario(args.scenario), args.zmp_margin)
+    scenario, calibration = apply_calibration_option(args, scenario)
     if args.log:
         check_log_path(args.log)
     if args.band is None and args.band_step is not None:
@@ -164,6 +167,8 @@ def run(args: argparse.Namespace) -> int:
         bar.close()
         journal.close()
     out = result.to_dict()
+    if calibration is not None:
+        out["calibration"] = calibration
     written = []
     if args.log:
         chosen = _telling(result)
@@ -280,6 +285,10 @@ def _text(result: PushTestResult, out: dict[str, Any], args: argparse.Namespace)
         )
     if out["journal"]:
         lines.append(f"  trials journal: {out['journal']} ({out['reused_trials']} reused)")
+    if out.get("calibration") is not None:
+        from impact_balance.cli.calibrate import calibration_line
+
+        lines.append(calibration_line(out["calibration"]))
     return "\n".join(lines)
 
 

@@ -17,6 +17,7 @@ from impact_balance.cli._options import (
     output_file,
     output_folder,
 )
+from impact_balance.cli.calibrate import add_calibration_option, apply_calibration_option
 from impact_balance.cli.output import print_json
 from impact_balance.cli.output_paths import writing
 
@@ -100,6 +101,7 @@ def add_parser(sub: Subcommands) -> list[str]:
         type=output_file("--video", (".mp4",)),
         help="render an MP4 (offscreen, EGL); one file per speed",
     )
+    add_calibration_option(a)
     return ["simulate"]
 
 
@@ -200,7 +202,9 @@ def run(args: argparse.Namespace) -> int:
         )
     if args.log:
         check_log_path(args.log)
-    scenario = load_scenario(args.scenario)
+    # simulate's predictions (the impact's jump sets) use no ZMP margin: a calibration is
+    # checked against the scenario's robot and recorded in the JSON.
+    scenario, calibration = apply_calibration_option(args, load_scenario(args.scenario))
     if scenario.impact is None:
         raise SimulationError(
             "impact", None, f"scenario {args.scenario!r} has no impact to simulate"
@@ -255,6 +259,9 @@ def run(args: argparse.Namespace) -> int:
                     written.append(path)
     if args.json:
         docs = [r.to_dict() for r in results]
+        for d in docs:
+            if calibration is not None:
+                d["calibration"] = calibration
         print_json(docs if several else docs[0])
     else:
         print("\n\n".join(_table(name, r) for r in results))

@@ -20,6 +20,7 @@ from impact_balance.cli._options import (
     scoring_margin,
     with_margins,
 )
+from impact_balance.cli.calibrate import add_calibration_option, apply_calibration_option
 
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
@@ -57,6 +58,7 @@ def add_parser(sub: Subcommands) -> list[str]:
         "--max-speed", type=float, default=4.0, help="largest approach speed tried, m/s (default 4)"
     )
     add_trial_options(a, impact=True)
+    add_calibration_option(a)
     add_output_options(a, "of the fastest trial survived")
     return ["validate"]
 
@@ -80,6 +82,7 @@ def run(args: argparse.Namespace) -> int:
     from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, write_trial_log
 
     scenario = with_margins(load_scenario(args.scenario), args.zmp_margin)
+    scenario, calibration = apply_calibration_option(args, scenario)
     if scenario.impact is None:
         raise SimulationError(
             "impact", None, f"scenario {scenario.name!r} has no impact: validate needs one"
@@ -126,6 +129,8 @@ def run(args: argparse.Namespace) -> int:
         journal.close()
     out = result.to_dict()
     out["joints"] = args.joints
+    if calibration is not None:
+        out["calibration"] = calibration
     written = []
     e = out["empirical"]
     if args.log:

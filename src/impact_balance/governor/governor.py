@@ -35,6 +35,11 @@ from impact_balance.scenario import (
     scenario_from_dict,
     with_source,
 )
+from impact_balance.scenario.calibration import (
+    CalibrationFile,
+    apply_calibration,
+    read_calibration,
+)
 
 __all__ = ["Governor"]
 
@@ -102,10 +107,15 @@ class Governor:
         velocity_margin: Overrides the scenario's ``velocity_margin`` (m/s; through
             :meth:`~impact_balance.scenario.Scenario.replace`, so checked by the schema).
             None (default): the scenario's.
+        calibration: A calibration file (``impact-balance calibrate --out``) or its read
+            :class:`~impact_balance.scenario.calibration.CalibrationFile`: its ``zmp_margin``
+            (m) replaces the scenario's. Its robot must be the scenario's. None (default): the
+            scenario's margin. The calibration read is :attr:`calibration`.
 
     Raises:
-        ScenarioError: no impact, an unknown frame, an impact model that cannot be built at
-            the scenario's posture (the scenario is evaluated once, as a check).
+        ScenarioError: another robot's or a bad calibration, no impact, an unknown frame, an
+            impact model that cannot be built at the scenario's posture (the scenario is
+            evaluated once, as a check).
         GovernorError: an unknown criterion, a bad tolerance, a bad ``velocity_margin``
             (or one with the "zmp" criterion), contact-aware options with the "zmp" criterion.
     """
@@ -118,13 +128,19 @@ class Governor:
         posture_tolerance: float = 0.0,
         contact_aware: ContactAwareOptions | bool | None = None,
         velocity_margin: float | None = None,
+        calibration: CalibrationFile | str | os.PathLike[str] | None = None,
     ) -> None:
         if criterion not in CRITERIA:
             raise GovernorError("criterion", criterion, f"must be one of {', '.join(CRITERIA)}")
         self.criterion: Criterion = criterion
         self.posture_tolerance = _tolerance(posture_tolerance)
         aware = _contact_aware(contact_aware, criterion)
-        self.scenario = scenario = _governed(scenario, criterion, velocity_margin)
+        scenario = _governed(scenario, criterion, velocity_margin)
+        #: The calibration whose ZMP margin is in use, or None.
+        self.calibration: CalibrationFile | None = None
+        if calibration is not None:
+            self.calibration, scenario = _calibrated(scenario, calibration)
+        self.scenario = scenario
         #: The velocity margin in use, m/s (the scenario's; 0 with the "zmp" criterion).
         self.velocity_margin = scenario.velocity_margin if criterion == "com" else 0.0
         self.robot: Robot = scenario.load_robot()
@@ -604,6 +620,18 @@ def _governed(
     if scenario.velocity_margin and criterion != "com":
         raise GovernorError("velocity_margin", margin, "applies to the com criterion only")
     return scenario
+
+
+def _calibrated(
+    scenario: Scenario, calibration: CalibrationFile | str | os.PathLike[str]
+) -> tuple[CalibrationFile, Scenario]:
+    """The calibration (read when a path) and ``scenario`` with its ZMP margin."""
+    if isinstance(calibration, CalibrationFile):
+        read, name = calibration, "calibration"
+    else:
+        name = os.fspath(calibration)
+        read = read_calibration(calibration, "calibration")
+    return read, apply_calibration(scenario, read, name, "calibration")
 
 
 def _fixed_in_frame(contact: dict[str, Any], spec: ContactSpec) -> dict[str, Any]:

@@ -237,6 +237,8 @@ class PushOutcome(TrialEntry):
             "zmp_criterion_safe_in_trial": self.safe("zmp_in_trial", margin, omega),
             # Before the trial, in the area the score uses (with the margin): m/s, >= 0 inside.
             "com_velocity_margin": float(self.prediction.com_velocity_margin - omega * margin),
+            # The same, without the margin (m/s): what a calibration compares with omega M.
+            "predicted_com_velocity_margin": float(self.prediction.com_velocity_margin),
             "predicted_com_velocity": self.prediction.com_velocity.tolist(),
             "predicted_zmp": self.prediction.zmp.tolist(),
             "trial": s,
@@ -262,6 +264,8 @@ class PushTestResult:
     journal: str | None = None
     reused: int = 0
     band: tuple[float, float] | None = None
+    body: str | None = None
+    robot: str | None = None
 
     @property
     def scored(self) -> list[PushOutcome]:
@@ -376,6 +380,8 @@ class PushTestResult:
         """JSON-ready: ``push-test --json``."""
         return {
             "scenario": self.scenario,
+            "robot": self.robot,
+            "body": self.body,
             "zmp_margin": self.zmp_margin,
             "controller_margin": self.controller_margin,
             "omega": self.omega,
@@ -539,4 +545,6 @@ def push_test(
         None if journal.path is None else str(journal.path),
         reused,
         None if band is None else (float(band[0]), float(band[1])),
+        mujoco.mj_id2name(setup.sim.model, mujoco.mjtObj.mjOBJ_BODY, body_id),
+        a.stance.robot.name,
     )
