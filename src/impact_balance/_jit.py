@@ -5,6 +5,9 @@ numba is a dependency; the fallback keeps the library importable where its wheel
 runs the same code interpreted without importing numba: loading numba and its cached kernels
 costs more than one interpreted analysis, so the one-shot ``impact-balance analyze`` command
 runs that way unless the variable says otherwise.
+
+:class:`KernelClock` times a block of code without the time numba spends loading or compiling
+kernels in it, and reports that time apart (what the first analysis of an installation pays).
 """
 
 from __future__ import annotations
@@ -12,10 +15,13 @@ from __future__ import annotations
 import hashlib
 import os
 import pickle
+import time
+from collections.abc import Iterator
+from contextlib import ExitStack, contextmanager
 from types import ModuleType
 from typing import Any
 
-__all__ = ["HAVE_NUMBA", "JIT_VARIABLE", "cache_depends_on", "njit"]
+__all__ = ["HAVE_NUMBA", "JIT_VARIABLE", "KernelClock", "cache_depends_on", "njit"]
 
 #: The environment variable that turns compilation off ("0", "false", "no" or "off").
 JIT_VARIABLE = "IMPACT_BALANCE_JIT"
@@ -60,3 +66,54 @@ def cache_depends_on(dispatcher: Any, *modules: ModuleType) -> Any:
     except (AttributeError, OSError, TypeError):
         pass
     return dispatcher
+
+
+class KernelClock:
+    """A clock that stops while numba loads or compiles a kernel.
+
+    Inside :meth:`running`, :meth:`now` is ``time.perf_counter()`` (s) less the time spent in
+    numba's compiler so far; that time is :attr:`loading` (s: a cached kernel loaded or a
+    kernel compiled), of which :attr:`compiling` (s) compiled. Both stay 0 without numba or
+    once every kernel a block calls is loaded. numba's compiler events are process-wide: a
+    kernel another thread loads meanwhile is counted too.
+    """
+
+    def __init__(self) -> None:
+        #: Seconds spent in numba's compiler lock (loading from its cache, or compiling).
+        self.loading = 0.0
+        #: Seconds of :attr:`loading` spent compiling (numba's cache had no kernel).
+        self.compiling = 0.0
+
+    def now(self) -> float:
+        """``time.perf_counter()`` (s) without the kernel time counted so far."""
+        return time.perf_counter() - self.loading
+
+    @contextmanager
+    def running(self) -> Iterator[KernelClock]:
+        """Count numba's loading and compiling while the block runs; yields this clock."""
+        if not HAVE_NUMBA:
+            yield self
+            return
+        from numba.core import event
+
+        clock = self
+
+        class _Timer(event.Listener):
+            def __init__(self, field: str) -> None:
+                self.field, self.depth, self.start = field, 0, 0.0
+
+            def on_start(self, ev: Any) -> None:
+                if self.depth == 0:
+                    self.start = time.perf_counter()
+                self.depth += 1
+
+            def on_end(self, ev: Any) -> None:
+                self.depth -= 1
+                if self.depth == 0:
+                    elapsed = time.perf_counter() - self.start
+                    setattr(clock, self.field, getattr(clock, self.field) + elapsed)
+
+        with ExitStack() as stack:
+            stack.enter_context(event.install_listener("numba:compiler_lock", _Timer("loading")))
+            stack.enter_context(event.install_listener("numba:compile", _Timer("compiling")))
+            yield self

@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
+from impact_balance._jit import KernelClock
 from impact_balance.analysis.diagnostics import diagnose
 from impact_balance.analysis.result import Analysis, ImpactAnswer
 from impact_balance.balance.areas import BalanceAreas, areas_from_polytope, with_reason
@@ -15,7 +17,12 @@ from impact_balance.contacts.stance import Stance
 from impact_balance.contacts.wrench_polytope import WrenchPolytope, wrench_polytope
 from impact_balance.criteria.cap import safe_contact_velocity
 from impact_balance.criteria.com import ComCriterion
-from impact_balance.criteria.qp import QPOptions, solve_contact_velocity_qp, static_torques
+from impact_balance.criteria.qp import (
+    QPOptions,
+    QPResult,
+    solve_contact_velocity_qp,
+    static_torques,
+)
 from impact_balance.criteria.zmp import zmp_max_contact_velocity
 from impact_balance.exceptions import NonFiniteResultError, ScenarioError, SolverError
 from impact_balance.geometry.polygon import Polygon
@@ -70,54 +77,39 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
         raise with_source(exc, scenario.source) from None
     robot.thread_data()  # its scratch pinocchio Data (~2-7 ms, first use per thread): loading too
     timings["robot_loading"] = time.perf_counter() - t
-    kernel = warm_up()  # the compiled projection kernel's one-time load, timed apart
-    if kernel:
-        timings["kernel_loading"] = kernel
-    t0 = time.perf_counter()
-    stance = scenario.build_stance(robot)
-    t1 = time.perf_counter()
-    polytope, areas, t2 = _stance_areas(scenario, stance)
-    t3 = time.perf_counter()
-    timings.update(stance=t1 - t0, constraints=t2 - t1, areas=t3 - t2)
-    if not areas.can_balance:  # explain why (LPs; only for a stance that cannot balance)
-        areas = with_reason(areas, stance, scenario.torque_limits, scenario.gravity)
-        timings["diagnosis"] = time.perf_counter() - t3
-        t3 = time.perf_counter()
-    _check_finite(_area_checks(stance, areas))
-    answer = None
-    if scenario.impact is not None:
-        cfg = scenario.impact
-        try:
-            model = impact_model(stance, cfg.spec())
-        except ScenarioError as exc:
-            raise with_source(exc, scenario.source) from None
-        _check_finite(_impact_checks(model))
-        answer = impact_answer(scenario, stance, areas, model)
-        qp = None
-        if (cfg.qp.solve if solve_qp is None else solve_qp) and cfg.reference_velocity is not None:
-            tau0 = static_torques(stance, polytope) if cfg.qp.impulsive_torque_limits else None
-            options = QPOptions(
-                cfg.qp.joint_velocity_limits,
-                cfg.qp.impulsive_torque_limits,
-                cfg.qp.peak_factor,
-                cfg.duration,
-                cfg.qp.solver,
-            )
+    clock = KernelClock()  # numba's loading and compiling are timed apart from the analysis
+    with clock.running():
+        warm_up()  # the compiled projection kernel's one-time load
+        t0 = clock.now()
+        stance = scenario.build_stance(robot)
+        t1 = clock.now()
+        polytope, areas, t2 = _stance_areas(scenario, stance, clock.now)
+        t3 = clock.now()
+        timings.update(stance=t1 - t0, constraints=t2 - t1, areas=t3 - t2)
+        if not areas.can_balance:  # explain why (LPs; only for a stance that cannot balance)
+            areas = with_reason(areas, stance, scenario.torque_limits, scenario.gravity)
+            timings["diagnosis"] = clock.now() - t3
+            t3 = clock.now()
+        _check_finite(_area_checks(stance, areas))
+        answer = None
+        if scenario.impact is not None:
+            cfg = scenario.impact
             try:
-                qp = solve_contact_velocity_qp(
-                    model,
-                    areas.com_velocity_area.inset(scenario.velocity_margin),
-                    scenario.com_velocity,
-                    cfg.reference_velocity,
-                    stance.robot,
-                    tau0,
-                    options,
+                model = impact_model(stance, cfg.spec())
+            except ScenarioError as exc:
+                raise with_source(exc, scenario.source) from None
+            _check_finite(_impact_checks(model))
+            answer = impact_answer(scenario, stance, areas, model)
+            if cfg.qp.solve if solve_qp is None else solve_qp:
+                answer = dataclasses.replace(
+                    answer, qp=_qp(scenario, stance, polytope, areas, model)
                 )
-            except SolverError as exc:
-                raise exc.within("impact.qp") from None
-        answer = dataclasses.replace(answer, qp=qp)
-        timings["impact"] = time.perf_counter() - t3
-    timings["total"] = time.perf_counter() - t0
+            timings["impact"] = clock.now() - t3
+        timings["total"] = clock.now() - t0
+    if clock.loading:
+        timings["kernel_loading"] = clock.loading
+    if clock.compiling:
+        timings["kernel_compiling"] = clock.compiling
     return Analysis(scenario, stance, areas, answer, timings, diagnose(scenario, stance, answer))
 
 
@@ -143,15 +135,55 @@ def stance_areas(scenario: Scenario, stance: Stance) -> tuple[WrenchPolytope, Ba
     return polytope, areas
 
 
-def _stance_areas(scenario: Scenario, stance: Stance) -> tuple[WrenchPolytope, BalanceAreas, float]:
-    """:func:`stance_areas`, and the time (``time.perf_counter``) between its two steps."""
+def _stance_areas(
+    scenario: Scenario, stance: Stance, now: Callable[[], float] = time.perf_counter
+) -> tuple[WrenchPolytope, BalanceAreas, float]:
+    """:func:`stance_areas`, and the time (s, by the clock ``now``) between its two steps."""
     polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
-    t = time.perf_counter()
+    t = now()
     try:
         areas = areas_from_polytope(polytope, scenario.plane_height, scenario.zmp_margin)
     except SolverError as exc:
         raise exc.within("contacts (projection of the contact wrench polytope)") from None
     return polytope, areas, t
+
+
+def _qp(
+    scenario: Scenario,
+    stance: Stance,
+    polytope: WrenchPolytope,
+    areas: BalanceAreas,
+    model: ImpactModel,
+) -> QPResult | None:
+    """The paper's QP in joint velocities for the scenario's impact (None without a reference).
+
+    Raises:
+        SolverError: The QP failed (its field is ``impact.qp``).
+    """
+    cfg = scenario.impact
+    assert cfg is not None  # called for a scenario with an impact
+    if cfg.reference_velocity is None:
+        return None
+    tau0 = static_torques(stance, polytope) if cfg.qp.impulsive_torque_limits else None
+    options = QPOptions(
+        cfg.qp.joint_velocity_limits,
+        cfg.qp.impulsive_torque_limits,
+        cfg.qp.peak_factor,
+        cfg.duration,
+        cfg.qp.solver,
+    )
+    try:
+        return solve_contact_velocity_qp(
+            model,
+            areas.com_velocity_area.inset(scenario.velocity_margin),
+            scenario.com_velocity,
+            cfg.reference_velocity,
+            stance.robot,
+            tau0,
+            options,
+        )
+    except SolverError as exc:
+        raise exc.within("impact.qp") from None
 
 
 def impact_answer(

@@ -122,8 +122,11 @@ class Analysis:
     ``timings`` (s): ``total`` is the analysis itself (stance, constraints, areas, impact,
     and ``diagnosis`` when it cannot balance), without loading; ``scenario_loading`` (when
     given a name or a path), ``robot_loading`` (the robot model, cached after its first
-    use) and ``kernel_loading`` (the compiled projection kernel, first call of the process
-    only) are apart.
+    use) and ``kernel_loading`` (numba loading or compiling the compiled kernels: the first
+    analysis of a process only) are apart, and ``kernel_compiling`` is the part of
+    ``kernel_loading`` spent compiling (the first run after an installation only). The
+    stage times (``stance``, ``constraints``, ``areas``, ``impact``) leave the kernels'
+    loading out too.
     """
 
     scenario: Scenario

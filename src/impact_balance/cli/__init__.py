@@ -84,6 +84,7 @@ COMMANDS: tuple[ModuleType, ...] = (
 
 
 def _kernel_is_compiled() -> bool:
+    """Whether numba's on-disk cache holds the projection kernel (else a run compiles it)."""
     # Imported here: the kernel's module brings numba and scipy, which `robots` does not need.
     from impact_balance.projection.walk import kernel_is_compiled
 
@@ -111,6 +112,7 @@ def _interpret_kernels() -> None:
 
 
 def _version() -> str:
+    """The installed version of impact-balance, or "unknown (not installed)"."""
     import importlib.metadata  # here: only --version reads it (the import costs ~50 ms)
 
     try:
@@ -143,6 +145,7 @@ class _Stdout:
         self.broken = False
 
     def _failed(self, exc: OSError) -> EnvironmentFailure:
+        """The :class:`EnvironmentFailure` of a failed write to this stream."""
         reason = (
             "it is closed"
             if self._stream is None
@@ -151,6 +154,7 @@ class _Stdout:
         return EnvironmentFailure("standard output", None, f"cannot write the output: {reason}")
 
     def write(self, text: str) -> int:
+        """Write ``text``; a failure other than a closed pipe names standard output."""
         if self._stream is None:
             raise self._failed(OSError(errno.EBADF, "closed"))
         try:
@@ -162,6 +166,7 @@ class _Stdout:
             raise self._failed(exc) from None
 
     def flush(self) -> None:
+        """Flush the stream; a failure other than a closed pipe names standard output."""
         if self._stream is None:
             return
         try:
@@ -173,6 +178,7 @@ class _Stdout:
             raise self._failed(exc) from None
 
     def isatty(self) -> bool:
+        """Whether the stream is a terminal (False when it is closed)."""
         return self._stream is not None and self._stream.isatty()
 
     def __getattr__(self, name: str) -> Any:
@@ -192,6 +198,7 @@ def _stdout_pipe_closed() -> bool:
 
 
 def _broken_pipe(exc: BaseException) -> bool:
+    """Whether ``exc`` is a closed pipe (``EPIPE``), whoever raised it."""
     return isinstance(exc, BrokenPipeError) or (
         isinstance(exc, OSError) and exc.errno == errno.EPIPE
     )
@@ -202,6 +209,7 @@ class _Terminated(KeyboardInterrupt):
 
 
 def _on_sigterm(signum: int, frame: Any) -> None:
+    """The SIGTERM handler: raise :class:`_Terminated` in the main thread."""
     raise _Terminated("SIGTERM")
 
 
@@ -284,6 +292,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _parser() -> tuple[argparse.ArgumentParser, dict[str, ModuleType]]:
+    """The ``impact-balance`` parser, and the module that runs each command name."""
     p = _Parser(
         prog="impact-balance",
         description="Impact-aware multi-contact balance: CoM velocity area and maximum contact "

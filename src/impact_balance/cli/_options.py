@@ -78,6 +78,7 @@ class CommandLineError(ImpactBalanceError):
 
 
 def _refused(exc: OptionError) -> CommandLineError:
+    """The :class:`CommandLineError` of an option the library refused."""
     return CommandLineError(exc.field, exc.value, exc.reason)
 
 
@@ -88,6 +89,7 @@ def output_folder(field: str) -> Callable[[str], str]:
     """
 
     def check(text: str) -> str:
+        """The folder checked before anything runs, else :class:`CommandLineError`."""
         from impact_balance.cli.output_paths import check_output_folder
 
         try:
@@ -107,6 +109,7 @@ def output_file(field: str, suffixes: Sequence[str] = ()) -> Callable[[str], str
     """
 
     def check(text: str) -> str:
+        """The file checked before anything runs, else :class:`CommandLineError`."""
         from impact_balance.cli.output_paths import check_output_file
 
         try:
@@ -120,6 +123,7 @@ def output_file(field: str, suffixes: Sequence[str] = ()) -> Callable[[str], str
 
 
 def _interval(lo: float, hi: float, lo_open: bool, unit: str) -> str:
+    """An interval as written in messages: ``[lo, hi] unit`` or ``(lo, hi] unit``."""
     return f"{'(' if lo_open else '['}{lo:g}, {hi:g}]{f' {unit}' if unit else ''}"
 
 
@@ -134,6 +138,7 @@ def number(
     span = _interval(lo, hi, lo_open, unit)
 
     def check(text: str) -> float:
+        """``text`` as a finite float in the interval, else :class:`CommandLineError`."""
         try:
             value = float(text)
         except ValueError:
@@ -151,6 +156,7 @@ def integer(field: str, lo: int, hi: int, why: str = "") -> Callable[[str], int]
     """Argparse type: an integer in ``[lo, hi]`` for option ``field``."""
 
     def check(text: str) -> int:
+        """``text`` as an integer in ``[lo, hi]``, else :class:`CommandLineError`."""
         try:
             value = int(text)
         except ValueError:
@@ -191,6 +197,7 @@ def add_trial_joints_option(parser: argparse.ArgumentParser) -> None:
     """
 
     def check(text: str) -> str:
+        """The joint model; the deprecated ``rigid`` is ``stiff``, with one line on stderr."""
         if text == "rigid":
             import sys
 
@@ -282,6 +289,7 @@ def a_number(field: str) -> Callable[[str], float]:
     """
 
     def check(text: str) -> float:
+        """``text`` as a float, else :class:`CommandLineError` ("not a number")."""
         try:
             return float(text)
         except ValueError:

@@ -316,14 +316,17 @@ def _print_text(
 
 
 def _f(x: float | None) -> str:
+    """A speed (m/s) with 3 decimals, or "-" when there is none."""
     return "-" if x is None else f"{x:.3f} m/s"
 
 
 def _s(x: float | None) -> str:
+    """A time (s) with 2 decimals, or "never (gave up)" when there is none."""
     return "never (gave up)" if x is None else f"{x:.2f} s"
 
 
 def _plot(trial: WallTrial, setup: BalanceSetup, out: Path, zmp_margin: float) -> Path:
+    """Write the trial's approach figure into ``out``; returns its path."""
     from impact_balance.plots.approach import plot_approach
     from impact_balance.plots.save import figure_prefix
 

@@ -109,6 +109,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _plots(check: LogCheck, out: Path) -> list[Path]:
+    """Write the log's margin figure into ``out``; returns the paths written."""
     from impact_balance.plots.balance import plot_log_margins
 
     out.mkdir(parents=True, exist_ok=True)

@@ -92,6 +92,7 @@ def robot_listing(
 
 
 def _vec(v: Sequence[float]) -> str:
+    """A vector as ``[+x.xxx +y.yyy ...]`` (3 decimals, signed)."""
     return "[" + " ".join(f"{x:+.3f}" for x in v) + "]"
 
 

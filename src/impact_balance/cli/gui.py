@@ -86,6 +86,7 @@ def run(args: argparse.Namespace) -> int:
     origins = tuple(normalize_origin(o) for o in args.allow_origin)
 
     def ready(app: GuiApp) -> None:
+        """Print the URL, the workspace and the extra origins once the server listens."""
         print(
             f"impact-balance gui: {app.session.state.scenario.name or 'scenario'} at {app.url}  "
             "(Ctrl-C to stop)\n"

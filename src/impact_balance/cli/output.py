@@ -37,6 +37,7 @@ class NonFiniteOutputError(ImpactBalanceError):
 
 
 def _non_finite_path(obj: Any, path: str = "") -> str | None:
+    """Where the first non-finite float of a JSON value is (``a.b[2]``), or None."""
     stack = [(obj, path)]
     while stack:
         node, where = stack.pop()

@@ -28,6 +28,11 @@ __all__ = ["check_output_file", "check_output_folder", "writing"]
 
 
 def _text(field: str, path: str | os.PathLike[str]) -> Path:
+    """An output path's text checked (not empty, no NUL, not too long) as a Path.
+
+    Raises:
+        OptionError: The name is empty, holds a NUL or is too long (naming ``field``).
+    """
     text = os.fspath(path)
     if not isinstance(text, str) or not text.strip():
         raise OptionError(field, text, "an empty name")

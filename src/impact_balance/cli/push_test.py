@@ -132,6 +132,7 @@ def run(args: argparse.Namespace) -> int:
     bar = progress_bar(f"push-test {scenario.name}", args.directions * levels)
 
     def progress(outcome: PushOutcome) -> None:
+        """Advance the progress bar by one push, with its magnitude and outcome."""
         bar.update(1)
         bar.set_postfix_str(f"{outcome.push.magnitude:.1f} N s {outcome.outcome}")
 
@@ -208,10 +209,12 @@ def _relative_levels(args: argparse.Namespace) -> list[float] | None:
 
 
 def _pct(x: float | None) -> str:
+    """A fraction as a percentage with 1 decimal, or "-" when there is none."""
     return "-" if x is None else f"{100 * x:.1f} %"
 
 
 def _ci(c: list[float] | None) -> str:
+    """A Wilson interval as `` [lo, hi]`` in percent, or "" when there is none."""
     return "" if c is None else f" [{100 * c[0]:.0f}, {100 * c[1]:.0f}]"
 
 
@@ -244,6 +247,7 @@ def _score_lines(scores: dict[str, Any], title: str) -> list[str]:
 
 
 def _text(result: PushTestResult, out: dict[str, Any], args: argparse.Namespace) -> str:
+    """The text report of a push test: outcomes, scores and the table per push level."""
     counts = out["counts"]
     o = counts["outcomes"]
     controller = out["controller"].get("name", args.controller)
@@ -295,6 +299,7 @@ def _text(result: PushTestResult, out: dict[str, Any], args: argparse.Namespace)
 
 
 def _by_level(result: PushTestResult) -> list[dict[str, Any]]:
+    """The outcomes counted per push level (fraction of the boundary, or N s)."""
     rows: dict[float, dict[str, Any]] = {}
     for o in result.outcomes:
         level = o.relative if o.relative is not None else o.push.magnitude
@@ -335,6 +340,7 @@ def _telling(result: PushTestResult) -> PushOutcome:
 
 
 def _plots(result: PushTestResult, out: Path) -> list[Path]:
+    """Write the push figures (ZMP and CoM velocity) into ``out``; returns their paths."""
     from impact_balance.plots.balance import PushView, plot_push_trajectories
     from impact_balance.plots.save import figure_prefix
 

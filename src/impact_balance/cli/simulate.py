@@ -127,11 +127,13 @@ def parse_speeds(text: str) -> list[float]:
 
 
 def _per_speed(path: str, speed: float, several: bool) -> Path:
+    """The output path of one speed: ``name_<speed>.ext`` when several are simulated."""
     p = Path(path)
     return p.with_name(f"{p.stem}_{speed:g}{p.suffix}") if several else p
 
 
 def _table(name: str, r: TrialResult) -> str:
+    """The text report of one trial: the measured CoM velocity jump against each prediction."""
     jump = r.com_velocity_jump_measured
     size = float(math.hypot(*jump))
     lines = [

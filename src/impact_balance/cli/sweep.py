@@ -29,6 +29,7 @@ USES_KERNEL = True
 
 
 def _positive(text: str) -> int:
+    """An integer >= 1 (argparse type; a bad value is a usage error)."""
     try:
         value = int(text)
     except ValueError:
@@ -39,6 +40,7 @@ def _positive(text: str) -> int:
 
 
 def _seconds(text: str) -> float:
+    """A positive, finite number of seconds (argparse type)."""
     import math
 
     try:
@@ -51,6 +53,7 @@ def _seconds(text: str) -> float:
 
 
 def _scheduler(text: str) -> str:
+    """A Dask scheduler address ``tcp://HOST:PORT``, checked (refused: exit 2)."""
     from impact_balance.exceptions import OptionError
     from impact_balance.sweep.cluster import check_scheduler_address
 
@@ -138,6 +141,7 @@ def add_parser(sub: Subcommands) -> list[str]:
 
 
 def _print(summary: dict[str, Any], as_json: bool) -> None:
+    """Print a sweep summary as text or as one JSON document."""
     from impact_balance.sweep.summary import format_summary
 
     if as_json:
@@ -147,10 +151,12 @@ def _print(summary: dict[str, Any], as_json: bool) -> None:
 
 
 def _warn(line: str) -> None:
+    """Print one ``impact-balance: warning:`` line on stderr."""
     print(f"impact-balance: warning: {line}", file=sys.stderr, flush=True)
 
 
 def _verify(args: argparse.Namespace) -> int:
+    """``sweep --verify``: check every part of a results folder; 0 if sound, 2 if not."""
     from impact_balance.sweep.store import check_folder
 
     check = check_folder(args.verify)

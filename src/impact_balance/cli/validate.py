@@ -109,6 +109,7 @@ def run(args: argparse.Namespace) -> int:
     bar = progress_bar(f"validate {scenario.name}")
 
     def progress(trial: ValidationTrial, stood: float | None, fell: float | None) -> None:
+        """Advance the progress bar by one trial, with the bracket so far."""
         bar.update(1)
         lo = "?" if stood is None else f"{stood:.3f}"
         hi = "?" if fell is None else f"{fell:.3f}"
@@ -166,6 +167,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _f(x: float | None) -> str:
+    """A speed (m/s) with 3 decimals, or "-" when there is none."""
     return "-" if x is None else f"{x:.3f} m/s"
 
 
@@ -181,6 +183,7 @@ def _verdict_line(v: dict[str, Any]) -> str:
 
 
 def _text(out: dict[str, Any], args: argparse.Namespace, n: int) -> str:
+    """The text report of ``validate``: the fall bracket, the verdict and the predictions."""
     e, p, pm = out["empirical"], out["predicted"], out["predicted_with_margin"]
     impact = (
         "rigid impact (joints held through the impact)" if out["rigid_impact"] else "free impact"
@@ -237,6 +240,7 @@ def _text(out: dict[str, Any], args: argparse.Namespace, n: int) -> str:
 
 
 def _plots(result: ValidationResult, out: Path) -> list[Path]:
+    """Write the validation figures into ``out``; returns their paths."""
     from impact_balance.plots.balance import plot_impact_trajectories, plot_validation
     from impact_balance.plots.save import figure_prefix
 
