@@ -406,7 +406,15 @@ def open_journal(
         "command": command,
         "trial_version": TRIAL_VERSION,
         "scenario": scenario.model_dump(
-            mode="json", exclude={"zmp_margin", "velocity_margin", "name", "description"}
+            # The criterion's settings judge trials; they are not an input of any trial.
+            mode="json",
+            exclude={
+                "zmp_margin",
+                "velocity_margin",
+                "angular_momentum_damping_time",
+                "name",
+                "description",
+            },
         ),
         "joints": joints,
         "options": dataclasses.asdict(dataclasses.replace(options, record=False)),
