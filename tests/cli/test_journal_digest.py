@@ -9,9 +9,9 @@ import pytest
 
 pytest.importorskip("mujoco")
 
-from impact_balance.cli._options import open_journal  # noqa: E402
-from impact_balance.scenario import load_scenario  # noqa: E402
-from impact_balance.sim.trials.balance_trial import BalanceTrialOptions  # noqa: E402
+from impact_balance.cli._options import open_journal
+from impact_balance.scenario import load_scenario
+from impact_balance.sim.trials.balance_trial import BalanceTrialOptions
 
 
 def _digest(scenario: object, tmp_path: Path) -> str:
