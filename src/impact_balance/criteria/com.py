@@ -92,10 +92,13 @@ class ComCriterion:
     inside the area (the area eroded by a disc of radius d: each half-plane moved in by d), a
     margin for the impact model's error; 0 is the paper's criterion.
 
-    With an ``angular_momentum`` term, the post-impact vertices are the *effective* CoM
-    velocities ``c0 + s (d_j + gain S((p - c) x iota_j) / m)`` that count the centroidal angular
-    momentum the impulse leaves (:mod:`impact_balance.impact.angular_momentum`); None is the
-    paper's criterion.
+    With an ``angular_momentum`` term, the post-impact vertices are the paper's ``c0 + s d_j``
+    *and* the effective CoM velocities ``c0 + s (d_j + gain S((p - c) x iota_j) / m)`` that
+    count the centroidal angular momentum the impulse leaves, removed with time constant tau
+    (:mod:`impact_balance.impact.angular_momentum`): the contacts remove it at a rate between
+    1/tau and 0, and the area being convex, both ends inside means every rate between is. The
+    term can then only lower the paper's answer (an impulse below the CoM, whose effective
+    velocity is smaller, keeps the paper's). None is the paper's criterion.
 
     Attributes:
         name: "com".
@@ -136,7 +139,12 @@ class ComCriterion:
         self.G, self.h = G, h
         impulse_rates = impact.impulse_rates
         if angular_momentum is not None and angular_momentum.gain != 0.0:
-            impulse_rates = effective_impulse_rates(impulse_rates, angular_momentum)
+            # The rate at which the contacts remove the angular momentum lies between 1/tau and
+            # 0 (never): the capture must hold at both ends, hence (the area being convex) at
+            # every rate between. Both vertex sets, the paper's and the effective one.
+            impulse_rates = np.vstack(
+                [impulse_rates, effective_impulse_rates(impulse_rates, angular_momentum)]
+            )
         self.rates = _jump_rates(impulse_rates, float(impact.mass), G)
 
     def margins(self, com_velocity: npt.ArrayLike) -> npt.NDArray[np.float64]:

@@ -202,10 +202,16 @@ class PushPrediction:
 
     @property
     def default_com_velocity_margin(self) -> float:
-        """The margin of the project's default prediction (the effective one when set), m/s."""
+        """The margin of the project's default prediction, m/s.
+
+        With the angular momentum counted, the smaller of the paper's and the effective
+        velocity's margins: the capture must hold whether the contacts remove the angular
+        momentum with the damping time or never (see
+        :class:`~impact_balance.criteria.com.ComCriterion`).
+        """
         if self.effective_com_velocity_margin is None:
             return self.com_velocity_margin
-        return self.effective_com_velocity_margin
+        return min(self.com_velocity_margin, self.effective_com_velocity_margin)
 
 
 @dataclass(kw_only=True)
