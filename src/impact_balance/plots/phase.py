@@ -7,7 +7,13 @@ from matplotlib.figure import Figure
 
 from impact_balance.analysis.analyze import Analysis
 from impact_balance.balance.lipm import PhasePortrait, phase_portrait
-from impact_balance.plots.style import new_figure
+from impact_balance.plots.style import (
+    COM_COLOR,
+    FONT_SMALL,
+    FONT_TITLE,
+    IMPACT_COLOR,
+    new_figure,
+)
 
 __all__ = ["analysis_phase_portrait", "plot_phase_portrait"]
 
@@ -52,11 +58,25 @@ def analysis_phase_portrait(analysis: Analysis, axis: int = 0) -> PhasePortrait:
     return phase_portrait(float(com[2] - areas.plane_height), (float(lo), float(hi)), areas.gravity)
 
 
-def plot_phase_portrait(portrait: PhasePortrait, title: str | None = None) -> Figure:
+def plot_phase_portrait(
+    portrait: PhasePortrait,
+    title: str | None = None,
+    pre_impact: float | None = None,
+    post_impact: tuple[float, float] | None = None,
+    post_label: str = "post-impact CoM velocities",
+) -> Figure:
     """LIPM phase portrait (c in m, cd in m/s) with the stable standing region shaded.
 
     The region lies between the lines c + cd / omega = z_lo and z_hi; its intersection with
     c = 0 gives the CoM velocity bounds, marked and annotated.
+
+    Args:
+        portrait: The phase portrait.
+        title: The title (default: the portrait's height, ZMP range and omega).
+        pre_impact: A CoM velocity at c = 0 to mark (m/s), e.g. the stance's pre-impact one.
+        post_impact: A range of CoM velocities at c = 0 to draw as a segment (m/s, lowest and
+            highest), e.g. the post-impact ones at the maximum contact velocity.
+        post_label: The legend entry of ``post_impact``.
     """
     w = portrait.omega
     z_lo, z_hi = portrait.zmp_range
@@ -92,7 +112,7 @@ def plot_phase_portrait(portrait: PhasePortrait, title: str | None = None) -> Fi
                 (cx, cd),
                 xytext=(-6 if right_half else 6, 0),
                 textcoords="offset points",
-                fontsize=8,
+                fontsize=FONT_SMALL,
                 color="darkgreen",
                 va="center",
                 ha="right" if right_half else "left",
@@ -120,26 +140,50 @@ def plot_phase_portrait(portrait: PhasePortrait, title: str | None = None) -> Fi
                 xytext=traj[i],
                 arrowprops={"arrowstyle": "->", "color": "0.35", "lw": 0.9},
             )
-    ax.axvline(0.0, color="tab:green", lw=1.2, ls="--", label="c = 0 (CoM at the reference)")
+    ax.axvline(0.0, color="#009E73", lw=1.2, ls="--", label="c = 0 (CoM at the reference)")
     ax.axhline(0.0, color="0.6", lw=0.6)
     # The values go in the legend, outside the axes: a label beside the points was crossed by
     # the trajectories that converge there.
     ax.plot(
         [0.0, 0.0],
         [v_lo, v_hi],
-        "o",
-        color="tab:red",
-        ms=8,
+        "D",
+        color="#0072B2",
+        ms=7,
         zorder=5,
         label=f"CoM velocity bounds at c = 0: {v_lo:+.4f} and {v_hi:+.4f} m/s",
     )
+    if post_impact is not None:
+        ax.plot(
+            [0.0, 0.0],
+            sorted(post_impact),
+            "-",
+            color=IMPACT_COLOR,
+            lw=5,
+            alpha=0.8,
+            solid_capstyle="butt",
+            zorder=4,
+            label=f"{post_label}: {min(post_impact):+.4f} to {max(post_impact):+.4f} m/s",
+        )
+    if pre_impact is not None:
+        ax.plot(
+            [0.0],
+            [pre_impact],
+            "o",
+            color=COM_COLOR,
+            mfc="white",
+            mew=2,
+            ms=8,
+            zorder=6,
+            label=f"pre-impact CoM velocity {pre_impact:+.4f} m/s",
+        )
     ax.set_xlim(*xlim)
     ax.set_ylim(*ylim)
     ax.set_xlabel("CoM position c (m)")
     ax.set_ylabel(r"CoM velocity $\dot c$ (m/s)")
     ax.grid(True, alpha=0.3)
     # Below the axes: inside, the trajectories run under it wherever it goes.
-    fig.legend(loc="outside lower center", ncol=2, fontsize=8.5, framealpha=0.9)
+    fig.legend(loc="outside lower center", ncol=2, fontsize=FONT_SMALL, framealpha=0.9)
     gravity = w * w * portrait.com_height  # omega = sqrt(g / h)
     ax.set_title(
         title
@@ -147,6 +191,6 @@ def plot_phase_portrait(portrait: PhasePortrait, title: str | None = None) -> Fi
             f"LIPM phase portrait: CoM height {portrait.com_height:.3g} m, "
             f"ZMP in [{z_lo:.3g}, {z_hi:.3g}] m,\nω = {w:.4f} 1/s with g = {gravity:.4g} m/s²"
         ),
-        fontsize=10,
+        fontsize=FONT_TITLE,
     )
     return fig
