@@ -38,6 +38,7 @@ from impact_balance.plots.style import (
     draw_polygon,
     new_figure,
     set_limits,
+    trim_height,
 )
 
 __all__ = [
@@ -243,6 +244,7 @@ def plot_impact_trajectories(result: Any, analysis: Analysis) -> Figure:
         fontsize=FONT_SMALL,
         frameon=False,
     )
+    trim_height(fig, [ax])
     return fig
 
 
@@ -341,6 +343,7 @@ def plot_push_trajectories(result: Any, kind: PushView = "com_velocity") -> Figu
         title_fontsize=FONT_SMALL,
     )
     legend.get_title().set_color("0.3")
+    trim_height(fig, [ax])
     return fig
 
 

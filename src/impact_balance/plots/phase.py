@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from impact_balance.analysis.analyze import Analysis
@@ -56,6 +57,65 @@ def analysis_phase_portrait(analysis: Analysis, axis: int = 0) -> PhasePortrait:
             "the ZMP support area has no bounded chord through the CoM along this axis"
         )
     return phase_portrait(float(com[2] - areas.plane_height), (float(lo), float(hi)), areas.gravity)
+
+
+def _draw_trajectories(
+    ax: Axes, portrait: PhasePortrait, xlim: tuple[float, float], ylim: tuple[float, float]
+) -> None:
+    """The portrait's LIPM trajectories, each with an arrow a third of the way in the view."""
+    for k, traj in enumerate(portrait.trajectories):
+        traj = np.asarray(traj, dtype=float)
+        if len(traj) < 2:
+            continue
+        ax.plot(
+            traj[:, 0],
+            traj[:, 1],
+            "-",
+            color="0.45",
+            lw=0.8,
+            label="LIPM trajectories, saturated ZMP feedback" if k == 0 else None,
+        )
+        inside = np.flatnonzero(
+            (traj[:, 0] > xlim[0]) & (traj[:, 0] < xlim[1]) & (np.abs(traj[:, 1]) < ylim[1])
+        )
+        if len(inside) > 4:
+            i = inside[len(inside) // 3]
+            ax.annotate(
+                "",
+                xy=traj[i + 1],
+                xytext=traj[i],
+                arrowprops={"arrowstyle": "->", "color": "0.35", "lw": 0.9},
+            )
+
+
+def _draw_velocities(
+    ax: Axes, pre: float | None, post: tuple[float, float] | None, post_label: str
+) -> None:
+    """A CoM velocity (a point) and a range of them (a segment) at c = 0, m/s."""
+    if post is not None:
+        ax.plot(
+            [0.0, 0.0],
+            sorted(post),
+            "-",
+            color=IMPACT_COLOR,
+            lw=5,
+            alpha=0.8,
+            solid_capstyle="butt",
+            zorder=4,
+            label=f"{post_label}: {min(post):+.4f} to {max(post):+.4f} m/s",
+        )
+    if pre is not None:
+        ax.plot(
+            [0.0],
+            [pre],
+            "o",
+            color=COM_COLOR,
+            mfc="white",
+            mew=2,
+            ms=8,
+            zorder=6,
+            label=f"pre-impact CoM velocity {pre:+.4f} m/s",
+        )
 
 
 def plot_phase_portrait(
@@ -117,29 +177,7 @@ def plot_phase_portrait(
                 va="center",
                 ha="right" if right_half else "left",
             )
-    for k, traj in enumerate(portrait.trajectories):
-        traj = np.asarray(traj, dtype=float)
-        if len(traj) < 2:
-            continue
-        ax.plot(
-            traj[:, 0],
-            traj[:, 1],
-            "-",
-            color="0.45",
-            lw=0.8,
-            label="LIPM trajectories, saturated ZMP feedback" if k == 0 else None,
-        )
-        inside = np.flatnonzero(
-            (traj[:, 0] > xlim[0]) & (traj[:, 0] < xlim[1]) & (np.abs(traj[:, 1]) < ylim[1])
-        )
-        if len(inside) > 4:
-            i = inside[len(inside) // 3]
-            ax.annotate(
-                "",
-                xy=traj[i + 1],
-                xytext=traj[i],
-                arrowprops={"arrowstyle": "->", "color": "0.35", "lw": 0.9},
-            )
+    _draw_trajectories(ax, portrait, xlim, ylim)
     ax.axvline(0.0, color="#009E73", lw=1.2, ls="--", label="c = 0 (CoM at the reference)")
     ax.axhline(0.0, color="0.6", lw=0.6)
     # The values go in the legend, outside the axes: a label beside the points was crossed by
@@ -153,30 +191,7 @@ def plot_phase_portrait(
         zorder=5,
         label=f"CoM velocity bounds at c = 0: {v_lo:+.4f} and {v_hi:+.4f} m/s",
     )
-    if post_impact is not None:
-        ax.plot(
-            [0.0, 0.0],
-            sorted(post_impact),
-            "-",
-            color=IMPACT_COLOR,
-            lw=5,
-            alpha=0.8,
-            solid_capstyle="butt",
-            zorder=4,
-            label=f"{post_label}: {min(post_impact):+.4f} to {max(post_impact):+.4f} m/s",
-        )
-    if pre_impact is not None:
-        ax.plot(
-            [0.0],
-            [pre_impact],
-            "o",
-            color=COM_COLOR,
-            mfc="white",
-            mew=2,
-            ms=8,
-            zorder=6,
-            label=f"pre-impact CoM velocity {pre_impact:+.4f} m/s",
-        )
+    _draw_velocities(ax, pre_impact, post_impact, post_label)
     ax.set_xlim(*xlim)
     ax.set_ylim(*ylim)
     ax.set_xlabel("CoM position c (m)")

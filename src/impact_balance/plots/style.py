@@ -113,7 +113,7 @@ def new_figure(width: float, height: float) -> Figure:
     No global state is touched (no ``matplotlib.use``, no pyplot figure manager), so these
     functions are safe in scripts, tests and notebooks alike; ``fig.savefig`` renders with Agg.
     """
-    fig = Figure(figsize=(width, height), layout="constrained")
+    fig = Figure(figsize=(width, height), dpi=DPI, layout="constrained")
     # A wider margin than the default (3 pt): a legend anchored outside its axes otherwise
     # ends on the canvas' edge, where its frame is cut.
     engine = fig.get_layout_engine()
@@ -337,8 +337,7 @@ def trim_height(fig: Figure, axes: Sequence[Axes], passes: int = 2, width: bool 
         # Never narrower than a title: an axes keeps its title's width.
         renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]
         room = min(
-            (ax.get_window_extent().width - ax.title.get_window_extent(renderer).width)
-            / fig.dpi
+            (ax.get_window_extent().width - ax.title.get_window_extent(renderer).width) / fig.dpi
             for ax in axes
         )
         cut_w = min(cut_w, max(room, 0.0) * len(axes))
