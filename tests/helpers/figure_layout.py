@@ -23,6 +23,7 @@ import re
 
 import numpy as np
 from matplotlib.axes import Axes
+from matplotlib.collections import PathCollection
 from matplotlib.figure import Figure
 from matplotlib.legend import Legend
 from matplotlib.patches import Patch
@@ -261,8 +262,7 @@ def _filled_paths(ax: Axes):
             if artist.get_fill() and face[3] > 0:
                 out.append(artist.get_transform().transform_path(artist.get_path()))
         elif hasattr(artist, "get_paths") and len(artist.get_facecolor()):
-            offsets = artist.get_offsets() if hasattr(artist, "get_offsets") else None
-            if offsets is not None and len(offsets) and len(artist.get_paths()) <= 1:
+            if isinstance(artist, PathCollection):
                 continue  # scatter markers: points, checked as data points
             out += [artist.get_transform().transform_path(p) for p in artist.get_paths()]
     return out

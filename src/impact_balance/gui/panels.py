@@ -143,11 +143,14 @@ class PanelsMixin(GuiHost):
 
         The form the scenario gives is editable; the other one shows the same rotation, disabled.
         """
-        mode = mode_of(self.session.state.get(("contacts", index), {}))
+        raw = self.session.state.get(("contacts", index), {})
+        mode = mode_of(raw)
         stance = self.session.analysis.stance
         contact = stance.contacts[index]
         frame_rotation = stance.frame_pose(contact.spec.frame).rotation
         normal, angle = normal_angle(frame_rotation, contact.rotation)
+        if mode == WORLD_NORMAL_MODE:  # as the scenario gives them (the normal at any scale)
+            normal, angle = raw["normal"], float(raw.get("angle") or 0.0)
         rpy = pin.rpy.matrixToRpy(frame_rotation.T @ contact.rotation)
         set_value(self.w_contact_orientation, mode)
         # Rounded to a micro-unit: no "-0.00" for a component at rounding-error level.

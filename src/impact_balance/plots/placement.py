@@ -16,7 +16,7 @@ import numpy as np
 import numpy.typing as npt
 from matplotlib.axes import Axes
 from matplotlib.backend_bases import RendererBase
-from matplotlib.collections import Collection
+from matplotlib.collections import Collection, PathCollection
 from matplotlib.legend import Legend
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
@@ -87,7 +87,7 @@ def covered_points(ax: Axes) -> tuple[npt.NDArray[np.float64], list[Path]]:
         elif isinstance(artist, Collection):
             offsets = np.asarray(artist.get_offsets())
             paths = artist.get_paths()
-            if len(offsets) and len(paths) <= 1:  # scatter markers
+            if isinstance(artist, PathCollection):  # scatter markers
                 points.append(artist.get_offset_transform().transform(offsets))
                 continue
             for path in paths:
