@@ -377,3 +377,8 @@ def test_demo(tmp_path, capsys):
     for p in pngs:
         assert_png(p)
     assert f"{len(pngs)} figures written" in out
+    # The index lists every figure once, with what it shows.
+    index = (tmp_path / "index.md").read_text()
+    for p in pngs:
+        assert index.count(f"[{p.name}]({p.name}): ") == 1, p.name
+    assert "index.md" in out

@@ -2,7 +2,9 @@
 
 The test starts the GUI server on a free port, opens the page, edits the impact friction
 field and waits for the displayed maximum contact velocity to change; then types a bad value
-and checks that it is refused with a message. It saves screenshots under pytest's tmp path.
+and checks that it is refused with a message, cleared by the next good edit. In the Contacts
+tab it switches a sole to its world normal and types a new normal. It saves screenshots
+under pytest's tmp path.
 Last, a page of another local site, in the same browser, tries to open the GUI's WebSocket:
 the server refuses it (its Origin is not the GUI's page).
 
@@ -160,6 +162,59 @@ def test_a_bad_value_is_refused_and_the_page_lives_on(page, app):
     )
     assert vmax_text(page) == f"{app.session.summary.max_contact_velocity:.3f} m/s"
     assert page.locator("#ib-message").count() == 0
+
+
+def _wait_until(condition, what: str, seconds: float = 60.0) -> None:
+    """Poll the server's side until ``condition()`` holds (the page's edits arrive async)."""
+    import time
+
+    end = time.monotonic() + seconds
+    while not condition():
+        assert time.monotonic() < end, f"timed out waiting for {what}"
+        time.sleep(0.1)
+
+
+def _choose(page, label: str, option: str) -> None:
+    """Pick ``option`` in the dropdown labelled ``label``."""
+    page.get_by_label(label, exact=True).click(force=True)
+    page.get_by_role("option", name=option, exact=True).click(force=True)
+
+
+def _vector_inputs(page, label: str):
+    """The inputs of the vector field labelled ``label`` (the label names the first)."""
+    first = page.get_by_label(label, exact=True)
+    return first.locator("xpath=ancestor::div[count(.//input) >= 3][1]").locator("input")
+
+
+def test_a_contact_is_edited_by_its_world_normal(page, app, tmp_path):
+    """In the Contacts tab: the right sole shows its world normal, switches to the normal
+    form, and a typed normal tilts it (analysed, shown); the offset rpy field is disabled."""
+    import math
+
+    page.get_by_role("tab", name="Contacts").click(force=True)
+    _choose(page, "contact", "1: right_sole_link")
+    _wait_until(lambda: app._contact_index == 1, "contact 1 selected")
+    normal = _vector_inputs(page, "world normal")
+    expect(normal.nth(2)).to_have_value("1")  # the flat sole's world normal, shown
+    _choose(page, "orientation", "world normal and angle")
+    _wait_until(
+        lambda: app.session.state.get(("contacts", 1, "normal")) is not None, "the normal form"
+    )
+    expect(_vector_inputs(page, "offset rpy (rad)").first).to_be_disabled()
+    expect(normal.nth(1)).to_be_enabled()
+    normal.nth(1).fill("0.2", force=True)
+    normal.nth(1).press("Enter")
+    _wait_until(
+        lambda: app.session.state.get(("contacts", 1, "normal")) == [0.0, 0.2, 1.0],
+        "the typed normal",
+    )
+    tilted = app.session.analysis.stance.contacts[1].normal
+    assert tilted == pytest.approx([0.0, 0.2 / math.hypot(0.2, 1.0), 1.0 / math.hypot(0.2, 1.0)])
+    expect(page.locator("#ib-vmax-com")).to_have_text(
+        f"{app.session.summary.max_contact_velocity:.3f} m/s"
+    )
+    assert page.locator("#ib-message").count() == 0
+    page.screenshot(path=str(tmp_path / "gui_world_normal.png"))
 
 
 #: Opens a WebSocket to the GUI as viser's client does; resolves to "open" or "refused".

@@ -41,6 +41,7 @@ from impact_balance.gui import (
     scene_objects,
     svg_view,
 )
+from impact_balance.gui.contact_orientation import RPY_MODE, WORLD_NORMAL_MODE
 from impact_balance.gui.scene import CONE_LENGTH, PLANE_LIFT
 from impact_balance.robot.robot import example_robot_data_root, load_robot
 from impact_balance.scenario import load_scenario
@@ -497,19 +498,80 @@ def test_app_refused_value_reverts_the_widget(app):
     assert app.w_impact_edges.value == 16
 
 
-def test_app_angular_momentum_field_sets_the_key_and_the_answer(app):
+def test_app_a_refusal_clears_on_the_next_good_edit(app):
     reset(app)
-    paper = app.session.summary.max_contact_velocity
-    app.w_angular_momentum.value = 0.0
-    try:
-        assert app.session.state.scenario.angular_momentum_damping_time == 0.0
-        extended = app.session.analysis.impact.extended
-        assert app.session.summary.max_contact_velocity == extended.max_contact_velocity < paper
-        assert f'id="ib-vmax-com">{extended.max_contact_velocity:.3f} m/s' in app.w_results.content
-    finally:
-        app.w_angular_momentum.value = -1.0
-    assert app.session.state.scenario.angular_momentum_damping_time is None
-    assert app.session.summary.max_contact_velocity == paper
+    app.w_impact_friction.value = -2.0
+    assert app.session.refused and 'id="ib-message"' in app.w_results.content
+    app.w_gizmos.value = not app.w_gizmos.value  # a view option: not refused, so it clears
+    assert not app.session.refused and 'id="ib-message"' not in app.w_results.content
+    app.w_gizmos.value = not app.w_gizmos.value
+    app.w_impact_edges.value = 2
+    assert app.session.refused
+    app.w_impact_friction.value = 0.3  # a good edit of another field
+    assert not app.session.refused and app.session.message is None
+    assert 'id="ib-message"' not in app.w_results.content
+    reset(app)
+
+
+def test_app_states_the_shared_session(app):
+    from impact_balance.gui.app import SHARED_SESSION_NOTE
+
+    assert "every browser tab" in SHARED_SESSION_NOTE
+    assert app.w_shared_session.content == SHARED_SESSION_NOTE and app.w_shared_session.visible
+
+
+def test_app_edits_a_contact_by_its_world_normal(app):
+    """Switch the right sole to the world-normal form: the fields show its world normal (not
+    "offset rpy 0 0 0"), the rpy field is disabled, and a new normal is analysed."""
+    reset(app)
+    app.w_contact_select.value = "1: right_sole_link"
+    sole = app.session.analysis.stance.contacts[1]
+    assert app.w_contact_orientation.value == RPY_MODE and not app.w_contact_rpy.disabled
+    assert app.w_contact_normal.disabled and app.w_contact_angle.disabled
+    assert np.allclose(app.w_contact_normal.value, sole.normal, atol=1e-6)  # shown, disabled
+    before = app.session.summary.max_contact_velocity
+    app.w_contact_orientation.value = WORLD_NORMAL_MODE
+    raw = app.session.state.get(("contacts", 1))
+    assert raw["normal"] == pytest.approx(sole.normal, abs=1e-9) and "rpy" not in raw["offset"]
+    assert app.session.summary.max_contact_velocity == pytest.approx(before, rel=1e-9)
+    assert app.w_contact_rpy.disabled and not app.w_contact_normal.disabled
+    tilt = math.radians(10.0)
+    app.w_contact_normal.value = (0.0, math.sin(tilt), math.cos(tilt))
+    assert app.session.analysis.stance.contacts[1].normal == pytest.approx(
+        [0.0, math.sin(tilt), math.cos(tilt)], abs=1e-12
+    )
+    app.w_contact_angle.value = 0.25
+    assert app.session.state.get(("contacts", 1, "angle")) == 0.25
+    # Another contact and back: the fields follow the selected contact.
+    app.w_contact_select.value = "0: left_sole_link"
+    assert app.w_contact_orientation.value == RPY_MODE
+    app.w_contact_select.value = "1: right_sole_link"
+    assert app.w_contact_orientation.value == WORLD_NORMAL_MODE
+    assert app.w_contact_angle.value == pytest.approx(0.25)
+    assert app.w_contact_normal.value == pytest.approx(
+        (0.0, math.sin(tilt), math.cos(tilt)), abs=1e-6
+    )  # shown to a micro-unit
+    # Back to rpy: the same contact, written in its frame.
+    rotation = app.session.analysis.stance.contacts[1].rotation
+    app.w_contact_orientation.value = RPY_MODE
+    assert app.session.state.get(("contacts", 1, "normal")) is None
+    assert np.allclose(app.session.analysis.stance.contacts[1].rotation, rotation, atol=1e-9)
+    reset(app)
+
+
+def test_app_saved_file_is_named_after_it(app):
+    reset(app)
+    app.w_file.value = "my_push.yaml"
+    app.w_overwrite.value = True
+    app._save()
+    saved = yaml.safe_load((app.workspace.root / "my_push.yaml").read_text())
+    assert saved["name"] == "my_push" and app.session.state.scenario.name == "my_push"
+    assert saved["description"].startswith(f"edited from {DEFAULT_SCENARIO}: ")
+    assert app.session.message == "saved my_push.yaml" and app.w_file.value == "my_push.yaml"
+    app._save()  # saved again under its own name: name and description kept
+    again = yaml.safe_load((app.workspace.root / "my_push.yaml").read_text())
+    assert again["name"] == "my_push" and again["description"] == saved["description"]
+    reset(app)
 
 
 @pytest.mark.slow
@@ -556,7 +618,8 @@ def test_app_contacts_impact_and_load(app, tmp_path):
     assert app.session.analysis.stance.robot.name == "g1"
     assert "left_knee_joint" in app._joint_widgets and "leg_left_4_joint" not in app._joint_widgets
     app.edit(lambda: app.session.load("gui_test_saved.yaml"))
-    assert app.session.state == saved and "CANNOT BALANCE" in app.w_results.content
+    assert app.session.state == saved.saved_as("gui_test_saved.yaml")
+    assert "CANNOT BALANCE" in app.w_results.content
     reset(app)
     assert app.session.analysis.stance.robot.name == "talos"
 
@@ -638,3 +701,18 @@ def test_cli_gui_serves_and_stops_on_ctrl_c():
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+def test_app_angular_momentum_field_sets_the_key_and_the_answer(app):
+    reset(app)
+    paper = app.session.summary.max_contact_velocity
+    app.w_angular_momentum.value = 0.0
+    try:
+        assert app.session.state.scenario.angular_momentum_damping_time == 0.0
+        extended = app.session.analysis.impact.extended
+        assert app.session.summary.max_contact_velocity == extended.max_contact_velocity < paper
+        assert f'id="ib-vmax-com">{extended.max_contact_velocity:.3f} m/s' in app.w_results.content
+    finally:
+        app.w_angular_momentum.value = -1.0
+    assert app.session.state.scenario.angular_momentum_damping_time is None
+    assert app.session.summary.max_contact_velocity == paper

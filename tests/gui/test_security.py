@@ -146,7 +146,8 @@ def test_load_save_round_trip_in_the_workspace(session, ws):
     assert session.save("sub/tuned.yaml") == ws / "sub" / "tuned.yaml"
     assert session.message == "saved sub/tuned.yaml"
     assert session.load("g1_two_feet") and session.analysis.stance.robot.name == "g1"
-    assert session.load("sub/tuned.yaml") and session.state == edited
+    assert session.load("sub/tuned.yaml") and session.state == edited.saved_as("tuned.yaml")
+    assert session.state.scenario.name == "tuned"  # named after its file
     assert (
         load_scenario(ws / "sub" / "tuned.yaml").impact.friction == 0.3
     )  # an ordinary scenario file

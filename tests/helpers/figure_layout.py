@@ -5,8 +5,13 @@
 - text or a legend outside the canvas (clipped when saved);
 - two texts that overlap (titles, axis labels, tick labels, notes, annotations, legends);
 - a legend or a text drawn over data: a point of a plotted line, polygon edge or marker
-  (sampled along each path every few pixels, in display coordinates) inside its box;
+  (sampled along each path every few pixels, in display coordinates) inside its box, or its
+  box over a filled area (a polygon, a band) of the axes;
+- a text smaller than :data:`MIN_POINTS` at the saved size;
 - an axis label without a unit in parentheses, e.g. ``time (s)``, ``friction (-)``.
+
+:func:`inside_axes` and :func:`data_fill` measure where a box sits and how much of a panel
+its data use.
 
 Tests call :func:`assert_layout`, which fails with every problem at once.
 """
@@ -18,14 +23,18 @@ import re
 
 import numpy as np
 from matplotlib.axes import Axes
+from matplotlib.collections import PathCollection
 from matplotlib.figure import Figure
 from matplotlib.legend import Legend
+from matplotlib.patches import Patch
 from matplotlib.text import Text
 
 #: Pixels of slack in every comparison (anti-aliasing, rounding of the renderer).
 SLACK = 1.0
 #: Spacing of the points sampled along a path, pixels.
 STEP = 3.0
+#: The smallest font size of any text, points at the saved size.
+MIN_POINTS = 8.0
 UNIT = re.compile(r"\(.*\S.*\)|\[.*\S.*\]")
 # : An artist with this gid is background (a full-height band, a reference line): legends may cover
 # it.
@@ -145,8 +154,8 @@ def data_points(ax: Axes) -> list[tuple[str, np.ndarray]]:
                         if artist.get_linestyle() not in ("None", "", " ")
                         else pts
                     )
-                else:
-                    pts = _samples(artist.get_path(), artist.get_transform())
+                else:  # the whole transform first: a log axis' is not affine
+                    pts = _samples(artist.get_transform().transform_path(artist.get_path()), None)
             else:
                 paths = artist.get_paths()
                 offsets = artist.get_offsets() if hasattr(artist, "get_offsets") else None
@@ -219,6 +228,16 @@ def layout_problems(fig: Figure, units: bool = True, dpi: float = 120) -> list[s
                         else f"text {box_artist.get_text()[:30]!r}"
                     )
                     problems.append(f"{what} covers {int(hit.sum())} points of {label!r}")
+    problems += _fill_problems(fig, renderer)
+    for kind, _, artist in texts:
+        for t in artist.get_texts() if isinstance(artist, Legend) else [artist]:
+            if _visible_text(t) and t.get_fontsize() < MIN_POINTS - 1e-9:
+                problems.append(
+                    f"{_name(kind, t)} is {t.get_fontsize():g} pt (< {MIN_POINTS:g} pt)"
+                )
+        if isinstance(artist, Legend) and artist.get_title().get_text():
+            if artist.get_title().get_fontsize() < MIN_POINTS - 1e-9:
+                problems.append(f"legend title is {artist.get_title().get_fontsize():g} pt")
     if units:
         for ax in fig.axes:
             if not is_panel(ax):
@@ -230,6 +249,77 @@ def layout_problems(fig: Figure, units: bool = True, dpi: float = 120) -> list[s
                 if _shown_ticks(axis) and not UNIT.search(text):
                     problems.append(f"axis label {text!r} has no unit in parentheses")
     return problems
+
+
+def _filled_paths(ax: Axes):
+    """Display outlines of the filled polygons and bands of an axes (not background ones)."""
+    out = []
+    for artist in list(ax.patches) + list(ax.collections):
+        if not artist.get_visible() or artist.get_gid() == BACKGROUND:
+            continue
+        if isinstance(artist, Patch):
+            face = artist.get_facecolor()
+            if artist.get_fill() and face[3] > 0:
+                out.append(artist.get_transform().transform_path(artist.get_path()))
+        elif hasattr(artist, "get_paths") and len(artist.get_facecolor()):
+            if isinstance(artist, PathCollection):
+                continue  # scatter markers: points, checked as data points
+            out += [artist.get_transform().transform_path(p) for p in artist.get_paths()]
+    return out
+
+
+def _fill_problems(fig: Figure, renderer) -> list[str]:
+    """A legend or a note whose box lies over a filled area of an axes (within the axes)."""
+    problems = []
+    for ax in fig.axes:
+        if not ax.get_visible() or hasattr(ax, "zaxis"):
+            continue
+        frame = ax.get_window_extent(renderer)
+        legends = ([ax.get_legend()] if ax.get_legend() is not None else []) + list(fig.legends)
+        boxes = legends + [t for t in ax.texts if _visible_text(t) and t.get_bbox_patch()]
+        paths = _filled_paths(ax)
+        for artist in boxes:
+            b = _box(artist, renderer)
+            xs = np.linspace(b.x0 + SLACK, b.x1 - SLACK, 9)
+            ys = np.linspace(b.y0 + SLACK, b.y1 - SLACK, 7)
+            grid = np.array([(x, y) for x in xs for y in ys])
+            grid = grid[
+                (grid[:, 0] > frame.x0)
+                & (grid[:, 0] < frame.x1)
+                & (grid[:, 1] > frame.y0)
+                & (grid[:, 1] < frame.y1)
+            ]
+            if len(grid) and any(p.contains_points(grid).any() for p in paths):
+                what = (
+                    "legend" if isinstance(artist, Legend) else f"text {artist.get_text()[:30]!r}"
+                )
+                problems.append(f"{what} lies over a filled area")
+    return problems
+
+
+def inside_axes(fig: Figure, ax: Axes, artist) -> bool:
+    """Whether the box of ``artist`` (a legend or a text) lies inside the frame of ``ax``."""
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    frame, box = ax.get_window_extent(renderer), _box(artist, renderer)
+    return (
+        box.x0 >= frame.x0 - SLACK
+        and box.x1 <= frame.x1 + SLACK
+        and box.y0 >= frame.y0 - SLACK
+        and box.y1 <= frame.y1 + SLACK
+    )
+
+
+def data_fill(fig: Figure, ax: Axes) -> float:
+    """The share of the axes' frame that the bounding box of its data covers (0 to 1)."""
+    fig.canvas.draw()
+    frame = ax.get_window_extent()
+    pts = np.vstack([p for _, p in data_points(ax) if len(p)] or [np.zeros((0, 2))])
+    if len(pts) == 0:
+        return 0.0
+    w = pts[:, 0].max() - pts[:, 0].min()
+    h = pts[:, 1].max() - pts[:, 1].min()
+    return float(w * h / (frame.width * frame.height))
 
 
 def assert_layout(fig: Figure, units: bool = True) -> None:

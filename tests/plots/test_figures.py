@@ -70,6 +70,17 @@ def test_layout_checks_catch_the_defects_they_are_for():
     assert "'time' has no unit" in problems
     assert "outside the canvas" in problems
     assert "note over the line" in problems and "overlaps legend" in problems
+    # A 6 pt annotation, and a legend over a filled area.
+    fig = new_figure(4, 3)
+    ax = fig.subplots()
+    ax.fill_between([0, 1], [0, 0], [1, 1], label="band")
+    ax.legend(loc="center")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.annotate("tiny", (0.5, 0.1), fontsize=6)
+    problems = "\n".join(layout_problems(fig))
+    assert "'tiny' is 6 pt" in problems
+    assert "legend lies over a filled area" in problems
 
 
 @pytest.mark.parametrize("name", SCENARIOS)

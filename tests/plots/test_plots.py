@@ -60,9 +60,14 @@ def _legend_texts(ax) -> list[str]:
     return [t.get_text() for t in legend.get_texts()] if legend is not None else []
 
 
-def _side(fig: Figure):
-    """The areas figure's column of the CoM velocity panel's legend and note."""
-    return fig.axes[2]
+def _velocity_legend(fig: Figure) -> list[str]:
+    """The entries of the areas figure's CoM velocity legend (under both panels)."""
+    return [t.get_text() for leg in fig.legends for t in leg.get_texts()]
+
+
+def _note(fig: Figure) -> str:
+    """The note inside the CoM velocity panel (the maxima, the impact's parameters)."""
+    return " ".join(t.get_text() for t in fig.axes[1].texts)
 
 
 def _line(ax, label: str):
@@ -89,10 +94,13 @@ def test_plot_areas(analysis: ib.Analysis) -> None:
     zmp_ax, vel_ax = fig.axes[:2]
     assert "(m)" in zmp_ax.get_xlabel() and "(m/s)" in vel_ax.get_xlabel()
     assert zmp_ax.get_aspect() == 1.0 and vel_ax.get_aspect() == 1.0
-    labels = _legend_texts(_side(fig))
+    labels = _velocity_legend(fig)
     vmax = analysis.impact.max_contact_velocity
     assert any(f"v_max = {vmax:.3g} m/s" in t for t in labels)
-    assert sum("post-impact set" in t for t in labels) == 5
+    # The five sets: the one at v_max, and one entry for the lighter four.
+    assert sum("post-impact set" in t for t in labels) == 2
+    assert any("0.2, 0.4, 0.6, 0.8 x v_max" in t for t in labels)
+    assert len(vel_ax.patches) >= 2 * 5  # each set: a fill and an outline
     assert any("falls" in t for t in labels), "the reference speed 0.8 m/s exceeds v_max"
     # The limiting vertex is marked where the model puts it, on the area's boundary.
     star = next(
@@ -105,15 +113,20 @@ def test_plot_areas(analysis: ib.Analysis) -> None:
     ]
     np.testing.assert_allclose(point, expected)
     assert abs(analysis.areas.com_velocity_area.margins(point)[0]) < 1e-8
-    text = " ".join(t.get_text() for t in _side(fig).texts)
+    text = _note(fig)
     assert f"CoM criterion: {vmax:.3g} m/s" in text and "ZMP criterion" in text
+    # The legend of the ZMP panel and the note are inside their panels.
+    fig.canvas.draw()
+    for ax, box in ((zmp_ax, zmp_ax.get_legend()), (vel_ax, vel_ax.texts[0])):
+        assert ax.get_window_extent().contains(*box.get_window_extent().p0)
+        assert ax.get_window_extent().contains(*box.get_window_extent().p1)
 
 
 def test_plot_areas_without_impact(no_impact: ib.Analysis) -> None:
     fig = plot_areas(no_impact)
     _check_axes(fig, 2)
-    assert not any("post-impact" in t for t in _legend_texts(_side(fig)))
-    assert "no impact" in " ".join(t.get_text() for t in _side(fig).texts)
+    assert not any("post-impact" in t for t in _velocity_legend(fig))
+    assert "no impact" in _note(fig)
 
 
 def test_plot_impulse_set(analysis: ib.Analysis) -> None:

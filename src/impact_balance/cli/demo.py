@@ -9,7 +9,16 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
 
-__all__ = ["DEMO_SCENARIOS", "FRICTION_SWEEP", "USES_KERNEL", "add_parser", "run"]
+__all__ = [
+    "DEMO_SCENARIOS",
+    "FIGURE_SUFFIXES",
+    "FRICTION_SWEEP",
+    "USES_KERNEL",
+    "add_parser",
+    "describe_figure",
+    "run",
+    "write_index",
+]
 
 USES_KERNEL = True
 
@@ -17,6 +26,58 @@ USES_KERNEL = True
 DEMO_SCENARIOS = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot")
 #: The impact-friction sweep (paper Fig. miu-compare).
 FRICTION_SWEEP = ("palm_push_mu010", "palm_push_mu024", "palm_push_mu040")
+
+
+#: What each figure of an analysis shows, by the end of its file name (``<scenario><suffix>``).
+FIGURE_SUFFIXES = {
+    "_areas.png": "ZMP support area (left); CoM velocity area with the post-impact CoM velocity "
+    "sets up to the maximum contact velocity and the limiting vertex (right)",
+    "_stance.png": "top and side views of the stance: contacts and normals, CoM, ZMP support "
+    "area, impact point, reference velocity and its cap at v_max",
+    "_impulse_set.png": "impulse set in its friction cone (3D) and the CoM velocity jump set at "
+    "the maximum contact velocity",
+    "_phase_portrait.png": "sagittal LIPM phase portrait of the stance, its pre-impact CoM "
+    "velocity and its post-impact CoM velocities at v_max",
+}
+#: What the demo's other figures show, by file name.
+_DEMO_FIGURES = {
+    "friction_comparison.png": "post-impact CoM velocity sets and maximum contact velocities "
+    "(CoM and ZMP criteria) for impact frictions 0.1, 0.24 and 0.4 (paper Fig. miu-compare)",
+    "phase_portrait.png": "the paper's LIPM phase portrait: CoM height 0.78 m, ZMP in "
+    "[-0.13, 0.13] m, the stable standing region (paper Fig. lipm-pplane)",
+}
+
+
+def describe_figure(name: str) -> str:
+    """One line on what the demo's figure file ``name`` shows (its scenario first)."""
+    if name in _DEMO_FIGURES:
+        return _DEMO_FIGURES[name]
+    for suffix, text in FIGURE_SUFFIXES.items():
+        if name.endswith(suffix):
+            return f"{name.removesuffix(suffix)}: {text}"
+    return "figure"
+
+
+def write_index(out: Path, figures: list[Path]) -> Path:
+    """Write ``out/index.md``: each figure as a link with one line on what it shows.
+
+    Args:
+        out: The figures' folder.
+        figures: The figures written, in the order listed.
+
+    Returns:
+        The index's path.
+    """
+    lines = [
+        "# impact-balance demo: figures",
+        "",
+        "The paper's studies on Talos (bundled scenarios), written by `impact-balance demo`.",
+        "",
+    ]
+    lines += [f"- [{p.name}]({p.name}): {describe_figure(p.name)}" for p in figures]
+    path = out / "index.md"
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
 
 
 def add_parser(sub: Subcommands) -> list[str]:
@@ -89,7 +150,8 @@ def run(args: argparse.Namespace) -> int:
             ):
                 fig.savefig(out / fname, dpi=120)
                 written.append(out / fname)
-        print(f"\n{len(written)} figures written to {out}/")
+            index = write_index(out, written)
+        print(f"\n{len(written)} figures written to {out}/ (what each shows: {index})")
     from impact_balance.balance.lipm import com_velocity_bounds
 
     bounds = [round(float(b), 4) for b in com_velocity_bounds(0.78, (-0.13, 0.13))]

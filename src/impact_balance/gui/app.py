@@ -34,7 +34,16 @@ from impact_balance.gui.workspace import Workspace
 if TYPE_CHECKING:
     import viser
 
-__all__ = ["GuiApp", "GuiError", "run"]
+__all__ = ["SHARED_SESSION_NOTE", "GuiApp", "GuiError", "run"]
+
+#: Shown on the page under the numbers: every tab and browser connected to one server edits the
+#: same session (one scenario, one analysis); an edit in one shows in all.
+SHARED_SESSION_NOTE = (
+    '<div id="ib-shared-session" style="color:#555;font-size:0.8em;margin:2px 0 4px 0">'
+    "One shared session: every browser tab open on this server shows and edits the same "
+    "scenario (an edit in one tab shows in all). Start another <code>impact-balance gui "
+    "--port</code> for a separate one.</div>"
+)
 
 
 class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
@@ -62,6 +71,7 @@ class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
     """
 
     w_results: viser.GuiHtmlHandle
+    w_shared_session: viser.GuiHtmlHandle
     w_view2d: viser.GuiHtmlHandle
 
     def __init__(
@@ -142,6 +152,7 @@ class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
         )
         gui.set_panel_label("impact-balance")
         self.w_results = gui.add_html("")
+        self.w_shared_session = gui.add_html(SHARED_SESSION_NOTE)
         tabs = gui.add_tab_group()
         with tabs.add_tab("Impact"):
             self._build_impact()

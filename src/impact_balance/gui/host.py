@@ -81,7 +81,8 @@ class GuiHost:
         """Run one edit of the session, then refresh the widgets and redraw.
 
         A value that cannot even be converted (``ValueError``, ``TypeError``,
-        ``OverflowError``) is shown as refused, like a value the session refuses.
+        ``OverflowError``) is shown as refused, like a value the session refuses. A refusal
+        shown before is cleared by the next edit that is not refused (whatever it changes).
 
         Args:
             apply: The edit, e.g. ``lambda: session.set(path, value)``.
@@ -90,6 +91,8 @@ class GuiHost:
             if self._syncing:  # a callback fired by refresh() setting a widget: not an edit
                 return
             t0 = time.perf_counter()
+            if self.session.refused:  # the next edit's own outcome replaces the refusal
+                self.session.message, self.session.refused = None, False
             try:
                 apply()
             except (ValueError, TypeError, OverflowError) as exc:

@@ -14,6 +14,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
+from impact_balance.gui.contact_orientation import (
+    ORIENTATION_MODES,
+    WORLD_NORMAL_MODE,
+    mode_of,
+    normal_angle,
+    switch_changes,
+)
 from impact_balance.gui.host import GuiHost, WidgetCallback, set_value, vec2, vec3
 from impact_balance.gui.limbs import joint_groups, joint_values
 from impact_balance.gui.state import FieldPath
@@ -64,6 +71,9 @@ class PanelsMixin(GuiHost):
     w_contact_size: viser.GuiVector2Handle
     w_contact_offset: viser.GuiVector3Handle
     w_contact_rpy: viser.GuiVector3Handle
+    w_contact_orientation: viser.GuiDropdownHandle[str]
+    w_contact_normal: viser.GuiVector3Handle
+    w_contact_angle: viser.GuiNumberHandle[float]
     w_contact_remove: viser.GuiButtonHandle
     w_new_frame: viser.GuiDropdownHandle[str]
     #: The contact the Contacts tab edits.
@@ -124,9 +134,48 @@ class PanelsMixin(GuiHost):
         set_value(self.w_contact_friction, float(contact.friction))
         set_value(self.w_contact_size, vec2(contact.size))
         set_value(self.w_contact_offset, vec3(contact.offset.position))
-        set_value(self.w_contact_rpy, vec3(contact.offset.rpy))
+        self._sync_contact_orientation(index)
         _set_options(self.w_new_frame, options)
         self.w_contact_remove.disabled = len(labels) <= 1
+
+    def _sync_contact_orientation(self, index: int) -> None:
+        """The orientation fields of contact ``index``.
+
+        The form the scenario gives is editable; the other one shows the same rotation, disabled.
+        """
+        raw = self.session.state.get(("contacts", index), {})
+        mode = mode_of(raw)
+        stance = self.session.analysis.stance
+        contact = stance.contacts[index]
+        frame_rotation = stance.frame_pose(contact.spec.frame).rotation
+        normal, angle = normal_angle(frame_rotation, contact.rotation)
+        if mode == WORLD_NORMAL_MODE:  # as the scenario gives them (the normal at any scale)
+            normal, angle = raw["normal"], float(raw.get("angle") or 0.0)
+        rpy = pin.rpy.matrixToRpy(frame_rotation.T @ contact.rotation)
+        set_value(self.w_contact_orientation, mode)
+        # Rounded to a micro-unit: no "-0.00" for a component at rounding-error level.
+        set_value(self.w_contact_rpy, vec3(np.round(rpy, 6) + 0.0))
+        set_value(self.w_contact_normal, vec3(np.round(normal, 6) + 0.0))
+        set_value(self.w_contact_angle, round(float(angle), 6) + 0.0)
+        by_normal = mode == WORLD_NORMAL_MODE
+        self.w_contact_rpy.disabled = by_normal
+        self.w_contact_normal.disabled = self.w_contact_angle.disabled = not by_normal
+
+    def _on_contact_orientation(self, event: Any) -> None:
+        """Switch the contact's orientation form, keeping its world rotation."""
+        mode = str(event.target.value)
+
+        def apply() -> bool:
+            i = self._contact_index
+            stance = self.session.analysis.stance
+            contact = stance.contacts[i]
+            frame_rotation = stance.frame_pose(contact.spec.frame).rotation
+            position = self.session.state.get(("contacts", i, "offset", "position"), [0.0] * 3)
+            return self.session.apply(
+                switch_changes(i, mode, frame_rotation, contact.rotation, position)
+            )
+
+        self.edit(apply)
 
     def _sync_impact(self, options: list[str]) -> None:
         """The Impact tab (its fields disabled without an impact); ``options``: the frames."""
@@ -269,6 +318,14 @@ class PanelsMixin(GuiHost):
             "offset (m)", (0.0, 0.0, 0.0), step=0.001, hint="Position in the frame, m"
         )
         self.w_contact_offset.on_update(contact_field(("offset", "position"), list))
+        self.w_contact_orientation = gui.add_dropdown(
+            "orientation",
+            list(ORIENTATION_MODES),
+            hint="How the scenario gives the contact's orientation: roll, pitch, yaw in its "
+            "frame, or the surface normal in the world and a turn about it (switching keeps "
+            "the contact where it is)",
+        )
+        self.w_contact_orientation.on_update(self._on_contact_orientation)
         self.w_contact_rpy = gui.add_vector3(
             "offset rpy (rad)",
             (0.0, 0.0, 0.0),
@@ -276,6 +333,21 @@ class PanelsMixin(GuiHost):
             hint="Roll, pitch, yaw in the frame, rad",
         )
         self.w_contact_rpy.on_update(contact_field(("offset", "rpy"), list))
+        self.w_contact_normal = gui.add_vector3(
+            "world normal",
+            (0.0, 0.0, 1.0),
+            step=0.001,
+            hint="Surface normal in the world, from the surface into the robot (any scale)",
+        )
+        self.w_contact_normal.on_update(contact_field(("normal",), list))
+        self.w_contact_angle = gui.add_number(
+            "angle about normal (rad)",
+            0.0,
+            step=0.01,
+            hint="Turn of the contact about its world normal, rad (0: the frame's x axis "
+            "projected on the surface)",
+        )
+        self.w_contact_angle.on_update(contact_field(("angle",), float))
         self.w_contact_remove = gui.add_button("Remove this contact", color="red")
         self.w_contact_remove.on_click(self._on_remove_contact)
         gui.add_divider()

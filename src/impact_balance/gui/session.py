@@ -286,15 +286,20 @@ class Session:
     def save(self, name: str, overwrite: bool = False) -> Path | None:
         """Save the current state to a workspace file; None (and :attr:`message`) if refused.
 
-        An existing file is replaced only with ``overwrite`` (the GUI's confirmation box).
+        An existing file is replaced only with ``overwrite`` (the GUI's confirmation box). The
+        file's ``name`` is its stem (``ramp.yaml`` is named ``ramp``); when that changes the
+        name, the ``description`` says which scenario it was edited from. The session then
+        holds what was written (its name, its file).
         """
         with self.lock:
             try:
-                out = self.files.save(self.state, name, overwrite=overwrite)
+                state = self.state.saved_as(name)
+                out = self.files.save(state, name, overwrite=overwrite)
             except ImpactBalanceError as exc:
                 self.message, self.refused = describe(exc, self.files.workspace), True
                 return None
-            self.message, self.refused = f"saved {self.files.workspace.relative(out)}", False
+            saved = GuiState(state.raw, str(out), state.robot_reader)
+            self._commit(lambda: saved, note=f"saved {self.files.workspace.relative(out)}")
             return out
 
     def drag(self, target: DragTarget, pose: pin.SE3) -> bool:

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from impact_balance.constants import MAX_DESCRIPTION
 from impact_balance.exceptions import ScenarioError
 from impact_balance.robot.robot import RobotFileReader
 from impact_balance.scenario import RobotFiles, Scenario, load_scenario, scenario_from_dict
@@ -189,6 +190,29 @@ class GuiState:
         except OSError as exc:
             raise ScenarioError("file", str(path), f"cannot write: {exc.strerror or exc}") from None
         return path
+
+    def saved_as(self, file_name: str) -> GuiState:
+        """This state as saved to ``file_name``: named after the file's stem.
+
+        When the stem changes the name, the ``description`` says which scenario it was edited
+        from (``edited from NAME: DESCRIPTION``, cut to the schema's length limit).
+
+        Args:
+            file_name: The file's name (a path; its stem is the new name).
+
+        Raises:
+            ScenarioError: The stem is not a valid scenario name (too long).
+        """
+        stem = Path(str(file_name)).stem
+        old_name = self._raw.get("name")
+        if stem == old_name or not stem:
+            return self
+        changes: dict[FieldPath, Any] = {("name",): stem}
+        if old_name:
+            old = self._raw.get("description")
+            text = f"edited from {old_name}" + (f": {old}" if old else "")
+            changes[("description",)] = text[:MAX_DESCRIPTION]
+        return self.with_changes(changes)
 
     # -- editing ------------------------------------------------------------------------
     def with_value(self, path: FieldPath, value: Any) -> GuiState:

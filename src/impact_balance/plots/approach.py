@@ -16,7 +16,13 @@ from matplotlib.lines import Line2D
 from impact_balance.analysis.analyze import Analysis
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.plots.balance import OUTCOME_COLORS
-from impact_balance.plots.style import AREA_COLOR, draw_polygon, new_figure, set_limits
+from impact_balance.plots.style import (
+    AREA_COLOR,
+    FONT_SMALL,
+    draw_polygon,
+    new_figure,
+    set_limits,
+)
 
 __all__ = ["plot_approach"]
 
@@ -46,8 +52,8 @@ def plot_approach(trial: Any, analysis: Analysis, margin_area: Polygon | None = 
             left.plot(t - t0, y, **kw)
 
     line("reference", color="0.5", ls="--", lw=1.2, label="reference")
-    line("cap", color="tab:green", lw=1.5, label=f"cap ({trial.options.governor} governor)")
-    line("commanded", color="tab:blue", lw=1.0, label="commanded")
+    line("cap", color="#009E73", lw=1.5, label=f"cap ({trial.options.governor} governor)")
+    line("commanded", color="#0072B2", lw=1.0, label="commanded")
     line("measured", color="black", lw=1.0, alpha=0.8, label="measured approach speed")
     if start is not None:
         left.axvline(start - t0, color=OUTCOME_COLORS["fell"], lw=0.8, ls=":", label="contact")
@@ -59,7 +65,7 @@ def plot_approach(trial: Any, analysis: Analysis, margin_area: Polygon | None = 
     speed = "-" if trial.speed_at_contact is None else f"{trial.speed_at_contact:.3f} m/s"
     cap = "-" if trial.cap_at_contact is None else f"{trial.cap_at_contact:.3f} m/s"
     left.set_title(f"speed at contact {speed}, cap {cap}", fontsize=9)
-    left.legend(loc="upper right", fontsize=7)
+    left.legend(loc="upper right", fontsize=FONT_SMALL)
 
     area = analysis.areas.com_velocity_area
     draw_polygon(right, area, color=AREA_COLOR, label="CoM velocity area")
@@ -89,10 +95,10 @@ def plot_approach(trial: Any, analysis: Analysis, margin_area: Polygon | None = 
                 trial.result.impact.com_velocity_after,
             )
             right.plot(
-                [before[0], after[0]], [before[1], after[1]], "o-", color="tab:red", ms=3, lw=1.2
+                [before[0], after[0]], [before[1], after[1]], "o-", color="#D55E00", ms=3, lw=1.2
             )
             handles.append(
-                Line2D([], [], color="tab:red", marker="o", ms=3, label="across the impact")
+                Line2D([], [], color="#D55E00", marker="o", ms=3, label="across the impact")
             )
     set_limits(right, [area.vertices, path], min_ratio=0.5)
     right.set_aspect("equal")
@@ -100,7 +106,7 @@ def plot_approach(trial: Any, analysis: Analysis, margin_area: Polygon | None = 
     right.set_ylabel("CoM velocity y (m/s)")
     right.grid(alpha=0.3)
     right.set_title("CoM velocity through the approach and the impact", fontsize=9)
-    right.legend(handles=handles, loc="upper left", fontsize=7)
+    right.legend(handles=handles, loc="upper left", fontsize=FONT_SMALL)
     o = trial.options
     fig.suptitle(
         f"{analysis.scenario.name}: approach at {o.reference:g} m/s reference, "

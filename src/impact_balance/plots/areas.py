@@ -18,11 +18,17 @@ from matplotlib.ticker import MaxNLocator
 from impact_balance.analysis.analyze import Analysis
 from impact_balance.analysis.result import ImpactAnswer
 from impact_balance.geometry.polygon import Polygon
+from impact_balance.plots.placement import place_inside
 from impact_balance.plots.style import (
     AREA_COLOR,
+    AREA_EDGE,
     COM_COLOR,
     CONTACT_COLOR,
+    DIGITS,
     FALL_COLOR,
+    FONT_SMALL,
+    FONT_SUPTITLE,
+    FONT_TITLE,
     ZMP_COLOR,
     area_view_points,
     centre_message,
@@ -32,6 +38,7 @@ from impact_balance.plots.style import (
     new_figure,
     scenario_title,
     set_limits,
+    trim_height,
 )
 
 __all__ = ["draw_com_velocity_area", "draw_zmp_area", "plot_areas", "short_reason"]
@@ -114,17 +121,11 @@ def draw_zmp_area(ax: Axes, analysis: Analysis) -> None:
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.xaxis.set_major_locator(MaxNLocator(5))  # a narrow panel crowds the default ticks
-    ax.set_title(f"ZMP support area (plane z = {areas.plane_height:g} m)")
+    ax.set_title(f"ZMP support area (plane z = {areas.plane_height:g} m)", fontsize=FONT_TITLE)
     ax.grid(True, alpha=0.3)
-    # Below the axes: a legend inside would cover the area's boundary.
-    ax.legend(
-        loc="upper center",
-        bbox_to_anchor=(0.5, 0.0),
-        borderaxespad=4.8,
-        fontsize=8,
-        framealpha=0.9,
-        ncol=2,
-    )
+    # Placed by plot_areas (place_inside): in a corner clear of the area, the view widened
+    # when no corner is.
+    ax.legend(fontsize=FONT_SMALL, framealpha=0.9)
 
 
 def draw_com_velocity_area(
@@ -132,14 +133,16 @@ def draw_com_velocity_area(
 ) -> None:
     """CoM velocity area, pre-impact CoM velocity and post-impact sets for increasing speeds.
 
-    The legend and the note (maxima, impact parameters, why the robot cannot balance) go in
-    ``side``, an axes without frame beside ``ax`` (default: right of ``ax``, outside it).
+    The legend and the note (maxima, impact parameters, why the robot cannot balance) are
+    inside ``ax``, or in ``side`` if given (an axes without frame beside ``ax``);
+    :func:`plot_areas` moves them to corners of ``ax`` clear of the data
+    (:func:`~impact_balance.plots.placement.place_inside`).
 
     Args:
         ax: The axes of the CoM velocity plane (m/s, world x and y).
         analysis: The analysis drawn.
         n_steps: Post-impact sets drawn, at ``k / n_steps`` of the maximum approach speed.
-        side: The axes of the legend and the note.
+        side: The axes of the legend and the note (default: ``ax``).
     """
     areas = analysis.areas
     area = areas.com_velocity_area
@@ -153,7 +156,7 @@ def draw_com_velocity_area(
         if not area.bounded:
             label += ", unbounded (clipped)"
         draw_polygon(
-            ax, area, color=AREA_COLOR, alpha=0.4, lw=2, edge="teal", label=label, zorder=1
+            ax, area, color=AREA_COLOR, alpha=0.35, lw=2, edge=AREA_EDGE, label=label, zorder=1
         )
     ax.plot(*c0, "o", color=COM_COLOR, ms=7, label="pre-impact CoM velocity", zorder=6)
 
@@ -170,8 +173,6 @@ def draw_com_velocity_area(
     if reason is not None:
         lines[:0] = ["CANNOT BALANCE, why:", *textwrap.wrap(str(reason), 46), ""]
     lines.append(f"ω = {areas.omega:.3f} 1/s")
-    # Outside the axes, in the side column (the legend above, this note below): nothing
-    # covers the area's boundary, whatever its shape.
     _note(ax, side, lines, alarm=falling or reason is not None)
     set_limits(ax, area_view_points(area, view), margin=0.12, min_ratio=0.5)
     if area.is_empty:
@@ -180,7 +181,7 @@ def draw_com_velocity_area(
     ax.set_xlabel(r"$\dot c_x$ (m/s)")
     ax.set_ylabel(r"$\dot c_y$ (m/s)")
     ax.xaxis.set_major_locator(MaxNLocator(6))
-    ax.set_title("CoM velocity area and post-impact CoM velocities")
+    ax.set_title("CoM velocity area and post-impact CoM velocities", fontsize=FONT_TITLE)
     ax.grid(True, alpha=0.3)
     _velocity_legend(ax, side)
 
@@ -223,7 +224,7 @@ def _draw_post_impact_sets(
         # An outline on top of the v_max set (no fill): when the reference is close to
         # v_max the two sets nearly coincide, and a filled red set would hide the other.
         above = 100.0 * (v_ref / vmax - 1.0) if vmax > 0 else math.inf
-        lab = f"at the reference {v_ref:.3g} m/s: falls"
+        lab = f"at the reference {v_ref:.{DIGITS}g} m/s: falls"
         if above < 10.0:
             lab += f"\n(only {above:.1f} % above v_max: nearly the same set)"
         draw_polygon(
@@ -248,18 +249,25 @@ def _draw_speed_series(
     n_steps: int,
     view: list[FloatArray],
 ) -> None:
-    """The post-impact sets at ``k / n_steps * top`` (m/s), k = 1..n_steps, the last one bold."""
+    """The post-impact sets at ``k / n_steps * top`` (m/s), k = 1..n_steps, the last one bold.
+
+    One legend entry for the lighter sets (their speeds as fractions of the last one's).
+    """
     model, limit = im.model, im.com
     cmap = colormaps["Blues"]
+    name = "v_max" if limit.is_finite else "the reference"
+    fractions = ", ".join(f"{k / n_steps:.2g}" for k in range(1, n_steps))
     for k in range(1, n_steps + 1):
         s = top * k / n_steps
         pts = model.post_impact_com_velocities(c0, s)
         view.append(pts)
         last = k == n_steps
-        if last and limit.is_finite:
-            lab = f"post-impact set at v_max = {s:.3g} m/s"
-        else:
-            lab = f"post-impact set at {s:.3g} m/s"
+        lab: str | None = None
+        if last:
+            at = "v_max = " if limit.is_finite else ""
+            lab = f"post-impact set at {at}{s:.{DIGITS}g} m/s"
+        elif k == 1:
+            lab = f"post-impact sets at {fractions} x {name} (light to dark)"
         color = cmap(0.35 + 0.6 * k / n_steps)
         draw_polygon(
             ax,
@@ -282,7 +290,7 @@ def _draw_limiting(ax: Axes, im: ImpactAnswer, area: Polygon, c0: FloatArray) ->
     ax.plot(
         *p,
         marker="*",
-        color="gold",
+        color="#F0E442",
         mec="black",
         ms=16,
         zorder=8,
@@ -295,9 +303,9 @@ def _draw_limiting(ax: Axes, im: ImpactAnswer, area: Polygon, c0: FloatArray) ->
             e[:, 0],
             e[:, 1],
             "-",
-            color="gold",
+            color="#F0E442",
             lw=4,
-            alpha=0.8,
+            alpha=0.9,
             zorder=2.5,
             label="limiting edge of the area",
         )
@@ -319,18 +327,19 @@ def _impact_note(im: ImpactAnswer, v_ref: float | None) -> list[str]:
 
 
 def _note(ax: Axes, side: Axes | None, lines: list[str], alarm: bool) -> None:
-    """The note at the bottom of ``side`` (or right of ``ax``), framed in red on an alarm."""
+    """The note (a framed text) in ``side`` or ``ax``, framed in red on an alarm."""
     where = side if side is not None else ax
-    x0 = 0.0 if side is not None else 1.03
     where.text(
-        x0,
-        0.0,
+        0.015,
+        0.015,
         "\n".join(lines),
         transform=where.transAxes,
         ha="left",
         va="bottom",
-        fontsize=8,
+        fontsize=FONT_SMALL,
+        multialignment="left",
         zorder=10,
+        gid="note",
         bbox={
             "boxstyle": "round,pad=0.4",
             "facecolor": "white",
@@ -341,20 +350,23 @@ def _note(ax: Axes, side: Axes | None, lines: list[str], alarm: bool) -> None:
 
 
 def _velocity_legend(ax: Axes, side: Axes | None) -> None:
-    """The legend of ``ax`` at the top of ``side`` (or right of ``ax``)."""
+    """The legend of ``ax``, in ``side`` or in ``ax``."""
     handles, labels = ax.get_legend_handles_labels()
-    if side is not None:
-        side.legend(
-            handles,
-            labels,
-            loc="upper left",
-            bbox_to_anchor=(0.0, 1.0),
-            borderaxespad=0.0,
-            fontsize=7.5,
-            framealpha=0.9,
-        )
-    else:
-        ax.legend(loc="upper left", bbox_to_anchor=(1.03, 1.0), fontsize=7.5, framealpha=0.9)
+    (side if side is not None else ax).legend(
+        handles, labels, fontsize=FONT_SMALL, framealpha=0.9, loc="upper left"
+    )
+
+
+def _size(fig: Figure, left: Axes, right: Axes, cannot_balance: bool) -> None:
+    """Panels as wide as their data at a common height (both have an equal aspect)."""
+    ratio = max(_aspect(left), _aspect(right), 0.75 if cannot_balance else 0.0)
+    height = float(np.clip(4.4 * ratio + 2.4, 4.5, 9.5))
+    axes_height = height - 2.3  # the titles, the tick labels and the legend below
+    widths = [axes_height / _aspect(left), axes_height / _aspect(right)]  # inches
+    grid = left.get_gridspec()
+    assert grid is not None
+    grid.set_width_ratios(widths)
+    fig.set_size_inches(float(np.clip(sum(widths) + 1.6, 9.0, 18.0)), height)
 
 
 def plot_areas(analysis: Analysis, n_steps: int = 5) -> Figure:
@@ -363,36 +375,35 @@ def plot_areas(analysis: Analysis, n_steps: int = 5) -> Figure:
     The post-impact CoM velocity sets are drawn for the approach speeds ``k / n_steps * v_max``,
     k = 1..n_steps (paper Fig. solving-opt), the one at v_max highlighted with its limiting
     vertex; when the reference approach speed exceeds v_max, the set at the reference speed is
-    drawn in red. Without an impact only the areas are drawn.
+    drawn in red. Without an impact only the areas are drawn. Each legend and the note (the
+    maxima, the impact's parameters) sit inside their panel, in a corner clear of the data.
     """
     if n_steps < 1 or not math.isfinite(n_steps):
         raise ValueError("n_steps must be >= 1")
-    fig = new_figure(15, 6.2)
-    # A third column holds the right panel's legend and note: constrained layout then keeps
-    # them inside the canvas (a legend anchored outside an axes reached the edge).
-    left, right, side = fig.subplots(1, 3, gridspec_kw={"width_ratios": [1, 1.25, 0.5]})
-    side.set_axis_off()
+    fig = new_figure(12, 6.0)
+    left, right = fig.subplots(1, 2)
     draw_zmp_area(left, analysis)
-    draw_com_velocity_area(right, analysis, n_steps, side=side)
-    # Height from the data: both axes have an equal aspect, so a flat area in a fixed-height
-    # figure leaves bands of blank space above and below it.
-    # Panels as wide as their data at a common height: fixed ratios left a blank band beside
-    # a narrow (tall) area.
-    ratio = max(
-        _aspect(left), _aspect(right), 0.75 if analysis.cannot_balance_reason is not None else 0.0
-    )
-    height = float(np.clip(4.2 * ratio + 2.6, 4.0, 9.0))
-    axes_height = height - 2.2  # titles, tick labels and the legend below the left panel
-    widths = [
-        axes_height / _aspect(left),
-        axes_height / _aspect(right),
-        3.0,
-    ]  # inches; 3 for the legend
-    left.get_gridspec().set_width_ratios(widths)
-    fig.set_size_inches(float(np.clip(sum(widths) + 1.8, 10.0, 20.0)), height)
+    draw_com_velocity_area(right, analysis, n_steps)
     why = short_reason(analysis)
     verdict = f"cannot balance because of the {why}" if why else analysis.verdict
-    fig.suptitle(f"Balance areas: {scenario_title(analysis)} - {verdict}", fontsize=12)
+    fig.suptitle(f"Balance areas: {scenario_title(analysis)} - {verdict}", fontsize=FONT_SUPTITLE)
+    cannot = analysis.cannot_balance_reason is not None
+
+    def relayout() -> None:
+        _size(fig, left, right, cannot)
+        trim_height(fig, [left, right], passes=3, width=True)
+
+    # The velocity panel's legend under both panels (too long for a corner of the panel);
+    # the ZMP panel's legend and the note inside their panels, clear of the data.
+    handles, labels = right.get_legend_handles_labels()
+    right.get_legend().remove()
+    ncol = 3 if len(labels) > 4 else 2
+    fig.legend(
+        handles, labels, loc="outside lower center", ncol=ncol, fontsize=FONT_SMALL, framealpha=0.9
+    )
+    relayout()
+    place_inside(left, [left.get_legend()], relayout=relayout)
+    place_inside(right, [t for t in right.texts if t.get_gid() == "note"], relayout=relayout)
     return fig
 
 

@@ -32,11 +32,13 @@ from impact_balance.geometry.polygon import Polygon
 from impact_balance.plots.style import (
     AREA_COLOR,
     FALL_COLOR,
+    FONT_SMALL,
     OK_COLOR,
     ZMP_COLOR,
     draw_polygon,
     new_figure,
     set_limits,
+    trim_height,
 )
 
 __all__ = [
@@ -51,7 +53,7 @@ __all__ = [
 #: Colour of each trial outcome.
 OUTCOME_COLORS = {
     "balanced": OK_COLOR,
-    "contact_broken": "tab:orange",
+    "contact_broken": "#E69F00",
     "fell": FALL_COLOR,
     "aborted": "0.6",
 }
@@ -104,8 +106,8 @@ def plot_validation(result: Any) -> Figure:
     top = max([*speeds, 0.1])
     lines = []
     for crit, color, name in (
-        ("com_criterion", "tab:blue", "CoM criterion"),
-        ("zmp_criterion", "tab:green", "ZMP criterion"),
+        ("com_criterion", "#0072B2", "CoM criterion"),
+        ("zmp_criterion", "#009E73", "ZMP criterion"),
     ):
         for values, ls, note in (
             (result.predicted, "-", "no margin"),
@@ -142,7 +144,7 @@ def plot_validation(result: Any) -> Figure:
         f"{result.scenario}: impact trials ({result.joints} joints{rigid})\n{bracket}", fontsize=10
     )
     ax.grid(alpha=0.3)
-    fig.legend(handles=handles, loc="outside right center", fontsize=7, frameon=False)
+    fig.legend(handles=handles, loc="outside right center", fontsize=FONT_SMALL, frameon=False)
     return fig
 
 
@@ -239,9 +241,10 @@ def plot_impact_trajectories(result: Any, analysis: Analysis) -> Figure:
         handles=handles + trial_handles,
         loc="outside lower center",
         ncols=3,
-        fontsize=7,
+        fontsize=FONT_SMALL,
         frameon=False,
     )
+    trim_height(fig, [ax])
     return fig
 
 
@@ -334,12 +337,13 @@ def plot_push_trajectories(result: Any, kind: PushView = "com_velocity") -> Figu
         handles=handles,
         loc="outside lower center",
         ncols=3,
-        fontsize=7,
+        fontsize=FONT_SMALL,
         frameon=False,
         title="\n".join(notes),
-        title_fontsize=6,
+        title_fontsize=FONT_SMALL,
     )
     legend.get_title().set_color("0.3")
+    trim_height(fig, [ax])
     return fig
 
 
@@ -381,7 +385,7 @@ def plot_log_margins(
     axes[0].axhline(0, color=FALL_COLOR, lw=0.8)
     axes[0].set_ylabel("CoM velocity margin (m/s)")
     if zmp_margin is not None:
-        axes[1].plot(time, np.where(np.isfinite(zmp_margin), zmp_margin, np.nan), color="tab:green")
+        axes[1].plot(time, np.where(np.isfinite(zmp_margin), zmp_margin, np.nan), color="#009E73")
         axes[1].axhline(0, color=FALL_COLOR, lw=0.8)
         axes[1].set_ylabel("ZMP margin (m)")
     axes[-1].set_xlabel("time (s)")

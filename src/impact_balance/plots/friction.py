@@ -12,17 +12,28 @@ import numpy.typing as npt
 from matplotlib import colormaps
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.typing import ColorType
 
 from impact_balance.analysis.analyze import Analysis
 from impact_balance.analysis.result import ImpactAnswer
 from impact_balance.plots.impulse import impulse_set_speed
+from impact_balance.plots.placement import place_inside
 from impact_balance.plots.style import (
     AREA_COLOR,
+    AREA_EDGE,
     COM_COLOR,
+    COM_CRITERION_COLOR,
+    DIGITS,
+    FONT_SMALL,
+    FONT_SUPTITLE,
+    FONT_TITLE,
+    PALETTE,
+    ZMP_CRITERION_COLOR,
     area_view_points,
     draw_polygon,
     fmt_speed,
     hull,
+    needs_log_scale,
     new_figure,
     set_limits,
 )
@@ -61,7 +72,7 @@ def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
     )
     if not runs:
         raise ValueError("plot_friction_comparison needs at least one analysis with an impact")
-    fig = new_figure(12, 6.2)
+    fig = new_figure(11, 5.6)
     ax, bar = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.1, 1]})
     _draw_sets(ax, runs)
     _draw_bars(bar, runs)
@@ -69,8 +80,11 @@ def plot_friction_comparison(analyses: Sequence[Analysis]) -> Figure:
     names = list(dict.fromkeys(r.scenario.name or "scenario" for r, _ in runs))
     stem = ", ".join(names) if len(names) <= 4 else f"{len(names)} scenarios"
     fig.suptitle(
-        f"Impact friction comparison ({stem}; robot {base.stance.robot.name})", fontsize=12
+        f"Impact friction comparison ({stem}; robot {base.stance.robot.name})",
+        fontsize=FONT_SUPTITLE,
     )
+    place_inside(ax, [ax.get_legend()])
+    place_inside(bar, [bar.get_legend()])
     return fig
 
 
@@ -84,14 +98,16 @@ def _draw_sets(ax: Axes, runs: list[_Run]) -> None:
             area,
             color=AREA_COLOR,
             alpha=0.4,
-            edge="teal",
+            edge=AREA_EDGE,
             lw=2,
             label="CoM velocity area",
             zorder=1,
         )
     view = list(area_view_points(area))
-    cmap = colormaps["plasma"]
-    colors = [cmap(0.05 + 0.75 * i / max(len(runs) - 1, 1)) for i in range(len(runs))]
+    # Palette colours after the area's blue (one per friction, up to seven; then a colormap).
+    colors: list[ColorType] = list(PALETTE[1 : len(runs) + 1])
+    if len(runs) > len(PALETTE) - 1:
+        colors = [colormaps["viridis"](i / (len(runs) - 1)) for i in range(len(runs))]
     for (run, im), color in zip(runs, colors, strict=True):
         mu = im.model.spec.friction
         c0 = run.com_velocity[:2]
@@ -112,7 +128,7 @@ def _draw_sets(ax: Axes, runs: list[_Run]) -> None:
         view.append(pts)
         label = f"μ = {mu:g}: v_max = {fmt_speed(im.max_contact_velocity)}"
         if which != "v_max":
-            label += f" (set at {speed:.3g} m/s)"
+            label += f" (set at {speed:.{DIGITS}g} m/s)"
         draw_polygon(
             ax, hull(pts), color=color, alpha=0.35, edge=color, lw=2, label=label, zorder=3
         )
@@ -127,53 +143,60 @@ def _draw_sets(ax: Axes, runs: list[_Run]) -> None:
     ax.set_xlabel(r"$\dot c_x$ (m/s)")
     ax.set_ylabel(r"$\dot c_y$ (m/s)")
     ax.set_title(
-        "Post-impact CoM velocity sets at each maximum (stars: limiting vertices)", fontsize=10
+        "Post-impact CoM velocity sets at each maximum\n(stars: limiting vertices)",
+        fontsize=FONT_TITLE,
     )
     ax.grid(True, alpha=0.3)
-    # Below the axes: inside, it would cover the area's boundary.
-    ax.legend(
-        loc="upper center",
-        bbox_to_anchor=(0.5, 0.0),
-        borderaxespad=4.8,
-        fontsize=8,
-        framealpha=0.9,
-        ncol=2,
-    )
+    ax.legend(fontsize=FONT_SMALL, framealpha=0.9)  # placed clear of the data (place_inside)
 
 
 def _draw_bars(bar: Axes, runs: list[_Run]) -> None:
-    """Right panel: v_max against mu, both criteria (bars with their values written on them)."""
+    """Right panel: v_max against mu, both criteria (bars with their values written on them).
+
+    The axis is logarithmic when the values span more than :data:`LOG_RATIO` (the ZMP
+    criterion's maxima are often a hundredth of the CoM criterion's).
+    """
     mus = [im.model.spec.friction for _, im in runs]
     com = np.array([im.max_contact_velocity for _, im in runs], dtype=np.float64)
     zmp = np.array([im.zmp_max_contact_velocity for _, im in runs], dtype=np.float64)
     x = np.arange(len(runs))
     width = 0.38
     finite = np.concatenate([com[np.isfinite(com)], zmp[np.isfinite(zmp)]])
-    top = float(finite.max()) if finite.size else 1.0
-    top = top if top > 0 else 1.0
+    positive = finite[finite > 0]
+    top = float(positive.max()) if positive.size else 1.0
+    log = needs_log_scale(finite)
+    bottom = float(positive.min()) / 3.0 if log else 0.0
     series: tuple[tuple[npt.NDArray[np.float64], float, str, str], ...] = (
-        (com, -width / 2, "tab:blue", "CoM velocity criterion"),
-        (zmp, width / 2, "tab:orange", "ZMP criterion"),
+        (com, -width / 2, COM_CRITERION_COLOR, "CoM velocity criterion"),
+        (zmp, width / 2, ZMP_CRITERION_COLOR, "ZMP criterion"),
     )
+    unbounded = 1.6 * top if log else 1.1 * top  # where a bar without a limit ends
     for values, dx, color, name in series:
-        shown = np.where(np.isfinite(values), values, 1.1 * top)
-        bars = bar.bar(x + dx, shown, width, color=color, label=name)
-        for rect, v in zip(bars, values, strict=True):
+        shown = np.where(np.isfinite(values), values, unbounded)
+        shown = np.maximum(shown, bottom)  # a zero on a log axis: a bar of no height
+        bars = bar.bar(x + dx, shown - bottom, width, bottom=bottom, color=color, label=name)
+        for rect, v, h in zip(bars, values, shown, strict=True):
             if not np.isfinite(v):
                 rect.set_hatch("//")  # no limit: drawn above the largest finite value
-            text = f"{v:.3g}" if np.isfinite(v) else "unbounded"
-            bar.text(
-                rect.get_x() + rect.get_width() / 2,
-                rect.get_height() + 0.01 * top,
+            text = f"{v:.{DIGITS}g}" if np.isfinite(v) else "unbounded"
+            bar.annotate(
                 text,
+                (rect.get_x() + rect.get_width() / 2, h),
+                xytext=(0, 2),
+                textcoords="offset points",
                 ha="center",
                 va="bottom",
-                fontsize=8,
+                fontsize=FONT_SMALL,
             )
     bar.set_xticks(x, [f"{m:g}" for m in mus])
     bar.set_xlabel("impact friction coefficient μ (-)")
-    bar.set_ylabel("maximum approach speed (m/s)")
-    bar.set_ylim(0, 1.25 * top)
-    bar.set_title("Maximum contact velocity vs impact friction", fontsize=10)
+    if log:
+        bar.set_yscale("log")
+        bar.set_ylim(bottom, top * 2.5)
+        bar.set_ylabel("maximum approach speed (m/s, log scale)")
+    else:
+        bar.set_ylim(0, 1.2 * top)
+        bar.set_ylabel("maximum approach speed (m/s)")
+    bar.set_title("Maximum contact velocity vs impact friction", fontsize=FONT_TITLE)
     bar.grid(True, axis="y", alpha=0.3)
-    bar.legend(loc="upper right", fontsize=8)
+    bar.legend(fontsize=FONT_SMALL, framealpha=0.9)

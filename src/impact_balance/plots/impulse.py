@@ -15,7 +15,12 @@ from scipy.spatial import ConvexHull, QhullError
 
 from impact_balance.analysis.analyze import Analysis
 from impact_balance.impact.model import ImpactModel
+from impact_balance.plots.placement import place_inside
 from impact_balance.plots.style import (
+    DIGITS,
+    FONT_SMALL,
+    FONT_SUPTITLE,
+    FONT_TITLE,
     IMPACT_COLOR,
     centre_message,
     draw_polygon,
@@ -80,17 +85,21 @@ def _draw_impulse_polytope(ax: Axes3D, model: ImpactModel, speed: float) -> None
     # generators.
     for ring, ls in ((hi, "-"), (lo, "--")):
         closed = np.vstack([ring, ring[:1]])
-        ax.plot(*closed.T, ls, color="darkred", lw=1.0)
+        ax.plot(*closed.T, ls, color="#9E3D00", lw=1.0)
     for i in range(n):
-        ax.plot(*np.vstack([hi[i], lo[i]]).T, "-", color="darkred", lw=0.6, alpha=0.7)
+        ax.plot(*np.vstack([hi[i], lo[i]]).T, "-", color="#9E3D00", lw=0.6, alpha=0.7)
     c_lo, c_hi = model.spec.restitution
     ax.scatter(
-        *hi.T, color="red", s=22, depthshade=False, label=f"vertices on the plane c_r = {c_hi:g}"
+        *hi.T,
+        color=IMPACT_COLOR,
+        s=22,
+        depthshade=False,
+        label=f"vertices on the plane c_r = {c_hi:g}",
     )
     ax.scatter(
         *lo.T,
         facecolor="white",
-        edgecolor="red",
+        edgecolor=IMPACT_COLOR,
         s=22,
         depthshade=False,
         label=f"vertices on the plane c_r = {c_lo:g}",
@@ -113,7 +122,7 @@ def _draw_impulse_polytope(ax: Axes3D, model: ImpactModel, speed: float) -> None
     ax.set_zlim(centre[2] - half, centre[2] + half)
     # Zoomed out a little: constrained layout does not see 3D axis labels, which the full
     # box would push out of the figure.
-    ax.set_box_aspect((1, 1, 1), zoom=0.82)
+    ax.set_box_aspect((1, 1, 1), zoom=0.78)
     # Horizontal labels, padded off the ticks: labels rotated along the axes read upside
     # down from some view directions.
     for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
@@ -138,7 +147,7 @@ def _draw_impulse_polytope(ax: Axes3D, model: ImpactModel, speed: float) -> None
     for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
         axis.set_major_locator(MaxNLocator(5))
     ax.view_init(elev=30, azim=azim)
-    ax.legend(loc="upper left", bbox_to_anchor=(0.0, 1.0), fontsize=7.5)
+    ax.legend(loc="upper left", bbox_to_anchor=(0.0, 1.0), fontsize=FONT_SMALL)
 
 
 def _draw_jump_set(ax: Axes, model: ImpactModel, speed: float) -> None:
@@ -149,32 +158,33 @@ def _draw_jump_set(ax: Axes, model: ImpactModel, speed: float) -> None:
         hull(jumps),
         color=IMPACT_COLOR,
         alpha=0.25,
-        edge="darkred",
+        edge="#9E3D00",
         lw=1.8,
         label="CoM velocity jump set (convex hull)",
         zorder=2,
     )
     c_lo, c_hi = model.spec.restitution
-    ax.plot(*jumps[0::2].T, "o", color="red", ms=4.5, label=f"vertices, c_r = {c_hi:g}", zorder=4)
+    ax.plot(
+        *jumps[0::2].T, "o", color=IMPACT_COLOR, ms=4.5, label=f"vertices, c_r = {c_hi:g}", zorder=4
+    )
     ax.plot(
         *jumps[1::2].T,
         "o",
         mfc="white",
-        mec="red",
+        mec=IMPACT_COLOR,
         ms=4.5,
         label=f"vertices, c_r = {c_lo:g}",
         zorder=4,
     )
     ax.plot(0, 0, "+", color="black", ms=12, mew=2, label="no jump", zorder=5)
-    # Nearly square (the 3D panel beside it is): a flat set in a flat panel left most of the
-    # figure blank.
-    set_limits(ax, [jumps, np.zeros((1, 2))], margin=0.15, min_span=0.02, min_ratio=0.8)
+    # Fitted to the set and the origin (the figure's size follows the view's shape).
+    set_limits(ax, [jumps, np.zeros((1, 2))], margin=0.12, min_span=0.02, min_ratio=0.35)
     ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel(r"$\Delta\dot c_x$ (m/s)")
     ax.set_ylabel(r"$\Delta\dot c_y$ (m/s)")
     ax.grid(True, alpha=0.3)
-    # Under the figure (constrained layout makes room): inside, it covered vertices.
-    ax.figure.legend(*ax.get_legend_handles_labels(), loc="outside lower right", ncol=4, fontsize=8)
+    # Placed by plot_impulse_set in a corner clear of the set (place_inside).
+    ax.legend(fontsize=FONT_SMALL, framealpha=0.9)
 
 
 def plot_impulse_set(analysis: Analysis, approach_speed: float | None = None) -> Figure:
@@ -188,7 +198,7 @@ def plot_impulse_set(analysis: Analysis, approach_speed: float | None = None) ->
     Returns:
         The figure.
     """
-    fig = new_figure(13, 6.2)
+    fig = new_figure(11, 5.4)
     grid = fig.add_gridspec(1, 2, width_ratios=[1.15, 1])
     ax3 = cast(Axes3D, fig.add_subplot(grid[0], projection="3d"))
     ax2 = fig.add_subplot(grid[1])
@@ -215,12 +225,12 @@ def plot_impulse_set(analysis: Analysis, approach_speed: float | None = None) ->
     n = model.cone.shape[1]
     _draw_impulse_polytope(ax3, model, speed)
     ax3.set_title(
-        f"Impulse set: {2 * n} vertices, friction cone with N = {n} edges "
+        f"Impulse set: {2 * n} vertices\nfriction cone with N = {n} edges "
         f"(μ = {model.spec.friction:g})",
-        fontsize=10,
+        fontsize=FONT_TITLE,
     )
     _draw_jump_set(ax2, model, speed)
-    ax2.set_title(f"CoM velocity jump set (xy), mass {model.mass:.1f} kg", fontsize=10)
+    ax2.set_title(f"CoM velocity jump set (xy), mass {model.mass:.1f} kg", fontsize=FONT_TITLE)
     tags: dict[str, str] = {
         "v_max": "the maximum contact velocity",
         "reference": "the reference approach speed",
@@ -228,5 +238,16 @@ def plot_impulse_set(analysis: Analysis, approach_speed: float | None = None) ->
         "given": "the given approach speed",
     }
     tag = tags[which]
-    fig.suptitle(f"Impulse set at {tag} {speed:.3g} m/s: {title}", fontsize=12)
+    fig.suptitle(f"Impulse set at {tag} {speed:.{DIGITS}g} m/s: {title}", fontsize=FONT_SUPTITLE)
+
+    def relayout() -> None:
+        # The 3D panel square, the jump set's panel as wide as its view at the same height.
+        (x0, x1), (y0, y1) = ax2.get_xlim(), ax2.get_ylim()
+        wide = float(np.clip(abs(x1 - x0) / max(abs(y1 - y0), 1e-12), 0.6, 2.4))
+        height = 5.4
+        grid.set_width_ratios([1.15, wide])
+        fig.set_size_inches(height * (1.15 + wide) * 0.8 + 0.6, height)
+
+    relayout()
+    place_inside(ax2, [ax2.get_legend()], relayout=relayout)
     return fig

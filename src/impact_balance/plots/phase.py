@@ -3,11 +3,18 @@
 from __future__ import annotations
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from impact_balance.analysis.analyze import Analysis
 from impact_balance.balance.lipm import PhasePortrait, phase_portrait
-from impact_balance.plots.style import new_figure
+from impact_balance.plots.style import (
+    COM_COLOR,
+    FONT_SMALL,
+    FONT_TITLE,
+    IMPACT_COLOR,
+    new_figure,
+)
 
 __all__ = ["analysis_phase_portrait", "plot_phase_portrait"]
 
@@ -52,11 +59,84 @@ def analysis_phase_portrait(analysis: Analysis, axis: int = 0) -> PhasePortrait:
     return phase_portrait(float(com[2] - areas.plane_height), (float(lo), float(hi)), areas.gravity)
 
 
-def plot_phase_portrait(portrait: PhasePortrait, title: str | None = None) -> Figure:
+def _draw_trajectories(
+    ax: Axes, portrait: PhasePortrait, xlim: tuple[float, float], ylim: tuple[float, float]
+) -> None:
+    """The portrait's LIPM trajectories, each with an arrow a third of the way in the view."""
+    for k, traj in enumerate(portrait.trajectories):
+        traj = np.asarray(traj, dtype=float)
+        if len(traj) < 2:
+            continue
+        ax.plot(
+            traj[:, 0],
+            traj[:, 1],
+            "-",
+            color="0.45",
+            lw=0.8,
+            label="LIPM trajectories, saturated ZMP feedback" if k == 0 else None,
+        )
+        inside = np.flatnonzero(
+            (traj[:, 0] > xlim[0]) & (traj[:, 0] < xlim[1]) & (np.abs(traj[:, 1]) < ylim[1])
+        )
+        if len(inside) > 4:
+            i = inside[len(inside) // 3]
+            ax.annotate(
+                "",
+                xy=traj[i + 1],
+                xytext=traj[i],
+                arrowprops={"arrowstyle": "->", "color": "0.35", "lw": 0.9},
+            )
+
+
+def _draw_velocities(
+    ax: Axes, pre: float | None, post: tuple[float, float] | None, post_label: str
+) -> None:
+    """A CoM velocity (a point) and a range of them (a segment) at c = 0, m/s."""
+    if post is not None:
+        ax.plot(
+            [0.0, 0.0],
+            sorted(post),
+            "-",
+            color=IMPACT_COLOR,
+            lw=5,
+            alpha=0.8,
+            solid_capstyle="butt",
+            zorder=4,
+            label=f"{post_label}: {min(post):+.4f} to {max(post):+.4f} m/s",
+        )
+    if pre is not None:
+        ax.plot(
+            [0.0],
+            [pre],
+            "o",
+            color=COM_COLOR,
+            mfc="white",
+            mew=2,
+            ms=8,
+            zorder=6,
+            label=f"pre-impact CoM velocity {pre:+.4f} m/s",
+        )
+
+
+def plot_phase_portrait(
+    portrait: PhasePortrait,
+    title: str | None = None,
+    pre_impact: float | None = None,
+    post_impact: tuple[float, float] | None = None,
+    post_label: str = "post-impact CoM velocities",
+) -> Figure:
     """LIPM phase portrait (c in m, cd in m/s) with the stable standing region shaded.
 
     The region lies between the lines c + cd / omega = z_lo and z_hi; its intersection with
     c = 0 gives the CoM velocity bounds, marked and annotated.
+
+    Args:
+        portrait: The phase portrait.
+        title: The title (default: the portrait's height, ZMP range and omega).
+        pre_impact: A CoM velocity at c = 0 to mark (m/s), e.g. the stance's pre-impact one.
+        post_impact: A range of CoM velocities at c = 0 to draw as a segment (m/s, lowest and
+            highest), e.g. the post-impact ones at the maximum contact velocity.
+        post_label: The legend entry of ``post_impact``.
     """
     w = portrait.omega
     z_lo, z_hi = portrait.zmp_range
@@ -92,54 +172,33 @@ def plot_phase_portrait(portrait: PhasePortrait, title: str | None = None) -> Fi
                 (cx, cd),
                 xytext=(-6 if right_half else 6, 0),
                 textcoords="offset points",
-                fontsize=8,
+                fontsize=FONT_SMALL,
                 color="darkgreen",
                 va="center",
                 ha="right" if right_half else "left",
             )
-    for k, traj in enumerate(portrait.trajectories):
-        traj = np.asarray(traj, dtype=float)
-        if len(traj) < 2:
-            continue
-        ax.plot(
-            traj[:, 0],
-            traj[:, 1],
-            "-",
-            color="0.45",
-            lw=0.8,
-            label="LIPM trajectories, saturated ZMP feedback" if k == 0 else None,
-        )
-        inside = np.flatnonzero(
-            (traj[:, 0] > xlim[0]) & (traj[:, 0] < xlim[1]) & (np.abs(traj[:, 1]) < ylim[1])
-        )
-        if len(inside) > 4:
-            i = inside[len(inside) // 3]
-            ax.annotate(
-                "",
-                xy=traj[i + 1],
-                xytext=traj[i],
-                arrowprops={"arrowstyle": "->", "color": "0.35", "lw": 0.9},
-            )
-    ax.axvline(0.0, color="tab:green", lw=1.2, ls="--", label="c = 0 (CoM at the reference)")
+    _draw_trajectories(ax, portrait, xlim, ylim)
+    ax.axvline(0.0, color="#009E73", lw=1.2, ls="--", label="c = 0 (CoM at the reference)")
     ax.axhline(0.0, color="0.6", lw=0.6)
     # The values go in the legend, outside the axes: a label beside the points was crossed by
     # the trajectories that converge there.
     ax.plot(
         [0.0, 0.0],
         [v_lo, v_hi],
-        "o",
-        color="tab:red",
-        ms=8,
+        "D",
+        color="#0072B2",
+        ms=7,
         zorder=5,
         label=f"CoM velocity bounds at c = 0: {v_lo:+.4f} and {v_hi:+.4f} m/s",
     )
+    _draw_velocities(ax, pre_impact, post_impact, post_label)
     ax.set_xlim(*xlim)
     ax.set_ylim(*ylim)
     ax.set_xlabel("CoM position c (m)")
     ax.set_ylabel(r"CoM velocity $\dot c$ (m/s)")
     ax.grid(True, alpha=0.3)
     # Below the axes: inside, the trajectories run under it wherever it goes.
-    fig.legend(loc="outside lower center", ncol=2, fontsize=8.5, framealpha=0.9)
+    fig.legend(loc="outside lower center", ncol=2, fontsize=FONT_SMALL, framealpha=0.9)
     gravity = w * w * portrait.com_height  # omega = sqrt(g / h)
     ax.set_title(
         title
@@ -147,6 +206,6 @@ def plot_phase_portrait(portrait: PhasePortrait, title: str | None = None) -> Fi
             f"LIPM phase portrait: CoM height {portrait.com_height:.3g} m, "
             f"ZMP in [{z_lo:.3g}, {z_hi:.3g}] m,\nω = {w:.4f} 1/s with g = {gravity:.4g} m/s²"
         ),
-        fontsize=10,
+        fontsize=FONT_TITLE,
     )
     return fig

@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import numpy as np
 from matplotlib.figure import Figure
 
 from impact_balance.analysis.analyze import Analysis
@@ -24,6 +25,21 @@ def figure_prefix(analysis: Analysis) -> str:
     return re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._") or "scenario"
 
 
+def _sagittal_velocities(analysis: Analysis) -> tuple[float, tuple[float, float] | None]:
+    """The CoM velocities along world x drawn on the sagittal phase portrait, m/s.
+
+    Returns:
+        The pre-impact one, and the range of the post-impact ones at the maximum contact
+        velocity (None without a finite maximum).
+    """
+    c0 = np.asarray(analysis.com_velocity[:2], dtype=float)
+    im = analysis.impact
+    if im is None or not im.com.is_finite:
+        return float(c0[0]), None
+    post = im.model.post_impact_com_velocities(c0, im.max_contact_velocity)[:, 0]
+    return float(c0[0]), (float(post.min()), float(post.max()))
+
+
 def save_figures(
     analysis: Analysis, out_dir: str | Path, dpi: int = DPI, skipped: list[Diagnostic] | None = None
 ) -> list[Path]:
@@ -31,8 +47,9 @@ def save_figures(
 
     The files are ``<scenario>_areas.png``, ``_stance.png``, ``_phase_portrait.png`` and, with
     an impact, ``_impulse_set.png``. The phase portrait is the sagittal one of the stance
-    (:func:`analysis_phase_portrait`); it is skipped when the ZMP support area has no chord
-    through the CoM along x.
+    (:func:`analysis_phase_portrait`) with the stance's pre-impact CoM velocity and the range of
+    its post-impact CoM velocities at the maximum contact velocity along x; it is skipped when
+    the ZMP support area has no chord through the CoM along x.
 
     Args:
         analysis: The analysis.
@@ -70,7 +87,19 @@ def save_figures(
             f"the chord of the ZMP support area along x\nthrough the CoM (at y = {com[1]:.3f} m); "
             f"other slices of the area give other bounds"
         )
-        figures.append(("phase_portrait", plot_phase_portrait(portrait, title=title)))
+        pre, post = _sagittal_velocities(analysis)
+        figures.append(
+            (
+                "phase_portrait",
+                plot_phase_portrait(
+                    portrait,
+                    title=title,
+                    pre_impact=pre,
+                    post_impact=post,
+                    post_label="post-impact CoM velocities at v_max",
+                ),
+            )
+        )
     written = []
     for name, fig in figures:
         path = out / f"{prefix}_{name}.png"

@@ -25,7 +25,7 @@ __all__ = ["plot_jump_on_sets", "plot_time_series"]
 # The trial results come from :mod:`impact_balance.sim`, a layer above the figures: they are
 # read by their attributes (``Any``), not imported.
 
-_MODEL_COLORS = {"composite": "tab:blue", "joint_space": "tab:orange"}
+_MODEL_COLORS = {"composite": "#0072B2", "joint_space": "#E69F00"}
 
 
 def plot_jump_on_sets(result: Any, title: str) -> Figure:
@@ -140,7 +140,7 @@ def plot_time_series(result: Any, title: str) -> Figure:
     fig = new_figure(9.0, 6.4)
     ax_f, ax_v = fig.subplots(2, 1, sharex=True)
     t = record.time
-    others = iter(("tab:blue", "tab:orange", "tab:brown", "tab:olive", "tab:cyan", "tab:pink"))
+    others = iter(("#0072B2", "#E69F00", "#8c564b", "0.45", "#56B4E9", "#F0E442"))
     for name, force in record.forces.items():
         label = "impact point" if name == "impact" else f"contact {name}"
         ax_f.plot(
@@ -151,7 +151,7 @@ def plot_time_series(result: Any, title: str) -> Figure:
         )
     ax_f.set_ylabel("contact force |f| (N)")
     for k, (axis, color) in enumerate(
-        zip("xy", ("tab:green", "tab:purple"), strict=True)
+        zip("xy", ("#009E73", "#CC79A7"), strict=True)
     ):  # not the forces' colours:
         ax_v.plot(
             t, record.com_velocity[:, k], label=f"CoM velocity {axis}", color=color

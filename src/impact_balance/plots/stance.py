@@ -12,9 +12,15 @@ from matplotlib.figure import Figure
 from impact_balance.analysis.analyze import Analysis
 from impact_balance.analysis.result import ImpactAnswer
 from impact_balance.plots.style import (
+    CAPPED_COLOR,
     COM_COLOR,
     CONTACT_COLOR,
+    DIGITS,
+    FONT_SMALL,
+    FONT_SUPTITLE,
+    FONT_TITLE,
     IMPACT_COLOR,
+    REFERENCE_COLOR,
     ZMP_COLOR,
     draw_polygon,
     hull,
@@ -73,8 +79,12 @@ def _arrow(
     width: float = 0.012,
     zorder: float = 7,
     ls: str = "-",
+    hollow: bool = False,
 ) -> bool:
-    """Arrow from ``start`` by ``delta`` (data units); nothing if it is too short to see."""
+    """Arrow from ``start`` by ``delta`` (data units); nothing if it is too short to see.
+
+    A ``hollow`` arrow is its outline only (another arrow drawn inside it stays visible).
+    """
     if float(np.linalg.norm(delta)) < 1e-4:
         return False
     ax.arrow(
@@ -82,11 +92,13 @@ def _arrow(
         start[1],
         delta[0],
         delta[1],
-        width=width * 0.35,
+        width=width * 0.35 * (2.0 if hollow else 1.0),
         head_width=width * 2.2,
         head_length=width * 2.5,
         length_includes_head=True,
-        color=color,
+        facecolor="none" if hollow else color,
+        edgecolor=color,
+        lw=1.5 if hollow else 1.0,
         zorder=zorder,
         label=label,
         ls=ls,
@@ -267,25 +279,30 @@ def _draw_impact(v: _View, im: ImpactAnswer) -> None:
     if reference is None:
         return
     ref = np.asarray(reference, dtype=float)
+    capped = im.contact_velocity
+    is_capped = capped is not None and not np.allclose(capped, ref)
+    # The reference as a wide hollow arrow, the capped velocity as a thin solid one inside it:
+    # when the two nearly coincide, both stay visible.
     _arrow(
         ax,
         p[[i, k]],
         VELOCITY_SCALE * ref[[i, k]],
-        "darkorange",
-        f"reference velocity {np.linalg.norm(ref):.3g} m/s",
-        width=0.012,
+        REFERENCE_COLOR,
+        f"reference velocity {np.linalg.norm(ref):.{DIGITS}g} m/s"
+        f" (arrows: {VELOCITY_SCALE:g} m per m/s)",
+        width=0.016,
         zorder=7,
+        hollow=is_capped,
     )
     v.view.append((p + VELOCITY_SCALE * ref)[None, [i, k]])
-    if im.contact_velocity is not None and not np.allclose(im.contact_velocity, ref):
-        capped = im.contact_velocity
+    if is_capped and capped is not None:
         _arrow(
             ax,
             p[[i, k]],
             VELOCITY_SCALE * capped[[i, k]],
-            "tab:green",
-            f"capped at v_max: {np.linalg.norm(capped):.3g} m/s",
-            width=0.007,
+            CAPPED_COLOR,
+            f"capped at v_max: {np.linalg.norm(capped):.{DIGITS}g} m/s",
+            width=0.006,
             zorder=7.5,
         )
 
@@ -314,9 +331,9 @@ def plot_stance(analysis: Analysis, robot: bool = True) -> Figure:
     fig = new_figure(13, 7)
     top, side = fig.subplots(1, 2)
     _draw_view(top, analysis, (0, 1), robot)
-    top.set_title("Top view (x-y)")
+    top.set_title("Top view (x-y)", fontsize=FONT_TITLE)
     _draw_view(side, analysis, (0, 2), robot)
-    side.set_title("Side view (x-z)")
+    side.set_title("Side view (x-z)", fontsize=FONT_TITLE)
     # Each panel as wide as its data at a common height (both have an equal aspect), and
     # the figure as wide as both: fixed ratios left a wide blank gap between the views.
     widths = [_aspect_width(ax) for ax in (top, side)]
@@ -330,8 +347,11 @@ def plot_stance(analysis: Analysis, robot: bool = True) -> Figure:
             handles.append(hnd)
             labels.append(lab)
     ncol = max(2, min(4, int(fig.get_figwidth() / 3.3)))  # as many columns as the width holds
-    fig.legend(handles, labels, loc="outside lower center", ncol=ncol, fontsize=8.5, framealpha=0.9)
+    fig.legend(
+        handles, labels, loc="outside lower center", ncol=ncol, fontsize=FONT_SMALL, framealpha=0.9
+    )
     fig.suptitle(
-        f"Stance: {scenario_title(analysis)}, mass {analysis.stance.mass:.1f} kg", fontsize=12
+        f"Stance: {scenario_title(analysis)}, mass {analysis.stance.mass:.1f} kg",
+        fontsize=FONT_SUPTITLE,
     )
     return fig

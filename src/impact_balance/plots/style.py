@@ -26,18 +26,31 @@ if TYPE_CHECKING:
 
 __all__ = [
     "AREA_COLOR",
+    "AREA_EDGE",
+    "CAPPED_COLOR",
     "COM_COLOR",
+    "COM_CRITERION_COLOR",
     "CONTACT_COLOR",
+    "DIGITS",
     "DPI",
     "FALL_COLOR",
+    "FONT_MIN",
+    "FONT_SMALL",
+    "FONT_SUPTITLE",
+    "FONT_TITLE",
     "IMPACT_COLOR",
+    "LOG_RATIO",
     "OK_COLOR",
+    "PALETTE",
+    "REFERENCE_COLOR",
     "ZMP_COLOR",
+    "ZMP_CRITERION_COLOR",
     "area_view_points",
     "centre_message",
     "draw_polygon",
     "fmt_speed",
     "hull",
+    "needs_log_scale",
     "new_figure",
     "scenario_title",
     "set_limits",
@@ -45,23 +58,53 @@ __all__ = [
     "trim_height",
 ]
 
-#: The ZMP support area.
-ZMP_COLOR = "#8fbc8f"
-#: The CoM velocity area (cyan, as in the paper).
-AREA_COLOR = "#7fd3e6"
+#: A colour-blind-safe palette (Okabe and Ito, 2008): blue, orange, bluish green, reddish
+#: purple, sky blue, vermillion, yellow, black. Series of one figure take its colours in order.
+PALETTE = (
+    "#0072B2",
+    "#E69F00",
+    "#009E73",
+    "#CC79A7",
+    "#56B4E9",
+    "#D55E00",
+    "#F0E442",
+    "#000000",
+)
+#: The ZMP support area (bluish green).
+ZMP_COLOR = "#009E73"
+#: The CoM velocity area (sky blue, the paper's cyan) and its boundary (blue).
+AREA_COLOR = "#56B4E9"
+AREA_EDGE = "#0072B2"
 #: The CoM, its projection and its velocity.
 COM_COLOR = "black"
-#: The impact: its point, its force and its impulse set.
-IMPACT_COLOR = "tab:red"
-#: A balanced outcome.
-OK_COLOR = "tab:blue"
-#: A fall, or what makes the robot fall.
-FALL_COLOR = "tab:red"
-#: The contact rectangles.
-CONTACT_COLOR = "tab:brown"
+#: The impact: its point, its force and its impulse set (vermillion).
+IMPACT_COLOR = "#D55E00"
+#: A balanced outcome (blue).
+OK_COLOR = "#0072B2"
+#: A fall, or what makes the robot fall (vermillion).
+FALL_COLOR = "#D55E00"
+#: The contact rectangles (brown: dark, apart from the palette's hues).
+CONTACT_COLOR = "#8c564b"
+#: The CoM criterion and the ZMP criterion, wherever the two are compared.
+COM_CRITERION_COLOR = "#0072B2"
+ZMP_CRITERION_COLOR = "#E69F00"
+#: A reference (an intended velocity) and its capped value.
+REFERENCE_COLOR = "#E69F00"
+CAPPED_COLOR = "#0072B2"
 
 #: Resolution of the written figures, dots per inch.
 DPI = 120
+#: Font sizes at the saved size, points: figure title, panel title, legends and notes. No text
+#: of a figure is smaller than :data:`FONT_MIN`.
+FONT_SUPTITLE = 12.0
+FONT_TITLE = 10.5
+FONT_SMALL = 8.5
+FONT_MIN = 8.0
+#: Significant digits of a number written on a figure (speeds, ratios).
+DIGITS = 3
+#: Two values of one axis further apart than this ratio are drawn on a log scale (the smaller
+#: would be a sliver under 5 % of a linear axis).
+LOG_RATIO = 20.0
 
 
 def new_figure(width: float, height: float) -> Figure:
@@ -70,7 +113,7 @@ def new_figure(width: float, height: float) -> Figure:
     No global state is touched (no ``matplotlib.use``, no pyplot figure manager), so these
     functions are safe in scripts, tests and notebooks alike; ``fig.savefig`` renders with Agg.
     """
-    fig = Figure(figsize=(width, height), layout="constrained")
+    fig = Figure(figsize=(width, height), dpi=DPI, layout="constrained")
     # A wider margin than the default (3 pt): a legend anchored outside its axes otherwise
     # ends on the canvas' edge, where its frame is cut.
     engine = fig.get_layout_engine()
@@ -80,7 +123,18 @@ def new_figure(width: float, height: float) -> Figure:
     return fig
 
 
-def fmt_speed(value: float | None, digits: int = 3) -> str:
+def needs_log_scale(values: Iterable[float]) -> bool:
+    """Whether ``values`` (drawn on one axis) need a log scale.
+
+    They do when their positive finite values span more than :data:`LOG_RATIO`: the smallest
+    would be invisible on a linear axis.
+    """
+    v = np.asarray([float(x) for x in values], dtype=float)
+    v = v[np.isfinite(v) & (v > 0)]
+    return bool(v.size >= 2 and v.max() > LOG_RATIO * v.min())
+
+
+def fmt_speed(value: float | None, digits: int = DIGITS) -> str:
     """An approach speed in m/s, ``unbounded`` for infinity."""
     if value is None or not math.isfinite(value):
         return "unbounded"
@@ -194,7 +248,11 @@ def set_limits(
 
 
 def text_box(
-    ax: Axes, text: str, loc: str = "upper left", fontsize: float = 9, edgecolor: str = "0.6"
+    ax: Axes,
+    text: str,
+    loc: str = "upper left",
+    fontsize: float = FONT_SMALL,
+    edgecolor: str = "0.6",
 ) -> None:
     """A boxed note inside the axes."""
     x, ha = (0.02, "left") if "left" in loc else (0.98, "right")
@@ -219,7 +277,7 @@ def text_box(
 
 
 def centre_message(
-    ax: Axes, text: str, color: str = "tab:red", y: float = 0.5, fontsize: float = 13
+    ax: Axes, text: str, color: str = FALL_COLOR, y: float = 0.5, fontsize: float = 13
 ) -> None:
     """A large message across the axes (e.g. "cannot balance"), at height ``y`` (axes fraction)."""
     put = getattr(ax, "text2D", ax.text)  # 3D axes place 2D text with text2D
@@ -256,18 +314,33 @@ def area_view_points(polygon: Polygon, extra: Sequence[npt.ArrayLike] = ()) -> l
     return out
 
 
-def trim_height(fig: Figure, axes: Sequence[Axes], passes: int = 2) -> None:
-    """Shrink the figure's height to what its equal-aspect ``axes`` (one row) use.
+def trim_height(fig: Figure, axes: Sequence[Axes], passes: int = 2, width: bool = False) -> None:
+    """Shrink the figure to what its equal-aspect ``axes`` (one row) use.
 
     Constrained layout gives each axes a cell; an equal aspect then shrinks the axes inside it
-    and leaves blank bands above and below. The height is reduced by the smallest band.
+    and leaves blank bands above and below (or beside) it. The height is reduced by the
+    smallest band; with ``width``, the width by the side bands of every axes.
     """
     for _ in range(passes):
         fig.canvas.draw()
-        spare = min(
+        spare_h = min(
             ax.get_position(original=True).height - ax.get_position(original=False).height
             for ax in axes
         )
-        if spare * fig.get_figheight() < 0.05:
+        spare_w = sum(
+            ax.get_position(original=True).width - ax.get_position(original=False).width
+            for ax in axes
+        )
+        w_in, h_in = fig.get_figwidth(), fig.get_figheight()
+        cut_h = spare_h * h_in if spare_h * h_in >= 0.05 else 0.0
+        cut_w = spare_w * w_in if width and spare_w * w_in >= 0.05 else 0.0
+        # Never narrower than a title: an axes keeps its title's width.
+        renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]
+        room = min(
+            (ax.get_window_extent().width - ax.title.get_window_extent(renderer).width) / fig.dpi
+            for ax in axes
+        )
+        cut_w = min(cut_w, max(room, 0.0) * len(axes))
+        if not cut_h and not cut_w:
             return
-        fig.set_figheight(fig.get_figheight() * (1.0 - spare) + 0.02)
+        fig.set_size_inches(w_in - 0.9 * cut_w, h_in - cut_h + (0.02 if cut_h else 0.0))

@@ -24,7 +24,15 @@ from matplotlib.axes import Axes
 from matplotlib.cm import ScalarMappable
 from matplotlib.figure import Figure
 
-from impact_balance.plots.style import DPI, new_figure
+from impact_balance.plots.style import (
+    COM_CRITERION_COLOR,
+    DPI,
+    FALL_COLOR,
+    OK_COLOR,
+    ZMP_CRITERION_COLOR,
+    needs_log_scale,
+    new_figure,
+)
 from impact_balance.sweep.columns import EVALUATED, Status
 from impact_balance.sweep.summary import load_frame
 
@@ -192,7 +200,7 @@ def axis_label(name: str, frame: str | None = None) -> str:
 VALUED: tuple[Status, ...] = ("ok", "unbounded")
 #: Marker, colour and legend text of the points that have no maximum to show.
 _MARKS: dict[Status, tuple[str, str, str]] = {
-    "already_falling": ("v", "tab:red", "falling before the impact (no maximum)"),
+    "already_falling": ("v", FALL_COLOR, "falling before the impact (no maximum)"),
     "cannot_balance": ("s", "black", "cannot balance (no maximum)"),
 }
 
@@ -207,9 +215,20 @@ def _curve(df: pd.DataFrame, x: str, title: str, frame: str | None = None) -> Fi
     z = df["zmp_max_contact_velocity"].to_numpy(dtype=float).copy()
     z[np.isnan(v)] = np.nan
     ax.plot(
-        xs, np.where(np.isfinite(v), v, np.nan), "-o", ms=3, color="tab:blue", label="CoM criterion"
+        xs,
+        np.where(np.isfinite(v), v, np.nan),
+        "-o",
+        ms=3,
+        color=COM_CRITERION_COLOR,
+        label="CoM criterion",
     )
-    ax.plot(xs, np.where(np.isfinite(z), z, np.nan), "--", color="tab:gray", label="ZMP criterion")
+    ax.plot(
+        xs,
+        np.where(np.isfinite(z), z, np.nan),
+        "--",
+        color=ZMP_CRITERION_COLOR,
+        label="ZMP criterion",
+    )
     ok = np.isfinite(v)
     if ok.any():
         best, worst = (
@@ -221,7 +240,7 @@ def _curve(df: pd.DataFrame, x: str, title: str, frame: str | None = None) -> Fi
             v[best],
             "*",
             ms=14,
-            color="tab:green",
+            color=OK_COLOR,
             label=f"highest maximum {v[best]:.3g} m/s",
         )
         ax.plot(
@@ -229,7 +248,7 @@ def _curve(df: pd.DataFrame, x: str, title: str, frame: str | None = None) -> Fi
             v[worst],
             "X",
             ms=10,
-            color="tab:red",
+            color=FALL_COLOR,
             label=f"lowest maximum {v[worst]:.3g} m/s",
         )
     _mark_statuses(ax, df, x, None)
@@ -244,7 +263,11 @@ def _curve(df: pd.DataFrame, x: str, title: str, frame: str | None = None) -> Fi
             label="limiting edge changes" if i == 0 else None,
         )
     ax.set_xlabel(axis_label(x, frame))
-    ax.set_ylabel("maximum contact velocity (m/s)")
+    if needs_log_scale(np.concatenate([v, z])):  # the ZMP criterion's maxima: a hundredth
+        ax.set_yscale("log")
+        ax.set_ylabel("maximum contact velocity (m/s, log scale)")
+    else:
+        ax.set_ylabel("maximum contact velocity (m/s)")
     ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
     fig.legend(
@@ -307,7 +330,7 @@ def _heatmap(
             b[y],
             "*",
             ms=16,
-            mfc="tab:green",
+            mfc=OK_COLOR,
             mec="w",
             label=f"highest maximum {b['_v']:.3g} m/s",
         )
@@ -316,7 +339,7 @@ def _heatmap(
             w[y],
             "X",
             ms=11,
-            mfc="tab:red",
+            mfc=FALL_COLOR,
             mec="w",
             label=f"lowest maximum {w['_v']:.3g} m/s",
         )
