@@ -56,6 +56,7 @@ __all__ = [
     "Projected",
     "areas_from_arrays",
     "areas_from_polytope",
+    "assembled_areas",
     "balance_areas",
     "projected_from_arrays",
     "warm_up",
@@ -480,6 +481,10 @@ def _assembled_areas(
     )
     return A, b, C, d, E, status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, Gv, hv
 
+
+#: The compiled pipeline of one posture (assembly, walk, certificate, maps), for compiled callers
+#: that loop over postures (:mod:`impact_balance.criteria.batch`).
+assembled_areas = _assembled_areas
 
 # The compiled functions above embed the polygon module's, the walk's and the assembly's.
 cache_depends_on(_maps, polygon)

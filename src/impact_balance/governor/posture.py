@@ -22,6 +22,7 @@ from __future__ import annotations
 import functools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -51,7 +52,7 @@ from impact_balance.impact.model import (
 )
 from impact_balance.robot.robot import Robot, Scratch
 
-__all__ = ["Posture", "PostureEvaluator", "PostureSettings"]
+__all__ = ["Kinematics", "Posture", "PostureEvaluator", "PostureSettings"]
 
 _POSITION = pin.KinematicLevel.POSITION
 
@@ -134,6 +135,37 @@ class Posture:
         return Stance(self.robot, self.q, self.settings.contacts)
 
 
+class Kinematics(NamedTuple):
+    """One configuration's kinematics, as :meth:`PostureEvaluator.kinematics` computes them.
+
+    Positions in m, world axes; ``*_local`` in the stance frame (origin at the base position
+    ``origin``, the free flyer's translation set to zero).
+
+    Attributes:
+        origin: (3,) the stance frame's origin in world, m.
+        com_local: (3,) the CoM, stance frame. com: (3,) the CoM, world.
+        mass: kg.
+        com_jacobian: (3, nv) generalized velocity to CoM velocity (world axes).
+        rotations: (m, 3, 3) the contacts' contact-to-world rotations.
+        local: (m, 3) the contact points, stance frame.
+        jacobians: (6m, nv) their world-aligned Jacobians stacked (linear rows first), or
+            (0, 0) without torque limits.
+        gravity_torques: (nv,) g(q), N m (zeros without torque limits).
+        inertia: (3, 3) the composite rotational inertia about the CoM, kg m^2.
+    """
+
+    origin: np.ndarray
+    com_local: np.ndarray
+    com: np.ndarray
+    mass: float
+    com_jacobian: np.ndarray
+    rotations: np.ndarray
+    local: np.ndarray
+    jacobians: np.ndarray
+    gravity_torques: np.ndarray
+    inertia: np.ndarray
+
+
 class PostureEvaluator:
     """Evaluates postures of one robot with one set of contacts and one impact.
 
@@ -194,7 +226,52 @@ class PostureEvaluator:
         that would not separate the contact), :class:`~impact_balance.exceptions.SolverError`
         (a projection that failed).
         """
-        robot, settings, data, model = self.robot, self.settings, self.scratch.data, self.model
+        robot, settings = self.robot, self.settings
+        k = self.kinematics(q)
+        origin, com_local, mass, com = k.origin, k.com_local, k.mass, k.com
+        rotations, local, jacobians = k.rotations, k.local, k.jacobians
+        gravity_torques, com_jacobian = k.gravity_torques, k.com_jacobian
+        areas = self._areas(
+            rotations, local, origin, com_local, mass, com, jacobians, gravity_torques
+        )
+        impact = self.impact_at(q, k)
+        com_criterion = zmp = None
+        if settings.criterion == "zmp":
+            if isinstance(areas, Projected):
+                areas = areas.areas()
+            zmp = zmp_max_contact_velocity(
+                areas.zmp_area,
+                impact,
+                com,
+                settings.plane_height,
+                settings.gravity,
+                settings.impact.duration,
+            )
+        else:
+            com_criterion = ComCriterion(areas.com_velocity_area, impact, settings.velocity_margin)
+        q = q.copy()
+        q.setflags(write=False)
+        return Posture(
+            q.tobytes(),
+            q,
+            robot,
+            settings,
+            com,
+            mass,
+            areas,
+            impact,
+            com_jacobian,
+            com_criterion,
+            zmp,
+        )
+
+    def kinematics(self, q: np.ndarray) -> Kinematics:
+        """The pinocchio step of :meth:`evaluate` at ``q`` (nq, float64, contiguous).
+
+        Left in this evaluator's Data: :meth:`impact_at` reads the impact frame from it, so
+        call it before the next :meth:`kinematics`. The arrays are new (the caller keeps them).
+        """
+        data, model = self.scratch.data, self.model
         # The kinematics in the stance frame (world axes, origin at the base position), as
         # Stance does: lever arms keep their precision however far the robot stands.
         q_local = self._q_local
@@ -226,41 +303,22 @@ class PostureEvaluator:
         # computeGeneralizedGravity to rounding (1e-14 N m of 327 on G1), without its pass.
         gravity_torques = -(self._gravity @ data.Ag[:3]) if self._torques else self._zero_velocity
         com = com_local + origin
-        areas = self._areas(
-            rotations, local, origin, com_local, mass, com, jacobians, gravity_torques
-        )
-        impact = self._impact(
-            q, q_local, origin, com_local, mass, np.array(Ig.inertia, dtype=float)
-        )
-        com_criterion = zmp = None
-        if settings.criterion == "zmp":
-            if isinstance(areas, Projected):
-                areas = areas.areas()
-            zmp = zmp_max_contact_velocity(
-                areas.zmp_area,
-                impact,
-                com,
-                settings.plane_height,
-                settings.gravity,
-                settings.impact.duration,
-            )
-        else:
-            com_criterion = ComCriterion(areas.com_velocity_area, impact, settings.velocity_margin)
-        q = q.copy()
-        q.setflags(write=False)
-        return Posture(
-            q.tobytes(),
-            q,
-            robot,
-            settings,
+        return Kinematics(
+            origin,
+            com_local,
             com,
             mass,
-            areas,
-            impact,
             com_jacobian,
-            com_criterion,
-            zmp,
+            rotations,
+            local,
+            jacobians,
+            gravity_torques,
+            np.array(Ig.inertia, dtype=float),
         )
+
+    def impact_at(self, q: np.ndarray, k: Kinematics) -> ImpactModel:
+        """The impact model at ``q``, whose :meth:`kinematics` ``k`` the Data holds."""
+        return self._impact(q, self._q_local, k.origin, k.com_local, k.mass, k.inertia)
 
     def _areas(
         self,
