@@ -9,7 +9,10 @@ garbage collector paused):
 
 - ``single``: N calls of ``governor.limit(q_k, v_k)`` (a posture-changing tick each);
 - ``batch``: one ``governor.limits(q, v)`` of the N rows;
-- ``batch_threads``: the same with ``threads=T`` (default 2).
+- ``batch_threads``: the same with ``threads=T`` (default 2);
+- ``velocity``: N calls of ``governor.limit(q_0, v_k)`` (one posture, N velocities: the
+  velocity-only tick), beside ``batch_velocity``: one ``governor.limits`` of the N rows
+  ``(q_0, v_k)`` (a row that repeats the previous row's q reuses its posture).
 
 Reported per scenario: the time per posture (median over rounds, us) of each case, the
 throughput ratio single / batch (target >= 3 at N = 1000) and the worst difference of the
@@ -43,8 +46,9 @@ __all__ = ["SCENARIOS", "bench_scenario", "main"]
 
 def bench_scenario(name: str, n: int, repeat: int, threads: int) -> dict[str, Any]:
     """One scenario's three cases, round-robin, ``repeat`` rounds of ``n`` postures."""
-    single, batched = Governor(name), Governor(name)
+    single, batched, steady = Governor(name), Governor(name), Governor(name)
     qs, vs = trajectory(single, n)
+    q0s = np.tile(qs[0], (n, 1))
     load_before = os.getloadavg()
     cases = {
         "single": Case(
@@ -55,14 +59,24 @@ def bench_scenario(name: str, n: int, repeat: int, threads: int) -> dict[str, An
         "batch_threads": Case(
             lambda: batched.limits(qs, vs, threads=threads), keep=lambda r: r.max_contact_velocity
         ),
+        "velocity": Case(
+            lambda: [steady.limit(qs[0], v).max_contact_velocity for v in vs], keep=np.asarray
+        ),
+        "batch_velocity": Case(
+            lambda: batched.limits(q0s, vs), keep=lambda r: r.max_contact_velocity
+        ),
     }
     times, results = measure(cases, repeat, 1)
     load_after = os.getloadavg()
-    want = results["single"][0]
-    finite = np.isfinite(want)
     worst = 0.0
     agree = True
-    for case in ("batch", "batch_threads"):
+    for case, reference in (
+        ("batch", "single"),
+        ("batch_threads", "single"),
+        ("batch_velocity", "velocity"),
+    ):
+        want = results[reference][0]
+        finite = np.isfinite(want)
         for got in results[case]:
             agree &= bool(np.array_equal(np.isfinite(got), finite))
             worst = max(worst, float(np.max(np.abs(got[finite] - want[finite]), initial=0.0)))
@@ -77,6 +91,8 @@ def bench_scenario(name: str, n: int, repeat: int, threads: int) -> dict[str, An
         "us_per_posture": per_posture,
         "ratio_single_over_batch": per_posture["single"] / per_posture["batch"],
         "ratio_single_over_batch_threads": per_posture["single"] / per_posture["batch_threads"],
+        "ratio_velocity_over_batch_velocity": per_posture["velocity"]
+        / per_posture["batch_velocity"],
         "worst_difference": worst,
         "agree": agree and worst <= 1e-12,
     }
@@ -85,13 +101,16 @@ def bench_scenario(name: str, n: int, repeat: int, threads: int) -> dict[str, An
 def _text(rows: list[dict[str, Any]]) -> str:
     out = [
         f"{'scenario':20s} {'single':>9s} {'batch':>9s} {'threads':>9s} {'ratio':>6s} "
-        f"{'ratio T':>7s}  worst diff  load avg (before, after)"
+        f"{'ratio T':>7s} {'velocity':>9s} {'batch v':>9s} {'ratio v':>7s}  worst diff  "
+        "load avg (before, after)"
     ]
     for r in rows:
         t = r["us_per_posture"]
         out.append(
             f"{r['scenario']:20s} {t['single']:9.1f} {t['batch']:9.1f} {t['batch_threads']:9.1f} "
-            f"{r['ratio_single_over_batch']:6.2f} {r['ratio_single_over_batch_threads']:7.2f}  "
+            f"{r['ratio_single_over_batch']:6.2f} {r['ratio_single_over_batch_threads']:7.2f} "
+            f"{t['velocity']:9.1f} {t['batch_velocity']:9.1f} "
+            f"{r['ratio_velocity_over_batch_velocity']:7.2f}  "
             f"{r['worst_difference']:.1e}     {r['loadavg_before'][0]:.2f}, "
             f"{r['loadavg_after'][0]:.2f}"
         )

@@ -172,3 +172,18 @@ def test_contact_aware_governor_refuses_a_batch():
     qs, vs = batch(g, 2, 0)
     with pytest.raises(GovernorError, match="contact_aware"):
         g.limits(qs, vs)
+
+
+@pytest.mark.parametrize("name", ["kick_one_foot", "g1_two_feet"])
+def test_many_velocities_at_one_posture_reuse_it(name):
+    # Rows that repeat the previous row's q are velocity-only ticks: the same answers as a
+    # governor whose posture is reused, and far cheaper than evaluating the posture again.
+    g = governor(name)
+    qs, vs = batch(g, 3, 21, 1.0)
+    qs = np.repeat(qs, [1, 40, 5], axis=0)
+    vs = np.random.default_rng(4).normal(0.0, 1.0, (len(qs), g.nv))
+    vs[:, :3] *= 0.3
+    answers = g.limits(qs, vs)
+    singles = [g.limit(q, v) for q, v in zip(qs, vs, strict=True)]
+    assert sum(s.posture_reused for s in singles) >= 42
+    assert_rows_equal(answers, singles)

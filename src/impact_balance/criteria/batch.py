@@ -52,9 +52,9 @@ def posture_exits(
     settings: np.ndarray,
     hint: np.ndarray,
     out: np.ndarray,
-    rows: np.ndarray,
+    same: np.ndarray,
 ) -> None:
-    """The first exit of the post-impact CoM velocities of the postures ``rows``.
+    """The first exit of the post-impact CoM velocities of every posture.
 
     Per posture i (leading axis): ``blocks`` (m, 32, 3)
     (:func:`~impact_balance.contacts.wrench_polytope.face_blocks`), ``positions`` (m, 3) world
@@ -64,7 +64,8 @@ def posture_exits(
     (world xy; ``ImpactModel.com_jump_rates``); ``com_velocities`` (2,) world xy, m/s.
     ``torque_indices`` and ``torque_limits`` are common. ``settings`` is ``(box, max_pivots,
     merge_tol, area_tol, zmp_margin, velocity_margin, boundary_tol)``. ``hint`` is the walk's
-    warm start, carried from one posture to the next.
+    warm start, carried from one posture to the next. Where ``same[i]`` (bool) is true,
+    posture i is posture i - 1 (only its CoM velocity is read): its area and rates are reused.
 
     Writes ``out[i] = (code, speed, vertex, edge)``: :func:`exit_kernel`'s answer, or code
     :data:`FALLBACK`.
@@ -72,7 +73,15 @@ def posture_exits(
     box, merge_tol, area_tol = settings[0], settings[2], settings[3]
     max_pivots = int(settings[1])
     zmp_margin, velocity_margin, tol = settings[4], settings[5], settings[6]
-    for i in rows:
+    G, h = np.empty((0, 2)), np.empty(0)
+    answered = False  # whether the last posture's area and rates are held in G, h
+    for i in range(same.size):
+        out[i, 0] = FALLBACK
+        if same[i]:
+            if answered:
+                _exit(G, h, jumps[i], com_velocities[i], velocity_margin, tol, out, i)
+            continue
+        answered = False
         result = assembled_areas(
             blocks[i],
             positions[i],
@@ -94,24 +103,43 @@ def posture_exits(
             hint,
         )
         status, force, G, h = result[5], result[6], result[12], result[13]
-        out[i, 0] = FALLBACK
         if status != OK or force.shape[0] == 0 or G.shape[0] == 0:
             continue
-        c0x, c0y = com_velocities[i, 0], com_velocities[i, 1]
-        margins = np.empty(h.size)
+        answered = True
+        _exit(G, h, jumps[i], com_velocities[i], velocity_margin, tol, out, i)
+
+
+@njit(cache=True)
+def _exit(
+    G: np.ndarray,
+    h: np.ndarray,
+    jumps: np.ndarray,
+    com_velocity: np.ndarray,
+    velocity_margin: float,
+    tol: float,
+    out: np.ndarray,
+    i: int,
+) -> None:
+    """``out[i]`` = the first exit of ``com_velocity + s jumps[j]`` from ``G x <= h``.
+
+    The area less the velocity margin (m/s); the numbers of
+    :meth:`ComCriterion.limit <impact_balance.criteria.com.ComCriterion.limit>`.
+    """
+    c0x, c0y = com_velocity[0], com_velocity[1]
+    margins = np.empty(h.size)
+    for k in range(h.size):
+        hk = h[k] - velocity_margin if velocity_margin != 0.0 else h[k]
+        margins[k] = hk - (G[k, 0] * c0x + G[k, 1] * c0y)
+    rates = np.empty((jumps.shape[0], h.size))
+    for j in range(jumps.shape[0]):
         for k in range(h.size):
-            hk = h[k] - velocity_margin if velocity_margin != 0.0 else h[k]
-            margins[k] = hk - (G[k, 0] * c0x + G[k, 1] * c0y)
-        d = jumps[i]
-        rates = np.empty((d.shape[0], h.size))
-        for j in range(d.shape[0]):
-            for k in range(h.size):
-                rates[j, k] = d[j, 0] * G[k, 0] + d[j, 1] * G[k, 1]
-        code, speed, vertex, edge = exit_kernel(margins, rates, tol)
-        out[i, 0] = code
-        out[i, 1] = speed
-        out[i, 2] = vertex
-        out[i, 3] = edge
+            rates[j, k] = jumps[j, 0] * G[k, 0] + jumps[j, 1] * G[k, 1]
+    code, speed, vertex, edge = exit_kernel(margins, rates, tol)
+    out[i, 0] = code
+    out[i, 1] = speed
+    out[i, 2] = vertex
+    out[i, 3] = edge
 
 
+cache_depends_on(_exit, linear_exit)
 cache_depends_on(posture_exits, areas, polygon, walk, kernel, wrench_polytope, linear_exit)

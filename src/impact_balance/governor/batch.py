@@ -30,14 +30,15 @@ from impact_balance.balance.areas import FORCE_BOX, MERGE_TOLERANCE
 from impact_balance.balance.lipm import lipm_omega
 from impact_balance.constants import MAX_SPEED
 from impact_balance.contacts.wrench_polytope import face_blocks
-from impact_balance.criteria.batch import FALLBACK, posture_exits
+from impact_balance.criteria.batch import posture_exits
 from impact_balance.criteria.linear_exit import BOUNDARY_TOLERANCE, EXIT_STATUSES
 from impact_balance.criteria.velocity_limit import LimitStatus
 from impact_balance.exceptions import GovernorError, SolverError
 from impact_balance.geometry.polygon import MERGE_AREA_TOLERANCE
 from impact_balance.governor.limit import SpeedLimit
 from impact_balance.governor.options import Criterion
-from impact_balance.governor.posture import PostureEvaluator
+from impact_balance.governor.posture import Kinematics, PostureEvaluator
+from impact_balance.impact.model import ImpactModel
 from impact_balance.projection.walk import MAX_PIVOTS
 from impact_balance.robot.robot import Robot
 
@@ -173,7 +174,9 @@ class BatchEvaluator:
             raise GovernorError("threads", threads, "must be an integer")
         if not 1 <= threads <= MAX_THREADS:
             raise GovernorError("threads", threads, f"must be in [1, {MAX_THREADS}]")
-        for i in range(len(qs)):
+        repeated = np.zeros(len(qs), dtype=np.bool_)  # row i's q is row i - 1's
+        repeated[1:] = (qs[1:] == qs[:-1]).all(axis=1)
+        for i in np.flatnonzero(~repeated):  # a repeated row passes the same check
             qs[i] = self.check(qs[i], f"q_batch[{i}]")
         rows = _Rows(len(qs))
         slices = np.array_split(np.arange(len(qs)), min(threads, max(len(qs), 1)))
@@ -230,15 +233,31 @@ class _Slice:
         e, s, n, rows = self.e, self.e.settings, len(indices), self.rows
         m, nv = len(e._frames), e.model.nv
         torques = e._torques
-        rotations = np.empty((n, m, 3, 3))
+        rotations = np.zeros((n, m, 3, 3))  # a repeated row's stay 0 (not read)
         positions, arms = np.empty((n, m, 3)), np.empty((n, m, 3))
         jacobians = np.empty((n, 6 * m, nv)) if torques else np.zeros((n, 0, 0))
         gravity_torques = np.empty((n, nv))
         weights, depths, omegas = np.empty(n), np.empty(n), np.empty(n)
         coms, velocities = np.empty((n, 3)), np.empty((n, 2))
-        jumps_list = []
+        jumps_list: list[np.ndarray] = []
+        same = np.zeros(n, dtype=np.bool_)
+        k: Kinematics | None = None
+        impact: ImpactModel | None = None
         for r, i in enumerate(indices):
             q = self.qs[i]
+            if k is not None and impact is not None and np.array_equal(q, self.qs[indices[r - 1]]):
+                # The previous row's posture: only the CoM velocity is new (a velocity-only
+                # tick); the compiled call reuses that row's area and rates.
+                same[r] = True
+                com_velocity = _com_velocity(k.com_jacobian, self.vs[i], int(i))
+                velocities[r] = com_velocity[:2]
+                rows.com_velocity[i], rows.normal[i], rows.point[i] = (
+                    com_velocity,
+                    impact.normal,
+                    impact.point,
+                )
+                jumps_list.append(jumps_list[-1])
+                continue
             k = e.kinematics(q)
             omegas[r] = lipm_omega(float(k.com[2]), s.plane_height, s.gravity, field="plane_height")
             impact = e.impact_at(q, k)
@@ -281,19 +300,21 @@ class _Slice:
             self.settings,
             e._hint,
             out,
-            np.arange(n),
+            same,
         )
+        codes = out[:, 0].astype(np.int64)
+        answered = (codes == 0) | (codes == 2)  # "ok" and "unbounded": from inside the area
+        done = indices[answered]
+        speeds = np.where(codes[answered] == 0, out[answered, 1], math.inf)
+        rows.speed[done] = speeds
+        rows.interval[done, 0], rows.interval[done, 1] = 0.0, speeds
+        ok = indices[codes == 0]
+        rows.vertex[ok], rows.edge[ok] = out[codes == 0, 2], out[codes == 0, 3]
         for r, i in enumerate(indices):
-            code = int(out[r, 0])
-            if code == FALLBACK or EXIT_STATUSES[code] == "already_falling":
-                self.single(int(i))  # Bretl's projection, a small area, a falling start
-                continue
-            status = EXIT_STATUSES[code]
-            speed = float(out[r, 1]) if code == 0 else math.inf
-            rows.speed[i], rows.status[i] = speed, status
-            if code == 0:
-                rows.vertex[i], rows.edge[i] = int(out[r, 2]), int(out[r, 3])
-            rows.interval[i] = (0.0, speed)
+            if answered[r]:
+                rows.status[i] = EXIT_STATUSES[codes[r]]
+            else:  # Bretl's projection, a small area, a falling start
+                self.single(int(i))
 
     def single(self, i: int) -> None:
         """Row ``i`` by the one-posture path (what :meth:`Governor.limit` does)."""
