@@ -28,15 +28,9 @@ import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
-from impact_balance.balance.areas import (
-    BalanceAreas,
-    Projected,
-    areas_from_polytope,
-    projected_from_arrays,
-)
+from impact_balance.balance.areas import BalanceAreas, Projected, posture_areas
 from impact_balance.contacts.cwc import local_faces
 from impact_balance.contacts.stance import ContactSpec, Stance, frame_point, has_free_flyer
-from impact_balance.contacts.wrench_polytope import assemble_polytope, friction_scaling
 from impact_balance.criteria.com import ComCriterion
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.criteria.zmp import zmp_max_contact_velocity
@@ -340,44 +334,26 @@ class PostureEvaluator:
             SolverError: The projection failed (naming the contacts).
         """
         settings = self.settings
-        areas: BalanceAreas | Projected
         try:
-            if self._scaled:  # a friction above 1: the polytope in friction-normalised variables
-                polytope = assemble_polytope(
-                    self._faces,
-                    rotations,
-                    local + origin,
-                    local - com_local,
-                    mass,
-                    com,
-                    settings.gravity,
-                    jacobians,
-                    self._idx,
-                    self._limit,
-                    gravity_torques,
-                    friction_scaling(self._frictions, list(rotations)),
-                )
-                areas = areas_from_polytope(polytope, settings.plane_height, settings.zmp_margin)
-            else:  # the same numbers, assembled and projected in one compiled call
-                areas = projected_from_arrays(
-                    self._faces,
-                    rotations,
-                    local + origin,
-                    local - com_local,
-                    mass,
-                    com,
-                    settings.gravity,
-                    jacobians,
-                    self._idx,
-                    self._limit,
-                    gravity_torques,
-                    settings.plane_height,
-                    settings.zmp_margin,
-                    self._hint,
-                )
+            return posture_areas(
+                self._faces,
+                rotations,
+                local + origin,
+                local - com_local,
+                mass,
+                com,
+                settings.gravity,
+                jacobians,
+                self._idx,
+                self._limit,
+                gravity_torques,
+                self._frictions,
+                settings.plane_height,
+                settings.zmp_margin,
+                self._hint,
+            )
         except SolverError as exc:
             raise exc.within("contacts (projection of the contact wrench polytope)") from None
-        return areas
 
     def _impact(
         self,
