@@ -187,3 +187,5 @@ def test_many_velocities_at_one_posture_reuse_it(name):
     singles = [g.limit(q, v) for q, v in zip(qs, vs, strict=True)]
     assert sum(s.posture_reused for s in singles) >= 42
     assert_rows_equal(answers, singles)
+    # Slices of threads that start inside a run of repeated rows evaluate their posture.
+    assert_rows_equal(g.limits(qs, vs, threads=4), singles)

@@ -16,6 +16,7 @@ take the one-posture path (:meth:`PostureEvaluator.evaluate
 
 from __future__ import annotations
 
+import itertools
 import math
 import threading
 from collections.abc import Callable, Sequence
@@ -37,8 +38,7 @@ from impact_balance.exceptions import GovernorError, SolverError
 from impact_balance.geometry.polygon import MERGE_AREA_TOLERANCE
 from impact_balance.governor.limit import SpeedLimit
 from impact_balance.governor.options import Criterion
-from impact_balance.governor.posture import Kinematics, PostureEvaluator
-from impact_balance.impact.model import ImpactModel
+from impact_balance.governor.posture import PostureEvaluator
 from impact_balance.projection.walk import MAX_PIVOTS
 from impact_balance.robot.robot import Robot
 
@@ -183,11 +183,11 @@ class BatchEvaluator:
         evaluators = self._take(len(slices))
         try:
             if len(slices) == 1:
-                _Slice(evaluators[0], qs, vs, rows, self._settings).run(slices[0])
+                _Slice(evaluators[0], qs, vs, rows, self._settings).run(slices[0], repeated)
             else:
                 with ThreadPoolExecutor(len(slices)) as pool:
                     futures = [
-                        pool.submit(_Slice(e, qs, vs, rows, self._settings).run, s)
+                        pool.submit(_Slice(e, qs, vs, rows, self._settings).run, s, repeated)
                         for e, s in zip(evaluators, slices, strict=True)
                     ]
                     for future in futures:
@@ -219,49 +219,44 @@ class _Slice:
         # The compiled call answers the "com" criterion of unscaled contacts (friction <= 1).
         self.compiled = evaluator.settings.criterion == "com" and not evaluator._scaled
 
-    def run(self, indices: npt.NDArray[np.int64]) -> None:
-        """Answer rows ``indices`` of the batch."""
+    def run(self, indices: npt.NDArray[np.int64], repeated: npt.NDArray[np.bool_]) -> None:
+        """Answer rows ``indices`` of the batch (``repeated[i]``: row i's q is row i - 1's)."""
         if not self.compiled:
             for i in indices:
                 self.single(int(i))
             return
-        for start in range(0, len(indices), BLOCK):
-            self.block(indices[start : start + BLOCK])
+        # Blocks of BLOCK postures, each with the rows that repeat it; the slice's first row is
+        # evaluated, whatever came before it.
+        if not len(indices):
+            return
+        starts: list[int] = np.union1d([0], np.flatnonzero(~repeated[indices])).tolist()
+        bounds = [*starts[::BLOCK], len(indices)]
+        for a, b in itertools.pairwise(bounds):
+            same = repeated[indices[a:b]].copy()
+            same[0] = False
+            self.block(indices[a:b], same)
 
-    def block(self, indices: npt.NDArray[np.int64]) -> None:
-        """The Python step of rows ``indices``, then their compiled call."""
+    def block(self, indices: npt.NDArray[np.int64], same: npt.NDArray[np.bool_]) -> None:
+        """The Python step of rows ``indices``, then their compiled call.
+
+        ``same[r]``: row r repeats the posture of row r - 1 (only its velocity is new).
+        """
         e, s, n, rows = self.e, self.e.settings, len(indices), self.rows
         m, nv = len(e._frames), e.model.nv
         torques = e._torques
-        rotations = np.zeros((n, m, 3, 3))  # a repeated row's stay 0 (not read)
-        positions, arms = np.empty((n, m, 3)), np.empty((n, m, 3))
-        jacobians = np.empty((n, 6 * m, nv)) if torques else np.zeros((n, 0, 0))
-        gravity_torques = np.empty((n, nv))
-        weights, depths, omegas = np.empty(n), np.empty(n), np.empty(n)
-        coms, velocities = np.empty((n, 3)), np.empty((n, 2))
-        jumps_list: list[np.ndarray] = []
-        same = np.zeros(n, dtype=np.bool_)
-        k: Kinematics | None = None
-        impact: ImpactModel | None = None
-        for r, i in enumerate(indices):
+        rotations = np.zeros((n, m, 3, 3))  # a repeated row's are not read
+        positions, arms = np.zeros((n, m, 3)), np.zeros((n, m, 3))
+        jacobians = np.zeros((n, 6 * m, nv)) if torques else np.zeros((n, 0, 0))
+        gravity_torques = np.zeros((n, nv))
+        weights, depths, omegas = np.zeros(n), np.zeros(n), np.zeros(n)
+        coms, velocities = np.zeros((n, 3)), np.zeros((n, 2))
+        jumps = np.zeros((0, 0, 2))
+        for r in np.flatnonzero(~same):
+            i = int(indices[r])
             q = self.qs[i]
-            if k is not None and impact is not None and np.array_equal(q, self.qs[indices[r - 1]]):
-                # The previous row's posture: only the CoM velocity is new (a velocity-only
-                # tick); the compiled call reuses that row's area and rates.
-                same[r] = True
-                com_velocity = _com_velocity(k.com_jacobian, self.vs[i], int(i))
-                velocities[r] = com_velocity[:2]
-                rows.com_velocity[i], rows.normal[i], rows.point[i] = (
-                    com_velocity,
-                    impact.normal,
-                    impact.point,
-                )
-                jumps_list.append(jumps_list[-1])
-                continue
             k = e.kinematics(q)
             omegas[r] = lipm_omega(float(k.com[2]), s.plane_height, s.gravity, field="plane_height")
             impact = e.impact_at(q, k)
-            com_velocity = _com_velocity(k.com_jacobian, self.vs[i], int(i))
             rotations[r] = k.rotations
             positions[r] = k.local + k.origin
             arms[r] = k.local - k.com_local
@@ -271,14 +266,19 @@ class _Slice:
             weights[r] = k.mass * s.gravity
             depths[r] = s.plane_height - float(k.com[2])
             coms[r] = k.com
-            velocities[r] = com_velocity[:2]
-            jumps_list.append(impact.com_jump_rates)
-            rows.com_velocity[i], rows.normal[i], rows.point[i] = (
-                com_velocity,
-                impact.normal,
-                impact.point,
-            )
-        jumps = np.ascontiguousarray(np.array(jumps_list).reshape(n, -1, 2))
+            rates = impact.com_jump_rates
+            if not jumps.size:
+                jumps = np.zeros((n, *rates.shape))
+            # This row and the rows that repeat its posture: their CoM velocities at once.
+            stop = r + 1
+            while stop < n and same[stop]:
+                stop += 1
+            run = indices[r:stop]
+            com_velocity = _com_velocities(k.com_jacobian, self.vs[run], run)
+            velocities[r:stop] = com_velocity[:, :2]
+            jumps[r:stop] = rates
+            rows.com_velocity[run] = com_velocity
+            rows.normal[run], rows.point[run] = impact.normal, impact.point
         # face_blocks of every row in one batched product (the same numbers row by row)
         blocks = face_blocks(np.tile(e._faces, (n, 1, 1)), rotations.reshape(n * m, 3, 3))
         blocks = blocks.reshape(n, m, 32, 3)
@@ -302,6 +302,11 @@ class _Slice:
             out,
             same,
         )
+        self.fill(indices, out)
+
+    def fill(self, indices: npt.NDArray[np.int64], out: npt.NDArray[np.float64]) -> None:
+        """Rows ``indices`` from the compiled answers ``out``; the one-posture path for the rest."""
+        rows = self.rows
         codes = out[:, 0].astype(np.int64)
         answered = (codes == 0) | (codes == 2)  # "ok" and "unbounded": from inside the area
         done = indices[answered]
@@ -345,14 +350,32 @@ def _com_velocity(
     com_jacobian: npt.NDArray[np.float64], v: npt.NDArray[np.float64], i: int
 ) -> npt.NDArray[np.float64]:
     """``com_jacobian @ v``, checked as :meth:`Governor.limit` checks it (world, m/s)."""
-    com_velocity: npt.NDArray[np.float64] = com_jacobian @ v
-    if not float(com_velocity @ com_velocity) <= MAX_SPEED * MAX_SPEED:
+    out: npt.NDArray[np.float64] = _com_velocities(com_jacobian, v[None], np.array([i]))[0]
+    return out
+
+
+def _com_velocities(
+    com_jacobian: npt.NDArray[np.float64],
+    vs: npt.NDArray[np.float64],
+    indices: npt.NDArray[np.int64],
+) -> npt.NDArray[np.float64]:
+    """``com_jacobian @ v`` of each row of ``vs`` (rows ``indices`` of the batch), checked.
+
+    One stacked product: numpy makes each row's matrix-vector product as for one vector (the
+    same numbers as :meth:`Governor.limit`'s ``com_jacobian @ v``).
+    """
+    out: npt.NDArray[np.float64] = np.matmul(com_jacobian, vs[:, :, None])[:, :, 0]
+    out = np.ascontiguousarray(out)
+    speeds: npt.NDArray[np.float64] = np.einsum("ij,ij->i", out, out)
+    bad = np.flatnonzero(~(speeds <= MAX_SPEED * MAX_SPEED))
+    if bad.size:
+        j = int(bad[0])
         raise GovernorError(
-            f"v_batch[{i}]",
-            f"CoM velocity {math.hypot(*com_velocity):.3g} m/s",
+            f"v_batch[{int(indices[j])}]",
+            f"CoM velocity {math.hypot(*out[j]):.3g} m/s",
             f"gives a CoM speed above {MAX_SPEED:g} m/s (the scenario's bound)",
         )
-    return com_velocity
+    return out
 
 
 def _matrix(x: ArrayLike, size: int, field: str) -> npt.NDArray[np.float64]:
