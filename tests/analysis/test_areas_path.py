@@ -1,5 +1,5 @@
 """analyze()'s areas step is the governor's (posture_areas, from the stance's arrays): the same
-numbers as projecting the stance's wrench polytope, for every bundled stance and for
+polytope as wrench_polytope and the same numbers as projecting it, for every bundled stance and for
 frictions either side of 1 (the compiled path and the friction-normalised one)."""
 
 from __future__ import annotations
@@ -31,12 +31,19 @@ def test_analyze_areas_equal_the_polytope_projection(name, scale):
     scenario = _with_friction(name, scale)
     stance = scenario.build_stance()
     polytope, areas = stance_areas(scenario, stance)
-    want = areas_from_polytope(
-        wrench_polytope(stance, scenario.torque_limits, scenario.gravity),
-        scenario.plane_height,
-        scenario.zmp_margin,
+    want_polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
+    want = areas_from_polytope(want_polytope, scenario.plane_height, scenario.zmp_margin)
+    for field in ("A", "b", "C", "d", "F", "grasp", "com"):
+        np.testing.assert_array_equal(getattr(polytope, field), getattr(want_polytope, field))
+    if want_polytope.scaling is None:
+        assert polytope.scaling is None
+    else:
+        np.testing.assert_array_equal(polytope.scaling, want_polytope.scaling)
+    assert (polytope.n_cwc_rows, polytope.mass, polytope.gravity) == (
+        want_polytope.n_cwc_rows,
+        want_polytope.mass,
+        want_polytope.gravity,
     )
-    assert polytope.A.shape[1] == 6 * len(stance.contacts)
     for got, expected in (
         (areas.force_area, want.force_area),
         (areas.zmp_area, want.zmp_area),

@@ -18,7 +18,12 @@ from impact_balance.balance.areas import (
 )
 from impact_balance.contacts.cwc import local_faces
 from impact_balance.contacts.stance import Stance
-from impact_balance.contacts.wrench_polytope import WrenchPolytope, wrench_polytope
+from impact_balance.contacts.wrench_polytope import (
+    WrenchPolytope,
+    assemble_polytope,
+    friction_scaling,
+    wrench_polytope,
+)
 from impact_balance.criteria.cap import safe_contact_velocity
 from impact_balance.criteria.com import ComCriterion
 from impact_balance.criteria.qp import QPOptions, solve_contact_velocity_qp, static_torques
@@ -147,19 +152,18 @@ def _stance_areas(scenario: Scenario, stance: Stance) -> tuple[WrenchPolytope, B
     The areas are a governor's (:func:`~impact_balance.balance.areas.posture_areas`, from the
     stance's arrays), the same numbers as the polytope's.
     """
-    polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
+    if not stance.contacts:  # nothing to assemble from: the polytope of no contact
+        polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
+        t = time.perf_counter()
+        return polytope, _projected_polytope(polytope, scenario), t
+    arrays = _stance_arrays(stance, scenario.torque_limits, scenario.gravity)
+    frictions = [float(c.spec.friction) for c in stance.contacts]
+    # wrench_polytope's numbers, from the same arrays as the areas
+    polytope = assemble_polytope(*arrays, friction_scaling(frictions, list(arrays[1])))
     t = time.perf_counter()
     try:
-        if stance.contacts:
-            projected = posture_areas(
-                *_stance_arrays(stance, scenario.torque_limits, scenario.gravity),
-                [float(c.spec.friction) for c in stance.contacts],
-                scenario.plane_height,
-                scenario.zmp_margin,
-            )
-            areas = projected if isinstance(projected, BalanceAreas) else projected.areas()
-        else:  # no contact: nothing to assemble from
-            areas = areas_from_polytope(polytope, scenario.plane_height, scenario.zmp_margin)
+        projected = posture_areas(*arrays, frictions, scenario.plane_height, scenario.zmp_margin)
+        areas = projected if isinstance(projected, BalanceAreas) else projected.areas()
     except SolverError as exc:
         raise exc.within("contacts (projection of the contact wrench polytope)") from None
     return polytope, areas, t
@@ -179,6 +183,14 @@ _Arrays = tuple[
     np.ndarray,
     np.ndarray,
 ]
+
+
+def _projected_polytope(polytope: WrenchPolytope, scenario: Scenario) -> BalanceAreas:
+    """The areas of ``polytope`` with the scenario's plane and ZMP margin."""
+    try:
+        return areas_from_polytope(polytope, scenario.plane_height, scenario.zmp_margin)
+    except SolverError as exc:
+        raise exc.within("contacts (projection of the contact wrench polytope)") from None
 
 
 def _stance_arrays(stance: Stance, torque_limits: bool, gravity: float) -> _Arrays:

@@ -249,7 +249,7 @@ def posture_areas(
     Raises:
         ScenarioError: The plane is not below the CoM. SolverError: The projection failed.
     """
-    if any(float(mu) > 1.0 for mu in frictions):
+    if frictions and max(frictions) > 1.0:
         polytope = assemble_polytope(
             faces,
             rotations,
