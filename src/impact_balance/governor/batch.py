@@ -269,15 +269,24 @@ class _Slice:
             rates = impact.com_jump_rates
             if not jumps.size:
                 jumps = np.zeros((n, *rates.shape))
-            # This row and the rows that repeat its posture: their CoM velocities at once.
             stop = r + 1
             while stop < n and same[stop]:
                 stop += 1
+            if stop == r + 1:  # a posture of its own
+                com_velocity = _com_velocity(k.com_jacobian, self.vs[i], i)
+                velocities[r], jumps[r] = com_velocity[:2], rates
+                rows.com_velocity[i], rows.normal[i], rows.point[i] = (
+                    com_velocity,
+                    impact.normal,
+                    impact.point,
+                )
+                continue
+            # This row and the rows that repeat its posture: their CoM velocities at once.
             run = indices[r:stop]
-            com_velocity = _com_velocities(k.com_jacobian, self.vs[run], run)
-            velocities[r:stop] = com_velocity[:, :2]
+            velocities_3d = _com_velocities(k.com_jacobian, self.vs[run], run)
+            velocities[r:stop] = velocities_3d[:, :2]
             jumps[r:stop] = rates
-            rows.com_velocity[run] = com_velocity
+            rows.com_velocity[run] = velocities_3d
             rows.normal[run], rows.point[run] = impact.normal, impact.point
         # face_blocks of every row in one batched product (the same numbers row by row)
         blocks = face_blocks(np.tile(e._faces, (n, 1, 1)), rotations.reshape(n * m, 3, 3))
@@ -349,9 +358,15 @@ class _Slice:
 def _com_velocity(
     com_jacobian: npt.NDArray[np.float64], v: npt.NDArray[np.float64], i: int
 ) -> npt.NDArray[np.float64]:
-    """``com_jacobian @ v``, checked as :meth:`Governor.limit` checks it (world, m/s)."""
-    out: npt.NDArray[np.float64] = _com_velocities(com_jacobian, v[None], np.array([i]))[0]
-    return out
+    """``com_jacobian @ v`` (row ``i``), checked as :meth:`Governor.limit` checks it (m/s)."""
+    com_velocity: npt.NDArray[np.float64] = com_jacobian @ v
+    if not float(com_velocity @ com_velocity) <= MAX_SPEED * MAX_SPEED:
+        raise GovernorError(
+            f"v_batch[{i}]",
+            f"CoM velocity {math.hypot(*com_velocity):.3g} m/s",
+            f"gives a CoM speed above {MAX_SPEED:g} m/s (the scenario's bound)",
+        )
+    return com_velocity
 
 
 def _com_velocities(
