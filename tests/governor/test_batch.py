@@ -189,3 +189,15 @@ def test_many_velocities_at_one_posture_reuse_it(name):
     assert_rows_equal(answers, singles)
     # Slices of threads that start inside a run of repeated rows evaluate their posture.
     assert_rows_equal(g.limits(qs, vs, threads=4), singles)
+
+
+def test_a_posture_the_pipeline_refuses_names_its_row():
+    # The CoM of row 1 below the LIPM plane: the ScenarioError limit() raises, with the row.
+    g = governor("kick_one_foot")
+    qs, vs = batch(g, 3, 9)
+    qs[1, 2] -= 5.0  # the base (and the CoM) 5 m lower
+    with pytest.raises(ib.ScenarioError, match=r"q_batch\[1\]: plane_height") as info:
+        g.limits(qs, vs)
+    assert info.value.field == "plane_height"
+    with pytest.raises(ib.ScenarioError, match="plane_height"):
+        g.limit(qs[1], vs[1])

@@ -34,7 +34,7 @@ from impact_balance.contacts.wrench_polytope import face_blocks
 from impact_balance.criteria.batch import posture_exits
 from impact_balance.criteria.linear_exit import BOUNDARY_TOLERANCE, EXIT_STATUSES
 from impact_balance.criteria.velocity_limit import LimitStatus
-from impact_balance.exceptions import GovernorError, SolverError
+from impact_balance.exceptions import GovernorError, ImpactBalanceError, SolverError
 from impact_balance.geometry.polygon import MERGE_AREA_TOLERANCE
 from impact_balance.governor.limit import SpeedLimit
 from impact_balance.governor.options import Criterion
@@ -255,8 +255,15 @@ class _Slice:
             i = int(indices[r])
             q = self.qs[i]
             k = e.kinematics(q)
-            omegas[r] = lipm_omega(float(k.com[2]), s.plane_height, s.gravity, field="plane_height")
-            impact = e.impact_at(q, k)
+            try:
+                omegas[r] = lipm_omega(
+                    float(k.com[2]), s.plane_height, s.gravity, field="plane_height"
+                )
+                impact = e.impact_at(q, k)
+            except ImpactBalanceError as exc:  # as limit() raises it, naming the row
+                if exc.args and isinstance(exc.args[0], str):
+                    exc.args = (f"q_batch[{i}]: {exc.args[0]}", *exc.args[1:])
+                raise
             rotations[r] = k.rotations
             positions[r] = k.local + k.origin
             arms[r] = k.local - k.com_local
