@@ -79,3 +79,18 @@ def test_median_interval_holds_the_median(values: list[float]) -> None:
         if k is not None and k + 1 <= n - k:
             below = sum(math.comb(n, j) for j in range(k + 1)) / 2**n
             assert 1 - 2 * below < 0.95
+
+
+def test_the_batch_benchmark_reports_ratios_and_agreement(capsys) -> None:
+    import json
+
+    from benchmarks import batch
+
+    assert batch.main(["--n", "4", "--repeat", "1", "--scenarios", "kick_one_foot", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    (row,) = out["scenarios"]
+    assert row["agree"] and row["worst_difference"] <= 1e-12
+    times = row["us_per_posture"]
+    assert set(times) == {"single", "batch", "batch_threads", "velocity", "batch_velocity"}
+    assert row["ratio_single_over_batch"] == pytest.approx(times["single"] / times["batch"])
+    assert batch.main(["--n", "0"]) == 2

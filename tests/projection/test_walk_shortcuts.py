@@ -109,7 +109,7 @@ def g1_path():
 
 def _capture(governor: Governor, postures):
     """The arguments the evaluator hands projected_from_arrays at each posture."""
-    import impact_balance.governor.posture as P
+    import impact_balance.balance.areas as P  # the evaluator's posture_areas calls it
 
     captured = []
     original = P.projected_from_arrays

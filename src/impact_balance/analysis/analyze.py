@@ -12,9 +12,20 @@ import numpy as np
 from impact_balance._jit import KernelClock
 from impact_balance.analysis.diagnostics import diagnose
 from impact_balance.analysis.result import Analysis, ImpactAnswer
-from impact_balance.balance.areas import BalanceAreas, areas_from_polytope, with_reason
+from impact_balance.balance.areas import (
+    BalanceAreas,
+    areas_from_polytope,
+    posture_areas,
+    with_reason,
+)
+from impact_balance.contacts.cwc import local_faces
 from impact_balance.contacts.stance import Stance
-from impact_balance.contacts.wrench_polytope import WrenchPolytope, wrench_polytope
+from impact_balance.contacts.wrench_polytope import (
+    WrenchPolytope,
+    assemble_polytope,
+    friction_scaling,
+    wrench_polytope,
+)
 from impact_balance.criteria.cap import safe_contact_velocity
 from impact_balance.criteria.com import ComCriterion
 from impact_balance.criteria.qp import (
@@ -138,11 +149,23 @@ def stance_areas(scenario: Scenario, stance: Stance) -> tuple[WrenchPolytope, Ba
 def _stance_areas(
     scenario: Scenario, stance: Stance, now: Callable[[], float] = time.perf_counter
 ) -> tuple[WrenchPolytope, BalanceAreas, float]:
-    """:func:`stance_areas`, and the time (s, by the clock ``now``) between its two steps."""
-    polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
+    """:func:`stance_areas`, and the time (s, by the clock ``now``) between its two steps.
+
+    The areas are a governor's (:func:`~impact_balance.balance.areas.posture_areas`, from the
+    stance's arrays), the same numbers as the polytope's.
+    """
+    if not stance.contacts:  # nothing to assemble from: the polytope of no contact
+        polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
+        t = now()
+        return polytope, _projected_polytope(polytope, scenario), t
+    arrays = _stance_arrays(stance, scenario.torque_limits, scenario.gravity)
+    frictions = [float(c.spec.friction) for c in stance.contacts]
+    # wrench_polytope's numbers, from the same arrays as the areas
+    polytope = assemble_polytope(*arrays, friction_scaling(frictions, list(arrays[1])))
     t = now()
     try:
-        areas = areas_from_polytope(polytope, scenario.plane_height, scenario.zmp_margin)
+        projected = posture_areas(*arrays, frictions, scenario.plane_height, scenario.zmp_margin)
+        areas = projected if isinstance(projected, BalanceAreas) else projected.areas()
     except SolverError as exc:
         raise exc.within("contacts (projection of the contact wrench polytope)") from None
     return polytope, areas, t
@@ -184,6 +207,57 @@ def _qp(
         )
     except SolverError as exc:
         raise exc.within("impact.qp") from None
+
+
+#: :func:`_stance_arrays`' answer.
+_Arrays = tuple[
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    float,
+    np.ndarray,
+    float,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+]
+
+
+def _projected_polytope(polytope: WrenchPolytope, scenario: Scenario) -> BalanceAreas:
+    """The areas of ``polytope`` with the scenario's plane and ZMP margin."""
+    try:
+        return areas_from_polytope(polytope, scenario.plane_height, scenario.zmp_margin)
+    except SolverError as exc:
+        raise exc.within("contacts (projection of the contact wrench polytope)") from None
+
+
+def _stance_arrays(stance: Stance, torque_limits: bool, gravity: float) -> _Arrays:
+    """:func:`~impact_balance.balance.areas.posture_areas`' arrays of a stance.
+
+    Up to the frictions, the numbers that
+    :func:`~impact_balance.contacts.wrench_polytope.wrench_polytope` assembles: faces,
+    rotations, world positions, lever arms about the CoM (stance frame), mass, CoM, ``gravity``
+    (m/s^2), then the Jacobians, torque-limited joints, limits and g(q) (empty without torque
+    limits).
+    """
+    contacts = stance.contacts
+    m = len(contacts)
+    faces = np.array(
+        [local_faces(float(c.spec.friction), c.half_length, c.half_width) for c in contacts]
+    ).reshape(m, 16, 6)
+    rotations = np.array([c.rotation for c in contacts], dtype=float).reshape(m, 3, 3)
+    positions = np.array([c.position for c in contacts], dtype=float).reshape(m, 3)
+    local = np.array([c.local_position for c in contacts], dtype=float).reshape(-1, 3)
+    idx, limit = stance.robot.effort_limits
+    J, g = np.zeros((0, 0)), np.zeros(0)
+    if torque_limits and idx.size:
+        J, g = np.concatenate([c.jacobian for c in contacts]), stance.gravity_torques
+    else:
+        idx, limit = np.zeros(0, dtype=np.int64), np.zeros(0)
+    arms = local - stance.com_local
+    return faces, rotations, positions, arms, stance.mass, stance.com, gravity, J, idx, limit, g
 
 
 def impact_answer(

@@ -19,6 +19,7 @@ by omega).
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -33,7 +34,9 @@ from impact_balance.contacts.stance import Stance
 from impact_balance.contacts.wrench_polytope import (
     WrenchPolytope,
     assemble_arrays,
+    assemble_polytope,
     face_blocks,
+    friction_scaling,
     wrench_polytope,
 )
 from impact_balance.exceptions import SolverError
@@ -56,7 +59,9 @@ __all__ = [
     "Projected",
     "areas_from_arrays",
     "areas_from_polytope",
+    "assembled_areas",
     "balance_areas",
+    "posture_areas",
     "projected_from_arrays",
     "warm_up",
     "with_reason",
@@ -209,6 +214,73 @@ def areas_from_arrays(
         plane_height,
         zmp_margin,
     ).areas()
+
+
+def posture_areas(
+    faces: np.ndarray,
+    rotations: np.ndarray,
+    positions: np.ndarray,
+    arms: np.ndarray,
+    mass: float,
+    com: np.ndarray,
+    gravity: float,
+    jacobians: np.ndarray,
+    torque_indices: np.ndarray,
+    torque_limits: np.ndarray,
+    gravity_torques: np.ndarray,
+    frictions: Sequence[float],
+    plane_height: float = 0.0,
+    zmp_margin: float = 0.0,
+    hint: np.ndarray | None = None,
+) -> BalanceAreas | Projected:
+    """The areas step of one posture, from its arrays: what a governor and ``analyze()`` run.
+
+    Contacts whose frictions are all at most 1: :func:`projected_from_arrays` (assembly,
+    walk and maps in one compiled call); else the polytope in friction-normalised variables
+    (:func:`~impact_balance.contacts.wrench_polytope.assemble_polytope` with
+    :func:`~impact_balance.contacts.wrench_polytope.friction_scaling`) and
+    :func:`areas_from_polytope`. Bretl's projection answers where the walk does not, as there.
+
+    The arguments are :func:`~impact_balance.contacts.wrench_polytope.assemble_polytope`'s
+    (``faces`` (m, 16, 6); ``positions`` (m, 3) world and ``arms`` (m, 3) contact point minus
+    CoM, m; ``com`` (3,) world, m), the contacts' frictions, the plane height (m), the ZMP
+    margin (m) and the walk's warm start (see :func:`projected_from_arrays`).
+
+    Raises:
+        ScenarioError: The plane is not below the CoM. SolverError: The projection failed.
+    """
+    if frictions and max(frictions) > 1.0:
+        polytope = assemble_polytope(
+            faces,
+            rotations,
+            positions,
+            arms,
+            mass,
+            com,
+            gravity,
+            jacobians,
+            torque_indices,
+            torque_limits,
+            gravity_torques,
+            friction_scaling(frictions, list(rotations)),
+        )
+        return areas_from_polytope(polytope, plane_height, zmp_margin)
+    return projected_from_arrays(
+        faces,
+        rotations,
+        positions,
+        arms,
+        mass,
+        com,
+        gravity,
+        jacobians,
+        torque_indices,
+        torque_limits,
+        gravity_torques,
+        plane_height,
+        zmp_margin,
+        hint,
+    )
 
 
 def projected_from_arrays(
@@ -480,6 +552,10 @@ def _assembled_areas(
     )
     return A, b, C, d, E, status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, Gv, hv
 
+
+#: The compiled pipeline of one posture (assembly, walk, certificate, maps), for compiled callers
+#: that loop over postures (:mod:`impact_balance.criteria.batch`).
+assembled_areas = _assembled_areas
 
 # The compiled functions above embed the polygon module's, the walk's and the assembly's.
 cache_depends_on(_maps, polygon)

@@ -23,6 +23,7 @@ See docs/governor.md for the conventions and how pink, mink or any QP controller
 """
 
 from impact_balance.criteria.cap import cap_approach
+from impact_balance.governor.batch import BatchLimits
 from impact_balance.governor.governor import Governor
 from impact_balance.governor.limit import SpeedLimit
 from impact_balance.governor.options import (
@@ -41,6 +42,7 @@ __all__ = [
     "CRITERIA",
     "ON_STALE",
     "STARTS",
+    "BatchLimits",
     "ContactAwareOptions",
     "Criterion",
     "Governor",

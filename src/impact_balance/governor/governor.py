@@ -20,6 +20,7 @@ from impact_balance.contacts.stance import ContactSpec, has_free_flyer
 from impact_balance.criteria.cap import cap_approach
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.exceptions import GovernorError, ScenarioError
+from impact_balance.governor.batch import BatchEvaluator, BatchLimits
 from impact_balance.governor.limit import Binding, SpeedLimit
 from impact_balance.governor.options import CRITERIA, ContactAwareOptions, Criterion
 from impact_balance.governor.posture import Posture, PostureEvaluator, PostureSettings
@@ -172,6 +173,7 @@ class Governor:
             scenario.angular_momentum_damping_time if criterion == "com" else None,
         )
         self._evaluator = PostureEvaluator(self.robot, settings)
+        self._batch = BatchEvaluator(self.robot, self._evaluator, self._checked_row)
         self._lock = threading.Lock()
         self._support: ContactAwareLimit | None = None
         if aware is not None:
@@ -256,6 +258,41 @@ class Governor:
                     f"gives a CoM speed above {MAX_SPEED:g} m/s (the scenario's bound)",
                 )
             return self._answer(posture, com_velocity, reused)
+
+    def limits(self, q_batch: ArrayLike, v_batch: ArrayLike, *, threads: int = 1) -> BatchLimits:
+        """The speed limits of N postures: row i is ``limit(q_batch[i], v_batch[i])``.
+
+        Equal to N calls of :meth:`limit` (to rounding: 1e-12 m/s in the tests), each posture
+        evaluated (the ``posture_tolerance`` and the last answer are neither used nor
+        changed). The areas and the criterion of all postures run in one compiled call
+        (:mod:`impact_balance.governor.batch`); ``threads`` > 1 splits the rows over threads.
+
+        Args:
+            q_batch: (N, nq) configurations, as :meth:`limit`'s ``q``.
+            v_batch: (N, nv) generalized velocities, as :meth:`limit`'s ``v``.
+            threads: Threads to share the rows (1 to 64; each makes its own pinocchio Data).
+
+        Returns:
+            The N answers as arrays (a row as a :class:`SpeedLimit`: ``answers[i]``).
+
+        Raises:
+            GovernorError: Not (N, nq) and (N, nv) real finite numbers, a row that
+                :meth:`limit` refuses (the field names the row: ``q_batch[3]``), ``threads``
+                out of range, or a ``contact_aware`` governor (the batch answers the floating
+                criterion only).
+            ScenarioError, ImpactModelError, SolverError: A posture the pipeline cannot
+                evaluate, as :meth:`limit`.
+        """
+        if self._support is not None:
+            raise GovernorError(
+                "contact_aware",
+                True,
+                "limits() answers the floating criterion only; call limit() per posture",
+            )
+        try:
+            return self._batch.limits(q_batch, v_batch, threads)
+        except ScenarioError as exc:
+            raise with_source(exc, self.scenario.source) from None
 
     def limit_com(self, q: ArrayLike, com_velocity: ArrayLike) -> SpeedLimit:
         """:meth:`limit` with the CoM velocity given, for a controller with its own estimate.
@@ -391,6 +428,15 @@ class Governor:
                     "the base quaternion (x, y, z, w) must be unit (within "
                     f"{QUATERNION_TOLERANCE:g}); normalise it",
                 )
+        return configuration
+
+    def _checked_row(self, q: npt.NDArray[np.float64], field: str) -> npt.NDArray[np.float64]:
+        """Row ``q`` of a batch checked as :meth:`limit` checks ``q`` (errors name ``field``)."""
+        try:
+            configuration = self._configuration(q)
+            self._joints.check(configuration)
+        except GovernorError as exc:
+            raise GovernorError(field + exc.field[1:], exc.value, exc.reason) from None
         return configuration
 
     def _posture_at(self, q: npt.NDArray[np.float64]) -> tuple[Posture, bool]:

@@ -22,21 +22,16 @@ from __future__ import annotations
 import functools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
-from impact_balance.balance.areas import (
-    BalanceAreas,
-    Projected,
-    areas_from_polytope,
-    projected_from_arrays,
-)
+from impact_balance.balance.areas import BalanceAreas, Projected, posture_areas
 from impact_balance.balance.lipm import lipm_omega
 from impact_balance.contacts.cwc import local_faces
 from impact_balance.contacts.stance import ContactSpec, Stance, frame_point, has_free_flyer
-from impact_balance.contacts.wrench_polytope import assemble_polytope, friction_scaling
 from impact_balance.criteria.com import ComCriterion
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.criteria.zmp import zmp_max_contact_velocity
@@ -53,7 +48,7 @@ from impact_balance.impact.model import (
 )
 from impact_balance.robot.robot import Robot, Scratch
 
-__all__ = ["Posture", "PostureEvaluator", "PostureSettings"]
+__all__ = ["Kinematics", "Posture", "PostureEvaluator", "PostureSettings"]
 
 _POSITION = pin.KinematicLevel.POSITION
 
@@ -140,6 +135,37 @@ class Posture:
         return Stance(self.robot, self.q, self.settings.contacts)
 
 
+class Kinematics(NamedTuple):
+    """One configuration's kinematics, as :meth:`PostureEvaluator.kinematics` computes them.
+
+    Positions in m, world axes; ``*_local`` in the stance frame (origin at the base position
+    ``origin``, the free flyer's translation set to zero).
+
+    Attributes:
+        origin: (3,) the stance frame's origin in world, m.
+        com_local: (3,) the CoM, stance frame. com: (3,) the CoM, world.
+        mass: kg.
+        com_jacobian: (3, nv) generalized velocity to CoM velocity (world axes).
+        rotations: (m, 3, 3) the contacts' contact-to-world rotations.
+        local: (m, 3) the contact points, stance frame.
+        jacobians: (6m, nv) their world-aligned Jacobians stacked (linear rows first), or
+            (0, 0) without torque limits.
+        gravity_torques: (nv,) g(q), N m (zeros without torque limits).
+        inertia: (3, 3) the composite rotational inertia about the CoM, kg m^2.
+    """
+
+    origin: np.ndarray
+    com_local: np.ndarray
+    com: np.ndarray
+    mass: float
+    com_jacobian: np.ndarray
+    rotations: np.ndarray
+    local: np.ndarray
+    jacobians: np.ndarray
+    gravity_torques: np.ndarray
+    inertia: np.ndarray
+
+
 class PostureEvaluator:
     """Evaluates postures of one robot with one set of contacts and one impact.
 
@@ -200,44 +226,15 @@ class PostureEvaluator:
         that would not separate the contact), :class:`~impact_balance.exceptions.SolverError`
         (a projection that failed).
         """
-        robot, settings, data, model = self.robot, self.settings, self.scratch.data, self.model
-        # The kinematics in the stance frame (world axes, origin at the base position), as
-        # Stance does: lever arms keep their precision however far the robot stands.
-        q_local = self._q_local
-        q_local[:] = q
-        origin = np.zeros(3)
-        if self._free_flyer:
-            origin = q[:3].copy()
-            q_local[:3] = 0.0
-        # ccrba: joint placements, joint Jacobians, the composite inertia Ig and the centroidal
-        # momentum matrix Ag (its linear rows are m times the CoM Jacobian).
-        pin.ccrba(model, data, q_local, self._zero_velocity)
-        self.scratch.holder = None  # what it holds is this evaluator's, never a Stance's
-        com_local = np.array(pin.centerOfMass(model, data, _POSITION, False), dtype=float)
-        Ig = data.Ig
-        mass = float(Ig.mass)
-        com_jacobian = data.Ag[:3] / mass
-        m = len(self._frames)
-        rotations = np.empty((m, 3, 3))
-        local = np.empty((m, 3))
-        jacobians = np.empty((6 * m, model.nv)) if self._torques else np.zeros((0, 0))
-        for i, fid in enumerate(self._frames):
-            placement, J = frame_point(model, data, fid, None, self._torques)
-            rotations[i] = placement.rotation
-            local[i] = placement.translation
-            if J is not None:
-                jacobians[6 * i : 6 * i + 6] = J
-        # g(q) = -Ag[:3]^T g: the gravity's generalized force is the CoM's (the centroidal
-        # momentum matrix's linear rows are m times the CoM Jacobian); equal to pinocchio's
-        # computeGeneralizedGravity to rounding (1e-14 N m of 327 on G1), without its pass.
-        gravity_torques = -(self._gravity @ data.Ag[:3]) if self._torques else self._zero_velocity
-        com = com_local + origin
+        robot, settings = self.robot, self.settings
+        k = self.kinematics(q)
+        origin, com_local, mass, com = k.origin, k.com_local, k.mass, k.com
+        rotations, local, jacobians = k.rotations, k.local, k.jacobians
+        gravity_torques, com_jacobian = k.gravity_torques, k.com_jacobian
         areas = self._areas(
             rotations, local, origin, com_local, mass, com, jacobians, gravity_torques
         )
-        impact = self._impact(
-            q, q_local, origin, com_local, mass, np.array(Ig.inertia, dtype=float)
-        )
+        impact = self.impact_at(q, k)
         com_criterion = zmp = None
         if settings.criterion == "zmp":
             if isinstance(areas, Projected):
@@ -273,6 +270,61 @@ class PostureEvaluator:
             zmp,
         )
 
+    def kinematics(self, q: np.ndarray) -> Kinematics:
+        """The pinocchio step of :meth:`evaluate` at ``q`` (nq, float64, contiguous).
+
+        Left in this evaluator's Data: :meth:`impact_at` reads the impact frame from it, so
+        call it before the next :meth:`kinematics`. The arrays are new (the caller keeps them).
+        """
+        data, model = self.scratch.data, self.model
+        # The kinematics in the stance frame (world axes, origin at the base position), as
+        # Stance does: lever arms keep their precision however far the robot stands.
+        q_local = self._q_local
+        q_local[:] = q
+        origin = np.zeros(3)
+        if self._free_flyer:
+            origin = q[:3].copy()
+            q_local[:3] = 0.0
+        # ccrba: joint placements, joint Jacobians, the composite inertia Ig and the centroidal
+        # momentum matrix Ag (its linear rows are m times the CoM Jacobian).
+        pin.ccrba(model, data, q_local, self._zero_velocity)
+        self.scratch.holder = None  # what it holds is this evaluator's, never a Stance's
+        com_local = np.array(pin.centerOfMass(model, data, _POSITION, False), dtype=float)
+        Ig = data.Ig
+        mass = float(Ig.mass)
+        com_jacobian = data.Ag[:3] / mass
+        m = len(self._frames)
+        rotations = np.empty((m, 3, 3))
+        local = np.empty((m, 3))
+        jacobians = np.empty((6 * m, model.nv)) if self._torques else np.zeros((0, 0))
+        for i, fid in enumerate(self._frames):
+            placement, J = frame_point(model, data, fid, None, self._torques)
+            rotations[i] = placement.rotation
+            local[i] = placement.translation
+            if J is not None:
+                jacobians[6 * i : 6 * i + 6] = J
+        # g(q) = -Ag[:3]^T g: the gravity's generalized force is the CoM's (the centroidal
+        # momentum matrix's linear rows are m times the CoM Jacobian); equal to pinocchio's
+        # computeGeneralizedGravity to rounding (1e-14 N m of 327 on G1), without its pass.
+        gravity_torques = -(self._gravity @ data.Ag[:3]) if self._torques else self._zero_velocity
+        com = com_local + origin
+        return Kinematics(
+            origin,
+            com_local,
+            com,
+            mass,
+            com_jacobian,
+            rotations,
+            local,
+            jacobians,
+            gravity_torques,
+            np.array(Ig.inertia, dtype=float),
+        )
+
+    def impact_at(self, q: np.ndarray, k: Kinematics) -> ImpactModel:
+        """The impact model at ``q``, whose :meth:`kinematics` ``k`` the Data holds."""
+        return self._impact(q, self._q_local, k.origin, k.com_local, k.mass, k.inertia)
+
     def _areas(
         self,
         rotations: npt.NDArray[np.float64],
@@ -293,44 +345,26 @@ class PostureEvaluator:
             SolverError: The projection failed (naming the contacts).
         """
         settings = self.settings
-        areas: BalanceAreas | Projected
         try:
-            if self._scaled:  # a friction above 1: the polytope in friction-normalised variables
-                polytope = assemble_polytope(
-                    self._faces,
-                    rotations,
-                    local + origin,
-                    local - com_local,
-                    mass,
-                    com,
-                    settings.gravity,
-                    jacobians,
-                    self._idx,
-                    self._limit,
-                    gravity_torques,
-                    friction_scaling(self._frictions, list(rotations)),
-                )
-                areas = areas_from_polytope(polytope, settings.plane_height, settings.zmp_margin)
-            else:  # the same numbers, assembled and projected in one compiled call
-                areas = projected_from_arrays(
-                    self._faces,
-                    rotations,
-                    local + origin,
-                    local - com_local,
-                    mass,
-                    com,
-                    settings.gravity,
-                    jacobians,
-                    self._idx,
-                    self._limit,
-                    gravity_torques,
-                    settings.plane_height,
-                    settings.zmp_margin,
-                    self._hint,
-                )
+            return posture_areas(
+                self._faces,
+                rotations,
+                local + origin,
+                local - com_local,
+                mass,
+                com,
+                settings.gravity,
+                jacobians,
+                self._idx,
+                self._limit,
+                gravity_torques,
+                self._frictions,
+                settings.plane_height,
+                settings.zmp_margin,
+                self._hint,
+            )
         except SolverError as exc:
             raise exc.within("contacts (projection of the contact wrench polytope)") from None
-        return areas
 
     def _angular_momentum(self, impact: ImpactModel, com: np.ndarray) -> AngularMomentumTerm | None:
         """The angular momentum term at this posture (None: the paper's criterion)."""

@@ -1,0 +1,144 @@
+#!/usr/bin/env python
+"""Issue 28 item 3: ``Governor.limits`` (N postures in one call) beside N single ticks.
+
+    python benchmarks/batch.py [--json] [--n N] [--repeat R] [--threads T] [--scenarios NAME ...]
+
+For each scenario of the wall study, the moving 500 Hz trajectory of ``benchmarks/governor.py``
+(N ticks, default 1000: every posture differs), timed round-robin in one run, R rounds (the
+garbage collector paused):
+
+- ``single``: N calls of ``governor.limit(q_k, v_k)`` (a posture-changing tick each);
+- ``batch``: one ``governor.limits(q, v)`` of the N rows;
+- ``batch_threads``: the same with ``threads=T`` (default 2);
+- ``velocity``: N calls of ``governor.limit(q_0, v_k)`` (one posture, N velocities: the
+  velocity-only tick), beside ``batch_velocity``: one ``governor.limits`` of the N rows
+  ``(q_0, v_k)`` (a row that repeats the previous row's q reuses its posture).
+
+Reported per scenario: the time per posture (median over rounds, us) of each case, the
+throughput ratio single / batch (target >= 3 at N = 1000) and the worst difference of the
+batch's maximum contact velocity from the single ticks' (must be <= 1e-12 m/s), with the load
+average before and after (the machine is shared: absolute times move with it, ratios less).
+Exit status 1 if an answer disagrees, else 0.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.speed.ticks import trajectory
+from benchmarks.speed.timing import Case, measure, progress
+from impact_balance.governor import Governor
+
+SCENARIOS = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot", "g1_two_feet")
+TARGET_RATIO = 3.0
+
+__all__ = ["SCENARIOS", "bench_scenario", "main"]
+
+
+def bench_scenario(name: str, n: int, repeat: int, threads: int) -> dict[str, Any]:
+    """One scenario's three cases, round-robin, ``repeat`` rounds of ``n`` postures."""
+    single, batched, steady = Governor(name), Governor(name), Governor(name)
+    qs, vs = trajectory(single, n)
+    q0s = np.tile(qs[0], (n, 1))
+    load_before = os.getloadavg()
+    cases = {
+        "single": Case(
+            lambda: [single.limit(q, v).max_contact_velocity for q, v in zip(qs, vs, strict=True)],
+            keep=np.asarray,
+        ),
+        "batch": Case(lambda: batched.limits(qs, vs), keep=lambda r: r.max_contact_velocity),
+        "batch_threads": Case(
+            lambda: batched.limits(qs, vs, threads=threads), keep=lambda r: r.max_contact_velocity
+        ),
+        "velocity": Case(
+            lambda: [steady.limit(qs[0], v).max_contact_velocity for v in vs], keep=np.asarray
+        ),
+        "batch_velocity": Case(
+            lambda: batched.limits(q0s, vs), keep=lambda r: r.max_contact_velocity
+        ),
+    }
+    times, results = measure(cases, repeat, 1)
+    load_after = os.getloadavg()
+    worst = 0.0
+    agree = True
+    for case, reference in (
+        ("batch", "single"),
+        ("batch_threads", "single"),
+        ("batch_velocity", "velocity"),
+    ):
+        want = results[reference][0]
+        finite = np.isfinite(want)
+        for got in results[case]:
+            agree &= bool(np.array_equal(np.isfinite(got), finite))
+            worst = max(worst, float(np.max(np.abs(got[finite] - want[finite]), initial=0.0)))
+    per_posture = {case: float(np.median(t)) / n for case, t in times.items()}
+    return {
+        "scenario": name,
+        "n": n,
+        "repeat": repeat,
+        "threads": threads,
+        "loadavg_before": load_before,
+        "loadavg_after": load_after,
+        "us_per_posture": per_posture,
+        "ratio_single_over_batch": per_posture["single"] / per_posture["batch"],
+        "ratio_single_over_batch_threads": per_posture["single"] / per_posture["batch_threads"],
+        "ratio_velocity_over_batch_velocity": per_posture["velocity"]
+        / per_posture["batch_velocity"],
+        "worst_difference": worst,
+        "agree": agree and worst <= 1e-12,
+    }
+
+
+def _text(rows: list[dict[str, Any]]) -> str:
+    out = [
+        f"{'scenario':20s} {'single':>9s} {'batch':>9s} {'threads':>9s} {'ratio':>6s} "
+        f"{'ratio T':>7s} {'velocity':>9s} {'batch v':>9s} {'ratio v':>7s}  worst diff  "
+        "load avg (before, after)"
+    ]
+    for r in rows:
+        t = r["us_per_posture"]
+        out.append(
+            f"{r['scenario']:20s} {t['single']:9.1f} {t['batch']:9.1f} {t['batch_threads']:9.1f} "
+            f"{r['ratio_single_over_batch']:6.2f} {r['ratio_single_over_batch_threads']:7.2f} "
+            f"{t['velocity']:9.1f} {t['batch_velocity']:9.1f} "
+            f"{r['ratio_velocity_over_batch_velocity']:7.2f}  "
+            f"{r['worst_difference']:.1e}     {r['loadavg_before'][0]:.2f}, "
+            f"{r['loadavg_after'][0]:.2f}"
+        )
+    out.append(f"us per posture (median over rounds); target ratio >= {TARGET_RATIO:g} at N = 1000")
+    return "\n".join(out)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[1])
+    parser.add_argument("--n", type=int, default=1000, help="postures per batch (default 1000)")
+    parser.add_argument("--repeat", type=int, default=5, help="rounds (default 5)")
+    parser.add_argument("--threads", type=int, default=2, help="threads of batch_threads")
+    parser.add_argument("--scenarios", nargs="+", default=list(SCENARIOS))
+    parser.add_argument("--json", action="store_true", help="one JSON document on stdout")
+    args = parser.parse_args(argv)
+    if args.n < 1 or args.repeat < 1 or not 1 <= args.threads <= 64:
+        print("error: --n and --repeat must be >= 1, --threads in [1, 64]", file=sys.stderr)
+        return 2
+    rows = []
+    for name in args.scenarios:
+        progress(f"{name} ...")
+        rows.append(bench_scenario(name, args.n, args.repeat, args.threads))
+    if args.json:
+        print(json.dumps({"scenarios": rows, "target_ratio": TARGET_RATIO}))
+    else:
+        print(_text(rows))
+    return 0 if all(r["agree"] for r in rows) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

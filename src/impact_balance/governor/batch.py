@@ -1,0 +1,429 @@
+"""A governor's answers for many postures in one call: :class:`BatchLimits`.
+
+:meth:`Governor.limits <impact_balance.governor.Governor.limits>` answers N configurations
+and N generalized velocities (a planner's candidate postures, a sweep's grid), as N calls of
+:meth:`~impact_balance.governor.Governor.limit` would, to rounding. Per posture the Python
+side runs pinocchio and the impact model (:meth:`PostureEvaluator.kinematics
+<impact_balance.governor.posture.PostureEvaluator.kinematics>`, the one-posture path's own
+step); the areas and the criterion of every posture then run in one compiled call
+(:func:`~impact_balance.criteria.batch.posture_exits`), which releases the GIL, so
+``threads`` > 1 evaluates slices of the postures side by side. A posture the compiled call
+does not answer (a projection Bretl's method answers, a CoM velocity already outside its
+area, an area of fewer than 3 vertices), the "zmp" criterion, contact frictions above 1 and the
+angular momentum option (``angular_momentum_damping_time``)
+take the one-posture path (:meth:`PostureEvaluator.evaluate
+<impact_balance.governor.posture.PostureEvaluator.evaluate>`).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import threading
+from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+from numpy.typing import ArrayLike
+
+from impact_balance.balance.areas import FORCE_BOX, MERGE_TOLERANCE
+from impact_balance.balance.lipm import lipm_omega
+from impact_balance.constants import MAX_SPEED
+from impact_balance.contacts.wrench_polytope import face_blocks
+from impact_balance.criteria.batch import posture_exits
+from impact_balance.criteria.linear_exit import BOUNDARY_TOLERANCE, EXIT_STATUSES
+from impact_balance.criteria.velocity_limit import LimitStatus
+from impact_balance.exceptions import GovernorError, ImpactBalanceError, SolverError
+from impact_balance.geometry.polygon import MERGE_AREA_TOLERANCE
+from impact_balance.governor.limit import SpeedLimit
+from impact_balance.governor.options import Criterion
+from impact_balance.governor.posture import PostureEvaluator
+from impact_balance.projection.walk import MAX_PIVOTS
+from impact_balance.robot.robot import Robot
+
+__all__ = ["BLOCK", "BatchEvaluator", "BatchLimits"]
+
+#: Postures per compiled call: the Python step of the next block runs while another thread's
+#: compiled call runs.
+BLOCK = 32
+#: The most threads a batch takes.
+MAX_THREADS = 64
+
+
+@dataclass(frozen=True)
+class BatchLimits:
+    """The governor's answers for N postures, row i for ``(q_batch[i], v_batch[i])``.
+
+    Frames and units as :class:`~impact_balance.governor.limit.SpeedLimit`'s (world axes, m/s).
+
+    Attributes:
+        criterion: "com" or "zmp".
+        max_contact_velocity: (N,) m/s (inf: no approach speed is unsafe).
+        status: N statuses ("ok", "unbounded", "already_falling", "cannot_balance").
+        limiting_vertex: (N,) int, -1 where :class:`SpeedLimit`'s is None.
+        limiting_edge: (N,) int, -1 where :class:`SpeedLimit`'s is None.
+        safe_interval: (N, 2) the safe approach speeds ``(lo, hi)``, m/s; NaN rows where there
+            are none.
+        com_velocity: (N, 3) the CoM velocities, world, m/s.
+        normal: (N, 3) the impact surface's unit normal, world.
+        point: (N, 3) the impact point, world, m.
+    """
+
+    criterion: Criterion
+    max_contact_velocity: npt.NDArray[np.float64]
+    status: tuple[LimitStatus, ...]
+    limiting_vertex: npt.NDArray[np.int64]
+    limiting_edge: npt.NDArray[np.int64]
+    safe_interval: npt.NDArray[np.float64]
+    com_velocity: npt.NDArray[np.float64]
+    normal: npt.NDArray[np.float64]
+    point: npt.NDArray[np.float64]
+
+    def __len__(self) -> int:
+        """N."""
+        return len(self.status)
+
+    def __getitem__(self, i: int) -> SpeedLimit:
+        """Row ``i`` as the :class:`SpeedLimit` :meth:`Governor.limit` answers for it."""
+        lo, hi = (float(x) for x in self.safe_interval[i])
+        vertex, edge = int(self.limiting_vertex[i]), int(self.limiting_edge[i])
+        return SpeedLimit(
+            self.criterion,
+            float(self.max_contact_velocity[i]),
+            self.status[i],
+            None if vertex < 0 else vertex,
+            None if edge < 0 else edge,
+            None if math.isnan(lo) else (lo, hi),
+            self.com_velocity[i].copy(),
+            self.normal[i].copy(),
+            self.point[i].copy(),
+            False,
+        )
+
+
+class _Rows:
+    """The batch's output arrays, filled row by row (each thread writes its own rows)."""
+
+    def __init__(self, n: int) -> None:
+        self.speed = np.zeros(n)
+        self.status: list[LimitStatus] = ["ok"] * n
+        self.vertex = np.full(n, -1, dtype=np.int64)
+        self.edge = np.full(n, -1, dtype=np.int64)
+        self.interval = np.full((n, 2), np.nan)
+        self.com_velocity = np.zeros((n, 3))
+        self.normal = np.zeros((n, 3))
+        self.point = np.zeros((n, 3))
+
+    def answer(self, criterion: Criterion) -> BatchLimits:
+        return BatchLimits(
+            criterion,
+            self.speed,
+            tuple(self.status),
+            self.vertex,
+            self.edge,
+            self.interval,
+            self.com_velocity,
+            self.normal,
+            self.point,
+        )
+
+
+class BatchEvaluator:
+    """Evaluates postures in batches, with one :class:`PostureEvaluator` per thread.
+
+    Args:
+        robot: The governor's robot. evaluator: Its posture evaluator (its settings are used;
+            it is not called).
+        check: The governor's per-configuration check: ``check(q, field)`` returns the
+            configuration as a contiguous float vector or raises
+            :class:`~impact_balance.exceptions.GovernorError`.
+    """
+
+    def __init__(
+        self,
+        robot: Robot,
+        evaluator: PostureEvaluator,
+        check: Callable[[npt.NDArray[np.float64], str], npt.NDArray[np.float64]],
+    ) -> None:
+        self.robot, self.settings, self.check = robot, evaluator.settings, check
+        self._evaluators: list[PostureEvaluator] = []
+        self._lock = threading.Lock()
+        self._settings = np.array(
+            [
+                FORCE_BOX,
+                MAX_PIVOTS,
+                MERGE_TOLERANCE,
+                MERGE_AREA_TOLERANCE,
+                self.settings.zmp_margin,
+                self.settings.velocity_margin,
+                BOUNDARY_TOLERANCE,
+            ]
+        )
+
+    def limits(self, q_batch: ArrayLike, v_batch: ArrayLike, threads: int = 1) -> BatchLimits:
+        """See :meth:`impact_balance.governor.Governor.limits`."""
+        model = self.robot.model
+        qs = _matrix(q_batch, model.nq, "q_batch")
+        vs = _matrix(v_batch, model.nv, "v_batch")
+        if len(vs) != len(qs):
+            raise GovernorError(
+                "v_batch", f"{len(vs)} rows", f"must have as many rows as q_batch ({len(qs)})"
+            )
+        if isinstance(threads, bool) or not isinstance(threads, int | np.integer):
+            raise GovernorError("threads", threads, "must be an integer")
+        if not 1 <= threads <= MAX_THREADS:
+            raise GovernorError("threads", threads, f"must be in [1, {MAX_THREADS}]")
+        repeated = np.zeros(len(qs), dtype=np.bool_)  # row i's q is row i - 1's
+        repeated[1:] = (qs[1:] == qs[:-1]).all(axis=1)
+        for i in np.flatnonzero(~repeated):  # a repeated row passes the same check
+            qs[i] = self.check(qs[i], f"q_batch[{i}]")
+        rows = _Rows(len(qs))
+        slices = np.array_split(np.arange(len(qs)), min(threads, max(len(qs), 1)))
+        evaluators = self._take(len(slices))
+        try:
+            if len(slices) == 1:
+                _Slice(evaluators[0], qs, vs, rows, self._settings).run(slices[0], repeated)
+            else:
+                with ThreadPoolExecutor(len(slices)) as pool:
+                    futures = [
+                        pool.submit(_Slice(e, qs, vs, rows, self._settings).run, s, repeated)
+                        for e, s in zip(evaluators, slices, strict=True)
+                    ]
+                    for future in futures:
+                        future.result()
+        finally:
+            with self._lock:
+                self._evaluators.extend(evaluators)
+        return rows.answer(self.settings.criterion)
+
+    def _take(self, n: int) -> list[PostureEvaluator]:
+        """``n`` evaluators of this batch's own (made on first use), not shared while taken."""
+        with self._lock:
+            taken, self._evaluators = self._evaluators[:n], self._evaluators[n:]
+        return taken + [PostureEvaluator(self.robot, self.settings) for _ in range(n - len(taken))]
+
+
+class _Slice:
+    """One thread's rows: the Python step and the compiled call, block by block."""
+
+    def __init__(
+        self,
+        evaluator: PostureEvaluator,
+        qs: npt.NDArray[np.float64],
+        vs: npt.NDArray[np.float64],
+        rows: _Rows,
+        settings: npt.NDArray[np.float64],
+    ) -> None:
+        self.e, self.qs, self.vs, self.rows, self.settings = evaluator, qs, vs, rows, settings
+        # The compiled call answers the paper's "com" criterion of unscaled contacts (friction
+        # <= 1); with the angular momentum counted, every row takes limit()'s path.
+        self.compiled = (
+            evaluator.settings.criterion == "com"
+            and not evaluator._scaled
+            and evaluator.settings.angular_momentum_damping_time is None
+        )
+
+    def run(self, indices: npt.NDArray[np.int64], repeated: npt.NDArray[np.bool_]) -> None:
+        """Answer rows ``indices`` of the batch (``repeated[i]``: row i's q is row i - 1's)."""
+        if not self.compiled:
+            for i in indices:
+                self.single(int(i))
+            return
+        # Blocks of BLOCK postures, each with the rows that repeat it; the slice's first row is
+        # evaluated, whatever came before it.
+        if not len(indices):
+            return
+        starts: list[int] = np.union1d([0], np.flatnonzero(~repeated[indices])).tolist()
+        bounds = [*starts[::BLOCK], len(indices)]
+        for a, b in itertools.pairwise(bounds):
+            same = repeated[indices[a:b]].copy()
+            same[0] = False
+            self.block(indices[a:b], same)
+
+    def block(self, indices: npt.NDArray[np.int64], same: npt.NDArray[np.bool_]) -> None:
+        """The Python step of rows ``indices``, then their compiled call.
+
+        ``same[r]``: row r repeats the posture of row r - 1 (only its velocity is new).
+        """
+        e, s, n, rows = self.e, self.e.settings, len(indices), self.rows
+        m, nv = len(e._frames), e.model.nv
+        torques = e._torques
+        rotations = np.zeros((n, m, 3, 3))  # a repeated row's are not read
+        positions, arms = np.zeros((n, m, 3)), np.zeros((n, m, 3))
+        jacobians = np.zeros((n, 6 * m, nv)) if torques else np.zeros((n, 0, 0))
+        gravity_torques = np.zeros((n, nv))
+        weights, depths, omegas = np.zeros(n), np.zeros(n), np.zeros(n)
+        coms, velocities = np.zeros((n, 3)), np.zeros((n, 2))
+        jumps = np.zeros((0, 0, 2))
+        for r in np.flatnonzero(~same):
+            i = int(indices[r])
+            q = self.qs[i]
+            k = e.kinematics(q)
+            try:
+                omegas[r] = lipm_omega(
+                    float(k.com[2]), s.plane_height, s.gravity, field="plane_height"
+                )
+                impact = e.impact_at(q, k)
+            except ImpactBalanceError as exc:  # as limit() raises it, naming the row
+                if exc.args and isinstance(exc.args[0], str):
+                    exc.args = (f"q_batch[{i}]: {exc.args[0]}", *exc.args[1:])
+                raise
+            rotations[r] = k.rotations
+            positions[r] = k.local + k.origin
+            arms[r] = k.local - k.com_local
+            if torques:
+                jacobians[r] = k.jacobians
+            gravity_torques[r] = k.gravity_torques
+            weights[r] = k.mass * s.gravity
+            depths[r] = s.plane_height - float(k.com[2])
+            coms[r] = k.com
+            rates = impact.com_jump_rates
+            if not jumps.size:
+                jumps = np.zeros((n, *rates.shape))
+            stop = r + 1
+            while stop < n and same[stop]:
+                stop += 1
+            if stop == r + 1:  # a posture of its own
+                com_velocity = _com_velocity(k.com_jacobian, self.vs[i], i)
+                velocities[r], jumps[r] = com_velocity[:2], rates
+                rows.com_velocity[i], rows.normal[i], rows.point[i] = (
+                    com_velocity,
+                    impact.normal,
+                    impact.point,
+                )
+                continue
+            # This row and the rows that repeat its posture: their CoM velocities at once.
+            run = indices[r:stop]
+            velocities_3d = _com_velocities(k.com_jacobian, self.vs[run], run)
+            velocities[r:stop] = velocities_3d[:, :2]
+            jumps[r:stop] = rates
+            rows.com_velocity[run] = velocities_3d
+            rows.normal[run], rows.point[run] = impact.normal, impact.point
+        # face_blocks of every row in one batched product (the same numbers row by row)
+        blocks = face_blocks(np.tile(e._faces, (n, 1, 1)), rotations.reshape(n * m, 3, 3))
+        blocks = blocks.reshape(n, m, 32, 3)
+        out = np.empty((n, 4))
+        posture_exits(
+            blocks,
+            positions,
+            arms,
+            jacobians,
+            e._idx,
+            e._limit,
+            gravity_torques,
+            weights,
+            depths,
+            coms,
+            omegas,
+            jumps,
+            velocities,
+            self.settings,
+            e._hint,
+            out,
+            same,
+        )
+        self.fill(indices, out)
+
+    def fill(self, indices: npt.NDArray[np.int64], out: npt.NDArray[np.float64]) -> None:
+        """Rows ``indices`` from the compiled answers ``out``; the one-posture path for the rest."""
+        rows = self.rows
+        codes = out[:, 0].astype(np.int64)
+        answered = (codes == 0) | (codes == 2)  # "ok" and "unbounded": from inside the area
+        done = indices[answered]
+        speeds = np.where(codes[answered] == 0, out[answered, 1], math.inf)
+        rows.speed[done] = speeds
+        rows.interval[done, 0], rows.interval[done, 1] = 0.0, speeds
+        ok = indices[codes == 0]
+        rows.vertex[ok], rows.edge[ok] = out[codes == 0, 2], out[codes == 0, 3]
+        for r, i in enumerate(indices):
+            if answered[r]:
+                rows.status[i] = EXIT_STATUSES[codes[r]]
+            else:  # Bretl's projection, a small area, a falling start
+                self.single(int(i))
+
+    def single(self, i: int) -> None:
+        """Row ``i`` by the one-posture path (what :meth:`Governor.limit` does)."""
+        rows = self.rows
+        try:
+            posture = self.e.evaluate(self.qs[i])
+        except SolverError as exc:
+            raise exc.within(f"q_batch[{i}]") from None
+        com_velocity = _com_velocity(posture.com_jacobian, self.vs[i], i)
+        criterion = posture.com_criterion
+        interval: tuple[float, float] | None
+        if criterion is not None:
+            limit = criterion.limit(com_velocity)
+            interval = criterion.interval(com_velocity, limit)
+        else:
+            assert posture.zmp_limit is not None  # the "zmp" criterion's posture has it
+            limit = posture.zmp_limit
+            interval = (0.0, limit.max_contact_velocity) if limit.from_inside else None
+        rows.speed[i], rows.status[i] = limit.max_contact_velocity, limit.status
+        rows.vertex[i] = -1 if limit.limiting_vertex is None else limit.limiting_vertex
+        rows.edge[i] = -1 if limit.limiting_edge is None else limit.limiting_edge
+        rows.interval[i] = (math.nan, math.nan) if interval is None else interval
+        rows.com_velocity[i] = com_velocity
+        rows.normal[i], rows.point[i] = posture.impact.normal, posture.impact.point
+
+
+def _com_velocity(
+    com_jacobian: npt.NDArray[np.float64], v: npt.NDArray[np.float64], i: int
+) -> npt.NDArray[np.float64]:
+    """``com_jacobian @ v`` (row ``i``), checked as :meth:`Governor.limit` checks it (m/s)."""
+    com_velocity: npt.NDArray[np.float64] = com_jacobian @ v
+    if not float(com_velocity @ com_velocity) <= MAX_SPEED * MAX_SPEED:
+        raise GovernorError(
+            f"v_batch[{i}]",
+            f"CoM velocity {math.hypot(*com_velocity):.3g} m/s",
+            f"gives a CoM speed above {MAX_SPEED:g} m/s (the scenario's bound)",
+        )
+    return com_velocity
+
+
+def _com_velocities(
+    com_jacobian: npt.NDArray[np.float64],
+    vs: npt.NDArray[np.float64],
+    indices: npt.NDArray[np.int64],
+) -> npt.NDArray[np.float64]:
+    """``com_jacobian @ v`` of each row of ``vs`` (rows ``indices`` of the batch), checked.
+
+    One stacked product: numpy makes each row's matrix-vector product as for one vector (the
+    same numbers as :meth:`Governor.limit`'s ``com_jacobian @ v``).
+    """
+    out: npt.NDArray[np.float64] = np.matmul(com_jacobian, vs[:, :, None])[:, :, 0]
+    out = np.ascontiguousarray(out)
+    speeds: npt.NDArray[np.float64] = np.einsum("ij,ij->i", out, out)
+    bad = np.flatnonzero(~(speeds <= MAX_SPEED * MAX_SPEED))
+    if bad.size:
+        j = int(bad[0])
+        raise GovernorError(
+            f"v_batch[{int(indices[j])}]",
+            f"CoM velocity {math.hypot(*out[j]):.3g} m/s",
+            f"gives a CoM speed above {MAX_SPEED:g} m/s (the scenario's bound)",
+        )
+    return out
+
+
+def _matrix(x: ArrayLike, size: int, field: str) -> npt.NDArray[np.float64]:
+    """``x`` as a (N, size) C-contiguous float array of finite real numbers (a copy)."""
+    try:
+        raw = np.asarray(x)
+        if raw.dtype.kind not in "iuf":
+            raise TypeError(raw.dtype)
+        a = np.array(raw, dtype=float, order="C")
+    except (TypeError, ValueError):
+        raise GovernorError(field, _shown(x), f"must be rows of {size} real numbers") from None
+    if a.ndim != 2 or a.shape[1] != size:
+        raise GovernorError(field, f"shape {a.shape}", f"must be (N, {size})")
+    bad = np.argwhere(~np.isfinite(a))
+    if bad.size:
+        i, j = (int(x) for x in bad[0])
+        raise GovernorError(f"{field}[{i}][{j}]", float(a[i, j]), "must be finite")
+    return a
+
+
+def _shown(x: object) -> object:
+    """``x`` for an error message (a sequence is shown by its type and length)."""
+    return f"{type(x).__name__} of {len(x)}" if isinstance(x, Sequence) else x

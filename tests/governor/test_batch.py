@@ -1,0 +1,216 @@
+"""Governor.limits: N postures in one call answer what N calls of Governor.limit answer, and
+what analyze() answers; bad batches are refused naming the field."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import impact_balance as ib
+from impact_balance.exceptions import GovernorError
+from impact_balance.governor import Governor
+
+SCENARIOS = ("kick_one_foot", "palm_push_two_feet", "g1_two_feet")
+_GOVERNORS: dict[tuple[str, str], Governor] = {}
+
+
+def governor(name: str, criterion: str = "com") -> Governor:
+    """One governor per scenario and criterion for the module (construction loads the model)."""
+    key = (name, criterion)
+    if key not in _GOVERNORS:
+        _GOVERNORS[key] = Governor(name, criterion=criterion)
+    return _GOVERNORS[key]
+
+
+def batch(g: Governor, n: int, seed: int, speed: float = 0.3) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` states near the scenario's posture: joints moved by up to 0.05 rad, the base by a few
+    cm, generalized velocities of standard deviation ``speed`` (rad/s; base 1/3 of it, m/s)."""
+    rng = np.random.default_rng(seed)
+    model = g.robot.model
+    qs = np.tile(g.configuration, (n, 1))
+    for name in g.robot.joint_names:
+        slot = g.robot.joint_slot(name)
+        if slot.nq == 1:
+            moved = qs[:, slot.idx_q] + rng.uniform(-0.05, 0.05, n)
+            qs[:, slot.idx_q] = np.clip(moved, slot.lower, slot.upper)
+    qs[:, :3] += rng.uniform(-0.03, 0.03, (n, 3))
+    vs = rng.normal(0.0, speed, (n, model.nv))
+    vs[:, :3] = rng.normal(0.0, speed / 3.0, (n, 3))
+    return qs, vs
+
+
+def assert_rows_equal(answers, singles, tol: float = 1e-12) -> None:
+    assert len(answers) == len(singles)
+    for i, one in enumerate(singles):
+        row = answers[i]
+        assert row.status == one.status, i
+        assert row.limiting_vertex == one.limiting_vertex, i
+        assert row.limiting_edge == one.limiting_edge, i
+        if math.isfinite(one.max_contact_velocity):
+            assert row.max_contact_velocity == pytest.approx(one.max_contact_velocity, abs=tol)
+        else:
+            assert row.max_contact_velocity == one.max_contact_velocity
+        if one.safe_interval is None:
+            assert row.safe_interval is None, i
+        else:
+            assert row.safe_interval is not None, i
+            np.testing.assert_allclose(row.safe_interval, one.safe_interval, rtol=0, atol=tol)
+        np.testing.assert_array_equal(row.com_velocity, one.com_velocity)
+        np.testing.assert_array_equal(row.point, one.point)
+        np.testing.assert_array_equal(row.normal, one.normal)
+        assert not row.posture_reused
+
+
+@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    name=st.sampled_from(SCENARIOS),
+    n=st.integers(1, 40),
+    seed=st.integers(0, 2**32 - 1),
+    speed=st.sampled_from([0.05, 0.3, 3.0]),
+)
+def test_batch_equals_single_ticks(name, n, seed, speed):
+    g = governor(name)
+    qs, vs = batch(g, n, seed, speed)
+    answers = g.limits(qs, vs)
+    singles = [g.limit(q, v) for q, v in zip(qs, vs, strict=True)]
+    assert_rows_equal(answers, singles)
+
+
+def test_batch_covers_falling_starts_and_agrees_with_analyze():
+    # Slow and fast CoM velocities: "ok" rows answered by the compiled call, "already_falling"
+    # rows by the one-posture path (their safe interval is computed from the margins).
+    g = governor("kick_one_foot")
+    qs, vs = batch(g, 24, 7, 0.3)
+    vs[::2] *= 20.0
+    answers = g.limits(qs, vs)
+    assert {"ok", "already_falling"} <= set(answers.status)
+    for i in range(0, 24, 5):  # an independent computation: the whole pipeline
+        analysis = ib.analyze(g.scenario_at(qs[i], answers.com_velocity[i]))
+        want = analysis.impact.max_contact_velocity
+        assert answers.max_contact_velocity[i] == pytest.approx(want, abs=1e-9)
+        assert answers.status[i] == analysis.impact.com.status
+        got, want_interval = answers[i].safe_interval, analysis.impact.safe_interval
+        assert (got is None) == (want_interval is None)
+        if got is not None:
+            np.testing.assert_allclose(got, want_interval, rtol=1e-9, atol=1e-9)
+
+
+def test_threads_answer_the_same():
+    g = governor("palm_push_two_feet")
+    qs, vs = batch(g, 70, 3)
+    one, two = g.limits(qs, vs), g.limits(qs, vs, threads=3)
+    np.testing.assert_allclose(two.max_contact_velocity, one.max_contact_velocity, atol=1e-12)
+    assert two.status == one.status
+    np.testing.assert_array_equal(two.limiting_edge, one.limiting_edge)
+
+
+def test_zmp_criterion_batch_equals_single_ticks():
+    g = governor("kick_one_foot", "zmp")
+    qs, vs = batch(g, 6, 11)
+    assert_rows_equal(g.limits(qs, vs), [g.limit(q, v) for q, v in zip(qs, vs, strict=True)])
+
+
+def test_angular_momentum_batch_equals_single_ticks_and_counts_the_term():
+    from impact_balance.scenario import load_scenario
+
+    scenario = load_scenario("palm_push_two_feet")
+    paper = governor("palm_push_two_feet")
+    g = Governor(scenario.replace(angular_momentum_damping_time=0.1))
+    qs, vs = batch(g, 8, 5)
+    answers = g.limits(qs, vs)
+    assert_rows_equal(answers, [g.limit(q, v) for q, v in zip(qs, vs, strict=True)])
+    # the palm is above the CoM: counting the angular momentum lowers every answer
+    assert np.all(answers.max_contact_velocity < paper.limits(qs, vs).max_contact_velocity)
+
+
+def test_empty_batch():
+    g = governor("kick_one_foot")
+    answers = g.limits(np.zeros((0, g.nq)), np.zeros((0, g.nv)))
+    assert len(answers) == 0 and answers.max_contact_velocity.shape == (0,)
+
+
+def test_batch_leaves_the_tick_state_alone():
+    g = Governor("kick_one_foot")
+    before = g.posture
+    qs, vs = batch(g, 3, 5)
+    g.limits(qs, vs)
+    assert g.last is None and g.posture is before
+
+
+@pytest.mark.parametrize(
+    ("q_rows", "v_rows", "threads", "field"),
+    [
+        ("flat", None, 1, "q_batch"),
+        (None, "short", 1, "v_batch"),
+        ("nan", None, 1, "q_batch[1][4]"),
+        (None, "rows", 1, "v_batch"),
+        ("joint", None, 1, "q_batch[2]"),
+        ("text", None, 1, "q_batch"),
+        (None, None, 0, "threads"),
+        (None, None, 65, "threads"),
+        (None, None, 1.5, "threads"),
+        (None, "fast", 1, "v_batch[0]"),
+    ],
+)
+def test_bad_batches_are_refused_naming_the_field(q_rows, v_rows, threads, field):
+    g = governor("kick_one_foot")
+    qs, vs = batch(g, 3, 1)
+    if q_rows == "flat":
+        qs = qs[0]
+    elif q_rows == "nan":
+        qs[1, 4] = np.nan
+    elif q_rows == "joint":
+        slot = g.robot.joint_slot(g.robot.joint_names[-1])
+        qs[2, slot.idx_q] = slot.upper + 1.0
+    elif q_rows == "text":
+        qs = [["a"] * g.nq] * 3
+    if v_rows == "short":
+        vs = vs[:, :-1]
+    elif v_rows == "rows":
+        vs = vs[:2]
+    elif v_rows == "fast":
+        vs[0] *= 1e6
+    with pytest.raises(GovernorError) as info:
+        g.limits(qs, vs, threads=threads)
+    assert info.value.field.startswith(field)
+    assert field in str(info.value)
+
+
+def test_contact_aware_governor_refuses_a_batch():
+    g = Governor("kick_one_foot", contact_aware=True)
+    qs, vs = batch(g, 2, 0)
+    with pytest.raises(GovernorError, match="contact_aware"):
+        g.limits(qs, vs)
+
+
+@pytest.mark.parametrize("name", ["kick_one_foot", "g1_two_feet"])
+def test_many_velocities_at_one_posture_reuse_it(name):
+    # Rows that repeat the previous row's q are velocity-only ticks: the same answers as a
+    # governor whose posture is reused, and far cheaper than evaluating the posture again.
+    g = governor(name)
+    qs, vs = batch(g, 3, 21, 1.0)
+    qs = np.repeat(qs, [1, 40, 5], axis=0)
+    vs = np.random.default_rng(4).normal(0.0, 1.0, (len(qs), g.nv))
+    vs[:, :3] *= 0.3
+    answers = g.limits(qs, vs)
+    singles = [g.limit(q, v) for q, v in zip(qs, vs, strict=True)]
+    assert sum(s.posture_reused for s in singles) >= 42
+    assert_rows_equal(answers, singles)
+    # Slices of threads that start inside a run of repeated rows evaluate their posture.
+    assert_rows_equal(g.limits(qs, vs, threads=4), singles)
+
+
+def test_a_posture_the_pipeline_refuses_names_its_row():
+    # The CoM of row 1 below the LIPM plane: the ScenarioError limit() raises, with the row.
+    g = governor("kick_one_foot")
+    qs, vs = batch(g, 3, 9)
+    qs[1, 2] -= 5.0  # the base (and the CoM) 5 m lower
+    with pytest.raises(ib.ScenarioError, match=r"q_batch\[1\]: plane_height") as info:
+        g.limits(qs, vs)
+    assert info.value.field == "plane_height"
+    with pytest.raises(ib.ScenarioError, match="plane_height"):
+        g.limit(qs[1], vs[1])
