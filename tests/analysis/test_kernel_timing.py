@@ -35,7 +35,8 @@ def test_the_clock_stops_while_numba_compiles():
         wall, elapsed = time.perf_counter() - wall0, clock.now() - t0
     assert clock.compiling > 0.0
     assert clock.loading >= clock.compiling
-    assert elapsed == pytest.approx(wall - clock.loading, abs=1e-6)
+    # the two clocks are read one call apart: a loaded machine puts microseconds between them
+    assert elapsed == pytest.approx(wall - clock.loading, abs=1e-4)
     assert elapsed < wall
     # Once compiled, calling it costs numba nothing more.
     again = KernelClock()
