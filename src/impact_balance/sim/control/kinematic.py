@@ -150,7 +150,9 @@ class BalanceController(Controller["ControlOutput"]):
         self._zmp_filtered: np.ndarray | None = None
         self.contact_tasks = []
         for c in stance.contacts:
-            task = FrameTask(c.spec.frame, gains.contact_cost, gains.contact_cost)
+            # A point foot rolls: its frame's orientation is free.
+            turn = 0.0 if c.is_point else gains.contact_cost
+            task = FrameTask(c.spec.frame, gains.contact_cost, turn)
             task.set_target(self.configuration.get_transform_frame_to_world(c.spec.frame))
             self.contact_tasks.append(task)
         self.com_task = ComTask(cost=gains.com_cost)

@@ -19,7 +19,9 @@ free-flyer velocity in the base frame):
    ``[f; tau]`` (world axes, at each contact point):
 
    - equalities: the 6 unactuated rows of ``M a + h = S^T tau + sum J_i^T w_i`` (the floating
-     base), and ``J_i a + J_i_dot v = -K_c J_i v`` for each contact (the contacts stay);
+     base), and ``J_i a + J_i_dot v = -K_c J_i v`` for each contact (the contacts stay); a point
+     contact (size ``[0, 0]``) keeps its linear rows only and its torque is zero instead (a
+     point foot rolls);
    - inequalities: each ``w_i`` in its contact wrench cone
      (:func:`impact_balance.contacts.cwc.cwc_faces_world`) (friction and rectangle shrunk by
      margins, see :class:`InverseDynamicsGains`) with a minimum normal force, the joint position
@@ -552,6 +554,10 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
             C[:6, nv + 6 * i : nv + 6 * i + 6] = -J[:, :6].T
             C[r : r + 6, :nv] = J
             upper[r : r + 6] = -drift - g.contact_damping * (J @ v)
+            if spec.is_point:  # a point foot may roll: no torque instead of no rotation
+                C[r + 3 : r + 6, :nv] = 0.0
+                C[r + 3 : r + 6, nv + 6 * i + 3 : nv + 6 * i + 6] = np.eye(3)
+                upper[r + 3 : r + 6] = 0.0
             self._Jw[6 * i : 6 * i + 6] = J
             k = ne + 16 * i
             C[k : k + 16, nv + 6 * i : nv + 6 * i + 6] = cwc_faces_world(

@@ -288,6 +288,7 @@ class _TrialRun:
             float(q_start[2]),
             _base_rotation(q_start),
             options.criteria,
+            points=[c.is_point for c in stance.contacts],
         )
         self.normals = np.array([c.normal for c in stance.contacts])
         self.recorder = (
