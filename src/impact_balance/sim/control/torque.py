@@ -64,7 +64,7 @@ from impact_balance.geometry.spatial import skew
 from impact_balance.sim.control.actuation import use_torque_motors
 from impact_balance.sim.control.approach import ImpactReference
 from impact_balance.sim.control.controller import Controller
-from impact_balance.sim.control.gains import InverseDynamicsGains, TrialGains
+from impact_balance.sim.control.gains import InverseDynamicsGains, TrialGains, trial_gains
 from impact_balance.sim.control.zmp import DcmFeedback
 from impact_balance.sim.model.build import SimModel
 
@@ -309,9 +309,9 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         sim: SimModel,
         support_v_index: npt.NDArray[np.int_],
     ) -> InverseDynamicsController:
-        """The controller of one trial, with ``options.id_gains``.
+        """The controller of one trial, with ``options.id_gains`` (derived from the robot).
 
-        See :meth:`Controller.for_trial`.
+        See :meth:`Controller.for_trial` and :func:`~impact_balance.sim.control.gains.trial_gains`.
 
         The torques are bounded when ``sim``'s motors are force-limited; MuJoCo's viscous joint
         damping (the URDF's) is compensated: the motors add ``damping * qdot``.
@@ -319,7 +319,7 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         controller = cls(
             analysis,
             q_start,
-            options.id_gains,
+            trial_gains(options, sim)[1],
             task,
             effort_limits=bool(sim.model.actuator_forcelimited[sim.actuator_ids].any()),
         )
@@ -347,7 +347,7 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         cls, options: TrialGains, sim: SimModel, effort_limits: bool
     ) -> dict[str, Any]:
         """Name, gains, rates and actuators (see :meth:`Controller.trial_description`)."""
-        gains = options.id_gains
+        gains = trial_gains(options, sim)[1]
         return {
             "name": cls.name,
             "gains": gains.to_dict(),

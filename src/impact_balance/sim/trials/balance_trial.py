@@ -66,7 +66,7 @@ _FloatArray = npt.NDArray[np.float64]
 BeforeControl = Callable[[float, _FloatArray, _FloatArray], None]
 
 #: Version of the trials' physics and measurements: journals of another version are not reused.
-TRIAL_VERSION = 4
+TRIAL_VERSION = 5
 
 __all__ = [
     "CONTROLLERS",
