@@ -22,6 +22,7 @@ from impact_balance.constants import GRAVITY
 from impact_balance.contacts.cwc import cwc_faces
 from impact_balance.contacts.stance import Contact, ContactSpec
 from impact_balance.contacts.wrench_polytope import contact_polytope
+from tests.helpers.quadrupeds import four_point_feet
 
 FAST = settings(max_examples=30, deadline=None)
 MASS = 16.0
@@ -137,24 +138,11 @@ def test_point_feet_areas_match_an_lp_over_forces(mu):
         assert areas.zmp_area.area < hull - 1e-3
 
 
-def _scenario(size):
-    return {
-        "robot": "go2",
-        "configuration": "standing",
-        "contacts": [
-            {"frame": f, "friction": 0.7, "size": size, "normal": [0, 0, 1]}
-            for f in ("FL_foot", "FR_foot", "RL_foot", "RR_foot")
-        ],
-    }
-
-
 def test_go2_on_four_points_analyzes_to_its_feet_hull_without_limits():
     from impact_balance.analysis.analyze import analyze
     from impact_balance.scenario.validate import scenario_from_dict
 
-    raw = _scenario([0, 0])
-    for c in raw["contacts"]:
-        c["friction"] = 50.0
+    raw = four_point_feet("go2", friction=50.0)
     raw["torque_limits"] = False
     scenario = scenario_from_dict(raw)
     analysis = analyze(scenario)

@@ -18,15 +18,9 @@ from impact_balance.sim.trials.aborts import (
     check_not_all_aborted,
 )
 from tests.helpers.cli import run_cli
+from tests.helpers.quadrupeds import four_point_feet
 
-GO2_FOUR = {
-    "robot": "go2",
-    "configuration": "standing",
-    "contacts": [
-        {"frame": f, "friction": 0.7, "size": [0, 0], "normal": [0, 0, 1]}
-        for f in ("FL_foot", "FR_foot", "RL_foot", "RR_foot")
-    ],
-}
+GO2_FOUR = four_point_feet("go2")
 
 
 def _trial(outcome, reason=None, detail=""):

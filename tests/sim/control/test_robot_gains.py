@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 pytest.importorskip("mujoco", reason="needs the sim extra (MuJoCo)")
 
 from impact_balance.scenario import load_scenario
+from impact_balance.scenario.validate import scenario_from_dict
 from impact_balance.sim.control.gains import (
     BalanceGains,
     InverseDynamicsGains,
@@ -19,10 +20,11 @@ from impact_balance.sim.control.gains import (
     robot_gains,
     robot_id_gains,
 )
+from tests.helpers.quadrupeds import four_point_feet
 
 
 def _scales(name: str, timestep: float = 0.001) -> RobotScales:
-    scenario = load_scenario(name)
+    scenario = scenario_from_dict(four_point_feet("go2")) if name == "go2" else load_scenario(name)
     return RobotScales.of(
         scenario.build_stance(), scenario.plane_height, scenario.gravity, timestep
     )
@@ -98,7 +100,7 @@ def test_the_rules(scales):
 def test_a_small_robot_gets_stiffer_faster_gains_and_a_lighter_force_floor():
     talos, go2 = (
         robot_id_gains(_scales("palm_push_two_feet")),
-        robot_id_gains(_scales("go2_four_feet")),
+        robot_id_gains(_scales("go2")),
     )
     assert go2.dcm_gain > talos.dcm_gain and go2.com_height_stiffness > talos.com_height_stiffness
     assert go2.min_normal_force < 0.2 * talos.min_normal_force  # 16 kg against 90 kg
@@ -106,7 +108,7 @@ def test_a_small_robot_gets_stiffer_faster_gains_and_a_lighter_force_floor():
 
 def test_the_given_gains_are_kept_outside_the_rules():
     base = InverseDynamicsGains(zmp_margin=0.02, friction_scale=0.5)
-    g = robot_id_gains(_scales("go2_four_feet"), base)
+    g = robot_id_gains(_scales("go2"), base)
     assert (g.zmp_margin, g.friction_scale) == (0.02, 0.5)
     with pytest.raises(ValueError, match="timestep"):
-        _scales("go2_four_feet", 0.0)
+        _scales("go2", 0.0)
