@@ -69,3 +69,16 @@ def test_points_must_match_the_contacts():
     R = np.eye(3)
     with pytest.raises(ValueError, match="points has 1 entries for 2 contacts"):
         OutcomeMonitor(["a", "b"], np.zeros((2, 3)), np.stack([R, R]), 1.0, R, points=[True])
+
+
+@given(weight=st.floats(1.0, 3000.0), contacts=st.integers(1, 4))
+@settings(max_examples=40, deadline=None)
+def test_a_light_robots_contacts_count_as_loaded(weight, contacts):
+    base = OutcomeCriteria()
+    scaled = base.for_robot(weight, contacts)
+    share = weight / contacts
+    assert scaled.load_force == min(base.load_force, 0.5 * share)
+    assert scaled.load_force <= share  # a contact carrying its share is loaded
+    assert scaled.min_force == base.min_force and scaled.max_tilt == base.max_tilt
+    if 0.5 * share >= base.load_force:  # a humanoid: nothing changes
+        assert scaled == base

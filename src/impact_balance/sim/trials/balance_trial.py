@@ -287,7 +287,7 @@ class _TrialRun:
             np.array([self.pdata.oMf[f].rotation for f in self.contact_frames]),
             float(q_start[2]),
             _base_rotation(q_start),
-            options.criteria,
+            options.criteria.for_robot(stance.mass * analysis.areas.gravity, len(stance.contacts)),
             points=[c.is_point for c in stance.contacts],
         )
         self.normals = np.array([c.normal for c in stance.contacts])

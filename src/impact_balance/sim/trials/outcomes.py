@@ -21,7 +21,8 @@ The criterion makes two promises, and a trial can break either, or both:
 - *the contacts stay*: the paper assumes the impact does not break the sustained contacts.
   A contact **event** is recorded (each kind once per contact, with its time) when a contact
 
-  - ``lifted``: had carried ``load_force`` (20 N) and then carried less than ``min_force``
+  - ``lifted``: had carried ``load_force`` (20 N, or half the contact's share of the weight
+    when that is less: :meth:`OutcomeCriteria.for_robot`) and then carried less than ``min_force``
     (1 N) for more than ``lost_time`` (20 ms), counted from the end of the disturbance (an
     impulsive push may unload a foot while it acts; the criterion judges the state it leaves);
   - ``slipped``: its frame moved more than ``max_slip`` (1 cm) from its start;
@@ -129,6 +130,18 @@ class OutcomeCriteria:
     def to_dict(self) -> dict[str, Any]:
         """The thresholds by name (JSON-ready)."""
         return asdict(self)
+
+    def for_robot(self, weight: float, contacts: int) -> OutcomeCriteria:
+        """These thresholds for a robot of ``weight`` (N) on ``contacts`` sustained contacts.
+
+        ``load_force`` is at most half a contact's share of the weight, so that a light robot's
+        contact counts as loaded (a 2.5 kg Solo 12 on three feet puts 8 N on each, never 20);
+        a humanoid's thresholds are unchanged (Talos: 221 N per sole at half its share).
+        """
+        if contacts < 1 or not weight > 0:
+            return self
+        share = 0.5 * float(weight) / contacts
+        return self if share >= self.load_force else replace(self, load_force=share)
 
 
 @dataclass(frozen=True)
