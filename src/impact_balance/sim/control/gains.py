@@ -25,7 +25,8 @@ below are what they give on Talos, m = 90.3 kg, h = 0.904 m, omega = 3.30 1/s, r
   acceleration moves the CoM in proportion to the leg's length); angular momentum weight
   ``0.1 (h / 0.9 m)^2 (0.44 m / rho)^4``;
 - regularisations per unit weight: wrenches ``0.08 / (m g)^2`` [1/N^2], contact torques
-  ``6.4 / (m g h)^2`` [1/(N m)^2]; minimum normal force ``0.0225 m g`` [N] per contact.
+  ``6.4 / (m g h)^2`` [1/(N m)^2]; minimum normal force ``max(0.0225 m g, 2 N)`` per contact (twice
+  the 1 N below which a trial counts a contact as unloaded).
 
 Margins (ZMP, friction, centre of pressure), the joint-limit horizon, the acceleration
 regularisation, the IK costs and the solver are not robot-dependent: they keep their values.
@@ -54,6 +55,8 @@ __all__ = [
     "trial_gains",
 ]
 
+#: The floor of the derived minimum normal force, N: twice the outcome monitor's ``min_force``.
+MIN_NORMAL_FORCE = 2.0
 #: Reference leg length (m) and radius of gyration (m) of the weight rules (Talos' values).
 REFERENCE_HEIGHT = 0.9
 REFERENCE_GYRATION = 0.44
@@ -276,7 +279,7 @@ def robot_id_gains(
         impact_orientation_weight=1.0 * length,
         wrench_regularization=0.08 / weight**2,
         torque_regularization=6.4 / (weight * scales.com_height) ** 2,
-        min_normal_force=0.0225 * weight,
+        min_normal_force=max(0.0225 * weight, MIN_NORMAL_FORCE),
     )
 
 
