@@ -2,17 +2,18 @@
 """Do the balance controllers keep each robot standing, and how many trials abort?
 
     python scripts/robots_standing.py [--controller id|ik] [--stand S] [--robots NAME ...]
-        [--directions N] [--speeds V ...] [--json]
+        [--directions N] [--relative F ...] [--json]
 
 For each robot's bundled stance (the table below), with the controller's gains derived from the
 robot (``impact_balance.sim.control.gains``):
 
 1. one trial standing unpushed for ``--stand`` seconds (5 by default; a push of 1 micro-N s
    marks the start): its outcome, the largest base drop, trunk tilt and contact slip;
-2. a small push grid: ``--directions`` directions at each of ``--speeds`` CoM velocity jumps
-   (the impulse is the robot's mass times the speed, so every robot gets the same test), each
-   trial 1.5 s after its push: the share of aborted trials (the target is under 5 %) and
-   the outcomes.
+2. a small push grid (``impact_balance.sim.studies.push.push_test``): ``--directions``
+   directions at each fraction ``--relative`` of the direction's boundary impulse (the one
+   that puts the predicted CoM velocity on the CoM velocity area's boundary, so every robot
+   gets the same test), each trial 1.5 s after its push: the share of aborted trials (the
+   target is under 5 %) and the outcomes at each fraction.
 
 The numbers of docs/studies/robots-standing.md come from this script. A small grid: about a
 minute of CPU per robot on a 2-core machine.
@@ -29,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from impact_balance.sim.studies.push import push_test
 from impact_balance.sim.trials.balance_trial import run_balance_trial
 from impact_balance.sim.trials.setup import BalanceSetup, BalanceTrialOptions, Push
 
@@ -63,15 +65,24 @@ def measure(robot: str, args: argparse.Namespace) -> dict[str, Any]:
     setup = BalanceSetup.create(STANCES[robot], options=stand)
     standing = _trial_row(run_balance_trial(setup, push=Push(0.0, 1e-6), options=stand))
     grid = BalanceTrialOptions(controller=args.controller, after=1.5)
-    mass = setup.analysis.stance.mass
-    rows = []
-    for speed in args.speeds:
-        for k in range(args.directions):
-            push = Push(2 * np.pi * k / args.directions, mass * speed)
-            row = _trial_row(run_balance_trial(setup, push=push, options=grid))
-            rows.append({"speed": speed, "direction": push.direction, **row})
+    result = push_test(
+        setup.scenario, args.directions, relative=args.relative, options=grid, setup=setup
+    )
+    rows = [
+        {
+            "relative": o.relative,
+            "outcome": o.outcome,
+            "why": o.summary["detail"] or o.summary["reason"],
+        }
+        for o in result.outcomes
+    ]
     outcomes = Counter(r["outcome"] for r in rows)
-    aborted = [r["detail"] or r["reason"] for r in rows if r["outcome"] == "aborted"]
+    by_level = {
+        f"{level:g}": dict(Counter(r["outcome"] for r in rows if r["relative"] == level))
+        for level in args.relative
+    }
+    aborted = [r["why"] for r in rows if r["outcome"] == "aborted"]
+    mass = setup.analysis.stance.mass
     return {
         "robot": robot,
         "scenario": STANCES[robot],
@@ -80,6 +91,7 @@ def measure(robot: str, args: argparse.Namespace) -> dict[str, Any]:
         "standing": standing,
         "pushes": len(rows),
         "outcomes": dict(outcomes),
+        "by_level": by_level,
         "aborted_share": outcomes["aborted"] / len(rows) if rows else 0.0,
         "aborted_reasons": dict(Counter(aborted)),
         "wall_time": time.perf_counter() - start,
@@ -93,7 +105,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--stand", type=float, default=5.0, help="standing time, s (default 5)")
     p.add_argument("--robots", nargs="+", choices=sorted(STANCES), default=list(STANCES))
     p.add_argument("--directions", type=int, default=4)
-    p.add_argument("--speeds", type=float, nargs="+", default=[0.05, 0.1], help="m/s")
+    p.add_argument(
+        "--relative", type=float, nargs="+", default=[0.5, 0.8], help="boundary fractions"
+    )
     p.add_argument("--json", action="store_true")
     args = p.parse_args(argv)
     results = []
@@ -103,14 +117,19 @@ def main(argv: list[str] | None = None) -> int:
     if args.json:
         print(json.dumps(results, indent=1))
         return 0
+    levels = " ".join(f"{x:g}" for x in args.relative)
+    print(f"controller {args.controller}; {args.directions} directions x boundary {levels}")
     print(
-        f"controller {args.controller}; push grid {args.directions} directions x {args.speeds} m/s"
+        f"| robot | scenario | standing {args.stand:g} s | drop / trunk / slip | pushes | aborted "
+        "| outcomes by boundary fraction |"
     )
-    print("| robot | scenario | standing 5 s | drop / trunk / slip | pushes | aborted | outcomes |")
     print("|---|---|---|---|---|---|---|")
     for r in results:
         s = r["standing"]
-        outcomes = ", ".join(f"{k} {v}" for k, v in sorted(r["outcomes"].items()))
+        outcomes = "; ".join(
+            f"x{level}: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items()))
+            for level, counts in r["by_level"].items()
+        )
         print(
             f"| {r['robot']} | `{r['scenario']}` | {s['outcome']} | "
             f"{100 * s['max_drop']:.1f} cm / {s['max_trunk_tilt_deg']:.1f}° / "
