@@ -2,7 +2,7 @@
 """Do the balance controllers keep each robot standing, and how many trials abort?
 
     python scripts/robots_standing.py [--controller id|ik] [--stand S] [--robots NAME ...]
-        [--directions N] [--relative F ...] [--json]
+        [--directions N] [--relative F ...] [--fixed-gains] [--json]
 
 For each robot's bundled stance (the table below), with the controller's gains derived from the
 robot (``impact_balance.sim.control.gains``):
@@ -61,10 +61,11 @@ def _trial_row(result: Any) -> dict[str, Any]:
 def measure(robot: str, args: argparse.Namespace) -> dict[str, Any]:
     """The standing trial and the push grid of one robot."""
     start = time.perf_counter()
-    stand = BalanceTrialOptions(controller=args.controller, after=args.stand)
+    derived = not args.fixed_gains
+    stand = BalanceTrialOptions(controller=args.controller, after=args.stand, robot_gains=derived)
     setup = BalanceSetup.create(STANCES[robot], options=stand)
     standing = _trial_row(run_balance_trial(setup, push=Push(0.0, 1e-6), options=stand))
-    grid = BalanceTrialOptions(controller=args.controller, after=1.5)
+    grid = BalanceTrialOptions(controller=args.controller, after=1.5, robot_gains=derived)
     result = push_test(
         setup.scenario, args.directions, relative=args.relative, options=grid, setup=setup
     )
@@ -108,6 +109,11 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument(
         "--relative", type=float, nargs="+", default=[0.5, 0.8], help="boundary fractions"
     )
+    p.add_argument(
+        "--fixed-gains",
+        action="store_true",
+        help="the gains' defaults (tuned on Talos) on every robot, not derived from it",
+    )
     p.add_argument("--json", action="store_true")
     args = p.parse_args(argv)
     results = []
@@ -118,7 +124,11 @@ def main(argv: list[str] | None = None) -> int:
         print(json.dumps(results, indent=1))
         return 0
     levels = " ".join(f"{x:g}" for x in args.relative)
-    print(f"controller {args.controller}; {args.directions} directions x boundary {levels}")
+    gains = "fixed (Talos')" if args.fixed_gains else "derived from the robot"
+    print(
+        f"controller {args.controller}, gains {gains}; {args.directions} directions x boundary "
+        f"{levels}"
+    )
     print(
         f"| robot | scenario | standing {args.stand:g} s | drop / trunk / slip | pushes | aborted "
         "| outcomes by boundary fraction |"
