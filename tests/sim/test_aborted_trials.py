@@ -86,3 +86,11 @@ def test_push_test_all_aborted_prints_why_and_exits_1(capsys, tmp_path, forced_a
         assert doc["counts"]["outcomes"]["aborted"] == 2
     else:
         assert "aborted (2): FL_foot slipped before the disturbance (forced)" in out
+
+
+@pytest.mark.slow
+def test_approach_all_aborted_prints_why_and_exits_1(capsys, forced_abort):
+    rc, out, err = run_cli(capsys, "approach", "go2_kick_three_feet", "--reference", "0.5")
+    assert rc == 1
+    assert "aborted (1): FL_foot slipped before the disturbance (forced)" in out
+    assert "all 1 trials of approach were aborted" in err and len(err.strip().splitlines()) == 1

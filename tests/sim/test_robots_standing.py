@@ -80,3 +80,16 @@ def test_the_trial_commands_run_on_the_quadrupeds(capsys, name):
     rc, out, err = run_cli(capsys, "simulate", name, "--speed", "0.3", "--json")
     assert rc == 0, err
     assert json.loads(out)["com_velocity_jump_measured"] is not None
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", KICKS)
+def test_a_rigid_impact_on_the_quadrupeds_is_a_trial(name):
+    """One ``validate --rigid-impact`` trial: the kick at 0.3 m/s touches and is not aborted."""
+    options = BalanceTrialOptions(controller="id", after=1.0, settle=0.2, rigid_impact=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ModelRepairWarning)
+        setup = BalanceSetup.create(name, options=options)
+    result = run_balance_trial(setup, impact_speed=0.3, options=options)
+    assert result.outcome != "aborted", result.detail
+    assert result.impact is not None and result.approach_speed == pytest.approx(0.3)
