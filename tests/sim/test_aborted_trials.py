@@ -94,3 +94,13 @@ def test_approach_all_aborted_prints_why_and_exits_1(capsys, forced_abort):
     assert rc == 1
     assert "aborted (1): FL_foot slipped before the disturbance (forced)" in out
     assert "all 1 trials of approach were aborted" in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.slow
+def test_validate_all_aborted_prints_why_and_exits_1(capsys, forced_abort):
+    argv = ["validate", "go2_kick_three_feet", "--no-journal", "--tolerance", "0.2"]
+    rc, out, err = run_cli(capsys, *argv)
+    assert rc == 1
+    n = sum(": aborted before_disturbance" in line for line in out.splitlines())
+    assert n > 0 and f"aborted ({n}): FL_foot slipped before the disturbance (forced)" in out
+    assert f"all {n} trials of validate were aborted" in err
