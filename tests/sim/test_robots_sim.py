@@ -6,8 +6,8 @@ checks here are independent of that repair: the compiled MuJoCo model's total ma
 composite inertia are compared with pinocchio's (which reads the URDF unrepaired), and the
 rigid robot's measured CoM velocity jump with the impact model's prediction.
 
-The trials assert that they run and return sane fields, not a fall outcome (the balance
-controllers are tuned on Talos; docs/robots.md reports each robot's outcomes).
+The trials assert that they run and return sane fields, not a fall outcome (the outcomes per
+robot are tests/sim/test_robots_standing.py's and docs/studies/robots-standing.md's).
 """
 
 from __future__ import annotations

@@ -10,9 +10,12 @@
 - Every other contact stays where it is; ``--com X Y`` moves the CoM's horizontal position
   (kept free otherwise).
 - A frame on a chain of fewer than 6 joints from the base (a quadruped's 3-joint leg) cannot
-  hold an orientation: its position alone is placed or kept (a point foot). ``--normal`` on
-  such a frame's contact is the surface's normal, written as the contact's ``normal:``.
-- A point foot on the ground is written flat, ``normal: [0, 0, 1]`` (:func:`flat_feet`).
+  hold an orientation: its position alone is placed or kept (a point foot). So is a point
+  contact (``size: [0, 0]``) given by its world ``normal:``. ``--normal`` on such a frame's
+  contact, or on any point contact, is the surface's normal, written as the contact's
+  ``normal:``.
+- A point foot on the ground (either kind) is written flat, ``normal: [0, 0, 1]``
+  (:func:`flat_feet`).
 
 The IK is :func:`impact_balance.robot.ik.solve_stance` (pink, as the GUI's drags), started from the
 scenario's stance and pulled towards it. The result is the scenario with an explicit ``base``
@@ -139,7 +142,9 @@ def pose_scenario(
                 raise ScenarioError(
                     "--normal", list(p.normal), "must be a non-zero vector"
                 ) from None
-            point_foot = index is not None and chain_dofs(robot, p.frame) < 6
+            point_foot = index is not None and (
+                chain_dofs(robot, p.frame) < 6 or stance.contacts[index].is_point
+            )
             if not point_foot:
                 rotation = aligning_rotation(rotation[:, 2], n) @ rotation
             if index is not None and (point_foot or scenario.contacts[index].normal is not None):
@@ -150,7 +155,13 @@ def pose_scenario(
     kept = sorted(contact_frames - set(targets))
     all_targets = dict(targets)
     all_targets.update({f: stance.frame_pose(f) for f in kept})
-    free = tuple(f for f in all_targets if chain_dofs(robot, f) < 6)
+    # A point contact given by its world normal has no orientation to hold: position only.
+    points = {
+        c.spec.frame
+        for c, config in zip(stance.contacts, scenario.contacts, strict=True)
+        if c.is_point and config.normal is not None
+    }
+    free = tuple(f for f in all_targets if chain_dofs(robot, f) < 6 or f in points)
     for p in placements:
         if p.normal is not None and p.frame in free and p.frame not in contact_frames:
             raise ScenarioError(
@@ -182,7 +193,8 @@ def flat_feet(scenario: Scenario, result: PoseResult) -> dict[int, tuple[float, 
     """The contacts to lay flat on the ground: ``{index: (0, 0, 1)}``.
 
     A contact is laid flat when its frame is on a chain of fewer than 6 joints (a point foot,
-    ``result.position_only``: its frame's orientation is the leg's, not the ground's), its
+    ``result.position_only``: its frame's orientation is the leg's, not the ground's) or it is
+    a point contact (``size: [0, 0]``), its
     orientation is not given (no ``normal``, no ``offset.rpy``) and its centre lies within
     :data:`GROUND_BAND` of the lowest contact centre at ``result.q``.
     """
@@ -197,7 +209,7 @@ def flat_feet(scenario: Scenario, result: PoseResult) -> dict[int, tuple[float, 
     return {
         i: (0.0, 0.0, 1.0)
         for i, c in enumerate(scenario.contacts)
-        if c.frame in result.position_only
+        if (c.frame in result.position_only or all(x == 0 for x in c.size))
         and c.normal is None
         and not any(c.offset.rpy)
         and heights[i] <= lowest + GROUND_BAND

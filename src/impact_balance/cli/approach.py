@@ -147,6 +147,7 @@ def run(args: argparse.Namespace) -> int:
         ScenarioError: A margin the schema refuses (naming its option).
     """
     from impact_balance.exceptions import SimulationError
+    from impact_balance.sim.trials.aborts import check_not_all_aborted
 
     if args.video and args.wall_distance_range is not None:
         raise SimulationError(
@@ -211,14 +212,15 @@ def run(args: argparse.Namespace) -> int:
     )
     if args.json:
         print_json(out)
-        return 0
-    _print_text(scenario.name, args, docs, written)
-    if len(docs) > 1 and out["tick_us"]["median"] is not None:
-        t = out["tick_us"]
-        print(
-            f"  governor over all {t['count']} ticks: median {t['median']:.0f} us, "
-            f"p99 {t['p99']:.0f} us"
-        )
+    else:
+        _print_text(scenario.name, args, docs, written)
+        if len(docs) > 1 and out["tick_us"]["median"] is not None:
+            t = out["tick_us"]
+            print(
+                f"  governor over all {t['count']} ticks: median {t['median']:.0f} us, "
+                f"p99 {t['p99']:.0f} us"
+            )
+    check_not_all_aborted("approach", scenario.name, docs)
     return 0
 
 
@@ -289,6 +291,8 @@ def _print_text(
     name: str | None, args: argparse.Namespace, docs: list[dict[str, Any]], written: list[Path]
 ) -> None:
     """Print the trials as text: one line per wall, then the files written."""
+    from impact_balance.sim.trials.aborts import aborted_lines
+
     print(
         f"{name}: approach at {args.reference:g} m/s reference, {args.governor} governor, "
         f"{args.controller} controller{', rigid impact' if args.rigid_impact else ''}"
@@ -311,6 +315,8 @@ def _print_text(
             f"{_f(d['speed_at_contact'])}, cap at contact {_f(d['cap_at_contact'])}, "
             f"time to contact {_s(d['time_to_contact'])}: {d['outcome']}{reason}{strict}{ticks}"
         )
+    for line in aborted_lines(docs):
+        print(line)
     for path in written:
         print(f"  wrote {path}")
 

@@ -139,7 +139,7 @@ def run(args: argparse.Namespace) -> int:
             print("contacts (centre, normal, tilt from vertical):")
         print(
             f"  [{i}] {c['frame']}: centre {_vec(c['centre'])}, normal {_vec(c['normal'])}, "
-            f"{c['normal_tilt_deg']:.1f}°, size {c['size'][0]:g} x {c['size'][1]:g} m"
+            f"{c['normal_tilt_deg']:.1f}°, {_size(c['size'])}"
         )
     if args.frame:
         return 0
@@ -152,3 +152,10 @@ def run(args: argparse.Namespace) -> int:
         effort = f"{j['effort']:g} N m" if j["effort"] is not None else "no effort limit"
         print(f"  {j['name']:<{width}}  {limits:<20} {effort}")
     return 0
+
+
+def _size(size: list[float]) -> str:
+    """A contact's size in words: ``size L x W m``, or ``point`` for ``[0, 0]``."""
+    if size[0] == 0 and size[1] == 0:
+        return "point (size 0 x 0)"
+    return f"size {size[0]:g} x {size[1]:g} m"

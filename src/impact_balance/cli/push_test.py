@@ -116,6 +116,7 @@ def run(args: argparse.Namespace) -> int:
     from impact_balance.logs import check_log_path
     from impact_balance.scenario import load_scenario
     from impact_balance.sim.studies.push import check_push_arguments, push_test
+    from impact_balance.sim.trials.aborts import check_not_all_aborted
     from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, write_trial_log
 
     scenario = with_margins(load_scenario(args.scenario), args.zmp_margin)
@@ -180,12 +181,14 @@ def run(args: argparse.Namespace) -> int:
     if args.plots:
         with writing("--plots", args.plots):
             written += _plots(result, Path(args.plots))
+    summaries = [o.summary for o in result.outcomes]
     if args.json:
         print_json(out)
-        return 0
-    print(_text(result, out, args))
-    for path in written:
-        print(f"  wrote {path}")
+    else:
+        print(_text(result, out, args))
+        for path in written:
+            print(f"  wrote {path}")
+    check_not_all_aborted("push-test", result.scenario, summaries)
     return 0
 
 
@@ -248,6 +251,8 @@ def _score_lines(scores: dict[str, Any], title: str) -> list[str]:
 
 def _text(result: PushTestResult, out: dict[str, Any], args: argparse.Namespace) -> str:
     """The text report of a push test: outcomes, scores and the table per push level."""
+    from impact_balance.sim.trials.aborts import aborted_lines
+
     counts = out["counts"]
     o = counts["outcomes"]
     controller = out["controller"].get("name", args.controller)
@@ -262,6 +267,7 @@ def _text(result: PushTestResult, out: dict[str, Any], args: argparse.Namespace)
     ]
     if counts["reasons"]:
         lines.append("  " + ", ".join(f"{k}: {v}" for k, v in sorted(counts["reasons"].items())))
+    lines += aborted_lines(t.summary for t in result.outcomes)
     margin = 1000 * out["zmp_margin"]
     lines.append(
         f"  {'magnitude':>14s} {'balanced':>8s} {'broken':>6s} {'fell':>5s} {'strict':>6s} "

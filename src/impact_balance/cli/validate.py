@@ -81,6 +81,7 @@ def run(args: argparse.Namespace) -> int:
     from impact_balance.ranges import check_tolerance
     from impact_balance.scenario import load_scenario
     from impact_balance.sim.studies.validate import validate
+    from impact_balance.sim.trials.aborts import check_not_all_aborted
     from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, write_trial_log
 
     scenario = with_margins(load_scenario(args.scenario), args.zmp_margin)
@@ -159,10 +160,11 @@ def run(args: argparse.Namespace) -> int:
             written += _plots(result, Path(args.plots))
     if args.json:
         print_json(out)
-        return 0
-    print(_text(out, args, len(result.trials)))
-    for path in written:
-        print(f"  wrote {path}")
+    else:
+        print(_text(out, args, len(result.trials)))
+        for path in written:
+            print(f"  wrote {path}")
+    check_not_all_aborted("validate", out["scenario"], out["trials"])
     return 0
 
 
@@ -184,6 +186,8 @@ def _verdict_line(v: dict[str, Any]) -> str:
 
 def _text(out: dict[str, Any], args: argparse.Namespace, n: int) -> str:
     """The text report of ``validate``: the fall bracket, the verdict and the predictions."""
+    from impact_balance.sim.trials.aborts import aborted_lines
+
     e, p, pm = out["empirical"], out["predicted"], out["predicted_with_margin"]
     impact = (
         "rigid impact (joints held through the impact)" if out["rigid_impact"] else "free impact"
@@ -230,6 +234,7 @@ def _text(out: dict[str, Any], args: argparse.Namespace, n: int) -> str:
             f"    {t['speed']:.3f} -> {_f(t['approach_speed_measured'])}: {t['outcome']}{why}"
             f"{strict}   {call}"
         )
+    lines += aborted_lines(out["trials"])
     lines.append(
         f"  controller: {out['controller'].get('name', args.controller)}; joint armature: "
         f"{out['controller'].get('armature')}"

@@ -60,13 +60,18 @@ def frame_point(
 
 @dataclass(frozen=True)
 class ContactSpec:
-    """A rectangular sustained contact on a robot frame.
+    """A rectangular sustained contact on a robot frame, or a point contact.
+
+    A contact of size ``(0, 0)`` is a *point* (a point foot): its wrench cone is the friction
+    cone of a force at the point, with no torque (the rectangle's centre-of-pressure and yaw
+    rows with zero half sizes, :func:`impact_balance.contacts.cwc.cwc_faces`).
 
     Attributes:
         frame: Robot frame name; its z axis (after ``offset``) is the surface normal,
             pointing from the environment into the robot.
         friction: Coulomb friction coefficient mu (> 0).
-        size: Full length (local x) and width (local y) of the rectangle, m.
+        size: Full length (local x) and width (local y) of the rectangle, m; ``(0, 0)`` for
+            a point.
         offset: Fixed pose of the contact in the frame.
     """
 
@@ -74,6 +79,11 @@ class ContactSpec:
     friction: float
     size: tuple[float, float]
     offset: pin.SE3 = field(default_factory=pin.SE3.Identity)
+
+    @property
+    def is_point(self) -> bool:
+        """Whether the contact is a point (size ``(0, 0)``): a force, no torque."""
+        return float(self.size[0]) == 0.0 and float(self.size[1]) == 0.0
 
 
 @dataclass(frozen=True)
@@ -108,12 +118,20 @@ class Contact:
         return 0.5 * float(self.spec.size[1])
 
     @property
+    def is_point(self) -> bool:
+        """Whether the contact is a point (:attr:`ContactSpec.is_point`)."""
+        return self.spec.is_point
+
+    @property
     def normal(self) -> np.ndarray:
         """Surface normal in world (contact z axis)."""
         return self.rotation[:, 2]
 
     def corners(self) -> np.ndarray:
-        """The 4 rectangle corners in world (4 x 3), counter-clockwise in the contact plane."""
+        """The 4 rectangle corners in world (4 x 3), counter-clockwise in the contact plane.
+
+        A point contact's 4 corners are its centre.
+        """
         X, Y = self.half_length, self.half_width
         local = np.array([[X, Y, 0], [-X, Y, 0], [-X, -Y, 0], [X, -Y, 0]], dtype=float)
         out: npt.NDArray[np.float64] = self.position + local @ self.rotation.T

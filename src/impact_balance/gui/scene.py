@@ -148,18 +148,26 @@ def _area_objects(
 
 
 def _contact_objects(stance: Stance) -> list[SceneObject]:
-    """Each contact rectangle on its surface and its normal (into the robot), world, m."""
+    """Each contact rectangle on its surface (a point contact: a dot) and its normal, world, m.
+
+    The normal points into the robot; a point's arrow is 5 cm long.
+    """
     out: list[SceneObject] = []
     for i, contact in enumerate(stance.contacts):
-        out.append(
-            Segments(
-                f"contacts/{i}/outline",
-                polyline_segments(contact.corners()),
-                COLORS["contact"],
-                0.008,
+        if contact.is_point:  # a point foot: a dot, no sole
+            out.append(
+                Points(f"contacts/{i}/point", contact.position[None], COLORS["contact"], 0.02)
             )
-        )
-        size = min(contact.spec.size)
+        else:
+            out.append(
+                Segments(
+                    f"contacts/{i}/outline",
+                    polyline_segments(contact.corners()),
+                    COLORS["contact"],
+                    0.008,
+                )
+            )
+        size = min(contact.spec.size) if not contact.is_point else 0.1
         out.append(
             Arrows(
                 f"contacts/{i}/normal",

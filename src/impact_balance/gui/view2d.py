@@ -435,6 +435,9 @@ def _zmp_panel(analysis: Analysis, layout: _Layout, y: float) -> tuple[list[str]
     zmp = areas.zmp_area
     legend: list[_LegendRow] = []
     for contact in analysis.stance.contacts:
+        if contact.is_point:  # a point foot: a dot
+            bottom.dot(contact.position[:2], PANEL_COLORS["contact"], 3.0)
+            continue
         corners = contact.corners()[:, :2]
         bottom.polygon(
             _hull(corners), "none", PANEL_COLORS["contact"], 0.0, 1.4, dash="4 2", fill_none=True

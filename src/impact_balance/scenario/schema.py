@@ -101,8 +101,13 @@ class ContactConfig(_Model):
     @field_validator("size")
     @classmethod
     def _size(cls, v: Vec2) -> Vec2:
+        if all(x == 0 for x in v):
+            return v  # a point contact: a force cone at the point, no torque
         if not all(0 < x <= MAX_SIZE for x in v):
-            raise ValueError(f"size must be [length, width], both in (0, {MAX_SIZE:g}] m")
+            raise ValueError(
+                f"size must be [length, width], both in (0, {MAX_SIZE:g}] m (a sole), "
+                "or [0, 0] (a point foot)"
+            )
         return v
 
     @field_validator("normal")

@@ -17,7 +17,7 @@ from impact_balance.analysis.analyze import analyze
 from impact_balance.exceptions import SimulationError
 from impact_balance.scenario import load_scenario
 from impact_balance.sim.control.controller import Controller
-from impact_balance.sim.control.gains import BalanceGains, InverseDynamicsGains
+from impact_balance.sim.control.gains import BalanceGains, InverseDynamicsGains, trial_gains
 from impact_balance.sim.control.kinematic import BalanceController
 from impact_balance.sim.control.registry import CONTROLLERS, controller_class
 from impact_balance.sim.control.torque import InverseDynamicsController
@@ -73,12 +73,16 @@ def test_omega_is_the_lipm_omega_of_the_start_com(analysis, cls):
     assert controller.rate == 500.0
 
 
-def test_trial_descriptions_keep_the_json_objects(sim):
-    options = BalanceTrialOptions()
+@pytest.mark.parametrize("robot_gains", [True, False])
+def test_trial_descriptions_keep_the_json_objects(sim, robot_gains):
+    options = BalanceTrialOptions(robot_gains=robot_gains)
+    ik_gains, id_gains = trial_gains(options, sim)
+    if not robot_gains:
+        assert (ik_gains, id_gains) == (options.gains, options.id_gains)
     ik = BalanceController.trial_description(options, sim, True)
     assert ik["name"] == BalanceController.name
-    assert ik["gains"] == dataclasses.asdict(options.gains)
-    assert ik["control_rate_hz"] == options.gains.rate
+    assert ik["gains"] == dataclasses.asdict(ik_gains)
+    assert ik["control_rate_hz"] == ik_gains.rate
     assert ik["sim_timestep"] == sim.model.opt.timestep
     assert ik["servo"] == {
         "kp": sim.kp.tolist(),
@@ -88,16 +92,16 @@ def test_trial_descriptions_keep_the_json_objects(sim):
     # push-test's object for ik: name and gains only
     assert BalanceController.trial_summary(options, sim, True) == {
         "name": BalanceController.name,
-        "gains": dataclasses.asdict(options.gains),
+        "gains": dataclasses.asdict(ik_gains),
     }
     idd = InverseDynamicsController.trial_description(options, sim, False)
-    assert idd["gains"] == dataclasses.asdict(options.id_gains)
+    assert idd["gains"] == dataclasses.asdict(id_gains)
     assert idd["effort_limits"] is False
     assert InverseDynamicsController.trial_summary(options, sim, False) == idd
 
 
 def test_for_trial_builds_each_member_for_its_actuators(analysis):
-    options = BalanceTrialOptions()
+    options = BalanceTrialOptions(robot_gains=False)
     support = np.array([6, 7], dtype=int)
     q = analysis.stance.q
     servo = build_model(SCENARIO, "servo", SimOptions(meshes=False))

@@ -5,14 +5,61 @@
 :class:`InverseDynamicsGains` the torque controller (``id``,
 :class:`~impact_balance.sim.control.torque.InverseDynamicsController`). A trial's options carry
 both (:class:`TrialGains`); each controller reads its own.
+
+**Gains derived from the robot.** A trial's controller does not use these defaults as they
+are: :func:`robot_gains` and :func:`robot_id_gains` replace every field that depends on the
+robot by a rule of its :class:`RobotScales` (mass m, CoM height h above the plane, LIPM
+omega = sqrt(g / h), radius of gyration rho about the CoM, the simulation step), so that a
+16 kg quadruped and a 90 kg humanoid get gains of the same meaning. The rules (the defaults
+below are what they give on Talos, m = 90.3 kg, h = 0.904 m, omega = 3.30 1/s, rho = 0.445 m,
+1 ms steps, within 2.5 %, the angular momentum weight within 4 %):
+
+- control rate: half the simulation rate (500 Hz at 1 ms steps);
+- task bandwidth ``w_c = min(3 omega, rate / 20)`` [1/s]: every PD is critically damped at it
+  (stiffness ``w_c^2``, damping ``2 w_c``: CoM height, posture, base orientation), the
+  impact point's at ``2 w_c``; angular momentum damping ``w_c``, contact damping ``2 w_c``;
+- DCM gain ``0.6 omega`` (``id``), ``0.3 omega`` (``ik``, and its ZMP admittance);
+- ``ik``: the measured ZMP filtered over 5 control periods; the CoM command's speed at most
+  ``0.1 omega h``;
+- weights of angular tasks against the CoM's: ``(h / 0.9 m)^2`` times the defaults (a joint
+  acceleration moves the CoM in proportion to the leg's length); angular momentum weight
+  ``0.1 (h / 0.9 m)^2 (0.44 m / rho)^4``;
+- regularisations per unit weight: wrenches ``0.08 / (m g)^2`` [1/N^2], contact torques
+  ``6.4 / (m g h)^2`` [1/(N m)^2]; minimum normal force ``max(0.0225 m g, 2 N)`` per contact (twice
+  the 1 N below which a trial counts a contact as unloaded).
+
+Margins (ZMP, friction, centre of pressure), the joint-limit horizon, the acceleration
+regularisation, the IK costs and the solver are not robot-dependent: they keep their values.
 """
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import Any, Protocol
 
-__all__ = ["BalanceGains", "InverseDynamicsGains", "TrialGains"]
+import numpy as np
+
+from impact_balance.balance.lipm import lipm_omega
+from impact_balance.contacts.stance import Stance
+from impact_balance.sim.model.build import SimModel
+
+__all__ = [
+    "REFERENCE_GYRATION",
+    "REFERENCE_HEIGHT",
+    "BalanceGains",
+    "InverseDynamicsGains",
+    "RobotScales",
+    "TrialGains",
+    "robot_gains",
+    "robot_id_gains",
+    "trial_gains",
+]
+
+#: The floor of the derived minimum normal force, N: twice the outcome monitor's ``min_force``.
+MIN_NORMAL_FORCE = 2.0
+#: Reference leg length (m) and radius of gyration (m) of the weight rules (Talos' values).
+REFERENCE_HEIGHT = 0.9
+REFERENCE_GYRATION = 0.44
 
 
 @dataclass(frozen=True)
@@ -123,6 +170,133 @@ class InverseDynamicsGains:
         return asdict(self)
 
 
+@dataclass(frozen=True)
+class RobotScales:
+    """What the gains are derived from (SI units).
+
+    Attributes:
+        mass: Total mass m, kg.
+        com_height: CoM height h above the contact plane, m.
+        omega: LIPM natural frequency sqrt(g / h), 1/s.
+        gyration: Radius of gyration about the CoM, sqrt(trace(I) / (2 m)), m.
+        gravity: g, m/s^2.
+        timestep: Simulation step, s.
+    """
+
+    mass: float
+    com_height: float
+    omega: float
+    gyration: float
+    gravity: float
+    timestep: float
+
+    @classmethod
+    def of(
+        cls, stance: Stance, plane_height: float, gravity: float, timestep: float
+    ) -> RobotScales:
+        """The scales of ``stance`` over the plane at ``plane_height`` (m), steps of ``timestep`` s.
+
+        Raises:
+            ValueError: ``timestep`` not positive and finite.
+        """
+        if not (np.isfinite(timestep) and timestep > 0):
+            raise ValueError(f"timestep must be positive and finite, not {timestep!r}")
+        height = float(stance.com[2]) - float(plane_height)
+        gyration = float(np.sqrt(max(np.trace(stance.com_inertia), 0.0) / (2.0 * stance.mass)))
+        return cls(
+            stance.mass,
+            height,
+            lipm_omega(float(stance.com[2]), plane_height, gravity),
+            gyration,
+            float(gravity),
+            float(timestep),
+        )
+
+    @classmethod
+    def of_sim(cls, sim: SimModel) -> RobotScales:
+        """The scales of a trial's MuJoCo model: its stance, plane, gravity and step."""
+        scenario = sim.scenario
+        return cls.of(
+            sim.stance, scenario.plane_height, scenario.gravity, float(sim.model.opt.timestep)
+        )
+
+    @property
+    def rate(self) -> float:
+        """The control rate: half the simulation rate, Hz."""
+        return 0.5 / self.timestep
+
+    @property
+    def bandwidth(self) -> float:
+        """The task bandwidth ``w_c = min(3 omega, rate / 20)``, 1/s."""
+        return float(min(3.0 * self.omega, self.rate / 20.0))
+
+
+def robot_gains(scales: RobotScales, base: BalanceGains | None = None) -> BalanceGains:
+    """``base`` (the defaults) with its robot-dependent fields derived from ``scales``.
+
+    See the module docstring for the rules.
+    """
+    base = base or BalanceGains()
+    rate = scales.rate
+    return replace(
+        base,
+        rate=rate,
+        dcm_gain=0.3 * scales.omega,
+        zmp_admittance=0.3 * scales.omega,
+        zmp_filter=5.0 / rate,
+        max_com_speed=0.1 * scales.omega * scales.com_height,
+    )
+
+
+def robot_id_gains(
+    scales: RobotScales, base: InverseDynamicsGains | None = None
+) -> InverseDynamicsGains:
+    """``base`` (the defaults) with its robot-dependent fields derived from ``scales``.
+
+    See the module docstring for the rules.
+    """
+    base = base or InverseDynamicsGains()
+    wc = scales.bandwidth
+    length = (scales.com_height / REFERENCE_HEIGHT) ** 2
+    weight = scales.mass * scales.gravity
+    return replace(
+        base,
+        rate=scales.rate,
+        dcm_gain=0.6 * scales.omega,
+        com_height_stiffness=wc**2,
+        com_height_damping=2.0 * wc,
+        angular_momentum_damping=wc,
+        contact_damping=2.0 * wc,
+        posture_stiffness=wc**2,
+        posture_damping=2.0 * wc,
+        base_orientation_stiffness=wc**2,
+        base_orientation_damping=2.0 * wc,
+        impact_stiffness=(2.0 * wc) ** 2,
+        impact_damping=4.0 * wc,
+        angular_momentum_weight=0.1 * length * (REFERENCE_GYRATION / scales.gyration) ** 4,
+        posture_weight=1e-2 * length,
+        base_orientation_weight=0.1 * length,
+        impact_orientation_weight=1.0 * length,
+        wrench_regularization=0.08 / weight**2,
+        torque_regularization=6.4 / (weight * scales.com_height) ** 2,
+        min_normal_force=max(0.0225 * weight, MIN_NORMAL_FORCE),
+    )
+
+
+def trial_gains(options: TrialGains, sim: SimModel) -> tuple[BalanceGains, InverseDynamicsGains]:
+    """The gains of a trial on ``sim``: ``options``' own, derived from the robot unless told not.
+
+    Returns:
+        ``(ik gains, id gains)``: :func:`robot_gains` and :func:`robot_id_gains` of
+        ``options.gains`` and ``options.id_gains`` when ``options.robot_gains``, else those as
+        they are.
+    """
+    if not options.robot_gains:
+        return options.gains, options.id_gains
+    scales = RobotScales.of_sim(sim)
+    return robot_gains(scales, options.gains), robot_id_gains(scales, options.id_gains)
+
+
 class TrialGains(Protocol):
     """What a trial's options hold for the controllers: the gains of each."""
 
@@ -134,4 +308,9 @@ class TrialGains(Protocol):
     @property
     def id_gains(self) -> InverseDynamicsGains:
         """Gains of the torque (``id``) controller."""
+        ...
+
+    @property
+    def robot_gains(self) -> bool:
+        """Derive the robot-dependent gains from the robot (:func:`robot_gains`)."""
         ...

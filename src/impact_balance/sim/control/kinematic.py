@@ -45,7 +45,7 @@ from impact_balance.robot.ik import IKOptions, solve_stance
 from impact_balance.sim.control.actuation import stiffen_support_limbs
 from impact_balance.sim.control.approach import ImpactReference
 from impact_balance.sim.control.controller import Controller
-from impact_balance.sim.control.gains import BalanceGains, TrialGains
+from impact_balance.sim.control.gains import BalanceGains, TrialGains, trial_gains
 from impact_balance.sim.control.zmp import DcmFeedback, clamp_to_polygon
 from impact_balance.sim.model.build import SimModel
 
@@ -150,7 +150,9 @@ class BalanceController(Controller["ControlOutput"]):
         self._zmp_filtered: np.ndarray | None = None
         self.contact_tasks = []
         for c in stance.contacts:
-            task = FrameTask(c.spec.frame, gains.contact_cost, gains.contact_cost)
+            # A point foot rolls: its frame's orientation is free.
+            turn = 0.0 if c.is_point else gains.contact_cost
+            task = FrameTask(c.spec.frame, gains.contact_cost, turn)
             task.set_target(self.configuration.get_transform_frame_to_world(c.spec.frame))
             self.contact_tasks.append(task)
         self.com_task = ComTask(cost=gains.com_cost)
@@ -187,8 +189,11 @@ class BalanceController(Controller["ControlOutput"]):
         sim: SimModel,
         support_v_index: npt.NDArray[np.int_],
     ) -> BalanceController:
-        """The controller of one trial, with ``options.gains``; see :meth:`Controller.for_trial`."""
-        controller = cls(analysis, q_start, options.gains, task)
+        """The controller of one trial, with ``options.gains`` (derived from the robot).
+
+        See :meth:`Controller.for_trial` and :func:`~impact_balance.sim.control.gains.trial_gains`.
+        """
+        controller = cls(analysis, q_start, trial_gains(options, sim)[0], task)
         controller.support_v_index = support_v_index
         return controller
 
@@ -215,7 +220,7 @@ class BalanceController(Controller["ControlOutput"]):
         cls, options: TrialGains, sim: SimModel, effort_limits: bool
     ) -> dict[str, Any]:
         """Name, gains, rates and servo gains (see :meth:`Controller.trial_description`)."""
-        gains = options.gains
+        gains = trial_gains(options, sim)[0]
         return {
             "name": cls.name,
             "gains": gains.to_dict(),
@@ -233,7 +238,7 @@ class BalanceController(Controller["ControlOutput"]):
         cls, options: TrialGains, sim: SimModel, effort_limits: bool
     ) -> dict[str, Any]:
         """Name and gains only (see :meth:`Controller.trial_summary`)."""
-        return {"name": cls.name, "gains": options.gains.to_dict()}
+        return {"name": cls.name, "gains": trial_gains(options, sim)[0].to_dict()}
 
     @property
     def q_ref(self) -> _FloatArray:

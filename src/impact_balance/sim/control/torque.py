@@ -19,7 +19,9 @@ free-flyer velocity in the base frame):
    ``[f; tau]`` (world axes, at each contact point):
 
    - equalities: the 6 unactuated rows of ``M a + h = S^T tau + sum J_i^T w_i`` (the floating
-     base), and ``J_i a + J_i_dot v = -K_c J_i v`` for each contact (the contacts stay);
+     base), and ``J_i a + J_i_dot v = -K_c J_i v`` for each contact (the contacts stay); a point
+     contact (size ``[0, 0]``) keeps its linear rows only and its torque is zero instead (a
+     point foot rolls);
    - inequalities: each ``w_i`` in its contact wrench cone
      (:func:`impact_balance.contacts.cwc.cwc_faces_world`) (friction and rectangle shrunk by
      margins, see :class:`InverseDynamicsGains`) with a minimum normal force, the joint position
@@ -62,7 +64,7 @@ from impact_balance.geometry.spatial import skew
 from impact_balance.sim.control.actuation import use_torque_motors
 from impact_balance.sim.control.approach import ImpactReference
 from impact_balance.sim.control.controller import Controller
-from impact_balance.sim.control.gains import InverseDynamicsGains, TrialGains
+from impact_balance.sim.control.gains import InverseDynamicsGains, TrialGains, trial_gains
 from impact_balance.sim.control.zmp import DcmFeedback
 from impact_balance.sim.model.build import SimModel
 
@@ -307,9 +309,9 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         sim: SimModel,
         support_v_index: npt.NDArray[np.int_],
     ) -> InverseDynamicsController:
-        """The controller of one trial, with ``options.id_gains``.
+        """The controller of one trial, with ``options.id_gains`` (derived from the robot).
 
-        See :meth:`Controller.for_trial`.
+        See :meth:`Controller.for_trial` and :func:`~impact_balance.sim.control.gains.trial_gains`.
 
         The torques are bounded when ``sim``'s motors are force-limited; MuJoCo's viscous joint
         damping (the URDF's) is compensated: the motors add ``damping * qdot``.
@@ -317,7 +319,7 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         controller = cls(
             analysis,
             q_start,
-            options.id_gains,
+            trial_gains(options, sim)[1],
             task,
             effort_limits=bool(sim.model.actuator_forcelimited[sim.actuator_ids].any()),
         )
@@ -345,7 +347,7 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         cls, options: TrialGains, sim: SimModel, effort_limits: bool
     ) -> dict[str, Any]:
         """Name, gains, rates and actuators (see :meth:`Controller.trial_description`)."""
-        gains = options.id_gains
+        gains = trial_gains(options, sim)[1]
         return {
             "name": cls.name,
             "gains": gains.to_dict(),
@@ -552,6 +554,10 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
             C[:6, nv + 6 * i : nv + 6 * i + 6] = -J[:, :6].T
             C[r : r + 6, :nv] = J
             upper[r : r + 6] = -drift - g.contact_damping * (J @ v)
+            if spec.is_point:  # a point foot may roll: no torque instead of no rotation
+                C[r + 3 : r + 6, :nv] = 0.0
+                C[r + 3 : r + 6, nv + 6 * i + 3 : nv + 6 * i + 6] = np.eye(3)
+                upper[r + 3 : r + 6] = 0.0
             self._Jw[6 * i : 6 * i + 6] = J
             k = ne + 16 * i
             C[k : k + 16, nv + 6 * i : nv + 6 * i + 6] = cwc_faces_world(

@@ -3,6 +3,9 @@
 On the robot (attached to the body of the frame's parent joint, placed at the stance):
 - one box per contact rectangle: its face on the contact plane, its size the rectangle's,
   its thickness inside the robot, with the contact's friction;
+- one sphere per point contact (size ``[0, 0]``): its surface touches the contact point, its
+  centre ``point_radius`` inside the robot along the contact normal (a ball foot: it rolls
+  without moving the point it touches by more than its radius times the roll);
 - a small sphere at the impact point: its surface touches the impact point, its centre is
   ``radius`` inside the robot along the impact normal, with the impact's friction.
 
@@ -49,6 +52,7 @@ class ContactParameters:
     Attributes:
         box_half_thickness: Half thickness of a sustained-contact box, m.
         impact_radius: Radius of the impact sphere, m.
+        point_radius: Radius of a point contact's sphere, m.
         support_margin: How far a support block extends beyond its contact rectangle, m.
         contact_solref: ``(timeconst s, dampratio)`` of the sustained contacts.
         impact_solref: ``(timeconst s, dampratio)`` of the impact. A damping ratio >= 2 keeps
@@ -58,6 +62,7 @@ class ContactParameters:
 
     box_half_thickness: float = 0.01
     impact_radius: float = 0.01
+    point_radius: float = 0.01
     support_margin: float = 0.1
     contact_solref: tuple[float, float] = (0.01, 1.0)
     impact_solref: tuple[float, float] = (0.004, 2.0)
@@ -182,16 +187,21 @@ def _add_contact(
 
     The support is the ground, or a block of its own.
     """
-    t = params.box_half_thickness
     spec_i = contact.spec
     frame = stance.model.frames[stance.robot.frame_id(spec_i.frame)]
     joint_pose = frame.placement * spec_i.offset  # contact in its parent joint's frame
+    if contact.is_point:  # a ball foot touching the contact point
+        t = params.point_radius
+        shape, size = mujoco.mjtGeom.mjGEOM_SPHERE, [t, 0.0, 0.0]
+    else:
+        t = params.box_half_thickness
+        shape, size = mujoco.mjtGeom.mjGEOM_BOX, [contact.half_length, contact.half_width, t]
     box = pin.SE3(joint_pose.rotation, joint_pose.act(np.array([0.0, 0.0, t])))
     name = f"contact_{i}"
     bodies[frame.parentJoint].add_geom(
         name=name,
-        type=mujoco.mjtGeom.mjGEOM_BOX,
-        size=[contact.half_length, contact.half_width, t],
+        type=shape,
+        size=size,
         pos=box.translation,
         quat=_quat(box.rotation),
         contype=0,

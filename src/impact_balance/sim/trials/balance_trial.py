@@ -66,7 +66,7 @@ _FloatArray = npt.NDArray[np.float64]
 BeforeControl = Callable[[float, _FloatArray, _FloatArray], None]
 
 #: Version of the trials' physics and measurements: journals of another version are not reused.
-TRIAL_VERSION = 4
+TRIAL_VERSION = 5
 
 __all__ = [
     "CONTROLLERS",
@@ -287,7 +287,8 @@ class _TrialRun:
             np.array([self.pdata.oMf[f].rotation for f in self.contact_frames]),
             float(q_start[2]),
             _base_rotation(q_start),
-            options.criteria,
+            options.criteria.for_robot(stance.mass * analysis.areas.gravity, len(stance.contacts)),
+            points=[c.is_point for c in stance.contacts],
         )
         self.normals = np.array([c.normal for c in stance.contacts])
         self.recorder = (

@@ -21,11 +21,13 @@ The criterion makes two promises, and a trial can break either, or both:
 - *the contacts stay*: the paper assumes the impact does not break the sustained contacts.
   A contact **event** is recorded (each kind once per contact, with its time) when a contact
 
-  - ``lifted``: had carried ``load_force`` (20 N) and then carried less than ``min_force``
+  - ``lifted``: had carried ``load_force`` (20 N, or half the contact's share of the weight
+    when that is less: :meth:`OutcomeCriteria.for_robot`) and then carried less than ``min_force``
     (1 N) for more than ``lost_time`` (20 ms), counted from the end of the disturbance (an
     impulsive push may unload a foot while it acts; the criterion judges the state it leaves);
   - ``slipped``: its frame moved more than ``max_slip`` (1 cm) from its start;
-  - ``tilted``: its frame turned more than ``max_tilt`` (5 degrees) from its start.
+  - ``tilted``: its frame turned more than ``max_tilt`` (5 degrees) from its start (a sole
+    only: a point contact, ``size: [0, 0]``, cannot tilt; its frame turns with the leg).
 
   A trial with an event after the disturbance and no fall is ``contact_broken``: the robot
   came to rest without a step, but not on the contacts it started with.
@@ -42,6 +44,10 @@ contact broke beyond the strict bounds (:data:`STRICT_BOUNDS`, fields of :class:
   ``min_force`` for more than 0.1 s (a foot lifted, a hand contact lost).
 
 A ``contact_broken`` trial within these bounds does not fail strictly; one beyond them does.
+
+**Point contacts** (point feet, ``size: [0, 0]``) break by slipping or lifting only, with the
+same bounds as a sole (lenient: 1 cm, 20 ms unloaded; strict: 3 cm, 0.1 s unloaded); their
+tilt is neither an event nor a strict failure, and is left out of ``max_tilt``.
 
 A trial is ``aborted`` when it went wrong before the disturbance (a fall or a contact event
 before the impact or the push, or an impact point that never reached the surface): it tests
@@ -125,6 +131,18 @@ class OutcomeCriteria:
         """The thresholds by name (JSON-ready)."""
         return asdict(self)
 
+    def for_robot(self, weight: float, contacts: int) -> OutcomeCriteria:
+        """These thresholds for a robot of ``weight`` (N) on ``contacts`` sustained contacts.
+
+        ``load_force`` is at most half a contact's share of the weight, so that a light robot's
+        contact counts as loaded (a 2.5 kg Solo 12 on three feet puts 8 N on each, never 20);
+        a humanoid's thresholds are unchanged (Talos: 221 N per sole at half its share).
+        """
+        if contacts < 1 or not weight > 0:
+            return self
+        share = 0.5 * float(weight) / contacts
+        return self if share >= self.load_force else replace(self, load_force=share)
+
 
 @dataclass(frozen=True)
 class ContactEvent:
@@ -195,6 +213,7 @@ class OutcomeMonitor:
         base_height: Start height of the base (m).
         base_rotation: Start rotation of the base (3 x 3, world).
         criteria: Thresholds.
+        points: Which contacts are points (no tilt rule), in ``names`` order; empty: none.
     """
 
     names: Sequence[str]
@@ -203,6 +222,7 @@ class OutcomeMonitor:
     base_height: float
     base_rotation: np.ndarray
     criteria: OutcomeCriteria = field(default_factory=OutcomeCriteria)
+    points: Sequence[bool] = ()
     disturbance: float | None = field(default=None, init=False)
     max_tilt: float = field(default=0.0, init=False)
     max_slip: float = field(default=0.0, init=False)
@@ -217,6 +237,7 @@ class OutcomeMonitor:
     _low_since: np.ndarray = field(init=False)
     _loaded: np.ndarray = field(init=False)
     _seen: set[tuple[int, EventKind]] = field(default_factory=set, init=False)
+    _tilts: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
         self.positions = np.asarray(self.positions, dtype=float).reshape(-1, 3)
@@ -224,6 +245,13 @@ class OutcomeMonitor:
         self.base_rotation = np.asarray(self.base_rotation, dtype=float).reshape(3, 3)
         self._low_since = np.full(len(self.names), np.nan)
         self._loaded = np.zeros(len(self.names), dtype=bool)
+        if len(self.points) not in (0, len(self.names)):
+            raise ValueError(
+                f"points has {len(self.points)} entries for {len(self.names)} contacts"
+            )
+        self._tilts = np.ones(len(self.names), dtype=bool)
+        if len(self.points):
+            self._tilts = ~np.asarray(self.points, dtype=bool)
 
     # -- during the trial ---------------------------------------------------------------
     @property
@@ -285,7 +313,7 @@ class OutcomeMonitor:
         rotations = np.asarray(rotations, dtype=float).reshape(-1, 3, 3)
         for i in range(len(self.names)):
             slip = float(np.linalg.norm(positions[i] - self.positions[i]))
-            tilt = _angle(self.rotations[i], rotations[i])
+            tilt = _angle(self.rotations[i], rotations[i]) if self._tilts[i] else 0.0
             self.max_slip = max(self.max_slip, slip)
             self.max_tilt = max(self.max_tilt, tilt)
             if tilt > c.max_tilt:

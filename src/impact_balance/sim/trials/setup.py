@@ -107,6 +107,9 @@ class BalanceTrialOptions:
             created.
         id_gains: Gains of the ``id`` controller.
         rigid_impact: Hold every joint's velocity through the impact (:mod:`.rigid_impact`).
+        robot_gains: Derive the robot-dependent fields of ``gains`` and ``id_gains`` from the
+            robot (mass, CoM height, omega, inertia, simulation step:
+            :mod:`impact_balance.sim.control.gains`); False: use them as given.
     """
 
     after: float = 2.5
@@ -118,6 +121,7 @@ class BalanceTrialOptions:
     controller: ControllerName = "ik"
     id_gains: InverseDynamicsGains = field(default_factory=InverseDynamicsGains)
     rigid_impact: bool = False
+    robot_gains: bool = True
 
 
 def controller_margin(options: BalanceTrialOptions) -> float:
