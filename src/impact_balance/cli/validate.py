@@ -25,6 +25,7 @@ from impact_balance.cli.calibrate import add_calibration_option, apply_calibrati
 
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
+    from impact_balance.scenario import Scenario
     from impact_balance.sim.studies.validate import ValidationResult, ValidationTrial
 
 __all__ = ["USES_KERNEL", "add_parser", "run"]
@@ -76,25 +77,11 @@ def run(args: argparse.Namespace) -> int:
     """
     from impact_balance.cli.output import print_json, progress_bar
     from impact_balance.cli.output_paths import writing
-    from impact_balance.exceptions import SimulationError
-    from impact_balance.logs import check_log_path
-    from impact_balance.ranges import check_tolerance
-    from impact_balance.scenario import load_scenario
     from impact_balance.sim.studies.validate import validate
     from impact_balance.sim.trials.aborts import check_not_all_aborted
     from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, write_trial_log
 
-    scenario = with_margins(load_scenario(args.scenario), args.zmp_margin)
-    scenario, calibration = apply_calibration_option(args, scenario)
-    if scenario.impact is None:
-        raise SimulationError(
-            "impact", None, f"scenario {scenario.name!r} has no impact: validate needs one"
-        )
-    if not (0 < args.max_speed <= 5.0):
-        raise SimulationError("--max-speed", args.max_speed, "must be in (0, 5] m/s")
-    check_tolerance(args.tolerance)
-    if args.log:
-        check_log_path(args.log)
+    scenario, calibration = _checked_scenario(args)
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
     joints = TRIAL_JOINTS[args.joints]  # the study's name (the journals' digests keep it)
     judged = for_trials(scenario, args.angular_momentum_damping_time, options)
@@ -166,6 +153,27 @@ def run(args: argparse.Namespace) -> int:
             print(f"  wrote {path}")
     check_not_all_aborted("validate", out["scenario"], out["trials"])
     return 0
+
+
+def _checked_scenario(args: argparse.Namespace) -> tuple[Scenario, dict[str, Any] | None]:
+    """The scenario with its margins and calibration, and every option checked before a trial."""
+    from impact_balance.exceptions import SimulationError
+    from impact_balance.logs import check_log_path
+    from impact_balance.ranges import check_tolerance
+    from impact_balance.scenario import load_scenario
+
+    scenario = with_margins(load_scenario(args.scenario), args.zmp_margin)
+    scenario, calibration = apply_calibration_option(args, scenario)
+    if scenario.impact is None:
+        raise SimulationError(
+            "impact", None, f"scenario {scenario.name!r} has no impact: validate needs one"
+        )
+    if not (0 < args.max_speed <= 5.0):
+        raise SimulationError("--max-speed", args.max_speed, "must be in (0, 5] m/s")
+    check_tolerance(args.tolerance)
+    if args.log:
+        check_log_path(args.log)
+    return scenario, calibration
 
 
 def _f(x: float | None) -> str:
