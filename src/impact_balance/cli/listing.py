@@ -7,21 +7,38 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
+    from impact_balance.robot.robot import Robot
 
-__all__ = ["KNOWN_FEET", "KNOWN_SOLES", "add_parser", "robot_rows", "run"]
+__all__ = [
+    "KNOWN_FEET",
+    "KNOWN_SOLES",
+    "POINT_SOLE",
+    "add_parser",
+    "is_point_foot",
+    "robot_rows",
+    "run",
+]
 
 #: Soles measured on the meshes (``examples/robot_sizes.py``, docs/robots.md): full length x
-#: width (m) in the sole frame, by robot. Other robots' soles are "unknown".
+#: width (m) in the sole frame, by robot. Other robots' soles are "point" (:data:`POINT_SOLE`)
+#: or "unknown".
 KNOWN_SOLES: dict[str, str] = {
     "talos": "0.211 x 0.124 m",
     "g1": "0.17 x 0.05 m (collision spheres)",
     "romeo": "0.194 x 0.125 m",
     "icub": "0.061 x 0.156 m",
+    "jvrc1": "0.225 x 0.084 m",
 }
 
+#: The sole column of a robot whose every foot frame is a point foot (:func:`is_point_foot`):
+#: write its contacts with ``size: [0, 0]`` (docs/robots.md, "Point feet and quadrupeds").
+POINT_SOLE = "point"
 
 #: Foot frames that no link name says (a bundled robot's sole frame, docs/robots.md).
-KNOWN_FEET: dict[str, tuple[str, ...]] = {"g1": ("left_ankle_roll_link", "right_ankle_roll_link")}
+KNOWN_FEET: dict[str, tuple[str, ...]] = {
+    "g1": ("left_ankle_roll_link", "right_ankle_roll_link"),
+    "jvrc1": ("l_ankle", "r_ankle"),
+}
 
 
 def add_parser(sub: Subcommands) -> list[str]:
@@ -44,11 +61,32 @@ def add_parser(sub: Subcommands) -> list[str]:
     return ["scenarios", "robots"]
 
 
+def is_point_foot(robot: Robot, frame: str) -> bool:
+    """Whether ``frame`` of ``robot`` is a point foot: on a chain of fewer than 6 joints.
+
+    A leg of fewer than 6 joints from the floating base (a quadruped's 3-joint leg, Bolt's)
+    cannot hold its foot's orientation, so its foot is a point (a ball): the rule by which
+    ``pose`` places such a frame by position only (:func:`impact_balance.robot.ik.chain_dofs`).
+
+    Args:
+        robot: The robot.
+        frame: A frame of its model.
+
+    Returns:
+        True when the joints between the base and ``frame`` have fewer than 6 degrees of
+        freedom in all.
+    """
+    from impact_balance.robot.ik import chain_dofs
+
+    return chain_dofs(robot, frame) < 6
+
+
 def robot_rows() -> list[tuple[str, str, str, str, str, str]]:
     """One row per robot loadable by name: name, mass, standing, feet, sole, description.
 
     The feet are the links named as feet (``Robot.foot_frames``), "unknown" when no name
-    says it; the sole size is known for the bundled robots only.
+    says it. The sole is the measured size for the bundled robots, "point" when every foot
+    is a point foot (:func:`is_point_foot`), else "unknown".
     """
     from impact_balance.robot.robot import load_robot, robot_names
 
@@ -56,8 +94,10 @@ def robot_rows() -> list[tuple[str, str, str, str, str, str]]:
     for name, spec in robot_names().items():
         robot = load_robot(name)
         mass = sum(float(inertia.mass) for inertia in robot.model.inertias)
-        feet = ", ".join(robot.foot_frames or KNOWN_FEET.get(name, ())) or "unknown"
-        sole = KNOWN_SOLES.get(name, "unknown")
+        frames = robot.foot_frames or KNOWN_FEET.get(name, ())
+        feet = ", ".join(frames) or "unknown"
+        points = bool(frames) and all(is_point_foot(robot, frame) for frame in frames)
+        sole = KNOWN_SOLES.get(name, POINT_SOLE if points else "unknown")
         rows.append((name, f"{mass:.2f} kg", robot.standing, feet, sole, spec.description))
     return rows
 
