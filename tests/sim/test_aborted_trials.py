@@ -104,3 +104,23 @@ def test_validate_all_aborted_prints_why_and_exits_1(capsys, forced_abort):
     n = sum(": aborted before_disturbance" in line for line in out.splitlines())
     assert n > 0 and f"aborted ({n}): FL_foot slipped before the disturbance (forced)" in out
     assert f"all {n} trials of validate were aborted" in err
+
+
+def test_an_unreachable_approach_start_is_an_aborted_trial_not_a_crash(monkeypatch):
+    """A speed whose retracted start the arm cannot reach is untestable: aborted, with why."""
+    import numpy as np
+
+    from impact_balance.robot.ik import IKError
+    from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, run_balance_trial
+    from impact_balance.sim.trials.setup import BalanceSetup
+
+    setup = BalanceSetup.create("palm_push_two_feet", "servo", BalanceTrialOptions())
+
+    def unreachable(standoff: float = 0.0) -> np.ndarray:
+        raise IKError("not converged", [], 300, np.zeros(1))
+
+    monkeypatch.setattr(setup, "start_configuration", unreachable)
+    result = run_balance_trial(setup, impact_speed=3.0, options=BalanceTrialOptions())
+    assert result.outcome == "aborted" and result.reason == "no_start"
+    assert "cannot start" in result.detail and "not converged" in result.detail
+    assert result.summary()["outcome"] == "aborted"

@@ -41,6 +41,7 @@ from impact_balance.exceptions import SimulationError
 from impact_balance.impact.model import ImpactModel
 from impact_balance.json_values import json_number
 from impact_balance.logs import write_log
+from impact_balance.robot.ik import IKError
 from impact_balance.sim.control.approach import ImpactReference, ImpactTask
 from impact_balance.sim.control.approach import standoff as approach_standoff
 from impact_balance.sim.control.controller import ControllerName, ControlStep
@@ -205,7 +206,20 @@ def _run(
 ) -> BalanceTrialResult:
     if impact_speed is not None and task is None:
         task, standoff = _commanded_task(setup.analysis, impact_speed, options.settle)
-    trial = _TrialRun(setup, impact_speed, push, options, hold, task, surface_point, standoff)
+    try:
+        trial = _TrialRun(setup, impact_speed, push, options, hold, task, surface_point, standoff)
+    except IKError as exc:  # the approach's start is out of the robot's reach: nothing to test
+        return BalanceTrialResult(
+            "aborted",
+            "no_start",
+            None,
+            f"the approach cannot start: its start, {standoff or 0.0:.3f} m off the surface, "
+            f"is out of the robot's reach ({exc})",
+            (),
+            None,
+            None,
+            approach_speed=impact_speed,
+        )
     trial.set_end_time(max_approach_time)
     trial.loop(before_control)
     return trial.result()
