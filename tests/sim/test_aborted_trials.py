@@ -117,7 +117,7 @@ def test_an_unreachable_approach_start_is_an_aborted_trial_not_a_crash(monkeypat
     setup = BalanceSetup.create("palm_push_two_feet", "servo", BalanceTrialOptions())
 
     def unreachable(standoff: float = 0.0) -> np.ndarray:
-        raise IKError("not converged", [], 300, np.zeros(1))
+        raise IKError("not converged", {}, 300, np.zeros(1))
 
     monkeypatch.setattr(setup, "start_configuration", unreachable)
     result = run_balance_trial(setup, impact_speed=3.0, options=BalanceTrialOptions())
