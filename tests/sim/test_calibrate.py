@@ -153,6 +153,27 @@ def test_mixed_trials_are_refused_naming_the_files(tmp_path, change, key):
     assert "a.json" in str(info.value) and "b.json" in str(info.value)
 
 
+@pytest.mark.parametrize("from_robot", [True, False])
+def test_gains_derived_from_the_robot_may_differ_between_stances(tmp_path, from_robot):
+    """Derived gains follow each stance's CoM height: one controller, other numbers."""
+    rows = [(0.1, False, False)]
+    docs = []
+    for name, gain in (("a", 2.0), ("b", 2.3)):
+        doc = push_test_document(rows, scenario=name)
+        doc["controller"] = {
+            "name": "id",
+            "gains": {"dcm_gain": gain},
+            "gains_from_robot": from_robot,
+        }
+        docs.append(write_document(tmp_path / f"{name}.json", doc))
+    if from_robot:
+        assert calibrate(docs).to_dict()["fell_given_safe"]["of"] == 2
+    else:
+        with pytest.raises(ScenarioError) as info:
+            calibrate(docs)
+        assert info.value.field == "controller"
+
+
 def test_unknown_criterion_settings_are_recorded_verbatim():
     document = push_test_document([(0.1, False, False)], angular_momentum_damping_time=0.3)
     out = calibrate([document, dict(document)]).to_dict()

@@ -217,11 +217,29 @@ def _no_constant(name: str) -> None:
     raise ValueError(f"{name} is not strict JSON")
 
 
+def _equal(a: object, b: object) -> bool:
+    return a == b
+
+
+def _same_controller(a: Mapping[str, Any], b: Mapping[str, Any]) -> bool:
+    """One controller: equal descriptions, but for the gains when both derive them from the robot.
+
+    Gains derived from the robot (``gains_from_robot``) follow its stance (CoM height, omega),
+    so two stances of one robot give different numbers from the same rules.
+    """
+    if a.get("gains_from_robot") is True and b.get("gains_from_robot") is True:
+        return {k: v for k, v in a.items() if k != "gains"} == {
+            k: v for k, v in b.items() if k != "gains"
+        }
+    return a == b
+
+
 def _check_same(sets: Sequence[TrainingSet]) -> None:
     """Refuse training files of several robots, controllers or settings, naming the files."""
     first = sets[0]
     for key in ("robot", "controller", "outcome_criteria", "criterion"):
-        other = next((s for s in sets[1:] if getattr(s, key) != getattr(first, key)), None)
+        same = _same_controller if key == "controller" else _equal
+        other = next((s for s in sets[1:] if not same(getattr(s, key), getattr(first, key))), None)
         if other is not None:
             what = f"{first.robot!r} and {other.robot!r}" if key == "robot" else "different values"
             raise ScenarioError(

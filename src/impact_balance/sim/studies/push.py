@@ -598,6 +598,8 @@ def push_test(
         options, setup.sim, setup.joints == "servo"
     )
     controller["armature"] = setup.sim.armature_source
+    # The gains from the robot's rules (they differ between stances of one robot) or as given.
+    controller["gains_from_robot"] = bool(options.robot_gains)
     repair = setup.sim.inertia_repair
     controller["inertia_repair"] = None if repair is None else repair.to_dict()
     return PushTestResult(
