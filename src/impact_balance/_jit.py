@@ -12,6 +12,7 @@ kernels in it, and reports that time apart (what the first analysis of an instal
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 import pickle
@@ -96,24 +97,36 @@ class KernelClock:
             return
         from numba.core import event
 
-        clock = self
-
-        class _Timer(event.Listener):
-            def __init__(self, field: str) -> None:
-                self.field, self.depth, self.start = field, 0, 0.0
-
-            def on_start(self, ev: Any) -> None:
-                if self.depth == 0:
-                    self.start = time.perf_counter()
-                self.depth += 1
-
-            def on_end(self, ev: Any) -> None:
-                self.depth -= 1
-                if self.depth == 0:
-                    elapsed = time.perf_counter() - self.start
-                    setattr(clock, self.field, getattr(clock, self.field) + elapsed)
-
+        timer = _timer_class()
         with ExitStack() as stack:
-            stack.enter_context(event.install_listener("numba:compiler_lock", _Timer("loading")))
-            stack.enter_context(event.install_listener("numba:compile", _Timer("compiling")))
+            stack.enter_context(
+                event.install_listener("numba:compiler_lock", timer(self, "loading"))
+            )
+            stack.enter_context(event.install_listener("numba:compile", timer(self, "compiling")))
             yield self
+
+
+@functools.cache
+def _timer_class() -> type:
+    """The numba event listener that adds a block's time to a :class:`KernelClock` field.
+
+    Made once (numba is imported on first use, not with this module).
+    """
+    from numba.core import event
+
+    class _Timer(event.Listener):
+        def __init__(self, clock: KernelClock, field: str) -> None:
+            self.clock, self.field, self.depth, self.start = clock, field, 0, 0.0
+
+        def on_start(self, ev: Any) -> None:
+            if self.depth == 0:
+                self.start = time.perf_counter()
+            self.depth += 1
+
+        def on_end(self, ev: Any) -> None:
+            self.depth -= 1
+            if self.depth == 0:
+                elapsed = time.perf_counter() - self.start
+                setattr(self.clock, self.field, getattr(self.clock, self.field) + elapsed)
+
+    return _Timer

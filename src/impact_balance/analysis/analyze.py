@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
 from collections.abc import Callable
 from typing import Any
@@ -359,7 +360,10 @@ def _check_finite(checks: list[tuple[str, Any, tuple[str, ...]]]) -> None:
     common case costs a few microseconds; the field is looked for only on failure.
     """
     with np.errstate(over="ignore", invalid="ignore"):
-        if np.isfinite(sum(float(np.sum(value)) for _, value, _ in checks)):
+        total = 0.0
+        for _, value, _ in checks:  # the array method: numpy's np.sum wrapper costs ~2 us each
+            total += value if isinstance(value, float) else float(np.asarray(value).sum())
+        if math.isfinite(total):
             return
         for name, value, inputs in checks:
             if not np.isfinite(value).all():
