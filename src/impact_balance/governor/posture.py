@@ -51,6 +51,7 @@ from impact_balance.robot.robot import Robot, Scratch
 __all__ = ["Kinematics", "Posture", "PostureEvaluator", "PostureSettings"]
 
 _POSITION = pin.KinematicLevel.POSITION
+_WORLD = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
 @dataclass(frozen=True)
@@ -292,21 +293,25 @@ class PostureEvaluator:
         com_local = np.array(pin.centerOfMass(model, data, _POSITION, False), dtype=float)
         Ig = data.Ig
         mass = float(Ig.mass)
-        com_jacobian = data.Ag[:3] / mass
+        linear = data.Ag[:3]  # m times the CoM Jacobian
+        com_jacobian = linear / mass
         m = len(self._frames)
         rotations = np.empty((m, 3, 3))
         local = np.empty((m, 3))
-        jacobians = np.empty((6 * m, model.nv)) if self._torques else np.zeros((0, 0))
+        torques = self._torques
+        jacobians = np.empty((6 * m, model.nv)) if torques else np.zeros((0, 0))
+        # frame_point's numbers (the evaluator's frames have no offset of their own), in
+        # pinocchio's calls directly: the pose as one 4 x 4 array, the Jacobian written in place.
         for i, fid in enumerate(self._frames):
-            placement, J = frame_point(model, data, fid, None, self._torques)
-            rotations[i] = placement.rotation
-            local[i] = placement.translation
-            if J is not None:
-                jacobians[6 * i : 6 * i + 6] = J
+            pose = pin.updateFramePlacement(model, data, fid).homogeneous
+            rotations[i] = pose[:3, :3]
+            local[i] = pose[:3, 3]
+            if torques:
+                jacobians[6 * i : 6 * i + 6] = pin.getFrameJacobian(model, data, fid, _WORLD)
         # g(q) = -Ag[:3]^T g: the gravity's generalized force is the CoM's (the centroidal
         # momentum matrix's linear rows are m times the CoM Jacobian); equal to pinocchio's
         # computeGeneralizedGravity to rounding (1e-14 N m of 327 on G1), without its pass.
-        gravity_torques = -(self._gravity @ data.Ag[:3]) if self._torques else self._zero_velocity
+        gravity_torques = -(self._gravity @ linear) if torques else self._zero_velocity
         com = com_local + origin
         return Kinematics(
             origin,
