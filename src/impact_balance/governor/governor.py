@@ -415,9 +415,9 @@ class Governor:
     # -- internals ---------------------------------------------------------------------------
     def _configuration(self, q: ArrayLike) -> npt.NDArray[np.float64]:
         """``q`` as a checked configuration vector (see :meth:`limit`)."""
-        configuration = _vector(q, self.nq, "q")
+        configuration, squared = _squared_vector(q, self.nq, "q")
         if self._free_flyer:
-            if np.vdot(configuration, configuration) > MAX_POSITION * MAX_POSITION:  # rarely
+            if squared > MAX_POSITION * MAX_POSITION:  # rarely
                 _base_within_bounds(configuration)
             quaternion = configuration[3:7]
             norm = float(quaternion @ quaternion)
@@ -768,6 +768,11 @@ def _vector(x: ArrayLike, size: int, field: str) -> npt.NDArray[np.float64]:
     Real numbers only: a complex, boolean, text or object entry is refused (numpy would drop
     an imaginary part with a warning, or parse text).
     """
+    return _squared_vector(x, size, field)[0]
+
+
+def _squared_vector(x: ArrayLike, size: int, field: str) -> tuple[npt.NDArray[np.float64], float]:
+    """:func:`_vector`'s answer and its squared norm (the one product its check takes)."""
     try:
         raw = np.asarray(x)
         if raw.dtype.kind not in "iuf":
@@ -779,7 +784,8 @@ def _vector(x: ArrayLike, size: int, field: str) -> npt.NDArray[np.float64]:
         raise GovernorError(
             field, f"shape {a.shape}", f"must have {size} entries (the model's n{field})"
         )
-    if not math.isfinite(np.vdot(a, a)):  # one product per tick (vdot: no overflow warning)
+    squared = float(np.vdot(a, a))  # one product per tick (vdot: no overflow warning)
+    if not math.isfinite(squared):
         bad = np.flatnonzero(~np.isfinite(a))
         if bad.size:
             raise GovernorError(field, x, f"must be finite (entry {int(bad[0])})")
@@ -787,7 +793,7 @@ def _vector(x: ArrayLike, size: int, field: str) -> npt.NDArray[np.float64]:
         raise GovernorError(
             f"{field}[{k}]", float(a[k]), "is finite but beyond any physical value (m, rad, m/s)"
         )
-    return a
+    return a, squared
 
 
 class _JointBounds:
