@@ -52,6 +52,10 @@ QUATERNION_TOLERANCE = 1e-6
 #: simulation, encoder noise), a posture farther out is not the robot's.
 JOINT_LIMIT_TOLERANCE = 0.1
 
+#: Below this squared CoM speed bound, (m/s)^2, a tick's CoM velocity is surely within
+#: MAX_SPEED (the bound's rounding is far inside the factor).
+_SURELY_SLOW = 0.999999 * MAX_SPEED * MAX_SPEED
+
 
 class Governor:
     """The maximum impact speed for the measured state, every control tick.
@@ -182,6 +186,8 @@ class Governor:
         self._last: SpeedLimit | None = None
         self._posture: Posture | None = self._first_posture()
         self._support_posture: bytes | None = None
+        self._jacobian_key: bytes | None = None  # the posture of _jacobian_squared
+        self._jacobian_squared = math.inf
         self._aware = aware
         self._clock = _RatesClock()  # the rates' age
         if self._support is not None and aware is not None and aware.asynchronous:
@@ -247,11 +253,14 @@ class Governor:
                 evaluate (see :meth:`~impact_balance.governor.posture.PostureEvaluator.evaluate`).
         """
         configuration = self._configuration(q)
-        velocity = _vector(v, self.nv, "v")
+        velocity, squared = _squared_vector(v, self.nv, "v")
         with self._lock:
             posture, reused = self._posture_at(configuration)
             com_velocity = posture.com_jacobian @ velocity  # |v| < 1e154: no overflow
-            if not float(com_velocity @ com_velocity) <= MAX_SPEED * MAX_SPEED:
+            # |J v|^2 <= |J|_F^2 |v|^2: the exact check only when this bound does not settle it
+            if not squared * self._jacobian_size(posture) <= _SURELY_SLOW and not (
+                float(np.dot(com_velocity, com_velocity)) <= MAX_SPEED * MAX_SPEED
+            ):
                 raise GovernorError(
                     "v",
                     f"CoM velocity {math.hypot(*com_velocity):.3g} m/s",
@@ -420,7 +429,7 @@ class Governor:
             if squared > MAX_POSITION * MAX_POSITION:  # rarely
                 _base_within_bounds(configuration)
             quaternion = configuration[3:7]
-            norm = float(quaternion @ quaternion)
+            norm = float(np.dot(quaternion, quaternion))  # the numbers of @, without the ufunc
             if abs(norm - 1.0) > 2.0 * QUATERNION_TOLERANCE:
                 raise GovernorError(
                     "q",
@@ -429,6 +438,17 @@ class Governor:
                     f"{QUATERNION_TOLERANCE:g}); normalise it",
                 )
         return configuration
+
+    def _jacobian_size(self, posture: Posture) -> float:
+        """The squared Frobenius norm of ``posture``'s CoM Jacobian, (m/s)^2 per unit of v^2.
+
+        Computed once per posture (under the lock).
+        """
+        if self._jacobian_key is not posture.key:
+            self._jacobian_key = posture.key
+            J = posture.com_jacobian
+            self._jacobian_squared = float(np.vdot(J, J))
+        return self._jacobian_squared
 
     def _checked_row(self, q: npt.NDArray[np.float64], field: str) -> npt.NDArray[np.float64]:
         """Row ``q`` of a batch checked as :meth:`limit` checks ``q`` (errors name ``field``)."""
