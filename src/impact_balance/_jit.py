@@ -16,9 +16,10 @@ import functools
 import hashlib
 import os
 import pickle
+import threading
 import time
 from collections.abc import Iterator
-from contextlib import ExitStack, contextmanager
+from contextlib import contextmanager
 from types import ModuleType
 from typing import Any
 
@@ -84,6 +85,7 @@ class KernelClock:
         self.loading = 0.0
         #: Seconds of :attr:`loading` spent compiling (numba's cache had no kernel).
         self.compiling = 0.0
+        self._since = 0.0  # when running() began (perf_counter, s)
 
     def now(self) -> float:
         """``time.perf_counter()`` (s) without the kernel time counted so far."""
@@ -95,28 +97,35 @@ class KernelClock:
         if not HAVE_NUMBA:
             yield self
             return
-        from numba.core import event
-
-        timer = _timer_class()
-        with ExitStack() as stack:
-            stack.enter_context(
-                event.install_listener("numba:compiler_lock", timer(self, "loading"))
-            )
-            stack.enter_context(event.install_listener("numba:compile", timer(self, "compiling")))
+        _register_timers()
+        self._since = time.perf_counter()
+        with _RUNNING_LOCK:
+            _RUNNING.append(self)
+        try:
             yield self
+        finally:
+            with _RUNNING_LOCK:
+                _RUNNING.remove(self)
+
+
+#: The clocks inside :meth:`KernelClock.running` (any thread), and their lock.
+_RUNNING: list[KernelClock] = []
+_RUNNING_LOCK = threading.Lock()
 
 
 @functools.cache
-def _timer_class() -> type:
-    """The numba event listener that adds a block's time to a :class:`KernelClock` field.
+def _register_timers() -> None:
+    """Listen to numba's compiler events once, for every running :class:`KernelClock`.
 
-    Made once (numba is imported on first use, not with this module).
+    numba's events are process-wide and its compiler lock is one lock: one event at a time
+    (nested in the same thread). The time of each outermost event (from its start, or from
+    the clock's start when it began later) is added to every clock running at its end.
     """
     from numba.core import event
 
     class _Timer(event.Listener):
-        def __init__(self, clock: KernelClock, field: str) -> None:
-            self.clock, self.field, self.depth, self.start = clock, field, 0, 0.0
+        def __init__(self, field: str) -> None:
+            self.field, self.depth, self.start = field, 0, 0.0
 
         def on_start(self, ev: Any) -> None:
             if self.depth == 0:
@@ -126,7 +135,12 @@ def _timer_class() -> type:
         def on_end(self, ev: Any) -> None:
             self.depth -= 1
             if self.depth == 0:
-                elapsed = time.perf_counter() - self.start
-                setattr(self.clock, self.field, getattr(self.clock, self.field) + elapsed)
+                end = time.perf_counter()
+                with _RUNNING_LOCK:
+                    clocks = list(_RUNNING)
+                for clock in clocks:
+                    elapsed = end - max(self.start, clock._since)
+                    setattr(clock, self.field, getattr(clock, self.field) + elapsed)
 
-    return _Timer
+    event.register("numba:compiler_lock", _Timer("loading"))  # type: ignore[no-untyped-call]
+    event.register("numba:compile", _Timer("compiling"))  # type: ignore[no-untyped-call]
