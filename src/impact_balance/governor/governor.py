@@ -432,12 +432,11 @@ class Governor:
         if self._free_flyer:
             if squared > MAX_POSITION * MAX_POSITION:  # rarely
                 _base_within_bounds(configuration)
-            quaternion = configuration[3:7]
-            norm = float(np.dot(quaternion, quaternion))  # the numbers of @, without the ufunc
-            if abs(norm - 1.0) > 2.0 * QUATERNION_TOLERANCE:
+            x, y, z, w = configuration[3:7].tolist()  # four Python floats: no array product
+            if abs(x * x + y * y + z * z + w * w - 1.0) > 2.0 * QUATERNION_TOLERANCE:
                 raise GovernorError(
                     "q",
-                    quaternion.tolist(),
+                    [x, y, z, w],
                     "the base quaternion (x, y, z, w) must be unit (within "
                     f"{QUATERNION_TOLERANCE:g}); normalise it",
                 )
