@@ -12,12 +12,14 @@ kernels in it, and reports that time apart (what the first analysis of an instal
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 import pickle
+import threading
 import time
 from collections.abc import Iterator
-from contextlib import ExitStack, contextmanager
+from contextlib import contextmanager
 from types import ModuleType
 from typing import Any
 
@@ -83,6 +85,7 @@ class KernelClock:
         self.loading = 0.0
         #: Seconds of :attr:`loading` spent compiling (numba's cache had no kernel).
         self.compiling = 0.0
+        self._since = 0.0  # when running() began (perf_counter, s)
 
     def now(self) -> float:
         """``time.perf_counter()`` (s) without the kernel time counted so far."""
@@ -94,26 +97,50 @@ class KernelClock:
         if not HAVE_NUMBA:
             yield self
             return
-        from numba.core import event
+        _register_timers()
+        self._since = time.perf_counter()
+        with _RUNNING_LOCK:
+            _RUNNING.append(self)
+        try:
+            yield self
+        finally:
+            with _RUNNING_LOCK:
+                _RUNNING.remove(self)
 
-        clock = self
 
-        class _Timer(event.Listener):
-            def __init__(self, field: str) -> None:
-                self.field, self.depth, self.start = field, 0, 0.0
+#: The clocks inside :meth:`KernelClock.running` (any thread), and their lock.
+_RUNNING: list[KernelClock] = []
+_RUNNING_LOCK = threading.Lock()
 
-            def on_start(self, ev: Any) -> None:
-                if self.depth == 0:
-                    self.start = time.perf_counter()
-                self.depth += 1
 
-            def on_end(self, ev: Any) -> None:
-                self.depth -= 1
-                if self.depth == 0:
-                    elapsed = time.perf_counter() - self.start
+@functools.cache
+def _register_timers() -> None:
+    """Listen to numba's compiler events once, for every running :class:`KernelClock`.
+
+    numba's events are process-wide and its compiler lock is one lock: one event at a time
+    (nested in the same thread). The time of each outermost event (from its start, or from
+    the clock's start when it began later) is added to every clock running at its end.
+    """
+    from numba.core import event
+
+    class _Timer(event.Listener):
+        def __init__(self, field: str) -> None:
+            self.field, self.depth, self.start = field, 0, 0.0
+
+        def on_start(self, ev: Any) -> None:
+            if self.depth == 0:
+                self.start = time.perf_counter()
+            self.depth += 1
+
+        def on_end(self, ev: Any) -> None:
+            self.depth -= 1
+            if self.depth == 0:
+                end = time.perf_counter()
+                with _RUNNING_LOCK:
+                    clocks = list(_RUNNING)
+                for clock in clocks:
+                    elapsed = end - max(self.start, clock._since)
                     setattr(clock, self.field, getattr(clock, self.field) + elapsed)
 
-        with ExitStack() as stack:
-            stack.enter_context(event.install_listener("numba:compiler_lock", _Timer("loading")))
-            stack.enter_context(event.install_listener("numba:compile", _Timer("compiling")))
-            yield self
+    event.register("numba:compiler_lock", _Timer("loading"))  # type: ignore[no-untyped-call]
+    event.register("numba:compile", _Timer("compiling"))  # type: ignore[no-untyped-call]

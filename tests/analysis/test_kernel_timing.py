@@ -80,3 +80,25 @@ def test_the_message_says_compile_and_load_apart():
     assert format_timings({"total": 0.0031}) == "analysis 3.1 ms"
     # A loaded kernel's dispatch (microseconds) is not worth a word.
     assert format_timings({"total": 0.0031, "kernel_loading": 1e-6}) == "analysis 3.1 ms"
+
+
+@needs_numba
+def test_every_running_clock_counts_a_compile_and_a_finished_one_does_not():
+    finished, outer, inner = KernelClock(), KernelClock(), KernelClock()
+    with finished.running():
+        pass
+    with outer.running():
+        wall0 = time.perf_counter()
+        with inner.running():
+            assert _fresh_kernel()(2.0) == 4.0
+        wall = time.perf_counter() - wall0
+    assert finished.loading == 0.0 and finished.compiling == 0.0
+    assert inner.compiling > 0.0
+    # the same compile, seen by both running clocks (the outer one started before it)
+    assert outer.compiling == pytest.approx(inner.compiling, rel=1e-9)
+    assert outer.loading == pytest.approx(inner.loading, rel=1e-9)
+    assert outer.loading <= wall
+    after = KernelClock()  # a clock started after the compile never sees it
+    with after.running():
+        _fresh_kernel()  # made, not called: nothing compiles
+    assert after.loading == 0.0

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
 from collections.abc import Callable
 from typing import Any
@@ -94,7 +95,10 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
         t0 = clock.now()
         stance = scenario.build_stance(robot)
         t1 = clock.now()
-        polytope, areas, t2 = _stance_areas(scenario, stance, clock.now)
+        qp = scenario.impact is not None and (
+            scenario.impact.qp.solve if solve_qp is None else solve_qp
+        )
+        polytope, areas, t2 = _stance_areas(scenario, stance, clock.now, polytope=qp)
         t3 = clock.now()
         timings.update(stance=t1 - t0, constraints=t2 - t1, areas=t3 - t2)
         if not areas.can_balance:  # explain why (LPs; only for a stance that cannot balance)
@@ -111,7 +115,8 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
                 raise with_source(exc, scenario.source) from None
             _check_finite(_impact_checks(model))
             answer = impact_answer(scenario, stance, areas, model)
-            if cfg.qp.solve if solve_qp is None else solve_qp:
+            if qp:
+                assert polytope is not None  # assembled for the QP
                 answer = dataclasses.replace(
                     answer, qp=_qp(scenario, stance, polytope, areas, model)
                 )
@@ -143,32 +148,38 @@ def stance_areas(scenario: Scenario, stance: Stance) -> tuple[WrenchPolytope, Ba
         SolverError: The projection failed (named as the projection of the contacts' polytope).
     """
     polytope, areas, _ = _stance_areas(scenario, stance)
+    assert polytope is not None  # asked for
     return polytope, areas
 
 
 def _stance_areas(
-    scenario: Scenario, stance: Stance, now: Callable[[], float] = time.perf_counter
-) -> tuple[WrenchPolytope, BalanceAreas, float]:
+    scenario: Scenario,
+    stance: Stance,
+    now: Callable[[], float] = time.perf_counter,
+    polytope: bool = True,
+) -> tuple[WrenchPolytope | None, BalanceAreas, float]:
     """:func:`stance_areas`, and the time (s, by the clock ``now``) between its two steps.
 
     The areas are a governor's (:func:`~impact_balance.balance.areas.posture_areas`, from the
-    stance's arrays), the same numbers as the polytope's.
+    stance's arrays), the same numbers as the polytope's. Without ``polytope`` (only the QP
+    reads it), the polytope is None unless the projection needs it (a stance without contacts).
     """
     if not stance.contacts:  # nothing to assemble from: the polytope of no contact
-        polytope = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
+        whole = wrench_polytope(stance, scenario.torque_limits, scenario.gravity)
         t = now()
-        return polytope, _projected_polytope(polytope, scenario), t
+        return whole, _projected_polytope(whole, scenario), t
     arrays = _stance_arrays(stance, scenario.torque_limits, scenario.gravity)
     frictions = [float(c.spec.friction) for c in stance.contacts]
-    # wrench_polytope's numbers, from the same arrays as the areas
-    polytope = assemble_polytope(*arrays, friction_scaling(frictions, list(arrays[1])))
+    assembled = None
+    if polytope:  # wrench_polytope's numbers, from the same arrays as the areas
+        assembled = assemble_polytope(*arrays, friction_scaling(frictions, list(arrays[1])))
     t = now()
     try:
         projected = posture_areas(*arrays, frictions, scenario.plane_height, scenario.zmp_margin)
         areas = projected if isinstance(projected, BalanceAreas) else projected.areas()
     except SolverError as exc:
         raise exc.within("contacts (projection of the contact wrench polytope)") from None
-    return polytope, areas, t
+    return assembled, areas, t
 
 
 def _qp(
@@ -359,7 +370,10 @@ def _check_finite(checks: list[tuple[str, Any, tuple[str, ...]]]) -> None:
     common case costs a few microseconds; the field is looked for only on failure.
     """
     with np.errstate(over="ignore", invalid="ignore"):
-        if np.isfinite(sum(float(np.sum(value)) for _, value, _ in checks)):
+        total = 0.0
+        for _, value, _ in checks:  # the array method: numpy's np.sum wrapper costs ~2 us each
+            total += value if isinstance(value, float) else float(np.asarray(value).sum())
+        if math.isfinite(total):
             return
         for name, value, inputs in checks:
             if not np.isfinite(value).all():

@@ -323,10 +323,11 @@ def projected_from_arrays(
         )
     w = lipm_omega(float(com[2]), plane_height, gravity, field="plane_height")
     depth = plane_height - float(com[2])
-    positions, arms, jacobians, torque_limits, gravity_torques = (
-        np.ascontiguousarray(x, dtype=np.float64)
-        for x in (positions, arms, jacobians, torque_limits, gravity_torques)
-    )
+    positions = np.ascontiguousarray(positions, dtype=np.float64)  # no copy when they are
+    arms = np.ascontiguousarray(arms, dtype=np.float64)
+    jacobians = np.ascontiguousarray(jacobians, dtype=np.float64)
+    torque_limits = np.ascontiguousarray(torque_limits, dtype=np.float64)
+    gravity_torques = np.ascontiguousarray(gravity_torques, dtype=np.float64)
     out = _assembled_areas(
         face_blocks(faces, rotations),
         positions,

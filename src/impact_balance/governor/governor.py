@@ -14,6 +14,7 @@ import numpy.typing as npt
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from impact_balance._jit import njit
 from impact_balance.balance.areas import warm_up as warm_up_maps
 from impact_balance.constants import MAX_POSITION, MAX_SPEED
 from impact_balance.contacts.stance import ContactSpec, has_free_flyer
@@ -51,6 +52,10 @@ QUATERNION_TOLERANCE = 1e-6
 #: prismatic joint): a measured state may overshoot a limit a little (a soft limit in
 #: simulation, encoder noise), a posture farther out is not the robot's.
 JOINT_LIMIT_TOLERANCE = 0.1
+
+#: Below this squared CoM speed bound, (m/s)^2, a tick's CoM velocity is surely within
+#: MAX_SPEED (the bound's rounding is far inside the factor).
+_SURELY_SLOW = 0.999999 * MAX_SPEED * MAX_SPEED
 
 
 class Governor:
@@ -182,6 +187,8 @@ class Governor:
         self._last: SpeedLimit | None = None
         self._posture: Posture | None = self._first_posture()
         self._support_posture: bytes | None = None
+        self._jacobian_key: bytes | None = None  # the posture of _jacobian_squared
+        self._jacobian_squared = math.inf
         self._aware = aware
         self._clock = _RatesClock()  # the rates' age
         if self._support is not None and aware is not None and aware.asynchronous:
@@ -200,6 +207,8 @@ class Governor:
         warm_up()  # the projection kernel's one-time load
         warm_up_bretl()  # the fallback's (HiGHS), so that a tick that falls back is not slow
         warm_up_maps()  # and the fallback's compiled map
+        joints = self._joints  # and the joint check's
+        _first_outside(self.configuration, joints.idx, joints.lower, joints.upper)
         try:
             posture = self._evaluator.evaluate(self.configuration)
         except ScenarioError as exc:
@@ -247,11 +256,15 @@ class Governor:
                 evaluate (see :meth:`~impact_balance.governor.posture.PostureEvaluator.evaluate`).
         """
         configuration = self._configuration(q)
-        velocity = _vector(v, self.nv, "v")
+        velocity, squared = _squared_vector(v, self.nv, "v")
         with self._lock:
             posture, reused = self._posture_at(configuration)
             com_velocity = posture.com_jacobian @ velocity  # |v| < 1e154: no overflow
-            if not float(com_velocity @ com_velocity) <= MAX_SPEED * MAX_SPEED:
+            # A reused posture (a velocity-only tick): |J v|^2 <= |J|_F^2 |v|^2 settles it
+            # unless v is near the bound; else the exact check.
+            if not (reused and squared * self._jacobian_size(posture) <= _SURELY_SLOW) and not (
+                float(np.dot(com_velocity, com_velocity)) <= MAX_SPEED * MAX_SPEED
+            ):
                 raise GovernorError(
                     "v",
                     f"CoM velocity {math.hypot(*com_velocity):.3g} m/s",
@@ -415,20 +428,30 @@ class Governor:
     # -- internals ---------------------------------------------------------------------------
     def _configuration(self, q: ArrayLike) -> npt.NDArray[np.float64]:
         """``q`` as a checked configuration vector (see :meth:`limit`)."""
-        configuration = _vector(q, self.nq, "q")
+        configuration, squared = _squared_vector(q, self.nq, "q")
         if self._free_flyer:
-            if np.vdot(configuration, configuration) > MAX_POSITION * MAX_POSITION:  # rarely
+            if squared > MAX_POSITION * MAX_POSITION:  # rarely
                 _base_within_bounds(configuration)
-            quaternion = configuration[3:7]
-            norm = float(quaternion @ quaternion)
-            if abs(norm - 1.0) > 2.0 * QUATERNION_TOLERANCE:
+            x, y, z, w = configuration[3:7].tolist()  # four Python floats: no array product
+            if abs(x * x + y * y + z * z + w * w - 1.0) > 2.0 * QUATERNION_TOLERANCE:
                 raise GovernorError(
                     "q",
-                    quaternion.tolist(),
+                    [x, y, z, w],
                     "the base quaternion (x, y, z, w) must be unit (within "
                     f"{QUATERNION_TOLERANCE:g}); normalise it",
                 )
         return configuration
+
+    def _jacobian_size(self, posture: Posture) -> float:
+        """The squared Frobenius norm of ``posture``'s CoM Jacobian, (m/s)^2 per unit of v^2.
+
+        Computed once per posture (under the lock).
+        """
+        if self._jacobian_key is not posture.key:
+            self._jacobian_key = posture.key
+            J = posture.com_jacobian
+            self._jacobian_squared = float(np.vdot(J, J))
+        return self._jacobian_squared
 
     def _checked_row(self, q: npt.NDArray[np.float64], field: str) -> npt.NDArray[np.float64]:
         """Row ``q`` of a batch checked as :meth:`limit` checks ``q`` (errors name ``field``)."""
@@ -768,6 +791,11 @@ def _vector(x: ArrayLike, size: int, field: str) -> npt.NDArray[np.float64]:
     Real numbers only: a complex, boolean, text or object entry is refused (numpy would drop
     an imaginary part with a warning, or parse text).
     """
+    return _squared_vector(x, size, field)[0]
+
+
+def _squared_vector(x: ArrayLike, size: int, field: str) -> tuple[npt.NDArray[np.float64], float]:
+    """:func:`_vector`'s answer and its squared norm (the one product its check takes)."""
     try:
         raw = np.asarray(x)
         if raw.dtype.kind not in "iuf":
@@ -779,7 +807,8 @@ def _vector(x: ArrayLike, size: int, field: str) -> npt.NDArray[np.float64]:
         raise GovernorError(
             field, f"shape {a.shape}", f"must have {size} entries (the model's n{field})"
         )
-    if not math.isfinite(np.vdot(a, a)):  # one product per tick (vdot: no overflow warning)
+    squared = float(np.vdot(a, a))  # one product per tick (vdot: no overflow warning)
+    if not math.isfinite(squared):
         bad = np.flatnonzero(~np.isfinite(a))
         if bad.size:
             raise GovernorError(field, x, f"must be finite (entry {int(bad[0])})")
@@ -787,7 +816,7 @@ def _vector(x: ArrayLike, size: int, field: str) -> npt.NDArray[np.float64]:
         raise GovernorError(
             f"{field}[{k}]", float(a[k]), "is finite but beyond any physical value (m, rad, m/s)"
         )
-    return a
+    return a, squared
 
 
 class _JointBounds:
@@ -820,10 +849,9 @@ class _JointBounds:
 
     def check(self, q: npt.NDArray[np.float64]) -> None:
         """Raise :class:`GovernorError` naming the first joint of ``q`` out of bounds."""
-        values = q[self.idx]
-        outside = (values < self.lower) | (values > self.upper)
-        if outside.any():
-            k = int(np.flatnonzero(outside)[0])
+        k = _first_outside(q, self.idx, self.lower, self.upper)
+        if k >= 0:
+            values = q[self.idx]
             lo = self.lower[k] + JOINT_LIMIT_TOLERANCE
             hi = self.upper[k] - JOINT_LIMIT_TOLERANCE
             raise GovernorError(
@@ -840,3 +868,21 @@ class _JointBounds:
                     [float(q[i]), float(q[i + 1])],
                     f"continuous joint {name!r}: (cos, sin) must be a unit pair",
                 )
+
+
+@njit(cache=True)
+def _first_outside(
+    q: npt.NDArray[np.float64],
+    idx: npt.NDArray[np.int64],
+    lower: npt.NDArray[np.float64],
+    upper: npt.NDArray[np.float64],
+) -> int:
+    """The first k with ``q[idx[k]]`` below ``lower[k]`` or above ``upper[k]``, else -1.
+
+    One compiled pass (a tick's joint check; numpy's took five array operations).
+    """
+    for k in range(idx.size):
+        value = q[idx[k]]
+        if value < lower[k] or value > upper[k]:
+            return k
+    return -1

@@ -6,7 +6,7 @@ polytope and its projection (the ZMP support area and the CoM velocity area), th
 model at the impacting frame, and the criterion's data that do not depend on the CoM velocity.
 
 The steps are the pipeline's own functions at the array level
-(:func:`~impact_balance.contacts.stance.frame_point`,
+(:func:`~impact_balance.contacts.stance.frame_point`'s numbers,
 :func:`~impact_balance.contacts.wrench_polytope.assemble_polytope`,
 :func:`~impact_balance.balance.areas.areas_from_polytope`,
 :func:`~impact_balance.impact.model.model_from_inertia_map`,
@@ -31,7 +31,7 @@ import pinocchio as pin
 from impact_balance.balance.areas import BalanceAreas, Projected, posture_areas
 from impact_balance.balance.lipm import lipm_omega
 from impact_balance.contacts.cwc import local_faces
-from impact_balance.contacts.stance import ContactSpec, Stance, frame_point, has_free_flyer
+from impact_balance.contacts.stance import ContactSpec, Stance, has_free_flyer
 from impact_balance.criteria.com import ComCriterion
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.criteria.zmp import zmp_max_contact_velocity
@@ -51,6 +51,7 @@ from impact_balance.robot.robot import Robot, Scratch
 __all__ = ["Kinematics", "Posture", "PostureEvaluator", "PostureSettings"]
 
 _POSITION = pin.KinematicLevel.POSITION
+_WORLD = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 
 
 @dataclass(frozen=True)
@@ -281,10 +282,11 @@ class PostureEvaluator:
         # Stance does: lever arms keep their precision however far the robot stands.
         q_local = self._q_local
         q_local[:] = q
-        origin = np.zeros(3)
         if self._free_flyer:
             origin = q[:3].copy()
             q_local[:3] = 0.0
+        else:
+            origin = np.zeros(3)
         # ccrba: joint placements, joint Jacobians, the composite inertia Ig and the centroidal
         # momentum matrix Ag (its linear rows are m times the CoM Jacobian).
         pin.ccrba(model, data, q_local, self._zero_velocity)
@@ -292,21 +294,25 @@ class PostureEvaluator:
         com_local = np.array(pin.centerOfMass(model, data, _POSITION, False), dtype=float)
         Ig = data.Ig
         mass = float(Ig.mass)
-        com_jacobian = data.Ag[:3] / mass
+        linear = data.Ag[:3]  # m times the CoM Jacobian
+        com_jacobian = linear / mass
         m = len(self._frames)
         rotations = np.empty((m, 3, 3))
         local = np.empty((m, 3))
-        jacobians = np.empty((6 * m, model.nv)) if self._torques else np.zeros((0, 0))
+        torques = self._torques
+        jacobians = np.empty((6 * m, model.nv)) if torques else np.zeros((0, 0))
+        # frame_point's numbers (the evaluator's frames have no offset of their own), in
+        # pinocchio's calls directly: the pose as one 4 x 4 array, the Jacobian written in place.
         for i, fid in enumerate(self._frames):
-            placement, J = frame_point(model, data, fid, None, self._torques)
-            rotations[i] = placement.rotation
-            local[i] = placement.translation
-            if J is not None:
-                jacobians[6 * i : 6 * i + 6] = J
+            pose = pin.updateFramePlacement(model, data, fid).homogeneous
+            rotations[i] = pose[:3, :3]
+            local[i] = pose[:3, 3]
+            if torques:
+                jacobians[6 * i : 6 * i + 6] = pin.getFrameJacobian(model, data, fid, _WORLD)
         # g(q) = -Ag[:3]^T g: the gravity's generalized force is the CoM's (the centroidal
         # momentum matrix's linear rows are m times the CoM Jacobian); equal to pinocchio's
         # computeGeneralizedGravity to rounding (1e-14 N m of 327 on G1), without its pass.
-        gravity_torques = -(self._gravity @ data.Ag[:3]) if self._torques else self._zero_velocity
+        gravity_torques = -(self._gravity @ linear) if torques else self._zero_velocity
         com = com_local + origin
         return Kinematics(
             origin,
@@ -392,11 +398,11 @@ class PostureEvaluator:
         As :func:`~impact_balance.impact.model.impact_model` computes it.
         """
         spec, data, model = self.settings.impact, self.scratch.data, self.model
-        placement, J6 = frame_point(model, data, self._impact_frame, None)
-        assert J6 is not None  # frame_point gives the Jacobian unless told not to
-        point_local = placement.translation.copy()
+        # frame_point's numbers (the impact point is a frame of the evaluator's model)
+        fid = self._impact_frame
+        point_local = pin.updateFramePlacement(model, data, fid).translation.copy()
         arm = point_local - com_local
-        J = J6[:3].copy()
+        J = pin.getFrameJacobian(model, data, fid, _WORLD)[:3].copy()
         if spec.inertia == "joint_space":
             with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported by the model
                 W = joint_space_inertia_map(self.scratch, model, q, J)

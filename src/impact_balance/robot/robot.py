@@ -359,14 +359,18 @@ class Robot:
         The robot's up axis as it stands at ``q`` (+z for a robot upright in the world); None
         when its feet are unknown (:attr:`foot_frames`).
         """
-        if not self.foot_frames:
+        feet_ids = self._foot_frame_ids
+        if not feet_ids:
             return None
-        data = self.model.createData()
+        data = self._up_data.data  # this thread's (a Data of its own: no Stance reads it)
         com = pin.centerOfMass(self.model, data, q)
         pin.updateFramePlacements(self.model, data)
-        feet = np.mean([data.oMf[self.frame_id(f)].translation for f in self.foot_frames], axis=0)
+        feet = data.oMf[feet_ids[0]].translation.copy()
+        for i in feet_ids[1:]:
+            feet += data.oMf[i].translation
+        feet /= len(feet_ids)  # their mean, summed in order as np.mean sums a few rows
         direction = np.asarray(com - feet, dtype=float)
-        length = float(np.linalg.norm(direction))
+        length = math.sqrt(float(direction @ direction))  # np.linalg.norm's numbers
         return direction / length if length > 1e-9 else None
 
     def up_axis_problem(self, q: np.ndarray) -> str | None:
@@ -391,6 +395,15 @@ class Robot:
     def _up_axis_answers(self) -> dict[bytes, str | None]:
         return {}
 
+    @functools.cached_property
+    def _foot_frame_ids(self) -> tuple[int, ...]:
+        return tuple(self.frame_id(f) for f in self.foot_frames)
+
+    @functools.cached_property
+    def _up_data(self) -> ThreadData:
+        # up_direction's Data (a large allocation, made once per thread and robot).
+        return ThreadData(self.model)
+
     def _up_axis_line(self, q: np.ndarray) -> str | None:
         up = self.up_direction(q)
         if up is None or up[2] >= math.cos(math.radians(45.0)):
@@ -405,9 +418,9 @@ class Robot:
         upright = aligning_rotation(axis_vector, (0.0, 0.0, 1.0)) @ base
         stood = np.array(q, dtype=float)
         stood[3:7] = pin.Quaternion(upright).coeffs()
-        data = self.model.createData()
+        data = self._up_data.data
         pin.framesForwardKinematics(self.model, data, stood)
-        lowest = min(float(data.oMf[self.frame_id(f)].translation[2]) for f in self.foot_frames)
+        lowest = min(float(data.oMf[i].translation[2]) for i in self._foot_frame_ids)
         position = [round(float(q[0]), 4), round(float(q[1]), 4), round(float(q[2]) - lowest, 4)]
         rpy = [round(float(v), 4) + 0.0 for v in pin.rpy.matrixToRpy(upright)]
         tilt = math.degrees(math.acos(max(-1.0, min(1.0, float(up[2])))))
