@@ -155,6 +155,9 @@ def run(args: argparse.Namespace) -> int:
         bar.close()
         journal.close()
     out = result.to_dict()
+    # The option as given ("controller", a number, "off" or null): a criterion setting of the
+    # predictions that a calibration records and requires to agree between its files.
+    out["angular_momentum_option"] = args.angular_momentum_damping_time
     if calibration is not None:
         out["calibration"] = calibration
     written = []
