@@ -10,6 +10,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+pytest.importorskip("mujoco")  # the push predictions live beside the simulation (the sim extra)
+
 from impact_balance import analyze
 from impact_balance.scenario import load_scenario
 from impact_balance.sim.studies.push import PushOutcome, boundary_impulse, predict_push
