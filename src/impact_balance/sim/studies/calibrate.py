@@ -21,6 +21,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import operator
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -217,10 +218,6 @@ def _no_constant(name: str) -> None:
     raise ValueError(f"{name} is not strict JSON")
 
 
-def _equal(a: object, b: object) -> bool:
-    return a == b
-
-
 def _same_controller(a: Mapping[str, Any], b: Mapping[str, Any]) -> bool:
     """One controller: equal descriptions, but for the gains when both derive them from the robot.
 
@@ -238,7 +235,7 @@ def _check_same(sets: Sequence[TrainingSet]) -> None:
     """Refuse training files of several robots, controllers or settings, naming the files."""
     first = sets[0]
     for key in ("robot", "controller", "outcome_criteria", "criterion"):
-        same = _same_controller if key == "controller" else _equal
+        same = _same_controller if key == "controller" else operator.eq
         other = next((s for s in sets[1:] if not same(getattr(s, key), getattr(first, key))), None)
         if other is not None:
             what = f"{first.robot!r} and {other.robot!r}" if key == "robot" else "different values"
