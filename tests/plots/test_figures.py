@@ -229,32 +229,15 @@ def test_flat_set_test():
 @pytest.mark.slow
 def test_video_frame(trials, tmp_path):
     """1280 x 720 frames, light background, caption with time and slow motion, CoM marker."""
-    import subprocess
-    import sys
-
     from impact_balance.sim.trials.video import frame_caption
+    from tests.helpers.cli import run_process
 
     lines = frame_caption(0.103, 0.1, 10.0, True)
     assert lines[0].startswith("t =") and "+3.0 ms" in lines[0]
     assert "10x slower than real time" in lines[1] and lines[2].startswith("IMPACT")
     video = tmp_path / "v.mp4"
-    proc = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "impact_balance",
-            "simulate",
-            "kick_one_foot",
-            "--speed",
-            "0.6",
-            "--duration",
-            "0.01",
-            "--video",
-            str(video),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=300,
+    proc = run_process(
+        "simulate", "kick_one_foot", "--speed", "0.6", "--duration", "0.01", "--video", str(video)
     )
     if proc.returncode != 0:
         assert proc.returncode == 2 and "Traceback" not in proc.stderr

@@ -256,27 +256,11 @@ def test_cli_scenario_without_impact(capsys, tmp_path):
 @pytest.mark.slow
 def test_cli_video(tmp_path):
     """Offscreen MP4 in a fresh process (MUJOCO_GL must be set before MuJoCo is imported)."""
-    import subprocess
-    import sys
+    from tests.helpers.cli import run_process
 
     video = tmp_path / "trial.mp4"
-    proc = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "impact_balance",
-            "simulate",
-            "kick_one_foot",
-            "--speed",
-            "0.6",
-            "--duration",
-            "0.01",
-            "--video",
-            str(video),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=300,
+    proc = run_process(
+        "simulate", "kick_one_foot", "--speed", "0.6", "--duration", "0.01", "--video", str(video)
     )
     if proc.returncode != 0:
         # Without a GL backend: one clear line, no traceback.
