@@ -146,9 +146,11 @@ def test_calibrate_on_a_real_push_test(tmp_path, capsys, monkeypatch):
     )
     assert rc == 0, err
     doc = strict_json(out)
-    # Counted independently: the smallest margin whose safe pushes fail at most half the time.
+    # Counted independently: the smallest margin whose safe pushes fail at most half the time,
+    # from the controller's own margin (the floor) up.
+    assert doc["margin_floor"] == trials["controller_margin"] == 0.01
     expected = None
-    for mm in range(61):
+    for mm in range(10, 61):
         safe = [
             p for p in trials["pushes"] if p["predicted_com_velocity_margin"] >= omega * mm / 1000
         ]
@@ -161,6 +163,29 @@ def test_calibrate_on_a_real_push_test(tmp_path, capsys, monkeypatch):
         assert rc == 0, err
         again = strict_json(out)
         assert again["zmp_margin"] == expected and again["calibration"]["applied"]
+
+
+def test_the_floor_is_the_controllers_margin_unless_given(tmp_path, capsys, monkeypatch):
+    from impact_balance.scenario.calibration import read_calibration
+
+    monkeypatch.chdir(tmp_path)
+    # Every push called safe at any margin stands: without a floor the answer is 0 mm.
+    document = push_test_document([(0.2, False, False)] * 5, controller_margin=0.01)
+    path = write_document(tmp_path / "t.json", document)
+    rc, out, err = run_cli(capsys, "calibrate", str(path), "--json", "--out", "c.yaml")
+    assert rc == 0, err
+    doc = strict_json(out)
+    assert (doc["zmp_margin"], doc["margin_floor"], doc["unfloored_margin"]) == (0.01, 0.01, 0.0)
+    written = read_calibration("c.yaml")
+    assert (written.zmp_margin, written.margin_floor, written.unfloored_margin) == (0.01, 0.01, 0.0)
+    rc, out, err = run_cli(capsys, "calibrate", str(path), "--json", "--floor", "0")
+    assert rc == 0, err
+    assert strict_json(out)["zmp_margin"] == 0.0
+    rc, out, err = run_cli(capsys, "calibrate", str(path), "--floor", "0.0125")
+    assert rc == 0, err
+    assert "ZMP margin 12.5 mm" in out and "without it: 0 mm" in out
+    rc, out, err = run_cli(capsys, "calibrate", str(path), "--floor", "-1")
+    assert rc == 2 and "--floor" in err and len(err.strip().splitlines()) == 1
 
 
 @pytest.mark.parametrize(

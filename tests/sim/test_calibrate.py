@@ -94,6 +94,41 @@ def test_the_upper_margin_is_where_the_upper_wilson_bound_reaches_its_target(row
     assert result.upper_margin == expected
 
 
+@settings(max_examples=40, deadline=None)
+@given(push_rows, st.integers(0, 60), st.booleans())
+def test_the_floor_bounds_the_answer_from_below(rows, floor_mm, from_files):
+    documents = _documents(rows)
+    if from_files:
+        for d in documents:
+            d["controller_margin"] = floor_mm / 1000
+        result = calibrate(documents)
+    else:
+        result = calibrate(documents, floor=floor_mm / 1000)
+    below = [(k, s, fell, st_) for k, s, fell, st_ in rows]
+    unfloored, _, _ = _brute(below, 0.05, True)
+    assert result.unfloored_margin == unfloored
+    assert result.floor == floor_mm / 1000
+    expected = None
+    for mm in range(floor_mm, 61):
+        safe = [fell or st_ for k, _, fell, st_ in rows if k >= mm]
+        if safe and sum(safe) <= 0.05 * len(safe):
+            expected = mm / 1000
+            break
+    assert result.zmp_margin == expected
+    assert result.to_dict()["margin_floor"] == floor_mm / 1000
+
+
+def test_without_a_recorded_controller_margin_there_is_no_floor():
+    result = calibrate([push_test_document([(0.2, False, False)] * 3)])
+    assert (result.floor, result.zmp_margin) == (0.0, 0.0)
+
+
+@pytest.mark.parametrize("floor", [-0.001, 1.5, float("nan"), "ik", True])
+def test_a_bad_floor_is_refused(floor):
+    with pytest.raises(ScenarioError, match="floor"):
+        calibrate([push_test_document([(0.2, False, False)])], floor=floor)
+
+
 def test_the_wilson_interval_agrees_with_scipy():
     stats = pytest.importorskip("scipy.stats")
     rows = [(0.01 * k, k % 7 == 0, False) for k in range(1, 30)]

@@ -59,6 +59,14 @@ def add_parser(sub: Subcommands) -> list[str]:
         help="also the smallest margin whose upper 95 %% Wilson bound reaches this (default 0.12)",
     )
     a.add_argument(
+        "--floor",
+        type=_floor_value,
+        default="controller",
+        metavar="M|controller",
+        help="smallest margin the answer may take, m (default controller: the margin the "
+        "trials' controller keeps, recorded in the files; 0: no floor)",
+    )
+    a.add_argument(
         "--lenient",
         action="store_true",
         help="score the lenient outcome (fell) instead of the strict one (fell, or a contact "
@@ -72,6 +80,12 @@ def add_parser(sub: Subcommands) -> list[str]:
     )
     a.add_argument("--json", action="store_true", help="print one JSON object")
     return ["calibrate"]
+
+
+def _floor_value(text: str) -> float | str:
+    if text == "controller":
+        return text
+    return number("--floor", 0.0, 1.0)(text)
 
 
 def add_calibration_option(parser: argparse.ArgumentParser) -> None:
@@ -141,7 +155,11 @@ def run(args: argparse.Namespace) -> int:
     from impact_balance.sim.studies.calibrate import calibrate
 
     result = calibrate(
-        args.files, target=args.target, strict=not args.lenient, upper_target=args.upper_target
+        args.files,
+        target=args.target,
+        strict=not args.lenient,
+        upper_target=args.upper_target,
+        floor=args.floor,
     )
     out = result.to_dict()
     out["out"] = None
@@ -187,6 +205,8 @@ def _file_model(result: Calibration) -> Any:
         safe_given_stood=CalibrationRate(**_rate(chosen["safe_given_stood"])),
         upper_target=result.upper_target,
         upper_margin=result.upper_margin,
+        margin_floor=result.floor,
+        unfloored_margin=result.unfloored_margin,
         training=[
             TrainingFile(
                 file=s.file,
@@ -226,6 +246,10 @@ def _pct(r: dict[str, Any] | None) -> str:
     return f"{100 * r['rate']:.1f} % [{100 * lo:.0f}, {100 * hi:.0f}] ({r['count']}/{r['of']})"
 
 
+def _answer_mm(margin: float | None) -> str:
+    return "no margin reaches the target" if margin is None else f"{1000 * margin:g} mm"
+
+
 def _text(result: Calibration, out: dict[str, Any], args: argparse.Namespace) -> str:
     name = out["controller"].get("name", "?")
     lines = [
@@ -233,8 +257,13 @@ def _text(result: Calibration, out: dict[str, Any], args: argparse.Namespace) ->
         f"{len(result.sets)} file(s); {out['outcome']} outcome, target P(failed | safe) <= "
         f"{100 * result.target:g} %",
     ]
+    floor = f"{1000 * result.floor:g} mm"
+    lines.append(
+        f"  floor {floor} (the smallest margin answered); without it: "
+        + _answer_mm(result.unfloored_margin)
+    )
     if result.zmp_margin is None:
-        lines.append(f"  {out['answer']} up to {1000 * result.grid[-1]:g} mm")
+        lines.append(f"  {out['answer']} from {floor} up to {1000 * result.grid[-1]:g} mm")
     else:
         lines += [
             f"  ZMP margin {out['answer']}: P(failed | safe) {_pct(out['fell_given_safe'])}, "

@@ -79,13 +79,17 @@ class CalibrationFile(_Strict):
         outcome: The outcome scored: ``strict`` (fell or broke a contact beyond the bounds)
             or ``lenient`` (fell).
         target: The false-safe rate P(failed | predicted safe) aimed at.
-        zmp_margin: The calibrated ZMP margin, m.
+        zmp_margin: The calibrated ZMP margin, m (never below ``margin_floor``).
         fell_given_safe: P(failed | predicted safe) at ``zmp_margin`` over the training pushes.
         safe_given_stood: The share of the standing pushes called safe at ``zmp_margin``.
         upper_target: Target of the upper Wilson bound of the false-safe rate.
         upper_margin: The smallest margin whose upper bound reaches ``upper_target`` (m), or
             None when none up to the grid's end does.
         training: The training files.
+        margin_floor: The smallest margin the calibration could answer, m: the trials'
+            controller's own ZMP margin by default (0 in files written before the floor).
+        unfloored_margin: The smallest margin meeting the target without the floor, m, or
+            None (none does, or the file predates the floor).
         created: When the file was written (ISO 8601, UTC).
         impact_balance_version: The package's version that wrote it.
     """
@@ -103,6 +107,10 @@ class CalibrationFile(_Strict):
     upper_target: Annotated[float, Field(gt=0.0, lt=1.0, allow_inf_nan=False)]
     upper_margin: Annotated[float, Field(ge=0.0, le=MAX_SIZE, allow_inf_nan=False)] | None
     training: Annotated[list[TrainingFile], Field(min_length=1)]
+    margin_floor: Annotated[float, Field(ge=0.0, le=MAX_SIZE, allow_inf_nan=False)] = 0.0
+    unfloored_margin: Annotated[float, Field(ge=0.0, le=MAX_SIZE, allow_inf_nan=False)] | None = (
+        None
+    )
     created: str
     impact_balance_version: str
 

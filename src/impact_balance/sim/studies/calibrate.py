@@ -114,6 +114,8 @@ class TrainingSet:
         outcome_criteria: The outcome thresholds.
         criterion: The criterion settings (``start_com_velocity`` and unknown keys, verbatim).
         pushes: The scored pushes.
+        controller_margin: The ZMP margin the trials' controller keeps (m), None when the file
+            does not say.
     """
 
     file: str
@@ -125,6 +127,7 @@ class TrainingSet:
     outcome_criteria: dict[str, Any]
     criterion: dict[str, Any]
     pushes: list[TrainingPush] = field(default_factory=list)
+    controller_margin: float | None = None
 
 
 def _bad(file: str, key: str, reason: str, value: Any = None) -> ScenarioError:
@@ -186,6 +189,11 @@ def training_set(data: Any, file: str, sha256: str | None = None) -> TrainingSet
     criterion.update({k: v for k, v in data.items() if k not in KNOWN_KEYS})
     controller = data.get("controller")
     outcome_criteria = data.get("outcome_criteria")
+    own = data.get("controller_margin")
+    if own is not None:
+        own = _number(data, "controller_margin", file)
+        if own < 0:
+            raise _bad(file, "controller_margin", "must be >= 0 m", own)
     return TrainingSet(
         file,
         sha256,
@@ -196,6 +204,7 @@ def training_set(data: Any, file: str, sha256: str | None = None) -> TrainingSet
         dict(outcome_criteria) if isinstance(outcome_criteria, Mapping) else {},
         criterion,
         [p for p in pushes if p is not None],
+        own,
     )
 
 
@@ -259,8 +268,13 @@ class Calibration:
         strict: Whether the strict outcome was scored (else the lenient one).
         grid: The margins searched, m.
         curve: Per margin of ``grid``, the pooled :func:`~.scores.confusion`.
-        zmp_margin: The smallest margin meeting ``target`` (m), None when none does.
-        upper_margin: The smallest margin whose upper bound meets ``upper_target``, or None.
+        zmp_margin: The smallest margin at or above ``floor`` meeting ``target`` (m), None
+            when none does.
+        upper_margin: The smallest margin at or above ``floor`` whose upper bound meets
+            ``upper_target``, or None.
+        floor: The smallest margin searched (m): the controller's own margin by default.
+        unfloored_margin: The smallest margin of the whole grid meeting ``target`` (m), None
+            when none does: what the training stances alone would allow.
     """
 
     sets: list[TrainingSet]
@@ -271,6 +285,8 @@ class Calibration:
     curve: list[dict[str, Any]]
     zmp_margin: float | None
     upper_margin: float | None
+    floor: float = 0.0
+    unfloored_margin: float | None = None
 
     @property
     def outcome(self) -> str:
@@ -313,6 +329,8 @@ class Calibration:
             "upper_target": self.upper_target,
             "zmp_margin": self.zmp_margin,
             "answer": _answer(self.zmp_margin, self.target),
+            "margin_floor": self.floor,
+            "unfloored_margin": self.unfloored_margin,
             "fell_given_safe": None if chosen is None else chosen["fell_given_safe"],
             "safe_given_stood": None if chosen is None else chosen["safe_given_stood"],
             "stood_given_unsafe": None if chosen is None else chosen["stood_given_unsafe"],
@@ -361,6 +379,7 @@ def calibrate(
     strict: bool = True,
     upper_target: float = UPPER_TARGET,
     grid: Sequence[float] = MARGIN_GRID,
+    floor: float | str = "controller",
 ) -> Calibration:
     """The smallest ZMP margin that brings the pooled false-safe rate to ``target``.
 
@@ -371,13 +390,16 @@ def calibrate(
         strict: Score the strict outcome (``strict_fail``); False: the lenient one (``fell``).
         upper_target: The target of the rate's upper Wilson bound, in (0, 1).
         grid: The margins searched (m), in increasing order.
+        floor: The smallest margin the answers may take (m), or ``"controller"`` (the
+            default): the controller's own ZMP margin recorded in the files
+            (``controller_margin``; 0 when no file records it). 0: no floor.
 
     Returns:
         The :class:`Calibration` (its ``zmp_margin`` None when no margin reaches the target).
 
     Raises:
         ScenarioError: No training file, a bad file, mixed robots, controllers or settings
-            (naming the files), a target outside (0, 1).
+            (naming the files), a target outside (0, 1), a bad floor.
     """
     target = _check_target("--target", target)
     upper_target = _check_target("--upper-target", upper_target)
@@ -385,9 +407,17 @@ def calibrate(
         raise ScenarioError("FILE", [], "give at least one training file")
     sets = [_as_set(r, i) for i, r in enumerate(results)]
     _check_same(sets)
+    low = _floor(floor, sets)
     pushes = [p for s in sets for p in s.pushes]
-    margins = tuple(float(m) for m in grid)
+    margins = tuple(sorted({float(m) for m in grid} | {low}))
     curve = [_confusion(pushes, m, strict) for m in margins]
+
+    def meets(r: dict[str, Any]) -> bool:
+        return r["rate"] is not None and r["rate"] <= target
+
+    def upper_meets(r: dict[str, Any]) -> bool:
+        return r["ci95"] is not None and r["ci95"][1] <= upper_target
+
     return Calibration(
         sets,
         target,
@@ -395,9 +425,23 @@ def calibrate(
         strict,
         margins,
         curve,
-        _first(margins, curve, lambda r: r["rate"] is not None and r["rate"] <= target),
-        _first(margins, curve, lambda r: r["ci95"] is not None and r["ci95"][1] <= upper_target),
+        _first(margins, curve, meets, low),
+        _first(margins, curve, upper_meets, low),
+        low,
+        _first(margins, curve, meets, 0.0),
     )
+
+
+def _floor(floor: float | str, sets: Sequence[TrainingSet]) -> float:
+    """The floor in metres: ``floor``, or the files' controller margin for ``"controller"``."""
+    if floor == "controller":
+        own = [s.controller_margin for s in sets if s.controller_margin is not None]
+        return max(own, default=0.0)
+    if isinstance(floor, bool) or not isinstance(floor, (int, float)):
+        raise ScenarioError("--floor", floor, "must be a margin in metres or 'controller'")
+    if not (math.isfinite(floor) and 0.0 <= floor <= 1.0):
+        raise ScenarioError("--floor", floor, "must be in [0, 1] m")
+    return float(floor)
 
 
 def _as_set(r: Any, i: int) -> TrainingSet:
@@ -408,8 +452,10 @@ def _as_set(r: Any, i: int) -> TrainingSet:
     return read_training(r)
 
 
-def _first(margins: Sequence[float], curve: Sequence[dict[str, Any]], ok: Any) -> float | None:
+def _first(
+    margins: Sequence[float], curve: Sequence[dict[str, Any]], ok: Any, low: float
+) -> float | None:
     for m, k in zip(margins, curve, strict=True):
-        if ok(k["fell_given_safe"]):
+        if m >= low and ok(k["fell_given_safe"]):
             return m
     return None
