@@ -250,6 +250,25 @@ def _answer_mm(margin: float | None) -> str:
     return "no margin reaches the target" if margin is None else f"{1000 * margin:g} mm"
 
 
+def _removal_line(out: dict[str, Any]) -> str:
+    """The controller's realised angular momentum removal, per axis, against its declared K_L."""
+    parts = []
+    for axis, name in (("x", "roll"), ("y", "pitch")):
+        r = out["angular_momentum_removal"][axis]
+        if r["share"] is None:
+            parts.append(f"{name} not measured")
+            continue
+        tau = "never" if r["damping_time"] is None else f"tau {r['damping_time']:.3f} s"
+        parts.append(f"{name} {tau} (share {r['share']:.2f}, {r['pushes']} pushes)")
+    gain = out["controller"].get("gains", {}).get("angular_momentum_damping")
+    declared = (
+        f"; declared 1/K_L {1.0 / gain:.3f} s"
+        if isinstance(gain, (int, float)) and not isinstance(gain, bool) and gain > 0
+        else ""
+    )
+    return "  angular momentum removal realised: " + ", ".join(parts) + declared
+
+
 def _text(result: Calibration, out: dict[str, Any], args: argparse.Namespace) -> str:
     name = out["controller"].get("name", "?")
     lines = [
@@ -280,6 +299,7 @@ def _text(result: Calibration, out: dict[str, Any], args: argparse.Namespace) ->
         f"  upper 95 % bound <= {100 * result.upper_target:g} %: "
         + ("no margin up to the grid's end" if upper is None else f"{1000 * upper:g} mm")
     )
+    lines.append(_removal_line(out))
     if out["out"]:
         lines.append(f"  wrote {out['out']}")
     elif args.out:

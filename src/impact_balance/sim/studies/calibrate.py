@@ -32,12 +32,15 @@ from impact_balance.files import read_bounded
 from impact_balance.sim.studies.scores import FALSE_SAFE_TARGET, MARGIN_GRID, confusion
 
 __all__ = [
+    "AXIS_SHARE",
     "KNOWN_KEYS",
     "MAX_TRAINING_BYTES",
+    "REMOVAL_AXES",
     "UPPER_TARGET",
     "Calibration",
     "TrainingPush",
     "TrainingSet",
+    "angular_momentum_removal",
     "calibrate",
     "read_training",
     "training_set",
@@ -88,12 +91,18 @@ class TrainingPush:
         omega: Its stance's LIPM ``omega``, 1/s.
         fell: The trial fell (lenient failure).
         strict_fail: The trial failed strictly.
+        angular_momentum_at_end: The centroidal angular momentum the push left (N m s, world),
+            None when the file does not have it.
+        angular_momentum_removed: Its divergence-weighted decrements after the push (N m s,
+            world; :mod:`impact_balance.sim.trials.angular_momentum_removal`), None likewise.
     """
 
     margin: float
     omega: float
     fell: bool
     strict_fail: bool
+    angular_momentum_at_end: tuple[float, float, float] | None = None
+    angular_momentum_removed: tuple[float, float, float] | None = None
 
     def safe(self, zmp_margin: float) -> bool:
         """Whether the CoM criterion calls the push safe at ZMP margin ``zmp_margin`` (m)."""
@@ -152,7 +161,28 @@ def _push(p: Any, i: int, omega: float, zmp_margin: float, file: str) -> Trainin
     fell, strict = p.get("fell"), p.get("strict_fail")
     if not isinstance(fell, bool) or not isinstance(strict, bool):
         raise _bad(file, f"{where}.fell", "fell and strict_fail must be true or false", fell)
-    return TrainingPush(float(raw), omega, fell, strict)
+    found = p.get("trial")
+    trial: Mapping[str, Any] = found if isinstance(found, Mapping) else {}
+    return TrainingPush(
+        float(raw),
+        omega,
+        fell,
+        strict,
+        _vector3(trial.get("angular_momentum_at_end")),
+        _vector3(trial.get("angular_momentum_removed")),
+    )
+
+
+def _vector3(value: Any) -> tuple[float, float, float] | None:
+    """``value`` as three finite floats, None when it is not (absent from older files)."""
+    if not isinstance(value, (list, tuple)) or len(value) != 3:
+        return None
+    if not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in value):
+        return None
+    x, y, z = (float(v) for v in value)
+    if not all(math.isfinite(v) for v in (x, y, z)):
+        return None
+    return x, y, z
 
 
 def _number(data: Mapping[str, Any], key: str, file: str) -> float:
@@ -342,6 +372,9 @@ class Calibration:
                 for s in self.sets
             ],
             "per_file": None if self.zmp_margin is None else self.per_file(self.zmp_margin),
+            "angular_momentum_removal": angular_momentum_removal(
+                [p for s in self.sets for p in s.pushes], self.strict
+            ),
             "pushes": sum(len(s.pushes) for s in self.sets),
             "curve": [
                 {
@@ -353,6 +386,56 @@ class Calibration:
                 for m, k in zip(self.grid, self.curve, strict=True)
             ],
         }
+
+
+#: A push counts on an axis when that axis carries at least this share of the momentum it left.
+AXIS_SHARE = 0.25
+#: Axes of the angular momentum reported: roll (about world x) and pitch (about world y).
+REMOVAL_AXES = ("x", "y")
+
+
+def angular_momentum_removal(
+    pushes: Sequence[TrainingPush], strict: bool = True
+) -> dict[str, dict[str, Any]]:
+    """The controller's realised removal of the angular momentum pushes left, per axis.
+
+    Pooled over the pushes that did not fail (strictly, or by falling with ``strict`` False)
+    and whose axis carries at least :data:`AXIS_SHARE` of the momentum left: the share
+    ``rho = sum(sign(L0_i) removed_i) / sum(|L0_i|)`` of the immediate removal's capture cost,
+    and ``tau = (1 / rho - 1) / omega`` (s, ``omega`` the pushes' ``|L0_i|``-weighted mean),
+    the exponential removal's time constant that costs the same
+    (:mod:`impact_balance.sim.trials.angular_momentum_removal`).
+
+    Returns:
+        Per axis (``x``: roll, ``y``: pitch) ``{pushes, share, damping_time}``; ``share`` and
+        ``damping_time`` are None without pushes (files written before the measurement, or no
+        push left momentum on that axis), ``damping_time`` None also when ``share <= 0``.
+    """
+    from impact_balance.sim.trials.angular_momentum_removal import equivalent_damping_time
+
+    out: dict[str, dict[str, Any]] = {}
+    for i, axis in enumerate(REMOVAL_AXES):
+        left = removed = weighted_omega = 0.0
+        count = 0
+        for p in pushes:
+            if (p.strict_fail if strict else p.fell) or p.angular_momentum_at_end is None:
+                continue
+            if p.angular_momentum_removed is None:
+                continue
+            at_end = p.angular_momentum_at_end
+            if abs(at_end[i]) < AXIS_SHARE * math.hypot(*at_end) or at_end[i] == 0.0:
+                continue
+            sign = math.copysign(1.0, at_end[i])
+            left += abs(at_end[i])
+            removed += sign * p.angular_momentum_removed[i]
+            weighted_omega += abs(at_end[i]) * p.omega
+            count += 1
+        share = removed / left if count else None
+        tau = None
+        if share is not None:
+            tau = equivalent_damping_time(removed, left, weighted_omega / left)
+        out[axis] = {"pushes": count, "share": share, "damping_time": tau}
+    return out
 
 
 def _answer(margin: float | None, target: float) -> str:

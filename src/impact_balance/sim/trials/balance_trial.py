@@ -47,6 +47,7 @@ from impact_balance.sim.control.approach import standoff as approach_standoff
 from impact_balance.sim.control.controller import ControllerName, ControlStep
 from impact_balance.sim.control.registry import controller_class
 from impact_balance.sim.model.build import SimModel
+from impact_balance.sim.trials.angular_momentum_removal import AngularMomentumRemoval
 from impact_balance.sim.trials.impact_tracker import ImpactTracker
 from impact_balance.sim.trials.log import LOG_START, LogRecorder
 from impact_balance.sim.trials.outcomes import OutcomeMonitor
@@ -318,6 +319,7 @@ class _TrialRun:
         self.impact_force = np.zeros(3)
         self.fn = 0.0
         self.angular_momentum: _FloatArray | None = None
+        self.removal: AngularMomentumRemoval | None = None
         self.disturbance: float | None = None
         self.disturbance_end: float | None = None
         self.end_time = 0.0
@@ -409,15 +411,7 @@ class _TrialRun:
         controller.actuate(sim, out)
         dcm_margin = self._record(t, zmp, out)
         pin.framesForwardKinematics(self.model, self.pdata, q)
-        if (
-            self.angular_momentum is None
-            and self.disturbance_end is not None
-            and t >= self.disturbance_end
-        ):
-            # What the LIPM leaves out: the angular momentum about the CoM the disturbance left.
-            self.angular_momentum = np.array(
-                pin.computeCentroidalMomentum(self.model, self.pdata, q, v).angular
-            )
+        self._angular_momentum(t, q, v)
         push = self.push
         if push is not None and t >= push.start:
             self.monitor.start_disturbance(push.start)
@@ -443,6 +437,23 @@ class _TrialRun:
                 )
             return True
         return False
+
+    def _angular_momentum(self, t: float, q: _FloatArray, v: _FloatArray) -> None:
+        """The angular momentum about the CoM the disturbance left, and its removal.
+
+        What the LIPM leaves out: L at the disturbance's end, then how the controller removes
+        it (every control step until a fall).
+        """
+        if self.disturbance_end is None or t < self.disturbance_end or self.monitor.fell:
+            return
+        now = np.array(pin.computeCentroidalMomentum(self.model, self.pdata, q, v).angular)
+        if self.angular_momentum is None:
+            self.angular_momentum = now
+            self.removal = AngularMomentumRemoval(
+                self.analysis.areas.omega, self.disturbance_end, now
+            )
+        elif self.removal is not None:
+            self.removal.add(t, now)
 
     def _record(self, t: float, zmp: _FloatArray, out: ControlStep) -> float:
         """Append one control step to the series; return the DCM's margin in the ZMP area (m)."""
@@ -493,6 +504,9 @@ class _TrialRun:
             series=arrays,
             log=self.recorder.frame() if self.recorder is not None else None,
             angular_momentum_at_end=self.angular_momentum,
+            angular_momentum_removed=None
+            if self.removal is None or self.removal.samples == 0
+            else self.removal.removed,
             strict_fail=outcome.strict_fail,
             strict_reason=outcome.strict_reason,
             stance_changed_time=None

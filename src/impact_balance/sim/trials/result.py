@@ -130,6 +130,11 @@ class BalanceTrialResult:
             tilt (rad) and drop (m) seen.
         angular_momentum_at_end: Angular momentum about the CoM when the disturbance ended (N m s,
             world): what the LIPM leaves out (a push above the CoM leaves some).
+        angular_momentum_removed: Its decrements after the disturbance until the trial ended or
+            fell, each weighted by ``exp(-omega (t - end))`` (N m s, world; see
+            :mod:`.angular_momentum_removal`): over ``angular_momentum_at_end`` per axis, the
+            share of the immediate removal's capture cost the controller spent. None before
+            the disturbance ended.
         strict_fail, strict_reason: Whether the trial failed strictly (fell, or a contact broke
             beyond the strict bounds of :mod:`.outcomes`) and why.
         stance_changed_time: When the contacts first went beyond the strict bounds (s), None if
@@ -159,6 +164,7 @@ class BalanceTrialResult:
     sim_time: float = 0.0
     wall_time: float = 0.0
     angular_momentum_at_end: np.ndarray | None = None
+    angular_momentum_removed: np.ndarray | None = None
     strict_fail: bool = False
     strict_reason: str | None = None
     stance_changed_time: float | None = None
@@ -233,6 +239,12 @@ class BalanceTrialResult:
                 "angular_momentum_at_end",
                 self.angular_momentum_at_end,
                 "the disturbance did not end",
+            ),
+            "angular_momentum_removed": finite_or_null(
+                nulls,
+                "angular_momentum_removed",
+                self.angular_momentum_removed,
+                "the disturbance did not end before the trial did",
             ),
             "max_tilt_deg": float(np.rad2deg(self.max_tilt)),
             "max_slip": float(self.max_slip),
