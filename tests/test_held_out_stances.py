@@ -73,7 +73,7 @@ HAND_FRAMES = {
 #: A contact whose normal makes more than this with the vertical is on a slope (deg).
 SLOPE_DEG = 5.0
 #: Two feet whose contact centres are at least this far apart sideways (world y) stand wide (m):
-#: Talos' bundled stances are 0.17 m wide, G1's 0.24 m, Romeo's 0.20 m, iCub's 0.21 m.
+#: Talos' bundled stances are 0.17 m wide, G1's 0.24 m, Romeo's and iCub's 0.21 m.
 WIDE_M = 0.28
 #: Two feet whose contact centres are at least this far apart fore and aft (world x) are
 #: staggered (m).
@@ -284,3 +284,64 @@ def test_the_simulation_model_builds_with_the_push_bodies(path: Path) -> None:
         assert push_body(sim, torso) != sim.root_body
         assert sim.model.body(push_body(sim, torso)).name == torso
     assert push_body(sim, pelvis) == sim.root_body
+
+
+PROTOCOL_3 = STUDIES.parent / "docs" / "studies" / "held-out-protocol-3.md"
+
+
+def _protocol_rows(cells: int) -> dict[str, list[str]]:
+    """The third protocol's table rows with ``cells`` cells after the stance's name, by stance."""
+    rows = {}
+    for line in PROTOCOL_3.read_text().splitlines():
+        match = re.match(r"^\| `(\w+)` \|(.*)\|$", line)
+        if match and len(match.group(2).split("|")) == cells:
+            rows[match.group(1)] = [c.strip() for c in match.group(2).split("|")]
+    return rows
+
+
+def test_the_third_protocol_lists_every_stance_of_its_set() -> None:
+    names = {f.stem for f in SET_FILES["held_out_3"]}
+    assert set(_protocol_rows(5)) == names  # the stances' table
+    assert set(_protocol_rows(7)) == names  # the impacts' predictions
+    assert set(_protocol_rows(2)) == names  # the pushes' predictions
+
+
+@pytest.mark.parametrize("path", SET_FILES["held_out_3"], ids=_id)
+def test_the_third_protocol_impact_predictions_are_the_criterion_s(path: Path) -> None:
+    """Rule 4: the protocol's impact table is analyze's answer, to its last printed digit."""
+    row = [float(c) for c in _protocol_rows(7)[path.stem]]
+    scenario = load_scenario(str(path))
+    options: list[dict[str, float]] = [
+        {},
+        {"zmp_margin": 0.01},
+        {"angular_momentum_damping_time": 0.1},
+        {"angular_momentum_damping_time": 0.1, "zmp_margin": 0.01},
+    ]
+    impacts = [analyze(scenario.replace(**o)).to_dict()["impact"] for o in options]
+    com = [i.get("default_max_contact_velocity", i["max_contact_velocity"]) for i in impacts]
+    zmp = [impacts[0]["zmp_max_contact_velocity"], impacts[1]["zmp_max_contact_velocity"]]
+    reference = float(np.linalg.norm(impacts[0]["reference_velocity"]))
+    np.testing.assert_allclose(row, [*com, *zmp, reference], rtol=0, atol=0.0005 + 1e-9)
+
+
+@pytest.mark.parametrize("path", SET_FILES["held_out_3"], ids=_id)
+def test_the_third_protocol_push_predictions_are_the_criterion_s(path: Path) -> None:
+    """Rule 4 for the push table, recomputed from the CoM velocity area's half-planes.
+
+    At rest the boundary impulse along ``u`` is ``m min_k h_k / (G_k u)`` over the half-planes
+    ahead (``G_k u > 0``), and the 10 mm criterion calls a fraction ``f`` of it safe while
+    ``h_k - f r G_k u >= omega 0.01`` for every k: ``f = min_k (h_k - omega 0.01) / (r G_k u)``.
+    """
+    impulses, fractions = ([float(x) for x in c.split()] for c in _protocol_rows(2)[path.stem])
+    a = analyze(str(path))
+    G, h = a.areas.com_velocity_area.halfplanes
+    mass, slack = a.stance.mass, float(a.areas.omega) * 0.01
+    assert np.all(h >= slack)  # the stance is 10 mm inside: f is the only bound
+    for k in range(8):
+        u = np.array([np.cos(k * np.pi / 4), np.sin(k * np.pi / 4)])
+        rate = G @ u
+        ahead = rate > 1e-12
+        r = float(np.min(h[ahead] / rate[ahead]))
+        f = float(np.min((h[ahead] - slack) / (r * rate[ahead])))
+        assert abs(mass * r - impulses[k]) <= 0.05 + 1e-9, (k, mass * r, impulses[k])
+        assert abs(f - fractions[k]) <= 0.005 + 1e-9, (k, f, fractions[k])
