@@ -1,9 +1,9 @@
-"""The held-out sets (studies/held_out/, studies/held_out_2/; docs/studies/held-out-protocol*.md).
+"""The held-out sets (studies/held_out*/; docs/studies/held-out-protocol*.md).
 
 Only the criterion is evaluated here (no simulation): each file loads, can balance at rest (also
 with the 10 mm ZMP margin and with the angular momentum term), has a finite maximum contact
 velocity and no warning; each set covers the robots and the categories its protocol lists; no
-stance repeats a bundled scenario's contacts and impact, nor a stance of either set.
+stance repeats a bundled scenario's contacts and impact, nor a stance of any set.
 """
 
 from __future__ import annotations
@@ -34,11 +34,16 @@ REQUIRED = {
     "pelvis push",
     "slope",
 }
-#: Each set's folder and what it must cover; the second adds pushes on one foot.
+#: Each set's folder and what it must cover; the second adds pushes on one foot, the third
+#: forward impacts and wide, staggered two-feet stances.
 SETS = {
     "held_out": REQUIRED,
     "held_out_2": REQUIRED | {"one foot"},
+    "held_out_3": REQUIRED | {"one foot", "forward impact", "wide stance", "staggered"},
 }
+#: The sets checked under the protocol's options (10 mm margin, angular momentum term) and
+#: whose impact friction and restitution must be new: each against the stances before it.
+NEW_SETS = ["held_out_2", "held_out_3"]
 SET_FILES = {name: sorted((STUDIES / name).glob("*.yaml")) for name in SETS}
 FILES = [f for files in SET_FILES.values() for f in files]
 #: Stances on one foot the second set must hold at least (its lesson: a margin from two-feet
@@ -67,6 +72,17 @@ HAND_FRAMES = {
 }
 #: A contact whose normal makes more than this with the vertical is on a slope (deg).
 SLOPE_DEG = 5.0
+#: Two feet whose contact centres are at least this far apart sideways (world y) stand wide (m):
+#: Talos' bundled stances are 0.17 m wide, G1's 0.24 m, Romeo's and iCub's 0.21 m.
+WIDE_M = 0.28
+#: Two feet whose contact centres are at least this far apart fore and aft (world x) are
+#: staggered (m).
+STAGGER_M = 0.06
+#: The third set: its minimum size and robots, and the wide stances it must hold (on as many
+#: robots): the second set's Romeo fell on a wide stance where a margin called safe.
+THIRD_MIN_FILES = 7
+THIRD_MIN_ROBOTS = 4
+THIRD_MIN_WIDE = 2
 
 
 def _header(path: Path, key: str) -> str:
@@ -99,9 +115,14 @@ def _id(path: Path) -> str:
     return f"{_set_of(path)}/{path.stem}"
 
 
+def _feet(d: dict[str, Any]) -> list[dict[str, Any]]:
+    return [c for c in d["contacts"] if c["frame"] in FOOT_FRAMES]
+
+
 @pytest.mark.parametrize("name", sorted(SETS))
 def test_the_set_is_there(name: str) -> None:
-    assert len(SET_FILES[name]) >= 6, [f.name for f in SET_FILES[name]]
+    least = THIRD_MIN_FILES if name == "held_out_3" else 6
+    assert len(SET_FILES[name]) >= least, [f.name for f in SET_FILES[name]]
 
 
 @pytest.mark.parametrize("path", FILES, ids=_id)
@@ -117,16 +138,20 @@ def test_each_stance_is_well_posed(path: Path) -> None:
     assert d["impact"]["status"] == "ok"
 
 
-@pytest.mark.parametrize("path", SET_FILES["held_out_2"], ids=_id)
+@pytest.mark.parametrize("path", [f for name in NEW_SETS for f in SET_FILES[name]], ids=_id)
 @pytest.mark.parametrize(
     "options",
-    [{"zmp_margin": 0.01}, {"angular_momentum_damping_time": 0.1}],
-    ids=["zmp_margin_10mm", "angular_momentum_0.1s"],
+    [
+        {"zmp_margin": 0.01},
+        {"angular_momentum_damping_time": 0.1},
+        {"zmp_margin": 0.01, "angular_momentum_damping_time": 0.1},
+    ],
+    ids=["zmp_margin_10mm", "angular_momentum_0.1s", "both"],
 )
-def test_the_second_set_balances_under_the_checked_options(
+def test_the_later_sets_balance_under_the_checked_options(
     path: Path, options: dict[str, float]
 ) -> None:
-    """The protocol's checks: at rest with the 10 mm margin, and with the angular momentum term."""
+    """The protocol's checks: at rest with the 10 mm margin, the angular momentum term, both."""
     paper = analyze(str(path)).to_dict()["impact"]["max_contact_velocity"]
     d = analyze(load_scenario(str(path)).replace(**options)).to_dict()
     assert d["can_balance"] is True and d["warnings"] == [], d["warnings"]
@@ -147,6 +172,8 @@ def test_declared_categories_match_the_data(path: Path) -> None:
     normal /= np.linalg.norm(normal)
     # The normal points from the surface into the robot: a wall behind pushes along +x.
     assert ("backward impact" in covers) == (normal[0] > 0.7)
+    if "forward impact" in required:  # a wall in front pushes along -x
+        assert ("forward impact" in covers) == (normal[0] < -0.7)
     assert ("lateral impact" in covers) == (abs(normal[1]) > 0.7)
     frame = d["impact"]["frame"]
     assert ("foot impact" in covers) == (frame in FOOT_FRAMES)
@@ -156,9 +183,18 @@ def test_declared_categories_match_the_data(path: Path) -> None:
         for c in d["contacts"]
     ]
     assert ("slope" in covers) == (max(tilts) > SLOPE_DEG), tilts
+    feet = _feet(d)
     if "one foot" in required:
-        feet = [c for c in d["contacts"] if c["frame"] in FOOT_FRAMES]
         assert ("one foot" in covers) == (len(d["contacts"]) == 1 == len(feet)), d["contacts"]
+    two_feet = len(d["contacts"]) == 2 == len(feet)
+    # To the millimetre (the IK places a contact to about 1e-7 m).
+    apart = (
+        np.abs(np.subtract(*(c["position"] for c in feet))).round(3) if two_feet else np.zeros(3)
+    )
+    if "wide stance" in required:
+        assert ("wide stance" in covers) == (two_feet and apart[1] >= WIDE_M), apart
+    if "staggered" in required:
+        assert ("staggered" in covers) == (two_feet and apart[0] >= STAGGER_M), apart
     # Every stance is pushed at the torso and at the pelvis; the header names the bodies (a robot
     # without a body named like "torso" names its trunk with --body).
     assert {"torso push", "pelvis push"} <= covers
@@ -180,15 +216,30 @@ def test_the_set_covers_three_robots_and_every_category(name: str) -> None:
         assert sum("one foot" in _covers(f) for f in files) >= ONE_FOOT_MIN
 
 
-def test_the_second_set_uses_impact_values_no_other_stance_uses() -> None:
-    """Its impact friction and restitution are new: neither bundled nor the first set's."""
+def test_the_third_set_covers_four_robots_wide_stances_and_impacts_on_one_foot_and_slopes() -> None:
+    """Its protocol's aims: four robots, wide stances on two, impacts on one foot and on slopes."""
+    files = SET_FILES["held_out_3"]
+    robot = {f: load_scenario(str(f)).robot for f in files}
+    assert len(set(robot.values())) >= THIRD_MIN_ROBOTS, robot
+    wide = [f for f in files if "wide stance" in _covers(f)]
+    assert len(wide) >= THIRD_MIN_WIDE and len({robot[f] for f in wide}) >= THIRD_MIN_WIDE, wide
+    # Every wide stance is also staggered (the second set's Romeo stance was both).
+    assert all("staggered" in _covers(f) for f in wide), wide
+    for category in ("one foot", "slope"):
+        assert any(category in _covers(f) for f in files), category
+
+
+@pytest.mark.parametrize("name", NEW_SETS)
+def test_the_later_sets_use_impact_values_no_earlier_stance_uses(name: str) -> None:
+    """Their impact friction and restitution are new: neither bundled nor an earlier set's."""
 
     def values(s: Any) -> tuple[float, tuple[float, ...]]:
         return (float(s.impact.friction), tuple(float(e) for e in s.impact.restitution))
 
     others = {values(load_scenario(n)) for n in bundled_scenarios() if load_scenario(n).impact}
-    others |= {values(load_scenario(str(f))) for f in SET_FILES["held_out"]}
-    for f in SET_FILES["held_out_2"]:
+    earlier = list(SETS)[: list(SETS).index(name)]
+    others |= {values(load_scenario(str(f))) for s in earlier for f in SET_FILES[s]}
+    for f in SET_FILES[name]:
         friction, restitution = values(load_scenario(str(f)))
         assert friction not in {o[0] for o in others}, (f.name, friction)
         assert restitution not in {o[1] for o in others}, (f.name, restitution)
@@ -233,3 +284,64 @@ def test_the_simulation_model_builds_with_the_push_bodies(path: Path) -> None:
         assert push_body(sim, torso) != sim.root_body
         assert sim.model.body(push_body(sim, torso)).name == torso
     assert push_body(sim, pelvis) == sim.root_body
+
+
+PROTOCOL_3 = STUDIES.parent / "docs" / "studies" / "held-out-protocol-3.md"
+
+
+def _protocol_rows(cells: int) -> dict[str, list[str]]:
+    """The third protocol's table rows with ``cells`` cells after the stance's name, by stance."""
+    rows = {}
+    for line in PROTOCOL_3.read_text().splitlines():
+        match = re.match(r"^\| `(\w+)` \|(.*)\|$", line)
+        if match and len(match.group(2).split("|")) == cells:
+            rows[match.group(1)] = [c.strip() for c in match.group(2).split("|")]
+    return rows
+
+
+def test_the_third_protocol_lists_every_stance_of_its_set() -> None:
+    names = {f.stem for f in SET_FILES["held_out_3"]}
+    assert set(_protocol_rows(5)) == names  # the stances' table
+    assert set(_protocol_rows(7)) == names  # the impacts' predictions
+    assert set(_protocol_rows(2)) == names  # the pushes' predictions
+
+
+@pytest.mark.parametrize("path", SET_FILES["held_out_3"], ids=_id)
+def test_the_third_protocol_impact_predictions_are_the_criterion_s(path: Path) -> None:
+    """Rule 4: the protocol's impact table is analyze's answer, to its last printed digit."""
+    row = [float(c) for c in _protocol_rows(7)[path.stem]]
+    scenario = load_scenario(str(path))
+    options: list[dict[str, float]] = [
+        {},
+        {"zmp_margin": 0.01},
+        {"angular_momentum_damping_time": 0.1},
+        {"angular_momentum_damping_time": 0.1, "zmp_margin": 0.01},
+    ]
+    impacts = [analyze(scenario.replace(**o)).to_dict()["impact"] for o in options]
+    com = [i.get("default_max_contact_velocity", i["max_contact_velocity"]) for i in impacts]
+    zmp = [impacts[0]["zmp_max_contact_velocity"], impacts[1]["zmp_max_contact_velocity"]]
+    reference = float(np.linalg.norm(impacts[0]["reference_velocity"]))
+    np.testing.assert_allclose(row, [*com, *zmp, reference], rtol=0, atol=0.0005 + 1e-9)
+
+
+@pytest.mark.parametrize("path", SET_FILES["held_out_3"], ids=_id)
+def test_the_third_protocol_push_predictions_are_the_criterion_s(path: Path) -> None:
+    """Rule 4 for the push table, recomputed from the CoM velocity area's half-planes.
+
+    At rest the boundary impulse along ``u`` is ``m min_k h_k / (G_k u)`` over the half-planes
+    ahead (``G_k u > 0``), and the 10 mm criterion calls a fraction ``f`` of it safe while
+    ``h_k - f r G_k u >= omega 0.01`` for every k: ``f = min_k (h_k - omega 0.01) / (r G_k u)``.
+    """
+    impulses, fractions = ([float(x) for x in c.split()] for c in _protocol_rows(2)[path.stem])
+    a = analyze(str(path))
+    G, h = a.areas.com_velocity_area.halfplanes
+    mass, slack = a.stance.mass, float(a.areas.omega) * 0.01
+    assert np.all(h >= slack)  # the stance is 10 mm inside: f is the only bound
+    for k in range(8):
+        u = np.array([np.cos(k * np.pi / 4), np.sin(k * np.pi / 4)])
+        rate = G @ u
+        ahead = rate > 1e-12
+        r = float(np.min(h[ahead] / rate[ahead]))
+        f = float(np.min((h[ahead] - slack) / (r * rate[ahead])))
+        assert abs(mass * r - impulses[k]) <= 0.05 + 1e-9, (k, mass * r, impulses[k])
+        assert abs(f - fractions[k]) <= 0.005 + 1e-9, (k, f, fractions[k])
