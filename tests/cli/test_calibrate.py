@@ -202,3 +202,29 @@ def test_every_trial_command_reads_the_calibration_before_any_trial(tmp_path, ca
     path.write_text(yaml.safe_dump(calibration_mapping(robot="g1")))
     rc, _, err = run_cli(capsys, *argv, "--calibration", str(path))
     assert_one_line_error(rc, err, "--calibration", "calibrated for robot 'g1'")
+
+
+def test_the_file_records_the_realised_angular_momentum_removal(tmp_path, capsys, monkeypatch):
+    from impact_balance.scenario.calibration import read_calibration
+
+    monkeypatch.chdir(tmp_path)
+    document = push_test_document([(0.2, False, False)] * 3 + [(0.2, True, True)])
+    measured = [([0.5, 6.0, 0.1], [0.2, 3.0, 0.0])] * 3 + [([0.0, 6.0, 0.0], [0.0, -5.0, 0.0])]
+    for push, (at_end, removed) in zip(document["pushes"], measured, strict=True):
+        push["trial"] = {"angular_momentum_at_end": at_end, "angular_momentum_removed": removed}
+    path = write_document(tmp_path / "t.json", document)
+    argv = ["calibrate", str(path), "--target", "0.5"]
+    rc, out, err = run_cli(capsys, *argv, "--json", "--out", "c.yaml")
+    assert rc == 0, err
+    removal = strict_json(out)["angular_momentum_removal"]
+    # The three pushes that stood: pitch share 3/6 = 0.5; the one that failed is left out; roll
+    # carries under a quarter of the momentum (0.5 of 6.02 N m s): not counted.
+    assert removal["y"]["pushes"] == 3 and removal["y"]["share"] == 0.5
+    assert removal["y"]["damping_time"] == pytest.approx((1 / 0.5 - 1) / 3.3, rel=1e-12)
+    assert removal["x"] == {"pushes": 0, "share": None, "damping_time": None}
+    written = read_calibration("c.yaml").angular_momentum_removal
+    assert written is not None
+    assert written["y"].model_dump() == removal["y"] and written["x"].model_dump() == removal["x"]
+    rc, out, err = run_cli(capsys, *argv)
+    assert "pitch tau 0.303 s (share 0.50, 3 pushes), roll not measured" not in out
+    assert "roll not measured, pitch tau 0.303 s (share 0.50, 3 pushes)" in out

@@ -186,11 +186,14 @@ def _file_model(result: Calibration) -> Any:
         CALIBRATION_VERSION,
         CalibrationFile,
         CalibrationRate,
+        RemovalAxis,
         TrainingFile,
     )
+    from impact_balance.sim.studies.calibrate import angular_momentum_removal
 
     assert result.zmp_margin is not None
     chosen = result.at(result.zmp_margin)
+    removal = angular_momentum_removal([p for s in result.sets for p in s.pushes], result.strict)
     first = result.sets[0]
     return CalibrationFile(
         version=CALIBRATION_VERSION,
@@ -207,6 +210,10 @@ def _file_model(result: Calibration) -> Any:
         upper_margin=result.upper_margin,
         margin_floor=result.floor,
         unfloored_margin=result.unfloored_margin,
+        angular_momentum_removal={
+            "x": RemovalAxis(**removal["x"]),
+            "y": RemovalAxis(**removal["y"]),
+        },
         training=[
             TrainingFile(
                 file=s.file,

@@ -29,6 +29,7 @@ __all__ = [
     "MAX_CALIBRATION_BYTES",
     "CalibrationFile",
     "CalibrationRate",
+    "RemovalAxis",
     "TrainingFile",
     "apply_calibration",
     "calibration_in_use",
@@ -55,6 +56,19 @@ class CalibrationRate(_Strict):
     ci95: Annotated[list[Fraction], Field(min_length=2, max_length=2)] | None
     count: Annotated[int, Field(ge=0)]
     of: Annotated[int, Field(ge=0)]
+
+
+class RemovalAxis(_Strict):
+    """The controller's realised angular momentum removal on one axis (``calibrate``).
+
+    ``share``: the part of the immediate removal's capture cost spent, pooled; ``damping_time``
+    (s): the exponential removal's time constant that costs the same; both None without pushes
+    (``damping_time`` also when nothing was removed).
+    """
+
+    pushes: Annotated[int, Field(ge=0)]
+    share: Annotated[float, Field(allow_inf_nan=False)] | None
+    damping_time: Annotated[float, Field(ge=0.0, allow_inf_nan=False)] | None
 
 
 class TrainingFile(_Strict):
@@ -90,6 +104,9 @@ class CalibrationFile(_Strict):
             controller's own ZMP margin by default (0 in files written before the floor).
         unfloored_margin: The smallest margin meeting the target without the floor, m, or
             None (none does, or the file predates the floor).
+        angular_momentum_removal: The trials' controller's realised removal of the angular
+            momentum pushes left, per axis (``x`` roll, ``y`` pitch), None in older files;
+            informative: no command reads it as the criterion's tau.
         created: When the file was written (ISO 8601, UTC).
         impact_balance_version: The package's version that wrote it.
     """
@@ -111,6 +128,7 @@ class CalibrationFile(_Strict):
     unfloored_margin: Annotated[float, Field(ge=0.0, le=MAX_SIZE, allow_inf_nan=False)] | None = (
         None
     )
+    angular_momentum_removal: dict[Literal["x", "y"], RemovalAxis] | None = None
     created: str
     impact_balance_version: str
 
