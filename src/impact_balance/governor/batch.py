@@ -40,6 +40,7 @@ from impact_balance.geometry.polygon import MERGE_AREA_TOLERANCE
 from impact_balance.governor.limit import SpeedLimit
 from impact_balance.governor.options import Criterion
 from impact_balance.governor.posture import PostureEvaluator
+from impact_balance.governor.tick import com_velocities, com_velocity
 from impact_balance.projection.walk import MAX_PIVOTS
 from impact_balance.robot.robot import Robot
 
@@ -371,15 +372,14 @@ class _Slice:
 def _com_velocity(
     com_jacobian: npt.NDArray[np.float64], v: npt.NDArray[np.float64], i: int
 ) -> npt.NDArray[np.float64]:
-    """``com_jacobian @ v`` (row ``i``), checked as :meth:`Governor.limit` checks it (m/s)."""
-    com_velocity: npt.NDArray[np.float64] = com_jacobian @ v
-    if not float(com_velocity @ com_velocity) <= MAX_SPEED * MAX_SPEED:
-        raise GovernorError(
-            f"v_batch[{i}]",
-            f"CoM velocity {math.hypot(*com_velocity):.3g} m/s",
-            f"gives a CoM speed above {MAX_SPEED:g} m/s (the scenario's bound)",
-        )
-    return com_velocity
+    """``com_jacobian @ v`` (row ``i``), checked as :meth:`Governor.limit` checks it (m/s).
+
+    The single tick's product (:func:`~impact_balance.governor.tick.com_velocity`).
+    """
+    out = np.empty(3)
+    com_velocity(com_jacobian, v, out)
+    _check_speeds(out[None, :], np.array([i]))
+    return out
 
 
 def _com_velocities(
@@ -389,11 +389,17 @@ def _com_velocities(
 ) -> npt.NDArray[np.float64]:
     """``com_jacobian @ v`` of each row of ``vs`` (rows ``indices`` of the batch), checked.
 
-    One stacked product: numpy makes each row's matrix-vector product as for one vector (the
-    same numbers as :meth:`Governor.limit`'s ``com_jacobian @ v``).
+    Row by row the single tick's product (:func:`~impact_balance.governor.tick.com_velocities`):
+    the same numbers as :meth:`Governor.limit`'s.
     """
-    out: npt.NDArray[np.float64] = np.matmul(com_jacobian, vs[:, :, None])[:, :, 0]
-    out = np.ascontiguousarray(out)
+    out = np.empty((len(vs), 3))
+    com_velocities(com_jacobian, np.ascontiguousarray(vs), out)
+    _check_speeds(out, indices)
+    return out
+
+
+def _check_speeds(out: npt.NDArray[np.float64], indices: npt.NDArray[np.int64]) -> None:
+    """:class:`GovernorError` naming the first row of ``out`` (CoM velocities, m/s) too fast."""
     speeds: npt.NDArray[np.float64] = np.einsum("ij,ij->i", out, out)
     bad = np.flatnonzero(~(speeds <= MAX_SPEED * MAX_SPEED))
     if bad.size:
@@ -403,7 +409,6 @@ def _com_velocities(
             f"CoM velocity {math.hypot(*out[j]):.3g} m/s",
             f"gives a CoM speed above {MAX_SPEED:g} m/s (the scenario's bound)",
         )
-    return out
 
 
 def _matrix(x: ArrayLike, size: int, field: str) -> npt.NDArray[np.float64]:

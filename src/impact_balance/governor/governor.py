@@ -7,7 +7,7 @@ import os
 import threading
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 import numpy as np
 import numpy.typing as npt
@@ -19,13 +19,15 @@ from impact_balance.balance.areas import warm_up as warm_up_maps
 from impact_balance.constants import MAX_POSITION, MAX_SPEED
 from impact_balance.contacts.stance import ContactSpec, has_free_flyer
 from impact_balance.criteria.cap import cap_approach
+from impact_balance.criteria.linear_exit import BOUNDARY_TOLERANCE
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.exceptions import GovernorError, ScenarioError
 from impact_balance.governor.batch import BatchEvaluator, BatchLimits
-from impact_balance.governor.limit import Binding, SpeedLimit
+from impact_balance.governor.limit import Binding, SpeedLimit, _floating_limit
 from impact_balance.governor.options import CRITERIA, ContactAwareOptions, Criterion
 from impact_balance.governor.posture import Posture, PostureEvaluator, PostureSettings
 from impact_balance.governor.support import ContactAwareLimit, combine
+from impact_balance.governor.tick import NOT_FINITE, velocity_exit
 from impact_balance.governor.worker import ContactAwareWorker
 from impact_balance.projection.bretl import warm_up as warm_up_bretl
 from impact_balance.projection.walk import warm_up
@@ -53,9 +55,11 @@ QUATERNION_TOLERANCE = 1e-6
 #: simulation, encoder noise), a posture farther out is not the robot's.
 JOINT_LIMIT_TOLERANCE = 0.1
 
-#: Below this squared CoM speed bound, (m/s)^2, a tick's CoM velocity is surely within
-#: MAX_SPEED (the bound's rounding is far inside the factor).
-_SURELY_SLOW = 0.999999 * MAX_SPEED * MAX_SPEED
+_MAX_SPEED_SQUARED = MAX_SPEED * MAX_SPEED
+_FLOAT = np.dtype(np.float64)  # numpy's own float64 dtype: a float array's dtype is this object
+_STRIDE = (8,)  # a contiguous float64 vector's
+#: The half-planes and rates :func:`velocity_exit` takes where there is no area to exit.
+_NO_AREA = (np.zeros((0, 2)), np.zeros(0), np.zeros((0, 0)))
 
 
 class Governor:
@@ -155,6 +159,7 @@ class Governor:
         self.robot: Robot = scenario.load_robot()
         model = self.robot.model
         self.nq, self.nv = model.nq, model.nv
+        self._q_shape, self._v_shape = (self.nq,), (self.nv,)
         self._free_flyer = has_free_flyer(model)
         self._joints = _JointBounds(self.robot)
         assert scenario.impact is not None  # _governed refuses a scenario without one
@@ -187,8 +192,6 @@ class Governor:
         self._last: SpeedLimit | None = None
         self._posture: Posture | None = self._first_posture()
         self._support_posture: bytes | None = None
-        self._jacobian_key: bytes | None = None  # the posture of _jacobian_squared
-        self._jacobian_squared = math.inf
         self._aware = aware
         self._clock = _RatesClock()  # the rates' age
         if self._support is not None and aware is not None and aware.asynchronous:
@@ -255,22 +258,62 @@ class Governor:
             ScenarioError, ImpactModelError, SolverError: a posture the pipeline cannot
                 evaluate (see :meth:`~impact_balance.governor.posture.PostureEvaluator.evaluate`).
         """
+        with self._lock:
+            posture = self._posture
+            # The very q of the cached posture (checked when it was evaluated): no check again.
+            if posture is not None and _is_key(q, posture.key, self._q_shape):
+                return self._tick(posture, _velocity(v, self._v_shape), True)
         configuration = self._configuration(q)
-        velocity, squared = _squared_vector(v, self.nv, "v")
+        velocity = _vector(v, self.nv, "v")
         with self._lock:
             posture, reused = self._posture_at(configuration)
-            com_velocity = posture.com_jacobian @ velocity  # |v| < 1e154: no overflow
-            # A reused posture (a velocity-only tick): |J v|^2 <= |J|_F^2 |v|^2 settles it
-            # unless v is near the bound; else the exact check.
-            if not (reused and squared * self._jacobian_size(posture) <= _SURELY_SLOW) and not (
-                float(np.dot(com_velocity, com_velocity)) <= MAX_SPEED * MAX_SPEED
-            ):
-                raise GovernorError(
-                    "v",
-                    f"CoM velocity {math.hypot(*com_velocity):.3g} m/s",
-                    f"gives a CoM speed above {MAX_SPEED:g} m/s (the scenario's bound)",
-                )
+            return self._tick(posture, velocity, reused)
+
+    def _tick(self, posture: Posture, v: npt.NDArray[np.float64], reused: bool) -> SpeedLimit:
+        """The answer at ``posture`` for the generalized velocity ``v`` (under the lock).
+
+        ``v``: (nv,) contiguous floats, checked here (not finite, or a CoM speed above
+        ``MAX_SPEED``: :class:`GovernorError`). The "com" criterion without the contact-aware
+        bound is one compiled call (:func:`~impact_balance.governor.tick.velocity_exit`) and the
+        answer; the others go through :meth:`_answer`.
+        """
+        criterion = posture.com_criterion
+        com_velocity = np.empty(3)
+        G, h, rates = _NO_AREA
+        fast = criterion is not None and criterion.G is not None and self._support is None
+        if criterion is not None and fast:
+            G, h, rates = criterion.G, criterion.h, criterion.rates  # type: ignore[assignment]
+        code, speed, j, k = velocity_exit(
+            posture.com_jacobian,
+            v,
+            G,
+            h,
+            rates,
+            BOUNDARY_TOLERANCE,
+            _MAX_SPEED_SQUARED,
+            com_velocity,
+        )
+        if code < 0:
+            _refuse_velocity(code, v, self.nv, com_velocity)
+        if not fast or code == 1:  # the general answer (already falling: the safe interval)
             return self._answer(posture, com_velocity, reused)
+        model = posture.impact
+        vertex, edge = (j, k) if code == 0 else (None, None)
+        if code != 0:  # unbounded
+            speed = math.inf
+        self._last = answer = _floating_limit(
+            self.criterion,
+            speed,
+            "ok" if code == 0 else "unbounded",
+            vertex,
+            edge,
+            (0.0, speed),
+            com_velocity,
+            model.normal,
+            model.point,
+            reused,
+        )
+        return answer
 
     def limits(self, q_batch: ArrayLike, v_batch: ArrayLike, *, threads: int = 1) -> BatchLimits:
         """The speed limits of N postures: row i is ``limit(q_batch[i], v_batch[i])``.
@@ -441,17 +484,6 @@ class Governor:
                     f"{QUATERNION_TOLERANCE:g}); normalise it",
                 )
         return configuration
-
-    def _jacobian_size(self, posture: Posture) -> float:
-        """The squared Frobenius norm of ``posture``'s CoM Jacobian, (m/s)^2 per unit of v^2.
-
-        Computed once per posture (under the lock).
-        """
-        if self._jacobian_key is not posture.key:
-            self._jacobian_key = posture.key
-            J = posture.com_jacobian
-            self._jacobian_squared = float(np.vdot(J, J))
-        return self._jacobian_squared
 
     def _checked_row(self, q: npt.NDArray[np.float64], field: str) -> npt.NDArray[np.float64]:
         """Row ``q`` of a batch checked as :meth:`limit` checks ``q`` (errors name ``field``)."""
@@ -775,6 +807,37 @@ def _zmp_interval(limit: ContactVelocityLimit) -> tuple[float, float] | None:
     ZMP area) or the area is empty.
     """
     return limit.interval_from_inside()
+
+
+def _is_key(q: object, key: bytes, shape: tuple[int]) -> bool:
+    """Whether ``q`` is a float64 array of ``shape`` whose bytes are ``key`` (a posture's q)."""
+    return (
+        type(q) is np.ndarray and q.dtype == np.float64 and q.shape == shape and q.tobytes() == key
+    )
+
+
+def _velocity(v: ArrayLike, shape: tuple[int]) -> npt.NDArray[np.float64]:
+    """``v`` as a contiguous float vector of ``shape`` (checked as :func:`_vector` checks it).
+
+    A contiguous float64 array of that shape as it is: its finiteness is checked by the
+    compiled call that reads it (:meth:`Governor._tick`).
+    """
+    if type(v) is np.ndarray and v.dtype is _FLOAT and v.shape == shape and v.strides == _STRIDE:
+        return v
+    return _vector(v, shape[0], "v")
+
+
+def _refuse_velocity(
+    code: int, v: npt.NDArray[np.float64], nv: int, com_velocity: npt.NDArray[np.float64]
+) -> NoReturn:
+    """Raise :class:`GovernorError` for :func:`velocity_exit`'s refusal ``code`` of ``v``."""
+    if code == NOT_FINITE:
+        _vector(v, nv, "v")  # raises, naming the entry
+    raise GovernorError(
+        "v",
+        f"CoM velocity {math.hypot(*com_velocity):.3g} m/s",
+        f"gives a CoM speed above {MAX_SPEED:g} m/s (the scenario's bound)",
+    )
 
 
 def _is_real(x: object) -> bool:
