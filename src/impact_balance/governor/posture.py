@@ -32,11 +32,14 @@ from impact_balance.balance.areas import BalanceAreas, Projected, posture_areas
 from impact_balance.balance.lipm import lipm_omega
 from impact_balance.contacts.cwc import local_faces
 from impact_balance.contacts.stance import ContactSpec, Stance, has_free_flyer
+from impact_balance.contacts.wrench_polytope import face_blocks
 from impact_balance.criteria.com import ComCriterion
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.criteria.zmp import zmp_max_contact_velocity
 from impact_balance.exceptions import SolverError
+from impact_balance.geometry.polygon import Polygon
 from impact_balance.governor.options import Criterion
+from impact_balance.governor.posture_kernel import constants, posture_kernel
 from impact_balance.impact.angular_momentum import AngularMomentumTerm, angular_momentum_gain
 from impact_balance.impact.model import (
     ImpactModel,
@@ -46,6 +49,7 @@ from impact_balance.impact.model import (
     joint_space_inertia_map,
     model_from_inertia_map,
 )
+from impact_balance.projection.walk import MAX_PIVOTS
 from impact_balance.robot.robot import Robot, Scratch
 
 __all__ = ["Kinematics", "Posture", "PostureEvaluator", "PostureSettings"]
@@ -210,6 +214,18 @@ class PostureEvaluator:
         self._idx: npt.NDArray[np.int64] = idx if self._torques else np.zeros(0, dtype=np.int64)
         self._limit: npt.NDArray[np.float64] = limit if self._torques else np.zeros(0)
         self._normal, self._cone = impact_cone(impact)
+        # The common case in one compiled call (posture_kernel): the paper's "com" criterion,
+        # the composite inertia, unscaled contacts (frictions <= 1).
+        self._compiled = (
+            settings.criterion == "com"
+            and impact.inertia == "composite"
+            and settings.angular_momentum_damping_time is None
+            and not self._scaled
+        )
+        lo, hi = impact.restitution
+        self._constants = constants(float(settings.zmp_margin), (float(lo), float(hi)))
+        self._limit = np.ascontiguousarray(self._limit, dtype=float)
+        self._idx = np.ascontiguousarray(self._idx, dtype=np.int64)
         # Buffers, overwritten every posture (the answers keep copies).
         self._q_local = np.zeros(model.nq)
         self._zero_velocity = np.zeros(model.nv)
@@ -229,6 +245,10 @@ class PostureEvaluator:
         """
         robot, settings = self.robot, self.settings
         k = self.kinematics(q)
+        if self._compiled:
+            posture = self._compiled_posture(q, k)
+            if posture is not None:
+                return posture
         origin, com_local, mass, com = k.origin, k.com_local, k.mass, k.com
         rotations, local, jacobians = k.rotations, k.local, k.jacobians
         gravity_torques, com_jacobian = k.gravity_torques, k.com_jacobian
@@ -269,6 +289,88 @@ class PostureEvaluator:
             com_jacobian,
             com_criterion,
             zmp,
+        )
+
+    def _compiled_posture(self, q: np.ndarray, k: Kinematics) -> Posture | None:
+        """:meth:`evaluate`'s answer by :func:`~.posture_kernel.posture_kernel` (one call).
+
+        None when the kernel leaves the posture to :meth:`evaluate`'s steps (a walk not
+        certified, an area of fewer than 3 vertices, an impact model they refuse).
+        """
+        settings, data, model = self.settings, self.scratch.data, self.model
+        com, mass = k.com, k.mass
+        w = lipm_omega(float(com[2]), settings.plane_height, settings.gravity, field="plane_height")
+        fid = self._impact_frame
+        point_local = pin.updateFramePlacement(model, data, fid).translation.copy()
+        J = pin.getFrameJacobian(model, data, fid, _WORLD)[:3].copy()
+        out = posture_kernel(
+            face_blocks(self._faces, k.rotations),
+            k.local + k.origin,
+            k.local - k.com_local,
+            k.jacobians,
+            self._idx,
+            self._limit,
+            k.gravity_torques,
+            mass * settings.gravity,
+            settings.plane_height - float(com[2]),
+            float(com[0]),
+            float(com[1]),
+            w,
+            self._hint,
+            MAX_PIVOTS,
+            self._constants,
+            point_local - k.com_local,
+            mass,
+            k.inertia,
+            self._normal,
+            self._cone,
+        )
+        code, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h, W, impulse, rates = out
+        if code:
+            return None
+        area = Polygon.with_halfplanes(vel, bool(vel_bounded), G, h)
+        impact = ImpactModel(
+            settings.impact,
+            point_local + k.origin,
+            self._normal.copy(),
+            self._cone.copy(),
+            W,
+            mass,
+            J,
+            impulse,
+        )
+        margin = settings.velocity_margin
+        criterion = ComCriterion.from_rates(
+            area, impact, margin, G, h - margin if margin else h, rates
+        )
+        projected = Projected(
+            force,
+            bool(bounded),
+            zmp,
+            bool(zmp_bounded),
+            area,
+            1,
+            w,
+            com,
+            settings.plane_height,
+            mass,
+            settings.gravity,
+            float(settings.zmp_margin),
+        )
+        q = q.copy()
+        q.setflags(write=False)
+        return Posture(
+            q.tobytes(),
+            q,
+            self.robot,
+            settings,
+            com,
+            mass,
+            projected,
+            impact,
+            k.com_jacobian,
+            criterion,
+            None,
         )
 
     def kinematics(self, q: np.ndarray) -> Kinematics:
