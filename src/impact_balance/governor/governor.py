@@ -210,8 +210,18 @@ class Governor:
         warm_up()  # the projection kernel's one-time load
         warm_up_bretl()  # the fallback's (HiGHS), so that a tick that falls back is not slow
         warm_up_maps()  # and the fallback's compiled map
-        joints = self._joints  # and the joint check's
-        _first_outside(self.configuration, joints.idx, joints.lower, joints.upper)
+        joints = self._joints  # and the state check's
+        _state_fault(
+            self.configuration,
+            np.zeros(self.nv),
+            joints.idx,
+            joints.lower,
+            joints.upper,
+            joints.pair_indices,
+            self._free_flyer,
+            MAX_POSITION,
+            QUATERNION_TOLERANCE,
+        )
         try:
             posture = self._evaluator.evaluate(self.configuration)
         except ScenarioError as exc:
@@ -263,11 +273,41 @@ class Governor:
             # The very q of the cached posture (checked when it was evaluated): no check again.
             if posture is not None and _is_key(q, posture.key, self._q_shape):
                 return self._tick(posture, _velocity(v, self._v_shape), True)
-        configuration = self._configuration(q)
-        velocity = _vector(v, self.nv, "v")
+        configuration, velocity = self._state(q, v)
         with self._lock:
-            posture, reused = self._posture_at(configuration)
+            posture, reused = self._posture_at(configuration, checked=True)
             return self._tick(posture, velocity, reused)
+
+    def _state(
+        self, q: ArrayLike, v: ArrayLike
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """``q`` and ``v`` as contiguous float vectors, checked as :meth:`limit` says.
+
+        Contiguous float64 arrays of the right sizes are checked in one compiled pass
+        (:func:`_state_fault`); anything else, or a state it finds at fault, by the checks that
+        name the field and value (in the order q, v, the joints).
+        """
+        configuration, velocity = _as_is(q, self._q_shape), _as_is(v, self._v_shape)
+        joints = self._joints
+        if (
+            configuration is None
+            or velocity is None
+            or _state_fault(
+                configuration,
+                velocity,
+                joints.idx,
+                joints.lower,
+                joints.upper,
+                joints.pair_indices,
+                self._free_flyer,
+                MAX_POSITION,
+                QUATERNION_TOLERANCE,
+            )
+        ):
+            configuration = self._configuration(q)
+            velocity = _vector(v, self.nv, "v")
+            joints.check(configuration)
+        return configuration, velocity
 
     def _tick(self, posture: Posture, v: npt.NDArray[np.float64], reused: bool) -> SpeedLimit:
         """The answer at ``posture`` for the generalized velocity ``v`` (under the lock).
@@ -494,17 +534,24 @@ class Governor:
             raise GovernorError(field + exc.field[1:], exc.value, exc.reason) from None
         return configuration
 
-    def _posture_at(self, q: npt.NDArray[np.float64]) -> tuple[Posture, bool]:
-        """The posture of ``q``, reused when it is the cached one (under the lock)."""
+    def _posture_at(
+        self, q: npt.NDArray[np.float64], checked: bool = False
+    ) -> tuple[Posture, bool]:
+        """The posture of ``q``, reused when it is the cached one (under the lock).
+
+        ``checked``: the joints of ``q`` were checked already.
+        """
         cached = self._posture
         if cached is not None:
             if self.posture_tolerance == 0.0:
                 if cached.key == q.tobytes():  # the very q checked when it was evaluated
                     return cached, True
             elif float(np.abs(q - cached.q).max()) <= self.posture_tolerance:
-                self._joints.check(q)
+                if not checked:
+                    self._joints.check(q)
                 return cached, True
-        self._joints.check(q)
+        if not checked:
+            self._joints.check(q)
         try:
             posture = self._evaluator.evaluate(q)
         except ScenarioError as exc:
@@ -816,15 +863,21 @@ def _is_key(q: object, key: bytes, shape: tuple[int]) -> bool:
     )
 
 
+def _as_is(x: object, shape: tuple[int]) -> npt.NDArray[np.float64] | None:
+    """``x`` when it is a contiguous float64 array of ``shape`` (numpy's own dtype), else None."""
+    if type(x) is np.ndarray and x.dtype is _FLOAT and x.shape == shape and x.strides == _STRIDE:
+        return x
+    return None
+
+
 def _velocity(v: ArrayLike, shape: tuple[int]) -> npt.NDArray[np.float64]:
     """``v`` as a contiguous float vector of ``shape`` (checked as :func:`_vector` checks it).
 
     A contiguous float64 array of that shape as it is: its finiteness is checked by the
     compiled call that reads it (:meth:`Governor._tick`).
     """
-    if type(v) is np.ndarray and v.dtype is _FLOAT and v.shape == shape and v.strides == _STRIDE:
-        return v
-    return _vector(v, shape[0], "v")
+    velocity = _as_is(v, shape)
+    return _vector(v, shape[0], "v") if velocity is None else velocity
 
 
 def _refuse_velocity(
@@ -909,6 +962,8 @@ class _JointBounds:
         self.lower = np.asarray(lower, dtype=float)
         self.upper = np.asarray(upper, dtype=float)
         self.pairs = pairs
+        #: The continuous joints' first indices in q (their (cos, sin) pairs).
+        self.pair_indices = np.asarray([i for _, i in pairs], dtype=np.int64)
 
     def check(self, q: npt.NDArray[np.float64]) -> None:
         """Raise :class:`GovernorError` naming the first joint of ``q`` out of bounds."""
@@ -931,6 +986,51 @@ class _JointBounds:
                     [float(q[i]), float(q[i + 1])],
                     f"continuous joint {name!r}: (cos, sin) must be a unit pair",
                 )
+
+
+@njit(cache=True)
+def _state_fault(
+    q: npt.NDArray[np.float64],
+    v: npt.NDArray[np.float64],
+    idx: npt.NDArray[np.int64],
+    lower: npt.NDArray[np.float64],
+    upper: npt.NDArray[np.float64],
+    pairs: npt.NDArray[np.int64],
+    free_flyer: bool,
+    max_position: float,
+    quaternion_tolerance: float,
+) -> int:
+    """0 when ``q`` and ``v`` pass :meth:`Governor.limit`'s checks, else the first that fails.
+
+    One compiled pass over them (a tick's checks): q finite, its base within ``max_position``
+    (m) and its quaternion unit (free flyer), v finite, the joints within ``lower``/``upper``
+    (:func:`_first_outside`), the continuous joints' (cos, sin) pairs at ``pairs`` unit. The
+    checks that name the field and value then raise (:meth:`Governor._state`).
+    """
+    squared = 0.0
+    for i in range(q.size):
+        squared += q[i] * q[i]
+    if not math.isfinite(squared):
+        return 1
+    if free_flyer:
+        if squared > max_position * max_position:
+            for i in range(3):
+                if abs(q[i]) > max_position:
+                    return 2
+        x, y, z, w = q[3], q[4], q[5], q[6]
+        if abs(x * x + y * y + z * z + w * w - 1.0) > 2.0 * quaternion_tolerance:
+            return 3
+    squared = 0.0
+    for i in range(v.size):
+        squared += v[i] * v[i]
+    if not math.isfinite(squared):
+        return 4
+    if _first_outside(q, idx, lower, upper) >= 0:
+        return 5
+    for i in pairs:
+        if abs(q[i] * q[i] + q[i + 1] * q[i + 1] - 1.0) > 2.0 * quaternion_tolerance:
+            return 6
+    return 0
 
 
 @njit(cache=True)
