@@ -32,7 +32,6 @@ from impact_balance.balance.areas import BalanceAreas, Projected, posture_areas
 from impact_balance.balance.lipm import lipm_omega
 from impact_balance.contacts.cwc import local_faces
 from impact_balance.contacts.stance import ContactSpec, Stance, has_free_flyer
-from impact_balance.contacts.wrench_polytope import face_blocks
 from impact_balance.criteria.com import ComCriterion
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.criteria.zmp import zmp_max_contact_velocity
@@ -304,7 +303,8 @@ class PostureEvaluator:
         point_local = pin.updateFramePlacement(model, data, fid).translation.copy()
         J = pin.getFrameJacobian(model, data, fid, _WORLD)[:3].copy()
         out = posture_kernel(
-            face_blocks(self._faces, k.rotations),
+            self._faces,
+            k.rotations,
             k.local + k.origin,
             k.local - k.com_local,
             k.jacobians,

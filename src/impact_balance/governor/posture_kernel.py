@@ -4,7 +4,8 @@ After pinocchio (the contacts' poses and Jacobians, the CoM, the composite inert
 governor's posture is the same compiled steps as the one-posture pipeline's, composed in one
 call instead of four: the contact wrench polytope's assembly, the certified projection walk and
 the maps to the ZMP and CoM velocity areas with the area's half-planes
-(:data:`~impact_balance.balance.areas.assembled_areas`), the composite-rigid-body impact map W
+(:data:`~impact_balance.balance.areas.assembled_areas`, from the faces in world axes of
+:func:`~impact_balance.contacts.wrench_polytope.face_blocks`), the composite-rigid-body impact map W
 and the impulse rates (:data:`~impact_balance.impact.model.composite_map_kernel`,
 :data:`~impact_balance.impact.model.impulse_rates_kernel`), and the CoM criterion's jump rates
 (:data:`~impact_balance.criteria.com.jump_rates_kernel`): the same numbers, fewer dispatches
@@ -43,7 +44,8 @@ SEPARATION = 1e-12
 
 @njit(cache=True)
 def posture_kernel(
-    blocks: np.ndarray,
+    faces: np.ndarray,
+    rotations: np.ndarray,
     positions: np.ndarray,
     arms: np.ndarray,
     jacobians: np.ndarray,
@@ -67,8 +69,8 @@ def posture_kernel(
     """One posture's areas, impact model and CoM criterion rates.
 
     Args:
-        blocks: (m, 32, 3) the contacts' faces in world axes
-            (:func:`~impact_balance.contacts.wrench_polytope.face_blocks`).
+        faces: (m, 16, 6) the contacts' CWC faces in their frames.
+        rotations: (m, 3, 3) the contacts' contact-to-world rotations.
         positions: (m, 3) the contact points, world, m.
         arms: (m, 3) contact point minus CoM, m.
         jacobians: (6m, nv) the contacts' stacked Jacobians ((0, 0) without torque limits).
@@ -98,6 +100,9 @@ def posture_kernel(
         impact map W (1/kg), the impulse rates (2N, 3) and the criterion's rates (2N, n_c).
     """
     box, merge_tol, area_tol, zmp_margin, lo, hi = constants
+    blocks = np.empty((faces.shape[0], 32, 3))
+    for i in range(faces.shape[0]):  # face_blocks: BLAS's product, as numpy's (the same numbers)
+        blocks[i] = np.dot(faces[i].reshape(32, 3), rotations[i].T)
     out = assembled_areas(
         blocks, positions, arms, jacobians, torque_indices, torque_limits, gravity_torques,
         weight, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, zmp_margin, hint,
