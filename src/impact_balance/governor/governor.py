@@ -226,9 +226,17 @@ class Governor:
             posture = self._evaluator.evaluate(self.configuration)
         except ScenarioError as exc:
             raise with_source(exc, self.scenario.source) from None
-        if posture.com_criterion is not None:  # the criterion's compiled code, here too
-            posture.com_criterion.limit(np.zeros(3))
-            posture.com_criterion.limits(np.zeros(3), np.zeros((1, 2)))
+        criterion = posture.com_criterion
+        if criterion is not None:  # the criterion's compiled code, here too
+            criterion.limit(np.zeros(3))
+            criterion.limits(np.zeros(3), np.zeros((1, 2)))
+        # and the tick's (velocity_exit), for the area's read-only half-planes and for none
+        still, c = np.zeros(self.nv), np.empty(3)
+        areas = [_NO_AREA]
+        if criterion is not None and criterion.G is not None:
+            areas.append((criterion.G, criterion.h, criterion.rates))  # type: ignore[arg-type]
+        for G, h, rates in areas:
+            velocity_exit(posture.com_jacobian, still, G, h, rates, 1e-10, 1.0, c)
         return posture
 
     def close(self) -> None:
