@@ -21,12 +21,12 @@ _CACHE: dict[str, tuple[Governor, PostureEvaluator, PostureEvaluator]] = {}
 
 
 def evaluators(name: str) -> tuple[Governor, PostureEvaluator, PostureEvaluator]:
-    """A governor, and two evaluators of its settings: the compiled one and the steps alone."""
+    """A governor, and two evaluators of its settings: one for the compiled call, one for the
+    steps (each with its own warm start)."""
     if name not in _CACHE:
         g = Governor(name)
         compiled = PostureEvaluator(g.robot, g._evaluator.settings)
         steps = PostureEvaluator(g.robot, g._evaluator.settings)
-        steps._compiled = False
         assert compiled._compiled
         _CACHE[name] = (g, compiled, steps)
     return _CACHE[name]
@@ -60,7 +60,7 @@ def test_compiled_posture_is_the_steps_to_the_last_digit(name, seed, spread):
     for q in postures(g, 6, seed, spread):
         a = compiled._compiled_posture(q, compiled.kinematics(q))  # evaluate()'s compiled path
         assert a is not None  # the kernel answered (not left to the steps)
-        b = steps.evaluate(q)
+        b = steps.evaluate(q, steps=True)
         ca, cb = a.com_criterion, b.com_criterion
         assert ca is not None and cb is not None
         np.testing.assert_array_equal(ca.area.vertices, cb.area.vertices)

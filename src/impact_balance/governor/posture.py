@@ -233,8 +233,12 @@ class PostureEvaluator:
         # projected_from_arrays): 2 + the wrench variables at most.
         self._hint = np.full(2 + 6 * m, -1, dtype=np.int64)
 
-    def evaluate(self, q: np.ndarray) -> Posture:
+    def evaluate(self, q: np.ndarray, *, steps: bool = False) -> Posture:
         """Everything the governor needs at configuration ``q`` (nq, float64, contiguous).
+
+        The common case is one compiled call (:mod:`.posture_kernel`), the rest the pipeline's
+        steps one by one; ``steps=True`` takes the steps whatever the case (the same numbers:
+        to load their compiled code, or to compare).
 
         Raises what the pipeline raises on a posture it cannot evaluate:
         :class:`~impact_balance.exceptions.ScenarioError` (the CoM at or below the LIPM
@@ -244,7 +248,7 @@ class PostureEvaluator:
         """
         robot, settings = self.robot, self.settings
         k = self.kinematics(q)
-        if self._compiled:
+        if self._compiled and not steps:
             posture = self._compiled_posture(q, k)
             if posture is not None:
                 return posture
