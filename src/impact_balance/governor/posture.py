@@ -303,9 +303,8 @@ class PostureEvaluator:
         settings, data, model = self.settings, self.scratch.data, self.model
         com, mass = k.com, k.mass
         w = lipm_omega(float(com[2]), settings.plane_height, settings.gravity, field="plane_height")
-        fid = self._impact_frame
-        point_local = pin.updateFramePlacement(model, data, fid).translation.copy()
-        J = pin.getFrameJacobian(model, data, fid, _WORLD)[:3].copy()
+        point_local = self.impact_point()
+        J = pin.getFrameJacobian(model, data, self._impact_frame, _WORLD)[:3].copy()
         out = posture_kernel(
             self._faces,
             k.rotations,
@@ -376,6 +375,15 @@ class PostureEvaluator:
             criterion,
             None,
         )
+
+    def impact_point(self) -> npt.NDArray[np.float64]:
+        """The impact point (3,), m, in the stance frame of the kinematics the Data holds.
+
+        Call it after :meth:`kinematics`, before the next one (a new array).
+        """
+        translation = pin.updateFramePlacement(self.model, self.scratch.data, self._impact_frame)
+        point: npt.NDArray[np.float64] = translation.translation.copy()
+        return point
 
     def kinematics(self, q: np.ndarray) -> Kinematics:
         """The pinocchio step of :meth:`evaluate` at ``q`` (nq, float64, contiguous).

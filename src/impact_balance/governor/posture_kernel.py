@@ -25,8 +25,9 @@ from impact_balance._jit import cache_depends_on, njit
 from impact_balance.balance import areas
 from impact_balance.balance.areas import FORCE_BOX, MERGE_TOLERANCE, assembled_areas
 from impact_balance.contacts import wrench_polytope
-from impact_balance.criteria import com
+from impact_balance.criteria import com, linear_exit
 from impact_balance.criteria.com import jump_rates_kernel
+from impact_balance.criteria.linear_exit import exit_kernel
 from impact_balance.geometry import polygon
 from impact_balance.geometry.polygon import MERGE_AREA_TOLERANCE
 from impact_balance.impact import model
@@ -34,7 +35,7 @@ from impact_balance.impact.model import composite_map_kernel, impulse_rates_kern
 from impact_balance.projection import kernel, walk
 from impact_balance.projection.kernel import OK
 
-__all__ = ["FALLBACK", "SEPARATION", "constants", "posture_kernel"]
+__all__ = ["FALLBACK", "SEPARATION", "constants", "posture_kernel", "postures_kernel"]
 
 #: :func:`posture_kernel`'s first answer when the caller must take the one-posture path.
 FALLBACK = 1
@@ -129,3 +130,69 @@ def constants(zmp_margin: float, restitution: tuple[float, float]) -> np.ndarray
 
 
 cache_depends_on(posture_kernel, areas, polygon, walk, kernel, wrench_polytope, model, com)
+
+
+@njit(cache=True, nogil=True)
+def postures_kernel(
+    faces: np.ndarray,
+    rotations: np.ndarray,
+    positions: np.ndarray,
+    arms: np.ndarray,
+    jacobians: np.ndarray,
+    torque_indices: np.ndarray,
+    torque_limits: np.ndarray,
+    gravity_torques: np.ndarray,
+    scalars: np.ndarray,
+    impact_arms: np.ndarray,
+    inertias: np.ndarray,
+    com_velocities: np.ndarray,
+    same: np.ndarray,
+    hint: np.ndarray,
+    max_pivots: int,
+    constants: np.ndarray,
+    normal: np.ndarray,
+    cone: np.ndarray,
+    velocity_margin: float,
+    tol: float,
+    out: np.ndarray,
+) -> None:
+    """:func:`posture_kernel` and the first exit of every posture of a batch (GIL released).
+
+    Per posture i (leading axis), :func:`posture_kernel`'s per-posture arguments:
+    ``rotations`` (m, 3, 3), ``positions`` and ``arms`` (m, 3), ``jacobians`` (6m, nv) or
+    (0, 0), ``gravity_torques`` (nv,), ``scalars`` (weight, depth, cx, cy, w, mass),
+    ``impact_arms`` (3,), ``inertias`` (3, 3); and the CoM velocity ``com_velocities`` (2,)
+    (world xy, m/s). The rest is common (``velocity_margin`` m/s, ``tol`` the boundary
+    tolerance). Where ``same[i]``, posture i is posture i - 1: only its CoM velocity is read.
+
+    Writes ``out[i] = (code, speed, vertex, edge)``: the numbers of a governor's tick
+    (:func:`~impact_balance.governor.tick.velocity_exit`: the exit kernel's code, an index
+    of ``EXIT_STATUSES``), or code -1 where the caller takes the one-posture path.
+    """
+    G, h, rates = np.empty((0, 2)), np.empty(0), np.empty((0, 0))
+    answered = False  # whether G, h, rates hold the last posture's
+    for i in range(same.size):
+        out[i, 0] = -1.0
+        if not same[i]:
+            weight, depth, cx, cy, w, mass = scalars[i]
+            answer = posture_kernel(
+                faces, rotations[i], positions[i], arms[i], jacobians[i], torque_indices,
+                torque_limits, gravity_torques[i], weight, depth, cx, cy, w, hint, max_pivots,
+                constants, impact_arms[i], mass, inertias[i], normal, cone,
+            )  # fmt: skip
+            answered = answer[0] == 0
+            G, h, rates = answer[7], answer[8], answer[11]
+            if answered and velocity_margin:
+                h = h - velocity_margin
+        if answered:
+            c0x, c0y = com_velocities[i, 0], com_velocities[i, 1]
+            margins = np.empty(h.size)
+            for k in range(h.size):
+                margins[k] = h[k] - (G[k, 0] * c0x + G[k, 1] * c0y)
+            code, speed, vertex, edge = exit_kernel(margins, rates, tol)
+            out[i, 0], out[i, 1], out[i, 2], out[i, 3] = code, speed, vertex, edge
+
+
+cache_depends_on(
+    postures_kernel, areas, polygon, walk, kernel, wrench_polytope, model, com, linear_exit
+)
