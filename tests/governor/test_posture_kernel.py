@@ -100,9 +100,11 @@ def test_velocity_only_tick_is_the_criterion_answer(seed, speed):
     assert answer.limiting_edge == want.limiting_edge
     if want.from_inside:
         assert answer.safe_interval == (0.0, want.max_contact_velocity)
-    else:
+    else:  # the margins by numpy's product there: equal to rounding
         want_interval = speed_interval(criterion.margins(com_velocity), criterion.rates)
-        assert answer.safe_interval == want_interval
+        assert (answer.safe_interval is None) == (want_interval is None)
+        if want_interval is not None:
+            np.testing.assert_allclose(answer.safe_interval, want_interval, rtol=0, atol=1e-12)
 
 
 def test_from_rates_is_the_constructed_criterion():
@@ -161,3 +163,27 @@ def test_a_posture_the_kernel_leaves_to_the_steps_is_answered_as_analyze():
     assert answer.safe_interval is None
     analysis = ib.analyze(g.scenario_at(q, answer.com_velocity))
     assert analysis.impact.com.status == "cannot_balance"
+
+
+def test_falling_starts_are_answered_by_the_compiled_tick_as_by_the_criterion():
+    g = evaluators("kick_one_foot")[0]
+    q = g.configuration
+    rng = np.random.default_rng(5)
+    seen = set()
+    for scale in np.geomspace(0.05, 5.0, 60):
+        v = rng.normal(0.0, scale, g.nv)
+        answer = g.limit(q, v)
+        seen.add((answer.status, answer.safe_interval is None))
+        criterion = g.posture.com_criterion
+        assert criterion is not None
+        com_velocity = g.posture.com_jacobian @ v
+        want = criterion.limit(com_velocity)
+        assert (answer.status, answer.max_contact_velocity) == (
+            want.status,
+            want.max_contact_velocity,
+        )
+        want_interval = criterion.interval(com_velocity, want)
+        assert (answer.safe_interval is None) == (want_interval is None)
+        if want_interval is not None:
+            np.testing.assert_allclose(answer.safe_interval, want_interval, rtol=0, atol=1e-12)
+    assert {s for s, _ in seen} >= {"already_falling", "ok"}

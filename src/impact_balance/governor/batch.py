@@ -9,8 +9,8 @@ step); the areas, the impact model and the criterion of every posture then run i
 call (:func:`~impact_balance.governor.posture_kernel.postures_kernel`: a tick's
 :func:`~impact_balance.governor.posture_kernel.posture_kernel` per posture, the same numbers),
 which releases the GIL, so ``threads`` > 1 evaluates slices of the postures side by side. A
-posture the compiled call does not answer (a projection Bretl's method answers, a CoM velocity
-already outside its area, an area of fewer than 3 vertices, an impact model it refuses), the
+posture the compiled call does not answer (a projection Bretl's method answers, an area of fewer
+than 3 vertices, an impact model it refuses), the
 "zmp" criterion, the joint-space inertia model, contact frictions above 1 and the angular
 momentum option (``angular_momentum_damping_time``) take the one-posture path
 (:meth:`PostureEvaluator.evaluate <impact_balance.governor.posture.PostureEvaluator.evaluate>`).
@@ -262,7 +262,7 @@ class _Slice:
             velocities[r:stop] = velocities_3d[:, :2]
             rows.com_velocity[run] = velocities_3d
             rows.normal[run], rows.point[run] = e._normal, point_local + k.origin
-        out = np.empty((n, 4))
+        out = np.empty((n, 6))
         postures_kernel(
             e._faces, rotations, positions, arms, jacobians, e._idx, e._limit, gravity_torques,
             scalars, impact_arms, inertias, velocities, same, e._hint, MAX_PIVOTS, e._constants,
@@ -288,18 +288,19 @@ class _Slice:
         """Rows ``indices`` from the compiled answers ``out``; the one-posture path for the rest."""
         rows = self.rows
         codes = out[:, 0].astype(np.int64)
-        answered = (codes == 0) | (codes == 2)  # "ok" and "unbounded": from inside the area
+        answered = codes >= 0  # "ok", "already_falling", "unbounded"
         done = indices[answered]
-        speeds = np.where(codes[answered] == 0, out[answered, 1], math.inf)
-        rows.speed[done] = speeds
-        rows.interval[done, 0], rows.interval[done, 1] = 0.0, speeds
+        rows.speed[done] = np.where(
+            codes[answered] == 0, out[answered, 1], np.where(codes[answered] == 1, 0.0, math.inf)
+        )
+        rows.interval[done] = out[answered, 4:6]
         ok = indices[codes == 0]
         rows.vertex[ok], rows.edge[ok] = out[codes == 0, 2], out[codes == 0, 3]
         status = rows.status
-        for i, code, yes in zip(indices.tolist(), codes.tolist(), answered.tolist(), strict=True):
-            if yes:
+        for i, code in zip(indices.tolist(), codes.tolist(), strict=True):
+            if code >= 0:
                 status[i] = EXIT_STATUSES[code]
-            else:  # Bretl's projection, a small area, a falling start
+            else:  # Bretl's projection, a small area, a refused impact model
                 self.single(i)
 
     def single(self, i: int) -> None:

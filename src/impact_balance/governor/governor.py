@@ -19,7 +19,7 @@ from impact_balance.balance.areas import warm_up as warm_up_maps
 from impact_balance.constants import MAX_POSITION, MAX_SPEED
 from impact_balance.contacts.stance import ContactSpec, has_free_flyer
 from impact_balance.criteria.cap import cap_approach
-from impact_balance.criteria.linear_exit import BOUNDARY_TOLERANCE
+from impact_balance.criteria.linear_exit import BOUNDARY_TOLERANCE, EXIT_STATUSES
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.exceptions import GovernorError, ScenarioError
 from impact_balance.governor.batch import BatchEvaluator, BatchLimits
@@ -332,7 +332,7 @@ class Governor:
         fast = criterion is not None and criterion.G is not None and self._support is None
         if criterion is not None and fast:
             G, h, rates = criterion.G, criterion.h, criterion.rates  # type: ignore[assignment]
-        code, speed, j, k = velocity_exit(
+        code, speed, j, k, lo, hi = velocity_exit(
             posture.com_jacobian,
             v,
             G,
@@ -344,19 +344,20 @@ class Governor:
         )
         if code < 0:
             _refuse_velocity(code, v, self.nv, com_velocity)
-        if not fast or code == 1:  # the general answer (already falling: the safe interval)
+        if not fast:  # the general answer
             return self._answer(posture, com_velocity, reused)
         model = posture.impact
         vertex, edge = (j, k) if code == 0 else (None, None)
-        if code != 0:  # unbounded
-            speed = math.inf
+        interval = None if math.isnan(lo) else (lo, hi)
+        if code != 0:  # "already_falling" (0) or "unbounded" (inf)
+            speed = 0.0 if code == 1 else math.inf
         self._last = answer = _floating_limit(
             self.criterion,
             speed,
-            "ok" if code == 0 else "unbounded",
+            EXIT_STATUSES[code],
             vertex,
             edge,
-            (0.0, speed),
+            interval,
             com_velocity,
             model.normal,
             model.point,

@@ -19,6 +19,8 @@ answers (or raises) as :func:`~impact_balance.analyze` does.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from impact_balance._jit import cache_depends_on, njit
@@ -27,7 +29,7 @@ from impact_balance.balance.areas import FORCE_BOX, MERGE_TOLERANCE, assembled_a
 from impact_balance.contacts import wrench_polytope
 from impact_balance.criteria import com, linear_exit
 from impact_balance.criteria.com import jump_rates_kernel
-from impact_balance.criteria.linear_exit import exit_kernel
+from impact_balance.criteria.linear_exit import exit_kernel, interval_kernel
 from impact_balance.geometry import polygon
 from impact_balance.geometry.polygon import MERGE_AREA_TOLERANCE
 from impact_balance.impact import model
@@ -165,9 +167,10 @@ def postures_kernel(
     (world xy, m/s). The rest is common (``velocity_margin`` m/s, ``tol`` the boundary
     tolerance). Where ``same[i]``, posture i is posture i - 1: only its CoM velocity is read.
 
-    Writes ``out[i] = (code, speed, vertex, edge)``: the numbers of a governor's tick
+    Writes ``out[i] = (code, speed, vertex, edge, lo, hi)``: the numbers of a governor's tick
     (:func:`~impact_balance.governor.tick.velocity_exit`: the exit kernel's code, an index
-    of ``EXIT_STATUSES``), or code -1 where the caller takes the one-posture path.
+    of ``EXIT_STATUSES``, and the safe interval, NaN when there is none), or code -1 where the
+    caller takes the one-posture path.
     """
     G, h, rates = np.empty((0, 2)), np.empty(0), np.empty((0, 0))
     answered = False  # whether G, h, rates hold the last posture's
@@ -191,6 +194,10 @@ def postures_kernel(
                 margins[k] = h[k] - (G[k, 0] * c0x + G[k, 1] * c0y)
             code, speed, vertex, edge = exit_kernel(margins, rates, tol)
             out[i, 0], out[i, 1], out[i, 2], out[i, 3] = code, speed, vertex, edge
+            out[i, 4], out[i, 5] = 0.0, speed
+            if code == 1:  # already falling: the safe speeds, if any, catch the fall
+                found, lo, hi = interval_kernel(margins, rates, tol)
+                out[i, 4], out[i, 5] = (lo, hi) if found else (math.nan, math.nan)
 
 
 cache_depends_on(

@@ -18,7 +18,7 @@ import numpy as np
 
 from impact_balance._jit import cache_depends_on, njit
 from impact_balance.criteria import linear_exit
-from impact_balance.criteria.linear_exit import exit_kernel
+from impact_balance.criteria.linear_exit import exit_kernel, interval_kernel
 
 __all__ = [
     "CANNOT_BALANCE",
@@ -63,7 +63,7 @@ def velocity_exit(
     tol: float,
     max_speed_squared: float,
     out: np.ndarray,
-) -> tuple[int, float, int, int]:
+) -> tuple[int, float, int, int, float, float]:
     """The CoM velocity ``out = J v`` (m/s, world) and the CoM criterion's first exit.
 
     Args:
@@ -77,23 +77,31 @@ def velocity_exit(
         out: (3,) written with the CoM velocity.
 
     Returns:
-        ``(code, speed, vertex, edge)``: ``code`` an index of ``EXIT_STATUSES`` with
-        :func:`~impact_balance.criteria.linear_exit.exit_kernel`'s answer, or
-        :data:`NOT_FINITE`, :data:`TOO_FAST`, :data:`CANNOT_BALANCE` (then the rest is unused).
+        ``(code, speed, vertex, edge, lo, hi)``: ``code`` an index of ``EXIT_STATUSES`` with
+        :func:`~impact_balance.criteria.linear_exit.exit_kernel`'s answer and the safe interval
+        ``(lo, hi)`` (m/s; from inside ``(0, speed)``; already falling
+        :func:`~impact_balance.criteria.linear_exit.interval_kernel`'s, NaN when there is none);
+        or :data:`NOT_FINITE`, :data:`TOO_FAST`, :data:`CANNOT_BALANCE` (then the rest is
+        unused).
     """
     squared = com_velocity(J, v, out)
     if not math.isfinite(squared):
-        return NOT_FINITE, 0.0, -1, -1
+        return NOT_FINITE, 0.0, -1, -1, 0.0, 0.0
     cx, cy, cz = out[0], out[1], out[2]
     if not cx * cx + cy * cy + cz * cz <= max_speed_squared:
-        return TOO_FAST, 0.0, -1, -1
+        return TOO_FAST, 0.0, -1, -1, 0.0, 0.0
     if G.shape[0] == 0:
-        return CANNOT_BALANCE, 0.0, -1, -1
+        return CANNOT_BALANCE, 0.0, -1, -1, 0.0, 0.0
     margins = np.empty(h.size)
     for k in range(h.size):
         margins[k] = h[k] - (G[k, 0] * cx + G[k, 1] * cy)
     code, speed, vertex, edge = exit_kernel(margins, rates, tol)
-    return code, speed, vertex, edge
+    lo, hi = 0.0, speed
+    if code == 1:  # already falling: the safe speeds, if any, catch the fall
+        found, lo, hi = interval_kernel(margins, rates, tol)
+        if not found:
+            lo = hi = math.nan
+    return code, speed, vertex, edge, lo, hi
 
 
 @njit(cache=True)
