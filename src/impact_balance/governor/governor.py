@@ -25,7 +25,14 @@ from impact_balance.exceptions import GovernorError, ScenarioError
 from impact_balance.governor.batch import BatchEvaluator, BatchLimits
 from impact_balance.governor.limit import Binding, SpeedLimit, _floating_limit
 from impact_balance.governor.options import CRITERIA, ContactAwareOptions, Criterion
-from impact_balance.governor.posture import Posture, PostureEvaluator, PostureSettings
+from impact_balance.governor.posture import (
+    NO_HALFPLANES as _NO_HALFPLANES,
+)
+from impact_balance.governor.posture import (
+    Posture,
+    PostureEvaluator,
+    PostureSettings,
+)
 from impact_balance.governor.support import ContactAwareLimit, combine
 from impact_balance.governor.tick import NOT_FINITE, velocity_exit
 from impact_balance.governor.worker import ContactAwareWorker
@@ -280,7 +287,13 @@ class Governor:
         with self._lock:
             posture = self._posture
             # The very q of the cached posture (checked when it was evaluated): no check again.
-            if posture is not None and _is_key(q, posture.key, self._q_shape):
+            if (
+                posture is not None
+                and type(q) is np.ndarray
+                and q.dtype is _FLOAT
+                and q.shape == self._q_shape
+                and q.tobytes() == posture.key
+            ):
                 return self._tick(posture, _velocity(v, self._v_shape), True)
         configuration, velocity = self._state(q, v)
         with self._lock:
@@ -326,21 +339,13 @@ class Governor:
         bound is one compiled call (:func:`~impact_balance.governor.tick.velocity_exit`) and the
         answer; the others go through :meth:`_answer`.
         """
-        criterion = posture.com_criterion
+        J, G, h, rates = posture.exit_arrays
+        fast = G is not _NO_HALFPLANES and self._support is None
+        if not fast:
+            G, h, rates = _NO_AREA
         com_velocity = np.empty(3)
-        G, h, rates = _NO_AREA
-        fast = criterion is not None and criterion.G is not None and self._support is None
-        if criterion is not None and fast:
-            G, h, rates = criterion.G, criterion.h, criterion.rates  # type: ignore[assignment]
         code, speed, j, k, lo, hi = velocity_exit(
-            posture.com_jacobian,
-            v,
-            G,
-            h,
-            rates,
-            BOUNDARY_TOLERANCE,
-            _MAX_SPEED_SQUARED,
-            com_velocity,
+            J, v, G, h, rates, BOUNDARY_TOLERANCE, _MAX_SPEED_SQUARED, com_velocity
         )
         if code < 0:
             _refuse_velocity(code, v, self.nv, com_velocity)
@@ -864,13 +869,6 @@ def _zmp_interval(limit: ContactVelocityLimit) -> tuple[float, float] | None:
     ZMP area) or the area is empty.
     """
     return limit.interval_from_inside()
-
-
-def _is_key(q: object, key: bytes, shape: tuple[int]) -> bool:
-    """Whether ``q`` is a float64 array of ``shape`` whose bytes are ``key`` (a posture's q)."""
-    return (
-        type(q) is np.ndarray and q.dtype == np.float64 and q.shape == shape and q.tobytes() == key
-    )
 
 
 def _as_is(x: object, shape: tuple[int]) -> npt.NDArray[np.float64] | None:

@@ -51,7 +51,12 @@ from impact_balance.impact.model import (
 from impact_balance.projection.walk import MAX_PIVOTS
 from impact_balance.robot.robot import Robot, Scratch
 
-__all__ = ["Kinematics", "Posture", "PostureEvaluator", "PostureSettings"]
+__all__ = ["NO_HALFPLANES", "Kinematics", "Posture", "PostureEvaluator", "PostureSettings"]
+
+#: :attr:`Posture.exit_arrays`' ``G`` when there are no half-planes (one object, compared by
+#: identity).
+NO_HALFPLANES = np.zeros((0, 2))
+NO_HALFPLANES.setflags(write=False)
 
 _POSITION = pin.KinematicLevel.POSITION
 _WORLD = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
@@ -129,6 +134,19 @@ class Posture:
         """See the class docstring."""
         projected = self.projected
         return projected.areas() if isinstance(projected, Projected) else projected
+
+    @functools.cached_property
+    def exit_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """What a tick's compiled call reads: ``(com_jacobian, G, h, rates)`` of the criterion.
+
+        ``G`` is :data:`NO_HALFPLANES` (and ``h``, ``rates`` empty) without a "com" criterion or
+        an area with half-planes.
+        """
+        criterion = self.com_criterion
+        if criterion is None or criterion.G is None or criterion.h is None:
+            return self.com_jacobian, NO_HALFPLANES, np.zeros(0), np.zeros((0, 0))
+        assert criterion.rates is not None  # made with G and h
+        return self.com_jacobian, criterion.G, criterion.h, criterion.rates
 
     @functools.cached_property
     def stance(self) -> Stance:
