@@ -58,7 +58,7 @@ def postures(g: Governor, n: int, seed: int, spread: float) -> np.ndarray:
 def test_compiled_posture_is_the_steps_to_the_last_digit(name, seed, spread):
     g, compiled, steps = evaluators(name)
     for q in postures(g, 6, seed, spread):
-        a = compiled._compiled_posture(q, compiled.kinematics(q))  # evaluate()'s compiled path
+        a = compiled._compiled_posture(q)  # evaluate()'s compiled path
         assert a is not None  # the kernel answered (not left to the steps)
         b = steps.evaluate(q, steps=True)
         ca, cb = a.com_criterion, b.com_criterion
@@ -156,8 +156,7 @@ def test_a_posture_the_kernel_leaves_to_the_steps_is_answered_as_analyze():
     g = Governor(scenario)
     q = g.configuration.copy()
     q[10] += 0.01
-    k = g._evaluator.kinematics(q)
-    assert g._evaluator._compiled_posture(q, k) is None
+    assert g._evaluator._compiled_posture(q) is None
     answer = g.limit(q, np.zeros(g.nv))
     assert answer.status == "cannot_balance" and answer.max_contact_velocity == 0.0
     assert answer.safe_interval is None

@@ -38,7 +38,7 @@ from impact_balance.criteria.zmp import zmp_max_contact_velocity
 from impact_balance.exceptions import SolverError
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.governor.options import Criterion
-from impact_balance.governor.posture_kernel import constants, posture_kernel
+from impact_balance.governor.posture_kernel import constants, kinematics_posture_kernel
 from impact_balance.impact.angular_momentum import AngularMomentumTerm, angular_momentum_gain
 from impact_balance.impact.model import (
     ImpactModel,
@@ -250,6 +250,13 @@ class PostureEvaluator:
         # The projection's warm start, carried from one posture to the next (see
         # projected_from_arrays): 2 + the wrench variables at most.
         self._hint = np.full(2 + 6 * m, -1, dtype=np.int64)
+        # The compiled posture's pinocchio arrays (rotations, points, Jacobians), read in the
+        # same call.
+        self._buffers = (
+            np.empty((m, 3, 3)),
+            np.empty((m, 3)),
+            np.empty((6 * m, model.nv)) if self._torques else np.zeros((0, 0)),
+        )
 
     def evaluate(self, q: np.ndarray, *, steps: bool = False) -> Posture:
         """Everything the governor needs at configuration ``q`` (nq, float64, contiguous).
@@ -265,11 +272,11 @@ class PostureEvaluator:
         (a projection that failed).
         """
         robot, settings = self.robot, self.settings
-        k = self.kinematics(q)
         if self._compiled and not steps:
-            posture = self._compiled_posture(q, k)
+            posture = self._compiled_posture(q)
             if posture is not None:
                 return posture
+        k = self.kinematics(q)
         origin, com_local, mass, com = k.origin, k.com_local, k.mass, k.com
         rotations, local, jacobians = k.rotations, k.local, k.jacobians
         gravity_torques, com_jacobian = k.gravity_torques, k.com_jacobian
@@ -312,47 +319,35 @@ class PostureEvaluator:
             zmp,
         )
 
-    def _compiled_posture(self, q: np.ndarray, k: Kinematics) -> Posture | None:
-        """:meth:`evaluate`'s answer by :func:`~.posture_kernel.posture_kernel` (one call).
+    def _compiled_posture(self, q: np.ndarray) -> Posture | None:
+        """:meth:`evaluate`'s answer by pinocchio and one compiled call.
 
-        None when the kernel leaves the posture to :meth:`evaluate`'s steps (a walk not
-        certified, an area of fewer than 3 vertices, an impact model they refuse).
+        :func:`~.posture_kernel.kinematics_posture_kernel`, into this evaluator's buffers. None
+        when the kernel leaves the posture to :meth:`evaluate`'s steps (a walk not certified,
+        an area of fewer than 3 vertices, an impact model they refuse).
         """
         settings, data, model = self.settings, self.scratch.data, self.model
-        com, mass = k.com, k.mass
-        w = lipm_omega(float(com[2]), settings.plane_height, settings.gravity, field="plane_height")
+        rotations, local, jacobians = self._buffers
+        origin, com_local, Ig, Ag = self._placements(q, rotations, local, jacobians)
+        mass = float(Ig.mass)
+        com_z = float(com_local[2]) + float(origin[2])
+        w = lipm_omega(com_z, settings.plane_height, settings.gravity, field="plane_height")
         point_local = self.impact_point()
         J = pin.getFrameJacobian(model, data, self._impact_frame, _WORLD)[:3].copy()
-        out = posture_kernel(
-            self._faces,
-            k.rotations,
-            k.local + k.origin,
-            k.local - k.com_local,
-            k.jacobians,
-            self._idx,
-            self._limit,
-            k.gravity_torques,
-            mass * settings.gravity,
-            settings.plane_height - float(com[2]),
-            float(com[0]),
-            float(com[1]),
-            w,
-            self._hint,
-            MAX_PIVOTS,
-            self._constants,
-            point_local - k.com_local,
-            mass,
-            k.inertia,
-            self._normal,
+        out = kinematics_posture_kernel(
+            self._faces, rotations, local, origin, com_local, Ag, self._gravity, self._torques,
+            jacobians, self._idx, self._limit, mass, settings.gravity, settings.plane_height, w,
+            self._hint, MAX_PIVOTS, self._constants, point_local, Ig.inertia, self._normal,
             self._cone,
-        )
-        code, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h, W, impulse, rates = out
+        )  # fmt: skip
+        code, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h, W, impulse, rates = out[:12]
         if code:
             return None
+        com, com_jacobian, point = out[12:]
         area = Polygon.with_halfplanes(vel, bool(vel_bounded), G, h)
         impact = ImpactModel(
             settings.impact,
-            point_local + k.origin,
+            point,
             self._normal.copy(),
             self._cone.copy(),
             W,
@@ -389,7 +384,7 @@ class PostureEvaluator:
             mass,
             projected,
             impact,
-            k.com_jacobian,
+            com_jacobian,
             criterion,
             None,
         )
@@ -409,38 +404,15 @@ class PostureEvaluator:
         Left in this evaluator's Data: :meth:`impact_at` reads the impact frame from it, so
         call it before the next :meth:`kinematics`. The arrays are new (the caller keeps them).
         """
-        data, model = self.scratch.data, self.model
-        # The kinematics in the stance frame (world axes, origin at the base position), as
-        # Stance does: lever arms keep their precision however far the robot stands.
-        q_local = self._q_local
-        q_local[:] = q
-        if self._free_flyer:
-            origin = q[:3].copy()
-            q_local[:3] = 0.0
-        else:
-            origin = np.zeros(3)
-        # ccrba: joint placements, joint Jacobians, the composite inertia Ig and the centroidal
-        # momentum matrix Ag (its linear rows are m times the CoM Jacobian).
-        pin.ccrba(model, data, q_local, self._zero_velocity)
-        self.scratch.holder = None  # what it holds is this evaluator's, never a Stance's
-        com_local = np.array(pin.centerOfMass(model, data, _POSITION, False), dtype=float)
-        Ig = data.Ig
-        mass = float(Ig.mass)
-        linear = data.Ag[:3]  # m times the CoM Jacobian
-        com_jacobian = linear / mass
-        m = len(self._frames)
+        m, torques = len(self._frames), self._torques
         rotations = np.empty((m, 3, 3))
         local = np.empty((m, 3))
-        torques = self._torques
-        jacobians = np.empty((6 * m, model.nv)) if torques else np.zeros((0, 0))
-        # frame_point's numbers (the evaluator's frames have no offset of their own), in
-        # pinocchio's calls directly: the pose as one 4 x 4 array, the Jacobian written in place.
-        for i, fid in enumerate(self._frames):
-            pose = pin.updateFramePlacement(model, data, fid).homogeneous
-            rotations[i] = pose[:3, :3]
-            local[i] = pose[:3, 3]
-            if torques:
-                jacobians[6 * i : 6 * i + 6] = pin.getFrameJacobian(model, data, fid, _WORLD)
+        jacobians = np.empty((6 * m, self.model.nv)) if torques else np.zeros((0, 0))
+        origin, com_local, Ig, Ag = self._placements(q, rotations, local, jacobians)
+        com_local = np.array(com_local, dtype=float)
+        mass = float(Ig.mass)
+        linear = Ag[:3]  # m times the CoM Jacobian
+        com_jacobian = linear / mass
         # g(q) = -Ag[:3]^T g: the gravity's generalized force is the CoM's (the centroidal
         # momentum matrix's linear rows are m times the CoM Jacobian); equal to pinocchio's
         # computeGeneralizedGravity to rounding (1e-14 N m of 327 on G1), without its pass.
@@ -458,6 +430,46 @@ class PostureEvaluator:
             gravity_torques,
             np.array(Ig.inertia, dtype=float),
         )
+
+    def _placements(
+        self,
+        q: np.ndarray,
+        rotations: npt.NDArray[np.float64],
+        local: npt.NDArray[np.float64],
+        jacobians: npt.NDArray[np.float64],
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], pin.Inertia, np.ndarray]:
+        """The pinocchio step at ``q``, in the stance frame (world axes, origin at the base).
+
+        Writes the contacts' contact-to-world ``rotations`` (m, 3, 3), points ``local`` (m, 3)
+        and, with torque limits, stacked world-aligned ``jacobians`` (6m, nv). Returns
+        ``(origin, com_local, Ig, Ag)``: the stance frame's origin in world (a new array, m),
+        the CoM in the stance frame (pinocchio's array, m), the composite inertia about the CoM
+        and the centroidal momentum matrix (pinocchio's), valid until the Data's next use.
+        """
+        data, model = self.scratch.data, self.model
+        # As Stance does: lever arms keep their precision however far the robot stands.
+        q_local = self._q_local
+        q_local[:] = q
+        if self._free_flyer:
+            origin = q[:3].copy()
+            q_local[:3] = 0.0
+        else:
+            origin = np.zeros(3)
+        # ccrba: joint placements, joint Jacobians, the composite inertia Ig and the centroidal
+        # momentum matrix Ag (its linear rows are m times the CoM Jacobian).
+        pin.ccrba(model, data, q_local, self._zero_velocity)
+        self.scratch.holder = None  # what it holds is this evaluator's, never a Stance's
+        com_local = pin.centerOfMass(model, data, _POSITION, False)
+        # frame_point's numbers (the evaluator's frames have no offset of their own), in
+        # pinocchio's calls directly: the pose as one 4 x 4 array, the Jacobian written in place.
+        torques = self._torques
+        for i, fid in enumerate(self._frames):
+            pose = pin.updateFramePlacement(model, data, fid).homogeneous
+            rotations[i] = pose[:3, :3]
+            local[i] = pose[:3, 3]
+            if torques:
+                jacobians[6 * i : 6 * i + 6] = pin.getFrameJacobian(model, data, fid, _WORLD)
+        return origin, com_local, data.Ig, data.Ag
 
     def impact_at(self, q: np.ndarray, k: Kinematics) -> ImpactModel:
         """The impact model at ``q``, whose :meth:`kinematics` ``k`` the Data holds."""

@@ -37,7 +37,14 @@ from impact_balance.impact.model import composite_map_kernel, impulse_rates_kern
 from impact_balance.projection import kernel, walk
 from impact_balance.projection.kernel import OK
 
-__all__ = ["FALLBACK", "SEPARATION", "constants", "posture_kernel", "postures_kernel"]
+__all__ = [
+    "FALLBACK",
+    "SEPARATION",
+    "constants",
+    "kinematics_posture_kernel",
+    "posture_kernel",
+    "postures_kernel",
+]
 
 #: :func:`posture_kernel`'s first answer when the caller must take the one-posture path.
 FALLBACK = 1
@@ -123,6 +130,89 @@ def posture_kernel(
     return code, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h, W, impulse, rates
 
 
+@njit(cache=True)
+def kinematics_posture_kernel(
+    faces: np.ndarray,
+    rotations: np.ndarray,
+    local: np.ndarray,
+    origin: np.ndarray,
+    com_local: np.ndarray,
+    centroidal: np.ndarray,
+    gravity_vector: np.ndarray,
+    torques: bool,
+    jacobians: np.ndarray,
+    torque_indices: np.ndarray,
+    torque_limits: np.ndarray,
+    mass: float,
+    gravity: float,
+    plane_height: float,
+    w: float,
+    hint: np.ndarray,
+    max_pivots: int,
+    constants: np.ndarray,
+    point_local: np.ndarray,
+    inertia: np.ndarray,
+    normal: np.ndarray,
+    cone: np.ndarray,
+) -> tuple:  # type: ignore[type-arg]
+    """:func:`posture_kernel` from pinocchio's arrays, with what a posture keeps of them.
+
+    Args:
+        faces: (m, 16, 6) the contacts' CWC faces in their frames.
+        rotations: (m, 3, 3) the contacts' contact-to-world rotations.
+        local: (m, 3) the contact points, stance frame (origin at ``origin``), m.
+        origin: (3,) the stance frame's origin in world, m.
+        com_local: (3,) the CoM, stance frame, m.
+        centroidal: (6, nv) the centroidal momentum matrix (linear rows first: m J_com).
+        gravity_vector: (3,) the model's gravity, world, m/s^2.
+        torques: Whether the torque limits bound the wrenches.
+        jacobians: (6m, nv) the contacts' stacked Jacobians ((0, 0) without torques).
+        torque_indices: The torque-limited joints' velocity indices.
+        torque_limits: Their limits, N m.
+        mass: kg.
+        gravity: g, m/s^2.
+        plane_height: h, m.
+        w: omega, 1/s.
+        hint: The walk's warm start (read and written).
+        max_pivots: The walk's pivot bound.
+        constants: :func:`constants`.
+        point_local: (3,) the impact point, stance frame, m.
+        inertia: (3, 3) the composite rotational inertia about the CoM, world axes, kg m^2.
+        normal: (3,) the impact normal.
+        cone: (3, N) the impact's friction-cone generators.
+
+    Returns:
+        :func:`posture_kernel`'s answer and ``(com, com_jacobian, point)``: the CoM (3,), world,
+        m; ``J_com`` (3, nv, column-major as numpy's ``Ag[:3] / m``); the impact point (3,),
+        world, m. The numbers of the array expressions of
+        :meth:`~impact_balance.governor.posture.PostureEvaluator.kinematics` (``g(q)`` by
+        BLAS's product, as numpy's).
+    """
+    m, nv = local.shape[0], centroidal.shape[1]
+    positions, arms = np.empty((m, 3)), np.empty((m, 3))
+    com, arm, point = np.empty(3), np.empty(3), np.empty(3)
+    for c in range(3):
+        for i in range(m):
+            positions[i, c] = local[i, c] + origin[c]
+            arms[i, c] = local[i, c] - com_local[c]
+        com[c] = com_local[c] + origin[c]
+        arm[c] = point_local[c] - com_local[c]
+        point[c] = point_local[c] + origin[c]
+    linear = np.asfortranarray(centroidal[:3])  # m J_com
+    com_jacobian = np.empty((nv, 3)).T
+    for r in range(3):
+        for i in range(nv):
+            com_jacobian[r, i] = linear[r, i] / mass
+    # g(q) = -Ag[:3]^T g (see PostureEvaluator.kinematics)
+    gravity_torques = -np.dot(gravity_vector, linear) if torques else np.zeros(nv)
+    answer = posture_kernel(
+        faces, rotations, positions, arms, jacobians, torque_indices, torque_limits,
+        gravity_torques, mass * gravity, plane_height - com[2], com[0], com[1], w, hint,
+        max_pivots, constants, arm, mass, inertia, normal, cone,
+    )  # fmt: skip
+    return answer + (com, com_jacobian, point)  # noqa: RUF005 (numba: tuple concatenation)
+
+
 def constants(zmp_margin: float, restitution: tuple[float, float]) -> np.ndarray:
     """:func:`posture_kernel`'s ``constants`` for a ZMP margin (m) and restitution bounds."""
     lo, hi = restitution
@@ -132,6 +222,9 @@ def constants(zmp_margin: float, restitution: tuple[float, float]) -> np.ndarray
 
 
 cache_depends_on(posture_kernel, areas, polygon, walk, kernel, wrench_polytope, model, com)
+cache_depends_on(
+    kinematics_posture_kernel, areas, polygon, walk, kernel, wrench_polytope, model, com
+)
 
 
 @njit(cache=True, nogil=True)
