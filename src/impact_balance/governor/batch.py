@@ -36,9 +36,9 @@ from impact_balance.criteria.velocity_limit import LimitStatus
 from impact_balance.exceptions import GovernorError, ImpactBalanceError, SolverError
 from impact_balance.governor.limit import SpeedLimit
 from impact_balance.governor.options import Criterion
-from impact_balance.governor.posture import Kinematics, PostureEvaluator
+from impact_balance.governor.posture import PostureEvaluator
 from impact_balance.governor.posture_kernel import postures_kernel
-from impact_balance.governor.tick import com_velocities, com_velocity
+from impact_balance.governor.tick import com_velocity
 from impact_balance.projection.walk import MAX_PIVOTS
 from impact_balance.robot.robot import Robot
 
@@ -226,63 +226,61 @@ class _Slice:
             self.block(indices[a:b], same)
 
     def block(self, indices: npt.NDArray[np.int64], same: npt.NDArray[np.bool_]) -> None:
-        """The Python step of rows ``indices``, then their compiled call.
+        """The pinocchio step of rows ``indices``, then their compiled call.
 
         ``same[r]``: row r repeats the posture of row r - 1 (only its velocity is new).
         """
-        e, n, rows = self.e, len(indices), self.rows
+        e, n, rows, s = self.e, len(indices), self.rows, self.e.settings
         m, nv = len(e._frames), e.model.nv
-        rotations = np.zeros((n, m, 3, 3))  # a repeated row's are not read
-        positions, arms = np.zeros((n, m, 3)), np.zeros((n, m, 3))
-        jacobians = np.zeros((n, 6 * m, nv)) if e._torques else np.zeros((n, 0, 0))
-        gravity_torques = np.zeros((n, nv))
-        scalars = np.zeros((n, 6))  # weight, depth, cx, cy, omega, mass
-        impact_arms, inertias = np.zeros((n, 3)), np.zeros((n, 3, 3))
-        velocities = np.zeros((n, 2))
-        for r in np.flatnonzero(~same):
+        new = np.flatnonzero(~same).tolist()  # the rows of a posture of their own
+        k = len(new)
+        rotations, local = np.zeros((k, m, 3, 3)), np.zeros((k, m, 3))
+        jacobians = np.zeros((k, 6 * m, nv)) if e._torques else np.zeros((k, 0, 0))
+        origins, com_locals, point_locals = np.zeros((k, 3)), np.zeros((k, 3)), np.zeros((k, 3))
+        centroidal, inertias = np.zeros((k, 6, nv)), np.zeros((k, 3, 3))
+        scalars = np.zeros((k, 6))  # mass, then (row 0) g, h, omega, velocity margin, tolerance
+        scalars[0, 1:3] = s.gravity, s.plane_height
+        scalars[0, 4:6] = s.velocity_margin, BOUNDARY_TOLERANCE
+        for p, r in enumerate(new):
             i = int(indices[r])
-            k = e.kinematics(self.qs[i])
-            scalars[r] = self.scalars(k, i)
-            rotations[r], positions[r], arms[r] = (
-                k.rotations,
-                k.local + k.origin,
-                k.local - k.com_local,
+            origin, com_local, Ig, Ag = e._placements(
+                self.qs[i], rotations[p], local[p], jacobians[p]
             )
-            if e._torques:
-                jacobians[r] = k.jacobians
-            gravity_torques[r], inertias[r] = k.gravity_torques, k.inertia
-            point_local = e.impact_point()
-            impact_arms[r] = point_local - k.com_local
-            stop = r + 1
-            while stop < n and same[stop]:
-                stop += 1
-            # This row and the rows that repeat its posture: their CoM velocities at once.
-            run = indices[r:stop]
-            velocities_3d = _com_velocities(k.com_jacobian, self.vs[run], run)
-            velocities[r:stop] = velocities_3d[:, :2]
-            rows.com_velocity[run] = velocities_3d
-            rows.normal[run], rows.point[run] = e._normal, point_local + k.origin
-        out = np.empty((n, 6))
+            origins[p], com_locals[p], centroidal[p], inertias[p] = (
+                origin,
+                com_local,
+                Ag,
+                Ig.inertia,
+            )
+            point_locals[p] = e.impact_point()
+            scalars[p, 0] = float(Ig.mass)
+            scalars[p, 3] = self.omega(float(com_local[2]) + float(origin[2]), i)
+        out, velocities, points = np.empty((n, 6)), np.empty((n, 3)), np.empty((n, 3))
         postures_kernel(
-            e._faces, rotations, positions, arms, jacobians, e._idx, e._limit, gravity_torques,
-            scalars, impact_arms, inertias, velocities, same, e._hint, MAX_PIVOTS, e._constants,
-            e._normal, e._cone, e.settings.velocity_margin, BOUNDARY_TOLERANCE, out,
+            e._faces, rotations, local, origins, com_locals, centroidal, e._gravity, e._torques,
+            jacobians, e._idx, e._limit, scalars, e._hint, MAX_PIVOTS, e._constants,
+            point_locals, inertias, e._normal, e._cone, self.vs[indices], same, out, velocities,
+            points,
         )  # fmt: skip
+        _check_speeds(velocities, indices)
+        rows.com_velocity[indices], rows.point[indices], rows.normal[indices] = (
+            velocities,
+            points,
+            e._normal,
+        )
         self.fill(indices, out)
 
-    def scalars(self, k: Kinematics, i: int) -> tuple[float, ...]:
-        """Row ``i``'s (weight N, depth m, CoM x and y m, omega 1/s, mass kg) at kinematics ``k``.
+    def omega(self, com_height: float, i: int) -> float:
+        """The LIPM's omega (1/s) of row ``i`` at its CoM height (m).
 
         Raises:
             ScenarioError: The plane is not below the CoM (naming the row, as ``limit``).
         """
         s = self.e.settings
         try:
-            omega = lipm_omega(float(k.com[2]), s.plane_height, s.gravity, field="plane_height")
+            return lipm_omega(com_height, s.plane_height, s.gravity, field="plane_height")
         except ImpactBalanceError as exc:
             raise _in_row(exc, i) from None
-        depth = s.plane_height - float(k.com[2])
-        return k.mass * s.gravity, depth, float(k.com[0]), float(k.com[1]), omega, k.mass
 
     def fill(self, indices: npt.NDArray[np.int64], out: npt.NDArray[np.float64]) -> None:
         """Rows ``indices`` from the compiled answers ``out``; the one-posture path for the rest."""
@@ -340,22 +338,6 @@ def _com_velocity(
     out = np.empty(3)
     com_velocity(com_jacobian, v, out)
     _check_speeds(out[None, :], np.array([i]))
-    return out
-
-
-def _com_velocities(
-    com_jacobian: npt.NDArray[np.float64],
-    vs: npt.NDArray[np.float64],
-    indices: npt.NDArray[np.int64],
-) -> npt.NDArray[np.float64]:
-    """``com_jacobian @ v`` of each row of ``vs`` (rows ``indices`` of the batch), checked.
-
-    Row by row the single tick's product (:func:`~impact_balance.governor.tick.com_velocities`):
-    the same numbers as :meth:`Governor.limit`'s.
-    """
-    out = np.empty((len(vs), 3))
-    com_velocities(com_jacobian, np.ascontiguousarray(vs), out)
-    _check_speeds(out, indices)
     return out
 
 

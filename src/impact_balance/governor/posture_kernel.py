@@ -231,60 +231,73 @@ cache_depends_on(
 def postures_kernel(
     faces: np.ndarray,
     rotations: np.ndarray,
-    positions: np.ndarray,
-    arms: np.ndarray,
+    local: np.ndarray,
+    origins: np.ndarray,
+    com_locals: np.ndarray,
+    centroidal: np.ndarray,
+    gravity_vector: np.ndarray,
+    torques: bool,
     jacobians: np.ndarray,
     torque_indices: np.ndarray,
     torque_limits: np.ndarray,
-    gravity_torques: np.ndarray,
     scalars: np.ndarray,
-    impact_arms: np.ndarray,
-    inertias: np.ndarray,
-    com_velocities: np.ndarray,
-    same: np.ndarray,
     hint: np.ndarray,
     max_pivots: int,
     constants: np.ndarray,
+    point_locals: np.ndarray,
+    inertias: np.ndarray,
     normal: np.ndarray,
     cone: np.ndarray,
-    velocity_margin: float,
-    tol: float,
+    velocities: np.ndarray,
+    same: np.ndarray,
     out: np.ndarray,
+    com_velocities: np.ndarray,
+    points: np.ndarray,
 ) -> None:
-    """:func:`posture_kernel` and the first exit of every posture of a batch (GIL released).
+    """:func:`kinematics_posture_kernel` and the tick's exit for every posture of a batch.
 
-    Per posture i (leading axis), :func:`posture_kernel`'s per-posture arguments:
-    ``rotations`` (m, 3, 3), ``positions`` and ``arms`` (m, 3), ``jacobians`` (6m, nv) or
-    (0, 0), ``gravity_torques`` (nv,), ``scalars`` (weight, depth, cx, cy, w, mass),
-    ``impact_arms`` (3,), ``inertias`` (3, 3); and the CoM velocity ``com_velocities`` (2,)
-    (world xy, m/s). The rest is common (``velocity_margin`` m/s, ``tol`` the boundary
-    tolerance). Where ``same[i]``, posture i is posture i - 1: only its CoM velocity is read.
+    The GIL is released. Row i (of ``same``, ``velocities``, the outputs) has the generalized
+    velocity ``velocities[i]`` (nv,) and the posture of row i - 1 where ``same[i]``, else the
+    next posture of the per-posture arguments (leading axis: the rows where ``same`` is
+    false, in order): :func:`kinematics_posture_kernel`'s ``rotations`` (m, 3, 3), ``local``
+    (m, 3), ``origins`` and ``com_locals`` (3,), ``centroidal`` (6, nv), ``jacobians`` (6m, nv)
+    or (0, 0), ``point_locals`` (3,), ``inertias`` (3, 3), ``scalars`` (mass kg, g m/s^2, plane
+    height m, omega 1/s, velocity margin m/s, boundary tolerance; row 0 holds the common
+    ones).
 
-    Writes ``out[i] = (code, speed, vertex, edge, lo, hi)``: the numbers of a governor's tick
-    (:func:`~impact_balance.governor.tick.velocity_exit`: the exit kernel's code, an index
-    of ``EXIT_STATUSES``, and the safe interval, NaN when there is none), or code -1 where the
-    caller takes the one-posture path.
+    Writes ``com_velocities[i]`` (J_com v, m/s, BLAS's product as a tick's), ``points[i]`` (the
+    impact point, m) and ``out[i] = (code, speed, vertex, edge, lo, hi)``: the numbers of a
+    governor's tick (:func:`~impact_balance.governor.tick.velocity_exit`: the exit kernel's
+    code, an index of ``EXIT_STATUSES``, and the safe interval, NaN when there is none), or
+    code -1 where the caller takes the one-posture path.
     """
+    gravity, plane_height = scalars[0, 1], scalars[0, 2]
+    velocity_margin, tol = scalars[0, 4], scalars[0, 5]
     G, h, rates = np.empty((0, 2)), np.empty(0), np.empty((0, 0))
+    J, point = np.zeros((velocities.shape[1], 3)).T, np.zeros(3)
     answered = False  # whether G, h, rates hold the last posture's
+    p = -1  # the posture of row i
     for i in range(same.size):
         out[i, 0] = -1.0
         if not same[i]:
-            weight, depth, cx, cy, w, mass = scalars[i]
-            answer = posture_kernel(
-                faces, rotations[i], positions[i], arms[i], jacobians[i], torque_indices,
-                torque_limits, gravity_torques[i], weight, depth, cx, cy, w, hint, max_pivots,
-                constants, impact_arms[i], mass, inertias[i], normal, cone,
+            p += 1
+            answer = kinematics_posture_kernel(
+                faces, rotations[p], local[p], origins[p], com_locals[p], centroidal[p],
+                gravity_vector, torques, jacobians[p], torque_indices, torque_limits,
+                scalars[p, 0], gravity, plane_height, scalars[p, 3], hint, max_pivots,
+                constants, point_locals[p], inertias[p], normal, cone,
             )  # fmt: skip
             answered = answer[0] == 0
-            G, h, rates = answer[7], answer[8], answer[11]
+            G, h, rates, J, point = answer[7], answer[8], answer[11], answer[13], answer[14]
             if answered and velocity_margin:
                 h = h - velocity_margin
+        c = np.dot(J, velocities[i])
+        com_velocities[i, 0], com_velocities[i, 1], com_velocities[i, 2] = c[0], c[1], c[2]
+        points[i, 0], points[i, 1], points[i, 2] = point[0], point[1], point[2]
         if answered:
-            c0x, c0y = com_velocities[i, 0], com_velocities[i, 1]
             margins = np.empty(h.size)
             for k in range(h.size):
-                margins[k] = h[k] - (G[k, 0] * c0x + G[k, 1] * c0y)
+                margins[k] = h[k] - (G[k, 0] * c[0] + G[k, 1] * c[1])
             code, speed, vertex, edge = exit_kernel(margins, rates, tol)
             out[i, 0], out[i, 1], out[i, 2], out[i, 3] = code, speed, vertex, edge
             out[i, 4], out[i, 5] = 0.0, speed

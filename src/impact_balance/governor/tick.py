@@ -6,8 +6,7 @@ first exit of the post-impact vertices from the CoM velocity area
 numbers :meth:`~impact_balance.criteria.com.ComCriterion.limit` gives). :func:`velocity_exit`
 does both, with the checks of ``v`` and of the CoM speed, in one call: a governor's
 velocity-only tick is then this call and the answer object. A batch computes its rows' CoM
-velocities with the same product (:func:`com_velocities`), so a row and a single tick agree to the
-last digit.
+velocities with the same product, so a row and a single tick agree to the last digit.
 """
 
 from __future__ import annotations
@@ -24,7 +23,6 @@ __all__ = [
     "CANNOT_BALANCE",
     "NOT_FINITE",
     "TOO_FAST",
-    "com_velocities",
     "com_velocity",
     "velocity_exit",
 ]
@@ -102,15 +100,6 @@ def velocity_exit(
         if not found:
             lo = hi = math.nan
     return code, speed, vertex, edge, lo, hi
-
-
-@njit(cache=True)
-def com_velocities(J: np.ndarray, vs: np.ndarray, out: np.ndarray) -> None:
-    """Row i of ``out`` (k, 3) is :func:`com_velocity` of ``J`` and row i of ``vs`` (k, nv)."""
-    row = np.empty(3)
-    for i in range(vs.shape[0]):
-        com_velocity(J, vs[i], row)
-        out[i, 0], out[i, 1], out[i, 2] = row[0], row[1], row[2]
 
 
 cache_depends_on(velocity_exit, linear_exit)
