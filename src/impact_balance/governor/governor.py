@@ -26,9 +26,7 @@ from impact_balance.governor.batch import BatchEvaluator, BatchLimits
 from impact_balance.governor.limit import Binding, SpeedLimit, _floating_limit
 from impact_balance.governor.options import CRITERIA, ContactAwareOptions, Criterion
 from impact_balance.governor.posture import (
-    NO_HALFPLANES as _NO_HALFPLANES,
-)
-from impact_balance.governor.posture import (
+    NO_HALFPLANES,
     Posture,
     PostureEvaluator,
     PostureSettings,
@@ -239,12 +237,10 @@ class Governor:
             criterion.limit(np.zeros(3))
             criterion.limits(np.zeros(3), np.zeros((1, 2)))
         # and the tick's (velocity_exit), for the area's read-only half-planes and for none
+        J, G, h, rates = posture.exit_arrays
         still, c = np.zeros(self.nv), np.empty(3)
-        areas = [_NO_AREA]
-        if criterion is not None and criterion.G is not None:
-            areas.append((criterion.G, criterion.h, criterion.rates))  # type: ignore[arg-type]
-        for G, h, rates in areas:
-            velocity_exit(posture.com_jacobian, still, G, h, rates, 1e-10, 1.0, c)
+        velocity_exit(J, still, G, h, rates, BOUNDARY_TOLERANCE, 1.0, c)
+        velocity_exit(J, still, _NO_AREA[0], _NO_AREA[1], _NO_AREA[2], BOUNDARY_TOLERANCE, 1.0, c)
         return posture
 
     def close(self) -> None:
@@ -340,7 +336,7 @@ class Governor:
         answer; the others go through :meth:`_answer`.
         """
         J, G, h, rates = posture.exit_arrays
-        fast = G is not _NO_HALFPLANES and self._support is None
+        fast = G is not NO_HALFPLANES and self._support is None
         if not fast:
             G, h, rates = _NO_AREA
         com_velocity = np.empty(3)
