@@ -122,7 +122,7 @@ def _capture(governor: Governor, postures):
     try:
         evaluator = PostureEvaluator(governor.robot, governor._evaluator.settings)
         for q in postures:
-            evaluator.evaluate(q)
+            evaluator.evaluate(q, steps=True)  # the steps call projected_from_arrays
     finally:
         P.projected_from_arrays = original
     return captured

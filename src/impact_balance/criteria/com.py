@@ -28,7 +28,7 @@ from impact_balance.geometry.polygon import Polygon
 from impact_balance.impact.angular_momentum import AngularMomentumTerm, effective_impulse_rates
 from impact_balance.impact.model import ImpactModel
 
-__all__ = ["ComCriterion", "max_contact_velocity", "safe_interval"]
+__all__ = ["ComCriterion", "jump_rates_kernel", "max_contact_velocity", "safe_interval"]
 
 
 @njit(cache=True)
@@ -74,6 +74,10 @@ def _com_exits(G, h, c0x, c0y, rates, jumps, tol):
     b = exit_kernel(margins, edge, tol)
     return a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]
 
+
+#: :func:`_jump_rates` for compiled callers that build a criterion's rates in their own call
+#: (a governor's tick; :meth:`ComCriterion.from_rates` takes them).
+jump_rates_kernel = _jump_rates
 
 cache_depends_on(_com_exit, linear_exit)
 cache_depends_on(_com_exits, linear_exit)
@@ -146,6 +150,30 @@ class ComCriterion:
                 [impulse_rates, effective_impulse_rates(impulse_rates, angular_momentum)]
             )
         self.rates = _jump_rates(impulse_rates, float(impact.mass), G)
+
+    @classmethod
+    def from_rates(
+        cls,
+        area: Polygon,
+        impact: ImpactModel,
+        velocity_margin: float,
+        G: npt.NDArray[np.float64],
+        h: npt.NDArray[np.float64],
+        rates: npt.NDArray[np.float64],
+    ) -> ComCriterion:
+        """The criterion whose half-planes and rates were computed by the caller.
+
+        The same object as ``ComCriterion(area, impact, velocity_margin)`` (no angular
+        momentum term) when ``(G, h)`` are ``area.halfplanes`` (``h`` less the margin) and
+        ``rates`` is :data:`jump_rates_kernel` of the impact's ``impulse_rates``, its mass and
+        ``G``: a compiled caller (a governor's tick) made them in its own call.
+        """
+        self = cls.__new__(cls)
+        self.area, self.impact = area, impact
+        self.velocity_margin = float(velocity_margin)
+        self.angular_momentum = None
+        self.G, self.h, self.rates = G, h, rates
+        return self
 
     def margins(self, com_velocity: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """The slack ``h - G c0`` of the pre-impact CoM velocity in each half-plane.

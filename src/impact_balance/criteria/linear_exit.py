@@ -22,6 +22,7 @@ __all__ = [
     "EXIT_STATUSES",
     "exit_kernel",
     "first_exit",
+    "interval_kernel",
     "limit_of_exit",
     "speed_interval",
 ]
@@ -119,21 +120,45 @@ def speed_interval(
     Returns:
         ``(lo, hi)`` (m/s), or None when no speed is safe.
     """
-    margins = np.asarray(margins, dtype=float)
-    rates = np.asarray(rates, dtype=float)
-    scale = tol * max(1.0, float(np.abs(rates).max(initial=0.0)))
-    positive, negative = rates > scale, rates < -scale
-    flat = ~(positive | negative)
-    m = np.broadcast_to(margins, rates.shape)
-    if (m[flat] < -tol).any():
-        return None  # a vertex outside that the impact does not move along that edge's normal
-    inside = bool((margins >= -tol).all())
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = m / rates
-    hi = float(
-        np.min(np.maximum(ratio[positive], 0.0) if inside else ratio[positive], initial=np.inf)
-    )
-    lo = 0.0 if inside else max(0.0, float(np.max(ratio[negative], initial=0.0)))
+    m = np.ascontiguousarray(margins, dtype=float)
+    r = np.ascontiguousarray(rates, dtype=float).reshape(-1, m.size)
+    found, lo, hi = interval_kernel(m, r, tol)
+    return (lo, hi) if found else None
+
+
+@njit(cache=True)
+def interval_kernel(margins, rates, tol):
+    """:func:`speed_interval` compiled: ``(found, lo, hi)`` (``lo``, ``hi`` unused unless found).
+
+    The numbers of the array expression it replaced, to the last digit (elementwise ratios,
+    their minimum and maximum): a zero rate is one within ``tol`` times the largest rate (and
+    1); with every margin >= ``-tol`` the interval starts at 0 and its top is the smallest
+    ``max(margin, 0) / rate`` over the positive rates.
+    """
+    n_v, n_c = rates.shape
+    big = 0.0
+    for j in range(n_v):
+        for k in range(n_c):
+            big = max(big, abs(rates[j, k]))
+    scale = tol * max(1.0, big)
+    inside = True
+    for k in range(n_c):
+        if not margins[k] >= -tol:
+            inside = False
+    hi, lo = math.inf, 0.0
+    for j in range(n_v):
+        for k in range(n_c):
+            r = rates[j, k]
+            if r > scale:
+                ratio = margins[k] / r
+                if inside and not ratio >= 0.0:
+                    ratio = 0.0
+                hi = min(hi, ratio)
+            elif r < -scale:
+                if not inside:
+                    lo = max(lo, margins[k] / r)
+            elif margins[k] < -tol:
+                return False, 0.0, 0.0  # outside an edge the impact does not move it along
     if lo > hi * (1.0 + 1e-12) + tol:
-        return None
-    return lo, max(lo, hi)
+        return False, 0.0, 0.0
+    return True, lo, max(lo, hi)

@@ -3,16 +3,17 @@
 :meth:`Governor.limits <impact_balance.governor.Governor.limits>` answers N configurations
 and N generalized velocities (a planner's candidate postures, a sweep's grid), as N calls of
 :meth:`~impact_balance.governor.Governor.limit` would, to rounding. Per posture the Python
-side runs pinocchio and the impact model (:meth:`PostureEvaluator.kinematics
+side runs pinocchio (:meth:`PostureEvaluator.kinematics
 <impact_balance.governor.posture.PostureEvaluator.kinematics>`, the one-posture path's own
-step); the areas and the criterion of every posture then run in one compiled call
-(:func:`~impact_balance.criteria.batch.posture_exits`), which releases the GIL, so
-``threads`` > 1 evaluates slices of the postures side by side. A posture the compiled call
-does not answer (a projection Bretl's method answers, a CoM velocity already outside its
-area, an area of fewer than 3 vertices), the "zmp" criterion, contact frictions above 1 and the
-angular momentum option (``angular_momentum_damping_time``)
-take the one-posture path (:meth:`PostureEvaluator.evaluate
-<impact_balance.governor.posture.PostureEvaluator.evaluate>`).
+step); the areas, the impact model and the criterion of every posture then run in one compiled
+call (:func:`~impact_balance.governor.posture_kernel.postures_kernel`: a tick's
+:func:`~impact_balance.governor.posture_kernel.posture_kernel` per posture, the same numbers),
+which releases the GIL, so ``threads`` > 1 evaluates slices of the postures side by side. A
+posture the compiled call does not answer (a projection Bretl's method answers, an area of fewer
+than 3 vertices, an impact model it refuses), the
+"zmp" criterion, the joint-space inertia model, contact frictions above 1 and the angular
+momentum option (``angular_momentum_damping_time``) take the one-posture path
+(:meth:`PostureEvaluator.evaluate <impact_balance.governor.posture.PostureEvaluator.evaluate>`).
 """
 
 from __future__ import annotations
@@ -28,18 +29,16 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import ArrayLike
 
-from impact_balance.balance.areas import FORCE_BOX, MERGE_TOLERANCE
 from impact_balance.balance.lipm import lipm_omega
 from impact_balance.constants import MAX_SPEED
-from impact_balance.contacts.wrench_polytope import face_blocks
-from impact_balance.criteria.batch import posture_exits
 from impact_balance.criteria.linear_exit import BOUNDARY_TOLERANCE, EXIT_STATUSES
 from impact_balance.criteria.velocity_limit import LimitStatus
 from impact_balance.exceptions import GovernorError, ImpactBalanceError, SolverError
-from impact_balance.geometry.polygon import MERGE_AREA_TOLERANCE
 from impact_balance.governor.limit import SpeedLimit
 from impact_balance.governor.options import Criterion
 from impact_balance.governor.posture import PostureEvaluator
+from impact_balance.governor.posture_kernel import postures_kernel
+from impact_balance.governor.tick import com_velocity
 from impact_balance.projection.walk import MAX_PIVOTS
 from impact_balance.robot.robot import Robot
 
@@ -150,17 +149,6 @@ class BatchEvaluator:
         self.robot, self.settings, self.check = robot, evaluator.settings, check
         self._evaluators: list[PostureEvaluator] = []
         self._lock = threading.Lock()
-        self._settings = np.array(
-            [
-                FORCE_BOX,
-                MAX_PIVOTS,
-                MERGE_TOLERANCE,
-                MERGE_AREA_TOLERANCE,
-                self.settings.zmp_margin,
-                self.settings.velocity_margin,
-                BOUNDARY_TOLERANCE,
-            ]
-        )
 
     def limits(self, q_batch: ArrayLike, v_batch: ArrayLike, threads: int = 1) -> BatchLimits:
         """See :meth:`impact_balance.governor.Governor.limits`."""
@@ -184,11 +172,11 @@ class BatchEvaluator:
         evaluators = self._take(len(slices))
         try:
             if len(slices) == 1:
-                _Slice(evaluators[0], qs, vs, rows, self._settings).run(slices[0], repeated)
+                _Slice(evaluators[0], qs, vs, rows).run(slices[0], repeated)
             else:
                 with ThreadPoolExecutor(len(slices)) as pool:
                     futures = [
-                        pool.submit(_Slice(e, qs, vs, rows, self._settings).run, s, repeated)
+                        pool.submit(_Slice(e, qs, vs, rows).run, s, repeated)
                         for e, s in zip(evaluators, slices, strict=True)
                     ]
                     for future in futures:
@@ -214,16 +202,11 @@ class _Slice:
         qs: npt.NDArray[np.float64],
         vs: npt.NDArray[np.float64],
         rows: _Rows,
-        settings: npt.NDArray[np.float64],
     ) -> None:
-        self.e, self.qs, self.vs, self.rows, self.settings = evaluator, qs, vs, rows, settings
-        # The compiled call answers the paper's "com" criterion of unscaled contacts (friction
-        # <= 1); with the angular momentum counted, every row takes limit()'s path.
-        self.compiled = (
-            evaluator.settings.criterion == "com"
-            and not evaluator._scaled
-            and evaluator.settings.angular_momentum_damping_time is None
-        )
+        self.e, self.qs, self.vs, self.rows = evaluator, qs, vs, rows
+        # The compiled call answers the posture kernel's case (the paper's "com" criterion, the
+        # composite inertia, unscaled contacts); every other row takes limit()'s path.
+        self.compiled = evaluator._compiled
 
     def run(self, indices: npt.NDArray[np.int64], repeated: npt.NDArray[np.bool_]) -> None:
         """Answer rows ``indices`` of the batch (``repeated[i]``: row i's q is row i - 1's)."""
@@ -243,105 +226,80 @@ class _Slice:
             self.block(indices[a:b], same)
 
     def block(self, indices: npt.NDArray[np.int64], same: npt.NDArray[np.bool_]) -> None:
-        """The Python step of rows ``indices``, then their compiled call.
+        """The pinocchio step of rows ``indices``, then their compiled call.
 
         ``same[r]``: row r repeats the posture of row r - 1 (only its velocity is new).
         """
-        e, s, n, rows = self.e, self.e.settings, len(indices), self.rows
+        e, n, rows, s = self.e, len(indices), self.rows, self.e.settings
         m, nv = len(e._frames), e.model.nv
-        torques = e._torques
-        rotations = np.zeros((n, m, 3, 3))  # a repeated row's are not read
-        positions, arms = np.zeros((n, m, 3)), np.zeros((n, m, 3))
-        jacobians = np.zeros((n, 6 * m, nv)) if torques else np.zeros((n, 0, 0))
-        gravity_torques = np.zeros((n, nv))
-        weights, depths, omegas = np.zeros(n), np.zeros(n), np.zeros(n)
-        coms, velocities = np.zeros((n, 3)), np.zeros((n, 2))
-        jumps = np.zeros((0, 0, 2))
-        for r in np.flatnonzero(~same):
+        new = np.flatnonzero(~same).tolist()  # the rows of a posture of their own
+        k = len(new)
+        rotations, local = np.zeros((k, m, 3, 3)), np.zeros((k, m, 3))
+        jacobians = np.zeros((k, 6 * m, nv)) if e._torques else np.zeros((k, 0, 0))
+        origins, com_locals, point_locals = np.zeros((k, 3)), np.zeros((k, 3)), np.zeros((k, 3))
+        centroidal, inertias = np.zeros((k, 6, nv)), np.zeros((k, 3, 3))
+        scalars = np.zeros((k, 6))  # mass, then (row 0) g, h, omega, velocity margin, tolerance
+        scalars[0, 1:3] = s.gravity, s.plane_height
+        scalars[0, 4:6] = s.velocity_margin, BOUNDARY_TOLERANCE
+        for p, r in enumerate(new):
             i = int(indices[r])
-            q = self.qs[i]
-            k = e.kinematics(q)
-            try:
-                omegas[r] = lipm_omega(
-                    float(k.com[2]), s.plane_height, s.gravity, field="plane_height"
-                )
-                impact = e.impact_at(q, k)
-            except ImpactBalanceError as exc:  # as limit() raises it, naming the row
-                if exc.args and isinstance(exc.args[0], str):
-                    exc.args = (f"q_batch[{i}]: {exc.args[0]}", *exc.args[1:])
-                raise
-            rotations[r] = k.rotations
-            positions[r] = k.local + k.origin
-            arms[r] = k.local - k.com_local
-            if torques:
-                jacobians[r] = k.jacobians
-            gravity_torques[r] = k.gravity_torques
-            weights[r] = k.mass * s.gravity
-            depths[r] = s.plane_height - float(k.com[2])
-            coms[r] = k.com
-            rates = impact.com_jump_rates
-            if not jumps.size:
-                jumps = np.zeros((n, *rates.shape))
-            stop = r + 1
-            while stop < n and same[stop]:
-                stop += 1
-            if stop == r + 1:  # a posture of its own
-                com_velocity = _com_velocity(k.com_jacobian, self.vs[i], i)
-                velocities[r], jumps[r] = com_velocity[:2], rates
-                rows.com_velocity[i], rows.normal[i], rows.point[i] = (
-                    com_velocity,
-                    impact.normal,
-                    impact.point,
-                )
-                continue
-            # This row and the rows that repeat its posture: their CoM velocities at once.
-            run = indices[r:stop]
-            velocities_3d = _com_velocities(k.com_jacobian, self.vs[run], run)
-            velocities[r:stop] = velocities_3d[:, :2]
-            jumps[r:stop] = rates
-            rows.com_velocity[run] = velocities_3d
-            rows.normal[run], rows.point[run] = impact.normal, impact.point
-        # face_blocks of every row in one batched product (the same numbers row by row)
-        blocks = face_blocks(np.tile(e._faces, (n, 1, 1)), rotations.reshape(n * m, 3, 3))
-        blocks = blocks.reshape(n, m, 32, 3)
-        out = np.empty((n, 4))
-        posture_exits(
-            blocks,
-            positions,
-            arms,
-            jacobians,
-            e._idx,
-            e._limit,
-            gravity_torques,
-            weights,
-            depths,
-            coms,
-            omegas,
-            jumps,
+            origin, com_local, Ig, Ag = e._placements(
+                self.qs[i], rotations[p], local[p], jacobians[p]
+            )
+            origins[p], com_locals[p], centroidal[p], inertias[p] = (
+                origin,
+                com_local,
+                Ag,
+                Ig.inertia,
+            )
+            point_locals[p] = e.impact_point()
+            scalars[p, 0] = float(Ig.mass)
+            scalars[p, 3] = self.omega(float(com_local[2]) + float(origin[2]), i)
+        out, velocities, points = np.empty((n, 6)), np.empty((n, 3)), np.empty((n, 3))
+        postures_kernel(
+            e._faces, rotations, local, origins, com_locals, centroidal, e._gravity, e._torques,
+            jacobians, e._idx, e._limit, scalars, e._hint, MAX_PIVOTS, e._constants,
+            point_locals, inertias, e._normal, e._cone, self.vs[indices], same, out, velocities,
+            points,
+        )  # fmt: skip
+        _check_speeds(velocities, indices)
+        rows.com_velocity[indices], rows.point[indices], rows.normal[indices] = (
             velocities,
-            self.settings,
-            e._hint,
-            out,
-            same,
+            points,
+            e._normal,
         )
         self.fill(indices, out)
+
+    def omega(self, com_height: float, i: int) -> float:
+        """The LIPM's omega (1/s) of row ``i`` at its CoM height (m).
+
+        Raises:
+            ScenarioError: The plane is not below the CoM (naming the row, as ``limit``).
+        """
+        s = self.e.settings
+        try:
+            return lipm_omega(com_height, s.plane_height, s.gravity, field="plane_height")
+        except ImpactBalanceError as exc:
+            raise _in_row(exc, i) from None
 
     def fill(self, indices: npt.NDArray[np.int64], out: npt.NDArray[np.float64]) -> None:
         """Rows ``indices`` from the compiled answers ``out``; the one-posture path for the rest."""
         rows = self.rows
         codes = out[:, 0].astype(np.int64)
-        answered = (codes == 0) | (codes == 2)  # "ok" and "unbounded": from inside the area
+        answered = codes >= 0  # "ok", "already_falling", "unbounded"
         done = indices[answered]
-        speeds = np.where(codes[answered] == 0, out[answered, 1], math.inf)
-        rows.speed[done] = speeds
-        rows.interval[done, 0], rows.interval[done, 1] = 0.0, speeds
+        rows.speed[done] = np.where(
+            codes[answered] == 0, out[answered, 1], np.where(codes[answered] == 1, 0.0, math.inf)
+        )
+        rows.interval[done] = out[answered, 4:6]
         ok = indices[codes == 0]
         rows.vertex[ok], rows.edge[ok] = out[codes == 0, 2], out[codes == 0, 3]
-        for r, i in enumerate(indices):
-            if answered[r]:
-                rows.status[i] = EXIT_STATUSES[codes[r]]
-            else:  # Bretl's projection, a small area, a falling start
-                self.single(int(i))
+        status = rows.status
+        for i, code in zip(indices.tolist(), codes.tolist(), strict=True):
+            if code >= 0:
+                status[i] = EXIT_STATUSES[code]
+            else:  # Bretl's projection, a small area, a refused impact model
+                self.single(i)
 
     def single(self, i: int) -> None:
         """Row ``i`` by the one-posture path (what :meth:`Governor.limit` does)."""
@@ -350,6 +308,8 @@ class _Slice:
             posture = self.e.evaluate(self.qs[i])
         except SolverError as exc:
             raise exc.within(f"q_batch[{i}]") from None
+        except ImpactBalanceError as exc:  # as limit() raises it, naming the row
+            raise _in_row(exc, i) from None
         com_velocity = _com_velocity(posture.com_jacobian, self.vs[i], i)
         criterion = posture.com_criterion
         interval: tuple[float, float] | None
@@ -371,29 +331,18 @@ class _Slice:
 def _com_velocity(
     com_jacobian: npt.NDArray[np.float64], v: npt.NDArray[np.float64], i: int
 ) -> npt.NDArray[np.float64]:
-    """``com_jacobian @ v`` (row ``i``), checked as :meth:`Governor.limit` checks it (m/s)."""
-    com_velocity: npt.NDArray[np.float64] = com_jacobian @ v
-    if not float(com_velocity @ com_velocity) <= MAX_SPEED * MAX_SPEED:
-        raise GovernorError(
-            f"v_batch[{i}]",
-            f"CoM velocity {math.hypot(*com_velocity):.3g} m/s",
-            f"gives a CoM speed above {MAX_SPEED:g} m/s (the scenario's bound)",
-        )
-    return com_velocity
+    """``com_jacobian @ v`` (row ``i``), checked as :meth:`Governor.limit` checks it (m/s).
 
-
-def _com_velocities(
-    com_jacobian: npt.NDArray[np.float64],
-    vs: npt.NDArray[np.float64],
-    indices: npt.NDArray[np.int64],
-) -> npt.NDArray[np.float64]:
-    """``com_jacobian @ v`` of each row of ``vs`` (rows ``indices`` of the batch), checked.
-
-    One stacked product: numpy makes each row's matrix-vector product as for one vector (the
-    same numbers as :meth:`Governor.limit`'s ``com_jacobian @ v``).
+    The single tick's product (:func:`~impact_balance.governor.tick.com_velocity`).
     """
-    out: npt.NDArray[np.float64] = np.matmul(com_jacobian, vs[:, :, None])[:, :, 0]
-    out = np.ascontiguousarray(out)
+    out = np.empty(3)
+    com_velocity(com_jacobian, v, out)
+    _check_speeds(out[None, :], np.array([i]))
+    return out
+
+
+def _check_speeds(out: npt.NDArray[np.float64], indices: npt.NDArray[np.int64]) -> None:
+    """:class:`GovernorError` naming the first row of ``out`` (CoM velocities, m/s) too fast."""
     speeds: npt.NDArray[np.float64] = np.einsum("ij,ij->i", out, out)
     bad = np.flatnonzero(~(speeds <= MAX_SPEED * MAX_SPEED))
     if bad.size:
@@ -403,7 +352,13 @@ def _com_velocities(
             f"CoM velocity {math.hypot(*out[j]):.3g} m/s",
             f"gives a CoM speed above {MAX_SPEED:g} m/s (the scenario's bound)",
         )
-    return out
+
+
+def _in_row(exc: ImpactBalanceError, i: int) -> ImpactBalanceError:
+    """``exc`` with its message prefixed by the row it is about (``q_batch[i]: ...``)."""
+    if exc.args and isinstance(exc.args[0], str):
+        exc.args = (f"q_batch[{i}]: {exc.args[0]}", *exc.args[1:])
+    return exc
 
 
 def _matrix(x: ArrayLike, size: int, field: str) -> npt.NDArray[np.float64]:

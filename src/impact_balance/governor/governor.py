@@ -7,7 +7,7 @@ import os
 import threading
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 import numpy as np
 import numpy.typing as npt
@@ -19,13 +19,20 @@ from impact_balance.balance.areas import warm_up as warm_up_maps
 from impact_balance.constants import MAX_POSITION, MAX_SPEED
 from impact_balance.contacts.stance import ContactSpec, has_free_flyer
 from impact_balance.criteria.cap import cap_approach
+from impact_balance.criteria.linear_exit import BOUNDARY_TOLERANCE, EXIT_STATUSES
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.exceptions import GovernorError, ScenarioError
 from impact_balance.governor.batch import BatchEvaluator, BatchLimits
-from impact_balance.governor.limit import Binding, SpeedLimit
+from impact_balance.governor.limit import Binding, SpeedLimit, _floating_limit
 from impact_balance.governor.options import CRITERIA, ContactAwareOptions, Criterion
-from impact_balance.governor.posture import Posture, PostureEvaluator, PostureSettings
+from impact_balance.governor.posture import (
+    NO_HALFPLANES,
+    Posture,
+    PostureEvaluator,
+    PostureSettings,
+)
 from impact_balance.governor.support import ContactAwareLimit, combine
+from impact_balance.governor.tick import NOT_FINITE, velocity_exit
 from impact_balance.governor.worker import ContactAwareWorker
 from impact_balance.projection.bretl import warm_up as warm_up_bretl
 from impact_balance.projection.walk import warm_up
@@ -53,9 +60,11 @@ QUATERNION_TOLERANCE = 1e-6
 #: simulation, encoder noise), a posture farther out is not the robot's.
 JOINT_LIMIT_TOLERANCE = 0.1
 
-#: Below this squared CoM speed bound, (m/s)^2, a tick's CoM velocity is surely within
-#: MAX_SPEED (the bound's rounding is far inside the factor).
-_SURELY_SLOW = 0.999999 * MAX_SPEED * MAX_SPEED
+_MAX_SPEED_SQUARED = MAX_SPEED * MAX_SPEED
+_FLOAT = np.dtype(np.float64)  # numpy's own float64 dtype: a float array's dtype is this object
+_STRIDE = (8,)  # a contiguous float64 vector's
+#: The half-planes and rates :func:`velocity_exit` takes where there is no area to exit.
+_NO_AREA = (np.zeros((0, 2)), np.zeros(0), np.zeros((0, 0)))
 
 
 class Governor:
@@ -155,6 +164,7 @@ class Governor:
         self.robot: Robot = scenario.load_robot()
         model = self.robot.model
         self.nq, self.nv = model.nq, model.nv
+        self._q_shape, self._v_shape = (self.nq,), (self.nv,)
         self._free_flyer = has_free_flyer(model)
         self._joints = _JointBounds(self.robot)
         assert scenario.impact is not None  # _governed refuses a scenario without one
@@ -187,8 +197,6 @@ class Governor:
         self._last: SpeedLimit | None = None
         self._posture: Posture | None = self._first_posture()
         self._support_posture: bytes | None = None
-        self._jacobian_key: bytes | None = None  # the posture of _jacobian_squared
-        self._jacobian_squared = math.inf
         self._aware = aware
         self._clock = _RatesClock()  # the rates' age
         if self._support is not None and aware is not None and aware.asynchronous:
@@ -207,15 +215,32 @@ class Governor:
         warm_up()  # the projection kernel's one-time load
         warm_up_bretl()  # the fallback's (HiGHS), so that a tick that falls back is not slow
         warm_up_maps()  # and the fallback's compiled map
-        joints = self._joints  # and the joint check's
-        _first_outside(self.configuration, joints.idx, joints.lower, joints.upper)
+        joints = self._joints  # and the state check's
+        _state_fault(
+            self.configuration,
+            np.zeros(self.nv),
+            joints.idx,
+            joints.lower,
+            joints.upper,
+            joints.pair_indices,
+            self._free_flyer,
+            MAX_POSITION,
+            QUATERNION_TOLERANCE,
+        )
         try:
             posture = self._evaluator.evaluate(self.configuration)
+            self._evaluator.evaluate(self.configuration, steps=True)  # what the kernel leaves
         except ScenarioError as exc:
             raise with_source(exc, self.scenario.source) from None
-        if posture.com_criterion is not None:  # the criterion's compiled code, here too
-            posture.com_criterion.limit(np.zeros(3))
-            posture.com_criterion.limits(np.zeros(3), np.zeros((1, 2)))
+        criterion = posture.com_criterion
+        if criterion is not None:  # the criterion's compiled code, here too
+            criterion.limit(np.zeros(3))
+            criterion.limits(np.zeros(3), np.zeros((1, 2)))
+        # and the tick's (velocity_exit), for the area's read-only half-planes and for none
+        J, G, h, rates = posture.exit_arrays
+        still, c = np.zeros(self.nv), np.empty(3)
+        velocity_exit(J, still, G, h, rates, BOUNDARY_TOLERANCE, 1.0, c)
+        velocity_exit(J, still, _NO_AREA[0], _NO_AREA[1], _NO_AREA[2], BOUNDARY_TOLERANCE, 1.0, c)
         return posture
 
     def close(self) -> None:
@@ -255,22 +280,91 @@ class Governor:
             ScenarioError, ImpactModelError, SolverError: a posture the pipeline cannot
                 evaluate (see :meth:`~impact_balance.governor.posture.PostureEvaluator.evaluate`).
         """
-        configuration = self._configuration(q)
-        velocity, squared = _squared_vector(v, self.nv, "v")
         with self._lock:
-            posture, reused = self._posture_at(configuration)
-            com_velocity = posture.com_jacobian @ velocity  # |v| < 1e154: no overflow
-            # A reused posture (a velocity-only tick): |J v|^2 <= |J|_F^2 |v|^2 settles it
-            # unless v is near the bound; else the exact check.
-            if not (reused and squared * self._jacobian_size(posture) <= _SURELY_SLOW) and not (
-                float(np.dot(com_velocity, com_velocity)) <= MAX_SPEED * MAX_SPEED
+            posture = self._posture
+            # The very q of the cached posture (checked when it was evaluated): no check again.
+            if (
+                posture is not None
+                and type(q) is np.ndarray
+                and q.dtype is _FLOAT
+                and q.shape == self._q_shape
+                and q.tobytes() == posture.key
             ):
-                raise GovernorError(
-                    "v",
-                    f"CoM velocity {math.hypot(*com_velocity):.3g} m/s",
-                    f"gives a CoM speed above {MAX_SPEED:g} m/s (the scenario's bound)",
-                )
+                return self._tick(posture, _velocity(v, self._v_shape), True)
+        configuration, velocity = self._state(q, v)
+        with self._lock:
+            posture, reused = self._posture_at(configuration, checked=True)
+            return self._tick(posture, velocity, reused)
+
+    def _state(
+        self, q: ArrayLike, v: ArrayLike
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """``q`` and ``v`` as contiguous float vectors, checked as :meth:`limit` says.
+
+        Contiguous float64 arrays of the right sizes are checked in one compiled pass
+        (:func:`_state_fault`); anything else, or a state it finds at fault, by the checks that
+        name the field and value (in the order q, v, the joints).
+        """
+        configuration, velocity = _as_is(q, self._q_shape), _as_is(v, self._v_shape)
+        joints = self._joints
+        if (
+            configuration is None
+            or velocity is None
+            or _state_fault(
+                configuration,
+                velocity,
+                joints.idx,
+                joints.lower,
+                joints.upper,
+                joints.pair_indices,
+                self._free_flyer,
+                MAX_POSITION,
+                QUATERNION_TOLERANCE,
+            )
+        ):
+            configuration = self._configuration(q)
+            velocity = _vector(v, self.nv, "v")
+            joints.check(configuration)
+        return configuration, velocity
+
+    def _tick(self, posture: Posture, v: npt.NDArray[np.float64], reused: bool) -> SpeedLimit:
+        """The answer at ``posture`` for the generalized velocity ``v`` (under the lock).
+
+        ``v``: (nv,) contiguous floats, checked here (not finite, or a CoM speed above
+        ``MAX_SPEED``: :class:`GovernorError`). The "com" criterion without the contact-aware
+        bound is one compiled call (:func:`~impact_balance.governor.tick.velocity_exit`) and the
+        answer; the others go through :meth:`_answer`.
+        """
+        J, G, h, rates = posture.exit_arrays
+        fast = G is not NO_HALFPLANES and self._support is None
+        if not fast:
+            G, h, rates = _NO_AREA
+        com_velocity = np.empty(3)
+        code, speed, j, k, lo, hi = velocity_exit(
+            J, v, G, h, rates, BOUNDARY_TOLERANCE, _MAX_SPEED_SQUARED, com_velocity
+        )
+        if code < 0:
+            _refuse_velocity(code, v, self.nv, com_velocity)
+        if not fast:  # the general answer
             return self._answer(posture, com_velocity, reused)
+        model = posture.impact
+        vertex, edge = (j, k) if code == 0 else (None, None)
+        interval = None if math.isnan(lo) else (lo, hi)
+        if code != 0:  # "already_falling" (0) or "unbounded" (inf)
+            speed = 0.0 if code == 1 else math.inf
+        self._last = answer = _floating_limit(
+            self.criterion,
+            speed,
+            EXIT_STATUSES[code],
+            vertex,
+            edge,
+            interval,
+            com_velocity,
+            model.normal,
+            model.point,
+            reused,
+        )
+        return answer
 
     def limits(self, q_batch: ArrayLike, v_batch: ArrayLike, *, threads: int = 1) -> BatchLimits:
         """The speed limits of N postures: row i is ``limit(q_batch[i], v_batch[i])``.
@@ -442,17 +536,6 @@ class Governor:
                 )
         return configuration
 
-    def _jacobian_size(self, posture: Posture) -> float:
-        """The squared Frobenius norm of ``posture``'s CoM Jacobian, (m/s)^2 per unit of v^2.
-
-        Computed once per posture (under the lock).
-        """
-        if self._jacobian_key is not posture.key:
-            self._jacobian_key = posture.key
-            J = posture.com_jacobian
-            self._jacobian_squared = float(np.vdot(J, J))
-        return self._jacobian_squared
-
     def _checked_row(self, q: npt.NDArray[np.float64], field: str) -> npt.NDArray[np.float64]:
         """Row ``q`` of a batch checked as :meth:`limit` checks ``q`` (errors name ``field``)."""
         try:
@@ -462,17 +545,24 @@ class Governor:
             raise GovernorError(field + exc.field[1:], exc.value, exc.reason) from None
         return configuration
 
-    def _posture_at(self, q: npt.NDArray[np.float64]) -> tuple[Posture, bool]:
-        """The posture of ``q``, reused when it is the cached one (under the lock)."""
+    def _posture_at(
+        self, q: npt.NDArray[np.float64], checked: bool = False
+    ) -> tuple[Posture, bool]:
+        """The posture of ``q``, reused when it is the cached one (under the lock).
+
+        ``checked``: the joints of ``q`` were checked already.
+        """
         cached = self._posture
         if cached is not None:
             if self.posture_tolerance == 0.0:
                 if cached.key == q.tobytes():  # the very q checked when it was evaluated
                     return cached, True
             elif float(np.abs(q - cached.q).max()) <= self.posture_tolerance:
-                self._joints.check(q)
+                if not checked:
+                    self._joints.check(q)
                 return cached, True
-        self._joints.check(q)
+        if not checked:
+            self._joints.check(q)
         try:
             posture = self._evaluator.evaluate(q)
         except ScenarioError as exc:
@@ -777,6 +867,36 @@ def _zmp_interval(limit: ContactVelocityLimit) -> tuple[float, float] | None:
     return limit.interval_from_inside()
 
 
+def _as_is(x: object, shape: tuple[int]) -> npt.NDArray[np.float64] | None:
+    """``x`` when it is a contiguous float64 array of ``shape`` (numpy's own dtype), else None."""
+    if type(x) is np.ndarray and x.dtype is _FLOAT and x.shape == shape and x.strides == _STRIDE:
+        return x
+    return None
+
+
+def _velocity(v: ArrayLike, shape: tuple[int]) -> npt.NDArray[np.float64]:
+    """``v`` as a contiguous float vector of ``shape`` (checked as :func:`_vector` checks it).
+
+    A contiguous float64 array of that shape as it is: its finiteness is checked by the
+    compiled call that reads it (:meth:`Governor._tick`).
+    """
+    velocity = _as_is(v, shape)
+    return _vector(v, shape[0], "v") if velocity is None else velocity
+
+
+def _refuse_velocity(
+    code: int, v: npt.NDArray[np.float64], nv: int, com_velocity: npt.NDArray[np.float64]
+) -> NoReturn:
+    """Raise :class:`GovernorError` for :func:`velocity_exit`'s refusal ``code`` of ``v``."""
+    if code == NOT_FINITE:
+        _vector(v, nv, "v")  # raises, naming the entry
+    raise GovernorError(
+        "v",
+        f"CoM velocity {math.hypot(*com_velocity):.3g} m/s",
+        f"gives a CoM speed above {MAX_SPEED:g} m/s (the scenario's bound)",
+    )
+
+
 def _is_real(x: object) -> bool:
     """Whether ``x`` is an array of real numbers (integers or floats; no complex, no text)."""
     try:
@@ -846,6 +966,8 @@ class _JointBounds:
         self.lower = np.asarray(lower, dtype=float)
         self.upper = np.asarray(upper, dtype=float)
         self.pairs = pairs
+        #: The continuous joints' first indices in q (their (cos, sin) pairs).
+        self.pair_indices = np.asarray([i for _, i in pairs], dtype=np.int64)
 
     def check(self, q: npt.NDArray[np.float64]) -> None:
         """Raise :class:`GovernorError` naming the first joint of ``q`` out of bounds."""
@@ -868,6 +990,51 @@ class _JointBounds:
                     [float(q[i]), float(q[i + 1])],
                     f"continuous joint {name!r}: (cos, sin) must be a unit pair",
                 )
+
+
+@njit(cache=True)
+def _state_fault(
+    q: npt.NDArray[np.float64],
+    v: npt.NDArray[np.float64],
+    idx: npt.NDArray[np.int64],
+    lower: npt.NDArray[np.float64],
+    upper: npt.NDArray[np.float64],
+    pairs: npt.NDArray[np.int64],
+    free_flyer: bool,
+    max_position: float,
+    quaternion_tolerance: float,
+) -> int:
+    """0 when ``q`` and ``v`` pass :meth:`Governor.limit`'s checks, else the first that fails.
+
+    One compiled pass over them (a tick's checks): q finite, its base within ``max_position``
+    (m) and its quaternion unit (free flyer), v finite, the joints within ``lower``/``upper``
+    (:func:`_first_outside`), the continuous joints' (cos, sin) pairs at ``pairs`` unit. The
+    checks that name the field and value then raise (:meth:`Governor._state`).
+    """
+    squared = 0.0
+    for i in range(q.size):
+        squared += q[i] * q[i]
+    if not math.isfinite(squared):
+        return 1
+    if free_flyer:
+        if squared > max_position * max_position:
+            for i in range(3):
+                if abs(q[i]) > max_position:
+                    return 2
+        x, y, z, w = q[3], q[4], q[5], q[6]
+        if abs(x * x + y * y + z * z + w * w - 1.0) > 2.0 * quaternion_tolerance:
+            return 3
+    squared = 0.0
+    for i in range(v.size):
+        squared += v[i] * v[i]
+    if not math.isfinite(squared):
+        return 4
+    if _first_outside(q, idx, lower, upper) >= 0:
+        return 5
+    for i in pairs:
+        if abs(q[i] * q[i] + q[i + 1] * q[i + 1] - 1.0) > 2.0 * quaternion_tolerance:
+            return 6
+    return 0
 
 
 @njit(cache=True)

@@ -6,7 +6,7 @@ The clamp of a reference velocity into the safe speeds is
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Literal
 
 import numpy as np
@@ -101,3 +101,58 @@ class SpeedLimit:
             See :func:`~impact_balance.criteria.cap.cap_approach`.
         """
         return cap_approach(reference_velocity, self.normal, self.safe_interval)
+
+
+# The slots' setters, in field order: a tick builds its answer with them (below).
+(
+    _criterion,
+    _max_contact_velocity,
+    _status,
+    _limiting_vertex,
+    _limiting_edge,
+    _safe_interval,
+    _com_velocity,
+    _normal,
+    _point,
+    _posture_reused,
+    _binding,
+    _rates_age,
+    _rates_age_seconds,
+    _stale,
+) = (SpeedLimit.__dict__[f.name].__set__ for f in fields(SpeedLimit))
+_new = object.__new__
+
+
+def _floating_limit(
+    criterion: CriterionName,
+    max_contact_velocity: float,
+    status: LimitStatus,
+    limiting_vertex: int | None,
+    limiting_edge: int | None,
+    safe_interval: tuple[float, float] | None,
+    com_velocity: npt.NDArray[np.float64],
+    normal: npt.NDArray[np.float64],
+    point: npt.NDArray[np.float64],
+    posture_reused: bool,
+) -> SpeedLimit:
+    """``SpeedLimit(...)`` of the floating model (the other fields at their defaults).
+
+    The same object, built by setting its slots directly: the frozen dataclass's ``__init__``
+    calls ``object.__setattr__`` once per field, half of a velocity-only tick's answer.
+    """
+    self = _new(SpeedLimit)
+    _criterion(self, criterion)
+    _max_contact_velocity(self, max_contact_velocity)
+    _status(self, status)
+    _limiting_vertex(self, limiting_vertex)
+    _limiting_edge(self, limiting_edge)
+    _safe_interval(self, safe_interval)
+    _com_velocity(self, com_velocity)
+    _normal(self, normal)
+    _point(self, point)
+    _posture_reused(self, posture_reused)
+    _binding(self, "floating")
+    _rates_age(self, None)
+    _rates_age_seconds(self, None)
+    _stale(self, False)
+    return self

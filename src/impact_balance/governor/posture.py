@@ -36,7 +36,9 @@ from impact_balance.criteria.com import ComCriterion
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.criteria.zmp import zmp_max_contact_velocity
 from impact_balance.exceptions import SolverError
+from impact_balance.geometry.polygon import Polygon
 from impact_balance.governor.options import Criterion
+from impact_balance.governor.posture_kernel import constants, kinematics_posture_kernel
 from impact_balance.impact.angular_momentum import AngularMomentumTerm, angular_momentum_gain
 from impact_balance.impact.model import (
     ImpactModel,
@@ -46,9 +48,15 @@ from impact_balance.impact.model import (
     joint_space_inertia_map,
     model_from_inertia_map,
 )
+from impact_balance.projection.walk import MAX_PIVOTS
 from impact_balance.robot.robot import Robot, Scratch
 
-__all__ = ["Kinematics", "Posture", "PostureEvaluator", "PostureSettings"]
+__all__ = ["NO_HALFPLANES", "Kinematics", "Posture", "PostureEvaluator", "PostureSettings"]
+
+#: :attr:`Posture.exit_arrays`' ``G`` when there are no half-planes (one object, compared by
+#: identity).
+NO_HALFPLANES = np.zeros((0, 2))
+NO_HALFPLANES.setflags(write=False)
 
 _POSITION = pin.KinematicLevel.POSITION
 _WORLD = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
@@ -126,6 +134,19 @@ class Posture:
         """See the class docstring."""
         projected = self.projected
         return projected.areas() if isinstance(projected, Projected) else projected
+
+    @functools.cached_property
+    def exit_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """What a tick's compiled call reads: ``(com_jacobian, G, h, rates)`` of the criterion.
+
+        ``G`` is :data:`NO_HALFPLANES` (and ``h``, ``rates`` empty) without a "com" criterion or
+        an area with half-planes.
+        """
+        criterion = self.com_criterion
+        if criterion is None or criterion.G is None or criterion.h is None:
+            return self.com_jacobian, NO_HALFPLANES, np.zeros(0), np.zeros((0, 0))
+        assert criterion.rates is not None  # made with G and h
+        return self.com_jacobian, criterion.G, criterion.h, criterion.rates
 
     @functools.cached_property
     def stance(self) -> Stance:
@@ -210,6 +231,18 @@ class PostureEvaluator:
         self._idx: npt.NDArray[np.int64] = idx if self._torques else np.zeros(0, dtype=np.int64)
         self._limit: npt.NDArray[np.float64] = limit if self._torques else np.zeros(0)
         self._normal, self._cone = impact_cone(impact)
+        # The common case in one compiled call (posture_kernel): the paper's "com" criterion,
+        # the composite inertia, unscaled contacts (frictions <= 1).
+        self._compiled = (
+            settings.criterion == "com"
+            and impact.inertia == "composite"
+            and settings.angular_momentum_damping_time is None
+            and not self._scaled
+        )
+        lo, hi = impact.restitution
+        self._constants = constants(float(settings.zmp_margin), (float(lo), float(hi)))
+        self._limit = np.ascontiguousarray(self._limit, dtype=float)
+        self._idx = np.ascontiguousarray(self._idx, dtype=np.int64)
         # Buffers, overwritten every posture (the answers keep copies).
         self._q_local = np.zeros(model.nq)
         self._zero_velocity = np.zeros(model.nv)
@@ -217,9 +250,20 @@ class PostureEvaluator:
         # The projection's warm start, carried from one posture to the next (see
         # projected_from_arrays): 2 + the wrench variables at most.
         self._hint = np.full(2 + 6 * m, -1, dtype=np.int64)
+        # The compiled posture's pinocchio arrays (rotations, points, Jacobians), read in the
+        # same call.
+        self._buffers = (
+            np.empty((m, 3, 3)),
+            np.empty((m, 3)),
+            np.empty((6 * m, model.nv)) if self._torques else np.zeros((0, 0)),
+        )
 
-    def evaluate(self, q: np.ndarray) -> Posture:
+    def evaluate(self, q: np.ndarray, *, steps: bool = False) -> Posture:
         """Everything the governor needs at configuration ``q`` (nq, float64, contiguous).
+
+        The common case is one compiled call (:mod:`.posture_kernel`), the rest the pipeline's
+        steps one by one; ``steps=True`` takes the steps whatever the case (the same numbers:
+        to load their compiled code, or to compare).
 
         Raises what the pipeline raises on a posture it cannot evaluate:
         :class:`~impact_balance.exceptions.ScenarioError` (the CoM at or below the LIPM
@@ -228,6 +272,10 @@ class PostureEvaluator:
         (a projection that failed).
         """
         robot, settings = self.robot, self.settings
+        if self._compiled and not steps:
+            posture = self._compiled_posture(q)
+            if posture is not None:
+                return posture
         k = self.kinematics(q)
         origin, com_local, mass, com = k.origin, k.com_local, k.mass, k.com
         rotations, local, jacobians = k.rotations, k.local, k.jacobians
@@ -271,44 +319,100 @@ class PostureEvaluator:
             zmp,
         )
 
+    def _compiled_posture(self, q: np.ndarray) -> Posture | None:
+        """:meth:`evaluate`'s answer by pinocchio and one compiled call.
+
+        :func:`~.posture_kernel.kinematics_posture_kernel`, into this evaluator's buffers. None
+        when the kernel leaves the posture to :meth:`evaluate`'s steps (a walk not certified,
+        an area of fewer than 3 vertices, an impact model they refuse).
+        """
+        settings, data, model = self.settings, self.scratch.data, self.model
+        rotations, local, jacobians = self._buffers
+        origin, com_local, Ig, Ag = self._placements(q, rotations, local, jacobians)
+        mass = float(Ig.mass)
+        com_z = float(com_local[2]) + float(origin[2])
+        w = lipm_omega(com_z, settings.plane_height, settings.gravity, field="plane_height")
+        point_local = self.impact_point()
+        J = pin.getFrameJacobian(model, data, self._impact_frame, _WORLD)[:3].copy()
+        out = kinematics_posture_kernel(
+            self._faces, rotations, local, origin, com_local, Ag, self._gravity, self._torques,
+            jacobians, self._idx, self._limit, mass, settings.gravity, settings.plane_height, w,
+            self._hint, MAX_PIVOTS, self._constants, point_local, Ig.inertia, self._normal,
+            self._cone,
+        )  # fmt: skip
+        code, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h, W, impulse, rates = out[:12]
+        if code:
+            return None
+        com, com_jacobian, point = out[12:]
+        area = Polygon.with_halfplanes(vel, bool(vel_bounded), G, h)
+        impact = ImpactModel(
+            settings.impact,
+            point,
+            self._normal.copy(),
+            self._cone.copy(),
+            W,
+            mass,
+            J,
+            impulse,
+        )
+        margin = settings.velocity_margin
+        criterion = ComCriterion.from_rates(
+            area, impact, margin, G, h - margin if margin else h, rates
+        )
+        projected = Projected(
+            force,
+            bool(bounded),
+            zmp,
+            bool(zmp_bounded),
+            area,
+            1,
+            w,
+            com,
+            settings.plane_height,
+            mass,
+            settings.gravity,
+            float(settings.zmp_margin),
+        )
+        q = q.copy()
+        q.setflags(write=False)
+        return Posture(
+            q.tobytes(),
+            q,
+            self.robot,
+            settings,
+            com,
+            mass,
+            projected,
+            impact,
+            com_jacobian,
+            criterion,
+            None,
+        )
+
+    def impact_point(self) -> npt.NDArray[np.float64]:
+        """The impact point (3,), m, in the stance frame of the kinematics the Data holds.
+
+        Call it after :meth:`kinematics`, before the next one (a new array).
+        """
+        translation = pin.updateFramePlacement(self.model, self.scratch.data, self._impact_frame)
+        point: npt.NDArray[np.float64] = translation.translation.copy()
+        return point
+
     def kinematics(self, q: np.ndarray) -> Kinematics:
         """The pinocchio step of :meth:`evaluate` at ``q`` (nq, float64, contiguous).
 
         Left in this evaluator's Data: :meth:`impact_at` reads the impact frame from it, so
         call it before the next :meth:`kinematics`. The arrays are new (the caller keeps them).
         """
-        data, model = self.scratch.data, self.model
-        # The kinematics in the stance frame (world axes, origin at the base position), as
-        # Stance does: lever arms keep their precision however far the robot stands.
-        q_local = self._q_local
-        q_local[:] = q
-        if self._free_flyer:
-            origin = q[:3].copy()
-            q_local[:3] = 0.0
-        else:
-            origin = np.zeros(3)
-        # ccrba: joint placements, joint Jacobians, the composite inertia Ig and the centroidal
-        # momentum matrix Ag (its linear rows are m times the CoM Jacobian).
-        pin.ccrba(model, data, q_local, self._zero_velocity)
-        self.scratch.holder = None  # what it holds is this evaluator's, never a Stance's
-        com_local = np.array(pin.centerOfMass(model, data, _POSITION, False), dtype=float)
-        Ig = data.Ig
-        mass = float(Ig.mass)
-        linear = data.Ag[:3]  # m times the CoM Jacobian
-        com_jacobian = linear / mass
-        m = len(self._frames)
+        m, torques = len(self._frames), self._torques
         rotations = np.empty((m, 3, 3))
         local = np.empty((m, 3))
-        torques = self._torques
-        jacobians = np.empty((6 * m, model.nv)) if torques else np.zeros((0, 0))
-        # frame_point's numbers (the evaluator's frames have no offset of their own), in
-        # pinocchio's calls directly: the pose as one 4 x 4 array, the Jacobian written in place.
-        for i, fid in enumerate(self._frames):
-            pose = pin.updateFramePlacement(model, data, fid).homogeneous
-            rotations[i] = pose[:3, :3]
-            local[i] = pose[:3, 3]
-            if torques:
-                jacobians[6 * i : 6 * i + 6] = pin.getFrameJacobian(model, data, fid, _WORLD)
+        jacobians = np.empty((6 * m, self.model.nv)) if torques else np.zeros((0, 0))
+        origin, com_local, Ig, Ag = self._placements(q, rotations, local, jacobians)
+        com_local = np.array(com_local, dtype=float)
+        mass = float(Ig.mass)
+        linear = Ag[:3]  # m times the CoM Jacobian
+        com_jacobian = linear / mass
         # g(q) = -Ag[:3]^T g: the gravity's generalized force is the CoM's (the centroidal
         # momentum matrix's linear rows are m times the CoM Jacobian); equal to pinocchio's
         # computeGeneralizedGravity to rounding (1e-14 N m of 327 on G1), without its pass.
@@ -326,6 +430,46 @@ class PostureEvaluator:
             gravity_torques,
             np.array(Ig.inertia, dtype=float),
         )
+
+    def _placements(
+        self,
+        q: np.ndarray,
+        rotations: npt.NDArray[np.float64],
+        local: npt.NDArray[np.float64],
+        jacobians: npt.NDArray[np.float64],
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], pin.Inertia, np.ndarray]:
+        """The pinocchio step at ``q``, in the stance frame (world axes, origin at the base).
+
+        Writes the contacts' contact-to-world ``rotations`` (m, 3, 3), points ``local`` (m, 3)
+        and, with torque limits, stacked world-aligned ``jacobians`` (6m, nv). Returns
+        ``(origin, com_local, Ig, Ag)``: the stance frame's origin in world (a new array, m),
+        the CoM in the stance frame (pinocchio's array, m), the composite inertia about the CoM
+        and the centroidal momentum matrix (pinocchio's), valid until the Data's next use.
+        """
+        data, model = self.scratch.data, self.model
+        # As Stance does: lever arms keep their precision however far the robot stands.
+        q_local = self._q_local
+        q_local[:] = q
+        if self._free_flyer:
+            origin = q[:3].copy()
+            q_local[:3] = 0.0
+        else:
+            origin = np.zeros(3)
+        # ccrba: joint placements, joint Jacobians, the composite inertia Ig and the centroidal
+        # momentum matrix Ag (its linear rows are m times the CoM Jacobian).
+        pin.ccrba(model, data, q_local, self._zero_velocity)
+        self.scratch.holder = None  # what it holds is this evaluator's, never a Stance's
+        com_local = pin.centerOfMass(model, data, _POSITION, False)
+        # frame_point's numbers (the evaluator's frames have no offset of their own), in
+        # pinocchio's calls directly: the pose as one 4 x 4 array, the Jacobian written in place.
+        torques = self._torques
+        for i, fid in enumerate(self._frames):
+            pose = pin.updateFramePlacement(model, data, fid).homogeneous
+            rotations[i] = pose[:3, :3]
+            local[i] = pose[:3, 3]
+            if torques:
+                jacobians[6 * i : 6 * i + 6] = pin.getFrameJacobian(model, data, fid, _WORLD)
+        return origin, com_local, data.Ig, data.Ag
 
     def impact_at(self, q: np.ndarray, k: Kinematics) -> ImpactModel:
         """The impact model at ``q``, whose :meth:`kinematics` ``k`` the Data holds."""

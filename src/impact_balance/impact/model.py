@@ -33,10 +33,12 @@ __all__ = [
     "ImpactModel",
     "ImpactSpec",
     "composite_inertia_map",
+    "composite_map_kernel",
     "cone_tangents",
     "friction_cone",
     "impact_cone",
     "impact_model",
+    "impulse_rates_kernel",
     "impulse_to_velocity",
     "joint_space_inertia_map",
     "model_from_inertia_map",
@@ -409,3 +411,13 @@ def _impulse_rates(normal, W, K, lo, hi):
             rates[2 * i, c] = a * K[c, i]
             rates[2 * i + 1, c] = b * K[c, i]
     return True, smallest, rates
+
+
+#: The compiled steps of :func:`composite_inertia_map` and :func:`model_from_inertia_map`, for
+#: compiled callers that build a posture's impact model in their own call (a governor's tick):
+#: ``composite_map_kernel(arm, mass, Ic, W)`` writes W and answers whether Ic was positive
+#: definite (else the caller takes :func:`composite_inertia_map`);
+#: ``impulse_rates_kernel(normal, W, K, lo, hi)`` answers ``(W finite, min_i n^T W K_i, rates)``,
+#: which :func:`model_from_inertia_map` checks (``> 1e-12``) before it builds the model.
+composite_map_kernel = _composite_map
+impulse_rates_kernel = _impulse_rates

@@ -1,0 +1,311 @@
+"""The compiled half of a posture's evaluation: areas, impact model and criterion rates at once.
+
+After pinocchio (the contacts' poses and Jacobians, the CoM, the composite inertia), a
+governor's posture is the same compiled steps as the one-posture pipeline's, composed in one
+call instead of four: the contact wrench polytope's assembly, the certified projection walk and
+the maps to the ZMP and CoM velocity areas with the area's half-planes
+(:data:`~impact_balance.balance.areas.assembled_areas`, from the faces in world axes of
+:func:`~impact_balance.contacts.wrench_polytope.face_blocks`), the composite-rigid-body impact map W
+and the impulse rates (:data:`~impact_balance.impact.model.composite_map_kernel`,
+:data:`~impact_balance.impact.model.impulse_rates_kernel`), and the CoM criterion's jump rates
+(:data:`~impact_balance.criteria.com.jump_rates_kernel`): the same numbers, fewer dispatches
+and fewer arrays handed back to Python.
+
+It answers the common case only: a certified walk whose CoM velocity area has 3 vertices or
+more, a positive definite composite inertia and an impact cone that separates the contact.
+Otherwise it says so (:data:`FALLBACK`) and the caller takes the one-posture path, which
+answers (or raises) as :func:`~impact_balance.analyze` does.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from impact_balance._jit import cache_depends_on, njit
+from impact_balance.balance import areas
+from impact_balance.balance.areas import FORCE_BOX, MERGE_TOLERANCE, assembled_areas
+from impact_balance.contacts import wrench_polytope
+from impact_balance.criteria import com, linear_exit
+from impact_balance.criteria.com import jump_rates_kernel
+from impact_balance.criteria.linear_exit import exit_kernel, interval_kernel
+from impact_balance.geometry import polygon
+from impact_balance.geometry.polygon import MERGE_AREA_TOLERANCE
+from impact_balance.impact import model
+from impact_balance.impact.model import composite_map_kernel, impulse_rates_kernel
+from impact_balance.projection import kernel, walk
+from impact_balance.projection.kernel import OK
+
+__all__ = [
+    "FALLBACK",
+    "SEPARATION",
+    "constants",
+    "kinematics_posture_kernel",
+    "posture_kernel",
+    "postures_kernel",
+]
+
+#: :func:`posture_kernel`'s first answer when the caller must take the one-posture path.
+FALLBACK = 1
+#: The smallest normal response ``n^T W K_i`` an impact cone edge may have (the impact model's).
+SEPARATION = 1e-12
+
+
+@njit(cache=True)
+def posture_kernel(
+    faces: np.ndarray,
+    rotations: np.ndarray,
+    positions: np.ndarray,
+    arms: np.ndarray,
+    jacobians: np.ndarray,
+    torque_indices: np.ndarray,
+    torque_limits: np.ndarray,
+    gravity_torques: np.ndarray,
+    weight: float,
+    depth: float,
+    cx: float,
+    cy: float,
+    w: float,
+    hint: np.ndarray,
+    max_pivots: int,
+    constants: np.ndarray,
+    arm: np.ndarray,
+    mass: float,
+    inertia: np.ndarray,
+    normal: np.ndarray,
+    cone: np.ndarray,
+) -> tuple:  # type: ignore[type-arg]
+    """One posture's areas, impact model and CoM criterion rates.
+
+    Args:
+        faces: (m, 16, 6) the contacts' CWC faces in their frames.
+        rotations: (m, 3, 3) the contacts' contact-to-world rotations.
+        positions: (m, 3) the contact points, world, m.
+        arms: (m, 3) contact point minus CoM, m.
+        jacobians: (6m, nv) the contacts' stacked Jacobians ((0, 0) without torque limits).
+        torque_indices: The torque-limited joints' velocity indices.
+        torque_limits: Their limits, N m.
+        gravity_torques: (nv,) g(q), N m.
+        weight: m g, N.
+        depth: h - c_z, m (< 0).
+        cx: The CoM's x, world, m.
+        cy: The CoM's y, world, m.
+        w: omega, 1/s.
+        hint: The walk's warm start (read and written).
+        max_pivots: The walk's pivot bound.
+        constants: The force box (units of m g), the merge's tolerances (units of m g, and of
+            area), the ZMP margin (m), the restitution bounds (lo, hi): :func:`constants`.
+        arm: (3,) impact point minus CoM, m.
+        mass: kg.
+        inertia: (3, 3) the composite rotational inertia about the CoM, world axes, kg m^2.
+        normal: (3,) the impact normal.
+        cone: (3, N) the impact's friction-cone generators.
+
+    Returns:
+        ``(code, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h, W, impulse_rates,
+        rates)``: ``code`` 0, or :data:`FALLBACK` (the rest is then not to be read); the
+        areas as :func:`~impact_balance.balance.areas.projected_from_arrays` makes them
+        (``G``, ``h`` the CoM velocity area's half-planes), the
+        impact map W (1/kg), the impulse rates (2N, 3) and the criterion's rates (2N, n_c).
+    """
+    box, merge_tol, area_tol, zmp_margin, lo, hi = constants
+    blocks = np.empty((faces.shape[0], 32, 3))
+    for i in range(faces.shape[0]):  # face_blocks: BLAS's product, as numpy's (the same numbers)
+        blocks[i] = np.dot(faces[i].reshape(32, 3), rotations[i].T)
+    out = assembled_areas(
+        blocks, positions, arms, jacobians, torque_indices, torque_limits, gravity_torques,
+        weight, box, max_pivots, merge_tol, area_tol, depth, cx, cy, w, zmp_margin, hint,
+    )  # fmt: skip
+    status, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h = out[5:]
+    W = np.empty((3, 3))
+    impulse, rates = np.empty((0, 3)), np.empty((0, 0))
+    code = FALLBACK
+    if status == OK and force.shape[0] > 0 and G.shape[0] > 0:
+        if composite_map_kernel(arm, mass, inertia, W):
+            finite, smallest, impulse = impulse_rates_kernel(normal, W, cone, lo, hi)
+            if finite and smallest > SEPARATION:
+                rates = jump_rates_kernel(impulse, mass, G)
+                code = 0
+    return code, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h, W, impulse, rates
+
+
+@njit(cache=True)
+def kinematics_posture_kernel(
+    faces: np.ndarray,
+    rotations: np.ndarray,
+    local: np.ndarray,
+    origin: np.ndarray,
+    com_local: np.ndarray,
+    centroidal: np.ndarray,
+    gravity_vector: np.ndarray,
+    torques: bool,
+    jacobians: np.ndarray,
+    torque_indices: np.ndarray,
+    torque_limits: np.ndarray,
+    mass: float,
+    gravity: float,
+    plane_height: float,
+    w: float,
+    hint: np.ndarray,
+    max_pivots: int,
+    constants: np.ndarray,
+    point_local: np.ndarray,
+    inertia: np.ndarray,
+    normal: np.ndarray,
+    cone: np.ndarray,
+) -> tuple:  # type: ignore[type-arg]
+    """:func:`posture_kernel` from pinocchio's arrays, with what a posture keeps of them.
+
+    Args:
+        faces: (m, 16, 6) the contacts' CWC faces in their frames.
+        rotations: (m, 3, 3) the contacts' contact-to-world rotations.
+        local: (m, 3) the contact points, stance frame (origin at ``origin``), m.
+        origin: (3,) the stance frame's origin in world, m.
+        com_local: (3,) the CoM, stance frame, m.
+        centroidal: (6, nv) the centroidal momentum matrix (linear rows first: m J_com).
+        gravity_vector: (3,) the model's gravity, world, m/s^2.
+        torques: Whether the torque limits bound the wrenches.
+        jacobians: (6m, nv) the contacts' stacked Jacobians ((0, 0) without torques).
+        torque_indices: The torque-limited joints' velocity indices.
+        torque_limits: Their limits, N m.
+        mass: kg.
+        gravity: g, m/s^2.
+        plane_height: h, m.
+        w: omega, 1/s.
+        hint: The walk's warm start (read and written).
+        max_pivots: The walk's pivot bound.
+        constants: :func:`constants`.
+        point_local: (3,) the impact point, stance frame, m.
+        inertia: (3, 3) the composite rotational inertia about the CoM, world axes, kg m^2.
+        normal: (3,) the impact normal.
+        cone: (3, N) the impact's friction-cone generators.
+
+    Returns:
+        :func:`posture_kernel`'s answer and ``(com, com_jacobian, point)``: the CoM (3,), world,
+        m; ``J_com`` (3, nv, column-major as numpy's ``Ag[:3] / m``); the impact point (3,),
+        world, m. The numbers of the array expressions of
+        :meth:`~impact_balance.governor.posture.PostureEvaluator.kinematics` (``g(q)`` by
+        BLAS's product, as numpy's).
+    """
+    m, nv = local.shape[0], centroidal.shape[1]
+    positions, arms = np.empty((m, 3)), np.empty((m, 3))
+    com, arm, point = np.empty(3), np.empty(3), np.empty(3)
+    for c in range(3):
+        for i in range(m):
+            positions[i, c] = local[i, c] + origin[c]
+            arms[i, c] = local[i, c] - com_local[c]
+        com[c] = com_local[c] + origin[c]
+        arm[c] = point_local[c] - com_local[c]
+        point[c] = point_local[c] + origin[c]
+    linear = np.asfortranarray(centroidal[:3])  # m J_com
+    com_jacobian = np.empty((nv, 3)).T
+    for r in range(3):
+        for i in range(nv):
+            com_jacobian[r, i] = linear[r, i] / mass
+    # g(q) = -Ag[:3]^T g (see PostureEvaluator.kinematics)
+    gravity_torques = -np.dot(gravity_vector, linear) if torques else np.zeros(nv)
+    answer = posture_kernel(
+        faces, rotations, positions, arms, jacobians, torque_indices, torque_limits,
+        gravity_torques, mass * gravity, plane_height - com[2], com[0], com[1], w, hint,
+        max_pivots, constants, arm, mass, inertia, normal, cone,
+    )  # fmt: skip
+    return answer + (com, com_jacobian, point)  # noqa: RUF005 (numba: tuple concatenation)
+
+
+def constants(zmp_margin: float, restitution: tuple[float, float]) -> np.ndarray:
+    """:func:`posture_kernel`'s ``constants`` for a ZMP margin (m) and restitution bounds."""
+    lo, hi = restitution
+    return np.array(
+        [FORCE_BOX, MERGE_TOLERANCE, MERGE_AREA_TOLERANCE, zmp_margin, lo, hi], dtype=float
+    )
+
+
+cache_depends_on(posture_kernel, areas, polygon, walk, kernel, wrench_polytope, model, com)
+cache_depends_on(
+    kinematics_posture_kernel, areas, polygon, walk, kernel, wrench_polytope, model, com
+)
+
+
+@njit(cache=True, nogil=True)
+def postures_kernel(
+    faces: np.ndarray,
+    rotations: np.ndarray,
+    local: np.ndarray,
+    origins: np.ndarray,
+    com_locals: np.ndarray,
+    centroidal: np.ndarray,
+    gravity_vector: np.ndarray,
+    torques: bool,
+    jacobians: np.ndarray,
+    torque_indices: np.ndarray,
+    torque_limits: np.ndarray,
+    scalars: np.ndarray,
+    hint: np.ndarray,
+    max_pivots: int,
+    constants: np.ndarray,
+    point_locals: np.ndarray,
+    inertias: np.ndarray,
+    normal: np.ndarray,
+    cone: np.ndarray,
+    velocities: np.ndarray,
+    same: np.ndarray,
+    out: np.ndarray,
+    com_velocities: np.ndarray,
+    points: np.ndarray,
+) -> None:
+    """:func:`kinematics_posture_kernel` and the tick's exit for every posture of a batch.
+
+    The GIL is released. Row i (of ``same``, ``velocities``, the outputs) has the generalized
+    velocity ``velocities[i]`` (nv,) and the posture of row i - 1 where ``same[i]``, else the
+    next posture of the per-posture arguments (leading axis: the rows where ``same`` is
+    false, in order): :func:`kinematics_posture_kernel`'s ``rotations`` (m, 3, 3), ``local``
+    (m, 3), ``origins`` and ``com_locals`` (3,), ``centroidal`` (6, nv), ``jacobians`` (6m, nv)
+    or (0, 0), ``point_locals`` (3,), ``inertias`` (3, 3), ``scalars`` (mass kg, g m/s^2, plane
+    height m, omega 1/s, velocity margin m/s, boundary tolerance; row 0 holds the common
+    ones).
+
+    Writes ``com_velocities[i]`` (J_com v, m/s, BLAS's product as a tick's), ``points[i]`` (the
+    impact point, m) and ``out[i] = (code, speed, vertex, edge, lo, hi)``: the numbers of a
+    governor's tick (:func:`~impact_balance.governor.tick.velocity_exit`: the exit kernel's
+    code, an index of ``EXIT_STATUSES``, and the safe interval, NaN when there is none), or
+    code -1 where the caller takes the one-posture path.
+    """
+    gravity, plane_height = scalars[0, 1], scalars[0, 2]
+    velocity_margin, tol = scalars[0, 4], scalars[0, 5]
+    G, h, rates = np.empty((0, 2)), np.empty(0), np.empty((0, 0))
+    J, point = np.zeros((velocities.shape[1], 3)).T, np.zeros(3)
+    answered = False  # whether G, h, rates hold the last posture's
+    p = -1  # the posture of row i
+    for i in range(same.size):
+        out[i, 0] = -1.0
+        if not same[i]:
+            p += 1
+            answer = kinematics_posture_kernel(
+                faces, rotations[p], local[p], origins[p], com_locals[p], centroidal[p],
+                gravity_vector, torques, jacobians[p], torque_indices, torque_limits,
+                scalars[p, 0], gravity, plane_height, scalars[p, 3], hint, max_pivots,
+                constants, point_locals[p], inertias[p], normal, cone,
+            )  # fmt: skip
+            answered = answer[0] == 0
+            G, h, rates, J, point = answer[7], answer[8], answer[11], answer[13], answer[14]
+            if answered and velocity_margin:
+                h = h - velocity_margin
+        c = np.dot(J, velocities[i])
+        com_velocities[i, 0], com_velocities[i, 1], com_velocities[i, 2] = c[0], c[1], c[2]
+        points[i, 0], points[i, 1], points[i, 2] = point[0], point[1], point[2]
+        if answered:
+            margins = np.empty(h.size)
+            for k in range(h.size):
+                margins[k] = h[k] - (G[k, 0] * c[0] + G[k, 1] * c[1])
+            code, speed, vertex, edge = exit_kernel(margins, rates, tol)
+            out[i, 0], out[i, 1], out[i, 2], out[i, 3] = code, speed, vertex, edge
+            out[i, 4], out[i, 5] = 0.0, speed
+            if code == 1:  # already falling: the safe speeds, if any, catch the fall
+                found, lo, hi = interval_kernel(margins, rates, tol)
+                out[i, 4], out[i, 5] = (lo, hi) if found else (math.nan, math.nan)
+
+
+cache_depends_on(
+    postures_kernel, areas, polygon, walk, kernel, wrench_polytope, model, com, linear_exit
+)
