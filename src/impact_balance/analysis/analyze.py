@@ -64,7 +64,10 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
     inside the CoM velocity area (the CoM criterion, its safe interval and the QP; the ZMP
     criterion has no velocity margin). A :class:`~impact_balance.governor.Governor` of the
     same scenario answers the same maximum contact velocity at the scenario's posture and
-    CoM velocity.
+    CoM velocity. After the stance, the areas, the impact model and the CoM criterion's rates
+    are the governor's one compiled call
+    (:func:`~impact_balance.criteria.posture_kernel.posture_kernel`) where it answers, the
+    steps one by one elsewhere: the same numbers.
 
     Args:
         scenario: A :class:`~impact_balance.scenario.Scenario`, a scenario file or the name
@@ -131,9 +134,10 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
 def stance_areas(scenario: Scenario, stance: Stance) -> tuple[WrenchPolytope, BalanceAreas]:
     """The scenario's contact wrench polytope and balance areas at a stance.
 
-    The one composition of the first half of the pipeline (stance -> constraints -> areas),
-    with the scenario's torque limits, gravity, ZMP plane and ZMP margin; :func:`analyze` and
-    the sweep evaluator both use it.
+    The first half of the pipeline (stance -> constraints -> areas) step by step, with the
+    scenario's torque limits, gravity, ZMP plane and ZMP margin: the sweep evaluator's, and
+    :func:`analyze`'s where the compiled posture does not answer (the same numbers as it
+    where it does).
 
     Args:
         scenario: Its ``torque_limits``, ``gravity``, ``plane_height`` (m) and ``zmp_margin``
