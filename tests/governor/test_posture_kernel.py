@@ -15,6 +15,7 @@ from impact_balance.criteria.com import ComCriterion
 from impact_balance.criteria.linear_exit import speed_interval
 from impact_balance.governor import Governor
 from impact_balance.governor.posture import PostureEvaluator
+from tests.helpers.postures import postures
 
 SCENARIOS = ("palm_push_two_feet", "kick_one_foot", "g1_two_feet")
 _CACHE: dict[str, tuple[Governor, PostureEvaluator, PostureEvaluator]] = {}
@@ -30,23 +31,6 @@ def evaluators(name: str) -> tuple[Governor, PostureEvaluator, PostureEvaluator]
         assert compiled._compiled
         _CACHE[name] = (g, compiled, steps)
     return _CACHE[name]
-
-
-def postures(g: Governor, n: int, seed: int, spread: float) -> np.ndarray:
-    """``n`` configurations near the scenario's: joints moved by up to ``spread`` rad, the base by
-    a few cm (a walk: each one near the previous, as in a control loop)."""
-    rng = np.random.default_rng(seed)
-    q = g.configuration.copy()
-    out = []
-    for _ in range(n):
-        for name in g.robot.joint_names:
-            slot = g.robot.joint_slot(name)
-            if slot.nq == 1:
-                moved = q[slot.idx_q] + rng.uniform(-spread, spread)
-                q[slot.idx_q] = np.clip(moved, slot.lower, slot.upper)
-        q[:3] += rng.uniform(-0.01, 0.01, 3)
-        out.append(q.copy())
-    return np.array(out)
 
 
 @settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -15,10 +15,12 @@ from impact_balance.analysis.diagnostics import diagnose
 from impact_balance.analysis.result import Analysis, ImpactAnswer
 from impact_balance.balance.areas import (
     BalanceAreas,
+    Projected,
     areas_from_polytope,
     posture_areas,
     with_reason,
 )
+from impact_balance.balance.lipm import lipm_omega
 from impact_balance.contacts.cwc import local_faces
 from impact_balance.contacts.stance import Stance
 from impact_balance.contacts.wrench_polytope import (
@@ -29,6 +31,7 @@ from impact_balance.contacts.wrench_polytope import (
 )
 from impact_balance.criteria.cap import safe_contact_velocity
 from impact_balance.criteria.com import ComCriterion
+from impact_balance.criteria.posture_kernel import constants, posture_kernel
 from impact_balance.criteria.qp import (
     QPOptions,
     QPResult,
@@ -39,8 +42,8 @@ from impact_balance.criteria.zmp import zmp_max_contact_velocity
 from impact_balance.exceptions import NonFiniteResultError, ScenarioError, SolverError
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.impact.angular_momentum import AngularMomentumTerm, angular_momentum_gain
-from impact_balance.impact.model import ImpactModel, impact_model
-from impact_balance.projection.walk import warm_up
+from impact_balance.impact.model import ImpactModel, impact_cone, impact_model
+from impact_balance.projection.walk import MAX_PIVOTS, NO_HINT, warm_up
 from impact_balance.scenario import Scenario, load_scenario, with_source
 
 __all__ = [
@@ -61,7 +64,10 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
     inside the CoM velocity area (the CoM criterion, its safe interval and the QP; the ZMP
     criterion has no velocity margin). A :class:`~impact_balance.governor.Governor` of the
     same scenario answers the same maximum contact velocity at the scenario's posture and
-    CoM velocity.
+    CoM velocity. After the stance, the areas, the impact model and the CoM criterion's rates
+    are the governor's one compiled call
+    (:func:`~impact_balance.criteria.posture_kernel.posture_kernel`) where it answers, the
+    steps one by one elsewhere: the same numbers.
 
     Args:
         scenario: A :class:`~impact_balance.scenario.Scenario`, a scenario file or the name
@@ -98,7 +104,14 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
         qp = scenario.impact is not None and (
             scenario.impact.qp.solve if solve_qp is None else solve_qp
         )
-        polytope, areas, t2 = _stance_areas(scenario, stance, clock.now, polytope=qp)
+        # The compiled posture (areas, impact model and criterion rates in one call) where it
+        # answers, else the steps one by one.
+        posture = _compiled_posture(scenario, stance, clock.now, polytope=qp)
+        if posture is None:
+            polytope, areas, t2 = _stance_areas(scenario, stance, clock.now, polytope=qp)
+            model, criterion = None, None
+        else:
+            polytope, areas, model, criterion, t2 = posture
         t3 = clock.now()
         timings.update(stance=t1 - t0, constraints=t2 - t1, areas=t3 - t2)
         if not areas.can_balance:  # explain why (LPs; only for a stance that cannot balance)
@@ -108,18 +121,7 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
         _check_finite(_area_checks(stance, areas))
         answer = None
         if scenario.impact is not None:
-            cfg = scenario.impact
-            try:
-                model = impact_model(stance, cfg.spec())
-            except ScenarioError as exc:
-                raise with_source(exc, scenario.source) from None
-            _check_finite(_impact_checks(model))
-            answer = impact_answer(scenario, stance, areas, model)
-            if qp:
-                assert polytope is not None  # assembled for the QP
-                answer = dataclasses.replace(
-                    answer, qp=_qp(scenario, stance, polytope, areas, model)
-                )
+            answer = _answer(scenario, stance, areas, model, criterion, polytope if qp else None)
             timings["impact"] = clock.now() - t3
         timings["total"] = clock.now() - t0
     if clock.loading:
@@ -132,9 +134,10 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
 def stance_areas(scenario: Scenario, stance: Stance) -> tuple[WrenchPolytope, BalanceAreas]:
     """The scenario's contact wrench polytope and balance areas at a stance.
 
-    The one composition of the first half of the pipeline (stance -> constraints -> areas),
-    with the scenario's torque limits, gravity, ZMP plane and ZMP margin; :func:`analyze` and
-    the sweep evaluator both use it.
+    The first half of the pipeline (stance -> constraints -> areas) step by step, with the
+    scenario's torque limits, gravity, ZMP plane and ZMP margin: the sweep evaluator's, and
+    :func:`analyze`'s where the compiled posture does not answer (the same numbers as it
+    where it does).
 
     Args:
         scenario: Its ``torque_limits``, ``gravity``, ``plane_height`` (m) and ``zmp_margin``
@@ -150,6 +153,90 @@ def stance_areas(scenario: Scenario, stance: Stance) -> tuple[WrenchPolytope, Ba
     polytope, areas, _ = _stance_areas(scenario, stance)
     assert polytope is not None  # asked for
     return polytope, areas
+
+
+def _answer(
+    scenario: Scenario,
+    stance: Stance,
+    areas: BalanceAreas,
+    model: ImpactModel | None,
+    criterion: ComCriterion | None,
+    polytope: WrenchPolytope | None,
+) -> ImpactAnswer:
+    """:func:`analyze`'s impact step: the model (unless given), its checks, the answer, the QP.
+
+    ``model`` and ``criterion`` are the compiled posture's (None: the steps make them); the QP
+    is solved when ``polytope`` is given.
+    """
+    cfg = scenario.impact
+    assert cfg is not None  # called for a scenario with an impact
+    if model is None:
+        try:
+            model = impact_model(stance, cfg.spec())
+        except ScenarioError as exc:
+            raise with_source(exc, scenario.source) from None
+    _check_finite(_impact_checks(model))
+    answer = impact_answer(scenario, stance, areas, model, criterion)
+    if polytope is not None:
+        answer = dataclasses.replace(answer, qp=_qp(scenario, stance, polytope, areas, model))
+    return answer
+
+
+def _compiled_posture(
+    scenario: Scenario,
+    stance: Stance,
+    now: Callable[[], float],
+    polytope: bool,
+) -> tuple[WrenchPolytope | None, BalanceAreas, ImpactModel, ComCriterion, float] | None:
+    """The areas, impact model and CoM criterion by the compiled posture, or None.
+
+    :func:`~impact_balance.criteria.posture_kernel.posture_kernel` on the stance's arrays (the
+    numbers of :func:`_stance_areas`, :func:`~impact_balance.impact.model.impact_model` and
+    :class:`~impact_balance.criteria.com.ComCriterion`), for a scenario with an impact of the
+    composite inertia and contacts whose frictions are at most 1. None where the kernel does
+    not answer, or a step would raise: the caller then takes the steps, which answer or raise
+    as they always do. Also returns the polytope (with ``polytope``, for the QP; else None) and
+    the time (s, by the clock ``now``) the compiled call began.
+    """
+    cfg = scenario.impact
+    if cfg is None or cfg.inertia != "composite" or not stance.contacts:
+        return None
+    if max(float(c.spec.friction) for c in stance.contacts) > 1.0:
+        return None  # friction-normalised variables: the steps
+    try:
+        spec = cfg.spec()
+        placement, J6 = stance.local_point(spec.frame, spec.offset, field="impact.frame")
+        w = lipm_omega(
+            float(stance.com[2]), scenario.plane_height, scenario.gravity, field="plane_height"
+        )
+    except ScenarioError:
+        return None  # the steps raise it, in their order
+    arrays = _stance_arrays(stance, scenario.torque_limits, scenario.gravity)
+    faces, rotations, positions, arms, mass, com, gravity, J, idx, limit, g = arrays
+    assembled = assemble_polytope(*arrays, None) if polytope else None
+    normal, cone = impact_cone(spec)
+    arm = placement.translation - stance.com_local  # as impact_model
+    lo, hi = spec.restitution
+    t = now()
+    out = posture_kernel(
+        faces, rotations, positions, arms, J, np.ascontiguousarray(idx, dtype=np.int64), limit,
+        g, mass * gravity, scenario.plane_height - float(com[2]), float(com[0]), float(com[1]),
+        w, NO_HINT, MAX_PIVOTS, constants(float(scenario.zmp_margin), (float(lo), float(hi))),
+        arm, mass, stance.com_inertia, normal, cone,
+    )  # fmt: skip
+    code, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h, W, impulse, rates = out
+    if code:
+        return None
+    area = Polygon.with_halfplanes(vel, bool(vel_bounded), G, h)
+    areas = Projected(
+        force, bool(bounded), zmp, bool(zmp_bounded), area, 1, w, com, scenario.plane_height,
+        mass, gravity, float(scenario.zmp_margin),
+    ).areas()  # fmt: skip
+    point = placement.translation + stance.origin
+    model = ImpactModel(spec, point, normal, cone, W, mass, J6[:3].copy(), impulse)
+    margin = float(scenario.velocity_margin)
+    criterion = ComCriterion.from_rates(area, model, margin, G, h - margin if margin else h, rates)
+    return assembled, areas, model, criterion, t
 
 
 def _stance_areas(
@@ -272,7 +359,11 @@ def _stance_arrays(stance: Stance, torque_limits: bool, gravity: float) -> _Arra
 
 
 def impact_answer(
-    scenario: Scenario, stance: Stance, areas: BalanceAreas, model: ImpactModel
+    scenario: Scenario,
+    stance: Stance,
+    areas: BalanceAreas,
+    model: ImpactModel,
+    criterion: ComCriterion | None = None,
 ) -> ImpactAnswer:
     """What the criteria answer for an impact: the second half of the pipeline, composed once.
 
@@ -287,6 +378,9 @@ def impact_answer(
         stance: The stance the areas were computed at.
         areas: Its ZMP support area and CoM velocity area.
         model: The impact model at that stance.
+        criterion: The paper's CoM criterion of ``areas`` and ``model`` with the scenario's
+            velocity margin, when the caller has made it (the compiled posture's rates); None:
+            made here.
 
     Returns:
         The answer, without the QP (``qp`` is None).
@@ -297,7 +391,8 @@ def impact_answer(
     cfg = scenario.impact
     if cfg is None:
         raise ScenarioError("impact", None, "the scenario has no impact to answer for")
-    criterion = ComCriterion(areas.com_velocity_area, model, scenario.velocity_margin)
+    if criterion is None:
+        criterion = ComCriterion(areas.com_velocity_area, model, scenario.velocity_margin)
     com = criterion.limit(scenario.com_velocity)
     zmp = zmp_max_contact_velocity(
         areas.zmp_area, model, stance.com, scenario.plane_height, scenario.gravity, cfg.duration

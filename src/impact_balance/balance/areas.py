@@ -555,7 +555,7 @@ def _assembled_areas(
 
 
 #: The compiled pipeline of one posture (assembly, walk, certificate, maps), for compiled callers
-#: that run it in their own call (:mod:`impact_balance.governor.posture_kernel`).
+#: that run it in their own call (:mod:`impact_balance.criteria.posture_kernel`).
 assembled_areas = _assembled_areas
 
 # The compiled functions above embed the polygon module's, the walk's and the assembly's.

@@ -6,7 +6,9 @@
   both criteria;
 - :mod:`.com`: the paper's CoM velocity criterion; :mod:`.zmp`: the ZMP criterion;
 - :mod:`.cap`: the approach-speed clamps of a reference velocity;
-- :mod:`.qp`: the paper's QP in joint velocities.
+- :mod:`.qp`: the paper's QP in joint velocities;
+- :mod:`.posture_kernel`: one posture's areas, impact model and CoM criterion rates in one
+  compiled call (what :func:`~impact_balance.analyze` and a governor run).
 """
 
 __all__: list[str] = []

@@ -33,12 +33,13 @@ from impact_balance.balance.lipm import lipm_omega
 from impact_balance.contacts.cwc import local_faces
 from impact_balance.contacts.stance import ContactSpec, Stance, has_free_flyer
 from impact_balance.criteria.com import ComCriterion
+from impact_balance.criteria.posture_kernel import constants
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.criteria.zmp import zmp_max_contact_velocity
 from impact_balance.exceptions import SolverError
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.governor.options import Criterion
-from impact_balance.governor.posture_kernel import constants, kinematics_posture_kernel
+from impact_balance.governor.posture_kernel import kinematics_posture_kernel
 from impact_balance.impact.angular_momentum import AngularMomentumTerm, angular_momentum_gain
 from impact_balance.impact.model import (
     ImpactModel,
