@@ -33,11 +33,11 @@ from impact_balance.balance.lipm import lipm_omega
 from impact_balance.contacts.cwc import local_faces
 from impact_balance.contacts.stance import ContactSpec, Stance, has_free_flyer
 from impact_balance.criteria.com import ComCriterion
+from impact_balance.criteria.posture_answer import posture_answer
 from impact_balance.criteria.posture_kernel import constants
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.criteria.zmp import zmp_max_contact_velocity
 from impact_balance.exceptions import SolverError
-from impact_balance.geometry.polygon import Polygon
 from impact_balance.governor.options import Criterion
 from impact_balance.governor.posture_kernel import kinematics_posture_kernel
 from impact_balance.impact.angular_momentum import AngularMomentumTerm, angular_momentum_gain
@@ -341,39 +341,14 @@ class PostureEvaluator:
             self._hint, MAX_PIVOTS, self._constants, point_local, Ig.inertia, self._normal,
             self._cone,
         )  # fmt: skip
-        code, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h, W, impulse, rates = out[:12]
-        if code:
-            return None
         com, com_jacobian, point = out[12:]
-        area = Polygon.with_halfplanes(vel, bool(vel_bounded), G, h)
-        impact = ImpactModel(
-            settings.impact,
-            point,
-            self._normal.copy(),
-            self._cone.copy(),
-            W,
-            mass,
-            J,
-            impulse,
-        )
-        margin = settings.velocity_margin
-        criterion = ComCriterion.from_rates(
-            area, impact, margin, G, h - margin if margin else h, rates
-        )
-        projected = Projected(
-            force,
-            bool(bounded),
-            zmp,
-            bool(zmp_bounded),
-            area,
-            1,
-            w,
-            com,
-            settings.plane_height,
-            mass,
-            settings.gravity,
-            float(settings.zmp_margin),
-        )
+        answer = posture_answer(
+            out, settings.impact, point, self._normal.copy(), self._cone.copy(), J, mass=mass,
+            omega=w, com=com, plane_height=settings.plane_height, gravity=settings.gravity,
+            zmp_margin=settings.zmp_margin, velocity_margin=settings.velocity_margin,
+        )  # fmt: skip
+        if answer is None:
+            return None
         q = q.copy()
         q.setflags(write=False)
         return Posture(
@@ -383,10 +358,10 @@ class PostureEvaluator:
             settings,
             com,
             mass,
-            projected,
-            impact,
+            answer.projected,
+            answer.impact,
             com_jacobian,
-            criterion,
+            answer.criterion,
             None,
         )
 
