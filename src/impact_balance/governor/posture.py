@@ -272,7 +272,7 @@ class PostureEvaluator:
         that would not separate the contact), :class:`~impact_balance.exceptions.SolverError`
         (a projection that failed).
         """
-        robot, settings = self.robot, self.settings
+        settings = self.settings
         if self._compiled and not steps:
             posture = self._compiled_posture(q)
             if posture is not None:
@@ -304,21 +304,7 @@ class PostureEvaluator:
                 settings.velocity_margin,
                 self._angular_momentum(impact, com),
             )
-        q = q.copy()
-        q.setflags(write=False)
-        return Posture(
-            q.tobytes(),
-            q,
-            robot,
-            settings,
-            com,
-            mass,
-            areas,
-            impact,
-            com_jacobian,
-            com_criterion,
-            zmp,
-        )
+        return self._posture(q, com, mass, areas, impact, com_jacobian, com_criterion, zmp)
 
     def _compiled_posture(self, q: np.ndarray) -> Posture | None:
         """:meth:`evaluate`'s answer by pinocchio and one compiled call.
@@ -349,20 +335,36 @@ class PostureEvaluator:
         )  # fmt: skip
         if answer is None:
             return None
+        return self._posture(
+            q, com, mass, answer.projected, answer.impact, com_jacobian, answer.criterion, None
+        )
+
+    def _posture(
+        self,
+        q: np.ndarray,
+        com: np.ndarray,
+        mass: float,
+        projected: BalanceAreas | Projected,
+        impact: ImpactModel,
+        com_jacobian: np.ndarray,
+        com_criterion: ComCriterion | None,
+        zmp_limit: ContactVelocityLimit | None,
+    ) -> Posture:
+        """The :class:`Posture` of these parts at ``q`` (kept as a read-only copy)."""
         q = q.copy()
         q.setflags(write=False)
         return Posture(
             q.tobytes(),
             q,
             self.robot,
-            settings,
+            self.settings,
             com,
             mass,
-            answer.projected,
-            answer.impact,
+            projected,
+            impact,
             com_jacobian,
-            answer.criterion,
-            None,
+            com_criterion,
+            zmp_limit,
         )
 
     def impact_point(self) -> npt.NDArray[np.float64]:
