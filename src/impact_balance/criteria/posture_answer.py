@@ -11,7 +11,7 @@ the sweep's evaluator) from a stance, a governor from pinocchio's arrays.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -23,8 +23,7 @@ from impact_balance.impact.model import ImpactModel, ImpactSpec
 __all__ = ["PostureAnswer", "posture_answer"]
 
 
-@dataclass(frozen=True)
-class PostureAnswer:
+class PostureAnswer(NamedTuple):
     """One posture's objects, made from the compiled call's arrays by :func:`posture_answer`.
 
     Attributes:
