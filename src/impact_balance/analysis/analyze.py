@@ -15,7 +15,6 @@ from impact_balance.analysis.diagnostics import diagnose
 from impact_balance.analysis.result import Analysis, ImpactAnswer
 from impact_balance.balance.areas import (
     BalanceAreas,
-    Projected,
     areas_from_polytope,
     posture_areas,
     with_reason,
@@ -31,6 +30,7 @@ from impact_balance.contacts.wrench_polytope import (
 )
 from impact_balance.criteria.cap import safe_contact_velocity
 from impact_balance.criteria.com import ComCriterion
+from impact_balance.criteria.posture_answer import posture_answer
 from impact_balance.criteria.posture_kernel import constants, posture_kernel
 from impact_balance.criteria.qp import (
     QPOptions,
@@ -39,7 +39,12 @@ from impact_balance.criteria.qp import (
     static_torques,
 )
 from impact_balance.criteria.zmp import zmp_max_contact_velocity
-from impact_balance.exceptions import NonFiniteResultError, ScenarioError, SolverError
+from impact_balance.exceptions import (
+    ImpactModelError,
+    NonFiniteResultError,
+    ScenarioError,
+    SolverError,
+)
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.impact.angular_momentum import AngularMomentumTerm, angular_momentum_gain
 from impact_balance.impact.model import ImpactModel, impact_cone, impact_model
@@ -53,6 +58,7 @@ __all__ = [
     "angular_momentum_term",
     "impact_answer",
     "stance_areas",
+    "stance_posture",
 ]
 
 
@@ -104,14 +110,7 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
         qp = scenario.impact is not None and (
             scenario.impact.qp.solve if solve_qp is None else solve_qp
         )
-        # The compiled posture (areas, impact model and criterion rates in one call) where it
-        # answers, else the steps one by one.
-        posture = _compiled_posture(scenario, stance, clock.now, polytope=qp)
-        if posture is None:
-            polytope, areas, t2 = _stance_areas(scenario, stance, clock.now, polytope=qp)
-            model, criterion = None, None
-        else:
-            polytope, areas, model, criterion, t2 = posture
+        polytope, areas, model, criterion, t2 = _posture(scenario, stance, clock.now, polytope=qp)
         t3 = clock.now()
         timings.update(stance=t1 - t0, constraints=t2 - t1, areas=t3 - t2)
         if not areas.can_balance:  # explain why (LPs; only for a stance that cannot balance)
@@ -131,13 +130,43 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
     return Analysis(scenario, stance, areas, answer, timings, diagnose(scenario, stance, answer))
 
 
+def stance_posture(
+    scenario: Scenario, stance: Stance
+) -> tuple[BalanceAreas, ImpactModel | None, ComCriterion | None]:
+    """The balance areas at a stance, and the impact model and CoM criterion where it can.
+
+    :func:`analyze`'s path from the stance: the compiled posture
+    (:func:`~impact_balance.criteria.posture_kernel.posture_kernel`, its objects by
+    :func:`~impact_balance.criteria.posture_answer.posture_answer`) where it answers, the areas
+    step by step (:func:`stance_areas`) where it does not; the same numbers either way. The
+    sweep evaluator's, at each stance of a sweep.
+
+    Args:
+        scenario: Its ``torque_limits``, ``gravity``, ``plane_height`` (m), ``zmp_margin`` (m),
+            ``velocity_margin`` (m/s) and ``impact`` are used.
+        stance: The robot at a configuration with its contacts (world frame).
+
+    Returns:
+        ``(areas, model, criterion)``: the ZMP support and CoM velocity areas; the impact model
+        of the scenario's impact and the paper's CoM criterion with the scenario's velocity
+        margin (both None where the compiled posture does not answer: the caller then makes
+        them, :func:`~impact_balance.impact.model.impact_model` and :func:`impact_answer`, and
+        they raise what they raise).
+
+    Raises:
+        SolverError: The projection failed (named as the projection of the contacts' polytope).
+    """
+    _, areas, model, criterion, _ = _posture(scenario, stance, time.perf_counter, polytope=False)
+    return areas, model, criterion
+
+
 def stance_areas(scenario: Scenario, stance: Stance) -> tuple[WrenchPolytope, BalanceAreas]:
     """The scenario's contact wrench polytope and balance areas at a stance.
 
     The first half of the pipeline (stance -> constraints -> areas) step by step, with the
-    scenario's torque limits, gravity, ZMP plane and ZMP margin: the sweep evaluator's, and
-    :func:`analyze`'s where the compiled posture does not answer (the same numbers as it
-    where it does).
+    scenario's torque limits, gravity, ZMP plane and ZMP margin: :func:`analyze`'s (and
+    :func:`stance_posture`'s) where the compiled posture does not answer (the same numbers as
+    it where it does).
 
     Args:
         scenario: Its ``torque_limits``, ``gravity``, ``plane_height`` (m) and ``zmp_margin``
@@ -182,6 +211,24 @@ def _answer(
     return answer
 
 
+def _posture(
+    scenario: Scenario,
+    stance: Stance,
+    now: Callable[[], float],
+    polytope: bool,
+) -> tuple[WrenchPolytope | None, BalanceAreas, ImpactModel | None, ComCriterion | None, float]:
+    """:func:`stance_posture`, the polytope (with ``polytope``, else None) and a time.
+
+    The time (s, by the clock ``now``) is when the projection began (the compiled call's or the
+    steps').
+    """
+    posture = _compiled_posture(scenario, stance, now, polytope)
+    if posture is None:
+        assembled, areas, t = _stance_areas(scenario, stance, now, polytope)
+        return assembled, areas, None, None, t
+    return posture
+
+
 def _compiled_posture(
     scenario: Scenario,
     stance: Stance,
@@ -209,12 +256,12 @@ def _compiled_posture(
         w = lipm_omega(
             float(stance.com[2]), scenario.plane_height, scenario.gravity, field="plane_height"
         )
-    except ScenarioError:
+        normal, cone = impact_cone(spec)
+    except (ScenarioError, ImpactModelError):
         return None  # the steps raise it, in their order
     arrays = _stance_arrays(stance, scenario.torque_limits, scenario.gravity)
     faces, rotations, positions, arms, mass, com, gravity, J, idx, limit, g = arrays
     assembled = assemble_polytope(*arrays, None) if polytope else None
-    normal, cone = impact_cone(spec)
     arm = placement.translation - stance.com_local  # as impact_model
     lo, hi = spec.restitution
     t = now()
@@ -224,18 +271,14 @@ def _compiled_posture(
         w, NO_HINT, MAX_PIVOTS, constants(float(scenario.zmp_margin), (float(lo), float(hi))),
         arm, mass, stance.com_inertia, normal, cone,
     )  # fmt: skip
-    code, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h, W, impulse, rates = out
-    if code:
+    answer = posture_answer(
+        out, spec, placement.translation + stance.origin, normal, cone, J6[:3].copy(),
+        mass=mass, omega=w, com=com, plane_height=scenario.plane_height, gravity=gravity,
+        zmp_margin=scenario.zmp_margin, velocity_margin=scenario.velocity_margin,
+    )  # fmt: skip
+    if answer is None:
         return None
-    area = Polygon.with_halfplanes(vel, bool(vel_bounded), G, h)
-    areas = Projected(
-        force, bool(bounded), zmp, bool(zmp_bounded), area, 1, w, com, scenario.plane_height,
-        mass, gravity, float(scenario.zmp_margin),
-    ).areas()  # fmt: skip
-    point = placement.translation + stance.origin
-    model = ImpactModel(spec, point, normal, cone, W, mass, J6[:3].copy(), impulse)
-    margin = float(scenario.velocity_margin)
-    criterion = ComCriterion.from_rates(area, model, margin, G, h - margin if margin else h, rates)
+    areas, model, criterion = answer.projected.areas(), answer.impact, answer.criterion
     return assembled, areas, model, criterion, t
 
 

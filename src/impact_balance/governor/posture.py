@@ -33,11 +33,11 @@ from impact_balance.balance.lipm import lipm_omega
 from impact_balance.contacts.cwc import local_faces
 from impact_balance.contacts.stance import ContactSpec, Stance, has_free_flyer
 from impact_balance.criteria.com import ComCriterion
+from impact_balance.criteria.posture_answer import posture_answer
 from impact_balance.criteria.posture_kernel import constants
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.criteria.zmp import zmp_max_contact_velocity
 from impact_balance.exceptions import SolverError
-from impact_balance.geometry.polygon import Polygon
 from impact_balance.governor.options import Criterion
 from impact_balance.governor.posture_kernel import kinematics_posture_kernel
 from impact_balance.impact.angular_momentum import AngularMomentumTerm, angular_momentum_gain
@@ -272,7 +272,7 @@ class PostureEvaluator:
         that would not separate the contact), :class:`~impact_balance.exceptions.SolverError`
         (a projection that failed).
         """
-        robot, settings = self.robot, self.settings
+        settings = self.settings
         if self._compiled and not steps:
             posture = self._compiled_posture(q)
             if posture is not None:
@@ -304,21 +304,7 @@ class PostureEvaluator:
                 settings.velocity_margin,
                 self._angular_momentum(impact, com),
             )
-        q = q.copy()
-        q.setflags(write=False)
-        return Posture(
-            q.tobytes(),
-            q,
-            robot,
-            settings,
-            com,
-            mass,
-            areas,
-            impact,
-            com_jacobian,
-            com_criterion,
-            zmp,
-        )
+        return self._posture(q, com, mass, areas, impact, com_jacobian, com_criterion, zmp)
 
     def _compiled_posture(self, q: np.ndarray) -> Posture | None:
         """:meth:`evaluate`'s answer by pinocchio and one compiled call.
@@ -341,53 +327,44 @@ class PostureEvaluator:
             self._hint, MAX_PIVOTS, self._constants, point_local, Ig.inertia, self._normal,
             self._cone,
         )  # fmt: skip
-        code, force, bounded, zmp, zmp_bounded, vel, vel_bounded, G, h, W, impulse, rates = out[:12]
-        if code:
-            return None
         com, com_jacobian, point = out[12:]
-        area = Polygon.with_halfplanes(vel, bool(vel_bounded), G, h)
-        impact = ImpactModel(
-            settings.impact,
-            point,
-            self._normal.copy(),
-            self._cone.copy(),
-            W,
-            mass,
-            J,
-            impulse,
+        answer = posture_answer(
+            out, settings.impact, point, self._normal.copy(), self._cone.copy(), J, mass=mass,
+            omega=w, com=com, plane_height=settings.plane_height, gravity=settings.gravity,
+            zmp_margin=settings.zmp_margin, velocity_margin=settings.velocity_margin,
+        )  # fmt: skip
+        if answer is None:
+            return None
+        return self._posture(
+            q, com, mass, answer.projected, answer.impact, com_jacobian, answer.criterion, None
         )
-        margin = settings.velocity_margin
-        criterion = ComCriterion.from_rates(
-            area, impact, margin, G, h - margin if margin else h, rates
-        )
-        projected = Projected(
-            force,
-            bool(bounded),
-            zmp,
-            bool(zmp_bounded),
-            area,
-            1,
-            w,
-            com,
-            settings.plane_height,
-            mass,
-            settings.gravity,
-            float(settings.zmp_margin),
-        )
+
+    def _posture(
+        self,
+        q: np.ndarray,
+        com: np.ndarray,
+        mass: float,
+        projected: BalanceAreas | Projected,
+        impact: ImpactModel,
+        com_jacobian: np.ndarray,
+        com_criterion: ComCriterion | None,
+        zmp_limit: ContactVelocityLimit | None,
+    ) -> Posture:
+        """The :class:`Posture` of these parts at ``q`` (kept as a read-only copy)."""
         q = q.copy()
         q.setflags(write=False)
         return Posture(
             q.tobytes(),
             q,
             self.robot,
-            settings,
+            self.settings,
             com,
             mass,
             projected,
             impact,
             com_jacobian,
-            criterion,
-            None,
+            com_criterion,
+            zmp_limit,
         )
 
     def impact_point(self) -> npt.NDArray[np.float64]:

@@ -1,8 +1,12 @@
 """Evaluate the points of a chunk: one row per point, never an exception for a bad point.
 
 A worker builds one :class:`Evaluator` (the robot is loaded once) and evaluates chunks with
-it. Within a chunk, points that share a stance (same values of every stance dimension) share
-its areas: only the impact model and the two criteria are recomputed. Each chunk starts from a
+it. A stance's areas are :func:`~impact_balance.analyze`'s
+(:func:`~impact_balance.analysis.analyze.stance_posture`: the compiled posture where it
+answers, with the impact model and CoM criterion of the stance's first point; the steps where
+it does not). Within a chunk, points that share a stance (same values of every stance
+dimension) share its areas: only the impact model and the two criteria are recomputed (a point
+with the first point's impact reuses its model and criterion). Each chunk starts from a
 clean cache and the posture IK of each chunk starts from the base stance, so that a chunk's
 rows depend on the plan alone, never on which worker ran it or what it ran before.
 
@@ -24,14 +28,15 @@ import numpy.typing as npt
 import pinocchio as pin
 import pyarrow as pa
 
-from impact_balance.analysis.analyze import impact_answer, stance_areas
+from impact_balance.analysis.analyze import impact_answer, stance_posture
 from impact_balance.balance.areas import BalanceAreas
 from impact_balance.contacts.stance import Stance
+from impact_balance.criteria.com import ComCriterion
 from impact_balance.exceptions import ImpactBalanceError, ScenarioError
-from impact_balance.impact.model import impact_model
+from impact_balance.impact.model import ImpactModel, impact_model
 from impact_balance.robot.ik import IKError, IKOptions, solve_stance
 from impact_balance.robot.robot import Robot
-from impact_balance.scenario import Scenario, scenario_from_dict
+from impact_balance.scenario import ImpactConfig, Scenario, scenario_from_dict
 from impact_balance.sweep.columns import RESULT_COLUMNS, STATUSES, Status, Verdict
 from impact_balance.sweep.paths import get_path, set_path
 from impact_balance.sweep.plan import Dimension, SweepPlan
@@ -48,9 +53,23 @@ def result_schema(plan: SweepPlan) -> pa.Schema:
     return pa.schema(fields, metadata={"impact_balance.sweep": plan.digest})
 
 
+@dataclass(frozen=True)
+class _CompiledImpact:
+    """The impact model and CoM criterion the compiled posture made for one impact."""
+
+    impact: ImpactConfig
+    velocity_margin: float
+    model: ImpactModel
+    criterion: ComCriterion
+
+
 @dataclass
 class _ReadyStance:
-    """A stance whose areas are computed, shared by the points of a chunk that have it."""
+    """A stance whose areas are computed, shared by the points of a chunk that have it.
+
+    ``compiled``: the impact model and criterion of the stance's first point, where the
+    compiled posture answered it (a point with the same impact and margin reuses them).
+    """
 
     stance: Stance
     areas: BalanceAreas
@@ -59,6 +78,7 @@ class _ReadyStance:
     edge_directions: list[float]
     identity: dict[str, Any]
     verdicts: dict[tuple[float, float], Verdict]
+    compiled: _CompiledImpact | None = None
 
 
 @dataclass
@@ -218,11 +238,20 @@ class Evaluator:
         cfg = scenario.impact
         if cfg is None:  # an error row (the plan refuses a base scenario without impact)
             raise ValueError("the scenario has no impact")
-        try:
-            model = impact_model(stance, cfg.spec())
-        except ImpactBalanceError as exc:
-            return {**out, "status": "invalid", "message": str(exc)}
-        answer = impact_answer(scenario, stance, areas, model)
+        compiled = ready.compiled
+        if (
+            compiled is not None
+            and compiled.velocity_margin == scenario.velocity_margin
+            and compiled.impact == cfg
+        ):
+            model, criterion = compiled.model, compiled.criterion
+        else:
+            try:
+                model = impact_model(stance, cfg.spec())
+            except ImpactBalanceError as exc:
+                return {**out, "status": "invalid", "message": str(exc)}
+            criterion = None
+        answer = impact_answer(scenario, stance, areas, model, criterion)
         com, zmp = answer.com, answer.zmp
         verdict = ready.verdicts.get(scenario.com_velocity)
         if verdict is None:
@@ -265,7 +294,7 @@ class Evaluator:
             stance = scenario.build_stance(self._robot(scenario))
             if self._posture is not None:
                 stance, residual = self._place(self._posture, stance, values, warm)
-            _, areas = stance_areas(scenario, stance)
+            areas, model, criterion = stance_posture(scenario, stance)
         except IKError as exc:
             return _StanceEntry(None, "unreachable", str(exc), _worst(exc.residuals))
         except ScenarioError as exc:
@@ -281,6 +310,10 @@ class Evaluator:
             identity=_identity(scenario, stance),
             verdicts={},
         )
+        if model is not None and criterion is not None and scenario.impact is not None:
+            ready.compiled = _CompiledImpact(
+                scenario.impact, scenario.velocity_margin, model, criterion
+            )
         return _StanceEntry(ready, ik_residual=residual)
 
     def _place(
