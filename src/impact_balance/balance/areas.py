@@ -249,23 +249,7 @@ def posture_areas(
     Raises:
         ScenarioError: The plane is not below the CoM. SolverError: The projection failed.
     """
-    if frictions and max(frictions) > 1.0:
-        polytope = assemble_polytope(
-            faces,
-            rotations,
-            positions,
-            arms,
-            mass,
-            com,
-            gravity,
-            jacobians,
-            torque_indices,
-            torque_limits,
-            gravity_torques,
-            friction_scaling(frictions, list(rotations)),
-        )
-        return areas_from_polytope(polytope, plane_height, zmp_margin)
-    return projected_from_arrays(
+    arrays = (
         faces,
         rotations,
         positions,
@@ -277,10 +261,11 @@ def posture_areas(
         torque_indices,
         torque_limits,
         gravity_torques,
-        plane_height,
-        zmp_margin,
-        hint,
     )
+    if frictions and max(frictions) > 1.0:
+        polytope = assemble_polytope(*arrays, friction_scaling(frictions, list(rotations)))
+        return areas_from_polytope(polytope, plane_height, zmp_margin)
+    return projected_from_arrays(*arrays, plane_height, zmp_margin, hint)
 
 
 def projected_from_arrays(

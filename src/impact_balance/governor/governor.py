@@ -215,18 +215,7 @@ class Governor:
         warm_up()  # the projection kernel's one-time load
         warm_up_bretl()  # the fallback's (HiGHS), so that a tick that falls back is not slow
         warm_up_maps()  # and the fallback's compiled map
-        joints = self._joints  # and the state check's
-        _state_fault(
-            self.configuration,
-            np.zeros(self.nv),
-            joints.idx,
-            joints.lower,
-            joints.upper,
-            joints.pair_indices,
-            self._free_flyer,
-            MAX_POSITION,
-            QUATERNION_TOLERANCE,
-        )
+        self._state(self.configuration, np.zeros(self.nv))  # and the state check's
         try:
             posture = self._evaluator.evaluate(self.configuration)
             self._evaluator.evaluate(self.configuration, steps=True)  # what the kernel leaves
