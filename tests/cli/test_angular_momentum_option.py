@@ -31,13 +31,24 @@ def test_controller_is_refused_for_the_ik_controller_before_any_trial(command, c
 
 
 @needs_extra("sim")
-def test_controller_is_one_over_the_id_controllers_gain():
-    from impact_balance.sim.trials.setup import BalanceTrialOptions
+@pytest.mark.parametrize("name", ["palm_push_two_feet", "g1_two_feet"])
+def test_controller_is_one_over_the_gain_the_trials_controller_runs_with(name):
+    # The controller's K_L is derived from the robot (G1: 11.25 /s, not the default 10 /s):
+    # the prediction's tau is 1 / the gain of the controller built for the trial.
+    from dataclasses import replace
+
+    from impact_balance.sim.control.gains import trial_gains
+    from impact_balance.sim.trials.setup import BalanceSetup, BalanceTrialOptions
 
     options = BalanceTrialOptions(controller="id")
-    scenario = for_trials(load_scenario("palm_push_two_feet"), CONTROLLER, options)
-    assert scenario.angular_momentum_damping_time == pytest.approx(
-        1.0 / options.id_gains.angular_momentum_damping, rel=1e-15
+    scenario = load_scenario(name)
+    judged = for_trials(scenario, CONTROLLER, options)
+    setup = BalanceSetup.create(scenario, "servo", options)
+    running = trial_gains(options, setup.sim)[1].angular_momentum_damping
+    assert judged.angular_momentum_damping_time == pytest.approx(1.0 / running, rel=1e-12)
+    fixed = replace(options, robot_gains=False)
+    assert for_trials(scenario, CONTROLLER, fixed).angular_momentum_damping_time == (
+        pytest.approx(1.0 / fixed.id_gains.angular_momentum_damping, rel=1e-15)
     )
 
 

@@ -153,6 +153,9 @@ def for_trials(
 ) -> Scenario:
     """:func:`with_angular_momentum` with the trial controller's K_L (for ``controller``).
 
+    K_L is the gain the trials' ``id`` controller runs with on this scenario's robot (derived
+    from the robot unless ``options.robot_gains`` is False).
+
     Args:
         scenario: The command's scenario.
         value: The option's value (None: the scenario's own).
@@ -161,5 +164,17 @@ def for_trials(
     Returns:
         The scenario the predictions use.
     """
-    damping = controller_damping(options.controller, options.id_gains.angular_momentum_damping)
+    from impact_balance.sim.control.gains import declared_angular_momentum_damping
+    from impact_balance.sim.model.build import SimOptions
+
+    damping = None
+    if value == CONTROLLER and options.controller == "id":
+        gain = declared_angular_momentum_damping(
+            options,
+            scenario.build_stance(),
+            scenario.plane_height,
+            scenario.gravity,
+            SimOptions().timestep,
+        )
+        damping = controller_damping(options.controller, gain)
     return with_angular_momentum(scenario, value, damping)

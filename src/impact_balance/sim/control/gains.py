@@ -50,6 +50,7 @@ __all__ = [
     "InverseDynamicsGains",
     "RobotScales",
     "TrialGains",
+    "declared_angular_momentum_damping",
     "robot_gains",
     "robot_id_gains",
     "trial_gains",
@@ -295,6 +296,28 @@ def trial_gains(options: TrialGains, sim: SimModel) -> tuple[BalanceGains, Inver
         return options.gains, options.id_gains
     scales = RobotScales.of_sim(sim)
     return robot_gains(scales, options.gains), robot_id_gains(scales, options.id_gains)
+
+
+def declared_angular_momentum_damping(
+    options: TrialGains, stance: Stance, plane_height: float, gravity: float, timestep: float
+) -> float:
+    """K_L (1/s): the ``id`` controller's angular momentum damping gain in a trial on ``stance``.
+
+    The gain the trial's controller runs with: derived from the robot
+    (:func:`robot_id_gains`, ``K_L = w_c``) unless ``options.robot_gains`` is False, then
+    ``options.id_gains``' own. The same number as :func:`trial_gains` on the trial's model.
+
+    Args:
+        options: The trial's options (their ``id_gains`` and ``robot_gains``).
+        stance: The scenario's stance (its mass, CoM and inertia).
+        plane_height: Height of the contact plane, m.
+        gravity: g, m/s^2.
+        timestep: The simulation's step, s.
+    """
+    if not options.robot_gains:
+        return float(options.id_gains.angular_momentum_damping)
+    scales = RobotScales.of(stance, plane_height, gravity, timestep)
+    return float(robot_id_gains(scales, options.id_gains).angular_momentum_damping)
 
 
 class TrialGains(Protocol):
