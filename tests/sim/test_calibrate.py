@@ -154,6 +154,15 @@ def test_aborted_trials_are_left_out():
     assert result.zmp_margin == 0.0
 
 
+def test_a_file_scored_with_the_reach_is_refused_by_name():
+    # Its calls depend on the reach at the score's margin: a margin scan would ignore it.
+    document = push_test_document([(0.1, False, False)])
+    document["com_reach"] = {"azimuths_deg": [0, 90, 180, 270], "radii": [0.1] * 4, "height": 1}
+    with pytest.raises(ScenarioError) as caught:
+        calibrate([document])
+    assert caught.value.field == "com_reach"
+
+
 def test_files_are_pooled_and_hashed(tmp_path):
     a = write_document(tmp_path / "a.json", push_test_document([(0.1, False, False)] * 3))
     b = write_document(

@@ -90,6 +90,12 @@ def add_parser(sub: Subcommands) -> list[str]:
     )
     a.add_argument("--duration", type=float, default=0.05, help="push duration, s (default 0.05)")
     a.add_argument("--body", help="MuJoCo body pushed (default: the torso)")
+    a.add_argument(
+        "--com-reach",
+        action="store_true",
+        help="the default prediction also asks the capture to stay within the CoM's reach at "
+        "constant height with every contact kept (whole-body IK; docs/com-reach.md)",
+    )
     add_controller_option(
         a,
         DEFAULT_CONTROLLER,
@@ -150,6 +156,7 @@ def run(args: argparse.Namespace) -> int:
             zmp_margin=scoring_margin(scenario),
             journal=journal,
             band=args.band,
+            reach=args.com_reach,
         )
     finally:
         bar.close()

@@ -212,6 +212,14 @@ def training_set(data: Any, file: str, sha256: str | None = None) -> TrainingSet
     robot = data.get("robot")
     if not isinstance(robot, str) or not robot:
         raise _bad(file, "robot", "no robot recorded: run push-test again with this version", robot)
+    if data.get("com_reach") is not None:
+        raise _bad(
+            file,
+            "com_reach",
+            "calibrate scans the ZMP margin without the reach check: calibrate from push-test "
+            "runs without --com-reach",
+            "set",
+        )
     omega = _number(data, "omega", file)
     zmp_margin = _number(data, "zmp_margin", file)
     pushes = [_push(p, i, omega, zmp_margin, file) for i, p in enumerate(data["pushes"])]

@@ -30,7 +30,9 @@ scenario's ``angular_momentum_damping_time`` tau set, ``com`` counts the centroi
 the push leaves, ``L = (p - c) x J u`` (p the pushed body's centre of mass, c the CoM): the
 effective post-push CoM velocity ``c0 + (J u + S(L) / (h (1 + omega tau))) / m``,
 ``S(L) = (L_y, -L_x)``, must lie in the area (:mod:`impact_balance.impact.angular_momentum`);
-without it the two are the same call. Each criterion is scored against the lenient outcome (fell)
+without it the two are the same call. With a reach (``push_test(..., reach=True)``, ``push-test
+--com-reach``), ``com`` also asks the capture to stay within the CoM's reach at constant height
+(:mod:`impact_balance.balance.reach`). Each criterion is scored against the lenient outcome (fell)
 and the strict one (:mod:`.scores`).
 """
 
@@ -45,6 +47,7 @@ import mujoco
 import numpy as np
 from numpy.typing import ArrayLike
 
+from impact_balance.balance.reach import ComReach, com_reach, reach_speed_limit
 from impact_balance.exceptions import SimulationError
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.impact.angular_momentum import angular_momentum_gain
@@ -190,6 +193,9 @@ class PushPrediction:
         effective_com_velocity: The effective post-push CoM velocity that counts it (m/s,
             world xy; None when the scenario's ``angular_momentum_damping_time`` is unset).
         effective_com_velocity_margin: Its margin in the CoM velocity area (m/s; None likewise).
+        reach: The CoM's reach at constant height (:mod:`impact_balance.balance.reach`), when
+            the default prediction also asks the capture to stay within it; else None.
+        area: The CoM velocity area without margin (m/s), for the reach check at any margin.
     """
 
     com_velocity: np.ndarray
@@ -199,6 +205,29 @@ class PushPrediction:
     angular_momentum: np.ndarray | None = None
     effective_com_velocity: np.ndarray | None = None
     effective_com_velocity_margin: float | None = None
+    reach: ComReach | None = None
+    area: Polygon | None = None
+
+    def reach_margin(self, margin: float, omega: float) -> float | None:
+        """The reach-limited capture's margin at ZMP margin ``margin`` (m), m/s; None without.
+
+        The reach speed limit (:func:`~impact_balance.balance.reach.reach_speed_limit`, in the
+        area inset by ``omega margin``) minus the speed, the smaller over the paper's and the
+        effective post-push velocities: >= 0 when the capture stays within the CoM's reach.
+        """
+        if self.reach is None or self.area is None:
+            return None
+        area = self.area.inset(omega * margin) if margin > 0 else self.area
+        worst = float("inf")
+        for velocity in (self.com_velocity, self.effective_com_velocity):
+            if velocity is None:
+                continue
+            speed = float(np.linalg.norm(velocity))
+            if speed == 0.0:
+                continue
+            limit = 0.0 if area.is_empty else reach_speed_limit(area, omega, self.reach, velocity)
+            worst = min(worst, limit - speed)
+        return worst
 
     @property
     def default_com_velocity_margin(self) -> float:
@@ -230,7 +259,10 @@ class PushOutcome(TrialEntry):
         """
         s, p = self.summary, self.prediction
         if criterion == "com":  # the project's default: with the angular momentum when set
-            return p.default_com_velocity_margin >= omega * margin
+            reach = p.reach_margin(margin, omega)
+            return p.default_com_velocity_margin >= omega * margin and (
+                reach is None or reach >= 0.0
+            )
         if criterion == "paper_com":
             return p.com_velocity_margin >= omega * margin
         if criterion == "zmp":
@@ -269,6 +301,8 @@ class PushOutcome(TrialEntry):
             # angular momentum is counted): what a calibration compares with omega M.
             "predicted_com_velocity_margin": float(self.prediction.default_com_velocity_margin),
             "predicted_com_velocity": self.prediction.com_velocity.tolist(),
+            # The reach-limited capture's margin at the score's margin (m/s; null without).
+            "com_reach_margin": self.prediction.reach_margin(margin, omega),
             **_angular_momentum_keys(self.prediction, margin, omega),
             "predicted_zmp": self.prediction.zmp.tolist(),
             "trial": s,
@@ -296,6 +330,7 @@ class PushTestResult:
     band: tuple[float, float] | None = None
     body: str | None = None
     robot: str | None = None
+    reach: ComReach | None = None
 
     @property
     def scored(self) -> list[PushOutcome]:
@@ -415,6 +450,8 @@ class PushTestResult:
             "zmp_margin": self.zmp_margin,
             "controller_margin": self.controller_margin,
             "omega": self.omega,
+            # The CoM's reach the default prediction keeps the capture within (null: not asked).
+            "com_reach": None if self.reach is None else self.reach.to_dict(),
             "pushes": [o.to_dict(self.zmp_margin, self.omega) for o in self.outcomes],
             "start_com_velocity": list(START_COM_VELOCITY),
             "counts": self.counts(),
@@ -469,12 +506,17 @@ def _impulse(setup: BalanceSetup, level: float, angle: float, relative: bool) ->
 
 
 def predict_push(
-    setup: BalanceSetup, push: Push, body_height: float, body_position: ArrayLike | None = None
+    setup: BalanceSetup,
+    push: Push,
+    body_height: float,
+    body_position: ArrayLike | None = None,
+    reach: ComReach | None = None,
 ) -> PushPrediction:
     """The push's before-trial predictions (see the module docstring).
 
     ``body_position`` (m, world) is the pushed body's centre of mass at the start, where the push
-    acts; without it, the point above the CoM at ``body_height`` (m).
+    acts; without it, the point above the CoM at ``body_height`` (m). With ``reach``, the
+    default prediction also asks the capture to stay within the CoM's reach.
     """
     a = setup.analysis
     areas, mass, g = a.areas, a.stance.mass, a.areas.gravity
@@ -504,6 +546,8 @@ def predict_push(
         L,
         effective,
         effective_margin,
+        reach,
+        None if reach is None else areas.com_velocity_area,
     )
 
 
@@ -522,6 +566,13 @@ def _angular_momentum_keys(p: PushPrediction, margin: float, omega: float) -> di
     return out
 
 
+def _reach_of(setup: BalanceSetup, reach: ComReach | bool) -> ComReach | None:
+    """The reach the default prediction keeps the capture within: given, computed, or none."""
+    if isinstance(reach, ComReach):
+        return reach
+    return com_reach(setup.analysis.stance) if reach else None
+
+
 def push_test(
     scenario: Scenario | str,
     directions: int = 16,
@@ -535,6 +586,7 @@ def push_test(
     zmp_margin: float | None = None,
     journal: TrialJournal | None = None,
     band: Sequence[float] | None = None,
+    reach: ComReach | bool = False,
 ) -> PushTestResult:
     """Push the robot in evenly spaced directions and score both criteria.
 
@@ -542,7 +594,8 @@ def push_test(
     direction's boundary impulse) for ``duration`` s; both criteria are scored at ``zmp_margin`` (m;
     default: the controller's own margin). Finished trials go to ``journal`` as they end, and trials
     it already holds are not run again. ``band`` (``(LO, HI)``, fractions of the boundary impulse,
-    with ``relative`` from :func:`band_levels`) adds the scores of the pushes in it.
+    with ``relative`` from :func:`band_levels`) adds the scores of the pushes in it. ``reach``
+    (True: :func:`.com_reach` of the stance) keeps the default's capture within the CoM's reach.
     """
     wall0 = time.perf_counter()
     if not isinstance(scenario, Scenario):
@@ -558,6 +611,7 @@ def push_test(
     a = setup.analysis
     omega = float(a.areas.omega)
     own = controller_margin(options)
+    limit = _reach_of(setup, reach)
     journal = journal or TrialJournal(None, "")
     outcomes, reused = [], 0
     levels = list(relative if relative is not None else magnitudes or ())
@@ -587,7 +641,7 @@ def push_test(
             outcome = PushOutcome(
                 push=push,
                 relative=None if relative is None else float(level),
-                prediction=predict_push(setup, push, height, position),
+                prediction=predict_push(setup, push, height, position, limit),
                 summary=entry["summary"],
                 trajectory=entry["trajectory"],
             )
@@ -617,4 +671,5 @@ def push_test(
         None if band is None else (float(band[0]), float(band[1])),
         mujoco.mj_id2name(setup.sim.model, mujoco.mjtObj.mjOBJ_BODY, body_id),
         a.stance.robot.name,
+        limit,
     )

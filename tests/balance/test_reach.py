@@ -1,0 +1,118 @@
+"""The CoM's reach (whole-body IK) and the capture it limits (balance/reach.py)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from impact_balance.analysis.analyze import analyze
+from impact_balance.balance.reach import (
+    ComReach,
+    ReachOptions,
+    com_reach,
+    ray_extent,
+    reach_speed_limit,
+)
+from impact_balance.exceptions import ScenarioError
+from impact_balance.geometry.polygon import Polygon
+from impact_balance.scenario import load_scenario
+from tests.helpers.lipm import stop_distance
+
+
+def _uniform(radius: float, n: int = 8) -> ComReach:
+    azimuths = np.arange(n, dtype=float) * 2 * math.pi / n
+    return ComReach(azimuths, np.full(n, radius), 0.8, np.zeros((n, 1)))
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    extent=st.floats(0.03, 0.3),
+    ratio=st.floats(0.05, 0.95),
+    omega=st.floats(2.0, 5.0),
+)
+def test_the_speed_limit_is_where_the_lipm_stops_at_the_reach(extent, ratio, omega):
+    # Independent of the formula: integrate the LIPM with the ZMP at the area's extent.
+    reach = ratio * extent
+    square = Polygon.from_points(np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * omega * extent)
+    limit = reach_speed_limit(square, omega, _uniform(reach), [1.0, 0.0])
+    assert stop_distance(0.99 * limit, extent, omega) <= reach + 1e-9
+    assert stop_distance(1.01 * limit, extent, omega) > reach
+
+
+def test_a_reach_beyond_the_area_leaves_the_papers_limit():
+    omega, extent = 3.3, 0.1
+    square = Polygon.from_points(np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * omega * extent)
+    for reach in (extent, 2 * extent):
+        limit = reach_speed_limit(square, omega, _uniform(reach), [0.0, 1.0])
+        assert limit == pytest.approx(omega * extent, rel=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    points=st.lists(st.tuples(st.floats(-1, 1), st.floats(-1, 1)), min_size=3, max_size=12).map(
+        np.array
+    ),
+    angle=st.floats(0, 2 * math.pi),
+)
+def test_ray_extent_is_the_boundary_found_by_bisection(points, angle):
+    cloud = np.vstack([points, [[0.3, 0.3], [-0.3, 0.3], [0.0, -0.3]]])  # the origin inside
+    area = Polygon.from_points(cloud)
+    u = np.array([math.cos(angle), math.sin(angle)])
+    lo, hi = 0.0, 10.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if area.contains(mid * u, tol=0.0) else (lo, mid)
+    assert ray_extent(area, u) == pytest.approx(lo, abs=1e-9)
+
+
+def test_along_is_exact_on_a_sample_and_the_smaller_neighbour_between():
+    radii = np.array([0.1, 0.2, 0.05, 0.3])
+    reach = ComReach(np.arange(4) * math.pi / 2, radii, 0.8, np.zeros((4, 1)))
+    for k, r in enumerate(radii):
+        a = k * math.pi / 2
+        assert reach.along([math.cos(a), math.sin(a)]) == r
+    assert reach.along([1.0, 1.0]) == 0.1
+    assert reach.along([-1.0, 0.2]) == 0.05
+    assert reach.along([0.3, -1.0]) == 0.1
+
+
+def test_too_few_directions_is_refused_by_name():
+    stance = analyze(load_scenario("palm_push_two_feet")).stance
+    with pytest.raises(ScenarioError) as caught:
+        com_reach(stance, ReachOptions(directions=3))
+    assert caught.value.field == "com_reach.directions"
+
+
+def test_each_posture_holds_the_contacts_and_puts_the_com_at_its_reach():
+    # Checked with pinocchio alone, outside the IK: the CoM where the reach says (height held),
+    # every contact frame where the stance has it, every joint within its limits.
+    scenario = load_scenario("palm_push_two_feet")
+    stance = analyze(scenario).stance
+    options = ReachOptions(directions=4, bisections=5)
+    reach = com_reach(stance, options)
+    model = stance.robot.model
+    data = model.createData()
+    start = {}
+    pin.framesForwardKinematics(model, data, np.asarray(stance.q, dtype=float))
+    frames = [c.spec.frame for c in stance.contacts]
+    for f in frames:
+        start[f] = data.oMf[model.getFrameId(f)].copy()
+    com = np.asarray(stance.com, dtype=float)
+    assert np.all(reach.radii > 0.0)
+    for a, r, q in zip(reach.azimuths, reach.radii, reach.postures, strict=True):
+        target = com + r * np.array([math.cos(a), math.sin(a), 0.0])
+        c = pin.centerOfMass(model, data, q)
+        assert np.linalg.norm(c - target) <= options.com_tolerance
+        assert abs(c[2] - reach.height) <= options.com_tolerance
+        pin.framesForwardKinematics(model, data, q)
+        for f in frames:
+            err = pin.log(start[f].actInv(data.oMf[model.getFrameId(f)])).vector
+            assert np.linalg.norm(err) <= options.contact_tolerance
+        joints = q[7:]
+        assert np.all(joints >= model.lowerPositionLimit[7:] - 1e-9)
+        assert np.all(joints <= model.upperPositionLimit[7:] + 1e-9)
