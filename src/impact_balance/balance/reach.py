@@ -40,7 +40,7 @@ from pink.tasks import ComTask, FrameTask, PostureTask
 from impact_balance.contacts.stance import Stance
 from impact_balance.exceptions import ScenarioError
 from impact_balance.geometry.polygon import Polygon
-from impact_balance.robot.ik import chain_dofs
+from impact_balance.robot.ik import chain_dofs, within_limits
 
 __all__ = ["ComReach", "ReachOptions", "com_reach", "ray_extent", "reach_speed_limit"]
 
@@ -117,7 +117,7 @@ def _reached(
     """The configuration that holds every contact with the CoM at ``target`` (world, m), or None."""
     robot = stance.robot
     model = robot.model
-    q0 = np.asarray(stance.q, dtype=float)
+    q0 = within_limits(robot, stance.q)  # a file's rounding can leave a joint 1e-6 outside
     configuration = pink.Configuration(model, model.createData(), q0.copy())
     tasks: list[FrameTask] = []
     for frame in frames:

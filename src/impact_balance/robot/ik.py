@@ -31,7 +31,14 @@ from pink.tasks import ComTask, FrameTask, PostureTask
 from impact_balance.exceptions import ImpactBalanceError
 from impact_balance.robot.robot import Robot
 
-__all__ = ["IKError", "IKOptions", "chain_dofs", "solve_stance", "stance_residuals"]
+__all__ = [
+    "IKError",
+    "IKOptions",
+    "chain_dofs",
+    "solve_stance",
+    "stance_residuals",
+    "within_limits",
+]
 
 _FloatArray = npt.NDArray[np.float64]
 
@@ -195,6 +202,18 @@ def _start(robot: Robot, q0: ArrayLike) -> _FloatArray:
         ):
             q[slot.idx_q] = min(max(q[slot.idx_q], slot.lower), slot.upper)
     return q
+
+
+def within_limits(robot: Robot, q: ArrayLike) -> _FloatArray:
+    """A float copy of ``q`` (nq) with its bounded 1-dof joints clamped into their limits.
+
+    pink refuses to start from a configuration outside the limits; a stance written to a file
+    with rounded joint values can sit a few 1e-6 rad outside one.
+
+    Raises:
+        ValueError: ``q`` does not have the model's nq coordinates.
+    """
+    return _start(robot, q)
 
 
 def _frame_targets(
