@@ -475,21 +475,26 @@ def angular_momentum_term(
 
 
 def _area_checks(stance: Stance, areas: BalanceAreas) -> list[tuple[str, Any, tuple[str, ...]]]:
-    """(result field, value, scenario fields that can make it overflow) of the areas step."""
+    """(result field, value, scenario fields that can make it overflow) of the areas step.
+
+    A polygon's value is its squared size (:func:`_check_finite` computes it): its overflow is
+    that of the area and of its edge normals.
+    """
     return [
         ("com", stance.com, ("base.position",)),
         ("omega", areas.omega, ("plane_height", "gravity")),
-        # The squared sizes: their overflow is that of the areas and of the edge normals.
-        ("zmp_area", _squared_size(areas.zmp_area), ("plane_height", "base.position")),
-        ("com_velocity_area", _squared_size(areas.com_velocity_area), ("plane_height", "gravity")),
+        ("zmp_area", areas.zmp_area, ("plane_height", "base.position")),
+        ("com_velocity_area", areas.com_velocity_area, ("plane_height", "gravity")),
     ]
 
 
 def _squared_size(polygon: Polygon) -> float:
-    """Sum of the squared vertex coordinates (inf when they overflow, NaN with a NaN)."""
+    """Sum of the squared vertex coordinates (inf when they overflow, NaN with a NaN).
+
+    Call it with numpy's overflow and invalid warnings off.
+    """
     v = polygon.vertices.ravel()
-    with np.errstate(over="ignore", invalid="ignore"):
-        return float(v @ v)
+    return float(v @ v)
 
 
 def _impact_checks(model: ImpactModel) -> list[tuple[str, Any, tuple[str, ...]]]:
@@ -504,16 +509,20 @@ def _impact_checks(model: ImpactModel) -> list[tuple[str, Any, tuple[str, ...]]]
 def _check_finite(checks: list[tuple[str, Any, tuple[str, ...]]]) -> None:
     """Raise :class:`NonFiniteResultError` naming the first non-finite result (never NaN out).
 
-    One sum over everything first (a NaN or an infinity anywhere makes it non-finite), so the
-    common case costs a few microseconds; the field is looked for only on failure.
+    The values are floats, arrays and polygons (their :func:`_squared_size`). One sum over
+    everything first (a NaN or an infinity anywhere makes it non-finite), so the common case
+    costs a few microseconds; the field is looked for only on failure.
     """
     with np.errstate(over="ignore", invalid="ignore"):
+        values = [
+            _squared_size(value) if isinstance(value, Polygon) else value for _, value, _ in checks
+        ]
         total = 0.0
-        for _, value, _ in checks:  # the array method: numpy's np.sum wrapper costs ~2 us each
+        for value in values:  # the array method: numpy's np.sum wrapper costs ~2 us each
             total += value if isinstance(value, float) else float(np.asarray(value).sum())
         if math.isfinite(total):
             return
-        for name, value, inputs in checks:
+        for (name, _, inputs), value in zip(checks, values, strict=True):
             if not np.isfinite(value).all():
                 raise NonFiniteResultError(name, inputs)
         # every part finite: only their sum overflowed

@@ -314,6 +314,15 @@ class Robot:
         # The caches (thread-local Data, look-up tables) are rebuilt on demand, never copied.
         return {f.name: self.__dict__[f.name] for f in fields(self)}
 
+    def __setattr__(self, name: str, value: Any) -> None:
+        # Every cache is computed from the model: another model drops them all (rebuilt on
+        # demand), so a robot given a new model never answers from the old one.
+        if name == "model" and self.__dict__.get("model", value) is not value:
+            kept = {f.name for f in fields(self)}
+            for key in [k for k in self.__dict__ if k not in kept]:
+                del self.__dict__[key]
+        object.__setattr__(self, name, value)
+
     @property
     def mass(self) -> float:
         """Total mass, kg."""
@@ -362,12 +371,13 @@ class Robot:
         feet_ids = self._foot_frame_ids
         if not feet_ids:
             return None
+        model = self.model
         data = self._up_data.data  # this thread's (a Data of its own: no Stance reads it)
-        com = pin.centerOfMass(self.model, data, q)
-        pin.updateFramePlacements(self.model, data)
-        feet = data.oMf[feet_ids[0]].translation.copy()
+        com = pin.centerOfMass(model, data, q)
+        # The feet's placements alone (updateFramePlacements' numbers, without the other frames)
+        feet = pin.updateFramePlacement(model, data, feet_ids[0]).translation.copy()
         for i in feet_ids[1:]:
-            feet += data.oMf[i].translation
+            feet += pin.updateFramePlacement(model, data, i).translation
         feet /= len(feet_ids)  # their mean, summed in order as np.mean sums a few rows
         direction = np.asarray(com - feet, dtype=float)
         length = math.sqrt(float(direction @ direction))  # np.linalg.norm's numbers
@@ -484,25 +494,38 @@ class Robot:
 
         A 1-dof joint takes its value (rad or m), checked against its finite position limits
         (1e-9 slack); a continuous joint takes (cos, sin) of its angle. Errors are
-        :class:`ScenarioError` on ``field.NAME``, for the first bad joint in order. Results
-        are cached by content (a stance is rebuilt from the same overrides many times):
-        do not modify the returned read-only arrays.
+        :class:`ScenarioError` on ``field.NAME``, for the first bad joint in order. The
+        indices and limits of a set of names are cached per model (a stance is rebuilt from
+        the same names many times): do not modify the returned read-only arrays.
         """
-        key = (field, tuple(joints.items()))
-        cached = self._assignments.get(key)
-        if cached is not None:
-            return cached
+        plan = self._assignment_plans.get(tuple(joints))
+        if plan is not None:  # 1-dof joints only: the values as given, checked at once
+            indices, low, high = plan
+            try:
+                values = np.fromiter(joints.values(), dtype=float, count=indices.size)
+            except (TypeError, ValueError):
+                values = None  # not numbers: the loop below says which
+            if values is not None and bool(((low <= values) & (values <= high)).all()):
+                values.setflags(write=False)
+                return indices, values
+        return self._joint_assignment(joints, field)
+
+    def _joint_assignment(
+        self, joints: Mapping[str, float], field: str
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`joint_assignment` joint by joint (raising on the first bad one).
+
+        Caches the names' plan when every joint is 1-dof: indices, and the lowest and highest
+        value each accepts (-inf and inf where the limits are not checked).
+        """
         indices, values = [], []
+        low, high = [], []
         for name, value in joints.items():
             slot = self.joint_slot(name, field=f"{field}.{name}")
             if slot.nq == 1:
                 lo, hi = slot.lower, slot.upper
-                if (
-                    math.isfinite(lo)
-                    and math.isfinite(hi)
-                    and lo < hi
-                    and not (lo - 1e-9 <= value <= hi + 1e-9)
-                ):
+                checked = math.isfinite(lo) and math.isfinite(hi) and lo < hi
+                if checked and not (lo - 1e-9 <= value <= hi + 1e-9):
                     raise ScenarioError(
                         f"{field}.{name}",
                         value,
@@ -510,6 +533,8 @@ class Robot:
                     )
                 indices.append(slot.idx_q)
                 values.append(value)
+                low.append(lo - 1e-9 if checked else -math.inf)
+                high.append(hi + 1e-9 if checked else math.inf)
             elif slot.nq == 2 and slot.nv == 1:  # continuous joint: (cos, sin)
                 indices += [slot.idx_q, slot.idx_q + 1]
                 values += [math.cos(value), math.sin(value)]
@@ -520,13 +545,15 @@ class Robot:
         result = np.asarray(indices, dtype=int), np.asarray(values, dtype=float)
         for array in result:
             array.setflags(write=False)
-        if len(self._assignments) >= 64:  # bounded: interactive use creates many
-            self._assignments.clear()
-        self._assignments[key] = result
+        plans = self._assignment_plans
+        if len(low) == len(joints):  # every joint 1-dof: the plan answers next time
+            if len(plans) >= 64:  # bounded: interactive use creates many
+                plans.clear()
+            plans[tuple(joints)] = (result[0], np.array(low), np.array(high))
         return result
 
     @functools.cached_property
-    def _assignments(self) -> dict[tuple[Any, ...], tuple[np.ndarray, np.ndarray]]:
+    def _assignment_plans(self) -> dict[tuple[str, ...], tuple[np.ndarray, ...]]:
         return {}
 
     def joint_values(self, q: np.ndarray) -> dict[str, float]:
