@@ -112,8 +112,10 @@ def test_the_approach_benchmark_pools_the_ticks_of_every_trial(capsys) -> None:
     trials = side["trials"]
     assert [t["wall_distance"] for t in trials] == [0.1, 0.2]
     assert all(t["ticks"] == t["command_ticks"] > 0 for t in trials)
-    assert side["tick_us"]["count"] == side["replayed_tick_us"]["count"] == sum(
-        t["ticks"] for t in trials
+    assert (
+        side["tick_us"]["count"]
+        == side["replayed_tick_us"]["count"]
+        == sum(t["ticks"] for t in trials)
     )
     assert 0 < side["tick_us"]["median"] <= side["tick_us"]["p99"]
     assert "pooled_ratio" not in out  # no baseline, no ratio

@@ -117,7 +117,10 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
             areas = with_reason(areas, stance, scenario.torque_limits, scenario.gravity)
             timings["diagnosis"] = clock.now() - t3
             t3 = clock.now()
-        _check_finite(_area_checks(stance, areas))
+        checks = _area_checks(stance, areas)
+        if model is not None:  # the compiled posture's: checked with the areas (after them)
+            checks += _impact_checks(model)
+        _check_finite(checks)
         answer = None
         if scenario.impact is not None:
             answer = _answer(scenario, stance, areas, model, criterion, polytope if qp else None)
@@ -194,8 +197,9 @@ def _answer(
 ) -> ImpactAnswer:
     """:func:`analyze`'s impact step: the model (unless given), its checks, the answer, the QP.
 
-    ``model`` and ``criterion`` are the compiled posture's (None: the steps make them); the QP
-    is solved when ``polytope`` is given.
+    ``model`` and ``criterion`` are the compiled posture's (None: the steps make them, and the
+    model's finiteness is checked here; a given one the caller checked); the QP is solved
+    when ``polytope`` is given.
     """
     cfg = scenario.impact
     assert cfg is not None  # called for a scenario with an impact
@@ -204,7 +208,7 @@ def _answer(
             model = impact_model(stance, cfg.spec())
         except ScenarioError as exc:
             raise with_source(exc, scenario.source) from None
-    _check_finite(_impact_checks(model))
+        _check_finite(_impact_checks(model))  # a given model was checked with the areas
     answer = impact_answer(scenario, stance, areas, model, criterion)
     if polytope is not None:
         answer = dataclasses.replace(answer, qp=_qp(scenario, stance, polytope, areas, model))
