@@ -130,3 +130,34 @@ def test_setting_the_same_model_again_keeps_the_caches():
     slots = robot._joint_slots
     robot.model = robot.model
     assert robot._joint_slots is slots
+
+
+def test_threads_assigning_the_same_names_each_get_their_own_values():
+    """The names' plan keeps the last values accepted; threads that alternate two sets of
+    values for the same names never get the other thread's."""
+    import threading
+
+    robot = dataclasses.replace(load_robot("talos"))
+    middle = {name: 0.5 * sum(_limits(robot.model, name)[1:]) for name in NAMES}
+    sets = [{name: v + 0.01 * k for name, v in middle.items()} for k in range(4)]
+    failures: list[str] = []
+    barrier = threading.Barrier(len(sets))
+
+    def run(k: int) -> None:
+        want = list(sets[k].values())
+        barrier.wait()
+        try:
+            for _ in range(2000):
+                got = robot.joint_assignment(sets[k])[1].tolist()
+                if got != want:
+                    failures.append(f"thread {k}: {got} != {want}")
+                    return
+        except Exception as exc:  # reported, not lost in the thread
+            failures.append(f"thread {k}: {exc!r}")
+
+    threads = [threading.Thread(target=run, args=(k,)) for k in range(len(sets))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert failures == []

@@ -282,6 +282,24 @@ class ThreadData(threading.local, Scratch):
         Scratch.__init__(self, model)
 
 
+class _JointPlan:
+    """:meth:`Robot.joint_assignment`'s plan for one set of 1-dof joint names.
+
+    Attributes:
+        indices: Their configuration indices (read-only).
+        low, high: The lowest and highest value each accepts (its limits with their 1e-9
+            slack; -inf and inf where the limits are not checked).
+        last: The last values accepted, as given and as a read-only array (one tuple,
+            replaced whole: a thread reads both of the same call).
+    """
+
+    __slots__ = ("high", "indices", "last", "low")
+
+    def __init__(self, indices: np.ndarray, low: np.ndarray, high: np.ndarray) -> None:
+        self.indices, self.low, self.high = indices, low, high
+        self.last: tuple[tuple[Any, ...] | None, np.ndarray] = (None, np.zeros(0))
+
+
 @dataclass
 class Robot:
     """A floating-base robot model.
@@ -495,19 +513,27 @@ class Robot:
         A 1-dof joint takes its value (rad or m), checked against its finite position limits
         (1e-9 slack); a continuous joint takes (cos, sin) of its angle. Errors are
         :class:`ScenarioError` on ``field.NAME``, for the first bad joint in order. The
-        indices and limits of a set of names are cached per model (a stance is rebuilt from
-        the same names many times): do not modify the returned read-only arrays.
+        indices and limits of a set of names are cached per model, with the last values
+        accepted (a stance is rebuilt from the same names many times, often with the same
+        values): do not modify the returned read-only arrays.
         """
         plan = self._assignment_plans.get(tuple(joints))
         if plan is not None:  # 1-dof joints only: the values as given, checked at once
-            indices, low, high = plan
+            given, last = tuple(joints.values()), plan.last  # one read: other threads swap it
+            if given == last[0]:  # the same values again (a scenario analysed again)
+                return plan.indices, last[1]
             try:
-                values = np.fromiter(joints.values(), dtype=float, count=indices.size)
+                values = np.array(given, dtype=float)
             except (TypeError, ValueError):
                 values = None  # not numbers: the loop below says which
-            if values is not None and bool(((low <= values) & (values <= high)).all()):
+            if (
+                values is not None
+                and values.shape == plan.low.shape
+                and bool(((plan.low <= values) & (values <= plan.high)).all())
+            ):
                 values.setflags(write=False)
-                return indices, values
+                plan.last = (given, values)
+                return plan.indices, values
         return self._joint_assignment(joints, field)
 
     def _joint_assignment(
@@ -549,11 +575,11 @@ class Robot:
         if len(low) == len(joints):  # every joint 1-dof: the plan answers next time
             if len(plans) >= 64:  # bounded: interactive use creates many
                 plans.clear()
-            plans[tuple(joints)] = (result[0], np.array(low), np.array(high))
+            plans[tuple(joints)] = _JointPlan(result[0], np.array(low), np.array(high))
         return result
 
     @functools.cached_property
-    def _assignment_plans(self) -> dict[tuple[str, ...], tuple[np.ndarray, ...]]:
+    def _assignment_plans(self) -> dict[tuple[str, ...], _JointPlan]:
         return {}
 
     def joint_values(self, q: np.ndarray) -> dict[str, float]:
