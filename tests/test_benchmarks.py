@@ -94,3 +94,30 @@ def test_the_batch_benchmark_reports_ratios_and_agreement(capsys) -> None:
     assert set(times) == {"single", "batch", "batch_threads", "velocity", "batch_velocity"}
     assert row["ratio_single_over_batch"] == pytest.approx(times["single"] / times["batch"])
     assert batch.main(["--n", "0"]) == 2
+
+
+@pytest.mark.slow
+def test_the_approach_benchmark_pools_the_ticks_of_every_trial(capsys) -> None:
+    """Every tick the command counted is timed, replayed once, and pooled over the trials."""
+    import json
+
+    import numpy as np
+
+    pytest.importorskip("mujoco")
+    from benchmarks import approach
+
+    assert approach.main(["--trials", "2", "--wall-distances", "0.1", "0.2", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)["approach"]
+    side = out["sides"]["current"]
+    trials = side["trials"]
+    assert [t["wall_distance"] for t in trials] == [0.1, 0.2]
+    assert all(t["ticks"] == t["command_ticks"] > 0 for t in trials)
+    assert (
+        side["tick_us"]["count"]
+        == side["replayed_tick_us"]["count"]
+        == sum(t["ticks"] for t in trials)
+    )
+    assert 0 < side["tick_us"]["median"] <= side["tick_us"]["p99"]
+    assert "pooled_ratio" not in out  # no baseline, no ratio
+    assert approach.main(["--trials", "0"]) == 2
+    assert approach.pooled([[1.0, 2.0], [3.0]])["median"] == np.median([1.0, 2.0, 3.0])

@@ -117,7 +117,10 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
             areas = with_reason(areas, stance, scenario.torque_limits, scenario.gravity)
             timings["diagnosis"] = clock.now() - t3
             t3 = clock.now()
-        _check_finite(_area_checks(stance, areas))
+        checks = _area_checks(stance, areas)
+        if model is not None:  # the compiled posture's: checked with the areas (after them)
+            checks += _impact_checks(model)
+        _check_finite(checks)
         answer = None
         if scenario.impact is not None:
             answer = _answer(scenario, stance, areas, model, criterion, polytope if qp else None)
@@ -194,8 +197,9 @@ def _answer(
 ) -> ImpactAnswer:
     """:func:`analyze`'s impact step: the model (unless given), its checks, the answer, the QP.
 
-    ``model`` and ``criterion`` are the compiled posture's (None: the steps make them); the QP
-    is solved when ``polytope`` is given.
+    ``model`` and ``criterion`` are the compiled posture's (None: the steps make them, and the
+    model's finiteness is checked here; a given one the caller checked); the QP is solved
+    when ``polytope`` is given.
     """
     cfg = scenario.impact
     assert cfg is not None  # called for a scenario with an impact
@@ -204,7 +208,7 @@ def _answer(
             model = impact_model(stance, cfg.spec())
         except ScenarioError as exc:
             raise with_source(exc, scenario.source) from None
-    _check_finite(_impact_checks(model))
+        _check_finite(_impact_checks(model))  # a given model was checked with the areas
     answer = impact_answer(scenario, stance, areas, model, criterion)
     if polytope is not None:
         answer = dataclasses.replace(answer, qp=_qp(scenario, stance, polytope, areas, model))
@@ -475,21 +479,26 @@ def angular_momentum_term(
 
 
 def _area_checks(stance: Stance, areas: BalanceAreas) -> list[tuple[str, Any, tuple[str, ...]]]:
-    """(result field, value, scenario fields that can make it overflow) of the areas step."""
+    """(result field, value, scenario fields that can make it overflow) of the areas step.
+
+    A polygon's value is its squared size (:func:`_check_finite` computes it): its overflow is
+    that of the area and of its edge normals.
+    """
     return [
         ("com", stance.com, ("base.position",)),
         ("omega", areas.omega, ("plane_height", "gravity")),
-        # The squared sizes: their overflow is that of the areas and of the edge normals.
-        ("zmp_area", _squared_size(areas.zmp_area), ("plane_height", "base.position")),
-        ("com_velocity_area", _squared_size(areas.com_velocity_area), ("plane_height", "gravity")),
+        ("zmp_area", areas.zmp_area, ("plane_height", "base.position")),
+        ("com_velocity_area", areas.com_velocity_area, ("plane_height", "gravity")),
     ]
 
 
 def _squared_size(polygon: Polygon) -> float:
-    """Sum of the squared vertex coordinates (inf when they overflow, NaN with a NaN)."""
+    """Sum of the squared vertex coordinates (inf when they overflow, NaN with a NaN).
+
+    Call it with numpy's overflow and invalid warnings off.
+    """
     v = polygon.vertices.ravel()
-    with np.errstate(over="ignore", invalid="ignore"):
-        return float(v @ v)
+    return float(v @ v)
 
 
 def _impact_checks(model: ImpactModel) -> list[tuple[str, Any, tuple[str, ...]]]:
@@ -504,16 +513,20 @@ def _impact_checks(model: ImpactModel) -> list[tuple[str, Any, tuple[str, ...]]]
 def _check_finite(checks: list[tuple[str, Any, tuple[str, ...]]]) -> None:
     """Raise :class:`NonFiniteResultError` naming the first non-finite result (never NaN out).
 
-    One sum over everything first (a NaN or an infinity anywhere makes it non-finite), so the
-    common case costs a few microseconds; the field is looked for only on failure.
+    The values are floats, arrays and polygons (their :func:`_squared_size`). One sum over
+    everything first (a NaN or an infinity anywhere makes it non-finite), so the common case
+    costs a few microseconds; the field is looked for only on failure.
     """
     with np.errstate(over="ignore", invalid="ignore"):
+        values = [
+            _squared_size(value) if isinstance(value, Polygon) else value for _, value, _ in checks
+        ]
         total = 0.0
-        for _, value, _ in checks:  # the array method: numpy's np.sum wrapper costs ~2 us each
+        for value in values:  # the array method: numpy's np.sum wrapper costs ~2 us each
             total += value if isinstance(value, float) else float(np.asarray(value).sum())
         if math.isfinite(total):
             return
-        for name, value, inputs in checks:
+        for (name, _, inputs), value in zip(checks, values, strict=True):
             if not np.isfinite(value).all():
                 raise NonFiniteResultError(name, inputs)
         # every part finite: only their sum overflowed

@@ -65,10 +65,17 @@ def _tilt_degrees(normal: np.ndarray) -> float:
     return math.degrees(math.acos(max(-1.0, min(1.0, float(normal[2])))))
 
 
+#: Above this world z, a unit normal is surely less than FLOOR_TILT from the vertical (the
+#: margin keeps rounding out of the question): no warning to compute.
+_FLAT_NORMAL_Z = math.cos(math.radians(FLOOR_TILT)) + 1e-9
+
+
 def contact_diagnostics(stance: Stance) -> list[Diagnostic]:
     """Contact normals pointing down or tilted between a floor and a wall."""
     out = []
     for i, contact in enumerate(stance.contacts):
+        if float(contact.rotation[2, 2]) > _FLAT_NORMAL_Z:  # a floor or gentle ramp: no warning
+            continue
         tilt = _tilt_degrees(contact.normal)
         field = f"contacts[{i}]"
         frame = contact.spec.frame

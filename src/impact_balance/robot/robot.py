@@ -282,6 +282,24 @@ class ThreadData(threading.local, Scratch):
         Scratch.__init__(self, model)
 
 
+class _JointPlan:
+    """:meth:`Robot.joint_assignment`'s plan for one set of 1-dof joint names.
+
+    Attributes:
+        indices: Their configuration indices (read-only).
+        low, high: The lowest and highest value each accepts (its limits with their 1e-9
+            slack; -inf and inf where the limits are not checked).
+        last: The last values accepted, as given and as a read-only array (one tuple,
+            replaced whole: a thread reads both of the same call).
+    """
+
+    __slots__ = ("high", "indices", "last", "low")
+
+    def __init__(self, indices: np.ndarray, low: np.ndarray, high: np.ndarray) -> None:
+        self.indices, self.low, self.high = indices, low, high
+        self.last: tuple[tuple[Any, ...] | None, np.ndarray] = (None, np.zeros(0))
+
+
 @dataclass
 class Robot:
     """A floating-base robot model.
@@ -313,6 +331,15 @@ class Robot:
     def __getstate__(self) -> dict[str, Any]:
         # The caches (thread-local Data, look-up tables) are rebuilt on demand, never copied.
         return {f.name: self.__dict__[f.name] for f in fields(self)}
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        # Every cache is computed from the model: another model drops them all (rebuilt on
+        # demand), so a robot given a new model never answers from the old one.
+        if name == "model" and self.__dict__.get("model", value) is not value:
+            kept = {f.name for f in fields(self)}
+            for key in [k for k in self.__dict__ if k not in kept]:
+                del self.__dict__[key]
+        object.__setattr__(self, name, value)
 
     @property
     def mass(self) -> float:
@@ -362,12 +389,13 @@ class Robot:
         feet_ids = self._foot_frame_ids
         if not feet_ids:
             return None
+        model = self.model
         data = self._up_data.data  # this thread's (a Data of its own: no Stance reads it)
-        com = pin.centerOfMass(self.model, data, q)
-        pin.updateFramePlacements(self.model, data)
-        feet = data.oMf[feet_ids[0]].translation.copy()
+        com = pin.centerOfMass(model, data, q)
+        # The feet's placements alone (updateFramePlacements' numbers, without the other frames)
+        feet = pin.updateFramePlacement(model, data, feet_ids[0]).translation.copy()
         for i in feet_ids[1:]:
-            feet += data.oMf[i].translation
+            feet += pin.updateFramePlacement(model, data, i).translation
         feet /= len(feet_ids)  # their mean, summed in order as np.mean sums a few rows
         direction = np.asarray(com - feet, dtype=float)
         length = math.sqrt(float(direction @ direction))  # np.linalg.norm's numbers
@@ -484,25 +512,46 @@ class Robot:
 
         A 1-dof joint takes its value (rad or m), checked against its finite position limits
         (1e-9 slack); a continuous joint takes (cos, sin) of its angle. Errors are
-        :class:`ScenarioError` on ``field.NAME``, for the first bad joint in order. Results
-        are cached by content (a stance is rebuilt from the same overrides many times):
-        do not modify the returned read-only arrays.
+        :class:`ScenarioError` on ``field.NAME``, for the first bad joint in order. The
+        indices and limits of a set of names are cached per model, with the last values
+        accepted (a stance is rebuilt from the same names many times, often with the same
+        values): do not modify the returned read-only arrays.
         """
-        key = (field, tuple(joints.items()))
-        cached = self._assignments.get(key)
-        if cached is not None:
-            return cached
+        plan = self._assignment_plans.get(tuple(joints))
+        if plan is not None:  # 1-dof joints only: the values as given, checked at once
+            given, last = tuple(joints.values()), plan.last  # one read: other threads swap it
+            if given == last[0]:  # the same values again (a scenario analysed again)
+                return plan.indices, last[1]
+            try:
+                values = np.array(given, dtype=float)
+            except (TypeError, ValueError):
+                values = None  # not numbers: the loop below says which
+            if (
+                values is not None
+                and values.shape == plan.low.shape
+                and bool(((plan.low <= values) & (values <= plan.high)).all())
+            ):
+                values.setflags(write=False)
+                plan.last = (given, values)
+                return plan.indices, values
+        return self._joint_assignment(joints, field)
+
+    def _joint_assignment(
+        self, joints: Mapping[str, float], field: str
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`joint_assignment` joint by joint (raising on the first bad one).
+
+        Caches the names' plan when every joint is 1-dof: indices, and the lowest and highest
+        value each accepts (-inf and inf where the limits are not checked).
+        """
         indices, values = [], []
+        low, high = [], []
         for name, value in joints.items():
             slot = self.joint_slot(name, field=f"{field}.{name}")
             if slot.nq == 1:
                 lo, hi = slot.lower, slot.upper
-                if (
-                    math.isfinite(lo)
-                    and math.isfinite(hi)
-                    and lo < hi
-                    and not (lo - 1e-9 <= value <= hi + 1e-9)
-                ):
+                checked = math.isfinite(lo) and math.isfinite(hi) and lo < hi
+                if checked and not (lo - 1e-9 <= value <= hi + 1e-9):
                     raise ScenarioError(
                         f"{field}.{name}",
                         value,
@@ -510,6 +559,8 @@ class Robot:
                     )
                 indices.append(slot.idx_q)
                 values.append(value)
+                low.append(lo - 1e-9 if checked else -math.inf)
+                high.append(hi + 1e-9 if checked else math.inf)
             elif slot.nq == 2 and slot.nv == 1:  # continuous joint: (cos, sin)
                 indices += [slot.idx_q, slot.idx_q + 1]
                 values += [math.cos(value), math.sin(value)]
@@ -520,13 +571,15 @@ class Robot:
         result = np.asarray(indices, dtype=int), np.asarray(values, dtype=float)
         for array in result:
             array.setflags(write=False)
-        if len(self._assignments) >= 64:  # bounded: interactive use creates many
-            self._assignments.clear()
-        self._assignments[key] = result
+        plans = self._assignment_plans
+        if len(low) == len(joints):  # every joint 1-dof: the plan answers next time
+            if len(plans) >= 64:  # bounded: interactive use creates many
+                plans.clear()
+            plans[tuple(joints)] = _JointPlan(result[0], np.array(low), np.array(high))
         return result
 
     @functools.cached_property
-    def _assignments(self) -> dict[tuple[Any, ...], tuple[np.ndarray, np.ndarray]]:
+    def _assignment_plans(self) -> dict[tuple[str, ...], _JointPlan]:
         return {}
 
     def joint_values(self, q: np.ndarray) -> dict[str, float]:
