@@ -133,3 +133,21 @@ def test_a_stance_a_rounding_outside_a_joint_limit_is_searched_from_within_it():
     others = np.arange(model.nq) != j
     assert np.array_equal(inside[others], q[others])
     assert np.array_equal(within_limits(stance.robot, stance.q), np.asarray(stance.q))
+
+
+@pytest.mark.slow
+def test_a_search_whose_steps_brush_a_joint_limit_finishes_within_the_limits():
+    # JVRC-1 on the fourth held-out set: the QP's steps left a joint 1.03e-6 rad past a limit,
+    # which pink refuses at the next step; the search projects each step into the limits.
+    from pathlib import Path
+
+    path = (
+        Path(__file__).parents[2] / "studies" / "held_out_4" / "jvrc1_wide_ramp_left_hand_side.yaml"
+    )
+    stance = analyze(load_scenario(str(path)).replace(zmp_margin=0.0)).stance
+    reach = com_reach(stance)  # the fourth set's search, which met the limit
+    model = stance.robot.model
+    assert np.all(reach.radii > 0.0)
+    for q in reach.postures:
+        assert np.all(q[7:] >= model.lowerPositionLimit[7:] - 1e-12)
+        assert np.all(q[7:] <= model.upperPositionLimit[7:] + 1e-12)

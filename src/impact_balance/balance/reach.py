@@ -36,6 +36,7 @@ import pink
 import pinocchio as pin
 from pink.limits import ConfigurationLimit
 from pink.tasks import ComTask, FrameTask, PostureTask
+from pink.utils import get_root_joint_dim
 
 from impact_balance.contacts.stance import Stance
 from impact_balance.exceptions import ScenarioError
@@ -130,11 +131,20 @@ def _reached(
     posture = PostureTask(cost=1e-3)
     posture.set_target(q0)
     limits = [ConfigurationLimit(model)]
+    lower, upper = model.lowerPositionLimit, model.upperPositionLimit
+    bounded = np.zeros(model.nq, dtype=bool)
+    root = get_root_joint_dim(model)[0]
+    bounded[root:] = upper[root:] > lower[root:] + 1e-6  # the joints pink checks
     for _ in range(options.iterations):
         velocity = pink.solve_ik(
             configuration, [*tasks, com, posture], 0.05, solver="daqp", limits=limits
         )
         configuration.integrate_inplace(velocity, 0.05)
+        # The QP keeps the limits to its tolerance; project the rest (pink refuses a start
+        # 1e-6 outside them at the next step).
+        configuration.update(
+            np.where(bounded, np.clip(configuration.q, lower, upper), configuration.q)
+        )
     q = configuration.q
     c = pin.centerOfMass(model, configuration.data, q)
     if float(np.linalg.norm(c - target)) > options.com_tolerance:
