@@ -151,3 +151,58 @@ def test_a_search_whose_steps_brush_a_joint_limit_finishes_within_the_limits():
     for q in reach.postures:
         assert np.all(q[7:] >= model.lowerPositionLimit[7:] - 1e-12)
         assert np.all(q[7:] <= model.upperPositionLimit[7:] + 1e-12)
+
+
+def _square(omega: float, extent: float) -> Polygon:
+    return Polygon.from_points(np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * omega * extent)
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    radii=st.lists(st.floats(0.01, 0.3), min_size=8, max_size=8),
+    jumps=st.lists(
+        st.tuples(st.floats(-1, 1), st.floats(-1, 1)).filter(lambda d: math.hypot(*d) > 0.05),
+        min_size=1,
+        max_size=6,
+    ),
+)
+def test_the_max_speed_from_rest_stops_every_vertex_within_its_reach(radii, jumps):
+    # Independent of the formula: each vertex's LIPM integrated along its own direction.
+    from impact_balance.balance.reach import reach_max_speed
+
+    omega, extent = 3.3, 0.12
+    area = _square(omega, extent)
+    azimuths = np.arange(8) * math.pi / 4
+    reach = ComReach(azimuths, np.array(radii), 0.8, np.zeros((8, 1)))
+    d = np.array(jumps)
+    s = reach_max_speed(area, omega, reach, [0.0, 0.0], d, upper=50.0)
+
+    def stops_within(speed: float) -> bool:
+        for dj in d:
+            v = speed * dj
+            u = v / np.linalg.norm(v)
+            e = ray_extent(area, u) / omega
+            if stop_distance(float(np.linalg.norm(v)), e, omega) > reach.along(u) + 1e-9:
+                return False
+        return True
+
+    assert stops_within(0.995 * s)
+    assert not stops_within(1.01 * s)
+
+
+def test_the_max_speed_away_from_rest_is_the_first_speed_out_of_reach():
+    from impact_balance.balance.reach import reach_max_speed
+
+    omega, extent = 3.3, 0.12
+    area = _square(omega, extent)
+    reach = ComReach(np.arange(8) * math.pi / 4, np.full(8, 0.05), 0.8, np.zeros((8, 1)))
+    start = np.array([0.05, 0.02])
+    d = np.array([[0.3, 0.1], [0.2, -0.2]])
+    s = reach_max_speed(area, omega, reach, start, d, upper=5.0)
+    limit = reach_speed_limit
+    for t in np.linspace(0.0, s, 50):  # every speed below it is within reach
+        for v in start + t * d:
+            assert np.linalg.norm(v) <= limit(area, omega, reach, v) + 1e-9
+    out = start + (s + 1e-6) * d
+    assert any(np.linalg.norm(v) > limit(area, omega, reach, v) for v in out)
+    assert reach_max_speed(area, omega, reach, [10.0, 0.0], d, upper=5.0) == 0.0

@@ -43,7 +43,14 @@ from impact_balance.exceptions import ScenarioError
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.robot.ik import chain_dofs, within_limits
 
-__all__ = ["ComReach", "ReachOptions", "com_reach", "ray_extent", "reach_speed_limit"]
+__all__ = [
+    "ComReach",
+    "ReachOptions",
+    "com_reach",
+    "ray_extent",
+    "reach_max_speed",
+    "reach_speed_limit",
+]
 
 _FloatArray = npt.NDArray[np.float64]
 
@@ -244,3 +251,76 @@ def reach_speed_limit(
     if R >= extent:
         return float(omega * extent)
     return float(omega * math.sqrt(R * (2.0 * extent - R)))
+
+
+def _within(
+    area: Polygon, omega: float, reach: ComReach, velocities: _FloatArray, tol: float
+) -> bool:
+    """Whether every velocity (k, 2) is within the reach's speed limit along its direction."""
+    for v in velocities:
+        speed = float(np.hypot(v[0], v[1]))
+        if speed > tol and speed > reach_speed_limit(area, omega, reach, v) + tol:
+            return False
+    return True
+
+
+def reach_max_speed(
+    area: Polygon,
+    omega: float,
+    reach: ComReach,
+    start: npt.ArrayLike,
+    jumps: npt.ArrayLike,
+    upper: float,
+    tol: float = 1e-9,
+) -> float:
+    """The largest approach speed ``s <= upper`` whose post-impact velocities stay within reach.
+
+    The post-impact CoM velocities are ``start + s d_j`` (m/s, world xy); each must satisfy
+    :func:`reach_speed_limit` along its own direction. From rest (``start`` = 0) every vertex
+    keeps its direction and the answer is ``min_j limit(d_j) / |d_j|``, exactly; otherwise the
+    directions turn with ``s``: the first speed out of reach on a grid of 256 steps up to
+    ``upper``, refined by bisection to ``tol`` (a stretch out of reach narrower than a step
+    can be missed).
+
+    Args:
+        area: The CoM velocity area (m/s), inset by the margin the controller keeps.
+        omega: LIPM natural frequency, 1/s.
+        reach: The CoM's reach (:func:`com_reach`).
+        start: (2,) pre-impact CoM velocity, world xy, m/s.
+        jumps: (k, 2) CoM velocity jumps per unit approach speed, world xy.
+        upper: The answer's upper bound (m/s; the area's own maximum contact velocity).
+        tol: Tolerance, m/s.
+
+    Returns:
+        The speed, m/s (0 when ``start`` itself is out of reach).
+    """
+    c0 = np.asarray(start, dtype=float)[:2]
+    d = np.asarray(jumps, dtype=float).reshape(-1, 2)
+    if not _within(area, omega, reach, c0[None, :], tol):
+        return 0.0
+    cap = float(upper) if math.isfinite(upper) else 1e3
+    if float(np.hypot(c0[0], c0[1])) <= tol:
+        best = cap
+        for dj in d:
+            norm = float(np.hypot(dj[0], dj[1]))
+            if norm > 0.0:
+                best = min(best, reach_speed_limit(area, omega, reach, dj) / norm)
+        return float(best)
+    # Away from rest the vertices turn with s: the first speed out of reach, found on a grid of
+    # 256 steps up to ``upper`` and refined by bisection (every speed below it is within).
+    grid = np.linspace(0.0, cap, 257)
+    lo = 0.0
+    for s in grid[1:]:
+        if not _within(area, omega, reach, c0[None, :] + s * d, tol):
+            hi = float(s)
+            break
+        lo = float(s)
+    else:
+        return cap
+    while hi - lo > tol * max(1.0, hi):
+        mid = 0.5 * (lo + hi)
+        if _within(area, omega, reach, c0[None, :] + mid * d, tol):
+            lo = mid
+        else:
+            hi = mid
+    return lo

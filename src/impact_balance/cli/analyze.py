@@ -17,6 +17,7 @@ from impact_balance.cli.angular_momentum import add_angular_momentum_option, wit
 from impact_balance.cli.calibrate import add_calibration_option, apply_calibration_option
 
 if TYPE_CHECKING:
+    from impact_balance.analysis.reach import ReachAnswer
     from impact_balance.analysis.result import Diagnostic
     from impact_balance.cli._options import Subcommands
 
@@ -53,6 +54,12 @@ def add_parser(sub: Subcommands) -> list[str]:
         "--qp", action="store_true", help="also solve the paper's QP in joint velocities"
     )
     a.add_argument("--strict", action="store_true", help="treat warnings as errors (exit status 2)")
+    a.add_argument(
+        "--com-reach",
+        action="store_true",
+        help="also answer within the CoM's reach at constant height (whole-body IK, a few "
+        "seconds; docs/com-reach.md)",
+    )
     add_zmp_margin_option(a, "default: the scenario's zmp_margin, 0 unless set")
     add_velocity_margin_option(a, "CoM criterion")
     add_calibration_option(a)
@@ -103,15 +110,36 @@ def run(args: argparse.Namespace) -> int:
         analysis = dataclasses.replace(analysis, warnings=analysis.warnings + tuple(skipped))
         if args.strict and skipped:
             raise StrictWarningsError(skipped)
+    reach = None
+    if args.com_reach:
+        from impact_balance.analysis.reach import reach_answer
+
+        reach = reach_answer(analysis)
     if args.json:
         out = analysis.to_dict()
         if calibration is not None:
             out["calibration"] = calibration
+        if reach is not None:
+            out["com_reach"] = reach.to_dict()
         print_json(out)
     else:
         print(format_analysis(analysis))
         if calibration is not None:
             print(calibration_line(calibration))
+        if reach is not None:
+            print(_reach_line(reach))
         for path in written:
             print(f"  figure: {path}")
     return 0
+
+
+def _reach_line(reach: ReachAnswer) -> str:
+    """One line of ``analyze --com-reach``: the reach and the maximum within it."""
+    radii = reach.reach.radii
+    line = f"CoM reach at constant height: {1000 * radii.min():.0f} to {1000 * radii.max():.0f} mm"
+    if reach.max_contact_velocity is not None:
+        line += (
+            f"; max contact velocity within reach {reach.max_contact_velocity:.3f} m/s "
+            f"(without: {reach.default_max_contact_velocity:.3f})"
+        )
+    return line
