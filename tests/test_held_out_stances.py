@@ -310,10 +310,12 @@ def test_the_simulation_model_builds_with_the_push_bodies(path: Path) -> None:
     assert push_body(sim, pelvis) == sim.root_body
 
 
+#: The sets whose protocol also tables the CoM's reach (impact_balance.balance.reach).
+REACH_TABLES = ["held_out_5"]
 #: The protocols whose tables of predictions the test recomputes, by set.
 PROTOCOLS = {
     name: STUDIES.parent / "docs" / "studies" / f"held-out-protocol-{name[-1]}.md"
-    for name in ["held_out_3", "held_out_4"]
+    for name in LATER_AIMS
 }
 PROTOCOL_FILES = [f for name in PROTOCOLS for f in SET_FILES[name]]
 
@@ -334,6 +336,8 @@ def test_the_later_protocols_list_every_stance_of_their_set(name: str) -> None:
     assert set(_protocol_rows(name, 5)) == names  # the stances' table
     assert set(_protocol_rows(name, 7)) == names  # the impacts' predictions
     assert set(_protocol_rows(name, 2)) == names  # the pushes' predictions
+    if name in REACH_TABLES:
+        assert set(_protocol_rows(name, 3)) == names  # the CoM's reach
 
 
 @pytest.mark.parametrize("path", PROTOCOL_FILES, ids=_id)
@@ -376,3 +380,39 @@ def test_the_protocols_push_predictions_are_the_criterion_s(path: Path) -> None:
         f = float(np.min((h[ahead] - slack) / (r * rate[ahead])))
         assert abs(mass * r - impulses[k]) <= 0.05 + 1e-9, (k, mass * r, impulses[k])
         assert abs(f - fractions[k]) <= 0.005 + 1e-9, (k, f, fractions[k])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("path", [f for name in REACH_TABLES for f in SET_FILES[name]], ids=_id)
+def test_the_protocols_reach_predictions_are_com_reach_s(path: Path) -> None:
+    """Rule 4 for the reach table: ``com_reach`` (push-test's search) and the capture it limits.
+
+    The reach at each push direction, the CoM height it holds, and the fraction of the paper's
+    boundary (margin 0) below which ``reach_speed_limit`` in the area inset by 10 mm calls a
+    push at rest safe; checked as well against the stopping distance of the LIPM, which the
+    fraction's speed must not overshoot beyond the reach.
+    """
+    from impact_balance.balance.reach import com_reach, ray_extent, reach_speed_limit
+
+    radii_cell, height_cell, fractions_cell = _protocol_rows(_set_of(path), 3)[path.stem]
+    radii = [float(x) for x in radii_cell.split()]
+    fractions = [float(x) for x in fractions_cell.split()]
+    a = analyze(str(path))
+    area, omega = a.areas.com_velocity_area, float(a.areas.omega)
+    reach = com_reach(a.stance)
+    inset = area.inset(omega * 0.01)
+    assert abs(reach.height - float(height_cell)) <= 0.0005 + 1e-9
+    for k in range(8):
+        u = np.array([np.cos(k * np.pi / 4), np.sin(k * np.pi / 4)])
+        R = reach.along(u)
+        limit = reach_speed_limit(inset, omega, reach, u)
+        fraction = limit / ray_extent(area, u)
+        assert abs(R - radii[k]) <= 0.00005 + 1e-9, (k, R, radii[k])
+        assert abs(fraction - fractions[k]) <= 0.005 + 1e-9, (k, fraction, fractions[k])
+        # Independently: the LIPM with the ZMP held at the inset extent e stops a CoM leaving
+        # at the limit speed after e - sqrt(e^2 - (s / omega)^2), within the reach (or the
+        # limit is the inset area's own extent).
+        e = ray_extent(inset, u) / omega
+        stop = e - np.sqrt(max(e**2 - (limit / omega) ** 2, 0.0))
+        assert limit <= omega * e + 1e-12
+        assert stop <= R + 1e-9 or abs(limit - omega * e) <= 1e-12, (k, stop, R)
