@@ -35,16 +35,18 @@ REQUIRED = {
     "slope",
 }
 #: Each set's folder and what it must cover; the second adds pushes on one foot, the third
-#: forward impacts and wide, staggered two-feet stances; the fourth covers what the third does.
+#: forward impacts and wide, staggered two-feet stances; the fourth and fifth cover what the third
+#: does.
 SETS = {
     "held_out": REQUIRED,
     "held_out_2": REQUIRED | {"one foot"},
     "held_out_3": REQUIRED | {"one foot", "forward impact", "wide stance", "staggered"},
     "held_out_4": REQUIRED | {"one foot", "forward impact", "wide stance", "staggered"},
+    "held_out_5": REQUIRED | {"one foot", "forward impact", "wide stance", "staggered"},
 }
 #: The sets checked under the protocol's options (10 mm margin, angular momentum term) and
 #: whose impact friction and restitution must be new: each against the stances before it.
-NEW_SETS = ["held_out_2", "held_out_3", "held_out_4"]
+NEW_SETS = ["held_out_2", "held_out_3", "held_out_4", "held_out_5"]
 SET_FILES = {name: sorted((STUDIES / name).glob("*.yaml")) for name in SETS}
 FILES = [f for files in SET_FILES.values() for f in files]
 #: Stances on one foot the second set must hold at least (its lesson: a margin from two-feet
@@ -86,7 +88,10 @@ THIRD_MIN_ROBOTS = 4
 THIRD_MIN_WIDE = 2
 #: The sets written to the third set's aims, with the stances on one foot each must hold at least
 #: and whether each of its wide stances must also be staggered (the third set's were).
-LATER_AIMS = {"held_out_3": (1, True), "held_out_4": (2, False)}
+LATER_AIMS = {"held_out_3": (1, True), "held_out_4": (2, False), "held_out_5": (1, False)}
+#: The fifth set is about the CoM's reach: wide stances on at least this many robots, side by
+#: side and staggered, flat and on slopes.
+FIFTH_MIN_WIDE_ROBOTS = 3
 
 
 def _header(path: Path, key: str) -> str:
@@ -237,6 +242,17 @@ def test_the_later_sets_cover_four_robots_wide_stances_and_impacts_on_one_foot_a
     assert any("slope" in _covers(f) for f in files)
 
 
+def test_the_fifth_set_holds_wide_stances_of_every_kind_on_three_robots() -> None:
+    """Its aim (the CoM's reach): wide stances on three robots, staggered or not, flat or not."""
+    wide = [f for f in SET_FILES["held_out_5"] if "wide stance" in _covers(f)]
+    robots = {load_scenario(str(f)).robot for f in wide}
+    assert len(robots) >= FIFTH_MIN_WIDE_ROBOTS, robots
+    staggered = {"staggered" in _covers(f) for f in wide}
+    sloped = {"slope" in _covers(f) for f in wide}
+    assert staggered == {True, False}, wide  # side by side and staggered
+    assert sloped == {True, False}, wide  # flat and on a slope or ramp
+
+
 @pytest.mark.parametrize("name", NEW_SETS)
 def test_the_later_sets_use_impact_values_no_earlier_stance_uses(name: str) -> None:
     """Their impact friction and restitution are new: neither bundled nor an earlier set's."""
@@ -294,6 +310,8 @@ def test_the_simulation_model_builds_with_the_push_bodies(path: Path) -> None:
     assert push_body(sim, pelvis) == sim.root_body
 
 
+#: The sets whose protocol also tables the CoM's reach (impact_balance.balance.reach).
+REACH_TABLES = ["held_out_5"]
 #: The protocols whose tables of predictions the test recomputes, by set.
 PROTOCOLS = {
     name: STUDIES.parent / "docs" / "studies" / f"held-out-protocol-{name[-1]}.md"
@@ -318,6 +336,8 @@ def test_the_later_protocols_list_every_stance_of_their_set(name: str) -> None:
     assert set(_protocol_rows(name, 5)) == names  # the stances' table
     assert set(_protocol_rows(name, 7)) == names  # the impacts' predictions
     assert set(_protocol_rows(name, 2)) == names  # the pushes' predictions
+    if name in REACH_TABLES:
+        assert set(_protocol_rows(name, 3)) == names  # the CoM's reach
 
 
 @pytest.mark.parametrize("path", PROTOCOL_FILES, ids=_id)
@@ -360,3 +380,39 @@ def test_the_protocols_push_predictions_are_the_criterion_s(path: Path) -> None:
         f = float(np.min((h[ahead] - slack) / (r * rate[ahead])))
         assert abs(mass * r - impulses[k]) <= 0.05 + 1e-9, (k, mass * r, impulses[k])
         assert abs(f - fractions[k]) <= 0.005 + 1e-9, (k, f, fractions[k])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("path", [f for name in REACH_TABLES for f in SET_FILES[name]], ids=_id)
+def test_the_protocols_reach_predictions_are_com_reach_s(path: Path) -> None:
+    """Rule 4 for the reach table: ``com_reach`` (push-test's search) and the capture it limits.
+
+    The reach at each push direction, the CoM height it holds, and the fraction of the paper's
+    boundary (margin 0) below which ``reach_speed_limit`` in the area inset by 10 mm calls a
+    push at rest safe; checked as well against the stopping distance of the LIPM, which the
+    fraction's speed must not overshoot beyond the reach.
+    """
+    from impact_balance.balance.reach import com_reach, ray_extent, reach_speed_limit
+
+    radii_cell, height_cell, fractions_cell = _protocol_rows(_set_of(path), 3)[path.stem]
+    radii = [float(x) for x in radii_cell.split()]
+    fractions = [float(x) for x in fractions_cell.split()]
+    a = analyze(str(path))
+    area, omega = a.areas.com_velocity_area, float(a.areas.omega)
+    reach = com_reach(a.stance)
+    inset = area.inset(omega * 0.01)
+    assert abs(reach.height - float(height_cell)) <= 0.0005 + 1e-9
+    for k in range(8):
+        u = np.array([np.cos(k * np.pi / 4), np.sin(k * np.pi / 4)])
+        R = reach.along(u)
+        limit = reach_speed_limit(inset, omega, reach, u)
+        fraction = limit / ray_extent(area, u)
+        assert abs(R - radii[k]) <= 0.00005 + 1e-9, (k, R, radii[k])
+        assert abs(fraction - fractions[k]) <= 0.005 + 1e-9, (k, fraction, fractions[k])
+        # Independently: the LIPM with the ZMP held at the inset extent e stops a CoM leaving
+        # at the limit speed after e - sqrt(e^2 - (s / omega)^2), within the reach (or the
+        # limit is the inset area's own extent).
+        e = ray_extent(inset, u) / omega
+        stop = e - np.sqrt(max(e**2 - (limit / omega) ** 2, 0.0))
+        assert limit <= omega * e + 1e-12
+        assert stop <= R + 1e-9 or abs(limit - omega * e) <= 1e-12, (k, stop, R)
