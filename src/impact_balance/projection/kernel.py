@@ -961,6 +961,38 @@ def _store_chain(hint, bases, recorded):
 
 
 @njit(cache=True)
+def _start(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work, hint):
+    """The walk's first basis, optimal for (c, dc) (theta0); returns (status, pivots).
+
+    Phase 1 when z = 0 is not feasible, then the warm start (``hint``) or the crash, pivots
+    to optimality, its inverse checked; its rows go to ``hint`` (the next call's start).
+    """
+    m, n = H.shape
+    k = 0
+    pivots = 0
+    if h.min() < 0.0:  # z = 0 is not feasible (it is for contact stances: x0 is inside)
+        status, pivots, k = _phase_one(H, h, z, W, active, max_pivots)
+        if status != OK:
+            return status, pivots
+    if not (k == 0 and h.min() >= 0.0 and _warm_start(H, h, W, Binv, z, active, work, hint)):
+        status, k = _crash(H, h, z, W, k, active, c, dc)
+        if status != OK:
+            return status, pivots
+        if not _refactor(H, h, W, Binv, z, work):
+            return FAILED, pivots
+    status, piv = _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work)
+    pivots += piv
+    if status != OK:
+        return status, pivots
+    if piv and not _accurate(H, h, W, Binv, z, work[2]) and not _refactor(H, h, W, Binv, z, work):
+        return FAILED, pivots
+    if hint.shape[0] >= n + 2:  # the optimal basis at theta0: the next call's start
+        hint[0], hint[1] = m, n
+        hint[2 : n + 2] = W
+    return OK, pivots
+
+
+@njit(cache=True)
 def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
     """Vertices of ``g0 + G {z : H z <= h}`` (rows of H unit norm; ``GT`` = G^T, n x 2).
 
@@ -990,32 +1022,13 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
         )
         if ok:
             return OK, vertices, count, 0
-    vertices = np.empty((0, 2))
     active = np.zeros(m, dtype=np.bool_)
-    k = 0
-    pivots = 0
-    if h.min() < 0.0:  # z = 0 is not feasible (it is for contact stances: x0 is inside)
-        status, pivots, k = _phase_one(H, h, z, W, active, max_pivots)
-        if status != OK:
-            return status, vertices, 0, pivots
     u = np.array([math.cos(theta0), math.sin(theta0)])
     du = np.array([-math.sin(theta0), math.cos(theta0)])
     c, dc = _times(GT, u), _times(GT, du)
-    if not (k == 0 and h.min() >= 0.0 and _warm_start(H, h, W, Binv, z, active, work, hint)):
-        status, k = _crash(H, h, z, W, k, active, c, dc)
-        if status != OK:
-            return status, vertices, 0, pivots
-        if not _refactor(H, h, W, Binv, z, work):
-            return FAILED, vertices, 0, pivots
-    status, piv = _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work)
-    pivots += piv
+    status, pivots = _start(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work, hint)
     if status != OK:
-        return status, vertices, 0, pivots
-    if piv and not _accurate(H, h, W, Binv, z, work[2]) and not _refactor(H, h, W, Binv, z, work):
-        return FAILED, vertices, 0, pivots
-    if hint.shape[0] >= n + 2:  # the optimal basis at theta0: the next call's start
-        hint[0], hint[1] = m, n
-        hint[2 : n + 2] = W
+        return status, np.empty((0, 2)), 0, pivots
     vertices = np.empty((max_pivots + 2, 2))
     _min_slack_near(H, h, z, worst, work[7], work[8])
     _point(g0, GT, z, vertices, 0)
@@ -1067,7 +1080,8 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
             count += 1
         if bases.shape[0]:  # a chain for the next call (see _keep)
             recorded = _keep(bases, recorded, W, vertices[count - 1], yfirst)
-    _store_chain(hint, bases, recorded)
+    if recorded < pivots:  # else re-certifying costs about what this walk did (one foot)
+        _store_chain(hint, bases, recorded)
     return OK, vertices, count, pivots
 
 
