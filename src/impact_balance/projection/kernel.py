@@ -21,6 +21,10 @@ The basis inverse is kept explicitly, updated by the rank-one formula at each pi
 recomputed every ``_REFACTOR`` pivots, and in the walk around the polygon whenever it no
 longer solves its system to near rounding or has carried ``_CARRY`` pivots. Without numba
 the same code runs as plain Python.
+
+A caller that projects postures in a row keeps a hint: the walk starts from its last optimal
+basis, and first checks whether the last walk's chain of bases (the first and last of each
+polygon vertex) still certifies the new polygon, which then needs no walk (:func:`walk`).
 """
 
 from __future__ import annotations
