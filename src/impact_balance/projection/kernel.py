@@ -451,12 +451,12 @@ def _pivot(H, h, W, Binv, z, leave, j, since, work):
         for i in range(n):
             alpha[i] += H[j, r] * Binv[r, i]
     piv = alpha[leave]
+    for i in range(n):
+        alpha[i] = alpha[i] / piv  # each quotient once: the same numbers as per element
     for r in range(n):
         for i in range(n):
-            if i == leave:
-                Binv[r, i] = col[r] / piv
-            else:
-                Binv[r, i] -= col[r] * (alpha[i] / piv)
+            Binv[r, i] -= col[r] * alpha[i]
+        Binv[r, leave] = col[r] / piv
     _vertex(h, W, Binv, z)
     return since + 1
 
@@ -841,23 +841,30 @@ def _next_basis(H, h, GT, W, Binv, z, theta, u0, u1, scale, kind, rows, since, w
     previous basis, checked by the caller): at the start of its own optimal arc, after the
     previous one's end and within pi of it; every direction between is a positive combination
     of the directions the vertex is optimal for at those two angles, so it is optimal in
-    between too (its normal cone is convex). ``since``: pivots since the last
-    fresh inverse (a fresh one at _CARRY, or when the updated one fails its check). Returns
-    theta = inf when the chain does not certify (c, dc then unset).
+    between too (its normal cone is convex). ``since``: pivots since the last fresh inverse
+    (after _CARRY, the new basis's inverse is a fresh one; so it is when the updated one fails
+    its check). Returns theta = inf when the chain does not certify (c, dc then unset).
     """
     theta = _breakpoint(Binv, GT, theta, u0, u1, scale, work[6])
     if since >= _CARRY:
-        if not _refactor(H, h, W, Binv, z, work):
-            return math.inf, since
-        since = 0
-    piv = _replace(H, h, W, Binv, z, rows, work)
+        for i in range(W.shape[0]):
+            if rows[i] < 0 or rows[i] >= H.shape[0]:
+                return math.inf, since
+        W[:] = rows
+        fresh = _refactor(H, h, W, Binv, z, work) and _accurate(H, h, W, Binv, z, work[2])
+        piv = -2 if fresh else -1
+    else:
+        piv = _replace(H, h, W, Binv, z, rows, work)
     if piv == -1:
         return math.inf, since
-    since = 0 if piv == -2 else since + piv
-    if piv > 0 and not _accurate(H, h, W, Binv, z, work[2]):
-        if not _refactor(H, h, W, Binv, z, work):
-            return math.inf, since
+    if piv == -2:  # a fresh inverse, checked
         since = 0
+    elif piv > 0:
+        since += piv
+        if not _accurate(H, h, W, Binv, z, work[2]):
+            if not _refactor(H, h, W, Binv, z, work):
+                return math.inf, since
+            since = 0
     if kind == 1:
         theta = _arc_start(Binv, GT, theta, scale)
     if theta < math.inf:
@@ -871,7 +878,7 @@ def _recertify(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work):
 
     The walk's certificate, without its ratio tests and pricing rounds: each basis of the chain
     is a vertex basis (its inverse solves its system to 1e-14, fresh at least every _CARRY
-    pivots), its vertex satisfies every row to 1e-14 max(1, |h_j|), it is lexicographically
+    pivots), its vertex satisfies every row to _EPS_RECERT max(1, |h_j|), it is lexicographically
     optimal at its angle (:func:`_next_basis`; the first at theta0), and the last one's arc
     reaches theta0 + 2 pi while no earlier angle does. Every direction then has an optimal
     vertex among the recorded ones: the polygon the walk would find. Returns
