@@ -82,6 +82,12 @@ _D_STEP = 1e-9
 #: of two bases of one polygon vertex.
 _EPS_RECERT = 1e-12
 _Y_SAME = 1e-10
+#: A re-certification scans every row at a vertex (the reference) and, at the next ones within
+#: _REF_MOVE of it, only the rows whose slack there is at most the distance moved plus
+#: _REF_MARGIN: a unit row's slack moves by at most the distance, so the others stay positive
+#: (the margin covers the slacks' rounding) and cannot lower the worst slack or fail the test.
+_REF_MOVE = 0.2
+_REF_MARGIN = 1e-8
 
 
 @njit(cache=True)
@@ -241,27 +247,6 @@ def _min_slack_near(H, h, z, worst, zd, dset):
             count += 1
     dset[0] = count
     zd[:] = z
-
-
-@njit(cache=True)
-def _strict(H, h, z, zd, dset):
-    """Whether every slack at z is at least -_EPS_RECERT max(1, |h_j|): a vertex to rounding.
-
-    Over the rows :func:`_min_slack_near` listed
-    near ``zd`` when z is within _D_MOVE of it (the others' slacks are positive there), else
-    over every row.
-    """
-    m, n = H.shape
-    count = dset[0]
-    near = count >= 0 and _near(z, zd)
-    for i in range(count if near else m):
-        j = dset[1 + i] if near else i
-        b = h[j]
-        for k in range(n):
-            b -= H[j, k] * z[k]
-        if b < 0.0 and b < -_EPS_RECERT * max(1.0, abs(h[j])):
-            return False
-    return True
 
 
 @njit(cache=True)
@@ -727,14 +712,40 @@ def _phase_one(H, h, z, W, active, max_pivots):
 
 
 @njit(cache=True)
-def _record(H, h, GT, g0, z, worst, work, vertices, count):
-    """Record the vertex z: ``(count, strict)``, the vertex count after it and its check.
+def _record(H, h, GT, g0, z, worst, ref, vertices, count):
+    """Record a re-certified vertex z: ``(count, strict)``, the vertex count after it and its check.
 
-    Its slacks go to ``worst`` (:func:`_min_slack_near`), ``strict`` is :func:`_strict`'s
-    answer; its point is kept when it differs from the last one.
+    Its slacks go to ``worst`` as :func:`_min_slack_near` sets it; ``strict`` is whether each is
+    at least -_EPS_RECERT max(1, |h_j|). ``ref`` (1 + m + n): a flag, every row's slack at the
+    reference vertex and that vertex (see _REF_MOVE), replaced by z when z is not within
+    _REF_MOVE of it. Its point is kept when it differs from the last one.
     """
-    _min_slack_near(H, h, z, worst, work[7], work[8])
-    strict = _strict(H, h, z, work[7], work[8])
+    m, n = H.shape
+    d = 0.0
+    if ref[0] > 0.0:
+        acc = 0.0
+        for k in range(n):
+            e = z[k] - ref[1 + m + k]
+            acc += e * e
+        d = math.sqrt(acc)
+    full = ref[0] <= 0.0 or d > _REF_MOVE
+    bound = d + _REF_MARGIN
+    strict = True
+    for j in range(m):
+        if not full and ref[1 + j] > bound:
+            continue  # positive at z
+        b = h[j]
+        for k in range(n):
+            b -= H[j, k] * z[k]
+        if full:
+            ref[1 + j] = b
+        if b < worst[0]:
+            worst[0] = b
+        if b < 0.0 and b < -_EPS_RECERT * max(1.0, abs(h[j])):
+            strict = False
+    if full:
+        ref[0] = 1.0
+        ref[1 + m : 1 + m + n] = z
     _point(g0, GT, z, vertices, count)
     if (
         count == 0
@@ -891,6 +902,7 @@ def _recertify(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work):
         return False, none, 0
     vertices = np.empty((K, 2))
     low = np.zeros(1)  # the walk's worst slack, kept apart until the chain is certified
+    ref = np.zeros(1 + m + n)  # the slacks at a reference vertex (see _record)
     c, dc = np.empty(n), np.empty(n)
     base = n + 3
     for i in range(n):
@@ -918,7 +930,7 @@ def _recertify(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work):
         if not _optimal(Binv, c, dc, scale):
             return False, none, 0
         last = count
-        count, strict = _record(H, h, GT, g0, z, low, work, vertices, count)
+        count, strict = _record(H, h, GT, g0, z, low, ref, vertices, count)
         if not strict or (k > 0 and hint[base + k * (n + 1)] == 1 and _moved(vertices, last)):
             return False, none, 0
     if _breakpoint(Binv, GT, theta, u0, u1, scale, work[6]) < theta0 + 2.0 * math.pi:
