@@ -49,7 +49,7 @@ from impact_balance.impact.model import (
     joint_space_inertia_map,
     model_from_inertia_map,
 )
-from impact_balance.projection.walk import MAX_PIVOTS
+from impact_balance.projection.walk import MAX_PIVOTS, hint_size
 from impact_balance.robot.robot import Robot, Scratch
 
 __all__ = ["NO_HALFPLANES", "Kinematics", "Posture", "PostureEvaluator", "PostureSettings"]
@@ -248,9 +248,9 @@ class PostureEvaluator:
         self._q_local = np.zeros(model.nq)
         self._zero_velocity = np.zeros(model.nv)
         self._gravity = np.array(model.gravity.linear, dtype=float)  # m/s^2, world
-        # The projection's warm start, carried from one posture to the next (see
-        # projected_from_arrays): 2 + the wrench variables at most.
-        self._hint = np.full(2 + 6 * m, -1, dtype=np.int64)
+        # The projection's warm start and chain of bases, carried from one posture to the next
+        # (see hint_size).
+        self._hint = np.full(hint_size(6 * m), -1, dtype=np.int64)
         # The compiled posture's pinocchio arrays (rotations, points, Jacobians), read in the
         # same call.
         self._buffers = (

@@ -21,6 +21,10 @@ The basis inverse is kept explicitly, updated by the rank-one formula at each pi
 recomputed every ``_REFACTOR`` pivots, and in the walk around the polygon whenever it no
 longer solves its system to near rounding or has carried ``_CARRY`` pivots. Without numba
 the same code runs as plain Python.
+
+A caller that projects postures in a row keeps a hint: the walk starts from its last optimal
+basis, and first checks whether the last walk's chain of bases (the first and last of each
+polygon vertex) still certifies the new polygon, which then needs no walk (:func:`walk`).
 """
 
 from __future__ import annotations
@@ -72,6 +76,18 @@ _EPS_CARRY = 1e-14
 _D_SLACK = 1e-8
 _D_MOVE = 1e-10
 _D_STEP = 1e-9
+#: Re-certifying the last walk's chain of bases (:func:`_recertify`): the most a row may be
+#: violated at a vertex of the chain (relative to max(1, |h_j|); rounding at a degenerate vertex
+#: shows 1e-16 to 3e-14), and the largest distance (units of the projection) between the points
+#: of two bases of one polygon vertex.
+_EPS_RECERT = 1e-12
+_Y_SAME = 1e-10
+#: A re-certification scans every row at a vertex (the reference) and, at the next ones within
+#: _REF_MOVE of it, only the rows whose slack there is at most the distance moved plus
+#: _REF_MARGIN: a unit row's slack moves by at most the distance, so the others stay positive
+#: (the margin covers the slacks' rounding) and cannot lower the worst slack or fail the test.
+_REF_MOVE = 0.2
+_REF_MARGIN = 1e-8
 
 
 @njit(cache=True)
@@ -370,8 +386,8 @@ def _invert(B, out):
 def _workspace(m, n):
     """The walk's work buffers, made once per walk.
 
-    (p, col, alpha) of n, (hp, slack) of m, an n x n basis copy and a 3 x n buffer for the
-    breakpoints.
+    (p, col, alpha) of n, (hp, slack) of m, an n x n basis copy, a 4 x n buffer for the
+    breakpoints, z's copy near a vertex and its list of rows.
     """
     dset = np.empty(m + 1, dtype=np.int64)  # [0]: count (-1: none yet), then the rows
     dset[0] = -1
@@ -382,7 +398,7 @@ def _workspace(m, n):
         np.empty(m),
         np.empty(m),
         np.empty((n, n)),
-        np.empty((3, n)),
+        np.empty((4, n)),
         np.empty(n),
         dset,
     )
@@ -420,12 +436,12 @@ def _pivot(H, h, W, Binv, z, leave, j, since, work):
         for i in range(n):
             alpha[i] += H[j, r] * Binv[r, i]
     piv = alpha[leave]
+    for i in range(n):
+        alpha[i] = alpha[i] / piv  # each quotient once: the same numbers as per element
     for r in range(n):
         for i in range(n):
-            if i == leave:
-                Binv[r, i] = col[r] / piv
-            else:
-                Binv[r, i] -= col[r] * (alpha[i] / piv)
+            Binv[r, i] -= col[r] * alpha[i]
+        Binv[r, leave] = col[r] / piv
     _vertex(h, W, Binv, z)
     return since + 1
 
@@ -468,6 +484,41 @@ def _vertex(h, W, Binv, z):
         z[r] = acc
 
 
+@njit(cache=True, inline="always")
+def _priced(Binv, i, c, dc, scale):
+    """Basis column i at theta+: ``(tier, rate)``, tier 2 when it is no entering candidate.
+
+    Tier 0: its multiplier ``lambda_i = Binv[:, i] . c`` is negative (rate ``lambda_i`` over
+    the column's norm); tier 1: within the tolerance of zero and decreasing (rate its
+    theta-derivative ``Binv[:, i] . dc`` over the norm). Inlined by numba (called per column).
+    """
+    n = Binv.shape[0]
+    lam, dlam, norm = 0.0, 0.0, 0.0
+    for r in range(n):
+        lam += Binv[r, i] * c[r]
+        dlam += Binv[r, i] * dc[r]
+        norm += Binv[r, i] * Binv[r, i]
+    norm = math.sqrt(norm)
+    eps = _EPS_DUAL * scale * max(1.0, norm)
+    if lam < -eps:
+        return 0, lam / norm
+    if lam <= eps and dlam < -eps:
+        return 1, dlam / norm
+    return 2, 0.0
+
+
+@njit(cache=True)
+def _optimal(Binv, c, dc, scale):
+    """Whether the basis is lexicographically optimal at theta+: no entering candidate.
+
+    Where :func:`_optimize` stops, by the same test.
+    """
+    for i in range(Binv.shape[0]):
+        if _priced(Binv, i, c, dc, scale)[0] != 2:
+            return False
+    return True
+
+
 @njit(cache=True)
 def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work):
     """Simplex pivots from the vertex basis (W, Binv, z) until it is lexicographically optimal.
@@ -492,19 +543,8 @@ def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work):
         tier = 2
         best = 0.0
         for i in range(n):
-            # lambda_i = Binv[:, i] . c, its theta-derivative Binv[:, i] . dc
-            lam, dlam, norm = 0.0, 0.0, 0.0
-            for r in range(n):
-                lam += Binv[r, i] * c[r]
-                dlam += Binv[r, i] * dc[r]
-                norm += Binv[r, i] * Binv[r, i]
-            norm = math.sqrt(norm)
-            eps = _EPS_DUAL * scale * max(1.0, norm)
-            if lam < -eps:
-                this_tier, rate = 0, lam / norm
-            elif lam <= eps and dlam < -eps:
-                this_tier, rate = 1, dlam / norm
-            else:
+            this_tier, rate = _priced(Binv, i, c, dc, scale)
+            if this_tier == 2:
                 continue
             if bland:
                 if leave < 0 or W[i] < W[leave]:
@@ -548,22 +588,26 @@ def _arc_end(a, b, theta):
 def _breakpoint(Binv, GT, theta, cos_t, sin_t, scale, ab):
     """Smallest angle > theta at which a multiplier of the basis turns negative (inf if none).
 
-    ``cos_t, sin_t``: cos and sin of theta; ``ab`` (3, n): work buffer. Each multiplier's
+    ``cos_t, sin_t``: cos and sin of theta; ``ab`` (4, n): work buffer. Each multiplier's
     step is ``_arc_end``'s (an atan2 and a modulo); a cheap lower bound skips those that
     cannot be the smallest by more than 1e-9 rad, so the answer is the same number.
     """
     n = Binv.shape[0]
     first = -1
+    # lambda_i(theta) = a cos(theta) + b sin(theta) = rho cos(phi), phi = theta - alpha_i: the
+    # columns' (a, b, |Binv[:, i]|^2) row by row of Binv (each sum in its column loop's order)
+    ab[0], ab[1], ab[3] = 0.0, 0.0, 0.0
+    for k in range(n):
+        g0, g1 = GT[k, 0], GT[k, 1]
+        for i in range(n):
+            x = Binv[k, i]
+            ab[0, i] += g0 * x
+            ab[1, i] += g1 * x
+            ab[3, i] += x * x
     for i in range(n):
-        # lambda_i(theta) = a cos(theta) + b sin(theta) = rho cos(phi), phi = theta - alpha_i
-        a = 0.0
-        b = 0.0
-        for k in range(n):
-            a += GT[k, 0] * Binv[k, i]
-            b += GT[k, 1] * Binv[k, i]
-        ab[0, i], ab[1, i] = a, b
+        a, b = ab[0, i], ab[1, i]
         rho = math.hypot(a, b)
-        if rho <= _EPS_DUAL * scale * max(1.0, _column_norm(Binv, i)):
+        if rho <= _EPS_DUAL * scale * max(1.0, math.sqrt(ab[3, i])):
             ab[2, i] = math.inf  # identically zero multiplier
             continue
         lam = a * cos_t + b * sin_t  # rho cos(phi)
@@ -668,51 +712,351 @@ def _phase_one(H, h, z, W, active, max_pivots):
 
 
 @njit(cache=True)
+def _record(H, h, GT, g0, z, worst, ref, vertices, count):
+    """Record a re-certified vertex z: ``(count, strict)``, the vertex count after it and its check.
+
+    Its slacks go to ``worst`` as :func:`_min_slack_near` sets it; ``strict`` is whether each is
+    at least -_EPS_RECERT max(1, |h_j|). ``ref`` (1 + m + n): a flag, every row's slack at the
+    reference vertex and that vertex (see _REF_MOVE), replaced by z when z is not within
+    _REF_MOVE of it. Its point is kept when it differs from the last one.
+    """
+    m, n = H.shape
+    d = 0.0
+    if ref[0] > 0.0:
+        acc = 0.0
+        for k in range(n):
+            e = z[k] - ref[1 + m + k]
+            acc += e * e
+        d = math.sqrt(acc)
+    full = ref[0] <= 0.0 or d > _REF_MOVE
+    bound = d + _REF_MARGIN
+    strict = True
+    for j in range(m):
+        if not full and ref[1 + j] > bound:
+            continue  # positive at z
+        b = h[j]
+        for k in range(n):
+            b -= H[j, k] * z[k]
+        if full:
+            ref[1 + j] = b
+        if b < worst[0]:
+            worst[0] = b
+        if b < 0.0 and b < -_EPS_RECERT * max(1.0, abs(h[j])):
+            strict = False
+    if full:
+        ref[0] = 1.0
+        ref[1 + m : 1 + m + n] = z
+    _point(g0, GT, z, vertices, count)
+    if (
+        count == 0
+        or abs(vertices[count, 0] - vertices[count - 1, 0])
+        + abs(vertices[count, 1] - vertices[count - 1, 1])
+        > 0.0
+    ):
+        count += 1
+    return count, strict
+
+
+@njit(cache=True)
+def _directions(GT, theta, c, dc):
+    """``c = G^T u(theta)``, ``dc = G^T u'(theta)`` in place; returns (cos theta, sin theta)."""
+    cos_t, sin_t = math.cos(theta), math.sin(theta)
+    for i in range(GT.shape[0]):  # _times_into's sums, term by term
+        c[i] = 0.0 + GT[i, 0] * cos_t + GT[i, 1] * sin_t
+        dc[i] = 0.0 + GT[i, 0] * -sin_t + GT[i, 1] * cos_t
+    return cos_t, sin_t
+
+
+@njit(cache=True)
+def _keep(bases, recorded, W, y, yfirst):
+    """One more basis of the walk's chain (optimal at a breakpoint, point y) into ``bases``.
+
+    The chain keeps, of each run of bases at one polygon vertex (y within _Y_SAME of the run's
+    first, ``yfirst``), the first (kind 0) and the last (kind 1): row ``[kind, W...]``.
+    Returns the chain's length, which may exceed the rows of ``bases`` (then it is not kept).
+    """
+    same = recorded > 0 and math.hypot(y[0] - yfirst[0], y[1] - yfirst[1]) <= _Y_SAME
+    slot = recorded
+    if same and recorded >= 2 and recorded <= bases.shape[0] and bases[recorded - 1, 0] == 1:
+        slot = recorded - 1  # the run's last so far: replaced
+    if not same:
+        yfirst[:] = y
+    if slot < bases.shape[0]:
+        bases[slot, 0] = 1 if same else 0
+        bases[slot, 1:] = W
+    return slot + 1
+
+
+@njit(cache=True)
+def _replace(H, h, W, Binv, z, target, work):
+    """The basis W turned into ``target`` (n rows): the rank-one pivots made, or -1.
+
+    Position by position (:func:`_pivot`), each through a pivot element ``H_j . Binv[:, i]``
+    the walk's ratio test would accept (above 1e-9 |Binv[:, i]|); when one is not (a
+    singular basis on the way), a fresh inverse of ``target`` instead, checked as
+    :func:`_warm_start` checks its own: -2. -1 when a row is out of range or ``target``'s
+    inverse fails.
+    """
+    m, n = H.shape
+    made = 0
+    for i in range(n):
+        j = target[i]
+        if j == W[i]:
+            continue
+        if j < 0 or j >= m:
+            return -1
+        piv = 0.0
+        for r in range(n):
+            piv += H[j, r] * Binv[r, i]
+        if abs(piv) <= _EPS_PIVOT * _column_norm(Binv, i):
+            W[:] = target
+            fresh = _refactor(H, h, W, Binv, z, work) and _accurate(H, h, W, Binv, z, work[2])
+            return -2 if fresh else -1
+        _pivot(H, h, W, Binv, z, i, j, 0, work)
+        made += 1
+    return made
+
+
+@njit(cache=True)
+def _arc_start(Binv, GT, theta, scale):
+    """Where the basis's optimal arc starts in [theta, theta + pi): inf if it has none there.
+
+    Each multiplier ``lambda_i = rho_i cos(t - alpha_i)`` is non-negative on the half-circle
+    that starts at ``alpha_i - pi/2``: within [theta, theta + pi], one that starts at
+    ``theta + s_i`` with s_i <= pi bounds the arc from below, one that starts later (s_i > pi)
+    ends at ``theta + s_i - pi``.
+    """
+    n = Binv.shape[0]
+    lo, hi = 0.0, math.pi
+    for i in range(n):
+        a = 0.0
+        b = 0.0
+        for k in range(n):
+            a += GT[k, 0] * Binv[k, i]
+            b += GT[k, 1] * Binv[k, i]
+        if math.hypot(a, b) <= _EPS_DUAL * scale * max(1.0, _column_norm(Binv, i)):
+            continue  # identically zero multiplier
+        s = (math.atan2(b, a) - 0.5 * math.pi - theta) % (2.0 * math.pi)
+        if s <= math.pi:
+            lo = max(lo, s)
+        else:
+            hi = min(hi, s - math.pi)
+    return theta + lo if lo <= hi and lo < math.pi else math.inf
+
+
+@njit(cache=True)
+def _next_basis(H, h, GT, W, Binv, z, theta, u0, u1, scale, kind, rows, since, work, c, dc):
+    """The chain's next basis (``rows``) and the angle it is optimal at: ``(theta, since)``.
+
+    Kind 0: at the previous basis's breakpoint. Kind 1 (the same polygon vertex as the
+    previous basis, checked by the caller): at the start of its own optimal arc, after the
+    previous one's end and within pi of it; every direction between is a positive combination
+    of the directions the vertex is optimal for at those two angles, so it is optimal in
+    between too (its normal cone is convex). ``since``: pivots since the last fresh inverse
+    (after _CARRY, the new basis's inverse is a fresh one; so it is when the updated one fails
+    its check). Returns theta = inf when the chain does not certify (c, dc then unset).
+    """
+    theta = _breakpoint(Binv, GT, theta, u0, u1, scale, work[6])
+    if since >= _CARRY:
+        for i in range(W.shape[0]):
+            if rows[i] < 0 or rows[i] >= H.shape[0]:
+                return math.inf, since
+        W[:] = rows
+        fresh = _refactor(H, h, W, Binv, z, work) and _accurate(H, h, W, Binv, z, work[2])
+        piv = -2 if fresh else -1
+    else:
+        piv = _replace(H, h, W, Binv, z, rows, work)
+    if piv == -1:
+        return math.inf, since
+    if piv == -2:  # a fresh inverse, checked
+        since = 0
+    elif piv > 0:
+        since += piv
+        if not _accurate(H, h, W, Binv, z, work[2]):
+            if not _refactor(H, h, W, Binv, z, work):
+                return math.inf, since
+            since = 0
+    if kind == 1:
+        theta = _arc_start(Binv, GT, theta, scale)
+    if theta < math.inf:
+        _directions(GT, theta, c, dc)
+    return theta, since
+
+
+@njit(cache=True)
+def _recertify(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work):
+    """The walk's vertices from the last walk's chain of bases (``hint``), if they certify it.
+
+    The walk's certificate, without its ratio tests and pricing rounds: each basis of the chain
+    is a vertex basis (its inverse solves its system to 1e-14, fresh at least every _CARRY
+    pivots), its vertex satisfies every row to _EPS_RECERT max(1, |h_j|), it is lexicographically
+    optimal at its angle (:func:`_next_basis`; the first at theta0), and the last one's arc
+    reaches theta0 + 2 pi while no earlier angle does. Every direction then has an optimal
+    vertex among the recorded ones: the polygon the walk would find. Returns
+    ``(ok, vertices, count)``; on ok, ``worst[0]`` as the walk sets it.
+    """
+    m, n = H.shape
+    K = hint[n + 2]
+    none = np.empty((0, 2))
+    if K > _chain_capacity(hint, n):
+        return False, none, 0
+    vertices = np.empty((K, 2))
+    low = np.zeros(1)  # the walk's worst slack, kept apart until the chain is certified
+    ref = np.zeros(1 + m + n)  # the slacks at a reference vertex (see _record)
+    c, dc = np.empty(n), np.empty(n)
+    base = n + 3
+    for i in range(n):
+        W[i] = hint[base + 1 + i]
+        if W[i] < 0 or W[i] >= m:
+            return False, none, 0
+    if hint[base] != 0 or not (
+        _refactor(H, h, W, Binv, z, work) and _accurate(H, h, W, Binv, z, work[2])
+    ):
+        return False, none, 0
+    theta = theta0
+    u0, u1 = _directions(GT, theta0, c, dc)
+    since = 0
+    count = 0
+    for k in range(K):
+        if k > 0:
+            at = base + k * (n + 1)
+            theta, since = _next_basis(
+                H, h, GT, W, Binv, z, theta, u0, u1, scale, hint[at], hint[at + 1 : at + 1 + n],
+                since, work, c, dc,
+            )  # fmt: skip
+            if theta >= theta0 + 2.0 * math.pi:
+                return False, none, 0
+            u0, u1 = math.cos(theta), math.sin(theta)
+        if not _optimal(Binv, c, dc, scale):
+            return False, none, 0
+        last = count
+        count, strict = _record(H, h, GT, g0, z, low, ref, vertices, count)
+        if not strict or (k > 0 and hint[base + k * (n + 1)] == 1 and _moved(vertices, last)):
+            return False, none, 0
+    if _breakpoint(Binv, GT, theta, u0, u1, scale, work[6]) < theta0 + 2.0 * math.pi:
+        return False, none, 0
+    worst[0] = min(worst[0], low[0])
+    return True, vertices, count
+
+
+@njit(cache=True)
+def _moved(vertices, i):
+    """Whether point i (at ``vertices[i]``, kept or not) is beyond _Y_SAME of point i - 1."""
+    return (
+        math.hypot(vertices[i, 0] - vertices[i - 1, 0], vertices[i, 1] - vertices[i - 1, 1])
+        > _Y_SAME
+    )
+
+
+@njit(cache=True)
+def _chain_capacity(hint, n):
+    """How many bases (a kind and n rows each) ``hint`` holds after its first n + 3 entries."""
+    return max(0, (hint.shape[0] - n - 3) // (n + 1))
+
+
+@njit(cache=True)
+def _from_chain(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work):
+    """:func:`_recertify` when ``hint`` holds a chain for this (m, n): ``(ok, vertices, count)``.
+
+    Otherwise, or when the chain does not certify, the walk's state back at its start (z = 0,
+    nothing listed near a vertex) and the chain dropped from ``hint``.
+    """
+    m, n = H.shape
+    if hint[0] == m and hint[1] == n and hint[n + 2] > 0:
+        ok, vertices, count = _recertify(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work)
+        if ok:
+            return ok, vertices, count
+        z[:] = 0.0
+        work[8][0] = -1
+    hint[n + 2] = 0
+    return False, np.empty((0, 2)), 0
+
+
+@njit(cache=True)
+def _store_chain(hint, bases, recorded):
+    """The walk's chain of ``recorded`` bases (:func:`_keep`) into ``hint``, when it fits."""
+    capacity, size = bases.shape
+    n = size - 1
+    if 0 < recorded <= capacity:
+        hint[n + 2] = recorded
+        for k in range(recorded):
+            hint[n + 3 + k * size : n + 3 + (k + 1) * size] = bases[k]
+
+
+@njit(cache=True)
+def _start(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work, hint):
+    """The walk's first basis, optimal for (c, dc) (theta0); returns (status, pivots).
+
+    Phase 1 when z = 0 is not feasible, then the warm start (``hint``) or the crash, pivots
+    to optimality, its inverse checked; its rows go to ``hint`` (the next call's start).
+    """
+    m, n = H.shape
+    k = 0
+    pivots = 0
+    if h.min() < 0.0:  # z = 0 is not feasible (it is for contact stances: x0 is inside)
+        status, pivots, k = _phase_one(H, h, z, W, active, max_pivots)
+        if status != OK:
+            return status, pivots
+    if not (k == 0 and h.min() >= 0.0 and _warm_start(H, h, W, Binv, z, active, work, hint)):
+        status, k = _crash(H, h, z, W, k, active, c, dc)
+        if status != OK:
+            return status, pivots
+        if not _refactor(H, h, W, Binv, z, work):
+            return FAILED, pivots
+    status, piv = _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work)
+    pivots += piv
+    if status != OK:
+        return status, pivots
+    if piv and not _accurate(H, h, W, Binv, z, work[2]) and not _refactor(H, h, W, Binv, z, work):
+        return FAILED, pivots
+    if hint.shape[0] >= n + 2:  # the optimal basis at theta0: the next call's start
+        hint[0], hint[1] = m, n
+        hint[2 : n + 2] = W
+    return OK, pivots
+
+
+@njit(cache=True)
 def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
     """Vertices of ``g0 + G {z : H z <= h}`` (rows of H unit norm; ``GT`` = G^T, n x 2).
 
     Returns (status, vertices, count, pivots): ``vertices[:count]`` are the support points
     in counter-clockwise order, consecutive duplicates removed (the last may equal the first).
     ``worst[0]`` receives the smallest slack of the recorded vertices (>= -rounding for a
-    sound walk; the caller rejects the walk otherwise). ``hint`` (int64): see :func:`_warm_start`;
-    an empty one is neither read nor written.
+    sound walk; the caller rejects the walk otherwise).
+
+    ``hint`` (int64), kept by a caller that projects postures in a row: ``(m, n)``, the optimal
+    basis at theta0 (n rows; see :func:`_warm_start`), then, when it has room, the number of
+    bases of the last walk's chain and the chain itself (n rows each). A chain that still
+    certifies this polytope's polygon answers without walking (:func:`_from_chain`, 0
+    pivots); else the walk starts from the basis and writes its own chain. An empty hint is
+    neither read nor written.
     """
     m, n = H.shape
-    vertices = np.empty((0, 2))
     z = np.zeros(n)
     W = np.zeros(n, dtype=np.int64)
+    Binv = np.empty((n, n))
+    work = _workspace(m, n)
+    scale = _norm(GT.ravel())  # sqrt(|G^T u|^2 + |G^T u'|^2), the same for every theta
+    bases = np.empty((_chain_capacity(hint, n), n + 1), dtype=np.int64)
+    yfirst = np.empty(2)  # the point of the chain's last run
+    if bases.shape[0]:
+        ok, vertices, count = _from_chain(
+            H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work
+        )
+        if ok:
+            return OK, vertices, count, 0
     active = np.zeros(m, dtype=np.bool_)
-    k = 0
-    pivots = 0
-    if h.min() < 0.0:  # z = 0 is not feasible (it is for contact stances: x0 is inside)
-        status, pivots, k = _phase_one(H, h, z, W, active, max_pivots)
-        if status != OK:
-            return status, vertices, 0, pivots
     u = np.array([math.cos(theta0), math.sin(theta0)])
     du = np.array([-math.sin(theta0), math.cos(theta0)])
     c, dc = _times(GT, u), _times(GT, du)
-    Binv = np.empty((n, n))
-    work = _workspace(m, n)
-    if not (k == 0 and h.min() >= 0.0 and _warm_start(H, h, W, Binv, z, active, work, hint)):
-        status, k = _crash(H, h, z, W, k, active, c, dc)
-        if status != OK:
-            return status, vertices, 0, pivots
-        if not _refactor(H, h, W, Binv, z, work):
-            return FAILED, vertices, 0, pivots
-    scale = _norm(GT.ravel())  # sqrt(|G^T u|^2 + |G^T u'|^2), the same for every theta
-    status, piv = _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work)
-    pivots += piv
+    status, pivots = _start(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work, hint)
     if status != OK:
-        return status, vertices, 0, pivots
-    if piv and not _accurate(H, h, W, Binv, z, work[2]) and not _refactor(H, h, W, Binv, z, work):
-        return FAILED, vertices, 0, pivots
-    if hint.shape[0] >= n + 2:  # the optimal basis at theta0: the next call's start
-        hint[0], hint[1] = m, n
-        hint[2 : n + 2] = W
+        return status, np.empty((0, 2)), 0, pivots
     vertices = np.empty((max_pivots + 2, 2))
     _min_slack_near(H, h, z, worst, work[7], work[8])
     _point(g0, GT, z, vertices, 0)
     count = 1
+    recorded = _keep(bases, 0, W, vertices[0], yfirst) if bases.shape[0] else 0
     theta = theta0
     since = _CARRY  # pivots since the last fresh inverse (the first breakpoint makes one)
     while True:
@@ -757,6 +1101,10 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
             > 0.0
         ):
             count += 1
+        if bases.shape[0]:  # a chain for the next call (see _keep)
+            recorded = _keep(bases, recorded, W, vertices[count - 1], yfirst)
+    if recorded < pivots:  # else re-certifying costs about what this walk did (one foot)
+        _store_chain(hint, bases, recorded)
     return OK, vertices, count, pivots
 
 

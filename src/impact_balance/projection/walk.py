@@ -39,12 +39,14 @@ from impact_balance.projection.kernel import (
 from impact_balance.projection.result import ProjectionResult
 
 __all__ = [
+    "CHAIN_BASES",
     "CHECK_MERGE",
     "MAX_PIVOTS",
     "NO_HINT",
     "RANK_TOLERANCE",
     "SLACK_TOLERANCE",
     "certified_walk",
+    "hint_size",
     "kernel_is_compiled",
     "project_walk",
     "warm_up",
@@ -63,6 +65,22 @@ CHECK_MERGE = 1e-9
 MAX_PIVOTS = 5000
 #: The kernel's warm-start hint when there is none (a one-off projection): never read or written.
 NO_HINT = np.zeros(0, dtype=np.int64)
+#: The longest chain of bases a :func:`hint_size` hint keeps (the walks of the bundled stances
+#: keep 5 to 32: two bases per polygon vertex at most).
+CHAIN_BASES = 64
+
+
+def hint_size(variables: int) -> int:
+    """The length of a walk hint with room for a chain of :data:`CHAIN_BASES` bases.
+
+    ``variables``: the projected polytope's variables (e.g. 6 per contact: at least the
+    walk's n, the variables left after the equalities). A caller that projects postures in a
+    row keeps one ``np.full(hint_size(variables), -1, dtype=np.int64)``: the walk starts from
+    its last optimal basis, and where the last walk's chain of optimal bases still certifies
+    the new polygon, answers without walking (``docs/numerics.md``). A shorter hint (at least
+    ``2 + n``) keeps the start only.
+    """
+    return 3 + variables + (variables + 1) * CHAIN_BASES
 
 
 def project_walk(

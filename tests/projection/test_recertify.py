@@ -1,0 +1,260 @@
+"""Re-certifying the last walk's chain of bases: the walk's polygon, without walking.
+
+A caller that projects postures in a row keeps a hint of :func:`hint_size`; the walk writes
+its chain of optimal bases there, and the next call answers from that chain when it still
+certifies the new polygon (0 pivots), else walks. Either way the polygon must be the one a
+walk without a hint finds (to 1e-9, issue 28's bound; the tests see 1e-13), and a chain
+that no longer fits (a polygon that changed, garbage) must fall back to the walk.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from impact_balance.balance.areas import FORCE_BOX, MERGE_TOLERANCE
+from impact_balance.contacts.wrench_polytope import assemble_arrays, face_blocks
+from impact_balance.geometry.polygon import MERGE_AREA_TOLERANCE
+from impact_balance.governor import Governor
+from impact_balance.projection import kernel as K
+from impact_balance.projection.walk import (
+    CHAIN_BASES,
+    MAX_PIVOTS,
+    NO_HINT,
+    certified_walk,
+    hint_size,
+)
+
+#: The benchmark's stances (``benchmarks/governor.py``): Talos on two feet, on a ramp, on one
+#: foot, and G1 on two feet.
+STANCES = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot", "g1_two_feet")
+
+
+@pytest.fixture(scope="module")
+def governors():
+    return {name: Governor(name) for name in STANCES}
+
+
+def _polytope(governor: Governor, q: np.ndarray):
+    """The governor's projection data ``(A, b, C, d, E)`` at ``q`` (units of m g)."""
+    ev = governor._evaluator
+    k = ev.kinematics(np.ascontiguousarray(q))
+    weight = k.mass * ev.settings.gravity
+    blocks = face_blocks(ev._faces, k.rotations)
+    A, b, C, G = assemble_arrays(
+        blocks, k.local + k.origin, k.local - k.com_local, k.jacobians, ev._idx, ev._limit,
+        k.gravity_torques,
+    )  # fmt: skip
+    return A, b / weight, C, np.array([1.0, 0.0, 0.0, 0.0]), np.ascontiguousarray(G[:2])
+
+
+def _walk(data, hint):
+    """``(status, vertices, pivots)`` of the certified walk of ``data`` with ``hint``."""
+    status, vertices, _, pivots, _, _ = certified_walk(
+        *data, FORCE_BOX, MAX_PIVOTS, MERGE_TOLERANCE, MERGE_AREA_TOLERANCE, hint
+    )
+    return status, vertices, pivots
+
+
+def _path(governor: Governor, count: int, step: float, seed: int):
+    """``count`` postures from the stance's, each joint moving by up to ``step`` rad a posture."""
+    q = governor.configuration.copy()
+    rng = np.random.default_rng(seed)
+    direction = rng.uniform(-1.0, 1.0, size=q.size - 7)
+    out = []
+    for _ in range(count):
+        out.append(q.copy())
+        q[7:] += step * direction
+    return out
+
+
+def _same_polygon(walked, cold):
+    """The same vertices in the same counter-clockwise order, to 1e-9, from the same first
+    vertex or another: a walk from a hint may start its list at a neighbour of the first
+    vertex of a walk without one (the warm start did before the chains: on two feet, three
+    vertices of the soles' right edge within 5e-5 in x, the start angle between them)."""
+    assert walked[0] == cold[0] == K.OK
+    assert walked[1].shape == cold[1].shape
+    shift = int(np.argmin(np.abs(cold[1] - walked[1][0]).sum(axis=1)))
+    np.testing.assert_allclose(walked[1], np.roll(cold[1], -shift, axis=0), rtol=0, atol=1e-9)
+
+
+@settings(max_examples=24, deadline=None)
+@given(
+    st.sampled_from(STANCES),
+    st.integers(min_value=0, max_value=2**32 - 1),
+    st.floats(min_value=1e-5, max_value=3e-3),
+)
+def test_a_recertified_polygon_is_the_walked_one(governors, name, seed, step):
+    governor = governors[name]
+    hint = np.full(hint_size(12), -1, dtype=np.int64)
+    for q in _path(governor, 6, step, seed):
+        data = _polytope(governor, q)
+        _same_polygon(_walk(data, hint), _walk(data, NO_HINT))
+
+
+@pytest.mark.parametrize("name", STANCES)
+def test_postures_in_a_row_are_mostly_recertified(governors, name):
+    """A governor's postures (1 mrad a tick): most keep their polygon's chain of bases. On one
+    foot (2 variables, a walk of 4 pivots for a chain of 5 bases) the chain is not kept: the
+    walk costs what re-certifying would."""
+    governor = governors[name]
+    hint = np.full(hint_size(12), -1, dtype=np.int64)
+    recertified = kept = 0
+    for q in _path(governor, 20, 1e-3, 7):
+        data = _polytope(governor, q)
+        walked = _walk(data, hint)
+        _same_polygon(walked, _walk(data, NO_HINT))
+        recertified += walked[2] == 0
+        n = data[0].shape[1] - 4
+        assert 0 <= hint[n + 2] <= CHAIN_BASES
+        kept += hint[n + 2] > 0
+    if name == "kick_one_foot":
+        assert kept == recertified == 0
+    else:
+        assert recertified >= 10 and kept == 20
+
+
+def test_a_posture_far_away_is_walked(governors):
+    """The chain of the stance's posture does not certify a posture 0.1 rad away."""
+    governor = governors["palm_push_two_feet"]
+    hint = np.full(hint_size(12), -1, dtype=np.int64)
+    near, far = _path(governor, 2, 0.1, 3)
+    _walk(_polytope(governor, near), hint)
+    data = _polytope(governor, far)
+    walked = _walk(data, hint)
+    assert walked[2] > 0
+    _same_polygon(walked, _walk(data, NO_HINT))
+
+
+def _square(cut: float):
+    """The square |z_i| <= 1 and the row z_0 + z_1 <= cut (unit rows), projected by G = I."""
+    H = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0], [1.0, 1.0]])
+    h = np.array([1.0, 1.0, 1.0, 1.0, cut])
+    norms = np.linalg.norm(H, axis=1)
+    return np.ascontiguousarray(H / norms[:, None]), h / norms
+
+
+def _kernel_walk(H, h, hint):
+    worst = np.zeros(1)
+    status, vertices, count, pivots = K.walk(H, h, np.eye(2), np.zeros(2), 0.0, 100, worst, hint)
+    return status, vertices[:count], pivots
+
+
+@pytest.mark.parametrize(
+    ("cut", "recertified", "corners"),
+    [
+        (2.5, True, [(1, 1), (-1, 1), (-1, -1), (1, -1)]),  # the cut stays away: the square
+        (1.5, False, [(1, 0.5), (0.5, 1), (-1, 1), (-1, -1), (1, -1)]),  # a new edge
+        (2.0, False, [(1, 1), (-1, 1), (-1, -1), (1, -1)]),  # the cut through the corner
+    ],
+)
+def test_a_polygon_that_changes_combinatorially_is_walked(cut, recertified, corners):
+    """The square's chain of bases against a cut that leaves it, cuts a corner off (a new
+    vertex: walked) or passes through one (a degenerate corner).
+
+    The chain as a walk keeps it (a walk this short does not: re-certifying its 4 bases costs
+    what its 4 pivots do): ``(m, n)``, the start, the length, then ``[kind, rows]`` per basis
+    in the walk's row positions: the corners (1, 1), (-1, 1), (-1, -1), (1, -1).
+    """
+    chain = [[0, 0, 1], [0, 2, 1], [0, 2, 3], [0, 0, 3]]
+    hint = np.array([5, 2, 0, 1, 4, *np.ravel(chain)], dtype=np.int64)
+    H, h = _square(3.0)
+    status, _, pivots = _kernel_walk(H, h, hint.copy())
+    assert status == K.OK and pivots == 0  # the chain certifies the square
+    H, h = _square(cut)
+    status, vertices, pivots = _kernel_walk(H, h, hint)
+    cold = _kernel_walk(H, h, NO_HINT)
+    assert status == cold[0] == K.OK
+    assert (pivots == 0) == recertified or cut == 2.0
+    # The polygon's corners, each recorded (consecutive duplicates removed), in either case.
+    kept = {tuple(np.round(v, 12)) for v in vertices}
+    assert (
+        kept == {tuple(map(float, c)) for c in corners} == {tuple(np.round(v, 12)) for v in cold[1]}
+    )
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(min_value=0, max_value=2**32 - 1), st.integers(min_value=1, max_value=20))
+def test_a_chain_of_garbage_changes_nothing(seed, length):
+    """Any chain (rows out of range, repeated, singular, the wrong kinds) gives the walk's
+    polygon: it certifies or the walk answers."""
+    H, h = _square(1.5)
+    rng = np.random.default_rng(seed)
+    hint = np.full(3 + 3 * 32, -1, dtype=np.int64)
+    hint[0], hint[1], hint[4] = 5, 2, length  # (m, n), then the chain's length after the start
+    hint[2:4] = rng.integers(-1, 6, size=2)
+    hint[5 : 5 + 3 * length] = rng.integers(-1, 6, size=3 * length)
+    hint[5 : 5 + 3 * length : 3] = rng.integers(0, 2, size=length)  # the kinds
+    status, vertices, _ = _kernel_walk(H, h, hint)
+    cold = _kernel_walk(H, h, NO_HINT)
+    assert status == cold[0]
+    np.testing.assert_allclose(vertices, cold[1], rtol=0, atol=1e-12)
+
+
+def test_the_hint_size_holds_the_chain():
+    n = 12  # 6 wrench variables per contact, two contacts: at most 12 after the equalities
+    assert (hint_size(n) - n - 3) // (n + 1) == CHAIN_BASES
+    assert hint_size(n) - 2 - n > 0
+    assert NO_HINT.size == 0
+
+
+def test_an_arc_start_is_where_the_multipliers_turn_non_negative():
+    """:func:`_arc_start` against a scan of the multipliers over the half circle after theta."""
+    rng = np.random.default_rng(11)
+    for _ in range(200):
+        n = int(rng.integers(2, 6))
+        Binv, GT = rng.normal(size=(n, n)), rng.normal(size=(n, 2))
+        theta = rng.uniform(0.0, 2.0 * math.pi)
+        start = K._arc_start(Binv, GT, theta, 1.0)
+        ts = theta + np.linspace(0.0, math.pi, 20001)[:-1]
+        lam = (GT.T @ Binv).T @ np.vstack([np.cos(ts), np.sin(ts)])  # (n, samples)
+        optimal = np.all(lam >= -1e-12, axis=0)
+        if math.isinf(start):
+            assert not optimal[1:-1].any()
+        else:
+            first = ts[np.argmax(optimal)]
+            assert optimal.any() and abs(first - start) <= math.pi / 20000 + 1e-12
+
+
+def _slacks(H, h, z):
+    """Every row's slack ``h_j - H_j z``, summed in the kernel's order (the same numbers)."""
+    out = []
+    for j in range(len(h)):
+        b = float(h[j])
+        for k in range(len(z)):
+            b -= float(H[j, k]) * float(z[k])
+        out.append(b)
+    return np.array(out)
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    st.integers(min_value=2, max_value=9),
+    st.integers(min_value=4, max_value=80),
+    st.integers(min_value=0, max_value=2**32 - 1),
+    st.floats(min_value=1e-12, max_value=1.0),
+)
+def test_a_re_certified_vertex_is_checked_as_by_a_full_scan(n, m, seed, step):
+    """``_record`` scans only the rows near its reference vertex: the worst slack and the strict
+    test must be the full scan's, exactly, along a path of vertices near and far."""
+    rng = np.random.default_rng(seed)
+    H = rng.normal(size=(m, n))
+    H = np.ascontiguousarray(H / np.linalg.norm(H, axis=1)[:, None])
+    z = rng.normal(size=n)
+    slack = np.where(rng.random(m) < 0.3, rng.choice([0.0, 1e-13, -1e-13, -1e-9], size=m), 0.0)
+    h = H @ z + slack + np.where(slack == 0.0, 10.0 ** rng.uniform(-9, 0, size=m), 0.0)
+    ref = np.zeros(1 + m + n)
+    vertices = np.empty((8, 2))
+    GT, g0 = rng.normal(size=(n, 2)), np.zeros(2)
+    count = 0
+    for k in range(8):
+        point = z + step * k * rng.normal(size=n) / np.sqrt(n)
+        worst, full = np.zeros(1), _slacks(H, h, point)
+        count, strict = K._record(H, h, GT, g0, point, worst, ref, vertices, count)
+        assert worst[0] == min(0.0, float(np.min(full)))
+        assert strict == bool(np.all(full >= -K._EPS_RECERT * np.maximum(1.0, np.abs(h))))
