@@ -37,9 +37,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks.speed.interleave import (
     BaselineError,
-    WorkerError,
     compare,
     current_tree,
+    exit_status,
     resolve_tree,
     run_interleaved,
 )
@@ -171,17 +171,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", action="store_true", help="print one JSON object")
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
-    try:
-        approach = measure(args)
-    except BaselineError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    except WorkerError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 1
-    except KeyboardInterrupt:
-        print("error: interrupted", file=sys.stderr)
-        return 130
+    status, approach = exit_status(lambda: measure(args))
+    if status:
+        return status
     result = {
         "benchmark": "impact_balance benchmarks/approach.py",
         "machine": machine_info(),

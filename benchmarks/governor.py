@@ -49,9 +49,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks.speed.interleave import (
     BaselineError,
-    WorkerError,
     compare,
     current_tree,
+    exit_status,
     resolve_tree,
     run_interleaved,
 )
@@ -293,19 +293,13 @@ def _main_baseline(args: argparse.Namespace) -> int:
     """``--baseline``: the interleaved run only (both sides in worker processes)."""
     t0 = time.perf_counter()
     ticks = max(2, args.ticks)
-    try:
-        side_by_side = bench_baseline(
+    status, side_by_side = exit_status(
+        lambda: bench_baseline(
             args.baseline, list(args.scenarios), ticks, args.criterion, args.blocks
         )
-    except BaselineError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    except WorkerError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 1
-    except KeyboardInterrupt:
-        print("error: interrupted", file=sys.stderr)
-        return 130
+    )
+    if status:
+        return status
     result = {
         "benchmark": "impact_balance benchmarks/governor.py --baseline",
         "machine": machine_info(),

@@ -28,7 +28,7 @@ import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -41,10 +41,13 @@ __all__ = [
     "WorkerError",
     "compare",
     "current_tree",
+    "exit_status",
     "median_interval",
     "resolve_tree",
     "run_interleaved",
 ]
+
+T = TypeVar("T")
 
 #: The folder holding the ``benchmarks`` package (the repository root): on every worker's path.
 BENCH_ROOT = Path(__file__).resolve().parents[2]
@@ -59,6 +62,25 @@ class BaselineError(ValueError):
     def __init__(self, field: str, value: object, reason: str) -> None:
         super().__init__(f"{field} {value!s}: {reason}")
         self.field, self.value, self.reason = field, value, reason
+
+
+def exit_status(call: Callable[[], T]) -> tuple[int, T | None]:
+    """Run a benchmark's measurement with the command line's error rule.
+
+    Returns ``(0, its result)``, or, with one ``error:`` line on stderr, ``(2, None)`` for a
+    :class:`BaselineError` (bad input), ``(1, None)`` for a :class:`WorkerError` (the
+    environment) and ``(130, None)`` for an interrupt.
+    """
+    try:
+        return 0, call()
+    except BaselineError as exc:
+        status, message = 2, str(exc)
+    except WorkerError as exc:
+        status, message = 1, str(exc)
+    except KeyboardInterrupt:
+        status, message = 130, "interrupted"
+    print(f"error: {message}", file=sys.stderr)
+    return status, None
 
 
 class WorkerError(RuntimeError):

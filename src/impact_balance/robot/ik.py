@@ -187,23 +187,6 @@ class _ReducedModel:
         return q
 
 
-def _start(robot: Robot, q0: ArrayLike) -> _FloatArray:
-    """``q0`` as a float copy, its bounded 1-dof joints clamped into their limits."""
-    q: _FloatArray = np.asarray(q0, dtype=float).copy()
-    nq = robot.model.nq
-    if q.shape != (nq,):
-        raise ValueError(f"q0 must have {nq} coordinates, got shape {q.shape}")
-    for slot in (robot.joint_slot(name) for name in robot.joint_names):
-        if (
-            slot.nq == 1
-            and np.isfinite(slot.lower)
-            and np.isfinite(slot.upper)
-            and slot.lower < slot.upper
-        ):
-            q[slot.idx_q] = min(max(q[slot.idx_q], slot.lower), slot.upper)
-    return q
-
-
 def within_limits(robot: Robot, q: ArrayLike) -> _FloatArray:
     """A float copy of ``q`` (nq) with its bounded 1-dof joints clamped into their limits.
 
@@ -213,7 +196,19 @@ def within_limits(robot: Robot, q: ArrayLike) -> _FloatArray:
     Raises:
         ValueError: ``q`` does not have the model's nq coordinates.
     """
-    return _start(robot, q)
+    out: _FloatArray = np.asarray(q, dtype=float).copy()
+    nq = robot.model.nq
+    if out.shape != (nq,):
+        raise ValueError(f"q0 must have {nq} coordinates, got shape {out.shape}")
+    for slot in (robot.joint_slot(name) for name in robot.joint_names):
+        if (
+            slot.nq == 1
+            and np.isfinite(slot.lower)
+            and np.isfinite(slot.upper)
+            and slot.lower < slot.upper
+        ):
+            out[slot.idx_q] = min(max(out[slot.idx_q], slot.lower), slot.upper)
+    return out
 
 
 def _frame_targets(
@@ -337,7 +332,7 @@ def solve_stance(
         ValueError: if ``q0`` does not have nq coordinates.
     """
     options = options or IKOptions()
-    q0 = _start(robot, q0)
+    q0 = within_limits(robot, q0)
     targets = _frame_targets(robot, q0, frame_targets, fixed_frames)
     free = set(position_only) | {name for name in targets if chain_dofs(robot, name) < 6}
     reduced = _ReducedModel(robot, locked_joints, q0)
