@@ -70,6 +70,9 @@ QUATERNION_TOLERANCE = 1e-6
 JOINT_LIMIT_TOLERANCE = 0.1
 
 _MAX_SPEED_SQUARED = MAX_SPEED * MAX_SPEED
+#: A bound within reach this close to the criterion's own (m/s) does not bind (the search's
+#: tolerance: where the reach exceeds the area, its answer is the area's own up to rounding).
+_REACH_TOLERANCE = 1e-9
 _FLOAT = np.dtype(np.float64)  # numpy's own float64 dtype: a float array's dtype is this object
 _STRIDE = (8,)  # a contiguous float64 vector's
 #: The half-planes and rates :func:`velocity_exit` takes where there is no area to exit.
@@ -722,8 +725,8 @@ class Governor:
                 criterion.angular_momentum,
                 speed,
             )
-            # Not binding at this velocity: no bound kept (the criterion's own is then smaller).
-            cached = (posture.key, within if within < speed else math.inf)
+            # Not binding at this velocity (within the search's 1e-9 m/s): no bound kept.
+            cached = (posture.key, within if within < speed - _REACH_TOLERANCE else math.inf)
             self._reach_bound = cached
         bound = cached[1]
         if not bound < speed:
