@@ -110,6 +110,20 @@ class ComReach:
         below = math.floor(k) % n
         return float(min(self.radii[below], self.radii[(below + 1) % n]))
 
+    def polygon(self, centre: npt.ArrayLike) -> _FloatArray:
+        """The reach's outline around ``centre``: ``c + R(a) (cos a, sin a)`` per azimuth.
+
+        Args:
+            centre: (2,) or (3,) the CoM it was computed from, world, m (x and y are used).
+
+        Returns:
+            (N, 2) points, world xy, m, in azimuth order (counter-clockwise from +x).
+        """
+        c = np.asarray(centre, dtype=float)[:2]
+        u = np.column_stack([np.cos(self.azimuths), np.sin(self.azimuths)])
+        points: _FloatArray = c + self.radii[:, None] * u
+        return points
+
     def to_dict(self) -> dict[str, object]:
         """JSON form: ``azimuths_deg``, ``radii`` (m), ``height`` (m)."""
         return {
