@@ -206,3 +206,45 @@ def test_the_max_speed_away_from_rest_is_the_first_speed_out_of_reach():
     out = start + (s + 1e-6) * d
     assert any(np.linalg.norm(v) > limit(area, omega, reach, v) for v in out)
     assert reach_max_speed(area, omega, reach, [10.0, 0.0], d, upper=5.0) == 0.0
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    radii=st.lists(st.floats(0.01, 0.5), min_size=8, max_size=8),
+    start=st.tuples(st.floats(-0.2, 0.2), st.floats(-0.2, 0.2)),
+    jumps=st.lists(
+        st.tuples(st.floats(-1, 1), st.floats(-1, 1)).filter(lambda d: math.hypot(*d) > 0.05),
+        min_size=1,
+        max_size=6,
+    ),
+)
+def test_the_max_speed_from_a_moving_com_ends_where_a_vertex_leaves_the_reach(radii, start, jumps):
+    # Checked with the scalar limit, vertex by vertex: within at the answer, out just above it.
+    from impact_balance.balance.reach import reach_max_speed
+
+    omega, extent, upper = 3.3, 0.12, 2.0
+    area = _square(omega, extent)
+    reach = ComReach(np.arange(8) * math.pi / 4, np.array(radii), 0.8, np.zeros((8, 1)))
+    c0, d = np.array(start), np.array(jumps)
+
+    def within(speed: float) -> bool:
+        return all(
+            np.linalg.norm(v) <= reach_speed_limit(area, omega, reach, v) + 1e-9
+            for v in c0 + speed * d
+            if np.linalg.norm(v) > 1e-9
+        )
+
+    s = reach_max_speed(area, omega, reach, c0, d, upper=upper)
+    if not within(0.0):
+        assert s == 0.0
+        return
+    assert 0.0 <= s <= upper and within(s)
+    if s < upper:
+        assert not within(s + 1e-6)
+    if min(radii) >= math.sqrt(2) * extent:  # the reach never binds: the square's own exit
+        G, h = area.halfplanes
+        exits = [
+            min((hk - gk @ c0) / (gk @ dj) for gk, hk in zip(G, h, strict=True) if gk @ dj > 1e-12)
+            for dj in d
+        ]
+        assert s == pytest.approx(min(upper, *exits), abs=1e-12)

@@ -22,10 +22,9 @@ from impact_balance.balance.reach import (
     ComReach,
     ReachOptions,
     com_reach,
-    reach_max_speed,
     reach_speed_limit,
 )
-from impact_balance.impact.angular_momentum import effective_impulse_rates
+from impact_balance.impact.within_reach import max_contact_velocity_within_reach
 
 __all__ = ["ReachAnswer", "reach_answer"]
 
@@ -63,14 +62,18 @@ class ReachAnswer:
         }
 
 
-def reach_answer(analysis: Analysis, options: ReachOptions | None = None) -> ReachAnswer:
+def reach_answer(
+    analysis: Analysis, options: ReachOptions | None = None, *, reach: ComReach | None = None
+) -> ReachAnswer:
     """The CoM's reach of ``analysis``'s stance and what it limits (module docstring).
 
     Args:
         analysis: An analysis (its stance, areas with their margin, and impact answer).
         options: The reach search (default :class:`~impact_balance.balance.reach.ReachOptions`).
+        reach: A reach already computed (e.g. of the stance's initial posture, as a governor
+            keeps it); then ``options`` is not used and no search runs.
     """
-    reach = com_reach(analysis.stance, options)
+    reach = com_reach(analysis.stance, options) if reach is None else reach
     areas = analysis.areas
     omega = float(areas.omega)
     area = areas.com_velocity_area
@@ -85,12 +88,13 @@ def reach_answer(analysis: Analysis, options: ReachOptions | None = None) -> Rea
     default = float(impact.default.max_contact_velocity)
     if not areas.can_balance or area.is_empty or not impact.default.from_inside:
         return ReachAnswer(reach, limits, 0.0, default)
-    model = impact.model
-    jumps = [model.com_jump_rates]
-    if impact.angular_momentum is not None:
-        effective = effective_impulse_rates(model.impulse_rates, impact.angular_momentum)
-        jumps.append(effective[:, :2] / model.mass)
-    speed = reach_max_speed(
-        area, omega, reach, analysis.com_velocity[:2], np.vstack(jumps), default
+    speed = max_contact_velocity_within_reach(
+        area,
+        omega,
+        reach,
+        impact.model,
+        analysis.com_velocity[:2],
+        impact.angular_momentum,
+        default,
     )
-    return ReachAnswer(reach, limits, min(speed, default), default)
+    return ReachAnswer(reach, limits, speed, default)

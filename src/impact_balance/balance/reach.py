@@ -110,6 +110,20 @@ class ComReach:
         below = math.floor(k) % n
         return float(min(self.radii[below], self.radii[(below + 1) % n]))
 
+    def polygon(self, centre: npt.ArrayLike) -> _FloatArray:
+        """The reach's outline around ``centre``: ``c + R(a) (cos a, sin a)`` per azimuth.
+
+        Args:
+            centre: (2,) or (3,) the CoM it was computed from, world, m (x and y are used).
+
+        Returns:
+            (N, 2) points, world xy, m, in azimuth order (counter-clockwise from +x).
+        """
+        c = np.asarray(centre, dtype=float)[:2]
+        u = np.column_stack([np.cos(self.azimuths), np.sin(self.azimuths)])
+        points: _FloatArray = c + self.radii[:, None] * u
+        return points
+
     def to_dict(self) -> dict[str, object]:
         """JSON form: ``azimuths_deg``, ``radii`` (m), ``height`` (m)."""
         return {
@@ -253,15 +267,76 @@ def reach_speed_limit(
     return float(omega * math.sqrt(R * (2.0 * extent - R)))
 
 
+def _along(reach: ComReach, directions: _FloatArray) -> _FloatArray:
+    """:meth:`ComReach.along` of each row of ``directions`` (N, 2), vectorised (m)."""
+    n = len(reach.radii)
+    step = 2.0 * math.pi / len(reach.azimuths)
+    k = (np.arctan2(directions[:, 1], directions[:, 0]) % (2.0 * math.pi)) / step
+    nearest = np.round(k)
+    below = np.floor(k).astype(np.int64) % n
+    between = np.minimum(reach.radii[below], reach.radii[(below + 1) % n])
+    exact = reach.radii[nearest.astype(np.int64) % n]
+    return np.where(np.abs(k - nearest) < 1e-9, exact, between)
+
+
+def _limits(area: Polygon, omega: float, reach: ComReach, velocities: _FloatArray) -> _FloatArray:
+    """:func:`reach_speed_limit` along each row of ``velocities`` (N, 2, nonzero), vectorised."""
+    G, h = area.halfplanes
+    u = velocities / np.hypot(velocities[:, 0], velocities[:, 1])[:, None]
+    gu = u @ G.T
+    ahead = gu > 1e-12
+    with np.errstate(divide="ignore", invalid="ignore"):
+        extent = np.min(np.where(ahead, h / np.where(ahead, gu, 1.0), math.inf), axis=1) / omega
+    R = _along(reach, u)
+    inside = extent > 0.0
+    capped = np.where(R >= extent, extent, np.sqrt(np.maximum(R * (2.0 * extent - R), 0.0)))
+    return np.where(inside, omega * capped, 0.0)
+
+
+def _within_each(
+    area: Polygon, omega: float, reach: ComReach, velocities: _FloatArray, tol: float
+) -> npt.NDArray[np.bool_]:
+    """Per row of ``velocities`` (N, 2): within the reach's speed limit along its direction."""
+    speed = np.hypot(velocities[:, 0], velocities[:, 1])
+    ok = speed <= tol
+    moving = ~ok
+    if np.any(moving):
+        limit = _limits(area, omega, reach, velocities[moving])
+        ok[moving] = ~(speed[moving] > limit + tol)
+    return ok
+
+
 def _within(
     area: Polygon, omega: float, reach: ComReach, velocities: _FloatArray, tol: float
 ) -> bool:
     """Whether every velocity (k, 2) is within the reach's speed limit along its direction."""
-    for v in velocities:
-        speed = float(np.hypot(v[0], v[1]))
-        if speed > tol and speed > reach_speed_limit(area, omega, reach, v) + tol:
-            return False
-    return True
+    return bool(np.all(_within_each(area, omega, reach, velocities, tol)))
+
+
+def _never_binds(area: Polygon, omega: float, reach: ComReach) -> bool:
+    """Whether the reach exceeds the area's extent (over omega) in every direction.
+
+    Then the reach's speed limit is the area's own boundary along every direction: within
+    reach is inside the area. Needs the origin strictly inside the area.
+    """
+    _, h = area.halfplanes
+    if area.vertices.shape[0] < 3 or not np.all(h > 0.0):
+        return False
+    farthest = float(np.max(np.hypot(area.vertices[:, 0], area.vertices[:, 1]))) / omega
+    return float(np.min(reach.radii)) >= farthest
+
+
+def _area_exit(area: Polygon, start: _FloatArray, jumps: _FloatArray, cap: float) -> float:
+    """The largest ``s <= cap`` with every ``start + s d_j`` in the area (0 if start is out)."""
+    G, h = area.halfplanes
+    slack = h - G @ start
+    if np.any(slack < 0.0):
+        return 0.0
+    rates = jumps @ G.T  # (k, m)
+    ahead = rates > 1e-12
+    with np.errstate(divide="ignore", invalid="ignore"):
+        exits = np.where(ahead, slack[None, :] / np.where(ahead, rates, 1.0), math.inf)
+    return float(min(cap, float(np.min(exits)) if exits.size else math.inf))
 
 
 def reach_max_speed(
@@ -299,6 +374,8 @@ def reach_max_speed(
     if not _within(area, omega, reach, c0[None, :], tol):
         return 0.0
     cap = float(upper) if math.isfinite(upper) else 1e3
+    if _never_binds(area, omega, reach):  # within reach is inside the area: its exit, exactly
+        return _area_exit(area, c0, d, cap)
     if float(np.hypot(c0[0], c0[1])) <= tol:
         best = cap
         for dj in d:
@@ -308,15 +385,16 @@ def reach_max_speed(
         return float(best)
     # Away from rest the vertices turn with s: the first speed out of reach, found on a grid of
     # 256 steps up to ``upper`` and refined by bisection (every speed below it is within).
-    grid = np.linspace(0.0, cap, 257)
-    lo = 0.0
-    for s in grid[1:]:
-        if not _within(area, omega, reach, c0[None, :] + s * d, tol):
-            hi = float(s)
-            break
-        lo = float(s)
-    else:
+    grid = np.linspace(0.0, cap, 257)[1:]
+    ok = _within_each(
+        area, omega, reach, (c0[None, None, :] + grid[:, None, None] * d).reshape(-1, 2), tol
+    )
+    failing = np.flatnonzero(~ok.reshape(len(grid), len(d)).all(axis=1))
+    if failing.size == 0:
         return cap
+    first = int(failing[0])
+    hi = float(grid[first])
+    lo = 0.0 if first == 0 else float(grid[first - 1])
     while hi - lo > tol * max(1.0, hi):
         mid = 0.5 * (lo + hi)
         if _within(area, omega, reach, c0[None, :] + mid * d, tol):

@@ -99,6 +99,12 @@ def add_parser(sub: Subcommands) -> list[str]:
     )
     add_velocity_margin_option(a, "com governor")
     a.add_argument(
+        "--com-reach",
+        action="store_true",
+        help="com governor: also cap within the CoM's reach at constant height, computed once "
+        "from the scenario's posture (whole-body IK, a few seconds; docs/com-reach.md)",
+    )
+    a.add_argument(
         "--rigid-impact",
         action="store_true",
         help="hold every joint's velocity through the impact (the paper's rigid robot)",
@@ -155,6 +161,8 @@ def run(args: argparse.Namespace) -> int:
         )
     if args.contact_aware_async and not args.contact_aware:
         raise SimulationError("--contact-aware-async", True, "needs --contact-aware")
+    if args.com_reach and args.governor != "com":
+        raise SimulationError("--com-reach", True, f"needs --governor com, not {args.governor}")
     import_mujoco(bool(args.video))  # before anything imports MuJoCo: the GL backend is read then
     from impact_balance.cli.output import print_json
     from impact_balance.scenario import load_scenario
@@ -210,10 +218,18 @@ def run(args: argparse.Namespace) -> int:
             "trials": docs,
         }
     )
+    reach = None if governor is None else governor.com_reach
+    if reach is not None:  # once: the reach of the scenario's posture, the governor's
+        out["com_reach"] = reach.to_dict()
     if args.json:
         print_json(out)
     else:
         _print_text(scenario.name, args, docs, written)
+        if reach is not None:
+            print(
+                f"  capped within the CoM's reach ({1000 * reach.radii.min():.0f} to "
+                f"{1000 * reach.radii.max():.0f} mm at constant height, the scenario's posture)"
+            )
         if len(docs) > 1 and out["tick_us"]["median"] is not None:
             t = out["tick_us"]
             print(
@@ -252,7 +268,12 @@ def _governor(args: argparse.Namespace, governed: Scenario) -> Governor | None:
     from impact_balance.governor import ContactAwareOptions, Governor
 
     aware = ContactAwareOptions(asynchronous=args.contact_aware_async)
-    return Governor(governed, args.governor, contact_aware=aware if args.contact_aware else None)
+    return Governor(
+        governed,
+        args.governor,
+        contact_aware=aware if args.contact_aware else None,
+        com_reach=bool(args.com_reach),
+    )
 
 
 def _trials(

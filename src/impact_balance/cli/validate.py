@@ -60,6 +60,13 @@ def add_parser(sub: Subcommands) -> list[str]:
         "--max-speed", type=float, default=4.0, help="largest approach speed tried, m/s (default 4)"
     )
     add_trial_options(a, impact=True)
+    a.add_argument(
+        "--com-reach",
+        action="store_true",
+        help="score the verdict against the default's maximum contact velocity within the CoM's "
+        "reach at constant height (whole-body IK once before the trials, a few seconds; "
+        "docs/com-reach.md)",
+    )
     add_calibration_option(a)
     add_output_options(a, "of the fastest trial survived")
     add_angular_momentum_option(a, controller=True)
@@ -115,6 +122,7 @@ def run(args: argparse.Namespace) -> int:
             options=options,
             zmp_margin=scoring_margin(scenario),
             journal=journal,
+            com_reach=args.com_reach,
         )
     finally:
         bar.close()
@@ -231,6 +239,8 @@ def _text(out: dict[str, Any], args: argparse.Namespace, n: int) -> str:
             f"joint_space {_f(p[crit]['joint_space'])} / {_f(pm[crit]['joint_space'])}"
         )
     lines.append(f"    default (the governor's cap) {_f(p['default'])}")
+    if "com_reach" in p:
+        lines.append(_reach_line(p["com_reach"]))
     lines.append("  trials (commanded -> measured: outcome):")
     for t in out["trials"]:
         why = f" {t['reason']}" if t["reason"] else ""
@@ -238,6 +248,8 @@ def _text(out: dict[str, Any], args: argparse.Namespace, n: int) -> str:
             t["com_criterion_safe"]
         ]
         strict = "; strict fail" if t["strict_fail"] else ""
+        if t.get("com_reach_safe") is not None:
+            call += "; within reach: " + ("safe" if t["com_reach_safe"] else "unsafe")
         lines.append(
             f"    {t['speed']:.3f} -> {_f(t['approach_speed_measured'])}: {t['outcome']}{why}"
             f"{strict}   {call}"
@@ -250,6 +262,15 @@ def _text(out: dict[str, Any], args: argparse.Namespace, n: int) -> str:
     if out["journal"]:
         lines.append(f"  trials journal: {out['journal']} ({out['reused_trials']} reused)")
     return "\n".join(lines)
+
+
+def _reach_line(reach: dict[str, Any]) -> str:
+    """One line of ``validate --com-reach``: the reach and the prediction within it."""
+    radii = reach["radii"]
+    return (
+        f"    within the CoM's reach ({1000 * min(radii):.0f} to {1000 * max(radii):.0f} mm at "
+        f"constant height) {_f(reach['max_contact_velocity'])}: the verdict's prediction"
+    )
 
 
 def _plots(result: ValidationResult, out: Path) -> list[Path]:

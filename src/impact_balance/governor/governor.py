@@ -6,8 +6,9 @@ import math
 import os
 import threading
 import time
+from dataclasses import replace
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 import numpy as np
 import numpy.typing as npt
@@ -24,7 +25,12 @@ from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.exceptions import GovernorError, ScenarioError
 from impact_balance.governor.batch import BatchEvaluator, BatchLimits
 from impact_balance.governor.limit import Binding, SpeedLimit, _floating_limit
-from impact_balance.governor.options import CRITERIA, ContactAwareOptions, Criterion
+from impact_balance.governor.options import (
+    CRITERIA,
+    ContactAwareOptions,
+    Criterion,
+    reach_option,
+)
 from impact_balance.governor.posture import (
     NO_HALFPLANES,
     Posture,
@@ -50,6 +56,9 @@ from impact_balance.scenario.calibration import (
     read_calibration,
 )
 
+if TYPE_CHECKING:
+    from impact_balance.balance.reach import ComReach, ReachOptions
+
 __all__ = ["Governor"]
 
 #: Largest |norm - 1| of the base quaternion in q (pinocchio's order x, y, z, w), and of a
@@ -61,6 +70,9 @@ QUATERNION_TOLERANCE = 1e-6
 JOINT_LIMIT_TOLERANCE = 0.1
 
 _MAX_SPEED_SQUARED = MAX_SPEED * MAX_SPEED
+#: A bound within reach this close to the criterion's own (m/s) does not bind (the search's
+#: tolerance: where the reach exceeds the area, its answer is the area's own up to rounding).
+_REACH_TOLERANCE = 1e-9
 _FLOAT = np.dtype(np.float64)  # numpy's own float64 dtype: a float array's dtype is this object
 _STRIDE = (8,)  # a contiguous float64 vector's
 #: The half-planes and rates :func:`velocity_exit` takes where there is no area to exit.
@@ -129,13 +141,27 @@ class Governor:
             :class:`~impact_balance.scenario.calibration.CalibrationFile`: its ``zmp_margin``
             (m) replaces the scenario's. Its robot must be the scenario's. None (default): the
             scenario's margin. The calibration read is :attr:`calibration`.
+        com_reach: Also cap within the CoM's reach at constant height (docs/com-reach.md):
+            each answer is at most the largest approach speed whose post-impact CoM velocities
+            (and their effective twins with the angular momentum term) stay within the reach
+            (:func:`~impact_balance.impact.within_reach.max_contact_velocity_within_reach`, in
+            the posture's CoM velocity area with the ZMP margin), binding "com_reach" where
+            that is smaller. The reach is that of the scenario's posture, computed once here
+            (the contacts do not change while the governor runs; the reach is not recomputed
+            as the posture moves). True: the default search (a few seconds); a
+            :class:`~impact_balance.balance.reach.ReachOptions`: that search; a
+            :class:`~impact_balance.balance.reach.ComReach`: used as is. A posture evaluation
+            computes the bound for its CoM velocity; a tick that reuses the posture reuses that
+            bound. "com" criterion only. None or False (default): off. The reach is
+            :attr:`com_reach`.
 
     Raises:
         ScenarioError: another robot's or a bad calibration, no impact, an unknown frame, an
             impact model that cannot be built at the scenario's posture (the scenario is
             evaluated once, as a check).
         GovernorError: an unknown criterion, a bad tolerance, a bad ``velocity_margin``
-            (or one with the "zmp" criterion), contact-aware options with the "zmp" criterion.
+            (or one with the "zmp" criterion), contact-aware options or a reach with the "zmp"
+            criterion, a ``com_reach`` of another type.
     """
 
     def __init__(
@@ -147,6 +173,7 @@ class Governor:
         contact_aware: ContactAwareOptions | bool | None = None,
         velocity_margin: float | None = None,
         calibration: CalibrationFile | str | os.PathLike[str] | None = None,
+        com_reach: ComReach | ReachOptions | bool | None = None,
     ) -> None:
         if criterion not in CRITERIA:
             raise GovernorError("criterion", criterion, f"must be one of {', '.join(CRITERIA)}")
@@ -176,6 +203,9 @@ class Governor:
         self.configuration: np.ndarray = stance.q.copy()
         #: The sustained contacts, resolved (frame, size, friction, offset in the frame).
         self.contacts: tuple[ContactSpec, ...] = tuple(c.spec for c in stance.contacts)
+        #: The CoM's reach of the scenario's posture the answers are capped within, or None.
+        self.com_reach: ComReach | None = reach_option(com_reach, criterion, stance)
+        self._reach_bound: tuple[bytes, float] | None = None  # (posture key, bound m/s)
         settings = PostureSettings(
             self.contacts,
             scenario.impact.spec(),
@@ -279,11 +309,13 @@ class Governor:
                 and q.shape == self._q_shape
                 and q.tobytes() == posture.key
             ):
-                return self._tick(posture, _velocity(v, self._v_shape), True)
+                answer = self._tick(posture, _velocity(v, self._v_shape), True)
+                return answer if self.com_reach is None else self._within_reach(posture, answer)
         configuration, velocity = self._state(q, v)
         with self._lock:
             posture, reused = self._posture_at(configuration, checked=True)
-            return self._tick(posture, velocity, reused)
+            answer = self._tick(posture, velocity, reused)
+            return answer if self.com_reach is None else self._within_reach(posture, answer)
 
     def _state(
         self, q: ArrayLike, v: ArrayLike
@@ -385,6 +417,10 @@ class Governor:
                 True,
                 "limits() answers the floating criterion only; call limit() per posture",
             )
+        if self.com_reach is not None:
+            raise GovernorError(
+                "com_reach", True, "limits() answers without the reach; call limit() per posture"
+            )
         try:
             return self._batch.limits(q_batch, v_batch, threads)
         except ScenarioError as exc:
@@ -416,7 +452,8 @@ class Governor:
         c = np.append(c, 0.0) if c.size == 2 else c.copy()
         with self._lock:
             posture, reused = self._posture_at(configuration)
-            return self._answer(posture, c, reused)
+            answer = self._answer(posture, c, reused)
+            return answer if self.com_reach is None else self._within_reach(posture, answer)
 
     def cap(
         self, reference_velocity: ArrayLike | None = None, limit: SpeedLimit | None = None
@@ -660,6 +697,45 @@ class Governor:
                 None if ages is None else ages[1],
                 stale,
             )
+        )
+
+    def _within_reach(self, posture: Posture, answer: SpeedLimit) -> SpeedLimit:
+        """``answer`` capped within the CoM's reach (under the lock); kept as the last.
+
+        The bound is computed when the posture is new (or has none yet) for the answer's CoM
+        velocity, and reused while the posture is (see ``com_reach`` in the class docstring).
+        """
+        reach, criterion = self.com_reach, posture.com_criterion
+        speed = answer.max_contact_velocity
+        if reach is None or criterion is None or not speed > 0.0:
+            return answer
+        cached = self._reach_bound
+        if cached is None or cached[0] != posture.key or not answer.posture_reused:
+            from impact_balance.balance.lipm import lipm_omega
+            from impact_balance.impact.within_reach import max_contact_velocity_within_reach
+
+            settings = self._evaluator.settings
+            omega = lipm_omega(float(posture.com[2]), settings.plane_height, settings.gravity)
+            within = max_contact_velocity_within_reach(
+                criterion.area,
+                omega,
+                reach,
+                posture.impact,
+                answer.com_velocity[:2],
+                criterion.angular_momentum,
+                speed,
+            )
+            # Not binding at this velocity (within the search's 1e-9 m/s): no bound kept.
+            cached = (posture.key, within if within < speed - _REACH_TOLERANCE else math.inf)
+            self._reach_bound = cached
+        bound = cached[1]
+        if not bound < speed:
+            return answer
+        interval = answer.safe_interval
+        if interval is not None:
+            interval = (interval[0], bound) if interval[0] <= bound else None
+        return self._keep(
+            replace(answer, max_contact_velocity=bound, safe_interval=interval, binding="com_reach")
         )
 
     def _keep(self, answer: SpeedLimit) -> SpeedLimit:

@@ -19,7 +19,7 @@ from impact_balance.criteria.velocity_limit import LimitStatus
 __all__ = ["Binding", "SpeedLimit"]
 
 #: Which impact model gave a governor's maximum: "floating" (the paper's) or "contact_aware".
-Binding = Literal["floating", "contact_aware"]
+Binding = Literal["floating", "contact_aware", "com_reach"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -56,7 +56,9 @@ class SpeedLimit:
             one unless the governor is ``contact_aware``) or "contact_aware" (then
             ``limiting_vertex`` is the row of its jump rates, ``ContactAwareAnswer.rates``:
             0 / 1 the lower / upper restitution bound with one start, else one row per
-            solution found, ``ContactAwareAnswer.restitution`` giving each row's bound).
+            solution found, ``ContactAwareAnswer.restitution`` giving each row's bound), or
+            "com_reach" (a governor with ``com_reach``: the maximum within the CoM's reach was
+            smaller; ``limiting_vertex`` and ``limiting_edge`` are then the criterion's own).
         rates_age: The contact-aware rates' age in postures (posture evaluations since the
             one they were computed for; 0: this posture's); None without contact-aware rates.
         rates_age_seconds: Their age in seconds (since the governor was given the posture

@@ -1,7 +1,8 @@
-"""The governor's options: its criterion and the contact-aware model's settings.
+"""The governor's options: its criterion, the contact-aware model's settings, the CoM's reach.
 
 A :class:`~impact_balance.governor.Governor` takes a criterion (:data:`Criterion`), a posture
-tolerance and, to opt in to the contact-aware impact model, a :class:`ContactAwareOptions`.
+tolerance, to opt in to the contact-aware impact model a :class:`ContactAwareOptions`, and to
+cap within the CoM's reach a reach (:func:`reach_option`).
 The margins are not options: the ZMP margin (m) and the velocity margin (m/s) are the
 scenario's own keys, as :func:`~impact_balance.analyze` reads them.
 """
@@ -11,9 +12,13 @@ from __future__ import annotations
 import math
 import numbers
 from dataclasses import dataclass
-from typing import Literal, get_args
+from typing import TYPE_CHECKING, Literal, get_args
 
 from impact_balance.exceptions import GovernorError
+
+if TYPE_CHECKING:
+    from impact_balance.balance.reach import ComReach, ReachOptions
+    from impact_balance.contacts.stance import Stance
 
 __all__ = [
     "CRITERIA",
@@ -23,6 +28,7 @@ __all__ = [
     "Criterion",
     "OnStale",
     "Starts",
+    "reach_option",
 ]
 
 #: A governor's criterion: "com", the CoM velocity area (the paper's); "zmp", the predicted
@@ -113,3 +119,37 @@ class ContactAwareOptions:
             raise GovernorError(
                 "contact_aware.on_stale", self.on_stale, f"must be one of {', '.join(ON_STALE)}"
             )
+
+
+def reach_option(
+    value: ComReach | ReachOptions | bool | None, criterion: Criterion, stance: Stance
+) -> ComReach | None:
+    """The CoM's reach a governor caps within, from its ``com_reach`` argument.
+
+    Args:
+        value: None or False (no reach); True (:func:`~impact_balance.balance.reach.com_reach`
+            of ``stance`` with the default search, a few seconds); a
+            :class:`~impact_balance.balance.reach.ReachOptions` (that search of ``stance``); or
+            a :class:`~impact_balance.balance.reach.ComReach` already computed (used as is).
+        criterion: The governor's criterion (the reach needs "com").
+        stance: The stance the governor is built on (its initial posture and contacts).
+
+    Returns:
+        The reach, or None.
+
+    Raises:
+        GovernorError: another type, or a reach with the "zmp" criterion (field ``com_reach``).
+    """
+    from impact_balance.balance.reach import ComReach, ReachOptions, com_reach
+
+    if value is None or value is False:
+        return None
+    if not isinstance(value, ComReach | ReachOptions) and value is not True:
+        raise GovernorError(
+            "com_reach", value, "must be True, False, None, a ReachOptions or a ComReach"
+        )
+    if criterion != "com":
+        raise GovernorError("com_reach", value, 'the reach caps the "com" criterion only')
+    if isinstance(value, ComReach):
+        return value
+    return com_reach(stance, None if value is True else value)

@@ -71,6 +71,7 @@ class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
     """
 
     w_results: viser.GuiHtmlHandle
+    w_com_reach: viser.GuiButtonHandle
     w_shared_session: viser.GuiHtmlHandle
     w_view2d: viser.GuiHtmlHandle
 
@@ -153,6 +154,13 @@ class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
         gui.set_panel_label("impact-balance")
         self.w_results = gui.add_html("")
         self.w_shared_session = gui.add_html(SHARED_SESSION_NOTE)
+        # On demand only (whole-body IK, seconds): cleared by an edit that changes the stance.
+        self.w_com_reach = gui.add_button(
+            "CoM reach",
+            hint="Compute how far the CoM moves at its height with every contact kept (a few "
+            "seconds) and draw it; an edit that moves the stance clears it",
+        )
+        self.w_com_reach.on_click(self._on_com_reach)
         tabs = gui.add_tab_group()
         with tabs.add_tab("Impact"):
             self._build_impact()
@@ -171,6 +179,10 @@ class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
         panel.dock_right()
         panel.set_width(440)
 
+    def _on_com_reach(self, _: object) -> None:
+        """The "CoM reach" button: compute the reach of the current stance, then redraw."""
+        self.edit(lambda: self.session.compute_reach())
+
     # -- refresh: widgets <- session, then redraw ----------------------------------------
     def refresh(self, t0: float | None = None) -> None:
         """Put every widget in line with the session and redraw (call with the session lock held).
@@ -187,7 +199,10 @@ class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
                 self._draw_robot(self.w_opacity.value)
                 self._draw_objects()
                 self._draw_gizmos(bool(self.w_gizmos.value))
-                self.w_view2d.content = svg_view(self.session.analysis)
+                reach = self.session.reach
+                self.w_view2d.content = svg_view(
+                    self.session.analysis, reach=None if reach is None else reach.reach
+                )
                 self.last_update_ms = 1e3 * (time.perf_counter() - t0)
                 self.update_times_ms.append(self.last_update_ms)
                 self.w_results.content = self._results_html()

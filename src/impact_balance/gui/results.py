@@ -3,7 +3,8 @@
 Every text from the scenario or a message is escaped, and lengths are capped (a warning at 300
 characters, ten warnings, a message at 400 characters); no file content is shown. The elements
 a test or a user script reads carry ids (``ib-verdict``, ``ib-vmax-com``, ``ib-vmax-zmp``,
-``ib-reference``, ``ib-governor-*``, ``ib-update-ms``, ``ib-warnings``, ``ib-message``).
+``ib-vmax-reach`` (after the "CoM reach" button), ``ib-reference``, ``ib-governor-*``,
+``ib-update-ms``, ``ib-warnings``, ``ib-message``).
 """
 
 from __future__ import annotations
@@ -101,6 +102,12 @@ def results_html(session: Session, last_update_ms: float) -> str:
         rows.append(f'<div style="color:{color};font-size:0.85em">{html.escape(s.verdict)}</div>')
     rows.append('<table style="font-size:0.9em;margin-top:4px;width:100%">')
     rows += _speed_rows(s)
+    if session.reach is not None and session.reach.max_contact_velocity is not None:
+        rows.append(
+            f"<tr><td>&nbsp;&nbsp;within the CoM's reach</td><td {_RIGHT}>"
+            f'<b id="ib-vmax-reach">'
+            f"{html.escape(format_speed(session.reach.max_contact_velocity))}</b></td></tr>"
+        )
     if session.governed is not None:
         rows += _governor_rows(session.governed)
     rows.append(

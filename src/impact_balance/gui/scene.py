@@ -8,6 +8,7 @@ Names are stable ("contacts/0/outline", "impact/cone"...) so that a redraw repla
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
@@ -16,6 +17,9 @@ from impact_balance.analysis.analyze import Analysis
 from impact_balance.contacts.stance import Stance
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.impact.model import ImpactModel
+
+if TYPE_CHECKING:
+    from impact_balance.balance.reach import ComReach
 
 __all__ = [
     "COLORS",
@@ -43,6 +47,7 @@ COLORS = {
     "impact_normal": "#d62728",
     "cone": "#d62728",
     "impulse": "#ff7f0e",
+    "com_reach": "#9467bd",
 }
 #: Length of the drawn friction cone along the normal, m.
 CONE_LENGTH = 0.15
@@ -271,7 +276,7 @@ def _impact_objects(model: ImpactModel) -> list[SceneObject]:
     return out
 
 
-def scene_objects(analysis: Analysis) -> list[SceneObject]:
+def scene_objects(analysis: Analysis, reach: ComReach | None = None) -> list[SceneObject]:
     """Everything the 3D view shows besides the robot, by stable name.
 
     - ``contacts/<i>/outline``, ``contacts/<i>/normal``: each contact rectangle on its surface
@@ -287,9 +292,12 @@ def scene_objects(analysis: Analysis) -> list[SceneObject]:
       longest is :data:`IMPULSE_LENGTH` (the set's shape does not depend on the approach
       speed), and ``impact/impulse_set_hi`` / ``_lo``: their ends on the two restitution
       planes.
+    - ``com_reach/outline``: with ``reach``, the CoM's reach ``c + R(a) u(a)`` around the CoM's
+      projection, on the ZMP plane (:mod:`impact_balance.balance.reach`).
 
     Args:
         analysis: The analysis to draw.
+        reach: The CoM's reach of the analysis's stance, or None.
 
     Returns:
         The scene objects, world coordinates, m.
@@ -303,4 +311,9 @@ def scene_objects(analysis: Analysis) -> list[SceneObject]:
     )
     if analysis.impact is not None:
         out += _impact_objects(analysis.impact.model)
+    if reach is not None:
+        outline = _on_plane(reach.polygon(areas.com), h + 2 * PLANE_LIFT)
+        out.append(
+            Segments("com_reach/outline", polyline_segments(outline), COLORS["com_reach"], 0.005)
+        )
     return out

@@ -29,6 +29,8 @@ from impact_balance.gui.state import DEFAULT_SCENARIO, FieldPath, GuiState
 from impact_balance.gui.workspace import Workspace
 
 if TYPE_CHECKING:
+    from impact_balance.analysis.reach import ReachAnswer
+    from impact_balance.balance.reach import ComReach, ReachOptions
     from impact_balance.governor import Governor
 
 __all__ = ["Governed", "Session", "Summary", "format_speed"]
@@ -128,6 +130,8 @@ class Session:
         refused: Whether the last edit was refused.
         analysis_ms: Wall time of the last successful validation + analysis, ms.
         lock: Re-entrant lock held during every edit (the app holds it while redrawing).
+        reach: The CoM's reach of the current stance and what it limits (:meth:`compute_reach`;
+            None until asked, and again after an edit that changes the stance).
     """
 
     def __init__(
@@ -152,6 +156,8 @@ class Session:
         #: :meth:`_govern`.
         self.governed: Governed | None = None
         self._govern()
+        self.reach: ReachAnswer | None = None
+        self._reach_of: tuple[str, bytes, str] | None = None  # the stance of ``reach``
 
     # -- edits ----------------------------------------------------------------------------
     def _commit(self, build: Callable[[], GuiState], note: str | None = None) -> bool:
@@ -173,6 +179,7 @@ class Session:
             self.message, self.refused = note, False
             self.revision += 1
             self._govern()
+            self._follow_reach()
             return True
 
     def _govern(self) -> None:
@@ -212,6 +219,47 @@ class Session:
             None if reference is None else float(-np.dot(reference, limit.normal)),
             None if capped is None else float(-np.dot(capped, limit.normal)),
         )
+
+    def compute_reach(self, options: ReachOptions | None = None) -> bool:
+        """The CoM's reach of the current stance into :attr:`reach` (whole-body IK: seconds).
+
+        :func:`~impact_balance.analysis.reach.reach_answer` of the current analysis, with the
+        search ``options`` (None: the default search). An edit that keeps the stance (robot,
+        configuration, contact frames) keeps the reach and answers again with it; one that
+        changes the stance clears it. Returns False (and :attr:`message`) when the search
+        fails.
+        """
+        from impact_balance.analysis.reach import reach_answer
+
+        with self.lock:
+            try:
+                answer = reach_answer(self.analysis, options)
+            except ImpactBalanceError as exc:
+                self.message, self.refused = describe(exc, self.files.workspace), True
+                return False
+            except Exception as exc:
+                log.exception("unexpected error while computing the CoM's reach")
+                self.message, self.refused = describe(exc), True
+                return False
+            self.reach, self._reach_of = answer, _stance_key(self.analysis)
+            radii = answer.reach.radii
+            self.message = (
+                f"CoM reach at constant height: {1000 * radii.min():.0f} to "
+                f"{1000 * radii.max():.0f} mm"
+            )
+            return True
+
+    def _follow_reach(self) -> None:
+        """After an edit: keep the reach for the same stance (answered again), else clear it."""
+        if self.reach is None:
+            return
+        if _stance_key(self.analysis) != self._reach_of:
+            self.reach = self._reach_of = None
+            return
+        from impact_balance.analysis.reach import reach_answer
+
+        kept: ComReach = self.reach.reach
+        self.reach = reach_answer(self.analysis, reach=kept)
 
     def refuse(self, message: str) -> None:
         """Show ``message`` as a refusal (an upload cut while it arrived); the state is kept."""
@@ -324,3 +372,10 @@ class Session:
     def summary(self) -> Summary:
         """The numbers shown for the current analysis."""
         return Summary.of(self.analysis)
+
+
+def _stance_key(analysis: Analysis) -> tuple[str, bytes, str]:
+    """What the CoM's reach depends on: the robot, the configuration, the contact frames."""
+    stance = analysis.stance
+    contacts = repr([(c.spec.frame, c.spec.offset.homogeneous.tobytes()) for c in stance.contacts])
+    return stance.robot.name, np.asarray(stance.q, dtype=float).tobytes(), contacts

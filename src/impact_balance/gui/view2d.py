@@ -5,7 +5,8 @@ drawn crisply by the browser at any size.
 Top panel: the CoM velocity area (m/s), the pre-impact CoM velocity, the post-impact CoM
 velocity set at the maximum contact velocity, and the set at the reference velocity (red
 when the robot would fall, green otherwise). Bottom panel: the ZMP support area (m), the
-contact rectangles projected on its plane and the CoM projection.
+contact rectangles projected on its plane, the CoM projection and, when computed, the CoM's
+reach around it.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import html
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
@@ -21,6 +23,9 @@ import numpy.typing as npt
 from impact_balance.analysis.result import Analysis, ImpactAnswer
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.gui.session import Summary, format_speed
+
+if TYPE_CHECKING:
+    from impact_balance.balance.reach import ComReach
 
 __all__ = ["PANEL_COLORS", "svg_view"]
 
@@ -37,6 +42,7 @@ PANEL_COLORS = {
     "limit": "#f2b705",
     "grid": "#e3e3e3",
     "axis": "#888888",
+    "com_reach": "#9467bd",
 }
 
 
@@ -413,11 +419,13 @@ def _com_velocity_panel(
     return parts, y
 
 
-def _zmp_panel(analysis: Analysis, layout: _Layout, y: float) -> tuple[list[str], float]:
+def _zmp_panel(
+    analysis: Analysis, layout: _Layout, y: float, reach: ComReach | None = None
+) -> tuple[list[str], float]:
     """The bottom panel from ``y`` (px) down, and the next free y.
 
     Its title, the ZMP support area (m), the contact rectangles projected on its plane, the
-    CoM projection, and its legend.
+    CoM's reach (when given), the CoM projection, and its legend.
     """
     areas = analysis.areas
     shrunk = f", shrunk by {areas.zmp_margin * 100:g} cm" if areas.zmp_margin > 0 else ""
@@ -451,6 +459,25 @@ def _zmp_panel(analysis: Analysis, layout: _Layout, y: float) -> tuple[list[str]
             ("fill", PANEL_COLORS["zmp"], f"ZMP support area ({zmp.area * 1e4:.0f} cm²){clipped}")
         )
     com = np.asarray(areas.com, dtype=float)[:2]
+    if reach is not None:
+        bottom.polygon(
+            reach.polygon(com),
+            "none",
+            PANEL_COLORS["com_reach"],
+            0.0,
+            1.6,
+            dash="2 2",
+            fill_none=True,
+        )
+        radii = reach.radii
+        legend.append(
+            (
+                "dash",
+                PANEL_COLORS["com_reach"],
+                f"CoM reach at constant height ({1000 * radii.min():.0f} to "
+                f"{1000 * radii.max():.0f} mm)",
+            )
+        )
     bottom.dot(com, PANEL_COLORS["com"], 4, "white", 2)
     legend.append(("dot", PANEL_COLORS["com"], f"CoM projection ({com[0]:.3f}, {com[1]:.3f}) m"))
     parts.append(bottom.render(("x (m)", "y (m)")))
@@ -462,12 +489,14 @@ def _zmp_panel(analysis: Analysis, layout: _Layout, y: float) -> tuple[list[str]
     return parts, y
 
 
-def svg_view(analysis: Analysis, width: int = 420) -> str:
+def svg_view(analysis: Analysis, width: int = 420, reach: ComReach | None = None) -> str:
     """The 2D view of ``analysis`` as an ``<svg>`` element (scales to its container's width).
 
     Args:
         analysis: The analysis to draw.
         width: Width of the drawing's view box, px (the height follows).
+        reach: The CoM's reach of the analysis's stance, drawn around the CoM projection in
+            the ZMP panel (:meth:`~impact_balance.balance.reach.ComReach.polygon`); None: not.
 
     Returns:
         An HTML ``<div>`` holding the ``<svg>``; text from the scenario is escaped.
@@ -476,7 +505,7 @@ def svg_view(analysis: Analysis, width: int = 420) -> str:
     layout = _Layout(width)
     parts = _header(summary, layout, 18)
     top, y = _com_velocity_panel(analysis, summary, layout, 18 + 14)
-    bottom, y = _zmp_panel(analysis, layout, y + 6)
+    bottom, y = _zmp_panel(analysis, layout, y + 6, reach)
     height = int(y + 4)
     # Inside a box that keeps clear of the panel's scroll bar, which would cover the right
     # edge of the drawing (the maxima and the x labels).

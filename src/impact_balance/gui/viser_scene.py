@@ -151,7 +151,8 @@ class SceneMixin(GuiHost):
         """Draw :func:`scene_objects`: skip unchanged objects, update changed ones in place."""
         scene = self.server.scene
         seen: set[str] = set()
-        for obj in scene_objects(self.session.analysis):
+        reach = self.session.reach
+        for obj in scene_objects(self.session.analysis, None if reach is None else reach.reach):
             name = f"/analysis/{obj.name}"
             data = _geometry(obj)
             if data is None:

@@ -29,6 +29,14 @@ bracket (``survived <= default <= fell``), ``optimistic`` by ``1 - fell / defaul
 fell below the prediction, ``conservative`` by ``survived / default - 1`` when it stood above it,
 and ``inconclusive`` when no trial fell (the bracket is open above; the fastest measured speed is
 named) or there is no prediction.
+
+With the CoM's reach (``validate(..., com_reach=True)``, ``validate --com-reach``), the reach of
+the scenario's stance is computed once before the trials
+(:func:`~impact_balance.analysis.reach.reach_answer`, the analysis of ``default``: the scoring ZMP
+margin, a CoM at rest), and the prediction the verdict compares with is the default's maximum
+contact velocity within reach (``predicted.com_reach.max_contact_velocity``); each trial's
+``com_reach_safe`` calls its measured speed against it. The search is unchanged (it starts at the
+CoM criterion's prediction without margin).
 """
 
 from __future__ import annotations
@@ -41,6 +49,9 @@ from typing import Any
 import numpy as np
 
 from impact_balance.analysis.analyze import analyze
+from impact_balance.analysis.reach import ReachAnswer, reach_answer
+from impact_balance.analysis.result import Analysis
+from impact_balance.balance.reach import ReachOptions
 from impact_balance.exceptions import SimulationError
 from impact_balance.impact.model import INERTIA_MODELS
 from impact_balance.json_values import json_number
@@ -103,15 +114,22 @@ def default_prediction(scenario: Scenario, zmp_margin: float) -> float | None:
     damping time (:attr:`~impact_balance.analysis.result.ImpactAnswer.default`), the ZMP support
     area shrunk by ``zmp_margin`` (m), from a CoM at rest (the trials start at rest).
     """
+    answer = _default_analysis(scenario, zmp_margin).impact
+    assert answer is not None  # _default_analysis refuses a scenario without an impact
+    return json_number(answer.default.max_contact_velocity)  # with the angular momentum when set
+
+
+def _default_analysis(scenario: Scenario, zmp_margin: float) -> Analysis:
+    """What :func:`default_prediction` answers from: ZMP margin ``zmp_margin`` (m), CoM at rest."""
     if scenario.impact is None:
         raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact")
     variant = scenario.model_copy(
         update={"zmp_margin": float(zmp_margin), "com_velocity": (0.0, 0.0)}
     )
-    answer = analyze(variant).impact
-    if answer is None:
+    analysis = analyze(variant)
+    if analysis.impact is None:
         raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact")
-    return json_number(answer.default.max_contact_velocity)  # with the angular momentum when set
+    return analysis
 
 
 @dataclass(kw_only=True)
@@ -236,6 +254,17 @@ class ValidationResult:
     reused: int = 0
     extra: dict[str, Any] = field(default_factory=dict)
     default: float | None = None
+    reach: ReachAnswer | None = None
+
+    @property
+    def scored_against(self) -> float | None:
+        """The prediction the verdict compares with (m/s; None if unbounded).
+
+        ``default``, or with the CoM's reach its maximum contact velocity within reach.
+        """
+        if self.reach is None:
+            return self.default
+        return json_number(self.reach.max_contact_velocity)
 
     @property
     def scored(self) -> list[ValidationTrial]:
@@ -363,16 +392,27 @@ class ValidationResult:
                     "trial": s,
                 }
             )
+            if self.reach is not None:  # the measured speed against the maximum within reach
+                within = self.scored_against
+                trials[-1]["com_reach_safe"] = (
+                    None if t.measured is None or within is None else bool(t.measured <= within)
+                )
         empirical = {**self.bracket(), "tolerance": self.tolerance, "max_speed": self.max_speed}
         verdict = fall_verdict(
-            empirical["survived"], empirical["fell"], self.default, empirical["fastest_measured"]
+            empirical["survived"],
+            empirical["fell"],
+            self.scored_against,
+            empirical["fastest_measured"],
         )
+        predicted = {**self.predicted, "default": self.default}
+        if self.reach is not None:
+            predicted["com_reach"] = self.reach.to_dict()
         return {
             "scenario": self.scenario,
             "joints": self.joints,
             "rigid_impact": self.rigid_impact,
             "zmp_margin": self.zmp_margin,
-            "predicted": {**self.predicted, "default": self.default},
+            "predicted": predicted,
             "predicted_with_margin": self.predicted_with_margin,
             "empirical": empirical,
             "verdict": verdict,
@@ -560,6 +600,7 @@ def validate(
     setup: BalanceSetup | None = None,
     zmp_margin: float | None = None,
     journal: TrialJournal | None = None,
+    com_reach: ReachOptions | bool = False,
 ) -> ValidationResult:
     """Bracket the approach speed at which the robot starts to fall (m/s); see the module docstring.
 
@@ -567,7 +608,10 @@ def validate(
     commanded speed until the outcome changes, then bisects until
     ``fell - stood <= tolerance * fell`` (commanded). If the robot stands at ``max_speed`` (or falls
     at ``min_speed``), or a trial is aborted, the bracket stays open on that side.
-    ``progress(trial, stood, fell)`` is called after every trial.
+    ``progress(trial, stood, fell)`` is called after every trial. ``com_reach`` (True: the
+    default :class:`~impact_balance.balance.reach.ReachOptions`; or the options) computes the
+    CoM's reach once, before the trials, and scores the verdict against the maximum contact
+    velocity within it (see the module docstring).
     """
     wall0 = time.perf_counter()
     if not isinstance(scenario, Scenario):
@@ -581,6 +625,10 @@ def validate(
     margin = controller_margin(options) if zmp_margin is None else float(zmp_margin)
     predicted = predictions(scenario)
     with_margin = predictions(scenario, margin)
+    reach = None
+    if com_reach is not False:
+        options_reach = None if com_reach is True else com_reach
+        reach = reach_answer(_default_analysis(scenario, margin), options_reach)
     setup = setup or BalanceSetup.create(scenario, joints, options)
     runner = _TrialRunner(setup, options, journal or TrialJournal(None, ""))
     start = predicted["com_criterion"]["composite"] or 0.5
@@ -612,4 +660,5 @@ def validate(
         reused,
         {"setup": setup},
         default_prediction(scenario, margin),
+        reach,
     )
