@@ -5,6 +5,7 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -78,3 +79,17 @@ def test_lift_off_and_falling_starts_are_the_array_formula():
         statuses.add((got.status, got.limiting_edge is None))
     assert ("ok", True) in statuses  # the lift-off bound was among them
     assert ("already_falling", True) in statuses
+
+
+@pytest.mark.parametrize(
+    "vertices",
+    [np.array([[-0.1, 0.0], [0.1, 0.02]]), np.array([[0.01, -0.02]])],
+    ids=["segment", "point"],
+)
+def test_a_segment_or_a_point_is_the_array_formula(vertices):
+    area = Polygon(vertices)
+    rows = np.array([[1.0, 0.5, 3.0], [-2.0, 0.0, -30.0], [0.0, -1.0, 2.0]])
+    for com in ([0.0, 0.0, 0.9], [0.01, -0.02, 0.9]):
+        impact = SimpleNamespace(mass=60.0, point=np.array([0.3, 0.0, 1.0]), impulse_rates=rows)
+        got = zmp_max_contact_velocity(area, impact, np.array(com), 0.0, 9.81, 0.01)
+        assert got == array_formula(Polygon(vertices), impact, com, 0.0, 9.81, 0.01)

@@ -21,7 +21,8 @@ from impact_balance.criteria import linear_exit
 from impact_balance.criteria.criterion import CriterionName
 from impact_balance.criteria.linear_exit import BOUNDARY_TOLERANCE, exit_kernel, limit_of_exit
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
-from impact_balance.geometry.polygon import Polygon
+from impact_balance.geometry import polygon
+from impact_balance.geometry.polygon import Polygon, edge_halfplanes
 from impact_balance.impact.model import ImpactModel
 
 __all__ = ["ZmpCriterion", "zmp_exit_kernel", "zmp_max_contact_velocity"]
@@ -104,13 +105,18 @@ def zmp_max_contact_velocity(
     """
     if zmp_area.is_empty:
         return ContactVelocityLimit(0.0, "cannot_balance")
-    G, h = zmp_area.halfplanes
     c = np.asarray(com, dtype=float)
-    code, speed, j, k = zmp_exit_kernel(
-        G, h, float(impact.mass * gravity), np.ascontiguousarray(impact.point, dtype=float),
+    rest = (
+        float(impact.mass * gravity), np.ascontiguousarray(impact.point, dtype=float),
         float(c[0]), float(c[1]), float(plane_height), float(duration),
         np.ascontiguousarray(impact.impulse_rates, dtype=float), BOUNDARY_TOLERANCE,
     )  # fmt: skip
+    vertices = zmp_area.vertices
+    if len(vertices) >= 3:  # the half-planes in the same call: the polygon's own numbers
+        code, speed, j, k = _area_exit(np.ascontiguousarray(vertices, dtype=float), *rest)
+    else:  # a segment's or a point's bounds
+        G, h = zmp_area.halfplanes
+        code, speed, j, k = zmp_exit_kernel(G, h, *rest)
     if code == 0 and k < 0:  # the lift-off bound: no limiting edge
         return ContactVelocityLimit(speed, "ok", j, None)
     return limit_of_exit(code, speed, j, k)
@@ -190,4 +196,26 @@ def zmp_exit_kernel(
     return code, speed, vertex, edge
 
 
+@njit(cache=True)
+def _area_exit(
+    vertices: np.ndarray,
+    weight: float,
+    point: np.ndarray,
+    cx: float,
+    cy: float,
+    plane_height: float,
+    duration: float,
+    impulse_rates: np.ndarray,
+    tol: float,
+) -> tuple[int, float, int, int]:
+    """:func:`zmp_exit_kernel` of the polygon of ``vertices`` (k >= 3, CCW).
+
+    Its half-planes are :func:`~impact_balance.geometry.polygon.edge_halfplanes`' (the
+    polygon's :attr:`~impact_balance.geometry.polygon.Polygon.halfplanes`).
+    """
+    G, h = edge_halfplanes(vertices)
+    return zmp_exit_kernel(G, h, weight, point, cx, cy, plane_height, duration, impulse_rates, tol)
+
+
 cache_depends_on(zmp_exit_kernel, linear_exit)
+cache_depends_on(_area_exit, linear_exit, polygon)
