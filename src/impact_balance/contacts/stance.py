@@ -8,6 +8,7 @@ constraint, area and impact steps.
 from __future__ import annotations
 
 import functools
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -29,9 +30,25 @@ __all__ = [
 _IDENTITY = pin.SE3.Identity()
 
 
+#: :func:`has_free_flyer`'s answers by model (``id``): the model (weakly) and its joint count
+#: when answered, and the answer.
+_FREE_FLYER: dict[int, tuple[weakref.ref[pin.Model], int, bool]] = {}
+
+
 def has_free_flyer(model: pin.Model) -> bool:
-    """Whether the model's first joint is a free flyer (then q[:3] is the base position)."""
-    return bool(model.njoints > 1 and model.joints[1].shortname() == "JointModelFreeFlyer")
+    """Whether the model's first joint is a free flyer (then q[:3] is the base position).
+
+    Answered once per model (and joint count): every stance asks it.
+    """
+    entry = _FREE_FLYER.get(id(model))
+    njoints = model.njoints
+    if entry is not None and entry[0]() is model and entry[1] == njoints:
+        return entry[2]
+    answer = bool(njoints > 1 and model.joints[1].shortname() == "JointModelFreeFlyer")
+    if len(_FREE_FLYER) >= 64:
+        _FREE_FLYER.clear()
+    _FREE_FLYER[id(model)] = (weakref.ref(model), njoints, answer)
+    return answer
 
 
 def frame_point(
