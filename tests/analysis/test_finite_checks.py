@@ -61,3 +61,21 @@ def test_huge_vertices_fail_on_their_squared_size():
     assert not pipeline._posture_finite(stance, areas, model)
     with pytest.raises(NonFiniteResultError, match="zmp_area"):
         pipeline._check_finite(pipeline._area_checks(stance, areas))
+
+
+def test_strided_arrays_are_checked_alike():
+    rows = np.arange(24.0).reshape(4, 6)
+    stance = SimpleNamespace(com=rows[0, ::2])  # strided views, a transposed W
+    areas = SimpleNamespace(
+        omega=3.0,
+        zmp_area=Polygon(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])),
+        com_velocity_area=Polygon(np.array([[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]])),
+    )
+    W = np.eye(3).T
+    model = SimpleNamespace(point=rows[1, 1::2], W=W, impulse_rates=rows[:, :3])
+    assert pipeline._posture_finite(stance, areas, model)
+    rows[3, 2] = np.inf  # in the impulse rates' view
+    assert not pipeline._posture_finite(stance, areas, model)
+    checks = pipeline._area_checks(stance, areas) + pipeline._impact_checks(model)
+    with pytest.raises(NonFiniteResultError, match=r"impact\.impulse_vertices"):
+        pipeline._check_finite(checks)

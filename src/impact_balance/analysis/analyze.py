@@ -545,16 +545,30 @@ def _finite_kernel(
     The squared size of ``zmp`` and ``velocity`` (vertices) is ``v @ v`` of the raveled
     vertices, BLAS's dot, as :func:`_squared_size`.
     """
-    if not math.isfinite(omega):
-        return False
-    for values in (com, point, W.ravel(), impulse_rates.ravel()):
-        for x in values:
-            if not math.isfinite(x):
-                return False
-    for vertices in (zmp.ravel(), velocity.ravel()):
-        if vertices.size and not math.isfinite(np.dot(vertices, vertices)):
+    return (
+        math.isfinite(omega)
+        and _all_finite(com)
+        and _all_finite(point)
+        and _all_finite(W.ravel())
+        and _all_finite(impulse_rates.ravel())
+        and _finite_size(zmp.ravel())
+        and _finite_size(velocity.ravel())
+    )
+
+
+@njit(cache=True)
+def _all_finite(values: np.ndarray) -> bool:
+    """Whether every number of ``values`` (1-d) is finite."""
+    for x in values:
+        if not math.isfinite(x):
             return False
     return True
+
+
+@njit(cache=True)
+def _finite_size(vertices: np.ndarray) -> bool:
+    """Whether the squared size ``v @ v`` of the raveled ``vertices`` is finite (BLAS's dot)."""
+    return vertices.size == 0 or math.isfinite(np.dot(vertices, vertices))
 
 
 def _check_finite(checks: list[tuple[str, Any, tuple[str, ...]]]) -> None:
