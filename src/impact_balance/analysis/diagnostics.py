@@ -168,6 +168,8 @@ def _surely_upright(stance: Stance) -> bool:
     feet = stance.robot.foot_frames
     if not feet:
         return True
+    if len(stance.contacts) < len(feet):  # a foot in the air
+        return False
     points = {c.spec.frame: c.local_position for c in stance.contacts if c.spec.offset == _IDENTITY}
     x = y = z = 0.0
     for frame in feet:
