@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import time
@@ -10,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from impact_balance._jit import KernelClock
+from impact_balance._jit import HAVE_NUMBA, KernelClock, njit
 from impact_balance.analysis.diagnostics import diagnose
 from impact_balance.analysis.result import Analysis, ImpactAnswer
 from impact_balance.balance.areas import (
@@ -117,10 +118,11 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
             areas = with_reason(areas, stance, scenario.torque_limits, scenario.gravity)
             timings["diagnosis"] = clock.now() - t3
             t3 = clock.now()
-        checks = _area_checks(stance, areas)
-        if model is not None:  # the compiled posture's: checked with the areas (after them)
-            checks += _impact_checks(model)
-        _check_finite(checks)
+        if model is None or not _posture_finite(stance, areas, model):
+            checks = _area_checks(stance, areas)
+            if model is not None:  # the compiled posture's: checked with the areas (after them)
+                checks += _impact_checks(model)
+            _check_finite(checks)  # names the first non-finite result
         answer = None
         if scenario.impact is not None:
             answer = _answer(scenario, stance, areas, model, criterion, polytope if qp else None)
@@ -508,6 +510,65 @@ def _impact_checks(model: ImpactModel) -> list[tuple[str, Any, tuple[str, ...]]]
         ("impact.W", model.W, ("impact.offset",)),
         ("impact.impulse_vertices", model.impulse_rates, ("impact.offset", "impact.friction")),
     ]
+
+
+def _posture_finite(stance: Stance, areas: BalanceAreas, model: ImpactModel) -> bool:
+    """Whether :func:`_check_finite` of the areas' and the model's checks passes, in one call.
+
+    :func:`_finite_kernel` on the values of :func:`_area_checks` and :func:`_impact_checks`:
+    False exactly where :func:`_check_finite` raises (its caller then calls it, to name the
+    field).
+    """
+    # interpreted (without numba), numpy's dot warns of the overflow it reports
+    quiet = contextlib.nullcontext() if HAVE_NUMBA else np.errstate(over="ignore", invalid="ignore")
+    with quiet:
+        return bool(
+            _finite_kernel(
+                stance.com, float(areas.omega), areas.zmp_area.vertices,
+                areas.com_velocity_area.vertices, model.point, model.W, model.impulse_rates,
+            )
+        )  # fmt: skip
+
+
+@njit(cache=True)
+def _finite_kernel(
+    com: np.ndarray,
+    omega: float,
+    zmp: np.ndarray,
+    velocity: np.ndarray,
+    point: np.ndarray,
+    W: np.ndarray,
+    impulse_rates: np.ndarray,
+) -> bool:
+    """Whether every number is finite, and each polygon's squared size.
+
+    The squared size of ``zmp`` and ``velocity`` (vertices) is ``v @ v`` of the raveled
+    vertices, BLAS's dot, as :func:`_squared_size`.
+    """
+    return (
+        math.isfinite(omega)
+        and _all_finite(com)
+        and _all_finite(point)
+        and _all_finite(W.ravel())
+        and _all_finite(impulse_rates.ravel())
+        and _finite_size(zmp.ravel())
+        and _finite_size(velocity.ravel())
+    )
+
+
+@njit(cache=True)
+def _all_finite(values: np.ndarray) -> bool:
+    """Whether every number of ``values`` (1-d) is finite."""
+    for x in values:
+        if not math.isfinite(x):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _finite_size(vertices: np.ndarray) -> bool:
+    """Whether the squared size ``v @ v`` of the raveled ``vertices`` is finite (BLAS's dot)."""
+    return vertices.size == 0 or math.isfinite(np.dot(vertices, vertices))
 
 
 def _check_finite(checks: list[tuple[str, Any, tuple[str, ...]]]) -> None:

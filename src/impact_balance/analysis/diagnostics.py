@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
+import pinocchio as pin
 
 from impact_balance.analysis.result import Diagnostic, ImpactAnswer
 
@@ -56,6 +57,8 @@ __all__ = [
 FLOOR_TILT = 40.0
 #: Least steep wall, degrees from the vertical.
 WALL_TILT = 70.0
+#: The identity pose: a contact without offset sits at its frame's origin.
+_IDENTITY = pin.SE3.Identity()
 #: Relative tolerance under which the QP's approach speed "equals" the reference's.
 _CAP_TOLERANCE = 1e-6
 
@@ -145,11 +148,48 @@ def impact_diagnostics(
     return out
 
 
+#: The robot surely stands when its feet-to-CoM axis, read from the stance, is this close to +z
+#: (a cosine): the up-axis check's 45 degrees, with a margin far above the rounding between the
+#: stance frame's numbers and the check's world ones (see :func:`_surely_upright`).
+_SURELY_UPRIGHT = math.cos(math.radians(45.0)) + 1e-6
+
+
+def _surely_upright(stance: Stance) -> bool:
+    """Whether ``robot_not_z_up`` surely cannot fire at the stance (False: ask the robot).
+
+    True for a robot whose feet are unknown (the check never fires). When every foot frame
+    (:attr:`~impact_balance.robot.robot.Robot.foot_frames`) is a contact of the stance at the
+    frame's own origin (no offset), the feet-to-CoM axis is the stance's CoM less the mean of
+    those contact points (stance frame, m); at least 1 mm long, within 1e6 m of the origin and
+    at least :data:`_SURELY_UPRIGHT` along +z, the robot stands (the check's own numbers, in
+    world coordinates, differ from these by less than 1e-7 in that cosine). Otherwise (a foot
+    in the air or offset, a tilt near the check's) the robot's check answers.
+    """
+    feet = stance.robot.foot_frames
+    if not feet:
+        return True
+    if len(stance.contacts) < len(feet):  # a foot in the air
+        return False
+    points = {c.spec.frame: c.local_position for c in stance.contacts if c.spec.offset == _IDENTITY}
+    x = y = z = 0.0
+    for frame in feet:
+        p = points.get(frame)
+        if p is None:
+            return False
+        x, y, z = x + float(p[0]), y + float(p[1]), z + float(p[2])
+    c, o, n = stance.com_local, stance.origin, len(feet)
+    if not max(abs(float(o[0])), abs(float(o[1])), abs(float(o[2]))) <= 1e6:
+        return False
+    dx, dy, dz = float(c[0]) - x / n, float(c[1]) - y / n, float(c[2]) - z / n
+    length = math.sqrt(dx * dx + dy * dy + dz * dz)
+    return length >= 1e-3 and dz >= _SURELY_UPRIGHT * length
+
+
 def diagnose(
     scenario: Scenario, stance: Stance, impact: ImpactAnswer | None
 ) -> tuple[Diagnostic, ...]:
     """Every warning of one analysis, in scenario order."""
-    problem = stance.robot.up_axis_problem(stance.q)
+    problem = None if _surely_upright(stance) else stance.robot.up_axis_problem(stance.q)
     out = [Diagnostic("robot_not_z_up", "base", problem)] if problem else []
     out += contact_diagnostics(stance)
     if impact is not None and scenario.impact is not None:

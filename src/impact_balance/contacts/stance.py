@@ -8,6 +8,7 @@ constraint, area and impact steps.
 from __future__ import annotations
 
 import functools
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -29,9 +30,25 @@ __all__ = [
 _IDENTITY = pin.SE3.Identity()
 
 
+#: :func:`has_free_flyer`'s answers by model (``id``): the model (weakly) and its joint count
+#: when answered, and the answer.
+_FREE_FLYER: dict[int, tuple[weakref.ref[pin.Model], int, bool]] = {}
+
+
 def has_free_flyer(model: pin.Model) -> bool:
-    """Whether the model's first joint is a free flyer (then q[:3] is the base position)."""
-    return bool(model.njoints > 1 and model.joints[1].shortname() == "JointModelFreeFlyer")
+    """Whether the model's first joint is a free flyer (then q[:3] is the base position).
+
+    Answered once per model (and joint count): every stance asks it.
+    """
+    entry = _FREE_FLYER.get(id(model))
+    njoints = model.njoints
+    if entry is not None and entry[0]() is model and entry[1] == njoints:
+        return entry[2]
+    answer = bool(njoints > 1 and model.joints[1].shortname() == "JointModelFreeFlyer")
+    if len(_FREE_FLYER) >= 64:
+        _FREE_FLYER.clear()
+    _FREE_FLYER[id(model)] = (weakref.ref(model), njoints, answer)
+    return answer
 
 
 def frame_point(
@@ -213,6 +230,46 @@ class Stance:
             self.contacts.append(
                 Contact(spec, placement.rotation.copy(), local + self.origin, jacobian, local)
             )
+
+    def moved_to(self, q: np.ndarray) -> Stance:
+        """This stance's robot and contacts at configuration ``q``: ``Stance(robot, q, specs)``.
+
+        Where ``q`` differs from :attr:`q` only in the free flyer's position ``q[:3]`` (world,
+        m), the kinematics, computed without it in the stance frame, are this stance's: they are
+        copied, not computed again, and the world positions (:attr:`com`, the contacts'
+        ``position``) are the stance frame's plus the new :attr:`origin`, as a new stance makes
+        them (the same numbers). Else a new stance is computed.
+
+        Args:
+            q: Configuration (nq).
+
+        Returns:
+            The stance at ``q`` (it shares no array with this one).
+        """
+        q = np.array(q, dtype=float)
+        if not (
+            has_free_flyer(self.model)
+            and q.shape == self.q.shape
+            and q[3:].tobytes() == self.q[3:].tobytes()
+        ):
+            return Stance(self.robot, q, [c.spec for c in self.contacts], self._scratch)
+        moved = Stance.__new__(Stance)
+        moved.robot, moved._scratch, moved.q = self.robot, self._scratch, q
+        moved.origin = q[:3].copy()
+        moved._q_local = self._q_local.copy()
+        moved.com_local = self.com_local.copy()
+        moved.com = moved.com_local + moved.origin
+        moved.mass = self.mass
+        moved.com_inertia = self.com_inertia.copy()
+        moved.gravity_torques = self.gravity_torques.copy()
+        moved.contacts = []
+        for c in self.contacts:
+            assert c.local_position is not None  # a stance's contacts have it
+            local = np.array(c.local_position, dtype=float)
+            moved.contacts.append(
+                Contact(c.spec, c.rotation.copy(), local + moved.origin, c.jacobian.copy(), local)
+            )
+        return moved
 
     @property
     def model(self) -> pin.Model:

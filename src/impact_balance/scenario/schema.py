@@ -442,7 +442,7 @@ class Scenario(_Model):
             if abs(lift) > 1e-12:
                 q = q.copy()
                 q[2] += lift
-                stance = Stance(robot, q, specs)
+                stance = stance.moved_to(q)  # the same kinematics, lifted
         if not stance.com[2] > self.plane_height:
             raise ScenarioError(
                 "plane_height",
