@@ -20,7 +20,9 @@ error grows with it), which keeps Bland's rule from chasing rounding noise.
 The basis inverse is kept explicitly, updated by the rank-one formula at each pivot and
 recomputed every ``_REFACTOR`` pivots, and in the walk around the polygon whenever it no
 longer solves its system to near rounding or has carried ``_CARRY`` pivots. Without numba
-the same code runs as plain Python.
+the same code runs as plain Python. The helpers the walk calls per pivot, per basis or per row
+are inlined into their callers by numba (``inline="always"``: the same operations in the same
+order, hence the same numbers, without a call and its array arguments each time).
 
 A caller that projects postures in a row keeps a hint: the walk starts from its last optimal
 basis, and first checks whether the last walk's chain of bases (the first and last of each
@@ -90,7 +92,7 @@ _REF_MOVE = 0.2
 _REF_MARGIN = 1e-8
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _column_norm(M, i):
     """Euclidean norm of column i (a strided slice: a loop avoids a copy)."""
     acc = 0.0
@@ -99,7 +101,7 @@ def _column_norm(M, i):
     return math.sqrt(acc)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _norm(v):
     """Euclidean norm (a loop: numba's linalg would add seconds of compile time)."""
     acc = 0.0
@@ -108,7 +110,7 @@ def _norm(v):
     return math.sqrt(acc)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _times(M, v):
     """M v for a 2-D M (a loop, for compile time and no BLAS call on tiny sizes)."""
     out = np.empty(M.shape[0])
@@ -116,7 +118,7 @@ def _times(M, v):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _times_into(M, v, out):
     """Out = M v (out preallocated)."""
     for i in range(M.shape[0]):
@@ -126,7 +128,7 @@ def _times_into(M, v, out):
         out[i] = acc
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _point(g0, GT, z, out, i):
     """``out[i]`` = the projected point g0 + G z (written in place: no allocation per vertex)."""
     y0, y1 = g0[0], g0[1]
@@ -159,7 +161,7 @@ def _ties(j, active, hp, slack, bound):
     return not active[j] and hp[j] > _EPS_PIVOT and max(slack[j], 0.0) / hp[j] <= bound
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _ratio_test(H, h, z, p, active, hp, slack):
     """Largest step along unit ``p`` that keeps ``H z <= h``: (row, step), row -1 if none.
 
@@ -182,7 +184,7 @@ def _ratio_test(H, h, z, p, active, hp, slack):
     return -1, 0.0  # unreachable
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _near(z, zd):
     """Whether |z - zd| <= _D_MOVE (Euclidean)."""
     acc = 0.0
@@ -192,7 +194,7 @@ def _near(z, zd):
     return acc <= _D_MOVE * _D_MOVE
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _ratio_test_near(H, h, z, p, active, hp, slack, zd, dset):
     """:func:`_ratio_test` over the rows listed near z (``dset``, at ``zd``).
 
@@ -216,7 +218,7 @@ def _ratio_test_near(H, h, z, p, active, hp, slack, zd, dset):
     return _ratio_test(H, h, z, p, active, hp, slack)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _min_slack_near(H, h, z, worst, zd, dset):
     """A vertex's feasibility check: ``worst[0]`` = min(worst[0], min_j h_j - H_j z).
 
@@ -249,7 +251,7 @@ def _min_slack_near(H, h, z, worst, zd, dset):
     zd[:] = z
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _project_out(Q, k, v, out):
     """``out`` = v minus its components along the k orthonormal rows of Q; returns |out|."""
     n = Q.shape[1]
@@ -342,7 +344,7 @@ def _crash(H, h, z, W, k, active, c, dc):
     return OK, k
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _invert(B, out):
     """Gauss-Jordan inverse with partial pivoting into ``out`` (B is overwritten).
 
@@ -404,7 +406,7 @@ def _workspace(m, n):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _refactor(H, h, W, Binv, z, work):
     """Recompute the basis inverse and the vertex from scratch; False if singular."""
     n = H.shape[1]
@@ -417,7 +419,7 @@ def _refactor(H, h, W, Binv, z, work):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _pivot(H, h, W, Binv, z, leave, j, since, work):
     """Row ``j`` replaces the basis row in position ``leave``; updates Binv and z in place.
 
@@ -446,7 +448,7 @@ def _pivot(H, h, W, Binv, z, leave, j, since, work):
     return since + 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _accurate(H, h, W, Binv, z, ones):
     """Whether a carried basis inverse still solves its system to near rounding.
 
@@ -473,7 +475,7 @@ def _accurate(H, h, W, Binv, z, ones):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _vertex(h, W, Binv, z):
     """Z = Binv h_W."""
     n = Binv.shape[0]
@@ -507,7 +509,7 @@ def _priced(Binv, i, c, dc, scale):
     return 2, 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _optimal(Binv, c, dc, scale):
     """Whether the basis is lexicographically optimal at theta+: no entering candidate.
 
@@ -519,7 +521,7 @@ def _optimal(Binv, c, dc, scale):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work):
     """Simplex pivots from the vertex basis (W, Binv, z) until it is lexicographically optimal.
 
@@ -576,7 +578,7 @@ def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work):
         since = _pivot(H, h, W, Binv, z, leave, j, since, work)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _arc_end(a, b, theta):
     """Step after theta at which ``a cos + b sin`` turns negative, in (0, 2 pi]."""
     # lambda = rho cos(theta - alpha) turns negative when theta - alpha passes pi/2
@@ -584,7 +586,7 @@ def _arc_end(a, b, theta):
     return 2.0 * math.pi if d < 1e-13 else d
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _breakpoint(Binv, GT, theta, cos_t, sin_t, scale, ab):
     """Smallest angle > theta at which a multiplier of the basis turns negative (inf if none).
 
@@ -711,7 +713,7 @@ def _phase_one(H, h, z, W, active, max_pivots):
     return OK, pivots, k
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _record(H, h, GT, g0, z, worst, ref, vertices, count):
     """Record a re-certified vertex z: ``(count, strict)``, the vertex count after it and its check.
 
@@ -757,7 +759,7 @@ def _record(H, h, GT, g0, z, worst, ref, vertices, count):
     return count, strict
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _directions(GT, theta, c, dc):
     """``c = G^T u(theta)``, ``dc = G^T u'(theta)`` in place; returns (cos theta, sin theta)."""
     cos_t, sin_t = math.cos(theta), math.sin(theta)
@@ -767,7 +769,7 @@ def _directions(GT, theta, c, dc):
     return cos_t, sin_t
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _keep(bases, recorded, W, y, yfirst):
     """One more basis of the walk's chain (optimal at a breakpoint, point y) into ``bases``.
 
@@ -787,7 +789,7 @@ def _keep(bases, recorded, W, y, yfirst):
     return slot + 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _replace(H, h, W, Binv, z, target, work):
     """The basis W turned into ``target`` (n rows): the rank-one pivots made, or -1.
 
@@ -817,7 +819,7 @@ def _replace(H, h, W, Binv, z, target, work):
     return made
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _arc_start(Binv, GT, theta, scale):
     """Where the basis's optimal arc starts in [theta, theta + pi): inf if it has none there.
 
@@ -844,7 +846,7 @@ def _arc_start(Binv, GT, theta, scale):
     return theta + lo if lo <= hi and lo < math.pi else math.inf
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _next_basis(H, h, GT, W, Binv, z, theta, u0, u1, scale, kind, rows, since, work, c, dc):
     """The chain's next basis (``rows``) and the angle it is optimal at: ``(theta, since)``.
 
@@ -883,7 +885,7 @@ def _next_basis(H, h, GT, W, Binv, z, theta, u0, u1, scale, kind, rows, since, w
     return theta, since
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _recertify(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work):
     """The walk's vertices from the last walk's chain of bases (``hint``), if they certify it.
 
@@ -939,7 +941,7 @@ def _recertify(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work):
     return True, vertices, count
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _moved(vertices, i):
     """Whether point i (at ``vertices[i]``, kept or not) is beyond _Y_SAME of point i - 1."""
     return (
@@ -948,13 +950,13 @@ def _moved(vertices, i):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _chain_capacity(hint, n):
     """How many bases (a kind and n rows each) ``hint`` holds after its first n + 3 entries."""
     return max(0, (hint.shape[0] - n - 3) // (n + 1))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _from_chain(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work):
     """:func:`_recertify` when ``hint`` holds a chain for this (m, n): ``(ok, vertices, count)``.
 
@@ -972,7 +974,7 @@ def _from_chain(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work):
     return False, np.empty((0, 2)), 0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _store_chain(hint, bases, recorded):
     """The walk's chain of ``recorded`` bases (:func:`_keep`) into ``hint``, when it fits."""
     capacity, size = bases.shape
