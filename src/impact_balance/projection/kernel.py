@@ -1156,22 +1156,24 @@ def project(A, b, E, x0, N, box, max_pivots, hint):
             if h0[i] < -_EPS_FEASIBLE:
                 return INFEASIBLE, none, 0, 0.0
         else:
-            H[m] = H0[i] / norms[i]
+            for j in range(k):  # element by element: no temporary array per row
+                H[m, j] = H0[i, j] / norms[i]
             h[m] = h0[i] / norms[i]
             m += 1
     # The clipping box: +-G_k z <= box -+ g0_k.
     for i in range(2):
         gk = _norm(G[i])
         if gk > 0.0:
-            H[m] = G[i] / gk
+            for j in range(k):
+                H[m, j] = G[i, j] / gk
+                H[m + 1, j] = -G[i, j] / gk
             h[m] = (box - g0[i]) / gk
-            H[m + 1] = -G[i] / gk
             h[m + 1] = (box + g0[i]) / gk
             m += 2
     worst = np.zeros(1)
-    status, vertices, count, pivots = walk(
-        H[:m].copy(), h[:m].copy(), G.T.copy(), g0, 0.0, max_pivots, worst, hint
-    )
+    if m < H.shape[0]:  # rows dropped (or no box): the walk's arrays are the kept rows
+        H, h = H[:m].copy(), h[:m].copy()
+    status, vertices, count, pivots = walk(H, h, G.T.copy(), g0, 0.0, max_pivots, worst, hint)
     if status != OK:
         return status, none, pivots, worst[0]
     # The caller merges near-duplicate vertices and checks convexity (walk._certify, with the
