@@ -8,11 +8,14 @@ side runs pinocchio (:meth:`PostureEvaluator.kinematics
 step); the areas, the impact model and the criterion of every posture then run in one compiled
 call (:func:`~impact_balance.governor.posture_kernel.postures_kernel`: a tick's
 :func:`~impact_balance.governor.posture_kernel.posture_kernel` per posture, the same numbers),
-which releases the GIL, so ``threads`` > 1 evaluates slices of the postures side by side. A
-posture the compiled call does not answer (a projection Bretl's method answers, an area of fewer
-than 3 vertices, an impact model it refuses), the
-"zmp" criterion, the joint-space inertia model, contact frictions above 1 and the angular
-momentum option (``angular_momentum_damping_time``) take the one-posture path
+which releases the GIL, so ``threads`` > 1 evaluates slices of the postures side by side. The
+rows of a thread share one projection hint, as a governor's successive ticks do: a row's walk
+first re-certifies the previous row's chain of bases, so rows in path order (nearby postures
+one after the other) cost less than the same rows shuffled; the answers do not depend on the
+order. A posture the compiled call does not answer (a projection Bretl's method answers, an
+area of fewer than 3 vertices, an impact model it refuses), the "zmp" criterion, the
+joint-space inertia model, contact frictions above 1 and the angular momentum option
+(``angular_momentum_damping_time``) take the one-posture path
 (:meth:`PostureEvaluator.evaluate <impact_balance.governor.posture.PostureEvaluator.evaluate>`).
 """
 
