@@ -283,3 +283,19 @@ def test_batch_rows_in_any_order_equal_single_ticks(name, n, seed, order):
     analysis = ib.analyze(g.scenario_at(qs[i], in_order.com_velocity[i]))
     want = analysis.impact.max_contact_velocity
     assert in_order.max_contact_velocity[i] == pytest.approx(want, abs=1e-9)
+
+
+def test_the_rows_of_a_batch_share_the_walks_hint():
+    # The batch's evaluator keeps one projection hint for its rows (a governor's ticks keep
+    # theirs): after rows along a path it holds the last walk's start basis and chain of bases.
+    g = Governor("palm_push_two_feet")
+    qs, vs = path(g, 30, 2)
+    g.limits(qs, vs)
+    (evaluator,) = g._batch._evaluators
+    hint = evaluator._hint
+    m, n = int(hint[0]), int(hint[1])
+    assert m > 0 and 0 < n < m
+    assert np.all((hint[2 : n + 2] >= 0) & (hint[2 : n + 2] < m))
+    assert hint[n + 2] > 0  # a chain: the next row re-certifies it before walking
+    # the batch's hint is its own: the governor's ticks keep theirs
+    assert evaluator is not g._evaluator
