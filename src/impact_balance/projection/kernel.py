@@ -20,9 +20,11 @@ error grows with it), which keeps Bland's rule from chasing rounding noise.
 The basis inverse is kept explicitly, updated by the rank-one formula at each pivot and
 recomputed every ``_REFACTOR`` pivots, and in the walk around the polygon whenever it no
 longer solves its system to near rounding or has carried ``_CARRY`` pivots. Without numba
-the same code runs as plain Python. The helpers the walk calls per pivot, per basis or per row
-are inlined into their callers by numba (``inline="always"``: the same operations in the same
-order, hence the same numbers, without a call and its array arguments each time).
+the same code runs as plain Python. The small helpers the walk calls per basis or per vertex
+(the rank-one update, the vertex, the accuracy and optimality checks, the breakpoint, the
+recorded vertex's scan) are inlined into their callers by numba (``inline="always"``: the same
+operations in the same order, hence the same numbers, without a call and its array arguments
+each time); the larger ones are not, which keeps the kernel's compile time.
 
 A caller that projects postures in a row keeps a hint: the walk starts from its last optimal
 basis, and first checks whether the last walk's chain of bases (the first and last of each
@@ -110,7 +112,7 @@ def _norm(v):
     return math.sqrt(acc)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _times(M, v):
     """M v for a 2-D M (a loop, for compile time and no BLAS call on tiny sizes)."""
     out = np.empty(M.shape[0])
@@ -161,7 +163,7 @@ def _ties(j, active, hp, slack, bound):
     return not active[j] and hp[j] > _EPS_PIVOT and max(slack[j], 0.0) / hp[j] <= bound
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _ratio_test(H, h, z, p, active, hp, slack):
     """Largest step along unit ``p`` that keeps ``H z <= h``: (row, step), row -1 if none.
 
@@ -194,7 +196,7 @@ def _near(z, zd):
     return acc <= _D_MOVE * _D_MOVE
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _ratio_test_near(H, h, z, p, active, hp, slack, zd, dset):
     """:func:`_ratio_test` over the rows listed near z (``dset``, at ``zd``).
 
@@ -218,7 +220,7 @@ def _ratio_test_near(H, h, z, p, active, hp, slack, zd, dset):
     return _ratio_test(H, h, z, p, active, hp, slack)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _min_slack_near(H, h, z, worst, zd, dset):
     """A vertex's feasibility check: ``worst[0]`` = min(worst[0], min_j h_j - H_j z).
 
@@ -251,7 +253,7 @@ def _min_slack_near(H, h, z, worst, zd, dset):
     zd[:] = z
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _project_out(Q, k, v, out):
     """``out`` = v minus its components along the k orthonormal rows of Q; returns |out|."""
     n = Q.shape[1]
@@ -344,7 +346,7 @@ def _crash(H, h, z, W, k, active, c, dc):
     return OK, k
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _invert(B, out):
     """Gauss-Jordan inverse with partial pivoting into ``out`` (B is overwritten).
 
@@ -406,7 +408,7 @@ def _workspace(m, n):
     )
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _refactor(H, h, W, Binv, z, work):
     """Recompute the basis inverse and the vertex from scratch; False if singular."""
     n = H.shape[1]
@@ -521,7 +523,7 @@ def _optimal(Binv, c, dc, scale):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work):
     """Simplex pivots from the vertex basis (W, Binv, z) until it is lexicographically optimal.
 
@@ -789,7 +791,7 @@ def _keep(bases, recorded, W, y, yfirst):
     return slot + 1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _replace(H, h, W, Binv, z, target, work):
     """The basis W turned into ``target`` (n rows): the rank-one pivots made, or -1.
 
@@ -819,7 +821,7 @@ def _replace(H, h, W, Binv, z, target, work):
     return made
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _arc_start(Binv, GT, theta, scale):
     """Where the basis's optimal arc starts in [theta, theta + pi): inf if it has none there.
 
@@ -846,7 +848,7 @@ def _arc_start(Binv, GT, theta, scale):
     return theta + lo if lo <= hi and lo < math.pi else math.inf
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _next_basis(H, h, GT, W, Binv, z, theta, u0, u1, scale, kind, rows, since, work, c, dc):
     """The chain's next basis (``rows``) and the angle it is optimal at: ``(theta, since)``.
 
@@ -885,7 +887,7 @@ def _next_basis(H, h, GT, W, Binv, z, theta, u0, u1, scale, kind, rows, since, w
     return theta, since
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _recertify(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work):
     """The walk's vertices from the last walk's chain of bases (``hint``), if they certify it.
 
@@ -950,13 +952,13 @@ def _moved(vertices, i):
     )
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _chain_capacity(hint, n):
     """How many bases (a kind and n rows each) ``hint`` holds after its first n + 3 entries."""
     return max(0, (hint.shape[0] - n - 3) // (n + 1))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _from_chain(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work):
     """:func:`_recertify` when ``hint`` holds a chain for this (m, n): ``(ok, vertices, count)``.
 
@@ -974,7 +976,7 @@ def _from_chain(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work):
     return False, np.empty((0, 2)), 0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _store_chain(hint, bases, recorded):
     """The walk's chain of ``recorded`` bases (:func:`_keep`) into ``hint``, when it fits."""
     capacity, size = bases.shape
