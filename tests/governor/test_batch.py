@@ -214,3 +214,88 @@ def test_a_posture_the_pipeline_refuses_names_its_row():
     assert info.value.field == "plane_height"
     with pytest.raises(ib.ScenarioError, match="plane_height"):
         g.limit(qs[1], vs[1])
+
+
+def path(g: Governor, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` states 2 ms apart along a smooth motion: every actuated joint follows
+    ``0.05 (sin(pi t + phase) - sin(phase))`` rad from the scenario's posture (clipped to its
+    limits), with its joint velocity; the base drifts forwards at 0.05 m/s. Consecutive rows
+    differ a little: each row's projection can re-certify the previous row's bases."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) * 0.002
+    qs = np.tile(g.configuration, (n, 1))
+    vs = np.zeros((n, g.nv))
+    for name in g.robot.joint_names:
+        slot = g.robot.joint_slot(name)
+        if slot.nq != 1:
+            continue
+        phase = rng.uniform(0.0, 2.0 * np.pi)
+        raw = qs[0, slot.idx_q] + 0.05 * (np.sin(np.pi * t + phase) - np.sin(phase))
+        qs[:, slot.idx_q] = np.clip(raw, slot.lower + 1e-6, slot.upper - 1e-6)
+        vs[:, g.robot.model.joints[slot.id].idx_v] = 0.05 * np.pi * np.cos(np.pi * t + phase)
+    qs[:, 0] += 0.05 * t
+    vs[:, 0] = 0.05  # the base's forward speed (base frame: the scenarios stand upright)
+    return qs, vs
+
+
+def assert_rows_agree(answers, singles, tol: float = 1e-9) -> None:
+    """Row for row, the same answer to ``tol`` m/s; the edge index only in kind (a walk from
+    another warm start may list the same polygon from a neighbouring first vertex)."""
+    assert len(answers) == len(singles)
+    for i, one in enumerate(singles):
+        row = answers[i]
+        assert row.status == one.status, i
+        assert row.limiting_vertex == one.limiting_vertex, i
+        assert (row.limiting_edge is None) == (one.limiting_edge is None), i
+        if math.isfinite(one.max_contact_velocity):
+            assert row.max_contact_velocity == pytest.approx(one.max_contact_velocity, abs=tol)
+        else:
+            assert row.max_contact_velocity == one.max_contact_velocity
+        assert (row.safe_interval is None) == (one.safe_interval is None), i
+        if one.safe_interval is not None:
+            np.testing.assert_allclose(row.safe_interval, one.safe_interval, rtol=0, atol=tol)
+        np.testing.assert_array_equal(row.com_velocity, one.com_velocity)
+        np.testing.assert_array_equal(row.point, one.point)
+
+
+@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    name=st.sampled_from(SCENARIOS),
+    n=st.integers(2, 40),
+    seed=st.integers(0, 2**32 - 1),
+    order=st.randoms(use_true_random=False),
+)
+def test_batch_rows_in_any_order_equal_single_ticks(name, n, seed, order):
+    # In path order each row's projection starts from the previous row's chain of bases (the
+    # batch's hint); shuffled, the chain mostly fails its check and the row walks. Either way
+    # every row is the single tick's answer, and the same rows in both orders agree.
+    g = governor(name)
+    qs, vs = path(g, n, seed)
+    singles = [g.limit(q, v) for q, v in zip(qs, vs, strict=True)]
+    in_order = g.limits(qs, vs)
+    assert_rows_agree(in_order, singles)
+    perm = list(range(n))
+    order.shuffle(perm)
+    shuffled = g.limits(qs[perm], vs[perm])
+    assert_rows_agree(shuffled, [singles[i] for i in perm])
+    # an independent computation for one row: the whole pipeline
+    i = n // 2
+    analysis = ib.analyze(g.scenario_at(qs[i], in_order.com_velocity[i]))
+    want = analysis.impact.max_contact_velocity
+    assert in_order.max_contact_velocity[i] == pytest.approx(want, abs=1e-9)
+
+
+def test_the_rows_of_a_batch_share_the_walks_hint():
+    # The batch's evaluator keeps one projection hint for its rows (a governor's ticks keep
+    # theirs): after rows along a path it holds the last walk's start basis and chain of bases.
+    g = Governor("palm_push_two_feet")
+    qs, vs = path(g, 30, 2)
+    g.limits(qs, vs)
+    (evaluator,) = g._batch._evaluators
+    hint = evaluator._hint
+    m, n = int(hint[0]), int(hint[1])
+    assert m > 0 and 0 < n < m
+    assert np.all((hint[2 : n + 2] >= 0) & (hint[2 : n + 2] < m))
+    assert hint[n + 2] > 0  # a chain: the next row re-certifies it before walking
+    # the batch's hint is its own: the governor's ticks keep theirs
+    assert evaluator is not g._evaluator

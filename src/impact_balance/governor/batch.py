@@ -8,11 +8,14 @@ side runs pinocchio (:meth:`PostureEvaluator.kinematics
 step); the areas, the impact model and the criterion of every posture then run in one compiled
 call (:func:`~impact_balance.governor.posture_kernel.postures_kernel`: a tick's
 :func:`~impact_balance.governor.posture_kernel.posture_kernel` per posture, the same numbers),
-which releases the GIL, so ``threads`` > 1 evaluates slices of the postures side by side. A
-posture the compiled call does not answer (a projection Bretl's method answers, an area of fewer
-than 3 vertices, an impact model it refuses), the
-"zmp" criterion, the joint-space inertia model, contact frictions above 1 and the angular
-momentum option (``angular_momentum_damping_time``) take the one-posture path
+which releases the GIL, so ``threads`` > 1 evaluates slices of the postures side by side. The
+rows of a thread share one projection hint, as a governor's successive ticks do: a row's walk
+first re-certifies the previous row's chain of bases, so rows in path order (nearby postures
+one after the other) cost less than the same rows shuffled; the answers do not depend on the
+order. A posture the compiled call does not answer (a projection Bretl's method answers, an
+area of fewer than 3 vertices, an impact model it refuses), the "zmp" criterion, the
+joint-space inertia model, contact frictions above 1 and the angular momentum option
+(``angular_momentum_damping_time``) take the one-posture path
 (:meth:`PostureEvaluator.evaluate <impact_balance.governor.posture.PostureEvaluator.evaluate>`).
 """
 
@@ -129,6 +132,27 @@ class _Rows:
         )
 
 
+class _Buffers:
+    """One thread's per-posture arrays of a block (:data:`BLOCK` postures), reused block by block.
+
+    The compiled call's per-posture arguments (see
+    :func:`~impact_balance.governor.posture_kernel.postures_kernel`): row p is the block's p-th
+    posture of its own; rows past the block's postures are not read.
+    """
+
+    def __init__(self, e: PostureEvaluator) -> None:
+        m, nv, s = len(e._frames), e.model.nv, e.settings
+        self.rotations, self.local = np.zeros((BLOCK, m, 3, 3)), np.zeros((BLOCK, m, 3))
+        self.jacobians = np.zeros((BLOCK, 6 * m, nv)) if e._torques else np.zeros((BLOCK, 0, 0))
+        self.origins, self.com_locals = np.zeros((BLOCK, 3)), np.zeros((BLOCK, 3))
+        self.point_locals, self.inertias = np.zeros((BLOCK, 3)), np.zeros((BLOCK, 3, 3))
+        self.centroidal = np.zeros((BLOCK, 6, nv))
+        # mass, then (row 0) g, h, omega, velocity margin, boundary tolerance
+        self.scalars = np.zeros((BLOCK, 6))
+        self.scalars[0, 1:3] = s.gravity, s.plane_height
+        self.scalars[0, 4:6] = s.velocity_margin, BOUNDARY_TOLERANCE
+
+
 class BatchEvaluator:
     """Evaluates postures in batches, with one :class:`PostureEvaluator` per thread.
 
@@ -207,6 +231,8 @@ class _Slice:
         # The compiled call answers the posture kernel's case (the paper's "com" criterion, the
         # composite inertia, unscaled contacts); every other row takes limit()'s path.
         self.compiled = evaluator._compiled
+        if self.compiled:
+            self.buffers = _Buffers(evaluator)
 
     def run(self, indices: npt.NDArray[np.int64], repeated: npt.NDArray[np.bool_]) -> None:
         """Answer rows ``indices`` of the batch (``repeated[i]``: row i's q is row i - 1's)."""
@@ -228,41 +254,34 @@ class _Slice:
     def block(self, indices: npt.NDArray[np.int64], same: npt.NDArray[np.bool_]) -> None:
         """The pinocchio step of rows ``indices``, then their compiled call.
 
-        ``same[r]``: row r repeats the posture of row r - 1 (only its velocity is new).
+        ``same[r]``: row r repeats the posture of row r - 1 (only its velocity is new). At most
+        :data:`BLOCK` rows have a posture of their own.
         """
-        e, n, rows, s = self.e, len(indices), self.rows, self.e.settings
-        m, nv = len(e._frames), e.model.nv
-        new = np.flatnonzero(~same).tolist()  # the rows of a posture of their own
-        k = len(new)
-        rotations, local = np.zeros((k, m, 3, 3)), np.zeros((k, m, 3))
-        jacobians = np.zeros((k, 6 * m, nv)) if e._torques else np.zeros((k, 0, 0))
-        origins, com_locals, point_locals = np.zeros((k, 3)), np.zeros((k, 3)), np.zeros((k, 3))
-        centroidal, inertias = np.zeros((k, 6, nv)), np.zeros((k, 3, 3))
-        scalars = np.zeros((k, 6))  # mass, then (row 0) g, h, omega, velocity margin, tolerance
-        scalars[0, 1:3] = s.gravity, s.plane_height
-        scalars[0, 4:6] = s.velocity_margin, BOUNDARY_TOLERANCE
-        for p, r in enumerate(new):
+        e, n, rows, b = self.e, len(indices), self.rows, self.buffers
+        rotations, local, jacobians, scalars = b.rotations, b.local, b.jacobians, b.scalars
+        for p, r in enumerate(np.flatnonzero(~same).tolist()):  # the rows of a posture of their own
             i = int(indices[r])
             origin, com_local, Ig, Ag = e._placements(
                 self.qs[i], rotations[p], local[p], jacobians[p]
             )
-            origins[p], com_locals[p], centroidal[p], inertias[p] = (
+            b.origins[p], b.com_locals[p], b.centroidal[p], b.inertias[p] = (
                 origin,
                 com_local,
                 Ag,
                 Ig.inertia,
             )
-            point_locals[p] = e.impact_point()
+            b.point_locals[p] = e.impact_point()
             scalars[p, 0] = float(Ig.mass)
             scalars[p, 3] = self.omega(float(com_local[2]) + float(origin[2]), i)
         out, velocities, points = np.empty((n, 6)), np.empty((n, 3)), np.empty((n, 3))
-        postures_kernel(
-            e._faces, rotations, local, origins, com_locals, centroidal, e._gravity, e._torques,
-            jacobians, e._idx, e._limit, scalars, e._hint, MAX_PIVOTS, e._constants,
-            point_locals, inertias, e._normal, e._cone, self.vs[indices], same, out, velocities,
-            points,
+        too_fast = postures_kernel(
+            e._faces, rotations, local, b.origins, b.com_locals, b.centroidal, e._gravity,
+            e._torques, jacobians, e._idx, e._limit, scalars, e._hint, MAX_PIVOTS, e._constants,
+            b.point_locals, b.inertias, e._normal, e._cone, self.vs[indices], same, out,
+            velocities, points, MAX_SPEED * MAX_SPEED,
         )  # fmt: skip
-        _check_speeds(velocities, indices)
+        if too_fast >= 0:
+            _too_fast(velocities[too_fast], int(indices[too_fast]))
         rows.com_velocity[indices], rows.point[indices], rows.normal[indices] = (
             velocities,
             points,
@@ -337,21 +356,19 @@ def _com_velocity(
     """
     out = np.empty(3)
     com_velocity(com_jacobian, v, out)
-    _check_speeds(out[None, :], np.array([i]))
+    cx, cy, cz = (float(x) for x in out)
+    if not cx * cx + cy * cy + cz * cz <= MAX_SPEED * MAX_SPEED:
+        _too_fast(out, i)
     return out
 
 
-def _check_speeds(out: npt.NDArray[np.float64], indices: npt.NDArray[np.int64]) -> None:
-    """:class:`GovernorError` naming the first row of ``out`` (CoM velocities, m/s) too fast."""
-    speeds: npt.NDArray[np.float64] = np.einsum("ij,ij->i", out, out)
-    bad = np.flatnonzero(~(speeds <= MAX_SPEED * MAX_SPEED))
-    if bad.size:
-        j = int(bad[0])
-        raise GovernorError(
-            f"v_batch[{int(indices[j])}]",
-            f"CoM velocity {math.hypot(*out[j]):.3g} m/s",
-            f"gives a CoM speed above {MAX_SPEED:g} m/s (the scenario's bound)",
-        )
+def _too_fast(com_velocity: npt.NDArray[np.float64], i: int) -> None:
+    """:class:`GovernorError` naming row ``i``, whose CoM velocity (m/s) is above the bound."""
+    raise GovernorError(
+        f"v_batch[{i}]",
+        f"CoM velocity {math.hypot(*com_velocity):.3g} m/s",
+        f"gives a CoM speed above {MAX_SPEED:g} m/s (the scenario's bound)",
+    )
 
 
 def _in_row(exc: ImpactBalanceError, i: int) -> ImpactBalanceError:

@@ -147,7 +147,8 @@ def postures_kernel(
     out: np.ndarray,
     com_velocities: np.ndarray,
     points: np.ndarray,
-) -> None:
+    max_speed_squared: float,
+) -> int:
     """:func:`kinematics_posture_kernel` and the tick's exit for every posture of a batch.
 
     The GIL is released. Row i (of ``same``, ``velocities``, the outputs) has the generalized
@@ -164,6 +165,10 @@ def postures_kernel(
     governor's tick (:func:`~impact_balance.governor.tick.velocity_exit`: the exit kernel's
     code, an index of ``EXIT_STATUSES``, and the safe interval, NaN when there is none), or
     code -1 where the caller takes the one-posture path.
+
+    Returns the first row whose CoM speed squared is not at most ``max_speed_squared``
+    ((m/s)^2, the single tick's test), -1 if none. Only the first ``same.size`` rows are read
+    and written; the per-posture arguments may have more (unused) leading entries.
     """
     gravity, plane_height = scalars[0, 1], scalars[0, 2]
     velocity_margin, tol = scalars[0, 4], scalars[0, 5]
@@ -171,6 +176,7 @@ def postures_kernel(
     J, point = np.zeros((velocities.shape[1], 3)).T, np.zeros(3)
     answered = False  # whether G, h, rates hold the last posture's
     p = -1  # the posture of row i
+    too_fast = -1
     for i in range(same.size):
         out[i, 0] = -1.0
         if not same[i]:
@@ -187,6 +193,8 @@ def postures_kernel(
                 h = h - velocity_margin
         c = np.dot(J, velocities[i])
         com_velocities[i, 0], com_velocities[i, 1], com_velocities[i, 2] = c[0], c[1], c[2]
+        if too_fast < 0 and not c[0] * c[0] + c[1] * c[1] + c[2] * c[2] <= max_speed_squared:
+            too_fast = i
         points[i, 0], points[i, 1], points[i, 2] = point[0], point[1], point[2]
         if answered:
             margins = np.empty(h.size)
@@ -198,6 +206,7 @@ def postures_kernel(
             if code == 1:  # already falling: the safe speeds, if any, catch the fall
                 found, lo, hi = interval_kernel(margins, rates, tol)
                 out[i, 4], out[i, 5] = (lo, hi) if found else (math.nan, math.nan)
+    return too_fast
 
 
 cache_depends_on(

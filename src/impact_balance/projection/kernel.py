@@ -20,7 +20,11 @@ error grows with it), which keeps Bland's rule from chasing rounding noise.
 The basis inverse is kept explicitly, updated by the rank-one formula at each pivot and
 recomputed every ``_REFACTOR`` pivots, and in the walk around the polygon whenever it no
 longer solves its system to near rounding or has carried ``_CARRY`` pivots. Without numba
-the same code runs as plain Python.
+the same code runs as plain Python. The small helpers the walk calls per basis or per vertex
+(the rank-one update, the vertex, the accuracy and optimality checks, the breakpoint, the
+recorded vertex's scan) are inlined into their callers by numba (``inline="always"``: the same
+operations in the same order, hence the same numbers, without a call and its array arguments
+each time); the larger ones are not, which keeps the kernel's compile time.
 
 A caller that projects postures in a row keeps a hint: the walk starts from its last optimal
 basis, and first checks whether the last walk's chain of bases (the first and last of each
@@ -90,7 +94,7 @@ _REF_MOVE = 0.2
 _REF_MARGIN = 1e-8
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _column_norm(M, i):
     """Euclidean norm of column i (a strided slice: a loop avoids a copy)."""
     acc = 0.0
@@ -99,7 +103,7 @@ def _column_norm(M, i):
     return math.sqrt(acc)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _norm(v):
     """Euclidean norm (a loop: numba's linalg would add seconds of compile time)."""
     acc = 0.0
@@ -116,7 +120,7 @@ def _times(M, v):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _times_into(M, v, out):
     """Out = M v (out preallocated)."""
     for i in range(M.shape[0]):
@@ -126,7 +130,7 @@ def _times_into(M, v, out):
         out[i] = acc
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _point(g0, GT, z, out, i):
     """``out[i]`` = the projected point g0 + G z (written in place: no allocation per vertex)."""
     y0, y1 = g0[0], g0[1]
@@ -182,7 +186,7 @@ def _ratio_test(H, h, z, p, active, hp, slack):
     return -1, 0.0  # unreachable
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _near(z, zd):
     """Whether |z - zd| <= _D_MOVE (Euclidean)."""
     acc = 0.0
@@ -417,7 +421,7 @@ def _refactor(H, h, W, Binv, z, work):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _pivot(H, h, W, Binv, z, leave, j, since, work):
     """Row ``j`` replaces the basis row in position ``leave``; updates Binv and z in place.
 
@@ -446,7 +450,7 @@ def _pivot(H, h, W, Binv, z, leave, j, since, work):
     return since + 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _accurate(H, h, W, Binv, z, ones):
     """Whether a carried basis inverse still solves its system to near rounding.
 
@@ -473,7 +477,7 @@ def _accurate(H, h, W, Binv, z, ones):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _vertex(h, W, Binv, z):
     """Z = Binv h_W."""
     n = Binv.shape[0]
@@ -507,7 +511,7 @@ def _priced(Binv, i, c, dc, scale):
     return 2, 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _optimal(Binv, c, dc, scale):
     """Whether the basis is lexicographically optimal at theta+: no entering candidate.
 
@@ -576,7 +580,7 @@ def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work):
         since = _pivot(H, h, W, Binv, z, leave, j, since, work)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _arc_end(a, b, theta):
     """Step after theta at which ``a cos + b sin`` turns negative, in (0, 2 pi]."""
     # lambda = rho cos(theta - alpha) turns negative when theta - alpha passes pi/2
@@ -584,7 +588,7 @@ def _arc_end(a, b, theta):
     return 2.0 * math.pi if d < 1e-13 else d
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _breakpoint(Binv, GT, theta, cos_t, sin_t, scale, ab):
     """Smallest angle > theta at which a multiplier of the basis turns negative (inf if none).
 
@@ -711,7 +715,7 @@ def _phase_one(H, h, z, W, active, max_pivots):
     return OK, pivots, k
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _record(H, h, GT, g0, z, worst, ref, vertices, count):
     """Record a re-certified vertex z: ``(count, strict)``, the vertex count after it and its check.
 
@@ -757,7 +761,7 @@ def _record(H, h, GT, g0, z, worst, ref, vertices, count):
     return count, strict
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _directions(GT, theta, c, dc):
     """``c = G^T u(theta)``, ``dc = G^T u'(theta)`` in place; returns (cos theta, sin theta)."""
     cos_t, sin_t = math.cos(theta), math.sin(theta)
@@ -767,7 +771,7 @@ def _directions(GT, theta, c, dc):
     return cos_t, sin_t
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _keep(bases, recorded, W, y, yfirst):
     """One more basis of the walk's chain (optimal at a breakpoint, point y) into ``bases``.
 
@@ -939,7 +943,7 @@ def _recertify(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work):
     return True, vertices, count
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _moved(vertices, i):
     """Whether point i (at ``vertices[i]``, kept or not) is beyond _Y_SAME of point i - 1."""
     return (
@@ -1154,22 +1158,24 @@ def project(A, b, E, x0, N, box, max_pivots, hint):
             if h0[i] < -_EPS_FEASIBLE:
                 return INFEASIBLE, none, 0, 0.0
         else:
-            H[m] = H0[i] / norms[i]
+            for j in range(k):  # element by element: no temporary array per row
+                H[m, j] = H0[i, j] / norms[i]
             h[m] = h0[i] / norms[i]
             m += 1
     # The clipping box: +-G_k z <= box -+ g0_k.
     for i in range(2):
         gk = _norm(G[i])
         if gk > 0.0:
-            H[m] = G[i] / gk
+            for j in range(k):
+                H[m, j] = G[i, j] / gk
+                H[m + 1, j] = -G[i, j] / gk
             h[m] = (box - g0[i]) / gk
-            H[m + 1] = -G[i] / gk
             h[m + 1] = (box + g0[i]) / gk
             m += 2
     worst = np.zeros(1)
-    status, vertices, count, pivots = walk(
-        H[:m].copy(), h[:m].copy(), G.T.copy(), g0, 0.0, max_pivots, worst, hint
-    )
+    if m < H.shape[0]:  # rows dropped (or no box): the walk's arrays are the kept rows
+        H, h = H[:m].copy(), h[:m].copy()
+    status, vertices, count, pivots = walk(H, h, G.T.copy(), g0, 0.0, max_pivots, worst, hint)
     if status != OK:
         return status, none, pivots, worst[0]
     # The caller merges near-duplicate vertices and checks convexity (walk._certify, with the
