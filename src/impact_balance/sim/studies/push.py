@@ -667,6 +667,19 @@ def _reach_of(setup: BalanceSetup, reach: ComReach | bool) -> ComReach | None:
     return com_reach(setup.analysis.stance) if reach else None
 
 
+def _controller_summary(setup: BalanceSetup, options: BalanceTrialOptions) -> dict[str, Any]:
+    """The controller's summary in ``push-test --json``: gains, armature, inertia repair."""
+    controller = controller_class(setup.controller).trial_summary(
+        options, setup.sim, setup.joints == "servo"
+    )
+    controller["armature"] = setup.sim.armature_source
+    # The gains from the robot's rules (they differ between stances of one robot) or as given.
+    controller["gains_from_robot"] = bool(options.robot_gains)
+    repair = setup.sim.inertia_repair
+    controller["inertia_repair"] = None if repair is None else repair.to_dict()
+    return controller
+
+
 def push_test(
     scenario: Scenario | str,
     directions: int = 16,
@@ -746,14 +759,7 @@ def push_test(
             outcomes.append(outcome)
             if progress:
                 progress(outcome)
-    controller = controller_class(setup.controller).trial_summary(
-        options, setup.sim, setup.joints == "servo"
-    )
-    controller["armature"] = setup.sim.armature_source
-    # The gains from the robot's rules (they differ between stances of one robot) or as given.
-    controller["gains_from_robot"] = bool(options.robot_gains)
-    repair = setup.sim.inertia_repair
-    controller["inertia_repair"] = None if repair is None else repair.to_dict()
+    controller = _controller_summary(setup, options)
     return PushTestResult(
         scenario.name,
         outcomes,
