@@ -129,6 +129,7 @@ def test_json_keys_only_with_the_option(setup):
     d_on, d_off = on.to_dict(0.01, omega), off.to_dict(0.01, omega)
     assert "finite_push_margin" not in d_off
     assert "predicted_finite_push_com_velocity" not in d_off
+    assert "finite_push_factor" not in d_off
     kappa = finite_push_factor(omega, 0.05)
     v = np.array(d_on["predicted_com_velocity"])
     assert d_on["predicted_finite_push_com_velocity"] == pytest.approx((kappa * v).tolist())
@@ -163,7 +164,8 @@ def test_push_test_finite_push_records_the_factor_and_each_pushs_margin(capsys, 
     assert all("finite_push_margin" not in p for p in plain["pushes"])
     omega = doc["omega"]
     kappa = finite_push_factor(omega, 0.08)
-    assert doc["finite_push"] == {"duration": 0.08, "factor": pytest.approx(kappa)}
+    assert doc["finite_push"] is True
+    assert all(p["finite_push_factor"] == pytest.approx(kappa) for p in doc["pushes"])
     a = analyze(load_scenario("palm_push_two_feet").replace(zmp_margin=0.0))
     for push in doc["pushes"]:
         v = kappa * np.array(push["predicted_com_velocity"])
@@ -174,3 +176,39 @@ def test_push_test_finite_push_records_the_factor_and_each_pushs_margin(capsys, 
     assert kappa * 0.95 > 1.0
     assert not any(p["com_criterion_safe"] for p in doc["pushes"])
     assert isinstance(PushTestResult, type)
+
+
+def test_calibrate_pools_finite_push_documents_of_stances_with_different_omegas():
+    # The top-level setting is the same on every stance (kappa, which depends on omega, is per
+    # push): calibrate pools two stances of one robot scored with the option, and refuses to
+    # pool one with the option and one without.
+    from impact_balance.exceptions import ScenarioError
+    from impact_balance.sim.studies.calibrate import calibrate, training_set
+
+    docs = {}
+    for name in ("palm_push_two_feet", "kick_one_foot"):
+        for finite in (True, False):
+            a = analyze(load_scenario(name))
+            setup = SimpleNamespace(analysis=a)
+            omega = float(a.areas.omega)
+            outcomes = []
+            for k in range(4):
+                angle = k * math.pi / 2
+                J = 0.9 * boundary_impulse(a.areas.com_velocity_area, a.stance.mass, angle)
+                push = Push(angle, J, 0.05)
+                p = predict_push(setup, push, 1.2, a.stance.com, finite_push=finite)
+                outcomes.append(_outcome(push, p))
+            result = PushTestResult(
+                name, outcomes, {"name": "id"}, {}, setup, 0.01, 0.01, omega, 0.0,
+                robot="talos",
+                finite_push=(0.05, finite_push_factor(omega, 0.05)) if finite else None,
+            )  # fmt: skip
+            docs[name, finite] = json.loads(json.dumps(result.to_dict()))
+    assert docs["palm_push_two_feet", True]["omega"] != docs["kick_one_foot", True]["omega"]
+    sets = [
+        training_set(docs[name, True], name) for name in ("palm_push_two_feet", "kick_one_foot")
+    ]
+    assert all(s.criterion["finite_push"] is True for s in sets)
+    calibrate(sets)  # no refusal: one criterion setting
+    with pytest.raises(ScenarioError, match="criterion"):
+        calibrate([sets[0], training_set(docs["kick_one_foot", False], "plain")])

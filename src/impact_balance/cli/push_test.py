@@ -313,8 +313,8 @@ def _text(result: PushTestResult, out: dict[str, Any], args: argparse.Namespace)
             f"  smallest ZMP margin that brings the CoM criterion's P(fell | safe) ({outcome}) to "
             "5 % or less: " + ("none up to 6 cm" if smallest is None else f"{1000 * smallest:g} mm")
         )
-    if out.get("finite_push") is not None:
-        kappa = out["finite_push"]["factor"]
+    if result.finite_push is not None:
+        kappa = result.finite_push[1]
         lines.append(
             f"  the default predicts the push's duration: CoM velocity x{kappa:.4f} (kappa)"
         )

@@ -493,17 +493,9 @@ class PushTestResult:
             "omega": self.omega,
             # The CoM's reach the default prediction keeps the capture within (null: not asked).
             "com_reach": None if self.reach is None else self.reach.to_dict(),
-            # The push's duration in the default prediction: only with the option.
-            **(
-                {}
-                if self.finite_push is None
-                else {
-                    "finite_push": {
-                        "duration": self.finite_push[0],
-                        "factor": self.finite_push[1],
-                    }
-                }
-            ),
+            # The push's duration in the default prediction: only with the option (a criterion
+            # setting, the same for every stance; each push's kappa is in the push).
+            **({} if self.finite_push is None else {"finite_push": True}),
             "pushes": [o.to_dict(self.zmp_margin, self.omega) for o in self.outcomes],
             "start_com_velocity": list(START_COM_VELOCITY),
             "counts": self.counts(),
@@ -639,6 +631,7 @@ def _finite_push_keys(p: PushPrediction, margin: float, omega: float) -> dict[st
     if p.finite_push_margin is None or p.finite_push_com_velocity is None:
         return {}
     return {
+        "finite_push_factor": p.finite_push_factor,
         "predicted_finite_push_com_velocity": p.finite_push_com_velocity.tolist(),
         # The default's margin with the push's duration, at the score's margin (m/s).
         "finite_push_margin": float(p.finite_push_margin - omega * margin),
