@@ -591,7 +591,9 @@ def predict_push(
         held = gain * np.array([L[1], -L[0]]) / mass
         effective = velocity + held
         effective_margin = float(areas.com_velocity_area.margins(effective)[0])
-    finite = _finite_push(areas.com_velocity_area, float(areas.omega), push, mass, held, tau)
+    finite: tuple[Any, ...] = (None, None, None, None)
+    if finite_push:
+        finite = _finite_push(areas.com_velocity_area, float(areas.omega), push, mass, held, tau)
     return PushPrediction(
         velocity,
         float(areas.com_velocity_area.margins(velocity)[0]),
@@ -602,7 +604,7 @@ def predict_push(
         effective_margin,
         reach,
         None if reach is None else areas.com_velocity_area,
-        *(finite if finite_push else (None, None, None, None)),
+        *finite,
     )
 
 
