@@ -149,7 +149,6 @@ def test_push_test_refuses_a_bad_duration_by_name(capsys):
     assert_one_line_error(rc, err, "--duration")
 
 
-@pytest.mark.slow
 def test_push_test_finite_push_records_the_factor_and_each_pushs_margin(capsys, tmp_path):
     journal = str(tmp_path / "j.jsonl")
     args = ("push-test", "palm_push_two_feet", "--controller", "id", "--directions", "2")
