@@ -17,7 +17,14 @@ import numpy as np
 from impact_balance.constants import GRAVITY, GRAVITY_RANGE, MAX_POSITION
 from impact_balance.exceptions import ScenarioError
 
-__all__ = ["HeightField", "PhasePortrait", "com_velocity_bounds", "lipm_omega", "phase_portrait"]
+__all__ = [
+    "HeightField",
+    "PhasePortrait",
+    "com_velocity_bounds",
+    "finite_push_factor",
+    "lipm_omega",
+    "phase_portrait",
+]
 
 #: The input a caller of :func:`lipm_omega` took from its user: the CoM height or the plane's.
 HeightField = Literal["com_height", "plane_height"]
@@ -66,6 +73,54 @@ def lipm_omega(
             "gravity", gravity, f"must be in [{GRAVITY_RANGE[0]:g}, {GRAVITY_RANGE[1]:g}] m/s^2"
         )
     return math.sqrt(gravity / (com_height - plane_height))
+
+
+def _is_number(x: object) -> bool:
+    """Whether ``x`` is a real number (int, float or NumPy's), not a bool."""
+    return isinstance(x, (int, float, np.integer, np.floating)) and not isinstance(x, bool)
+
+
+def finite_push_factor(omega: float, duration: float) -> float:
+    """The DCM's growth over a push of finite duration: kappa = (exp(omega T) - 1) / (omega T).
+
+    A horizontal force ``F`` (N) acts on the LIPM of mass ``m`` (kg) for ``T = duration`` (s),
+    an impulse ``J = F T`` (N s). Along the push, the CoM obeys
+    ``c'' = omega^2 (c - z) + F / m`` and the DCM ``xi = c + c' / omega``
+
+        xi' = omega (xi - z) + F / (m omega).
+
+    With the robot at rest and the ZMP ``z`` under the CoM at the push's start (``xi(0) = z = 0``,
+    the CoM's starting position as origin) and held there while the push acts,
+
+        xi(T) = F / (m omega^2) (exp(omega T) - 1) = kappa J / (m omega).
+
+    The impulsive push (the paper's: the CoM velocity jumps by ``J / m``, the CoM does not
+    move) gives ``J / (m omega)``: the finite push's DCM at its end equals the impulsive one's
+    with the CoM velocity ``kappa J / m``, the CoM's displacement during the push included.
+    kappa is 1 at ``T = 0``, increases with ``omega T`` and is about ``1 + omega T / 2`` for a
+    short push.
+
+    Args:
+        omega: The LIPM natural frequency, 1/s (:func:`lipm_omega`), > 0.
+        duration: The push's duration T, s, >= 0.
+
+    Returns:
+        kappa (dimensionless, >= 1).
+
+    Raises:
+        ScenarioError: ``omega`` not a finite number > 0 (the error names "omega"), or
+            ``duration`` not a finite number >= 0 (names "duration"), or their product over 50.
+    """
+    if not (_is_number(omega) and math.isfinite(omega) and omega > 0):
+        raise ScenarioError("omega", omega, "must be a finite number > 0 (1/s)")
+    if not (_is_number(duration) and math.isfinite(duration) and duration >= 0):
+        raise ScenarioError("duration", duration, "must be a finite number >= 0 (s)")
+    x = float(omega) * float(duration)
+    if x > 50.0:
+        raise ScenarioError(
+            "duration", duration, f"omega * duration = {x:g} is not a push (at most 50)"
+        )
+    return 1.0 if x == 0.0 else math.expm1(x) / x
 
 
 def _check_com_height(com_height: float) -> None:

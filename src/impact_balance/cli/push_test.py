@@ -96,6 +96,13 @@ def add_parser(sub: Subcommands) -> list[str]:
         help="the default prediction also asks the capture to stay within the CoM's reach at "
         "constant height with every contact kept (whole-body IK; docs/com-reach.md)",
     )
+    a.add_argument(
+        "--finite-push",
+        action="store_true",
+        help="the default prediction counts the push's duration: a constant force for "
+        "--duration with the ZMP under the starting CoM, the impulse's CoM velocity scaled by "
+        "kappa = (exp(omega T) - 1) / (omega T) (docs/simulation.md)",
+    )
     add_controller_option(
         a,
         DEFAULT_CONTROLLER,
@@ -157,6 +164,7 @@ def run(args: argparse.Namespace) -> int:
             journal=journal,
             band=args.band,
             reach=args.com_reach,
+            finite_push=args.finite_push,
         )
     finally:
         bar.close()
@@ -304,6 +312,11 @@ def _text(result: PushTestResult, out: dict[str, Any], args: argparse.Namespace)
         lines.append(
             f"  smallest ZMP margin that brings the CoM criterion's P(fell | safe) ({outcome}) to "
             "5 % or less: " + ("none up to 6 cm" if smallest is None else f"{1000 * smallest:g} mm")
+        )
+    if result.finite_push is not None:
+        kappa = result.finite_push[1]
+        lines.append(
+            f"  the default predicts the push's duration: CoM velocity x{kappa:.4f} (kappa)"
         )
     if out["journal"]:
         lines.append(f"  trials journal: {out['journal']} ({out['reused_trials']} reused)")

@@ -32,8 +32,16 @@ effective post-push CoM velocity ``c0 + (J u + S(L) / (h (1 + omega tau))) / m``
 ``S(L) = (L_y, -L_x)``, must lie in the area (:mod:`impact_balance.impact.angular_momentum`);
 without it the two are the same call. With a reach (``push_test(..., reach=True)``, ``push-test
 --com-reach``), ``com`` also asks the capture to stay within the CoM's reach at constant height
-(:mod:`impact_balance.balance.reach`). Each criterion is scored against the lenient outcome (fell)
-and the strict one (:mod:`.scores`).
+(:mod:`impact_balance.balance.reach`). With the push's duration (``push_test(...,
+finite_push=True)``, ``push-test --finite-push``), ``com`` predicts a push of constant force
+``J u / T`` for its duration ``T`` with the ZMP held under the starting CoM, not an impulse: the
+velocity of the impulse, ``J u / m``, is scaled by ``kappa = (exp(omega T) - 1) / (omega T)``
+(:func:`~impact_balance.balance.lipm.finite_push_factor`) in every velocity the default tests
+(the paper's and the effective one, in the area and against the reach), so that the area test
+``c0 + kappa J u / m`` in the CoM velocity area is exactly the LIPM's DCM at the push's end,
+``xi(T) = kappa J / (m omega) u`` from the starting CoM, in the ZMP support area (the CoM's
+displacement during the push included). ``paper_com`` stays impulsive. Each criterion is
+scored against the lenient outcome (fell) and the strict one (:mod:`.scores`).
 """
 
 from __future__ import annotations
@@ -47,6 +55,7 @@ import mujoco
 import numpy as np
 from numpy.typing import ArrayLike
 
+from impact_balance.balance.lipm import finite_push_factor
 from impact_balance.balance.reach import ComReach, com_reach, reach_speed_limit
 from impact_balance.exceptions import SimulationError
 from impact_balance.geometry.polygon import Polygon
@@ -196,6 +205,16 @@ class PushPrediction:
         reach: The CoM's reach at constant height (:mod:`impact_balance.balance.reach`), when
             the default prediction also asks the capture to stay within it; else None.
         area: The CoM velocity area without margin (m/s), for the reach check at any margin.
+        finite_push_factor: kappa of the push's duration
+            (:func:`~impact_balance.balance.lipm.finite_push_factor`) when the default predicts
+            a push of finite duration; None for the impulsive push.
+        finite_push_com_velocity: ``c0 + kappa J u / m`` (m/s, world xy; None likewise): the
+            CoM velocity whose DCM from the starting CoM is the LIPM's at the push's end.
+        finite_push_effective_com_velocity: The effective velocity with the impulse's part
+            scaled likewise, ``c0 + (kappa J u + S(L) / (h (1 + omega tau))) / m`` (m/s; None
+            without the angular momentum or the finite push).
+        finite_push_margin: The default's margin with the finite push, the smaller of the two
+            scaled velocities' margins in the CoM velocity area (m/s; None likewise).
     """
 
     com_velocity: np.ndarray
@@ -207,19 +226,35 @@ class PushPrediction:
     effective_com_velocity_margin: float | None = None
     reach: ComReach | None = None
     area: Polygon | None = None
+    finite_push_factor: float | None = None
+    finite_push_com_velocity: np.ndarray | None = None
+    finite_push_effective_com_velocity: np.ndarray | None = None
+    finite_push_margin: float | None = None
+
+    @property
+    def default_velocities(self) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """The velocities the default tests (m/s): the paper's and the effective one.
+
+        With the finite push, their kappa-scaled counterparts; the effective one is None
+        without the angular momentum.
+        """
+        if self.finite_push_factor is not None:
+            return self.finite_push_com_velocity, self.finite_push_effective_com_velocity
+        return self.com_velocity, self.effective_com_velocity
 
     def reach_margin(self, margin: float, omega: float) -> float | None:
         """The reach-limited capture's margin at ZMP margin ``margin`` (m), m/s; None without.
 
         The reach speed limit (:func:`~impact_balance.balance.reach.reach_speed_limit`, in the
-        area inset by ``omega margin``) minus the speed, the smaller over the paper's and the
-        effective post-push velocities: >= 0 when the capture stays within the CoM's reach.
+        area inset by ``omega margin``) minus the speed, the smaller over the default's
+        velocities (:attr:`default_velocities`: the paper's and the effective post-push ones,
+        kappa-scaled with the finite push): >= 0 when the capture stays within the CoM's reach.
         """
         if self.reach is None or self.area is None:
             return None
         area = self.area.inset(omega * margin) if margin > 0 else self.area
         worst = float("inf")
-        for velocity in (self.com_velocity, self.effective_com_velocity):
+        for velocity in self.default_velocities:
             if velocity is None:
                 continue
             speed = float(np.linalg.norm(velocity))
@@ -236,8 +271,11 @@ class PushPrediction:
         With the angular momentum counted, the smaller of the paper's and the effective
         velocity's margins: the capture must hold whether the contacts remove the angular
         momentum with the damping time or never (see
-        :class:`~impact_balance.criteria.com.ComCriterion`).
+        :class:`~impact_balance.criteria.com.ComCriterion`). With the finite push,
+        :attr:`finite_push_margin`.
         """
+        if self.finite_push_margin is not None:
+            return self.finite_push_margin
         if self.effective_com_velocity_margin is None:
             return self.com_velocity_margin
         return min(self.com_velocity_margin, self.effective_com_velocity_margin)
@@ -304,6 +342,7 @@ class PushOutcome(TrialEntry):
             # The reach-limited capture's margin at the score's margin (m/s; null without).
             "com_reach_margin": self.prediction.reach_margin(margin, omega),
             **_angular_momentum_keys(self.prediction, margin, omega),
+            **_finite_push_keys(self.prediction, margin, omega),
             "predicted_zmp": self.prediction.zmp.tolist(),
             "trial": s,
         }
@@ -331,6 +370,8 @@ class PushTestResult:
     body: str | None = None
     robot: str | None = None
     reach: ComReach | None = None
+    #: The push's duration (s) and its kappa, when the default predicts a finite push.
+    finite_push: tuple[float, float] | None = None
 
     @property
     def scored(self) -> list[PushOutcome]:
@@ -452,6 +493,9 @@ class PushTestResult:
             "omega": self.omega,
             # The CoM's reach the default prediction keeps the capture within (null: not asked).
             "com_reach": None if self.reach is None else self.reach.to_dict(),
+            # The push's duration in the default prediction: only with the option (a criterion
+            # setting, the same for every stance; each push's kappa is in the push).
+            **({} if self.finite_push is None else {"finite_push": True}),
             "pushes": [o.to_dict(self.zmp_margin, self.omega) for o in self.outcomes],
             "start_com_velocity": list(START_COM_VELOCITY),
             "counts": self.counts(),
@@ -511,12 +555,19 @@ def predict_push(
     body_height: float,
     body_position: ArrayLike | None = None,
     reach: ComReach | None = None,
+    finite_push: bool = False,
 ) -> PushPrediction:
     """The push's before-trial predictions (see the module docstring).
 
     ``body_position`` (m, world) is the pushed body's centre of mass at the start, where the push
     acts; without it, the point above the CoM at ``body_height`` (m). With ``reach``, the
-    default prediction also asks the capture to stay within the CoM's reach.
+    default prediction also asks the capture to stay within the CoM's reach. With
+    ``finite_push``, the default predicts a push of ``push.duration`` (s): the impulse's
+    velocity ``J u / m`` scaled by kappa (:func:`~impact_balance.balance.lipm.finite_push_factor`)
+    in every velocity it tests.
+
+    Raises:
+        ScenarioError: With ``finite_push``, a push duration that kappa does not take.
     """
     a = setup.analysis
     areas, mass, g = a.areas, a.stance.mass, a.areas.gravity
@@ -534,10 +585,15 @@ def predict_push(
     L = np.cross(point - com, np.array([*(push.magnitude * u), 0.0]))
     tau = a.scenario.angular_momentum_damping_time
     effective = effective_margin = None
+    held = np.zeros(2)
     if tau is not None:
         gain = angular_momentum_gain(float(areas.omega), g, tau)
-        effective = velocity + gain * np.array([L[1], -L[0]]) / mass
+        held = gain * np.array([L[1], -L[0]]) / mass
+        effective = velocity + held
         effective_margin = float(areas.com_velocity_area.margins(effective)[0])
+    finite: tuple[Any, ...] = (None, None, None, None)
+    if finite_push:
+        finite = _finite_push(areas.com_velocity_area, float(areas.omega), push, mass, held, tau)
     return PushPrediction(
         velocity,
         float(areas.com_velocity_area.margins(velocity)[0]),
@@ -548,7 +604,40 @@ def predict_push(
         effective_margin,
         reach,
         None if reach is None else areas.com_velocity_area,
+        *finite,
     )
+
+
+def _finite_push(
+    area: Polygon, omega: float, push: Push, mass: float, held: np.ndarray, tau: float | None
+) -> tuple[float, np.ndarray, np.ndarray | None, float]:
+    """kappa, the scaled paper's and effective velocities (m/s), and the smaller margin (m/s).
+
+    ``held`` is the angular momentum's term of the effective velocity (m/s), counted when
+    ``tau`` is set.
+    """
+    kappa = finite_push_factor(omega, float(push.duration))
+    u = np.array([np.cos(push.direction), np.sin(push.direction)])
+    c0 = np.asarray(START_COM_VELOCITY, dtype=float)
+    scaled = c0 + kappa * push.magnitude * u / mass
+    margin = float(area.margins(scaled)[0])
+    effective = None
+    if tau is not None:
+        effective = scaled + held
+        margin = min(margin, float(area.margins(effective)[0]))
+    return kappa, scaled, effective, margin
+
+
+def _finite_push_keys(p: PushPrediction, margin: float, omega: float) -> dict[str, Any]:
+    """The JSON keys of the finite push's prediction (none without the option)."""
+    if p.finite_push_margin is None or p.finite_push_com_velocity is None:
+        return {}
+    return {
+        "finite_push_factor": p.finite_push_factor,
+        "predicted_finite_push_com_velocity": p.finite_push_com_velocity.tolist(),
+        # The default's margin with the push's duration, at the score's margin (m/s).
+        "finite_push_margin": float(p.finite_push_margin - omega * margin),
+    }
 
 
 def _angular_momentum_keys(p: PushPrediction, margin: float, omega: float) -> dict[str, Any]:
@@ -573,6 +662,19 @@ def _reach_of(setup: BalanceSetup, reach: ComReach | bool) -> ComReach | None:
     return com_reach(setup.analysis.stance) if reach else None
 
 
+def _controller_summary(setup: BalanceSetup, options: BalanceTrialOptions) -> dict[str, Any]:
+    """The controller's summary in ``push-test --json``: gains, armature, inertia repair."""
+    controller = controller_class(setup.controller).trial_summary(
+        options, setup.sim, setup.joints == "servo"
+    )
+    controller["armature"] = setup.sim.armature_source
+    # The gains from the robot's rules (they differ between stances of one robot) or as given.
+    controller["gains_from_robot"] = bool(options.robot_gains)
+    repair = setup.sim.inertia_repair
+    controller["inertia_repair"] = None if repair is None else repair.to_dict()
+    return controller
+
+
 def push_test(
     scenario: Scenario | str,
     directions: int = 16,
@@ -587,6 +689,7 @@ def push_test(
     journal: TrialJournal | None = None,
     band: Sequence[float] | None = None,
     reach: ComReach | bool = False,
+    finite_push: bool = False,
 ) -> PushTestResult:
     """Push the robot in evenly spaced directions and score both criteria.
 
@@ -596,6 +699,9 @@ def push_test(
     it already holds are not run again. ``band`` (``(LO, HI)``, fractions of the boundary impulse,
     with ``relative`` from :func:`band_levels`) adds the scores of the pushes in it. ``reach``
     (True: :func:`.com_reach` of the stance) keeps the default's capture within the CoM's reach.
+    ``finite_push`` makes the default predict a push of ``duration``, not an impulse (kappa,
+    :func:`~impact_balance.balance.lipm.finite_push_factor`); without it the predictions are
+    the impulsive ones.
     """
     wall0 = time.perf_counter()
     if not isinstance(scenario, Scenario):
@@ -641,21 +747,14 @@ def push_test(
             outcome = PushOutcome(
                 push=push,
                 relative=None if relative is None else float(level),
-                prediction=predict_push(setup, push, height, position, limit),
+                prediction=predict_push(setup, push, height, position, limit, finite_push),
                 summary=entry["summary"],
                 trajectory=entry["trajectory"],
             )
             outcomes.append(outcome)
             if progress:
                 progress(outcome)
-    controller = controller_class(setup.controller).trial_summary(
-        options, setup.sim, setup.joints == "servo"
-    )
-    controller["armature"] = setup.sim.armature_source
-    # The gains from the robot's rules (they differ between stances of one robot) or as given.
-    controller["gains_from_robot"] = bool(options.robot_gains)
-    repair = setup.sim.inertia_repair
-    controller["inertia_repair"] = None if repair is None else repair.to_dict()
+    controller = _controller_summary(setup, options)
     return PushTestResult(
         scenario.name,
         outcomes,
@@ -672,4 +771,5 @@ def push_test(
         mujoco.mj_id2name(setup.sim.model, mujoco.mjtObj.mjOBJ_BODY, body_id),
         a.stance.robot.name,
         limit,
+        (float(duration), finite_push_factor(omega, duration)) if finite_push else None,
     )
