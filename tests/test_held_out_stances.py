@@ -35,18 +35,19 @@ REQUIRED = {
     "slope",
 }
 #: Each set's folder and what it must cover; the second adds pushes on one foot, the third
-#: forward impacts and wide, staggered two-feet stances; the fourth and fifth cover what the third
-#: does.
+#: forward impacts and wide, staggered two-feet stances; the fourth, fifth and sixth cover what
+#: the third does.
 SETS = {
     "held_out": REQUIRED,
     "held_out_2": REQUIRED | {"one foot"},
     "held_out_3": REQUIRED | {"one foot", "forward impact", "wide stance", "staggered"},
     "held_out_4": REQUIRED | {"one foot", "forward impact", "wide stance", "staggered"},
     "held_out_5": REQUIRED | {"one foot", "forward impact", "wide stance", "staggered"},
+    "held_out_6": REQUIRED | {"one foot", "forward impact", "wide stance", "staggered"},
 }
 #: The sets checked under the protocol's options (10 mm margin, angular momentum term) and
 #: whose impact friction and restitution must be new: each against the stances before it.
-NEW_SETS = ["held_out_2", "held_out_3", "held_out_4", "held_out_5"]
+NEW_SETS = ["held_out_2", "held_out_3", "held_out_4", "held_out_5", "held_out_6"]
 SET_FILES = {name: sorted((STUDIES / name).glob("*.yaml")) for name in SETS}
 FILES = [f for files in SET_FILES.values() for f in files]
 #: Stances on one foot the second set must hold at least (its lesson: a margin from two-feet
@@ -88,10 +89,23 @@ THIRD_MIN_ROBOTS = 4
 THIRD_MIN_WIDE = 2
 #: The sets written to the third set's aims, with the stances on one foot each must hold at least
 #: and whether each of its wide stances must also be staggered (the third set's were).
-LATER_AIMS = {"held_out_3": (1, True), "held_out_4": (2, False), "held_out_5": (1, False)}
-#: The fifth set is about the CoM's reach: wide stances on at least this many robots, side by
-#: side and staggered, flat and on slopes.
+LATER_AIMS = {
+    "held_out_3": (1, True),
+    "held_out_4": (2, False),
+    "held_out_5": (1, False),
+    "held_out_6": (1, False),
+}
+#: The fifth and sixth sets are about the CoM's reach: wide stances on at least this many robots,
+#: side by side and staggered, flat and on slopes.
 FIFTH_MIN_WIDE_ROBOTS = 3
+REACH_SETS = ["held_out_5", "held_out_6"]
+#: Two feet whose contact centres are this far apart sideways stand at an ordinary width (m): the
+#: sixth set holds such stances (the fifth held none) on at least ORDINARY_MIN_ROBOTS robots.
+ORDINARY_M = (0.15, 0.25)
+ORDINARY_MIN_ROBOTS = 2
+#: The sixth set's robots with wide stances: JVRC-1 twice (flat side by side, and on a slope or
+#: ramp no earlier JVRC-1 wide stance stood on), G1 and Romeo.
+SIXTH_WIDE = {"jvrc1": 2, "g1": 1, "romeo": 1}
 
 
 def _header(path: Path, key: str) -> str:
@@ -242,15 +256,65 @@ def test_the_later_sets_cover_four_robots_wide_stances_and_impacts_on_one_foot_a
     assert any("slope" in _covers(f) for f in files)
 
 
-def test_the_fifth_set_holds_wide_stances_of_every_kind_on_three_robots() -> None:
-    """Its aim (the CoM's reach): wide stances on three robots, staggered or not, flat or not."""
-    wide = [f for f in SET_FILES["held_out_5"] if "wide stance" in _covers(f)]
+@pytest.mark.parametrize("name", REACH_SETS)
+def test_the_reach_sets_hold_wide_stances_of_every_kind_on_three_robots(name: str) -> None:
+    """Their aim (the CoM's reach): wide stances on three robots, staggered or not, flat or not."""
+    wide = [f for f in SET_FILES[name] if "wide stance" in _covers(f)]
     robots = {load_scenario(str(f)).robot for f in wide}
     assert len(robots) >= FIFTH_MIN_WIDE_ROBOTS, robots
     staggered = {"staggered" in _covers(f) for f in wide}
     sloped = {"slope" in _covers(f) for f in wide}
     assert staggered == {True, False}, wide  # side by side and staggered
     assert sloped == {True, False}, wide  # flat and on a slope or ramp
+
+
+def _apart(path: Path) -> np.ndarray | None:
+    """Two feet's centres' distance apart (|dx|, |dy|, |dz|, m, to the mm), or None."""
+    d = analyze(str(path)).to_dict()
+    feet = _feet(d)
+    if len(feet) != 2 or len(d["contacts"]) != 2:
+        return None
+    return np.abs(np.subtract(*(c["position"] for c in feet))).round(3)
+
+
+def _normals(path: Path) -> list[np.ndarray]:
+    """The unit normals of a stance's feet (world)."""
+    feet = _feet(analyze(str(path)).to_dict())
+    return [np.asarray(c["normal"], dtype=float) / np.linalg.norm(c["normal"]) for c in feet]
+
+
+def test_the_sixth_set_holds_wide_jvrc1_g1_romeo_and_ordinary_width_stances() -> None:
+    """Its aims: two wide JVRC-1 stances (flat side by side; a ground no earlier one stood on),
+    wide G1 and Romeo stances, and two-feet stances of ordinary width on two robots."""
+    files = SET_FILES["held_out_6"]
+    robot = {f: load_scenario(str(f)).robot for f in files}
+    wide = [f for f in files if "wide stance" in _covers(f)]
+    for name, least in SIXTH_WIDE.items():
+        assert sum(robot[f] == name for f in wide) >= least, (name, wide)
+    jvrc1 = [f for f in wide if robot[f] == "jvrc1"]
+    assert any(not {"slope", "staggered"} & _covers(f) for f in jvrc1), jvrc1
+    earlier = [
+        n
+        for s in ("held_out_4", "held_out_5")
+        for f in SET_FILES[s]
+        if load_scenario(str(f)).robot == "jvrc1" and {"wide stance", "slope"} <= _covers(f)
+        for n in _normals(f)
+    ]
+    assert earlier  # set 4's ramp and set 5's cross slope
+    sloped = [f for f in jvrc1 if "slope" in _covers(f)]
+    assert sloped, jvrc1
+    for f in sloped:
+        for n in _normals(f):
+            # Another ground: its normal at least 3 degrees from every earlier one's.
+            angles = [math.degrees(math.acos(min(1.0, float(n @ m)))) for m in earlier]
+            assert min(angles) > 3.0, (f.name, angles)
+    ordinary = []
+    for f in files:
+        apart = _apart(f)
+        if apart is not None and ORDINARY_M[0] <= apart[1] <= ORDINARY_M[1]:
+            assert "wide stance" not in _covers(f)
+            ordinary.append(f)
+    assert len({robot[f] for f in ordinary}) >= ORDINARY_MIN_ROBOTS, ordinary
 
 
 @pytest.mark.parametrize("name", NEW_SETS)
@@ -311,7 +375,7 @@ def test_the_simulation_model_builds_with_the_push_bodies(path: Path) -> None:
 
 
 #: The sets whose protocol also tables the CoM's reach (impact_balance.balance.reach).
-REACH_TABLES = ["held_out_5"]
+REACH_TABLES = ["held_out_5", "held_out_6"]
 #: The protocols whose tables of predictions the test recomputes, by set.
 PROTOCOLS = {
     name: STUDIES.parent / "docs" / "studies" / f"held-out-protocol-{name[-1]}.md"
