@@ -12,7 +12,6 @@ from hypothesis import strategies as st
 
 from impact_balance.analysis.analyze import analyze
 from impact_balance.balance.reach import (
-    ComReach,
     ReachOptions,
     com_reach,
     ray_extent,
@@ -22,11 +21,7 @@ from impact_balance.exceptions import ScenarioError
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.scenario import load_scenario
 from tests.helpers.lipm import stop_distance
-
-
-def _uniform(radius: float, n: int = 8) -> ComReach:
-    azimuths = np.arange(n, dtype=float) * 2 * math.pi / n
-    return ComReach(azimuths, np.full(n, radius), 0.8, np.zeros((n, 1)))
+from tests.helpers.reach import evenly_spaced_reach, extent_by_bisection
 
 
 @settings(max_examples=40, deadline=None)
@@ -39,7 +34,7 @@ def test_the_speed_limit_is_where_the_lipm_stops_at_the_reach(extent, ratio, ome
     # Independent of the formula: integrate the LIPM with the ZMP at the area's extent.
     reach = ratio * extent
     square = Polygon.from_points(np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * omega * extent)
-    limit = reach_speed_limit(square, omega, _uniform(reach), [1.0, 0.0])
+    limit = reach_speed_limit(square, omega, evenly_spaced_reach(np.full(8, reach)), [1.0, 0.0])
     assert stop_distance(0.99 * limit, extent, omega) <= reach + 1e-9
     assert stop_distance(1.01 * limit, extent, omega) > reach
 
@@ -48,7 +43,7 @@ def test_a_reach_beyond_the_area_leaves_the_papers_limit():
     omega, extent = 3.3, 0.1
     square = Polygon.from_points(np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * omega * extent)
     for reach in (extent, 2 * extent):
-        limit = reach_speed_limit(square, omega, _uniform(reach), [0.0, 1.0])
+        limit = reach_speed_limit(square, omega, evenly_spaced_reach(np.full(8, reach)), [0.0, 1.0])
         assert limit == pytest.approx(omega * extent, rel=1e-12)
 
 
@@ -63,16 +58,12 @@ def test_ray_extent_is_the_boundary_found_by_bisection(points, angle):
     cloud = np.vstack([points, [[0.3, 0.3], [-0.3, 0.3], [0.0, -0.3]]])  # the origin inside
     area = Polygon.from_points(cloud)
     u = np.array([math.cos(angle), math.sin(angle)])
-    lo, hi = 0.0, 10.0
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if area.contains(mid * u, tol=0.0) else (lo, mid)
-    assert ray_extent(area, u) == pytest.approx(lo, abs=1e-9)
+    assert ray_extent(area, u) == pytest.approx(extent_by_bisection(area, u), abs=1e-9)
 
 
 def test_along_is_exact_on_a_sample_and_the_smaller_neighbour_between():
     radii = np.array([0.1, 0.2, 0.05, 0.3])
-    reach = ComReach(np.arange(4) * math.pi / 2, radii, 0.8, np.zeros((4, 1)))
+    reach = evenly_spaced_reach(radii)
     for k, r in enumerate(radii):
         a = k * math.pi / 2
         assert reach.along([math.cos(a), math.sin(a)]) == r
@@ -172,8 +163,7 @@ def test_the_max_speed_from_rest_stops_every_vertex_within_its_reach(radii, jump
 
     omega, extent = 3.3, 0.12
     area = _square(omega, extent)
-    azimuths = np.arange(8) * math.pi / 4
-    reach = ComReach(azimuths, np.array(radii), 0.8, np.zeros((8, 1)))
+    reach = evenly_spaced_reach(radii)
     d = np.array(jumps)
     s = reach_max_speed(area, omega, reach, [0.0, 0.0], d, upper=50.0)
 
@@ -195,7 +185,7 @@ def test_the_max_speed_away_from_rest_is_the_first_speed_out_of_reach():
 
     omega, extent = 3.3, 0.12
     area = _square(omega, extent)
-    reach = ComReach(np.arange(8) * math.pi / 4, np.full(8, 0.05), 0.8, np.zeros((8, 1)))
+    reach = evenly_spaced_reach(np.full(8, 0.05))
     start = np.array([0.05, 0.02])
     d = np.array([[0.3, 0.1], [0.2, -0.2]])
     s = reach_max_speed(area, omega, reach, start, d, upper=5.0)
@@ -224,7 +214,7 @@ def test_the_max_speed_from_a_moving_com_ends_where_a_vertex_leaves_the_reach(ra
 
     omega, extent, upper = 3.3, 0.12, 2.0
     area = _square(omega, extent)
-    reach = ComReach(np.arange(8) * math.pi / 4, np.array(radii), 0.8, np.zeros((8, 1)))
+    reach = evenly_spaced_reach(radii)
     c0, d = np.array(start), np.array(jumps)
 
     def within(speed: float) -> bool:

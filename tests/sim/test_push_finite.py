@@ -15,7 +15,6 @@ pytest.importorskip("mujoco")  # the push predictions live beside the simulation
 
 from impact_balance import analyze
 from impact_balance.balance.lipm import finite_push_factor
-from impact_balance.balance.reach import ComReach
 from impact_balance.scenario import load_scenario
 from impact_balance.sim.studies.push import (
     PushOutcome,
@@ -26,6 +25,7 @@ from impact_balance.sim.studies.push import (
 from impact_balance.sim.trials.setup import Push
 from tests.helpers.cli import assert_one_line_error, run_cli
 from tests.helpers.lipm import captured_after_push
+from tests.helpers.reach import evenly_spaced_reach, extent_by_bisection
 
 SUMMARY = {
     "outcome": "balanced",
@@ -47,15 +47,6 @@ def setup():
 def setup_tau():
     scenario = load_scenario("palm_push_two_feet").replace(angular_momentum_damping_time=0.1)
     return SimpleNamespace(analysis=analyze(scenario))
-
-
-def _extent(area, u) -> float:
-    """The area's extent along u by bisection on ``contains`` (not the module's margins)."""
-    lo, hi = 0.0, 10.0
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if area.contains(mid * u, tol=0.0) else (lo, mid)
-    return lo
 
 
 def _outcome(push, prediction) -> PushOutcome:
@@ -80,7 +71,7 @@ def test_the_finite_push_call_is_the_lipm_capture_after_the_push(setup, level, k
     push = Push(angle, J, duration)
     height = float(a.stance.com[2])
     p = predict_push(setup, push, height, a.stance.com, finite_push=True)
-    extent = _extent(a.areas.zmp_area.inset(margin).affine(1.0, -a.stance.com[:2]), u)
+    extent = extent_by_bisection(a.areas.zmp_area.inset(margin).affine(1.0, -a.stance.com[:2]), u)
     kappa = finite_push_factor(omega, duration)
     assume(abs(kappa * J / mass - omega * extent) > 1e-4)  # not on the boundary itself
     captured = captured_after_push(J / mass / duration, duration, extent, omega)
@@ -97,7 +88,7 @@ def test_the_finite_push_call_is_the_lipm_capture_after_the_push(setup, level, k
 def test_with_the_angular_momentum_and_the_reach_the_scaled_velocities_are_tested(setup_tau):
     a = setup_tau.analysis
     omega, mass = float(a.areas.omega), a.stance.mass
-    reach = ComReach(np.arange(8) * math.pi / 4, np.full(8, 0.06), 0.8, np.zeros((8, 1)))
+    reach = evenly_spaced_reach(np.full(8, 0.06))
     area = a.areas.com_velocity_area
     for k in range(8):
         angle = k * math.pi / 4

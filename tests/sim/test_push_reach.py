@@ -18,6 +18,7 @@ from impact_balance.scenario import load_scenario
 from impact_balance.sim.studies.push import PushOutcome, boundary_impulse, predict_push
 from impact_balance.sim.trials.setup import Push
 from tests.helpers.lipm import stop_distance
+from tests.helpers.reach import evenly_spaced_reach, extent_by_bisection
 
 SUMMARY = {"outcome": "balanced", "com_velocity_margin_at_end": 0.0}
 
@@ -26,21 +27,6 @@ SUMMARY = {"outcome": "balanced", "com_velocity_margin_at_end": 0.0}
 def setup():
     scenario = load_scenario("palm_push_two_feet").replace(angular_momentum_damping_time=0.1)
     return SimpleNamespace(analysis=analyze(scenario))
-
-
-def _reach(radii) -> ComReach:
-    radii = np.asarray(radii, dtype=float)
-    n = len(radii)
-    return ComReach(np.arange(n) * 2 * math.pi / n, radii, 0.8, np.zeros((n, 1)))
-
-
-def _extent(area, u) -> float:
-    """The area's extent along u by bisection on ``contains`` (not the module's ray_extent)."""
-    lo, hi = 0.0, 10.0
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if area.contains(mid * u, tol=0.0) else (lo, mid)
-    return lo
 
 
 @settings(max_examples=30, deadline=None)
@@ -58,7 +44,7 @@ def test_called_safe_with_a_reach_means_the_lipm_stops_within_it(setup, level, k
     angle = k * math.pi / 4
     u = np.array([math.cos(angle), math.sin(angle)])
     J = level * boundary_impulse(a.areas.com_velocity_area, a.stance.mass, angle)
-    reach = _reach(radii)
+    reach = evenly_spaced_reach(radii)
     p = predict_push(setup, Push(angle, J), float(a.stance.com[2]), a.stance.com, reach)
     free = predict_push(setup, Push(angle, J), float(a.stance.com[2]), a.stance.com)
     outcome = PushOutcome(push=Push(angle, J), relative=None, summary=SUMMARY, prediction=p)
@@ -68,7 +54,7 @@ def test_called_safe_with_a_reach_means_the_lipm_stops_within_it(setup, level, k
         assert without.safe("com", margin, omega)
         area = a.areas.com_velocity_area.inset(omega * margin)
         speed = float(np.linalg.norm(p.com_velocity))
-        stop = stop_distance(speed, _extent(area, u) / omega, omega)
+        stop = stop_distance(speed, extent_by_bisection(area, u) / omega, omega)
         assert stop <= reach.along(u) + 1e-9
 
 
@@ -80,7 +66,7 @@ def test_a_reach_beyond_the_area_changes_nothing_and_none_calls_nothing_safe(set
         J = 0.6 * boundary_impulse(a.areas.com_velocity_area, a.stance.mass, angle)
         push = Push(angle, J)
         calls = []
-        for reach in (None, _reach([10.0] * 8), _reach([0.0] * 8)):
+        for reach in (None, evenly_spaced_reach([10.0] * 8), evenly_spaced_reach([0.0] * 8)):
             p = predict_push(setup, push, float(a.stance.com[2]), a.stance.com, reach)
             o = PushOutcome(push=push, relative=None, summary=SUMMARY, prediction=p)
             calls.append(o.safe("com", 0.01, omega))

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import math
 
 import numpy as np
 import pytest
@@ -13,11 +12,12 @@ pytest.importorskip("pandas", reason="needs the logs extra (pandas)")
 
 from impact_balance import analyze, load_scenario
 from impact_balance.analysis.reach import ReachAnswer, reach_answer
-from impact_balance.balance.reach import ComReach, ReachOptions
+from impact_balance.balance.reach import ReachOptions
 from impact_balance.cli import main
 from impact_balance.sim.studies.journal import TrialJournal
 from impact_balance.sim.studies.validate import ValidationResult, validate
 from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions
+from tests.helpers.reach import evenly_spaced_reach
 
 SCENARIO = "palm_push_two_feet"
 #: A cheap search (4 azimuths, 3 bisections, 150 IK steps): the same code as the default's.
@@ -47,8 +47,7 @@ def _synthetic(reach: ReachAnswer | None, default: float) -> ValidationResult:
 @pytest.mark.parametrize("within", [0.0, 0.21, 0.5])
 def test_the_verdict_is_scored_against_the_maximum_within_reach(within):
     n = 4
-    azimuths = np.arange(n) * (2 * math.pi / n)
-    reach = ComReach(azimuths, np.full(n, 0.05), 0.8, np.zeros((n, 3)))
+    reach = evenly_spaced_reach(np.full(n, 0.05), nq=3)
     answer = ReachAnswer(reach, np.full(n, 0.3), within, 0.5)
     doc = _synthetic(answer, 0.5).to_dict()
     assert doc["predicted"]["default"] == 0.5

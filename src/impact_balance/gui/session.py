@@ -167,13 +167,8 @@ class Session:
             try:
                 state = build()
                 analysis = analyze(state.scenario)
-            except ImpactBalanceError as exc:
-                self.message, self.refused = describe(exc, self.files.workspace), True
-                return False
             except Exception as exc:
-                log.exception("unexpected error while applying an edit")
-                self.message, self.refused = describe(exc), True
-                return False
+                return self._refuse(exc, "applying an edit")
             self.state, self.analysis = state, analysis
             self.analysis_ms = 1e3 * (time.perf_counter() - t0)
             self.message, self.refused = note, False
@@ -234,13 +229,8 @@ class Session:
         with self.lock:
             try:
                 answer = reach_answer(self.analysis, options)
-            except ImpactBalanceError as exc:
-                self.message, self.refused = describe(exc, self.files.workspace), True
-                return False
             except Exception as exc:
-                log.exception("unexpected error while computing the CoM's reach")
-                self.message, self.refused = describe(exc), True
-                return False
+                return self._refuse(exc, "computing the CoM's reach")
             self.reach, self._reach_of = answer, _stance_key(self.analysis)
             radii = answer.reach.radii
             self.message = (
@@ -278,6 +268,20 @@ class Session:
     def replace(self, state: GuiState) -> bool:
         """Switch to another (already parsed) state."""
         return self._commit(lambda: state)
+
+    def _refuse(self, exc: Exception, doing: str) -> bool:
+        """Refuse what raised ``exc`` while ``doing``: its message shown, the session unchanged.
+
+        An :class:`~impact_balance.exceptions.ImpactBalanceError` is bad input (its message names
+        the field); anything else is logged with its traceback. Returns False (refused).
+        """
+        if isinstance(exc, ImpactBalanceError):
+            self.message = describe(exc, self.files.workspace)
+        else:
+            log.exception("unexpected error while %s", doing)
+            self.message = describe(exc)
+        self.refused = True
+        return False
 
     @staticmethod
     def _read(read: Callable[[], GuiState]) -> GuiState | BaseException:
