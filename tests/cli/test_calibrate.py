@@ -136,9 +136,11 @@ def test_calibrate_on_a_real_push_test(tmp_path, capsys, monkeypatch):
     trials = strict_json(out)
     assert trials["robot"] == "talos"
     omega, margin = trials["omega"], trials["zmp_margin"]
+    assert trials["finite_push"] is True  # the default counts the push's duration
     for push in trials["pushes"]:
         raw = push["predicted_com_velocity_margin"]
-        assert raw - omega * margin == pytest.approx(push["com_velocity_margin"], abs=1e-12)
+        assert raw - omega * margin == pytest.approx(push["finite_push_margin"], abs=1e-12)
+        assert push["finite_push_margin"] < push["com_velocity_margin"]  # kappa > 1
     path = tmp_path / "trials.json"
     path.write_text(out)
     rc, out, err = run_cli(

@@ -144,10 +144,14 @@ def test_push_test_finite_push_records_the_factor_and_each_pushs_margin(capsys, 
     journal = str(tmp_path / "j.jsonl")
     args = ("push-test", "palm_push_two_feet", "--controller", "id", "--directions", "2")
     args += ("--relative", "0.95", "--duration", "0.08", "--json", "--journal", journal)
-    rc, out, _ = run_cli(capsys, *args, "--finite-push")
+    rc, out, _ = run_cli(capsys, *args)  # the push's duration is counted by default
     assert rc == 0
     doc = json.loads(out)
-    rc, out, _ = run_cli(capsys, *args)  # the same trials, reused
+    rc, out, _ = run_cli(capsys, *args, "--finite-push")  # the same trials, reused
+    assert rc == 0
+    again = json.loads(out)
+    assert {**again, "wall_time": 0, "reused_trials": 0} == {**doc, "wall_time": 0}
+    rc, out, _ = run_cli(capsys, *args, "--no-finite-push")  # the paper's impulse
     assert rc == 0
     plain = json.loads(out)
     assert "finite_push" not in plain

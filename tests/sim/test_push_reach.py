@@ -95,6 +95,7 @@ def test_push_test_com_reach_reports_the_reach_and_each_pushs_margin(capsys, tmp
         "--relative",
         "0.5",
         "--com-reach",
+        "--no-finite-push",  # the impulse's velocity against the reach (kappa: test_push_finite)
         "--json",
         "--journal",
         str(tmp_path / "j.jsonl"),

@@ -98,10 +98,12 @@ def add_parser(sub: Subcommands) -> list[str]:
     )
     a.add_argument(
         "--finite-push",
-        action="store_true",
-        help="the default prediction counts the push's duration: a constant force for "
-        "--duration with the ZMP under the starting CoM, the impulse's CoM velocity scaled by "
-        "kappa = (exp(omega T) - 1) / (omega T) (docs/simulation.md)",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="the default prediction counts the push's duration (on by default): a constant "
+        "force for --duration with the ZMP under the starting CoM, the impulse's CoM velocity "
+        "scaled by kappa = (exp(omega T) - 1) / (omega T); --no-finite-push predicts the push "
+        "as the paper's impulse (docs/simulation.md)",
     )
     add_controller_option(
         a,

@@ -33,7 +33,8 @@ effective post-push CoM velocity ``c0 + (J u + S(L) / (h (1 + omega tau))) / m``
 without it the two are the same call. With a reach (``push_test(..., reach=True)``, ``push-test
 --com-reach``), ``com`` also asks the capture to stay within the CoM's reach at constant height
 (:mod:`impact_balance.balance.reach`). With the push's duration (``push_test(...,
-finite_push=True)``, ``push-test --finite-push``), ``com`` predicts a push of constant force
+finite_push=True)``, the default of both ``push_test`` and ``push-test``; ``finite_push=False``,
+``push-test --no-finite-push`` predict an impulse), ``com`` predicts a push of constant force
 ``J u / T`` for its duration ``T`` with the ZMP held under the starting CoM, not an impulse: the
 velocity of the impulse, ``J u / m``, is scaled by ``kappa = (exp(omega T) - 1) / (omega T)``
 (:func:`~impact_balance.balance.lipm.finite_push_factor`) in every velocity the default tests
@@ -689,7 +690,7 @@ def push_test(
     journal: TrialJournal | None = None,
     band: Sequence[float] | None = None,
     reach: ComReach | bool = False,
-    finite_push: bool = False,
+    finite_push: bool = True,
 ) -> PushTestResult:
     """Push the robot in evenly spaced directions and score both criteria.
 
@@ -699,9 +700,9 @@ def push_test(
     it already holds are not run again. ``band`` (``(LO, HI)``, fractions of the boundary impulse,
     with ``relative`` from :func:`band_levels`) adds the scores of the pushes in it. ``reach``
     (True: :func:`.com_reach` of the stance) keeps the default's capture within the CoM's reach.
-    ``finite_push`` makes the default predict a push of ``duration``, not an impulse (kappa,
-    :func:`~impact_balance.balance.lipm.finite_push_factor`); without it the predictions are
-    the impulsive ones.
+    ``finite_push`` (the default) makes the default predict a push of ``duration``, not an
+    impulse (kappa, :func:`~impact_balance.balance.lipm.finite_push_factor`); with
+    ``finite_push=False`` the predictions are the impulsive ones.
     """
     wall0 = time.perf_counter()
     if not isinstance(scenario, Scenario):
