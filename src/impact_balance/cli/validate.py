@@ -67,6 +67,15 @@ def add_parser(sub: Subcommands) -> list[str]:
         "reach at constant height (whole-body IK once before the trials, a few seconds; "
         "docs/com-reach.md)",
     )
+    a.add_argument(
+        "--impact-model",
+        default="floating",
+        choices=("floating", "held-stance"),
+        help="floating: the paper's impact model only (default); held-stance: also the "
+        "held-stance model's maximum contact velocity (the contact-aware jump at the "
+        "restitution bounds, the paper's answer where its fixed point is not reached), "
+        "computed before the trials, with each trial's call against it (docs/simulation.md)",
+    )
     add_calibration_option(a)
     add_output_options(a, "of the fastest trial survived")
     add_angular_momentum_option(a, controller=True)
@@ -123,6 +132,7 @@ def run(args: argparse.Namespace) -> int:
             zmp_margin=scoring_margin(scenario),
             journal=journal,
             com_reach=args.com_reach,
+            impact_model=args.impact_model,
         )
     finally:
         bar.close()
@@ -241,6 +251,8 @@ def _text(out: dict[str, Any], args: argparse.Namespace, n: int) -> str:
     lines.append(f"    default (the governor's cap) {_f(p['default'])}")
     if "com_reach" in p:
         lines.append(_reach_line(p["com_reach"]))
+    if "held_stance" in p:
+        lines.append(_held_stance_line(p["held_stance"], out["zmp_margin"]))
     lines.append("  trials (commanded -> measured: outcome):")
     for t in out["trials"]:
         why = f" {t['reason']}" if t["reason"] else ""
@@ -250,6 +262,8 @@ def _text(out: dict[str, Any], args: argparse.Namespace, n: int) -> str:
         strict = "; strict fail" if t["strict_fail"] else ""
         if t.get("com_reach_safe") is not None:
             call += "; within reach: " + ("safe" if t["com_reach_safe"] else "unsafe")
+        if t.get("held_stance_safe") is not None:
+            call += "; held stance: " + ("safe" if t["held_stance_safe"] else "unsafe")
         lines.append(
             f"    {t['speed']:.3f} -> {_f(t['approach_speed_measured'])}: {t['outcome']}{why}"
             f"{strict}   {call}"
@@ -271,6 +285,20 @@ def _reach_line(reach: dict[str, Any]) -> str:
         f"    within the CoM's reach ({1000 * min(radii):.0f} to {1000 * max(radii):.0f} mm at "
         f"constant height) {_f(reach['max_contact_velocity'])}: the verdict's prediction"
     )
+
+
+def _held_stance_line(held: dict[str, Any], zmp_margin: float) -> str:
+    """One line of ``validate --impact-model held-stance``: its maximum and how it was reached.
+
+    ``zmp_margin``: the scoring ZMP margin it was computed at, m.
+    """
+    if held["fell_back"]:
+        how = "the paper's answer: the fixed point was not reached"
+    elif held["binding_restitution"] is None:
+        how = "no approach speed leaves the area"
+    else:
+        how = f"binding restitution {held['binding_restitution']:g}"
+    return f"    held stance ({1000 * zmp_margin:g} mm) {_f(held['max_contact_velocity'])} ({how})"
 
 
 def _plots(result: ValidationResult, out: Path) -> list[Path]:

@@ -43,7 +43,9 @@ to exist or be reached in general: ``converged`` says whether it was.
 
 Limits: the impact is instantaneous, so the supports' pre-impact load (the weight) plays no
 part: a corner cannot give back part of the load it carried (its impulse is >= 0), and a foot
-the impact does not press has no friction during the impact. Experimental: no criterion uses it.
+the impact does not press has no friction during the impact. Experimental: the paper's criteria do
+not use it; the held-stance model (:mod:`impact_balance.impact.held_stance`) and the governor's
+contact-aware option do.
 """
 
 from __future__ import annotations

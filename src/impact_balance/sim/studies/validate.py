@@ -37,6 +37,14 @@ margin, a CoM at rest), and the prediction the verdict compares with is the defa
 contact velocity within reach (``predicted.com_reach.max_contact_velocity``); each trial's
 ``com_reach_safe`` calls its measured speed against it. The search is unchanged (it starts at the
 CoM criterion's prediction without margin).
+
+With the held-stance impact model (``validate(..., impact_model="held-stance")``,
+``validate --impact-model held-stance``), its maximum contact velocity
+(:func:`~impact_balance.analysis.held_stance.held_stance_max_contact_velocity`: the composite
+model, the scoring ZMP margin, a CoM at rest; the paper's answer where its fixed point is not
+reached) is computed once before the trials and kept in ``predicted.held_stance``; each trial's
+``held_stance_safe`` calls its measured speed against it. The search and the verdict are
+unchanged.
 """
 
 from __future__ import annotations
@@ -49,6 +57,7 @@ from typing import Any
 import numpy as np
 
 from impact_balance.analysis.analyze import analyze
+from impact_balance.analysis.held_stance import HeldStanceLimit, held_stance_max_contact_velocity
 from impact_balance.analysis.reach import ReachAnswer, reach_answer
 from impact_balance.analysis.result import Analysis
 from impact_balance.balance.reach import ReachOptions
@@ -69,6 +78,7 @@ from impact_balance.sim.trials.outcomes import OutcomeName
 from impact_balance.sim.trials.result import TrialEntry, trajectory
 
 __all__ = [
+    "IMPACT_MODELS",
     "INERTIA_MODELS",
     "TrialTest",
     "ValidationProgress",
@@ -76,9 +86,14 @@ __all__ = [
     "ValidationTrial",
     "default_prediction",
     "fall_verdict",
+    "held_stance_prediction",
     "predictions",
     "validate",
 ]
+
+#: The impact models ``validate`` can predict with: "floating" (the paper's, always reported)
+#: and "held-stance" (also :func:`held_stance_prediction`, in ``predicted.held_stance``).
+IMPACT_MODELS = ("floating", "held-stance")
 
 
 def predictions(scenario: Scenario, zmp_margin: float = 0.0) -> dict[str, dict[str, float | None]]:
@@ -130,6 +145,23 @@ def _default_analysis(scenario: Scenario, zmp_margin: float) -> Analysis:
     if analysis.impact is None:
         raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact")
     return analysis
+
+
+def held_stance_prediction(scenario: Scenario, zmp_margin: float) -> HeldStanceLimit:
+    """The held-stance model's maximum contact velocity (m/s) before the trials.
+
+    :func:`~impact_balance.analysis.held_stance.held_stance_max_contact_velocity` of the
+    scenario with the composite inertia model, the ZMP support area shrunk by ``zmp_margin``
+    (m), the scenario's velocity margin and a CoM at rest (the trials start at rest). Its
+    fallback is then the CoM criterion's composite answer with that margin.
+    """
+    impact = scenario.impact
+    if impact is None:
+        raise SimulationError("impact", None, f"scenario {scenario.name!r} has no impact")
+    variant = scenario.model_copy(
+        update={"impact": impact.model_copy(update={"inertia": "composite"})}
+    )
+    return held_stance_max_contact_velocity(_default_analysis(variant, zmp_margin))
 
 
 @dataclass(kw_only=True)
@@ -255,6 +287,7 @@ class ValidationResult:
     extra: dict[str, Any] = field(default_factory=dict)
     default: float | None = None
     reach: ReachAnswer | None = None
+    held_stance: HeldStanceLimit | None = None
 
     @property
     def scored_against(self) -> float | None:
@@ -397,6 +430,11 @@ class ValidationResult:
                 trials[-1]["com_reach_safe"] = (
                     None if t.measured is None or within is None else bool(t.measured <= within)
                 )
+            if self.held_stance is not None:  # the measured speed against the held stance's
+                held = self.held_stance.max_contact_velocity
+                trials[-1]["held_stance_safe"] = (
+                    None if t.measured is None else bool(t.measured <= held)
+                )
         empirical = {**self.bracket(), "tolerance": self.tolerance, "max_speed": self.max_speed}
         verdict = fall_verdict(
             empirical["survived"],
@@ -407,6 +445,8 @@ class ValidationResult:
         predicted = {**self.predicted, "default": self.default}
         if self.reach is not None:
             predicted["com_reach"] = self.reach.to_dict()
+        if self.held_stance is not None:
+            predicted["held_stance"] = self.held_stance.to_dict()
         return {
             "scenario": self.scenario,
             "joints": self.joints,
@@ -601,6 +641,7 @@ def validate(
     zmp_margin: float | None = None,
     journal: TrialJournal | None = None,
     com_reach: ReachOptions | bool = False,
+    impact_model: str = "floating",
 ) -> ValidationResult:
     """Bracket the approach speed at which the robot starts to fall (m/s); see the module docstring.
 
@@ -611,7 +652,8 @@ def validate(
     ``progress(trial, stood, fell)`` is called after every trial. ``com_reach`` (True: the
     default :class:`~impact_balance.balance.reach.ReachOptions`; or the options) computes the
     CoM's reach once, before the trials, and scores the verdict against the maximum contact
-    velocity within it (see the module docstring).
+    velocity within it (see the module docstring). ``impact_model`` (one of
+    :data:`IMPACT_MODELS`) "held-stance" adds :func:`held_stance_prediction` before the trials.
     """
     wall0 = time.perf_counter()
     if not isinstance(scenario, Scenario):
@@ -621,6 +663,10 @@ def validate(
             "impact", None, f"scenario {scenario.name!r} has no impact to validate"
         )
     check_tolerance(tolerance)  # numeric_limits: a bracket the bisection can close
+    if impact_model not in IMPACT_MODELS:
+        raise SimulationError(
+            "impact_model", impact_model, f"must be one of {', '.join(IMPACT_MODELS)}"
+        )
     options = options or BalanceTrialOptions()
     margin = controller_margin(options) if zmp_margin is None else float(zmp_margin)
     predicted = predictions(scenario)
@@ -629,6 +675,7 @@ def validate(
     if com_reach is not False:
         options_reach = None if com_reach is True else com_reach
         reach = reach_answer(_default_analysis(scenario, margin), options_reach)
+    held = held_stance_prediction(scenario, margin) if impact_model == "held-stance" else None
     setup = setup or BalanceSetup.create(scenario, joints, options)
     runner = _TrialRunner(setup, options, journal or TrialJournal(None, ""))
     start = predicted["com_criterion"]["composite"] or 0.5
@@ -661,4 +708,5 @@ def validate(
         {"setup": setup},
         default_prediction(scenario, margin),
         reach,
+        held,
     )
