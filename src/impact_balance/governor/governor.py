@@ -165,9 +165,9 @@ class Governor:
             ``c0 + s j`` in the posture's CoM velocity area with the velocity margin for both
             jumps j, binding "held_stance" (the angular momentum term is not counted). Where
             a fixed point was not reached, the answers are the floating model's (binding
-            "floating"), as :func:`~impact_balance.analysis.held_stance.\
-held_stance_max_contact_velocity` falls back. "com" criterion only, not with
-            ``contact_aware`` or ``com_reach``. The jumps are :attr:`held_stance`.
+            "floating"), the fallback of ``analyze --impact-model held-stance``. "com"
+            criterion only, not with ``contact_aware`` or ``com_reach``. The jumps are
+            :attr:`held_stance`.
 
     Raises:
         ScenarioError: another robot's or a bad calibration, no impact, an unknown frame, an
