@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -17,6 +18,7 @@ from impact_balance.cli.angular_momentum import add_angular_momentum_option, wit
 from impact_balance.cli.calibrate import add_calibration_option, apply_calibration_option
 
 if TYPE_CHECKING:
+    from impact_balance.analysis.held_stance import HeldStanceLimit
     from impact_balance.analysis.reach import ReachAnswer
     from impact_balance.analysis.result import Diagnostic
     from impact_balance.cli._options import Subcommands
@@ -59,6 +61,15 @@ def add_parser(sub: Subcommands) -> list[str]:
         action="store_true",
         help="also answer within the CoM's reach at constant height (whole-body IK, a few "
         "seconds; docs/com-reach.md)",
+    )
+    a.add_argument(
+        "--impact-model",
+        default="floating",
+        choices=("floating", "held-stance"),
+        help="floating: the paper's impact model only (default); held-stance: also the "
+        "held-stance model's maximum contact velocity (the contact-aware jump at the "
+        "restitution bounds, the paper's answer where its fixed point is not reached; "
+        "docs/simulation.md)",
     )
     add_zmp_margin_option(a, "default: the scenario's zmp_margin, 0 unless set")
     add_velocity_margin_option(a, "CoM criterion")
@@ -115,12 +126,19 @@ def run(args: argparse.Namespace) -> int:
         from impact_balance.analysis.reach import reach_answer
 
         reach = reach_answer(analysis)
+    held = None
+    if args.impact_model == "held-stance":
+        from impact_balance.analysis.held_stance import held_stance_max_contact_velocity
+
+        held = held_stance_max_contact_velocity(analysis)
     if args.json:
         out = analysis.to_dict()
         if calibration is not None:
             out["calibration"] = calibration
         if reach is not None:
             out["com_reach"] = reach.to_dict()
+        if held is not None:
+            out["held_stance"] = held.to_dict()
         print_json(out)
     else:
         print(format_analysis(analysis))
@@ -128,6 +146,8 @@ def run(args: argparse.Namespace) -> int:
             print(calibration_line(calibration))
         if reach is not None:
             print(_reach_line(reach))
+        if held is not None:
+            print(_held_stance_line(held))
         for path in written:
             print(f"  figure: {path}")
     return 0
@@ -143,3 +163,16 @@ def _reach_line(reach: ReachAnswer) -> str:
             f"(without: {reach.default_max_contact_velocity:.3f})"
         )
     return line
+
+
+def _held_stance_line(held: HeldStanceLimit) -> str:
+    """One line of ``analyze --impact-model held-stance``: its maximum and how it was reached."""
+    speed = held.max_contact_velocity
+    value = f"{speed:.3f} m/s" if math.isfinite(speed) else "unbounded"
+    if held.fell_back:
+        how = "the paper's answer: the fixed point was not reached"
+    elif held.binding_restitution is None:
+        how = "no approach speed leaves the area"
+    else:
+        how = f"binding restitution {held.binding_restitution:g}"
+    return f"held-stance max contact velocity {value} ({how})"

@@ -28,6 +28,7 @@ from impact_balance.cli.calibrate import add_calibration_option, apply_calibrati
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
     from impact_balance.governor import Governor
+    from impact_balance.impact.held_stance import HeldStanceJumps
     from impact_balance.scenario import Scenario
     from impact_balance.sim.studies.wall import WallTrial
     from impact_balance.sim.trials.balance_trial import BalanceSetup, BalanceTrialOptions
@@ -104,6 +105,7 @@ def add_parser(sub: Subcommands) -> list[str]:
         help="com governor: also cap within the CoM's reach at constant height, computed once "
         "from the scenario's posture (whole-body IK, a few seconds; docs/com-reach.md)",
     )
+    _add_impact_model_option(a)
     a.add_argument(
         "--rigid-impact",
         action="store_true",
@@ -138,6 +140,18 @@ def add_parser(sub: Subcommands) -> list[str]:
     return ["approach"]
 
 
+def _add_impact_model_option(a: argparse.ArgumentParser) -> None:
+    """Add ``--impact-model`` (the governor's impact model) to ``approach``'s parser ``a``."""
+    a.add_argument(
+        "--impact-model",
+        default="floating",
+        choices=("floating", "held-stance"),
+        help="com governor: floating, the paper's impact model (default); held-stance, the "
+        "held-stance jumps of the scenario's posture, computed once, in place of the floating "
+        "model's (the floating answer where its fixed point is not reached; docs/governor.md)",
+    )
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``approach``: one governed trial per wall distance, as text or JSON.
 
@@ -163,6 +177,7 @@ def run(args: argparse.Namespace) -> int:
         raise SimulationError("--contact-aware-async", True, "needs --contact-aware")
     if args.com_reach and args.governor != "com":
         raise SimulationError("--com-reach", True, f"needs --governor com, not {args.governor}")
+    _check_impact_model(args)
     import_mujoco(bool(args.video))  # before anything imports MuJoCo: the GL backend is read then
     from impact_balance.cli.output import print_json
     from impact_balance.scenario import load_scenario
@@ -218,18 +233,13 @@ def run(args: argparse.Namespace) -> int:
             "trials": docs,
         }
     )
-    reach = None if governor is None else governor.com_reach
-    if reach is not None:  # once: the reach of the scenario's posture, the governor's
-        out["com_reach"] = reach.to_dict()
+    once = _record_once(out, governor)
     if args.json:
         print_json(out)
     else:
         _print_text(scenario.name, args, docs, written)
-        if reach is not None:
-            print(
-                f"  capped within the CoM's reach ({1000 * reach.radii.min():.0f} to "
-                f"{1000 * reach.radii.max():.0f} mm at constant height, the scenario's posture)"
-            )
+        for line in once:
+            print(f"  {line}")
         if len(docs) > 1 and out["tick_us"]["median"] is not None:
             t = out["tick_us"]
             print(
@@ -273,6 +283,66 @@ def _governor(args: argparse.Namespace, governed: Scenario) -> Governor | None:
         args.governor,
         contact_aware=aware if args.contact_aware else None,
         com_reach=bool(args.com_reach),
+        impact_model=args.impact_model,
+    )
+
+
+def _check_impact_model(args: argparse.Namespace) -> None:
+    """Refuse ``--impact-model held-stance`` without the com governor or with another cap."""
+    from impact_balance.exceptions import SimulationError
+
+    if args.impact_model == "floating":
+        return
+    if args.governor != "com":
+        raise SimulationError(
+            "--impact-model", args.impact_model, f"needs --governor com, not {args.governor}"
+        )
+    for option, on in (("--com-reach", args.com_reach), ("--contact-aware", args.contact_aware)):
+        if on:
+            raise SimulationError("--impact-model", args.impact_model, f"not with {option}")
+
+
+def _record_once(out: dict[str, Any], governor: Governor | None) -> list[str]:
+    """Add what the governor computed once (the reach, the held-stance jumps) to ``out``.
+
+    Returns:
+        The text report's lines about them.
+    """
+    lines = []
+    reach = None if governor is None else governor.com_reach
+    if reach is not None:  # once: the reach of the scenario's posture, the governor's
+        out["com_reach"] = reach.to_dict()
+        lines.append(
+            f"capped within the CoM's reach ({1000 * reach.radii.min():.0f} to "
+            f"{1000 * reach.radii.max():.0f} mm at constant height, the scenario's posture)"
+        )
+    held = None if governor is None else governor.held_stance
+    if held is not None:  # once: the jumps of the scenario's posture, the governor's
+        out["held_stance"] = _held_stance_dict(held)
+        lines.append(_held_stance_line(held))
+    return lines
+
+
+def _held_stance_dict(held: HeldStanceJumps) -> dict[str, Any]:
+    """``approach --impact-model held-stance``'s ``held_stance``: the governor's jumps."""
+    return {
+        "restitution": list(held.restitution),
+        "jumps": held.jumps.tolist(),
+        "converged": held.all_converged,
+        "fell_back": not held.all_converged,
+        "iterations": held.iterations,
+    }
+
+
+def _held_stance_line(held: HeldStanceJumps) -> str:
+    """One line of ``approach --impact-model held-stance``: what the governor answers with."""
+    if not held.all_converged:
+        return (
+            "held stance: the fixed point was not reached; the governor answers the floating model"
+        )
+    return (
+        "governed with the held-stance jumps of the scenario's posture (restitution "
+        f"{held.restitution[0]:g} and {held.restitution[1]:g})"
     )
 
 

@@ -20,7 +20,7 @@ from impact_balance.balance.areas import warm_up as warm_up_maps
 from impact_balance.constants import MAX_POSITION, MAX_SPEED
 from impact_balance.contacts.stance import ContactSpec, has_free_flyer
 from impact_balance.criteria.cap import cap_approach
-from impact_balance.criteria.linear_exit import BOUNDARY_TOLERANCE, EXIT_STATUSES
+from impact_balance.criteria.linear_exit import BOUNDARY_TOLERANCE, EXIT_STATUSES, speed_interval
 from impact_balance.criteria.velocity_limit import ContactVelocityLimit
 from impact_balance.exceptions import GovernorError, ScenarioError
 from impact_balance.governor.batch import BatchEvaluator, BatchLimits
@@ -29,6 +29,7 @@ from impact_balance.governor.options import (
     CRITERIA,
     ContactAwareOptions,
     Criterion,
+    held_stance_option,
     reach_option,
 )
 from impact_balance.governor.posture import (
@@ -40,6 +41,7 @@ from impact_balance.governor.posture import (
 from impact_balance.governor.support import ContactAwareLimit, combine
 from impact_balance.governor.tick import NOT_FINITE, velocity_exit
 from impact_balance.governor.worker import ContactAwareWorker
+from impact_balance.impact.held_stance import HeldStanceJumps, held_stance_jumps
 from impact_balance.projection.bretl import warm_up as warm_up_bretl
 from impact_balance.projection.walk import warm_up
 from impact_balance.robot.robot import Robot
@@ -154,6 +156,18 @@ class Governor:
             computes the bound for its CoM velocity; a tick that reuses the posture reuses that
             bound. "com" criterion only. None or False (default): off. The reach is
             :attr:`com_reach`.
+        impact_model: "floating" (default: the paper's impact model) or "held-stance"
+            (docs/governor.md): the held-stance jumps
+            (:func:`~impact_balance.impact.held_stance.held_stance_jumps`, the contact-aware
+            model at the restitution bounds) of the scenario's posture, computed once here
+            (like the reach, not recomputed as the posture moves), replace the floating
+            model's post-impact jumps: each answer is the largest approach speed keeping
+            ``c0 + s j`` in the posture's CoM velocity area with the velocity margin for both
+            jumps j, binding "held_stance" (the angular momentum term is not counted). Where
+            a fixed point was not reached, the answers are the floating model's (binding
+            "floating"), the fallback of ``analyze --impact-model held-stance``. "com"
+            criterion only, not with ``contact_aware`` or ``com_reach``. The jumps are
+            :attr:`held_stance`.
 
     Raises:
         ScenarioError: another robot's or a bad calibration, no impact, an unknown frame, an
@@ -161,7 +175,8 @@ class Governor:
             evaluated once, as a check).
         GovernorError: an unknown criterion, a bad tolerance, a bad ``velocity_margin``
             (or one with the "zmp" criterion), contact-aware options or a reach with the "zmp"
-            criterion, a ``com_reach`` of another type.
+            criterion, a ``com_reach`` of another type, an unknown ``impact_model`` or
+            "held-stance" with the "zmp" criterion, ``contact_aware`` or ``com_reach``.
     """
 
     def __init__(
@@ -174,9 +189,11 @@ class Governor:
         velocity_margin: float | None = None,
         calibration: CalibrationFile | str | os.PathLike[str] | None = None,
         com_reach: ComReach | ReachOptions | bool | None = None,
+        impact_model: str = "floating",
     ) -> None:
         if criterion not in CRITERIA:
             raise GovernorError("criterion", criterion, f"must be one of {', '.join(CRITERIA)}")
+        held_stance_option(impact_model, criterion, contact_aware, com_reach)
         self.criterion: Criterion = criterion
         self.posture_tolerance = _tolerance(posture_tolerance)
         aware = _contact_aware(contact_aware, criterion)
@@ -206,6 +223,11 @@ class Governor:
         #: The CoM's reach of the scenario's posture the answers are capped within, or None.
         self.com_reach: ComReach | None = reach_option(com_reach, criterion, stance)
         self._reach_bound: tuple[bytes, float] | None = None  # (posture key, bound m/s)
+        #: The held-stance jumps of the scenario's posture (``impact_model="held-stance"``),
+        #: or None.
+        self.held_stance: HeldStanceJumps | None = None
+        if impact_model == "held-stance":
+            self.held_stance = held_stance_jumps(stance, scenario.impact.spec())
         settings = PostureSettings(
             self.contacts,
             scenario.impact.spec(),
@@ -310,11 +332,15 @@ class Governor:
                 and q.tobytes() == posture.key
             ):
                 answer = self._tick(posture, _velocity(v, self._v_shape), True)
+                if self.held_stance is not None:
+                    return self._held(posture, answer)
                 return answer if self.com_reach is None else self._within_reach(posture, answer)
         configuration, velocity = self._state(q, v)
         with self._lock:
             posture, reused = self._posture_at(configuration, checked=True)
             answer = self._tick(posture, velocity, reused)
+            if self.held_stance is not None:
+                return self._held(posture, answer)
             return answer if self.com_reach is None else self._within_reach(posture, answer)
 
     def _state(
@@ -421,6 +447,12 @@ class Governor:
             raise GovernorError(
                 "com_reach", True, "limits() answers without the reach; call limit() per posture"
             )
+        if self.held_stance is not None:
+            raise GovernorError(
+                "impact_model",
+                "held-stance",
+                "limits() answers the floating model only; call limit() per posture",
+            )
         try:
             return self._batch.limits(q_batch, v_batch, threads)
         except ScenarioError as exc:
@@ -453,6 +485,8 @@ class Governor:
         with self._lock:
             posture, reused = self._posture_at(configuration)
             answer = self._answer(posture, c, reused)
+            if self.held_stance is not None:
+                return self._held(posture, answer)
             return answer if self.com_reach is None else self._within_reach(posture, answer)
 
     def cap(
@@ -736,6 +770,36 @@ class Governor:
             interval = (interval[0], bound) if interval[0] <= bound else None
         return self._keep(
             replace(answer, max_contact_velocity=bound, safe_interval=interval, binding="com_reach")
+        )
+
+    def _held(self, posture: Posture, answer: SpeedLimit) -> SpeedLimit:
+        """``answer`` with the held-stance jumps in place of the floating model's (under the lock).
+
+        Kept as the last. Unchanged where a fixed point was not reached (the fallback).
+        """
+        held, criterion = self.held_stance, posture.com_criterion
+        if held is None or criterion is None or not all(held.converged):
+            return answer
+        _, limit = criterion.limits(answer.com_velocity, held.jumps)
+        interval: tuple[float, float] | None
+        if criterion.G is None:
+            interval = None
+        elif limit.from_inside:
+            interval = limit.interval_from_inside()
+        else:
+            interval = speed_interval(
+                criterion.margins(answer.com_velocity), held.jumps @ criterion.G.T
+            )
+        return self._keep(
+            replace(
+                answer,
+                max_contact_velocity=limit.max_contact_velocity,
+                status=limit.status,
+                limiting_vertex=limit.limiting_vertex,
+                limiting_edge=limit.limiting_edge,
+                safe_interval=interval,
+                binding="held_stance",
+            )
         )
 
     def _keep(self, answer: SpeedLimit) -> SpeedLimit:

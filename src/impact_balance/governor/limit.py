@@ -18,8 +18,9 @@ from impact_balance.criteria.velocity_limit import LimitStatus
 
 __all__ = ["Binding", "SpeedLimit"]
 
-#: Which impact model gave a governor's maximum: "floating" (the paper's) or "contact_aware".
-Binding = Literal["floating", "contact_aware", "com_reach"]
+#: Which impact model gave a governor's maximum: "floating" (the paper's), "contact_aware",
+#: "com_reach" or "held_stance".
+Binding = Literal["floating", "contact_aware", "com_reach", "held_stance"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -58,7 +59,10 @@ class SpeedLimit:
             0 / 1 the lower / upper restitution bound with one start, else one row per
             solution found, ``ContactAwareAnswer.restitution`` giving each row's bound), or
             "com_reach" (a governor with ``com_reach``: the maximum within the CoM's reach was
-            smaller; ``limiting_vertex`` and ``limiting_edge`` are then the criterion's own).
+            smaller; ``limiting_vertex`` and ``limiting_edge`` are then the criterion's own), or
+            "held_stance" (a governor with ``impact_model="held-stance"`` whose fixed point was
+            reached: the held-stance jumps replace the floating model's; ``limiting_vertex`` 0 /
+            1 is the lower / upper restitution bound).
         rates_age: The contact-aware rates' age in postures (posture evaluations since the
             one they were computed for; 0: this posture's); None without contact-aware rates.
         rates_age_seconds: Their age in seconds (since the governor was given the posture

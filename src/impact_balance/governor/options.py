@@ -22,12 +22,14 @@ if TYPE_CHECKING:
 
 __all__ = [
     "CRITERIA",
+    "IMPACT_MODELS",
     "ON_STALE",
     "STARTS",
     "ContactAwareOptions",
     "Criterion",
     "OnStale",
     "Starts",
+    "held_stance_option",
     "reach_option",
 ]
 
@@ -153,3 +155,35 @@ def reach_option(
     if isinstance(value, ComReach):
         return value
     return com_reach(stance, None if value is True else value)
+
+
+#: The impact models a governor answers with: "floating" (the paper's) and "held-stance".
+IMPACT_MODELS = ("floating", "held-stance")
+
+
+def held_stance_option(
+    impact_model: object, criterion: Criterion, contact_aware: object, com_reach: object
+) -> None:
+    """Check a governor's ``impact_model`` against its other options.
+
+    Args:
+        impact_model: One of :data:`IMPACT_MODELS`.
+        criterion: The governor's criterion ("held-stance" needs "com").
+        contact_aware: The governor's ``contact_aware`` (off with "held-stance").
+        com_reach: The governor's ``com_reach`` (off with "held-stance").
+
+    Raises:
+        GovernorError: An unknown model, or "held-stance" with the "zmp" criterion,
+            ``contact_aware`` or ``com_reach`` (field ``impact_model``).
+    """
+    if not isinstance(impact_model, str) or impact_model not in IMPACT_MODELS:
+        raise GovernorError(
+            "impact_model", impact_model, f"must be one of {', '.join(IMPACT_MODELS)}"
+        )
+    if impact_model == "floating":
+        return
+    if criterion != "com":
+        raise GovernorError("impact_model", impact_model, 'answers the "com" criterion only')
+    for name, value in (("contact_aware", contact_aware), ("com_reach", com_reach)):
+        if value is not None and value is not False:
+            raise GovernorError("impact_model", impact_model, f"does not combine with {name}")

@@ -72,6 +72,7 @@ class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
 
     w_results: viser.GuiHtmlHandle
     w_com_reach: viser.GuiButtonHandle
+    w_held_stance: viser.GuiButtonHandle
     w_shared_session: viser.GuiHtmlHandle
     w_view2d: viser.GuiHtmlHandle
 
@@ -161,6 +162,12 @@ class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
             "seconds) and draw it; an edit that moves the stance clears it",
         )
         self.w_com_reach.on_click(self._on_com_reach)
+        self.w_held_stance = gui.add_button(
+            "Held stance",
+            hint="Compute the maximum contact velocity by the held-stance impact model (the "
+            "paper's answer where its fixed point is not reached); any edit clears it",
+        )
+        self.w_held_stance.on_click(self._on_held_stance)
         tabs = gui.add_tab_group()
         with tabs.add_tab("Impact"):
             self._build_impact()
@@ -182,6 +189,10 @@ class GuiApp(SceneMixin, GizmoMixin, PanelsMixin, ScenarioTabMixin):
     def _on_com_reach(self, _: object) -> None:
         """The "CoM reach" button: compute the reach of the current stance, then redraw."""
         self.edit(lambda: self.session.compute_reach())
+
+    def _on_held_stance(self, _: object) -> None:
+        """The "Held stance" button: the held-stance maximum of the current analysis, shown."""
+        self.edit(lambda: self.session.compute_held_stance())
 
     # -- refresh: widgets <- session, then redraw ----------------------------------------
     def refresh(self, t0: float | None = None) -> None:

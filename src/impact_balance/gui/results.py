@@ -3,7 +3,8 @@
 Every text from the scenario or a message is escaped, and lengths are capped (a warning at 300
 characters, ten warnings, a message at 400 characters); no file content is shown. The elements
 a test or a user script reads carry ids (``ib-verdict``, ``ib-vmax-com``, ``ib-vmax-zmp``,
-``ib-vmax-reach`` (after the "CoM reach" button), ``ib-reference``, ``ib-governor-*``,
+``ib-vmax-reach`` (after the "CoM reach" button), ``ib-vmax-held`` (after the "Held
+stance" button), ``ib-reference``, ``ib-governor-*``,
 ``ib-update-ms``, ``ib-warnings``, ``ib-message``).
 """
 
@@ -107,6 +108,14 @@ def results_html(session: Session, last_update_ms: float) -> str:
             f"<tr><td>&nbsp;&nbsp;within the CoM's reach</td><td {_RIGHT}>"
             f'<b id="ib-vmax-reach">'
             f"{html.escape(format_speed(session.reach.max_contact_velocity))}</b></td></tr>"
+        )
+    held = session.held_stance
+    if held is not None:
+        note = " (paper's: not converged)" if held.fell_back else ""
+        rows.append(
+            f"<tr><td>&nbsp;&nbsp;held stance{note}</td><td {_RIGHT}>"
+            f'<b id="ib-vmax-held">'
+            f"{html.escape(format_speed(held.max_contact_velocity))}</b></td></tr>"
         )
     if session.governed is not None:
         rows += _governor_rows(session.governed)

@@ -29,6 +29,7 @@ from impact_balance.gui.state import DEFAULT_SCENARIO, FieldPath, GuiState
 from impact_balance.gui.workspace import Workspace
 
 if TYPE_CHECKING:
+    from impact_balance.analysis.held_stance import HeldStanceLimit
     from impact_balance.analysis.reach import ReachAnswer
     from impact_balance.balance.reach import ComReach, ReachOptions
     from impact_balance.governor import Governor
@@ -132,6 +133,8 @@ class Session:
         lock: Re-entrant lock held during every edit (the app holds it while redrawing).
         reach: The CoM's reach of the current stance and what it limits (:meth:`compute_reach`;
             None until asked, and again after an edit that changes the stance).
+        held_stance: The held-stance maximum contact velocity of the current analysis
+            (:meth:`compute_held_stance`; None until asked, and again after any accepted edit).
     """
 
     def __init__(
@@ -158,6 +161,7 @@ class Session:
         self._govern()
         self.reach: ReachAnswer | None = None
         self._reach_of: tuple[str, bytes, str] | None = None  # the stance of ``reach``
+        self.held_stance: HeldStanceLimit | None = None
 
     # -- edits ----------------------------------------------------------------------------
     def _commit(self, build: Callable[[], GuiState], note: str | None = None) -> bool:
@@ -175,6 +179,7 @@ class Session:
             self.revision += 1
             self._govern()
             self._follow_reach()
+            self.held_stance = None  # the analysis changed: asked again on demand
             return True
 
     def _govern(self) -> None:
@@ -236,6 +241,33 @@ class Session:
             self.message = (
                 f"CoM reach at constant height: {1000 * radii.min():.0f} to "
                 f"{1000 * radii.max():.0f} mm"
+            )
+            return True
+
+    def compute_held_stance(self) -> bool:
+        """The held-stance maximum contact velocity of the analysis into :attr:`held_stance`.
+
+        :func:`~impact_balance.analysis.held_stance.held_stance_max_contact_velocity` (the paper's
+        answer where its fixed point is not reached, ``fell_back``). Any accepted edit clears
+        it. Returns False (and :attr:`message`) when it cannot be computed (no impact).
+        """
+        from impact_balance.analysis.held_stance import held_stance_max_contact_velocity
+
+        with self.lock:
+            try:
+                answer = held_stance_max_contact_velocity(self.analysis)
+            except Exception as exc:
+                return self._refuse(exc, "computing the held-stance model")
+            self.held_stance = answer
+            if answer.fell_back:
+                how = "the fixed point was not reached: the paper's answer"
+            elif answer.binding_restitution is None:
+                how = "no approach speed leaves the area"
+            else:
+                how = f"binding restitution {answer.binding_restitution:g}"
+            self.message = (
+                f"held-stance max contact velocity {format_speed(answer.max_contact_velocity)} "
+                f"({how})"
             )
             return True
 
