@@ -368,7 +368,7 @@ class Governor:
             _refuse_velocity(code, v, self.nv, com_velocity)
         if not fast:  # the general answer
             return self._answer(posture, com_velocity, reused)
-        model = posture.impact
+        point, normal = posture.impact_point_normal
         vertex, edge = (j, k) if code == 0 else (None, None)
         interval = None if math.isnan(lo) else (lo, hi)
         if code != 0:  # "already_falling" (0) or "unbounded" (inf)
@@ -381,8 +381,8 @@ class Governor:
             edge,
             interval,
             com_velocity,
-            model.normal,
-            model.point,
+            normal,
+            point,
             reused,
         )
         return answer
