@@ -86,6 +86,24 @@ def test_a_tick_makes_none_of_the_objects_and_answers_with_the_models_arrays():
     assert criterion.limit(answer.com_velocity).max_contact_velocity == answer.max_contact_velocity
 
 
+def test_objects_made_after_other_postures_are_their_own_postures():
+    # The evaluator's Data and buffers move on; a posture read later keeps its own arrays.
+    g, compiled, steps = evaluators("palm_push_two_feet")
+    qs = postures(g, 4, 3, 0.02)
+    lazy = [compiled.evaluate(q) for q in qs]
+    for q, posture in zip(qs, lazy, strict=True):
+        want = steps.evaluate(q, steps=True)
+        for field in ("point", "normal", "cone", "W", "jacobian", "impulse_rates"):
+            np.testing.assert_array_equal(
+                getattr(posture.impact, field), getattr(want.impact, field)
+            )
+        assert posture.impact.mass == want.impact.mass
+        np.testing.assert_array_equal(posture.areas.zmp_area.vertices, want.areas.zmp_area.vertices)
+        assert posture.areas.omega == want.areas.omega
+    # The cone is the model's own copy, not the evaluator's.
+    assert lazy[0].impact.cone is not compiled._cone
+
+
 def test_unknown_attributes_and_the_steps_posture_raise_attribute_error():
     g, compiled, steps = evaluators("kick_one_foot")
     lazy = compiled.evaluate(g.configuration)
