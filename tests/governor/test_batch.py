@@ -299,3 +299,59 @@ def test_the_rows_of_a_batch_share_the_walks_hint():
     assert hint[n + 2] > 0  # a chain: the next row re-certifies it before walking
     # the batch's hint is its own: the governor's ticks keep theirs
     assert evaluator is not g._evaluator
+
+
+def _spoil(g: Governor, q: np.ndarray, fault: str, rng: np.random.Generator) -> None:
+    """Make configuration ``q`` one that limit() refuses (in place)."""
+    if fault == "nan":
+        q[int(rng.integers(0, g.nq))] = np.nan
+    elif fault == "joint":
+        slot = g.robot.joint_slot(
+            g.robot.joint_names[int(rng.integers(0, len(g.robot.joint_names)))]
+        )
+        if slot.nq == 1 and slot.lower < slot.upper:
+            q[slot.idx_q] = slot.upper + float(rng.uniform(0.01, 1.0))
+        else:
+            q[3:7] *= 1.5  # the base quaternion instead
+    elif fault == "quaternion":
+        q[3:7] *= float(rng.choice([0.5, 1.1]))
+    else:  # a base beyond any physical position
+        q[int(rng.integers(0, 3))] = float(rng.choice([-1.0, 1.0])) * 1e200
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    bad=st.lists(st.integers(0, 7), min_size=0, max_size=3, unique=True),
+    faults=st.lists(st.sampled_from(["nan", "joint", "quaternion", "far"]), min_size=3, max_size=3),
+)
+def test_rows_are_checked_as_limit_checks_them(seed, bad, faults):
+    # Independent of the batch's one compiled pass: limit() on each row in turn, the first row
+    # it refuses is the one the batch names, with the same reason (a number not finite is
+    # named first, wherever it is, by its row and column).
+    g = governor("kick_one_foot")
+    qs, vs = batch(g, 8, seed % 1000)
+    rng = np.random.default_rng(seed)
+    for row, fault in zip(bad, faults, strict=False):
+        _spoil(g, qs[row], fault, rng)
+    if np.isnan(qs).any():
+        i, j = (int(x) for x in np.argwhere(np.isnan(qs))[0])
+        with pytest.raises(GovernorError, match="must be finite") as info:
+            g.limits(qs, vs)
+        assert info.value.field == f"q_batch[{i}][{j}]"
+        return
+    want = None
+    for i, (q, v) in enumerate(zip(qs, vs, strict=True)):
+        try:
+            g.limit(q, v)
+        except GovernorError as exc:
+            want = (i, exc)
+            break
+    if want is None:
+        assert len(g.limits(qs, vs)) == 8
+        return
+    with pytest.raises(GovernorError) as info:
+        g.limits(qs, vs, threads=int(rng.integers(1, 3)))
+    i, exc = want
+    assert info.value.field == f"q_batch[{i}]" + exc.field[1:]
+    assert info.value.reason == exc.reason

@@ -157,30 +157,33 @@ _SURELY_UPRIGHT = math.cos(math.radians(45.0)) + 1e-6
 def _surely_upright(stance: Stance) -> bool:
     """Whether ``robot_not_z_up`` surely cannot fire at the stance (False: ask the robot).
 
-    True for a robot whose feet are unknown (the check never fires). When every foot frame
-    (:attr:`~impact_balance.robot.robot.Robot.foot_frames`) is a contact of the stance at the
-    frame's own origin (no offset), the feet-to-CoM axis is the stance's CoM less the mean of
-    those contact points (stance frame, m); at least 1 mm long, within 1e6 m of the origin and
-    at least :data:`_SURELY_UPRIGHT` along +z, the robot stands (the check's own numbers, in
-    world coordinates, differ from these by less than 1e-7 in that cosine). Otherwise (a foot
-    in the air or offset, a tilt near the check's) the robot's check answers.
+    True for a robot whose feet are unknown (the check never fires). The feet-to-CoM axis is
+    the stance's CoM less the mean of the foot frames
+    (:attr:`~impact_balance.robot.robot.Robot.foot_frames`; stance frame, m): a foot that is a
+    contact at the frame's own origin (no offset) is that contact's point, another one (in the
+    air, offset) the frame's placement in the stance's kinematics
+    (:meth:`~impact_balance.contacts.stance.Stance.frame_pose`, less the origin). At least 1 mm
+    long, within 1e6 m of the origin and at least :data:`_SURELY_UPRIGHT` along +z, the robot
+    stands (the check's own numbers, in world coordinates, differ from these by less than 1e-7
+    in that cosine). Otherwise (a tilt near the check's) the robot's check answers.
     """
     feet = stance.robot.foot_frames
     if not feet:
         return True
-    if len(stance.contacts) < len(feet):  # a foot in the air
+    com, o, n = stance.com_local, stance.origin, len(feet)
+    ox, oy, oz = float(o[0]), float(o[1]), float(o[2])
+    if not max(abs(ox), abs(oy), abs(oz)) <= 1e6:
         return False
     points = {c.spec.frame: c.local_position for c in stance.contacts if c.spec.offset == _IDENTITY}
     x = y = z = 0.0
     for frame in feet:
         p = points.get(frame)
-        if p is None:
-            return False
-        x, y, z = x + float(p[0]), y + float(p[1]), z + float(p[2])
-    c, o, n = stance.com_local, stance.origin, len(feet)
-    if not max(abs(float(o[0])), abs(float(o[1])), abs(float(o[2]))) <= 1e6:
-        return False
-    dx, dy, dz = float(c[0]) - x / n, float(c[1]) - y / n, float(c[2]) - z / n
+        if p is None:  # not a contact: where the stance's kinematics place the frame
+            t = stance.frame_pose(frame).translation
+            x, y, z = x + (float(t[0]) - ox), y + (float(t[1]) - oy), z + (float(t[2]) - oz)
+        else:
+            x, y, z = x + float(p[0]), y + float(p[1]), z + float(p[2])
+    dx, dy, dz = float(com[0]) - x / n, float(com[1]) - y / n, float(com[2]) - z / n
     length = math.sqrt(dx * dx + dy * dy + dz * dz)
     return length >= 1e-3 and dz >= _SURELY_UPRIGHT * length
 

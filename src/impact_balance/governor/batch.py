@@ -162,6 +162,8 @@ class BatchEvaluator:
         check: The governor's per-configuration check: ``check(q, field)`` returns the
             configuration as a contiguous float vector or raises
             :class:`~impact_balance.exceptions.GovernorError`.
+        first_fault: The same check over rows: ``first_fault(qs)`` ((N, nq) C-contiguous
+            floats) is the first row ``check`` refuses, -1 if none (``check`` then names it).
     """
 
     def __init__(
@@ -169,8 +171,10 @@ class BatchEvaluator:
         robot: Robot,
         evaluator: PostureEvaluator,
         check: Callable[[npt.NDArray[np.float64], str], npt.NDArray[np.float64]],
+        first_fault: Callable[[npt.NDArray[np.float64]], int],
     ) -> None:
         self.robot, self.settings, self.check = robot, evaluator.settings, check
+        self.first_fault = first_fault
         self._evaluators: list[PostureEvaluator] = []
         self._lock = threading.Lock()
 
@@ -189,8 +193,11 @@ class BatchEvaluator:
             raise GovernorError("threads", threads, f"must be in [1, {MAX_THREADS}]")
         repeated = np.zeros(len(qs), dtype=np.bool_)  # row i's q is row i - 1's
         repeated[1:] = (qs[1:] == qs[:-1]).all(axis=1)
-        for i in np.flatnonzero(~repeated):  # a repeated row passes the same check
+        start = 0  # every row in one compiled pass; a row at fault is named by the check
+        while (k := self.first_fault(qs[start:])) >= 0:
+            i = start + k
             qs[i] = self.check(qs[i], f"q_batch[{i}]")
+            start = i + 1
         rows = _Rows(len(qs))
         slices = np.array_split(np.arange(len(qs)), min(threads, max(len(qs), 1)))
         evaluators = self._take(len(slices))

@@ -240,7 +240,9 @@ class Governor:
             scenario.angular_momentum_damping_time if criterion == "com" else None,
         )
         self._evaluator = PostureEvaluator(self.robot, settings)
-        self._batch = BatchEvaluator(self.robot, self._evaluator, self._checked_row)
+        self._batch = BatchEvaluator(
+            self.robot, self._evaluator, self._checked_row, self._first_faulty_row
+        )
         self._lock = threading.Lock()
         self._support: ContactAwareLimit | None = None
         if aware is not None:
@@ -394,7 +396,7 @@ class Governor:
             _refuse_velocity(code, v, self.nv, com_velocity)
         if not fast:  # the general answer
             return self._answer(posture, com_velocity, reused)
-        model = posture.impact
+        point, normal = posture.impact_point_normal
         vertex, edge = (j, k) if code == 0 else (None, None)
         interval = None if math.isnan(lo) else (lo, hi)
         if code != 0:  # "already_falling" (0) or "unbounded" (inf)
@@ -407,8 +409,8 @@ class Governor:
             edge,
             interval,
             com_velocity,
-            model.normal,
-            model.point,
+            normal,
+            point,
             reused,
         )
         return answer
@@ -595,6 +597,19 @@ class Governor:
                     f"{QUATERNION_TOLERANCE:g}); normalise it",
                 )
         return configuration
+
+    def _first_faulty_row(self, qs: npt.NDArray[np.float64]) -> int:
+        """The first row that :meth:`_checked_row` refuses, -1 if none (one compiled pass).
+
+        ``qs``: (N, nq) C-contiguous floats; :func:`_rows_fault`.
+        """
+        joints = self._joints
+        return int(
+            _rows_fault(
+                qs, joints.idx, joints.lower, joints.upper, joints.pair_indices,
+                self._free_flyer, MAX_POSITION, QUATERNION_TOLERANCE,
+            )
+        )  # fmt: skip
 
     def _checked_row(self, q: npt.NDArray[np.float64], field: str) -> npt.NDArray[np.float64]:
         """Row ``q`` of a batch checked as :meth:`limit` checks ``q`` (errors name ``field``)."""
@@ -1164,6 +1179,31 @@ def _state_fault(
         if abs(q[i] * q[i] + q[i + 1] * q[i + 1] - 1.0) > 2.0 * quaternion_tolerance:
             return 6
     return 0
+
+
+@njit(cache=True)
+def _rows_fault(
+    qs: npt.NDArray[np.float64],
+    idx: npt.NDArray[np.int64],
+    lower: npt.NDArray[np.float64],
+    upper: npt.NDArray[np.float64],
+    pairs: npt.NDArray[np.int64],
+    free_flyer: bool,
+    max_position: float,
+    quaternion_tolerance: float,
+) -> int:
+    """The first row of ``qs`` (N, nq) at which :func:`_state_fault` finds a fault, else -1.
+
+    The configuration checks of :func:`_state_fault` (no velocity), row by row in one call.
+    """
+    no_velocity = np.zeros(0)
+    for i in range(qs.shape[0]):
+        if _state_fault(
+            qs[i], no_velocity, idx, lower, upper, pairs, free_flyer, max_position,
+            quaternion_tolerance,
+        ):  # fmt: skip
+            return i
+    return -1
 
 
 @njit(cache=True)

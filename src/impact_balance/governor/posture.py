@@ -116,6 +116,11 @@ class Posture:
         com_criterion: The CoM criterion's half-planes and rates (None in "zmp" mode).
         zmp_limit: The ZMP criterion's answer (None in "com" mode; it does not depend on
             the CoM velocity).
+
+    A posture of the one compiled call (:meth:`PostureEvaluator.evaluate`'s common case) holds
+    the call's arrays and makes ``projected``, ``impact`` and ``com_criterion`` on first access
+    (:func:`~impact_balance.criteria.posture_answer.posture_answer`'s objects, the same numbers);
+    a tick reads only :attr:`exit_arrays`, the impact normal and point, which it has at once.
     """
 
     key: bytes
@@ -129,6 +134,24 @@ class Posture:
     com_jacobian: np.ndarray
     com_criterion: ComCriterion | None
     zmp_limit: ContactVelocityLimit | None
+
+    def __getattr__(self, name: str) -> object:
+        """``projected``, ``impact`` or ``com_criterion`` of a compiled posture (first access).
+
+        Called only for an attribute the instance does not hold: the three are made together
+        from the compiled call's arrays and kept.
+
+        Raises:
+            AttributeError: Any other name (or any name on a posture made by the steps).
+        """
+        made = self.__dict__.get("_made")  # not getattr: no recursion (while unpickling)
+        if made is None or name not in _MADE:
+            raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+        answer = made()
+        assert answer is not None  # a compiled posture is made only where the call answered
+        parts = dict(zip(_MADE, (answer.projected, answer.impact, answer.criterion), strict=True))
+        self.__dict__.update(parts)
+        return parts[name]
 
     @functools.cached_property
     def areas(self) -> BalanceAreas:
@@ -150,12 +173,26 @@ class Posture:
         return self.com_jacobian, criterion.G, criterion.h, criterion.rates
 
     @functools.cached_property
+    def impact_point_normal(self) -> tuple[np.ndarray, np.ndarray]:
+        """The impact point (3,), world, m, and the surface's unit normal (3,), world.
+
+        The impact model's own arrays (``impact.point``, ``impact.normal``); a compiled posture
+        has them without making the model.
+        """
+        return self.impact.point, self.impact.normal
+
+    @functools.cached_property
     def stance(self) -> Stance:
         """The :class:`~impact_balance.contacts.stance.Stance` at ``q``, for plots and displays.
 
         Built on first access, in the robot's per-thread Data.
         """
         return Stance(self.robot, self.q, self.settings.contacts)
+
+
+#: The :class:`Posture` fields a compiled posture makes on first access (``Posture.__getattr__``).
+_MADE = ("projected", "impact", "com_criterion")
+_new = object.__new__
 
 
 class Kinematics(NamedTuple):
@@ -327,17 +364,38 @@ class PostureEvaluator:
             self._hint, MAX_PIVOTS, self._constants, point_local, Ig.inertia, self._normal,
             self._cone,
         )  # fmt: skip
+        if out[0]:  # FALLBACK: posture_answer's None
+            return None
         com, com_jacobian, point = out[12:]
-        answer = posture_answer(
-            out, settings.impact, point, self._normal.copy(), self._cone.copy(), J, mass=mass,
+        normal = self._normal.copy()  # the impact model's, and every answer's at this posture
+        made = functools.partial(
+            posture_answer, out, settings.impact, point, normal, self._cone.copy(), J, mass=mass,
             omega=w, com=com, plane_height=settings.plane_height, gravity=settings.gravity,
             zmp_margin=settings.zmp_margin, velocity_margin=settings.velocity_margin,
         )  # fmt: skip
-        if answer is None:
-            return None
-        return self._posture(
-            q, com, mass, answer.projected, answer.impact, com_jacobian, answer.criterion, None
+        # The criterion's arrays as posture_answer gives them: h less the velocity margin.
+        margin = float(settings.velocity_margin)
+        G, h, rates = out[7], out[8], out[11]
+        exits = (com_jacobian, G, h - margin if margin else h, rates)
+        q = q.copy()
+        q.setflags(write=False)
+        # Posture(...) without its frozen __init__ (one object.__setattr__ per field), the three
+        # objects left to __getattr__, the tick's arrays in the cached properties' own slots.
+        posture: Posture = _new(Posture)
+        vars(posture).update(
+            key=q.tobytes(),
+            q=q,
+            robot=self.robot,
+            settings=settings,
+            com=com,
+            mass=mass,
+            com_jacobian=com_jacobian,
+            zmp_limit=None,
+            exit_arrays=exits,
+            impact_point_normal=(point, normal),
+            _made=made,
         )
+        return posture
 
     def _posture(
         self,
