@@ -175,4 +175,10 @@ def _held_stance_line(held: HeldStanceLimit) -> str:
         how = "no approach speed leaves the area"
     else:
         how = f"binding restitution {held.binding_restitution:g}"
-    return f"held-stance max contact velocity {value} ({how})"
+    line = f"held-stance max contact velocity {value} ({how})"
+    term = held.angular_momentum
+    if term is not None:
+        speed = term.max_contact_velocity
+        with_term = f"{speed:.3f} m/s" if math.isfinite(speed) else "unbounded"
+        line += f"; with the angular momentum it leaves (tau {term.damping_time:g} s) {with_term}"
+    return line

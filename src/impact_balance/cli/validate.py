@@ -298,7 +298,14 @@ def _held_stance_line(held: dict[str, Any], zmp_margin: float) -> str:
         how = "no approach speed leaves the area"
     else:
         how = f"binding restitution {held['binding_restitution']:g}"
-    return f"    held stance ({1000 * zmp_margin:g} mm) {_f(held['max_contact_velocity'])} ({how})"
+    line = f"    held stance ({1000 * zmp_margin:g} mm) {_f(held['max_contact_velocity'])} ({how})"
+    term = held.get("angular_momentum")
+    if term is not None:
+        line += (
+            f"; with the angular momentum it leaves (tau {term['damping_time']:g} s) "
+            f"{_f(term['max_contact_velocity'])}"
+        )
+    return line
 
 
 def _plots(result: ValidationResult, out: Path) -> list[Path]:

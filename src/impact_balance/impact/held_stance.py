@@ -7,6 +7,12 @@ end ``lo`` and ``hi`` of the scenario's restitution range, from rest (gauges 0: 
 at an approach speed of 1 m/s. The jump is linear in the approach speed, so each answer is the
 CoM velocity jump per m/s of approach speed, world xy.
 
+Each solution also has the locked body's angular velocity jump dw (rad/s), hence the
+centroidal angular momentum the impact leaves, ``L = Ic dw`` (N m s per m/s, world axes, about
+the CoM, Ic the composite inertia about the CoM): the moment about the CoM of *all* the
+impulses, the impact point's and the sustained contacts' (``sum_p (p - c) x iota_p``), the
+held-stance counterpart of the floating model's ``(p - c) x iota``.
+
 :func:`held_stance_jumps` gives the two jumps and whether both fixed points were reached. The
 maximum contact velocity built on them, with its fallback to the paper's floating model where a
 fixed point is not reached, is
@@ -36,12 +42,16 @@ class HeldStanceJumps:
             at ``lo``, row 1 at ``hi``.
         converged: (2,) whether each fixed point was reached (else its last iterate).
         iterations: QP solves of both fixed points.
+        angular_momentum: (2, 3) centroidal angular momentum ``Ic dw`` the impact leaves per
+            m/s of approach speed, world axes, about the CoM (N m s per m/s); row 0 at ``lo``,
+            row 1 at ``hi`` (module docstring).
     """
 
     restitution: tuple[float, float]
     jumps: np.ndarray
     converged: tuple[bool, bool]
     iterations: int
+    angular_momentum: np.ndarray
 
     @property
     def all_converged(self) -> bool:
@@ -77,4 +87,7 @@ def held_stance_jumps(
         jumps=np.array([a.com_velocity_jump for a in answers], dtype=float),
         converged=(bool(answers[0].converged), bool(answers[1].converged)),
         iterations=sum(a.iterations for a in answers),
+        angular_momentum=np.array(
+            [stance.com_inertia @ a.angular_velocity_jump for a in answers], dtype=float
+        ),
     )
