@@ -86,3 +86,31 @@ def test_a_bad_impact_model_is_one_line_naming_the_option(capsys, value):
     assert rc == 2 and out == "" and "Traceback" not in err
     assert err.count("\n") == 1
     assert f"--impact-model: invalid choice: {value!r}" in err
+
+
+def test_with_tau_the_block_and_the_line_carry_the_angular_momentum(capsys):
+    args = ("analyze", "palm_push_two_feet", "--impact-model", "held-stance")
+    rc, out, _ = run_cli(capsys, *args, "--angular-momentum-damping-time", "0.1", "--json")
+    assert rc == 0
+    held = strict_json(out)["held_stance"]
+    expected = held_stance_max_contact_velocity(
+        analyze(load_scenario("palm_push_two_feet").replace(angular_momentum_damping_time=0.1))
+    )
+    term = held["angular_momentum"]
+    assert term["damping_time"] == 0.1
+    assert term["max_contact_velocity"] == pytest.approx(
+        expected.angular_momentum.max_contact_velocity, abs=1e-12
+    )
+    assert term["max_contact_velocity"] < held["max_contact_velocity"]  # the term binds here
+    np.testing.assert_allclose(
+        term["angular_momentum"], expected.angular_momentum.angular_momentum, atol=1e-12
+    )
+    rc, text, _ = run_cli(capsys, *args, "--angular-momentum-damping-time", "0.1")
+    assert rc == 0
+    line = text.splitlines()[-1]
+    assert line.endswith(
+        f"; with the angular momentum it leaves (tau 0.1 s) {term['max_contact_velocity']:.3f} m/s"
+    )
+    # Off: no block, whatever the scenario would say.
+    rc, out, _ = run_cli(capsys, *args, "--angular-momentum-damping-time", "off", "--json")
+    assert rc == 0 and "angular_momentum" not in strict_json(out)["held_stance"]

@@ -82,3 +82,48 @@ def test_the_joint_space_inertia_model_is_refused():
     with pytest.raises(ImpactModelError) as info:
         held_stance_jumps(stance, dataclasses.replace(spec, inertia="joint_space"))
     assert info.value.field == "impact.inertia"
+
+
+def _corner_arms(stance: Stance) -> np.ndarray:
+    """(k, 4, 3) each sustained contact's corners minus the CoM, world, m (cwc_span's order)."""
+    arms = []
+    for c in stance.contacts:
+        X, Y = c.half_length, c.half_width
+        arms.append(
+            [
+                c.position + c.rotation @ np.array([px, py, 0.0]) - stance.com
+                for px, py in ((X, Y), (X, -Y), (-X, Y), (-X, -Y))
+            ]
+        )
+    return np.array(arms, dtype=float).reshape(len(stance.contacts), 4, 3)
+
+
+@pytest.mark.parametrize("name", ["palm_push_two_feet", "g1_two_feet", "jvrc1_kick_one_foot"])
+def test_the_angular_momentum_left_is_ic_dw_and_the_moment_of_all_impulses(name):
+    """L = Ic dw of each bound's solution, and the moment about the CoM of the point's and
+    every corner's impulses (arms from the contacts' own geometry and the impact model's point)."""
+    stance, spec = _stance_and_spec(name)
+    held = held_stance_jumps(stance, spec)
+    assert held.all_converged and held.angular_momentum.shape == (2, 3)
+    point = impact_model(stance, spec).point - stance.com
+    arms = _corner_arms(stance)
+    for row, c in enumerate(held.restitution):
+        answer = contact_impact(stance, spec, 1.0, restitution=c)
+        L = held.angular_momentum[row]
+        np.testing.assert_allclose(L, stance.com_inertia @ answer.angular_velocity_jump, atol=1e-12)
+        moment = np.cross(point, answer.impact_impulse) + np.cross(
+            arms, answer.corner_impulses
+        ).sum(axis=(0, 1))
+        np.testing.assert_allclose(L, moment, rtol=0, atol=1e-9 * max(1.0, np.abs(L).max()))
+        # The feet take part: their share of the moment is not negligible on the two-feet walls.
+        if name != "jvrc1_kick_one_foot":
+            feet = np.cross(arms, answer.corner_impulses).sum(axis=(0, 1))
+            assert np.linalg.norm(feet) > 0.1 * np.linalg.norm(L)
+    # Linear in the approach speed, as the jumps are.
+    twice = contact_impact(stance, spec, 2.0, restitution=held.restitution[1])
+    np.testing.assert_allclose(
+        stance.com_inertia @ twice.angular_velocity_jump,
+        2 * held.angular_momentum[1],
+        rtol=1e-9,
+        atol=1e-9,
+    )

@@ -131,3 +131,24 @@ def test_validate_impact_model_cli_json_and_text(capsys, tmp_path):
     assert main(argv) == 0
     text = capsys.readouterr().out
     assert text.count("held stance (10 mm)") == 1 and "held stance: safe" in text
+
+
+def test_with_the_controllers_tau_the_prediction_carries_the_angular_momentum():
+    """``--angular-momentum-damping-time controller``: the scenario the predictions use has
+    tau = 1 / K_L, and the held-stance prediction then has its ``angular_momentum`` block."""
+    from impact_balance.cli.angular_momentum import for_trials
+
+    options = BalanceTrialOptions(controller="id")
+    judged = for_trials(load_scenario(SCENARIO), "controller", options)
+    tau = judged.angular_momentum_damping_time
+    assert tau is not None and 0.05 < tau < 0.2
+    held = held_stance_prediction(judged, 0.01)
+    expected = held_stance_max_contact_velocity(
+        analyze(judged.replace(zmp_margin=0.01, com_velocity=(0.0, 0.0)))
+    )
+    assert held.to_dict() == expected.to_dict()
+    assert held.angular_momentum.damping_time == tau
+    assert held.angular_momentum.max_contact_velocity <= held.max_contact_velocity
+    plain = held_stance_prediction(load_scenario(SCENARIO), 0.01)
+    assert plain.angular_momentum is None
+    assert plain.max_contact_velocity == held.max_contact_velocity
