@@ -34,6 +34,7 @@ __all__ = [
     "CommandLineError",
     "a_number",
     "add_controller_option",
+    "add_impact_model_option",
     "add_output_options",
     "add_trial_joints_option",
     "add_trial_options",
@@ -275,6 +276,24 @@ def add_velocity_margin_option(parser: argparse.ArgumentParser, what: str) -> No
         help=f"{what}: every post-impact CoM velocity must lie V m/s inside the CoM velocity "
         "area (a margin for the impact model's error; default: the scenario's velocity_margin, "
         "0 unless set, the paper's criterion)",
+    )
+
+
+def add_impact_model_option(parser: argparse.ArgumentParser, what: str) -> None:
+    """Add ``--impact-model {floating,held-stance}`` (default ``floating``, the paper's model).
+
+    Args:
+        parser: The command's parser.
+        what: What the held-stance model does in this command, for the help.
+    """
+    from impact_balance.impact import IMPACT_MODELS
+
+    parser.add_argument(
+        "--impact-model",
+        default=IMPACT_MODELS[0],
+        choices=IMPACT_MODELS,
+        help=f"floating: the paper's impact model (default); held-stance: {what} "
+        "(docs/simulation.md#the-held-stance-impact-model-impact-model)",
     )
 
 

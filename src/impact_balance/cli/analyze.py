@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from impact_balance.cli._options import (
+    add_impact_model_option,
     add_velocity_margin_option,
     add_zmp_margin_option,
     output_folder,
@@ -62,14 +63,10 @@ def add_parser(sub: Subcommands) -> list[str]:
         help="also answer within the CoM's reach at constant height (whole-body IK, a few "
         "seconds; docs/com-reach.md)",
     )
-    a.add_argument(
-        "--impact-model",
-        default="floating",
-        choices=("floating", "held-stance"),
-        help="floating: the paper's impact model only (default); held-stance: also the "
-        "held-stance model's maximum contact velocity (the contact-aware jump at the "
-        "restitution bounds, the paper's answer where its fixed point is not reached; "
-        "docs/simulation.md)",
+    add_impact_model_option(
+        a,
+        "also the held-stance model's maximum contact velocity (the contact-aware jump at the "
+        "restitution bounds, the paper's answer where its fixed point is not reached)",
     )
     add_zmp_margin_option(a, "default: the scenario's zmp_margin, 0 unless set")
     add_velocity_margin_option(a, "CoM criterion")

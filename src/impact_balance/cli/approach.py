@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 from impact_balance.cli._options import (
     DEFAULT_CONTROLLER,
     add_controller_option,
+    add_impact_model_option,
     add_velocity_margin_option,
     add_zmp_margin_option,
     import_mujoco,
@@ -142,13 +143,11 @@ def add_parser(sub: Subcommands) -> list[str]:
 
 def _add_impact_model_option(a: argparse.ArgumentParser) -> None:
     """Add ``--impact-model`` (the governor's impact model) to ``approach``'s parser ``a``."""
-    a.add_argument(
-        "--impact-model",
-        default="floating",
-        choices=("floating", "held-stance"),
-        help="com governor: floating, the paper's impact model (default); held-stance, the "
-        "held-stance jumps of the scenario's posture, computed once, in place of the floating "
-        "model's (the floating answer where its fixed point is not reached; docs/governor.md)",
+    add_impact_model_option(
+        a,
+        "the com governor caps with the held-stance jumps of the scenario's posture, computed "
+        "once, in place of the floating model's (the floating answer where its fixed point is "
+        "not reached)",
     )
 
 

@@ -13,6 +13,7 @@ from impact_balance.cli._options import (
     DEFAULT_CONTROLLER,
     TRIAL_JOINTS,
     add_controller_option,
+    add_impact_model_option,
     add_output_options,
     add_trial_joints_option,
     add_trial_options,
@@ -67,14 +68,11 @@ def add_parser(sub: Subcommands) -> list[str]:
         "reach at constant height (whole-body IK once before the trials, a few seconds; "
         "docs/com-reach.md)",
     )
-    a.add_argument(
-        "--impact-model",
-        default="floating",
-        choices=("floating", "held-stance"),
-        help="floating: the paper's impact model only (default); held-stance: also the "
-        "held-stance model's maximum contact velocity (the contact-aware jump at the "
+    add_impact_model_option(
+        a,
+        "also the held-stance model's maximum contact velocity (the contact-aware jump at the "
         "restitution bounds, the paper's answer where its fixed point is not reached), "
-        "computed before the trials, with each trial's call against it (docs/simulation.md)",
+        "computed before the trials, with each trial's call against it",
     )
     add_calibration_option(a)
     add_output_options(a, "of the fastest trial survived")

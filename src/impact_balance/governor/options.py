@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal, get_args
 
 from impact_balance.exceptions import GovernorError
+from impact_balance.impact import IMPACT_MODELS
 
 if TYPE_CHECKING:
     from impact_balance.balance.reach import ComReach, ReachOptions
@@ -155,10 +156,6 @@ def reach_option(
     if isinstance(value, ComReach):
         return value
     return com_reach(stance, None if value is True else value)
-
-
-#: The impact models a governor answers with: "floating" (the paper's) and "held-stance".
-IMPACT_MODELS = ("floating", "held-stance")
 
 
 def held_stance_option(

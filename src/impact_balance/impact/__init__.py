@@ -5,4 +5,9 @@ contact-aware model (:mod:`.contact_aware`) and the held-stance jumps built on i
 (:mod:`.held_stance`).
 """
 
-__all__: list[str] = []
+__all__ = ["IMPACT_MODELS"]
+
+#: The impact models the commands (``--impact-model``) and the governor (``impact_model``) take:
+#: "floating", the paper's (the robot floats through the impact, :mod:`.model`), and
+#: "held-stance" (its sustained contacts take impulses too, :mod:`.held_stance`).
+IMPACT_MODELS = ("floating", "held-stance")

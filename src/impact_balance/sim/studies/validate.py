@@ -62,6 +62,7 @@ from impact_balance.analysis.reach import ReachAnswer, reach_answer
 from impact_balance.analysis.result import Analysis
 from impact_balance.balance.reach import ReachOptions
 from impact_balance.exceptions import SimulationError
+from impact_balance.impact import IMPACT_MODELS
 from impact_balance.impact.model import INERTIA_MODELS
 from impact_balance.json_values import json_number
 from impact_balance.ranges import check_tolerance
@@ -90,10 +91,6 @@ __all__ = [
     "predictions",
     "validate",
 ]
-
-#: The impact models ``validate`` can predict with: "floating" (the paper's, always reported)
-#: and "held-stance" (also :func:`held_stance_prediction`, in ``predicted.held_stance``).
-IMPACT_MODELS = ("floating", "held-stance")
 
 
 def predictions(scenario: Scenario, zmp_margin: float = 0.0) -> dict[str, dict[str, float | None]]:
