@@ -36,7 +36,7 @@ REQUIRED = {
 }
 #: Each set's folder and what it must cover; the second adds pushes on one foot, the third
 #: forward impacts and wide, staggered two-feet stances; the fourth, fifth and sixth cover what
-#: the third does; the seventh what the third does but wide stances (it has none).
+#: the third does; the seventh and eighth what the third does but wide stances (none).
 SETS = {
     "held_out": REQUIRED,
     "held_out_2": REQUIRED | {"one foot"},
@@ -45,16 +45,25 @@ SETS = {
     "held_out_5": REQUIRED | {"one foot", "forward impact", "wide stance", "staggered"},
     "held_out_6": REQUIRED | {"one foot", "forward impact", "wide stance", "staggered"},
     "held_out_7": REQUIRED | {"one foot", "forward impact", "staggered"},
+    "held_out_8": REQUIRED | {"one foot", "forward impact", "staggered"},
 }
 #: The sets checked under the protocol's options (10 mm margin, angular momentum term) and
 #: whose impact friction and restitution must be new: each against the stances before it.
-NEW_SETS = ["held_out_2", "held_out_3", "held_out_4", "held_out_5", "held_out_6", "held_out_7"]
+NEW_SETS = [
+    "held_out_2",
+    "held_out_3",
+    "held_out_4",
+    "held_out_5",
+    "held_out_6",
+    "held_out_7",
+    "held_out_8",
+]
 SET_FILES = {name: sorted((STUDIES / name).glob("*.yaml")) for name in SETS}
 FILES = [f for files in SET_FILES.values() for f in files]
 #: Stances on one foot the second set must hold at least (its lesson: a margin from two-feet
 #: stances failed on one foot), and the sets that hold fewer (the seventh: one).
 ONE_FOOT_MIN = 2
-ONE_FOOT_MIN_BY_SET = {"held_out_7": 1}
+ONE_FOOT_MIN_BY_SET = {"held_out_7": 1, "held_out_8": 1}
 #: The feet: sole frames, and the ankle frames of the robots without one (G1, JVRC-1).
 FOOT_FRAMES = {
     "left_sole_link",
@@ -118,6 +127,14 @@ SEVENTH_ROBOTS = {"talos", "g1", "jvrc1", "romeo", "icub"}
 SEVENTH_MIN_ROBOTS = 4
 SEVENTH_MIN_ON = {"talos": 2, "g1": 2}
 SEVENTH_MIN_ORDINARY = 2
+#: The eighth set (the held-stance impact model's): its robots and their least counts, its hand
+#: impacts on two feet (at least EIGHTH_MIN_HAND_TWO_FEET, forward, backward and lateral among
+#: them), its foot impacts (at least two, one with a hand holding), and its impact values: two
+#: frictions on half the set each, restitution ranges with lo = 0 and with hi = 0.6.
+EIGHTH = "held_out_8"
+EIGHTH_MIN_ON = {"talos": 2, "g1": 2, "jvrc1": 1, "romeo": 1, "icub": 1}
+EIGHTH_MIN_HAND_TWO_FEET = 5
+EIGHTH_MIN_FOOT = 2
 
 
 def _header(path: Path, key: str) -> str:
@@ -156,7 +173,13 @@ def _feet(d: dict[str, Any]) -> list[dict[str, Any]]:
 
 @pytest.mark.parametrize("name", sorted(SETS))
 def test_the_set_is_there(name: str) -> None:
-    least = SEVENTH_MIN_FILES if name == SEVENTH else THIRD_MIN_FILES if name in LATER_AIMS else 6
+    least = (
+        SEVENTH_MIN_FILES
+        if name in (SEVENTH, EIGHTH)
+        else THIRD_MIN_FILES
+        if name in LATER_AIMS
+        else 6
+    )
     assert len(SET_FILES[name]) >= least, [f.name for f in SET_FILES[name]]
 
 
@@ -445,11 +468,13 @@ def test_the_simulation_model_builds_with_the_push_bodies(path: Path) -> None:
 
 
 #: The sets whose protocol also tables the CoM's reach (impact_balance.balance.reach).
-REACH_TABLES = ["held_out_5", "held_out_6", "held_out_7"]
+REACH_TABLES = ["held_out_5", "held_out_6", "held_out_7", "held_out_8"]
+#: The sets whose protocol also tables the held-stance impact model's predictions.
+HELD_TABLES = ["held_out_8"]
 #: The protocols whose tables of predictions the test recomputes, by set.
 PROTOCOLS = {
     name: STUDIES.parent / "docs" / "studies" / f"held-out-protocol-{name[-1]}.md"
-    for name in [*LATER_AIMS, SEVENTH]
+    for name in [*LATER_AIMS, SEVENTH, EIGHTH]
 }
 PROTOCOL_FILES = [f for name in PROTOCOLS for f in SET_FILES[name]]
 
@@ -472,6 +497,8 @@ def test_the_later_protocols_list_every_stance_of_their_set(name: str) -> None:
     assert set(_protocol_rows(name, 2)) == names  # the pushes' predictions
     if name in REACH_TABLES:
         assert set(_protocol_rows(name, 3)) == names  # the CoM's reach
+    if name in HELD_TABLES:
+        assert set(_protocol_rows(name, 4)) == names  # the held-stance model
 
 
 @pytest.mark.parametrize("path", PROTOCOL_FILES, ids=_id)
@@ -553,3 +580,107 @@ def test_the_protocols_reach_predictions_are_com_reach_s(path: Path) -> None:
         stop = e - np.sqrt(max(e**2 - (limit / omega) ** 2, 0.0))
         assert limit <= omega * e + 1e-12
         assert stop <= R + 1e-9 or abs(limit - omega * e) <= 1e-12, (k, stop, R)
+
+
+def _held(path: Path, margin: float) -> Any:
+    """The held-stance model's answer on ``path`` with the ZMP margin ``margin`` (m)."""
+    from impact_balance.analysis.held_stance import held_stance_max_contact_velocity
+
+    a = analyze(load_scenario(str(path)).replace(zmp_margin=margin))
+    return a, held_stance_max_contact_velocity(a)
+
+
+def test_the_eighth_set_holds_hand_impacts_on_two_feet_and_two_foot_impacts() -> None:
+    """Its aims: Talos and G1 twice, JVRC-1, Romeo and iCub; no wide stance; hand impacts on two
+    feet against forward, backward and lateral walls; two foot impacts, one on one foot and one
+    with the other foot and a hand holding."""
+    files = SET_FILES[EIGHTH]
+    robot = {f: load_scenario(str(f)).robot for f in files}
+    for name, least in EIGHTH_MIN_ON.items():
+        assert sum(r == name for r in robot.values()) >= least, (name, robot)
+    hand_two_feet: set[str] = set()
+    n_hand_two_feet, foot_impacts = 0, []
+    for f in files:
+        d = analyze(str(f)).to_dict()
+        apart = _apart(f)
+        assert apart is None or apart[1] < WIDE_M, (f.name, apart)
+        normal = np.asarray(d["impact"]["normal"], dtype=float)
+        normal /= np.linalg.norm(normal)
+        if d["impact"]["frame"] in HAND_FRAMES and apart is not None:
+            n_hand_two_feet += 1
+            if normal[0] < -0.7:
+                hand_two_feet.add("forward")
+            if normal[0] > 0.7:
+                hand_two_feet.add("backward")
+            if abs(normal[1]) > 0.7:
+                hand_two_feet.add("lateral")
+        if d["impact"]["frame"] in FOOT_FRAMES:
+            frames = [c["frame"] for c in d["contacts"]]
+            foot_impacts.append(
+                (sum(c in FOOT_FRAMES for c in frames), sum(c in HAND_FRAMES for c in frames))
+            )
+    assert n_hand_two_feet >= EIGHTH_MIN_HAND_TWO_FEET
+    assert hand_two_feet == {"forward", "backward", "lateral"}, hand_two_feet
+    assert len(foot_impacts) >= EIGHTH_MIN_FOOT, foot_impacts
+    assert (1, 0) in foot_impacts and (1, 1) in foot_impacts, foot_impacts
+
+
+def test_the_eighth_set_uses_configurations_no_earlier_stance_uses() -> None:
+    """Every configuration (contacts about their centre, their normals, the CoM height) of the
+    eighth set is new against the bundled scenarios and the seven earlier sets."""
+    bundled = [n for n in bundled_scenarios() if load_scenario(n).impact is not None]
+    earlier = [str(f) for s in SETS if s != EIGHTH for f in SET_FILES[s]]
+    layouts = {_layout(n) for n in [*bundled, *earlier]}
+    for f in SET_FILES[EIGHTH]:
+        assert _layout(str(f)) not in layouts, f.name
+
+
+def test_the_eighth_set_crosses_two_frictions_with_two_restitution_ranges() -> None:
+    """Two impact frictions, each on half the set, each with both restitution ranges (one from
+    lo = 0, one up to hi = 0.6) on two stances."""
+    cells: dict[tuple[float, tuple[float, ...]], int] = {}
+    for f in SET_FILES[EIGHTH]:
+        impact = load_scenario(str(f)).impact
+        assert impact is not None
+        key = (float(impact.friction), tuple(float(e) for e in impact.restitution))
+        cells[key] = cells.get(key, 0) + 1
+    frictions = sorted({k[0] for k in cells})
+    ranges = sorted({k[1] for k in cells})
+    assert len(frictions) == 2 and len(ranges) == 2, cells
+    assert ranges[0][0] == 0.0 and ranges[1][1] == 0.6, ranges
+    assert all(cells.get((m, r)) == 2 for m in frictions for r in ranges), cells
+
+
+@pytest.mark.parametrize("path", SET_FILES[EIGHTH], ids=_id)
+def test_the_eighth_set_is_feasible_under_the_held_stance_model(path: Path) -> None:
+    """The held-stance model answers (no fallback) at margin 0 and 10 mm, above 0.05 m/s, and
+    its answer is the largest speed keeping both jumps in the area, from the half-planes."""
+    answers = []
+    for margin in (0.0, 0.01):
+        a, held = _held(path, margin)
+        assert not held.fell_back and held.binding_restitution is not None
+        v = held.max_contact_velocity
+        assert math.isfinite(v) and v > 0.05, (margin, v)
+        G, h = a.areas.com_velocity_area.halfplanes
+        c0 = np.asarray(a.com_velocity, dtype=float)
+        speeds = []
+        for jump in held.to_dict()["jumps"]:
+            rate = G @ np.asarray(jump, dtype=float)
+            ahead = rate > 1e-12
+            speeds.append(float(np.min((h[ahead] - G[ahead] @ c0) / rate[ahead])))
+        assert abs(min(speeds) - v) <= 1e-6 * max(1.0, v), (speeds, v)
+        answers.append(v)
+    assert answers[1] <= answers[0] + 1e-9  # the margin only takes speed away
+
+
+@pytest.mark.parametrize("path", [f for name in HELD_TABLES for f in SET_FILES[name]], ids=_id)
+def test_the_protocols_held_stance_predictions_are_the_model_s(path: Path) -> None:
+    """Rule 4 for the held-stance table: margin 0, 10 mm, fallback and binding restitution."""
+    zero, ten, fell_back, binding = _protocol_rows(_set_of(path), 4)[path.stem]
+    _, held0 = _held(path, 0.0)
+    _, held10 = _held(path, 0.01)
+    assert abs(held0.max_contact_velocity - float(zero)) <= 0.0005 + 1e-9
+    assert abs(held10.max_contact_velocity - float(ten)) <= 0.0005 + 1e-9
+    assert fell_back == ("yes" if held10.fell_back else "no")
+    expected = held10.binding_restitution
+    assert binding == ("–" if expected is None else f"{expected:.2f}")
