@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,22 +14,7 @@ from impact_balance import analyze, load_scenario
 from impact_balance.analysis.held_stance import HeldStanceLimit, held_stance_max_contact_velocity
 from impact_balance.exceptions import ImpactModelError
 from impact_balance.impact.contact_aware import contact_impact
-
-#: A frozen held-out stance whose fixed point is not reached in 1000 QP solves at either bound
-#: (docs/studies/impact-held-stance.md).
-NOT_CONVERGING = (
-    Path(__file__).resolve().parents[2]
-    / "studies"
-    / "held_out_5"
-    / "icub_wide_ramp_left_hand_side.yaml"
-)
-
-
-def _ray(G: np.ndarray, h: np.ndarray, c0: np.ndarray, jump: np.ndarray) -> float:
-    """Largest s with G (c0 + s jump) <= h (inf when no half-plane is approached)."""
-    rates = G @ jump
-    ahead = rates > 1e-12
-    return float(np.min((h - G @ c0)[ahead] / rates[ahead])) if ahead.any() else math.inf
+from tests.helpers.held_stance import NOT_CONVERGING, ray
 
 
 @pytest.mark.parametrize(
@@ -59,7 +43,7 @@ def test_the_answer_is_the_smallest_ray_of_the_two_bounds(name, changes):
     rays = {}
     for c in spec.restitution:
         jump = contact_impact(analysis.stance, spec, 1.0, restitution=float(c)).com_velocity_jump
-        rays[float(c)] = _ray(G, h, c0, jump)
+        rays[float(c)] = ray(G, h, c0, jump)
     assert answer.restitution == tuple(float(c) for c in spec.restitution)
     assert answer.max_contact_velocity == pytest.approx(min(rays.values()), rel=1e-9)
     assert answer.binding_restitution == min(rays, key=rays.get)
@@ -83,7 +67,7 @@ def test_a_fixed_point_not_reached_falls_back_to_the_papers_answer():
     assert answer.status == analysis.impact.status
     # The last iterates alone would answer something else (much faster: optimistic there).
     own = min(
-        _ray(*analysis.areas.com_velocity_area.halfplanes, np.zeros(2), j) for j in answer.jumps
+        ray(*analysis.areas.com_velocity_area.halfplanes, np.zeros(2), j) for j in answer.jumps
     )
     assert own > 5 * answer.max_contact_velocity
 

@@ -5,8 +5,6 @@ contact-aware model directly; absent without tau; the fallback the analysis's de
 from __future__ import annotations
 
 import json
-import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,21 +14,7 @@ from hypothesis import strategies as st
 from impact_balance import analyze, load_scenario
 from impact_balance.analysis.held_stance import held_stance_max_contact_velocity
 from impact_balance.impact.contact_aware import contact_impact
-
-#: A frozen held-out stance whose fixed point is not reached (docs/studies/impact-held-stance.md).
-NOT_CONVERGING = (
-    Path(__file__).resolve().parents[2]
-    / "studies"
-    / "held_out_5"
-    / "icub_wide_ramp_left_hand_side.yaml"
-)
-
-
-def _ray(G: np.ndarray, h: np.ndarray, c0: np.ndarray, jump: np.ndarray) -> float:
-    """Largest s with G (c0 + s jump) <= h (inf when no half-plane is approached)."""
-    rates = G @ jump
-    ahead = rates > 1e-12
-    return float(np.min((h - G @ c0)[ahead] / rates[ahead])) if ahead.any() else math.inf
+from tests.helpers.held_stance import NOT_CONVERGING, ray
 
 
 def _independent(analysis, tau: float) -> dict[tuple[float, bool], float]:
@@ -47,8 +31,8 @@ def _independent(analysis, tau: float) -> dict[tuple[float, bool], float]:
         answer = contact_impact(stance, spec, 1.0, restitution=float(c))
         L = stance.com_inertia @ answer.angular_velocity_jump
         shift = np.array([L[1], -L[0]]) / (stance.mass * height * (1.0 + omega * tau))
-        rays[float(c), False] = _ray(G, h, c0, answer.com_velocity_jump)
-        rays[float(c), True] = _ray(G, h, c0, answer.com_velocity_jump + shift)
+        rays[float(c), False] = ray(G, h, c0, answer.com_velocity_jump)
+        rays[float(c), True] = ray(G, h, c0, answer.com_velocity_jump + shift)
     return rays
 
 

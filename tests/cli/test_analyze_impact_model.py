@@ -3,22 +3,13 @@ analysis's own answer, the fallback reported, a bad value refused in one line.""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 from impact_balance import analyze, load_scenario
 from impact_balance.analysis.held_stance import held_stance_max_contact_velocity
 from tests.helpers.cli import run_cli, strict_json
-
-#: A frozen held-out stance whose fixed point is not reached (docs/studies/impact-held-stance.md).
-NOT_CONVERGING = (
-    Path(__file__).resolve().parents[2]
-    / "studies"
-    / "held_out_5"
-    / "icub_wide_ramp_left_hand_side.yaml"
-)
+from tests.helpers.held_stance import NOT_CONVERGING
 
 
 @pytest.mark.parametrize("name", ["palm_push_two_feet", "jvrc1_kick_one_foot"])

@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import math
-from pathlib import Path
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -14,14 +11,7 @@ from impact_balance import analyze, load_scenario
 from impact_balance.analysis.held_stance import held_stance_max_contact_velocity
 from impact_balance.exceptions import GovernorError
 from impact_balance.governor import Governor
-
-#: A frozen held-out stance whose fixed point is not reached (docs/studies/impact-held-stance.md).
-NOT_CONVERGING = (
-    Path(__file__).resolve().parents[2]
-    / "studies"
-    / "held_out_5"
-    / "icub_wide_ramp_left_hand_side.yaml"
-)
+from tests.helpers.held_stance import NOT_CONVERGING, ray
 
 
 @pytest.fixture(scope="module")
@@ -33,13 +23,6 @@ def talos():
     other = q.copy()
     other[-1] += 0.05  # a neighbouring posture (the last arm joint)
     return scenario, held, plain, q, other
-
-
-def _ray(G: np.ndarray, h: np.ndarray, c0: np.ndarray, jump: np.ndarray) -> float:
-    """Largest s with G (c0 + s jump) <= h (inf when no half-plane is approached)."""
-    rates = G @ jump
-    ahead = rates > 1e-12
-    return float(np.min((h - G @ c0)[ahead] / rates[ahead])) if ahead.any() else math.inf
 
 
 @settings(max_examples=8, deadline=None)
@@ -70,7 +53,7 @@ def test_the_jumps_are_the_initial_postures_at_another_posture(talos):
     G, h = analysis.areas.com_velocity_area.halfplanes
     h = h - scenario.velocity_margin
     initial = held_stance_max_contact_velocity(analyze(governor.scenario_at(q, c)))
-    expected = min(_ray(G, h, c[:2], j) for j in initial.jumps)
+    expected = min(ray(G, h, c[:2], j) for j in initial.jumps)
     assert limit.max_contact_velocity == pytest.approx(expected, abs=1e-9)
     np.testing.assert_allclose(governor.held_stance.jumps, initial.jumps, rtol=0, atol=1e-12)
     # ... which is not the held-stance answer of the new posture's own jumps

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 
 pytest.importorskip("viser", reason="needs the gui extra (viser)")
@@ -11,14 +9,7 @@ pytest.importorskip("viser", reason="needs the gui extra (viser)")
 from impact_balance.analysis.held_stance import held_stance_max_contact_velocity
 from impact_balance.gui import DEFAULT_SCENARIO, Session
 from impact_balance.gui.session import format_speed
-
-#: A frozen held-out stance whose fixed point is not reached (docs/studies/impact-held-stance.md).
-NOT_CONVERGING = (
-    Path(__file__).resolve().parents[2]
-    / "studies"
-    / "held_out_5"
-    / "icub_wide_ramp_left_hand_side.yaml"
-)
+from tests.helpers.held_stance import NOT_CONVERGING
 
 
 @pytest.fixture()
