@@ -17,6 +17,8 @@ from typing import TYPE_CHECKING, Any
 #: costs only what the names a program touches need (the command line lists robots in ~0.2 s).
 _EXPORTS: dict[str, str] = {
     "Analysis": ".analysis.analyze",
+    "HeldStanceLimit": ".analysis.held_stance",
+    "held_stance_max_contact_velocity": ".analysis.held_stance",
     "ImpactAnswer": ".analysis.analyze",
     "analyze": ".analysis.analyze",
     "BalanceAreas": ".balance.areas",
@@ -52,6 +54,7 @@ _EXPORTS: dict[str, str] = {
     "impact_model": ".impact.model",
     "PhasePortrait": ".balance.lipm",
     "com_velocity_bounds": ".balance.lipm",
+    "finite_push_factor": ".balance.lipm",
     "lipm_omega": ".balance.lipm",
     "phase_portrait": ".balance.lipm",
     "Polygon": ".geometry.polygon",
@@ -86,6 +89,7 @@ __all__ = [
     "ContactVelocityLimit",
     "Diagnostic",
     "Governor",
+    "HeldStanceLimit",
     "ImpactAnswer",
     "ImpactBalanceError",
     "ImpactModel",
@@ -120,7 +124,9 @@ __all__ = [
     "cwc_faces",
     "cwc_faces_world",
     "cwc_span",
+    "finite_push_factor",
     "friction_cone",
+    "held_stance_max_contact_velocity",
     "impact_model",
     "lipm_omega",
     "load_robot",
@@ -154,11 +160,16 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # static analysers and IDEs see the plain imports
     from impact_balance.analysis.analyze import Analysis, ImpactAnswer, analyze
+    from impact_balance.analysis.held_stance import (
+        HeldStanceLimit,
+        held_stance_max_contact_velocity,
+    )
     from impact_balance.analysis.result import Diagnostic
     from impact_balance.balance.areas import BalanceAreas, areas_from_polytope, balance_areas
     from impact_balance.balance.lipm import (
         PhasePortrait,
         com_velocity_bounds,
+        finite_push_factor,
         lipm_omega,
         phase_portrait,
     )
