@@ -7,8 +7,8 @@ A run directory holds, per stance, the outputs of the commands of the protocol (
 other word for another governor). The records are one row per push, per impact search, per
 governed approach and per reach azimuth. Prediction keys the records do not name are carried
 through: every boolean ``*_safe`` key of a push (a column of that name, 0 or 1) and every
-``predicted.<name>.max_contact_velocity`` (and one level deeper) of a search
-(``predicted_<name>_mps``).
+``predicted.<name>.max_contact_velocity`` (and one level deeper, ``predicted_<name>_<sub>_mps``)
+or number ``predicted.<name>`` of a search (``predicted_<name>_mps``).
 """
 
 from __future__ import annotations
@@ -139,9 +139,14 @@ def push_rows(run_dir: Path, commit: str = "") -> list[dict[str, Any]]:
 
 
 def _predictions(predicted: dict[str, Any]) -> dict[str, Any]:
-    """Every ``max_contact_velocity`` under ``predicted`` (two levels), by its column name."""
+    """Every ``max_contact_velocity`` under ``predicted`` (two levels), by its column name.
+
+    A number directly under ``predicted`` (but ``default``) is a speed too.
+    """
     columns: dict[str, Any] = dict.fromkeys(NAMED_PREDICTIONS.values(), "")
     for key, value in predicted.items():
+        if isinstance(value, (int, float)) and not isinstance(value, bool) and key != "default":
+            columns[f"predicted_{key}_mps"] = value  # a speed of its own beside the default's
         if not isinstance(value, dict):
             continue
         paths: list[tuple[tuple[str, ...], dict[str, Any]]] = [((key,), value)]
