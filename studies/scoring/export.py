@@ -73,6 +73,11 @@ def _candidate_flags(push: dict[str, Any]) -> dict[str, int]:
     }
 
 
+def _rounded(value: float | None) -> float | str:
+    """``value`` to 6 decimals, or an empty cell when it is None."""
+    return "" if value is None else round(value, 6)
+
+
 def _angular_momentum_margin(push: dict[str, Any]) -> float:
     """The paper's margin with the angular momentum term alone (m/s, no push duration, no reach).
 
@@ -98,7 +103,7 @@ def _push_row(
         "default_margin_mps": round(push["predicted_com_velocity_margin"], 6),
         "paper_margin_mps": round(push["com_velocity_margin"] + omega * margin, 6),
         "default_safe": int(push["com_criterion_safe"]),
-        "com_reach_margin_mps": round(push["com_reach_margin"], 6),
+        "com_reach_margin_mps": _rounded(push.get("com_reach_margin")),
         "commit": commit,
         "finite_push_factor": round(push.get("finite_push_factor") or 1.0, 6),
         "outcome": push["outcome"],

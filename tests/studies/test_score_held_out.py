@@ -138,7 +138,7 @@ def _push(direction: float, relative: float, default: bool, candidate: bool, fai
         "com_criterion_safe": default,
         "paper_com_criterion_safe": default,
         "hand_contact_safe": candidate,
-        "com_reach_margin": 0.1,
+        "com_reach_margin": None if direction == 90 else 0.1,  # no reach: an empty cell
         "outcome": "fell" if failed else "balanced",
         "fell": failed,
         "strict_fail": failed,
