@@ -15,6 +15,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from tests.helpers.markdown_tables import markdown_tables
 
@@ -215,3 +217,72 @@ def test_bad_input_is_one_line_and_status_2(
     assert out == ""
     lines = err.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0] and "Traceback" not in err
+
+
+STANCES = ("talos_wide_front", "g1_left_foot_toe_front")
+push_draws = st.lists(
+    st.tuples(
+        st.sampled_from(STANCES),
+        st.sampled_from(("pelvis", "torso")),
+        st.sampled_from((0, 90, 180)),
+        st.sampled_from((0.5, 0.78, 0.99, 1.05, 1.3)),
+        st.booleans(),  # the default's call
+        st.booleans(),  # the candidate's call
+        st.booleans(),  # failed strictly
+        st.booleans(),  # aborted
+    ),
+    min_size=1,
+    max_size=40,
+)
+
+
+@settings(max_examples=40, deadline=None)
+@given(draws=push_draws)
+def test_pooled_counts_equal_an_independent_count(draws: list[tuple[Any, ...]]) -> None:
+    _script()  # puts studies/ on the path
+    push_scores = importlib.import_module("scoring.push_scores")
+    rows = [
+        {
+            "stance": stance,
+            "body": body,
+            "direction_deg": str(direction),
+            "relative": str(relative),
+            "omega": "3.0",
+            "zmp_margin": "0.01",
+            "default_margin_mps": "0.05" if default else "-0.05",
+            "paper_margin_mps": "0.08" if default else "0.0",
+            "default_safe": str(int(default)),
+            "hand_safe": str(int(candidate)),
+            "outcome": "aborted" if aborted else ("fell" if failed else "balanced"),
+            "fell": str(int(failed and not aborted)),
+            "strict_fail": str(int(failed and not aborted)),
+        }
+        for stance, body, direction, relative, default, candidate, failed, aborted in draws
+    ]
+    candidates = push_scores.candidate_columns(rows)
+    assert candidates == ["hand_safe"]
+    header, table_rows = markdown_tables(
+        push_scores.pooled_table(push_scores.pushes(rows, candidates), candidates)
+    )[0]
+    by_label = {row[0]: row for row in table_rows}
+    groups = {
+        "all": lambda d: True,
+        "one foot": lambda d: "_foot_" in d[0],
+        "two feet": lambda d: "_foot_" not in d[0],
+    }
+    for label, member in groups.items():
+        chosen = [d for d in draws if member(d) and not d[7] and 0.75 <= d[3] <= 1.05]
+        if not [d for d in draws if member(d)]:
+            assert label not in by_label
+            continue
+        for index, column in ((4, "default"), (5, "hand_safe")):
+            safe = [d for d in chosen if d[index]]
+            failed = sum(d[6] for d in safe)
+            cell = by_label[label][header.index(f"{column}: P(failed strictly \\| safe), band")]
+            assert cell.endswith(f"({failed}/{len(safe)})")
+            if safe:
+                assert cell.startswith(f"{100 * failed / len(safe):.0f} %")
+            stood = [d for d in chosen if not d[6]]
+            cell = by_label[label][header.index(f"{column}: standing called safe")]
+            expected = f"({sum(d[index] for d in stood)}/{len(stood)})" if stood else "–"
+            assert cell.endswith(expected)
