@@ -764,8 +764,9 @@ def test_the_ninth_set_s_hand_holds_are_new() -> None:
 
 @pytest.mark.parametrize("path", SET_FILES[NINTH], ids=_id)
 def test_the_ninth_set_s_hand_holds_carry_a_share_of_the_balance(path: Path) -> None:
-    """A hand hold is a real support: without it the CoM velocity area is smaller by a fifth at
-    least (or the stance cannot balance), so a push test on it tests the hand's contact."""
+    """A hand hold is a real support: the CoM velocity area with it is more than 1.2 times the
+    area without it (or the stance cannot balance without it), so a push tests the hand's
+    contact."""
     scenario = load_scenario(str(path))
     kept = [c for c in scenario.contacts if c.frame not in HAND_FRAMES]
     if len(kept) == len(scenario.contacts):
