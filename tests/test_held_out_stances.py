@@ -36,7 +36,8 @@ REQUIRED = {
 }
 #: Each set's folder and what it must cover; the second adds pushes on one foot, the third
 #: forward impacts and wide, staggered two-feet stances; the fourth, fifth and sixth cover what
-#: the third does; the seventh and eighth what the third does but wide stances (none).
+#: the third does; the seventh and eighth what the third does but wide stances (none); the ninth
+#: what the seventh does but stances on one foot alone (its one-foot stances hold a hand).
 SETS = {
     "held_out": REQUIRED,
     "held_out_2": REQUIRED | {"one foot"},
@@ -46,6 +47,7 @@ SETS = {
     "held_out_6": REQUIRED | {"one foot", "forward impact", "wide stance", "staggered"},
     "held_out_7": REQUIRED | {"one foot", "forward impact", "staggered"},
     "held_out_8": REQUIRED | {"one foot", "forward impact", "staggered"},
+    "held_out_9": REQUIRED | {"forward impact", "staggered"},
 }
 #: The sets checked under the protocol's options (10 mm margin, angular momentum term) and
 #: whose impact friction and restitution must be new: each against the stances before it.
@@ -57,6 +59,7 @@ NEW_SETS = [
     "held_out_6",
     "held_out_7",
     "held_out_8",
+    "held_out_9",
 ]
 SET_FILES = {name: sorted((STUDIES / name).glob("*.yaml")) for name in SETS}
 FILES = [f for files in SET_FILES.values() for f in files]
@@ -135,6 +138,16 @@ EIGHTH = "held_out_8"
 EIGHTH_MIN_ON = {"talos": 2, "g1": 2, "jvrc1": 1, "romeo": 1, "icub": 1}
 EIGHTH_MIN_HAND_TWO_FEET = 5
 EIGHTH_MIN_FOOT = 2
+#: The ninth set (hand holds): at least NINTH_MIN_HOLDS stances with a hand on a support, on three
+#: robots at least (Talos, G1 and one of NINTH_THIRD_ROBOTS), on one foot and on two feet, against
+#: at least two kinds of support (a table, a wall, a rail); Talos and G1 twice each over the set.
+NINTH = "held_out_9"
+NINTH_MIN_HOLDS = 4
+NINTH_THIRD_ROBOTS = {"romeo", "icub", "jvrc1"}
+NINTH_MIN_ON = {"talos": 2, "g1": 2}
+#: A support's kind by its normal's tilt from the vertical (deg): a table below SLOPE_DEG, a
+#: wall above NINTH_WALL_DEG, a rail or ramp between.
+NINTH_WALL_DEG = 70.0
 
 
 def _header(path: Path, key: str) -> str:
@@ -159,6 +172,12 @@ def _signature(scenario: Any) -> tuple[Any, ...]:
     )
 
 
+def _tilt(normal: Any) -> float:
+    """A normal's angle from the vertical (deg)."""
+    n = np.asarray(normal, dtype=float)
+    return math.degrees(math.acos(min(1.0, float(n[2] / np.linalg.norm(n)))))
+
+
 def _set_of(path: Path) -> str:
     return path.parent.name
 
@@ -175,7 +194,7 @@ def _feet(d: dict[str, Any]) -> list[dict[str, Any]]:
 def test_the_set_is_there(name: str) -> None:
     least = (
         SEVENTH_MIN_FILES
-        if name in (SEVENTH, EIGHTH)
+        if name in (SEVENTH, EIGHTH, NINTH)
         else THIRD_MIN_FILES
         if name in LATER_AIMS
         else 6
@@ -236,15 +255,13 @@ def test_declared_categories_match_the_data(path: Path) -> None:
     frame = d["impact"]["frame"]
     assert ("foot impact" in covers) == (frame in FOOT_FRAMES)
     assert ("hand impact" in covers) == (frame in HAND_FRAMES)
-    tilts = [
-        math.degrees(math.acos(min(1.0, c["normal"][2] / np.linalg.norm(c["normal"]))))
-        for c in d["contacts"]
-    ]
-    assert ("slope" in covers) == (max(tilts) > SLOPE_DEG), tilts
     feet = _feet(d)
+    # The ground under the feet (a hand's table, wall or rail is not a slope).
+    tilts = [_tilt(c["normal"]) for c in feet]
+    assert ("slope" in covers) == (max(tilts) > SLOPE_DEG), tilts
     if "one foot" in required:
         assert ("one foot" in covers) == (len(d["contacts"]) == 1 == len(feet)), d["contacts"]
-    two_feet = len(d["contacts"]) == 2 == len(feet)
+    two_feet = len(feet) == 2  # a hand may hold a support besides
     # To the millimetre (the IK places a contact to about 1e-7 m).
     apart = (
         np.abs(np.subtract(*(c["position"] for c in feet))).round(3) if two_feet else np.zeros(3)
@@ -468,13 +485,13 @@ def test_the_simulation_model_builds_with_the_push_bodies(path: Path) -> None:
 
 
 #: The sets whose protocol also tables the CoM's reach (impact_balance.balance.reach).
-REACH_TABLES = ["held_out_5", "held_out_6", "held_out_7", "held_out_8"]
+REACH_TABLES = ["held_out_5", "held_out_6", "held_out_7", "held_out_8", "held_out_9"]
 #: The sets whose protocol also tables the held-stance impact model's predictions.
-HELD_TABLES = ["held_out_8"]
+HELD_TABLES = ["held_out_8", "held_out_9"]
 #: The protocols whose tables of predictions the test recomputes, by set.
 PROTOCOLS = {
     name: STUDIES.parent / "docs" / "studies" / f"held-out-protocol-{name[-1]}.md"
-    for name in [*LATER_AIMS, SEVENTH, EIGHTH]
+    for name in [*LATER_AIMS, SEVENTH, EIGHTH, NINTH]
 }
 PROTOCOL_FILES = [f for name in PROTOCOLS for f in SET_FILES[name]]
 
@@ -684,3 +701,77 @@ def test_the_protocols_held_stance_predictions_are_the_model_s(path: Path) -> No
     assert fell_back == ("yes" if held10.fell_back else "no")
     expected = held10.binding_restitution
     assert binding == ("–" if expected is None else f"{expected:.2f}")
+
+
+def _holds(path: Path) -> list[dict[str, Any]]:
+    """A stance's hand contacts (a hand holding a support), from analyze."""
+    return [c for c in analyze(str(path)).to_dict()["contacts"] if c["frame"] in HAND_FRAMES]
+
+
+def _support_kind(normal: Any) -> str:
+    tilt = _tilt(normal)
+    return "table" if tilt <= SLOPE_DEG else "wall" if tilt >= NINTH_WALL_DEG else "rail"
+
+
+def test_the_ninth_set_holds_hands_on_supports_on_three_robots() -> None:
+    """Its aims: at least four stances with a hand holding a support, on Talos, G1 and Romeo,
+    iCub or JVRC-1, on one foot and on two feet, on two kinds of support at least; stances of
+    ordinary support besides (two feet, no hand held) with lateral and backward impacts; Talos
+    and G1 twice each; no wide stance."""
+    files = SET_FILES[NINTH]
+    robot = {f: load_scenario(str(f)).robot for f in files}
+    for name, least in NINTH_MIN_ON.items():
+        assert sum(r == name for r in robot.values()) >= least, (name, robot)
+    holds = {f: _holds(f) for f in files}
+    held = [f for f in files if holds[f]]
+    assert len(held) >= NINTH_MIN_HOLDS, held
+    held_robots = {robot[f] for f in held}
+    assert {"talos", "g1"} <= held_robots and held_robots & NINTH_THIRD_ROBOTS, held_robots
+    feet = {f: len(_feet(analyze(str(f)).to_dict())) for f in held}
+    assert set(feet.values()) == {1, 2}, feet  # on one foot and on two feet
+    kinds = {_support_kind(c["normal"]) for f in held for c in holds[f]}
+    assert len(kinds) >= 2, kinds
+    plain = [f for f in files if not holds[f]]
+    assert plain, files
+    walls = set()
+    for f in plain:
+        apart = _apart(f)
+        assert apart is not None and apart[1] < WIDE_M, (f.name, apart)
+        walls |= _covers(f) & {"lateral impact", "backward impact"}
+    # Lateral and backward impacts over the set, on stances of ordinary support among them.
+    covered = set().union(*(_covers(f) for f in files))
+    assert {"lateral impact", "backward impact"} <= covered and walls, (covered, walls)
+
+
+def test_the_ninth_set_s_hand_holds_are_new() -> None:
+    """No hand hold of the ninth set repeats an earlier one's robot and contact frames (the bundled
+    scenarios' and the eight earlier sets'), and every configuration of the set is new."""
+    bundled = [n for n in bundled_scenarios() if load_scenario(n).impact is not None]
+    earlier = [str(f) for s in SETS if s != NINTH for f in SET_FILES[s]]
+    earlier_holds = {
+        (load_scenario(n).robot, tuple(sorted(c.frame for c in load_scenario(n).contacts)))
+        for n in [*bundled, *earlier]
+        if any(c.frame in HAND_FRAMES for c in load_scenario(n).contacts)
+    }
+    assert earlier_holds  # talos_three_contacts and set 8's hand hold
+    layouts = {_layout(n) for n in [*bundled, *earlier]}
+    for f in SET_FILES[NINTH]:
+        s = load_scenario(str(f))
+        frames = tuple(sorted(c.frame for c in s.contacts))
+        assert (s.robot, frames) not in earlier_holds, f.name
+        assert _layout(str(f)) not in layouts, f.name
+
+
+@pytest.mark.parametrize("path", SET_FILES[NINTH], ids=_id)
+def test_the_ninth_set_s_hand_holds_carry_a_share_of_the_balance(path: Path) -> None:
+    """A hand hold is a real support: the CoM velocity area with it is more than 1.2 times the
+    area without it (or the stance cannot balance without it), so a push tests the hand's
+    contact."""
+    scenario = load_scenario(str(path))
+    kept = [c for c in scenario.contacts if c.frame not in HAND_FRAMES]
+    if len(kept) == len(scenario.contacts):
+        pytest.skip("no hand hold")
+    full = analyze(scenario).areas.com_velocity_area.area
+    without = analyze(scenario.replace(contacts=kept))
+    if without.to_dict()["can_balance"]:
+        assert full > 1.2 * without.areas.com_velocity_area.area, (full, without)
