@@ -84,3 +84,31 @@ def test_motor_torques_stay_within_the_effort_limits_while_moving(trial_controll
         np.testing.assert_allclose(applied, expected, atol=1e-9)
         if not out.torque_limited:
             assert np.all(applied <= hi + 1e-6) and np.all(applied >= lo - 1e-6)
+
+
+def test_a_hand_holding_a_table_holds_through_a_pelvis_push():
+    """Talos on one foot, its gripper on a table (set 8's spent stance): 0.75 of the boundary at 0°.
+
+    Without the friction's compensation the gripper rolled past 5° and the trunk tipped (the
+    same trial on the code before the change; docs/studies/hand-contacts.md).
+    """
+    from pathlib import Path
+
+    from impact_balance.sim.studies.push import START_COM_VELOCITY, boundary_impulse
+    from impact_balance.sim.trials.balance_trial import Push, run_balance_trial
+
+    stance = Path(__file__).parents[3] / "studies/held_out_8"
+    options = BalanceTrialOptions(controller="id", after=1.0)
+    setup = BalanceSetup.create(
+        str(stance / "talos_right_foot_right_hand_hold_left_toe_front.yaml"), options=options
+    )
+    a = setup.analysis
+    impulse = 0.75 * boundary_impulse(
+        a.areas.com_velocity_area, a.stance.mass, 0.0, START_COM_VELOCITY
+    )
+    result = run_balance_trial(
+        setup, push=Push(0.0, impulse, 0.05, options.settle, "base_link"), options=options
+    )
+    summary = result.summary()
+    assert summary["outcome"] == "balanced", summary
+    assert not summary["events"]
