@@ -134,6 +134,10 @@ class InverseDynamicsGains:
         min_normal_force: Every contact carries at least this normal force [N]. The ZMP support area
             includes ZMPs reached only by unloading a contact (its cone contains zero); the fall
             detector counts an unloaded contact as lost, so the QP keeps each one loaded.
+        friction_velocity: v_f [rad/s]: the motors compensate a joint's dry friction F by
+            ``F clip(qdot / v_f, -1, 1)``
+            (:func:`~impact_balance.sim.control.torque.motor_compensation`): in full above v_f,
+            linearly below, so that a joint at rest gets no switching torque.
         joint_limit_horizon: T [s] of the joint position limits on the accelerations: braking at
             ``a`` from ``(q, v)`` stays within the limits for T, ``q + v T + a T^2 / 2`` in
             ``[lower, upper]``. MuJoCo enforces the limits with forces the QP would not know.
@@ -164,6 +168,7 @@ class InverseDynamicsGains:
     friction_scale: float = 0.65
     cop_margin: float = 0.0
     min_normal_force: float = 20.0
+    friction_velocity: float = 0.01
     joint_limit_horizon: float = 0.1
 
     def to_dict(self) -> dict[str, Any]:

@@ -25,12 +25,14 @@ free-flyer velocity in the base frame):
    - inequalities: each ``w_i`` in its contact wrench cone
      (:func:`impact_balance.contacts.cwc.cwc_faces_world`) (friction and rectangle shrunk by
      margins, see :class:`InverseDynamicsGains`) with a minimum normal force, the joint position
-     limits (as acceleration bounds), and ``|tau| <= effort`` with ``tau`` the actuated rows of
-     ``M a + h - sum J_i^T w_i``; with a governed approach (a task whose ``speed_bound()`` is
-     finite, :class:`~impact_balance.sim.studies.wall.GovernedApproach`), the impact point's
-     approach speed one control period ahead, ``-n . (J_p (v + a dt) + J_p_dot v dt)``, at most the
-     governor's cap: the paper's "track the maximum contact velocity with a whole-body QP" as a hard
-     bound, so that the torque controller's tracking lag cannot carry the point past a falling cap;
+     limits (as acceleration bounds), and ``|tau + c| <= effort`` with ``tau`` the actuated rows
+     of ``M a + h - sum J_i^T w_i`` and ``c`` what the motors add to it (step 4): the motor, not
+     the QP's share of it, is what saturates; with a governed approach (a task whose
+     ``speed_bound()`` is finite, :class:`~impact_balance.sim.studies.wall.GovernedApproach`),
+     the impact point's approach speed one control period ahead,
+     ``-n . (J_p (v + a dt) + J_p_dot v dt)``, at most the governor's cap: the paper's "track
+     the maximum contact velocity with a whole-body QP" as a hard bound, so that the torque
+     controller's tracking lag cannot carry the point past a falling cap;
    - cost (weighted least squares): the CoM acceleration of the LIPM,
      ``c_dd_xy = omega^2 (c_xy - p)``, with a PD on the CoM height; angular momentum damping
      ``L_dot = -K_L L``; the impact point's acceleration (the :class:`~.approach.ImpactTask`
@@ -40,7 +42,11 @@ free-flyer velocity in the base frame):
    If the torque limits make the QP infeasible, it is solved without them and the torques are
    clipped (MuJoCo clips them too); then, if need be, without the joint limits, then without
    the approach speed's bound.
-4. The torques ``tau`` go to MuJoCo's motors.
+4. The torques ``tau`` go to MuJoCo's motors, plus ``c``, the compensation of the joints' viscous
+   damping and dry friction (:func:`motor_compensation`: MuJoCo's ``damping`` and
+   ``frictionloss``, the URDF's ``<dynamics damping friction>``), which the QP's model leaves out.
+   On a joint whose effort limit is a few N m (a wrist: Talos' 3 to 6.6 N m against its 1 N m of
+   friction) an uncompensated friction is a large share of what the QP plans.
 
 The measured ZMP is not needed (the wrenches are chosen, not admitted); the argument is kept so
 that both controllers share :meth:`step`'s signature.
@@ -68,7 +74,7 @@ from impact_balance.sim.control.gains import InverseDynamicsGains, TrialGains, t
 from impact_balance.sim.control.zmp import DcmFeedback
 from impact_balance.sim.model.build import SimModel
 
-__all__ = ["InverseDynamicsController", "TorqueOutput"]
+__all__ = ["InverseDynamicsController", "TorqueOutput", "motor_compensation"]
 
 _FloatArray = npt.NDArray[np.float64]
 
@@ -145,6 +151,20 @@ class _Rows:
     m1: int
 
 
+def motor_compensation(
+    damping: _FloatArray, friction: _FloatArray, qdot: _FloatArray, friction_velocity: float
+) -> _FloatArray:
+    """The torque the motors add to the QP's to cancel the joints' damping and dry friction.
+
+    ``D qdot + F clip(qdot / v_f, -1, 1)`` (N m), elementwise: MuJoCo's viscous joint damping
+    ``D`` (N m s/rad) and dry friction ``F`` (``frictionloss``, N m) at the joint velocities
+    ``qdot`` (rad/s); the friction's sign is linear below ``v_f = friction_velocity`` (rad/s), so
+    that a joint at rest gets no full-size switching torque.
+    """
+    answer: _FloatArray = damping * qdot + friction * np.clip(qdot / friction_velocity, -1.0, 1.0)
+    return answer
+
+
 def _point_jacobian(
     model: pin.Model, data: pin.Data, fid: int, offset: pin.SE3
 ) -> tuple[pin.SE3, np.ndarray, np.ndarray]:
@@ -186,6 +206,8 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
     Attributes:
         joint_damping: MuJoCo's viscous joint damping (N m s/rad, by simulated joint) that
             :meth:`actuate` compensates; none unless built by :meth:`for_trial`.
+        joint_friction: MuJoCo's dry joint friction (``frictionloss``, N m, by simulated joint)
+            that :meth:`actuate` compensates; none unless built by :meth:`for_trial`.
     """
 
     name = "dcm-zmp-clamp + inverse-dynamics QP -> joint torques"
@@ -209,7 +231,12 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         self.rate = gains.rate
         self.dt = 1.0 / gains.rate
         self.joint_damping: _FloatArray = np.zeros(0)
+        self.joint_friction: _FloatArray = np.zeros(0)
         self.nv = nv = model.nv
+        # The damping (N m s/rad) and dry friction (N m) the motors compensate, by actuated
+        # velocity row (see for_trial and compensation()).
+        self._damping_rows: _FloatArray = np.zeros(nv - 6)
+        self._friction_rows: _FloatArray = np.zeros(nv - 6)
         self.nc = len(stance.contacts)
         self.n = nv + 6 * self.nc
         self.mass = float(sum(inertia.mass for inertia in model.inertias))
@@ -314,7 +341,8 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         See :meth:`Controller.for_trial` and :func:`~impact_balance.sim.control.gains.trial_gains`.
 
         The torques are bounded when ``sim``'s motors are force-limited; MuJoCo's viscous joint
-        damping (the URDF's) is compensated: the motors add ``damping * qdot``.
+        damping and dry friction (the URDF's) are compensated: the motors add
+        :func:`motor_compensation`, and the QP bounds the sum by the effort limits.
         """
         controller = cls(
             analysis,
@@ -324,22 +352,38 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
             effort_limits=bool(sim.model.actuator_forcelimited[sim.actuator_ids].any()),
         )
         controller.joint_damping = sim.model.dof_damping[sim.dof_adr].copy()
+        controller._damping_rows[sim.v_index - 6] = controller.joint_damping
+        controller.joint_friction = sim.model.dof_frictionloss[sim.dof_adr].copy()
+        controller._friction_rows[sim.v_index - 6] = controller.joint_friction
         return controller
+
+    def compensation(self, v: _FloatArray) -> _FloatArray:
+        """What :meth:`actuate` adds to the QP's torques at ``v`` (N m, actuated rows).
+
+        :func:`motor_compensation` of the joints' damping and dry friction (zero unless built
+        by :meth:`for_trial`) at the actuated rows of ``v`` (pinocchio order).
+        """
+        return motor_compensation(
+            self._damping_rows, self._friction_rows, v[6:], self.gains.friction_velocity
+        )
 
     def hold(self, sim: SimModel, q_start: _FloatArray) -> None:
         """The motors apply the holding torques (see :meth:`Controller.hold`)."""
         sim.data.ctrl[sim.actuator_ids] = sim.tau_hold
 
     def actuate(self, sim: SimModel, out: TorqueOutput) -> None:
-        """The motors apply ``out.tau`` plus the compensation of the joint damping.
+        """The motors apply ``out.tau`` plus the compensation of the joint damping and friction.
 
         Args:
             sim: The trial's MuJoCo model.
             out: What :meth:`step` returned.
         """
         d = sim.data
-        d.ctrl[sim.actuator_ids] = (
-            out.tau[sim.v_index - 6] + self.joint_damping * d.qvel[sim.dof_adr]
+        d.ctrl[sim.actuator_ids] = out.tau[sim.v_index - 6] + motor_compensation(
+            self.joint_damping,
+            self.joint_friction,
+            d.qvel[sim.dof_adr],
+            self.gains.friction_velocity,
         )
 
     @classmethod
@@ -353,7 +397,9 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
             "gains": gains.to_dict(),
             "control_rate_hz": gains.rate,
             "sim_timestep": float(sim.model.opt.timestep),
-            "actuators": "torque motors (MuJoCo), viscous joint damping compensated",
+            "actuators": (
+                "torque motors (MuJoCo), viscous joint damping and dry friction compensated"
+            ),
             "effort_limits": effort_limits,
             "impact_task": {"force_threshold": 15.0, "retract": 0.05},
         }
@@ -389,7 +435,8 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         a, w = x[:nv], x[nv:]
         tau = T @ x + t0
         if self.effort_limits:
-            tau = np.clip(tau, -self.effort, self.effort)
+            compensation = self.compensation(v)
+            tau = np.clip(tau, -self.effort - compensation, self.effort - compensation)
         out = TorqueOutput(
             tau,
             a,
@@ -591,9 +638,11 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         upper[m0:m1] = 2.0 * (self._q_upper - qj - vj * T2) / T2**2
         lower[m0:m1] = np.minimum(2.0 * (self._q_lower - qj - vj * T2) / T2**2, upper[m0:m1])
         if limited.size:
+            # The motors add the compensation to tau (actuate): the effort bounds the sum.
+            bias = t0[limited] + self.compensation(v)[limited]
             C[m1:, :] = T[limited]
-            upper[m1:] = self.effort[limited] - t0[limited]
-            lower[m1:] = -self.effort[limited] - t0[limited]
+            upper[m1:] = self.effort[limited] - bias
+            lower[m1:] = -self.effort[limited] - bias
         return T, t0, _Rows(ms, m0, m1)
 
     def _solve(self, P: _FloatArray, c: _FloatArray, rows: _Rows) -> tuple[_FloatArray, bool]:
