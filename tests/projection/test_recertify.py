@@ -311,7 +311,7 @@ def test_the_optimality_test_from_the_rates_is_the_pricings(n, seed, theta):
     dc = GT @ np.array([-math.sin(theta), math.cos(theta)])
     scale = float(np.linalg.norm(GT))
     ab = np.empty((4, n))
-    K._rates(Binv, GT, ab)
+    K._rates(Binv, GT, scale, ab)
     norms = np.linalg.norm(Binv, axis=0)
     eps = K._EPS_DUAL * scale * np.maximum(1.0, norms)
     lam, dlam = Binv.T @ c, Binv.T @ dc
@@ -320,9 +320,7 @@ def test_the_optimality_test_from_the_rates_is_the_pricings(n, seed, theta):
         np.abs(np.abs(dlam) - eps) > rounding
     )
     if clear:
-        assert K._optimal_at(ab, math.cos(theta), math.sin(theta), scale) == K._optimal(
-            Binv, c, dc, scale
-        )
+        assert K._optimal_at(ab, math.cos(theta), math.sin(theta)) == K._optimal(Binv, c, dc, scale)
 
 
 @settings(max_examples=60, deadline=None)

@@ -286,9 +286,9 @@ def _longest_axis(Q, k, out):
             left -= Q[r, i] * Q[r, i]
         if left > best:
             best, axis = left, i
-    e = np.zeros(n)
-    e[axis] = 1.0
-    return _project_out(Q, k, e, out)
+    out[:] = 0.0
+    out[axis] = 1.0
+    return _project_out(Q, k, out, out)
 
 
 @njit(cache=True)
@@ -601,17 +601,18 @@ def _breakpoint(Binv, GT, theta, cos_t, sin_t, scale, ab):
     ``cos_t, sin_t``: cos and sin of theta; ``ab`` (4, n): work buffer. :func:`_rates`, then
     :func:`_breakpoint_at`.
     """
-    _rates(Binv, GT, ab)
-    return _breakpoint_at(ab, theta, cos_t, sin_t, scale)
+    _rates(Binv, GT, scale, ab)
+    return _breakpoint_at(ab, theta, cos_t, sin_t)
 
 
 @njit(cache=True, inline="always")
-def _rates(Binv, GT, ab):
-    """The multipliers' coefficients of the basis: ``ab[0], ab[1], ab[3]`` (n each).
+def _rates(Binv, GT, scale, ab):
+    """The multipliers' coefficients of the basis and their tolerances: ``ab[0], ab[1], ab[3]``.
 
-    ``lambda_i(theta) = a_i cos(theta) + b_i sin(theta)`` with ``(a_i, b_i) = GT^T Binv[:, i]``,
-    and ``|Binv[:, i]|^2``: the columns' sums row by row of Binv (each sum in its column loop's
-    order). ``ab[2]`` is left for :func:`_breakpoint_at`.
+    ``lambda_i(theta) = a_i cos(theta) + b_i sin(theta)`` with ``(a_i, b_i) = GT^T Binv[:, i]``
+    (the columns' sums row by row of Binv, each in its column loop's order), and the tolerance
+    within which lambda_i counts as zero, ``_EPS_DUAL scale max(1, |Binv[:, i]|)`` (as
+    :func:`_priced`'s). ``ab[2]`` is left for :func:`_breakpoint_at`.
     """
     n = Binv.shape[0]
     ab[0], ab[1], ab[3] = 0.0, 0.0, 0.0
@@ -622,10 +623,12 @@ def _rates(Binv, GT, ab):
             ab[0, i] += g0 * x
             ab[1, i] += g1 * x
             ab[3, i] += x * x
+    for i in range(n):
+        ab[3, i] = _EPS_DUAL * scale * max(1.0, math.sqrt(ab[3, i]))
 
 
 @njit(cache=True, inline="always")
-def _breakpoint_at(ab, theta, cos_t, sin_t, scale):
+def _breakpoint_at(ab, theta, cos_t, sin_t):
     """:func:`_breakpoint` from the basis's :func:`_rates` (``ab[2]``: work).
 
     Each multiplier's step is ``_arc_end``'s (an atan2 and a modulo); a cheap lower bound skips
@@ -637,7 +640,7 @@ def _breakpoint_at(ab, theta, cos_t, sin_t, scale):
     for i in range(n):
         a, b = ab[0, i], ab[1, i]
         rho = math.hypot(a, b)
-        if rho <= _EPS_DUAL * scale * max(1.0, math.sqrt(ab[3, i])):
+        if rho <= ab[3, i]:
             ab[2, i] = math.inf  # identically zero multiplier
             continue
         lam = a * cos_t + b * sin_t  # rho cos(phi)
@@ -659,7 +662,7 @@ def _breakpoint_at(ab, theta, cos_t, sin_t, scale):
 
 
 @njit(cache=True, inline="always")
-def _optimal_at(ab, cos_t, sin_t, scale):
+def _optimal_at(ab, cos_t, sin_t):
     """:func:`_optimal`'s test at theta, from the basis's :func:`_rates`.
 
     The multipliers are ``lambda_i = a_i cos + b_i sin``, their theta-derivatives
@@ -669,7 +672,7 @@ def _optimal_at(ab, cos_t, sin_t, scale):
         a, b = ab[0, i], ab[1, i]
         lam = a * cos_t + b * sin_t
         dlam = b * cos_t - a * sin_t
-        eps = _EPS_DUAL * scale * max(1.0, math.sqrt(ab[3, i]))
+        eps = ab[3, i]
         if lam < -eps or (lam <= eps and dlam < -eps):
             return False
     return True
@@ -874,12 +877,12 @@ def _arc_start(Binv, GT, theta, scale):
     :func:`_arc_start_at` of the basis's :func:`_rates`.
     """
     ab = np.empty((4, Binv.shape[0]))
-    _rates(Binv, GT, ab)
-    return _arc_start_at(ab, theta, scale)
+    _rates(Binv, GT, scale, ab)
+    return _arc_start_at(ab, theta)
 
 
 @njit(cache=True, inline="always")
-def _arc_start_at(ab, theta, scale):
+def _arc_start_at(ab, theta):
     """:func:`_arc_start` from the basis's :func:`_rates`.
 
     Each multiplier ``lambda_i = rho_i cos(t - alpha_i)`` is non-negative on the half-circle
@@ -890,7 +893,7 @@ def _arc_start_at(ab, theta, scale):
     lo, hi = 0.0, math.pi
     for i in range(ab.shape[1]):
         a, b = ab[0, i], ab[1, i]
-        if math.hypot(a, b) <= _EPS_DUAL * scale * max(1.0, math.sqrt(ab[3, i])):
+        if math.hypot(a, b) <= ab[3, i]:
             continue  # identically zero multiplier
         s = (math.atan2(b, a) - 0.5 * math.pi - theta) % (2.0 * math.pi)
         if s <= math.pi:
@@ -932,9 +935,9 @@ def _next_basis(H, h, GT, W, Binv, z, theta, scale, kind, rows, since, work):
             if not _refactor(H, h, W, Binv, z, work):
                 return math.inf, since
             since = 0
-    _rates(Binv, GT, work[6])
+    _rates(Binv, GT, scale, work[6])
     if kind == 1:
-        theta = _arc_start_at(work[6], theta, scale)
+        theta = _arc_start_at(work[6], theta)
     return theta, since
 
 
@@ -977,7 +980,7 @@ def _recertify(H, h, GT, g0, theta0, scale, low, hint, W, Binv, z, work, yrun):
         _refactor(H, h, W, Binv, z, work) and _accurate(H, h, W, Binv, z, work[2])
     ):
         return FAILED, none, 0, theta0, 0
-    _rates(Binv, GT, ab)
+    _rates(Binv, GT, scale, ab)
     end = theta0 + 2.0 * math.pi
     theta, good_theta = theta0, theta0
     u0, u1 = math.cos(theta0), math.sin(theta0)
@@ -987,7 +990,7 @@ def _recertify(H, h, GT, g0, theta0, scale, low, hint, W, Binv, z, work, yrun):
     for k in range(K):
         at = base + k * (n + 1)
         if k > 0:
-            step = _breakpoint_at(ab, theta, u0, u1, scale)
+            step = _breakpoint_at(ab, theta, u0, u1)
             if step >= end:  # the previous basis's arc closes the polygon
                 return OK, vertices, count, good_theta, good
             theta, since = _next_basis(
@@ -997,7 +1000,7 @@ def _recertify(H, h, GT, g0, theta0, scale, low, hint, W, Binv, z, work, yrun):
             if theta >= end:
                 break
             u0, u1 = math.cos(theta), math.sin(theta)
-        if not _optimal_at(ab, u0, u1, scale):
+        if not _optimal_at(ab, u0, u1):
             break
         last, before = count, low[0]
         count, strict = _record(H, h, GT, g0, z, low, ref, vertices, count)
@@ -1007,7 +1010,7 @@ def _recertify(H, h, GT, g0, theta0, scale, low, hint, W, Binv, z, work, yrun):
         good, good_theta = k + 1, theta
         if hint[at] == 0:
             yrun[0], yrun[1] = vertices[count - 1, 0], vertices[count - 1, 1]
-    if good == K and _breakpoint_at(ab, theta, u0, u1, scale) >= end:
+    if good == K and _breakpoint_at(ab, theta, u0, u1) >= end:
         return OK, vertices, count, good_theta, good
     return (_PREFIX if good > 0 else FAILED), vertices, count, good_theta, good
 
