@@ -105,6 +105,10 @@ def _answer(data):
 # A posture where the walk without a hint fails (122 pivots) and the areas fall back to Bretl's
 # projection: the re-certified chain gives Bretl's polygon (to 3e-13).
 @example("palm_push_two_feet", 1552546378, 0.0003891760975884306)
+# A G1 path whose fifth posture's chain certifies its first two bases; the walk that goes on from
+# the second cycles at a degenerate vertex (1e-16 from the walk's own numbers there) and fails,
+# and the walk from the warm start answers.
+@example("g1_two_feet", 13723, 1e-05)
 def test_a_recertified_polygon_is_the_walked_one(governors, name, seed, step):
     governor = governors[name]
     hint = np.full(hint_size(12), -1, dtype=np.int64)

@@ -28,7 +28,8 @@ each time); the larger ones are not, which keeps the kernel's compile time.
 
 A caller that projects postures in a row keeps a hint: the walk starts from its last optimal
 basis, and first checks whether the last walk's chain of bases (the first and last of each
-polygon vertex) still certifies the new polygon, which then needs no walk (:func:`walk`).
+polygon vertex) still certifies the new polygon, which then needs no walk, or goes on from the
+last of the chain's bases that certify (:func:`walk`).
 """
 
 from __future__ import annotations
@@ -351,7 +352,9 @@ def _invert(B, out):
     """Gauss-Jordan inverse with partial pivoting into ``out`` (B is overwritten).
 
     For the small bases here this beats a LAPACK call through numba by its fixed cost.
-    Returns False when B is singular to working precision.
+    Returns False when B is singular to working precision. Only B's columns after the pivot's
+    are updated: the others are never read again (the pivots, their rows' factors and ``out``
+    are the full elimination's numbers).
     """
     n = B.shape[0]
     out[:, :] = 0.0
@@ -369,19 +372,22 @@ def _invert(B, out):
         if abs(B[piv, col]) <= 1e-14 * norm:
             return False
         if piv != col:
-            for j in range(n):
+            for j in range(col, n):
                 B[col, j], B[piv, j] = B[piv, j], B[col, j]
+            for j in range(n):
                 out[col, j], out[piv, j] = out[piv, j], out[col, j]
         inv = 1.0 / B[col, col]
-        for j in range(n):
+        for j in range(col + 1, n):
             B[col, j] *= inv
+        for j in range(n):
             out[col, j] *= inv
         for r in range(n):
             if r != col:
                 f = B[r, col]
                 if f != 0.0:
-                    for j in range(n):
+                    for j in range(col + 1, n):
                         B[r, j] -= f * B[col, j]
+                    for j in range(n):
                         out[r, j] -= f * out[col, j]
     return True
 
@@ -414,7 +420,8 @@ def _refactor(H, h, W, Binv, z, work):
     n = H.shape[1]
     B = work[5]
     for i in range(n):
-        B[i] = H[W[i]]
+        for j in range(n):
+            B[i, j] = H[W[i], j]
     if not _invert(B, Binv):
         return False
     _vertex(h, W, Binv, z)
@@ -1125,20 +1132,10 @@ def _resume(hint, W, active, bases, good, prefix, count, vertices):
 
 
 @njit(cache=True)
-def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
-    """Vertices of ``g0 + G {z : H z <= h}`` (rows of H unit norm; ``GT`` = G^T, n x 2).
+def _walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
+    """:func:`walk`, and whether it went on from a chain's certified bases.
 
-    Returns (status, vertices, count, pivots): ``vertices[:count]`` are the support points
-    in counter-clockwise order, consecutive duplicates removed (the last may equal the first).
-    ``worst[0]`` receives the smallest slack of the recorded vertices (>= -rounding for a
-    sound walk; the caller rejects the walk otherwise).
-
-    ``hint`` (int64), kept by a caller that projects postures in a row: ``(m, n)``, the optimal
-    basis at theta0 (n rows; see :func:`_warm_start`), then, when it has room, the number of
-    bases of the last walk's chain and the chain itself (n rows each). A chain that still
-    certifies this polytope's polygon answers without walking (:func:`_from_chain`, 0
-    pivots); else the walk starts from the basis and writes its own chain. An empty hint is
-    neither read nor written.
+    Returns ``(status, vertices, count, pivots, resumed)``.
     """
     m, n = H.shape
     z = np.zeros(n)
@@ -1154,7 +1151,7 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
             H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work, yfirst
         )
         if status == OK:
-            return OK, prefix, count, 0
+            return OK, prefix, count, 0, False
     active = np.zeros(m, dtype=np.bool_)
     u = np.array([math.cos(theta0), math.sin(theta0)])
     du = np.array([-math.sin(theta0), math.cos(theta0)])
@@ -1169,7 +1166,7 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
     else:
         status, pivots = _start(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work, hint)
         if status != OK:
-            return status, np.empty((0, 2)), 0, pivots
+            return status, np.empty((0, 2)), 0, pivots, False
         _min_slack_near(H, h, z, worst, work[7], work[8])
         _point(g0, GT, z, vertices, 0)
         count = 1
@@ -1190,20 +1187,20 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
         # precision (docs/studies/design-history.md, "Core floors").
         if since >= _CARRY:
             if not _refactor(H, h, W, Binv, z, work):
-                return FAILED, vertices, count, pivots
+                return FAILED, vertices, count, pivots, resumed
             since = 0
         status, piv = _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work)
         pivots += piv
         since += piv
         if status != OK or count > max_pivots:
-            return FAILED, vertices, count, pivots
+            return FAILED, vertices, count, pivots, resumed
         # The vertex from a fresh inverse when the pivots' rank-one updates left the inverse
         # off: through a small pivot element (a basis at condition 4e6 on G1) the inverse was
         # 1e-5 off and its vertex violated a row by 2e-6, which made the walk refuse and fall
         # back to Bretl (5 ms) on 5 % of G1's postures; the basis's own vertex is within 1e-11.
         if piv and not _accurate(H, h, W, Binv, z, work[2]):
             if not _refactor(H, h, W, Binv, z, work):
-                return FAILED, vertices, count, pivots
+                return FAILED, vertices, count, pivots, resumed
             since = 0
         # piv == 0: the crossing multiplier was within the tolerance of zero; the next
         # breakpoint search starts past it. A vertex reached by zero steps (a new basis of it)
@@ -1224,7 +1221,35 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
     # when the walk went on from one.
     if recorded < pivots or resumed:
         _store_chain(hint, bases, recorded)
-    return OK, vertices, count, pivots
+    return OK, vertices, count, pivots, resumed
+
+
+@njit(cache=True)
+def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
+    """Vertices of ``g0 + G {z : H z <= h}`` (rows of H unit norm; ``GT`` = G^T, n x 2).
+
+    Returns (status, vertices, count, pivots): ``vertices[:count]`` are the support points
+    in counter-clockwise order, consecutive duplicates removed (the last may equal the first).
+    ``worst[0]`` receives the smallest slack of the recorded vertices (>= -rounding for a
+    sound walk; the caller rejects the walk otherwise).
+
+    ``hint`` (int64), kept by a caller that projects postures in a row: ``(m, n)``, the optimal
+    basis at theta0 (n rows; see :func:`_warm_start`), then, when it has room, the number of
+    bases of the last walk's chain and the chain itself (n rows each). A chain that still
+    certifies this polytope's polygon answers without walking (:func:`_from_chain`, 0
+    pivots); one whose first bases certify it only in part, from the first on, has the walk
+    go on from the last of those (its pivots the ones after it); else the walk starts from
+    the basis, as it does when going on from a chain's bases fails (a cycle of zero steps that
+    the walk from the start may not meet). Either walk writes its own chain. An empty hint is
+    neither read nor written.
+    """
+    start = worst[0]
+    status, vertices, count, pivots, resumed = _walk(H, h, GT, g0, theta0, max_pivots, worst, hint)
+    if status == FAILED and resumed:  # the chain is dropped: from the warm start
+        worst[0] = start
+        status, vertices, count, more, _ = _walk(H, h, GT, g0, theta0, max_pivots, worst, hint)
+        pivots += more
+    return status, vertices, count, pivots
 
 
 @njit(cache=True)
