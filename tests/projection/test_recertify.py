@@ -302,8 +302,9 @@ def test_a_chain_whose_tail_is_garbage_gives_the_walked_polygon(governors, name,
 )
 def test_the_optimality_test_from_the_rates_is_the_pricings(n, seed, theta):
     """:func:`_optimal_at` (the re-certification's test, from the multipliers' coefficients)
-    answers as :func:`_optimal` (the walk's, from ``c``, ``dc``) wherever no multiplier is
-    within rounding of the tolerance: random bases, multipliers at zero and at the tolerance."""
+    answers as the walk's pricing (:func:`_priced` of every column, from ``c``, ``dc``: where
+    :func:`_optimize` stops) wherever no multiplier is within rounding of the tolerance: random
+    bases, multipliers at zero and at the tolerance."""
     rng = np.random.default_rng(seed)
     Binv, GT = rng.normal(size=(n, n)), rng.normal(size=(n, 2))
     if rng.random() < 0.5:  # a multiplier at zero at theta (a breakpoint), or at its tolerance
@@ -324,7 +325,8 @@ def test_the_optimality_test_from_the_rates_is_the_pricings(n, seed, theta):
         np.abs(np.abs(dlam) - eps) > rounding
     )
     if clear:
-        assert K._optimal_at(ab, math.cos(theta), math.sin(theta)) == K._optimal(Binv, c, dc, scale)
+        priced = all(K._priced(Binv, i, c, dc, scale)[0] == 2 for i in range(n))
+        assert K._optimal_at(ab, math.cos(theta), math.sin(theta)) == priced
 
 
 @settings(max_examples=60, deadline=None)

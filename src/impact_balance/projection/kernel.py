@@ -524,18 +524,6 @@ def _priced(Binv, i, c, dc, scale):
     return 2, 0.0
 
 
-@njit(cache=True, inline="always")
-def _optimal(Binv, c, dc, scale):
-    """Whether the basis is lexicographically optimal at theta+: no entering candidate.
-
-    Where :func:`_optimize` stops, by the same test.
-    """
-    for i in range(Binv.shape[0]):
-        if _priced(Binv, i, c, dc, scale)[0] != 2:
-            return False
-    return True
-
-
 @njit(cache=True)
 def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work):
     """Simplex pivots from the vertex basis (W, Binv, z) until it is lexicographically optimal.
@@ -670,10 +658,11 @@ def _breakpoint_at(ab, theta, cos_t, sin_t):
 
 @njit(cache=True, inline="always")
 def _optimal_at(ab, cos_t, sin_t):
-    """:func:`_optimal`'s test at theta, from the basis's :func:`_rates`.
+    """Whether the basis is lexicographically optimal at theta+, from its :func:`_rates`.
 
-    The multipliers are ``lambda_i = a_i cos + b_i sin``, their theta-derivatives
-    ``-a_i sin + b_i cos`` (the same numbers as ``Binv[:, i] . c`` to rounding).
+    Where :func:`_optimize` stops: no column is an entering candidate by :func:`_priced`'s test,
+    with the multipliers ``lambda_i = a_i cos + b_i sin`` and their theta-derivatives
+    ``-a_i sin + b_i cos`` (``Binv[:, i] . c`` and ``. dc`` to rounding).
     """
     for i in range(ab.shape[1]):
         a, b = ab[0, i], ab[1, i]
