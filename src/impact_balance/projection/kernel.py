@@ -1353,11 +1353,25 @@ def equality_basis(C, d):
     for k in range(r):
         for j in range(n):
             x0[j] += y[k] * Q[k, j]
-    # Complete Q with the coordinate axes that keep most of their length.
+    # Complete Q with the coordinate axes that keep most of their length (_longest_axis's
+    # choice, its |P e_i|^2 = 1 - sum_r Q[r, i]^2 carried from one row to the next: the same
+    # subtractions in the same order).
+    left = np.ones(n)
+    for k in range(r):
+        for i in range(n):
+            left[i] -= Q[k, i] * Q[k, i]
     for count in range(r, n):
-        norm = _longest_axis(Q, count, v)
+        best, axis = -1.0, 0
+        for i in range(n):
+            if left[i] > best:
+                best, axis = left[i], i
+        v[:] = 0.0
+        v[axis] = 1.0
+        norm = _project_out(Q, count, v, v)
         for j in range(n):
             Q[count, j] = v[j] / norm
+        for i in range(n):
+            left[i] -= Q[count, i] * Q[count, i]
     return OK, x0, Q[r:].T.copy()
 
 
