@@ -105,6 +105,10 @@ def _answer(data):
 # A posture where the walk without a hint fails (122 pivots) and the areas fall back to Bretl's
 # projection: the re-certified chain gives Bretl's polygon (to 3e-13).
 @example("palm_push_two_feet", 1552546378, 0.0003891760975884306)
+# A G1 path whose fifth posture's chain certifies its first two bases; the walk that goes on from
+# the second cycles at a degenerate vertex (1e-16 from the walk's own numbers there) and fails,
+# and the walk from the warm start answers.
+@example("g1_two_feet", 13723, 1e-05)
 def test_a_recertified_polygon_is_the_walked_one(governors, name, seed, step):
     governor = governors[name]
     hint = np.full(hint_size(12), -1, dtype=np.int64)
@@ -192,6 +196,137 @@ def test_a_polygon_that_changes_combinatorially_is_walked(cut, recertified, corn
     assert (
         kept == {tuple(map(float, c)) for c in corners} == {tuple(np.round(v, 12)) for v in cold[1]}
     )
+
+
+def _square_cuts(cuts):
+    """The square |z_i| <= 1 and the rows ``row . z <= cut`` (unit rows), projected by G = I."""
+    H = np.vstack([np.eye(2), -np.eye(2), [row for row, _ in cuts]])
+    h = np.concatenate([np.ones(4), [cut for _, cut in cuts]])
+    norms = np.linalg.norm(H, axis=1)
+    return np.ascontiguousarray(H / norms[:, None]), h / norms
+
+
+#: The square's chain as a walk from theta = 0 keeps it: the corners (1, 1), (-1, 1), (-1, -1),
+#: (1, -1), ``[kind, rows]`` each.
+SQUARE_CHAIN = [[0, 0, 1], [0, 2, 1], [0, 2, 3], [0, 0, 3]]
+
+
+def _square_hint(chain, m=5):
+    """A hint of the square's walk: ``(m, n)``, the start, the chain's length and the chain."""
+    return np.array([m, 2, *chain[0][1:], len(chain), *np.ravel(chain), *[-1] * 30], dtype=np.int64)
+
+
+def test_a_chain_that_fails_midway_goes_on_from_its_last_certified_basis():
+    """A cut through the third corner: the chain's first two bases still certify, the walk goes
+    on from the second (fewer pivots than a walk from the start) and writes a chain that begins
+    with them; the polygon is the walk's without a hint."""
+    H, h = _square_cuts([([-1.0, -1.0], 1.5)])
+    hint = _square_hint(SQUARE_CHAIN)
+    status, vertices, pivots = _kernel_walk(H, h, hint)
+    cold = _kernel_walk(H, h, NO_HINT)
+    assert status == cold[0] == K.OK
+    assert 0 < pivots < cold[2]
+    np.testing.assert_allclose(vertices, cold[1], rtol=0, atol=1e-12)
+    corners = {tuple(np.round(v, 12)) for v in vertices}
+    assert corners == {(1, 1), (-1, 1), (-1, -0.5), (-0.5, -1), (1, -1)}
+    assert hint[4] == 5 and hint[5:11].tolist() == np.ravel(SQUARE_CHAIN[:2]).tolist()
+    # The new chain certifies the cut square: the next call does not walk.
+    assert _kernel_walk(H, h, hint)[2] == 0
+
+
+def test_a_chain_that_closes_early_is_shortened():
+    """A chain with a basis more than its polygon needs: the arcs of the first four reach the
+    start angle plus 2 pi, which certifies the square; the chain keeps those four."""
+    H, h = _square_cuts([([-1.0, -1.0], 3.0)])
+    hint = _square_hint([*SQUARE_CHAIN, [0, 0, 1]])
+    status, vertices, pivots = _kernel_walk(H, h, hint)
+    assert status == K.OK and pivots == 0 and hint[4] == 4
+    np.testing.assert_allclose(vertices, _kernel_walk(H, h, NO_HINT)[1], rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("name", ["palm_push_two_feet", "palm_push_ramp", "g1_two_feet"])
+def test_a_chain_whose_last_basis_fails_costs_less_than_a_walk(governors, name):
+    """The last basis of a stance's chain made singular (its first row twice), at a posture
+    the chain certifies: the walk goes on from the basis before it, with fewer pivots than a
+    walk from the warm start alone, and finds the polygon of a walk without a hint."""
+    governor = governors[name]
+    hint = np.full(hint_size(12), -1, dtype=np.int64)
+    for q in _path(governor, 3, 1e-3, 5):  # a governor's first ticks
+        data = _polytope(governor, q)
+        _walk(data, hint)
+    assert _walk(data, hint.copy())[2] == 0  # the chain certifies the last posture's polygon
+    n = 8  # 12 wrench variables less the 4 equalities
+    length = int(hint[n + 2])
+    assert length > 2
+    start_only = hint.copy()
+    start_only[n + 2] = 0  # the warm start, no chain
+    last = n + 3 + (length - 1) * (n + 1)
+    hint[last + 2 : last + 1 + n] = hint[last + 1]
+    resumed, warm = _walk(data, hint), _walk(data, start_only)
+    _same_polygon(resumed, _answer(data))
+    _same_polygon(warm, _answer(data))
+    assert 0 < resumed[2] < warm[2]
+
+
+@settings(max_examples=20, deadline=None)
+@given(
+    st.sampled_from(("palm_push_two_feet", "palm_push_ramp", "g1_two_feet")),
+    st.integers(min_value=0, max_value=2**32 - 1),
+    st.floats(min_value=1e-5, max_value=3e-3),
+)
+def test_a_chain_whose_tail_is_garbage_gives_the_walked_polygon(governors, name, seed, step):
+    """A stance's chain with its bases from a random one on replaced by random rows and kinds:
+    whatever certifies, the walk goes on from there and finds the polygon of a walk without a
+    hint (or Bretl's, where that walk cannot answer)."""
+    governor = governors[name]
+    first, second = _path(governor, 2, step, seed)
+    hint = np.full(hint_size(12), -1, dtype=np.int64)
+    _walk(_polytope(governor, first), hint)
+    data = _polytope(governor, second)
+    n, m = 8, data[0].shape[0] + 4  # the walk's variables and rows (the box's four with them)
+    length = int(hint[n + 2])
+    rng = np.random.default_rng(seed)
+    if length > 1:
+        cut = int(rng.integers(1, length))
+        at = n + 3 + cut * (n + 1)
+        hint[at : n + 3 + length * (n + 1)] = rng.integers(0, m, size=(length - cut) * (n + 1))
+        hint[at : n + 3 + length * (n + 1) : n + 1] = rng.integers(0, 2, size=length - cut)
+    _same_polygon(_walk(data, hint), _answer(data))
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.integers(min_value=1, max_value=9),
+    st.integers(min_value=0, max_value=2**32 - 1),
+    st.floats(min_value=0.0, max_value=2.0 * math.pi),
+)
+def test_the_optimality_test_from_the_rates_is_the_pricings(n, seed, theta):
+    """:func:`_optimal_at` (the re-certification's test, from the multipliers' coefficients)
+    answers as the walk's pricing (:func:`_priced` of every column, from ``c``, ``dc``: where
+    :func:`_optimize` stops) wherever no multiplier is within rounding of the tolerance: random
+    bases, multipliers at zero and at the tolerance."""
+    rng = np.random.default_rng(seed)
+    Binv, GT = rng.normal(size=(n, n)), rng.normal(size=(n, 2))
+    if rng.random() < 0.5:  # a multiplier at zero at theta (a breakpoint), or at its tolerance
+        i = int(rng.integers(n))
+        u = np.array([math.cos(theta), math.sin(theta)])
+        target = rng.choice([0.0, 1e-11, -1e-11]) * np.linalg.norm(Binv[:, i])
+        Binv[:, i] += (target - (GT @ u) @ Binv[:, i]) * (GT @ u) / float((GT @ u) @ (GT @ u))
+    c = GT @ np.array([math.cos(theta), math.sin(theta)])
+    dc = GT @ np.array([-math.sin(theta), math.cos(theta)])
+    scale = float(np.linalg.norm(GT))
+    ab = np.empty((4, n))
+    K._rates(Binv, GT, scale, ab)
+    norms = np.linalg.norm(Binv, axis=0)
+    eps = K._EPS_DUAL * scale * np.maximum(1.0, norms)
+    lam, dlam = Binv.T @ c, Binv.T @ dc
+    rounding = 1e-13 * (1.0 + np.abs(Binv).sum(axis=0) * np.abs(GT).sum())
+    clear = np.all(np.abs(np.abs(lam) - eps) > rounding) and np.all(
+        np.abs(np.abs(dlam) - eps) > rounding
+    )
+    if clear:
+        priced = all(K._priced(Binv, i, c, dc, scale)[0] == 2 for i in range(n))
+        assert K._optimal_at(ab, math.cos(theta), math.sin(theta)) == priced
 
 
 @settings(max_examples=60, deadline=None)

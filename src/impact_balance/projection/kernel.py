@@ -28,7 +28,8 @@ each time); the larger ones are not, which keeps the kernel's compile time.
 
 A caller that projects postures in a row keeps a hint: the walk starts from its last optimal
 basis, and first checks whether the last walk's chain of bases (the first and last of each
-polygon vertex) still certifies the new polygon, which then needs no walk (:func:`walk`).
+polygon vertex) still certifies the new polygon, which then needs no walk, or goes on from the
+last of the chain's bases that certify (:func:`walk`).
 """
 
 from __future__ import annotations
@@ -286,9 +287,9 @@ def _longest_axis(Q, k, out):
             left -= Q[r, i] * Q[r, i]
         if left > best:
             best, axis = left, i
-    e = np.zeros(n)
-    e[axis] = 1.0
-    return _project_out(Q, k, e, out)
+    out[:] = 0.0
+    out[axis] = 1.0
+    return _project_out(Q, k, out, out)
 
 
 @njit(cache=True)
@@ -351,7 +352,9 @@ def _invert(B, out):
     """Gauss-Jordan inverse with partial pivoting into ``out`` (B is overwritten).
 
     For the small bases here this beats a LAPACK call through numba by its fixed cost.
-    Returns False when B is singular to working precision.
+    Returns False when B is singular to working precision. Only B's columns after the pivot's
+    are updated: the others are never read again (the pivots, their rows' factors and ``out``
+    are the full elimination's numbers).
     """
     n = B.shape[0]
     out[:, :] = 0.0
@@ -369,19 +372,22 @@ def _invert(B, out):
         if abs(B[piv, col]) <= 1e-14 * norm:
             return False
         if piv != col:
-            for j in range(n):
+            for j in range(col, n):
                 B[col, j], B[piv, j] = B[piv, j], B[col, j]
+            for j in range(n):
                 out[col, j], out[piv, j] = out[piv, j], out[col, j]
         inv = 1.0 / B[col, col]
-        for j in range(n):
+        for j in range(col + 1, n):
             B[col, j] *= inv
+        for j in range(n):
             out[col, j] *= inv
         for r in range(n):
             if r != col:
                 f = B[r, col]
                 if f != 0.0:
-                    for j in range(n):
+                    for j in range(col + 1, n):
                         B[r, j] -= f * B[col, j]
+                    for j in range(n):
                         out[r, j] -= f * out[col, j]
     return True
 
@@ -414,7 +420,8 @@ def _refactor(H, h, W, Binv, z, work):
     n = H.shape[1]
     B = work[5]
     for i in range(n):
-        B[i] = H[W[i]]
+        for j in range(n):
+            B[i, j] = H[W[i], j]
     if not _invert(B, Binv):
         return False
     _vertex(h, W, Binv, z)
@@ -427,10 +434,18 @@ def _pivot(H, h, W, Binv, z, leave, j, since, work):
 
     Returns the pivots since the last refactorisation.
     """
-    n = H.shape[1]
     W[leave] = j
     if since + 1 >= _REFACTOR and _refactor(H, h, W, Binv, z, work):
         return 0
+    _update(H, Binv, leave, j, work)
+    _vertex(h, W, Binv, z)
+    return since + 1
+
+
+@njit(cache=True, inline="always")
+def _update(H, Binv, leave, j, work):
+    """The rank-one update of Binv for row ``j`` entering in position ``leave`` (z untouched)."""
+    n = H.shape[1]
     # Rank-one update: column i of the new inverse is Binv[:, i] - col (a . Binv[:, i]) / piv
     # for i != leave, and col / piv for i == leave, with col = Binv[:, leave], a = H[j].
     col, alpha = work[1], work[2]
@@ -446,8 +461,6 @@ def _pivot(H, h, W, Binv, z, leave, j, since, work):
         for i in range(n):
             Binv[r, i] -= col[r] * alpha[i]
         Binv[r, leave] = col[r] / piv
-    _vertex(h, W, Binv, z)
-    return since + 1
 
 
 @njit(cache=True, inline="always")
@@ -509,18 +522,6 @@ def _priced(Binv, i, c, dc, scale):
     if lam <= eps and dlam < -eps:
         return 1, dlam / norm
     return 2, 0.0
-
-
-@njit(cache=True, inline="always")
-def _optimal(Binv, c, dc, scale):
-    """Whether the basis is lexicographically optimal at theta+: no entering candidate.
-
-    Where :func:`_optimize` stops, by the same test.
-    """
-    for i in range(Binv.shape[0]):
-        if _priced(Binv, i, c, dc, scale)[0] != 2:
-            return False
-    return True
 
 
 @njit(cache=True)
@@ -592,14 +593,23 @@ def _arc_end(a, b, theta):
 def _breakpoint(Binv, GT, theta, cos_t, sin_t, scale, ab):
     """Smallest angle > theta at which a multiplier of the basis turns negative (inf if none).
 
-    ``cos_t, sin_t``: cos and sin of theta; ``ab`` (4, n): work buffer. Each multiplier's
-    step is ``_arc_end``'s (an atan2 and a modulo); a cheap lower bound skips those that
-    cannot be the smallest by more than 1e-9 rad, so the answer is the same number.
+    ``cos_t, sin_t``: cos and sin of theta; ``ab`` (4, n): work buffer. :func:`_rates`, then
+    :func:`_breakpoint_at`.
+    """
+    _rates(Binv, GT, scale, ab)
+    return _breakpoint_at(ab, theta, cos_t, sin_t)
+
+
+@njit(cache=True, inline="always")
+def _rates(Binv, GT, scale, ab):
+    """The multipliers' coefficients of the basis and their tolerances: ``ab[0], ab[1], ab[3]``.
+
+    ``lambda_i(theta) = a_i cos(theta) + b_i sin(theta)`` with ``(a_i, b_i) = GT^T Binv[:, i]``
+    (the columns' sums row by row of Binv, each in its column loop's order), and the tolerance
+    within which lambda_i counts as zero, ``_EPS_DUAL scale max(1, |Binv[:, i]|)`` (as
+    :func:`_priced`'s). ``ab[2]`` is left for :func:`_breakpoint_at`.
     """
     n = Binv.shape[0]
-    first = -1
-    # lambda_i(theta) = a cos(theta) + b sin(theta) = rho cos(phi), phi = theta - alpha_i: the
-    # columns' (a, b, |Binv[:, i]|^2) row by row of Binv (each sum in its column loop's order)
     ab[0], ab[1], ab[3] = 0.0, 0.0, 0.0
     for k in range(n):
         g0, g1 = GT[k, 0], GT[k, 1]
@@ -609,9 +619,23 @@ def _breakpoint(Binv, GT, theta, cos_t, sin_t, scale, ab):
             ab[1, i] += g1 * x
             ab[3, i] += x * x
     for i in range(n):
+        ab[3, i] = _EPS_DUAL * scale * max(1.0, math.sqrt(ab[3, i]))
+
+
+@njit(cache=True, inline="always")
+def _breakpoint_at(ab, theta, cos_t, sin_t):
+    """:func:`_breakpoint` from the basis's :func:`_rates` (``ab[2]``: work).
+
+    Each multiplier's step is ``_arc_end``'s (an atan2 and a modulo); a cheap lower bound skips
+    those that cannot be the smallest by more than 1e-9 rad, so the answer is the same number.
+    """
+    n = ab.shape[1]
+    first = -1
+    # lambda_i(theta) = a cos(theta) + b sin(theta) = rho cos(phi), phi = theta - alpha_i
+    for i in range(n):
         a, b = ab[0, i], ab[1, i]
         rho = math.hypot(a, b)
-        if rho <= _EPS_DUAL * scale * max(1.0, math.sqrt(ab[3, i])):
+        if rho <= ab[3, i]:
             ab[2, i] = math.inf  # identically zero multiplier
             continue
         lam = a * cos_t + b * sin_t  # rho cos(phi)
@@ -630,6 +654,24 @@ def _breakpoint(Binv, GT, theta, cos_t, sin_t, scale, ab):
         if i != first and ab[2, i] <= step + 1e-9:
             step = min(step, _arc_end(ab[0, i], ab[1, i], theta))
     return theta + step
+
+
+@njit(cache=True, inline="always")
+def _optimal_at(ab, cos_t, sin_t):
+    """Whether the basis is lexicographically optimal at theta+, from its :func:`_rates`.
+
+    Where :func:`_optimize` stops: no column is an entering candidate by :func:`_priced`'s test,
+    with the multipliers ``lambda_i = a_i cos + b_i sin`` and their theta-derivatives
+    ``-a_i sin + b_i cos`` (``Binv[:, i] . c`` and ``. dc`` to rounding).
+    """
+    for i in range(ab.shape[1]):
+        a, b = ab[0, i], ab[1, i]
+        lam = a * cos_t + b * sin_t
+        dlam = b * cos_t - a * sin_t
+        eps = ab[3, i]
+        if lam < -eps or (lam <= eps and dlam < -eps):
+            return False
+    return True
 
 
 @njit(cache=True)
@@ -793,13 +835,13 @@ def _keep(bases, recorded, W, y, yfirst):
 
 @njit(cache=True)
 def _replace(H, h, W, Binv, z, target, work):
-    """The basis W turned into ``target`` (n rows): the rank-one pivots made, or -1.
+    """The basis W turned into ``target`` (n rows): the rank-one updates made, or -1.
 
-    Position by position (:func:`_pivot`), each through a pivot element ``H_j . Binv[:, i]``
-    the walk's ratio test would accept (above 1e-9 |Binv[:, i]|); when one is not (a
-    singular basis on the way), a fresh inverse of ``target`` instead, checked as
-    :func:`_warm_start` checks its own: -2. -1 when a row is out of range or ``target``'s
-    inverse fails.
+    Position by position (:func:`_update`, the vertex once after the last), each through a
+    pivot element ``H_j . Binv[:, i]`` the walk's ratio test would accept (above 1e-9
+    |Binv[:, i]|); when one is not (a singular basis on the way), a fresh inverse of ``target``
+    instead, checked as :func:`_warm_start` checks its own: -2. -1 when a row is out of range
+    or ``target``'s inverse fails.
     """
     m, n = H.shape
     made = 0
@@ -816,8 +858,11 @@ def _replace(H, h, W, Binv, z, target, work):
             W[:] = target
             fresh = _refactor(H, h, W, Binv, z, work) and _accurate(H, h, W, Binv, z, work[2])
             return -2 if fresh else -1
-        _pivot(H, h, W, Binv, z, i, j, 0, work)
+        W[i] = j
+        _update(H, Binv, i, j, work)
         made += 1
+    if made:
+        _vertex(h, W, Binv, z)
     return made
 
 
@@ -825,20 +870,26 @@ def _replace(H, h, W, Binv, z, target, work):
 def _arc_start(Binv, GT, theta, scale):
     """Where the basis's optimal arc starts in [theta, theta + pi): inf if it has none there.
 
+    :func:`_arc_start_at` of the basis's :func:`_rates`.
+    """
+    ab = np.empty((4, Binv.shape[0]))
+    _rates(Binv, GT, scale, ab)
+    return _arc_start_at(ab, theta)
+
+
+@njit(cache=True, inline="always")
+def _arc_start_at(ab, theta):
+    """:func:`_arc_start` from the basis's :func:`_rates`.
+
     Each multiplier ``lambda_i = rho_i cos(t - alpha_i)`` is non-negative on the half-circle
     that starts at ``alpha_i - pi/2``: within [theta, theta + pi], one that starts at
     ``theta + s_i`` with s_i <= pi bounds the arc from below, one that starts later (s_i > pi)
     ends at ``theta + s_i - pi``.
     """
-    n = Binv.shape[0]
     lo, hi = 0.0, math.pi
-    for i in range(n):
-        a = 0.0
-        b = 0.0
-        for k in range(n):
-            a += GT[k, 0] * Binv[k, i]
-            b += GT[k, 1] * Binv[k, i]
-        if math.hypot(a, b) <= _EPS_DUAL * scale * max(1.0, _column_norm(Binv, i)):
+    for i in range(ab.shape[1]):
+        a, b = ab[0, i], ab[1, i]
+        if math.hypot(a, b) <= ab[3, i]:
             continue  # identically zero multiplier
         s = (math.atan2(b, a) - 0.5 * math.pi - theta) % (2.0 * math.pi)
         if s <= math.pi:
@@ -849,18 +900,18 @@ def _arc_start(Binv, GT, theta, scale):
 
 
 @njit(cache=True)
-def _next_basis(H, h, GT, W, Binv, z, theta, u0, u1, scale, kind, rows, since, work, c, dc):
+def _next_basis(H, h, GT, W, Binv, z, theta, scale, kind, rows, since, work):
     """The chain's next basis (``rows``) and the angle it is optimal at: ``(theta, since)``.
 
-    Kind 0: at the previous basis's breakpoint. Kind 1 (the same polygon vertex as the
-    previous basis, checked by the caller): at the start of its own optimal arc, after the
-    previous one's end and within pi of it; every direction between is a positive combination
-    of the directions the vertex is optimal for at those two angles, so it is optimal in
-    between too (its normal cone is convex). ``since``: pivots since the last fresh inverse
-    (after _CARRY, the new basis's inverse is a fresh one; so it is when the updated one fails
-    its check). Returns theta = inf when the chain does not certify (c, dc then unset).
+    ``theta``: the previous basis's breakpoint. Kind 0: optimal there. Kind 1 (the same
+    polygon vertex as the previous basis, checked by the caller): at the start of its own
+    optimal arc, after the previous one's end and within pi of it; every direction between is
+    a positive combination of the directions the vertex is optimal for at those two angles, so
+    it is optimal in between too (its normal cone is convex). ``since``: pivots since the last
+    fresh inverse (after _CARRY, the new basis's inverse is a fresh one; so it is when the
+    updated one fails its check). The new basis's :func:`_rates` go to ``work[6]``. Returns
+    theta = inf when the chain does not certify.
     """
-    theta = _breakpoint(Binv, GT, theta, u0, u1, scale, work[6])
     if since >= _CARRY:
         for i in range(W.shape[0]):
             if rows[i] < 0 or rows[i] >= H.shape[0]:
@@ -880,67 +931,84 @@ def _next_basis(H, h, GT, W, Binv, z, theta, u0, u1, scale, kind, rows, since, w
             if not _refactor(H, h, W, Binv, z, work):
                 return math.inf, since
             since = 0
+    _rates(Binv, GT, scale, work[6])
     if kind == 1:
-        theta = _arc_start(Binv, GT, theta, scale)
-    if theta < math.inf:
-        _directions(GT, theta, c, dc)
+        theta = _arc_start_at(work[6], theta)
     return theta, since
 
 
+#: :func:`_recertify`'s status when only the chain's first bases certify: the walk goes on
+#: from the last of them (:func:`walk`).
+_PREFIX = 5
+
+
 @njit(cache=True)
-def _recertify(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work):
-    """The walk's vertices from the last walk's chain of bases (``hint``), if they certify it.
+def _recertify(H, h, GT, g0, theta0, scale, low, hint, W, Binv, z, work, yrun):
+    """The walk's vertices from the last walk's chain of bases (``hint``), as far as they certify.
 
     The walk's certificate, without its ratio tests and pricing rounds: each basis of the chain
     is a vertex basis (its inverse solves its system to 1e-14, fresh at least every _CARRY
     pivots), its vertex satisfies every row to _EPS_RECERT max(1, |h_j|), it is lexicographically
-    optimal at its angle (:func:`_next_basis`; the first at theta0), and the last one's arc
-    reaches theta0 + 2 pi while no earlier angle does. Every direction then has an optimal
-    vertex among the recorded ones: the polygon the walk would find. Returns
-    ``(ok, vertices, count)``; on ok, ``worst[0]`` as the walk sets it.
+    optimal at its angle (:func:`_next_basis`; the first at theta0), and the last certified
+    one's arc reaches theta0 + 2 pi. Every direction then has an optimal vertex among the
+    recorded ones: the polygon the walk would find.
+
+    Returns ``(status, vertices, count, theta, good)``: OK (the polygon: ``vertices[:count]``
+    of the first ``good`` bases), _PREFIX (only the first ``good`` bases certify, the last one
+    optimal at ``theta``: where the walk goes on) or FAILED. ``low[0]``: the worst slack of the
+    certified vertices, as the walk sets its own; ``yrun``: the point of the last certified
+    basis of kind 0 (the first of its polygon vertex).
     """
     m, n = H.shape
     K = hint[n + 2]
     none = np.empty((0, 2))
     if K > _chain_capacity(hint, n):
-        return False, none, 0
+        return FAILED, none, 0, theta0, 0
     vertices = np.empty((K, 2))
-    low = np.zeros(1)  # the walk's worst slack, kept apart until the chain is certified
     ref = np.zeros(1 + m + n)  # the slacks at a reference vertex (see _record)
-    c, dc = np.empty(n), np.empty(n)
+    ab = work[6]
     base = n + 3
     for i in range(n):
         W[i] = hint[base + 1 + i]
         if W[i] < 0 or W[i] >= m:
-            return False, none, 0
+            return FAILED, none, 0, theta0, 0
     if hint[base] != 0 or not (
         _refactor(H, h, W, Binv, z, work) and _accurate(H, h, W, Binv, z, work[2])
     ):
-        return False, none, 0
-    theta = theta0
-    u0, u1 = _directions(GT, theta0, c, dc)
+        return FAILED, none, 0, theta0, 0
+    _rates(Binv, GT, scale, ab)
+    end = theta0 + 2.0 * math.pi
+    theta, good_theta = theta0, theta0
+    u0, u1 = math.cos(theta0), math.sin(theta0)
     since = 0
     count = 0
+    good = 0
     for k in range(K):
+        at = base + k * (n + 1)
         if k > 0:
-            at = base + k * (n + 1)
+            step = _breakpoint_at(ab, theta, u0, u1)
+            if step >= end:  # the previous basis's arc closes the polygon
+                return OK, vertices, count, good_theta, good
             theta, since = _next_basis(
-                H, h, GT, W, Binv, z, theta, u0, u1, scale, hint[at], hint[at + 1 : at + 1 + n],
-                since, work, c, dc,
+                H, h, GT, W, Binv, z, step, scale, hint[at], hint[at + 1 : at + 1 + n], since,
+                work,
             )  # fmt: skip
-            if theta >= theta0 + 2.0 * math.pi:
-                return False, none, 0
+            if theta >= end:
+                break
             u0, u1 = math.cos(theta), math.sin(theta)
-        if not _optimal(Binv, c, dc, scale):
-            return False, none, 0
-        last = count
+        if not _optimal_at(ab, u0, u1):
+            break
+        last, before = count, low[0]
         count, strict = _record(H, h, GT, g0, z, low, ref, vertices, count)
-        if not strict or (k > 0 and hint[base + k * (n + 1)] == 1 and _moved(vertices, last)):
-            return False, none, 0
-    if _breakpoint(Binv, GT, theta, u0, u1, scale, work[6]) < theta0 + 2.0 * math.pi:
-        return False, none, 0
-    worst[0] = min(worst[0], low[0])
-    return True, vertices, count
+        if not strict or (k > 0 and hint[at] == 1 and _moved(vertices, last)):
+            count, low[0] = last, before
+            break
+        good, good_theta = k + 1, theta
+        if hint[at] == 0:
+            yrun[0], yrun[1] = vertices[count - 1, 0], vertices[count - 1, 1]
+    if good == K and _breakpoint_at(ab, theta, u0, u1) >= end:
+        return OK, vertices, count, good_theta, good
+    return (_PREFIX if good > 0 else FAILED), vertices, count, good_theta, good
 
 
 @njit(cache=True, inline="always")
@@ -959,21 +1027,36 @@ def _chain_capacity(hint, n):
 
 
 @njit(cache=True)
-def _from_chain(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work):
-    """:func:`_recertify` when ``hint`` holds a chain for this (m, n): ``(ok, vertices, count)``.
+def _from_chain(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work, yrun):
+    """:func:`_recertify` when ``hint`` holds a chain for this (m, n).
 
-    Otherwise, or when the chain does not certify, the walk's state back at its start (z = 0,
-    nothing listed near a vertex) and the chain dropped from ``hint``.
+    Returns ``(status, vertices, count, theta, good)``: OK (the polygon, its chain shortened
+    to the ``good`` bases that certify it), _PREFIX (the basis to go on from in W, Binv and z,
+    a fresh inverse, checked, optimal at ``theta``; the chain's first ``good`` bases still in
+    ``hint``) or FAILED (the walk's state back at its start: z = 0, nothing listed near a
+    vertex, the chain dropped from ``hint``). ``worst[0]`` takes the certified vertices' worst
+    slack unless FAILED.
     """
     m, n = H.shape
+    work[8][0] = -1  # nothing listed near a vertex
     if hint[0] == m and hint[1] == n and hint[n + 2] > 0:
-        ok, vertices, count = _recertify(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work)
-        if ok:
-            return ok, vertices, count
+        low = np.zeros(1)  # the walk's worst slack, kept apart until the chain is certified
+        status, vertices, count, theta, good = _recertify(
+            H, h, GT, g0, theta0, scale, low, hint, W, Binv, z, work, yrun
+        )
+        if status == _PREFIX:  # the last certified basis again, a fresh inverse
+            at = n + 3 + (good - 1) * (n + 1)
+            W[:] = hint[at + 1 : at + 1 + n]
+            if not (_refactor(H, h, W, Binv, z, work) and _accurate(H, h, W, Binv, z, work[2])):
+                status = FAILED
+        if status != FAILED:
+            if status == OK:
+                hint[n + 2] = good
+            worst[0] = min(worst[0], low[0])
+            return status, vertices, count, theta, good
         z[:] = 0.0
-        work[8][0] = -1
     hint[n + 2] = 0
-    return False, np.empty((0, 2)), 0
+    return FAILED, np.empty((0, 2)), 0, theta0, 0
 
 
 @njit(cache=True)
@@ -1020,20 +1103,28 @@ def _start(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work, hint):
 
 
 @njit(cache=True)
-def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
-    """Vertices of ``g0 + G {z : H z <= h}`` (rows of H unit norm; ``GT`` = G^T, n x 2).
+def _resume(hint, W, active, bases, good, prefix, count, vertices):
+    """The walk's state after the chain's first ``good`` certified bases (:func:`_from_chain`).
 
-    Returns (status, vertices, count, pivots): ``vertices[:count]`` are the support points
-    in counter-clockwise order, consecutive duplicates removed (the last may equal the first).
-    ``worst[0]`` receives the smallest slack of the recorded vertices (>= -rounding for a
-    sound walk; the caller rejects the walk otherwise).
+    Their points (``prefix[:count]``) into ``vertices``, their rows into ``bases`` (the chain
+    the walk goes on writing) and the last one's rows (``W``) flagged in ``active``; the chain
+    dropped from ``hint`` until the walk stores its own.
+    """
+    n = W.shape[0]
+    vertices[:count] = prefix[:count]
+    for k in range(good):
+        at = n + 3 + k * (n + 1)
+        bases[k] = hint[at : at + n + 1]
+    hint[n + 2] = 0
+    for i in range(n):
+        active[W[i]] = True
 
-    ``hint`` (int64), kept by a caller that projects postures in a row: ``(m, n)``, the optimal
-    basis at theta0 (n rows; see :func:`_warm_start`), then, when it has room, the number of
-    bases of the last walk's chain and the chain itself (n rows each). A chain that still
-    certifies this polytope's polygon answers without walking (:func:`_from_chain`, 0
-    pivots); else the walk starts from the basis and writes its own chain. An empty hint is
-    neither read nor written.
+
+@njit(cache=True)
+def _walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
+    """:func:`walk`, and whether it went on from a chain's certified bases.
+
+    Returns ``(status, vertices, count, pivots, resumed)``.
     """
     m, n = H.shape
     z = np.zeros(n)
@@ -1043,26 +1134,34 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
     scale = _norm(GT.ravel())  # sqrt(|G^T u|^2 + |G^T u'|^2), the same for every theta
     bases = np.empty((_chain_capacity(hint, n), n + 1), dtype=np.int64)
     yfirst = np.empty(2)  # the point of the chain's last run
+    status, prefix, count, theta, recorded = FAILED, np.empty((0, 2)), 0, theta0, 0
     if bases.shape[0]:
-        ok, vertices, count = _from_chain(
-            H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work
+        status, prefix, count, theta, recorded = _from_chain(
+            H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work, yfirst
         )
-        if ok:
-            return OK, vertices, count, 0
+        if status == OK:
+            return OK, prefix, count, 0, False
     active = np.zeros(m, dtype=np.bool_)
     u = np.array([math.cos(theta0), math.sin(theta0)])
     du = np.array([-math.sin(theta0), math.cos(theta0)])
     c, dc = _times(GT, u), _times(GT, du)
-    status, pivots = _start(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work, hint)
-    if status != OK:
-        return status, np.empty((0, 2)), 0, pivots
     vertices = np.empty((max_pivots + 2, 2))
-    _min_slack_near(H, h, z, worst, work[7], work[8])
-    _point(g0, GT, z, vertices, 0)
-    count = 1
-    recorded = _keep(bases, 0, W, vertices[0], yfirst) if bases.shape[0] else 0
-    theta = theta0
-    since = _CARRY  # pivots since the last fresh inverse (the first breakpoint makes one)
+    pivots = 0
+    resumed = status == _PREFIX
+    if resumed:  # the walk goes on from the chain's last certified basis, optimal at theta
+        _resume(hint, W, active, bases, recorded, prefix, count, vertices)
+        u[0], u[1] = math.cos(theta), math.sin(theta)
+        since = 0
+    else:
+        status, pivots = _start(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work, hint)
+        if status != OK:
+            return status, np.empty((0, 2)), 0, pivots, False
+        _min_slack_near(H, h, z, worst, work[7], work[8])
+        _point(g0, GT, z, vertices, 0)
+        count = 1
+        recorded = _keep(bases, 0, W, vertices[0], yfirst) if bases.shape[0] else 0
+        theta = theta0
+        since = _CARRY  # pivots since the last fresh inverse (the first breakpoint makes one)
     while True:
         theta = _breakpoint(Binv, GT, theta, u[0], u[1], scale, work[6])
         if theta >= theta0 + 2.0 * math.pi:
@@ -1077,20 +1176,20 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
         # precision (docs/studies/design-history.md, "Core floors").
         if since >= _CARRY:
             if not _refactor(H, h, W, Binv, z, work):
-                return FAILED, vertices, count, pivots
+                return FAILED, vertices, count, pivots, resumed
             since = 0
         status, piv = _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work)
         pivots += piv
         since += piv
         if status != OK or count > max_pivots:
-            return FAILED, vertices, count, pivots
+            return FAILED, vertices, count, pivots, resumed
         # The vertex from a fresh inverse when the pivots' rank-one updates left the inverse
         # off: through a small pivot element (a basis at condition 4e6 on G1) the inverse was
         # 1e-5 off and its vertex violated a row by 2e-6, which made the walk refuse and fall
         # back to Bretl (5 ms) on 5 % of G1's postures; the basis's own vertex is within 1e-11.
         if piv and not _accurate(H, h, W, Binv, z, work[2]):
             if not _refactor(H, h, W, Binv, z, work):
-                return FAILED, vertices, count, pivots
+                return FAILED, vertices, count, pivots, resumed
             since = 0
         # piv == 0: the crossing multiplier was within the tolerance of zero; the next
         # breakpoint search starts past it. A vertex reached by zero steps (a new basis of it)
@@ -1107,9 +1206,39 @@ def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
             count += 1
         if bases.shape[0]:  # a chain for the next call (see _keep)
             recorded = _keep(bases, recorded, W, vertices[count - 1], yfirst)
-    if recorded < pivots:  # else re-certifying costs about what this walk did (one foot)
+    # A chain is kept when re-certifying it costs less than the walk did (not on one foot), or
+    # when the walk went on from one.
+    if recorded < pivots or resumed:
         _store_chain(hint, bases, recorded)
-    return OK, vertices, count, pivots
+    return OK, vertices, count, pivots, resumed
+
+
+@njit(cache=True)
+def walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
+    """Vertices of ``g0 + G {z : H z <= h}`` (rows of H unit norm; ``GT`` = G^T, n x 2).
+
+    Returns (status, vertices, count, pivots): ``vertices[:count]`` are the support points
+    in counter-clockwise order, consecutive duplicates removed (the last may equal the first).
+    ``worst[0]`` receives the smallest slack of the recorded vertices (>= -rounding for a
+    sound walk; the caller rejects the walk otherwise).
+
+    ``hint`` (int64), kept by a caller that projects postures in a row: ``(m, n)``, the optimal
+    basis at theta0 (n rows; see :func:`_warm_start`), then, when it has room, the number of
+    bases of the last walk's chain and the chain itself (n rows each). A chain that still
+    certifies this polytope's polygon answers without walking (:func:`_from_chain`, 0
+    pivots); one whose first bases certify it only in part, from the first on, has the walk
+    go on from the last of those (its pivots the ones after it); else the walk starts from
+    the basis, as it does when going on from a chain's bases fails (a cycle of zero steps that
+    the walk from the start may not meet). Either walk writes its own chain. An empty hint is
+    neither read nor written.
+    """
+    start = worst[0]
+    status, vertices, count, pivots, resumed = _walk(H, h, GT, g0, theta0, max_pivots, worst, hint)
+    if status == FAILED and resumed:  # the chain is dropped: from the warm start
+        worst[0] = start
+        status, vertices, count, more, _ = _walk(H, h, GT, g0, theta0, max_pivots, worst, hint)
+        pivots += more
+    return status, vertices, count, pivots
 
 
 @njit(cache=True)
@@ -1224,11 +1353,25 @@ def equality_basis(C, d):
     for k in range(r):
         for j in range(n):
             x0[j] += y[k] * Q[k, j]
-    # Complete Q with the coordinate axes that keep most of their length.
+    # Complete Q with the coordinate axes that keep most of their length (_longest_axis's
+    # choice, its |P e_i|^2 = 1 - sum_r Q[r, i]^2 carried from one row to the next: the same
+    # subtractions in the same order).
+    left = np.ones(n)
+    for k in range(r):
+        for i in range(n):
+            left[i] -= Q[k, i] * Q[k, i]
     for count in range(r, n):
-        norm = _longest_axis(Q, count, v)
+        best, axis = -1.0, 0
+        for i in range(n):
+            if left[i] > best:
+                best, axis = left[i], i
+        v[:] = 0.0
+        v[axis] = 1.0
+        norm = _project_out(Q, count, v, v)
         for j in range(n):
             Q[count, j] = v[j] / norm
+        for i in range(n):
+            left[i] -= Q[count, i] * Q[count, i]
     return OK, x0, Q[r:].T.copy()
 
 

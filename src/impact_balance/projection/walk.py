@@ -77,8 +77,8 @@ def hint_size(variables: int) -> int:
     walk's n, the variables left after the equalities). A caller that projects postures in a
     row keeps one ``np.full(hint_size(variables), -1, dtype=np.int64)``: the walk starts from
     its last optimal basis, and where the last walk's chain of optimal bases still certifies
-    the new polygon, answers without walking (``docs/numerics.md``). A shorter hint (at least
-    ``2 + n``) keeps the start only.
+    the new polygon, answers without walking, or walks on from the last of its first bases that
+    do (``docs/numerics.md``). A shorter hint (at least ``2 + n``) keeps the start only.
     """
     return 3 + variables + (variables + 1) * CHAIN_BASES
 
