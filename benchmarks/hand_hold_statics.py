@@ -28,10 +28,16 @@ from impact_balance.scenario.load import load_scenario
 
 
 def residual_moment(
-    stance: Any, scale: float, min_normal_force: float, torque_limits: bool = True
+    stance: Any,
+    scale: float,
+    min_normal_force: float,
+    torque_limits: bool = True,
+    com_acceleration: tuple[float, float] = (0.0, 0.0),
 ) -> dict[str, Any]:
     """The smallest max-norm moment about the CoM (N m) and the wrenches that reach it.
 
+    ``com_acceleration``: the CoM's horizontal acceleration (m/s^2, world) the contacts must give,
+    the LIPM's ``omega^2 (c - z)`` for a desired ZMP ``z``.
     ``torque_limits``: the actuated joints' quasi-static torques ``g_a(q) - (sum J_i^T w_i)_a``
     within the URDF's effort limits (the criterion's ``torque_limits: true`` rows).
     """
@@ -68,7 +74,7 @@ def residual_moment(
         A_ub.extend(-jt)
         b_ub.extend(effort + g)
     A_eq.extend(force_rows)
-    b_eq.extend([0.0, 0.0, mass * GRAVITY])
+    b_eq.extend([mass * com_acceleration[0], mass * com_acceleration[1], mass * GRAVITY])
     for sign in (1.0, -1.0):
         block = sign * moment_rows.copy()
         block[:, -1] = -1.0
@@ -91,7 +97,7 @@ def residual_moment(
     return {
         "feasible": True,
         "max_moment": float(res.x[-1]),
-        "moment": (moment_rows[:, :-1] @ res.x[:-1]).tolist(),
+        "moment": (moment_rows[:, :-1] @ res.x[:-1]).round(3).tolist(),
         "normal_forces": {
             ct.spec.frame: float(ct.normal @ w[i, :3]) for i, ct in enumerate(contacts)
         },
@@ -103,6 +109,7 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("scenarios", nargs="+")
     p.add_argument("--no-torque-limits", action="store_true")
+    p.add_argument("--com-acceleration", nargs=2, type=float, default=(0.0, 0.0))
     p.add_argument("--scale", type=float, default=0.65, help="friction scale (id: 0.65)")
     p.add_argument(
         "--min-normal-force",
@@ -116,7 +123,9 @@ def main(argv: list[str] | None = None) -> int:
         f_min = args.min_normal_force
         if f_min is None:
             f_min = max(0.0225 * float(stance.mass) * GRAVITY, 2.0)
-        out = residual_moment(stance, args.scale, f_min, not args.no_torque_limits)
+        out = residual_moment(
+            stance, args.scale, f_min, not args.no_torque_limits, tuple(args.com_acceleration)
+        )
         print(path.split("/")[-1], f"f_min {f_min:.1f} N", out)
     return 0
 
