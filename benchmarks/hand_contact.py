@@ -35,6 +35,7 @@ import mujoco
 import numpy as np
 import pinocchio as pin
 
+from impact_balance.geometry.polygon import Polygon
 from impact_balance.sim.control.torque import InverseDynamicsController
 from impact_balance.sim.studies.push import START_COM_VELOCITY, boundary_impulse
 from impact_balance.sim.trials.balance_trial import run_balance_trial
@@ -71,8 +72,10 @@ def _realised(sim: Any, geom: int, point: np.ndarray) -> tuple[np.ndarray, np.nd
 class _Log:
     """The per-step rows of one trial (see the module docstring)."""
 
-    def __init__(self, sim: Any, contact: int) -> None:
+    def __init__(self, sim: Any, contact: int, analysis: Any = None) -> None:
         self.sim, self.contact, self.rows = sim, contact, []
+        self.analysis = analysis
+        self.base_start: np.ndarray | None = None
         self.start: np.ndarray | None = None
         self.planned: np.ndarray | None = None
 
@@ -112,8 +115,81 @@ class _Log:
                 "torque_limited": bool(out.torque_limited),
                 "at_effort_limit": [names[int(i) + 6] for i in at_limit],
                 "worst_joint_plan_realised": worst,
+                **self._balance(c, out),
             }
         )
+
+    def _balance(self, c: InverseDynamicsController, out: Any) -> dict[str, Any]:
+        """Every contact's plan and MuJoCo's, the CoM velocity in its area, the ZMPs (m, world).
+
+        ``zmp_lipm_planned``/``zmp_lipm_realised``: the CoM minus the contacts' horizontal force
+        over m omega^2 (the LIPM's ZMP of the planned / realised total contact force);
+        ``hand_zmp_shift_*``: the non-sole contacts' part of it (-f_xy / (m omega^2)), the capture
+        the hand makes; ``desired_zmp_in_feet``: whether the controller's (clamped) desired ZMP
+        lies in the convex hull of the sole contacts' corners (the feet alone at zero hand force).
+        """
+        sim, a = self.sim, self.analysis
+        mass, omega = float(a.stance.mass), float(c.omega)
+        rows, planned_xy, realised_xy = [], np.zeros(2), np.zeros(2)
+        hand_p, hand_r = np.zeros(2), np.zeros(2)
+        com3 = np.asarray(out.com, dtype=float)
+        moment_p, moment_r, total_p, total_r = np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3)
+        for k, contact in enumerate(a.stance.contacts):
+            placement = c.data.oMf[c.contact_frames[k]] * c.contact_offsets[k]
+            R, p = placement.rotation, placement.translation
+            force, moment, count = _realised(sim, sim.contact_geoms[k], p)
+            w = out.wrenches[k]
+            rows.append(
+                {
+                    "frame": contact.spec.frame,
+                    "planned_normal_force": float(R[:, 2] @ w[:3]),
+                    "realised_normal_force": float(R[:, 2] @ force),
+                    "planned_cop": _cop(R.T @ w[:3], R.T @ w[3:]),
+                    "realised_cop": _cop(R.T @ force, R.T @ moment),
+                    "planned_tangential_force": float(np.linalg.norm(R[:, :2].T @ w[:3])),
+                    "realised_tangential_force": float(np.linalg.norm(R[:, :2].T @ force)),
+                    "points": count,
+                }
+            )
+            planned_xy += w[:2]
+            realised_xy += force[:2]
+            total_p += w[:3]
+            total_r += force
+            moment_p += np.cross(p - com3, w[:3]) + w[3:]
+            moment_r += np.cross(p - com3, force) + moment
+            if not _is_sole(contact.spec.frame):
+                hand_p += w[:2]
+                hand_r += force[:2]
+        k2 = mass * omega**2
+        com, vel = np.asarray(out.com)[:2], np.asarray(out.com_velocity)[:2]
+        area = a.areas.com_velocity_area
+        feet = np.vstack(
+            [ct.corners()[:, :2] for ct in a.stance.contacts if _is_sole(ct.spec.frame)]
+        )
+        hull = Polygon.from_points(feet)
+        if self.base_start is None:
+            self.base_start = c.data.oMi[1].rotation.copy()
+        base_tilt = pin.log3(self.base_start.T @ c.data.oMi[1].rotation)
+        return {
+            "base_rotation_deg": float(np.degrees(np.linalg.norm(base_tilt))),
+            "com_acceleration_demanded": (omega**2 * (com - np.asarray(out.zmp)[:2])).tolist(),
+            "com_acceleration_planned": (total_p[:2] / mass).tolist(),
+            "com_acceleration_realised": (total_r[:2] / mass).tolist(),
+            "angular_momentum_rate_planned": moment_p.tolist(),
+            "angular_momentum_rate_realised": moment_r.tolist(),
+            "contacts": rows,
+            "com_velocity_xy": vel.tolist(),
+            "com_velocity_margin": float(np.min(area.margins(vel[None, :]))),
+            "desired_zmp": np.asarray(out.zmp)[:2].tolist(),
+            "zmp_clamped": bool(out.clamped),
+            "dcm": np.asarray(out.dcm)[:2].tolist(),
+            "zmp_lipm_planned": (com - planned_xy / k2).tolist(),
+            "zmp_lipm_realised": (com - realised_xy / k2).tolist(),
+            "hand_zmp_shift_planned": (-hand_p / k2).tolist(),
+            "hand_zmp_shift_realised": (-hand_r / k2).tolist(),
+            "desired_zmp_feet_margin": float(np.min(hull.margins(np.asarray(out.zmp)[None, :2]))),
+            "effort_use": float(np.max(np.abs(out.tau) / np.maximum(c.effort, 1e-9))),
+        }
 
 
 @contextlib.contextmanager
@@ -133,11 +209,16 @@ def _logged(log: _Log) -> Iterator[None]:
         InverseDynamicsController.step = step  # type: ignore[method-assign]
 
 
+def _is_sole(frame: str) -> bool:
+    """Whether a contact frame is a foot's (the study's convention: ``sole``/``foot``/``ankle``)."""
+    return any(w in frame for w in ("sole", "foot", "ankle"))
+
+
 def _contact_index(setup: BalanceSetup, name: str | None) -> int:
     contacts = [c.spec.frame for c in setup.analysis.stance.contacts]
     if name is not None:
         return contacts.index(name)
-    return next(i for i, f in enumerate(contacts) if "sole" not in f and "foot" not in f)
+    return next(i for i, f in enumerate(contacts) if not _is_sole(f))
 
 
 def _what_ifs(setup: BalanceSetup, args: argparse.Namespace) -> None:
@@ -147,6 +228,18 @@ def _what_ifs(setup: BalanceSetup, args: argparse.Namespace) -> None:
     for name in args.effort_joints:
         a = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
         m.actuator_forcerange[a] *= args.effort_scale
+
+
+def _scale_gains(pairs: list[list[str]]) -> None:
+    """Scale the controller's gains once built (``for_trial`` wrapped for the trial)."""
+    original = InverseDynamicsController.__init__
+
+    def init(self: Any, *a: Any, **k: Any) -> None:
+        original(self, *a, **k)
+        for name, factor in pairs:
+            self.gains = replace(self.gains, **{name: getattr(self.gains, name) * float(factor)})
+
+    InverseDynamicsController.__init__ = init  # type: ignore[method-assign]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -161,6 +254,14 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--contact", default=None, help="contact frame (default: first non-sole)")
     p.add_argument("--cop-margin", type=float, default=None)
     p.add_argument("--no-joint-friction", action="store_true")
+    p.add_argument(
+        "--id-gain-scale",
+        nargs=2,
+        action="append",
+        default=[],
+        metavar=("NAME", "FACTOR"),
+        help="what-if: multiply one InverseDynamicsGains field (after the robot's scaling)",
+    )
     p.add_argument("--effort-scale", type=float, default=1.0)
     p.add_argument("--effort-joints", nargs="*", default=[])
     p.add_argument("--every", type=int, default=10)
@@ -170,6 +271,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.cop_margin is not None:
         options = replace(options, id_gains=replace(options.id_gains, cop_margin=args.cop_margin))
     setup = BalanceSetup.create(args.scenario, "servo", options)
+    if args.id_gain_scale:
+        _scale_gains(args.id_gain_scale)
     _what_ifs(setup, args)
     if args.effort_joints:  # the QP's own limits follow MuJoCo's
         original = InverseDynamicsController.for_trial.__func__  # type: ignore[attr-defined]
@@ -187,7 +290,7 @@ def main(argv: list[str] | None = None) -> int:
     impulse = args.relative * boundary_impulse(
         a.areas.com_velocity_area, a.stance.mass, angle, START_COM_VELOCITY
     )
-    log = _Log(setup.sim, _contact_index(setup, args.contact))
+    log = _Log(setup.sim, _contact_index(setup, args.contact), a)
     with _logged(log):
         result = run_balance_trial(
             setup,

@@ -611,10 +611,13 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
                 g.friction_scale * spec.friction, *self.contact_half_sizes[i], placement.rotation
             )
         lower[:ne] = upper[:ne]
-        # Minimum normal force (rows after the cones): n_i . f_i >= f_min.
+        # Minimum normal force (rows after the cones): n_i . f_i >= f_min, n_i the contact's normal
+        # (the frame's axes turned by the contact's offset, as in the cones).
         k = ne + 16 * nc
-        for i, fid in enumerate(self.contact_frames):
-            C[k + i, nv + 6 * i : nv + 6 * i + 3] = data.oMf[fid].rotation[:, 2]
+        for i, (fid, offset) in enumerate(
+            zip(self.contact_frames, self.contact_offsets, strict=True)
+        ):
+            C[k + i, nv + 6 * i : nv + 6 * i + 3] = data.oMf[fid].rotation @ offset.rotation[:, 2]
         lower[k : k + nc] = g.min_normal_force
         upper[k : k + nc] = 1e30
         # The governed approach speed (one row, after the minimum normal forces; 1e30: inactive).
