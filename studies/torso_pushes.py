@@ -1,0 +1,168 @@
+"""Torso pushes after the fact: the angular momentum term's calls re-made on spent records.
+
+Usage (from the repository root, with impact-balance and its ``sim`` extra installed)::
+
+    python studies/torso_pushes.py 6 7 8 9
+
+For every push of ``studies/held_out_results_N/pushes.csv`` it rebuilds the push's prediction
+from the stance ``studies/held_out_N/<stance>.yaml`` (the library's ``predict_push`` with the
+push's duration and the trial controller's K_L, no trial run), checks that it reproduces the
+record's default margin and call, and re-makes the call with the removal share of the angular
+momentum's cost ``s`` replaced by each candidate's (the default: ``1 / (1 + omega tau)``, tau =
+1/K_L). A horizontal push J u at height d above the CoM then calls safe when ``(kappa + s d / h)
+J / m`` and ``kappa J / m`` lie in the CoM velocity area inset by ``omega M`` along u and within
+the CoM's reach. It prints P(failed strictly | safe) with its Wilson interval and the standing
+pushes called safe on the band (0.75 to 1.05), per body and robot, ordinary supports and hand
+holds apart (docs/studies/torso-pushes.md). It writes nothing.
+"""
+
+from __future__ import annotations
+
+import sys
+import warnings
+
+import numpy as np
+import pandas as pd
+import pinocchio as pin
+
+from impact_balance.cli.angular_momentum import for_trials
+from impact_balance.scenario import load_scenario
+from impact_balance.sim.studies.push import _body_position, predict_push
+from impact_balance.sim.studies.scores import wilson
+from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, Push
+from impact_balance.sim.trials.setup import BalanceSetup, push_body
+
+BAND = (0.749, 1.051)
+HAND = "hand_(?:wall|table|rail|hold)"
+
+
+def _body_name(robot: str, body: str) -> str | None:
+    """The MuJoCo body the protocols pushed (None: the robot's default trunk)."""
+    if body == "torso":
+        return "WAIST_R_S" if robot == "jvrc1" else None
+    return "pelvis" if robot == "g1" else "base_link"
+
+
+def _stance_rows(set_id: str, stance: str, records: pd.DataFrame) -> list[dict[str, object]]:
+    options = BalanceTrialOptions(controller="id")
+    scenario = for_trials(
+        load_scenario(f"studies/held_out_{set_id}/{stance}.yaml"), "controller", options
+    )
+    setup = BalanceSetup.create(scenario, "servo", options)
+    a = setup.analysis
+    omega, tau = float(a.areas.omega), float(scenario.angular_momentum_damping_time or 0.0)
+    com = np.asarray(a.stance.com, dtype=float)
+    data = a.stance.robot.model.createData()
+    pin.ccrba(a.stance.robot.model, data, a.stance.q, np.zeros(a.stance.robot.model.nv))
+    inertia = np.array(data.Ig.inertia)
+    halfplanes, offsets = a.areas.com_velocity_area.halfplanes
+    rows = []
+    for body in ("pelvis", "torso"):
+        name = _body_name(stance.split("_")[0], body)
+        position = _body_position(setup, push_body(setup.sim, name))
+        for _, r in records[(records.stance == stance) & (records.body == body)].iterrows():
+            angle = np.deg2rad(r.direction_deg)
+            push = Push(angle, r.impulse_Ns, 0.05, options.settle, name)
+            p = predict_push(setup, push, float(position[2]), position, None, True)
+            u = np.array([np.cos(angle), np.sin(angle)])
+            rate = halfplanes @ u
+            ahead = rate > 1e-12
+            boundary = float(np.min(offsets[ahead] / rate[ahead]))  # m/s along u, margin 0
+            inset = float(np.min((offsets[ahead] - omega * r.zmp_margin) / rate[ahead]))
+            axis = np.array([*p.angular_momentum[:2], 0.0])
+            norm = float(np.linalg.norm(axis))
+            kappa = float(p.finite_push_factor or 1.0)
+            speed = r.relative * boundary
+            rows.append(
+                {
+                    **r.to_dict(),
+                    "set": set_id,
+                    "omega": omega,
+                    "tau": tau,
+                    "h": a.areas.gravity / omega**2,
+                    "d": float(position[2] - com[2]),
+                    "kappa": kappa,
+                    "rho": inset / boundary,
+                    "boundary": boundary,
+                    "angular_momentum": norm,
+                    "inertia": float(axis @ inertia @ axis) / norm**2 if norm else np.nan,
+                    "margin_check": float(p.finite_push_margin or 0.0) - r.default_margin_mps,
+                    # the reach's speed limit along u: the record's margin plus the larger speed
+                    "reach_limit": r.com_reach_margin_mps
+                    + speed * max(kappa, float(np.linalg.norm(p.default_velocities[1])) / speed),
+                }
+            )
+    return rows
+
+
+def _calls(table: pd.DataFrame, share: pd.Series) -> pd.Series:
+    """The call with removal share ``share`` (both ends, the reach on the larger speed)."""
+    larger = np.maximum(table.kappa, table.kappa + share * table.d / table.h)
+    inside = larger * table.relative <= table.rho + 1e-12
+    reach = table.reach_limit - larger * table.relative * table.boundary >= -1e-12
+    return inside & reach
+
+
+def _held_share(table: pd.DataFrame, degrees: float) -> pd.Series:
+    """L kept (the body turning) until it has turned ``degrees``, then removed at 1/K_L."""
+    hold = np.maximum(0.0, np.deg2rad(degrees) * table.inertia / table.angular_momentum - table.tau)
+    return np.exp(-table.omega * hold) / (1 + table.omega * table.tau)
+
+
+def _cell(called: pd.Series, rows: pd.Series, table: pd.DataFrame) -> str:
+    failed = int((called & rows & (table.strict_fail == 1)).sum())
+    safe = int((called & rows).sum())
+    standing = int((rows & (table.strict_fail == 0)).sum())
+    kept = int((called & rows & (table.strict_fail == 0)).sum())
+    interval = wilson(failed, safe)
+    rate = (
+        "– (0/0)"
+        if interval is None
+        else f"{100 * failed / safe:.0f} % [{100 * interval[0]:.0f}, "
+        f"{100 * interval[1]:.0f}] ({failed}/{safe})"
+    )
+    return f"{rate} | {kept}/{standing}"
+
+
+def main(sets: list[str]) -> int:
+    """Print the candidates' scores on the band of ``sets``; 0."""
+    warnings.simplefilter("ignore")
+    rows: list[dict[str, object]] = []
+    for set_id in sets:
+        records = pd.read_csv(f"studies/held_out_results_{set_id}/pushes.csv")
+        records = records[records.outcome != "aborted"]
+        for stance in records.stance.unique():
+            rows += _stance_rows(set_id, stance, records)
+    table = pd.DataFrame(rows)
+    default = 1 / (1 + table.omega * table.tau)
+    print(
+        f"margin check: {table.margin_check.abs().max():.1e} m/s; default call reproduced:",
+        bool((_calls(table, default) == table.default_safe.astype(bool)).all()),
+    )
+    candidates = {
+        "default (1/K_L)": default,
+        "no removal (tau = inf)": 0.0 * default,
+        "removal at tau = 0.52 s": 1 / (1 + table.omega * 0.52),
+        "turn 10 deg, then 1/K_L": _held_share(table, 10.0),
+        "turn 25 deg, then 1/K_L": _held_share(table, 25.0),
+    }
+    band = table.relative.between(*BAND)
+    hand = table.stance.str.contains(HAND)
+    robot = table.stance.str.split("_").str[0]
+    for body in ("torso", "pelvis"):
+        for label, support in (("ordinary supports", ~hand), ("hand holds", hand)):
+            print(f"\n{body}, {label}: P(failed strictly | safe) | standing called safe")
+            for name, share in candidates.items():
+                called = _calls(table, share)
+                cells = [_cell(called, band & support & (table.body == body), table)]
+                cells += [
+                    f"{r}: "
+                    + _cell(called, band & support & (table.body == body) & (robot == r), table)
+                    for r in sorted(robot[support].unique())
+                ]
+                print(f"| {name} | " + " | ".join(cells) + " |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:] or ["6", "7", "8", "9"]))
