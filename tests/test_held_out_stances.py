@@ -37,7 +37,8 @@ REQUIRED = {
 #: Each set's folder and what it must cover; the second adds pushes on one foot, the third
 #: forward impacts and wide, staggered two-feet stances; the fourth, fifth and sixth cover what
 #: the third does; the seventh and eighth what the third does but wide stances (none); the ninth
-#: what the seventh does but stances on one foot alone (its one-foot stances hold a hand).
+#: what the seventh does but stances on one foot alone (its one-foot stances hold a hand); the
+#: tenth what the ninth does but foot impacts (its impacts are all by a hand).
 SETS = {
     "held_out": REQUIRED,
     "held_out_2": REQUIRED | {"one foot"},
@@ -48,6 +49,7 @@ SETS = {
     "held_out_7": REQUIRED | {"one foot", "forward impact", "staggered"},
     "held_out_8": REQUIRED | {"one foot", "forward impact", "staggered"},
     "held_out_9": REQUIRED | {"forward impact", "staggered"},
+    "held_out_10": (REQUIRED - {"foot impact"}) | {"forward impact", "staggered"},
 }
 #: The sets checked under the protocol's options (10 mm margin, angular momentum term) and
 #: whose impact friction and restitution must be new: each against the stances before it.
@@ -60,6 +62,7 @@ NEW_SETS = [
     "held_out_7",
     "held_out_8",
     "held_out_9",
+    "held_out_10",
 ]
 SET_FILES = {name: sorted((STUDIES / name).glob("*.yaml")) for name in SETS}
 FILES = [f for files in SET_FILES.values() for f in files]
@@ -148,6 +151,11 @@ NINTH_MIN_ON = {"talos": 2, "g1": 2}
 #: A support's kind by its normal's tilt from the vertical (deg): a table below SLOPE_DEG, a
 #: wall above NINTH_WALL_DEG, a rail or ramp between.
 NINTH_WALL_DEG = 70.0
+#: The tenth set (the id controller's hand contacts since set 9, the default alone): six stances,
+#: three hand holds (on Talos, G1 and one of NINTH_THIRD_ROBOTS) and three ordinary supports.
+TENTH = "held_out_10"
+TENTH_FILES = 6
+TENTH_HOLDS = 3
 
 
 def _header(path: Path, key: str) -> str:
@@ -195,6 +203,8 @@ def test_the_set_is_there(name: str) -> None:
     least = (
         SEVENTH_MIN_FILES
         if name in (SEVENTH, EIGHTH, NINTH)
+        else TENTH_FILES
+        if name == TENTH
         else THIRD_MIN_FILES
         if name in LATER_AIMS
         else 6
@@ -485,13 +495,20 @@ def test_the_simulation_model_builds_with_the_push_bodies(path: Path) -> None:
 
 
 #: The sets whose protocol also tables the CoM's reach (impact_balance.balance.reach).
-REACH_TABLES = ["held_out_5", "held_out_6", "held_out_7", "held_out_8", "held_out_9"]
+REACH_TABLES = [
+    "held_out_5",
+    "held_out_6",
+    "held_out_7",
+    "held_out_8",
+    "held_out_9",
+    "held_out_10",
+]
 #: The sets whose protocol also tables the held-stance impact model's predictions.
-HELD_TABLES = ["held_out_8", "held_out_9"]
+HELD_TABLES = ["held_out_8", "held_out_9", "held_out_10"]
 #: The protocols whose tables of predictions the test recomputes, by set.
 PROTOCOLS = {
-    name: STUDIES.parent / "docs" / "studies" / f"held-out-protocol-{name[-1]}.md"
-    for name in [*LATER_AIMS, SEVENTH, EIGHTH, NINTH]
+    name: STUDIES.parent / "docs" / "studies" / f"held-out-protocol-{name.split('_')[-1]}.md"
+    for name in [*LATER_AIMS, SEVENTH, EIGHTH, NINTH, TENTH]
 }
 PROTOCOL_FILES = [f for name in PROTOCOLS for f in SET_FILES[name]]
 
@@ -743,27 +760,31 @@ def test_the_ninth_set_holds_hands_on_supports_on_three_robots() -> None:
     assert {"lateral impact", "backward impact"} <= covered and walls, (covered, walls)
 
 
-def test_the_ninth_set_s_hand_holds_are_new() -> None:
-    """No hand hold of the ninth set repeats an earlier one's robot and contact frames (the bundled
-    scenarios' and the eight earlier sets'), and every configuration of the set is new."""
+@pytest.mark.parametrize("name", [NINTH, TENTH])
+def test_the_hand_hold_sets_hand_holds_are_new(name: str) -> None:
+    """No hand hold of the ninth (tenth) set repeats an earlier one's robot and contact frames (the
+    bundled scenarios' and every earlier set's), and every configuration of the set is new against
+    the bundled scenarios and every other set."""
     bundled = [n for n in bundled_scenarios() if load_scenario(n).impact is not None]
-    earlier = [str(f) for s in SETS if s != NINTH for f in SET_FILES[s]]
+    before = list(SETS)[: list(SETS).index(name)]
+    earlier = [str(f) for s in before for f in SET_FILES[s]]
+    others = [str(f) for s in SETS if s != name for f in SET_FILES[s]]
     earlier_holds = {
         (load_scenario(n).robot, tuple(sorted(c.frame for c in load_scenario(n).contacts)))
         for n in [*bundled, *earlier]
         if any(c.frame in HAND_FRAMES for c in load_scenario(n).contacts)
     }
     assert earlier_holds  # talos_three_contacts and set 8's hand hold
-    layouts = {_layout(n) for n in [*bundled, *earlier]}
-    for f in SET_FILES[NINTH]:
+    layouts = {_layout(n) for n in [*bundled, *others]}
+    for f in SET_FILES[name]:
         s = load_scenario(str(f))
         frames = tuple(sorted(c.frame for c in s.contacts))
         assert (s.robot, frames) not in earlier_holds, f.name
         assert _layout(str(f)) not in layouts, f.name
 
 
-@pytest.mark.parametrize("path", SET_FILES[NINTH], ids=_id)
-def test_the_ninth_set_s_hand_holds_carry_a_share_of_the_balance(path: Path) -> None:
+@pytest.mark.parametrize("path", [*SET_FILES[NINTH], *SET_FILES[TENTH]], ids=_id)
+def test_the_hand_hold_sets_hand_holds_carry_a_share_of_the_balance(path: Path) -> None:
     """A hand hold is a real support: the CoM velocity area with it is more than 1.2 times the
     area without it (or the stance cannot balance without it), so a push tests the hand's
     contact."""
@@ -775,3 +796,28 @@ def test_the_ninth_set_s_hand_holds_carry_a_share_of_the_balance(path: Path) -> 
     without = analyze(scenario.replace(contacts=kept))
     if without.to_dict()["can_balance"]:
         assert full > 1.2 * without.areas.com_velocity_area.area, (full, without)
+
+
+def test_the_tenth_set_holds_three_hand_holds_and_three_ordinary_supports() -> None:
+    """Its aims: three stances with a hand holding a support (Talos, G1 and Romeo, iCub or
+    JVRC-1, one each), three of ordinary support (two feet, no hand held, not wide) with a
+    backward and a lateral impact among them; every impact by a hand; Talos and G1 twice each."""
+    files = SET_FILES[TENTH]
+    assert len(files) == TENTH_FILES, files
+    robot = {f: load_scenario(str(f)).robot for f in files}
+    for name, least in NINTH_MIN_ON.items():
+        assert sum(r == name for r in robot.values()) >= least, (name, robot)
+    holds = {f: _holds(f) for f in files}
+    held = [f for f in files if holds[f]]
+    assert len(held) == TENTH_HOLDS, held
+    held_robots = sorted(str(robot[f]) for f in held)
+    assert {"talos", "g1"} <= set(held_robots) and set(held_robots) & NINTH_THIRD_ROBOTS
+    assert len(set(held_robots)) == TENTH_HOLDS, held_robots
+    plain = [f for f in files if not holds[f]]
+    walls: set[str] = set()
+    for f in plain:
+        apart = _apart(f)
+        assert apart is not None and apart[1] < WIDE_M, (f.name, apart)
+        walls |= _covers(f) & {"lateral impact", "backward impact"}
+    assert walls == {"lateral impact", "backward impact"}, walls
+    assert all("hand impact" in _covers(f) for f in files)
