@@ -15,17 +15,16 @@ from typing import Any
 import numpy as np
 
 from impact_balance.analysis.analyze import analyze
+from impact_balance.balance.reach import ray_extent
+from impact_balance.geometry.polygon import Polygon
 from impact_balance.scenario.load import load_scenario
 
 __all__ = ["jump_reaches", "premise"]
 
 
-def jump_reaches(halfplanes: tuple[np.ndarray, np.ndarray], jump: np.ndarray) -> float:
-    """The speed (m/s) at which ``speed * jump`` leaves ``{v : G v <= h}`` (inf if never)."""
-    normals, offsets = halfplanes
-    along = normals @ jump
-    leaving = along > 1e-15
-    return float(np.min(offsets[leaving] / along[leaving])) if leaving.any() else float("inf")
+def jump_reaches(area: Polygon, jump: np.ndarray) -> float:
+    """The speed (m/s) at which ``speed * jump`` leaves ``area`` (inf if never): its ray."""
+    return ray_extent(area, jump) / float(np.linalg.norm(jump))
 
 
 def _mean_jump(document: dict[str, Any]) -> tuple[np.ndarray | None, int]:
@@ -66,7 +65,7 @@ def premise(run_dir: Path, set_dir: Path) -> dict[str, dict[str, Any]]:
             continue
         scenario = load_scenario(scenario_path).replace(zmp_margin=0.0, com_velocity=(0.0, 0.0))
         area = analyze(scenario).areas.com_velocity_area
-        reaches = jump_reaches(area.halfplanes, jump)
+        reaches = jump_reaches(area, jump)
         strict = document["empirical"]["strict_failed"]
         out[name] = {
             "jump_reaches": reaches,

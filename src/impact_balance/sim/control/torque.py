@@ -429,13 +429,13 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         zmp, xi, clamped = self.feedback.desired_zmp(state.com[:2], state.com_velocity[:2])
         tasks, speed_row = self._tasks(t, v, impact_force, state, zmp)
         P, c = self._cost(tasks, q, v)
-        T, t0, rows = self._constraints(q, v, state, speed_row)
+        compensation = self.compensation(v)
+        T, t0, rows = self._constraints(q, v, state, speed_row, compensation)
         x, torque_limited = self._solve(P, c, rows)
         nv, nc = self.nv, self.nc
         a, w = x[:nv], x[nv:]
         tau = T @ x + t0
         if self.effort_limits:
-            compensation = self.compensation(v)
             tau = np.clip(tau, -self.effort - compensation, self.effort - compensation)
         out = TorqueOutput(
             tau,
@@ -578,10 +578,12 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         v: _FloatArray,
         state: _Dynamics,
         speed_row: tuple[_FloatArray, float] | None,
+        compensation: _FloatArray,
     ) -> tuple[_FloatArray, _FloatArray, _Rows]:
         """Fill the QP's constraints; return the torques' map and where each block starts.
 
-        The torques are ``tau = T x + t0``.
+        The torques are ``tau = T x + t0``; ``compensation`` is what the motors add to them
+        (:meth:`compensation` at ``v``, N m, actuated rows): the effort limits bound the sum.
 
         Stacked for daqp: [floating base (6); contacts (6 nc)] equalities, the contact wrench cones
         (16 nc), the minimum normal forces (nc), the governed approach speed (0 or 1), the joint
@@ -642,7 +644,7 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         lower[m0:m1] = np.minimum(2.0 * (self._q_lower - qj - vj * T2) / T2**2, upper[m0:m1])
         if limited.size:
             # The motors add the compensation to tau (actuate): the effort bounds the sum.
-            bias = t0[limited] + self.compensation(v)[limited]
+            bias = t0[limited] + compensation[limited]
             C[m1:, :] = T[limited]
             upper[m1:] = self.effort[limited] - bias
             lower[m1:] = -self.effort[limited] - bias
