@@ -2,7 +2,9 @@
 
 Usage (from the repository root, with impact-balance and its ``sim`` extra installed)::
 
-    python studies/torso_pushes.py 6 7 8 9
+    python studies/torso_pushes.py 6 7 8 9 10 --cache=/tmp/torso_pushes.pkl
+
+(``--cache=FILE``: the rebuilt table is written there, and read from there when it exists.)
 
 For every push of ``studies/held_out_results_N/pushes.csv`` it rebuilds the push's prediction
 from the stance ``studies/held_out_N/<stance>.yaml`` (the library's ``predict_push`` with the
@@ -20,6 +22,7 @@ from __future__ import annotations
 
 import sys
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -109,6 +112,21 @@ def _held_share(table: pd.DataFrame, degrees: float) -> pd.Series:
     return np.exp(-table.omega * hold) / (1 + table.omega * table.tau)
 
 
+def turn_during_capture(table: pd.DataFrame) -> pd.Series:
+    """The angle (rad) the robot turns while the capture holds the ZMP at the area's edge.
+
+    Along u the CoM moves at ``kappa J / m`` toward an edge ``e`` away (the inset area's extent
+    over omega); the ZMP held at the edge stops it after ``atanh(kappa J / (m omega e)) /
+    omega``. With the ZMP at the edge no moment is left to remove L, so the locked robot turns
+    at ``|L| / I`` meanwhile (I: its centroidal inertia about L's axis). Infinite when the
+    CoM is not captured.
+    """
+    ratio = (table.kappa * table.relative / table.rho).clip(upper=1.0)
+    stop = np.arctanh(ratio.where(ratio < 1.0, np.nan)) / table.omega
+    rate = (table.angular_momentum / table.inertia).fillna(0.0)
+    return (rate * stop).fillna(np.inf)
+
+
 def _cell(called: pd.Series, rows: pd.Series, table: pd.DataFrame) -> str:
     failed = int((called & rows & (table.strict_fail == 1)).sum())
     safe = int((called & rows).sum())
@@ -127,13 +145,20 @@ def _cell(called: pd.Series, rows: pd.Series, table: pd.DataFrame) -> str:
 def main(sets: list[str]) -> int:
     """Print the candidates' scores on the band of ``sets``; 0."""
     warnings.simplefilter("ignore")
-    rows: list[dict[str, object]] = []
-    for set_id in sets:
-        records = pd.read_csv(f"studies/held_out_results_{set_id}/pushes.csv")
-        records = records[records.outcome != "aborted"]
-        for stance in records.stance.unique():
-            rows += _stance_rows(set_id, stance, records)
-    table = pd.DataFrame(rows)
+    cache = next((a.split("=", 1)[1] for a in sets if a.startswith("--cache=")), None)
+    sets = [a for a in sets if not a.startswith("--cache=")]
+    if cache is not None and Path(cache).exists():
+        table = pd.read_pickle(cache)
+    else:
+        rows: list[dict[str, object]] = []
+        for set_id in sets:
+            records = pd.read_csv(f"studies/held_out_results_{set_id}/pushes.csv")
+            records = records[records.outcome != "aborted"]
+            for stance in records.stance.unique():
+                rows += _stance_rows(set_id, stance, records)
+        table = pd.DataFrame(rows)
+        if cache is not None:
+            table.to_pickle(cache)
     default = 1 / (1 + table.omega * table.tau)
     print(
         f"margin check: {table.margin_check.abs().max():.1e} m/s; default call reproduced:",
@@ -146,14 +171,20 @@ def main(sets: list[str]) -> int:
         "turn 10 deg, then 1/K_L": _held_share(table, 10.0),
         "turn 25 deg, then 1/K_L": _held_share(table, 25.0),
     }
+    turn = turn_during_capture(table)
+    no_removal = _calls(table, 0.0 * default)
+    tilt_checks = {
+        f"no removal, turn during the capture <= {deg} deg": no_removal & (turn <= np.deg2rad(deg))
+        for deg in (10.0, 25.0)
+    }
     band = table.relative.between(*BAND)
     hand = table.stance.str.contains(HAND)
     robot = table.stance.str.split("_").str[0]
     for body in ("torso", "pelvis"):
         for label, support in (("ordinary supports", ~hand), ("hand holds", hand)):
             print(f"\n{body}, {label}: P(failed strictly | safe) | standing called safe")
-            for name, share in candidates.items():
-                called = _calls(table, share)
+            calls = {name: _calls(table, share) for name, share in candidates.items()}
+            for name, called in {**calls, **tilt_checks}.items():
                 cells = [_cell(called, band & support & (table.body == body), table)]
                 cells += [
                     f"{r}: "
