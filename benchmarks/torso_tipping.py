@@ -6,9 +6,9 @@ push of ``studies/held_out_results_N/pushes.csv`` (the record's impulse, directi
 QP's planned and MuJoCo's realised normal force (N), centre of pressure (m, sole axes, beside the
 rectangle's half sizes), the planned contact's rate of change of the angular momentum about the
 CoM (``(p - c) x f + tau``, N m, world) and the sole's tilt from its start (deg); and for the
-whole robot: the centroidal angular momentum L (N m s, world, about the CoM, pinocchio), the QP's
-target rate ``-K_L L``, the planned and realised total rate, and whether the desired ZMP was
-clamped.
+whole robot: the root body's rotation from its start (deg), the centroidal angular momentum L
+(N m s, world, about the CoM, pinocchio), the QP's target rate ``-K_L L``, the planned and
+realised total rate, and whether the desired ZMP was clamped.
 
     python benchmarks/torso_tipping.py 6 g1_wide_left_palm_oblique_side torso 90 0.75 \
         --json /tmp/g1_90_075.json
@@ -61,6 +61,7 @@ class SoleLog:
             k for k, c in enumerate(setup.analysis.stance.contacts) if _is_sole(c.spec.frame)
         ]
         self.start: dict[int, np.ndarray] = {}
+        self.base_start: np.ndarray | None = None
         self.data: Any = None
 
     def add(self, c: InverseDynamicsController, t: float, q: Any, v: Any, out: Any) -> None:
@@ -99,9 +100,13 @@ class SoleLog:
                     "tilt_deg": math.degrees(float(np.linalg.norm(tilt))),
                 }
             )
+        if self.base_start is None:
+            self.base_start = c.data.oMi[1].rotation.copy()
+        base_tilt = pin.log3(self.base_start.T @ c.data.oMi[1].rotation)
         self.rows.append(
             {
                 "time": t,
+                "base_rotation_deg": math.degrees(float(np.linalg.norm(base_tilt))),
                 "angular_momentum": L.tolist(),
                 "target_rate": (-c.gains.angular_momentum_damping * L).tolist(),
                 "planned_rate": rate_p.tolist(),

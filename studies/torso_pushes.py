@@ -29,6 +29,7 @@ import pandas as pd
 import pinocchio as pin
 
 from impact_balance.cli.angular_momentum import for_trials
+from impact_balance.geometry.polygon import Polygon
 from impact_balance.scenario import load_scenario
 from impact_balance.sim.studies.push import _body_position, predict_push
 from impact_balance.sim.studies.scores import wilson
@@ -44,6 +45,35 @@ def _body_name(robot: str, body: str) -> str | None:
     if body == "torso":
         return "WAIST_R_S" if robot == "jvrc1" else None
     return "pelvis" if robot == "g1" else "base_link"
+
+
+def _is_sole(frame: str) -> bool:
+    return any(w in frame for w in ("sole", "foot", "ankle"))
+
+
+def _sole_alone(a: object, u: np.ndarray, margin: float) -> tuple[float, float]:
+    """The capture's ZMP extent e along u, and where the ray enters the sole that holds it alone.
+
+    ``e`` (m): from the CoM to the edge of the ZMP area inset by ``margin`` along u. When that
+    edge point lies in exactly one sole's rectangle of a stance of several soles, the capture
+    holds the ZMP on that sole alone while the ZMP is beyond ``e_in`` (m, the distance along u
+    at which the ray from the CoM enters that rectangle); otherwise ``e_in`` is NaN.
+    """
+    com = np.asarray(a.stance.com, dtype=float)[:2]  # type: ignore[attr-defined]
+    G, h = a.areas.zmp_area.inset(margin).halfplanes  # type: ignore[attr-defined]
+    rate = G @ u
+    ahead = rate > 1e-12
+    e = float(np.min((h[ahead] - G[ahead] @ com) / rate[ahead]))
+    soles = [c for c in a.stance.contacts if _is_sole(c.spec.frame)]  # type: ignore[attr-defined]
+    rects = [Polygon.from_points(c.corners()[:, :2]) for c in soles]
+    holding = [p for p in rects if bool(np.all(p.contains((com + e * u)[None, :], tol=1e-6)))]
+    if len(soles) < 2 or len(holding) != 1:
+        return e, float("nan")
+    Gr, hr = holding[0].halfplanes
+    rr = Gr @ u
+    behind = rr < -1e-12
+    entry = float(np.max((hr[behind] - Gr[behind] @ com) / rr[behind])) if behind.any() else 0.0
+    return e, max(0.0, entry)
 
 
 def _stance_rows(set_id: str, stance: str, records: pd.DataFrame) -> list[dict[str, object]]:
@@ -76,6 +106,7 @@ def _stance_rows(set_id: str, stance: str, records: pd.DataFrame) -> list[dict[s
             norm = float(np.linalg.norm(axis))
             kappa = float(p.finite_push_factor or 1.0)
             speed = r.relative * boundary
+            e, e_in = _sole_alone(a, u, float(r.zmp_margin))
             rows.append(
                 {
                     **r.to_dict(),
@@ -89,6 +120,8 @@ def _stance_rows(set_id: str, stance: str, records: pd.DataFrame) -> list[dict[s
                     "boundary": boundary,
                     "angular_momentum": norm,
                     "inertia": float(axis @ inertia @ axis) / norm**2 if norm else np.nan,
+                    "zmp_extent": e,
+                    "sole_entry": e_in,
                     "margin_check": float(p.finite_push_margin or 0.0) - r.default_margin_mps,
                     # the reach's speed limit along u: the record's margin plus the larger speed
                     "reach_limit": r.com_reach_margin_mps
@@ -125,6 +158,23 @@ def turn_during_capture(table: pd.DataFrame) -> pd.Series:
     stop = np.arctanh(ratio.where(ratio < 1.0, np.nan)) / table.omega
     rate = (table.angular_momentum / table.inertia).fillna(0.0)
     return (rate * stop).fillna(np.inf)
+
+
+def turn_on_one_sole(table: pd.DataFrame) -> pd.Series:
+    """The angle (rad) the robot turns while the capture holds the ZMP on one sole alone.
+
+    With the ZMP held at the edge ``e`` along u, the DCM ``xi`` (from the CoM, along u) moves
+    as ``e - xi(t) = (e - xi0) exp(omega t)``, ``xi0 = kappa J / (m omega)``; the ZMP may
+    leave the sole that holds it alone once ``xi <= e_in``, after ``ln((e - e_in) / (e -
+    xi0)) / omega``. Meanwhile the other soles carry nothing and no moment is left to remove L:
+    the locked robot turns at ``|L| / I`` about L's axis, and the unloaded soles with it. Zero
+    when no sole holds the capture alone; infinite when the CoM is not captured.
+    """
+    ratio = table.kappa * table.relative / table.rho  # xi0 / e
+    xi0 = ratio * table.zmp_extent
+    alone = np.log(((table.zmp_extent - table.sole_entry) / (table.zmp_extent - xi0)).clip(lower=1))
+    time = (alone / table.omega).where(ratio < 1.0, np.inf).fillna(0.0)
+    return (table.angular_momentum / table.inertia).fillna(0.0) * time
 
 
 def _cell(called: pd.Series, rows: pd.Series, table: pd.DataFrame) -> str:
@@ -177,6 +227,9 @@ def main(sets: list[str]) -> int:
         f"no removal, turn during the capture <= {deg} deg": no_removal & (turn <= np.deg2rad(deg))
         for deg in (10.0, 25.0)
     }
+    tilt_checks["no removal, unloaded soles turn <= 10 deg"] = no_removal & (
+        turn_on_one_sole(table) <= np.deg2rad(10.0)
+    )
     band = table.relative.between(*BAND)
     hand = table.stance.str.contains(HAND)
     robot = table.stance.str.split("_").str[0]
