@@ -15,7 +15,10 @@ momentum's cost ``s`` replaced by each candidate's (the default: ``1 / (1 + omeg
 J / m`` and ``kappa J / m`` lie in the CoM velocity area inset by ``omega M`` along u and within
 the CoM's reach. It prints P(failed strictly | safe) with its Wilson interval and the standing
 pushes called safe on the band (0.75 to 1.05), per body and robot, ordinary supports and hand
-holds apart (docs/studies/torso-pushes.md). It writes nothing.
+holds apart (docs/studies/torso-pushes.md). Beside the shares, two checks of the robot's turn
+with the term off (§6 of that page): the locked robot's turn ``|L| t / I`` over the whole capture
+(``turn_during_capture``) and over the time the capture holds the ZMP on one sole alone
+(``turn_on_one_sole``), each against a bound on the angle. It writes nothing (but the cache).
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ import numpy as np
 import pandas as pd
 import pinocchio as pin
 
+from impact_balance.analysis.result import Analysis
 from impact_balance.cli.angular_momentum import for_trials
 from impact_balance.geometry.polygon import Polygon
 from impact_balance.scenario import load_scenario
@@ -51,7 +55,7 @@ def _is_sole(frame: str) -> bool:
     return any(w in frame for w in ("sole", "foot", "ankle"))
 
 
-def _sole_alone(a: object, u: np.ndarray, margin: float) -> tuple[float, float]:
+def _sole_alone(a: Analysis, u: np.ndarray, margin: float) -> tuple[float, float]:
     """The capture's ZMP extent e along u, and where the ray enters the sole that holds it alone.
 
     ``e`` (m): from the CoM to the edge of the ZMP area inset by ``margin`` along u. When that
@@ -59,12 +63,12 @@ def _sole_alone(a: object, u: np.ndarray, margin: float) -> tuple[float, float]:
     holds the ZMP on that sole alone while the ZMP is beyond ``e_in`` (m, the distance along u
     at which the ray from the CoM enters that rectangle); otherwise ``e_in`` is NaN.
     """
-    com = np.asarray(a.stance.com, dtype=float)[:2]  # type: ignore[attr-defined]
-    G, h = a.areas.zmp_area.inset(margin).halfplanes  # type: ignore[attr-defined]
+    com = np.asarray(a.stance.com, dtype=float)[:2]
+    G, h = a.areas.zmp_area.inset(margin).halfplanes
     rate = G @ u
     ahead = rate > 1e-12
     e = float(np.min((h[ahead] - G[ahead] @ com) / rate[ahead]))
-    soles = [c for c in a.stance.contacts if _is_sole(c.spec.frame)]  # type: ignore[attr-defined]
+    soles = [c for c in a.stance.contacts if _is_sole(c.spec.frame)]
     rects = [Polygon.from_points(c.corners()[:, :2]) for c in soles]
     holding = [p for p in rects if bool(np.all(p.contains((com + e * u)[None, :], tol=1e-6)))]
     if len(soles) < 2 or len(holding) != 1:
