@@ -1,0 +1,211 @@
+"""One recorded push rerun with the id controller, per control step: every sole's plan and MuJoCo's.
+
+The measurement of docs/studies/torso-pushes.md §6 (after the fact, on spent sets). It reruns a
+push of ``studies/held_out_results_N/pushes.csv`` (the record's impulse, direction and body, the
+``id`` controller, 2.5 s after the push) and logs, every control step, per sole contact: the
+QP's planned and MuJoCo's realised normal force (N), centre of pressure (m, sole axes, beside the
+rectangle's half sizes), the planned contact's rate of change of the angular momentum about the
+CoM (``(p - c) x f + tau``, N m, world) and the sole's tilt from its start (deg); and for the
+whole robot: the root body's rotation from its start (deg), the centroidal angular momentum L
+(N m s, world, about the CoM, pinocchio), the QP's target rate ``-K_L L``, the planned and
+realised total rate, and whether the desired ZMP was clamped.
+
+    python benchmarks/torso_tipping.py 6 g1_wide_left_palm_oblique_side torso 90 0.75 \
+        --json /tmp/g1_90_075.json
+
+One trial takes a few minutes on a 2-core machine. Nothing here is part of the library: the
+controller's step is wrapped for the trial's duration.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import math
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import pinocchio as pin
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from hand_contact import _cop, _is_sole, _realised
+
+from impact_balance.sim.control.torque import InverseDynamicsController
+from impact_balance.sim.trials.balance_trial import run_balance_trial
+from impact_balance.sim.trials.setup import (
+    BalanceSetup,
+    BalanceTrialOptions,
+    Push,
+)
+
+
+def body_name(robot: str, body: str) -> str | None:
+    """The MuJoCo body the protocols pushed (None: the robot's default trunk)."""
+    if body == "torso":
+        return "WAIST_R_S" if robot == "jvrc1" else None
+    return "pelvis" if robot == "g1" else "base_link"
+
+
+class SoleLog:
+    """The per-step rows of one trial (see the module docstring)."""
+
+    def __init__(self, setup: BalanceSetup) -> None:
+        self.sim, self.analysis, self.rows = setup.sim, setup.analysis, []
+        self.soles = [
+            k for k, c in enumerate(setup.analysis.stance.contacts) if _is_sole(c.spec.frame)
+        ]
+        self.start: dict[int, np.ndarray] = {}
+        self.base_start: np.ndarray | None = None
+        self.data: Any = None
+
+    def add(self, c: InverseDynamicsController, t: float, q: Any, v: Any, out: Any) -> None:
+        """One control step, after the QP."""
+        if self.data is None:
+            self.data = c.model.createData()
+        hg = pin.computeCentroidalMomentum(c.model, self.data, q, v)
+        L = np.array(hg.angular)
+        com = np.asarray(out.com, dtype=float)
+        soles, rate_p, rate_r = [], np.zeros(3), np.zeros(3)
+        for k, contact in enumerate(self.analysis.stance.contacts):
+            frame = c.data.oMf[c.contact_frames[k]]
+            placement = frame * c.contact_offsets[k]
+            R, p = placement.rotation, placement.translation
+            w = out.wrenches[k]
+            force, moment, count = _realised(self.sim, self.sim.contact_geoms[k], p)
+            planned_rate = np.cross(p - com, w[:3]) + w[3:]
+            realised_rate = np.cross(p - com, force) + moment
+            rate_p += planned_rate
+            rate_r += realised_rate
+            if k not in self.soles:
+                continue
+            self.start.setdefault(k, frame.rotation.copy())
+            tilt = pin.log3(self.start[k].T @ frame.rotation)
+            soles.append(
+                {
+                    "frame": contact.spec.frame,
+                    "half_sizes": [c.contact_half_sizes[k][0], c.contact_half_sizes[k][1]],
+                    "planned_normal_force": float(R[:, 2] @ w[:3]),
+                    "realised_normal_force": float(R[:, 2] @ force),
+                    "planned_cop": _cop(R.T @ w[:3], R.T @ w[3:]),
+                    "realised_cop": _cop(R.T @ force, R.T @ moment),
+                    "planned_rate": planned_rate.tolist(),
+                    "realised_rate": realised_rate.tolist(),
+                    "points": count,
+                    "tilt_deg": math.degrees(float(np.linalg.norm(tilt))),
+                }
+            )
+        if self.base_start is None:
+            self.base_start = c.data.oMi[1].rotation.copy()
+        base_tilt = pin.log3(self.base_start.T @ c.data.oMi[1].rotation)
+        self.rows.append(
+            {
+                "time": t,
+                "base_rotation_deg": math.degrees(float(np.linalg.norm(base_tilt))),
+                "angular_momentum": L.tolist(),
+                "target_rate": (-c.gains.angular_momentum_damping * L).tolist(),
+                "planned_rate": rate_p.tolist(),
+                "realised_rate": rate_r.tolist(),
+                "zmp_clamped": bool(out.clamped),
+                "torque_limited": bool(out.torque_limited),
+                "com_velocity": np.asarray(out.com_velocity, dtype=float).tolist(),
+                "soles": soles,
+            }
+        )
+
+
+@contextlib.contextmanager
+def logged(log: SoleLog) -> Iterator[None]:
+    """Wrap the id controller's step for the trial's duration."""
+    step = InverseDynamicsController.step
+
+    def logged_step(self: InverseDynamicsController, t: float, q: Any, v: Any, *args: Any) -> Any:
+        out = step(self, t, q, v, *args)
+        log.add(self, t, q, v, out)
+        return out
+
+    InverseDynamicsController.step = logged_step  # type: ignore[method-assign]
+    try:
+        yield
+    finally:
+        InverseDynamicsController.step = step  # type: ignore[method-assign]
+
+
+def summary(rows: list[dict[str, Any]], push_end: float) -> dict[str, Any]:
+    """Per sole: the largest tilt and when; when its realised CoP first reaches 95 % of an edge."""
+    out: dict[str, Any] = {}
+    for i, sole in enumerate(rows[0]["soles"]):
+        hx, hy = sole["half_sizes"]
+        tilts = [r["soles"][i]["tilt_deg"] for r in rows]
+        k = int(np.argmax(tilts))
+        edge, planned_edge = None, None
+        for r in rows:
+            s = r["soles"][i]
+            x, y = s["realised_cop"]
+            if edge is None and (
+                s["realised_normal_force"] < 1.0 or abs(x) >= 0.95 * hx or abs(y) >= 0.95 * hy
+            ):
+                edge = r["time"] - push_end
+            px, py = s["planned_cop"]
+            if planned_edge is None and (abs(px) >= 0.95 * hx or abs(py) >= 0.95 * hy):
+                planned_edge = r["time"] - push_end
+        out[sole["frame"]] = {
+            "max_tilt_deg": tilts[k],
+            "at_s_after_push": rows[k]["time"] - push_end,
+            "realised_cop_at_edge_s": edge,
+            "planned_cop_at_edge_s": planned_edge,
+        }
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Rerun one recorded push, print its summary and every ``--every``-th row."""
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("set")
+    p.add_argument("stance")
+    p.add_argument("body", choices=("torso", "pelvis"))
+    p.add_argument("direction", type=float, help="deg, world")
+    p.add_argument("relative", type=float)
+    p.add_argument("--after", type=float, default=2.5)
+    p.add_argument("--every", type=int, default=50)
+    p.add_argument("--json", default=None)
+    args = p.parse_args(argv)
+    records = pd.read_csv(f"studies/held_out_results_{args.set}/pushes.csv")
+    r = records[
+        (records.stance == args.stance)
+        & (records.body == args.body)
+        & (records.direction_deg == args.direction)
+        & ((records.relative - args.relative).abs() < 1e-6)
+    ].iloc[0]
+    options = BalanceTrialOptions(controller="id", after=args.after)
+    setup = BalanceSetup.create(f"studies/held_out_{args.set}/{args.stance}.yaml", "servo", options)
+    push = Push(
+        math.radians(args.direction),
+        float(r.impulse_Ns),
+        0.05,
+        options.settle,
+        body_name(args.stance.split("_")[0], args.body),
+    )
+    log = SoleLog(setup)
+    with logged(log):
+        result = run_balance_trial(setup, push=push, options=options)
+    s = result.summary()
+    head = {k: s.get(k) for k in ("outcome", "reason", "strict_fail")}
+    head["record"] = {"outcome": r.outcome, "strict_reason": r.strict_reason}
+    head["soles"] = summary(log.rows, push.start + push.duration)
+    print(json.dumps(head, default=str))
+    for row in log.rows[:: args.every]:
+        print(json.dumps(row))
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump({"summary": head, "rows": log.rows}, f)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
