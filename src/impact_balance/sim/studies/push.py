@@ -576,7 +576,10 @@ def predict_push(
         ScenarioError: With ``finite_push``, a push duration that kappa does not take.
     """
     a = setup.analysis
-    areas, mass, g = setup.prediction_areas, a.stance.mass, a.areas.gravity
+    # The criterion's areas, at the scenario's friction_scale (none: the analysis's).
+    criterion = getattr(setup, "criterion_areas", None)
+    areas = a.areas if criterion is None else criterion
+    mass, g = a.stance.mass, a.areas.gravity
     u = np.array([np.cos(push.direction), np.sin(push.direction)])
     c0 = np.asarray(START_COM_VELOCITY, dtype=float)  # the trial starts at rest
     velocity = c0 + push.magnitude * u / mass

@@ -202,11 +202,6 @@ class BalanceSetup:
             )
         return cls(scenario, joint_model, analysis, sim, support_v, options.controller, criterion)
 
-    @property
-    def prediction_areas(self) -> BalanceAreas:
-        """The areas the predictions use (no ZMP margin), at the scenario's friction scale."""
-        return self.analysis.areas if self.criterion_areas is None else self.criterion_areas
-
     def start_configuration(self, standoff: float = 0.0) -> np.ndarray:
         """The stance with the impact point backed off ``standoff`` (m) along the normal (cached).
 
