@@ -25,3 +25,17 @@ def test_the_governor_answers_analyze_default_with_the_angular_momentum(name, ta
     # the scenario of a tick keeps the option
     replay = governor.scenario_at(governor.configuration, scenario.com_velocity)
     assert replay.angular_momentum_damping_time == tau
+
+
+@pytest.mark.parametrize("name", ["talos_three_contacts", "palm_push_two_feet"])
+def test_the_governor_answers_analyze_with_the_friction_scale(name):
+    scenario = load_scenario(name).replace(friction_scale=0.65)
+    governor = Governor(scenario)
+    limit = governor.limit_com(governor.configuration, scenario.com_velocity)
+    expected = analyze(scenario).impact
+    assert limit.max_contact_velocity == pytest.approx(
+        expected.default.max_contact_velocity, abs=1e-9
+    )
+    assert (
+        governor.scenario_at(governor.configuration, scenario.com_velocity).friction_scale == 0.65
+    )

@@ -21,6 +21,7 @@ from impact_balance.balance.areas import (
     with_reason,
 )
 from impact_balance.balance.lipm import lipm_omega
+from impact_balance.contacts.contact_model import scaled_stance
 from impact_balance.contacts.cwc import local_faces
 from impact_balance.contacts.stance import Stance
 from impact_balance.contacts.wrench_polytope import (
@@ -57,6 +58,7 @@ __all__ = [
     "ImpactAnswer",
     "analyze",
     "angular_momentum_term",
+    "contact_model_areas",
     "impact_answer",
     "stance_areas",
     "stance_posture",
@@ -69,10 +71,12 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
     The scenario's ``zmp_margin`` (m) shrinks the ZMP support area, and the CoM velocity
     area with it; its ``velocity_margin`` (m/s) keeps every post-impact CoM velocity that far
     inside the CoM velocity area (the CoM criterion, its safe interval and the QP; the ZMP
-    criterion has no velocity margin). A :class:`~impact_balance.governor.Governor` of the
-    same scenario answers the same maximum contact velocity at the scenario's posture and
-    CoM velocity. After the stance, the areas, the impact model and the CoM criterion's rates
-    are the governor's one compiled call
+    criterion has no velocity margin); its ``friction_scale`` multiplies every contact's
+    friction in the areas (:func:`~impact_balance.contacts.contact_model.scaled_stance`; the
+    returned stance keeps the scenario's frictions). A
+    :class:`~impact_balance.governor.Governor` of the same scenario answers the same maximum
+    contact velocity at the scenario's posture and CoM velocity. After the stance, the areas,
+    the impact model and the CoM criterion's rates are the governor's one compiled call
     (:func:`~impact_balance.criteria.posture_kernel.posture_kernel`) where it answers, the
     steps one by one elsewhere: the same numbers.
 
@@ -111,11 +115,15 @@ def analyze(scenario: Scenario | str, solve_qp: bool | None = None) -> Analysis:
         qp = scenario.impact is not None and (
             scenario.impact.qp.solve if solve_qp is None else solve_qp
         )
-        polytope, areas, model, criterion, t2 = _posture(scenario, stance, clock.now, polytope=qp)
+        # The criterion's contacts: the scenario's, their friction times its friction_scale.
+        criterion_stance = scaled_stance(stance, scenario.friction_scale)
+        polytope, areas, model, criterion, t2 = _posture(
+            scenario, criterion_stance, clock.now, polytope=qp
+        )
         t3 = clock.now()
         timings.update(stance=t1 - t0, constraints=t2 - t1, areas=t3 - t2)
         if not areas.can_balance:  # explain why (LPs; only for a stance that cannot balance)
-            areas = with_reason(areas, stance, scenario.torque_limits, scenario.gravity)
+            areas = with_reason(areas, criterion_stance, scenario.torque_limits, scenario.gravity)
             timings["diagnosis"] = clock.now() - t3
             t3 = clock.now()
         if model is None or not _posture_finite(stance, areas, model):
@@ -148,7 +156,7 @@ def stance_posture(
 
     Args:
         scenario: Its ``torque_limits``, ``gravity``, ``plane_height`` (m), ``zmp_margin`` (m),
-            ``velocity_margin`` (m/s) and ``impact`` are used.
+            ``velocity_margin`` (m/s), ``friction_scale`` and ``impact`` are used.
         stance: The robot at a configuration with its contacts (world frame).
 
     Returns:
@@ -161,7 +169,10 @@ def stance_posture(
     Raises:
         SolverError: The projection failed (named as the projection of the contacts' polytope).
     """
-    _, areas, model, criterion, _ = _posture(scenario, stance, time.perf_counter, polytope=False)
+    criterion_stance = scaled_stance(stance, scenario.friction_scale)
+    _, areas, model, criterion, _ = _posture(
+        scenario, criterion_stance, time.perf_counter, polytope=False
+    )
     return areas, model, criterion
 
 
@@ -174,8 +185,8 @@ def stance_areas(scenario: Scenario, stance: Stance) -> tuple[WrenchPolytope, Ba
     it where it does).
 
     Args:
-        scenario: Its ``torque_limits``, ``gravity``, ``plane_height`` (m) and ``zmp_margin``
-            (m) are used.
+        scenario: Its ``torque_limits``, ``gravity``, ``plane_height`` (m), ``zmp_margin``
+            (m) and ``friction_scale`` are used.
         stance: The robot at a configuration with its contacts (world frame).
 
     Returns:
@@ -184,9 +195,37 @@ def stance_areas(scenario: Scenario, stance: Stance) -> tuple[WrenchPolytope, Ba
     Raises:
         SolverError: The projection failed (named as the projection of the contacts' polytope).
     """
-    polytope, areas, _ = _stance_areas(scenario, stance)
+    polytope, areas, _ = _stance_areas(scenario, scaled_stance(stance, scenario.friction_scale))
     assert polytope is not None  # asked for
     return polytope, areas
+
+
+def contact_model_areas(
+    scenario: Scenario, stance: Stance, friction_scale: float, cop_margin: float = 0.0
+) -> BalanceAreas:
+    """The balance areas of a contact model narrower than the scenario's contacts.
+
+    :func:`stance_areas`' pipeline (the scenario's torque limits, gravity, plane and ZMP
+    margin) on :func:`~impact_balance.contacts.contact_model.scaled_stance`: every contact's
+    friction times ``friction_scale`` and its rectangle inset by ``cop_margin``, whatever the
+    scenario's own ``friction_scale``. The areas a controller whose contact wrench cones are
+    those can realise (the ``id`` controller's ZMP clamp).
+
+    Args:
+        scenario: As for :func:`stance_areas` (its ``friction_scale`` is not used).
+        stance: The robot at a configuration with the scenario's contacts (world frame).
+        friction_scale: In (0, 1].
+        cop_margin: The rectangles' inset on every side, m (>= 0).
+
+    Returns:
+        The ZMP support and CoM velocity areas (world frame).
+
+    Raises:
+        ScenarioError: A friction scale outside (0, 1] or a negative ``cop_margin``.
+        SolverError: The projection failed.
+    """
+    narrower = scaled_stance(stance, friction_scale, cop_margin)
+    return _stance_areas(scenario, narrower, polytope=False)[1]
 
 
 def _answer(

@@ -187,6 +187,11 @@ class Analysis:
                 if self.scenario.angular_momentum_damping_time is None
                 else {"angular_momentum_damping_time": self.scenario.angular_momentum_damping_time}
             ),
+            **(
+                {}
+                if self.scenario.friction_scale == 1.0
+                else {"friction_scale": self.scenario.friction_scale}
+            ),
             "gravity": a.gravity,
             "com_velocity": self.com_velocity.tolist(),
             "com_velocity_inside": self.com_velocity_inside,

@@ -431,6 +431,7 @@ def open_journal(
                 "zmp_margin",
                 "velocity_margin",
                 "angular_momentum_damping_time",
+                "friction_scale",
                 "name",
                 "description",
             },

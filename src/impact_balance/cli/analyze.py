@@ -17,6 +17,7 @@ from impact_balance.cli._options import (
 )
 from impact_balance.cli.angular_momentum import add_angular_momentum_option, with_angular_momentum
 from impact_balance.cli.calibrate import add_calibration_option, apply_calibration_option
+from impact_balance.cli.friction_scale import add_friction_scale_option, with_friction_scale
 
 if TYPE_CHECKING:
     from impact_balance.analysis.held_stance import HeldStanceLimit
@@ -72,6 +73,7 @@ def add_parser(sub: Subcommands) -> list[str]:
     add_velocity_margin_option(a, "CoM criterion")
     add_calibration_option(a)
     add_angular_momentum_option(a, controller=False)
+    add_friction_scale_option(a, controller=False)
     return ["analyze"]
 
 
@@ -103,6 +105,13 @@ def run(args: argparse.Namespace) -> int:
         scenario = with_angular_momentum(
             load_scenario(scenario) if isinstance(scenario, str) else scenario,
             args.angular_momentum_damping_time,
+        )
+    if args.friction_scale is not None:
+        from impact_balance.scenario import load_scenario
+
+        scenario = with_friction_scale(
+            load_scenario(scenario) if isinstance(scenario, str) else scenario,
+            args.friction_scale,
         )
     analysis = analyze(scenario, solve_qp=True if args.qp else None)
     if args.strict and analysis.warnings:

@@ -25,6 +25,7 @@ from impact_balance.cli._options import (
 )
 from impact_balance.cli.angular_momentum import add_angular_momentum_option, for_trials
 from impact_balance.cli.calibrate import add_calibration_option, apply_calibration_option
+from impact_balance.cli.friction_scale import add_friction_scale_option, friction_scale_for_trials
 
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
@@ -142,7 +143,8 @@ def add_parser(sub: Subcommands) -> list[str]:
 
 
 def _add_impact_model_option(a: argparse.ArgumentParser) -> None:
-    """Add ``--impact-model`` (the governor's impact model) to ``approach``'s parser ``a``."""
+    """Add ``--impact-model`` and ``--friction-scale`` to ``approach``'s parser ``a``."""
+    add_friction_scale_option(a, controller=True)
     add_impact_model_option(
         a,
         "the com governor caps with the held-stance jumps of the scenario's posture, computed "
@@ -196,6 +198,7 @@ def run(args: argparse.Namespace) -> int:
     _check_distances(args, distances)
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
     scenario = for_trials(scenario, args.angular_momentum_damping_time, options)
+    scenario = friction_scale_for_trials(scenario, args.friction_scale, options)
     own = scoring_margin(scenario)
     margin = controller_margin(options) if own is None else own
     # The governor's view: the area the controller can use.
@@ -218,6 +221,8 @@ def run(args: argparse.Namespace) -> int:
             governed.angular_momentum_damping_time if governor is not None else None
         )
         d["contact_aware_async"] = bool(args.contact_aware_async and governor is not None)
+        if governed.friction_scale != 1.0 and governor is not None:
+            d["friction_scale"] = governed.friction_scale
         if calibration is not None:
             d["calibration"] = calibration
     from impact_balance.sim.studies.wall import pooled_tick_statistics

@@ -20,6 +20,7 @@ from impact_balance.cli._options import (
 )
 from impact_balance.cli.angular_momentum import add_angular_momentum_option, for_trials
 from impact_balance.cli.calibrate import add_calibration_option, apply_calibration_option
+from impact_balance.cli.friction_scale import add_friction_scale_option, friction_scale_for_trials
 
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
@@ -114,6 +115,7 @@ def add_parser(sub: Subcommands) -> list[str]:
     add_calibration_option(a)
     add_output_options(a, "of one telling push")
     add_angular_momentum_option(a, controller=True)
+    add_friction_scale_option(a, controller=True)
     return ["push-test"]
 
 
@@ -142,6 +144,7 @@ def run(args: argparse.Namespace) -> int:
     check_push_arguments(args.directions, args.magnitudes, args.duration, relative)
     options = BalanceTrialOptions(controller=args.controller)
     judged = for_trials(scenario, args.angular_momentum_damping_time, options)
+    judged = friction_scale_for_trials(judged, args.friction_scale, options)
     journal = open_journal(args, "push-test", scenario, "servo", options, {"body": args.body})
     scenario = judged  # the trials journal keys the scenario without the option
     levels = len(relative or args.magnitudes or [0] * 6)
@@ -175,6 +178,8 @@ def run(args: argparse.Namespace) -> int:
     # The option as given ("controller", a number, "off" or null): a criterion setting of the
     # predictions that a calibration records and requires to agree between its files.
     out["angular_momentum_option"] = args.angular_momentum_damping_time
+    if scenario.friction_scale != 1.0:
+        out["friction_scale"] = scenario.friction_scale
     if calibration is not None:
         out["calibration"] = calibration
     written = []

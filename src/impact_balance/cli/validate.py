@@ -23,6 +23,7 @@ from impact_balance.cli._options import (
 )
 from impact_balance.cli.angular_momentum import add_angular_momentum_option, for_trials
 from impact_balance.cli.calibrate import add_calibration_option, apply_calibration_option
+from impact_balance.cli.friction_scale import add_friction_scale_option, friction_scale_for_trials
 
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
@@ -77,6 +78,7 @@ def add_parser(sub: Subcommands) -> list[str]:
     add_calibration_option(a)
     add_output_options(a, "of the fastest trial survived")
     add_angular_momentum_option(a, controller=True)
+    add_friction_scale_option(a, controller=True)
     return ["validate"]
 
 
@@ -99,6 +101,7 @@ def run(args: argparse.Namespace) -> int:
     options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
     joints = TRIAL_JOINTS[args.joints]  # the study's name (the journals' digests keep it)
     judged = for_trials(scenario, args.angular_momentum_damping_time, options)
+    judged = friction_scale_for_trials(judged, args.friction_scale, options)
     journal = open_journal(
         args,
         "validate",
@@ -137,6 +140,8 @@ def run(args: argparse.Namespace) -> int:
         journal.close()
     out = result.to_dict()
     out["joints"] = args.joints
+    if scenario.friction_scale != 1.0:
+        out["friction_scale"] = scenario.friction_scale
     if calibration is not None:
         out["calibration"] = calibration
     written = []

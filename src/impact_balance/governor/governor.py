@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike
 from impact_balance._jit import njit
 from impact_balance.balance.areas import warm_up as warm_up_maps
 from impact_balance.constants import MAX_POSITION, MAX_SPEED
+from impact_balance.contacts.contact_model import scaled_contact
 from impact_balance.contacts.stance import ContactSpec, has_free_flyer
 from impact_balance.criteria.cap import cap_approach
 from impact_balance.criteria.linear_exit import BOUNDARY_TOLERANCE, EXIT_STATUSES, speed_interval
@@ -124,6 +125,8 @@ class Governor:
     Its ``angular_momentum_damping_time`` (s) likewise makes the "com" criterion count the
     centroidal angular momentum the impulse leaves, as ``analyze``'s default answer does
     (:mod:`impact_balance.impact.angular_momentum`; the contact-aware bound does not count it).
+    Its ``friction_scale`` makes both criteria see every contact's friction times it, as
+    ``analyze`` does (the areas a controller that uses that share of the cones can realise).
 
     Args:
         scenario: A :class:`~impact_balance.scenario.Scenario`, a scenario file or a bundled
@@ -229,7 +232,8 @@ class Governor:
         if impact_model == "held-stance":
             self.held_stance = held_stance_jumps(stance, scenario.impact.spec())
         settings = PostureSettings(
-            self.contacts,
+            # The criterion's contacts: friction times the scenario's friction_scale.
+            tuple(scaled_contact(c, scenario.friction_scale) for c in self.contacts),
             scenario.impact.spec(),
             float(scenario.plane_height),
             float(scenario.gravity),

@@ -78,6 +78,17 @@ class ScenarioTabMixin(GuiHost):
         self.w_angular_momentum.on_update(
             self._field(("angular_momentum_damping_time",), _damping_time)
         )
+        self.w_friction_scale = gui.add_number(
+            "friction scale",
+            1.0,
+            min=0.05,
+            max=1.0,
+            step=0.05,
+            hint="The criterion sees every contact's friction times this, in (0, 1]: what a "
+            "controller that uses that share of the cones can realise (0.65: the id "
+            "controller); 1: the paper's",
+        )
+        self.w_friction_scale.on_update(self._field(("friction_scale",), float))
         self.w_gizmos = gui.add_checkbox(
             "drag gizmos",
             True,
@@ -136,6 +147,7 @@ class ScenarioTabMixin(GuiHost):
         set_value(self.w_zmp_margin, float(scenario.zmp_margin))
         tau = scenario.angular_momentum_damping_time
         set_value(self.w_angular_momentum, -1.0 if tau is None else float(tau))
+        set_value(self.w_friction_scale, float(scenario.friction_scale))
         source = state.source
         name = (
             self.workspace.relative(os.path.abspath(source))

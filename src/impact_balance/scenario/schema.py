@@ -258,6 +258,10 @@ class Scenario(_Model):
     angular_momentum_damping_time: (
         Annotated[Number, _scalar(0.0, MAX_ANGULAR_MOMENTUM_DAMPING_TIME, "s")] | None
     ) = DEFAULT_ANGULAR_MOMENTUM_DAMPING_TIME
+    #: The criterion sees every contact's friction times this factor, in (0, 1]: the balance a
+    #: controller that keeps its contact forces within that share of the friction cone can
+    #: realise (docs/robots.md). 1 is the paper's criterion. The simulated contacts keep theirs.
+    friction_scale: Annotated[Number, _scalar(0.0, 1.0, lo_open=True)] = 1.0
     torque_limits: Flag = True
     gravity: Annotated[Number, _scalar(*GRAVITY_RANGE, "m/s^2")] = 9.81
     contacts: list[ContactConfig] = Field(min_length=1)

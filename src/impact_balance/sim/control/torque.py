@@ -13,7 +13,12 @@ free-flyer velocity in the base frame):
    momentum matrix ``A_g`` and its drift ``A_g_dot v``, the contact Jacobians ``J_i`` (world-aligned
    axes, at the contact point) and their drifts ``J_i_dot v``.
 2. :class:`~.zmp.DcmFeedback` (the same as the kinematic controller's) picks the desired ZMP
-   ``p = xi + (k/omega)(xi - xi_ref)`` clamped to the scenario's ZMP support area.
+   ``p = xi + (k/omega)(xi - xi_ref)`` clamped to the ZMP support area of the contact model
+   the QP enforces (:func:`clamp_areas`): the scenario's stance, torque limits, plane and ZMP
+   margin, every contact's friction times ``friction_scale`` and its rectangle shrunk by
+   ``cop_margin``, computed once by the library's pipeline
+   (:func:`~impact_balance.analysis.analyze.contact_model_areas`). A ZMP of the full-friction
+   area outside this one needs wrenches the QP's cones refuse.
 3. One dense QP (daqp, called directly: the step must stay well under a millisecond) in
    ``x = [a (nv); w_1 .. w_nc (6 each)]``, the joint accelerations and the contact wrenches
    ``[f; tau]`` (world axes, at each contact point):
@@ -63,8 +68,10 @@ import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
-from impact_balance.analysis.analyze import Analysis
+from impact_balance.analysis.analyze import Analysis, contact_model_areas
+from impact_balance.balance.areas import BalanceAreas
 from impact_balance.balance.lipm import lipm_omega
+from impact_balance.contacts.contact_model import inset_half_size
 from impact_balance.contacts.cwc import cwc_faces_world
 from impact_balance.geometry.spatial import skew
 from impact_balance.sim.control.actuation import use_torque_motors
@@ -74,7 +81,7 @@ from impact_balance.sim.control.gains import InverseDynamicsGains, TrialGains, t
 from impact_balance.sim.control.zmp import DcmFeedback
 from impact_balance.sim.model.build import SimModel
 
-__all__ = ["InverseDynamicsController", "TorqueOutput", "motor_compensation"]
+__all__ = ["InverseDynamicsController", "TorqueOutput", "clamp_areas", "motor_compensation"]
 
 _FloatArray = npt.NDArray[np.float64]
 
@@ -165,6 +172,33 @@ def motor_compensation(
     return answer
 
 
+def clamp_areas(analysis: Analysis, gains: InverseDynamicsGains) -> BalanceAreas:
+    """The balance areas of the contact model the ``id`` controller's QP enforces.
+
+    :func:`~impact_balance.analysis.analyze.contact_model_areas` of the analysis's scenario and
+    stance with every contact's friction times ``gains.friction_scale`` and its rectangle shrunk
+    by ``gains.cop_margin`` (m; never below half its size, as the QP's). The analysis's own
+    areas when both leave the contacts as they are (scale 1, margin 0, and the analysis at the
+    scenario's frictions).
+
+    Args:
+        analysis: The scenario's analysis (its stance's contacts are the scenario's).
+        gains: The controller's gains.
+
+    Returns:
+        The ZMP support area and CoM velocity area (world frame) the desired ZMP is clamped to.
+    """
+    if (
+        gains.friction_scale == 1.0
+        and gains.cop_margin == 0.0
+        and analysis.scenario.friction_scale == 1.0
+    ):
+        return analysis.areas
+    return contact_model_areas(
+        analysis.scenario, analysis.stance, gains.friction_scale, gains.cop_margin
+    )
+
+
 def _point_jacobian(
     model: pin.Model, data: pin.Data, fid: int, offset: pin.SE3
 ) -> tuple[pin.SE3, np.ndarray, np.ndarray]:
@@ -245,8 +279,10 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         com0 = np.array(pin.centerOfMass(model, self.data, self.q0), dtype=float)
         self.com_height = float(com0[2])
         self.omega = lipm_omega(self.com_height, self.plane_height, self.gravity)
+        #: The areas of the QP's contact model (:func:`clamp_areas`): the desired ZMP's clamp.
+        self.clamp_areas = clamp_areas(analysis, gains)
         self.feedback = DcmFeedback(
-            analysis.areas.zmp_area, self.omega, com0[:2].copy(), gains.dcm_gain, gains.zmp_margin
+            self.clamp_areas.zmp_area, self.omega, com0[:2].copy(), gains.dcm_gain, gains.zmp_margin
         )
         pin.framesForwardKinematics(model, self.data, self.q0)
         self.contact_frames = [model.getFrameId(c.spec.frame) for c in stance.contacts]
@@ -254,8 +290,8 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         self.contact_specs = [c.spec for c in stance.contacts]
         self.contact_half_sizes = [
             (
-                max(c.half_length - gains.cop_margin, 0.5 * c.half_length),
-                max(c.half_width - gains.cop_margin, 0.5 * c.half_width),
+                inset_half_size(c.half_length, gains.cop_margin),
+                inset_half_size(c.half_width, gains.cop_margin),
             )
             for c in stance.contacts
         ]

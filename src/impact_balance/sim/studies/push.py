@@ -25,6 +25,11 @@ of 0.03, say) plus a few far points; the scores are then also given on the band 
 Every trial starts at rest, so the predictions start from a CoM at rest too (``c0 = 0``), whatever
 the scenario's ``com_velocity``.
 
+With the scenario's ``friction_scale`` below 1, every prediction (``com`` and ``paper_com``) uses
+the areas of the contacts at that share of their friction
+(:func:`~impact_balance.analysis.analyze.contact_model_areas`); the grid's boundary impulses stay
+those of the contacts' own friction, so that the pushes do not move with a criterion setting.
+
 ``com`` is the project's default prediction; ``paper_com`` is the paper's CoM criterion. With the
 scenario's ``angular_momentum_damping_time`` tau set, ``com`` counts the centroidal angular momentum
 the push leaves, ``L = (p - c) x J u`` (p the pushed body's centre of mass, c the CoM): the
@@ -571,7 +576,10 @@ def predict_push(
         ScenarioError: With ``finite_push``, a push duration that kappa does not take.
     """
     a = setup.analysis
-    areas, mass, g = a.areas, a.stance.mass, a.areas.gravity
+    # The criterion's areas, at the scenario's friction_scale (none: the analysis's).
+    criterion = getattr(setup, "criterion_areas", None)
+    areas = a.areas if criterion is None else criterion
+    mass, g = a.stance.mass, a.areas.gravity
     u = np.array([np.cos(push.direction), np.sin(push.direction)])
     c0 = np.asarray(START_COM_VELOCITY, dtype=float)  # the trial starts at rest
     velocity = c0 + push.magnitude * u / mass

@@ -12,7 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from impact_balance.analysis.analyze import Analysis, analyze
+from impact_balance.analysis.analyze import Analysis, analyze, contact_model_areas
+from impact_balance.balance.areas import BalanceAreas
 from impact_balance.exceptions import SimulationError
 from impact_balance.scenario import Scenario, load_scenario
 from impact_balance.sim.control.actuation import STIFF_SERVOS, support_joints
@@ -137,8 +138,10 @@ def controller_margin(options: BalanceTrialOptions) -> float:
 class BalanceSetup:
     """A scenario prepared for trials: analysis, MuJoCo model, start configurations.
 
-    The analysis is without ZMP margin (the controller is configured on its own); one start
-    configuration per standoff of the impacting point.
+    The analysis is without ZMP margin and at the contacts' own frictions (the controller is
+    configured on its own); one start configuration per standoff of the impacting point.
+    ``criterion_areas`` are the areas the predictions use when the scenario's
+    ``friction_scale`` is below 1 (without ZMP margin); None: the analysis's.
     """
 
     scenario: Scenario
@@ -147,6 +150,7 @@ class BalanceSetup:
     sim: SimModel
     support_v_index: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     controller: ControllerName = "ik"
+    criterion_areas: BalanceAreas | None = None
     _starts: dict[float, np.ndarray] = field(default_factory=dict)
 
     @classmethod
@@ -168,8 +172,9 @@ class BalanceSetup:
             scenario = load_scenario(scenario)
         joint_model = check_joint_model(joints)
         controller = controller_class(options.controller)
-        # The controller works on the areas themselves: a scoring margin is applied afterwards.
-        analysis = analyze(scenario.model_copy(update={"zmp_margin": 0.0}))
+        # The controller works on the areas themselves: a scoring margin is applied afterwards;
+        # the criterion's friction_scale is a prediction's setting, not the controller's.
+        analysis = analyze(scenario.model_copy(update={"zmp_margin": 0.0, "friction_scale": 1.0}))
         if not analysis.areas.can_balance:
             raise SimulationError(
                 "scenario",
@@ -190,7 +195,12 @@ class BalanceSetup:
         controller.prepare_model(sim, analysis)
         support = [analysis.stance.robot.joint_slot(n) for n in support_joints(sim, analysis)]
         support_v = np.array([analysis.stance.model.joints[j.id].idx_v for j in support], dtype=int)
-        return cls(scenario, joint_model, analysis, sim, support_v, options.controller)
+        criterion = None
+        if scenario.friction_scale != 1.0:
+            criterion = contact_model_areas(
+                analysis.scenario, analysis.stance, scenario.friction_scale
+            )
+        return cls(scenario, joint_model, analysis, sim, support_v, options.controller, criterion)
 
     def start_configuration(self, standoff: float = 0.0) -> np.ndarray:
         """The stance with the impact point backed off ``standoff`` (m) along the normal (cached).
