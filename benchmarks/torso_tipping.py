@@ -25,6 +25,7 @@ import json
 import math
 import sys
 from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +37,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from hand_contact import _cop, _is_sole, _realised
 
+from impact_balance.sim.control.gains import (
+    RobotScales,
+    capture_angular_momentum_weight,
+    robot_id_gains,
+)
 from impact_balance.sim.control.torque import InverseDynamicsController
 from impact_balance.sim.trials.balance_trial import run_balance_trial
 from impact_balance.sim.trials.setup import (
@@ -163,6 +169,19 @@ def summary(rows: list[dict[str, Any]], push_end: float) -> dict[str, Any]:
     return out
 
 
+def with_capture_weight(options: BalanceTrialOptions, setup: BalanceSetup) -> BalanceTrialOptions:
+    """``options`` with the robot's id gains, the L task weighted by the capture's cost.
+
+    :func:`~impact_balance.sim.control.gains.capture_angular_momentum_weight` in place of the
+    default rule; every other gain derived from the robot as the trial would.
+    """
+    scales = RobotScales.of_sim(setup.sim)
+    gains = robot_id_gains(scales, options.id_gains)
+    weight = capture_angular_momentum_weight(scales, gains.com_weight)
+    gains = replace(gains, angular_momentum_weight=weight)
+    return replace(options, id_gains=gains, robot_gains=False)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Rerun one recorded push, print its summary and every ``--every``-th row."""
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -174,6 +193,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--after", type=float, default=2.5)
     p.add_argument("--every", type=int, default=50)
     p.add_argument("--json", default=None)
+    p.add_argument(
+        "--angular-momentum-weight",
+        choices=("robot", "capture"),
+        default="robot",
+        help="the L task's weight: the default rule, or com_weight / h^2 (the capture's cost)",
+    )
     args = p.parse_args(argv)
     records = pd.read_csv(f"studies/held_out_results_{args.set}/pushes.csv")
     r = records[
@@ -184,6 +209,8 @@ def main(argv: list[str] | None = None) -> int:
     ].iloc[0]
     options = BalanceTrialOptions(controller="id", after=args.after)
     setup = BalanceSetup.create(f"studies/held_out_{args.set}/{args.stance}.yaml", "servo", options)
+    if args.angular_momentum_weight == "capture":
+        options = with_capture_weight(options, setup)
     push = Push(
         math.radians(args.direction),
         float(r.impulse_Ns),
@@ -197,6 +224,7 @@ def main(argv: list[str] | None = None) -> int:
     s = result.summary()
     head = {k: s.get(k) for k in ("outcome", "reason", "strict_fail")}
     head["record"] = {"outcome": r.outcome, "strict_reason": r.strict_reason}
+    head["angular_momentum_weight"] = args.angular_momentum_weight
     head["soles"] = summary(log.rows, push.start + push.duration)
     print(json.dumps(head, default=str))
     for row in log.rows[:: args.every]:

@@ -17,6 +17,7 @@ from impact_balance.sim.control.gains import (
     BalanceGains,
     InverseDynamicsGains,
     RobotScales,
+    capture_angular_momentum_weight,
     robot_gains,
     robot_id_gains,
 )
@@ -112,3 +113,44 @@ def test_the_given_gains_are_kept_outside_the_rules():
     assert (g.zmp_margin, g.friction_scale) == (0.02, 0.5)
     with pytest.raises(ValueError, match="timestep"):
         _scales("go2", 0.0)
+
+
+CONSISTENT_SCALES = st.builds(
+    lambda mass, height, gyration: RobotScales(
+        mass, height, math.sqrt(9.81 / height), gyration, 9.81, 0.001
+    ),
+    mass=st.floats(1.0, 200.0),
+    height=st.floats(0.1, 1.5),
+    gyration=st.floats(0.05, 0.8),
+)
+
+
+@given(
+    scales=CONSISTENT_SCALES,
+    com_weight=st.floats(1.0, 1e4),
+    displacement=st.floats(1e-4, 0.2),
+)
+@settings(max_examples=50, deadline=None)
+def test_the_capture_weight_prices_a_metre_of_cmp_as_the_com_task_does(
+    scales, com_weight, displacement
+):
+    # Independently of the rule's h: a CoM acceleration error moves the CMP by e_c / omega^2;
+    # a moment error tau about the CoM moves the ZMP off the CMP by tau / (m g), and the QP's
+    # L rows are per unit mass (e_L = tau / m).
+    weight = capture_angular_momentum_weight(scales, com_weight)
+    com_error = displacement * scales.omega**2
+    moment = displacement * scales.mass * scales.gravity
+    com_cost = com_weight * com_error**2
+    angular_cost = weight * (moment / scales.mass) ** 2
+    assert angular_cost == pytest.approx(com_cost, rel=1e-9)
+
+
+def test_the_capture_weight_on_talos_and_its_bad_input():
+    scales = _scales("palm_push_two_feet")
+    weight = capture_angular_momentum_weight(scales, InverseDynamicsGains().com_weight)
+    assert weight == pytest.approx(1000.0 / scales.com_height**2)
+    assert weight > 1e4 * InverseDynamicsGains().angular_momentum_weight
+    with pytest.raises(ValueError, match="com_weight"):
+        capture_angular_momentum_weight(scales, 0.0)
+    with pytest.raises(ValueError, match="com_height"):
+        capture_angular_momentum_weight(dataclasses.replace(scales, com_height=-0.1), 1000.0)

@@ -50,6 +50,7 @@ __all__ = [
     "InverseDynamicsGains",
     "RobotScales",
     "TrialGains",
+    "capture_angular_momentum_weight",
     "declared_angular_momentum_damping",
     "robot_gains",
     "robot_id_gains",
@@ -287,6 +288,33 @@ def robot_id_gains(
         torque_regularization=6.4 / (weight * scales.com_height) ** 2,
         min_normal_force=max(0.0225 * weight, MIN_NORMAL_FORCE),
     )
+
+
+def capture_angular_momentum_weight(scales: RobotScales, com_weight: float) -> float:
+    """The angular momentum task's weight that costs the capture what the CoM task's does.
+
+    The ``id`` QP weighs the CoM task's residual ``e_c`` (m/s^2, the CoM acceleration's) by
+    ``com_weight`` and the angular momentum task's ``e_L`` (m^2/s^2, the rate of L about the CoM
+    per unit mass) by the returned weight. Under the LIPM (CoM at height h, omega^2 = g / h), a
+    horizontal CoM acceleration error ``e_c`` moves the centroidal moment pivot by
+    ``e_c / omega^2 = e_c h / g`` (m), and a horizontal moment error ``m e_L`` about the CoM moves
+    the ZMP away from the CMP by ``m e_L / (m g) = e_L / g`` (m). Equal cost per metre of either
+    displacement, ``com_weight (g / h)^2 = w_L g^2``, gives ``w_L = com_weight / h^2`` (1/m^2 times
+    the CoM task's units): nothing fitted, only h of ``scales``.
+
+    Args:
+        scales: The robot's scales (its CoM height h, m).
+        com_weight: The CoM task's weight.
+
+    Raises:
+        ValueError: h or ``com_weight`` not positive and finite.
+    """
+    h = float(scales.com_height)
+    if not (np.isfinite(h) and h > 0):
+        raise ValueError(f"scales.com_height must be positive and finite, not {h!r}")
+    if not (np.isfinite(com_weight) and com_weight > 0):
+        raise ValueError(f"com_weight must be positive and finite, not {com_weight!r}")
+    return float(com_weight) / h**2
 
 
 def trial_gains(options: TrialGains, sim: SimModel) -> tuple[BalanceGains, InverseDynamicsGains]:
