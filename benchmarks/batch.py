@@ -2,6 +2,7 @@
 """Issue 28 item 3: ``Governor.limits`` (N postures in one call) beside N single ticks.
 
     python benchmarks/batch.py [--json] [--n N] [--repeat R] [--threads T] [--scenarios NAME ...]
+        [--profile]
 
 For each scenario of the wall study, the moving 500 Hz trajectory of ``benchmarks/governor.py``
 (N ticks, default 1000: every posture differs), timed round-robin in one run, R rounds (the
@@ -18,7 +19,8 @@ Reported per scenario: the time per posture (median over rounds, us) of each cas
 throughput ratio single / batch (target >= 3 at N = 1000) and the worst difference of the
 batch's maximum contact velocity from the single ticks' (must be <= 1e-12 m/s), with the load
 average before and after (the machine is shared: absolute times move with it, ratios less).
-Exit status 1 if an answer disagrees, else 0.
+Exit status 1 if an answer disagrees, else 0. ``--profile`` reports instead, per scenario, where a
+batch row's microseconds go (:mod:`benchmarks.speed.batch_profile`).
 """
 
 from __future__ import annotations
@@ -118,6 +120,26 @@ def _text(rows: list[dict[str, Any]]) -> str:
     return "\n".join(out)
 
 
+def _profile(names: list[str], n: int, repeat: int, as_json: bool) -> int:
+    from benchmarks.speed.batch_profile import profile_batch
+
+    load_before = os.getloadavg()
+    table = {}
+    for name in names:
+        progress(f"{name} (profile) ...")
+        table[name] = profile_batch(name, n, repeat)
+    load = {"loadavg_before": load_before, "loadavg_after": os.getloadavg()}
+    if as_json:
+        print(json.dumps({"us_per_row": table, **load}))
+        return 0
+    stages = list(next(iter(table.values())))
+    print(f"{'us per row':45s} " + " ".join(f"{k[:18]:>18s}" for k in table))
+    for stage in stages:
+        print(f"{stage:45s} " + " ".join(f"{table[k][stage]:18.2f}" for k in table))
+    print(f"load average before {load_before[0]:.2f}, after {load['loadavg_after'][0]:.2f}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[1])
     parser.add_argument("--n", type=int, default=1000, help="postures per batch (default 1000)")
@@ -125,10 +147,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--threads", type=int, default=2, help="threads of batch_threads")
     parser.add_argument("--scenarios", nargs="+", default=list(SCENARIOS))
     parser.add_argument("--json", action="store_true", help="one JSON document on stdout")
+    parser.add_argument("--profile", action="store_true", help="where a batch row's time goes")
     args = parser.parse_args(argv)
     if args.n < 1 or args.repeat < 1 or not 1 <= args.threads <= 64:
         print("error: --n and --repeat must be >= 1, --threads in [1, 64]", file=sys.stderr)
         return 2
+    if args.profile:
+        return _profile(args.scenarios, args.n, args.repeat, args.json)
     rows = []
     for name in args.scenarios:
         progress(f"{name} ...")
