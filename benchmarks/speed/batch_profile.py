@@ -2,7 +2,7 @@
 
 The N postures of the benchmark's path, each stage of a row's compiled call timed in a compiled
 loop over the N postures of its own (inputs made beforehand; the walk's hint carried along the
-path as the batch carries it, reset before each pass), best of ``repeat`` passes:
+path as the batch carries it, reset before each pass), the best CPU time of ``repeat`` passes:
 
 - ``kinematics``: :func:`~impact_balance.governor.tree_kernel.tree_postures` per row (the
   batch's compiled kinematics), beside ``pinocchio``: the one-posture path's pinocchio step
@@ -109,13 +109,17 @@ def _kinematics_posture_loop(
 
 
 def _best(fn: Callable[[], Any], repeat: int, reset: Callable[[], None], n: int) -> float:
-    """The best of ``repeat`` timed calls of ``fn`` (``reset()`` untimed before each), us / n."""
+    """The best CPU time of ``repeat`` calls of ``fn`` (``reset()`` untimed before each), us / n.
+
+    CPU time of the process (one thread runs): the machine is shared, and a pass that waited
+    for a core does not count the wait.
+    """
     best = float("inf")
     for _ in range(repeat + 1):  # the first call compiles or loads
         reset()
-        t0 = time.perf_counter()
+        t0 = time.process_time()
         fn()
-        best = min(best, time.perf_counter() - t0)
+        best = min(best, time.process_time() - t0)
     return 1e6 * best / n
 
 
