@@ -142,8 +142,8 @@ def profile_batch(name: str, n: int, repeat: int) -> dict[str, Any]:
     tree_args = (
         tree.parents, tree.kinds, tree.idx_q, tree.idx_v, tree.placements, tree.masses,
         tree.levers, tree.inertias, tree.frame_joints, tree.frame_placements, qs, e._free_flyer,
-        True, float(s.plane_height), float(s.gravity), rot, loc, jac, ori, com_l, cen, pts, ine,
-        sca,
+        True, float(s.plane_height), float(s.gravity), rot, loc, jac, ori, com_l, cen, pts,
+        np.zeros((0, 3, nv)), ine, sca,
     )  # fmt: skip
     hint0 = e._hint.copy()
     hint = e._hint

@@ -57,6 +57,7 @@ def run_tree(tree: KinematicTree, qs, m, nv, free_flyer, torques, plane=-10.0, g
         "com_locals": np.zeros((n, 3)),
         "centroidal": np.zeros((n, 6, nv)),
         "point_locals": np.zeros((n, 3)),
+        "point_jacobians": np.zeros((n, 3, nv)),
         "inertias": np.zeros((n, 3, 3)),
         "scalars": np.zeros((n, 6)),
     }
@@ -87,8 +88,14 @@ def pinocchio_reference(model, frames, impact_frame, q, free_flyer):
         pin.getFrameJacobian(model, data, f, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED) for f in frames
     ]
     point = data.oMf[impact_frame].translation.copy()
+    point_jac = pin.getFrameJacobian(
+        model, data, impact_frame, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+    )[:3]
     mass = float(data.Ig.mass)
-    return origin, com, mass * J_com, data.Ig.inertia.copy(), mass, rotations, points, jac, point
+    return (
+        origin, com, mass * J_com, data.Ig.inertia.copy(), mass, rotations, points, jac, point,
+        point_jac,
+    )  # fmt: skip
 
 
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -108,8 +115,8 @@ def test_tree_kinematics_equal_pinocchios(name, seed, spread):
     low, out = run_tree(tree, qs, m, nv, e._free_flyer, True)
     assert low == -1
     for p, q in enumerate(qs):
-        origin, com, mJ, inertia, mass, rotations, points, jac, point = pinocchio_reference(
-            e.model, e._frames, e._impact_frame, q, e._free_flyer
+        origin, com, mJ, inertia, mass, rotations, points, jac, point, point_jac = (
+            pinocchio_reference(e.model, e._frames, e._impact_frame, q, e._free_flyer)
         )
         np.testing.assert_array_equal(out["origins"][p], origin)
         np.testing.assert_allclose(out["com_locals"][p], com, rtol=0, atol=1e-13)
@@ -123,6 +130,7 @@ def test_tree_kinematics_equal_pinocchios(name, seed, spread):
                 out["jacobians"][p][6 * i : 6 * i + 6], jac[i], rtol=0, atol=1e-13
             )
         np.testing.assert_allclose(out["point_locals"][p], point, rtol=0, atol=1e-13)
+        np.testing.assert_allclose(out["point_jacobians"][p], point_jac, rtol=0, atol=1e-13)
         height = out["com_locals"][p][2] + origin[2]
         assert out["scalars"][p, 3] == pytest.approx(lipm_omega(height, -10.0, 9.81), rel=1e-14)
 
@@ -145,7 +153,7 @@ def test_a_random_humanoid_with_offset_frames(seed, torques):
     low, out = run_tree(tree, qs, 2, model.nv, True, torques)
     assert low == -1
     for p, q in enumerate(qs):
-        _, com, mJ, inertia, mass, rotations, points, jac, point = pinocchio_reference(
+        _, com, mJ, inertia, mass, rotations, points, jac, point, point_jac = pinocchio_reference(
             model, frames[:2], frames[2], q, True
         )
         np.testing.assert_allclose(out["com_locals"][p], com, rtol=0, atol=1e-12)
@@ -154,6 +162,7 @@ def test_a_random_humanoid_with_offset_frames(seed, torques):
         np.testing.assert_allclose(out["rotations"][p], np.array(rotations), rtol=0, atol=1e-13)
         np.testing.assert_allclose(out["local"][p], np.array(points), rtol=0, atol=1e-12)
         np.testing.assert_allclose(out["point_locals"][p], point, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(out["point_jacobians"][p], point_jac, rtol=0, atol=1e-12)
         if torques:
             np.testing.assert_allclose(out["jacobians"][p], np.vstack(jac), rtol=0, atol=1e-12)
 

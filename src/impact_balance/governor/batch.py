@@ -155,6 +155,7 @@ class _Buffers:
         # The tree's kinematics of a block (tree_postures), when the model's joints allow it.
         tree = KinematicTree.of(e.model, [*e._frames, e._impact_frame])
         self.tree = tree if tree.supported else None
+        self.no_jacobians = np.zeros((0, 3, nv))  # the impact point's: not read by the batch
 
 
 class BatchEvaluator:
@@ -276,17 +277,17 @@ class _Slice:
         else:
             for p, r in enumerate(own.tolist()):
                 i = int(indices[r])
-                origin, com_local, Ig, Ag = e._placements(
+                origin, com_local, mass, inertia, Ag = e._placements(
                     self.qs[i], rotations[p], local[p], jacobians[p]
                 )
                 b.origins[p], b.com_locals[p], b.centroidal[p], b.inertias[p] = (
                     origin,
                     com_local,
                     Ag,
-                    Ig.inertia,
+                    inertia,
                 )
                 b.point_locals[p] = e.impact_point()
-                scalars[p, 0] = float(Ig.mass)
+                scalars[p, 0] = mass
                 scalars[p, 3] = self.omega(float(com_local[2]) + float(origin[2]), i)
         out, velocities, points = np.empty((n, 6)), np.empty((n, 3)), np.empty((n, 3))
         too_fast = postures_kernel(
@@ -317,7 +318,8 @@ class _Slice:
             t.parents, t.kinds, t.idx_q, t.idx_v, t.placements, t.masses, t.levers, t.inertias,
             t.frame_joints, t.frame_placements, self.qs[rows], e._free_flyer, e._torques,
             float(s.plane_height), float(s.gravity), b.rotations, b.local, b.jacobians,
-            b.origins, b.com_locals, b.centroidal, b.point_locals, b.inertias, b.scalars,
+            b.origins, b.com_locals, b.centroidal, b.point_locals, b.no_jacobians, b.inertias,
+            b.scalars,
         )  # fmt: skip
         if low >= 0:  # the CoM not above the plane: the check names the row
             self.omega(float(b.com_locals[low, 2]) + float(b.origins[low, 2]), int(rows[low]))

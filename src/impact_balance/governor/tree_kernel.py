@@ -326,6 +326,7 @@ def tree_postures(
     com_locals: np.ndarray,
     centroidal: np.ndarray,
     point_locals: np.ndarray,
+    point_jacobians: np.ndarray,
     body_inertias: np.ndarray,
     scalars: np.ndarray,
 ) -> int:
@@ -353,6 +354,8 @@ def tree_postures(
     first, mass_sub = np.empty((nj, 3)), np.empty(nj)
     frame_poses = np.empty((f, 4, 4))
     lin, ang, com, inertia = np.empty(3), np.empty(3), np.empty(3), np.empty((3, 3))
+    nv = centroidal.shape[2]
+    point_jacobian = np.empty((6, nv))
     for r in range(4):
         for c in range(4):
             poses[0, r, c] = 1.0 if r == c else 0.0
@@ -375,6 +378,14 @@ def tree_postures(
                     parents, kinds, idx_v, poses, frame_joints[i], frame_poses[i, :3, 3],
                     jacobians[p, 6 * i : 6 * i + 6], lin, ang,
                 )  # fmt: skip
+        if point_jacobians.shape[0]:
+            _frame_jacobian(
+                parents, kinds, idx_v, poses, frame_joints[m], frame_poses[m, :3, 3],
+                point_jacobian, lin, ang,
+            )  # fmt: skip
+            for r in range(3):
+                for c in range(nv):
+                    point_jacobians[p, r, c] = point_jacobian[r, c]
         for r in range(3):
             point_locals[p, r] = frame_poses[m, r, 3]
             origins[p, r] = q[r] if free_flyer else 0.0
