@@ -10,8 +10,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from impact_balance._jit import HAVE_NUMBA
 from impact_balance.balance.lipm import lipm_omega
-from impact_balance.governor import Governor
+from impact_balance.governor import Governor, tree_kernel
 from impact_balance.governor import batch as batch_module
 from impact_balance.governor.batch import BLOCK, _Buffers
 from impact_balance.governor.tree_kernel import KinematicTree, tree_postures
@@ -109,7 +110,7 @@ def test_tree_kinematics_equal_pinocchios(name, seed, spread):
     e = g._evaluator
     frames = [*e._frames, e._impact_frame]
     tree = KinematicTree.of(e.model, frames)
-    assert tree.supported
+    assert tree.supported == HAVE_NUMBA  # interpreted, the governor keeps pinocchio
     m, nv = len(e._frames), e.model.nv
     qs = random_configurations(e.model, 5, seed, spread)
     low, out = run_tree(tree, qs, m, nv, e._free_flyer, True)
@@ -148,7 +149,7 @@ def test_a_random_humanoid_with_offset_frames(seed, torques):
         offset = pin.SE3(pin.rpy.rpyToMatrix(*rng.uniform(-3, 3, 3)), rng.uniform(-0.2, 0.2, 3))
         frames.append(model.addFrame(pin.Frame(f"f{k}", joint, 0, offset, pin.FrameType.OP_FRAME)))
     tree = KinematicTree.of(model, frames)
-    assert tree.supported
+    assert tree.supported == HAVE_NUMBA
     qs = random_configurations(model, 3, seed, 3.0)
     low, out = run_tree(tree, qs, 2, model.nv, True, torques)
     assert low == -1
@@ -179,12 +180,15 @@ def test_the_first_row_below_the_plane_is_returned():
     assert out["scalars"][1, 3] > 0.0
 
 
-def test_other_joints_are_not_supported():
+def test_other_joints_are_not_supported(monkeypatch):
     model = pin.Model()
     body = pin.Inertia.Random()
     j = model.addJoint(0, pin.JointModelRX(), pin.SE3.Identity(), "a")
     model.appendBodyToJoint(j, body, pin.SE3.Identity())
-    assert KinematicTree.of(model, []).supported
+    assert KinematicTree.of(model, []).supported == HAVE_NUMBA
+    with monkeypatch.context() as patch:  # without numba the governor keeps pinocchio
+        patch.setattr(tree_kernel, "HAVE_NUMBA", False)
+        assert not KinematicTree.of(model, []).supported
     k = model.addJoint(j, pin.JointModelPX(), pin.SE3.Identity(), "b")
     model.appendBodyToJoint(k, body, pin.SE3.Identity())
     assert not KinematicTree.of(model, []).supported
@@ -210,7 +214,7 @@ def test_a_batch_without_the_tree_calls_pinocchio_and_agrees(monkeypatch):
     monkeypatch.setattr(batch_module._Buffers, "__init__", without_tree)
     fresh = Governor("palm_push_two_feet")
     without = fresh.limits(qs, vs)
-    assert built == [True]
+    assert built == [HAVE_NUMBA]
     np.testing.assert_allclose(
         without.max_contact_velocity, with_tree.max_contact_velocity, rtol=0, atol=1e-12
     )

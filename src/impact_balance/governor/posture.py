@@ -564,7 +564,9 @@ class PostureEvaluator:
             out.com_locals[0],
             float(out.scalars[0, 0]),
             out.inertias[0],
-            out.centroidal[0],
+            # column-major, as pinocchio's Ag: numpy's products on it and the compiled call's
+            # arguments are then the pinocchio path's (the same BLAS calls, the same numbers)
+            np.asfortranarray(out.centroidal[0]),
         )
 
     def impact_at(self, q: np.ndarray, k: Kinematics) -> ImpactModel:

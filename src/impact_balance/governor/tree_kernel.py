@@ -5,8 +5,9 @@ the CoM and ``m J_com``, the composite rotational inertia about the CoM, the imp
 LIPM's omega), computed for many configurations in one compiled call that releases the GIL, so
 that a batch's threads run side by side. The tree is read once from a pinocchio model whose
 joints are all free flyers or revolute joints about a joint axis (``RX``, ``RY``, ``RZ``: the
-bundled robots); any other joint leaves :attr:`KinematicTree.supported` false and the batch
-calls pinocchio per row. The numbers are pinocchio's to rounding (about 1e-15 m and 1e-13 of
+bundled robots); any other joint leaves :attr:`KinematicTree.supported` false, and so does a
+library without numba (interpreted, the tree would be slower than pinocchio): the governor then
+calls pinocchio. The numbers are pinocchio's to rounding (about 1e-15 m and 1e-13 of
 the inertia, tested), not to the last digit: the batch's answers equal the single ticks' to
 1e-9, not bit for bit.
 
@@ -24,7 +25,7 @@ import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
-from impact_balance._jit import njit
+from impact_balance._jit import HAVE_NUMBA, njit
 
 __all__ = ["KinematicTree", "tree_postures"]
 
@@ -45,8 +46,8 @@ class KinematicTree:
     Joint 0 is the universe; joint j > 0 has parent ``parents[j]`` < j.
 
     Attributes:
-        supported: Whether every joint is a free flyer or an ``RX``, ``RY``, ``RZ`` joint (the
-            arrays are then valid).
+        supported: Whether every joint is a free flyer or an ``RX``, ``RY``, ``RZ`` joint and
+            numba compiles :func:`tree_postures` (the arrays are valid either way).
         parents: (nj,) int.
         kinds: (nj,) int, the joint kinds (:data:`FREE_FLYER`, ...; -1 for the universe).
         idx_q: (nj,) int, the joints' first configuration index.
@@ -76,7 +77,7 @@ class KinematicTree:
         """The tree of ``model``, with the pinocchio frames ``frames`` (their indices)."""
         nj = model.njoints
         kinds = np.full(nj, -1, dtype=np.int64)
-        supported = True
+        supported = HAVE_NUMBA
         for j in range(1, nj):
             kind = _KINDS.get(model.joints[j].shortname(), -1)
             supported &= kind >= 0
@@ -167,7 +168,7 @@ def _poses(
     """Every joint's placement at ``q`` (stance frame: a free flyer's translation zero)."""
     for j in range(1, parents.size):
         _joint_motion(kinds[j], q, idx_q[j], motion)
-        if kinds[j] == FREE_FLYER and free_flyer:
+        if free_flyer and j == 1:  # the first joint's translation: the stance frame's origin
             motion[0, 3] = motion[1, 3] = motion[2, 3] = 0.0
         _compose(poses[parents[j]], placements[j], joint)
         for r in range(3):
@@ -333,14 +334,16 @@ def tree_postures(
     """The kinematics of configurations ``qs`` (n, nq) into a batch's per-posture buffers.
 
     The first arguments are :class:`KinematicTree`'s arrays (its frames: the m contacts', then
-    the impact point's); ``free_flyer``: the model has one (its translation is the stance
-    frame's origin). For row p: ``rotations[p]`` (m, 3, 3) and ``local[p]`` (m, 3) the
-    contacts' contact-to-world rotations and points, ``jacobians[p]`` (6m, nv) their stacked
-    Jacobians (linear rows first, world axes, at the contact point; only with ``torques``),
-    ``origins[p]`` the stance frame's origin (the free flyer's translation, else 0),
-    ``com_locals[p]`` the CoM, ``centroidal[p][:3]`` (3, nv) ``m J_com`` (the centroidal
-    momentum matrix's linear rows; the others are set to 0), ``point_locals[p]`` the impact
-    point, ``body_inertias[p]`` the composite rotational inertia about the CoM (world axes),
+    the impact point's); ``free_flyer``: the model's first joint is a free flyer (its
+    translation is the stance frame's origin, ``q[:3]``). For row p: ``rotations[p]``
+    (m, 3, 3) and ``local[p]`` (m, 3) the contacts' contact-to-world rotations and points,
+    ``jacobians[p]`` (6m, nv) their stacked Jacobians (linear rows first, world axes, at the
+    contact point; only with ``torques``), ``origins[p]`` the stance frame's origin (the free
+    flyer's translation, else 0), ``com_locals[p]`` the CoM, ``centroidal[p][:3]`` (3, nv)
+    ``m J_com`` (the centroidal momentum matrix's linear rows; the others are set to 0),
+    ``point_locals[p]`` the impact point and, where ``point_jacobians`` has rows (else
+    (0, 3, nv)), ``point_jacobians[p]`` its (3, nv) translational Jacobian (world axes),
+    ``body_inertias[p]`` the composite rotational inertia about the CoM (world axes),
     ``scalars[p, 0]`` the mass (kg) and ``scalars[p, 3]`` omega (1/s) for the plane at
     ``plane_height`` (m) and ``gravity`` (m/s^2).
 
