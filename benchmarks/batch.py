@@ -2,6 +2,7 @@
 """Issue 28 item 3: ``Governor.limits`` (N postures in one call) beside N single ticks.
 
     python benchmarks/batch.py [--json] [--n N] [--repeat R] [--threads T] [--scenarios NAME ...]
+        [--profile]
 
 For each scenario of the wall study, the moving 500 Hz trajectory of ``benchmarks/governor.py``
 (N ticks, default 1000: every posture differs), timed round-robin in one run, R rounds (the
@@ -15,10 +16,12 @@ garbage collector paused):
   ``(q_0, v_k)`` (a row that repeats the previous row's q reuses its posture).
 
 Reported per scenario: the time per posture (median over rounds, us) of each case, the
-throughput ratio single / batch (target >= 3 at N = 1000) and the worst difference of the
+throughput ratio single / batch (target >= 3 at N = 1000), the same ratio in CPU time (best of
+R more rounds of ``single`` and ``batch``: the machine is shared) and the worst difference of the
 batch's maximum contact velocity from the single ticks' (must be <= 1e-12 m/s), with the load
 average before and after (the machine is shared: absolute times move with it, ratios less).
-Exit status 1 if an answer disagrees, else 0.
+Exit status 1 if an answer disagrees, else 0. ``--profile`` reports instead, per scenario, where a
+batch row's microseconds go (:mod:`benchmarks.speed.batch_profile`).
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ import argparse
 import json
 import os
 import sys
+import time
 from pathlib import Path
 from typing import Any
 
@@ -67,6 +71,9 @@ def bench_scenario(name: str, n: int, repeat: int, threads: int) -> dict[str, An
         ),
     }
     times, results = measure(cases, repeat, 1)
+    # CPU time of the one-thread cases (the machine is shared: a pass that waited for a core
+    # does not count the wait), best of the rounds
+    cpu, _ = measure({k: cases[k] for k in ("single", "batch")}, repeat, 0, time.process_time)
     load_after = os.getloadavg()
     worst = 0.0
     agree = True
@@ -93,6 +100,8 @@ def bench_scenario(name: str, n: int, repeat: int, threads: int) -> dict[str, An
         "ratio_single_over_batch_threads": per_posture["single"] / per_posture["batch_threads"],
         "ratio_velocity_over_batch_velocity": per_posture["velocity"]
         / per_posture["batch_velocity"],
+        "cpu_us_per_posture": {k: min(t) / n for k, t in cpu.items()},
+        "cpu_ratio_single_over_batch": min(cpu["single"]) / min(cpu["batch"]),
         "worst_difference": worst,
         "agree": agree and worst <= 1e-12,
     }
@@ -101,7 +110,8 @@ def bench_scenario(name: str, n: int, repeat: int, threads: int) -> dict[str, An
 def _text(rows: list[dict[str, Any]]) -> str:
     out = [
         f"{'scenario':20s} {'single':>9s} {'batch':>9s} {'threads':>9s} {'ratio':>6s} "
-        f"{'ratio T':>7s} {'velocity':>9s} {'batch v':>9s} {'ratio v':>7s}  worst diff  "
+        f"{'ratio T':>7s} {'velocity':>9s} {'batch v':>9s} {'ratio v':>7s} {'CPU ratio':>9s}  "
+        "worst diff  "
         "load avg (before, after)"
     ]
     for r in rows:
@@ -110,12 +120,33 @@ def _text(rows: list[dict[str, Any]]) -> str:
             f"{r['scenario']:20s} {t['single']:9.1f} {t['batch']:9.1f} {t['batch_threads']:9.1f} "
             f"{r['ratio_single_over_batch']:6.2f} {r['ratio_single_over_batch_threads']:7.2f} "
             f"{t['velocity']:9.1f} {t['batch_velocity']:9.1f} "
-            f"{r['ratio_velocity_over_batch_velocity']:7.2f}  "
+            f"{r['ratio_velocity_over_batch_velocity']:7.2f} "
+            f"{r['cpu_ratio_single_over_batch']:9.2f}  "
             f"{r['worst_difference']:.1e}     {r['loadavg_before'][0]:.2f}, "
             f"{r['loadavg_after'][0]:.2f}"
         )
     out.append(f"us per posture (median over rounds); target ratio >= {TARGET_RATIO:g} at N = 1000")
     return "\n".join(out)
+
+
+def _profile(names: list[str], n: int, repeat: int, as_json: bool) -> int:
+    from benchmarks.speed.batch_profile import profile_batch
+
+    load_before = os.getloadavg()
+    table = {}
+    for name in names:
+        progress(f"{name} (profile) ...")
+        table[name] = profile_batch(name, n, repeat)
+    load = {"loadavg_before": load_before, "loadavg_after": os.getloadavg()}
+    if as_json:
+        print(json.dumps({"us_per_row": table, **load}))
+        return 0
+    stages = list(next(iter(table.values())))
+    print(f"{'us per row':45s} " + " ".join(f"{k[:18]:>18s}" for k in table))
+    for stage in stages:
+        print(f"{stage:45s} " + " ".join(f"{table[k][stage]:18.2f}" for k in table))
+    print(f"load average before {load_before[0]:.2f}, after {load['loadavg_after'][0]:.2f}")
+    return 0
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -125,10 +156,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--threads", type=int, default=2, help="threads of batch_threads")
     parser.add_argument("--scenarios", nargs="+", default=list(SCENARIOS))
     parser.add_argument("--json", action="store_true", help="one JSON document on stdout")
+    parser.add_argument("--profile", action="store_true", help="where a batch row's time goes")
     args = parser.parse_args(argv)
     if args.n < 1 or args.repeat < 1 or not 1 <= args.threads <= 64:
         print("error: --n and --repeat must be >= 1, --threads in [1, 64]", file=sys.stderr)
         return 2
+    if args.profile:
+        return _profile(args.scenarios, args.n, args.repeat, args.json)
     rows = []
     for name in args.scenarios:
         progress(f"{name} ...")

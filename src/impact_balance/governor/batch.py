@@ -42,6 +42,7 @@ from impact_balance.governor.options import Criterion
 from impact_balance.governor.posture import PostureEvaluator
 from impact_balance.governor.posture_kernel import postures_kernel
 from impact_balance.governor.tick import com_velocity
+from impact_balance.governor.tree_kernel import KinematicTree, tree_postures
 from impact_balance.projection.walk import MAX_PIVOTS
 from impact_balance.robot.robot import Robot
 
@@ -151,6 +152,10 @@ class _Buffers:
         self.scalars = np.zeros((BLOCK, 6))
         self.scalars[0, 1:3] = s.gravity, s.plane_height
         self.scalars[0, 4:6] = s.velocity_margin, BOUNDARY_TOLERANCE
+        # The tree's kinematics of a block (tree_postures), when the model's joints allow it.
+        tree = KinematicTree.of(e.model, [*e._frames, e._impact_frame])
+        self.tree = tree if tree.supported else None
+        self.no_jacobians = np.zeros((0, 3, nv))  # the impact point's: not read by the batch
 
 
 class BatchEvaluator:
@@ -266,20 +271,24 @@ class _Slice:
         """
         e, n, rows, b = self.e, len(indices), self.rows, self.buffers
         rotations, local, jacobians, scalars = b.rotations, b.local, b.jacobians, b.scalars
-        for p, r in enumerate(np.flatnonzero(~same).tolist()):  # the rows of a posture of their own
-            i = int(indices[r])
-            origin, com_local, Ig, Ag = e._placements(
-                self.qs[i], rotations[p], local[p], jacobians[p]
-            )
-            b.origins[p], b.com_locals[p], b.centroidal[p], b.inertias[p] = (
-                origin,
-                com_local,
-                Ag,
-                Ig.inertia,
-            )
-            b.point_locals[p] = e.impact_point()
-            scalars[p, 0] = float(Ig.mass)
-            scalars[p, 3] = self.omega(float(com_local[2]) + float(origin[2]), i)
+        own = np.flatnonzero(~same)  # the rows of a posture of their own
+        if b.tree is not None:
+            self.tree_kinematics(indices[own])
+        else:
+            for p, r in enumerate(own.tolist()):
+                i = int(indices[r])
+                origin, com_local, mass, inertia, Ag = e._placements(
+                    self.qs[i], rotations[p], local[p], jacobians[p]
+                )
+                b.origins[p], b.com_locals[p], b.centroidal[p], b.inertias[p] = (
+                    origin,
+                    com_local,
+                    Ag,
+                    inertia,
+                )
+                b.point_locals[p] = e.impact_point()
+                scalars[p, 0] = mass
+                scalars[p, 3] = self.omega(float(com_local[2]) + float(origin[2]), i)
         out, velocities, points = np.empty((n, 6)), np.empty((n, 3)), np.empty((n, 3))
         too_fast = postures_kernel(
             e._faces, rotations, local, b.origins, b.com_locals, b.centroidal, e._gravity,
@@ -295,6 +304,25 @@ class _Slice:
             e._normal,
         )
         self.fill(indices, out)
+
+    def tree_kinematics(self, rows: npt.NDArray[np.int64]) -> None:
+        """The kinematics of batch rows ``rows`` into the block's buffers, in one compiled call.
+
+        :func:`~impact_balance.governor.tree_kernel.tree_postures` (the GIL released), for the
+        block's postures of their own, in order.
+        """
+        e, b, s = self.e, self.buffers, self.e.settings
+        t = b.tree
+        assert t is not None
+        low = tree_postures(
+            t.parents, t.kinds, t.idx_q, t.idx_v, t.placements, t.masses, t.levers, t.inertias,
+            t.frame_joints, t.frame_placements, self.qs[rows], e._free_flyer, e._torques,
+            float(s.plane_height), float(s.gravity), b.rotations, b.local, b.jacobians,
+            b.origins, b.com_locals, b.centroidal, b.point_locals, b.no_jacobians, b.inertias,
+            b.scalars,
+        )  # fmt: skip
+        if low >= 0:  # the CoM not above the plane: the check names the row
+            self.omega(float(b.com_locals[low, 2]) + float(b.origins[low, 2]), int(rows[low]))
 
     def omega(self, com_height: float, i: int) -> float:
         """The LIPM's omega (1/s) of row ``i`` at its CoM height (m).

@@ -20,6 +20,7 @@ demand), the ZMP criterion in "com" mode, the diagnostics, the cannot-balance di
 from __future__ import annotations
 
 import functools
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import NamedTuple
@@ -40,6 +41,7 @@ from impact_balance.criteria.zmp import zmp_max_contact_velocity
 from impact_balance.exceptions import SolverError
 from impact_balance.governor.options import Criterion
 from impact_balance.governor.posture_kernel import kinematics_posture_kernel
+from impact_balance.governor.tree_kernel import KinematicTree, tree_postures
 from impact_balance.impact.angular_momentum import AngularMomentumTerm, angular_momentum_gain
 from impact_balance.impact.model import (
     ImpactModel,
@@ -255,6 +257,20 @@ class PostureEvaluator:
         )
         self.scratch = Scratch(model)
         self._free_flyer = has_free_flyer(model)
+        # The kinematics in one compiled call (tree_postures) where the model's joints allow it,
+        # else pinocchio's; the tree's arrays of one posture (see _placements).
+        tree = KinematicTree.of(model, [*self._frames, self._impact_frame])
+        self._tree = tree if tree.supported else None
+        nv = model.nv
+        self._tree_out = _TreeOut(
+            np.zeros((1, 3)),
+            np.zeros((1, 3)),
+            np.zeros((1, 6, nv)),
+            np.zeros((1, 3)),
+            np.zeros((1, 3, nv)),
+            np.zeros((1, 3, 3)),
+            np.zeros((1, 6)),
+        )
         m = len(contacts)
         self._faces = np.array(
             [
@@ -350,18 +366,16 @@ class PostureEvaluator:
         when the kernel leaves the posture to :meth:`evaluate`'s steps (a walk not certified,
         an area of fewer than 3 vertices, an impact model they refuse).
         """
-        settings, data, model = self.settings, self.scratch.data, self.model
+        settings = self.settings
         rotations, local, jacobians = self._buffers
-        origin, com_local, Ig, Ag = self._placements(q, rotations, local, jacobians)
-        mass = float(Ig.mass)
+        origin, com_local, mass, inertia, Ag = self._placements(q, rotations, local, jacobians)
         com_z = float(com_local[2]) + float(origin[2])
         w = lipm_omega(com_z, settings.plane_height, settings.gravity, field="plane_height")
-        point_local = self.impact_point()
-        J = pin.getFrameJacobian(model, data, self._impact_frame, _WORLD)[:3].copy()
+        point_local, J = self._impact_point_jacobian()
         out = kinematics_posture_kernel(
             self._faces, rotations, local, origin, com_local, Ag, self._gravity, self._torques,
             jacobians, self._idx, self._limit, mass, settings.gravity, settings.plane_height, w,
-            self._hint, MAX_PIVOTS, self._constants, point_local, Ig.inertia, self._normal,
+            self._hint, MAX_PIVOTS, self._constants, point_local, inertia, self._normal,
             self._cone,
         )  # fmt: skip
         if out[0]:  # FALLBACK: posture_answer's None
@@ -426,13 +440,28 @@ class PostureEvaluator:
         )
 
     def impact_point(self) -> npt.NDArray[np.float64]:
-        """The impact point (3,), m, in the stance frame of the kinematics the Data holds.
+        """The impact point (3,), m, in the stance frame of the last kinematics computed.
 
         Call it after :meth:`kinematics`, before the next one (a new array).
         """
+        if self._tree is not None:
+            local: npt.NDArray[np.float64] = self._tree_out.point_locals[0].copy()
+            return local
         translation = pin.updateFramePlacement(self.model, self.scratch.data, self._impact_frame)
         point: npt.NDArray[np.float64] = translation.translation.copy()
         return point
+
+    def _impact_point_jacobian(self) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """The impact point (3,), stance frame, m, and its (3, nv) Jacobian (world axes).
+
+        Of the last kinematics computed (new arrays).
+        """
+        if self._tree is not None:
+            out = self._tree_out
+            return out.point_locals[0].copy(), out.point_jacobians[0].copy()
+        data, model, fid = self.scratch.data, self.model, self._impact_frame
+        point = pin.updateFramePlacement(model, data, fid).translation.copy()
+        return point, pin.getFrameJacobian(model, data, fid, _WORLD)[:3].copy()
 
     def kinematics(self, q: np.ndarray) -> Kinematics:
         """The pinocchio step of :meth:`evaluate` at ``q`` (nq, float64, contiguous).
@@ -444,9 +473,8 @@ class PostureEvaluator:
         rotations = np.empty((m, 3, 3))
         local = np.empty((m, 3))
         jacobians = np.empty((6 * m, self.model.nv)) if torques else np.zeros((0, 0))
-        origin, com_local, Ig, Ag = self._placements(q, rotations, local, jacobians)
+        origin, com_local, mass, inertia, Ag = self._placements(q, rotations, local, jacobians)
         com_local = np.array(com_local, dtype=float)
-        mass = float(Ig.mass)
         linear = Ag[:3]  # m times the CoM Jacobian
         com_jacobian = linear / mass
         # g(q) = -Ag[:3]^T g: the gravity's generalized force is the CoM's (the centroidal
@@ -464,7 +492,7 @@ class PostureEvaluator:
             local,
             jacobians,
             gravity_torques,
-            np.array(Ig.inertia, dtype=float),
+            np.array(inertia, dtype=float),
         )
 
     def _placements(
@@ -473,15 +501,20 @@ class PostureEvaluator:
         rotations: npt.NDArray[np.float64],
         local: npt.NDArray[np.float64],
         jacobians: npt.NDArray[np.float64],
-    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], pin.Inertia, np.ndarray]:
-        """The pinocchio step at ``q``, in the stance frame (world axes, origin at the base).
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], float, np.ndarray, np.ndarray]:
+        """The kinematics at ``q``, in the stance frame (world axes, origin at the base).
 
         Writes the contacts' contact-to-world ``rotations`` (m, 3, 3), points ``local`` (m, 3)
         and, with torque limits, stacked world-aligned ``jacobians`` (6m, nv). Returns
-        ``(origin, com_local, Ig, Ag)``: the stance frame's origin in world (a new array, m),
-        the CoM in the stance frame (pinocchio's array, m), the composite inertia about the CoM
-        and the centroidal momentum matrix (pinocchio's), valid until the Data's next use.
+        ``(origin, com_local, mass, inertia, Ag)``: the stance frame's origin in world (a new
+        array, m), the CoM in the stance frame (m), the mass (kg), the composite rotational
+        inertia about the CoM (world axes, kg m^2) and the centroidal momentum matrix (6, nv;
+        its linear rows are m J_com), valid until the next kinematics. By
+        :func:`~impact_balance.governor.tree_kernel.tree_postures` where the model's joints
+        allow it (pinocchio's numbers to rounding), else by pinocchio.
         """
+        if self._tree is not None:
+            return self._tree_placements(q, rotations, local, jacobians)
         data, model = self.scratch.data, self.model
         # As Stance does: lever arms keep their precision however far the robot stands.
         q_local = self._q_local
@@ -505,7 +538,36 @@ class PostureEvaluator:
             local[i] = pose[:3, 3]
             if torques:
                 jacobians[6 * i : 6 * i + 6] = pin.getFrameJacobian(model, data, fid, _WORLD)
-        return origin, com_local, data.Ig, data.Ag
+        Ig = data.Ig
+        return origin, com_local, float(Ig.mass), Ig.inertia, data.Ag
+
+    def _tree_placements(
+        self,
+        q: np.ndarray,
+        rotations: npt.NDArray[np.float64],
+        local: npt.NDArray[np.float64],
+        jacobians: npt.NDArray[np.float64],
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], float, np.ndarray, np.ndarray]:
+        """:meth:`_placements` by the compiled tree (the impact point and its Jacobian too)."""
+        t, out = self._tree, self._tree_out
+        assert t is not None
+        tree_postures(
+            t.parents, t.kinds, t.idx_q, t.idx_v, t.placements, t.masses, t.levers, t.inertias,
+            t.frame_joints, t.frame_placements, q.reshape(1, -1), self._free_flyer,
+            self._torques, -math.inf, 0.0, rotations.reshape((1, *rotations.shape)),
+            local.reshape((1, *local.shape)), jacobians.reshape((1, *jacobians.shape)),
+            out.origins, out.com_locals, out.centroidal, out.point_locals, out.point_jacobians,
+            out.inertias, out.scalars,
+        )  # fmt: skip
+        return (
+            out.origins[0].copy(),
+            out.com_locals[0],
+            float(out.scalars[0, 0]),
+            out.inertias[0],
+            # column-major, as pinocchio's Ag: numpy's products on it and the compiled call's
+            # arguments are then the pinocchio path's (the same BLAS calls, the same numbers)
+            np.asfortranarray(out.centroidal[0]),
+        )
 
     def impact_at(self, q: np.ndarray, k: Kinematics) -> ImpactModel:
         """The impact model at ``q``, whose :meth:`kinematics` ``k`` the Data holds."""
@@ -577,12 +639,10 @@ class PostureEvaluator:
 
         As :func:`~impact_balance.impact.model.impact_model` computes it.
         """
-        spec, data, model = self.settings.impact, self.scratch.data, self.model
+        spec, model = self.settings.impact, self.model
         # frame_point's numbers (the impact point is a frame of the evaluator's model)
-        fid = self._impact_frame
-        point_local = pin.updateFramePlacement(model, data, fid).translation.copy()
+        point_local, J = self._impact_point_jacobian()
         arm = point_local - com_local
-        J = pin.getFrameJacobian(model, data, fid, _WORLD)[:3].copy()
         if spec.inertia == "joint_space":
             with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported by the model
                 W = joint_space_inertia_map(self.scratch, model, q, J)
@@ -591,6 +651,18 @@ class PostureEvaluator:
         return model_from_inertia_map(
             spec, point_local + origin, arm, self._normal.copy(), self._cone.copy(), W, mass, J
         )
+
+
+class _TreeOut(NamedTuple):
+    """:func:`~impact_balance.governor.tree_kernel.tree_postures`'s arrays of one posture."""
+
+    origins: np.ndarray
+    com_locals: np.ndarray
+    centroidal: np.ndarray
+    point_locals: np.ndarray
+    point_jacobians: np.ndarray
+    inertias: np.ndarray
+    scalars: np.ndarray
 
 
 def _point_frame(model: pin.Model, fid: int, offset: pin.SE3 | None, name: str) -> int:
