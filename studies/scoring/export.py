@@ -193,7 +193,10 @@ def _impact_row(stance: str, mode: str, document: dict[str, Any]) -> dict[str, A
 
 
 def impact_rows(run_dir: Path) -> list[dict[str, Any]]:
-    """One row per ``val_<stance>_<mode>.json`` (an impact search), in file-name order.
+    """One row per ``val_<stance>_<mode>.json`` (an impact search), by stance and mode.
+
+    ``valpaper_<stance>_<mode>.json`` is the same search run without the held-stance model (a
+    stance whose held-stance QP has no answer): its held-stance predictions are left empty.
 
     Returns:
         The rows of ``impacts.csv``: the measured speeds (m/s: survived, fell, failed strictly,
@@ -204,7 +207,11 @@ def impact_rows(run_dir: Path) -> list[dict[str, Any]]:
         RecordsError: A file is not a ``validate --json`` document.
     """
     rows = []
-    for name, path in _outputs(run_dir, "val_"):
+    outputs = sorted(
+        [*_outputs(run_dir, "val_"), *_outputs(run_dir, "valpaper_")],
+        key=lambda output: output[0].rpartition("_")[::2],
+    )
+    for name, path in outputs:
         stance, _, mode = name.rpartition("_")
         try:
             rows.append(_impact_row(stance, mode, _load(path)))
