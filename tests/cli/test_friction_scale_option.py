@@ -7,6 +7,7 @@ import pytest
 from impact_balance import analyze
 from impact_balance.scenario import load_scenario
 from tests.helpers.cli import assert_one_line_error, run_cli, strict_json
+from tests.helpers.extras import needs_extra
 
 
 @pytest.mark.parametrize("bad", ["0", "1.5", "nan", "-0.2", "abc", "inf"])
@@ -21,6 +22,7 @@ def test_controller_is_refused_by_analyze(capsys):
     assert_one_line_error(rc, err, "--friction-scale", "controller")
 
 
+@needs_extra("sim")
 def test_controller_needs_the_id_controller(capsys):
     rc, _, err = run_cli(
         capsys,

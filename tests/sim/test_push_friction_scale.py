@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+pytest.importorskip("mujoco", reason="needs the sim extra (MuJoCo)")
+
 from impact_balance.analysis.analyze import contact_model_areas
 from impact_balance.scenario import load_scenario
 from impact_balance.sim.studies.push import push_test

@@ -13,12 +13,12 @@ from pathlib import Path
 from types import ModuleType, SimpleNamespace
 
 import numpy as np
-import pandas as pd
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 pytest.importorskip("mujoco")  # the script imports the simulation's push prediction
+pd = pytest.importorskip("pandas", reason="needs the study extra (pandas)")
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -7,6 +7,8 @@ import dataclasses
 import numpy as np
 import pytest
 
+pytest.importorskip("mujoco", reason="needs the sim extra (MuJoCo)")
+
 from impact_balance import analyze
 from impact_balance.scenario import Scenario, load_scenario
 from impact_balance.sim.control.gains import InverseDynamicsGains
