@@ -10,6 +10,13 @@ whole robot: the root body's rotation from its start (deg), the centroidal angul
 (N m s, world, about the CoM, pinocchio), the QP's target rate ``-K_L L``, the planned and
 realised total rate, and whether the desired ZMP was clamped.
 
+What-ifs (docs/studies/torso-pushes.md §7, §8): ``--angular-momentum-weight capture`` prices the L
+task by the capture (``com_weight / h^2``); ``--feedback cmp`` makes the DCM feedback choose the
+centroidal moment pivot (CMP) and book the removal of L at ``-K_L L``, as the criterion does
+(:class:`CmpFeedback`): the desired ZMP is ``p_cmp + d``, ``d = K_L (L_y, -L_x) / (m g)``
+(:func:`zmp_offset`), clamped to the area, and the CoM task pivots about the clamped ZMP minus
+``d``. Under ``--feedback cmp`` the rows' ``zmp_clamped`` is the clamp of ``p_cmp + d``.
+
     python benchmarks/torso_tipping.py 6 g1_wide_left_palm_oblique_side torso 90 0.75 \
         --json /tmp/g1_90_075.json
 
@@ -43,6 +50,7 @@ from impact_balance.sim.control.gains import (
     robot_id_gains,
 )
 from impact_balance.sim.control.torque import InverseDynamicsController
+from impact_balance.sim.control.zmp import DcmFeedback, clamp_to_polygon, dcm
 from impact_balance.sim.trials.balance_trial import run_balance_trial
 from impact_balance.sim.trials.setup import (
     BalanceSetup,
@@ -125,12 +133,57 @@ class SoleLog:
         )
 
 
+def zmp_offset(angular_momentum: Any, damping: float, mass: float, gravity: float) -> np.ndarray:
+    """ZMP minus CMP (m, world, horizontal) while the angular momentum decays as ``-K_L L``.
+
+    About the CoM, ``L_dot = (p - c) x f`` plus the contacts' vertical moments; with ``f_z = m g``
+    its horizontal components give ``p = p_cmp - S(L_dot) / (m g)``, ``S(a) = (a_y, -a_x)``,
+    ``p_cmp = c_xy - c_dd_xy / omega^2`` (docs/angular-momentum.md). With ``L_dot = -K_L L``:
+    ``d = K_L (L_y, -L_x) / (m g)``.
+
+    Args:
+        angular_momentum: Centroidal angular momentum L (N m s, world axes, about the CoM).
+        damping: K_L (1/s).
+        mass: Total mass m (kg).
+        gravity: g (m/s^2).
+    """
+    L = np.asarray(angular_momentum, dtype=float)
+    return damping * np.array([L[1], -L[0]]) / (mass * gravity)
+
+
+class CmpFeedback(DcmFeedback):
+    """The DCM feedback choosing the CMP, the ZMP offset by :func:`zmp_offset` (the what-if).
+
+    ``p_cmp = xi + (k / omega)(xi - xi_ref)``; ``p_cmp + d`` is clamped to the area (``p``);
+    :meth:`desired_zmp` returns ``p - d``, the CMP the CoM task pivots about (the controller's
+    ``c_dd = omega^2 (c - .)``). L is the controller's centroidal angular momentum of this
+    control step (pinocchio's ``data.hg``, computed before the feedback is asked).
+    """
+
+    def __init__(self, plain: DcmFeedback, controller: InverseDynamicsController) -> None:
+        super().__init__(plain.zmp_area, plain.omega, plain.dcm_reference, plain.gain, plain.margin)
+        self.controller = controller
+
+    def desired_zmp(
+        self, com_xy: np.ndarray, com_velocity_xy: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, bool]:
+        """``(CMP the CoM task pivots about, DCM, p_cmp + d clamped?)`` (m, world)."""
+        c = self.controller
+        d = zmp_offset(c.data.hg.angular, c.gains.angular_momentum_damping, c.mass, c.gravity)
+        xi = dcm(com_xy, com_velocity_xy, self.omega)
+        wanted = xi + (self.gain / self.omega) * (xi - self.dcm_reference) + d
+        p = clamp_to_polygon(self.zmp_area, wanted, self.margin)
+        return p - d, xi, bool(np.linalg.norm(p - wanted) > 1e-9)
+
+
 @contextlib.contextmanager
-def logged(log: SoleLog) -> Iterator[None]:
-    """Wrap the id controller's step for the trial's duration."""
+def logged(log: SoleLog, cmp_feedback: bool = False) -> Iterator[None]:
+    """Wrap the id controller's step for the trial's duration (and its feedback: ``--feedback``)."""
     step = InverseDynamicsController.step
 
     def logged_step(self: InverseDynamicsController, t: float, q: Any, v: Any, *args: Any) -> Any:
+        if cmp_feedback and not isinstance(self.feedback, CmpFeedback):
+            self.feedback = CmpFeedback(self.feedback, self)
         out = step(self, t, q, v, *args)
         log.add(self, t, q, v, out)
         return out
@@ -199,6 +252,13 @@ def main(argv: list[str] | None = None) -> int:
         default="robot",
         help="the L task's weight: the default rule, or com_weight / h^2 (the capture's cost)",
     )
+    p.add_argument(
+        "--feedback",
+        choices=("zmp", "cmp"),
+        default="zmp",
+        help="the DCM feedback chooses the ZMP (the controller's), or the CMP with the ZMP offset "
+        "d = K_L (L_y, -L_x) / (m g) that removes L at K_L (the what-if of §8)",
+    )
     args = p.parse_args(argv)
     records = pd.read_csv(f"studies/held_out_results_{args.set}/pushes.csv")
     r = records[
@@ -219,12 +279,13 @@ def main(argv: list[str] | None = None) -> int:
         body_name(args.stance.split("_")[0], args.body),
     )
     log = SoleLog(setup)
-    with logged(log):
+    with logged(log, cmp_feedback=args.feedback == "cmp"):
         result = run_balance_trial(setup, push=push, options=options)
     s = result.summary()
     head = {k: s.get(k) for k in ("outcome", "reason", "strict_fail")}
     head["record"] = {"outcome": r.outcome, "strict_reason": r.strict_reason}
     head["angular_momentum_weight"] = args.angular_momentum_weight
+    head["feedback"] = args.feedback
     head["soles"] = summary(log.rows, push.start + push.duration)
     print(json.dumps(head, default=str))
     for row in log.rows[:: args.every]:
