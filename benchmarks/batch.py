@@ -2,7 +2,7 @@
 """Issue 28 item 3: ``Governor.limits`` (N postures in one call) beside N single ticks.
 
     python benchmarks/batch.py [--json] [--n N] [--repeat R] [--threads T] [--scenarios NAME ...]
-        [--profile]
+        [--profile] [--gil]
 
 For each scenario of the wall study, the moving 500 Hz trajectory of ``benchmarks/governor.py``
 (N ticks, default 1000: every posture differs), timed round-robin in one run, R rounds (the
@@ -21,7 +21,13 @@ R more rounds of ``single`` and ``batch``: the machine is shared) and the worst 
 batch's maximum contact velocity from the single ticks' (must be <= 1e-12 m/s), with the load
 average before and after (the machine is shared: absolute times move with it, ratios less).
 Exit status 1 if an answer disagrees, else 0. ``--profile`` reports instead, per scenario, where a
-batch row's microseconds go (:mod:`benchmarks.speed.batch_profile`).
+batch row's microseconds go (:mod:`benchmarks.speed.batch_profile`). ``--gil`` reports instead,
+per scenario, one thread beside ``--threads`` T (best wall time of R passes each): the batch's
+wall time per row, the compiled calls' thread CPU time per row summed over the threads (the part
+that runs without the GIL), the rest of the threads' wall time per row (Python holding the GIL,
+or waiting for it or for a core), the slowest thread's compiled CPU over the threads' mean (the
+slices' imbalance) and the compiled calls' wall over their thread CPU (above 1: a thread waited
+for a core the machine did not give it).
 """
 
 from __future__ import annotations
@@ -45,7 +51,7 @@ from impact_balance.governor import Governor
 SCENARIOS = ("palm_push_two_feet", "palm_push_ramp", "kick_one_foot", "g1_two_feet")
 TARGET_RATIO = 3.0
 
-__all__ = ["SCENARIOS", "bench_scenario", "main"]
+__all__ = ["SCENARIOS", "bench_scenario", "gil_scenario", "main"]
 
 
 def bench_scenario(name: str, n: int, repeat: int, threads: int) -> dict[str, Any]:
@@ -149,6 +155,89 @@ def _profile(names: list[str], n: int, repeat: int, as_json: bool) -> int:
     return 0
 
 
+def gil_scenario(name: str, n: int, repeat: int, threads: int) -> dict[str, Any]:
+    """One scenario's batch on 1 and ``threads`` threads: where the threads' time goes."""
+    import threading
+
+    import impact_balance.governor.batch as batch_module
+
+    spent: dict[int, list[float]] = {}  # thread id -> [compiled wall, compiled thread CPU] (s)
+    lock = threading.Lock()
+    originals = batch_module.postures_kernel, batch_module.tree_postures
+
+    def timed(f: Any) -> Any:
+        def call(*args: Any) -> Any:
+            wall, cpu = time.perf_counter(), time.thread_time()
+            out = f(*args)
+            wall, cpu = time.perf_counter() - wall, time.thread_time() - cpu
+            with lock:
+                row = spent.setdefault(threading.get_ident(), [0.0, 0.0])
+                row[0] += wall
+                row[1] += cpu
+            return out
+
+        return call
+
+    governor = Governor(name)
+    qs, vs = trajectory(governor, n)
+    out: dict[str, Any] = {"scenario": name, "n": n, "loadavg_before": os.getloadavg()}
+    batch_module.postures_kernel, batch_module.tree_postures = (timed(f) for f in originals)
+    try:
+        for t in (1, threads):
+            governor.limits(qs, vs, threads=t)  # warm-up: the threads' evaluators
+            best: tuple[float, dict[int, list[float]]] | None = None
+            for _ in range(repeat):
+                spent.clear()
+                start = time.perf_counter()
+                governor.limits(qs, vs, threads=t)
+                wall = time.perf_counter() - start
+                if best is None or wall < best[0]:
+                    best = (wall, {k: list(v) for k, v in spent.items()})
+            assert best is not None
+            wall, per_thread = best
+            compiled_wall = sum(v[0] for v in per_thread.values())
+            cpus = [v[1] for v in per_thread.values()]
+            out[f"threads_{t}"] = {
+                "us_per_row": wall / n * 1e6,
+                "compiled_cpu_us_per_row": sum(cpus) / n * 1e6,
+                "outside_compiled_us_per_row": (wall * t - compiled_wall) / n * 1e6,
+                "imbalance": max(cpus) / (sum(cpus) / len(cpus)),
+                "compiled_wall_over_cpu": compiled_wall / sum(cpus),
+            }
+    finally:
+        batch_module.postures_kernel, batch_module.tree_postures = originals
+    out["speedup"] = out["threads_1"]["us_per_row"] / out[f"threads_{threads}"]["us_per_row"]
+    out["loadavg_after"] = os.getloadavg()
+    return out
+
+
+def _gil(names: list[str], n: int, repeat: int, threads: int, as_json: bool) -> int:
+    rows = []
+    for name in names:
+        progress(f"{name} (gil) ...")
+        rows.append(gil_scenario(name, n, repeat, threads))
+    if as_json:
+        print(json.dumps({"scenarios": rows, "threads": threads}))
+        return 0
+    print(
+        f"{'scenario':20s} {'T':>2s} {'us/row':>7s} {'compiled CPU':>12s} {'outside':>8s} "
+        f"{'imbalance':>9s} {'wall/CPU':>8s} {'speedup':>7s}  load avg (before, after)"
+    )
+    for r in rows:
+        for t in (1, threads):
+            c = r[f"threads_{t}"]
+            print(
+                f"{r['scenario']:20s} {t:2d} {c['us_per_row']:7.1f} "
+                f"{c['compiled_cpu_us_per_row']:12.1f} {c['outside_compiled_us_per_row']:8.1f} "
+                f"{c['imbalance']:9.2f} {c['compiled_wall_over_cpu']:8.2f} "
+                + (f"{r['speedup']:7.2f}" if t != 1 else " " * 7)
+                + f"  {r['loadavg_before'][0]:.2f}, {r['loadavg_after'][0]:.2f}"
+            )
+    print("us per row of the batch (best wall time of the passes); outside: the threads' wall")
+    print("time outside the compiled calls (Python holding the GIL, or waiting for it or a core)")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[1])
     parser.add_argument("--n", type=int, default=1000, help="postures per batch (default 1000)")
@@ -157,12 +246,17 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--scenarios", nargs="+", default=list(SCENARIOS))
     parser.add_argument("--json", action="store_true", help="one JSON document on stdout")
     parser.add_argument("--profile", action="store_true", help="where a batch row's time goes")
+    parser.add_argument(
+        "--gil", action="store_true", help="1 and T threads: compiled time, the GIL's, imbalance"
+    )
     args = parser.parse_args(argv)
     if args.n < 1 or args.repeat < 1 or not 1 <= args.threads <= 64:
         print("error: --n and --repeat must be >= 1, --threads in [1, 64]", file=sys.stderr)
         return 2
     if args.profile:
         return _profile(args.scenarios, args.n, args.repeat, args.json)
+    if args.gil:
+        return _gil(args.scenarios, args.n, args.repeat, args.threads, args.json)
     rows = []
     for name in args.scenarios:
         progress(f"{name} ...")

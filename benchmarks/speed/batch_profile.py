@@ -158,9 +158,9 @@ def profile_batch(name: str, n: int, repeat: int) -> dict[str, Any]:
     def pinocchio_rows() -> None:
         R, L, J = np.empty((m, 3, 3)), np.empty((m, 3)), np.empty((6 * m, nv))
         for q in qs:
-            origin, com_local, Ig, _ = e._placements(q, R, L, J)
+            origin, com_local, mass, _, _ = e._placements(q, R, L, J)
             e.impact_point()
-            float(Ig.mass)
+            float(mass)
             lipm_omega(float(com_local[2]) + float(origin[2]), s.plane_height, s.gravity)
 
     out["pinocchio"] = _best(pinocchio_rows, repeat, reset, n)

@@ -291,7 +291,7 @@ def test_the_rows_of_a_batch_share_the_walks_hint():
     g = Governor("palm_push_two_feet")
     qs, vs = path(g, 30, 2)
     g.limits(qs, vs)
-    (evaluator,) = g._batch._evaluators
+    ((evaluator, _buffers),) = g._batch._evaluators
     hint = evaluator._hint
     m, n = int(hint[0]), int(hint[1])
     assert m > 0 and 0 < n < m
@@ -355,3 +355,62 @@ def test_rows_are_checked_as_limit_checks_them(seed, bad, faults):
     i, exc = want
     assert info.value.field == f"q_batch[{i}]" + exc.field[1:]
     assert info.value.reason == exc.reason
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_a_batchs_buffers_serve_the_next_batches(threads):
+    # The block buffers of each thread's evaluator are kept for the next batch: a small batch
+    # after a larger one (its buffers holding the larger one's last block) answers as the
+    # single ticks do, rows that repeat a posture included, and the buffers are the same arrays.
+    g = Governor("palm_push_two_feet")
+    qs, vs = batch(g, 45, 11)
+    assert_rows_equal(
+        g.limits(qs, vs, threads=threads), [g.limit(q, v) for q, v in zip(qs, vs, strict=True)]
+    )
+    kept = {id(b) for _, b in g._batch._evaluators}
+    assert len(kept) == threads and None not in {b for _, b in g._batch._evaluators}
+    small_q, small_v = batch(g, 4, 12)
+    small_q = np.repeat(small_q, [1, 3, 1, 2], axis=0)
+    small_v = np.random.default_rng(13).normal(0.0, 0.3, (len(small_q), g.nv))
+    singles = [g.limit(q, v) for q, v in zip(small_q, small_v, strict=True)]
+    assert_rows_equal(g.limits(small_q, small_v, threads=threads), singles)
+    assert {id(b) for _, b in g._batch._evaluators} == kept
+
+
+def test_the_threads_of_a_batch_serve_the_next_batches(monkeypatch):
+    # threads > 1 runs on a pool kept by the governor: the next batch of as many threads or
+    # fewer takes the same pool, a batch of more threads a larger one, a process forked after
+    # the pool was made (its copy has no threads) a new one; the answers are the single ticks'.
+    import impact_balance.governor.batch as batch_module
+
+    g = Governor("kick_one_foot")
+    qs, vs = batch(g, 24, 21)
+    singles = [g.limit(q, v) for q, v in zip(qs, vs, strict=True)]
+    assert_rows_equal(g.limits(qs, vs, threads=2), singles)
+    pool, size, _ = g._batch._pool
+    assert size == 2
+    assert_rows_equal(g.limits(qs, vs, threads=2), singles)
+    assert g._batch._pool[0] is pool
+    assert_rows_equal(g.limits(qs, vs, threads=3), singles)
+    larger, size, _ = g._batch._pool
+    assert larger is not pool and size == 3
+    assert_rows_equal(g.limits(qs, vs, threads=2), singles)
+    assert g._batch._pool[0] is larger
+    monkeypatch.setattr(batch_module.os, "getpid", lambda: -1)  # as in a forked child
+    assert_rows_equal(g.limits(qs, vs, threads=2), singles)
+    assert g._batch._pool[0] is not larger and g._batch._pool[1:] == (2, -1)
+
+
+def test_a_refused_row_in_a_threads_slice_leaves_the_governor_usable():
+    # A slice's error is raised once every slice is done: the evaluators go back to the pool
+    # and the next batch on the same threads answers.
+    g = Governor("kick_one_foot")
+    qs, vs = batch(g, 12, 22)
+    bad = vs.copy()
+    bad[9] *= 1e6  # a CoM speed above the bound, in the second slice
+    with pytest.raises(GovernorError, match=r"v_batch\[9\]"):
+        g.limits(qs, bad, threads=2)
+    assert len(g._batch._evaluators) == 2
+    assert_rows_equal(
+        g.limits(qs, vs, threads=2), [g.limit(q, v) for q, v in zip(qs, vs, strict=True)]
+    )

@@ -23,9 +23,10 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
 import threading
 from collections.abc import Callable, Sequence
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass
 
 import numpy as np
@@ -180,8 +181,13 @@ class BatchEvaluator:
     ) -> None:
         self.robot, self.settings, self.check = robot, evaluator.settings, check
         self.first_fault = first_fault
-        self._evaluators: list[PostureEvaluator] = []
+        # Each evaluator with its block buffers (None where the compiled call does not answer),
+        # made on first use and kept for the next batches.
+        self._evaluators: list[tuple[PostureEvaluator, _Buffers | None]] = []
         self._lock = threading.Lock()
+        # The threads of threads > 1, kept for the next batches (starting threads costs about as
+        # much as 10 to 50 rows): the pool, its size and the process that made it.
+        self._pool: tuple[ThreadPoolExecutor, int, int] | None = None
 
     def limits(self, q_batch: ArrayLike, v_batch: ArrayLike, threads: int = 1) -> BatchLimits:
         """See :meth:`impact_balance.governor.Governor.limits`."""
@@ -208,25 +214,49 @@ class BatchEvaluator:
         evaluators = self._take(len(slices))
         try:
             if len(slices) == 1:
-                _Slice(evaluators[0], qs, vs, rows).run(slices[0], repeated)
+                _Slice(*evaluators[0], qs, vs, rows).run(slices[0], repeated)
             else:
-                with ThreadPoolExecutor(len(slices)) as pool:
-                    futures = [
-                        pool.submit(_Slice(e, qs, vs, rows).run, s, repeated)
-                        for e, s in zip(evaluators, slices, strict=True)
-                    ]
+                pool = self._executor(len(slices))
+                futures = [
+                    pool.submit(_Slice(*e, qs, vs, rows).run, s, repeated)
+                    for e, s in zip(evaluators, slices, strict=True)
+                ]
+                try:
                     for future in futures:
                         future.result()
+                finally:  # every slice done before its evaluator goes back or an error is raised
+                    wait(futures)
         finally:
             with self._lock:
                 self._evaluators.extend(evaluators)
         return rows.answer(self.settings.criterion)
 
-    def _take(self, n: int) -> list[PostureEvaluator]:
-        """``n`` evaluators of this batch's own (made on first use), not shared while taken."""
+    def _executor(self, n: int) -> ThreadPoolExecutor:
+        """A pool of at least ``n`` threads, kept for the next batches.
+
+        Made again for more threads than it has (the previous pool is dropped, not shut down:
+        a batch running on it finishes there, and its threads end with it), and in a process
+        forked after it was made (whose copy has no threads).
+        """
+        with self._lock:
+            pid = os.getpid()
+            if self._pool is not None and self._pool[1] >= n and self._pool[2] == pid:
+                return self._pool[0]
+            pool = ThreadPoolExecutor(n, thread_name_prefix="impact-balance-batch")
+            self._pool = (pool, n, pid)
+            return pool
+
+    def _take(self, n: int) -> list[tuple[PostureEvaluator, _Buffers | None]]:
+        """``n`` evaluators of this batch's own, with their buffers (made on first use).
+
+        Not shared while taken.
+        """
         with self._lock:
             taken, self._evaluators = self._evaluators[:n], self._evaluators[n:]
-        return taken + [PostureEvaluator(self.robot, self.settings) for _ in range(n - len(taken))]
+        for _ in range(n - len(taken)):
+            e = PostureEvaluator(self.robot, self.settings)
+            taken.append((e, _Buffers(e) if e._compiled else None))
+        return taken
 
 
 class _Slice:
@@ -235,6 +265,7 @@ class _Slice:
     def __init__(
         self,
         evaluator: PostureEvaluator,
+        buffers: _Buffers | None,
         qs: npt.NDArray[np.float64],
         vs: npt.NDArray[np.float64],
         rows: _Rows,
@@ -244,7 +275,8 @@ class _Slice:
         # composite inertia, unscaled contacts); every other row takes limit()'s path.
         self.compiled = evaluator._compiled
         if self.compiled:
-            self.buffers = _Buffers(evaluator)
+            assert buffers is not None  # made with the evaluator (BatchEvaluator._take)
+            self.buffers = buffers
 
     def run(self, indices: npt.NDArray[np.int64], repeated: npt.NDArray[np.bool_]) -> None:
         """Answer rows ``indices`` of the batch (``repeated[i]``: row i's q is row i - 1's)."""

@@ -425,7 +425,8 @@ class Governor:
         Equal to N calls of :meth:`limit` (to rounding: 1e-12 m/s in the tests), each posture
         evaluated (the ``posture_tolerance`` and the last answer are neither used nor
         changed). The areas and the criterion of all postures run in one compiled call
-        (:mod:`impact_balance.governor.batch`); ``threads`` > 1 splits the rows over threads.
+        (:mod:`impact_balance.governor.batch`); ``threads`` > 1 splits the rows over threads
+        (contiguous slices), kept by the governor for its next batches.
 
         Args:
             q_batch: (N, nq) configurations, as :meth:`limit`'s ``q``.
