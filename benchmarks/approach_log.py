@@ -34,7 +34,7 @@ import argparse
 import contextlib
 import json
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -45,7 +45,7 @@ import pinocchio as pin
 # for the ``benchmarks`` package.
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks.hand_contact import _Log, _realised
+from benchmarks.hand_contact import _Log, _realised, step_replaced
 from impact_balance.sim.control.torque import InverseDynamicsController
 from impact_balance.sim.trials.balance_trial import run_balance_trial
 from impact_balance.sim.trials.setup import BalanceSetup, BalanceTrialOptions
@@ -132,29 +132,26 @@ class _ApproachLog(_Log):
         return names
 
 
-@contextlib.contextmanager
-def _logged(log: _ApproachLog) -> Iterator[None]:
+def _logged(log: _ApproachLog) -> contextlib.AbstractContextManager[None]:
     """Wrap the id controller's step for the trial's duration."""
-    step = InverseDynamicsController.step
 
-    def logged_step(
-        self: InverseDynamicsController,
-        t: float,
-        q: Any,
-        v: Any,
-        zmp: Any = None,
-        impact_force: float = 0.0,
-    ) -> Any:
-        out = step(self, t, q, v, zmp, impact_force)
-        self.last = out
-        log.add_step(self, t, q, v, impact_force)
-        return out
+    def wrap(step: Callable[..., Any]) -> Callable[..., Any]:
+        def logged_step(
+            self: InverseDynamicsController,
+            t: float,
+            q: Any,
+            v: Any,
+            zmp: Any = None,
+            impact_force: float = 0.0,
+        ) -> Any:
+            out = step(self, t, q, v, zmp, impact_force)
+            self.last = out
+            log.add_step(self, t, q, v, impact_force)
+            return out
 
-    InverseDynamicsController.step = logged_step  # type: ignore[method-assign]
-    try:
-        yield
-    finally:
-        InverseDynamicsController.step = step  # type: ignore[method-assign]
+        return logged_step
+
+    return step_replaced(wrap)
 
 
 def _firsts(rows: list[dict[str, Any]], min_normal: float) -> dict[str, Any]:

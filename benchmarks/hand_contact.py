@@ -27,7 +27,7 @@ import contextlib
 import json
 import math
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import replace
 from typing import Any
 
@@ -193,20 +193,30 @@ class _Log:
 
 
 @contextlib.contextmanager
-def _logged(log: _Log) -> Iterator[None]:
-    """Wrap the id controller's step for the trial's duration."""
+def step_replaced(wrap: Callable[[Callable[..., Any]], Callable[..., Any]]) -> Iterator[None]:
+    """The id controller's ``step`` replaced by ``wrap(step)`` inside the block, then restored."""
     step = InverseDynamicsController.step
-
-    def logged_step(self: InverseDynamicsController, t: float, q: Any, v: Any, *args: Any) -> Any:
-        out = step(self, t, q, v, *args)
-        log.add(self, t, v, out)
-        return out
-
-    InverseDynamicsController.step = logged_step  # type: ignore[method-assign]
+    InverseDynamicsController.step = wrap(step)  # type: ignore[method-assign]
     try:
         yield
     finally:
         InverseDynamicsController.step = step  # type: ignore[method-assign]
+
+
+def _logged(log: _Log) -> contextlib.AbstractContextManager[None]:
+    """Wrap the id controller's step for the trial's duration."""
+
+    def wrap(step: Callable[..., Any]) -> Callable[..., Any]:
+        def logged_step(
+            self: InverseDynamicsController, t: float, q: Any, v: Any, *args: Any
+        ) -> Any:
+            out = step(self, t, q, v, *args)
+            log.add(self, t, v, out)
+            return out
+
+        return logged_step
+
+    return step_replaced(wrap)
 
 
 def _is_sole(frame: str) -> bool:

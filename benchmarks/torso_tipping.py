@@ -31,7 +31,7 @@ import contextlib
 import json
 import math
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -42,7 +42,7 @@ import pinocchio as pin
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from hand_contact import _cop, _is_sole, _realised
+from hand_contact import _cop, _is_sole, _realised, step_replaced
 
 from impact_balance.sim.control.gains import (
     RobotScales,
@@ -176,23 +176,22 @@ class CmpFeedback(DcmFeedback):
         return p - d, xi, bool(np.linalg.norm(p - wanted) > 1e-9)
 
 
-@contextlib.contextmanager
-def logged(log: SoleLog, cmp_feedback: bool = False) -> Iterator[None]:
+def logged(log: SoleLog, cmp_feedback: bool = False) -> contextlib.AbstractContextManager[None]:
     """Wrap the id controller's step for the trial's duration (and its feedback: ``--feedback``)."""
-    step = InverseDynamicsController.step
 
-    def logged_step(self: InverseDynamicsController, t: float, q: Any, v: Any, *args: Any) -> Any:
-        if cmp_feedback and not isinstance(self.feedback, CmpFeedback):
-            self.feedback = CmpFeedback(self.feedback, self)
-        out = step(self, t, q, v, *args)
-        log.add(self, t, q, v, out)
-        return out
+    def wrap(step: Callable[..., Any]) -> Callable[..., Any]:
+        def logged_step(
+            self: InverseDynamicsController, t: float, q: Any, v: Any, *args: Any
+        ) -> Any:
+            if cmp_feedback and not isinstance(self.feedback, CmpFeedback):
+                self.feedback = CmpFeedback(self.feedback, self)
+            out = step(self, t, q, v, *args)
+            log.add(self, t, q, v, out)
+            return out
 
-    InverseDynamicsController.step = logged_step  # type: ignore[method-assign]
-    try:
-        yield
-    finally:
-        InverseDynamicsController.step = step  # type: ignore[method-assign]
+        return logged_step
+
+    return step_replaced(wrap)
 
 
 def summary(rows: list[dict[str, Any]], push_end: float) -> dict[str, Any]:

@@ -6,10 +6,7 @@ least-norm static distribution against the weight it must carry on a bundled sta
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import sys
-from pathlib import Path
 from types import ModuleType
 
 import numpy as np
@@ -17,21 +14,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-pytest.importorskip("qpsolvers")
+from tests.helpers.scripts import load_study
 
-ROOT = Path(__file__).resolve().parents[2]
+pytest.importorskip("qpsolvers")
 
 
 @pytest.fixture(scope="module")
 def script() -> ModuleType:
-    spec = importlib.util.spec_from_file_location(
-        "hold_through_impact", ROOT / "studies" / "hold_through_impact.py"
-    )
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # its dataclass looks its module up
-    spec.loader.exec_module(module)
-    return module
+    return load_study("hold_through_impact")
 
 
 def _inside(f: np.ndarray, n: np.ndarray, mu: float) -> bool:

@@ -19,6 +19,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tests.helpers.markdown_tables import markdown_tables
+from tests.helpers.scripts import load_study
 
 pytest.importorskip("mujoco")  # the library's Wilson interval lives in impact_balance.sim
 
@@ -47,13 +48,7 @@ TWO_KEYS = ("body", "model", "reference (m/s)")
 
 
 def _script() -> Callable[[list[str]], int]:
-    spec = importlib.util.spec_from_file_location(
-        "score_held_out", ROOT / "studies" / "score_held_out.py"
-    )
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    main: Callable[[list[str]], int] = module.main
+    main: Callable[[list[str]], int] = load_study("score_held_out").main
     return main
 
 

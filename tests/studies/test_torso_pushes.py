@@ -7,9 +7,7 @@ the ray on two synthetic soles.
 
 from __future__ import annotations
 
-import importlib.util
 import math
-from pathlib import Path
 from types import ModuleType, SimpleNamespace
 
 import numpy as np
@@ -17,21 +15,15 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tests.helpers.scripts import load_study
+
 pytest.importorskip("mujoco")  # the script imports the simulation's push prediction
 pd = pytest.importorskip("pandas", reason="needs the study extra (pandas)")
-
-ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")
 def script() -> ModuleType:
-    spec = importlib.util.spec_from_file_location(
-        "torso_pushes", ROOT / "studies" / "torso_pushes.py"
-    )
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_study("torso_pushes")
 
 
 def _time_on_one_sole(omega: float, e: float, e_in: float, xi0: float) -> float:
