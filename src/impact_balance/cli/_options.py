@@ -42,6 +42,7 @@ __all__ = [
     "add_zmp_margin_option",
     "integer",
     "number",
+    "number_or_words",
     "open_journal",
     "output_file",
     "output_folder",
@@ -169,6 +170,44 @@ def integer(field: str, lo: int, hi: int, why: str = "") -> Callable[[str], int]
         return value
 
     check.__name__ = "integer"
+    return check
+
+
+def number_or_words(
+    field: str,
+    words: tuple[str, ...],
+    inside: Callable[[float], bool],
+    not_a_number: str,
+    outside: str,
+    name: str,
+) -> Callable[[str], float | str]:
+    """Argparse type: one of ``words`` as it is, or a finite number that ``inside`` accepts.
+
+    Args:
+        field: The option, named in the errors.
+        words: The words taken as they are (``off``, ``controller``).
+        inside: Whether a finite number is in the option's range.
+        not_a_number: The error's reason for text that is neither a word nor a number.
+        outside: The error's reason for a number out of range (or not finite).
+        name: The type's name (argparse's).
+
+    Returns:
+        The type: text to a float or to the word; a :class:`CommandLineError` otherwise.
+    """
+
+    def check(text: str) -> float | str:
+        """``text`` as one of the words or a number in range, else :class:`CommandLineError`."""
+        if text in words:
+            return text
+        try:
+            value = float(text)
+        except ValueError:
+            raise CommandLineError(field, text, not_a_number) from None
+        if not (math.isfinite(value) and inside(value)):
+            raise CommandLineError(field, text, outside)
+        return value
+
+    check.__name__ = name
     return check
 
 

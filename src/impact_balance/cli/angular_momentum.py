@@ -9,11 +9,10 @@ gain (1/s).
 from __future__ import annotations
 
 import argparse
-import math
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from impact_balance.cli._options import CommandLineError
+from impact_balance.cli._options import number_or_words
 
 if TYPE_CHECKING:
     from impact_balance.scenario import Scenario
@@ -48,26 +47,14 @@ def damping_time_value(controller: bool) -> Callable[[str], float | str]:
         The type: text to a float or to the words; a :class:`CommandLineError` otherwise.
     """
     words = (OFF, CONTROLLER) if controller else (OFF,)
-
-    def check(text: str) -> float | str:
-        if text in words:
-            return text
-        try:
-            value = float(text)
-        except ValueError:
-            raise CommandLineError(
-                ANGULAR_MOMENTUM_OPTION,
-                text,
-                f"not a number of seconds or one of {', '.join(words)}",
-            ) from None
-        if not (value >= 0.0 and math.isfinite(value)):
-            raise CommandLineError(
-                ANGULAR_MOMENTUM_OPTION, text, f"must be a finite number >= 0 (s) or {OFF}"
-            )
-        return value
-
-    check.__name__ = "damping time"
-    return check
+    return number_or_words(
+        ANGULAR_MOMENTUM_OPTION,
+        words,
+        lambda value: value >= 0.0,
+        f"not a number of seconds or one of {', '.join(words)}",
+        f"must be a finite number >= 0 (s) or {OFF}",
+        "damping time",
+    )
 
 
 def add_angular_momentum_option(parser: argparse.ArgumentParser, controller: bool) -> None:

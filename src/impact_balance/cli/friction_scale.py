@@ -11,11 +11,10 @@ friction cone can realise. 1 is the paper's criterion. The simulation commands a
 from __future__ import annotations
 
 import argparse
-import math
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from impact_balance.cli._options import CommandLineError
+from impact_balance.cli._options import number_or_words
 
 if TYPE_CHECKING:
     from impact_balance.scenario import Scenario
@@ -46,23 +45,15 @@ def friction_scale_value(controller: bool) -> Callable[[str], float | str]:
         The type: text to a float or to the word; a :class:`CommandLineError` naming the
         option and the value otherwise.
     """
-
-    def check(text: str) -> float | str:
-        if controller and text == CONTROLLER:
-            return text
-        words = f" or {CONTROLLER}" if controller else ""
-        try:
-            value = float(text)
-        except ValueError:
-            raise CommandLineError(
-                FRICTION_SCALE_OPTION, text, f"not a number in (0, 1]{words}"
-            ) from None
-        if not (math.isfinite(value) and 0.0 < value <= 1.0):
-            raise CommandLineError(FRICTION_SCALE_OPTION, text, f"must be in (0, 1]{words}")
-        return value
-
-    check.__name__ = "friction scale"
-    return check
+    words = f" or {CONTROLLER}" if controller else ""
+    return number_or_words(
+        FRICTION_SCALE_OPTION,
+        (CONTROLLER,) if controller else (),
+        lambda value: 0.0 < value <= 1.0,
+        f"not a number in (0, 1]{words}",
+        f"must be in (0, 1]{words}",
+        "friction scale",
+    )
 
 
 def add_friction_scale_option(parser: argparse.ArgumentParser, controller: bool) -> None:
