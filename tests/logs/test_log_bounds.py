@@ -6,7 +6,8 @@ uncompressed size of each read Parquet column bounded from the footer before rea
 - a used column whose uncompressed size is beyond a column of numbers is refused from the
   footer, named;
 - a FIFO or a folder named as the log is refused at once;
-- the peak memory of reading such a file stays under 500 MB.
+- the peak memory of reading such a file stays under 500 MB;
+- the read starts no thread (Arrow's reader threads can abort the process at exit).
 """
 
 from __future__ import annotations
@@ -131,3 +132,30 @@ def test_reading_a_padded_parquet_stays_under_500_mb(tmp_path, log_frame):
     assert columns == len(log_frame.columns)
     print(f"peak {before / 1024:.0f} MB after the imports, {after / 1024:.0f} MB after the read")
     assert after - before < 100 * 1024, f"reading grew the peak by {(after - before) / 1024:.0f} MB"
+
+
+THREADS = r"""
+import os, sys
+from impact_balance.logs import read_log
+threads = lambda: len(os.listdir("/proc/self/task"))
+before = threads()
+read_log(sys.argv[1])
+print("THREADS", before, threads())
+"""
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self/task"), reason="counts threads in /proc")
+def test_reading_a_parquet_log_starts_no_thread(tmp_path, log_frame):
+    """No reader thread is left to run at exit (apache/arrow#34314: SIGABRT at interpreter exit)."""
+    path = tmp_path / "log.parquet"
+    pq.write_table(pa.Table.from_pandas(log_frame, preserve_index=False), path)
+    proc = subprocess.run(
+        [sys.executable, "-c", THREADS, str(path)],
+        env={**os.environ, "PYTHONPATH": SRC},
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert proc.returncode == 0, proc.stderr
+    before, after = (int(x) for x in proc.stdout.split("THREADS")[1].split())
+    assert after == before

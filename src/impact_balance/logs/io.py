@@ -145,7 +145,7 @@ def _used(name: object) -> bool:
 def _read_parquet(f: BinaryIO, shown: str) -> pd.DataFrame:
     import pyarrow.parquet as pq
 
-    parquet = pq.ParquetFile(f)
+    parquet = pq.ParquetFile(f, pre_buffer=False)
     meta = parquet.metadata  # counts and sizes from the footer: no column is read yet
     _size_limits(shown, meta.num_rows, meta.num_columns)
     used = [name for name in parquet.schema_arrow.names if _used(name)]
@@ -165,8 +165,9 @@ def _read_parquet(f: BinaryIO, shown: str) -> pd.DataFrame:
                 f"column {name}: {sizes[name]:,} bytes once uncompressed for {meta.num_rows:,} "
                 f"rows (at most {MAX_LOG_COLUMN_BYTES_PER_ROW} a row): not a column of numbers",
             )
-    f.seek(0)
-    return pd.read_parquet(f, columns=used)
+    # Read and convert on this thread: Arrow's reader and conversion threads can still run at
+    # interpreter exit and abort the process there (apache/arrow#34314).
+    return parquet.read(columns=used, use_threads=False).to_pandas(use_threads=False)
 
 
 def _last_line(f: BinaryIO) -> tuple[bool, str]:

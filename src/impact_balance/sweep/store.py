@@ -367,7 +367,7 @@ def _check_part_in(
         # without blocking): a FIFO swapped in after the checks above is never waited on.
         limit = _PART_ALLOWANCE + (stop - start) * MAX_PART_ROW_BYTES
         handle = stack.enter_context(open_regular(path, limit=limit, what=rel))
-        parquet = pq.ParquetFile(handle)
+        parquet = pq.ParquetFile(handle, pre_buffer=False)  # no reader thread (in read_log)
         meta = parquet.schema_arrow.metadata or {}
         stored_rows = parquet.metadata.num_rows
         footer = _footer_problem(parquet, manifest, stop - start)
@@ -431,7 +431,7 @@ def _checked_values(
 ) -> pa.Table | str:
     """A part's rows, read once its footer passed; or what is wrong with its values."""
     try:
-        table = parquet.read()
+        table = parquet.read(use_threads=False)
     except Exception:
         return "cannot be read to the end (cut short or overwritten)"
     table = table.replace_schema_metadata(None)
