@@ -90,3 +90,21 @@ def test_an_unknown_contact_frame_is_named_with_its_index(placed, bad):
         Stance(robot, q0, wrong)
     assert info.value.field == f"contacts[{bad}].frame"
     assert "no_such_frame" in str(info.value)
+
+
+def test_a_frames_local_position_is_its_world_one_less_the_origin(placed):
+    robot, q0, specs = placed
+    stance = Stance(robot, q0, specs)
+    model = robot.model
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q0)
+    for frame in (*robot.foot_frames, specs[0].frame):
+        local = stance.local_frame_position(frame)
+        world = data.oMf[robot.frame_id(frame)].translation
+        np.testing.assert_allclose(local + stance.origin, world, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(
+            local + stance.origin, stance.frame_pose(frame).translation, rtol=0, atol=1e-12
+        )
+    with pytest.raises(UnknownFrameError) as info:
+        stance.local_frame_position("no_such_frame", field="feet")
+    assert info.value.field == "feet"

@@ -307,7 +307,8 @@ def _compiled_posture(
     arrays = _stance_arrays(stance, scenario.torque_limits, scenario.gravity)
     faces, rotations, positions, arms, mass, com, gravity, J, idx, limit, g = arrays
     assembled = assemble_polytope(*arrays, None) if polytope else None
-    arm = placement.translation - stance.com_local  # as impact_model
+    point_local = placement.translation  # (a view into the placement: read once)
+    arm = point_local - stance.com_local  # as impact_model
     lo, hi = spec.restitution
     kernel_constants = constants(float(scenario.zmp_margin), (float(lo), float(hi)))
     t = now()
@@ -317,7 +318,7 @@ def _compiled_posture(
         w, NO_HINT, MAX_PIVOTS, kernel_constants, arm, mass, stance.com_inertia, normal, cone,
     )  # fmt: skip
     answer = posture_answer(
-        out, spec, placement.translation + stance.origin, normal, cone, J6[:3].copy(),
+        out, spec, point_local + stance.origin, normal, cone, J6[:3].copy(),
         mass=mass, omega=w, com=com, plane_height=scenario.plane_height, gravity=gravity,
         zmp_margin=scenario.zmp_margin, velocity_margin=scenario.velocity_margin,
     )  # fmt: skip

@@ -352,6 +352,16 @@ class Stance:
         placement = pin.updateFramePlacement(self.model, self._kinematics(), fid)
         return pin.SE3(placement.rotation, placement.translation + self.origin)
 
+    def local_frame_position(self, frame: str, field: str = "frame") -> np.ndarray:
+        """A frame's origin in the stance frame (world axes, origin at :attr:`origin`), m.
+
+        A new array; ``field`` names the frame in an unknown-frame error.
+        """
+        fid = self.robot.frame_id(frame, field=field)
+        placement = pin.updateFramePlacement(self.model, self._kinematics(), fid)
+        position: npt.NDArray[np.float64] = placement.translation.copy()
+        return position
+
     def lowest_contact_height(self) -> float:
         """Lowest z of any contact corner, m (nan without contacts)."""
         if not self.contacts:
