@@ -121,3 +121,40 @@ def test_the_approach_benchmark_pools_the_ticks_of_every_trial(capsys) -> None:
     assert "pooled_ratio" not in out  # no baseline, no ratio
     assert approach.main(["--trials", "0"]) == 2
     assert approach.pooled([[1.0, 2.0], [3.0]])["median"] == np.median([1.0, 2.0, 3.0])
+
+
+def test_the_analyze_steps_profile_times_every_step_and_restores_the_pipeline(capsys) -> None:
+    """Every wrapped step runs in an analysis the compiled posture answers; the steps' sum and
+    the glue add up to the instrumented total; after the timers the pipeline is unchanged."""
+    import importlib
+    import json
+    from collections import Counter
+
+    import impact_balance as ib
+    from benchmarks import analyze_steps
+
+    def originals() -> list[object]:
+        out = []
+        for _, _, module, path in analyze_steps.STEPS:
+            owner = importlib.import_module(module)
+            for part in path.split("."):
+                owner = getattr(owner, part)
+            out.append(owner)
+        return out
+
+    before = originals()
+    totals: Counter[str] = Counter()
+    with analyze_steps.timed_steps(totals):
+        ib.analyze("kick_one_foot")
+    assert {label for _, label, _, _ in analyze_steps.STEPS} == {k for k, v in totals.items() if v}
+    assert originals() == before
+    assert analyze_steps.main(["--ticks", "3", "--passes", "2", "--scenarios", "kick_one_foot",
+                               "--json"]) == 0  # fmt: skip
+    (row,) = json.loads(capsys.readouterr().out)["scenarios"]
+    steps = row["step_us"]
+    top = sum(steps[label] for depth, label, _, _ in analyze_steps.STEPS if depth == 0)
+    assert row["steps_us"] == pytest.approx(top)
+    added = row["timer_us"]["added"] * len(analyze_steps.STEPS)
+    assert row["steps_us"] + row["glue_us"] + added == pytest.approx(row["instrumented_us"])
+    assert steps["compiled call"] > 0 and row["analyze_us"] > 0
+    assert analyze_steps.main(["--ticks", "0"]) == 2

@@ -66,3 +66,10 @@ def test_only_the_specs_change(scale, margin):
     assert [c.spec.friction for c in STANCE.contacts] == [
         c.spec.friction for c in load_scenario("talos_three_contacts").build_stance().contacts
     ]
+
+
+def test_scale_one_with_a_bad_margin_is_still_refused():
+    with pytest.raises(ScenarioError) as info:
+        scaled_stance(STANCE, 1.0, -0.01)
+    assert info.value.field == "cop_margin"
+    assert scaled_stance(STANCE, 1.0, 0.01) is not STANCE  # a margin alone narrows the contacts

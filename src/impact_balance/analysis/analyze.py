@@ -23,7 +23,7 @@ from impact_balance.balance.areas import (
 from impact_balance.balance.lipm import lipm_omega
 from impact_balance.contacts.contact_model import scaled_stance
 from impact_balance.contacts.cwc import local_faces
-from impact_balance.contacts.stance import Stance
+from impact_balance.contacts.stance import ContactSpec, Stance
 from impact_balance.contacts.wrench_polytope import (
     WrenchPolytope,
     assemble_polytope,
@@ -307,17 +307,18 @@ def _compiled_posture(
     arrays = _stance_arrays(stance, scenario.torque_limits, scenario.gravity)
     faces, rotations, positions, arms, mass, com, gravity, J, idx, limit, g = arrays
     assembled = assemble_polytope(*arrays, None) if polytope else None
-    arm = placement.translation - stance.com_local  # as impact_model
+    point_local = placement.translation  # (a view into the placement: read once)
+    arm = point_local - stance.com_local  # as impact_model
     lo, hi = spec.restitution
+    kernel_constants = constants(float(scenario.zmp_margin), (float(lo), float(hi)))
     t = now()
     out = posture_kernel(
         faces, rotations, positions, arms, J, np.ascontiguousarray(idx, dtype=np.int64), limit,
         g, mass * gravity, scenario.plane_height - float(com[2]), float(com[0]), float(com[1]),
-        w, NO_HINT, MAX_PIVOTS, constants(float(scenario.zmp_margin), (float(lo), float(hi))),
-        arm, mass, stance.com_inertia, normal, cone,
+        w, NO_HINT, MAX_PIVOTS, kernel_constants, arm, mass, stance.com_inertia, normal, cone,
     )  # fmt: skip
     answer = posture_answer(
-        out, spec, placement.translation + stance.origin, normal, cone, J6[:3].copy(),
+        out, spec, point_local + stance.origin, normal, cone, J6[:3].copy(),
         mass=mass, omega=w, com=com, plane_height=scenario.plane_height, gravity=gravity,
         zmp_margin=scenario.zmp_margin, velocity_margin=scenario.velocity_margin,
     )  # fmt: skip
@@ -430,20 +431,42 @@ def _stance_arrays(stance: Stance, torque_limits: bool, gravity: float) -> _Arra
     """
     contacts = stance.contacts
     m = len(contacts)
-    faces = np.array(
-        [local_faces(float(c.spec.friction), c.half_length, c.half_width) for c in contacts]
-    ).reshape(m, 16, 6)
+    faces = _faces(tuple(c.spec for c in contacts))
     rotations = np.array([c.rotation for c in contacts], dtype=float).reshape(m, 3, 3)
     positions = np.array([c.position for c in contacts], dtype=float).reshape(m, 3)
     local = np.array([c.local_position for c in contacts], dtype=float).reshape(-1, 3)
     idx, limit = stance.robot.effort_limits
-    J, g = np.zeros((0, 0)), np.zeros(0)
     if torque_limits and idx.size:
         J, g = np.concatenate([c.jacobian for c in contacts]), stance.gravity_torques
     else:
+        J, g = np.zeros((0, 0)), np.zeros(0)
         idx, limit = np.zeros(0, dtype=np.int64), np.zeros(0)
     arms = local - stance.com_local
     return faces, rotations, positions, arms, stance.mass, stance.com, gravity, J, idx, limit, g
+
+
+#: :func:`_faces`' last answer: the contacts' specs (the objects) and their stacked faces.
+_LAST_FACES: tuple[tuple[ContactSpec, ...], np.ndarray] = ((), np.zeros((0, 16, 6)))
+
+
+def _faces(specs: tuple[ContactSpec, ...]) -> np.ndarray:
+    """The contacts' CWC faces in their frames, stacked (m, 16, 6): callers only read them.
+
+    The last specs' array is kept (specs are immutable; a scenario's contacts give the same
+    spec objects at every posture): one tuple, swapped whole, so threads never mix two answers.
+    """
+    global _LAST_FACES
+    last, faces = _LAST_FACES
+    if len(last) == len(specs) and all(a is b for a, b in zip(last, specs, strict=True)):
+        return faces
+    faces = np.array(
+        [
+            local_faces(float(c.friction), 0.5 * float(c.size[0]), 0.5 * float(c.size[1]))
+            for c in specs
+        ]
+    ).reshape(len(specs), 16, 6)
+    _LAST_FACES = (specs, faces)
+    return faces
 
 
 def impact_answer(

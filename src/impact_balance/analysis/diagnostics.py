@@ -162,7 +162,7 @@ def _surely_upright(stance: Stance) -> bool:
     (:attr:`~impact_balance.robot.robot.Robot.foot_frames`; stance frame, m): a foot that is a
     contact at the frame's own origin (no offset) is that contact's point, another one (in the
     air, offset) the frame's placement in the stance's kinematics
-    (:meth:`~impact_balance.contacts.stance.Stance.frame_pose`, less the origin). At least 1 mm
+    (:meth:`~impact_balance.contacts.stance.Stance.local_frame_position`). At least 1 mm
     long, within 1e6 m of the origin and at least :data:`_SURELY_UPRIGHT` along +z, the robot
     stands (the check's own numbers, in world coordinates, differ from these by less than 1e-7
     in that cosine). Otherwise (a tilt near the check's) the robot's check answers.
@@ -179,10 +179,8 @@ def _surely_upright(stance: Stance) -> bool:
     for frame in feet:
         p = points.get(frame)
         if p is None:  # not a contact: where the stance's kinematics place the frame
-            t = stance.frame_pose(frame).translation
-            x, y, z = x + (float(t[0]) - ox), y + (float(t[1]) - oy), z + (float(t[2]) - oz)
-        else:
-            x, y, z = x + float(p[0]), y + float(p[1]), z + float(p[2])
+            p = stance.local_frame_position(frame)
+        x, y, z = x + float(p[0]), y + float(p[1]), z + float(p[2])
     dx, dy, dz = float(com[0]) - x / n, float(com[1]) - y / n, float(com[2]) - z / n
     length = math.sqrt(dx * dx + dy * dy + dz * dz)
     return length >= 1e-3 and dz >= _SURELY_UPRIGHT * length

@@ -87,6 +87,8 @@ def scaled_stance(stance: Stance, friction_scale: float, cop_margin: float = 0.0
     Raises:
         ScenarioError: See :func:`scaled_contact`.
     """
+    if friction_scale == 1.0 and cop_margin == 0.0:  # every contact its own spec: no change
+        return stance
     specs = [scaled_contact(c.spec, friction_scale, cop_margin) for c in stance.contacts]
     if all(s is c.spec for s, c in zip(specs, stance.contacts, strict=True)):
         return stance

@@ -16,6 +16,7 @@ import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
+from impact_balance.exceptions import UnknownFrameError
 from impact_balance.geometry.spatial import skew
 from impact_balance.robot.robot import Robot, Scratch
 
@@ -28,6 +29,16 @@ __all__ = [
 ]
 
 _IDENTITY = pin.SE3.Identity()
+_POSITION = pin.KinematicLevel.POSITION
+_WORLD = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+
+@functools.lru_cache(maxsize=16)
+def _zero_velocity(nv: int) -> np.ndarray:
+    """A read-only zero velocity (nv,): ccrba's, which it only reads."""
+    zero = np.zeros(nv)
+    zero.setflags(write=False)
+    return zero
 
 
 #: :func:`has_free_flyer`'s answers by model (``id``): the model (weakly) and its joint count
@@ -61,11 +72,7 @@ def frame_point(
     (None) without ``jacobian``. The pose may be ``data``'s own: copy what you keep.
     """
     frame_pose = pin.updateFramePlacement(model, data, fid)
-    J = (
-        pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
-        if jacobian
-        else None
-    )
+    J = pin.getFrameJacobian(model, data, fid, _WORLD) if jacobian else None
     if offset is None or offset == _IDENTITY:  # exact test: contacts mostly have no offset
         return frame_pose, J
     placement = frame_pose * offset
@@ -198,38 +205,43 @@ class Stance:
         # An explicit scratch Data is kept; else the robot's per-thread one is looked up at
         # each use (a stance may be read from another thread than the one that built it).
         self._scratch = workspace
-        self.q = np.array(q, dtype=float)
-        self.origin = np.zeros(3)
-        self._q_local = self.q
+        self.q = q = np.array(q, dtype=float)
         if has_free_flyer(model):
-            self.origin = self.q[:3].copy()
-            self._q_local = self.q.copy()
-            self._q_local[:3] = 0.0
-        scratch = self.workspace()
+            self.origin = q[:3].copy()
+            self._q_local = q_local = q.copy()
+            q_local[:3] = 0.0
+        else:
+            self.origin = np.zeros(3)
+            self._q_local = q_local = q
+        scratch = workspace if workspace is not None else robot.thread_data()
         data = scratch.data
         # ccrba runs the forward kinematics and also fills the joint Jacobians data.J (as
         # computeJointJacobians does) and data.Ig, the centroidal composite inertia in world axes.
-        pin.ccrba(model, data, self._q_local, np.zeros(model.nv))
-        scratch.holder = self._q_local.tobytes()
-        self.com_local = np.array(
-            pin.centerOfMass(model, data, pin.KinematicLevel.POSITION, False), dtype=float
-        )
+        pin.ccrba(model, data, q_local, _zero_velocity(model.nv))
+        scratch.holder = q_local.tobytes()
+        self.com_local = np.array(pin.centerOfMass(model, data, _POSITION, False), dtype=float)
         self.com = self.com_local + self.origin
         Ig = data.Ig
         self.mass = float(Ig.mass)
         self.com_inertia = np.array(Ig.inertia, dtype=float)
         # g(q) does not depend on the base position (its base rows are moments about the base).
         self.gravity_torques = np.array(
-            pin.computeGeneralizedGravity(model, data, self._q_local), dtype=float
+            pin.computeGeneralizedGravity(model, data, q_local), dtype=float
         )
-        self.contacts: list[Contact] = []
-        for i, spec in enumerate(contacts):
+        self.contacts: list[Contact] = [
+            self._contact(data, i, spec) for i, spec in enumerate(contacts)
+        ]
+
+    def _contact(self, data: pin.Data, i: int, spec: ContactSpec) -> Contact:
+        """Contact ``i`` of ``spec`` resolved in ``data`` (this stance's kinematics)."""
+        robot = self.robot
+        try:  # the field named only in the error (its string costs as much as the look-up)
+            fid = robot.frame_id(spec.frame)
+        except UnknownFrameError:
             fid = robot.frame_id(spec.frame, f"contacts[{i}].frame")
-            placement, jacobian = self._point(data, fid, spec.offset)
-            local = placement.translation.copy()
-            self.contacts.append(
-                Contact(spec, placement.rotation.copy(), local + self.origin, jacobian, local)
-            )
+        placement, jacobian = self._point(data, fid, spec.offset)
+        local = placement.translation.copy()
+        return Contact(spec, placement.rotation.copy(), local + self.origin, jacobian, local)
 
     def moved_to(self, q: np.ndarray) -> Stance:
         """This stance's robot and contacts at configuration ``q``: ``Stance(robot, q, specs)``.
@@ -339,6 +351,16 @@ class Stance:
         fid = self.robot.frame_id(frame, field=field)
         placement = pin.updateFramePlacement(self.model, self._kinematics(), fid)
         return pin.SE3(placement.rotation, placement.translation + self.origin)
+
+    def local_frame_position(self, frame: str, field: str = "frame") -> np.ndarray:
+        """A frame's origin in the stance frame (world axes, origin at :attr:`origin`), m.
+
+        A new array; ``field`` names the frame in an unknown-frame error.
+        """
+        fid = self.robot.frame_id(frame, field=field)
+        placement = pin.updateFramePlacement(self.model, self._kinematics(), fid)
+        position: npt.NDArray[np.float64] = placement.translation.copy()
+        return position
 
     def lowest_contact_height(self) -> float:
         """Lowest z of any contact corner, m (nan without contacts)."""
