@@ -74,11 +74,13 @@ def slip_speed(static: np.ndarray, per_speed: np.ndarray, normal: np.ndarray, mu
     qb = 2 * (float(a_t @ b_t) - mu**2 * a_n * b_n)
     qc = float(a_t @ a_t) - mu**2 * a_n**2
     roots = [-a_n / b_n] if b_n < 0 else []
-    if abs(qa) > 1e-14:
-        disc = qb * qb - 4 * qa * qc
-        if disc >= 0:
-            roots += [(-qb - math.sqrt(disc)) / (2 * qa), (-qb + math.sqrt(disc)) / (2 * qa)]
-    elif abs(qb) > 1e-14:
+    disc = qb * qb - 4 * qa * qc
+    if abs(qa) > 1e-14 and disc >= 0:
+        # The stable form (no cancellation when qa is small against qb: mu near the cone's
+        # growth ratio): q = -(qb + sign(qb) sqrt(disc)) / 2, the roots q / qa and qc / q.
+        q = -0.5 * (qb + math.copysign(math.sqrt(disc), qb))
+        roots += [q / qa] + ([qc / q] if q != 0.0 else [])
+    elif abs(qa) <= 1e-14 and abs(qb) > 1e-14:
         roots.append(-qc / qb)
     for v in sorted(r for r in roots if r > 0):
         if outside(v * (1 + 1e-9) + 1e-12):

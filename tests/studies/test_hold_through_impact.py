@@ -11,7 +11,7 @@ from types import ModuleType
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from tests.helpers.scripts import load_study
@@ -34,6 +34,9 @@ vec = st.lists(component, min_size=3, max_size=3)
 
 
 @settings(max_examples=60, deadline=None)
+# mu near the growth's |b_t| / |b_n|: the quadratic's leading coefficient is tiny (the cone's
+# exit at 1/14 was lost to cancellation and the normal's zero, 1/7, returned).
+@example(tangential=[0.0, 0.0, 0.0], growth=[0.0, -7.0, -7.0], normal_load=1.0, mu=1.0 - 1e-13)
 @given(tangential=vec, growth=vec, normal_load=st.floats(1.0, 100.0), mu=st.floats(0.1, 1.0))
 def test_slip_speed_against_a_scan(
     script: ModuleType,
