@@ -46,6 +46,7 @@ import pinocchio as pin
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks.hand_contact import _Log, _realised, step_replaced
+from impact_balance.sim.control.gains import InverseDynamicsGains
 from impact_balance.sim.control.torque import InverseDynamicsController
 from impact_balance.sim.trials.balance_trial import run_balance_trial
 from impact_balance.sim.trials.setup import BalanceSetup, BalanceTrialOptions
@@ -109,8 +110,11 @@ class _ApproachLog(_Log):
         target = task.reference(t, 0.0)[0]  # 0 N: never marks the contact itself
         n = np.asarray(task.normal, dtype=float)
         sim = self.sim
+        planned = c.last.touch_force if c.last is not None else None
         return {
             "impact_phase": "approach" if task.contact_time is None else "withdraw",
+            "touching": c.touching,
+            "touch_force_planned": None if planned is None else np.asarray(planned).tolist(),
             "impact_normal_force": float(fn),
             "impact_tracking_error": float(np.linalg.norm(target - placement.translation)),
             "impact_error_along_normal": float(n @ (placement.translation - target)),
@@ -160,6 +164,7 @@ def _firsts(rows: list[dict[str, Any]], min_normal: float) -> dict[str, Any]:
         "zmp_clamped": lambda r: r["zmp_clamped"],
         "impact_force_over_1N": lambda r: r.get("impact_normal_force", 0.0) > 1.0,
         "withdraw": lambda r: r.get("impact_phase") == "withdraw",
+        "touch_contact": lambda r: bool(r.get("touching")),
         "com_outside_clamp": lambda r: r["com_margin_clamp"] < 0.0,
         "dcm_outside_clamp": lambda r: r["dcm_margin_clamp"] < 0.0,
         "base_rotation_over_2deg": lambda r: r["base_rotation_deg"] > 2.0,
@@ -200,10 +205,19 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument(
         "--force-threshold", type=float, default=None, help="what-if: N (15; inf: no withdrawal)"
     )
+    p.add_argument(
+        "--touch-contact",
+        action="store_true",
+        help="the id controller's touch_contact: the touching point a contact of the QP",
+    )
     p.add_argument("--every", type=int, default=25)
     p.add_argument("--json", default=None, help="write every row to this file")
     args = p.parse_args(argv)
-    options = BalanceTrialOptions(controller="id", rigid_impact=args.rigid_impact)
+    options = BalanceTrialOptions(
+        controller="id",
+        rigid_impact=args.rigid_impact,
+        id_gains=InverseDynamicsGains(touch_contact=args.touch_contact),
+    )
     setup = BalanceSetup.create(args.scenario, "servo", options)
     a = setup.analysis
     contacts = [c.spec.frame for c in a.stance.contacts]
