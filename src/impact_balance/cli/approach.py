@@ -140,13 +140,13 @@ def add_parser(sub: Subcommands) -> list[str]:
         help="render an MP4 of the trial (one trial: give --wall-distance)",
     )
     add_angular_momentum_option(a, controller=True)
-    add_touch_contact_option(a)
     return ["approach"]
 
 
 def _add_impact_model_option(a: argparse.ArgumentParser) -> None:
-    """Add ``--impact-model`` and ``--friction-scale`` to ``approach``'s parser ``a``."""
+    """Add ``--impact-model``, ``--friction-scale`` and ``--touch-contact`` to parser ``a``."""
     add_friction_scale_option(a, controller=True)
+    add_touch_contact_option(a)
     add_impact_model_option(
         a,
         "the com governor caps with the held-stance jumps of the scenario's posture, computed "

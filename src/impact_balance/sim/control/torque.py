@@ -336,12 +336,8 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         self._damping_rows: _FloatArray = np.zeros(nv - 6)
         self._friction_rows: _FloatArray = np.zeros(nv - 6)
         self.nc = len(stance.contacts)
-        # The touching point's force (3 variables, 8 rows) with touch_contact and an impact task.
-        touch = bool(gains.touch_contact and impact is not None)
-        self._touch_vars, self._touch_rows = (3, 8) if touch else (0, 0)
+        self._init_touch(analysis, gains, impact)
         self.n = nv + 6 * self.nc + self._touch_vars
-        #: When the impact point first touched (s; the first positive measured normal force).
-        self.touch_time: float | None = None
         self.mass = float(sum(inertia.mass for inertia in model.inertias))
         self.gravity = analysis.areas.gravity
         self.plane_height = analysis.areas.plane_height
@@ -380,15 +376,6 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
             self._impact_frame = model.getFrameId(impact.frame)
             pose = self.data.oMf[self._impact_frame] * impact.offset
             self._impact_rotation = pose.rotation.copy()
-        if touch:
-            assert impact is not None
-            self._touch_normal = np.asarray(impact.normal, dtype=float)
-            self._touch_faces = touch_faces(self._touch_normal, _impact_friction(analysis, gains))
-            #: The touching point's pressing force while it is a contact (N).
-            threshold = float(getattr(impact, "force_threshold", 0.0))
-            self.touch_force = threshold if np.isfinite(threshold) and threshold > 0 else 0.0
-            self._touch_point: tuple[_FloatArray, _FloatArray] | None = None
-            self._touch_jacobian = np.zeros((3, nv))
         self._zero = np.zeros(nv)
         # Posture weights per velocity row: none on the base translation (the CoM task owns it).
         self._posture_w = np.full(nv, gains.posture_weight)
@@ -417,6 +404,30 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         bound = getattr(impact, "speed_bound", None)
         self._speed_bound: Callable[[], float] | None = bound if callable(bound) else None
         self._speed_rows = int(impact is not None and self._speed_bound is not None)
+        self._init_rows()
+
+    def _init_touch(
+        self, analysis: Analysis, gains: InverseDynamicsGains, impact: ImpactReference | None
+    ) -> None:
+        """The touching point's force (3 variables, 8 rows) with ``touch_contact`` and a task."""
+        touch = bool(gains.touch_contact and impact is not None)
+        self._touch_vars, self._touch_rows = (3, 8) if touch else (0, 0)
+        #: When the impact point first touched (s; the first positive measured normal force).
+        self.touch_time: float | None = None
+        #: The touching point's pressing force while it is a contact (N).
+        self.touch_force = 0.0
+        if impact is None or not touch:
+            return
+        self._touch_normal = np.asarray(impact.normal, dtype=float)
+        self._touch_faces = touch_faces(self._touch_normal, _impact_friction(analysis, gains))
+        threshold = float(getattr(impact, "force_threshold", 0.0))
+        self.touch_force = threshold if np.isfinite(threshold) and threshold > 0 else 0.0
+        self._touch_point: tuple[_FloatArray, _FloatArray] | None = None
+        self._touch_jacobian = np.zeros((3, self.nv))
+
+    def _init_rows(self) -> None:
+        """The QP's constraint buffers (see :meth:`_constraints` for their order)."""
+        n, nc, nv = self.n, self.nc, self.nv
         m = (
             6
             + 6 * nc
