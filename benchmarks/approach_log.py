@@ -11,7 +11,9 @@ their effort limit) and, added here:
 - ``com``, ``dcm`` and the desired ZMP's margins (m) in the controller's own clamp area
   (``controller.feedback.zmp_area``: the QP's contact model on this tree, the scenario's
   full-friction area on set 10's) and in the scenario's ZMP support area;
-- the impact task: its phase (``approach``, ``withdraw``), the measured normal force at the
+- the impact task: its phase (``approach``, ``withdraw``), whether the touching point is a
+  contact of the QP (``touching``) and its planned force (``touch_force_planned``, N, world;
+  zero outside the contact, None without ``--touch-contact``), the measured normal force at the
   impact point (N), the point's tracking error to the task's reference (m, world) and its
   velocity along the normal (m/s, positive towards the surface);
 - the joints within ``--limit-tol`` rad of a position limit;
@@ -20,6 +22,8 @@ their effort limit) and, added here:
 
     nice -n 5 python benchmarks/approach_log.py \
         studies/held_out_11/icub_right_hand_wall_left_palm_oblique_side.yaml --speed 0.02
+    # the id controller's touch contact (the touching point a contact of its QP):
+    nice -n 5 python benchmarks/approach_log.py ... --speed 0.02 --touch-contact
     # set 10's controller (before the clamp change), the same script:
     PYTHONPATH=/work/wt/frozen10/src python benchmarks/approach_log.py ... --speed 0.02
 
