@@ -11,7 +11,9 @@ their effort limit) and, added here:
 - ``com``, ``dcm`` and the desired ZMP's margins (m) in the controller's own clamp area
   (``controller.feedback.zmp_area``: the QP's contact model on this tree, the scenario's
   full-friction area on set 10's) and in the scenario's ZMP support area;
-- the impact task: its phase (``approach``, ``withdraw``), the measured normal force at the
+- the impact task: its phase (``approach``, ``withdraw``), whether the touching point is a
+  contact of the QP (``touching``) and its planned force (``touch_force_planned``, N, world;
+  zero outside the contact, None without ``--touch-contact``), the measured normal force at the
   impact point (N), the point's tracking error to the task's reference (m, world) and its
   velocity along the normal (m/s, positive towards the surface);
 - the joints within ``--limit-tol`` rad of a position limit;
@@ -20,6 +22,8 @@ their effort limit) and, added here:
 
     nice -n 5 python benchmarks/approach_log.py \
         studies/held_out_11/icub_right_hand_wall_left_palm_oblique_side.yaml --speed 0.02
+    # the id controller's touch contact (the touching point a contact of its QP):
+    nice -n 5 python benchmarks/approach_log.py ... --speed 0.02 --touch-contact
     # set 10's controller (before the clamp change), the same script:
     PYTHONPATH=/work/wt/frozen10/src python benchmarks/approach_log.py ... --speed 0.02
 
@@ -46,6 +50,7 @@ import pinocchio as pin
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks.hand_contact import _Log, _realised, step_replaced
+from impact_balance.sim.control.gains import InverseDynamicsGains
 from impact_balance.sim.control.torque import InverseDynamicsController
 from impact_balance.sim.trials.balance_trial import run_balance_trial
 from impact_balance.sim.trials.setup import BalanceSetup, BalanceTrialOptions
@@ -109,8 +114,11 @@ class _ApproachLog(_Log):
         target = task.reference(t, 0.0)[0]  # 0 N: never marks the contact itself
         n = np.asarray(task.normal, dtype=float)
         sim = self.sim
+        planned = c.last.touch_force if c.last is not None else None
         return {
             "impact_phase": "approach" if task.contact_time is None else "withdraw",
+            "touching": c.touching,
+            "touch_force_planned": None if planned is None else np.asarray(planned).tolist(),
             "impact_normal_force": float(fn),
             "impact_tracking_error": float(np.linalg.norm(target - placement.translation)),
             "impact_error_along_normal": float(n @ (placement.translation - target)),
@@ -160,6 +168,7 @@ def _firsts(rows: list[dict[str, Any]], min_normal: float) -> dict[str, Any]:
         "zmp_clamped": lambda r: r["zmp_clamped"],
         "impact_force_over_1N": lambda r: r.get("impact_normal_force", 0.0) > 1.0,
         "withdraw": lambda r: r.get("impact_phase") == "withdraw",
+        "touch_contact": lambda r: bool(r.get("touching")),
         "com_outside_clamp": lambda r: r["com_margin_clamp"] < 0.0,
         "dcm_outside_clamp": lambda r: r["dcm_margin_clamp"] < 0.0,
         "base_rotation_over_2deg": lambda r: r["base_rotation_deg"] > 2.0,
@@ -200,10 +209,19 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument(
         "--force-threshold", type=float, default=None, help="what-if: N (15; inf: no withdrawal)"
     )
+    p.add_argument(
+        "--touch-contact",
+        action="store_true",
+        help="the id controller's touch_contact: the touching point a contact of the QP",
+    )
     p.add_argument("--every", type=int, default=25)
     p.add_argument("--json", default=None, help="write every row to this file")
     args = p.parse_args(argv)
-    options = BalanceTrialOptions(controller="id", rigid_impact=args.rigid_impact)
+    options = BalanceTrialOptions(
+        controller="id",
+        rigid_impact=args.rigid_impact,
+        id_gains=InverseDynamicsGains(touch_contact=args.touch_contact),
+    )
     setup = BalanceSetup.create(args.scenario, "servo", options)
     a = setup.analysis
     contacts = [c.spec.frame for c in a.stance.contacts]

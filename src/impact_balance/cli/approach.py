@@ -26,6 +26,7 @@ from impact_balance.cli._options import (
 from impact_balance.cli.angular_momentum import add_angular_momentum_option, for_trials
 from impact_balance.cli.calibrate import add_calibration_option, apply_calibration_option
 from impact_balance.cli.friction_scale import add_friction_scale_option, friction_scale_for_trials
+from impact_balance.cli.touch_contact import add_touch_contact_option, impact_trial_options
 
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
@@ -143,8 +144,9 @@ def add_parser(sub: Subcommands) -> list[str]:
 
 
 def _add_impact_model_option(a: argparse.ArgumentParser) -> None:
-    """Add ``--impact-model`` and ``--friction-scale`` to ``approach``'s parser ``a``."""
+    """Add ``--impact-model``, ``--friction-scale`` and ``--touch-contact`` to parser ``a``."""
     add_friction_scale_option(a, controller=True)
+    add_touch_contact_option(a)
     add_impact_model_option(
         a,
         "the com governor caps with the held-stance jumps of the scenario's posture, computed "
@@ -184,7 +186,6 @@ def run(args: argparse.Namespace) -> int:
     from impact_balance.scenario import load_scenario
     from impact_balance.sim.trials.balance_trial import (
         BalanceSetup,
-        BalanceTrialOptions,
         controller_margin,
     )
 
@@ -196,7 +197,7 @@ def run(args: argparse.Namespace) -> int:
         )
     distances = _distances(args)
     _check_distances(args, distances)
-    options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
+    options = impact_trial_options(args.controller, args.rigid_impact, args.touch_contact)
     scenario = for_trials(scenario, args.angular_momentum_damping_time, options)
     scenario = friction_scale_for_trials(scenario, args.friction_scale, options)
     own = scoring_margin(scenario)

@@ -24,6 +24,7 @@ from impact_balance.cli._options import (
 from impact_balance.cli.angular_momentum import add_angular_momentum_option, for_trials
 from impact_balance.cli.calibrate import add_calibration_option, apply_calibration_option
 from impact_balance.cli.friction_scale import add_friction_scale_option, friction_scale_for_trials
+from impact_balance.cli.touch_contact import add_touch_contact_option, impact_trial_options
 
 if TYPE_CHECKING:
     from impact_balance.cli._options import Subcommands
@@ -79,6 +80,7 @@ def add_parser(sub: Subcommands) -> list[str]:
     add_output_options(a, "of the fastest trial survived")
     add_angular_momentum_option(a, controller=True)
     add_friction_scale_option(a, controller=True)
+    add_touch_contact_option(a)
     return ["validate"]
 
 
@@ -95,10 +97,10 @@ def run(args: argparse.Namespace) -> int:
     from impact_balance.cli.output_paths import writing
     from impact_balance.sim.studies.validate import validate
     from impact_balance.sim.trials.aborts import check_not_all_aborted
-    from impact_balance.sim.trials.balance_trial import BalanceTrialOptions, write_trial_log
+    from impact_balance.sim.trials.balance_trial import write_trial_log
 
     scenario, calibration = _checked_scenario(args)
-    options = BalanceTrialOptions(controller=args.controller, rigid_impact=args.rigid_impact)
+    options = impact_trial_options(args.controller, args.rigid_impact, args.touch_contact)
     joints = TRIAL_JOINTS[args.joints]  # the study's name (the journals' digests keep it)
     judged = for_trials(scenario, args.angular_momentum_damping_time, options)
     judged = friction_scale_for_trials(judged, args.friction_scale, options)
@@ -160,6 +162,7 @@ def run(args: argparse.Namespace) -> int:
                         {"approach_speed": speed, "joints": joints},
                         impact_speed=speed,
                         rigid_impact=args.rigid_impact,
+                        id_gains=options.id_gains,
                     )
                 )
             out["log"] = {"file": str(args.log), "approach_speed": speed}
@@ -220,7 +223,7 @@ def _text(out: dict[str, Any], args: argparse.Namespace, n: int) -> str:
     e, p, pm = out["empirical"], out["predicted"], out["predicted_with_margin"]
     impact = (
         "rigid impact (joints held through the impact)" if out["rigid_impact"] else "free impact"
-    )
+    ) + (", touch contact" if args.touch_contact else "")
     lines = [
         f"{out['scenario']}: fall threshold of the impact ({args.joints} joints, {args.controller} "
         "controller, "

@@ -142,6 +142,12 @@ class InverseDynamicsGains:
         joint_limit_horizon: T [s] of the joint position limits on the accelerations: braking at
             ``a`` from ``(q, v)`` stays within the limits for T, ``q + v T + a T^2 / 2`` in
             ``[lower, upper]``. MuJoCo enforces the limits with forces the QP would not know.
+        touch_contact: From the impact point's first touch (a positive measured normal force)
+            until its withdrawal starts, the impact point is a contact of the QP: a point
+            contact that stays (zero relative acceleration), its force in the impact's friction
+            cone times ``friction_scale``, pressing with at least the impact task's
+            ``force_threshold`` (see :mod:`impact_balance.sim.control.torque`). False: the
+            impact is no contact of the QP.
     """
 
     rate: float = 500.0
@@ -171,6 +177,7 @@ class InverseDynamicsGains:
     min_normal_force: float = 20.0
     friction_velocity: float = 0.01
     joint_limit_horizon: float = 0.1
+    touch_contact: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         """The gains by field name (JSON-ready)."""

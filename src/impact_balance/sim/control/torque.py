@@ -44,6 +44,23 @@ free-flyer velocity in the base frame):
      reference's acceleration, plus a PD to its position and velocity); a posture
      PD to the start configuration (joints) and one on the base orientation; a small regularisation.
 
+   With ``touch_contact`` (:class:`InverseDynamicsGains`) and an impact task, ``x`` also holds
+   the touching point's force ``f_h`` (3, world axes, on the robot at the impact point): from
+   the first control step whose measured normal force at the impact point is positive until
+   the task starts its withdrawal (its ``contact_time``), the point is a contact of the QP,
+
+   - ``J_h a + J_h_dot v = -K_c J_h v`` (the point stays, as the stance's contacts; ``J_h`` the
+     linear rows of the impact point's Jacobian) and ``J_h^T f_h`` in the floating base's rows
+     and in ``tau``;
+   - ``|t_k . f_h| <= mu_h n . f_h`` (k = 1, 2; ``n`` the surface normal into the robot, ``t_k``
+     two tangents; ``mu_h`` the impact's friction times ``friction_scale``);
+   - ``n . f_h >= f_press``, the task's ``force_threshold`` (N): the force at which the task
+     withdraws, so that the withdrawal starts as without the option (0 for a task without a
+     finite one);
+
+   otherwise ``f_h = 0``. The task's reference still enters the cost; while the point is a
+   contact its linear rows cannot move it.
+
    If the torque limits make the QP infeasible, it is solved without them and the torques are
    clipped (MuJoCo clips them too); then, if need be, without the joint limits, then without
    the approach speed's bound.
@@ -73,6 +90,7 @@ from impact_balance.balance.areas import BalanceAreas
 from impact_balance.balance.lipm import lipm_omega
 from impact_balance.contacts.contact_model import inset_half_size
 from impact_balance.contacts.cwc import cwc_faces_world
+from impact_balance.exceptions import SimulationError
 from impact_balance.geometry.spatial import skew
 from impact_balance.sim.control.actuation import use_torque_motors
 from impact_balance.sim.control.approach import ImpactReference
@@ -81,7 +99,13 @@ from impact_balance.sim.control.gains import InverseDynamicsGains, TrialGains, t
 from impact_balance.sim.control.zmp import DcmFeedback
 from impact_balance.sim.model.build import SimModel
 
-__all__ = ["InverseDynamicsController", "TorqueOutput", "clamp_areas", "motor_compensation"]
+__all__ = [
+    "InverseDynamicsController",
+    "TorqueOutput",
+    "clamp_areas",
+    "motor_compensation",
+    "touch_faces",
+]
 
 _FloatArray = npt.NDArray[np.float64]
 
@@ -104,6 +128,8 @@ class TorqueOutput:
         com_velocity: Measured CoM velocity (m/s, world).
         torque_limited: Whether the torque limits had to be dropped (infeasible) and the torques
             clipped.
+        touch_force: The touching point's planned contact force (N, world, on the robot; zero
+            while it is no contact of the QP); None without ``touch_contact``.
     """
 
     tau: np.ndarray
@@ -115,6 +141,7 @@ class TorqueOutput:
     com: np.ndarray
     com_velocity: np.ndarray
     torque_limited: bool = False
+    touch_force: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -199,6 +226,43 @@ def clamp_areas(analysis: Analysis, gains: InverseDynamicsGains) -> BalanceAreas
     )
 
 
+def touch_faces(normal: npt.ArrayLike, friction: float) -> _FloatArray:
+    """The friction pyramid of a point contact: ``F f <= 0`` (4 x 3, world axes).
+
+    Rows ``(+-t_k - mu n)`` for two unit tangents ``t_1``, ``t_2`` orthogonal to the unit
+    ``normal`` ``n``: ``|t_k . f| <= mu n . f``, the pyramid of
+    :func:`~impact_balance.contacts.cwc.cwc_faces_world` at a point.
+
+    Args:
+        normal: The surface normal, into the robot (world; normalised here).
+        friction: The friction coefficient ``mu`` (>= 0).
+
+    Raises:
+        ValueError: A zero or non-finite normal, or a negative or non-finite friction.
+    """
+    n = np.asarray(normal, dtype=float)
+    norm = float(np.linalg.norm(n))
+    if not (np.isfinite(norm) and norm > 0):
+        raise ValueError(f"normal must be a non-zero finite vector, not {n.tolist()!r}")
+    if not (np.isfinite(friction) and friction >= 0):
+        raise ValueError(f"friction must be finite and >= 0, not {friction!r}")
+    n = n / norm
+    helper = np.eye(3)[int(np.argmin(np.abs(n)))]
+    t1 = np.cross(n, helper)
+    t1 /= np.linalg.norm(t1)
+    t2 = np.cross(n, t1)
+    mu = float(friction)
+    faces: _FloatArray = np.array([t1 - mu * n, -t1 - mu * n, t2 - mu * n, -t2 - mu * n])
+    return faces
+
+
+def _impact_friction(analysis: Analysis, gains: InverseDynamicsGains) -> float:
+    """The touching point's friction in the QP: the impact's times ``gains.friction_scale``."""
+    if analysis.impact is None:
+        raise SimulationError("touch_contact", True, "the scenario has no impact: nothing touches")
+    return float(gains.friction_scale * analysis.impact.model.spec.friction)
+
+
 def _point_jacobian(
     model: pin.Model, data: pin.Data, fid: int, offset: pin.SE3
 ) -> tuple[pin.SE3, np.ndarray, np.ndarray]:
@@ -272,7 +336,8 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         self._damping_rows: _FloatArray = np.zeros(nv - 6)
         self._friction_rows: _FloatArray = np.zeros(nv - 6)
         self.nc = len(stance.contacts)
-        self.n = nv + 6 * self.nc
+        self._init_touch(analysis, gains, impact)
+        self.n = nv + 6 * self.nc + self._touch_vars
         self.mass = float(sum(inertia.mass for inertia in model.inertias))
         self.gravity = analysis.areas.gravity
         self.plane_height = analysis.areas.plane_height
@@ -322,8 +387,11 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         n, nc = self.n, self.nc
         P_diag = np.zeros((n, n))
         P_diag[np.arange(nv), np.arange(nv)] = self._posture_w + gains.acceleration_regularization
-        P_diag[np.arange(nv, n), np.arange(nv, n)] = np.tile(
-            [gains.wrench_regularization] * 3 + [gains.torque_regularization] * 3, nc
+        P_diag[np.arange(nv, n), np.arange(nv, n)] = np.concatenate(
+            [
+                np.tile([gains.wrench_regularization] * 3 + [gains.torque_regularization] * 3, nc),
+                np.full(self._touch_vars, gains.wrench_regularization),
+            ]
         )
         self._P_diag, self._P = P_diag, np.zeros((n, n))
         # Position limits of the 1-dof joints (a continuous joint has nq = 2 and no limit).
@@ -336,12 +404,46 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         bound = getattr(impact, "speed_bound", None)
         self._speed_bound: Callable[[], float] | None = bound if callable(bound) else None
         self._speed_rows = int(impact is not None and self._speed_bound is not None)
-        m = 6 + 6 * nc + 17 * nc + self._speed_rows + self._limit_q.size + self._limited.size
+        self._init_rows()
+
+    def _init_touch(
+        self, analysis: Analysis, gains: InverseDynamicsGains, impact: ImpactReference | None
+    ) -> None:
+        """The touching point's force (3 variables, 8 rows) with ``touch_contact`` and a task."""
+        touch = bool(gains.touch_contact and impact is not None)
+        self._touch_vars, self._touch_rows = (3, 8) if touch else (0, 0)
+        #: When the impact point first touched (s; the first positive measured normal force).
+        self.touch_time: float | None = None
+        #: The touching point's pressing force while it is a contact (N).
+        self.touch_force = 0.0
+        if impact is None or not touch:
+            return
+        self._touch_normal = np.asarray(impact.normal, dtype=float)
+        self._touch_faces = touch_faces(self._touch_normal, _impact_friction(analysis, gains))
+        threshold = float(getattr(impact, "force_threshold", 0.0))
+        self.touch_force = threshold if np.isfinite(threshold) and threshold > 0 else 0.0
+        self._touch_point: tuple[_FloatArray, _FloatArray] | None = None
+        self._touch_jacobian = np.zeros((3, self.nv))
+
+    def _init_rows(self) -> None:
+        """The QP's constraint buffers (see :meth:`_constraints` for their order)."""
+        n, nc, nv = self.n, self.nc, self.nv
+        m = (
+            6
+            + 6 * nc
+            + 17 * nc
+            + self._touch_rows
+            + self._speed_rows
+            + self._limit_q.size
+            + self._limited.size
+        )
         self._C = np.zeros((m, n))
         self._upper = np.zeros(m)
         self._lower = np.full(m, -1e30)
         self._sense = np.zeros(m, dtype=np.intc)
         self._sense[: 6 + 6 * nc] = 5  # daqp: active and immutable = equality
+        touch_equalities = 6 + 23 * nc  # after the cones and the minimum normal forces
+        self._sense[touch_equalities : touch_equalities + min(self._touch_rows, 3)] = 5
         self._Jw = np.zeros((6 * nc, nv))  # contact Jacobians at the contact points (world axes)
         self._x: np.ndarray | None = None
 
@@ -462,6 +564,8 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
             The torques and the QP's accelerations and wrenches (see :class:`TorqueOutput`).
         """
         state = self._dynamics(q, v)
+        if self._touch_rows and self.touch_time is None and impact_force > 0.0:
+            self.touch_time = float(t)
         zmp, xi, clamped = self.feedback.desired_zmp(state.com[:2], state.com_velocity[:2])
         tasks, speed_row = self._tasks(t, v, impact_force, state, zmp)
         P, c = self._cost(tasks, q, v)
@@ -469,7 +573,7 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         T, t0, rows = self._constraints(q, v, state, speed_row, compensation)
         x, torque_limited = self._solve(P, c, rows)
         nv, nc = self.nv, self.nc
-        a, w = x[:nv], x[nv:]
+        a, w = x[:nv], x[nv : nv + 6 * nc]
         tau = T @ x + t0
         if self.effort_limits:
             tau = np.clip(tau, -self.effort - compensation, self.effort - compensation)
@@ -483,6 +587,7 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
             state.com,
             state.com_velocity,
             torque_limited,
+            x[nv + 6 * nc :].copy() if self._touch_vars else None,
         )
         self.last = out
         return out
@@ -575,6 +680,8 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         )
         tasks.add(Ji[:3], lin - drift[:3], g.impact_weight)
         tasks.add(Ji[3:], ang - drift[3:], g.impact_orientation_weight)
+        if self._touch_rows:
+            self._touch_point = (Ji[:3].copy(), drift[:3].copy())
         if not self._speed_rows:
             return None
         # Approach speed one control period ahead (torques are held for dt):
@@ -658,16 +765,20 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
             C[k + i, nv + 6 * i : nv + 6 * i + 3] = data.oMf[fid].rotation @ offset.rotation[:, 2]
         lower[k : k + nc] = g.min_normal_force
         upper[k : k + nc] = 1e30
-        # The governed approach speed (one row, after the minimum normal forces; 1e30: inactive).
-        ms = ne + 17 * nc
+        # The touching point (rows after the minimum normal forces), then the approach speed.
+        if self._touch_rows:
+            self._touch_constraints(ne + 17 * nc, v)
+        ms = ne + 17 * nc + self._touch_rows
         if self._speed_rows:
             C[ms, :] = 0.0
             if speed_row is None:
                 upper[ms] = 1e30
             else:
                 C[ms, :nv], upper[ms] = speed_row
-        # tau = M[6:] a + h[6:] - Jw[:, 6:]^T w (actuated rows)
+        # tau = M[6:] a + h[6:] - Jw[:, 6:]^T w - J_h[:, 6:]^T f_h (actuated rows)
         T = np.hstack([M[6:], -self._Jw[:, 6:].T])
+        if self._touch_rows:
+            T = np.hstack([T, -self._touch_jacobian[:, 6:].T])
         t0 = h[6:]
         limited = self._limited
         m0 = ms + self._speed_rows
@@ -685,6 +796,53 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
             upper[m1:] = self.effort[limited] - bias
             lower[m1:] = -self.effort[limited] - bias
         return T, t0, _Rows(ms, m0, m1)
+
+    @property
+    def touching(self) -> bool:
+        """Whether the impact point is a contact of the QP now (``touch_contact``).
+
+        From its first touch (:attr:`touch_time`) until the impact task's withdrawal starts
+        (its ``contact_time``).
+        """
+        return (
+            self._touch_rows > 0
+            and self.touch_time is not None
+            and self.impact is not None
+            and self.impact.contact_time is None
+        )
+
+    def _touch_constraints(self, k: int, v: _FloatArray) -> None:
+        """Fill the touching point's 8 rows from ``k`` and its columns (see the module docstring).
+
+        Touching: ``J_h a = -J_h_dot v - K_c J_h v`` (3 equalities), the 4 friction faces
+        ``F f_h <= 0`` (:func:`touch_faces`) and ``n . f_h >= f_press``; otherwise ``f_h = 0``
+        and the inequalities inactive. ``J_h^T f_h`` enters the floating base's rows here, the
+        torques' map in :meth:`_constraints`.
+        """
+        nv, g = self.nv, self.gains
+        C, upper, lower = self._C, self._upper, self._lower
+        f = slice(nv + 6 * self.nc, self.n)
+        assert self._touch_point is not None
+        J, drift = self._touch_point
+        self._touch_jacobian = J
+        C[k : k + 8, :] = 0.0
+        C[:6, f] = -J[:, :6].T
+        if self.touching:
+            C[k : k + 3, :nv] = J
+            upper[k : k + 3] = -drift - g.contact_damping * (J @ v)
+            C[k + 3 : k + 7, f] = self._touch_faces
+            upper[k + 3 : k + 7] = 0.0
+            C[k + 7, f] = self._touch_normal
+            lower[k + 7] = self.touch_force
+            upper[k + 7] = 1e30
+        else:
+            C[k : k + 3, f] = np.eye(3)
+            upper[k : k + 3] = 0.0
+            upper[k + 3 : k + 8] = 1e30
+        lower[k : k + 3] = upper[k : k + 3]
+        lower[k + 3 : k + 7] = -1e30
+        if not self.touching:
+            lower[k + 7] = -1e30
 
     def _solve(self, P: _FloatArray, c: _FloatArray, rows: _Rows) -> tuple[_FloatArray, bool]:
         """Solve the QP (daqp), dropping constraints while it is infeasible.

@@ -45,6 +45,7 @@ from impact_balance.robot.ik import IKError
 from impact_balance.sim.control.approach import ImpactReference, ImpactTask
 from impact_balance.sim.control.approach import standoff as approach_standoff
 from impact_balance.sim.control.controller import ControllerName, ControlStep
+from impact_balance.sim.control.gains import InverseDynamicsGains
 from impact_balance.sim.control.registry import controller_class
 from impact_balance.sim.model.build import SimModel
 from impact_balance.sim.trials.angular_momentum_removal import AngularMomentumRemoval
@@ -555,6 +556,7 @@ def write_trial_log(
     impact_speed: float | None = None,
     push: Push | None = None,
     rigid_impact: bool = False,
+    id_gains: InverseDynamicsGains | None = None,
 ) -> Path:
     """Run one trial again with recording on and write its log.
 
@@ -568,6 +570,7 @@ def write_trial_log(
         impact_speed: Commanded approach speed of an impact trial (m/s).
         push: The push of a push trial.
         rigid_impact: Hold every joint's velocity through the impact.
+        id_gains: The ``id`` controller's gains (default :class:`InverseDynamicsGains`).
 
     Returns:
         The path written.
@@ -576,7 +579,12 @@ def write_trial_log(
         setup,
         impact_speed=impact_speed,
         push=push,
-        options=BalanceTrialOptions(record=True, controller=controller, rigid_impact=rigid_impact),
+        options=BalanceTrialOptions(
+            record=True,
+            controller=controller,
+            rigid_impact=rigid_impact,
+            id_gains=id_gains or InverseDynamicsGains(),
+        ),
     )
     assert trial.log is not None  # recorded
     values = {"scenario": setup.scenario.name, **metadata}
