@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import pytest
 
+pytest.importorskip("mujoco", reason="needs the sim extra (MuJoCo)")
+
 from impact_balance.cli.touch_contact import impact_trial_options
 from impact_balance.exceptions import SimulationError
 from impact_balance.sim.control.gains import InverseDynamicsGains
 from tests.helpers.cli import assert_one_line_error, run_cli
-from tests.helpers.extras import needs_extra
 
 
-@needs_extra("sim")
 @pytest.mark.parametrize("command", ["validate", "approach"])
 def test_the_ik_controller_has_no_touch_contact(capsys, command):
     rc, _, err = run_cli(
