@@ -55,7 +55,7 @@ __all__ = ["BLOCK", "CHUNK", "BatchEvaluator", "BatchLimits"]
 
 #: Postures per compiled call: the Python step of the next block runs while another thread's
 #: compiled call runs.
-BLOCK = 32
+BLOCK = 64
 #: Postures of their own per chunk (with the rows that repeat them): the unit a thread takes,
 #: in blocks of :data:`BLOCK`, whose walks start from a cold projection hint (whatever thread
 #: runs it and whatever ran before), so a batch's answers do not depend on its threads.
