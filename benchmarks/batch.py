@@ -30,12 +30,15 @@ slices' imbalance) and the compiled calls' wall over their thread CPU (above 1: 
 for a core the machine did not give it). ``--chunks K ...`` reports instead, per scenario and
 chunk size K (``impact_balance.governor.batch.CHUNK``, postures per chunk; the sizes alternated
 round-robin, best of R passes): the one-thread batch's CPU time per row (what the chunks' cold
-starts cost) and the ``--threads`` T batch's wall time per row (what their balance buys).
+starts cost), the ``--threads`` T batch's wall time per row, and the wall time per row T free
+cores would take (the one-thread pass's chunks, their CPU times, handed out in order to the first
+free core: what the chunks' balance buys, whatever the machine's load).
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import os
 import sys
@@ -241,31 +244,56 @@ def _gil(names: list[str], n: int, repeat: int, threads: int, as_json: bool) -> 
     return 0
 
 
+def _makespan(durations: list[float], threads: int) -> float:
+    """The wall time of ``durations`` handed out in order, each to the first free of ``threads``."""
+    free = [0.0] * threads
+    for d in durations:
+        free[free.index(min(free))] += d
+    return max(free)
+
+
 def chunk_scenario(
     name: str, n: int, repeat: int, threads: int, sizes: list[int]
 ) -> dict[str, Any]:
-    """One scenario's batch per chunk size: one thread's CPU and ``threads`` threads' wall."""
+    """One scenario's batch per chunk size: one thread's CPU and ``threads`` threads' wall.
+
+    Also the wall time ``threads`` free cores would take (``predicted``): the one-thread pass's
+    chunks (their thread CPU times, from one ``take`` to the next) handed out in order to the
+    first free core, as the batch hands them out: the balance, whatever the machine's load.
+    """
     import impact_balance.governor.batch as batch_module
 
     governor = Governor(name)
     qs, vs = trajectory(governor, n)
-    original = batch_module.CHUNK
+    original, take = batch_module.CHUNK, batch_module._Chunks.take
+    marks: list[float] = []
+
+    def timed_take(self: Any) -> int | None:
+        marks.append(time.thread_time())
+        return take(self)
+
     cpu = {k: float("inf") for k in sizes}
     wall = {k: float("inf") for k in sizes}
+    predicted = {k: float("inf") for k in sizes}
     load_before = os.getloadavg()
     try:
         governor.limits(qs, vs, threads=threads)  # warm-up: the threads' evaluators
         for _ in range(repeat):
             for k in sizes:
                 batch_module.CHUNK = k
+                batch_module._Chunks.take = timed_take  # type: ignore[method-assign]
+                marks.clear()
                 start = time.process_time()
                 governor.limits(qs, vs)
                 cpu[k] = min(cpu[k], time.process_time() - start)
+                batch_module._Chunks.take = take  # type: ignore[method-assign]
+                durations = [b - a for a, b in itertools.pairwise(marks)]
+                predicted[k] = min(predicted[k], _makespan(durations, threads))
                 start = time.perf_counter()
                 governor.limits(qs, vs, threads=threads)
                 wall[k] = min(wall[k], time.perf_counter() - start)
     finally:
-        batch_module.CHUNK = original
+        batch_module.CHUNK, batch_module._Chunks.take = original, take  # type: ignore[method-assign]
     return {
         "scenario": name,
         "n": n,
@@ -277,6 +305,7 @@ def chunk_scenario(
                 "chunk": k,
                 "cpu_us_per_row_one_thread": cpu[k] / n * 1e6,
                 "wall_us_per_row_threads": wall[k] / n * 1e6,
+                "predicted_us_per_row_threads": predicted[k] / n * 1e6,
             }
             for k in sizes
         ],
@@ -295,16 +324,17 @@ def _chunks(
         return 0
     print(
         f"{'scenario':20s} {'chunk':>6s} {'CPU 1 thread':>12s} "
-        f"{f'wall {threads} threads':>15s}  load avg (before, after)"
+        f"{f'wall {threads} threads':>15s} {'predicted':>9s}  load avg (before, after)"
     )
     for r in rows:
         for c in r["chunks"]:
             print(
                 f"{r['scenario']:20s} {c['chunk']:6d} {c['cpu_us_per_row_one_thread']:12.2f} "
-                f"{c['wall_us_per_row_threads']:15.2f}  {r['loadavg_before'][0]:.2f}, "
-                f"{r['loadavg_after'][0]:.2f}"
+                f"{c['wall_us_per_row_threads']:15.2f} {c['predicted_us_per_row_threads']:9.2f}  "
+                f"{r['loadavg_before'][0]:.2f}, {r['loadavg_after'][0]:.2f}"
             )
-    print("us per row of the batch (best of the passes)")
+    print("us per row of the batch (best of the passes); predicted: the one-thread pass's chunks")
+    print(f"(their CPU times) handed out in order to {threads} free cores")
     return 0
 
 
