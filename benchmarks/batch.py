@@ -28,11 +28,12 @@ that runs without the GIL), the rest of the threads' wall time per row (Python h
 or waiting for it or for a core), the slowest thread's compiled CPU over the threads' mean (the
 slices' imbalance) and the compiled calls' wall over their thread CPU (above 1: a thread waited
 for a core the machine did not give it). ``--chunks K ...`` reports instead, per scenario and
-chunk size K (``impact_balance.governor.batch.CHUNK``, postures per chunk; the sizes alternated
-round-robin, best of R passes): the one-thread batch's CPU time per row (what the chunks' cold
-starts cost), the ``--threads`` T batch's wall time per row, and the wall time per row T free
-cores would take (the one-thread pass's chunks, their CPU times, handed out in order to the first
-free core: what the chunks' balance buys, whatever the machine's load).
+chunk size K (postures per chunk: ``CHUNK`` and ``MIN_CHUNK`` of
+``impact_balance.governor.batch`` set to K; the sizes alternated round-robin, best of R
+passes): the one-thread batch's CPU time per row (what the chunks' cold starts cost), the
+``--threads`` T batch's wall time per row, and the wall time per row T free cores would take
+(the one-thread pass's chunks, their CPU times, handed out in order to the first free core: what
+the chunks' balance buys, whatever the machine's load).
 """
 
 from __future__ import annotations
@@ -265,7 +266,8 @@ def chunk_scenario(
 
     governor = Governor(name)
     qs, vs = trajectory(governor, n)
-    original, take = batch_module.CHUNK, batch_module._Chunks.take
+    original = batch_module.CHUNK, batch_module.MIN_CHUNK, batch_module._Chunks.take
+    take = original[2]
     marks: list[float] = []
 
     def timed_take(self: Any) -> int | None:
@@ -280,7 +282,7 @@ def chunk_scenario(
         governor.limits(qs, vs, threads=threads)  # warm-up: the threads' evaluators
         for _ in range(repeat):
             for k in sizes:
-                batch_module.CHUNK = k
+                batch_module.CHUNK = batch_module.MIN_CHUNK = k
                 batch_module._Chunks.take = timed_take  # type: ignore[method-assign]
                 marks.clear()
                 start = time.process_time()
@@ -293,7 +295,7 @@ def chunk_scenario(
                 governor.limits(qs, vs, threads=threads)
                 wall[k] = min(wall[k], time.perf_counter() - start)
     finally:
-        batch_module.CHUNK, batch_module._Chunks.take = original, take  # type: ignore[method-assign]
+        batch_module.CHUNK, batch_module.MIN_CHUNK, batch_module._Chunks.take = original  # type: ignore[method-assign]
     return {
         "scenario": name,
         "n": n,

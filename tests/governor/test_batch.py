@@ -3,6 +3,7 @@ what analyze() answers; bad batches are refused naming the field."""
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import math
 from unittest import mock
@@ -105,9 +106,17 @@ def test_batch_covers_falling_starts_and_agrees_with_analyze():
 def test_threads_answer_the_same():
     g = governor("palm_push_two_feet")
     qs, vs = batch(g, 70, 3)
-    with mock.patch.object(batch_module, "CHUNK", 8):
+    with chunks_of(8):
         one, two = g.limits(qs, vs), g.limits(qs, vs, threads=3)
     assert_batches_identical(two, one)
+
+
+def chunks_of(size: int) -> contextlib.ExitStack:
+    """Within: a batch's chunks have ``size`` postures of their own each (the last one fewer)."""
+    stack = contextlib.ExitStack()
+    stack.enter_context(mock.patch.object(batch_module, "CHUNK", size))
+    stack.enter_context(mock.patch.object(batch_module, "MIN_CHUNK", size))
+    return stack
 
 
 def assert_batches_identical(got, want) -> None:
@@ -143,7 +152,7 @@ def test_answers_do_not_depend_on_the_threads(name, n, seed, chunk, threads, rep
     qs, vs = path(g, n, seed)
     qs = np.repeat(qs, repeats[:n], axis=0)  # some rows repeat the posture before them
     vs = np.repeat(vs, repeats[:n], axis=0) * np.linspace(0.5, 1.5, len(qs))[:, None]
-    with mock.patch.object(batch_module, "CHUNK", chunk):
+    with chunks_of(chunk):
         one = g.limits(qs, vs)
         many = g.limits(qs, vs, threads=threads)
         again = g.limits(qs, vs)  # after a batch on other threads, with other hints left
@@ -161,6 +170,32 @@ def test_answers_do_not_depend_on_the_threads(name, n, seed, chunk, threads, rep
         assert_rows_agree([one[i]], [g.limit(qs[i], vs[i])])
 
 
+@given(
+    postures=st.integers(1, 3000),
+    repeats=st.lists(st.integers(1, 4), min_size=1, max_size=3000),
+)
+def test_chunks_cut_the_postures_evenly(postures, repeats):
+    # Chunks start at a posture of its own (a row that repeats the one before stays with it),
+    # hold the same number of postures but the last, between MIN_CHUNK and CHUNK, and are
+    # CHUNKS where those bounds allow it.
+    counts = (repeats * (postures // len(repeats) + 1))[:postures]
+    repeated = np.ones(sum(counts), dtype=bool)
+    starts = np.cumsum([0, *counts[:-1]])
+    repeated[starts] = False
+    bounds = batch_module._chunk_bounds(repeated)
+    assert bounds[0] == 0 and bounds[-1] == len(repeated)
+    assert not repeated[bounds[:-1]].any()
+    sizes = [int(np.count_nonzero(~repeated[a:b])) for a, b in itertools.pairwise(bounds)]
+    assert sum(sizes) == postures and len(set(sizes[:-1])) <= 1 and 0 < sizes[-1] <= sizes[0]
+    if len(sizes) > 1:
+        assert batch_module.MIN_CHUNK <= sizes[0] <= batch_module.CHUNK
+    chunks = batch_module.CHUNKS
+    if chunks * batch_module.MIN_CHUNK <= postures <= chunks * batch_module.CHUNK:
+        assert len(sizes) == chunks or (len(sizes) < chunks and sizes[-1] == sizes[0])
+    elif postures < chunks * batch_module.MIN_CHUNK:
+        assert sizes[0] == min(postures, batch_module.MIN_CHUNK)
+
+
 @settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
     bad=st.lists(st.integers(0, 39), min_size=1, max_size=4, unique=True),
@@ -173,7 +208,7 @@ def test_the_first_refused_row_is_named_whatever_the_threads(bad, chunk, threads
     g = governor("kick_one_foot")
     qs, vs = batch(g, 40, 17)
     vs[bad] *= 1e6
-    with mock.patch.object(batch_module, "CHUNK", chunk), pytest.raises(GovernorError) as info:
+    with chunks_of(chunk), pytest.raises(GovernorError) as info:
         g.limits(qs, vs, threads=threads)
     assert info.value.field == f"v_batch[{min(bad)}]"
     with pytest.raises(GovernorError):  # the single tick refuses that row too
@@ -273,7 +308,7 @@ def test_many_velocities_at_one_posture_reuse_it(name):
     assert sum(s.posture_reused for s in singles) >= 42
     assert_rows_equal(answers, singles)
     # Chunks of one posture each (with its repeated rows) over four threads: the same.
-    with mock.patch.object(batch_module, "CHUNK", 1):
+    with chunks_of(1):
         assert_rows_equal(g.limits(qs, vs, threads=4), singles)
 
 
@@ -438,6 +473,7 @@ def test_a_batchs_buffers_serve_the_next_batches(threads, monkeypatch):
     g = Governor("palm_push_two_feet")
     qs, vs = batch(g, 45, 11)
     monkeypatch.setattr(batch_module, "CHUNK", 8)  # six chunks: every thread takes some
+    monkeypatch.setattr(batch_module, "MIN_CHUNK", 8)
     assert_rows_equal(
         g.limits(qs, vs, threads=threads), [g.limit(q, v) for q, v in zip(qs, vs, strict=True)]
     )
@@ -457,6 +493,7 @@ def test_the_threads_of_a_batch_serve_the_next_batches(monkeypatch):
     # larger one, a process forked after the pool was made (its copy has no threads) a new one;
     # the answers are the single ticks'.
     monkeypatch.setattr(batch_module, "CHUNK", 4)
+    monkeypatch.setattr(batch_module, "MIN_CHUNK", 4)
     g = Governor("kick_one_foot")
     qs, vs = batch(g, 24, 21)
     singles = [g.limit(q, v) for q, v in zip(qs, vs, strict=True)]
@@ -479,6 +516,7 @@ def test_a_refused_row_in_a_threads_chunk_leaves_the_governor_usable(monkeypatch
     # A chunk's error is raised once every thread is done: the evaluators go back to the pool
     # and the next batch on the same threads answers.
     monkeypatch.setattr(batch_module, "CHUNK", 4)
+    monkeypatch.setattr(batch_module, "MIN_CHUNK", 4)
     g = Governor("kick_one_foot")
     qs, vs = batch(g, 12, 22)
     bad = vs.copy()

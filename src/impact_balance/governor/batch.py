@@ -9,9 +9,10 @@ step); the areas, the impact model and the criterion of every posture then run i
 call (:func:`~impact_balance.governor.posture_kernel.postures_kernel`: a tick's
 :func:`~impact_balance.governor.posture_kernel.posture_kernel` per posture, the same numbers),
 which releases the GIL, so ``threads`` > 1 evaluates postures side by side. The rows go in
-chunks of :data:`CHUNK` postures of their own (with the rows that repeat them), handed to the
-threads in order as each asks for the next. The rows of a chunk share one projection hint, as a
-governor's successive ticks do: a row's walk first re-certifies the previous row's chain of
+chunks of :data:`MIN_CHUNK` to :data:`CHUNK` postures of their own (:data:`CHUNKS` chunks
+where that allows; with the rows that repeat them), handed to the threads in order as each asks
+for the next. The rows of a chunk share one projection hint, as a governor's successive ticks
+do: a row's walk first re-certifies the previous row's chain of
 bases, so rows in path order (nearby postures one after the other) cost less than the same rows
 shuffled; each chunk starts from a cold hint, whatever thread runs it and whatever ran before,
 so the answers do not depend on the number of threads or on the schedule, to the last digit
@@ -51,15 +52,20 @@ from impact_balance.governor.tree_kernel import KinematicTree, tree_postures
 from impact_balance.projection.walk import MAX_PIVOTS
 from impact_balance.robot.robot import Robot
 
-__all__ = ["BLOCK", "CHUNK", "BatchEvaluator", "BatchLimits"]
+__all__ = ["BLOCK", "CHUNK", "CHUNKS", "MIN_CHUNK", "BatchEvaluator", "BatchLimits"]
 
 #: Postures per compiled call: the Python step of the next block runs while another thread's
 #: compiled call runs.
 BLOCK = 64
-#: Postures of their own per chunk (with the rows that repeat them): the unit a thread takes,
-#: in blocks of :data:`BLOCK`, whose walks start from a cold projection hint (whatever thread
-#: runs it and whatever ran before), so a batch's answers do not depend on its threads.
+#: The most postures of their own per chunk (with the rows that repeat them): the unit a thread
+#: takes, in blocks of :data:`BLOCK`, whose walks start from a cold projection hint (whatever
+#: thread runs it and whatever ran before), so a batch's answers do not depend on its threads.
 CHUNK = 64
+#: The fewest postures per chunk (but the last): a chunk's cold start costs about one row.
+MIN_CHUNK = 16
+#: The chunks a batch of P postures is cut into, between :data:`MIN_CHUNK` and :data:`CHUNK`
+#: postures each: ``ceil(P / CHUNKS)`` (a function of P only, not of the threads).
+CHUNKS = 16
 #: The statuses by the compiled exit's codes (an index of ``EXIT_STATUSES``).
 _STATUSES = np.array(EXIT_STATUSES, dtype=object)
 #: The most threads a batch takes.
@@ -220,7 +226,7 @@ class BatchEvaluator:
             qs[i] = self.check(qs[i], f"q_batch[{i}]")
             start = i + 1
         rows = _Rows(len(qs))
-        chunks = _Chunks(_chunk_bounds(repeated, CHUNK))
+        chunks = _Chunks(_chunk_bounds(repeated))
         workers = min(threads, chunks.count)
         evaluators = self._take(workers)
         try:
@@ -275,13 +281,15 @@ class BatchEvaluator:
         return taken
 
 
-def _chunk_bounds(repeated: npt.NDArray[np.bool_], size: int) -> list[int]:
+def _chunk_bounds(repeated: npt.NDArray[np.bool_]) -> list[int]:
     """The rows' chunks, as bounds: chunk c is rows ``bounds[c]`` to ``bounds[c + 1]``.
 
-    Each chunk has ``size`` postures of their own (the last one fewer) with the rows that repeat
-    them (``repeated[i]``: row i's q is row i - 1's; ``repeated[0]`` is false).
+    Of P postures of their own (``repeated[i]``: row i's q is row i - 1's; ``repeated[0]`` is
+    false), each chunk has ``min(CHUNK, max(MIN_CHUNK, ceil(P / CHUNKS)))`` (the last one
+    fewer), with the rows that repeat them.
     """
     starts = np.flatnonzero(~repeated)
+    size = min(CHUNK, max(MIN_CHUNK, -(-len(starts) // CHUNKS)))
     return [*starts[::size].tolist(), len(repeated)]
 
 
