@@ -376,13 +376,13 @@ class _Slice:
                 return
 
     def block(self, start: int, stop: int, same: npt.NDArray[np.bool_]) -> None:
-        """The kinematics of rows ``start`` to ``stop``, then their compiled call.
+        """The kinematics of rows ``start`` to ``stop``, then their compiled call and answers.
 
         ``same[r]``: row ``start + r`` repeats the posture of the row before it (only its
         velocity is new); ``same[0]`` is false. At most :data:`BLOCK` rows have a posture of
         their own.
         """
-        e, n, rows, b = self.e, stop - start, self.rows, self.buffers
+        e, n, rows, b = self.e, stop - start, self.rows, self.buffers  # the kernel writes rows
         rotations, local, jacobians, scalars = b.rotations, b.local, b.jacobians, b.scalars
         own = start + np.flatnonzero(~same)  # the rows of a posture of their own
         if b.tree is not None:
@@ -401,17 +401,21 @@ class _Slice:
                 b.point_locals[p] = e.impact_point()
                 scalars[p, 0] = mass
                 scalars[p, 3] = self.omega(float(com_local[2]) + float(origin[2]), i)
-        out, velocities = np.empty((n, 6)), rows.com_velocity[start:stop]
+        codes, velocities = np.empty(n, dtype=np.int64), rows.com_velocity[start:stop]
         too_fast = postures_kernel(
             e._faces, rotations, local, b.origins, b.com_locals, b.centroidal, e._gravity,
             e._torques, jacobians, e._idx, e._limit, scalars, e._hint, MAX_PIVOTS, e._constants,
-            b.point_locals, b.inertias, e._normal, e._cone, self.vs[start:stop], same, out,
-            velocities, rows.point[start:stop], MAX_SPEED * MAX_SPEED,
+            b.point_locals, b.inertias, e._normal, e._cone, self.vs[start:stop], same, codes,
+            rows.speed[start:stop], rows.vertex[start:stop], rows.edge[start:stop],
+            rows.interval[start:stop], velocities, rows.point[start:stop], MAX_SPEED * MAX_SPEED,
         )  # fmt: skip
         if too_fast >= 0:
             _too_fast(velocities[too_fast], start + too_fast)
         rows.normal[start:stop] = e._normal
-        self.fill(start, stop, out)
+        rows.status[start:stop] = _STATUSES[codes].tolist()  # code -1: overwritten below
+        for r in np.flatnonzero(codes < 0).tolist():
+            # Bretl's projection, a small area, a refused impact model
+            self.single(start + r)
 
     def tree_kinematics(self, rows: npt.NDArray[np.int64]) -> None:
         """The kinematics of batch rows ``rows`` into the block's buffers, in one compiled call.
@@ -443,25 +447,6 @@ class _Slice:
             return lipm_omega(com_height, s.plane_height, s.gravity, field="plane_height")
         except ImpactBalanceError as exc:
             raise _in_row(exc, i) from None
-
-    def fill(self, start: int, stop: int, out: npt.NDArray[np.float64]) -> None:
-        """Rows ``start`` to ``stop`` from the compiled answers ``out``.
-
-        The one-posture path answers the rows the compiled call leaves (code -1).
-        """
-        rows = self.rows
-        codes = out[:, 0].astype(np.int64)
-        rows.speed[start:stop] = np.where(
-            codes == 0, out[:, 1], np.where(codes == 1, 0.0, math.inf)
-        )
-        rows.interval[start:stop] = out[:, 4:6]
-        ok = codes == 0
-        rows.vertex[start:stop] = np.where(ok, out[:, 2], -1)
-        rows.edge[start:stop] = np.where(ok, out[:, 3], -1)
-        rows.status[start:stop] = _STATUSES[codes].tolist()  # code -1: overwritten below
-        for r in np.flatnonzero(codes < 0).tolist():
-            # Bretl's projection, a small area, a refused impact model
-            self.single(start + r)
 
     def single(self, i: int) -> None:
         """Row ``i`` by the one-posture path (what :meth:`Governor.limit` does)."""
