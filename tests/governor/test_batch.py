@@ -175,9 +175,9 @@ def test_answers_do_not_depend_on_the_threads(name, n, seed, chunk, threads, rep
     repeats=st.lists(st.integers(1, 4), min_size=1, max_size=3000),
 )
 def test_chunks_cut_the_postures_evenly(postures, repeats):
-    # Chunks start at a posture of its own (a row that repeats the one before stays with it),
-    # hold the same number of postures but the last, between MIN_CHUNK and CHUNK, and are
-    # CHUNKS where those bounds allow it.
+    # Chunks start at a posture of its own (a row that repeats the one before stays with it)
+    # and hold the same number of postures but the last, at most CHUNK: CHUNKS chunks, or a
+    # power of two fewer of at least MIN_CHUNK postures each when there are fewer postures.
     counts = (repeats * (postures // len(repeats) + 1))[:postures]
     repeated = np.ones(sum(counts), dtype=bool)
     starts = np.cumsum([0, *counts[:-1]])
@@ -187,13 +187,14 @@ def test_chunks_cut_the_postures_evenly(postures, repeats):
     assert not repeated[bounds[:-1]].any()
     sizes = [int(np.count_nonzero(~repeated[a:b])) for a, b in itertools.pairwise(bounds)]
     assert sum(sizes) == postures and len(set(sizes[:-1])) <= 1 and 0 < sizes[-1] <= sizes[0]
-    if len(sizes) > 1:
-        assert batch_module.MIN_CHUNK <= sizes[0] <= batch_module.CHUNK
-    chunks = batch_module.CHUNKS
-    if chunks * batch_module.MIN_CHUNK <= postures <= chunks * batch_module.CHUNK:
-        assert len(sizes) == chunks or (len(sizes) < chunks and sizes[-1] == sizes[0])
-    elif postures < chunks * batch_module.MIN_CHUNK:
-        assert sizes[0] == min(postures, batch_module.MIN_CHUNK)
+    chunk, least, most = batch_module.CHUNKS, batch_module.MIN_CHUNK, batch_module.CHUNK
+    assert sizes[0] <= most
+    if postures > chunk * most:
+        assert sizes[0] == most
+    else:
+        assert len(sizes) in {chunk >> k for k in range(chunk.bit_length())}
+        assert len(sizes) == 1 or sizes[0] >= least  # no chunk below MIN_CHUNK but the last
+        assert len(sizes) == chunk or postures < 2 * len(sizes) * least  # no more could be made
 
 
 @settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])

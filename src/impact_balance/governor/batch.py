@@ -9,8 +9,8 @@ step); the areas, the impact model and the criterion of every posture then run i
 call (:func:`~impact_balance.governor.posture_kernel.postures_kernel`: a tick's
 :func:`~impact_balance.governor.posture_kernel.posture_kernel` per posture, the same numbers),
 which releases the GIL, so ``threads`` > 1 evaluates postures side by side. The rows go in
-chunks of :data:`MIN_CHUNK` to :data:`CHUNK` postures of their own (:data:`CHUNKS` chunks
-where that allows; with the rows that repeat them), handed to the threads in order as each asks
+chunks of up to :data:`CHUNK` postures of their own (:data:`CHUNKS` chunks, or fewer of at least
+:data:`MIN_CHUNK`; with the rows that repeat them), handed to the threads in order as each asks
 for the next. The rows of a chunk share one projection hint, as a governor's successive ticks
 do: a row's walk first re-certifies the previous row's chain of
 bases, so rows in path order (nearby postures one after the other) cost less than the same rows
@@ -63,8 +63,9 @@ BLOCK = 64
 CHUNK = 64
 #: The fewest postures per chunk (but the last): a chunk's cold start costs about one row.
 MIN_CHUNK = 16
-#: The chunks a batch of P postures is cut into, between :data:`MIN_CHUNK` and :data:`CHUNK`
-#: postures each: ``ceil(P / CHUNKS)`` (a function of P only, not of the threads).
+#: The chunks a batch of P postures is cut into, of ``ceil(P / CHUNKS)`` postures each; half
+#: as many (down to one) while they would have fewer than :data:`MIN_CHUNK`, more while they
+#: would have more than :data:`CHUNK`. A function of P only, not of the threads.
 CHUNKS = 16
 #: The statuses by the compiled exit's codes (an index of ``EXIT_STATUSES``).
 _STATUSES = np.array(EXIT_STATUSES, dtype=object)
@@ -285,11 +286,15 @@ def _chunk_bounds(repeated: npt.NDArray[np.bool_]) -> list[int]:
     """The rows' chunks, as bounds: chunk c is rows ``bounds[c]`` to ``bounds[c + 1]``.
 
     Of P postures of their own (``repeated[i]``: row i's q is row i - 1's; ``repeated[0]`` is
-    false), each chunk has ``min(CHUNK, max(MIN_CHUNK, ceil(P / CHUNKS)))`` (the last one
-    fewer), with the rows that repeat them.
+    false), each chunk has ``ceil(P / c)`` (the last one fewer, at most :data:`CHUNK`), with the
+    rows that repeat them: c is :data:`CHUNKS`, halved while ``P < c * MIN_CHUNK`` and c > 1
+    (an even count of equal chunks shares out evenly).
     """
     starts = np.flatnonzero(~repeated)
-    size = min(CHUNK, max(MIN_CHUNK, -(-len(starts) // CHUNKS)))
+    count = CHUNKS
+    while count > 1 and len(starts) < count * MIN_CHUNK:
+        count //= 2
+    size = max(1, min(CHUNK, -(-len(starts) // count)))
     return [*starts[::size].tolist(), len(repeated)]
 
 
