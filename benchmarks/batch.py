@@ -26,14 +26,14 @@ per scenario, one thread beside ``--threads`` T (best wall time of R passes each
 wall time per row, the compiled calls' thread CPU time per row summed over the threads (the part
 that runs without the GIL), the rest of the threads' wall time per row (Python holding the GIL,
 or waiting for it or for a core), the slowest thread's compiled CPU over the threads' mean (the
-slices' imbalance) and the compiled calls' wall over their thread CPU (above 1: a thread waited
-for a core the machine did not give it). ``--chunks K ...`` reports instead, per scenario and
-chunk size K (postures per chunk: ``CHUNK`` and ``MIN_CHUNK`` of
-``impact_balance.governor.batch`` set to K; the sizes alternated round-robin, best of R
-passes): the one-thread batch's CPU time per row (what the chunks' cold starts cost), the
-``--threads`` T batch's wall time per row, and the wall time per row T free cores would take
-(the one-thread pass's chunks, their CPU times, handed out in order to the first free core: what
-the chunks' balance buys, whatever the machine's load).
+threads' shares: a chunk goes to the thread that asks first) and the compiled calls' wall over
+their thread CPU (above 1: a thread waited for a core the machine did not give it).
+``--chunks K ...`` reports instead, per scenario and chunk size K (postures per chunk:
+``CHUNK`` and ``MIN_CHUNK`` of ``impact_balance.governor.batch`` set to K; the sizes
+alternated round-robin, best of R passes): the one-thread batch's CPU time per row (what the
+chunks' cold starts cost), the ``--threads`` T batch's wall time per row, and the wall time per
+row T free cores would take (the one-thread pass's chunks, their CPU times, handed out in order
+to the first free core: what the chunks' balance buys, whatever the machine's load).
 """
 
 from __future__ import annotations

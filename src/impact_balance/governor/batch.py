@@ -232,15 +232,15 @@ class BatchEvaluator:
         evaluators = self._take(workers)
         try:
             if workers == 1:
-                _Slice(*evaluators[0], qs, vs, rows).run(chunks, repeated)
+                _Worker(*evaluators[0], qs, vs, rows).run(chunks, repeated)
             elif workers > 1:
                 pool = self._executor(workers - 1)
                 futures = [
-                    pool.submit(_Slice(*e, qs, vs, rows).run, chunks, repeated)
+                    pool.submit(_Worker(*e, qs, vs, rows).run, chunks, repeated)
                     for e in evaluators[1:]
                 ]
                 try:  # the calling thread takes chunks too
-                    _Slice(*evaluators[0], qs, vs, rows).run(chunks, repeated)
+                    _Worker(*evaluators[0], qs, vs, rows).run(chunks, repeated)
                 except BaseException:  # e.g. KeyboardInterrupt: the workers take no more chunks
                     chunks.stop()
                     raise
@@ -337,8 +337,8 @@ class _Chunks:
             raise self._errors[min(self._errors)]
 
 
-class _Slice:
-    """One thread's rows: the Python step and the compiled call, block by block."""
+class _Worker:
+    """One thread of a batch: the chunks it takes, their Python step and compiled calls."""
 
     def __init__(
         self,
