@@ -2,7 +2,7 @@
 """Issue 28 item 3: ``Governor.limits`` (N postures in one call) beside N single ticks.
 
     python benchmarks/batch.py [--json] [--n N] [--repeat R] [--threads T] [--scenarios NAME ...]
-        [--profile] [--gil]
+        [--profile] [--gil] [--chunks K ...]
 
 For each scenario of the wall study, the moving 500 Hz trajectory of ``benchmarks/governor.py``
 (N ticks, default 1000: every posture differs), timed round-robin in one run, R rounds (the
@@ -26,13 +26,20 @@ per scenario, one thread beside ``--threads`` T (best wall time of R passes each
 wall time per row, the compiled calls' thread CPU time per row summed over the threads (the part
 that runs without the GIL), the rest of the threads' wall time per row (Python holding the GIL,
 or waiting for it or for a core), the slowest thread's compiled CPU over the threads' mean (the
-slices' imbalance) and the compiled calls' wall over their thread CPU (above 1: a thread waited
-for a core the machine did not give it).
+threads' shares: a chunk goes to the thread that asks first) and the compiled calls' wall over
+their thread CPU (above 1: a thread waited for a core the machine did not give it).
+``--chunks K ...`` reports instead, per scenario and chunk size K (postures per chunk:
+``CHUNK`` and ``MIN_CHUNK`` of ``impact_balance.governor.batch`` set to K; the sizes
+alternated round-robin, best of R passes): the one-thread batch's CPU time per row (what the
+chunks' cold starts cost), the ``--threads`` T batch's wall time per row, and the wall time per
+row T free cores would take (the one-thread pass's chunks, their CPU times, handed out in order
+to the first free core: what the chunks' balance buys, whatever the machine's load).
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import os
 import sys
@@ -238,6 +245,101 @@ def _gil(names: list[str], n: int, repeat: int, threads: int, as_json: bool) -> 
     return 0
 
 
+def _makespan(durations: list[float], threads: int) -> float:
+    """The wall time of ``durations`` handed out in order, each to the first free of ``threads``."""
+    free = [0.0] * threads
+    for d in durations:
+        free[free.index(min(free))] += d
+    return max(free)
+
+
+def chunk_scenario(
+    name: str, n: int, repeat: int, threads: int, sizes: list[int]
+) -> dict[str, Any]:
+    """One scenario's batch per chunk size: one thread's CPU and ``threads`` threads' wall.
+
+    Also the wall time ``threads`` free cores would take (``predicted``): the one-thread pass's
+    chunks (their thread CPU times, from one ``take`` to the next) handed out in order to the
+    first free core, as the batch hands them out: the balance, whatever the machine's load.
+    """
+    import impact_balance.governor.batch as batch_module
+
+    governor = Governor(name)
+    qs, vs = trajectory(governor, n)
+    original = batch_module.CHUNK, batch_module.MIN_CHUNK, batch_module._Chunks.take
+    take = original[2]
+    marks: list[float] = []
+
+    def timed_take(self: Any) -> int | None:
+        marks.append(time.thread_time())
+        return take(self)
+
+    cpu = {k: float("inf") for k in sizes}
+    wall = {k: float("inf") for k in sizes}
+    predicted = {k: float("inf") for k in sizes}
+    load_before = os.getloadavg()
+    try:
+        governor.limits(qs, vs, threads=threads)  # warm-up: the threads' evaluators
+        for _ in range(repeat):
+            for k in sizes:
+                batch_module.CHUNK = batch_module.MIN_CHUNK = k
+                batch_module._Chunks.take = timed_take  # type: ignore[method-assign]
+                marks.clear()
+                start = time.process_time()
+                governor.limits(qs, vs)
+                cpu[k] = min(cpu[k], time.process_time() - start)
+                batch_module._Chunks.take = take  # type: ignore[method-assign]
+                durations = [b - a for a, b in itertools.pairwise(marks)]
+                predicted[k] = min(predicted[k], _makespan(durations, threads))
+                start = time.perf_counter()
+                governor.limits(qs, vs, threads=threads)
+                wall[k] = min(wall[k], time.perf_counter() - start)
+    finally:
+        batch_module.CHUNK, batch_module.MIN_CHUNK, batch_module._Chunks.take = original  # type: ignore[method-assign]
+    return {
+        "scenario": name,
+        "n": n,
+        "threads": threads,
+        "loadavg_before": load_before,
+        "loadavg_after": os.getloadavg(),
+        "chunks": [
+            {
+                "chunk": k,
+                "cpu_us_per_row_one_thread": cpu[k] / n * 1e6,
+                "wall_us_per_row_threads": wall[k] / n * 1e6,
+                "predicted_us_per_row_threads": predicted[k] / n * 1e6,
+            }
+            for k in sizes
+        ],
+    }
+
+
+def _chunks(
+    names: list[str], n: int, repeat: int, threads: int, sizes: list[int], as_json: bool
+) -> int:
+    rows = []
+    for name in names:
+        progress(f"{name} (chunks) ...")
+        rows.append(chunk_scenario(name, n, repeat, threads, sizes))
+    if as_json:
+        print(json.dumps({"scenarios": rows, "threads": threads}))
+        return 0
+    print(
+        f"{'scenario':20s} {'chunk':>6s} {'CPU 1 thread':>12s} "
+        f"{f'wall {threads} threads':>15s} {'predicted':>9s}  load avg (before, after)"
+    )
+    for r in rows:
+        for c in r["chunks"]:
+            print(
+                f"{r['scenario']:20s} {c['chunk']:6d} {c['cpu_us_per_row_one_thread']:12.2f} "
+                f"{c['wall_us_per_row_threads']:15.2f} {c['predicted_us_per_row_threads']:9.2f}  "
+                f"{r['loadavg_before'][0]:.2f}, {r['loadavg_after'][0]:.2f}"
+            )
+    print("us per row of the batch (best of the passes); predicted: the one-thread pass's chunks")
+    print(f"(their CPU times) handed out in order to {threads} free cores")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[1])
     parser.add_argument("--n", type=int, default=1000, help="postures per batch (default 1000)")
@@ -249,10 +351,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--gil", action="store_true", help="1 and T threads: compiled time, the GIL's, imbalance"
     )
+    parser.add_argument(
+        "--chunks", type=int, nargs="+", metavar="K", help="per chunk size: cold starts, balance"
+    )
     args = parser.parse_args(argv)
     if args.n < 1 or args.repeat < 1 or not 1 <= args.threads <= 64:
         print("error: --n and --repeat must be >= 1, --threads in [1, 64]", file=sys.stderr)
         return 2
+    if args.chunks is not None and min(args.chunks) < 1:
+        print(f"error: --chunks must be >= 1, got {min(args.chunks)}", file=sys.stderr)
+        return 2
+    if args.chunks:
+        return _chunks(args.scenarios, args.n, args.repeat, args.threads, args.chunks, args.json)
     if args.profile:
         return _profile(args.scenarios, args.n, args.repeat, args.json)
     if args.gil:

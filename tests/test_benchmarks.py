@@ -96,6 +96,26 @@ def test_the_batch_benchmark_reports_ratios_and_agreement(capsys) -> None:
     assert batch.main(["--n", "0"]) == 2
 
 
+def test_the_batch_benchmark_times_chunk_sizes(capsys) -> None:
+    import json
+
+    from benchmarks import batch
+    from impact_balance.governor import batch as batch_module
+
+    chunk = batch_module.CHUNK
+    argv = ["--n", "6", "--repeat", "1", "--scenarios", "kick_one_foot", "--chunks", "2", "5"]
+    assert batch.main([*argv, "--json"]) == 0
+    (row,) = json.loads(capsys.readouterr().out)["scenarios"]
+    assert [c["chunk"] for c in row["chunks"]] == [2, 5]
+    for c in row["chunks"]:
+        assert c["cpu_us_per_row_one_thread"] > 0
+        # two free cores take at least half the one thread's chunks' time, at most all of it
+        assert 0 < c["predicted_us_per_row_threads"] <= c["cpu_us_per_row_one_thread"]
+    assert batch._makespan([3.0, 1.0, 1.0, 2.0], 2) == 4.0  # 3 | 1 1, then 2 on the second
+    assert batch_module.CHUNK == chunk  # put back
+    assert batch.main(["--chunks", "0"]) == 2
+
+
 @pytest.mark.slow
 def test_the_approach_benchmark_pools_the_ticks_of_every_trial(capsys) -> None:
     """Every tick the command counted is timed, replayed once, and pooled over the trials."""

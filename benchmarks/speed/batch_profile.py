@@ -217,10 +217,13 @@ def profile_batch(name: str, n: int, repeat: int) -> dict[str, Any]:
     out["areas"] = walk_areas - out["walk"]
     # the postures' call from the batch's buffers: all rows in one call
     same = np.zeros(n, dtype=np.bool_)
-    res, vel, pnt = np.empty((n, 6)), np.empty((n, 3)), np.empty((n, 3))
+    codes, speeds = np.empty(n, dtype=np.int64), np.empty(n)
+    vertices, edges = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+    intervals, vel, pnt = np.empty((n, 2)), np.empty((n, 3)), np.empty((n, 3))
     p_args = (
         e._faces, rot, loc, ori, com_l, cen, e._gravity, True, jac, e._idx, e._limit, sca, hint,
-        MAX_PIVOTS, e._constants, pts, ine, e._normal, e._cone, vs, same, res, vel, pnt, 1e4,
+        MAX_PIVOTS, e._constants, pts, ine, e._normal, e._cone, vs, same, codes, speeds,
+        vertices, edges, intervals, vel, pnt, 1e4,
     )  # fmt: skip
     postures = _best(lambda: postures_kernel(*p_args), repeat, reset, n)
     batch = _best(lambda: g.limits(qs, vs), repeat, lambda: None, n)

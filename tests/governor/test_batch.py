@@ -3,7 +3,10 @@ what analyze() answers; bad batches are refused naming the field."""
 
 from __future__ import annotations
 
+import contextlib
+import itertools
 import math
+from unittest import mock
 
 import numpy as np
 import pytest
@@ -11,6 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import impact_balance as ib
+import impact_balance.governor.batch as batch_module
 from impact_balance.exceptions import GovernorError
 from impact_balance.governor import Governor
 
@@ -102,10 +106,114 @@ def test_batch_covers_falling_starts_and_agrees_with_analyze():
 def test_threads_answer_the_same():
     g = governor("palm_push_two_feet")
     qs, vs = batch(g, 70, 3)
-    one, two = g.limits(qs, vs), g.limits(qs, vs, threads=3)
-    np.testing.assert_allclose(two.max_contact_velocity, one.max_contact_velocity, atol=1e-12)
-    assert two.status == one.status
-    np.testing.assert_array_equal(two.limiting_edge, one.limiting_edge)
+    with chunks_of(8):
+        one, two = g.limits(qs, vs), g.limits(qs, vs, threads=3)
+    assert_batches_identical(two, one)
+
+
+def chunks_of(size: int) -> contextlib.ExitStack:
+    """Within: a batch's chunks have ``size`` postures of their own each (the last one fewer)."""
+    stack = contextlib.ExitStack()
+    stack.enter_context(mock.patch.object(batch_module, "CHUNK", size))
+    stack.enter_context(mock.patch.object(batch_module, "MIN_CHUNK", size))
+    return stack
+
+
+def assert_batches_identical(got, want) -> None:
+    """Two batches' answers equal to the last digit, every array and status."""
+    assert got.criterion == want.criterion and got.status == want.status
+    for key in (
+        "max_contact_velocity",
+        "limiting_vertex",
+        "limiting_edge",
+        "safe_interval",
+        "com_velocity",
+        "normal",
+        "point",
+    ):
+        np.testing.assert_array_equal(getattr(got, key), getattr(want, key), err_msg=key)
+
+
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    name=st.sampled_from(SCENARIOS),
+    n=st.integers(1, 60),
+    seed=st.integers(0, 2**32 - 1),
+    chunk=st.integers(1, 40),
+    threads=st.integers(2, 4),
+    repeats=st.lists(st.integers(1, 3), min_size=60, max_size=60),
+)
+def test_answers_do_not_depend_on_the_threads(name, n, seed, chunk, threads, repeats):
+    # The rows go in chunks of CHUNK postures of their own, handed to the threads as they ask,
+    # each chunk's walks starting from a cold hint: one thread and several give the same
+    # numbers to the last digit, whatever ran before. Independently: each chunk's rows as a
+    # batch of their own on a fresh governor give those numbers too, and the single ticks agree.
+    g = governor(name)
+    qs, vs = path(g, n, seed)
+    qs = np.repeat(qs, repeats[:n], axis=0)  # some rows repeat the posture before them
+    vs = np.repeat(vs, repeats[:n], axis=0) * np.linspace(0.5, 1.5, len(qs))[:, None]
+    with chunks_of(chunk):
+        one = g.limits(qs, vs)
+        many = g.limits(qs, vs, threads=threads)
+        again = g.limits(qs, vs)  # after a batch on other threads, with other hints left
+        starts = np.flatnonzero(np.r_[True, np.diff(np.repeat(np.arange(n), repeats[:n])) != 0])
+        bounds = [*starts[::chunk].tolist(), len(qs)]
+        fresh = Governor(name)
+        alone = [fresh.limits(qs[a:b], vs[a:b]) for a, b in itertools.pairwise(bounds)]
+    assert_batches_identical(many, one)
+    assert_batches_identical(again, one)
+    np.testing.assert_array_equal(
+        np.concatenate([x.max_contact_velocity for x in alone]), one.max_contact_velocity
+    )
+    assert sum((x.status for x in alone), ()) == one.status
+    for i in range(0, len(qs), max(1, len(qs) // 5)):
+        assert_rows_agree([one[i]], [g.limit(qs[i], vs[i])])
+
+
+@given(
+    postures=st.integers(1, 3000),
+    repeats=st.lists(st.integers(1, 4), min_size=1, max_size=3000),
+)
+def test_chunks_cut_the_postures_evenly(postures, repeats):
+    # Chunks start at a posture of its own (a row that repeats the one before stays with it)
+    # and hold the same number of postures but the last, at most CHUNK: CHUNKS chunks, or a
+    # power of two fewer of at least MIN_CHUNK postures each when there are fewer postures.
+    counts = (repeats * (postures // len(repeats) + 1))[:postures]
+    repeated = np.ones(sum(counts), dtype=bool)
+    starts = np.cumsum([0, *counts[:-1]])
+    repeated[starts] = False
+    bounds = batch_module._chunk_bounds(repeated)
+    assert bounds[0] == 0 and bounds[-1] == len(repeated)
+    assert not repeated[bounds[:-1]].any()
+    sizes = [int(np.count_nonzero(~repeated[a:b])) for a, b in itertools.pairwise(bounds)]
+    assert sum(sizes) == postures and len(set(sizes[:-1])) <= 1 and 0 < sizes[-1] <= sizes[0]
+    chunk, least, most = batch_module.CHUNKS, batch_module.MIN_CHUNK, batch_module.CHUNK
+    assert sizes[0] <= most
+    if postures > chunk * most:
+        assert sizes[0] == most
+    else:
+        assert len(sizes) in {chunk >> k for k in range(chunk.bit_length())}
+        assert len(sizes) == 1 or sizes[0] >= least  # no chunk below MIN_CHUNK but the last
+        assert len(sizes) == chunk or postures < 2 * len(sizes) * least  # no more could be made
+
+
+@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    bad=st.lists(st.integers(0, 39), min_size=1, max_size=4, unique=True),
+    chunk=st.integers(1, 12),
+    threads=st.integers(1, 3),
+)
+def test_the_first_refused_row_is_named_whatever_the_threads(bad, chunk, threads):
+    # CoM speeds above the bound on rows ``bad``: the batch names the first of them, as one
+    # thread taking the rows in order would, however many threads share the chunks.
+    g = governor("kick_one_foot")
+    qs, vs = batch(g, 40, 17)
+    vs[bad] *= 1e6
+    with chunks_of(chunk), pytest.raises(GovernorError) as info:
+        g.limits(qs, vs, threads=threads)
+    assert info.value.field == f"v_batch[{min(bad)}]"
+    with pytest.raises(GovernorError):  # the single tick refuses that row too
+        g.limit(qs[min(bad)], vs[min(bad)])
 
 
 def test_zmp_criterion_batch_equals_single_ticks():
@@ -200,8 +308,9 @@ def test_many_velocities_at_one_posture_reuse_it(name):
     singles = [g.limit(q, v) for q, v in zip(qs, vs, strict=True)]
     assert sum(s.posture_reused for s in singles) >= 42
     assert_rows_equal(answers, singles)
-    # Slices of threads that start inside a run of repeated rows evaluate their posture.
-    assert_rows_equal(g.limits(qs, vs, threads=4), singles)
+    # Chunks of one posture each (with its repeated rows) over four threads: the same.
+    with chunks_of(1):
+        assert_rows_equal(g.limits(qs, vs, threads=4), singles)
 
 
 def test_a_posture_the_pipeline_refuses_names_its_row():
@@ -358,12 +467,14 @@ def test_rows_are_checked_as_limit_checks_them(seed, bad, faults):
 
 
 @pytest.mark.parametrize("threads", [1, 2])
-def test_a_batchs_buffers_serve_the_next_batches(threads):
+def test_a_batchs_buffers_serve_the_next_batches(threads, monkeypatch):
     # The block buffers of each thread's evaluator are kept for the next batch: a small batch
     # after a larger one (its buffers holding the larger one's last block) answers as the
     # single ticks do, rows that repeat a posture included, and the buffers are the same arrays.
     g = Governor("palm_push_two_feet")
     qs, vs = batch(g, 45, 11)
+    monkeypatch.setattr(batch_module, "CHUNK", 8)  # six chunks: every thread takes some
+    monkeypatch.setattr(batch_module, "MIN_CHUNK", 8)
     assert_rows_equal(
         g.limits(qs, vs, threads=threads), [g.limit(q, v) for q, v in zip(qs, vs, strict=True)]
     )
@@ -378,36 +489,39 @@ def test_a_batchs_buffers_serve_the_next_batches(threads):
 
 
 def test_the_threads_of_a_batch_serve_the_next_batches(monkeypatch):
-    # threads > 1 runs on a pool kept by the governor: the next batch of as many threads or
-    # fewer takes the same pool, a batch of more threads a larger one, a process forked after
-    # the pool was made (its copy has no threads) a new one; the answers are the single ticks'.
-    import impact_balance.governor.batch as batch_module
-
+    # threads > 1 runs on the calling thread and a pool of threads - 1 kept by the governor:
+    # the next batch of as many threads or fewer takes the same pool, a batch of more threads a
+    # larger one, a process forked after the pool was made (its copy has no threads) a new one;
+    # the answers are the single ticks'.
+    monkeypatch.setattr(batch_module, "CHUNK", 4)
+    monkeypatch.setattr(batch_module, "MIN_CHUNK", 4)
     g = Governor("kick_one_foot")
     qs, vs = batch(g, 24, 21)
     singles = [g.limit(q, v) for q, v in zip(qs, vs, strict=True)]
     assert_rows_equal(g.limits(qs, vs, threads=2), singles)
     pool, size, _ = g._batch._pool
-    assert size == 2
+    assert size == 1
     assert_rows_equal(g.limits(qs, vs, threads=2), singles)
     assert g._batch._pool[0] is pool
     assert_rows_equal(g.limits(qs, vs, threads=3), singles)
     larger, size, _ = g._batch._pool
-    assert larger is not pool and size == 3
+    assert larger is not pool and size == 2
     assert_rows_equal(g.limits(qs, vs, threads=2), singles)
     assert g._batch._pool[0] is larger
     monkeypatch.setattr(batch_module.os, "getpid", lambda: -1)  # as in a forked child
     assert_rows_equal(g.limits(qs, vs, threads=2), singles)
-    assert g._batch._pool[0] is not larger and g._batch._pool[1:] == (2, -1)
+    assert g._batch._pool[0] is not larger and g._batch._pool[1:] == (1, -1)
 
 
-def test_a_refused_row_in_a_threads_slice_leaves_the_governor_usable():
-    # A slice's error is raised once every slice is done: the evaluators go back to the pool
+def test_a_refused_row_in_a_threads_chunk_leaves_the_governor_usable(monkeypatch):
+    # A chunk's error is raised once every thread is done: the evaluators go back to the pool
     # and the next batch on the same threads answers.
+    monkeypatch.setattr(batch_module, "CHUNK", 4)
+    monkeypatch.setattr(batch_module, "MIN_CHUNK", 4)
     g = Governor("kick_one_foot")
     qs, vs = batch(g, 12, 22)
     bad = vs.copy()
-    bad[9] *= 1e6  # a CoM speed above the bound, in the second slice
+    bad[9] *= 1e6  # a CoM speed above the bound, in the third chunk
     with pytest.raises(GovernorError, match=r"v_batch\[9\]"):
         g.limits(qs, bad, threads=2)
     assert len(g._batch._evaluators) == 2

@@ -8,14 +8,19 @@ side runs pinocchio (:meth:`PostureEvaluator.kinematics
 step); the areas, the impact model and the criterion of every posture then run in one compiled
 call (:func:`~impact_balance.governor.posture_kernel.postures_kernel`: a tick's
 :func:`~impact_balance.governor.posture_kernel.posture_kernel` per posture, the same numbers),
-which releases the GIL, so ``threads`` > 1 evaluates slices of the postures side by side. The
-rows of a thread share one projection hint, as a governor's successive ticks do: a row's walk
-first re-certifies the previous row's chain of bases, so rows in path order (nearby postures
-one after the other) cost less than the same rows shuffled; the answers do not depend on the
-order. A posture the compiled call does not answer (a projection Bretl's method answers, an
-area of fewer than 3 vertices, an impact model it refuses), the "zmp" criterion, the
-joint-space inertia model, contact frictions above 1 and the angular momentum option
-(``angular_momentum_damping_time``) take the one-posture path
+which releases the GIL, so ``threads`` > 1 evaluates postures side by side. The rows go in
+chunks of up to :data:`CHUNK` postures of their own (:data:`CHUNKS` chunks, or fewer of at least
+:data:`MIN_CHUNK`; with the rows that repeat them), handed to the threads in order as each asks
+for the next. The rows of a chunk share one projection hint, as a governor's successive ticks
+do: a row's walk first re-certifies the previous row's chain of
+bases, so rows in path order (nearby postures one after the other) cost less than the same rows
+shuffled; each chunk starts from a cold hint, whatever thread runs it and whatever ran before,
+so the answers do not depend on the number of threads or on the schedule, to the last digit
+(they equal the single ticks' to rounding, in any order). A batch that meets errors raises the
+first chunk's, the error one thread raises. A posture the compiled call does not answer (a
+projection Bretl's method answers, an area of fewer than 3 vertices, an impact model it
+refuses), the "zmp" criterion, the joint-space inertia model, contact frictions above 1 and the
+angular momentum option (``angular_momentum_damping_time``) take the one-posture path
 (:meth:`PostureEvaluator.evaluate <impact_balance.governor.posture.PostureEvaluator.evaluate>`).
 """
 
@@ -47,11 +52,23 @@ from impact_balance.governor.tree_kernel import KinematicTree, tree_postures
 from impact_balance.projection.walk import MAX_PIVOTS
 from impact_balance.robot.robot import Robot
 
-__all__ = ["BLOCK", "BatchEvaluator", "BatchLimits"]
+__all__ = ["BLOCK", "CHUNK", "CHUNKS", "MIN_CHUNK", "BatchEvaluator", "BatchLimits"]
 
 #: Postures per compiled call: the Python step of the next block runs while another thread's
 #: compiled call runs.
-BLOCK = 32
+BLOCK = 64
+#: The most postures of their own per chunk (with the rows that repeat them): the unit a thread
+#: takes, in blocks of :data:`BLOCK`, whose walks start from a cold projection hint (whatever
+#: thread runs it and whatever ran before), so a batch's answers do not depend on its threads.
+CHUNK = 64
+#: The fewest postures per chunk (but the last): a chunk's cold start costs about one row.
+MIN_CHUNK = 16
+#: The chunks a batch of P postures is cut into, of ``ceil(P / CHUNKS)`` postures each; half
+#: as many (down to one) while they would have fewer than :data:`MIN_CHUNK`, more while they
+#: would have more than :data:`CHUNK`. A function of P only, not of the threads.
+CHUNKS = 16
+#: The statuses by the compiled exit's codes (an index of ``EXIT_STATUSES``).
+_STATUSES = np.array(EXIT_STATUSES, dtype=object)
 #: The most threads a batch takes.
 MAX_THREADS = 64
 
@@ -210,22 +227,28 @@ class BatchEvaluator:
             qs[i] = self.check(qs[i], f"q_batch[{i}]")
             start = i + 1
         rows = _Rows(len(qs))
-        slices = np.array_split(np.arange(len(qs)), min(threads, max(len(qs), 1)))
-        evaluators = self._take(len(slices))
+        chunks = _Chunks(_chunk_bounds(repeated))
+        workers = min(threads, chunks.count)
+        evaluators = self._take(workers)
         try:
-            if len(slices) == 1:
-                _Slice(*evaluators[0], qs, vs, rows).run(slices[0], repeated)
-            else:
-                pool = self._executor(len(slices))
+            if workers == 1:
+                _Worker(*evaluators[0], qs, vs, rows).run(chunks, repeated)
+            elif workers > 1:
+                pool = self._executor(workers - 1)
                 futures = [
-                    pool.submit(_Slice(*e, qs, vs, rows).run, s, repeated)
-                    for e, s in zip(evaluators, slices, strict=True)
+                    pool.submit(_Worker(*e, qs, vs, rows).run, chunks, repeated)
+                    for e in evaluators[1:]
                 ]
-                try:
-                    for future in futures:
-                        future.result()
-                finally:  # every slice done before its evaluator goes back or an error is raised
+                try:  # the calling thread takes chunks too
+                    _Worker(*evaluators[0], qs, vs, rows).run(chunks, repeated)
+                except BaseException:  # e.g. KeyboardInterrupt: the workers take no more chunks
+                    chunks.stop()
+                    raise
+                finally:  # every chunk done before the evaluators go back or an error is raised
                     wait(futures)
+                for future in futures:
+                    future.result()  # a worker's own fault (its chunks' errors are in chunks)
+            chunks.raise_first()
         finally:
             with self._lock:
                 self._evaluators.extend(evaluators)
@@ -259,8 +282,63 @@ class BatchEvaluator:
         return taken
 
 
-class _Slice:
-    """One thread's rows: the Python step and the compiled call, block by block."""
+def _chunk_bounds(repeated: npt.NDArray[np.bool_]) -> list[int]:
+    """The rows' chunks, as bounds: chunk c is rows ``bounds[c]`` to ``bounds[c + 1]``.
+
+    Of P postures of their own (``repeated[i]``: row i's q is row i - 1's; ``repeated[0]`` is
+    false), each chunk has ``ceil(P / c)`` (the last one fewer, at most :data:`CHUNK`), with the
+    rows that repeat them: c is :data:`CHUNKS`, halved while ``P < c * MIN_CHUNK`` and c > 1
+    (an even count of equal chunks shares out evenly).
+    """
+    starts = np.flatnonzero(~repeated)
+    count = CHUNKS
+    while count > 1 and len(starts) < count * MIN_CHUNK:
+        count //= 2
+    size = max(1, min(CHUNK, -(-len(starts) // count)))
+    return [*starts[::size].tolist(), len(repeated)]
+
+
+class _Chunks:
+    """A batch's chunks, handed to its threads in order as they ask (thread-safe).
+
+    A thread that meets an error in a chunk records it (:meth:`fail`) and takes no more; the
+    other threads finish the chunks they hold and take no more. :meth:`raise_first` then raises
+    the error of the first chunk that had one: the error a one-thread batch raises.
+    """
+
+    def __init__(self, bounds: list[int]) -> None:
+        self.bounds, self.count = bounds, len(bounds) - 1
+        self._next, self._stopped = 0, False
+        self._errors: dict[int, BaseException] = {}
+        self._lock = threading.Lock()
+
+    def take(self) -> int | None:
+        """The next chunk's index, None when none is left (or the batch stopped)."""
+        with self._lock:
+            if self._stopped or self._next >= self.count:
+                return None
+            self._next += 1
+            return self._next - 1
+
+    def fail(self, chunk: int, error: BaseException) -> None:
+        """Record chunk ``chunk``'s error; no chunk is handed out after it."""
+        with self._lock:
+            self._errors[chunk] = error
+            self._stopped = True
+
+    def stop(self) -> None:
+        """Hand out no more chunks."""
+        with self._lock:
+            self._stopped = True
+
+    def raise_first(self) -> None:
+        """Raise the error of the first chunk that had one (none: return)."""
+        if self._errors:
+            raise self._errors[min(self._errors)]
+
+
+class _Worker:
+    """One thread of a batch: the chunks it takes, their Python step and compiled calls."""
 
     def __init__(
         self,
@@ -278,37 +356,44 @@ class _Slice:
             assert buffers is not None  # made with the evaluator (BatchEvaluator._take)
             self.buffers = buffers
 
-    def run(self, indices: npt.NDArray[np.int64], repeated: npt.NDArray[np.bool_]) -> None:
-        """Answer rows ``indices`` of the batch (``repeated[i]``: row i's q is row i - 1's)."""
-        if not self.compiled:
-            for i in indices:
-                self.single(int(i))
-            return
-        # Blocks of BLOCK postures, each with the rows that repeat it; the slice's first row is
-        # evaluated, whatever came before it.
-        if not len(indices):
-            return
-        starts: list[int] = np.union1d([0], np.flatnonzero(~repeated[indices])).tolist()
-        bounds = [*starts[::BLOCK], len(indices)]
-        for a, b in itertools.pairwise(bounds):
-            same = repeated[indices[a:b]].copy()
-            same[0] = False
-            self.block(indices[a:b], same)
+    def run(self, chunks: _Chunks, repeated: npt.NDArray[np.bool_]) -> None:
+        """Answer the chunks this thread takes, until none is left.
 
-    def block(self, indices: npt.NDArray[np.int64], same: npt.NDArray[np.bool_]) -> None:
-        """The pinocchio step of rows ``indices``, then their compiled call.
-
-        ``same[r]``: row r repeats the posture of row r - 1 (only its velocity is new). At most
-        :data:`BLOCK` rows have a posture of their own.
+        ``repeated``: as :func:`_chunk_bounds`'s. Each chunk's walks start from a cold projection
+        hint, then carry it from row to row. An error is recorded with its chunk
+        (:meth:`_Chunks.fail`), not raised.
         """
-        e, n, rows, b = self.e, len(indices), self.rows, self.buffers
+        hint = self.e._hint
+        while (c := chunks.take()) is not None:
+            a, b = chunks.bounds[c], chunks.bounds[c + 1]
+            hint.fill(-1)
+            try:
+                if not self.compiled:
+                    for i in range(a, b):
+                        self.single(i)
+                    continue
+                # Blocks of BLOCK postures of their own, each with the rows that repeat them.
+                starts = (a + np.flatnonzero(~repeated[a:b])).tolist()
+                for lo, hi in itertools.pairwise([*starts[::BLOCK], b]):
+                    self.block(lo, hi, repeated[lo:hi])
+            except Exception as exc:  # raised by the batch once every thread is done
+                chunks.fail(c, exc)
+                return
+
+    def block(self, start: int, stop: int, same: npt.NDArray[np.bool_]) -> None:
+        """The kinematics of rows ``start`` to ``stop``, then their compiled call and answers.
+
+        ``same[r]``: row ``start + r`` repeats the posture of the row before it (only its
+        velocity is new); ``same[0]`` is false. At most :data:`BLOCK` rows have a posture of
+        their own.
+        """
+        e, n, rows, b = self.e, stop - start, self.rows, self.buffers  # the kernel writes rows
         rotations, local, jacobians, scalars = b.rotations, b.local, b.jacobians, b.scalars
-        own = np.flatnonzero(~same)  # the rows of a posture of their own
+        own = start + np.flatnonzero(~same)  # the rows of a posture of their own
         if b.tree is not None:
-            self.tree_kinematics(indices[own])
+            self.tree_kinematics(own)
         else:
-            for p, r in enumerate(own.tolist()):
-                i = int(indices[r])
+            for p, i in enumerate(own.tolist()):
                 origin, com_local, mass, inertia, Ag = e._placements(
                     self.qs[i], rotations[p], local[p], jacobians[p]
                 )
@@ -321,21 +406,21 @@ class _Slice:
                 b.point_locals[p] = e.impact_point()
                 scalars[p, 0] = mass
                 scalars[p, 3] = self.omega(float(com_local[2]) + float(origin[2]), i)
-        out, velocities, points = np.empty((n, 6)), np.empty((n, 3)), np.empty((n, 3))
+        codes, velocities = np.empty(n, dtype=np.int64), rows.com_velocity[start:stop]
         too_fast = postures_kernel(
             e._faces, rotations, local, b.origins, b.com_locals, b.centroidal, e._gravity,
             e._torques, jacobians, e._idx, e._limit, scalars, e._hint, MAX_PIVOTS, e._constants,
-            b.point_locals, b.inertias, e._normal, e._cone, self.vs[indices], same, out,
-            velocities, points, MAX_SPEED * MAX_SPEED,
+            b.point_locals, b.inertias, e._normal, e._cone, self.vs[start:stop], same, codes,
+            rows.speed[start:stop], rows.vertex[start:stop], rows.edge[start:stop],
+            rows.interval[start:stop], velocities, rows.point[start:stop], MAX_SPEED * MAX_SPEED,
         )  # fmt: skip
         if too_fast >= 0:
-            _too_fast(velocities[too_fast], int(indices[too_fast]))
-        rows.com_velocity[indices], rows.point[indices], rows.normal[indices] = (
-            velocities,
-            points,
-            e._normal,
-        )
-        self.fill(indices, out)
+            _too_fast(velocities[too_fast], start + too_fast)
+        rows.normal[start:stop] = e._normal
+        rows.status[start:stop] = _STATUSES[codes].tolist()  # code -1: overwritten below
+        for r in np.flatnonzero(codes < 0).tolist():
+            # Bretl's projection, a small area, a refused impact model
+            self.single(start + r)
 
     def tree_kinematics(self, rows: npt.NDArray[np.int64]) -> None:
         """The kinematics of batch rows ``rows`` into the block's buffers, in one compiled call.
@@ -367,25 +452,6 @@ class _Slice:
             return lipm_omega(com_height, s.plane_height, s.gravity, field="plane_height")
         except ImpactBalanceError as exc:
             raise _in_row(exc, i) from None
-
-    def fill(self, indices: npt.NDArray[np.int64], out: npt.NDArray[np.float64]) -> None:
-        """Rows ``indices`` from the compiled answers ``out``; the one-posture path for the rest."""
-        rows = self.rows
-        codes = out[:, 0].astype(np.int64)
-        answered = codes >= 0  # "ok", "already_falling", "unbounded"
-        done = indices[answered]
-        rows.speed[done] = np.where(
-            codes[answered] == 0, out[answered, 1], np.where(codes[answered] == 1, 0.0, math.inf)
-        )
-        rows.interval[done] = out[answered, 4:6]
-        ok = indices[codes == 0]
-        rows.vertex[ok], rows.edge[ok] = out[codes == 0, 2], out[codes == 0, 3]
-        status = rows.status
-        for i, code in zip(indices.tolist(), codes.tolist(), strict=True):
-            if code >= 0:
-                status[i] = EXIT_STATUSES[code]
-            else:  # Bretl's projection, a small area, a refused impact model
-                self.single(i)
 
     def single(self, i: int) -> None:
         """Row ``i`` by the one-posture path (what :meth:`Governor.limit` does)."""

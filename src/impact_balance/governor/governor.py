@@ -425,8 +425,9 @@ class Governor:
         Equal to N calls of :meth:`limit` (to rounding: 1e-12 m/s in the tests), each posture
         evaluated (the ``posture_tolerance`` and the last answer are neither used nor
         changed). The areas and the criterion of all postures run in one compiled call
-        (:mod:`impact_balance.governor.batch`); ``threads`` > 1 splits the rows over threads
-        (contiguous slices), kept by the governor for its next batches.
+        (:mod:`impact_balance.governor.batch`); ``threads`` > 1 hands chunks of rows to the
+        calling thread and threads kept by the governor for its next batches. The answers do
+        not depend on ``threads``, to the last digit.
 
         Args:
             q_batch: (N, nq) configurations, as :meth:`limit`'s ``q``.

@@ -144,7 +144,11 @@ def postures_kernel(
     cone: np.ndarray,
     velocities: np.ndarray,
     same: np.ndarray,
-    out: np.ndarray,
+    codes: np.ndarray,
+    speeds: np.ndarray,
+    vertices: np.ndarray,
+    edges: np.ndarray,
+    intervals: np.ndarray,
     com_velocities: np.ndarray,
     points: np.ndarray,
     max_speed_squared: float,
@@ -161,10 +165,13 @@ def postures_kernel(
     ones).
 
     Writes ``com_velocities[i]`` (J_com v, m/s, BLAS's product as a tick's), ``points[i]`` (the
-    impact point, m) and ``out[i] = (code, speed, vertex, edge, lo, hi)``: the numbers of a
-    governor's tick (:func:`~impact_balance.governor.tick.velocity_exit`: the exit kernel's
-    code, an index of ``EXIT_STATUSES``, and the safe interval, NaN when there is none), or
-    code -1 where the caller takes the one-posture path.
+    impact point, m) and the numbers of a governor's tick
+    (:func:`~impact_balance.governor.tick.velocity_exit`): ``codes[i]`` (int64: the exit
+    kernel's code, an index of ``EXIT_STATUSES``), ``speeds[i]`` (m/s: 0 already falling, inf
+    unbounded), ``vertices[i]`` and ``edges[i]`` (int64, -1 but for code 0) and
+    ``intervals[i]`` (the safe interval ``(lo, hi)``, m/s, NaN when there is none); or
+    ``codes[i] = -1`` where the caller takes the one-posture path (the other outputs of the row
+    are then not written).
 
     Returns the first row whose CoM speed squared is not at most ``max_speed_squared``
     ((m/s)^2, the single tick's test), -1 if none. Only the first ``same.size`` rows are read
@@ -178,7 +185,7 @@ def postures_kernel(
     p = -1  # the posture of row i
     too_fast = -1
     for i in range(same.size):
-        out[i, 0] = -1.0
+        codes[i] = -1
         if not same[i]:
             p += 1
             answer = kinematics_posture_kernel(
@@ -201,11 +208,11 @@ def postures_kernel(
             for k in range(h.size):
                 margins[k] = h[k] - (G[k, 0] * c[0] + G[k, 1] * c[1])
             code, speed, vertex, edge = exit_kernel(margins, rates, tol)
-            out[i, 0], out[i, 1], out[i, 2], out[i, 3] = code, speed, vertex, edge
-            out[i, 4], out[i, 5] = 0.0, speed
+            codes[i], speeds[i], vertices[i], edges[i] = code, speed, vertex, edge
+            intervals[i, 0], intervals[i, 1] = 0.0, speed
             if code == 1:  # already falling: the safe speeds, if any, catch the fall
                 found, lo, hi = interval_kernel(margins, rates, tol)
-                out[i, 4], out[i, 5] = (lo, hi) if found else (math.nan, math.nan)
+                intervals[i, 0], intervals[i, 1] = (lo, hi) if found else (math.nan, math.nan)
     return too_fast
 
 
