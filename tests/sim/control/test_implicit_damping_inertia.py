@@ -137,3 +137,30 @@ def test_a_light_damped_wrist_realises_the_plan_only_with_the_term():
     np.testing.assert_allclose(realised, planned, atol=0.02 * scale)
     planned, realised = _left_arm_first_step(False)
     assert np.abs(realised - planned).max() > 0.3 * np.abs(planned).max()
+
+
+@pytest.mark.slow
+def test_icubs_wall_touch_holds_with_the_term_and_tips_without():
+    """Set 11's wall hold, free joints, the left palm at the wall at 0.02 m/s, 0.3 s after it.
+
+    With ``M`` alone the touch back-drives the wrist into its damping's saturation and the arm's
+    swing turns the trunk past 5° within 0.2 s (docs/studies/hand-contacts.md); with the plant's
+    inertia the trunk stays within 2°.
+    """
+    from impact_balance.sim.trials.balance_trial import run_balance_trial
+
+    tilt = {}
+    for flag in (True, False):
+        options = BalanceTrialOptions(
+            controller="id",
+            after=0.3,
+            id_gains=InverseDynamicsGains(implicit_damping_inertia=flag),
+        )
+        setup = BalanceSetup.create(str(STANCE), options=options)
+        result = run_balance_trial(setup, impact_speed=0.02, options=options)
+        summary = result.summary()
+        assert result.impact is not None and result.impact.contact_time is not None
+        tilt[flag] = summary["max_trunk_tilt_deg"]
+        if flag:
+            assert summary["outcome"] == "balanced", summary
+    assert tilt[True] < 2.0 < 5.0 < tilt[False], tilt
