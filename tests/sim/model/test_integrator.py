@@ -19,7 +19,9 @@ import mujoco
 
 from impact_balance.sim.model.integrator import damping_is_implicit, implicit_damping_inertia
 
-IMPLICIT = ("implicitfast", "implicit", "Euler")
+IMPLICIT = ("implicitfast", "implicit", "Euler") + (
+    ("discrete",) if hasattr(mujoco.mjtIntegrator, "mjINT_DISCRETE") else ()
+)
 
 
 def _chain(integrator: str, timestep: float, damping: tuple[float, float, float]) -> str:

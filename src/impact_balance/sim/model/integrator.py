@@ -7,7 +7,8 @@ integrator unless the ``eulerdamp`` flag is disabled, integrate the joints' visc
 armature, ``f`` every other generalised force). A torque that cancels ``D qdot`` (a motor's
 damping compensation) leaves ``(M + h D) a = f``: the plant's inertia is ``M + h D``, ``h D`` a
 diagonal term of ``h * dof_damping`` (kg m^2 on a hinge, kg on a slide). ``RK4`` integrates the
-damping explicitly: no term.
+damping explicitly: no term. (``discrete`` also adds ``h^2 K`` of joint stiffness, not counted
+here: the project's models have none.)
 """
 
 from __future__ import annotations
