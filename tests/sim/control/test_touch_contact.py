@@ -205,7 +205,9 @@ def test_touch_faces_refuse_bad_input(normal, mu):
 def test_icub_wall_touch_becomes_a_contact_and_withdraws_at_once():
     """iCub's wall hold at 0.02 m/s: the palm is a contact from the first touch, presses its
     15 N and the withdrawal starts within a few milliseconds (without the option the palm
-    pivots on the wall for tens of milliseconds before the force reaches 15 N)."""
+    pivots on the wall for tens of milliseconds before the force reaches 15 N). The QP with
+    ``M`` alone (``implicit_damping_inertia=False``): with the plant's inertia the palm, without
+    the option, no longer pivots and stays under 15 N (tested in test_implicit_damping_inertia)."""
     from impact_balance.sim.trials.balance_trial import run_balance_trial
     from impact_balance.sim.trials.setup import BalanceSetup, BalanceTrialOptions
 
@@ -225,7 +227,9 @@ def test_icub_wall_touch_becomes_a_contact_and_withdraws_at_once():
             return out
 
         options = BalanceTrialOptions(
-            controller="id", after=0.3, id_gains=InverseDynamicsGains(touch_contact=touch)
+            controller="id",
+            after=0.3,
+            id_gains=InverseDynamicsGains(touch_contact=touch, implicit_damping_inertia=False),
         )
         setup = BalanceSetup.create(str(STANCE), options=options)
         InverseDynamicsController.step = kept

@@ -148,6 +148,11 @@ class InverseDynamicsGains:
             cone times ``friction_scale``, pressing with at least the impact task's
             ``force_threshold`` (see :mod:`impact_balance.sim.control.torque`). False: the
             impact is no contact of the QP.
+        implicit_damping_inertia: The QP's joint-space inertia is the simulated plant's,
+            ``M + h D`` (h the simulation step, s; D each joint's viscous damping, N m s/rad):
+            the inertia MuJoCo's integrator adds when it integrates the damping implicitly
+            (:func:`~impact_balance.sim.model.integrator.implicit_damping_inertia`; zero with an
+            explicit integrator). False: the QP plans with ``M`` alone.
     """
 
     rate: float = 500.0
@@ -178,6 +183,7 @@ class InverseDynamicsGains:
     friction_velocity: float = 0.01
     joint_limit_horizon: float = 0.1
     touch_contact: bool = False
+    implicit_damping_inertia: bool = True
 
     def to_dict(self) -> dict[str, Any]:
         """The gains by field name (JSON-ready)."""

@@ -9,9 +9,10 @@ control step: the zero-step capture that the CoM criterion assumes.
 At every control step (500 Hz by default), from the measured ``(q, v)`` (pinocchio order, the
 free-flyer velocity in the base frame):
 
-1. pinocchio computes the mass matrix ``M``, the nonlinear effects ``h``, the centroidal
-   momentum matrix ``A_g`` and its drift ``A_g_dot v``, the contact Jacobians ``J_i`` (world-aligned
-   axes, at the contact point) and their drifts ``J_i_dot v``.
+1. pinocchio computes the mass matrix ``M`` (plus, with ``implicit_damping_inertia``, the
+   simulated plant's ``h_s D`` on the actuated joints: below), the nonlinear effects ``h``, the
+   centroidal momentum matrix ``A_g`` and its drift ``A_g_dot v``, the contact Jacobians ``J_i``
+   (world-aligned axes, at the contact point) and their drifts ``J_i_dot v``.
 2. :class:`~.zmp.DcmFeedback` (the same as the kinematic controller's) picks the desired ZMP
    ``p = xi + (k/omega)(xi - xi_ref)`` clamped to the ZMP support area of the contact model
    the QP enforces (:func:`clamp_areas`): the scenario's stance, torque limits, plane and ZMP
@@ -70,6 +71,16 @@ free-flyer velocity in the base frame):
    On a joint whose effort limit is a few N m (a wrist: Talos' 3 to 6.6 N m against its 1 N m of
    friction) an uncompensated friction is a large share of what the QP plans.
 
+**The plant's inertia.** MuJoCo's implicit(-fast) integrator integrates the joint damping ``D``
+implicitly: a step of ``h_s`` seconds solves ``(M + h_s D) a = ...``
+(:func:`~impact_balance.sim.model.integrator.implicit_damping_inertia`). The motors cancel
+``D qdot``; the ``h_s D`` of inertia stays. With ``implicit_damping_inertia``
+(:class:`InverseDynamicsGains`, the default) the QP's ``M`` is ``M + diag(h_s D)`` on the
+actuated joints (built by :meth:`InverseDynamicsController.for_trial` from the trial's model: its
+timestep, integrator and ``dof_damping``; zero on the floating base, so its six rows are
+unchanged), in the torques' rows and so in every torque the QP plans. On a light damped joint
+(iCub's wrists: ``M_ii`` 4.8e-4 kg m^2 against ``h_s D`` = 1e-3) it is most of the inertia.
+
 The measured ZMP is not needed (the wrenches are chosen, not admitted); the argument is kept so
 that both controllers share :meth:`step`'s signature.
 """
@@ -98,6 +109,7 @@ from impact_balance.sim.control.controller import Controller
 from impact_balance.sim.control.gains import InverseDynamicsGains, TrialGains, trial_gains
 from impact_balance.sim.control.zmp import DcmFeedback
 from impact_balance.sim.model.build import SimModel
+from impact_balance.sim.model.integrator import implicit_damping_inertia
 
 __all__ = [
     "InverseDynamicsController",
@@ -148,7 +160,7 @@ class TorqueOutput:
 class _Dynamics:
     """What one control step computes at the measured state (pinocchio; world frame)."""
 
-    M: _FloatArray  # mass matrix (nv x nv), both triangles
+    M: _FloatArray  # mass matrix (nv x nv), both triangles, plus the plant's h_s D (actuated)
     h: _FloatArray  # nonlinear effects (nv)
     Ag: _FloatArray  # centroidal momentum matrix (6 x nv)
     drift_hg: _FloatArray  # centroidal momentum drift A_g_dot v (6)
@@ -306,6 +318,10 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
             :meth:`actuate` compensates; none unless built by :meth:`for_trial`.
         joint_friction: MuJoCo's dry joint friction (``frictionloss``, N m, by simulated joint)
             that :meth:`actuate` compensates; none unless built by :meth:`for_trial`.
+        implicit_inertia: The inertia added to the QP's ``M`` on each actuated velocity row
+            (nv - 6, pinocchio order; kg m^2): ``h_s D`` of the simulated joint
+            (:func:`~impact_balance.sim.model.integrator.implicit_damping_inertia`) when built by
+            :meth:`for_trial` with ``implicit_damping_inertia``, else zeros.
     """
 
     name = "dcm-zmp-clamp + inverse-dynamics QP -> joint torques"
@@ -335,6 +351,8 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         # velocity row (see for_trial and compensation()).
         self._damping_rows: _FloatArray = np.zeros(nv - 6)
         self._friction_rows: _FloatArray = np.zeros(nv - 6)
+        self.implicit_inertia: _FloatArray = np.zeros(nv - 6)
+        self._actuated_diagonal = (np.arange(6, nv), np.arange(6, nv))
         self.nc = len(stance.contacts)
         self._init_touch(analysis, gains, impact)
         self.n = nv + 6 * self.nc + self._touch_vars
@@ -480,7 +498,9 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
 
         The torques are bounded when ``sim``'s motors are force-limited; MuJoCo's viscous joint
         damping and dry friction (the URDF's) are compensated: the motors add
-        :func:`motor_compensation`, and the QP bounds the sum by the effort limits.
+        :func:`motor_compensation`, and the QP bounds the sum by the effort limits. With
+        ``implicit_damping_inertia`` the QP's inertia is the plant's, ``M + h_s D``
+        (:attr:`implicit_inertia`, from ``sim``'s model).
         """
         controller = cls(
             analysis,
@@ -493,6 +513,9 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         controller._damping_rows[sim.v_index - 6] = controller.joint_damping
         controller.joint_friction = sim.model.dof_frictionloss[sim.dof_adr].copy()
         controller._friction_rows[sim.v_index - 6] = controller.joint_friction
+        if controller.gains.implicit_damping_inertia:
+            added = implicit_damping_inertia(sim.model)[sim.dof_adr]
+            controller.implicit_inertia[sim.v_index - 6] = added
         return controller
 
     def compensation(self, v: _FloatArray) -> _FloatArray:
@@ -598,6 +621,7 @@ class InverseDynamicsController(Controller["TorqueOutput"]):
         pin.crba(model, data, q)
         M = data.M.copy()
         M[self._lower_triangle] = M.T[self._lower_triangle]  # crba fills the upper triangle only
+        M[self._actuated_diagonal] += self.implicit_inertia  # the plant's h_s D (for_trial)
         h = pin.nonLinearEffects(model, data, q, v)
         pin.forwardKinematics(model, data, q, v, self._zero)
         pin.computeJointJacobians(model, data, q)
