@@ -882,23 +882,40 @@ def _arc_start(Binv, GT, theta, scale):
 
 @njit(cache=True, inline="always")
 def _arc_start_at(ab, theta):
-    """:func:`_arc_start` from the basis's :func:`_rates`.
+    """:func:`_arc_start` from the basis's :func:`_rates` (``ab[2]``: work).
 
     Each multiplier ``lambda_i = rho_i cos(t - alpha_i)`` is non-negative on the half-circle
     that starts at ``alpha_i - pi/2``: within [theta, theta + pi], one that starts at
-    ``theta + s_i`` with s_i <= pi bounds the arc from below, one that starts later (s_i > pi)
-    ends at ``theta + s_i - pi``.
+    ``theta + s_i`` with s_i <= pi bounds the arc from below (lo), one that starts later
+    (s_i > pi) ends at ``theta + s_i - pi`` (hi). A multiplier clearly positive at theta (above
+    1e-9 rho_i) is one of the latter, and its end comes no sooner than a cheap lower bound
+    (:func:`_breakpoint_at`'s); its angle (an atan2 and a modulo) is computed only when that
+    bound does not clear lo by 1e-9: the same answer.
     """
+    cos_t, sin_t = math.cos(theta), math.sin(theta)
     lo, hi = 0.0, math.pi
     for i in range(ab.shape[1]):
         a, b = ab[0, i], ab[1, i]
-        if math.hypot(a, b) <= ab[3, i]:
+        rho = math.hypot(a, b)
+        ab[2, i] = -1.0  # no bound: done, or identically zero
+        if rho <= ab[3, i]:
             continue  # identically zero multiplier
+        lam = a * cos_t + b * sin_t  # rho cos(theta - alpha_i)
+        if lam > 1e-9 * rho:  # s_i in (pi, 2 pi): an end; its lower bound for later
+            ab[2, i] = 0.5 * math.pi if a * sin_t - b * cos_t <= 0.0 else lam / rho
+            continue
         s = (math.atan2(b, a) - 0.5 * math.pi - theta) % (2.0 * math.pi)
         if s <= math.pi:
             lo = max(lo, s)
         else:
             hi = min(hi, s - math.pi)
+    for i in range(ab.shape[1]):
+        if ab[2, i] >= 0.0 and ab[2, i] <= lo + 1e-9:
+            s = (math.atan2(ab[1, i], ab[0, i]) - 0.5 * math.pi - theta) % (2.0 * math.pi)
+            if s <= math.pi:  # not reached (s_i > pi), kept for the same answer
+                lo = max(lo, s)
+            else:
+                hi = min(hi, s - math.pi)
     return theta + lo if lo <= hi and lo < math.pi else math.inf
 
 
