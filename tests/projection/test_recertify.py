@@ -372,6 +372,81 @@ def test_an_arc_start_is_where_the_multipliers_turn_non_negative():
             assert optimal.any() and abs(first - start) <= math.pi / 20000 + 1e-12
 
 
+def _arc_start_every_angle(Binv, GT, theta, scale):
+    """The arc's start with every multiplier's angle computed (the formula, in Python)."""
+    ab = np.empty((4, Binv.shape[0]))
+    K._rates(Binv, GT, scale, ab)
+    lo, hi = 0.0, math.pi
+    for i in range(Binv.shape[0]):
+        a, b = float(ab[0, i]), float(ab[1, i])
+        if math.hypot(a, b) <= ab[3, i]:
+            continue
+        s = (math.atan2(b, a) - 0.5 * math.pi - theta) % (2.0 * math.pi)
+        if s <= math.pi:
+            lo = max(lo, s)
+        else:
+            hi = min(hi, s - math.pi)
+    return theta + lo if lo <= hi and lo < math.pi else math.inf
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.integers(min_value=1, max_value=12),
+    st.integers(min_value=0, max_value=2**32 - 1),
+    st.floats(min_value=0.0, max_value=2.0 * math.pi),
+    st.sampled_from((0.0, 1e-12, 1e-9, 1e-3)),
+)
+def test_an_arc_start_skips_no_angle_that_decides_it(n, seed, theta, near):
+    """:func:`_arc_start` (which computes a multiplier's angle only where its lower bound does
+    not clear the others) equals the formula with every angle computed, bit for bit: random
+    bases, and multipliers placed at or near zero at theta (``near`` of their norm), where a
+    bound is tightest."""
+    rng = np.random.default_rng(seed)
+    Binv, GT = rng.normal(size=(n, n)), rng.normal(size=(n, 2))
+    u = np.array([math.cos(theta), math.sin(theta)])
+    for i in range(n):
+        if rng.random() < 0.4:  # lambda_i(theta) moved to +-near |(a_i, b_i)|
+            target = rng.choice([-1.0, 1.0]) * near * np.linalg.norm(GT.T @ Binv[:, i])
+            Binv[:, i] += (target - (GT @ u) @ Binv[:, i]) * (GT @ u) / float((GT @ u) @ (GT @ u))
+    for scale in (1.0, 1e9):  # 1e9: some multipliers within the tolerance of zero
+        expected = _arc_start_every_angle(Binv, GT, theta, scale)
+        assert K._arc_start(Binv, GT, theta, scale) == expected
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.integers(min_value=1, max_value=12),
+    st.integers(min_value=0, max_value=2**32 - 1),
+    st.floats(min_value=0.0, max_value=2.0 * math.pi),
+    st.sampled_from((0.0, 1e-12, 1e-9, 1e-3)),
+    st.sampled_from((1.0, 1e9, 1e-120, 1e120)),
+)
+def test_a_breakpoint_is_the_first_arc_end_of_every_multiplier(n, seed, theta, near, size):
+    """:func:`_breakpoint` (an arc end computed only where its lower bound does not clear the
+    smallest) equals the smallest arc end with every one computed by ``hypot`` and ``atan2``,
+    bit for bit: random bases of any size (the squares' overflow and underflow), multipliers
+    at or near zero at theta."""
+    rng = np.random.default_rng(seed)
+    Binv, GT = rng.normal(size=(n, n)) * size, rng.normal(size=(n, 2))
+    u = np.array([math.cos(theta), math.sin(theta)])
+    for i in range(n):
+        if rng.random() < 0.4:  # lambda_i(theta) moved to +-near |(a_i, b_i)|
+            target = rng.choice([-1.0, 1.0]) * near * np.linalg.norm(GT.T @ Binv[:, i])
+            Binv[:, i] += (target - (GT @ u) @ Binv[:, i]) * (GT @ u) / float((GT @ u) @ (GT @ u))
+    for scale in (1.0, 1e9):
+        ab = np.empty((4, n))
+        K._rates(Binv, GT, scale, ab)
+        expected = math.inf
+        for i in range(n):
+            a, b = float(ab[0, i]), float(ab[1, i])
+            if math.hypot(a, b) <= ab[3, i]:
+                continue
+            d = (math.atan2(b, a) + 0.5 * math.pi - theta) % (2.0 * math.pi)
+            expected = min(expected, 2.0 * math.pi if d < 1e-13 else d)
+        got = K._breakpoint(Binv, GT, theta, math.cos(theta), math.sin(theta), scale, ab)
+        assert got == theta + expected
+
+
 def _slacks(H, h, z):
     """Every row's slack ``h_j - H_j z``, summed in the kernel's order (the same numbers)."""
     out = []

@@ -258,7 +258,8 @@ def _min_slack_near(H, h, z, worst, zd, dset):
 def _project_out(Q, k, v, out):
     """``out`` = v minus its components along the k orthonormal rows of Q; returns |out|."""
     n = Q.shape[1]
-    out[:] = v
+    for j in range(n):  # element by element: out may be v (a slice copy would allocate)
+        out[j] = v[j]
     for _ in range(2):  # twice is enough (Kahan): keeps out orthogonal to working precision
         for i in range(k):
             d = 0.0
@@ -415,10 +416,12 @@ def _workspace(m, n):
 
 
 @njit(cache=True)
-def _refactor(H, h, W, Binv, z, work):
-    """Recompute the basis inverse and the vertex from scratch; False if singular."""
+def _refactor(H, h, W, Binv, z, B):
+    """Recompute the basis inverse and the vertex from scratch; False if singular.
+
+    ``B`` (n x n): a work buffer (the walk's ``work[5]``).
+    """
     n = H.shape[1]
-    B = work[5]
     for i in range(n):
         for j in range(n):
             B[i, j] = H[W[i], j]
@@ -435,7 +438,7 @@ def _pivot(H, h, W, Binv, z, leave, j, since, work):
     Returns the pivots since the last refactorisation.
     """
     W[leave] = j
-    if since + 1 >= _REFACTOR and _refactor(H, h, W, Binv, z, work):
+    if since + 1 >= _REFACTOR and _refactor(H, h, W, Binv, z, work[5]):
         return 0
     _update(H, Binv, leave, j, work)
     _vertex(h, W, Binv, z)
@@ -582,6 +585,22 @@ def _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work):
 
 
 @njit(cache=True, inline="always")
+def _rho(a, b, eps):
+    """``(zero, rho)``: whether ``hypot(a, b) <= eps``, and |(a, b)| to within an ulp.
+
+    ``hypot`` (about 13 ns) only where ``max(|a|, |b|) <= eps`` (above it, hypot, which is at
+    least that max, exceeds eps: the same test) or where the squares could overflow or
+    underflow; else ``sqrt(a^2 + b^2)`` (2 ns), which callers use only in lower bounds that
+    carry a margin far above its rounding.
+    """
+    big = max(abs(a), abs(b))
+    if big <= eps or not (1e-100 < big < 1e100):
+        rho = math.hypot(a, b)
+        return rho <= eps, rho
+    return False, math.sqrt(a * a + b * b)
+
+
+@njit(cache=True, inline="always")
 def _arc_end(a, b, theta):
     """Step after theta at which ``a cos + b sin`` turns negative, in (0, 2 pi]."""
     # lambda = rho cos(theta - alpha) turns negative when theta - alpha passes pi/2
@@ -634,8 +653,8 @@ def _breakpoint_at(ab, theta, cos_t, sin_t):
     # lambda_i(theta) = a cos(theta) + b sin(theta) = rho cos(phi), phi = theta - alpha_i
     for i in range(n):
         a, b = ab[0, i], ab[1, i]
-        rho = math.hypot(a, b)
-        if rho <= ab[3, i]:
+        zero, rho = _rho(a, b, ab[3, i])
+        if zero:
             ab[2, i] = math.inf  # identically zero multiplier
             continue
         lam = a * cos_t + b * sin_t  # rho cos(phi)
@@ -694,7 +713,7 @@ def _warm_start(H, h, W, Binv, z, active, work, hint):
             return False
     # A singular basis (a row twice, say) can pass _invert's pivot test at condition 1e16:
     # _accurate refuses its inverse, whose vertex is not the basis's.
-    if not (_refactor(H, h, W, Binv, z, work) and _accurate(H, h, W, Binv, z, work[2])):
+    if not (_refactor(H, h, W, Binv, z, work[5]) and _accurate(H, h, W, Binv, z, work[2])):
         z[:] = 0.0
         return False
     for j in range(m):  # feasible to the rounding of a fresh vertex, as the crash's are
@@ -736,7 +755,7 @@ def _phase_one(H, h, z, W, active, max_pivots):
         return status, 0, 0
     Binv_a = np.empty((n + 1, n + 1))
     work = _workspace(m + 1, n + 1)
-    if not _refactor(Ha, ha, Wa, Binv_a, za, work):
+    if not _refactor(Ha, ha, Wa, Binv_a, za, work[5]):
         return FAILED, 0, 0
     status, pivots = _optimize(
         Ha, ha, za, Wa, Binv_a, active_a, c1, np.zeros(n + 1), 1.0, max_pivots, work
@@ -856,7 +875,7 @@ def _replace(H, h, W, Binv, z, target, work):
             piv += H[j, r] * Binv[r, i]
         if abs(piv) <= _EPS_PIVOT * _column_norm(Binv, i):
             W[:] = target
-            fresh = _refactor(H, h, W, Binv, z, work) and _accurate(H, h, W, Binv, z, work[2])
+            fresh = _refactor(H, h, W, Binv, z, work[5]) and _accurate(H, h, W, Binv, z, work[2])
             return -2 if fresh else -1
         W[i] = j
         _update(H, Binv, i, j, work)
@@ -879,23 +898,40 @@ def _arc_start(Binv, GT, theta, scale):
 
 @njit(cache=True, inline="always")
 def _arc_start_at(ab, theta):
-    """:func:`_arc_start` from the basis's :func:`_rates`.
+    """:func:`_arc_start` from the basis's :func:`_rates` (``ab[2]``: work).
 
     Each multiplier ``lambda_i = rho_i cos(t - alpha_i)`` is non-negative on the half-circle
     that starts at ``alpha_i - pi/2``: within [theta, theta + pi], one that starts at
-    ``theta + s_i`` with s_i <= pi bounds the arc from below, one that starts later (s_i > pi)
-    ends at ``theta + s_i - pi``.
+    ``theta + s_i`` with s_i <= pi bounds the arc from below (lo), one that starts later
+    (s_i > pi) ends at ``theta + s_i - pi`` (hi). A multiplier clearly positive at theta (above
+    1e-9 rho_i) is one of the latter, and its end comes no sooner than a cheap lower bound
+    (:func:`_breakpoint_at`'s); its angle (an atan2 and a modulo) is computed only when that
+    bound does not clear lo by 1e-9: the same answer.
     """
+    cos_t, sin_t = math.cos(theta), math.sin(theta)
     lo, hi = 0.0, math.pi
     for i in range(ab.shape[1]):
         a, b = ab[0, i], ab[1, i]
-        if math.hypot(a, b) <= ab[3, i]:
+        zero, rho = _rho(a, b, ab[3, i])
+        ab[2, i] = -1.0  # no bound: done, or identically zero
+        if zero:
             continue  # identically zero multiplier
+        lam = a * cos_t + b * sin_t  # rho cos(theta - alpha_i)
+        if lam > 1e-9 * rho:  # s_i in (pi, 2 pi): an end; its lower bound for later
+            ab[2, i] = 0.5 * math.pi if a * sin_t - b * cos_t <= 0.0 else lam / rho
+            continue
         s = (math.atan2(b, a) - 0.5 * math.pi - theta) % (2.0 * math.pi)
         if s <= math.pi:
             lo = max(lo, s)
         else:
             hi = min(hi, s - math.pi)
+    for i in range(ab.shape[1]):
+        if ab[2, i] >= 0.0 and ab[2, i] <= lo + 1e-9:
+            s = (math.atan2(ab[1, i], ab[0, i]) - 0.5 * math.pi - theta) % (2.0 * math.pi)
+            if s <= math.pi:  # not reached (s_i > pi), kept for the same answer
+                lo = max(lo, s)
+            else:
+                hi = min(hi, s - math.pi)
     return theta + lo if lo <= hi and lo < math.pi else math.inf
 
 
@@ -917,7 +953,7 @@ def _next_basis(H, h, GT, W, Binv, z, theta, scale, kind, rows, since, work):
             if rows[i] < 0 or rows[i] >= H.shape[0]:
                 return math.inf, since
         W[:] = rows
-        fresh = _refactor(H, h, W, Binv, z, work) and _accurate(H, h, W, Binv, z, work[2])
+        fresh = _refactor(H, h, W, Binv, z, work[5]) and _accurate(H, h, W, Binv, z, work[2])
         piv = -2 if fresh else -1
     else:
         piv = _replace(H, h, W, Binv, z, rows, work)
@@ -928,7 +964,7 @@ def _next_basis(H, h, GT, W, Binv, z, theta, scale, kind, rows, since, work):
     elif piv > 0:
         since += piv
         if not _accurate(H, h, W, Binv, z, work[2]):
-            if not _refactor(H, h, W, Binv, z, work):
+            if not _refactor(H, h, W, Binv, z, work[5]):
                 return math.inf, since
             since = 0
     _rates(Binv, GT, scale, work[6])
@@ -973,7 +1009,7 @@ def _recertify(H, h, GT, g0, theta0, scale, low, hint, W, Binv, z, work, yrun):
         if W[i] < 0 or W[i] >= m:
             return FAILED, none, 0, theta0, 0
     if hint[base] != 0 or not (
-        _refactor(H, h, W, Binv, z, work) and _accurate(H, h, W, Binv, z, work[2])
+        _refactor(H, h, W, Binv, z, work[5]) and _accurate(H, h, W, Binv, z, work[2])
     ):
         return FAILED, none, 0, theta0, 0
     _rates(Binv, GT, scale, ab)
@@ -1047,7 +1083,7 @@ def _from_chain(H, h, GT, g0, theta0, scale, worst, hint, W, Binv, z, work, yrun
         if status == _PREFIX:  # the last certified basis again, a fresh inverse
             at = n + 3 + (good - 1) * (n + 1)
             W[:] = hint[at + 1 : at + 1 + n]
-            if not (_refactor(H, h, W, Binv, z, work) and _accurate(H, h, W, Binv, z, work[2])):
+            if not (_refactor(H, h, W, Binv, z, work[5]) and _accurate(H, h, W, Binv, z, work[2])):
                 status = FAILED
         if status != FAILED:
             if status == OK:
@@ -1088,14 +1124,15 @@ def _start(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work, hint):
         status, k = _crash(H, h, z, W, k, active, c, dc)
         if status != OK:
             return status, pivots
-        if not _refactor(H, h, W, Binv, z, work):
+        if not _refactor(H, h, W, Binv, z, work[5]):
             return FAILED, pivots
     status, piv = _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work)
     pivots += piv
     if status != OK:
         return status, pivots
-    if piv and not _accurate(H, h, W, Binv, z, work[2]) and not _refactor(H, h, W, Binv, z, work):
-        return FAILED, pivots
+    if piv and not _accurate(H, h, W, Binv, z, work[2]):
+        if not _refactor(H, h, W, Binv, z, work[5]):
+            return FAILED, pivots
     if hint.shape[0] >= n + 2:  # the optimal basis at theta0: the next call's start
         hint[0], hint[1] = m, n
         hint[2 : n + 2] = W
@@ -1175,7 +1212,7 @@ def _walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
         # at most _CARRY pivots; then a fresh one. The check, not the count, guards the
         # precision (docs/studies/design-history.md, "Core floors").
         if since >= _CARRY:
-            if not _refactor(H, h, W, Binv, z, work):
+            if not _refactor(H, h, W, Binv, z, work[5]):
                 return FAILED, vertices, count, pivots, resumed
             since = 0
         status, piv = _optimize(H, h, z, W, Binv, active, c, dc, scale, max_pivots, work)
@@ -1188,7 +1225,7 @@ def _walk(H, h, GT, g0, theta0, max_pivots, worst, hint):
         # 1e-5 off and its vertex violated a row by 2e-6, which made the walk refuse and fall
         # back to Bretl (5 ms) on 5 % of G1's postures; the basis's own vertex is within 1e-11.
         if piv and not _accurate(H, h, W, Binv, z, work[2]):
-            if not _refactor(H, h, W, Binv, z, work):
+            if not _refactor(H, h, W, Binv, z, work[5]):
                 return FAILED, vertices, count, pivots, resumed
             since = 0
         # piv == 0: the crossing multiplier was within the tolerance of zero; the next
@@ -1253,43 +1290,44 @@ def project(A, b, E, x0, N, box, max_pivots, hint):
     none = np.empty((0, 2))
     n, k = N.shape
     m0 = A.shape[0]
-    H0 = np.zeros((m0, k))
-    h0 = b - _times(A, x0)
+    H = np.zeros((m0 + 4, k))  # the rows of A N first, then scaled and compacted in place
+    h = np.empty(m0 + 4)
     G = np.zeros((2, k))
     g0 = _times(E, x0)
+    norms = np.empty(m0)
+    biggest = 1.0
     for i in range(m0):
+        acc = 0.0  # h_i = b_i - A_i x0 (_times's sum)
+        for r in range(n):
+            acc += A[i, r] * x0[r]
+        h[i] = b[i] - acc
         for r in range(n):
             if A[i, r] != 0.0:  # A is sparse (contact blocks)
                 for j in range(k):
-                    H0[i, j] += A[i, r] * N[r, j]
+                    H[i, j] += A[i, r] * N[r, j]
+        norms[i] = _norm(H[i])
+        biggest = max(biggest, norms[i])
     for i in range(2):
         for r in range(n):
             for j in range(k):
                 G[i, j] += E[i, r] * N[r, j]
     if k == 0:  # a single point
         for i in range(m0):
-            if h0[i] < -_EPS_FEASIBLE:
+            if h[i] < -_EPS_FEASIBLE:
                 return INFEASIBLE, none, 0, 0.0
         out = np.empty((1, 2))
         out[0] = g0
         return OK, out, 0, 0.0
-    # Unit rows; zero rows are checked then dropped.
-    norms = np.empty(m0)
-    biggest = 1.0
-    for i in range(m0):
-        norms[i] = _norm(H0[i])
-        biggest = max(biggest, norms[i])
-    H = np.empty((m0 + 4, k))
-    h = np.empty(m0 + 4)
+    # Unit rows; zero rows are checked then dropped (row m <= i: compacted in place).
     m = 0
     for i in range(m0):
         if norms[i] <= _RANK * biggest:
-            if h0[i] < -_EPS_FEASIBLE:
+            if h[i] < -_EPS_FEASIBLE:
                 return INFEASIBLE, none, 0, 0.0
         else:
             for j in range(k):  # element by element: no temporary array per row
-                H[m, j] = H0[i, j] / norms[i]
-            h[m] = h0[i] / norms[i]
+                H[m, j] = H[i, j] / norms[i]
+            h[m] = h[i] / norms[i]
             m += 1
     # The clipping box: +-G_k z <= box -+ g0_k.
     for i in range(2):
