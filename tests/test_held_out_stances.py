@@ -856,11 +856,12 @@ def test_the_tenth_set_holds_three_hand_holds_and_three_ordinary_supports() -> N
     assert all("hand impact" in _covers(f) for f in files)
 
 
-def test_the_eleventh_set_holds_three_hand_holds_a_kick_and_three_ordinary_supports() -> None:
-    """Its aims: three hand holds (one on one foot, two on two feet), three ordinary supports (two
-    feet, no hand held, not wide) with lateral and backward impacts among the set's, a foot impact
-    (a kick) beside hand impacts; Talos and G1 among its robots."""
-    files = SET_FILES[ELEVENTH]
+def _robots_and_hand_holds(
+    files: list[Path],
+) -> tuple[dict[Path, str], dict[Path, bool], list[Path]]:
+    """Each stance's robot, whether it holds a hand contact, and the hand holds; checked: six
+    stances, Talos and G1 among at least three robots, three hand holds, one on one foot and two
+    on two feet."""
     assert len(files) == TENTH_FILES, files
     robot = {f: load_scenario(str(f)).robot for f in files}
     assert {"talos", "g1"} <= set(robot.values()) and len(set(robot.values())) >= 3, robot
@@ -869,6 +870,15 @@ def test_the_eleventh_set_holds_three_hand_holds_a_kick_and_three_ordinary_suppo
     assert len(held) == TENTH_HOLDS, held
     feet = sorted(len(_feet(analyze(str(f)).to_dict())) for f in held)
     assert feet == [1, 2, 2], feet
+    return robot, holds, held
+
+
+def test_the_eleventh_set_holds_three_hand_holds_a_kick_and_three_ordinary_supports() -> None:
+    """Its aims: three hand holds (one on one foot, two on two feet), three ordinary supports (two
+    feet, no hand held, not wide) with lateral and backward impacts among the set's, a foot impact
+    (a kick) beside hand impacts; Talos and G1 among its robots."""
+    files = SET_FILES[ELEVENTH]
+    _, holds, _ = _robots_and_hand_holds(files)
     plain = [f for f in files if not holds[f]]
     for f in plain:
         apart = _apart(f)
@@ -883,16 +893,9 @@ def test_the_twelfth_set_holds_three_hand_holds_a_kick_and_three_ordinary_suppor
     with lateral and backward impacts among the set's, a foot impact (a kick) beside hand
     impacts; Talos and G1 among its robots, and a third."""
     files = SET_FILES[TWELFTH]
-    assert len(files) == TENTH_FILES, files
-    robot = {f: load_scenario(str(f)).robot for f in files}
-    assert {"talos", "g1"} <= set(robot.values()) and len(set(robot.values())) >= 3, robot
-    holds = {f: _holds(f) for f in files}
-    held = [f for f in files if holds[f]]
-    assert len(held) == TENTH_HOLDS, held
+    robot, holds, held = _robots_and_hand_holds(files)
     assert len({robot[f] for f in held}) == TENTH_HOLDS, held
     assert {robot[f] for f in held} & {"talos", "g1"}, held
-    feet = sorted(len(_feet(analyze(str(f)).to_dict())) for f in held)
-    assert feet == [1, 2, 2], feet
     plain = [f for f in files if not holds[f]]
     wide = []
     for f in plain:

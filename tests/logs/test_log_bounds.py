@@ -101,6 +101,19 @@ def test_a_log_that_is_not_a_regular_file_is_refused_at_once(tmp_path, capsys, k
     assert stdout == ""
 
 
+def _child(script: str, path, tag: str) -> list[int]:
+    """Run ``script`` on ``path`` in a fresh interpreter; the integers it prints after ``tag``."""
+    proc = subprocess.run(
+        [sys.executable, "-c", script, str(path)],
+        env={**os.environ, "PYTHONPATH": SRC},
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert proc.returncode == 0, proc.stderr
+    return [int(x) for x in proc.stdout.split(tag)[1].split()]
+
+
 READ = r"""
 import resource, sys
 from impact_balance.logs import read_log
@@ -120,15 +133,7 @@ def test_reading_a_padded_parquet_stays_under_500_mb(tmp_path, log_frame):
     whole under 500 MB.
     """
     path = _padded(log_frame, tmp_path / "padded.parquet")
-    proc = subprocess.run(
-        [sys.executable, "-c", READ, str(path)],
-        env={**os.environ, "PYTHONPATH": SRC},
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert proc.returncode == 0, proc.stderr
-    before, after, columns = (int(x) for x in proc.stdout.split("PEAK_KB")[1].split())
+    before, after, columns = _child(READ, path, "PEAK_KB")
     assert columns == len(log_frame.columns)
     print(f"peak {before / 1024:.0f} MB after the imports, {after / 1024:.0f} MB after the read")
     assert after - before < 100 * 1024, f"reading grew the peak by {(after - before) / 1024:.0f} MB"
@@ -149,13 +154,5 @@ def test_reading_a_parquet_log_starts_no_thread(tmp_path, log_frame):
     """No reader thread is left to run at exit (apache/arrow#34314: SIGABRT at interpreter exit)."""
     path = tmp_path / "log.parquet"
     pq.write_table(pa.Table.from_pandas(log_frame, preserve_index=False), path)
-    proc = subprocess.run(
-        [sys.executable, "-c", THREADS, str(path)],
-        env={**os.environ, "PYTHONPATH": SRC},
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert proc.returncode == 0, proc.stderr
-    before, after = (int(x) for x in proc.stdout.split("THREADS")[1].split())
+    before, after = _child(THREADS, path, "THREADS")
     assert after == before
